@@ -1,0 +1,97 @@
+//! Typed errors of the core, in descriptive struct variants.
+
+use std::fmt;
+
+/// An error raised by a model while it is evaluated (for instance a Python exception inside a
+/// user closure). The core carries it unchanged so that the binding can re-raise the original.
+pub type ModelError = Box<dyn std::error::Error + Send + Sync + 'static>;
+
+/// What stops a computation.
+#[derive(Debug)]
+pub enum Error {
+    /// An argument is malformed: wrong shape, not finite, out of range, unknown name.
+    InvalidArgument {
+        argument: &'static str,
+        reason: String,
+    },
+    /// The numerical solution left every sensible bound: a non-finite state, or an energy error
+    /// beyond the threshold the user set.
+    Divergence {
+        step: usize,
+        time: f64,
+        reason: String,
+    },
+    /// The model failed while it was evaluated during `step` (which starts at `time`).
+    Model {
+        step: usize,
+        time: f64,
+        source: ModelError,
+    },
+    /// The interrupt poll (Ctrl-C) asked the run to stop before `step`.
+    Interrupted {
+        step: usize,
+        time: f64,
+        source: ModelError,
+    },
+}
+
+impl Error {
+    /// Shorthand for [`Error::InvalidArgument`].
+    pub fn invalid(argument: &'static str, reason: impl Into<String>) -> Self {
+        Error::InvalidArgument {
+            argument,
+            reason: reason.into(),
+        }
+    }
+}
+
+impl fmt::Display for Error {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Error::InvalidArgument { argument, reason } => write!(f, "{argument}: {reason}"),
+            Error::Divergence { step, time, reason } => {
+                write!(
+                    f,
+                    "integration diverged at step {step} (t = {time}): {reason}"
+                )
+            }
+            Error::Model { step, time, source } => {
+                write!(
+                    f,
+                    "model evaluation failed at step {step} (t = {time}): {source}"
+                )
+            }
+            Error::Interrupted { step, time, .. } => {
+                write!(f, "integration interrupted at step {step} (t = {time})")
+            }
+        }
+    }
+}
+
+impl std::error::Error for Error {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        match self {
+            Error::Model { source, .. } | Error::Interrupted { source, .. } => {
+                Some(source.as_ref())
+            }
+            _ => None,
+        }
+    }
+}
+
+/// Checks that `x` has `n` entries, all finite.
+pub(crate) fn check_vector(argument: &'static str, x: &[f64], n: usize) -> Result<(), Error> {
+    if x.len() != n {
+        return Err(Error::invalid(
+            argument,
+            format!("expected {n} entries, got {}", x.len()),
+        ));
+    }
+    if let Some(i) = x.iter().position(|v| !v.is_finite()) {
+        return Err(Error::invalid(
+            argument,
+            format!("entry {i} is not finite ({})", x[i]),
+        ));
+    }
+    Ok(())
+}

@@ -1,0 +1,303 @@
+use std::time::{Duration, Instant};
+
+use super::{compensated, Integrator, Method};
+use crate::diagnostics::hamiltonian;
+use crate::error::check_vector;
+use crate::model::MechanicalSystem;
+use crate::{Error, ModelError};
+
+/// Options of a fixed-step run.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Options {
+    /// The step h > 0.
+    pub dt: f64,
+    /// Number of steps.
+    pub steps: usize,
+    /// Keep every k-th state (the initial and the final state are always kept).
+    pub save_every: usize,
+    /// Add the increments with compensated summation (on by default, as in Hairer's GNI codes).
+    pub compensated: bool,
+    /// Stop with [`Error::Divergence`] when the relative energy error |H − H₀|/|H₀| at a saved
+    /// state exceeds this (the absolute error when H₀ = 0). `None`: only non-finite states stop
+    /// the run. Checking costs one potential evaluation per saved state.
+    pub max_energy_error: Option<f64>,
+    /// The initial time.
+    pub t0: f64,
+}
+
+impl Options {
+    /// `steps` steps of size `dt`, every state kept, compensated summation on.
+    pub fn new(dt: f64, steps: usize) -> Self {
+        Options {
+            dt,
+            steps,
+            save_every: 1,
+            compensated: true,
+            max_energy_error: None,
+            t0: 0.0,
+        }
+    }
+
+    fn check(&self) -> Result<(), Error> {
+        if !(self.dt.is_finite() && self.dt > 0.0) {
+            return Err(Error::invalid(
+                "dt",
+                format!("must be finite and positive, got {}", self.dt),
+            ));
+        }
+        if self.save_every == 0 {
+            return Err(Error::invalid("save_every", "must be at least 1"));
+        }
+        if !self.t0.is_finite() {
+            return Err(Error::invalid("t0", "must be finite"));
+        }
+        match self.max_energy_error {
+            Some(x) if !(x > 0.0) => Err(Error::invalid(
+                "max_energy_error",
+                format!("must be positive, got {x}"),
+            )),
+            _ => Ok(()),
+        }
+    }
+}
+
+/// The saved states of a run: row k is (t[k], q[k], p[k]); q and p are stored row-major.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Trajectory {
+    pub dim: usize,
+    pub t: Vec<f64>,
+    pub q: Vec<f64>,
+    pub p: Vec<f64>,
+    /// Steps completed.
+    pub steps: usize,
+    /// Force evaluations ∇V made.
+    pub force_evaluations: u64,
+}
+
+impl Trajectory {
+    /// Number of saved states.
+    pub fn len(&self) -> usize {
+        self.t.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.t.is_empty()
+    }
+
+    /// q at saved state k.
+    pub fn q_at(&self, k: usize) -> &[f64] {
+        &self.q[k * self.dim..(k + 1) * self.dim]
+    }
+
+    /// p at saved state k.
+    pub fn p_at(&self, k: usize) -> &[f64] {
+        &self.p[k * self.dim..(k + 1) * self.dim]
+    }
+
+    fn push(&mut self, t: f64, q: &[f64], p: &[f64]) {
+        self.t.push(t);
+        self.q.extend_from_slice(q);
+        self.p.extend_from_slice(p);
+    }
+}
+
+/// A run that stopped early: why, and every state saved up to the last good step.
+#[derive(Debug)]
+pub struct Failure {
+    pub error: Error,
+    pub partial: Trajectory,
+}
+
+/// Polls for interrupts at a stride that adapts to keep polls about 10–40 ms apart, so that a
+/// step of 50 ns and a step of 50 ms are both interruptible promptly and cheaply.
+struct InterruptPoll {
+    stride: usize,
+    countdown: usize,
+    last: Instant,
+}
+
+impl InterruptPoll {
+    const FAST: Duration = Duration::from_millis(10);
+    const SLOW: Duration = Duration::from_millis(40);
+
+    fn new() -> Self {
+        InterruptPoll {
+            stride: 1,
+            countdown: 1,
+            last: Instant::now(),
+        }
+    }
+
+    /// Whether to poll before this step.
+    #[inline]
+    fn due(&mut self) -> bool {
+        self.countdown -= 1;
+        if self.countdown > 0 {
+            return false;
+        }
+        let now = Instant::now();
+        let elapsed = now - self.last;
+        if elapsed < Self::FAST {
+            self.stride = (self.stride * 2).min(1 << 24);
+        } else if elapsed > Self::SLOW {
+            self.stride = (self.stride / 2).max(1);
+        }
+        self.last = now;
+        self.countdown = self.stride;
+        true
+    }
+}
+
+/// Integrates `sys` from (q0, p0) with `method` for `options.steps` steps of `options.dt`.
+///
+/// `poll` is called every 10–40 ms of run time; an error from it stops the run with
+/// [`Error::Interrupted`] (the binding checks for Ctrl-C there). The step loop allocates
+/// nothing beyond the saved states, whose storage is reserved up front.
+///
+/// On failure the returned [`Failure`] holds every state saved so far and the last good state.
+pub fn integrate<S, P>(
+    sys: &S,
+    method: Method,
+    q0: &[f64],
+    p0: &[f64],
+    options: &Options,
+    mut poll: P,
+) -> Result<Trajectory, Box<Failure>>
+where
+    S: MechanicalSystem + ?Sized,
+    P: FnMut() -> Result<(), ModelError>,
+{
+    let n = sys.dim();
+    let mut traj = Trajectory {
+        dim: n,
+        ..Default::default()
+    };
+    let fail = |error, partial| Box::new(Failure { error, partial });
+    if let Err(e) = check_vector("q0", q0, n)
+        .and(check_vector("p0", p0, n))
+        .and(options.check())
+    {
+        return Err(fail(e, traj));
+    }
+    let Options {
+        dt,
+        steps,
+        save_every,
+        compensated,
+        max_energy_error,
+        t0,
+    } = *options;
+    let saved = steps / save_every + 2;
+    traj.t.reserve(saved);
+    traj.q.reserve(saved * n);
+    traj.p.reserve(saved * n);
+
+    let (mut q, mut p) = (q0.to_vec(), p0.to_vec());
+    let (mut dq, mut dp) = (vec![0.0; n], vec![0.0; n]);
+    let (mut eq, mut ep) = (vec![0.0; n], vec![0.0; n]);
+    let mut integrator = Integrator::new(method, n);
+    let mut interrupt = InterruptPoll::new();
+    traj.push(t0, &q, &p);
+    let h0 = match max_energy_error {
+        Some(_) => match hamiltonian(sys, &q, &p) {
+            Ok(h) => Some(h),
+            Err(source) => {
+                return Err(fail(
+                    Error::Model {
+                        step: 0,
+                        time: t0,
+                        source,
+                    },
+                    traj,
+                ))
+            }
+        },
+        None => None,
+    };
+
+    for step in 1..=steps {
+        let time = t0 + (step - 1) as f64 * dt;
+        // Stops with the last good state (step − 1) kept, and the work counted.
+        let stop =
+            |error: Error, mut traj: Trajectory, q: &[f64], p: &[f64], integrator: &Integrator| {
+                if traj.t.last() != Some(&time) {
+                    traj.push(time, q, p);
+                }
+                traj.steps = step - 1;
+                traj.force_evaluations = integrator.force_evaluations();
+                fail(error, traj)
+            };
+        if interrupt.due() {
+            if let Err(source) = poll() {
+                return Err(stop(
+                    Error::Interrupted { step, time, source },
+                    traj,
+                    &q,
+                    &p,
+                    &integrator,
+                ));
+            }
+        }
+        if let Err(source) = integrator.increment(sys, &q, &p, dt, &mut dq, &mut dp) {
+            return Err(stop(
+                Error::Model { step, time, source },
+                traj,
+                &q,
+                &p,
+                &integrator,
+            ));
+        }
+        if !dq.iter().chain(&dp).sum::<f64>().is_finite() {
+            let reason = "the state became non-finite (the method is unstable at this step size, or the model is singular here)".to_string();
+            return Err(stop(
+                Error::Divergence { step, time, reason },
+                traj,
+                &q,
+                &p,
+                &integrator,
+            ));
+        }
+        if compensated {
+            compensated::add(&mut q, &mut eq, &dq);
+            compensated::add(&mut p, &mut ep, &dp);
+        } else {
+            q.iter_mut().zip(&dq).for_each(|(x, d)| *x += d);
+            p.iter_mut().zip(&dp).for_each(|(x, d)| *x += d);
+        }
+        if step % save_every == 0 || step == steps {
+            let t = t0 + step as f64 * dt;
+            traj.push(t, &q, &p);
+            if let (Some(tol), Some(h0)) = (max_energy_error, h0) {
+                // The state of this step is kept: it is finite, only its energy is off.
+                let error = match hamiltonian(sys, &q, &p) {
+                    Ok(h) => {
+                        let err = (h - h0).abs() / if h0 != 0.0 { h0.abs() } else { 1.0 };
+                        (!(err <= tol)).then(|| {
+                            let reason = format!(
+                                "energy error {err:.3e} exceeds max_energy_error = {tol:.3e}"
+                            );
+                            Error::Divergence {
+                                step,
+                                time: t,
+                                reason,
+                            }
+                        })
+                    }
+                    Err(source) => Some(Error::Model {
+                        step,
+                        time: t,
+                        source,
+                    }),
+                };
+                if let Some(error) = error {
+                    traj.steps = step;
+                    traj.force_evaluations = integrator.force_evaluations();
+                    return Err(fail(error, traj));
+                }
+            }
+        }
+    }
+    traj.steps = steps;
+    traj.force_evaluations = integrator.force_evaluations();
+    Ok(traj)
+}

@@ -1,0 +1,113 @@
+use super::Composition;
+use crate::model::MechanicalSystem;
+use crate::ModelError;
+
+/// A kick–drift splitting method for H = ½pᵀM⁻¹p + V(q):
+///
+/// p ← p − a₀h∇V(q); then for i = 1..s: q ← q + bᵢhM⁻¹p, p ← p − aᵢh∇V(q).
+///
+/// A Verlet composition with fractions γ has bᵢ = γᵢ, a₀ = γ₁/2, aᵢ = (γᵢ + γᵢ₊₁)/2 and
+/// aₛ = γₛ/2: adjacent half kicks merged. The force at the end of a step is kept for the first
+/// kick of the next (first same as last), so the composition costs s force evaluations a step.
+#[derive(Clone, Debug)]
+pub struct KickDrift {
+    kicks: Vec<f64>,
+    drifts: Vec<f64>,
+    q: Vec<f64>,
+    p: Vec<f64>,
+    force: Vec<f64>,
+    force_cached: bool,
+    evaluations: u64,
+}
+
+impl KickDrift {
+    fn new(kicks: Vec<f64>, drifts: Vec<f64>, n: usize) -> Self {
+        debug_assert_eq!(kicks.len(), drifts.len() + 1);
+        KickDrift {
+            kicks,
+            drifts,
+            q: vec![0.0; n],
+            p: vec![0.0; n],
+            force: vec![0.0; n],
+            force_cached: false,
+            evaluations: 0,
+        }
+    }
+
+    /// The composition of Störmer–Verlet with the fractions of `c`.
+    pub fn composition(c: &Composition, n: usize) -> Self {
+        let g = c.gamma();
+        let s = g.len();
+        let kicks = (0..=s)
+            .map(|i| match i {
+                0 => 0.5 * g[0],
+                i if i == s => 0.5 * g[s - 1],
+                i => 0.5 * (g[i - 1] + g[i]),
+            })
+            .collect();
+        Self::new(kicks, g.to_vec(), n)
+    }
+
+    /// Symplectic Euler: p₁ = p₀ − h∇V(q₀), q₁ = q₀ + hM⁻¹p₁.
+    pub fn symplectic_euler(n: usize) -> Self {
+        Self::new(vec![1.0, 0.0], vec![1.0], n)
+    }
+
+    pub(super) fn reset(&mut self) {
+        self.force_cached = false;
+    }
+
+    pub(super) fn force_evaluations(&self) -> u64 {
+        self.evaluations
+    }
+
+    fn evaluate<S: MechanicalSystem + ?Sized>(&mut self, sys: &S) -> Result<(), ModelError> {
+        self.evaluations += 1;
+        let r = sys.gradient(&self.q, &mut self.force);
+        // A failed evaluation leaves no stale force behind.
+        self.force_cached = r.is_ok();
+        r
+    }
+
+    pub(super) fn increment<S: MechanicalSystem + ?Sized>(
+        &mut self,
+        sys: &S,
+        q: &[f64],
+        p: &[f64],
+        h: f64,
+        dq: &mut [f64],
+        dp: &mut [f64],
+    ) -> Result<(), ModelError> {
+        dq.fill(0.0);
+        dp.fill(0.0);
+        self.q.copy_from_slice(q);
+        if !self.force_cached {
+            self.evaluate(sys)?;
+        }
+        let s = self.drifts.len();
+        for i in 0..=s {
+            let a = self.kicks[i] * h;
+            dp.iter_mut()
+                .zip(&self.force)
+                .for_each(|(d, f)| *d -= a * f);
+            if i == s {
+                break;
+            }
+            self.p
+                .iter_mut()
+                .zip(p.iter().zip(dp.iter()))
+                .for_each(|(w, (x, d))| *w = x + d);
+            sys.mass().add_velocity(self.drifts[i] * h, &self.p, dq);
+            self.q
+                .iter_mut()
+                .zip(q.iter().zip(dq.iter()))
+                .for_each(|(w, (x, d))| *w = x + d);
+            if self.kicks[i + 1] != 0.0 {
+                self.evaluate(sys)?;
+            } else {
+                self.force_cached = false;
+            }
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,174 @@
+use super::Composition;
+use crate::Error;
+
+/// The fixed-step methods of varmech.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Method {
+    /// Explicit Euler (baseline; not symplectic).
+    ExplicitEuler,
+    /// Symplectic Euler, the variational integrator of L_d = h·L(q₀, (q₁−q₀)/h).
+    SymplecticEuler,
+    /// Störmer–Verlet, the variational integrator of the trapezoidal L_d.
+    Verlet,
+    /// Yoshida's triple jump (Yoshida 1990), order 4.
+    Yoshida4,
+    /// Suzuki's 5-stage composition (Suzuki 1990), order 4.
+    Suzuki4,
+    /// McLachlan's 5-stage composition (McLachlan 1995), order 4.
+    McLachlan4,
+    /// Yoshida's 7-stage composition (Yoshida 1990, solution A), order 6.
+    Yoshida6,
+    /// Kahan & Li's 9-stage composition (Kahan & Li 1997), order 6.
+    KahanLi6,
+    /// Suzuki & Umeno's 15-stage composition (Suzuki & Umeno 1993), order 8.
+    SuzukiUmeno8,
+    /// Kahan & Li's 17-stage composition (Kahan & Li 1997), order 8.
+    KahanLi8,
+    /// The classical Runge–Kutta method (baseline; not symplectic).
+    Rk4,
+}
+
+/// What `varmech.methods()` lists about a method.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MethodInfo {
+    pub method: Method,
+    pub name: &'static str,
+    pub order: u32,
+    /// Stages of the composition (1 for the others).
+    pub stages: usize,
+    /// Force evaluations ∇V per step, first-same-as-last evaluations reused.
+    pub force_evaluations: usize,
+    pub symplectic: bool,
+    pub symmetric: bool,
+    /// Linear stability limit: the method is stable on q̈ = −ω²q iff hω < `h_omega_max`
+    /// (0 for explicit Euler, which is never stable).
+    pub h_omega_max: f64,
+    pub reference: &'static str,
+}
+
+impl Method {
+    /// Every method, from the simplest.
+    pub const ALL: [Method; 11] = [
+        Method::ExplicitEuler,
+        Method::SymplecticEuler,
+        Method::Verlet,
+        Method::Yoshida4,
+        Method::Suzuki4,
+        Method::McLachlan4,
+        Method::Yoshida6,
+        Method::KahanLi6,
+        Method::SuzukiUmeno8,
+        Method::KahanLi8,
+        Method::Rk4,
+    ];
+
+    /// The method's facts.
+    pub fn info(self) -> MethodInfo {
+        let (name, order, symplectic, symmetric, h_omega_max, reference) = match self {
+            Method::ExplicitEuler => ("explicit_euler", 1, false, false, 0.0, "baseline"),
+            Method::SymplecticEuler => (
+                "symplectic_euler",
+                1,
+                true,
+                false,
+                2.0,
+                "HLW I.1; L_d = h L(q0, v)",
+            ),
+            Method::Verlet => ("verlet", 2, true, true, 2.0, "HLW I.3; trapezoidal L_d"),
+            Method::Yoshida4 => (
+                "yoshida4",
+                4,
+                true,
+                true,
+                1.5734,
+                "Yoshida, Phys. Lett. A 150 (1990)",
+            ),
+            Method::Suzuki4 => (
+                "suzuki4",
+                4,
+                true,
+                true,
+                2.721,
+                "Suzuki, Phys. Lett. A 146 (1990)",
+            ),
+            Method::McLachlan4 => (
+                "mclachlan4",
+                4,
+                true,
+                true,
+                3.0182,
+                "McLachlan, SIAM J. Sci. Comput. 16 (1995)",
+            ),
+            Method::Yoshida6 => (
+                "yoshida6",
+                6,
+                true,
+                true,
+                2.2691,
+                "Yoshida, Phys. Lett. A 150 (1990)",
+            ),
+            Method::KahanLi6 => (
+                "kahan_li6",
+                6,
+                true,
+                true,
+                2.5326,
+                "Kahan & Li, Math. Comp. 66 (1997)",
+            ),
+            Method::SuzukiUmeno8 => (
+                "suzuki_umeno8",
+                8,
+                true,
+                true,
+                3.3932,
+                "Suzuki & Umeno (1993)",
+            ),
+            Method::KahanLi8 => (
+                "kahan_li8",
+                8,
+                true,
+                true,
+                3.0964,
+                "Kahan & Li, Math. Comp. 66 (1997)",
+            ),
+            Method::Rk4 => (
+                "rk4",
+                4,
+                false,
+                false,
+                2.0 * std::f64::consts::SQRT_2,
+                "baseline",
+            ),
+        };
+        let stages = Composition::of(self).map_or(1, |c| c.gamma().len());
+        let force_evaluations = if self == Method::Rk4 { 4 } else { stages };
+        MethodInfo {
+            method: self,
+            name,
+            order,
+            stages,
+            force_evaluations,
+            symplectic,
+            symmetric,
+            h_omega_max,
+            reference,
+        }
+    }
+
+    /// The method called `name` (as listed by [`Method::info`]).
+    pub fn from_name(name: &str) -> Result<Method, Error> {
+        Method::ALL
+            .into_iter()
+            .find(|m| m.info().name == name)
+            .ok_or_else(|| {
+                let names: Vec<_> = Method::ALL.iter().map(|m| m.info().name).collect();
+                Error::invalid(
+                    "method",
+                    format!(
+                        "unknown method {name:?}; choose one of {}",
+                        names.join(", ")
+                    ),
+                )
+            })
+    }
+}

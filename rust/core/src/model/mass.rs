@@ -1,0 +1,164 @@
+use nalgebra::{DMatrix, DVector};
+
+use crate::Error;
+
+/// A constant symmetric positive-definite mass matrix M.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Mass {
+    /// M = m·I.
+    Scalar(f64),
+    /// M = diag(m₁, …, mₙ).
+    Diagonal(DVector<f64>),
+    /// A full matrix, stored with its inverse so that M⁻¹p costs one matrix–vector product.
+    Full {
+        matrix: DMatrix<f64>,
+        inverse: DMatrix<f64>,
+    },
+}
+
+impl Mass {
+    /// M = m·I with m > 0.
+    pub fn scalar(m: f64) -> Result<Self, Error> {
+        if !(m.is_finite() && m > 0.0) {
+            return Err(Error::invalid(
+                "mass",
+                format!("must be finite and positive, got {m}"),
+            ));
+        }
+        Ok(Mass::Scalar(m))
+    }
+
+    /// M = diag(m) with every mᵢ > 0.
+    pub fn diagonal(m: Vec<f64>) -> Result<Self, Error> {
+        if let Some(i) = m.iter().position(|x| !(x.is_finite() && *x > 0.0)) {
+            return Err(Error::invalid(
+                "mass",
+                format!("entry {i} must be finite and positive, got {}", m[i]),
+            ));
+        }
+        Ok(Mass::Diagonal(DVector::from_vec(m)))
+    }
+
+    /// A full matrix; it must be symmetric (to 1e-12 relative) and positive definite.
+    pub fn full(matrix: DMatrix<f64>) -> Result<Self, Error> {
+        if !matrix.is_square() {
+            return Err(Error::invalid(
+                "mass",
+                format!("must be square, got {}×{}", matrix.nrows(), matrix.ncols()),
+            ));
+        }
+        if matrix.iter().any(|x| !x.is_finite()) {
+            return Err(Error::invalid("mass", "has non-finite entries"));
+        }
+        let scale = matrix.amax();
+        if (&matrix - matrix.transpose()).amax() > 1e-12 * scale {
+            return Err(Error::invalid("mass", "must be symmetric"));
+        }
+        let chol = matrix
+            .clone()
+            .cholesky()
+            .ok_or_else(|| Error::invalid("mass", "must be positive definite"))?;
+        Ok(Mass::Full {
+            inverse: chol.inverse(),
+            matrix,
+        })
+    }
+
+    /// The dimension this mass fixes, if any (a scalar mass fits every dimension).
+    pub fn dim(&self) -> Option<usize> {
+        match self {
+            Mass::Scalar(_) => None,
+            Mass::Diagonal(m) => Some(m.len()),
+            Mass::Full { matrix, .. } => Some(matrix.nrows()),
+        }
+    }
+
+    /// q ← q + c·M⁻¹p (the drift of a splitting method); allocation-free.
+    #[inline]
+    pub fn add_velocity(&self, c: f64, p: &[f64], q: &mut [f64]) {
+        match self {
+            Mass::Scalar(m) => {
+                let s = c / m;
+                q.iter_mut().zip(p).for_each(|(qi, pi)| *qi += s * pi);
+            }
+            Mass::Diagonal(m) => {
+                for ((qi, pi), mi) in q.iter_mut().zip(p).zip(m.iter()) {
+                    *qi += c * pi / mi;
+                }
+            }
+            Mass::Full { inverse, .. } => {
+                for (i, qi) in q.iter_mut().enumerate() {
+                    let s: f64 = p
+                        .iter()
+                        .enumerate()
+                        .map(|(j, pj)| inverse[(i, j)] * pj)
+                        .sum();
+                    *qi += c * s;
+                }
+            }
+        }
+    }
+
+    /// v = M⁻¹p.
+    pub fn velocity(&self, p: &[f64], v: &mut [f64]) {
+        v.fill(0.0);
+        self.add_velocity(1.0, p, v);
+    }
+
+    /// p = M v.
+    pub fn momentum(&self, v: &[f64], p: &mut [f64]) {
+        match self {
+            Mass::Scalar(m) => p.iter_mut().zip(v).for_each(|(pi, vi)| *pi = m * vi),
+            Mass::Diagonal(m) => {
+                for ((pi, vi), mi) in p.iter_mut().zip(v).zip(m.iter()) {
+                    *pi = mi * vi;
+                }
+            }
+            Mass::Full { matrix, .. } => {
+                for (i, pi) in p.iter_mut().enumerate() {
+                    *pi = v
+                        .iter()
+                        .enumerate()
+                        .map(|(j, vj)| matrix[(i, j)] * vj)
+                        .sum();
+                }
+            }
+        }
+    }
+
+    /// T = ½ pᵀ M⁻¹ p.
+    pub fn kinetic_energy(&self, p: &[f64]) -> f64 {
+        match self {
+            Mass::Scalar(m) => 0.5 * p.iter().map(|x| x * x).sum::<f64>() / m,
+            Mass::Diagonal(m) => {
+                0.5 * p
+                    .iter()
+                    .zip(m.iter())
+                    .map(|(x, mi)| x * x / mi)
+                    .sum::<f64>()
+            }
+            Mass::Full { inverse, .. } => 0.5 * quadratic_form(inverse, p),
+        }
+    }
+
+    /// T = ½ vᵀ M v.
+    pub fn kinetic_energy_of_velocity(&self, v: &[f64]) -> f64 {
+        match self {
+            Mass::Scalar(m) => 0.5 * m * v.iter().map(|x| x * x).sum::<f64>(),
+            Mass::Diagonal(m) => {
+                0.5 * v
+                    .iter()
+                    .zip(m.iter())
+                    .map(|(x, mi)| mi * x * x)
+                    .sum::<f64>()
+            }
+            Mass::Full { matrix, .. } => 0.5 * quadratic_form(matrix, v),
+        }
+    }
+}
+
+/// xᵀ A x.
+fn quadratic_form(a: &DMatrix<f64>, x: &[f64]) -> f64 {
+    let x = nalgebra::DVectorView::from_slice(x, x.len());
+    x.dot(&(a * x))
+}

@@ -1,0 +1,25 @@
+use super::{Generator, Mass};
+use crate::ModelError;
+
+/// A separable mechanical system, L(q, q̇) = ½ q̇ᵀ M q̇ − V(q), with constant mass matrix M.
+///
+/// Its Hamiltonian is H(q, p) = ½ pᵀ M⁻¹ p + V(q) and its equations of motion are
+/// q̇ = M⁻¹p, ṗ = −∇V(q): the setting of Störmer–Verlet and of its compositions.
+pub trait MechanicalSystem {
+    /// Number of generalized coordinates n.
+    fn dim(&self) -> usize;
+
+    /// The constant mass matrix M.
+    fn mass(&self) -> &Mass;
+
+    /// The potential V(q).
+    fn potential(&self, q: &[f64]) -> Result<f64, ModelError>;
+
+    /// Writes ∇V(q) into `grad` (length n). Step loops call this; it must not allocate.
+    fn gradient(&self, q: &[f64], grad: &mut [f64]) -> Result<(), ModelError>;
+
+    /// The symmetries the model declares; each has a conserved Noether momentum J = p·ξ(q).
+    fn symmetries(&self) -> Vec<Generator> {
+        Vec::new()
+    }
+}

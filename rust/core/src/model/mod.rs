@@ -1,0 +1,18 @@
+//! Models: what is integrated.
+//!
+//! - [`Lagrangian`]: a Lagrangian system L(q, q̇, t) on ℝⁿ, the most general model;
+//! - [`MechanicalSystem`]: the separable case L = ½q̇ᵀMq̇ − V(q) with constant mass;
+//! - [`Mass`]: the constant mass matrix M (scalar, diagonal or full symmetric positive definite);
+//! - [`Generator`]: infinitesimal symmetries ξ(q) and their Noether momenta J = p·ξ(q);
+//! - [`finite_difference`]: derivatives a model does not supply.
+
+pub mod finite_difference;
+mod lagrangian;
+mod mass;
+mod mechanical;
+mod symmetry;
+
+pub use lagrangian::Lagrangian;
+pub use mass::Mass;
+pub use mechanical::MechanicalSystem;
+pub use symmetry::Generator;

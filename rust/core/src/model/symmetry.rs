@@ -1,0 +1,73 @@
+/// An infinitesimal symmetry ξ(q) of the configuration space. If L is invariant under the flow
+/// of ξ, Noether's theorem gives the conserved momentum J(q, p) = p·ξ(q), and a variational
+/// integrator whose L_d shares the invariance conserves J exactly (discrete Noether theorem).
+///
+/// Coordinates of particle systems are laid out body by body: q = (x₁, …, x_N) with each xᵢ in
+/// ℝ^`spatial_dim`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Generator {
+    /// Every body moves along `axis`: J is the total linear momentum along it.
+    Translation { axis: usize, spatial_dim: usize },
+    /// Every body turns about `axis` (in the plane when `spatial_dim` = 2, where `axis` is
+    /// ignored): J is the total angular momentum about it.
+    Rotation { axis: usize, spatial_dim: usize },
+    /// Coordinate `index` is cyclic (∂L/∂q_index = 0): J = p_index.
+    Cyclic { index: usize },
+}
+
+impl Generator {
+    /// A short name: `P_x`, `L_z`, `p[3]`.
+    pub fn name(&self) -> String {
+        const AXES: [&str; 3] = ["x", "y", "z"];
+        match *self {
+            Generator::Translation { axis, .. } => format!("P_{}", AXES.get(axis).unwrap_or(&"?")),
+            Generator::Rotation { spatial_dim: 2, .. } => "L".to_string(),
+            Generator::Rotation { axis, .. } => format!("L_{}", AXES.get(axis).unwrap_or(&"?")),
+            Generator::Cyclic { index } => format!("p[{index}]"),
+        }
+    }
+
+    /// Checks that the generator applies to `n` coordinates.
+    pub fn check(&self, n: usize) -> Result<(), crate::Error> {
+        let ok = match *self {
+            Generator::Translation { axis, spatial_dim } => {
+                spatial_dim > 0 && axis < spatial_dim && n % spatial_dim == 0
+            }
+            Generator::Rotation { axis, spatial_dim } => {
+                (spatial_dim == 2 || (spatial_dim == 3 && axis < 3)) && n % spatial_dim == 0
+            }
+            Generator::Cyclic { index } => index < n,
+        };
+        if ok {
+            Ok(())
+        } else {
+            Err(crate::Error::invalid(
+                "generator",
+                format!("{self:?} does not apply to {n} coordinates"),
+            ))
+        }
+    }
+
+    /// J(q, p) = p·ξ(q).
+    pub fn momentum(&self, q: &[f64], p: &[f64]) -> f64 {
+        match *self {
+            Generator::Translation { axis, spatial_dim } => {
+                p.iter().skip(axis).step_by(spatial_dim).sum()
+            }
+            Generator::Rotation { spatial_dim: 2, .. } => q
+                .chunks_exact(2)
+                .zip(p.chunks_exact(2))
+                .map(|(x, y)| x[0] * y[1] - x[1] * y[0])
+                .sum(),
+            Generator::Rotation { axis, .. } => {
+                // (x × p)·e_axis
+                let (a, b) = ((axis + 1) % 3, (axis + 2) % 3);
+                q.chunks_exact(3)
+                    .zip(p.chunks_exact(3))
+                    .map(|(x, y)| x[a] * y[b] - x[b] * y[a])
+                    .sum()
+            }
+            Generator::Cyclic { index } => p[index],
+        }
+    }
+}

@@ -1,0 +1,84 @@
+//! Native test problems, each in the fewest coordinates its physics needs, with its initial
+//! data and, where one is published or exact, a reference solution.
+//!
+//! The data and references are copied from the literature into `reference/` of the repository,
+//! which names the sources; tests and benches use these problems (as diffsol ships its test
+//! problems in the library).
+
+mod fermi_pasta_ulam;
+mod harmonic_oscillator;
+mod henon_heiles;
+mod kepler;
+mod nbody;
+mod pendulum;
+
+pub use fermi_pasta_ulam::FermiPastaUlam;
+pub use harmonic_oscillator::HarmonicOscillator;
+pub use henon_heiles::HenonHeiles;
+pub use kepler::Kepler;
+pub use nbody::NBody;
+pub use pendulum::Pendulum;
+
+use crate::model::{Generator, Mass, MechanicalSystem};
+use crate::ModelError;
+
+/// A state (q, p) at time t.
+#[derive(Clone, Debug, PartialEq)]
+pub struct State {
+    pub t: f64,
+    pub q: Vec<f64>,
+    pub p: Vec<f64>,
+}
+
+/// A system with its initial state, the horizon of its test protocol and a reference solution.
+#[derive(Clone, Debug)]
+pub struct Problem<S> {
+    pub system: S,
+    pub initial: State,
+    pub t_end: f64,
+    /// The exact or published solution, and where it comes from.
+    pub reference: Option<(State, &'static str)>,
+}
+
+/// Any native scene, for callers (the Python binding) that choose one at run time.
+#[derive(Clone, Debug)]
+pub enum Scene {
+    HarmonicOscillator(HarmonicOscillator),
+    Pendulum(Pendulum),
+    Kepler(Kepler),
+    HenonHeiles(HenonHeiles),
+    FermiPastaUlam(FermiPastaUlam),
+    NBody(NBody),
+}
+
+macro_rules! dispatch {
+    ($self:ident, $s:ident => $e:expr) => {
+        match $self {
+            Scene::HarmonicOscillator($s) => $e,
+            Scene::Pendulum($s) => $e,
+            Scene::Kepler($s) => $e,
+            Scene::HenonHeiles($s) => $e,
+            Scene::FermiPastaUlam($s) => $e,
+            Scene::NBody($s) => $e,
+        }
+    };
+}
+
+impl MechanicalSystem for Scene {
+    fn dim(&self) -> usize {
+        dispatch!(self, s => s.dim())
+    }
+    fn mass(&self) -> &Mass {
+        dispatch!(self, s => s.mass())
+    }
+    fn potential(&self, q: &[f64]) -> Result<f64, ModelError> {
+        dispatch!(self, s => s.potential(q))
+    }
+    #[inline]
+    fn gradient(&self, q: &[f64], grad: &mut [f64]) -> Result<(), ModelError> {
+        dispatch!(self, s => s.gradient(q, grad))
+    }
+    fn symmetries(&self) -> Vec<Generator> {
+        dispatch!(self, s => s.symmetries())
+    }
+}
