@@ -13,23 +13,14 @@ fn closed_form_reproduces_the_published_reference() {
     let problem = Pendulum::problem();
     let (reference, _) = problem.reference.as_ref().unwrap();
     let (q, p) = Pendulum::exact_from_bottom(problem.initial.p[0], reference.t).unwrap();
-    assert!(
-        (q - reference.q[0]).abs() <= 1e-15,
-        "q: {q} vs {}",
-        reference.q[0]
-    );
-    assert!(
-        (p - reference.p[0]).abs() <= 1e-15,
-        "p: {p} vs {}",
-        reference.p[0]
-    );
+    assert!((q - reference.q[0]).abs() <= 1e-15, "q: {q} vs {}", reference.q[0]);
+    assert!((p - reference.p[0]).abs() <= 1e-15, "p: {p} vs {}", reference.p[0]);
 }
 
 /// Error in (q, p) at t = 2π with `steps` steps.
 fn error(method: Method, steps: usize) -> f64 {
     let problem = Pendulum::problem();
-    let (q_exact, p_exact) =
-        Pendulum::exact_from_bottom(problem.initial.p[0], problem.t_end).unwrap();
+    let (q_exact, p_exact) = Pendulum::exact_from_bottom(problem.initial.p[0], problem.t_end).unwrap();
     let options = Options {
         save_every: steps,
         ..Options::new(problem.t_end / steps as f64, steps)

@@ -10,29 +10,14 @@ pub type ModelError = Box<dyn std::error::Error + Send + Sync + 'static>;
 #[derive(Debug)]
 pub enum Error {
     /// An argument is malformed: wrong shape, not finite, out of range, unknown name.
-    InvalidArgument {
-        argument: &'static str,
-        reason: String,
-    },
+    InvalidArgument { argument: &'static str, reason: String },
     /// The numerical solution left every sensible bound: a non-finite state, or an energy error
     /// beyond the threshold the user set.
-    Divergence {
-        step: usize,
-        time: f64,
-        reason: String,
-    },
+    Divergence { step: usize, time: f64, reason: String },
     /// The model failed while it was evaluated during `step` (which starts at `time`).
-    Model {
-        step: usize,
-        time: f64,
-        source: ModelError,
-    },
+    Model { step: usize, time: f64, source: ModelError },
     /// The interrupt poll (Ctrl-C) asked the run to stop before `step`.
-    Interrupted {
-        step: usize,
-        time: f64,
-        source: ModelError,
-    },
+    Interrupted { step: usize, time: f64, source: ModelError },
 }
 
 impl Error {
@@ -50,16 +35,10 @@ impl fmt::Display for Error {
         match self {
             Error::InvalidArgument { argument, reason } => write!(f, "{argument}: {reason}"),
             Error::Divergence { step, time, reason } => {
-                write!(
-                    f,
-                    "integration diverged at step {step} (t = {time}): {reason}"
-                )
+                write!(f, "integration diverged at step {step} (t = {time}): {reason}")
             }
             Error::Model { step, time, source } => {
-                write!(
-                    f,
-                    "model evaluation failed at step {step} (t = {time}): {source}"
-                )
+                write!(f, "model evaluation failed at step {step} (t = {time}): {source}")
             }
             Error::Interrupted { step, time, .. } => {
                 write!(f, "integration interrupted at step {step} (t = {time})")
@@ -71,9 +50,7 @@ impl fmt::Display for Error {
 impl std::error::Error for Error {
     fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
         match self {
-            Error::Model { source, .. } | Error::Interrupted { source, .. } => {
-                Some(source.as_ref())
-            }
+            Error::Model { source, .. } | Error::Interrupted { source, .. } => Some(source.as_ref()),
             _ => None,
         }
     }
@@ -88,10 +65,7 @@ pub(crate) fn check_vector(argument: &'static str, x: &[f64], n: usize) -> Resul
         ));
     }
     if let Some(i) = x.iter().position(|v| !v.is_finite()) {
-        return Err(Error::invalid(
-            argument,
-            format!("entry {i} is not finite ({})", x[i]),
-        ));
+        return Err(Error::invalid(argument, format!("entry {i} is not finite ({})", x[i])));
     }
     Ok(())
 }

@@ -54,17 +54,13 @@ impl EnergyStatistics {
         let e: Vec<f64> = h.iter().map(|x| (x - initial) / scale).collect();
         let max_abs = |s: &[f64]| s.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
         let tenth = (e.len() / 10).max(1);
-        let (lo, hi) = e
-            .iter()
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &x| {
-                (lo.min(x), hi.max(x))
-            });
+        let (lo, hi) = e.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &x| {
+            (lo.min(x), hi.max(x))
+        });
         let (drift_rate, drift_rate_stderr) = linear_fit_slope(t, &e);
         let first = max_abs(&e[..tenth]);
         let last = max_abs(&e[e.len() - tenth..]);
-        let drifts = last > 2.0 * first
-            && drift_rate.abs() > 3.0 * drift_rate_stderr
-            && last > Self::NOISE_FLOOR;
+        let drifts = last > 2.0 * first && drift_rate.abs() > 3.0 * drift_rate_stderr && last > Self::NOISE_FLOOR;
         EnergyStatistics {
             initial,
             max_error: max_abs(&e),
@@ -94,9 +90,7 @@ pub struct InvariantStatistics {
 impl InvariantStatistics {
     pub fn new(values: &[f64]) -> Self {
         let initial = values.first().copied().unwrap_or(0.0);
-        let max_abs_error = values
-            .iter()
-            .fold(0.0_f64, |m, x| m.max((x - initial).abs()));
+        let max_abs_error = values.iter().fold(0.0_f64, |m, x| m.max((x - initial).abs()));
         let scale = if initial != 0.0 { initial.abs() } else { 1.0 };
         InvariantStatistics {
             initial,
@@ -141,15 +135,9 @@ mod tests {
     #[test]
     fn a_ramp_drifts_and_an_oscillation_is_bounded() {
         let t: Vec<f64> = (0..1000).map(|k| k as f64 * 0.1).collect();
-        let ramp: Vec<f64> = t
-            .iter()
-            .map(|x| 1.0 + 1e-6 * x + 1e-7 * (3.0 * x).sin())
-            .collect();
+        let ramp: Vec<f64> = t.iter().map(|x| 1.0 + 1e-6 * x + 1e-7 * (3.0 * x).sin()).collect();
         let wave: Vec<f64> = t.iter().map(|x| 1.0 + 1e-6 * (3.0 * x).sin()).collect();
-        assert_eq!(
-            EnergyStatistics::new(&t, &ramp).verdict,
-            Verdict::SecularDrift
-        );
+        assert_eq!(EnergyStatistics::new(&t, &ramp).verdict, Verdict::SecularDrift);
         assert_eq!(EnergyStatistics::new(&t, &wave).verdict, Verdict::Bounded);
     }
 }

@@ -23,10 +23,7 @@ pub fn symplecticity_defect<S: MechanicalSystem + ?Sized>(
     check_vector("q", q, n)?;
     check_vector("p", p, n)?;
     if !(h.is_finite() && h > 0.0) {
-        return Err(Error::invalid(
-            "dt",
-            format!("must be finite and positive, got {h}"),
-        ));
+        return Err(Error::invalid("dt", format!("must be finite and positive, got {h}")));
     }
     let mut integrator = Integrator::new(method, n);
     let mut flow = |x: &[f64]| -> Result<Vec<f64>, Error> {

@@ -10,13 +10,7 @@ use crate::ModelError;
 pub struct Trapezoidal;
 
 impl DiscreteLagrangian for Trapezoidal {
-    fn value<S: MechanicalSystem + ?Sized>(
-        &self,
-        sys: &S,
-        q0: &[f64],
-        q1: &[f64],
-        h: f64,
-    ) -> Result<f64, ModelError> {
+    fn value<S: MechanicalSystem + ?Sized>(&self, sys: &S, q0: &[f64], q1: &[f64], h: f64) -> Result<f64, ModelError> {
         let (v, _) = velocity_momentum(sys, q0, q1, h);
         Ok(0.5 * h * (sys.lagrangian(q0, &v, 0.0)? + sys.lagrangian(q1, &v, h)?))
     }

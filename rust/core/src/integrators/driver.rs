@@ -52,10 +52,7 @@ impl Options {
             return Err(Error::invalid("t0", "must be finite"));
         }
         match self.max_energy_error {
-            Some(x) if !(x > 0.0) => Err(Error::invalid(
-                "max_energy_error",
-                format!("must be positive, got {x}"),
-            )),
+            Some(x) if x.is_nan() || x <= 0.0 => Err(Error::invalid("max_energy_error", format!("must be positive, got {x}"))),
             _ => Ok(()),
         }
     }
@@ -188,9 +185,16 @@ where
         t0,
     } = *options;
     let saved = steps / save_every + 2;
-    traj.t.reserve(saved);
-    traj.q.reserve(saved * n);
-    traj.p.reserve(saved * n);
+    let reserved = traj
+        .t
+        .try_reserve_exact(saved)
+        .and(traj.q.try_reserve_exact(saved * n))
+        .and(traj.p.try_reserve_exact(saved * n));
+    if reserved.is_err() {
+        let gib = (saved * (2 * n + 1) * 8) as f64 / (1u64 << 30) as f64;
+        let reason = format!("keeping {saved} states needs {gib:.1} GiB, more than can be allocated; raise save_every");
+        return Err(fail(Error::invalid("save_every", reason), traj));
+    }
 
     let (mut q, mut p) = (q0.to_vec(), p0.to_vec());
     let (mut dq, mut dp) = (vec![0.0; n], vec![0.0; n]);
@@ -218,15 +222,14 @@ where
     for step in 1..=steps {
         let time = t0 + (step - 1) as f64 * dt;
         // Stops with the last good state (step − 1) kept, and the work counted.
-        let stop =
-            |error: Error, mut traj: Trajectory, q: &[f64], p: &[f64], integrator: &Integrator| {
-                if traj.t.last() != Some(&time) {
-                    traj.push(time, q, p);
-                }
-                traj.steps = step - 1;
-                traj.force_evaluations = integrator.force_evaluations();
-                fail(error, traj)
-            };
+        let stop = |error: Error, mut traj: Trajectory, q: &[f64], p: &[f64], integrator: &Integrator| {
+            if traj.t.last() != Some(&time) {
+                traj.push(time, q, p);
+            }
+            traj.steps = step - 1;
+            traj.force_evaluations = integrator.force_evaluations();
+            fail(error, traj)
+        };
         if interrupt.due() {
             if let Err(source) = poll() {
                 return Err(stop(
@@ -239,16 +242,19 @@ where
             }
         }
         if let Err(source) = integrator.increment(sys, &q, &p, dt, &mut dq, &mut dp) {
-            return Err(stop(
-                Error::Model { step, time, source },
-                traj,
-                &q,
-                &p,
-                &integrator,
-            ));
+            return Err(stop(Error::Model { step, time, source }, traj, &q, &p, &integrator));
         }
-        if !dq.iter().chain(&dp).sum::<f64>().is_finite() {
-            let reason = "the state became non-finite (the method is unstable at this step size, or the model is singular here)".to_string();
+        // One sum tells whether any entry of the new state would be non-finite (or huge).
+        let next = q
+            .iter()
+            .zip(&dq)
+            .chain(p.iter().zip(&dp))
+            .map(|(x, d)| x + d)
+            .sum::<f64>();
+        if !next.is_finite() {
+            let reason =
+                "the state became non-finite (the method is unstable at this step size, or the model is singular here)"
+                    .to_string();
             return Err(stop(
                 Error::Divergence { step, time, reason },
                 traj,
@@ -272,22 +278,12 @@ where
                 let error = match hamiltonian(sys, &q, &p) {
                     Ok(h) => {
                         let err = (h - h0).abs() / if h0 != 0.0 { h0.abs() } else { 1.0 };
-                        (!(err <= tol)).then(|| {
-                            let reason = format!(
-                                "energy error {err:.3e} exceeds max_energy_error = {tol:.3e}"
-                            );
-                            Error::Divergence {
-                                step,
-                                time: t,
-                                reason,
-                            }
+                        (err.is_nan() || err > tol).then(|| {
+                            let reason = format!("energy error {err:.3e} exceeds max_energy_error = {tol:.3e}");
+                            Error::Divergence { step, time: t, reason }
                         })
                     }
-                    Err(source) => Some(Error::Model {
-                        step,
-                        time: t,
-                        source,
-                    }),
+                    Err(source) => Some(Error::Model { step, time: t, source }),
                 };
                 if let Some(error) = error {
                     traj.steps = step;

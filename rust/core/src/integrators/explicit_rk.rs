@@ -39,11 +39,7 @@ impl ExplicitRk {
 
     /// The classical fourth-order Runge–Kutta method.
     pub fn rk4(n: usize) -> Self {
-        Self::new(
-            &[0.0, 0.5, 0.5, 1.0],
-            &[1.0 / 6.0, 1.0 / 3.0, 1.0 / 3.0, 1.0 / 6.0],
-            n,
-        )
+        Self::new(&[0.0, 0.5, 0.5, 1.0], &[1.0 / 6.0, 1.0 / 3.0, 1.0 / 3.0, 1.0 / 6.0], n)
     }
 
     pub(super) fn force_evaluations(&self) -> u64 {

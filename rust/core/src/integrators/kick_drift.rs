@@ -87,9 +87,7 @@ impl KickDrift {
         let s = self.drifts.len();
         for i in 0..=s {
             let a = self.kicks[i] * h;
-            dp.iter_mut()
-                .zip(&self.force)
-                .for_each(|(d, f)| *d -= a * f);
+            dp.iter_mut().zip(&self.force).for_each(|(d, f)| *d -= a * f);
             if i == s {
                 break;
             }

@@ -66,31 +66,10 @@ impl Method {
     pub fn info(self) -> MethodInfo {
         let (name, order, symplectic, symmetric, h_omega_max, reference) = match self {
             Method::ExplicitEuler => ("explicit_euler", 1, false, false, 0.0, "baseline"),
-            Method::SymplecticEuler => (
-                "symplectic_euler",
-                1,
-                true,
-                false,
-                2.0,
-                "HLW I.1; L_d = h L(q0, v)",
-            ),
+            Method::SymplecticEuler => ("symplectic_euler", 1, true, false, 2.0, "HLW I.1; L_d = h L(q0, v)"),
             Method::Verlet => ("verlet", 2, true, true, 2.0, "HLW I.3; trapezoidal L_d"),
-            Method::Yoshida4 => (
-                "yoshida4",
-                4,
-                true,
-                true,
-                1.5734,
-                "Yoshida, Phys. Lett. A 150 (1990)",
-            ),
-            Method::Suzuki4 => (
-                "suzuki4",
-                4,
-                true,
-                true,
-                2.721,
-                "Suzuki, Phys. Lett. A 146 (1990)",
-            ),
+            Method::Yoshida4 => ("yoshida4", 4, true, true, 1.5734, "Yoshida, Phys. Lett. A 150 (1990)"),
+            Method::Suzuki4 => ("suzuki4", 4, true, true, 2.721, "Suzuki, Phys. Lett. A 146 (1990)"),
             Method::McLachlan4 => (
                 "mclachlan4",
                 4,
@@ -99,46 +78,11 @@ impl Method {
                 3.0182,
                 "McLachlan, SIAM J. Sci. Comput. 16 (1995)",
             ),
-            Method::Yoshida6 => (
-                "yoshida6",
-                6,
-                true,
-                true,
-                2.2691,
-                "Yoshida, Phys. Lett. A 150 (1990)",
-            ),
-            Method::KahanLi6 => (
-                "kahan_li6",
-                6,
-                true,
-                true,
-                2.5326,
-                "Kahan & Li, Math. Comp. 66 (1997)",
-            ),
-            Method::SuzukiUmeno8 => (
-                "suzuki_umeno8",
-                8,
-                true,
-                true,
-                3.3932,
-                "Suzuki & Umeno (1993)",
-            ),
-            Method::KahanLi8 => (
-                "kahan_li8",
-                8,
-                true,
-                true,
-                3.0964,
-                "Kahan & Li, Math. Comp. 66 (1997)",
-            ),
-            Method::Rk4 => (
-                "rk4",
-                4,
-                false,
-                false,
-                2.0 * std::f64::consts::SQRT_2,
-                "baseline",
-            ),
+            Method::Yoshida6 => ("yoshida6", 6, true, true, 2.2691, "Yoshida, Phys. Lett. A 150 (1990)"),
+            Method::KahanLi6 => ("kahan_li6", 6, true, true, 2.5326, "Kahan & Li, Math. Comp. 66 (1997)"),
+            Method::SuzukiUmeno8 => ("suzuki_umeno8", 8, true, true, 3.3932, "Suzuki & Umeno (1993)"),
+            Method::KahanLi8 => ("kahan_li8", 8, true, true, 3.0964, "Kahan & Li, Math. Comp. 66 (1997)"),
+            Method::Rk4 => ("rk4", 4, false, false, 2.0 * std::f64::consts::SQRT_2, "baseline"),
         };
         let stages = Composition::of(self).map_or(1, |c| c.gamma().len());
         let force_evaluations = if self == Method::Rk4 { 4 } else { stages };
@@ -157,18 +101,12 @@ impl Method {
 
     /// The method called `name` (as listed by [`Method::info`]).
     pub fn from_name(name: &str) -> Result<Method, Error> {
-        Method::ALL
-            .into_iter()
-            .find(|m| m.info().name == name)
-            .ok_or_else(|| {
-                let names: Vec<_> = Method::ALL.iter().map(|m| m.info().name).collect();
-                Error::invalid(
-                    "method",
-                    format!(
-                        "unknown method {name:?}; choose one of {}",
-                        names.join(", ")
-                    ),
-                )
-            })
+        Method::ALL.into_iter().find(|m| m.info().name == name).ok_or_else(|| {
+            let names: Vec<_> = Method::ALL.iter().map(|m| m.info().name).collect();
+            Error::invalid(
+                "method",
+                format!("unknown method {name:?}; choose one of {}", names.join(", ")),
+            )
+        })
     }
 }

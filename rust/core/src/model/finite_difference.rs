@@ -7,12 +7,7 @@ use crate::ModelError;
 /// (ε the machine epsilon), for an error of order ε^{2/3} ≈ 4e-11 relative.
 ///
 /// `work` (length n) is scratch space, so the call allocates nothing.
-pub fn central_gradient<F>(
-    mut f: F,
-    q: &[f64],
-    work: &mut [f64],
-    grad: &mut [f64],
-) -> Result<(), ModelError>
+pub fn central_gradient<F>(mut f: F, q: &[f64], work: &mut [f64], grad: &mut [f64]) -> Result<(), ModelError>
 where
     F: FnMut(&[f64]) -> Result<f64, ModelError>,
 {

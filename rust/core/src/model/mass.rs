@@ -20,10 +20,7 @@ impl Mass {
     /// M = m·I with m > 0.
     pub fn scalar(m: f64) -> Result<Self, Error> {
         if !(m.is_finite() && m > 0.0) {
-            return Err(Error::invalid(
-                "mass",
-                format!("must be finite and positive, got {m}"),
-            ));
+            return Err(Error::invalid("mass", format!("must be finite and positive, got {m}")));
         }
         Ok(Mass::Scalar(m))
     }
@@ -88,11 +85,7 @@ impl Mass {
             }
             Mass::Full { inverse, .. } => {
                 for (i, qi) in q.iter_mut().enumerate() {
-                    let s: f64 = p
-                        .iter()
-                        .enumerate()
-                        .map(|(j, pj)| inverse[(i, j)] * pj)
-                        .sum();
+                    let s: f64 = p.iter().enumerate().map(|(j, pj)| inverse[(i, j)] * pj).sum();
                     *qi += c * s;
                 }
             }
@@ -116,11 +109,7 @@ impl Mass {
             }
             Mass::Full { matrix, .. } => {
                 for (i, pi) in p.iter_mut().enumerate() {
-                    *pi = v
-                        .iter()
-                        .enumerate()
-                        .map(|(j, vj)| matrix[(i, j)] * vj)
-                        .sum();
+                    *pi = v.iter().enumerate().map(|(j, vj)| matrix[(i, j)] * vj).sum();
                 }
             }
         }
@@ -130,13 +119,7 @@ impl Mass {
     pub fn kinetic_energy(&self, p: &[f64]) -> f64 {
         match self {
             Mass::Scalar(m) => 0.5 * p.iter().map(|x| x * x).sum::<f64>() / m,
-            Mass::Diagonal(m) => {
-                0.5 * p
-                    .iter()
-                    .zip(m.iter())
-                    .map(|(x, mi)| x * x / mi)
-                    .sum::<f64>()
-            }
+            Mass::Diagonal(m) => 0.5 * p.iter().zip(m.iter()).map(|(x, mi)| x * x / mi).sum::<f64>(),
             Mass::Full { inverse, .. } => 0.5 * quadratic_form(inverse, p),
         }
     }
@@ -145,13 +128,7 @@ impl Mass {
     pub fn kinetic_energy_of_velocity(&self, v: &[f64]) -> f64 {
         match self {
             Mass::Scalar(m) => 0.5 * m * v.iter().map(|x| x * x).sum::<f64>(),
-            Mass::Diagonal(m) => {
-                0.5 * v
-                    .iter()
-                    .zip(m.iter())
-                    .map(|(x, mi)| mi * x * x)
-                    .sum::<f64>()
-            }
+            Mass::Diagonal(m) => 0.5 * v.iter().zip(m.iter()).map(|(x, mi)| mi * x * x).sum::<f64>(),
             Mass::Full { matrix, .. } => 0.5 * quadratic_form(matrix, v),
         }
     }

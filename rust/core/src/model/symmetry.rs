@@ -31,10 +31,10 @@ impl Generator {
     pub fn check(&self, n: usize) -> Result<(), crate::Error> {
         let ok = match *self {
             Generator::Translation { axis, spatial_dim } => {
-                spatial_dim > 0 && axis < spatial_dim && n % spatial_dim == 0
+                spatial_dim > 0 && axis < spatial_dim && n.is_multiple_of(spatial_dim)
             }
             Generator::Rotation { axis, spatial_dim } => {
-                (spatial_dim == 2 || (spatial_dim == 3 && axis < 3)) && n % spatial_dim == 0
+                (spatial_dim == 2 || (spatial_dim == 3 && axis < 3)) && n.is_multiple_of(spatial_dim)
             }
             Generator::Cyclic { index } => index < n,
         };
@@ -51,9 +51,7 @@ impl Generator {
     /// J(q, p) = p·ξ(q).
     pub fn momentum(&self, q: &[f64], p: &[f64]) -> f64 {
         match *self {
-            Generator::Translation { axis, spatial_dim } => {
-                p.iter().skip(axis).step_by(spatial_dim).sum()
-            }
+            Generator::Translation { axis, spatial_dim } => p.iter().skip(axis).step_by(spatial_dim).sum(),
             Generator::Rotation { spatial_dim: 2, .. } => q
                 .chunks_exact(2)
                 .zip(p.chunks_exact(2))

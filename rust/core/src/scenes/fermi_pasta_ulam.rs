@@ -74,9 +74,7 @@ impl MechanicalSystem for FermiPastaUlam {
         &self.mass
     }
     fn potential(&self, q: &[f64]) -> Result<f64, ModelError> {
-        let stiff: f64 = (1..=self.m)
-            .map(|i| (q[2 * i - 1] - q[2 * i - 2]).powi(2))
-            .sum();
+        let stiff: f64 = (1..=self.m).map(|i| (q[2 * i - 1] - q[2 * i - 2]).powi(2)).sum();
         let soft: f64 = (0..=self.m)
             .map(|i| (self.position(q, 2 * i + 1) - self.position(q, 2 * i)).powi(4))
             .sum();

@@ -21,10 +21,7 @@ impl Kepler {
     /// state is the initial state.
     pub fn problem(e: f64) -> Result<Problem<Self>, Error> {
         if !(0.0..1.0).contains(&e) {
-            return Err(Error::invalid(
-                "e",
-                format!("eccentricity must lie in [0, 1), got {e}"),
-            ));
+            return Err(Error::invalid("e", format!("eccentricity must lie in [0, 1), got {e}")));
         }
         let initial = State {
             t: 0.0,

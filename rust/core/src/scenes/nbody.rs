@@ -16,10 +16,7 @@ pub struct NBody {
 impl NBody {
     pub fn new(g: f64, masses: Vec<f64>) -> Result<Self, Error> {
         if !(g.is_finite() && g > 0.0) {
-            return Err(Error::invalid(
-                "G",
-                format!("must be finite and positive, got {g}"),
-            ));
+            return Err(Error::invalid("G", format!("must be finite and positive, got {g}")));
         }
         if masses.len() < 2 {
             return Err(Error::invalid("masses", "need at least two bodies"));
@@ -30,12 +27,7 @@ impl NBody {
             .flat_map(|i| (i + 1..n).map(move |j| (i, j)))
             .map(|(i, j)| g * masses[i] * masses[j])
             .collect();
-        Ok(NBody {
-            g,
-            masses,
-            gmm,
-            mass,
-        })
+        Ok(NBody { g, masses, gmm, mass })
     }
 
     pub fn masses(&self) -> &[f64] {
@@ -84,43 +76,15 @@ impl NBody {
             [31.78592511375764, 38.63618958160644, 3.192794169732889],
         ];
         const V_REF: [[f64; 3]; 6] = [
-            [
-                9.417379703028725e-06,
-                -7.855256238249194e-06,
-                -3.646926313230521e-06,
-            ],
-            [
-                -0.002495503201917009,
-                0.006896467194473328,
-                0.003007950247474123,
-            ],
-            [
-                -0.002255335935351989,
-                -0.004905913854771086,
-                -0.001938473641716708,
-            ],
-            [
-                -0.002186170231167942,
-                0.002817177012110666,
-                0.001262882639181183,
-            ],
-            [
-                -0.002148728705895163,
-                0.002128650077635786,
-                0.0009248501411662923,
-            ],
-            [
-                -0.001675173186229401,
-                0.001011833320388655,
-                0.000823180003857652,
-            ],
+            [9.417379703028725e-06, -7.855256238249194e-06, -3.646926313230521e-06],
+            [-0.002495503201917009, 0.006896467194473328, 0.003007950247474123],
+            [-0.002255335935351989, -0.004905913854771086, -0.001938473641716708],
+            [-0.002186170231167942, 0.002817177012110666, 0.001262882639181183],
+            [-0.002148728705895163, 0.002128650077635786, 0.0009248501411662923],
+            [-0.001675173186229401, 0.001011833320388655, 0.000823180003857652],
         ];
-        let momenta = |v: &[[f64; 3]; 6]| -> Vec<f64> {
-            v.iter()
-                .zip(MASSES)
-                .flat_map(|(vi, m)| vi.map(|x| m * x))
-                .collect()
-        };
+        let momenta =
+            |v: &[[f64; 3]; 6]| -> Vec<f64> { v.iter().zip(MASSES).flat_map(|(vi, m)| vi.map(|x| m * x)).collect() };
         let t_end = 500_000.0;
         Problem {
             system: Self::new(G, MASSES.to_vec()).expect("valid data"),
@@ -193,14 +157,8 @@ impl MechanicalSystem for NBody {
     }
     fn symmetries(&self) -> Vec<Generator> {
         (0..3)
-            .map(|axis| Generator::Translation {
-                axis,
-                spatial_dim: 3,
-            })
-            .chain((0..3).map(|axis| Generator::Rotation {
-                axis,
-                spatial_dim: 3,
-            }))
+            .map(|axis| Generator::Translation { axis, spatial_dim: 3 })
+            .chain((0..3).map(|axis| Generator::Rotation { axis, spatial_dim: 3 }))
             .collect()
     }
 }

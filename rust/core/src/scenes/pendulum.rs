@@ -19,7 +19,7 @@ impl Pendulum {
     /// The exact flow from the bottom, (q, p) = (0, p₀) with |p₀| < 2 (libration):
     /// q(t) = 2 arcsin(k sn(t | k²)), p(t) = 2k cn(t | k²) with k = p₀/2.
     pub fn exact_from_bottom(p0: f64, t: f64) -> Result<(f64, f64), Error> {
-        if !(p0.abs() < 2.0) {
+        if p0.is_nan() || p0.abs() >= 2.0 {
             return Err(Error::invalid(
                 "p0",
                 format!("the closed form holds for librations, |p0| < 2, got {p0}"),

@@ -1,0 +1,46 @@
+//! Helpers shared by the integration tests.
+#![allow(dead_code)]
+
+use varmech::integrators::{integrate, Method, Options, Trajectory};
+use varmech::model::MechanicalSystem;
+use varmech::scenes::Problem;
+
+/// Integrates `problem` from its initial state with `steps` steps to `t_end`, keeping every
+/// `save_every`-th state.
+pub fn run<S: MechanicalSystem>(
+    problem: &Problem<S>,
+    method: Method,
+    t_end: f64,
+    steps: usize,
+    save_every: usize,
+) -> Trajectory {
+    let options = Options {
+        save_every,
+        ..Options::new(t_end / steps as f64, steps)
+    };
+    integrate(
+        &problem.system,
+        method,
+        &problem.initial.q,
+        &problem.initial.p,
+        &options,
+        || Ok(()),
+    )
+    .unwrap_or_else(|f| panic!("{:?} failed: {}", method, f.error))
+}
+
+/// ‖(q, p) − (q_ref, p_ref)‖₂ at the last saved state.
+pub fn final_error(traj: &Trajectory, q_ref: &[f64], p_ref: &[f64]) -> f64 {
+    let k = traj.len() - 1;
+    let dq = traj.q_at(k).iter().zip(q_ref).map(|(a, b)| (a - b).powi(2));
+    let dp = traj.p_at(k).iter().zip(p_ref).map(|(a, b)| (a - b).powi(2));
+    dq.chain(dp).sum::<f64>().sqrt()
+}
+
+/// Asserts `measured` is within a factor `factor` of `published`.
+pub fn assert_within_factor(what: &str, measured: f64, published: f64, factor: f64) {
+    assert!(
+        measured <= factor * published && measured >= published / factor,
+        "{what}: measured {measured:.3e}, published {published:.3e} (allowed factor {factor})"
+    );
+}

@@ -1,0 +1,74 @@
+//! Linear stability exactly at the documented limits: on q̈ = −ω²q every method is stable 1%
+//! below its hω_max (reference/compositions.json) and unstable 1% above, where the run stops
+//! with a typed divergence error rather than producing non-finite numbers.
+
+use varmech::integrators::{integrate, Method, Options};
+use varmech::scenes::HarmonicOscillator;
+use varmech::Error;
+
+const STEPS: usize = 200_000;
+
+fn run(method: Method, h: f64) -> Result<f64, Error> {
+    let sys = HarmonicOscillator::new(1.0).unwrap();
+    let options = Options {
+        save_every: STEPS,
+        ..Options::new(h, STEPS)
+    };
+    match integrate(&sys, method, &[0.0], &[1.0], &options, || Ok(())) {
+        Ok(traj) => {
+            let k = traj.len() - 1;
+            Ok(traj.q_at(k)[0].hypot(traj.p_at(k)[0]))
+        }
+        Err(failure) => {
+            let partial = &failure.partial;
+            assert!(
+                partial.q.iter().chain(&partial.p).all(|x| x.is_finite()),
+                "partial trajectory holds non-finite values"
+            );
+            Err(failure.error)
+        }
+    }
+}
+
+#[test]
+fn every_method_is_stable_just_below_and_unstable_just_above_its_limit() {
+    for method in Method::ALL {
+        let info = method.info();
+        if info.h_omega_max > 0.0 {
+            let below = run(method, 0.99 * info.h_omega_max);
+            // The invariant ellipse of a symplectic method near its limit is elongated (hence
+            // the generous bound), but it is bounded for all time.
+            assert!(
+                matches!(below, Ok(r) if r < 1e3),
+                "{} at 0.99·hω_max: {below:?}",
+                info.name
+            );
+        }
+        let h_above = if info.h_omega_max > 0.0 {
+            1.01 * info.h_omega_max
+        } else {
+            0.1
+        };
+        match run(method, h_above) {
+            Err(Error::Divergence { step, time, .. }) => {
+                assert!(step > 1 && (time - (step - 1) as f64 * h_above).abs() < 1e-9 * time.max(1.0));
+            }
+            other => panic!("{} at hω = {h_above}: expected divergence, got {other:?}", info.name),
+        }
+    }
+}
+
+#[test]
+fn rk4_is_dissipative_below_its_limit() {
+    // |R(iy)|² = 1 − y⁶/72 + y⁸/576 < 1 for 0 < y < 2√2: the amplitude decays by |R| a step.
+    let (y, steps): (f64, usize) = (1.0, 1000);
+    let r2 = 1.0 - y.powi(6) / 72.0 + y.powi(8) / 576.0;
+    let sys = HarmonicOscillator::new(1.0).unwrap();
+    let traj = integrate(&sys, Method::Rk4, &[0.0], &[1.0], &Options::new(y, steps), || Ok(())).unwrap();
+    let amplitude = traj.q_at(steps)[0].hypot(traj.p_at(steps)[0]);
+    let expected = r2.powf(steps as f64 / 2.0);
+    assert!(
+        (amplitude / expected - 1.0).abs() < 1e-10,
+        "{amplitude:e} vs {expected:e}"
+    );
+}
