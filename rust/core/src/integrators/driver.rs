@@ -52,7 +52,9 @@ impl Options {
             return Err(Error::invalid("t0", "must be finite"));
         }
         match self.max_energy_error {
-            Some(x) if x.is_nan() || x <= 0.0 => Err(Error::invalid("max_energy_error", format!("must be positive, got {x}"))),
+            Some(x) if x.is_nan() || x <= 0.0 => {
+                Err(Error::invalid("max_energy_error", format!("must be positive, got {x}")))
+            }
             _ => Ok(()),
         }
     }

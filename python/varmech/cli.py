@@ -1,0 +1,69 @@
+"""The command line: ``python -m varmech tour | methods``."""
+
+from __future__ import annotations
+
+import argparse
+import time
+from pathlib import Path
+
+from . import scenes
+from .conservation import check_conservation
+from .integrate import integrate
+from .methods import format_table
+
+#: (scene, methods, horizon): each scene over a horizon long enough to tell bounded from drifting.
+TOUR = [
+    ("harmonic_oscillator", ("verlet", "rk4", "symplectic_euler"), 1000.0),
+    ("pendulum", ("verlet", "yoshida4", "rk4"), 2000.0),
+    ("kepler", ("verlet", "kahan_li8", "rk4"), None),
+    ("henon_heiles", ("verlet", "kahan_li6", "rk4"), 5000.0),
+    ("fermi_pasta_ulam", ("verlet", "mclachlan4", "rk4"), 200.0),
+    ("outer_solar_system", ("verlet", "kahan_li8", "rk4"), None),
+]
+
+
+def tour(out: Path, quick: bool) -> int:
+    """Integrate every scene with a few methods, print their conservation reports, and write
+    energy-error plots to ``out``."""
+    try:
+        from . import charts
+    except ImportError:
+        charts = None
+    for name, methods, horizon in TOUR:
+        scene = scenes.get(name)
+        t_end = horizon if horizon is not None else scene.t_end
+        if quick:
+            t_end /= 10
+        steps = round(t_end / scene.dt)
+        save_every = max(1, steps // 20000)
+        print(f"\n=== {name}: {scene.description}; dt = {scene.dt:g}, {steps} steps to t = {steps * scene.dt:g}")
+        runs = {}
+        for method in methods:
+            start = time.perf_counter()
+            traj = integrate(scene, dt=scene.dt, steps=steps, method=method, save_every=save_every)
+            elapsed = time.perf_counter() - start
+            runs[method] = traj
+            print(f"--- {method}: {traj.nfev} force evaluations in {elapsed:.3f} s")
+            print(check_conservation(traj))
+        if charts is not None:
+            try:
+                path = charts.energy_error(runs, out / f"{name}_energy.png", title=f"{name}, dt = {scene.dt:g}")
+                print(f"wrote {path}")
+            except ImportError as e:
+                print(f"(no plots: {e})")
+                charts = None
+    return 0
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(prog="python -m varmech", description=__doc__)
+    sub = parser.add_subparsers(dest="command", required=True)
+    t = sub.add_parser("tour", help="integrate every scene, print conservation reports, plot energy errors")
+    t.add_argument("--out", type=Path, default=Path("out/tour"), help="folder for the plots (default out/tour)")
+    t.add_argument("--quick", action="store_true", help="a tenth of each horizon")
+    sub.add_parser("methods", help="print the table of methods")
+    args = parser.parse_args(argv)
+    if args.command == "tour":
+        return tour(args.out, args.quick)
+    print(format_table())
+    return 0

@@ -1,0 +1,195 @@
+"""Fixed-step integration and its result."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Union
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from . import _core
+from ._util import positive, vector
+from .model import Model
+
+if TYPE_CHECKING:
+    from .scenes import Scene
+
+
+@dataclass
+class Trajectory:
+    """The saved states of a run (scipy-style result).
+
+    ``t`` has shape (N,), ``q`` and ``p`` shape (N, n); ``v`` = M⁻¹p is computed on demand.
+    ``status`` is 0 when the run reached its end, -1 for the partial trajectory attached to an
+    error (``err.partial``); ``message`` says which.
+    """
+
+    t: np.ndarray
+    q: np.ndarray
+    p: np.ndarray
+    model: Model
+    method: str
+    dt: float
+    steps: int
+    nfev: int
+    status: int = 0
+    message: str = "The integration reached its final time."
+    _v: np.ndarray | None = field(default=None, repr=False)
+
+    @property
+    def success(self) -> bool:
+        return self.status == 0
+
+    @property
+    def v(self) -> np.ndarray:
+        """Velocities q̇ = M⁻¹p, shape (N, n)."""
+        if self._v is None:
+            self._v = self.model.velocity(self.p)
+        return self._v
+
+    def energy(self) -> np.ndarray:
+        """The energy H = p·q̇ − L = ½pᵀM⁻¹p + V(q) at each saved state, shape (N,)."""
+        return _core.energy(self.model._core, self.q, self.p)
+
+    def __len__(self) -> int:
+        return len(self.t)
+
+    def __repr__(self) -> str:
+        return (
+            f"Trajectory({self.model.name!r}, method={self.method!r}, dt={self.dt:g}, steps={self.steps}, "
+            f"saved={len(self.t)}, nfev={self.nfev}, status={self.status})"
+        )
+
+
+def _steps(dt: float, t0: float, steps: int | None, t_end: float | None) -> int:
+    if (steps is None) == (t_end is None):
+        raise ValueError("steps, t_end: give exactly one of them")
+    if steps is not None:
+        if isinstance(steps, bool) or not isinstance(steps, (int, np.integer)) or steps < 0:
+            raise ValueError(f"steps: must be a non-negative integer, got {steps!r}")
+        return int(steps)
+    t_end = float(t_end)  # type: ignore[arg-type]
+    if not math.isfinite(t_end) or t_end < t0:
+        raise ValueError(f"t_end: must be finite and not before t0 = {t0}, got {t_end}")
+    n = round((t_end - t0) / dt)
+    if abs(n * dt - (t_end - t0)) > 1e-9 * max(abs(t_end - t0), dt):
+        raise ValueError(
+            f"t_end: {t_end} is not a whole number of steps dt = {dt} from t0 = {t0} "
+            f"({(t_end - t0) / dt:.6g} steps); adjust dt or pass steps"
+        )
+    return n
+
+
+def integrate(
+    model: Union[Model, "Scene"],
+    q0: ArrayLike | None = None,
+    p0: ArrayLike | None = None,
+    *,
+    v0: ArrayLike | None = None,
+    dt: float,
+    steps: int | None = None,
+    t_end: float | None = None,
+    method: str = "verlet",
+    save_every: int = 1,
+    compensated: bool = True,
+    max_energy_error: float | None = None,
+    t0: float = 0.0,
+) -> Trajectory:
+    """Integrate ``model`` from (q0, p0) with a fixed step.
+
+    Parameters
+    ----------
+    model:
+        A :class:`~varmech.MechanicalSystem`, a native model, or a :class:`~varmech.scenes.Scene`
+        (whose initial state is then the default).
+    q0, p0, v0:
+        Initial positions and momenta, arrays (n,); give the velocities ``v0`` instead of
+        ``p0`` to start from p0 = M v0.
+    dt:
+        The step h > 0.
+    steps, t_end:
+        How far: a number of steps, or a final time that is a whole number of steps.
+    method:
+        A name from :func:`varmech.methods` (default ``"verlet"``).
+    save_every:
+        Keep every k-th state; the initial and final states are always kept.
+    compensated:
+        Add the step increments with compensated summation (default), so that round-off grows
+        like √N rather than N over N steps.
+    max_energy_error:
+        Stop with :class:`~varmech.DivergenceError` when the relative energy error at a saved
+        state exceeds this (costs one potential evaluation per saved state). Non-finite states
+        always stop the run.
+    t0:
+        The initial time.
+
+    Raises
+    ------
+    ValueError
+        Malformed arguments; the message starts with the argument's name.
+    DivergenceError
+        The solution blew up; ``err.step``, ``err.time`` and ``err.partial`` (the trajectory up
+        to the last good step) are attached.
+    Exception
+        An exception raised by a closure (or KeyboardInterrupt) propagates unchanged, with
+        ``err.partial``, ``err.step`` and ``err.time`` attached where the exception allows.
+    """
+    from .scenes import Scene
+
+    if isinstance(model, Scene):
+        if q0 is None:
+            q0 = model.q0
+            if p0 is None and v0 is None:
+                p0 = model.p0
+        model = model.model
+    if not isinstance(model, Model):
+        raise TypeError(f"model: expected a varmech model or scene, got {type(model).__name__}")
+    n = model.dim
+    dt = positive("dt", dt)
+    t0 = float(t0)
+    if not math.isfinite(t0):
+        raise ValueError(f"t0: must be finite, got {t0}")
+    nsteps = _steps(dt, t0, steps, t_end)
+    if isinstance(save_every, bool) or not isinstance(save_every, (int, np.integer)) or save_every < 1:
+        raise ValueError(f"save_every: must be a positive integer, got {save_every!r}")
+    if max_energy_error is not None:
+        max_energy_error = positive("max_energy_error", max_energy_error)
+    if q0 is None:
+        raise ValueError("q0: the initial positions are required")
+    q = vector("q0", q0, n)
+    if (p0 is None) == (v0 is None):
+        raise ValueError("p0, v0: give exactly one of the initial momenta p0 and velocities v0")
+    p = vector("p0", p0, n) if p0 is not None else model.momentum(vector("v0", v0, n))
+    try:
+        t, qs, ps, done, nfev = _core.integrate(
+            model._core,
+            q,
+            p,
+            dt=dt,
+            steps=nsteps,
+            method=method,
+            save_every=int(save_every),
+            compensated=bool(compensated),
+            max_energy_error=max_energy_error,
+            t0=t0,
+        )
+    except BaseException as err:
+        raw = getattr(err, "_varmech_partial", None)
+        if raw is not None:
+            t, qs, ps, done, nfev = raw
+            del err._varmech_partial
+            err.partial = Trajectory(t, qs, ps, model, method, dt, done, nfev, status=-1, message=str(err))
+        raise
+    return Trajectory(t, qs, ps, model, method, dt, done, nfev)
+
+
+def symplecticity_defect(model: Model, method: str, q: ArrayLike, p: ArrayLike, dt: float) -> float:
+    """‖ΨᵀJΨ − J‖_F for the Jacobian Ψ of one step of ``method`` from (q, p), J = [[0, I], [−I, 0]].
+
+    Ψ comes from fourth-order central differences of the one-step map; a symplectic method
+    gives round-off (≲1e-10 on problems of unit scale), a non-symplectic one O(h^{p+1}).
+    """
+    n = model.dim
+    return _core.symplecticity_defect(model._core, method, vector("q", q, n), vector("p", p, n), positive("dt", dt))

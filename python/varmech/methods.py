@@ -1,0 +1,46 @@
+"""The catalogue of integration methods."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from . import _core
+
+
+@dataclass(frozen=True)
+class MethodInfo:
+    """Facts about one fixed-step method.
+
+    ``h_omega_max`` is the linear stability limit: the method is stable on q'' = -ω²q exactly
+    when hω < h_omega_max (0 for explicit Euler, which is never stable).
+    ``force_evaluations`` counts gradient evaluations per step, first-same-as-last reused.
+    """
+
+    name: str
+    order: int
+    stages: int
+    force_evaluations: int
+    symplectic: bool
+    symmetric: bool
+    h_omega_max: float
+    reference: str
+
+
+def methods() -> list[MethodInfo]:
+    """Every method varmech integrates with, from the simplest."""
+    return [MethodInfo(**d) for d in _core.methods()]
+
+
+def method_names() -> list[str]:
+    return [m.name for m in methods()]
+
+
+def format_table() -> str:
+    """The methods as a Markdown table."""
+    rows = ["| method | order | force evaluations / step | symplectic | symmetric | hω_max |", "|---|---|---|---|---|---|"]
+    for m in methods():
+        yes = lambda b: "yes" if b else "no"  # noqa: E731
+        rows.append(
+            f"| `{m.name}` | {m.order} | {m.force_evaluations} | {yes(m.symplectic)} | {yes(m.symmetric)} | {m.h_omega_max:.4g} |"
+        )
+    return "\n".join(rows)

@@ -1,0 +1,165 @@
+"""Models: mechanical systems from Python closures, native scenes, and their symmetries."""
+
+from __future__ import annotations
+
+import warnings
+from dataclasses import dataclass
+from typing import Callable, Sequence, Union
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from . import _core
+
+_AXES = "xyz"
+
+
+@dataclass(frozen=True)
+class Translation:
+    """Every body moves along ``axis``: J is the total linear momentum along it.
+
+    Coordinates are laid out body by body, each body with ``spatial_dim`` coordinates.
+    """
+
+    axis: int
+    spatial_dim: int = 3
+
+    @property
+    def name(self) -> str:
+        return f"P_{_AXES[self.axis]}" if self.axis < 3 else f"P_{self.axis}"
+
+    def spec(self) -> tuple[str, int, int]:
+        return ("translation", self.axis, self.spatial_dim)
+
+
+@dataclass(frozen=True)
+class Rotation:
+    """Every body turns about ``axis`` (in the plane when ``spatial_dim`` is 2): J is the total
+    angular momentum about it."""
+
+    axis: int = 2
+    spatial_dim: int = 3
+
+    @property
+    def name(self) -> str:
+        return "L" if self.spatial_dim == 2 else f"L_{_AXES[self.axis]}"
+
+    def spec(self) -> tuple[str, int, int]:
+        return ("rotation", self.axis, self.spatial_dim)
+
+
+@dataclass(frozen=True)
+class Cyclic:
+    """Coordinate ``index`` is cyclic (∂L/∂q_index = 0): J = p_index."""
+
+    index: int
+
+    @property
+    def name(self) -> str:
+        return f"p[{self.index}]"
+
+    def spec(self) -> tuple[str, int, int]:
+        return ("cyclic", self.index, 0)
+
+
+Symmetry = Union[Translation, Rotation, Cyclic]
+#: A generator ξ(q) of a symmetry: a built-in one, or a closure returning an array (n,).
+Generator = Union[Symmetry, Callable[[np.ndarray], ArrayLike]]
+
+
+def _symmetry_from_spec(kind: str, a: int, d: int) -> Symmetry:
+    return {"translation": lambda: Translation(a, d), "rotation": lambda: Rotation(a, d), "cyclic": lambda: Cyclic(a)}[kind]()
+
+
+class Model:
+    """A varmech model: n generalized coordinates, a mass matrix, a potential, and the
+    symmetries it declares (each with a conserved Noether momentum)."""
+
+    _core: _core.NativeModel | _core.ClosureModel
+    symmetries: tuple[Symmetry, ...]
+    name: str
+
+    @property
+    def dim(self) -> int:
+        """Number of generalized coordinates n."""
+        return self._core.dim
+
+    def velocity(self, p: ArrayLike) -> np.ndarray:
+        """q̇ = M⁻¹p, for one state (n,) or for rows (N, n)."""
+        return self._apply_mass(p, inverse=True)
+
+    def momentum(self, v: ArrayLike) -> np.ndarray:
+        """p = Mq̇, for one state (n,) or for rows (N, n)."""
+        return self._apply_mass(v, inverse=False)
+
+    def _apply_mass(self, x: ArrayLike, inverse: bool) -> np.ndarray:
+        a = np.ascontiguousarray(x, dtype=float)
+        out = _core.apply_mass(self._core, np.atleast_2d(a), inverse)
+        return out.reshape(a.shape)
+
+    def __repr__(self) -> str:
+        return f"{type(self).__name__}({self.name!r}, dim={self.dim})"
+
+
+class NativeSystem(Model):
+    """A model evaluated natively in Rust (a built-in scene): no Python call per step, and the
+    GIL is released while it runs."""
+
+    def __init__(self, core: _core.NativeModel):
+        self._core = core
+        self.name = core.name
+        self.symmetries = tuple(_symmetry_from_spec(k, a, d) for k, a, d, _ in core.symmetries)
+
+
+class MechanicalSystem(Model):
+    """A mechanical system L = ½ q̇ᵀ M q̇ − V(q) given by Python closures.
+
+    Parameters
+    ----------
+    dim:
+        Number of generalized coordinates n.
+    potential:
+        ``potential(q) -> float``, V(q) for q an array (n,).
+    gradient:
+        ``gradient(q) -> array (n,)``, ∇V(q). Optional: without it, central differences of the
+        potential are used (2n potential calls per force, about 1e-10 relative accuracy), and
+        a warning says so.
+    mass:
+        The constant mass matrix: a positive scalar (M = mI), a vector (n,) of positive
+        entries (diagonal), or a symmetric positive-definite matrix (n, n).
+    symmetries:
+        Symmetries of L (:class:`Translation`, :class:`Rotation`, :class:`Cyclic`); their
+        momenta are checked by :func:`varmech.check_conservation`.
+    name:
+        A label for reports.
+    """
+
+    def __init__(
+        self,
+        dim: int,
+        potential: Callable[[np.ndarray], float],
+        gradient: Callable[[np.ndarray], ArrayLike] | None = None,
+        *,
+        mass: ArrayLike = 1.0,
+        symmetries: Sequence[Symmetry] = (),
+        name: str = "mechanical system",
+    ):
+        if isinstance(dim, bool) or not isinstance(dim, (int, np.integer)) or dim < 1:
+            raise ValueError(f"dim: must be a positive integer, got {dim!r}")
+        m = np.array(mass, dtype=float)
+        if m.ndim > 2 or (m.ndim >= 1 and any(s != dim for s in m.shape)):
+            raise ValueError(f"mass: must be a scalar, a vector ({dim},) or a matrix ({dim}, {dim}), got shape {m.shape}")
+        if not np.all(np.isfinite(m)):
+            raise ValueError("mass: must be finite")
+        if gradient is None:
+            warnings.warn(
+                f"{name}: no gradient given; forces come from central differences of the potential "
+                f"({2 * dim} potential calls per force, about 1e-10 relative accuracy)",
+                stacklevel=2,
+            )
+        self._core = _core.ClosureModel(int(dim), potential, gradient, m, [s.spec() for s in symmetries])
+        self.potential = potential
+        self.gradient = gradient
+        self.mass = m
+        self.symmetries = tuple(symmetries)
+        self.name = name

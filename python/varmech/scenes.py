@@ -1,0 +1,120 @@
+"""Built-in scenes: native models in the fewest coordinates their physics needs, with initial
+data, test horizon, invariants and, where known, a reference solution (sources in
+``reference/`` of the repository)."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Callable
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from . import _core
+from .model import NativeSystem
+
+
+@dataclass(frozen=True)
+class Reference:
+    """The solution at time ``t``, exact or published, and where it comes from."""
+
+    t: float
+    q: np.ndarray
+    p: np.ndarray
+    source: str
+
+
+@dataclass(frozen=True)
+class Scene:
+    """A native model with its initial state and test protocol.
+
+    ``dt`` is a step that resolves the scene for a quick look (the tour uses it);
+    ``invariants`` holds the values of the conserved quantities at t = 0.
+    """
+
+    name: str
+    description: str
+    model: NativeSystem
+    q0: np.ndarray
+    p0: np.ndarray
+    t_end: float
+    dt: float
+    invariants: dict[str, float] = field(default_factory=dict)
+    reference: Reference | None = None
+
+
+def _scene(name: str, description: str, dt: float, invariants: dict[str, float], **params: float) -> Scene:
+    core, q0, p0, t_end, ref = _core.scene(name, **params)
+    reference = Reference(*ref) if ref is not None else None
+    return Scene(name, description, NativeSystem(core), q0, p0, t_end, dt, invariants, reference)
+
+
+def harmonic_oscillator(omega: float = 1.0) -> Scene:
+    """H = p²/2 + ω²q²/2 from (q, p) = (0, 1); exact solution at t = 10."""
+    return _scene(
+        "harmonic_oscillator", "the linear test equation q'' = -ω²q", 0.1 / omega, {"H": 0.5}, omega=omega
+    )
+
+
+def pendulum() -> Scene:
+    """H = p²/2 − cos q in the angle from the downward vertical, from (0, 1) to t = 2π (HLW I.1)."""
+    return _scene("pendulum", "mathematical pendulum in its angle", 2 * math.pi / 64, {"H": -0.5})
+
+
+def kepler(e: float = 0.6) -> Scene:
+    """H = |p|²/2 − 1/|q| in the plane, eccentricity ``e``, 200 periods of 2π (HLW I.2)."""
+    return _scene(
+        "kepler",
+        f"Kepler orbit, eccentricity {e}",
+        2 * math.pi / 200,
+        {"H": -0.5, "L": math.sqrt(1 - e * e)},
+        e=e,
+    )
+
+
+def henon_heiles() -> Scene:
+    """The Hénon–Heiles system at H = 0.13 from q = (0.1, 0), p = (0, 0.5), to t = 5·10⁴."""
+    return _scene("henon_heiles", "Hénon–Heiles, H = 0.13", 0.1, {"H": 0.13})
+
+
+def fermi_pasta_ulam() -> Scene:
+    """The Fermi–Pasta–Ulam chain of HLW I.5: m = 3 stiff springs, ω = 50."""
+    return _scene("fermi_pasta_ulam", "Fermi–Pasta–Ulam chain, ω = 50 (HLW I.5)", 0.001, {"H": 2.00120008, "I": 1.0})
+
+
+def outer_solar_system() -> Scene:
+    """Sun (with the inner planets), Jupiter, Saturn, Uranus, Neptune and Pluto over 500 000
+    days (HLW I.2.4), against the reference state of the GNI test codes."""
+    return _scene("outer_solar_system", "outer solar system (AU, days, solar masses)", 50.0, {"H": -3.215453183208163e-08})
+
+
+def nbody(masses: ArrayLike, positions: ArrayLike, velocities: ArrayLike, G: float = 1.0, t_end: float = 1.0, dt: float = 1e-3) -> Scene:
+    """A native gravitational N-body model in 3 dimensions from masses (N,), positions and
+    velocities (N, 3)."""
+    m = np.asarray(masses, dtype=float)
+    x = np.asarray(positions, dtype=float)
+    v = np.asarray(velocities, dtype=float)
+    if m.ndim != 1 or x.shape != (len(m), 3) or v.shape != (len(m), 3):
+        raise ValueError(f"positions, velocities: must have shape ({len(m)}, 3) to match masses")
+    model = NativeSystem(_core.nbody(float(G), [float(mi) for mi in m]))
+    p = (m[:, None] * v).ravel()
+    return Scene("nbody", f"{len(m)}-body problem", model, x.ravel().copy(), p, float(t_end), float(dt))
+
+
+CATALOGUE: dict[str, Callable[[], Scene]] = {
+    "harmonic_oscillator": harmonic_oscillator,
+    "pendulum": pendulum,
+    "kepler": kepler,
+    "henon_heiles": henon_heiles,
+    "fermi_pasta_ulam": fermi_pasta_ulam,
+    "outer_solar_system": outer_solar_system,
+}
+
+
+def get(name: str) -> Scene:
+    """The scene called ``name`` with its default parameters (see :data:`CATALOGUE`)."""
+    try:
+        return CATALOGUE[name]()
+    except KeyError:
+        raise ValueError(f"name: unknown scene {name!r}; choose one of {', '.join(CATALOGUE)}") from None
