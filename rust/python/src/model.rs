@@ -37,6 +37,15 @@ impl NativeModel {
         self.name
     }
 
+    /// (G, masses) of an N-body scene, None for the others.
+    #[getter]
+    fn gravity(&self) -> Option<(f64, Vec<f64>)> {
+        match &self.scene {
+            Scene::NBody(s) => Some((s.gravitational_constant(), s.masses().to_vec())),
+            _ => None,
+        }
+    }
+
     /// The declared symmetries, as (kind, axis or index, spatial_dim, name).
     #[getter]
     fn symmetries(&self) -> Vec<(&'static str, usize, usize, String)> {

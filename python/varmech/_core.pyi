@@ -1,0 +1,77 @@
+"""Stubs of the compiled extension ``varmech._core`` (hand-written; see rust/python/src)."""
+
+from typing import Any, Callable, Sequence
+
+import numpy as np
+from numpy.typing import NDArray
+
+FloatArray = NDArray[np.float64]
+GeneratorSpec = tuple[str, int, int]
+
+class VarmechError(RuntimeError):
+    """Base class of varmech's errors."""
+
+class DivergenceError(VarmechError):
+    """The solution blew up: a non-finite state, or an energy error beyond max_energy_error."""
+
+    step: int
+    time: float
+    partial: Any
+
+class NativeModel:
+    """A native scene: evaluated in Rust with the GIL released."""
+
+    @property
+    def dim(self) -> int: ...
+    @property
+    def name(self) -> str: ...
+    @property
+    def symmetries(self) -> list[tuple[str, int, int, str]]: ...
+    @property
+    def gravity(self) -> tuple[float, list[float]] | None:
+        """(G, masses) of an N-body scene, None for the others."""
+
+class ClosureModel:
+    """L = ½q̇ᵀMq̇ − V(q) from Python closures."""
+
+    def __init__(
+        self,
+        dim: int,
+        potential: Callable[[FloatArray], float],
+        gradient: Callable[[FloatArray], Any] | None,
+        mass: FloatArray,
+        symmetries: Sequence[GeneratorSpec],
+    ) -> None: ...
+    @property
+    def dim(self) -> int: ...
+    @property
+    def has_gradient(self) -> bool: ...
+
+Model = NativeModel | ClosureModel
+
+def integrate(
+    model: Model,
+    q0: FloatArray,
+    p0: FloatArray,
+    *,
+    dt: float,
+    steps: int,
+    method: str,
+    save_every: int = 1,
+    compensated: bool = True,
+    max_energy_error: float | None = None,
+    t0: float = 0.0,
+) -> tuple[FloatArray, FloatArray, FloatArray, int, int]:
+    """(t, q, p, steps, force_evaluations); on failure the exception carries ``_varmech_partial``."""
+
+def energy(model: Model, q: FloatArray, p: FloatArray) -> FloatArray: ...
+def apply_mass(model: Model, x: FloatArray, inverse: bool) -> FloatArray: ...
+def momentum(generator: GeneratorSpec, q: FloatArray, p: FloatArray) -> FloatArray: ...
+def energy_statistics(t: FloatArray, h: FloatArray) -> dict[str, Any]: ...
+def invariant_statistics(values: FloatArray) -> tuple[float, float, float]: ...
+def symplecticity_defect(model: Model, method: str, q: FloatArray, p: FloatArray, dt: float) -> float: ...
+def methods() -> list[dict[str, Any]]: ...
+def scene(
+    name: str, *, e: float = 0.6, omega: float = 1.0
+) -> tuple[NativeModel, FloatArray, FloatArray, float, tuple[float, FloatArray, FloatArray, str] | None]: ...
+def nbody(g: float, masses: Sequence[float]) -> NativeModel: ...

@@ -1,0 +1,112 @@
+"""Closure (NumPy) versions of the built-in scenes.
+
+Each is an example of a :class:`~varmech.MechanicalSystem` written in Python, and each computes
+the same formulas as its native scene, so the tests and benchmarks use them to check and time
+the closure path against the native one.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .model import MechanicalSystem, Rotation, Translation
+from .scenes import Scene
+
+
+def harmonic_oscillator(omega: float = 1.0) -> MechanicalSystem:
+    w2 = omega * omega
+    return MechanicalSystem(1, lambda q: 0.5 * w2 * q[0] * q[0], lambda q: w2 * q, name="harmonic_oscillator (closure)")
+
+
+def pendulum() -> MechanicalSystem:
+    return MechanicalSystem(1, lambda q: -math.cos(q[0]), np.sin, name="pendulum (closure)")
+
+
+def kepler() -> MechanicalSystem:
+    def potential(q: np.ndarray) -> float:
+        return -1.0 / math.hypot(q[0], q[1])
+
+    def gradient(q: np.ndarray) -> np.ndarray:
+        r2 = q[0] * q[0] + q[1] * q[1]
+        return q * (1.0 / (r2 * math.sqrt(r2)))
+
+    return MechanicalSystem(2, potential, gradient, symmetries=[Rotation(spatial_dim=2)], name="kepler (closure)")
+
+
+def henon_heiles() -> MechanicalSystem:
+    def potential(q: np.ndarray) -> float:
+        x, y = q
+        return 0.5 * (x * x + y * y) + x * x * y - y * y * y / 3.0
+
+    def gradient(q: np.ndarray) -> np.ndarray:
+        x, y = q
+        return np.array([x + 2.0 * x * y, y + x * x - y * y])
+
+    return MechanicalSystem(2, potential, gradient, name="henon_heiles (closure)")
+
+
+def fermi_pasta_ulam(m: int = 3, omega: float = 50.0) -> MechanicalSystem:
+    def springs(q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        stiff = q[1::2] - q[0::2]
+        ends = np.concatenate(([0.0], q, [0.0]))
+        soft = ends[1::2] - ends[0::2]
+        return stiff, soft
+
+    def potential(q: np.ndarray) -> float:
+        stiff, soft = springs(q)
+        return 0.25 * omega * omega * float(stiff @ stiff) + float(np.sum(soft**4))
+
+    def gradient(q: np.ndarray) -> np.ndarray:
+        stiff, soft = springs(q)
+        g = np.zeros(2 * m)
+        d = 0.5 * omega * omega * stiff
+        g[1::2] += d
+        g[0::2] -= d
+        f = 4.0 * soft**3
+        g[0::2] += f[:-1]
+        g[1::2] -= f[1:]
+        return g
+
+    return MechanicalSystem(2 * m, potential, gradient, name="fermi_pasta_ulam (closure)")
+
+
+def nbody(G: float, masses: np.ndarray) -> MechanicalSystem:
+    """Gravitational N-body in 3 dimensions, vectorised over pairs."""
+    m = np.asarray(masses, dtype=float)
+    n = len(m)
+    i, j = np.triu_indices(n, 1)
+    gmm = G * m[i] * m[j]
+
+    def potential(q: np.ndarray) -> float:
+        x = q.reshape(n, 3)
+        d = x[i] - x[j]
+        return -float(np.sum(gmm / np.sqrt(np.einsum("ij,ij->i", d, d))))
+
+    def gradient(q: np.ndarray) -> np.ndarray:
+        x = q.reshape(n, 3)
+        d = x[i] - x[j]
+        r2 = np.einsum("ij,ij->i", d, d)
+        f = (gmm / (r2 * np.sqrt(r2)))[:, None] * d
+        g = np.zeros((n, 3))
+        np.add.at(g, i, f)
+        np.add.at(g, j, -f)
+        return g.ravel()
+
+    symmetries = [Translation(a) for a in range(3)] + [Rotation(a) for a in range(3)]
+    return MechanicalSystem(3 * n, potential, gradient, mass=np.repeat(m, 3), symmetries=symmetries, name="nbody (closure)")
+
+
+def closure_of(scene: Scene) -> MechanicalSystem:
+    """The closure version of a built-in scene (with its default parameters)."""
+    gravity = scene.model._core.gravity
+    if gravity is not None:
+        return nbody(*gravity)
+    return {
+        "harmonic_oscillator": harmonic_oscillator,
+        "pendulum": pendulum,
+        "kepler": kepler,
+        "henon_heiles": henon_heiles,
+        "fermi_pasta_ulam": fermi_pasta_ulam,
+    }[scene.name]()

@@ -1,0 +1,193 @@
+"""Bad input gets a clear error naming the argument; failures keep the partial trajectory."""
+
+import math
+import os
+import signal
+import threading
+import time
+import traceback
+
+import numpy as np
+import pytest
+
+import varmech
+from varmech import examples, scenes
+
+
+@pytest.fixture
+def kepler():
+    return scenes.kepler()
+
+
+@pytest.mark.parametrize(
+    "kwargs, argument",
+    [
+        (dict(q0=[0.4], p0=[0.0, 2.0]), "q0"),
+        (dict(q0=[[0.4, 0.0]], p0=[0.0, 2.0]), "q0"),
+        (dict(q0=[0.4, math.nan], p0=[0.0, 2.0]), "q0"),
+        (dict(q0=[0.4, 0.0], p0=[0.0, math.inf]), "p0"),
+        (dict(q0=[0.4, 0.0], p0=["a", 2.0]), "p0"),
+        (dict(q0=[0.4, 0.0], v0=[0.0, math.nan]), "v0"),
+        (dict(q0=[0.4, 0.0], p0=[0.0, 2.0], v0=[0.0, 2.0]), "p0, v0"),
+        (dict(q0=[0.4, 0.0], p0=[0.0, 2.0], dt=0.0), "dt"),
+        (dict(q0=[0.4, 0.0], p0=[0.0, 2.0], dt=-0.1), "dt"),
+        (dict(q0=[0.4, 0.0], p0=[0.0, 2.0], dt=math.nan), "dt"),
+        (dict(q0=[0.4, 0.0], p0=[0.0, 2.0], dt=math.inf), "dt"),
+        (dict(q0=[0.4, 0.0], p0=[0.0, 2.0], method="leapfrog"), "method"),
+        (dict(q0=[0.4, 0.0], p0=[0.0, 2.0], steps=None, t_end=None), "steps, t_end"),
+        (dict(q0=[0.4, 0.0], p0=[0.0, 2.0], steps=None, t_end=0.15), "t_end"),
+        (dict(q0=[0.4, 0.0], p0=[0.0, 2.0], steps=-1), "steps"),
+        (dict(q0=[0.4, 0.0], p0=[0.0, 2.0], save_every=0), "save_every"),
+        (dict(q0=[0.4, 0.0], p0=[0.0, 2.0], max_energy_error=0.0), "max_energy_error"),
+    ],
+)
+def test_bad_input_raises_value_error_naming_the_argument(kepler, kwargs, argument):
+    args = dict(dt=0.1, steps=10) | kwargs
+    with pytest.raises(ValueError, match=f"^{argument}:"):
+        varmech.integrate(kepler.model, **args)
+
+
+def test_bad_models_are_refused():
+    with pytest.raises(ValueError, match="^mass:"):
+        varmech.MechanicalSystem(2, lambda q: 0.0, lambda q: q, mass=[1.0, 2.0, 3.0])
+    with pytest.raises(ValueError, match="^mass:"):
+        varmech.MechanicalSystem(2, lambda q: 0.0, lambda q: q, mass=[[1.0, 2.0], [2.0, 1.0]])
+    with pytest.raises(ValueError, match="^mass:"):
+        varmech.MechanicalSystem(1, lambda q: 0.0, lambda q: q, mass=-1.0)
+    with pytest.raises(ValueError, match="^dim:"):
+        varmech.MechanicalSystem(0, lambda q: 0.0, lambda q: q)
+    with pytest.raises(TypeError, match="^potential:"):
+        varmech.MechanicalSystem(1, 3.0, lambda q: q)
+    with pytest.raises(ValueError, match="generator"):
+        varmech.MechanicalSystem(3, lambda q: 0.0, lambda q: q, symmetries=[varmech.Cyclic(5)])
+    with pytest.raises(ValueError, match="^e:"):
+        scenes.kepler(e=1.0)
+    with pytest.raises(TypeError, match="^model:"):
+        varmech.integrate("kepler", [0.0], [1.0], dt=0.1, steps=1)
+
+
+class Boom(Exception):
+    pass
+
+
+def exploding_gradient(after):
+    calls = {"n": 0}
+
+    def gradient(q):
+        calls["n"] += 1
+        if calls["n"] > after:
+            raise Boom(f"boom at call {calls['n']}")
+        return np.sin(q)
+
+    return gradient
+
+
+def test_closure_exception_propagates_unchanged_with_partial_trajectory():
+    model = varmech.MechanicalSystem(1, lambda q: -math.cos(q[0]), exploding_gradient(after=10))
+    with pytest.raises(Boom, match="boom at call 11") as info:
+        varmech.integrate(model, [0.0], [1.0], dt=0.1, steps=100, method="verlet")
+    err = info.value
+    # Evaluation 11 is step 10's (one before step 1, then one a step): steps 0..9 are kept.
+    assert err.step == 10 and err.time == pytest.approx(0.9)
+    partial = err.partial
+    assert partial.status == -1 and partial.steps == 9 and len(partial) == 10
+    clean = varmech.integrate(varmech.MechanicalSystem(1, lambda q: -math.cos(q[0]), np.sin), [0.0], [1.0], dt=0.1, steps=9)
+    np.testing.assert_array_equal(partial.q, clean.q)
+    # The traceback still reaches into the closure.
+    frames = [f.name for f in traceback.extract_tb(err.__traceback__)]
+    assert "gradient" in frames
+
+
+@pytest.mark.parametrize(
+    "returned, error, match",
+    [
+        (lambda q: np.zeros(3), ValueError, r"gradient\(q\) returned 3 values, expected 2"),
+        (lambda q: [1.0], ValueError, r"gradient\(q\) returned 1 values, expected 2"),
+        (lambda q: "ab", TypeError, r"gradient\(q\) must return a 1-d array of 2 floats, got str"),
+        (lambda q: None, TypeError, r"gradient\(q\) must return .* got NoneType"),
+        (lambda q: np.zeros((2, 2)), TypeError, r"gradient\(q\) must return .* shape \(2, 2\)"),
+    ],
+)
+def test_closure_returning_the_wrong_shape_or_type_is_named(returned, error, match):
+    model = varmech.MechanicalSystem(2, lambda q: 0.0, returned)
+    with pytest.raises(error, match=match) as info:
+        varmech.integrate(model, [1.0, 0.0], [0.0, 1.0], dt=0.1, steps=5)
+    assert info.value.partial.steps == 0
+
+
+def test_potential_returning_a_non_float_is_named():
+    model = varmech.MechanicalSystem(1, lambda q: [1.0, 2.0], lambda q: q)
+    traj = varmech.integrate(model, [1.0], [0.0], dt=0.1, steps=3)
+    with pytest.raises(TypeError, match=r"potential\(q\) must return a float, got list"):
+        traj.energy()
+
+
+def test_integer_gradients_and_sequences_are_accepted():
+    model = varmech.MechanicalSystem(2, lambda q: 0.0, lambda q: [0, 0])
+    traj = varmech.integrate(model, [1.0, 0.0], [0.0, 1.0], dt=0.5, steps=4)
+    np.testing.assert_allclose(traj.q[-1], [1.0, 2.0])
+
+
+def test_blow_up_raises_divergence_error_with_finite_partial_trajectory():
+    scene = scenes.harmonic_oscillator()
+    with pytest.raises(varmech.DivergenceError, match="diverged at step") as info:
+        varmech.integrate(scene, dt=2.02, steps=100_000, method="verlet")
+    err = info.value
+    assert isinstance(err, varmech.VarmechError)
+    assert err.step > 1 and err.time == pytest.approx((err.step - 1) * 2.02)
+    assert np.all(np.isfinite(err.partial.q)) and np.all(np.isfinite(err.partial.p))
+    assert err.partial.steps == err.step - 1
+
+
+def test_energy_threshold_raises_divergence_error():
+    # Explicit Euler multiplies the oscillator's energy by 1 + h² a step: (1.01)^k > 2 at k = 70.
+    with pytest.raises(varmech.DivergenceError, match="max_energy_error") as info:
+        varmech.integrate(scenes.harmonic_oscillator(), dt=0.1, steps=10_000, method="explicit_euler", max_energy_error=1.0)
+    assert info.value.step == 70
+    assert len(info.value.partial) == 71
+
+
+def _interrupt_after(delay):
+    sent = {}
+
+    def fire():
+        sent["at"] = time.perf_counter()
+        os.kill(os.getpid(), signal.SIGINT)
+
+    timer = threading.Timer(delay, fire)
+    timer.start()
+    return timer, sent
+
+
+@pytest.mark.parametrize("native", [True, False])
+def test_ctrl_c_interrupts_a_long_run_and_keeps_the_partial_trajectory(native):
+    scene = scenes.kepler()
+    model = scene.model if native else examples.kepler()
+    steps = 10**10 if native else 10**8
+    timer, sent = _interrupt_after(0.3)
+    with pytest.raises(KeyboardInterrupt) as info:
+        varmech.integrate(model, scene.q0, scene.p0, dt=1e-3, steps=steps, save_every=10**5)
+    latency = time.perf_counter() - sent["at"]
+    timer.join()
+    partial = info.value.partial
+    assert 0 < partial.steps < steps
+    assert np.all(np.isfinite(partial.q))
+    # Responsiveness, not speed: the poll runs every 10-40 ms, so well under a second.
+    assert latency < 1.0, f"interrupt took {latency:.3f} s"
+
+
+def test_native_runs_release_the_gil():
+    scene = scenes.outer_solar_system()
+    done = threading.Event()
+
+    def run():
+        varmech.integrate(scene, dt=1.0, steps=5_000_000, save_every=1_000_000)
+        done.set()
+
+    worker = threading.Thread(target=run)
+    worker.start()
+    time.sleep(0.05)
+    # This line runs only if the worker let go of the GIL while integrating.
+    running_while_we_run = not done.is_set()
+    worker.join()
+    assert running_while_we_run
