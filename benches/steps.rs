@@ -1,1 +1,60 @@
-fn main() {}
+//! Steps per second of every method on the native Kepler problem and outer solar system.
+//!
+//! `cargo bench --bench steps`; each iteration runs the public driver for a fixed number of
+//! steps, keeping only the final state, so the figure includes the driver's checks and the
+//! compensated summation, as users get them.
+
+use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
+use std::hint::black_box;
+use std::time::Duration;
+use varmech::integrators::{integrate, Method, Options};
+use varmech::model::MechanicalSystem;
+use varmech::scenes::{Kepler, NBody, Problem};
+
+const STEPS: usize = 2_000;
+
+fn bench_problem<S: MechanicalSystem>(c: &mut Criterion, name: &str, problem: &Problem<S>, dt: f64) {
+    let mut group = c.benchmark_group(name);
+    group.throughput(Throughput::Elements(STEPS as u64));
+    for method in Method::ALL {
+        let options = Options {
+            save_every: STEPS,
+            ..Options::new(dt, STEPS)
+        };
+        group.bench_with_input(
+            BenchmarkId::from_parameter(method.info().name),
+            &options,
+            |b, options| {
+                b.iter(|| {
+                    let traj = integrate(
+                        &problem.system,
+                        method,
+                        &problem.initial.q,
+                        &problem.initial.p,
+                        options,
+                        || Ok(()),
+                    );
+                    black_box(traj.map(|t| t.q).unwrap_or_default())
+                })
+            },
+        );
+    }
+    group.finish();
+}
+
+fn steps(c: &mut Criterion) {
+    bench_problem(
+        c,
+        "kepler",
+        &Kepler::problem(0.6).unwrap(),
+        2.0 * std::f64::consts::PI / 200.0,
+    );
+    bench_problem(c, "outer_solar_system", &NBody::outer_solar_system(), 50.0);
+}
+
+criterion_group! {
+    name = benches;
+    config = Criterion::default().warm_up_time(Duration::from_millis(500)).measurement_time(Duration::from_secs(2)).sample_size(30);
+    targets = steps
+}
+criterion_main!(benches);

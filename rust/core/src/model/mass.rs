@@ -7,8 +7,8 @@ use crate::Error;
 pub enum Mass {
     /// M = m·I.
     Scalar(f64),
-    /// M = diag(m₁, …, mₙ).
-    Diagonal(DVector<f64>),
+    /// M = diag(m₁, …, mₙ), stored with the reciprocals that the drifts multiply by.
+    Diagonal { m: DVector<f64>, inverse: DVector<f64> },
     /// A full matrix, stored with its inverse so that M⁻¹p costs one matrix–vector product.
     Full {
         matrix: DMatrix<f64>,
@@ -33,7 +33,11 @@ impl Mass {
                 format!("entry {i} must be finite and positive, got {}", m[i]),
             ));
         }
-        Ok(Mass::Diagonal(DVector::from_vec(m)))
+        let m = DVector::from_vec(m);
+        Ok(Mass::Diagonal {
+            inverse: m.map(|x| 1.0 / x),
+            m,
+        })
     }
 
     /// A full matrix; it must be symmetric (to 1e-12 relative) and positive definite.
@@ -65,7 +69,7 @@ impl Mass {
     pub fn dim(&self) -> Option<usize> {
         match self {
             Mass::Scalar(_) => None,
-            Mass::Diagonal(m) => Some(m.len()),
+            Mass::Diagonal { m, .. } => Some(m.len()),
             Mass::Full { matrix, .. } => Some(matrix.nrows()),
         }
     }
@@ -78,9 +82,9 @@ impl Mass {
                 let s = c / m;
                 q.iter_mut().zip(p).for_each(|(qi, pi)| *qi += s * pi);
             }
-            Mass::Diagonal(m) => {
-                for ((qi, pi), mi) in q.iter_mut().zip(p).zip(m.iter()) {
-                    *qi += c * pi / mi;
+            Mass::Diagonal { inverse, .. } => {
+                for ((qi, pi), wi) in q.iter_mut().zip(p).zip(inverse.iter()) {
+                    *qi += c * wi * pi;
                 }
             }
             Mass::Full { inverse, .. } => {
@@ -102,7 +106,7 @@ impl Mass {
     pub fn momentum(&self, v: &[f64], p: &mut [f64]) {
         match self {
             Mass::Scalar(m) => p.iter_mut().zip(v).for_each(|(pi, vi)| *pi = m * vi),
-            Mass::Diagonal(m) => {
+            Mass::Diagonal { m, .. } => {
                 for ((pi, vi), mi) in p.iter_mut().zip(v).zip(m.iter()) {
                     *pi = mi * vi;
                 }
@@ -119,7 +123,7 @@ impl Mass {
     pub fn kinetic_energy(&self, p: &[f64]) -> f64 {
         match self {
             Mass::Scalar(m) => 0.5 * p.iter().map(|x| x * x).sum::<f64>() / m,
-            Mass::Diagonal(m) => 0.5 * p.iter().zip(m.iter()).map(|(x, mi)| x * x / mi).sum::<f64>(),
+            Mass::Diagonal { inverse, .. } => 0.5 * p.iter().zip(inverse.iter()).map(|(x, wi)| wi * x * x).sum::<f64>(),
             Mass::Full { inverse, .. } => 0.5 * quadratic_form(inverse, p),
         }
     }
@@ -128,7 +132,7 @@ impl Mass {
     pub fn kinetic_energy_of_velocity(&self, v: &[f64]) -> f64 {
         match self {
             Mass::Scalar(m) => 0.5 * m * v.iter().map(|x| x * x).sum::<f64>(),
-            Mass::Diagonal(m) => 0.5 * v.iter().zip(m.iter()).map(|(x, mi)| mi * x * x).sum::<f64>(),
+            Mass::Diagonal { m, .. } => 0.5 * v.iter().zip(m.iter()).map(|(x, mi)| mi * x * x).sum::<f64>(),
             Mass::Full { matrix, .. } => 0.5 * quadratic_form(matrix, v),
         }
     }

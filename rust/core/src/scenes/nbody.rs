@@ -134,23 +134,26 @@ impl MechanicalSystem for NBody {
     #[inline]
     fn gradient(&self, q: &[f64], grad: &mut [f64]) -> Result<(), ModelError> {
         grad.fill(0.0);
-        let mut k = 0;
-        let n = self.masses.len();
-        for i in 0..n {
-            let xi = [q[3 * i], q[3 * i + 1], q[3 * i + 2]];
+        let mut gmm = self.gmm.iter();
+        for i in 0..self.masses.len() {
+            let (head, tail) = grad.split_at_mut(3 * i + 3);
+            let xi = &q[3 * i..3 * i + 3];
             let mut gi = [0.0; 3];
-            for j in i + 1..n {
-                let d = [xi[0] - q[3 * j], xi[1] - q[3 * j + 1], xi[2] - q[3 * j + 2]];
+            for ((xj, gj), k) in q[3 * i + 3..]
+                .chunks_exact(3)
+                .zip(tail.chunks_exact_mut(3))
+                .zip(&mut gmm)
+            {
+                let d = [xi[0] - xj[0], xi[1] - xj[1], xi[2] - xj[2]];
                 let r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
-                let f = self.gmm[k] / (r2 * r2.sqrt());
-                k += 1;
+                let f = k / (r2 * r2.sqrt());
                 for a in 0..3 {
                     gi[a] += f * d[a];
-                    grad[3 * j + a] -= f * d[a];
+                    gj[a] -= f * d[a];
                 }
             }
-            for a in 0..3 {
-                grad[3 * i + a] += gi[a];
+            for (g, v) in head[3 * i..].iter_mut().zip(gi) {
+                *g += v;
             }
         }
         Ok(())

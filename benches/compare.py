@@ -1,0 +1,239 @@
+"""Side by side, in one run, on the same problems: varmech (native and Python-closure models),
+REBOUND (leapfrog, WHFast), scipy.integrate.solve_ivp (DOP853, RK45) and a plain-Python Verlet
+loop with the same closure.
+
+    python benches/compare.py [--quick] [--markdown FILE]
+
+Needs the ``bench`` extra (scipy, rebound). Every timing is the best of several repeats of a run
+with nothing saved but the final state; accuracy comes from a separate run that samples the
+energy. Ratios, not absolute figures, are what carries over between machines.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+import varmech
+from varmech import examples, scenes
+
+
+@dataclass
+class Row:
+    problem: str
+    method: str
+    steps: int
+    seconds: float
+    energy_error: float
+    final_error: float
+
+    @property
+    def steps_per_second(self) -> float:
+        return self.steps / self.seconds
+
+
+def best_time(run, repeat: int) -> float:
+    best = math.inf
+    for _ in range(repeat):
+        start = time.perf_counter()
+        run()
+        best = min(best, time.perf_counter() - start)
+    return best
+
+
+def max_rel(values: np.ndarray) -> float:
+    return float(np.max(np.abs(values - values[0])) / abs(values[0]))
+
+
+def verlet_loop(gradient, q, p, inv_mass, h, steps):
+    """Störmer–Verlet written directly in Python, calling the same closure once a step."""
+    g = gradient(q)
+    for _ in range(steps):
+        p = p - 0.5 * h * g
+        q = q + h * inv_mass * p
+        g = gradient(q)
+        p = p - 0.5 * h * g
+    return q, p
+
+
+# --------------------------------------------------------------------------- outer solar system
+
+
+def solar_system(quick: bool, repeat: int) -> list[Row]:
+    import rebound
+    from scipy.integrate import solve_ivp
+
+    scene = scenes.outer_solar_system()
+    G, masses = scene.model._core.gravity
+    m3 = np.repeat(masses, 3)
+    ref = scene.reference
+    v_ref = ref.p / m3
+    t_end = ref.t / (10 if quick else 1)
+    compare_ref = not quick
+    h = 50.0
+    steps = round(t_end / h)
+    closure = examples.closure_of(scene)
+    rows = []
+    name = f"outer solar system, {t_end:g} days"
+
+    def error(q, v):
+        return float(np.sqrt(np.sum((q - ref.q) ** 2) + np.sum((v - v_ref) ** 2))) if compare_ref else math.nan
+
+    def varmech_row(model, label, method, dt):
+        n = round(t_end / dt)
+        seconds = best_time(lambda: varmech.integrate(model, scene.q0, scene.p0, dt=dt, steps=n, method=method, save_every=n), repeat)
+        traj = varmech.integrate(model, scene.q0, scene.p0, dt=dt, steps=n, method=method, save_every=max(1, n // 500))
+        rows.append(Row(name, label, n, seconds, max_rel(traj.energy()), error(traj.q[-1], traj.v[-1])))
+
+    varmech_row(scene.model, "varmech verlet (native)", "verlet", h)
+    varmech_row(scene.model, "varmech kahan_li8 (native), h = 200", "kahan_li8", 200.0)
+    varmech_row(closure, "varmech verlet (NumPy closure)", "verlet", h)
+
+    def make_sim(integrator):
+        sim = rebound.Simulation()
+        sim.G = G
+        for m, x, p in zip(masses, scene.q0.reshape(-1, 3), scene.p0.reshape(-1, 3)):
+            v = p / m
+            sim.add(m=m, x=x[0], y=x[1], z=x[2], vx=v[0], vy=v[1], vz=v[2])
+        sim.integrator = integrator
+        sim.dt = h
+        return sim
+
+    for integrator in ("leapfrog", "whfast"):
+        seconds = best_time(lambda: make_sim(integrator).integrate(t_end, exact_finish_time=0), repeat)
+        sim = make_sim(integrator)
+        energies = [sim.energy()]
+        for t in np.linspace(0, t_end, 501)[1:]:
+            sim.integrate(t, exact_finish_time=0)
+            energies.append(sim.energy())
+        q = np.array([[pt.x, pt.y, pt.z] for pt in sim.particles]).ravel()
+        v = np.array([[pt.vx, pt.vy, pt.vz] for pt in sim.particles]).ravel()
+        # REBOUND stops at the first step past t_end; with h dividing t_end that is t_end.
+        rows.append(Row(name, f"REBOUND {integrator}", steps, seconds, max_rel(np.array(energies)), error(q, v)))
+
+    def rhs(_t, y):
+        q, v = y[: len(m3)], y[len(m3) :]
+        return np.concatenate([v, -closure.gradient(q) / m3])
+
+    y0 = np.concatenate([scene.q0, scene.p0 / m3])
+    h_scene = scene.model
+    for method, tol in (("DOP853", 1e-10), ("RK45", 1e-8)):
+        seconds = best_time(lambda: solve_ivp(rhs, (0, t_end), y0, method=method, rtol=tol, atol=tol * 1e-3), 1)
+        sol = solve_ivp(rhs, (0, t_end), y0, method=method, rtol=tol, atol=tol * 1e-3, dense_output=False)
+        q, v = sol.y[: len(m3)].T, sol.y[len(m3) :].T
+        energies = np.array([float(h) for h in _energies(h_scene, q[:: max(1, len(q) // 500)], (v * m3)[:: max(1, len(q) // 500)])])
+        rows.append(Row(name, f"solve_ivp {method} (rtol {tol:g})", sol.t.size - 1, seconds, max_rel(energies), error(q[-1], v[-1])))
+
+    q0, p0 = scene.q0.copy(), scene.p0.copy()
+    loop_steps = steps // 10
+    seconds = best_time(lambda: verlet_loop(closure.gradient, q0, p0, 1 / m3, h, loop_steps), 1)
+    rows.append(Row(f"{name} (first {loop_steps} steps)", "plain-Python Verlet loop (same closure)", loop_steps, seconds, math.nan, math.nan))
+    return rows
+
+
+def _energies(model, q, p):
+    from varmech import _core
+
+    return _core.energy(model._core, np.ascontiguousarray(q), np.ascontiguousarray(p))
+
+
+# ---------------------------------------------------------------------------------- Kepler
+
+
+def kepler(quick: bool, repeat: int) -> tuple[list[Row], dict[str, float]]:
+    from scipy.integrate import solve_ivp
+
+    scene = scenes.kepler(0.6)
+    closure = examples.kepler()
+    periods = 20 if quick else 200
+    t_end = periods * 2 * math.pi
+    h = 2 * math.pi / 200
+    steps = round(t_end / h)
+    name = f"Kepler e = 0.6, {periods} periods"
+    rows = []
+
+    def error(q, p):
+        return float(np.hypot(np.linalg.norm(q - scene.q0), np.linalg.norm(p - scene.p0)))
+
+    for model, label in ((scene.model, "native"), (closure, "Python closure")):
+        seconds = best_time(lambda: varmech.integrate(model, scene.q0, scene.p0, dt=h, steps=steps, save_every=steps), repeat)
+        traj = varmech.integrate(model, scene.q0, scene.p0, dt=h, steps=steps, save_every=max(1, steps // 1000))
+        rows.append(Row(name, f"varmech verlet ({label})", steps, seconds, max_rel(traj.energy()), error(traj.q[-1], traj.p[-1])))
+
+    seconds = best_time(lambda: verlet_loop(closure.gradient, scene.q0, scene.p0, 1.0, h, steps), repeat)
+    q, p = verlet_loop(closure.gradient, scene.q0, scene.p0, 1.0, h, steps)
+    rows.append(Row(name, "plain-Python Verlet loop (same closure)", steps, seconds, math.nan, error(q, p)))
+
+    def rhs(_t, y):
+        return np.concatenate([y[2:], -closure.gradient(y[:2])])
+
+    y0 = np.concatenate([scene.q0, scene.p0])
+    for method, tol in (("DOP853", 1e-10), ("RK45", 1e-8)):
+        seconds = best_time(lambda: solve_ivp(rhs, (0, t_end), y0, method=method, rtol=tol, atol=tol), 1)
+        sol = solve_ivp(rhs, (0, t_end), y0, method=method, rtol=tol, atol=tol)
+        qs, ps = sol.y[:2].T, sol.y[2:].T
+        energies = 0.5 * np.sum(ps**2, 1) - 1 / np.hypot(qs[:, 0], qs[:, 1])
+        rows.append(Row(name, f"solve_ivp {method} (rtol {tol:g})", sol.t.size - 1, seconds, max_rel(energies), error(qs[-1], ps[-1])))
+
+    # The closure's own cost, called from Python as the plain loop calls it.
+    q = scene.q0.copy()
+    calls = 200_000
+    call_cost = best_time(lambda: [closure.gradient(q) for _ in range(calls)], repeat) / calls
+    loop_overhead = best_time(lambda: [None for _ in range(calls)], repeat) / calls
+    call_cost -= loop_overhead
+    per_step = {r.method: r.seconds / r.steps for r in rows}
+    varmech_step = per_step["varmech verlet (Python closure)"]
+    facts = {
+        "closure call (s)": call_cost,
+        "varmech closure step (s)": varmech_step,
+        "overhead per step / closure call": (varmech_step - call_cost) / call_cost,
+        "speed-up over plain-Python loop": per_step["plain-Python Verlet loop (same closure)"] / varmech_step,
+    }
+    return rows, facts
+
+
+def table(rows: list[Row]) -> str:
+    out = ["| problem | method | steps | steps/s | max rel. energy error | final error |", "|---|---|---:|---:|---:|---:|"]
+    for r in rows:
+        out.append(
+            f"| {r.problem} | {r.method} | {r.steps} | {r.steps_per_second:,.0f} | {r.energy_error:.2e} | {r.final_error:.2e} |"
+        )
+    return "\n".join(out)
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--quick", action="store_true", help="a tenth of each horizon, fewer repeats")
+    parser.add_argument("--markdown", type=Path, help="also write the tables to this file")
+    args = parser.parse_args()
+    repeat = 2 if args.quick else 5
+
+    sun = solar_system(args.quick, repeat)
+    kep, facts = kepler(args.quick, repeat)
+    by = {r.method: r for r in sun}
+    ratios = {
+        "varmech verlet (native) / REBOUND leapfrog, steps/s": by["varmech verlet (native)"].steps_per_second
+        / by["REBOUND leapfrog"].steps_per_second,
+        "varmech verlet (native) / REBOUND whfast, steps/s": by["varmech verlet (native)"].steps_per_second
+        / by["REBOUND whfast"].steps_per_second,
+        "varmech verlet (NumPy closure) / plain-Python loop, steps/s": by["varmech verlet (NumPy closure)"].steps_per_second
+        / sun[-1].steps_per_second,
+        "Kepler: varmech verlet (closure) / plain-Python loop, steps/s": facts["speed-up over plain-Python loop"],
+        "Kepler: integrator overhead per step / closure call cost": facts["overhead per step / closure call"],
+    }
+    text = [table(sun + kep), "", "| ratio | value |", "|---|---:|"]
+    text += [f"| {k} | {v:.2f} |" for k, v in ratios.items()]
+    text += ["", f"Kepler closure call: {facts['closure call (s)'] * 1e9:.0f} ns; varmech step with it: {facts['varmech closure step (s)'] * 1e9:.0f} ns."]
+    report = "\n".join(text)
+    print(report)
+    if args.markdown:
+        args.markdown.write_text(report + "\n")
+
+
+if __name__ == "__main__":
+    main()
