@@ -74,7 +74,7 @@ pub fn generator_spec(g: Generator) -> (&'static str, usize, usize, String) {
 
 /// A row-major buffer of N rows as an (N, n) array.
 pub fn matrix<'py>(py: Python<'py>, data: Vec<f64>, n: usize) -> PyResult<Bound<'py, PyAny>> {
-    let rows = if n == 0 { 0 } else { data.len() / n };
+    let rows = data.len().checked_div(n).unwrap_or(0);
     Ok(PyArray1::from_vec(py, data).reshape([rows, n])?.into_any())
 }
 

@@ -201,6 +201,10 @@ where
     let (mut q, mut p) = (q0.to_vec(), p0.to_vec());
     let (mut dq, mut dp) = (vec![0.0; n], vec![0.0; n]);
     let (mut eq, mut ep) = (vec![0.0; n], vec![0.0; n]);
+    // The next state is written beside the current one and swapped in once it is known to be
+    // finite, so that a failing step leaves the last good state intact.
+    let (mut q_next, mut p_next) = (vec![0.0; n], vec![0.0; n]);
+    let (mut eq_next, mut ep_next) = (vec![0.0; n], vec![0.0; n]);
     let mut integrator = Integrator::new(method, n);
     let mut interrupt = InterruptPoll::new();
     traj.push(t0, &q, &p);
@@ -246,14 +250,13 @@ where
         if let Err(source) = integrator.increment(sys, &q, &p, dt, &mut dq, &mut dp) {
             return Err(stop(Error::Model { step, time, source }, traj, &q, &p, &integrator));
         }
-        // One sum tells whether any entry of the new state would be non-finite (or huge).
-        let next = q
-            .iter()
-            .zip(&dq)
-            .chain(p.iter().zip(&dp))
-            .map(|(x, d)| x + d)
-            .sum::<f64>();
-        if !next.is_finite() {
+        let finite = if compensated {
+            compensated::add(&q, &eq, &dq, &mut q_next, &mut eq_next)
+                & compensated::add(&p, &ep, &dp, &mut p_next, &mut ep_next)
+        } else {
+            compensated::add_plain(&q, &dq, &mut q_next) & compensated::add_plain(&p, &dp, &mut p_next)
+        };
+        if !finite {
             let reason =
                 "the state became non-finite (the method is unstable at this step size, or the model is singular here)"
                     .to_string();
@@ -265,12 +268,11 @@ where
                 &integrator,
             ));
         }
+        std::mem::swap(&mut q, &mut q_next);
+        std::mem::swap(&mut p, &mut p_next);
         if compensated {
-            compensated::add(&mut q, &mut eq, &dq);
-            compensated::add(&mut p, &mut ep, &dp);
-        } else {
-            q.iter_mut().zip(&dq).for_each(|(x, d)| *x += d);
-            p.iter_mut().zip(&dp).for_each(|(x, d)| *x += d);
+            std::mem::swap(&mut eq, &mut eq_next);
+            std::mem::swap(&mut ep, &mut ep_next);
         }
         if step % save_every == 0 || step == steps {
             let t = t0 + step as f64 * dt;

@@ -79,31 +79,29 @@ impl KickDrift {
         dp: &mut [f64],
     ) -> Result<(), ModelError> {
         dq.fill(0.0);
-        dp.fill(0.0);
-        self.q.copy_from_slice(q);
         if !self.force_cached {
+            self.q.copy_from_slice(q);
             self.evaluate(sys)?;
         }
         let s = self.drifts.len();
-        for i in 0..=s {
-            let a = self.kicks[i] * h;
-            dp.iter_mut().zip(&self.force).for_each(|(d, f)| *d -= a * f);
-            if i == s {
-                break;
-            }
-            self.p
-                .iter_mut()
-                .zip(p.iter().zip(dp.iter()))
-                .for_each(|(w, (x, d))| *w = x + d);
-            sys.mass().add_velocity(self.drifts[i] * h, &self.p, dq);
-            self.q
-                .iter_mut()
-                .zip(q.iter().zip(dq.iter()))
-                .for_each(|(w, (x, d))| *w = x + d);
-            if self.kicks[i + 1] != 0.0 {
-                self.evaluate(sys)?;
-            } else {
+        // The first kick writes δp; each later one adds to it. Each pass over the state fuses
+        // an update of the increment with the state the next evaluation needs.
+        let a = self.kicks[0] * h;
+        for (((d, w), x), f) in dp.iter_mut().zip(&mut self.p).zip(p).zip(&self.force) {
+            *d = -a * f;
+            *w = x + *d;
+        }
+        for i in 0..s {
+            sys.mass().drift(self.drifts[i] * h, &self.p, q, dq, &mut self.q);
+            let a = self.kicks[i + 1] * h;
+            if a == 0.0 {
                 self.force_cached = false;
+                continue;
+            }
+            self.evaluate(sys)?;
+            for (((d, w), x), f) in dp.iter_mut().zip(&mut self.p).zip(p).zip(&self.force) {
+                *d -= a * f;
+                *w = x + *d;
             }
         }
         Ok(())

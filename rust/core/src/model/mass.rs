@@ -74,23 +74,24 @@ impl Mass {
         }
     }
 
-    /// q ← q + c·M⁻¹p (the drift of a splitting method); allocation-free.
+    /// The drift of a splitting method in one pass: δq ← δq + c·M⁻¹p, then q̃ = q + δq (the
+    /// position the next force is evaluated at); allocation-free.
     #[inline]
-    pub fn add_velocity(&self, c: f64, p: &[f64], q: &mut [f64]) {
+    pub fn drift(&self, c: f64, p: &[f64], q: &[f64], dq: &mut [f64], q_stage: &mut [f64]) {
+        let mut update = |i: usize, v: f64| {
+            dq[i] += c * v;
+            q_stage[i] = q[i] + dq[i];
+        };
         match self {
-            Mass::Scalar(m) => {
-                let s = c / m;
-                q.iter_mut().zip(p).for_each(|(qi, pi)| *qi += s * pi);
-            }
-            Mass::Diagonal { inverse, .. } => {
-                for ((qi, pi), wi) in q.iter_mut().zip(p).zip(inverse.iter()) {
-                    *qi += c * wi * pi;
-                }
-            }
+            Mass::Scalar(m) => p.iter().enumerate().for_each(|(i, pi)| update(i, pi / m)),
+            Mass::Diagonal { inverse, .. } => p
+                .iter()
+                .zip(inverse.as_slice())
+                .enumerate()
+                .for_each(|(i, (pi, wi))| update(i, wi * pi)),
             Mass::Full { inverse, .. } => {
-                for (i, qi) in q.iter_mut().enumerate() {
-                    let s: f64 = p.iter().enumerate().map(|(j, pj)| inverse[(i, j)] * pj).sum();
-                    *qi += c * s;
+                for i in 0..p.len() {
+                    update(i, p.iter().enumerate().map(|(j, pj)| inverse[(i, j)] * pj).sum());
                 }
             }
         }
@@ -98,8 +99,19 @@ impl Mass {
 
     /// v = M⁻¹p.
     pub fn velocity(&self, p: &[f64], v: &mut [f64]) {
-        v.fill(0.0);
-        self.add_velocity(1.0, p, v);
+        match self {
+            Mass::Scalar(m) => v.iter_mut().zip(p).for_each(|(vi, pi)| *vi = pi / m),
+            Mass::Diagonal { inverse, .. } => {
+                for ((vi, pi), wi) in v.iter_mut().zip(p).zip(inverse.as_slice()) {
+                    *vi = wi * pi;
+                }
+            }
+            Mass::Full { inverse, .. } => {
+                for (i, vi) in v.iter_mut().enumerate() {
+                    *vi = p.iter().enumerate().map(|(j, pj)| inverse[(i, j)] * pj).sum();
+                }
+            }
+        }
     }
 
     /// p = M v.
@@ -107,7 +119,7 @@ impl Mass {
         match self {
             Mass::Scalar(m) => p.iter_mut().zip(v).for_each(|(pi, vi)| *pi = m * vi),
             Mass::Diagonal { m, .. } => {
-                for ((pi, vi), mi) in p.iter_mut().zip(v).zip(m.iter()) {
+                for ((pi, vi), mi) in p.iter_mut().zip(v).zip(m.as_slice()) {
                     *pi = mi * vi;
                 }
             }
@@ -123,7 +135,9 @@ impl Mass {
     pub fn kinetic_energy(&self, p: &[f64]) -> f64 {
         match self {
             Mass::Scalar(m) => 0.5 * p.iter().map(|x| x * x).sum::<f64>() / m,
-            Mass::Diagonal { inverse, .. } => 0.5 * p.iter().zip(inverse.iter()).map(|(x, wi)| wi * x * x).sum::<f64>(),
+            Mass::Diagonal { inverse, .. } => {
+                0.5 * p.iter().zip(inverse.as_slice()).map(|(x, wi)| wi * x * x).sum::<f64>()
+            }
             Mass::Full { inverse, .. } => 0.5 * quadratic_form(inverse, p),
         }
     }
@@ -132,7 +146,7 @@ impl Mass {
     pub fn kinetic_energy_of_velocity(&self, v: &[f64]) -> f64 {
         match self {
             Mass::Scalar(m) => 0.5 * m * v.iter().map(|x| x * x).sum::<f64>(),
-            Mass::Diagonal { m, .. } => 0.5 * v.iter().zip(m.iter()).map(|(x, mi)| mi * x * x).sum::<f64>(),
+            Mass::Diagonal { m, .. } => 0.5 * v.iter().zip(m.as_slice()).map(|(x, mi)| mi * x * x).sum::<f64>(),
             Mass::Full { matrix, .. } => 0.5 * quadratic_form(matrix, v),
         }
     }
