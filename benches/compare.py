@@ -11,6 +11,12 @@ energy. Ratios, not absolute figures, are what carries over between machines.
 
 from __future__ import annotations
 
+import os
+
+# OpenBLAS's idle worker threads spin on a core of their own; nothing here uses BLAS, and on a
+# two-core machine they would distort every timing.
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+
 import argparse
 import math
 import time

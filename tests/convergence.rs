@@ -5,7 +5,9 @@
 //! against the closed-form solution (Jacobi elliptic functions), which is first checked against
 //! the published reference.
 
-use varmech::integrators::{integrate, Method, Options};
+mod common;
+
+use varmech::integrators::Method;
 use varmech::scenes::Pendulum;
 
 #[test]
@@ -21,21 +23,11 @@ fn closed_form_reproduces_the_published_reference() {
 fn error(method: Method, steps: usize) -> f64 {
     let problem = Pendulum::problem();
     let (q_exact, p_exact) = Pendulum::exact_from_bottom(problem.initial.p[0], problem.t_end).unwrap();
-    let options = Options {
-        save_every: steps,
-        ..Options::new(problem.t_end / steps as f64, steps)
-    };
-    let traj = integrate(
-        &problem.system,
-        method,
-        &problem.initial.q,
-        &problem.initial.p,
-        &options,
-        || Ok(()),
+    common::final_error(
+        &common::run(&problem, method, problem.t_end, steps, steps),
+        &[q_exact],
+        &[p_exact],
     )
-    .unwrap();
-    let k = traj.len() - 1;
-    (traj.q_at(k)[0] - q_exact).hypot(traj.p_at(k)[0] - p_exact)
 }
 
 /// Steps of the coarsest run and the number of halvings: the error must be in the asymptotic
