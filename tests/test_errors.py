@@ -37,6 +37,8 @@ def kepler():
         (dict(q0=[0.4, 0.0], p0=[0.0, 2.0], steps=None, t_end=None), "steps, t_end"),
         (dict(q0=[0.4, 0.0], p0=[0.0, 2.0], steps=None, t_end=0.15), "t_end"),
         (dict(q0=[0.4, 0.0], p0=[0.0, 2.0], steps=-1), "steps"),
+        (dict(q0=[0.4, 0.0], p0=[0.0, 2.0], steps=2**64), "steps"),
+        (dict(q0=[0.4, 0.0], p0=[0.0, 2.0], steps=2**62), "save_every"),
         (dict(q0=[0.4, 0.0], p0=[0.0, 2.0], save_every=0), "save_every"),
         (dict(q0=[0.4, 0.0], p0=[0.0, 2.0], max_energy_error=0.0), "max_energy_error"),
     ],

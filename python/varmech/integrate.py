@@ -67,8 +67,8 @@ def _steps(dt: float, t0: float, steps: int | None, t_end: float | None) -> int:
     if (steps is None) == (t_end is None):
         raise ValueError("steps, t_end: give exactly one of them")
     if steps is not None:
-        if isinstance(steps, bool) or not isinstance(steps, (int, np.integer)) or steps < 0:
-            raise ValueError(f"steps: must be a non-negative integer, got {steps!r}")
+        if isinstance(steps, bool) or not isinstance(steps, (int, np.integer)) or not 0 <= steps < 2**63:
+            raise ValueError(f"steps: must be an integer from 0 to 2**63 - 1, got {steps!r}")
         return int(steps)
     t_end = float(t_end)  # type: ignore[arg-type]
     if not math.isfinite(t_end) or t_end < t0:

@@ -186,15 +186,16 @@ where
         max_energy_error,
         t0,
     } = *options;
-    let saved = steps / save_every + 2;
-    let reserved = traj
-        .t
-        .try_reserve_exact(saved)
-        .and(traj.q.try_reserve_exact(saved * n))
-        .and(traj.p.try_reserve_exact(saved * n));
-    if reserved.is_err() {
-        let gib = (saved * (2 * n + 1) * 8) as f64 / (1u64 << 30) as f64;
-        let reason = format!("keeping {saved} states needs {gib:.1} GiB, more than can be allocated; raise save_every");
+    let saved = (steps / save_every).saturating_add(2);
+    let reserved = saved.checked_mul(n).is_some_and(|len| {
+        traj.t.try_reserve_exact(saved).is_ok()
+            && traj.q.try_reserve_exact(len).is_ok()
+            && traj.p.try_reserve_exact(len).is_ok()
+    });
+    if !reserved {
+        let gib = saved as f64 * (2 * n + 1) as f64 * 8.0 / (1u64 << 30) as f64;
+        let reason =
+            format!("keeping {saved} states needs {gib:.3e} GiB, more than can be allocated; raise save_every");
         return Err(fail(Error::invalid("save_every", reason), traj));
     }
 
