@@ -30,8 +30,11 @@ fn symplectic_methods_conserve_angular_momentum_and_bound_the_energy() {
             .collect();
         let l_stats = InvariantStatistics::new(&l);
         assert!((l_stats.initial - 0.8).abs() < 1e-15);
+        // Explicit methods conserve L to round-off; the implicit ones to the round-off of
+        // their Newton solve each step, ~2e-16·|p| a step.
+        let bound = if method.info().implicit { 1e-12 } else { 1e-13 };
         assert!(
-            l_stats.max_rel_error <= 1e-13,
+            l_stats.max_rel_error <= bound,
             "{}: angular momentum error {:.3e}",
             method.info().name,
             l_stats.max_rel_error

@@ -193,3 +193,14 @@ def test_native_runs_release_the_gil():
     running_while_we_run = not done.is_set()
     worker.join()
     assert running_while_we_run
+
+
+def test_newton_failure_raises_convergence_error_with_partial_trajectory():
+    # V = |q|: at h = 1 from q0 = 0.001 the midpoint equation q1 = q0 - (h²/2) sign((q0 + q1)/2)
+    # has no solution, and Newton's iterates flip sides for ever.
+    model = varmech.MechanicalSystem(1, lambda q: abs(q[0]), np.sign)
+    with pytest.raises(varmech.ConvergenceError, match="did not converge at step 1") as info:
+        varmech.integrate(model, [0.001], [0.0], dt=1.0, steps=10, method="midpoint")
+    err = info.value
+    assert err.step == 1 and err.time == 0.0 and err.iterations == 50 and err.residual > 0.1
+    assert err.partial.steps == 0 and len(err.partial) == 1

@@ -2,10 +2,10 @@
 //! symplectic where they say so.
 
 use varmech::diagnostics::symplecticity_defect;
-use varmech::discrete::{DiscreteLagrangian, Rectangle, Trapezoidal};
+use varmech::discrete::{increment, DiscreteLagrangian, Midpoint, Rectangle, Trapezoidal, Workspace};
 use varmech::integrators::{Composition, Integrator, Method};
-use varmech::model::{finite_difference, MechanicalSystem};
-use varmech::scenes::{FermiPastaUlam, HenonHeiles, Kepler, NBody};
+use varmech::model::{finite_difference, Lagrangian, MechanicalSystem};
+use varmech::scenes::{DoublePendulum, FermiPastaUlam, HenonHeiles, Kepler, NBody};
 
 fn max_diff(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).fold(0.0_f64, |m, (x, y)| m.max((x - y).abs()))
@@ -24,8 +24,8 @@ fn check_legendre<S: MechanicalSystem, D: DiscreteLagrangian>(
     Integrator::new(method, sys.dim())
         .step(sys, &mut q1, &mut p1, h)
         .unwrap();
-    let minus = ld.momentum_minus(sys, q0, &q1, h).unwrap();
-    let plus = ld.momentum_plus(sys, q0, &q1, h).unwrap();
+    let minus = ld.momentum_minus(sys, q0, &q1, 0.0, h).unwrap();
+    let plus = ld.momentum_plus(sys, q0, &q1, 0.0, h).unwrap();
     let scale = p0.iter().chain(&p1).fold(1.0_f64, |m, x| m.max(x.abs()));
     assert!(
         max_diff(&minus, p0) < 1e-14 * scale,
@@ -72,31 +72,68 @@ fn symplectic_euler_is_the_variational_integrator_of_the_rectangle_rule() {
     );
 }
 
-#[test]
-fn discrete_legendre_transforms_are_the_slot_derivatives_of_the_discrete_lagrangian() {
-    // p₁ = D₂L_d and p₀ = −D₁L_d, checked against differences of L_d itself.
-    let hh = HenonHeiles::problem();
-    let (q0, q1, h) = ([0.1, -0.2], [0.15, -0.1], 0.1);
-    let d = |ld: &dyn Fn(&[f64], &[f64]) -> f64, slot: usize, i: usize| {
+/// Checks p₀ = −D₁L_d, p₁ = D₂L_d and p₁ − p₀ = D₁L_d + D₂L_d of `ld` against central
+/// differences of L_d itself, on a non-separable Lagrangian (the double pendulum) and a
+/// separable one (Hénon–Heiles).
+fn check_slot_derivatives<D: DiscreteLagrangian, S: Lagrangian>(ld: &D, sys: &S, q0: [f64; 2], q1: [f64; 2], h: f64) {
+    let value = |a: &[f64], b: &[f64]| ld.value(sys, a, &increment(a, b), 0.3, h).unwrap();
+    let d = |slot: usize, i: usize| {
         let e = 1e-6;
         let (mut a, mut b) = ((q0.to_vec(), q1.to_vec()), (q0.to_vec(), q1.to_vec()));
-        if slot == 0 {
-            a.0[i] += e;
-            b.0[i] -= e;
+        let (x, y) = if slot == 0 {
+            (&mut a.0, &mut b.0)
         } else {
-            a.1[i] += e;
-            b.1[i] -= e;
-        }
-        (ld(&a.0, &a.1) - ld(&b.0, &b.1)) / (2.0 * e)
+            (&mut a.1, &mut b.1)
+        };
+        x[i] += e;
+        y[i] -= e;
+        (value(&a.0, &a.1) - value(&b.0, &b.1)) / (2.0 * e)
     };
-    let trap = |a: &[f64], b: &[f64]| Trapezoidal.value(&hh.system, a, b, h).unwrap();
-    let rect = |a: &[f64], b: &[f64]| Rectangle.value(&hh.system, a, b, h).unwrap();
+    let minus = ld.momentum_minus(sys, &q0, &q1, 0.3, h).unwrap();
+    let plus = ld.momentum_plus(sys, &q0, &q1, 0.3, h).unwrap();
+    let mut change = [0.0; 2];
+    ld.momentum_change(
+        sys,
+        &q0,
+        &increment(&q0, &q1),
+        0.3,
+        h,
+        &mut change,
+        &mut Workspace::new(2),
+    )
+    .unwrap();
     for i in 0..2 {
-        assert!((d(&trap, 0, i) + Trapezoidal.momentum_minus(&hh.system, &q0, &q1, h).unwrap()[i]).abs() < 1e-8);
-        assert!((d(&trap, 1, i) - Trapezoidal.momentum_plus(&hh.system, &q0, &q1, h).unwrap()[i]).abs() < 1e-8);
-        assert!((d(&rect, 0, i) + Rectangle.momentum_minus(&hh.system, &q0, &q1, h).unwrap()[i]).abs() < 1e-8);
-        assert!((d(&rect, 1, i) - Rectangle.momentum_plus(&hh.system, &q0, &q1, h).unwrap()[i]).abs() < 1e-8);
+        let scale = minus[i].abs().max(1.0);
+        assert!(
+            (d(0, i) + minus[i]).abs() < 1e-7 * scale,
+            "D1[{i}]: {} vs {}",
+            d(0, i),
+            -minus[i]
+        );
+        assert!(
+            (d(1, i) - plus[i]).abs() < 1e-7 * scale,
+            "D2[{i}]: {} vs {}",
+            d(1, i),
+            plus[i]
+        );
+        assert!(
+            (change[i] - (plus[i] - minus[i])).abs() < 1e-12 * scale,
+            "D1 + D2 [{i}]"
+        );
     }
+}
+
+#[test]
+fn discrete_legendre_transforms_are_the_slot_derivatives_of_the_discrete_lagrangian() {
+    let hh = HenonHeiles::problem().system;
+    let dp = DoublePendulum::problem().system;
+    let (q0, q1, h) = ([0.1, -0.2], [0.15, -0.1], 0.1);
+    check_slot_derivatives(&Trapezoidal, &hh, q0, q1, h);
+    check_slot_derivatives(&Rectangle, &hh, q0, q1, h);
+    check_slot_derivatives(&Midpoint, &hh, q0, q1, h);
+    check_slot_derivatives(&Trapezoidal, &dp, q0, q1, h);
+    check_slot_derivatives(&Rectangle, &dp, q0, q1, h);
+    check_slot_derivatives(&Midpoint, &dp, q0, q1, h);
 }
 
 #[test]

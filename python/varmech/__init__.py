@@ -17,7 +17,7 @@ Hamilton's principle, and check what it conserves::
     print(varmech.check_conservation(traj))
 """
 
-from ._core import DivergenceError, VarmechError
+from ._core import ConvergenceError, DivergenceError, VarmechError
 from .conservation import ConservationReport, EnergyReport, MomentumReport, check_conservation, momentum
 from .integrate import Trajectory, integrate, symplecticity_defect
 from .methods import MethodInfo, methods
@@ -28,6 +28,7 @@ __version__ = "0.1.0"
 
 __all__ = [
     "ConservationReport",
+    "ConvergenceError",
     "Cyclic",
     "DivergenceError",
     "EnergyReport",

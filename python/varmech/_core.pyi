@@ -18,6 +18,15 @@ class DivergenceError(VarmechError):
     time: float
     partial: Any
 
+class ConvergenceError(VarmechError):
+    """Newton's method did not solve a step's implicit equations."""
+
+    step: int
+    time: float
+    residual: float
+    iterations: int
+    partial: Any
+
 class NativeModel:
     """A native scene: evaluated in Rust with the GIL released."""
 
@@ -61,8 +70,9 @@ def integrate(
     compensated: bool = True,
     max_energy_error: float | None = None,
     t0: float = 0.0,
-) -> tuple[FloatArray, FloatArray, FloatArray, int, int]:
-    """(t, q, p, steps, force_evaluations); on failure the exception carries ``_varmech_partial``."""
+) -> tuple[FloatArray, FloatArray, FloatArray, int, int, int]:
+    """(t, q, p, steps, force_evaluations, newton_iterations); on failure the exception carries
+    ``_varmech_partial``."""
 
 def energy(model: Model, q: FloatArray, p: FloatArray) -> FloatArray: ...
 def apply_mass(model: Model, x: FloatArray, inverse: bool) -> FloatArray: ...

@@ -22,6 +22,8 @@ class Trajectory:
     """The saved states of a run (scipy-style result).
 
     ``t`` has shape (N,), ``q`` and ``p`` shape (N, n); ``v`` = M⁻¹p is computed on demand.
+    ``nfev`` counts force evaluations (for the implicit methods, evaluations of the discrete
+    Lagrangian's slot derivatives) and ``newton_iterations`` the implicit methods' iterations.
     ``status`` is 0 when the run reached its end, -1 for the partial trajectory attached to an
     error (``err.partial``); ``message`` says which.
     """
@@ -34,6 +36,7 @@ class Trajectory:
     dt: float
     steps: int
     nfev: int
+    newton_iterations: int = 0
     status: int = 0
     message: str = "The integration reached its final time."
     _v: np.ndarray | None = field(default=None, repr=False)
@@ -132,6 +135,9 @@ def integrate(
     DivergenceError
         The solution blew up; ``err.step``, ``err.time`` and ``err.partial`` (the trajectory up
         to the last good step) are attached.
+    ConvergenceError
+        An implicit method's Newton iteration failed; ``err.step``, ``err.time``,
+        ``err.residual``, ``err.iterations`` and ``err.partial`` are attached.
     Exception
         An exception raised by a closure (or KeyboardInterrupt) propagates unchanged, with
         ``err.partial``, ``err.step`` and ``err.time`` attached where the exception allows.
@@ -163,7 +169,7 @@ def integrate(
         raise ValueError("p0, v0: give exactly one of the initial momenta p0 and velocities v0")
     p = vector("p0", p0, n) if p0 is not None else model.momentum(vector("v0", v0, n))
     try:
-        t, qs, ps, done, nfev = _core.integrate(
+        t, qs, ps, done, nfev, newton = _core.integrate(
             model._core,
             q,
             p,
@@ -178,11 +184,11 @@ def integrate(
     except BaseException as err:
         raw = getattr(err, "_varmech_partial", None)
         if raw is not None:
-            t, qs, ps, done, nfev = raw
+            t, qs, ps, done, nfev, newton = raw
             del err._varmech_partial
-            err.partial = Trajectory(t, qs, ps, model, method, dt, done, nfev, status=-1, message=str(err))
+            err.partial = Trajectory(t, qs, ps, model, method, dt, done, nfev, newton, status=-1, message=str(err))
         raise
-    return Trajectory(t, qs, ps, model, method, dt, done, nfev)
+    return Trajectory(t, qs, ps, model, method, dt, done, nfev, newton)
 
 
 def symplecticity_defect(model: Model, method: str, q: ArrayLike, p: ArrayLike, dt: float) -> float:

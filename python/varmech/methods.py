@@ -13,13 +13,16 @@ class MethodInfo:
 
     ``h_omega_max`` is the linear stability limit: the method is stable on q'' = -ω²q exactly
     when hω < h_omega_max (0 for explicit Euler, which is never stable).
-    ``force_evaluations`` counts gradient evaluations per step, first-same-as-last reused.
+    ``force_evaluations`` counts gradient evaluations per step, first-same-as-last reused (0 for
+    the implicit methods, whose cost depends on their Newton iterations). ``implicit`` methods
+    solve each step by Newton's method.
     """
 
     name: str
     order: int
     stages: int
     force_evaluations: int
+    implicit: bool
     symplectic: bool
     symmetric: bool
     h_omega_max: float
@@ -37,10 +40,14 @@ def method_names() -> list[str]:
 
 def format_table() -> str:
     """The methods as a Markdown table."""
-    rows = ["| method | order | force evaluations / step | symplectic | symmetric | hω_max |", "|---|---|---|---|---|---|"]
+    rows = [
+        "| method | order | force evaluations / step | symplectic | symmetric | hω_max |",
+        "|---|---|---|---|---|---|",
+    ]
     for m in methods():
         yes = lambda b: "yes" if b else "no"  # noqa: E731
         rows.append(
-            f"| `{m.name}` | {m.order} | {m.force_evaluations} | {yes(m.symplectic)} | {yes(m.symmetric)} | {m.h_omega_max:.4g} |"
+            f"| `{m.name}` | {m.order} | {'Newton' if m.implicit else m.force_evaluations} | {yes(m.symplectic)} | "
+            f"{yes(m.symmetric)} | {m.h_omega_max:.4g} |"
         )
     return "\n".join(rows)

@@ -14,6 +14,14 @@ pub enum Error {
     /// The numerical solution left every sensible bound: a non-finite state, or an energy error
     /// beyond the threshold the user set.
     Divergence { step: usize, time: f64, reason: String },
+    /// Newton's method did not solve the implicit equations of `step` (which starts at `time`).
+    Convergence {
+        step: usize,
+        time: f64,
+        residual: f64,
+        iterations: usize,
+        reason: &'static str,
+    },
     /// The model failed while it was evaluated during `step` (which starts at `time`).
     Model { step: usize, time: f64, source: ModelError },
     /// The interrupt poll (Ctrl-C) asked the run to stop before `step`.
@@ -37,6 +45,17 @@ impl fmt::Display for Error {
             Error::Divergence { step, time, reason } => {
                 write!(f, "integration diverged at step {step} (t = {time}): {reason}")
             }
+            Error::Convergence {
+                step,
+                time,
+                residual,
+                iterations,
+                reason,
+            } => write!(
+                f,
+                "{reason} at step {step} (t = {time}): residual {residual:.3e} after {iterations} iterations; \
+                 a smaller step usually helps"
+            ),
             Error::Model { step, time, source } => {
                 write!(f, "model evaluation failed at step {step} (t = {time}): {source}")
             }

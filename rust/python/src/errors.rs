@@ -10,6 +10,12 @@ use crate::convert::trajectory_tuple;
 pyo3::create_exception!(_core, VarmechError, PyRuntimeError, "Base class of varmech's errors.");
 pyo3::create_exception!(
     _core,
+    ConvergenceError,
+    VarmechError,
+    "Newton's method did not solve a step's implicit equations (a smaller step usually helps)."
+);
+pyo3::create_exception!(
+    _core,
     DivergenceError,
     VarmechError,
     "The solution blew up: a non-finite state, or an energy error beyond max_energy_error."
@@ -25,6 +31,24 @@ pub fn to_pyerr(py: Python<'_>, error: Error) -> PyErr {
             let value = err.value(py);
             // Attributes of our own exception class: setting them cannot fail.
             let _ = value.setattr("step", step).and(value.setattr("time", time));
+            err
+        }
+        Error::Convergence {
+            step,
+            time,
+            residual,
+            iterations,
+            reason,
+        } => {
+            let err = ConvergenceError::new_err(format!(
+                "{reason} at step {step} (t = {time}): residual {residual:.3e} after {iterations} iterations; a smaller step usually helps"
+            ));
+            let value = err.value(py);
+            let _ = value
+                .setattr("step", step)
+                .and(value.setattr("time", time))
+                .and(value.setattr("residual", residual))
+                .and(value.setattr("iterations", iterations));
             err
         }
         Error::Model { step, time, source } | Error::Interrupted { step, time, source } => {

@@ -55,7 +55,8 @@ macro_rules! with_system {
     }};
 }
 
-/// Integrates; returns (t, q, p, steps, force_evaluations) or raises with `_varmech_partial`.
+/// Integrates; returns (t, q, p, steps, force_evaluations, newton_iterations) or raises with
+/// `_varmech_partial`.
 #[pyfunction]
 #[pyo3(signature = (model, q0, p0, *, dt, steps, method, save_every=1, compensated=true, max_energy_error=None, t0=0.0))]
 #[allow(clippy::too_many_arguments)]
@@ -247,6 +248,7 @@ fn methods(py: Python<'_>) -> PyResult<Vec<Bound<'_, PyDict>>> {
             d.set_item("order", i.order)?;
             d.set_item("stages", i.stages)?;
             d.set_item("force_evaluations", i.force_evaluations)?;
+            d.set_item("implicit", i.implicit)?;
             d.set_item("symplectic", i.symplectic)?;
             d.set_item("symmetric", i.symmetric)?;
             d.set_item("h_omega_max", i.h_omega_max)?;

@@ -16,6 +16,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     let py = m.py();
     m.add("VarmechError", py.get_type::<errors::VarmechError>())?;
     m.add("DivergenceError", py.get_type::<errors::DivergenceError>())?;
+    m.add("ConvergenceError", py.get_type::<errors::ConvergenceError>())?;
     m.add_class::<model::NativeModel>()?;
     m.add_class::<model::ClosureModel>()?;
     functions::register(m)?;

@@ -29,13 +29,7 @@ pub fn symplecticity_defect<S: MechanicalSystem + ?Sized>(
     let mut flow = |x: &[f64]| -> Result<Vec<f64>, Error> {
         let (mut q1, mut p1) = (x[..n].to_vec(), x[n..].to_vec());
         integrator.reset();
-        integrator
-            .step(sys, &mut q1, &mut p1, h)
-            .map_err(|source| Error::Model {
-                step: 1,
-                time: 0.0,
-                source,
-            })?;
+        integrator.step(sys, &mut q1, &mut p1, h).map_err(|e| e.at(1, 0.0))?;
         q1.extend(p1);
         Ok(q1)
     };

@@ -1,57 +1,144 @@
-//! Discrete Lagrangians L_d(q₀, q₁, h) ≈ ∫₀ʰ L(q, q̇) dt and their discrete Legendre transforms
+//! Discrete Lagrangians L_d(q₀, q₁, h) ≈ ∫ L(q, q̇, t) dt over [t, t + h], and their discrete
+//! Legendre transforms
 //!
 //! p₀ = −D₁L_d(q₀, q₁),   p₁ = D₂L_d(q₀, q₁)      (Marsden & West, Acta Numerica 2001).
 //!
 //! A one-step method (q₀, p₀) ↦ (q₁, p₁) defined by these two equations is symplectic, and it
-//! conserves p·ξ(q) whenever L_d is invariant under the symmetry ξ. The explicit methods of
-//! [`crate::integrators`] are the solutions of these equations for separable systems:
-//! Störmer–Verlet for [`Trapezoidal`], symplectic Euler for [`Rectangle`].
+//! conserves p·ξ(q) whenever L_d is invariant under the symmetry ξ. For separable systems the
+//! explicit methods of [`crate::integrators`] solve them in closed form (Störmer–Verlet for
+//! [`Trapezoidal`], symplectic Euler for [`Rectangle`]); for general Lagrangians
+//! [`crate::integrators::Del`] solves them by Newton's method.
+//!
+//! The end point is passed by its increment, q₁ = q₀ + δq: the discrete velocity δq/h then
+//! carries the increment's full precision rather than the round-off of q₁ − q₀ (HLW VIII.5).
 
+mod midpoint;
 mod rectangle;
 mod trapezoidal;
 
+pub use midpoint::Midpoint;
 pub use rectangle::Rectangle;
 pub use trapezoidal::Trapezoidal;
 
-use crate::model::MechanicalSystem;
+use crate::model::Lagrangian;
 use crate::ModelError;
 
-/// A discrete Lagrangian for mechanical systems, with its exact slot derivatives.
+/// Scratch space for the slot derivatives of a discrete Lagrangian, so that Newton iterations
+/// allocate nothing.
+#[derive(Clone, Debug)]
+pub struct Workspace {
+    v: Vec<f64>,
+    x: Vec<f64>,
+    a: Vec<f64>,
+    b: Vec<f64>,
+    c: Vec<f64>,
+}
+
+impl Workspace {
+    pub fn new(n: usize) -> Self {
+        Workspace {
+            v: vec![0.0; n],
+            x: vec![0.0; n],
+            a: vec![0.0; n],
+            b: vec![0.0; n],
+            c: vec![0.0; n],
+        }
+    }
+
+    /// v = δq/h and x = q₀ + s·δq.
+    fn set(&mut self, q0: &[f64], dq: &[f64], h: f64, s: f64) {
+        for (((v, x), a), d) in self.v.iter_mut().zip(self.x.iter_mut()).zip(q0).zip(dq) {
+            *v = d / h;
+            *x = a + s * d;
+        }
+    }
+}
+
+/// A discrete Lagrangian of a [`Lagrangian`] system, with its slot derivatives, at
+/// (q₀, q₁ = q₀ + δq) for the step [t, t + h].
 pub trait DiscreteLagrangian {
-    /// L_d(q₀, q₁, h).
-    fn value<S: MechanicalSystem + ?Sized>(&self, sys: &S, q0: &[f64], q1: &[f64], h: f64) -> Result<f64, ModelError>;
+    /// L_d(q₀, q₀ + δq, h).
+    fn value<S: Lagrangian + ?Sized>(&self, sys: &S, q0: &[f64], dq: &[f64], t: f64, h: f64)
+        -> Result<f64, ModelError>;
+
+    /// Writes D₁L_d(q₀, q₀ + δq, h) into `out`.
+    #[allow(clippy::too_many_arguments)]
+    fn d1<S: Lagrangian + ?Sized>(
+        &self,
+        sys: &S,
+        q0: &[f64],
+        dq: &[f64],
+        t: f64,
+        h: f64,
+        out: &mut [f64],
+        ws: &mut Workspace,
+    ) -> Result<(), ModelError>;
+
+    /// Writes D₂L_d(q₀, q₀ + δq, h) into `out`.
+    #[allow(clippy::too_many_arguments)]
+    fn d2<S: Lagrangian + ?Sized>(
+        &self,
+        sys: &S,
+        q0: &[f64],
+        dq: &[f64],
+        t: f64,
+        h: f64,
+        out: &mut [f64],
+        ws: &mut Workspace,
+    ) -> Result<(), ModelError>;
+
+    /// Writes D₁L_d + D₂L_d, the change of momentum p₁ − p₀ over the step when p₀ = −D₁L_d,
+    /// in a form free of the cancellation between the two (the ∂L/∂q̇ terms drop out).
+    #[allow(clippy::too_many_arguments)]
+    fn momentum_change<S: Lagrangian + ?Sized>(
+        &self,
+        sys: &S,
+        q0: &[f64],
+        dq: &[f64],
+        t: f64,
+        h: f64,
+        out: &mut [f64],
+        ws: &mut Workspace,
+    ) -> Result<(), ModelError>;
 
     /// The discrete Legendre transform F⁻L_d: p₀ = −D₁L_d(q₀, q₁, h).
-    fn momentum_minus<S: MechanicalSystem + ?Sized>(
+    fn momentum_minus<S: Lagrangian + ?Sized>(
         &self,
         sys: &S,
         q0: &[f64],
         q1: &[f64],
+        t: f64,
         h: f64,
-    ) -> Result<Vec<f64>, ModelError>;
+    ) -> Result<Vec<f64>, ModelError> {
+        let mut p = vec![0.0; q0.len()];
+        self.d1(sys, q0, &increment(q0, q1), t, h, &mut p, &mut Workspace::new(q0.len()))?;
+        p.iter_mut().for_each(|x| *x = -*x);
+        Ok(p)
+    }
 
     /// The discrete Legendre transform F⁺L_d: p₁ = D₂L_d(q₀, q₁, h).
-    fn momentum_plus<S: MechanicalSystem + ?Sized>(
+    fn momentum_plus<S: Lagrangian + ?Sized>(
         &self,
         sys: &S,
         q0: &[f64],
         q1: &[f64],
+        t: f64,
         h: f64,
-    ) -> Result<Vec<f64>, ModelError>;
+    ) -> Result<Vec<f64>, ModelError> {
+        let mut p = vec![0.0; q0.len()];
+        self.d2(sys, q0, &increment(q0, q1), t, h, &mut p, &mut Workspace::new(q0.len()))?;
+        Ok(p)
+    }
 }
 
-/// The momentum of the discrete velocity, M(q₁ − q₀)/h, shared by the rules here.
-fn velocity_momentum<S: MechanicalSystem + ?Sized>(sys: &S, q0: &[f64], q1: &[f64], h: f64) -> (Vec<f64>, Vec<f64>) {
-    let v: Vec<f64> = q0.iter().zip(q1).map(|(a, b)| (b - a) / h).collect();
-    let mut p = vec![0.0; v.len()];
-    sys.mass().momentum(&v, &mut p);
-    (v, p)
+/// δq = q₁ − q₀.
+pub fn increment(q0: &[f64], q1: &[f64]) -> Vec<f64> {
+    q0.iter().zip(q1).map(|(a, b)| b - a).collect()
 }
 
-/// p ← p + c·∇V(q).
-fn add_gradient<S: MechanicalSystem + ?Sized>(sys: &S, c: f64, q: &[f64], p: &mut [f64]) -> Result<(), ModelError> {
-    let mut g = vec![0.0; q.len()];
-    sys.gradient(q, &mut g)?;
-    p.iter_mut().zip(&g).for_each(|(pi, gi)| *pi += c * gi);
-    Ok(())
+/// out = α·a + β·b.
+fn combine(out: &mut [f64], alpha: f64, a: &[f64], beta: f64, b: &[f64]) {
+    for ((o, x), y) in out.iter_mut().zip(a).zip(b) {
+        *o = alpha * x + beta * y;
+    }
 }

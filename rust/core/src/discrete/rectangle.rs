@@ -1,39 +1,73 @@
-use super::{add_gradient, velocity_momentum, DiscreteLagrangian};
-use crate::model::{Lagrangian, MechanicalSystem};
+use super::{combine, DiscreteLagrangian, Workspace};
+use crate::model::Lagrangian;
 use crate::ModelError;
 
-/// The left rectangle rule, L_d = h·L(q₀, v) with v = (q₁ − q₀)/h.
+/// The left rectangle rule, L_d = h·L(q₀, δq/h, t).
 ///
-/// For L = ½vᵀMv − V its Legendre transforms are p₀ = Mv + h∇V(q₀) and p₁ = Mv: solved for
-/// (q₁, p₁) they are symplectic Euler, p₁ = p₀ − h∇V(q₀), q₁ = q₀ + hM⁻¹p₁.
+/// D₁L_d = h∂L/∂q(q₀) − ∂L/∂q̇(q₀) and D₂L_d = ∂L/∂q̇(q₀). For L = ½vᵀMv − V these give
+/// symplectic Euler, p₁ = p₀ − h∇V(q₀), q₁ = q₀ + hM⁻¹p₁.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Rectangle;
 
 impl DiscreteLagrangian for Rectangle {
-    fn value<S: MechanicalSystem + ?Sized>(&self, sys: &S, q0: &[f64], q1: &[f64], h: f64) -> Result<f64, ModelError> {
-        let (v, _) = velocity_momentum(sys, q0, q1, h);
-        Ok(h * sys.lagrangian(q0, &v, 0.0)?)
-    }
-
-    fn momentum_minus<S: MechanicalSystem + ?Sized>(
+    fn value<S: Lagrangian + ?Sized>(
         &self,
         sys: &S,
         q0: &[f64],
-        q1: &[f64],
+        dq: &[f64],
+        t: f64,
         h: f64,
-    ) -> Result<Vec<f64>, ModelError> {
-        let (_, mut p) = velocity_momentum(sys, q0, q1, h);
-        add_gradient(sys, h, q0, &mut p)?;
-        Ok(p)
+    ) -> Result<f64, ModelError> {
+        let mut ws = Workspace::new(q0.len());
+        ws.set(q0, dq, h, 0.0);
+        Ok(h * sys.lagrangian(q0, &ws.v, t)?)
     }
 
-    fn momentum_plus<S: MechanicalSystem + ?Sized>(
+    fn d1<S: Lagrangian + ?Sized>(
         &self,
         sys: &S,
         q0: &[f64],
-        q1: &[f64],
+        dq: &[f64],
+        t: f64,
         h: f64,
-    ) -> Result<Vec<f64>, ModelError> {
-        Ok(velocity_momentum(sys, q0, q1, h).1)
+        out: &mut [f64],
+        ws: &mut Workspace,
+    ) -> Result<(), ModelError> {
+        ws.set(q0, dq, h, 0.0);
+        sys.dl_dq(q0, &ws.v, t, &mut ws.a)?;
+        sys.dl_dv(q0, &ws.v, t, &mut ws.b)?;
+        combine(out, h, &ws.a, -1.0, &ws.b);
+        Ok(())
+    }
+
+    fn d2<S: Lagrangian + ?Sized>(
+        &self,
+        sys: &S,
+        q0: &[f64],
+        dq: &[f64],
+        t: f64,
+        h: f64,
+        out: &mut [f64],
+        ws: &mut Workspace,
+    ) -> Result<(), ModelError> {
+        ws.set(q0, dq, h, 0.0);
+        sys.dl_dv(q0, &ws.v, t, out)
+    }
+
+    /// h·∂L/∂q(q₀).
+    fn momentum_change<S: Lagrangian + ?Sized>(
+        &self,
+        sys: &S,
+        q0: &[f64],
+        dq: &[f64],
+        t: f64,
+        h: f64,
+        out: &mut [f64],
+        ws: &mut Workspace,
+    ) -> Result<(), ModelError> {
+        ws.set(q0, dq, h, 0.0);
+        sys.dl_dq(q0, &ws.v, t, out)?;
+        out.iter_mut().for_each(|x| *x *= h);
+        Ok(())
     }
 }

@@ -1,41 +1,101 @@
-use super::{add_gradient, velocity_momentum, DiscreteLagrangian};
-use crate::model::{Lagrangian, MechanicalSystem};
+use super::{combine, DiscreteLagrangian, Workspace};
+use crate::model::Lagrangian;
 use crate::ModelError;
 
-/// The trapezoidal rule, L_d = (h/2)[L(q₀, v) + L(q₁, v)] with v = (q₁ − q₀)/h.
+/// The trapezoidal rule, L_d = (h/2)[L(q₀, v, t) + L(q₁, v, t + h)] with v = δq/h.
 ///
-/// For L = ½vᵀMv − V its Legendre transforms are p₀ = Mv + (h/2)∇V(q₀) and
-/// p₁ = Mv − (h/2)∇V(q₁): solved for (q₁, p₁) they are Störmer–Verlet.
+/// D₁L_d = (h/2)∂L/∂q(q₀) − ½[∂L/∂q̇(q₀) + ∂L/∂q̇(q₁)] and
+/// D₂L_d = (h/2)∂L/∂q(q₁) + ½[∂L/∂q̇(q₀) + ∂L/∂q̇(q₁)]. For L = ½vᵀMv − V these are
+/// p₀ = Mv + (h/2)∇V(q₀) and p₁ = Mv − (h/2)∇V(q₁): solved for (q₁, p₁), Störmer–Verlet.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Trapezoidal;
 
+impl Trapezoidal {
+    /// ∂L/∂q at q₀ (`at_end` false) or q₁ into ws.a, and ½[∂L/∂q̇(q₀) + ∂L/∂q̇(q₁)] into ws.b.
+    #[allow(clippy::too_many_arguments)]
+    fn derivatives<S: Lagrangian + ?Sized>(
+        sys: &S,
+        q0: &[f64],
+        dq: &[f64],
+        t: f64,
+        h: f64,
+        at_end: bool,
+        ws: &mut Workspace,
+    ) -> Result<(), ModelError> {
+        ws.set(q0, dq, h, 1.0);
+        if at_end {
+            sys.dl_dq(&ws.x, &ws.v, t + h, &mut ws.a)?;
+        } else {
+            sys.dl_dq(q0, &ws.v, t, &mut ws.a)?;
+        }
+        sys.dl_dv(q0, &ws.v, t, &mut ws.b)?;
+        sys.dl_dv(&ws.x, &ws.v, t + h, &mut ws.c)?;
+        for (b, c) in ws.b.iter_mut().zip(&ws.c) {
+            *b = 0.5 * (*b + c);
+        }
+        Ok(())
+    }
+}
+
 impl DiscreteLagrangian for Trapezoidal {
-    fn value<S: MechanicalSystem + ?Sized>(&self, sys: &S, q0: &[f64], q1: &[f64], h: f64) -> Result<f64, ModelError> {
-        let (v, _) = velocity_momentum(sys, q0, q1, h);
-        Ok(0.5 * h * (sys.lagrangian(q0, &v, 0.0)? + sys.lagrangian(q1, &v, h)?))
-    }
-
-    fn momentum_minus<S: MechanicalSystem + ?Sized>(
+    fn value<S: Lagrangian + ?Sized>(
         &self,
         sys: &S,
         q0: &[f64],
-        q1: &[f64],
+        dq: &[f64],
+        t: f64,
         h: f64,
-    ) -> Result<Vec<f64>, ModelError> {
-        let (_, mut p) = velocity_momentum(sys, q0, q1, h);
-        add_gradient(sys, 0.5 * h, q0, &mut p)?;
-        Ok(p)
+    ) -> Result<f64, ModelError> {
+        let mut ws = Workspace::new(q0.len());
+        ws.set(q0, dq, h, 1.0);
+        Ok(0.5 * h * (sys.lagrangian(q0, &ws.v, t)? + sys.lagrangian(&ws.x, &ws.v, t + h)?))
     }
 
-    fn momentum_plus<S: MechanicalSystem + ?Sized>(
+    fn d1<S: Lagrangian + ?Sized>(
         &self,
         sys: &S,
         q0: &[f64],
-        q1: &[f64],
+        dq: &[f64],
+        t: f64,
         h: f64,
-    ) -> Result<Vec<f64>, ModelError> {
-        let (_, mut p) = velocity_momentum(sys, q0, q1, h);
-        add_gradient(sys, -0.5 * h, q1, &mut p)?;
-        Ok(p)
+        out: &mut [f64],
+        ws: &mut Workspace,
+    ) -> Result<(), ModelError> {
+        Self::derivatives(sys, q0, dq, t, h, false, ws)?;
+        combine(out, 0.5 * h, &ws.a, -1.0, &ws.b);
+        Ok(())
+    }
+
+    fn d2<S: Lagrangian + ?Sized>(
+        &self,
+        sys: &S,
+        q0: &[f64],
+        dq: &[f64],
+        t: f64,
+        h: f64,
+        out: &mut [f64],
+        ws: &mut Workspace,
+    ) -> Result<(), ModelError> {
+        Self::derivatives(sys, q0, dq, t, h, true, ws)?;
+        combine(out, 0.5 * h, &ws.a, 1.0, &ws.b);
+        Ok(())
+    }
+
+    /// (h/2)[∂L/∂q(q₀) + ∂L/∂q(q₁)].
+    fn momentum_change<S: Lagrangian + ?Sized>(
+        &self,
+        sys: &S,
+        q0: &[f64],
+        dq: &[f64],
+        t: f64,
+        h: f64,
+        out: &mut [f64],
+        ws: &mut Workspace,
+    ) -> Result<(), ModelError> {
+        ws.set(q0, dq, h, 1.0);
+        sys.dl_dq(q0, &ws.v, t, &mut ws.a)?;
+        sys.dl_dq(&ws.x, &ws.v, t + h, &mut ws.b)?;
+        combine(out, 0.5 * h, &ws.a, 0.5 * h, &ws.b);
+        Ok(())
     }
 }

@@ -1,10 +1,101 @@
 use std::time::{Duration, Instant};
 
-use super::{compensated, Integrator, Method};
+use super::{compensated, Integrator, Method, StepError};
 use crate::diagnostics::hamiltonian;
 use crate::error::check_vector;
-use crate::model::MechanicalSystem;
+use crate::model::{Lagrangian, MechanicalSystem};
 use crate::{Error, ModelError};
+
+/// What the driver integrates: separable mechanical systems take every method; a general
+/// Lagrangian, wrapped in [`General`], takes the implicit (variational) methods.
+pub trait Integrable {
+    /// Number of coordinates n.
+    fn dim(&self) -> usize;
+
+    /// Whether `method` applies to this system.
+    fn check_method(&self, method: Method) -> Result<(), Error>;
+
+    /// One step's increments, from (q, p) at time t.
+    #[allow(clippy::too_many_arguments)]
+    fn increment(
+        &self,
+        integrator: &mut Integrator,
+        t: f64,
+        q: &[f64],
+        p: &[f64],
+        h: f64,
+        dq: &mut [f64],
+        dp: &mut [f64],
+    ) -> Result<(), StepError>;
+
+    /// The conserved energy at (q, p), where the driver can evaluate it.
+    fn energy(&self, q: &[f64], p: &[f64]) -> Option<Result<f64, ModelError>>;
+}
+
+impl<S: MechanicalSystem + ?Sized> Integrable for S {
+    fn dim(&self) -> usize {
+        MechanicalSystem::dim(self)
+    }
+
+    fn check_method(&self, _method: Method) -> Result<(), Error> {
+        Ok(())
+    }
+
+    fn increment(
+        &self,
+        integrator: &mut Integrator,
+        t: f64,
+        q: &[f64],
+        p: &[f64],
+        h: f64,
+        dq: &mut [f64],
+        dp: &mut [f64],
+    ) -> Result<(), StepError> {
+        integrator.increment(self, t, q, p, h, dq, dp)
+    }
+
+    fn energy(&self, q: &[f64], p: &[f64]) -> Option<Result<f64, ModelError>> {
+        Some(hamiltonian(self, q, p))
+    }
+}
+
+/// A general Lagrangian L(q, q̇, t), for the implicit variational methods.
+pub struct General<'a, L: ?Sized>(pub &'a L);
+
+impl<L: Lagrangian + ?Sized> Integrable for General<'_, L> {
+    fn dim(&self) -> usize {
+        self.0.dim()
+    }
+
+    fn check_method(&self, method: Method) -> Result<(), Error> {
+        if method.info().implicit {
+            Ok(())
+        } else {
+            let reason = format!(
+                "{} needs a separable mechanical system; use midpoint or trapezoid",
+                method.info().name
+            );
+            Err(Error::invalid("method", reason))
+        }
+    }
+
+    fn increment(
+        &self,
+        integrator: &mut Integrator,
+        t: f64,
+        q: &[f64],
+        p: &[f64],
+        h: f64,
+        dq: &mut [f64],
+        dp: &mut [f64],
+    ) -> Result<(), StepError> {
+        integrator.increment_lagrangian(self.0, t, q, p, h, dq, dp)
+    }
+
+    fn energy(&self, _q: &[f64], _p: &[f64]) -> Option<Result<f64, ModelError>> {
+        None
+    }
+}
 
 /// Options of a fixed-step run.
 #[derive(Clone, Debug, PartialEq)]
@@ -60,7 +151,7 @@ impl Options {
     }
 }
 
-/// The saved states of a run: row k is (t[k], q[k], p[k]); q and p are stored row-major.
+/// The saved states of a run: row k is (`t[k]`, `q[k]`, `p[k]`); q and p are stored row-major.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Trajectory {
     pub dim: usize,
@@ -69,8 +160,10 @@ pub struct Trajectory {
     pub p: Vec<f64>,
     /// Steps completed.
     pub steps: usize,
-    /// Force evaluations ∇V made.
+    /// Force evaluations made (see [`Integrator::force_evaluations`]).
     pub force_evaluations: u64,
+    /// Newton iterations made (implicit methods).
+    pub newton_iterations: u64,
 }
 
 impl Trajectory {
@@ -163,7 +256,7 @@ pub fn integrate<S, P>(
     mut poll: P,
 ) -> Result<Trajectory, Box<Failure>>
 where
-    S: MechanicalSystem + ?Sized,
+    S: Integrable + ?Sized,
     P: FnMut() -> Result<(), ModelError>,
 {
     let n = sys.dim();
@@ -172,9 +265,18 @@ where
         ..Default::default()
     };
     let fail = |error, partial| Box::new(Failure { error, partial });
+    let energy_check = match options.max_energy_error {
+        Some(_) if sys.energy(q0, p0).is_none() => Err(Error::invalid(
+            "max_energy_error",
+            "needs the energy of the model, which the driver evaluates for mechanical systems only",
+        )),
+        _ => Ok(()),
+    };
     if let Err(e) = check_vector("q0", q0, n)
         .and(check_vector("p0", p0, n))
         .and(options.check())
+        .and(sys.check_method(method))
+        .and(energy_check)
     {
         return Err(fail(e, traj));
     }
@@ -209,8 +311,9 @@ where
     let mut integrator = Integrator::new(method, n);
     let mut interrupt = InterruptPoll::new();
     traj.push(t0, &q, &p);
-    let h0 = match max_energy_error {
-        Some(_) => match hamiltonian(sys, &q, &p) {
+    let h0 = match max_energy_error.and_then(|_| sys.energy(&q, &p)) {
+        None => None,
+        Some(energy) => match energy {
             Ok(h) => Some(h),
             Err(source) => {
                 return Err(fail(
@@ -223,7 +326,6 @@ where
                 ))
             }
         },
-        None => None,
     };
 
     for step in 1..=steps {
@@ -235,6 +337,7 @@ where
             }
             traj.steps = step - 1;
             traj.force_evaluations = integrator.force_evaluations();
+            traj.newton_iterations = integrator.newton_iterations();
             fail(error, traj)
         };
         if interrupt.due() {
@@ -248,8 +351,8 @@ where
                 ));
             }
         }
-        if let Err(source) = integrator.increment(sys, &q, &p, dt, &mut dq, &mut dp) {
-            return Err(stop(Error::Model { step, time, source }, traj, &q, &p, &integrator));
+        if let Err(e) = sys.increment(&mut integrator, time, &q, &p, dt, &mut dq, &mut dp) {
+            return Err(stop(e.at(step, time), traj, &q, &p, &integrator));
         }
         let finite = if compensated {
             compensated::add(&q, &eq, &dq, &mut q_next, &mut eq_next)
@@ -280,7 +383,7 @@ where
             traj.push(t, &q, &p);
             if let (Some(tol), Some(h0)) = (max_energy_error, h0) {
                 // The state of this step is kept: it is finite, only its energy is off.
-                let error = match hamiltonian(sys, &q, &p) {
+                let error = match sys.energy(&q, &p).expect("checked before the first step") {
                     Ok(h) => {
                         let err = (h - h0).abs() / if h0 != 0.0 { h0.abs() } else { 1.0 };
                         (err.is_nan() || err > tol).then(|| {
@@ -293,6 +396,7 @@ where
                 if let Some(error) = error {
                     traj.steps = step;
                     traj.force_evaluations = integrator.force_evaluations();
+                    traj.newton_iterations = integrator.newton_iterations();
                     return Err(fail(error, traj));
                 }
             }
@@ -300,5 +404,6 @@ where
     }
     traj.steps = steps;
     traj.force_evaluations = integrator.force_evaluations();
+    traj.newton_iterations = integrator.newton_iterations();
     Ok(traj)
 }

@@ -26,6 +26,11 @@ pub enum Method {
     KahanLi8,
     /// The classical Runge–Kutta method (baseline; not symplectic).
     Rk4,
+    /// The variational integrator of the midpoint discrete Lagrangian (implicit; any L).
+    Midpoint,
+    /// The variational integrator of the trapezoidal discrete Lagrangian (implicit; any L;
+    /// Störmer–Verlet for separable systems).
+    Trapezoid,
 }
 
 /// What `varmech.methods()` lists about a method.
@@ -36,19 +41,23 @@ pub struct MethodInfo {
     pub order: u32,
     /// Stages of the composition (1 for the others).
     pub stages: usize,
-    /// Force evaluations ∇V per step, first-same-as-last evaluations reused.
+    /// Force evaluations ∇V per step, first-same-as-last evaluations reused (0 for the
+    /// implicit methods, whose cost depends on the Newton iterations).
     pub force_evaluations: usize,
+    /// Whether each step solves implicit equations (by Newton's method); implicit methods
+    /// integrate general Lagrangians, explicit ones only separable mechanical systems.
+    pub implicit: bool,
     pub symplectic: bool,
     pub symmetric: bool,
     /// Linear stability limit: the method is stable on q̈ = −ω²q iff hω < `h_omega_max`
-    /// (0 for explicit Euler, which is never stable).
+    /// (0 for explicit Euler, which is never stable; infinite for the midpoint rule).
     pub h_omega_max: f64,
     pub reference: &'static str,
 }
 
 impl Method {
     /// Every method, from the simplest.
-    pub const ALL: [Method; 11] = [
+    pub const ALL: [Method; 13] = [
         Method::ExplicitEuler,
         Method::SymplecticEuler,
         Method::Verlet,
@@ -60,6 +69,8 @@ impl Method {
         Method::SuzukiUmeno8,
         Method::KahanLi8,
         Method::Rk4,
+        Method::Midpoint,
+        Method::Trapezoid,
     ];
 
     /// The method's facts.
@@ -83,15 +94,37 @@ impl Method {
             Method::SuzukiUmeno8 => ("suzuki_umeno8", 8, true, true, 3.3932, "Suzuki & Umeno (1993)"),
             Method::KahanLi8 => ("kahan_li8", 8, true, true, 3.0964, "Kahan & Li, Math. Comp. 66 (1997)"),
             Method::Rk4 => ("rk4", 4, false, false, 2.0 * std::f64::consts::SQRT_2, "baseline"),
+            Method::Midpoint => (
+                "midpoint",
+                2,
+                true,
+                true,
+                f64::INFINITY,
+                "Marsden & West (2001); midpoint L_d",
+            ),
+            Method::Trapezoid => (
+                "trapezoid",
+                2,
+                true,
+                true,
+                2.0,
+                "Marsden & West (2001); trapezoidal L_d",
+            ),
         };
+        let implicit = matches!(self, Method::Midpoint | Method::Trapezoid);
         let stages = Composition::of(self).map_or(1, |c| c.gamma().len());
-        let force_evaluations = if self == Method::Rk4 { 4 } else { stages };
+        let force_evaluations = match self {
+            Method::Rk4 => 4,
+            _ if implicit => 0,
+            _ => stages,
+        };
         MethodInfo {
             method: self,
             name,
             order,
             stages,
             force_evaluations,
+            implicit,
             symplectic,
             symmetric,
             h_omega_max,

@@ -10,19 +10,68 @@
 
 pub mod compensated;
 mod composition;
+mod del;
 mod driver;
 mod explicit_rk;
 mod kick_drift;
 mod method;
 
 pub use composition::Composition;
-pub use driver::{integrate, Failure, Options, Trajectory};
+pub use del::{Del, NewtonOptions};
+pub use driver::{integrate, Failure, General, Integrable, Options, Trajectory};
 pub use explicit_rk::ExplicitRk;
 pub use kick_drift::KickDrift;
 pub use method::{Method, MethodInfo};
 
-use crate::model::MechanicalSystem;
+use crate::discrete::{Midpoint, Trapezoidal};
+use crate::model::{Lagrangian, MechanicalSystem};
 use crate::ModelError;
+
+/// Why a step failed.
+#[derive(Debug)]
+pub enum StepError {
+    /// The model failed while it was evaluated.
+    Model(ModelError),
+    /// Newton's method did not solve the step's implicit equations.
+    Convergence {
+        residual: f64,
+        iterations: usize,
+        reason: &'static str,
+    },
+    /// The step's equations became non-finite: the solution is blowing up.
+    NonFinite { reason: &'static str },
+}
+
+impl StepError {
+    /// The error of the run that failed at `step`, which started at `time`.
+    pub fn at(self, step: usize, time: f64) -> crate::Error {
+        match self {
+            StepError::Model(source) => crate::Error::Model { step, time, source },
+            StepError::Convergence {
+                residual,
+                iterations,
+                reason,
+            } => crate::Error::Convergence {
+                step,
+                time,
+                residual,
+                iterations,
+                reason,
+            },
+            StepError::NonFinite { reason } => crate::Error::Divergence {
+                step,
+                time,
+                reason: reason.to_string(),
+            },
+        }
+    }
+}
+
+impl From<ModelError> for StepError {
+    fn from(e: ModelError) -> Self {
+        StepError::Model(e)
+    }
+}
 
 /// A one-step method Ψ_h: (qₙ, pₙ) ↦ (qₙ + δq, pₙ + δp) with its work buffers.
 #[derive(Clone, Debug)]
@@ -35,12 +84,21 @@ pub struct Integrator {
 enum Scheme {
     KickDrift(KickDrift),
     ExplicitRk(ExplicitRk),
+    Midpoint(Del<Midpoint>),
+    Trapezoid(Del<Trapezoidal>),
 }
 
 impl Integrator {
     /// An integrator of `method` for n coordinates; buffers are allocated here, not per step.
     pub fn new(method: Method, n: usize) -> Self {
+        Self::with_newton(method, n, NewtonOptions::default())
+    }
+
+    /// As [`Integrator::new`], with the options of the implicit methods' Newton iteration.
+    pub fn with_newton(method: Method, n: usize, newton: NewtonOptions) -> Self {
         let scheme = match method {
+            Method::Midpoint => Scheme::Midpoint(Del::new(Midpoint, n, newton)),
+            Method::Trapezoid => Scheme::Trapezoid(Del::new(Trapezoidal, n, newton)),
             Method::ExplicitEuler => Scheme::ExplicitRk(ExplicitRk::euler(n)),
             Method::Rk4 => Scheme::ExplicitRk(ExplicitRk::rk4(n)),
             Method::SymplecticEuler => Scheme::KickDrift(KickDrift::symplectic_euler(n)),
@@ -57,49 +115,91 @@ impl Integrator {
         self.method
     }
 
-    /// Forgets the force cached from the last step (first same as last): call it whenever
-    /// the next step does not start where the last one ended.
+    /// Forgets the force cached from the last step (first same as last) and the implicit
+    /// methods' predictor: call it whenever the next step does not start where the last one
+    /// ended.
     pub fn reset(&mut self) {
-        if let Scheme::KickDrift(s) = &mut self.scheme {
-            s.reset();
+        match &mut self.scheme {
+            Scheme::KickDrift(s) => s.reset(),
+            Scheme::Midpoint(s) => s.reset(),
+            Scheme::Trapezoid(s) => s.reset(),
+            Scheme::ExplicitRk(_) => {}
         }
     }
 
-    /// Force evaluations ∇V made so far.
+    /// Evaluations made so far: of ∇V for the explicit methods, of D₁L_d or D₂L_d (each one
+    /// evaluation of ∂L/∂q and ∂L/∂q̇) for the implicit ones.
     pub fn force_evaluations(&self) -> u64 {
         match &self.scheme {
             Scheme::KickDrift(s) => s.force_evaluations(),
             Scheme::ExplicitRk(s) => s.force_evaluations(),
+            Scheme::Midpoint(s) => s.evaluations(),
+            Scheme::Trapezoid(s) => s.evaluations(),
         }
     }
 
-    /// Writes the increments of one step of size h from (q, p) into (dq, dp).
+    /// Newton iterations made so far (0 for the explicit methods).
+    pub fn newton_iterations(&self) -> u64 {
+        match &self.scheme {
+            Scheme::Midpoint(s) => s.iterations(),
+            Scheme::Trapezoid(s) => s.iterations(),
+            _ => 0,
+        }
+    }
+
+    /// Writes the increments of one step of size h from (q, p) at time t into (dq, dp).
+    #[allow(clippy::too_many_arguments)]
     pub fn increment<S: MechanicalSystem + ?Sized>(
         &mut self,
         sys: &S,
+        t: f64,
         q: &[f64],
         p: &[f64],
         h: f64,
         dq: &mut [f64],
         dp: &mut [f64],
-    ) -> Result<(), ModelError> {
+    ) -> Result<(), StepError> {
         match &mut self.scheme {
-            Scheme::KickDrift(s) => s.increment(sys, q, p, h, dq, dp),
-            Scheme::ExplicitRk(s) => s.increment(sys, q, p, h, dq, dp),
+            Scheme::KickDrift(s) => Ok(s.increment(sys, q, p, h, dq, dp)?),
+            Scheme::ExplicitRk(s) => Ok(s.increment(sys, q, p, h, dq, dp)?),
+            _ => self.increment_lagrangian(sys, t, q, p, h, dq, dp),
         }
     }
 
-    /// One plain step (q, p) ← Ψ_h(q, p), without compensated summation.
+    /// As [`Integrator::increment`] for a general Lagrangian, which only the implicit
+    /// (variational) methods integrate; an explicit method is an error here (the driver
+    /// refuses it before the first step).
+    #[allow(clippy::too_many_arguments)]
+    pub fn increment_lagrangian<S: Lagrangian + ?Sized>(
+        &mut self,
+        sys: &S,
+        t: f64,
+        q: &[f64],
+        p: &[f64],
+        h: f64,
+        dq: &mut [f64],
+        dp: &mut [f64],
+    ) -> Result<(), StepError> {
+        match &mut self.scheme {
+            Scheme::Midpoint(s) => s.increment(sys, t, q, p, h, dq, dp),
+            Scheme::Trapezoid(s) => s.increment(sys, t, q, p, h, dq, dp),
+            _ => Err(StepError::Model(
+                "explicit methods integrate separable mechanical systems only".into(),
+            )),
+        }
+    }
+
+    /// One plain step (q, p) ← Ψ_h(q, p) from t = 0, without compensated summation.
     pub fn step<S: MechanicalSystem + ?Sized>(
         &mut self,
         sys: &S,
         q: &mut [f64],
         p: &mut [f64],
         h: f64,
-    ) -> Result<(), ModelError> {
+    ) -> Result<(), StepError> {
         let mut dq = vec![0.0; q.len()];
         let mut dp = vec![0.0; p.len()];
-        self.increment(sys, q, p, h, &mut dq, &mut dp)?;
+        self.increment(sys, 0.0, q, p, h, &mut dq, &mut dp)?;
         q.iter_mut().zip(&dq).for_each(|(x, d)| *x += d);
         p.iter_mut().zip(&dp).for_each(|(x, d)| *x += d);
         Ok(())

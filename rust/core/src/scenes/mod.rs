@@ -5,6 +5,7 @@
 //! which names the sources; tests and benches use these problems (as diffsol ships its test
 //! problems in the library).
 
+mod double_pendulum;
 mod fermi_pasta_ulam;
 mod harmonic_oscillator;
 mod henon_heiles;
@@ -12,6 +13,7 @@ mod kepler;
 mod nbody;
 mod pendulum;
 
+pub use double_pendulum::DoublePendulum;
 pub use fermi_pasta_ulam::FermiPastaUlam;
 pub use harmonic_oscillator::HarmonicOscillator;
 pub use henon_heiles::HenonHeiles;

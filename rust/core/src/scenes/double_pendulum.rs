@@ -1,0 +1,109 @@
+use super::{Problem, State};
+use crate::model::Lagrangian;
+use crate::{Error, ModelError};
+
+/// The planar double pendulum in its two angles from the downward vertical:
+///
+/// L = ½(m₁+m₂)l₁²θ̇₁² + ½m₂l₂²θ̇₂² + m₂l₁l₂θ̇₁θ̇₂cos(θ₁−θ₂) + (m₁+m₂)gl₁cos θ₁ + m₂gl₂cos θ₂.
+///
+/// Its mass matrix depends on the configuration, so it is a general Lagrangian (integrated by
+/// the implicit variational methods), with exact derivatives.
+#[derive(Clone, Debug)]
+pub struct DoublePendulum {
+    m1: f64,
+    m2: f64,
+    l1: f64,
+    l2: f64,
+    g: f64,
+}
+
+impl DoublePendulum {
+    pub fn new(m1: f64, m2: f64, l1: f64, l2: f64, g: f64) -> Result<Self, Error> {
+        for (name, x) in [("m1", m1), ("m2", m2), ("l1", l1), ("l2", l2)] {
+            if !(x.is_finite() && x > 0.0) {
+                return Err(Error::invalid(name, format!("must be finite and positive, got {x}")));
+            }
+        }
+        if !g.is_finite() {
+            return Err(Error::invalid("g", "must be finite"));
+        }
+        Ok(DoublePendulum { m1, m2, l1, l2, g })
+    }
+
+    /// The mass matrix M(θ): L = ½θ̇ᵀM(θ)θ̇ − V(θ).
+    fn mass(&self, q: &[f64]) -> [[f64; 2]; 2] {
+        let c = self.m2 * self.l1 * self.l2 * (q[0] - q[1]).cos();
+        [
+            [(self.m1 + self.m2) * self.l1 * self.l1, c],
+            [c, self.m2 * self.l2 * self.l2],
+        ]
+    }
+
+    /// θ̇ = M(θ)⁻¹p, the inverse Legendre transform.
+    pub fn velocity(&self, q: &[f64], p: &[f64]) -> [f64; 2] {
+        let [[a, b], [_, d]] = self.mass(q);
+        let det = a * d - b * b;
+        [(d * p[0] - b * p[1]) / det, (a * p[1] - b * p[0]) / det]
+    }
+
+    /// The energy E = p·θ̇ − L = ½θ̇ᵀMθ̇ + V, conserved.
+    pub fn energy(&self, q: &[f64], p: &[f64]) -> Result<f64, ModelError> {
+        let v = self.velocity(q, p);
+        Ok(p[0] * v[0] + p[1] * v[1] - self.lagrangian(q, &v, 0.0)?)
+    }
+
+    /// GeometricProblems.jl's defaults (l = (2, 3), m = (1, 2), g = 9.80665), from
+    /// θ = (π/4, π/2), θ̇ = (0, π/8) to T = 10, against its reference (accurate to about 1e-11).
+    pub fn problem() -> Problem<Self> {
+        let system = Self::new(1.0, 2.0, 2.0, 3.0, 9.80665).expect("valid parameters");
+        let momentum = |q: &[f64], v: &[f64]| {
+            let mut p = vec![0.0; 2];
+            system.dl_dv(q, v, 0.0, &mut p).expect("exact");
+            p
+        };
+        let q0 = vec![std::f64::consts::FRAC_PI_4, std::f64::consts::FRAC_PI_2];
+        let p0 = momentum(&q0, &[0.0, std::f64::consts::PI / 8.0]);
+        let q_ref = vec![0.87467888012, 0.55850349694];
+        let p_ref = momentum(&q_ref, &[-4.08255226002, 1.66594428518]);
+        Problem {
+            initial: State { t: 0.0, q: q0, p: p0 },
+            t_end: 10.0,
+            reference: Some((
+                State {
+                    t: 10.0,
+                    q: q_ref,
+                    p: p_ref,
+                },
+                "GeometricProblems.jl (double pendulum), accurate to about 1e-11",
+            )),
+            system,
+        }
+    }
+}
+
+impl Lagrangian for DoublePendulum {
+    fn dim(&self) -> usize {
+        2
+    }
+
+    fn lagrangian(&self, q: &[f64], v: &[f64], _t: f64) -> Result<f64, ModelError> {
+        let [[a, b], [_, d]] = self.mass(q);
+        let kinetic = 0.5 * (a * v[0] * v[0] + 2.0 * b * v[0] * v[1] + d * v[1] * v[1]);
+        let potential = -(self.m1 + self.m2) * self.g * self.l1 * q[0].cos() - self.m2 * self.g * self.l2 * q[1].cos();
+        Ok(kinetic - potential)
+    }
+
+    fn dl_dq(&self, q: &[f64], v: &[f64], _t: f64, out: &mut [f64]) -> Result<(), ModelError> {
+        let k = self.m2 * self.l1 * self.l2 * v[0] * v[1] * (q[0] - q[1]).sin();
+        out[0] = -k - (self.m1 + self.m2) * self.g * self.l1 * q[0].sin();
+        out[1] = k - self.m2 * self.g * self.l2 * q[1].sin();
+        Ok(())
+    }
+
+    fn dl_dv(&self, q: &[f64], v: &[f64], _t: f64, out: &mut [f64]) -> Result<(), ModelError> {
+        let [[a, b], [_, d]] = self.mass(q);
+        out[0] = a * v[0] + b * v[1];
+        out[1] = b * v[0] + d * v[1];
+        Ok(())
+    }
+}
