@@ -34,7 +34,7 @@ fn run<L: Lagrangian>(
 #[test]
 fn initial_energy_matches_the_published_value() {
     let p = DoublePendulum::problem();
-    let e = p.system.energy(&p.initial.q, &p.initial.p).unwrap();
+    let e = p.system.energy(&p.initial.q, &p.initial.p, 0.0).unwrap();
     assert!((e + 40.218179175435154).abs() < 1e-12, "E0 = {e}");
 }
 
@@ -110,7 +110,7 @@ fn energy_stays_bounded_and_newton_converges_in_a_few_iterations() {
     let steps = 100_000;
     let traj = run(&problem.system, Method::Midpoint, steps, 1000.0, 10).unwrap();
     let e: Vec<f64> = (0..traj.len())
-        .map(|k| problem.system.energy(traj.q_at(k), traj.p_at(k)).unwrap())
+        .map(|k| problem.system.energy(traj.q_at(k), traj.p_at(k), 0.0).unwrap())
         .collect();
     let stats = varmech::diagnostics::EnergyStatistics::new(&traj.t, &e);
     assert_eq!(stats.verdict, varmech::diagnostics::Verdict::Bounded, "{stats:?}");
@@ -121,29 +121,45 @@ fn energy_stays_bounded_and_newton_converges_in_a_few_iterations() {
 }
 
 #[test]
-fn explicit_methods_and_the_energy_threshold_need_a_mechanical_system() {
+fn explicit_methods_need_a_mechanical_system() {
     let problem = DoublePendulum::problem();
     match run(&problem.system, Method::Verlet, 10, 1.0, 1) {
         Err(Error::InvalidArgument { argument: "method", .. }) => {}
         other => panic!("expected an invalid method, got {other:?}"),
     }
+}
+
+#[test]
+fn the_energy_function_of_a_general_lagrangian_uses_the_inverse_legendre_transform() {
+    // The default Newton solve of ∂L/∂q̇ = p agrees with the closed form M(θ)⁻¹p.
+    let problem = DoublePendulum::problem();
+    let only = LagrangianOnly(problem.system.clone());
+    let (q, p) = ([0.3, -1.2], [2.0, -7.0]);
+    let (mut exact, mut newton) = ([0.0; 2], [0.0; 2]);
+    problem.system.velocity(&q, &p, 0.0, &mut exact).unwrap();
+    only.velocity(&q, &p, 0.0, &mut newton).unwrap();
+    assert!(
+        exact.iter().zip(&newton).all(|(a, b)| (a - b).abs() < 1e-8),
+        "{exact:?} vs {newton:?}"
+    );
+    let (e1, e2) = (
+        problem.system.energy(&q, &p, 0.0).unwrap(),
+        only.energy(&q, &p, 0.0).unwrap(),
+    );
+    assert!((e1 - e2).abs() < 1e-8 * e1.abs());
+    // The energy threshold works for general Lagrangians too: a huge step blows the energy up.
     let options = Options {
-        max_energy_error: Some(1.0),
-        ..Options::new(0.1, 10)
+        max_energy_error: Some(1e-6),
+        ..Options::new(0.1, 100)
     };
-    let result = integrate(
+    let failure = integrate(
         &General(&problem.system),
         Method::Midpoint,
         &problem.initial.q,
         &problem.initial.p,
         &options,
         || Ok(()),
-    );
-    assert!(matches!(
-        result.map_err(|f| f.error),
-        Err(Error::InvalidArgument {
-            argument: "max_energy_error",
-            ..
-        })
-    ));
+    )
+    .unwrap_err();
+    assert!(matches!(failure.error, Error::Divergence { .. }), "{}", failure.error);
 }

@@ -2,11 +2,8 @@ use nalgebra::{DMatrix, DVector};
 
 use super::StepError;
 use crate::discrete::{DiscreteLagrangian, Workspace};
+use crate::model::finite_difference::NOISE_FLOOR;
 use crate::model::Lagrangian;
-
-/// Corrections below this (relative to ‖q₁‖∞) that a fresh Newton step cannot shrink are
-/// taken as converged: √ε, the accuracy of equations built from central differences.
-const NOISE_FLOOR: f64 = 1.5e-8;
 
 /// Options of the Newton iteration that solves the discrete Euler–Lagrange equations.
 ///

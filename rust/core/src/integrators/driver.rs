@@ -92,8 +92,9 @@ impl<L: Lagrangian + ?Sized> Integrable for General<'_, L> {
         integrator.increment_lagrangian(self.0, t, q, p, h, dq, dp)
     }
 
-    fn energy(&self, _q: &[f64], _p: &[f64]) -> Option<Result<f64, ModelError>> {
-        None
+    /// E = p·q̇ − L, unless L depends on t (then nothing is conserved to check).
+    fn energy(&self, q: &[f64], p: &[f64]) -> Option<Result<f64, ModelError>> {
+        (!self.0.is_time_dependent()).then(|| self.0.energy(q, p, 0.0))
     }
 }
 
@@ -268,7 +269,7 @@ where
     let energy_check = match options.max_energy_error {
         Some(_) if sys.energy(q0, p0).is_none() => Err(Error::invalid(
             "max_energy_error",
-            "needs the energy of the model, which the driver evaluates for mechanical systems only",
+            "needs a conserved energy, and a time-dependent Lagrangian has none",
         )),
         _ => Ok(()),
     };

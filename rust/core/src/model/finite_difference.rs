@@ -2,6 +2,11 @@
 
 use crate::ModelError;
 
+/// √ε: relative changes below this in a Newton iteration whose equations are built from central
+/// differences (accurate to about ε^{2/3}) are noise, and a correction there that a fresh
+/// Newton step cannot halve means the iteration has converged as far as it can.
+pub const NOISE_FLOOR: f64 = 1.5e-8;
+
 /// ∇f(q) by central differences, ∂f/∂qᵢ ≈ [f(q + hᵢeᵢ) − f(q − hᵢeᵢ)] / 2hᵢ, with the step
 /// hᵢ = ε^{1/3}·max(|qᵢ|, 1) that balances the O(h²) truncation against the O(ε/h) round-off
 /// (ε the machine epsilon), for an error of order ε^{2/3} ≈ 4e-11 relative.

@@ -33,6 +33,59 @@ pub trait Lagrangian {
     fn is_time_dependent(&self) -> bool {
         false
     }
+
+    /// Writes the velocity q̇ with ∂L/∂q̇(q, q̇, t) = p into `v`: the inverse Legendre
+    /// transform, unique for a regular Lagrangian. Default: Newton's method from `v` as given,
+    /// with a difference Jacobian (exact in one step when L is quadratic in q̇), to round-off or
+    /// to the noise floor of difference derivatives.
+    fn velocity(&self, q: &[f64], p: &[f64], t: f64, v: &mut [f64]) -> Result<(), ModelError> {
+        let n = v.len();
+        let (mut r, mut plus, mut minus) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
+        let mut jacobian = nalgebra::DMatrix::zeros(n, n);
+        let mut last = f64::INFINITY;
+        for _ in 0..50 {
+            self.dl_dv(q, v, t, &mut r)?;
+            r.iter_mut().zip(p).for_each(|(r, p)| *r -= p);
+            for j in 0..n {
+                let x = v[j];
+                let e = f64::EPSILON.cbrt() * x.abs().max(1.0);
+                v[j] = x + e;
+                self.dl_dv(q, v, t, &mut plus)?;
+                v[j] = x - e;
+                self.dl_dv(q, v, t, &mut minus)?;
+                v[j] = x;
+                for i in 0..n {
+                    jacobian[(i, j)] = (plus[i] - minus[i]) / (2.0 * e);
+                }
+            }
+            let delta = jacobian
+                .clone()
+                .lu()
+                .solve(&nalgebra::DVector::from_column_slice(&r))
+                .ok_or_else(|| {
+                    ModelError::from("the Hessian ∂²L/∂q̇² is singular: the Lagrangian is not regular here")
+                })?;
+            let mut size = 0.0_f64;
+            for (x, d) in v.iter_mut().zip(delta.iter()) {
+                *x -= d;
+                size = size.max(d.abs() / x.abs().max(1.0));
+            }
+            // Converged, or at the noise floor of difference derivatives.
+            if size <= 1e-14 || (size > 0.5 * last && size <= finite_difference::NOISE_FLOOR) {
+                return Ok(());
+            }
+            last = size;
+        }
+        Err("the inverse Legendre transform ∂L/∂q̇ = p did not converge".into())
+    }
+
+    /// The energy function E(q, p, t) = p·q̇ − L(q, q̇, t), with q̇ from [`Lagrangian::velocity`];
+    /// conserved when L does not depend on t.
+    fn energy(&self, q: &[f64], p: &[f64], t: f64) -> Result<f64, ModelError> {
+        let mut v = vec![0.0; q.len()];
+        self.velocity(q, p, t, &mut v)?;
+        Ok(p.iter().zip(&v).map(|(a, b)| a * b).sum::<f64>() - self.lagrangian(q, &v, t)?)
+    }
 }
 
 /// L = ½ q̇ᵀ M q̇ − V(q): ∂L/∂q = −∇V(q), ∂L/∂q̇ = M q̇.
@@ -53,6 +106,11 @@ impl<S: MechanicalSystem + ?Sized> Lagrangian for S {
 
     fn dl_dv(&self, _q: &[f64], v: &[f64], _t: f64, out: &mut [f64]) -> Result<(), ModelError> {
         self.mass().momentum(v, out);
+        Ok(())
+    }
+
+    fn velocity(&self, _q: &[f64], p: &[f64], _t: f64, v: &mut [f64]) -> Result<(), ModelError> {
+        self.mass().velocity(p, v);
         Ok(())
     }
 }

@@ -39,19 +39,6 @@ impl DoublePendulum {
         ]
     }
 
-    /// θ̇ = M(θ)⁻¹p, the inverse Legendre transform.
-    pub fn velocity(&self, q: &[f64], p: &[f64]) -> [f64; 2] {
-        let [[a, b], [_, d]] = self.mass(q);
-        let det = a * d - b * b;
-        [(d * p[0] - b * p[1]) / det, (a * p[1] - b * p[0]) / det]
-    }
-
-    /// The energy E = p·θ̇ − L = ½θ̇ᵀMθ̇ + V, conserved.
-    pub fn energy(&self, q: &[f64], p: &[f64]) -> Result<f64, ModelError> {
-        let v = self.velocity(q, p);
-        Ok(p[0] * v[0] + p[1] * v[1] - self.lagrangian(q, &v, 0.0)?)
-    }
-
     /// GeometricProblems.jl's defaults (l = (2, 3), m = (1, 2), g = 9.80665), from
     /// θ = (π/4, π/2), θ̇ = (0, π/8) to T = 10, against its reference (accurate to about 1e-11).
     pub fn problem() -> Problem<Self> {
@@ -104,6 +91,15 @@ impl Lagrangian for DoublePendulum {
         let [[a, b], [_, d]] = self.mass(q);
         out[0] = a * v[0] + b * v[1];
         out[1] = b * v[0] + d * v[1];
+        Ok(())
+    }
+
+    /// θ̇ = M(θ)⁻¹p.
+    fn velocity(&self, q: &[f64], p: &[f64], _t: f64, v: &mut [f64]) -> Result<(), ModelError> {
+        let [[a, b], [_, d]] = self.mass(q);
+        let det = a * d - b * b;
+        v[0] = (d * p[0] - b * p[1]) / det;
+        v[1] = (a * p[1] - b * p[0]) / det;
         Ok(())
     }
 }
