@@ -7,8 +7,14 @@ import varmech
 from varmech import examples, scenes
 
 
-@pytest.mark.parametrize("name", list(scenes.CATALOGUE))
-@pytest.mark.parametrize("method", ["verlet", "kahan_li8", "rk4", "symplectic_euler"])
+SEPARABLE = [n for n in scenes.CATALOGUE if scenes.get(n).model.separable]
+
+
+@pytest.mark.parametrize(
+    "name, method",
+    [(n, m) for n in SEPARABLE for m in ["verlet", "kahan_li8", "rk4", "symplectic_euler", "midpoint"]]
+    + [("double_pendulum", m) for m in ["midpoint", "trapezoid"]],
+)
 def test_closure_reproduces_native(name, method):
     scene = scenes.get(name)
     closure = examples.closure_of(scene)
@@ -16,10 +22,13 @@ def test_closure_reproduces_native(name, method):
     native = varmech.integrate(scene, dt=scene.dt, steps=steps, method=method)
     python = varmech.integrate(closure, scene.q0, scene.p0, dt=scene.dt, steps=steps, method=method)
     assert python.nfev == native.nfev
+    # Explicit methods agree to round-off; implicit ones to their Newton tolerance, through
+    # which round-off differences between Rust and NumPy arithmetic pass.
+    tol = 1e-12 if not native.newton_iterations else 1e-10
     for a, b in [(native.q, python.q), (native.p, python.p)]:
         scale = np.max(np.abs(a))
-        assert np.max(np.abs(a - b)) <= 1e-12 * scale
-    np.testing.assert_allclose(python.energy(), native.energy(), rtol=1e-12, atol=1e-12 * abs(native.energy()[0]))
+        assert np.max(np.abs(a - b)) <= tol * scale
+    np.testing.assert_allclose(python.energy(), native.energy(), rtol=tol, atol=tol * abs(native.energy()[0]))
 
 
 def test_closure_symmetries_are_checked_like_native_ones():

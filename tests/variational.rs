@@ -3,7 +3,7 @@
 
 use varmech::diagnostics::symplecticity_defect;
 use varmech::discrete::{increment, DiscreteLagrangian, Midpoint, Rectangle, Trapezoidal, Workspace};
-use varmech::integrators::{Composition, Integrator, Method};
+use varmech::integrators::{integrate, Composition, Method, Options};
 use varmech::model::{finite_difference, Lagrangian, MechanicalSystem};
 use varmech::scenes::{DoublePendulum, FermiPastaUlam, HenonHeiles, Kepler, NBody};
 
@@ -20,10 +20,12 @@ fn check_legendre<S: MechanicalSystem, D: DiscreteLagrangian>(
     p0: &[f64],
     h: f64,
 ) {
-    let (mut q1, mut p1) = (q0.to_vec(), p0.to_vec());
-    Integrator::new(method, sys.dim())
-        .step(sys, &mut q1, &mut p1, h)
-        .unwrap();
+    let options = Options {
+        compensated: false,
+        ..Options::new(h, 1)
+    };
+    let traj = integrate(sys, method, q0, p0, &options, || Ok(())).unwrap();
+    let (q1, p1) = (traj.q_at(1).to_vec(), traj.p_at(1).to_vec());
     let minus = ld.momentum_minus(sys, q0, &q1, 0.0, h).unwrap();
     let plus = ld.momentum_plus(sys, q0, &q1, 0.0, h).unwrap();
     let scale = p0.iter().chain(&p1).fold(1.0_f64, |m, x| m.max(x.abs()));

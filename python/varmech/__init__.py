@@ -19,9 +19,10 @@ Hamilton's principle, and check what it conserves::
 
 from ._core import ConvergenceError, DivergenceError, VarmechError
 from .conservation import ConservationReport, EnergyReport, MomentumReport, check_conservation, momentum
+from .derivatives import DerivativeCheck, check_derivatives
 from .integrate import Trajectory, integrate, symplecticity_defect
 from .methods import MethodInfo, methods
-from .model import Cyclic, MechanicalSystem, Model, NativeSystem, Rotation, Translation
+from .model import Cyclic, Lagrangian, MechanicalSystem, Model, NativeSystem, Rotation, Translation
 from . import scenes
 
 __version__ = "0.1.0"
@@ -30,8 +31,10 @@ __all__ = [
     "ConservationReport",
     "ConvergenceError",
     "Cyclic",
+    "DerivativeCheck",
     "DivergenceError",
     "EnergyReport",
+    "Lagrangian",
     "MechanicalSystem",
     "MethodInfo",
     "Model",
@@ -42,6 +45,7 @@ __all__ = [
     "Translation",
     "VarmechError",
     "check_conservation",
+    "check_derivatives",
     "integrate",
     "methods",
     "momentum",

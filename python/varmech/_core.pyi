@@ -33,6 +33,10 @@ class NativeModel:
     @property
     def dim(self) -> int: ...
     @property
+    def separable(self) -> bool: ...
+    @property
+    def time_dependent(self) -> bool: ...
+    @property
     def name(self) -> str: ...
     @property
     def symmetries(self) -> list[tuple[str, int, int, str]]: ...
@@ -55,8 +59,30 @@ class ClosureModel:
     def dim(self) -> int: ...
     @property
     def has_gradient(self) -> bool: ...
+    @property
+    def separable(self) -> bool: ...
+    @property
+    def time_dependent(self) -> bool: ...
 
-Model = NativeModel | ClosureModel
+class ClosureLagrangian:
+    """A general Lagrangian L(q, q̇, t) from Python closures."""
+
+    def __init__(
+        self,
+        dim: int,
+        lagrangian: Callable[[FloatArray, FloatArray, float], float],
+        dl_dq: Callable[[FloatArray, FloatArray, float], Any] | None,
+        dl_dv: Callable[[FloatArray, FloatArray, float], Any] | None,
+        time_dependent: bool,
+    ) -> None: ...
+    @property
+    def dim(self) -> int: ...
+    @property
+    def separable(self) -> bool: ...
+    @property
+    def time_dependent(self) -> bool: ...
+
+Model = NativeModel | ClosureModel | ClosureLagrangian
 
 def integrate(
     model: Model,
@@ -74,8 +100,15 @@ def integrate(
     """(t, q, p, steps, force_evaluations, newton_iterations); on failure the exception carries
     ``_varmech_partial``."""
 
-def energy(model: Model, q: FloatArray, p: FloatArray) -> FloatArray: ...
-def apply_mass(model: Model, x: FloatArray, inverse: bool) -> FloatArray: ...
+def energy(model: Model, t: FloatArray, q: FloatArray, p: FloatArray) -> FloatArray:
+    """The energy function p·q̇ − L at each state."""
+
+def velocities(model: Model, t: FloatArray, q: FloatArray, p: FloatArray) -> FloatArray:
+    """q̇ with ∂L/∂q̇ = p at each state (the inverse Legendre transform)."""
+
+def momenta(model: Model, t: FloatArray, q: FloatArray, v: FloatArray) -> FloatArray:
+    """p = ∂L/∂q̇ at each state."""
+
 def momentum(generator: GeneratorSpec, q: FloatArray, p: FloatArray) -> FloatArray: ...
 def energy_statistics(t: FloatArray, h: FloatArray) -> dict[str, Any]: ...
 def invariant_statistics(values: FloatArray) -> tuple[float, float, float]: ...

@@ -19,6 +19,7 @@ TOUR = [
     ("henon_heiles", ("verlet", "kahan_li6", "rk4"), 5000.0),
     ("fermi_pasta_ulam", ("verlet", "mclachlan4", "rk4"), 200.0),
     ("outer_solar_system", ("verlet", "kahan_li8", "rk4"), None),
+    ("double_pendulum", ("midpoint", "trapezoid"), 100.0),
 ]
 
 

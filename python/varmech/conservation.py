@@ -62,6 +62,9 @@ class MomentumReport:
     max_rel_error: float
 
 
+NOT_CONSERVED = "not conserved (L depends on t)"
+
+
 @dataclass(frozen=True)
 class ConservationReport:
     """What a run conserved: its energy statistics and the errors of its Noether momenta."""
@@ -70,24 +73,28 @@ class ConservationReport:
     method: str
     dt: float
     t_end: float
-    energy: EnergyReport
+    #: None when L depends on t: its energy function is then not conserved, so not judged.
+    energy: EnergyReport | None
     momenta: tuple[MomentumReport, ...]
 
     @property
     def verdict(self) -> str:
-        """The energy verdict: "bounded" or "secular drift"."""
-        return self.energy.verdict
+        """The energy verdict: "bounded", "secular drift", or "not conserved (L depends on t)"."""
+        return self.energy.verdict if self.energy is not None else NOT_CONSERVED
 
     def __str__(self) -> str:
         e = self.energy
-        lines = [
-            f"Conservation report: {self.model}, {self.method}, dt = {self.dt:g}, t = 0 … {self.t_end:g}",
-            f"  energy   H0 = {e.initial:.12g}",
-            f"           max |ΔH/H0| = {e.max_error:.3e}   band = {e.band:.3e}",
-            f"           first tenth {e.max_error_first_tenth:.3e}   last tenth {e.max_error_last_tenth:.3e}",
-            f"           drift rate {e.drift_rate:+.3e} ± {e.drift_rate_stderr:.1e} per unit time",
-            f"           verdict: {e.verdict}",
-        ]
+        lines = [f"Conservation report: {self.model}, {self.method}, dt = {self.dt:g}, t = 0 … {self.t_end:g}"]
+        if e is None:
+            lines.append(f"  energy   {NOT_CONSERVED}")
+        else:
+            lines += [
+                f"  energy   H0 = {e.initial:.12g}",
+                f"           max |ΔH/H0| = {e.max_error:.3e}   band = {e.band:.3e}",
+                f"           first tenth {e.max_error_first_tenth:.3e}   last tenth {e.max_error_last_tenth:.3e}",
+                f"           drift rate {e.drift_rate:+.3e} ± {e.drift_rate_stderr:.1e} per unit time",
+                f"           verdict: {e.verdict}",
+            ]
         for m in self.momenta:
             lines.append(f"  momentum {m.name:<6} J0 = {m.initial:+.12g}   max |ΔJ| = {m.max_abs_error:.3e} (rel {m.max_rel_error:.3e})")
         return "\n".join(lines)
@@ -96,12 +103,14 @@ class ConservationReport:
 def check_conservation(traj: Trajectory, generators: Sequence[Generator] | None = None) -> ConservationReport:
     """Check the energy and the Noether momenta of ``traj``.
 
+    The energy function p·q̇ − L is judged only when L does not depend on t.
+
     ``generators`` defaults to the symmetries the model declares; a closure generator is named
     ``xi[k]``.
     """
     if generators is None:
         generators = traj.model.symmetries
-    energy = EnergyReport(**_core.energy_statistics(traj.t, traj.energy()))
+    energy = None if traj.model.time_dependent else EnergyReport(**_core.energy_statistics(traj.t, traj.energy()))
     momenta = []
     for k, g in enumerate(generators):
         name = g.name if isinstance(g, (Translation, Rotation, Cyclic)) else f"xi[{k}]"

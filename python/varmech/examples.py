@@ -11,7 +11,7 @@ import math
 
 import numpy as np
 
-from .model import MechanicalSystem, Rotation, Translation
+from .model import Lagrangian, MechanicalSystem, Rotation, Translation
 from .scenes import Scene
 
 
@@ -98,7 +98,28 @@ def nbody(G: float, masses: np.ndarray) -> MechanicalSystem:
     return MechanicalSystem(3 * n, potential, gradient, mass=np.repeat(m, 3), symmetries=symmetries, name="nbody (closure)")
 
 
-def closure_of(scene: Scene) -> MechanicalSystem:
+def double_pendulum(m1: float = 1.0, m2: float = 2.0, l1: float = 2.0, l2: float = 3.0, g: float = 9.80665) -> Lagrangian:
+    """The planar double pendulum as a general Lagrangian with exact derivatives."""
+
+    def mass(q: np.ndarray) -> np.ndarray:
+        c = m2 * l1 * l2 * math.cos(q[0] - q[1])
+        return np.array([[(m1 + m2) * l1 * l1, c], [c, m2 * l2 * l2]])
+
+    def lagrangian(q: np.ndarray, v: np.ndarray, t: float) -> float:
+        potential = -(m1 + m2) * g * l1 * math.cos(q[0]) - m2 * g * l2 * math.cos(q[1])
+        return 0.5 * float(v @ mass(q) @ v) - potential
+
+    def dl_dq(q: np.ndarray, v: np.ndarray, t: float) -> np.ndarray:
+        k = m2 * l1 * l2 * v[0] * v[1] * math.sin(q[0] - q[1])
+        return np.array([-k - (m1 + m2) * g * l1 * math.sin(q[0]), k - m2 * g * l2 * math.sin(q[1])])
+
+    def dl_dv(q: np.ndarray, v: np.ndarray, t: float) -> np.ndarray:
+        return mass(q) @ v
+
+    return Lagrangian(2, lagrangian, dl_dq=dl_dq, dl_dv=dl_dv, name="double_pendulum (closure)")
+
+
+def closure_of(scene: Scene) -> MechanicalSystem | Lagrangian:
     """The closure version of a built-in scene (with its default parameters)."""
     gravity = scene.model._core.gravity
     if gravity is not None:
@@ -109,4 +130,5 @@ def closure_of(scene: Scene) -> MechanicalSystem:
         "kepler": kepler,
         "henon_heiles": henon_heiles,
         "fermi_pasta_ulam": fermi_pasta_ulam,
+        "double_pendulum": double_pendulum,
     }[scene.name]()

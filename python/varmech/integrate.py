@@ -47,14 +47,15 @@ class Trajectory:
 
     @property
     def v(self) -> np.ndarray:
-        """Velocities q̇ = M⁻¹p, shape (N, n)."""
+        """Velocities q̇ (with ∂L/∂q̇ = p; M⁻¹p for mechanical systems), shape (N, n)."""
         if self._v is None:
-            self._v = self.model.velocity(self.p)
+            self._v = _core.velocities(self.model._core, self.t, self.q, self.p)
         return self._v
 
     def energy(self) -> np.ndarray:
-        """The energy H = p·q̇ − L = ½pᵀM⁻¹p + V(q) at each saved state, shape (N,)."""
-        return _core.energy(self.model._core, self.q, self.p)
+        """The energy function E = p·q̇ − L (= ½pᵀM⁻¹p + V(q) for mechanical systems) at each
+        saved state, shape (N,)."""
+        return _core.energy(self.model._core, self.t, self.q, self.p)
 
     def __len__(self) -> int:
         return len(self.t)
@@ -94,7 +95,7 @@ def integrate(
     dt: float,
     steps: int | None = None,
     t_end: float | None = None,
-    method: str = "verlet",
+    method: str | None = None,
     save_every: int = 1,
     compensated: bool = True,
     max_energy_error: float | None = None,
@@ -109,13 +110,14 @@ def integrate(
         (whose initial state is then the default).
     q0, p0, v0:
         Initial positions and momenta, arrays (n,); give the velocities ``v0`` instead of
-        ``p0`` to start from p0 = M v0.
+        ``p0`` to start from p0 = ∂L/∂q̇(q0, v0, t0) (M v0 for mechanical systems).
     dt:
         The step h > 0.
     steps, t_end:
         How far: a number of steps, or a final time that is a whole number of steps.
     method:
-        A name from :func:`varmech.methods` (default ``"verlet"``).
+        A name from :func:`varmech.methods`. Default: ``"verlet"`` for separable mechanical
+        systems, ``"midpoint"`` for general Lagrangians.
     save_every:
         Keep every k-th state; the initial and final states are always kept.
     compensated:
@@ -153,6 +155,8 @@ def integrate(
     if not isinstance(model, Model):
         raise TypeError(f"model: expected a varmech model or scene, got {type(model).__name__}")
     n = model.dim
+    if method is None:
+        method = "verlet" if model.separable else "midpoint"
     dt = positive("dt", dt)
     t0 = float(t0)
     if not math.isfinite(t0):
@@ -167,7 +171,7 @@ def integrate(
     q = vector("q0", q0, n)
     if (p0 is None) == (v0 is None):
         raise ValueError("p0, v0: give exactly one of the initial momenta p0 and velocities v0")
-    p = vector("p0", p0, n) if p0 is not None else model.momentum(vector("v0", v0, n))
+    p = vector("p0", p0, n) if p0 is not None else model.momentum(q, vector("v0", v0, n), t0)
     try:
         t, qs, ps, done, nfev, newton = _core.integrate(
             model._core,

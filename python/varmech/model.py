@@ -72,10 +72,14 @@ def _symmetry_from_spec(kind: str, a: int, d: int) -> Symmetry:
 
 
 class Model:
-    """A varmech model: n generalized coordinates, a mass matrix, a potential, and the
-    symmetries it declares (each with a conserved Noether momentum)."""
+    """A varmech model: a Lagrangian L(q, q̇, t) in n generalized coordinates, and the
+    symmetries it declares (each with a conserved Noether momentum).
 
-    _core: _core.NativeModel | _core.ClosureModel
+    Separable mechanical systems (L = ½q̇ᵀMq̇ − V) take every method; general Lagrangians the
+    implicit variational ones (``midpoint``, ``trapezoid``).
+    """
+
+    _core: _core.NativeModel | _core.ClosureModel | _core.ClosureLagrangian
     symmetries: tuple[Symmetry, ...]
     name: str
 
@@ -84,18 +88,31 @@ class Model:
         """Number of generalized coordinates n."""
         return self._core.dim
 
-    def velocity(self, p: ArrayLike) -> np.ndarray:
-        """q̇ = M⁻¹p, for one state (n,) or for rows (N, n)."""
-        return self._apply_mass(p, inverse=True)
+    @property
+    def separable(self) -> bool:
+        """Whether L = ½q̇ᵀMq̇ − V(q) with constant M (then explicit methods apply)."""
+        return self._core.separable
 
-    def momentum(self, v: ArrayLike) -> np.ndarray:
-        """p = Mq̇, for one state (n,) or for rows (N, n)."""
-        return self._apply_mass(v, inverse=False)
+    @property
+    def time_dependent(self) -> bool:
+        """Whether L depends on t explicitly (then its energy function is not conserved)."""
+        return self._core.time_dependent
 
-    def _apply_mass(self, x: ArrayLike, inverse: bool) -> np.ndarray:
-        a = np.ascontiguousarray(x, dtype=float)
-        out = _core.apply_mass(self._core, np.atleast_2d(a), inverse)
-        return out.reshape(a.shape)
+    def velocity(self, q: ArrayLike, p: ArrayLike, t: ArrayLike = 0.0) -> np.ndarray:
+        """q̇ with ∂L/∂q̇(q, q̇, t) = p (M⁻¹p for mechanical systems), for one state (n,) or
+        for rows (N, n)."""
+        return self._legendre(_core.velocities, q, p, t)
+
+    def momentum(self, q: ArrayLike, v: ArrayLike, t: ArrayLike = 0.0) -> np.ndarray:
+        """p = ∂L/∂q̇(q, q̇, t) (Mq̇ for mechanical systems), for one state (n,) or rows (N, n)."""
+        return self._legendre(_core.momenta, q, v, t)
+
+    def _legendre(self, transform, q: ArrayLike, x: ArrayLike, t: ArrayLike) -> np.ndarray:
+        x = np.ascontiguousarray(x, dtype=float)
+        rows = np.atleast_2d(x)
+        q2 = np.ascontiguousarray(np.broadcast_to(np.asarray(q, dtype=float), rows.shape))
+        t1 = np.ascontiguousarray(np.broadcast_to(np.asarray(t, dtype=float), rows.shape[:1]))
+        return transform(self._core, t1, q2, rows).reshape(x.shape)
 
     def __repr__(self) -> str:
         return f"{type(self).__name__}({self.name!r}, dim={self.dim})"
@@ -161,5 +178,62 @@ class MechanicalSystem(Model):
         self.potential = potential
         self.gradient = gradient
         self.mass = m
+        self.symmetries = tuple(symmetries)
+        self.name = name
+
+
+class Lagrangian(Model):
+    """A general Lagrangian L(q, q̇, t) given by Python closures, for the implicit variational
+    methods (``midpoint``, ``trapezoid``).
+
+    Parameters
+    ----------
+    dim:
+        Number of generalized coordinates n.
+    lagrangian:
+        ``lagrangian(q, v, t) -> float``.
+    dl_dq, dl_dv:
+        ``dl_dq(q, v, t) -> array (n,)`` and ``dl_dv(q, v, t) -> array (n,)``, the derivatives
+        ∂L/∂q and ∂L/∂q̇ (the momentum). Optional: missing ones come from central differences
+        of L (2n calls of L each, about 1e-10 relative accuracy), and a warning says so.
+        :func:`varmech.check_derivatives` checks supplied ones.
+    time_dependent:
+        Whether L depends on t; then the energy function p·q̇ − L is not conserved and the
+        conservation report says so instead of judging it.
+    symmetries:
+        Symmetries of L whose Noether momenta :func:`varmech.check_conservation` checks.
+    name:
+        A label for reports.
+    """
+
+    def __init__(
+        self,
+        dim: int,
+        lagrangian: Callable[[np.ndarray, np.ndarray, float], float],
+        *,
+        dl_dq: Callable[[np.ndarray, np.ndarray, float], ArrayLike] | None = None,
+        dl_dv: Callable[[np.ndarray, np.ndarray, float], ArrayLike] | None = None,
+        time_dependent: bool = False,
+        symmetries: Sequence[Symmetry] = (),
+        name: str = "lagrangian",
+    ):
+        if isinstance(dim, bool) or not isinstance(dim, (int, np.integer)) or dim < 1:
+            raise ValueError(f"dim: must be a positive integer, got {dim!r}")
+        missing = [n for n, f in (("dl_dq", dl_dq), ("dl_dv", dl_dv)) if f is None]
+        if missing:
+            warnings.warn(
+                f"{name}: no {' and no '.join(missing)} given; central differences of L are used "
+                f"({2 * dim} calls of L each, about 1e-10 relative accuracy)",
+                stacklevel=2,
+            )
+        for s in symmetries:
+            if not isinstance(s, (Translation, Rotation, Cyclic)):
+                raise TypeError(f"symmetries: expected Translation, Rotation or Cyclic, got {s!r}")
+            if max(s.spec()[1], 0) >= dim and isinstance(s, Cyclic):
+                raise ValueError(f"symmetries: {s} does not apply to {dim} coordinates")
+        self._core = _core.ClosureLagrangian(int(dim), lagrangian, dl_dq, dl_dv, bool(time_dependent))
+        self.lagrangian = lagrangian
+        self.dl_dq = dl_dq
+        self.dl_dv = dl_dv
         self.symmetries = tuple(symmetries)
         self.name = name

@@ -89,6 +89,14 @@ def outer_solar_system() -> Scene:
     return _scene("outer_solar_system", "outer solar system (AU, days, solar masses)", 50.0, {"H": -3.215453183208163e-08})
 
 
+def double_pendulum() -> Scene:
+    """The planar double pendulum in its two angles (l = (2, 3), m = (1, 2), g = 9.80665), a
+    general Lagrangian (configuration-dependent mass), from θ = (π/4, π/2), θ̇ = (0, π/8) to
+    T = 10 against the GeometricProblems.jl reference. Integrate it with ``midpoint`` or
+    ``trapezoid``."""
+    return _scene("double_pendulum", "double pendulum (configuration-dependent mass)", 0.01, {"E": -40.218179175435154})
+
+
 def nbody(masses: ArrayLike, positions: ArrayLike, velocities: ArrayLike, G: float = 1.0, t_end: float = 1.0, dt: float = 1e-3) -> Scene:
     """A native gravitational N-body model in 3 dimensions from masses (N,), positions and
     velocities (N, 3)."""
@@ -109,6 +117,7 @@ CATALOGUE: dict[str, Callable[[], Scene]] = {
     "henon_heiles": henon_heiles,
     "fermi_pasta_ulam": fermi_pasta_ulam,
     "outer_solar_system": outer_solar_system,
+    "double_pendulum": double_pendulum,
 }
 
 

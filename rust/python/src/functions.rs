@@ -5,19 +5,19 @@ use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
 use varmech::diagnostics::{self, EnergyStatistics, InvariantStatistics};
-use varmech::integrators::{self, Method, Options};
-use varmech::model::MechanicalSystem;
-use varmech::scenes::{self, Problem, Scene};
-use varmech::{Error, ModelError};
+use varmech::integrators::{self, General, Integrable, Method, Options};
+use varmech::scenes::{self, LagrangianScene, Problem, Scene};
+use varmech::ModelError;
 
 use crate::convert::{self, rows, slice, trajectory_tuple};
 use crate::errors::{failure_to_pyerr, to_pyerr};
-use crate::model::{ClosureModel, ClosureSystem, NativeModel};
+use crate::model::{ClosureLagrangian, ClosureLagrangianSystem, ClosureModel, ClosureSystem, Native, NativeModel};
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(integrate, m)?)?;
     m.add_function(wrap_pyfunction!(energy, m)?)?;
-    m.add_function(wrap_pyfunction!(apply_mass, m)?)?;
+    m.add_function(wrap_pyfunction!(velocities, m)?)?;
+    m.add_function(wrap_pyfunction!(momenta, m)?)?;
     m.add_function(wrap_pyfunction!(momentum, m)?)?;
     m.add_function(wrap_pyfunction!(energy_statistics, m)?)?;
     m.add_function(wrap_pyfunction!(invariant_statistics, m)?)?;
@@ -35,24 +35,62 @@ fn boxed(e: PyErr) -> ModelError {
 fn model_type_error(model: &Bound<'_, PyAny>) -> PyErr {
     let ty = model.get_type().name().map(|n| n.to_string()).unwrap_or_default();
     PyTypeError::new_err(format!(
-        "model: expected a varmech model (a scene's or varmech.MechanicalSystem), got {ty}"
+        "model: expected a varmech model (a scene's, MechanicalSystem or Lagrangian), got {ty}"
     ))
 }
 
-/// Runs `body` with the model as a core system: a native scene with the GIL released, a
-/// closure model with it held.
+/// Runs `body` with `sys` bound to the model as an [`Integrable`], and `poll` to the Ctrl-C
+/// check: native models with the GIL released (the poll takes it back briefly), closure models
+/// with it held.
 macro_rules! with_system {
-    ($py:ident, $model:expr, |$sys:ident| $body:expr) => {{
+    ($py:ident, $model:expr, |$sys:ident, $poll:ident| $body:expr) => {{
         if let Ok(native) = $model.cast::<NativeModel>() {
-            let $sys = &native.get().scene;
-            $py.detach(|| $body)
+            match &native.get().native {
+                Native::Mechanical(scene) => $py.detach(|| {
+                    let $sys: &Scene = scene;
+                    let $poll = || Python::attach(|py| py.check_signals()).map_err(boxed);
+                    $body
+                }),
+                Native::General(scene) => $py.detach(|| {
+                    let $sys = &General::<LagrangianScene>(scene);
+                    let $poll = || Python::attach(|py| py.check_signals()).map_err(boxed);
+                    $body
+                }),
+            }
         } else if let Ok(closure) = $model.cast::<ClosureModel>() {
             let $sys = &ClosureSystem::new($py, closure.get());
+            let $poll = || $py.check_signals().map_err(boxed);
+            $body
+        } else if let Ok(closure) = $model.cast::<ClosureLagrangian>() {
+            let closure = ClosureLagrangianSystem::new($py, closure.get());
+            let $sys = &General(&closure);
+            let $poll = || $py.check_signals().map_err(boxed);
             $body
         } else {
             return Err(model_type_error($model));
         }
     }};
+}
+
+/// The number of coordinates of a model.
+fn model_dim(model: &Bound<'_, PyAny>) -> PyResult<usize> {
+    if let Ok(native) = model.cast::<NativeModel>() {
+        Ok(native.get().dim())
+    } else if let Ok(closure) = model.cast::<ClosureModel>() {
+        Ok(closure.get().dim())
+    } else if let Ok(closure) = model.cast::<ClosureLagrangian>() {
+        Ok(closure.get().dim())
+    } else {
+        Err(model_type_error(model))
+    }
+}
+
+/// A model's error as the Python exception it stands for.
+fn model_error(e: ModelError) -> PyErr {
+    match e.downcast::<PyErr>() {
+        Ok(err) => *err,
+        Err(e) => PyValueError::new_err(e.to_string()),
+    }
 }
 
 /// Integrates; returns (t, q, p, steps, force_evaluations, newton_iterations) or raises with
@@ -83,88 +121,104 @@ fn integrate<'py>(
         t0,
     };
     let (q0, p0) = (slice("q0", &q0)?.to_vec(), slice("p0", &p0)?.to_vec());
-    let result = if let Ok(native) = model.cast::<NativeModel>() {
-        let scene: &Scene = &native.get().scene;
-        // No Python runs here; the poll takes the GIL only to look for Ctrl-C.
-        py.detach(|| {
-            integrators::integrate(scene, method, &q0, &p0, &options, || {
-                Python::attach(|py| py.check_signals()).map_err(boxed)
-            })
-        })
-    } else if let Ok(closure) = model.cast::<ClosureModel>() {
-        let sys = ClosureSystem::new(py, closure.get());
-        integrators::integrate(&sys, method, &q0, &p0, &options, || py.check_signals().map_err(boxed))
-    } else {
-        return Err(model_type_error(model));
-    };
+    let result = with_system!(py, model, |sys, poll| integrators::integrate(
+        sys, method, &q0, &p0, &options, poll
+    ));
     match result {
         Ok(traj) => trajectory_tuple(py, traj),
         Err(failure) => Err(failure_to_pyerr(py, *failure)),
     }
 }
 
-/// H(q, p) = ½pᵀM⁻¹p + V(q) for each row of (q, p).
+/// Checks that t, q and x are N times, and (N, n) arrays for the model's n, and returns them.
+fn states<'a>(
+    model: &Bound<'_, PyAny>,
+    t: &'a PyReadonlyArray1<'_, f64>,
+    q: &'a PyReadonlyArray2<'_, f64>,
+    x: &'a PyReadonlyArray2<'_, f64>,
+) -> PyResult<(&'a [f64], &'a [f64], &'a [f64], usize)> {
+    let dim = model_dim(model)?;
+    let (t, (q, n), (x, m)) = (slice("t", t)?, rows("q", q)?, rows("x", x)?);
+    if n != dim || m != dim || q.len() != x.len() || q.len() != t.len() * dim {
+        return Err(PyValueError::new_err(format!(
+            "t, q: need N times and two (N, {dim}) arrays of states"
+        )));
+    }
+    Ok((t, q, x, dim))
+}
+
+/// The energy function E = p·q̇ − L (= ½pᵀM⁻¹p + V for mechanical systems) at each state.
 #[pyfunction]
 fn energy<'py>(
     py: Python<'py>,
     model: &Bound<'py, PyAny>,
+    t: PyReadonlyArray1<'py, f64>,
     q: PyReadonlyArray2<'py, f64>,
     p: PyReadonlyArray2<'py, f64>,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
-    let ((q, n), (p, _)) = (rows("q", &q)?, rows("p", &p)?);
-    check_rows(model, n, q.len(), p.len())?;
-    let result: Result<Vec<f64>, ModelError> = with_system!(py, model, |sys| {
-        q.chunks_exact(n)
-            .zip(p.chunks_exact(n))
-            .map(|(q, p)| diagnostics::hamiltonian(sys, q, p))
+    let (t, q, p, n) = states(model, &t, &q, &p)?;
+    let result: Result<Vec<f64>, ModelError> = with_system!(py, model, |sys, _poll| {
+        let l = sys.as_lagrangian();
+        t.iter()
+            .zip(q.chunks_exact(n).zip(p.chunks_exact(n)))
+            .map(|(t, (q, p))| l.energy(q, p, *t))
             .collect()
     });
-    match result {
-        Ok(h) => Ok(PyArray1::from_vec(py, h)),
-        Err(e) => Err(match e.downcast::<PyErr>() {
-            Ok(err) => *err,
-            Err(e) => PyValueError::new_err(e.to_string()),
-        }),
-    }
+    Ok(PyArray1::from_vec(py, result.map_err(model_error)?))
 }
 
-/// Checks that q and p are (N, n) arrays of the model's dimension n.
-fn check_rows(model: &Bound<'_, PyAny>, n: usize, q_len: usize, p_len: usize) -> PyResult<()> {
-    let dim = if let Ok(native) = model.cast::<NativeModel>() {
-        native.get().scene.dim()
-    } else if let Ok(closure) = model.cast::<ClosureModel>() {
-        closure.get().dim()
-    } else {
-        return Err(model_type_error(model));
-    };
-    if n != dim || q_len != p_len {
-        return Err(PyValueError::new_err(format!("q, p: must both have shape (N, {dim})")));
-    }
-    Ok(())
-}
-
-/// q̇ = M⁻¹p for each row of `x` (`inverse`), or p = Mq̇.
-#[pyfunction]
-fn apply_mass<'py>(
+/// Applies a Legendre transform to each state: q̇ from p (`inverse`) or p = ∂L/∂q̇ from q̇.
+fn legendre<'py>(
     py: Python<'py>,
     model: &Bound<'py, PyAny>,
+    t: PyReadonlyArray1<'py, f64>,
+    q: PyReadonlyArray2<'py, f64>,
     x: PyReadonlyArray2<'py, f64>,
     inverse: bool,
 ) -> PyResult<Bound<'py, PyAny>> {
-    let (x, n) = rows("x", &x)?;
-    check_rows(model, n, x.len(), x.len())?;
-    let y: Vec<f64> = with_system!(py, model, |sys| {
+    let (t, q, x, n) = states(model, &t, &q, &x)?;
+    let result: Result<Vec<f64>, ModelError> = with_system!(py, model, |sys, _poll| {
+        let l = sys.as_lagrangian();
         let mut y = vec![0.0; x.len()];
-        for (x, y) in x.chunks_exact(n).zip(y.chunks_exact_mut(n)) {
+        let rows = t
+            .iter()
+            .zip(q.chunks_exact(n).zip(x.chunks_exact(n)))
+            .zip(y.chunks_exact_mut(n));
+        rows.map(|((t, (q, x)), y)| {
             if inverse {
-                sys.mass().velocity(x, y)
+                l.velocity(q, x, *t, y)
             } else {
-                sys.mass().momentum(x, y)
+                l.dl_dv(q, x, *t, y)
             }
-        }
-        y
+        })
+        .collect::<Result<(), ModelError>>()
+        .map(|()| y)
     });
-    convert::matrix(py, y, n)
+    convert::matrix(py, result.map_err(model_error)?, n)
+}
+
+/// q̇ with ∂L/∂q̇ = p at each state (M⁻¹p for mechanical systems).
+#[pyfunction]
+fn velocities<'py>(
+    py: Python<'py>,
+    model: &Bound<'py, PyAny>,
+    t: PyReadonlyArray1<'py, f64>,
+    q: PyReadonlyArray2<'py, f64>,
+    p: PyReadonlyArray2<'py, f64>,
+) -> PyResult<Bound<'py, PyAny>> {
+    legendre(py, model, t, q, p, true)
+}
+
+/// p = ∂L/∂q̇ at each state (Mq̇ for mechanical systems).
+#[pyfunction]
+fn momenta<'py>(
+    py: Python<'py>,
+    model: &Bound<'py, PyAny>,
+    t: PyReadonlyArray1<'py, f64>,
+    q: PyReadonlyArray2<'py, f64>,
+    v: PyReadonlyArray2<'py, f64>,
+) -> PyResult<Bound<'py, PyAny>> {
+    legendre(py, model, t, q, v, false)
 }
 
 /// J = p·ξ(q) of a generator spec for each row of (q, p).
@@ -230,7 +284,7 @@ fn symplecticity_defect<'py>(
 ) -> PyResult<f64> {
     let method = Method::from_name(method).map_err(|e| to_pyerr(py, e))?;
     let (q, p) = (slice("q", &q)?, slice("p", &p)?);
-    let result = with_system!(py, model, |sys| diagnostics::symplecticity_defect(
+    let result = with_system!(py, model, |sys, _poll| diagnostics::symplecticity_defect(
         sys, method, q, p, dt
     ));
     result.map_err(|e| to_pyerr(py, e))
@@ -269,7 +323,7 @@ type SceneTuple<'py> = (
 fn scene_tuple<'py, S>(
     py: Python<'py>,
     p: Problem<S>,
-    wrap: fn(S) -> Scene,
+    wrap: impl FnOnce(S) -> Native,
     name: &'static str,
 ) -> PyResult<SceneTuple<'py>> {
     let reference = match p.reference {
@@ -291,33 +345,48 @@ fn scene_tuple<'py, S>(
 #[pyfunction]
 #[pyo3(signature = (name, *, e=0.6, omega=1.0))]
 fn scene<'py>(py: Python<'py>, name: &str, e: f64, omega: f64) -> PyResult<SceneTuple<'py>> {
-    let invalid = |err: Error| to_pyerr(py, err);
+    let mech = |s| Native::Mechanical(s);
+    let err = |e| to_pyerr(py, e);
     match name {
-        "harmonic_oscillator" => scene_tuple(
+        "harmonic_oscillator" => {
+            let p = scenes::HarmonicOscillator::problem(omega).map_err(err)?;
+            scene_tuple(py, p, |s| mech(Scene::HarmonicOscillator(s)), "harmonic_oscillator")
+        }
+        "pendulum" => scene_tuple(
             py,
-            scenes::HarmonicOscillator::problem(omega).map_err(invalid)?,
-            Scene::HarmonicOscillator,
-            "harmonic_oscillator",
+            scenes::Pendulum::problem(),
+            |s| mech(Scene::Pendulum(s)),
+            "pendulum",
         ),
-        "pendulum" => scene_tuple(py, scenes::Pendulum::problem(), Scene::Pendulum, "pendulum"),
         "kepler" => scene_tuple(
             py,
-            scenes::Kepler::problem(e).map_err(invalid)?,
-            Scene::Kepler,
+            scenes::Kepler::problem(e).map_err(err)?,
+            |s| mech(Scene::Kepler(s)),
             "kepler",
         ),
-        "henon_heiles" => scene_tuple(py, scenes::HenonHeiles::problem(), Scene::HenonHeiles, "henon_heiles"),
+        "henon_heiles" => scene_tuple(
+            py,
+            scenes::HenonHeiles::problem(),
+            |s| mech(Scene::HenonHeiles(s)),
+            "henon_heiles",
+        ),
         "fermi_pasta_ulam" => scene_tuple(
             py,
             scenes::FermiPastaUlam::problem(),
-            Scene::FermiPastaUlam,
+            |s| mech(Scene::FermiPastaUlam(s)),
             "fermi_pasta_ulam",
         ),
         "outer_solar_system" => scene_tuple(
             py,
             scenes::NBody::outer_solar_system(),
-            Scene::NBody,
+            |s| mech(Scene::NBody(s)),
             "outer_solar_system",
+        ),
+        "double_pendulum" => scene_tuple(
+            py,
+            scenes::DoublePendulum::problem(),
+            |s| Native::General(LagrangianScene::DoublePendulum(s)),
+            "double_pendulum",
         ),
         _ => Err(PyValueError::new_err(format!("name: unknown scene {name:?}"))),
     }
@@ -325,8 +394,7 @@ fn scene<'py>(py: Python<'py>, name: &str, e: f64, omega: f64) -> PyResult<Scene
 
 /// A native gravitational N-body model in 3 dimensions.
 #[pyfunction]
-#[pyo3(name = "nbody")]
 fn nbody(py: Python<'_>, g: f64, masses: Vec<f64>) -> PyResult<NativeModel> {
     let system = scenes::NBody::new(g, masses).map_err(|e| to_pyerr(py, e))?;
-    Ok(NativeModel::new(Scene::NBody(system), "nbody"))
+    Ok(NativeModel::new(Native::Mechanical(Scene::NBody(system)), "nbody"))
 }

@@ -19,6 +19,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("ConvergenceError", py.get_type::<errors::ConvergenceError>())?;
     m.add_class::<model::NativeModel>()?;
     m.add_class::<model::ClosureModel>()?;
+    m.add_class::<model::ClosureLagrangian>()?;
     functions::register(m)?;
     Ok(())
 }

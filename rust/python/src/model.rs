@@ -1,35 +1,48 @@
-//! Models seen from Python: native scenes, and Python closures adapted to the core's
-//! [`MechanicalSystem`] trait.
+//! Models seen from Python: native scenes, and Python closures adapted to the core's model
+//! traits ([`MechanicalSystem`] and [`Lagrangian`]).
 
 use std::cell::RefCell;
 
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
-use varmech::model::{finite_difference, Generator, Mass, MechanicalSystem};
-use varmech::scenes::Scene;
+use varmech::model::{finite_difference, Generator, Lagrangian, Mass, MechanicalSystem};
+use varmech::scenes::{LagrangianScene, Scene};
 use varmech::ModelError;
 
 use crate::convert;
 
+/// A native scene: a separable mechanical system, or a general Lagrangian.
+pub enum Native {
+    Mechanical(Scene),
+    General(LagrangianScene),
+}
+
 /// A native scene: every evaluation runs in Rust, with the GIL released.
 #[pyclass(frozen, module = "varmech._core")]
 pub struct NativeModel {
-    pub scene: Scene,
+    pub native: Native,
     name: &'static str,
 }
 
 impl NativeModel {
-    pub fn new(scene: Scene, name: &'static str) -> Self {
-        NativeModel { scene, name }
+    pub fn new(native: Native, name: &'static str) -> Self {
+        NativeModel { native, name }
+    }
+
+    pub fn dim(&self) -> usize {
+        match &self.native {
+            Native::Mechanical(s) => MechanicalSystem::dim(s),
+            Native::General(s) => Lagrangian::dim(s),
+        }
     }
 }
 
 #[pymethods]
 impl NativeModel {
-    #[getter]
-    fn dim(&self) -> usize {
-        self.scene.dim()
+    #[getter(dim)]
+    fn py_dim(&self) -> usize {
+        self.dim()
     }
 
     #[getter]
@@ -37,11 +50,22 @@ impl NativeModel {
         self.name
     }
 
+    /// Whether the model is a separable mechanical system (every method applies to it).
+    #[getter]
+    fn separable(&self) -> bool {
+        matches!(self.native, Native::Mechanical(_))
+    }
+
+    #[getter]
+    fn time_dependent(&self) -> bool {
+        false
+    }
+
     /// (G, masses) of an N-body scene, None for the others.
     #[getter]
     fn gravity(&self) -> Option<(f64, Vec<f64>)> {
-        match &self.scene {
-            Scene::NBody(s) => Some((s.gravitational_constant(), s.masses().to_vec())),
+        match &self.native {
+            Native::Mechanical(Scene::NBody(s)) => Some((s.gravitational_constant(), s.masses().to_vec())),
             _ => None,
         }
     }
@@ -49,15 +73,14 @@ impl NativeModel {
     /// The declared symmetries, as (kind, axis or index, spatial_dim, name).
     #[getter]
     fn symmetries(&self) -> Vec<(&'static str, usize, usize, String)> {
-        self.scene
-            .symmetries()
-            .into_iter()
-            .map(convert::generator_spec)
-            .collect()
+        match &self.native {
+            Native::Mechanical(s) => s.symmetries().into_iter().map(convert::generator_spec).collect(),
+            Native::General(_) => Vec::new(),
+        }
     }
 
     fn __repr__(&self) -> String {
-        format!("NativeModel({:?}, dim={})", self.name, self.scene.dim())
+        format!("NativeModel({:?}, dim={})", self.name, self.dim())
     }
 }
 
@@ -84,16 +107,7 @@ impl ClosureModel {
         mass: &Bound<'_, PyAny>,
         symmetries: Vec<(String, usize, usize)>,
     ) -> PyResult<Self> {
-        if dim == 0 {
-            return Err(PyValueError::new_err("dim: must be at least 1"));
-        }
-        for (name, f) in [("potential", Some(&potential)), ("gradient", gradient.as_ref())] {
-            if let Some(f) = f {
-                if !f.is_callable() {
-                    return Err(PyTypeError::new_err(format!("{name}: must be callable")));
-                }
-            }
-        }
+        check_closures(dim, [("potential", Some(&potential)), ("gradient", gradient.as_ref())])?;
         let mass = convert::mass(mass)?;
         if let Some(n) = mass.dim().filter(|n| *n != dim) {
             return Err(PyValueError::new_err(format!(
@@ -126,9 +140,149 @@ impl ClosureModel {
         self.gradient.is_some()
     }
 
+    #[getter]
+    fn separable(&self) -> bool {
+        true
+    }
+
+    #[getter]
+    fn time_dependent(&self) -> bool {
+        false
+    }
+
     fn __repr__(&self) -> String {
         format!("ClosureModel(dim={})", self.dim)
     }
+}
+
+/// A general Lagrangian L(q, q̇, t) given by Python closures: `lagrangian(q, v, t) -> float`
+/// and, optionally, `dl_dq(q, v, t)` and `dl_dv(q, v, t)` (arrays (n,)); missing derivatives
+/// come from central differences of L.
+#[pyclass(frozen, module = "varmech._core")]
+pub struct ClosureLagrangian {
+    dim: usize,
+    lagrangian: Py<PyAny>,
+    dl_dq: Option<Py<PyAny>>,
+    dl_dv: Option<Py<PyAny>>,
+    time_dependent: bool,
+}
+
+#[pymethods]
+impl ClosureLagrangian {
+    #[new]
+    #[pyo3(signature = (dim, lagrangian, dl_dq, dl_dv, time_dependent))]
+    fn new(
+        dim: usize,
+        lagrangian: Bound<'_, PyAny>,
+        dl_dq: Option<Bound<'_, PyAny>>,
+        dl_dv: Option<Bound<'_, PyAny>>,
+        time_dependent: bool,
+    ) -> PyResult<Self> {
+        check_closures(
+            dim,
+            [
+                ("lagrangian", Some(&lagrangian)),
+                ("dl_dq", dl_dq.as_ref()),
+                ("dl_dv", dl_dv.as_ref()),
+            ],
+        )?;
+        Ok(ClosureLagrangian {
+            dim,
+            lagrangian: lagrangian.unbind(),
+            dl_dq: dl_dq.map(Bound::unbind),
+            dl_dv: dl_dv.map(Bound::unbind),
+            time_dependent,
+        })
+    }
+
+    #[getter]
+    pub fn dim(&self) -> usize {
+        self.dim
+    }
+
+    #[getter]
+    fn separable(&self) -> bool {
+        false
+    }
+
+    #[getter]
+    fn time_dependent(&self) -> bool {
+        self.time_dependent
+    }
+
+    fn __repr__(&self) -> String {
+        format!("ClosureLagrangian(dim={})", self.dim)
+    }
+}
+
+/// A positive dimension and callable closures (the optional ones may be None).
+fn check_closures<const N: usize>(dim: usize, closures: [(&str, Option<&Bound<'_, PyAny>>); N]) -> PyResult<()> {
+    if dim == 0 {
+        return Err(PyValueError::new_err("dim: must be at least 1"));
+    }
+    for (name, f) in closures {
+        if f.is_some_and(|f| !f.is_callable()) {
+            return Err(PyTypeError::new_err(format!("{name}: must be callable")));
+        }
+    }
+    Ok(())
+}
+
+fn boxed(e: PyErr) -> ModelError {
+    Box::new(e)
+}
+
+/// The name of a Python object's type, for messages.
+fn type_name(x: &Bound<'_, PyAny>) -> String {
+    x.get_type().name().map(|n| n.to_string()).unwrap_or_default()
+}
+
+/// Reads a closure's result, a float; a wrong type is a TypeError naming the closure as `call`.
+fn call_scalar(result: PyResult<Bound<'_, PyAny>>, call: &str) -> Result<f64, ModelError> {
+    let result = result.map_err(boxed)?;
+    result.extract::<f64>().map_err(|_| {
+        boxed(PyTypeError::new_err(format!(
+            "{call} must return a float, got {}",
+            type_name(&result)
+        )))
+    })
+}
+
+/// Reads a closure's result, an array (n,) of floats, into `out`: a float64 numpy array is
+/// read in place, any other sequence of numbers is converted. A wrong length is a ValueError
+/// and a wrong type a TypeError, both naming the closure as `call`.
+fn call_vector(result: PyResult<Bound<'_, PyAny>>, call: &str, out: &mut [f64]) -> Result<(), ModelError> {
+    let result = result.map_err(boxed)?;
+    let n = out.len();
+    let wrong_length = |len: usize| {
+        boxed(PyValueError::new_err(format!(
+            "{call} returned {len} values, expected {n} (one per coordinate)"
+        )))
+    };
+    if let Ok(arr) = result.cast::<PyArray1<f64>>() {
+        let ro = arr.readonly();
+        let view = ro.as_array();
+        if view.len() != n {
+            return Err(wrong_length(view.len()));
+        }
+        out.iter_mut().zip(view.iter()).for_each(|(o, v)| *o = *v);
+        return Ok(());
+    }
+    let values: Vec<f64> = result.extract().map_err(|_| {
+        let shape = result
+            .getattr("shape")
+            .map(|s| format!(" of shape {s}"))
+            .unwrap_or_default();
+        boxed(PyTypeError::new_err(format!(
+            "{call} must return a 1-d array of {n} floats, got {}{shape}",
+            type_name(&result)
+        )))
+    })?;
+    if values.len() != n {
+        return Err(wrong_length(values.len()));
+    }
+    out.copy_from_slice(&values);
+    Ok(())
 }
 
 /// A [`ClosureModel`] bound to the GIL for the duration of a call: it implements the core's
@@ -153,10 +307,6 @@ impl<'a, 'py> ClosureSystem<'a, 'py> {
     }
 }
 
-fn boxed(e: PyErr) -> ModelError {
-    Box::new(e)
-}
-
 impl MechanicalSystem for ClosureSystem<'_, '_> {
     fn dim(&self) -> usize {
         self.model.dim
@@ -167,58 +317,79 @@ impl MechanicalSystem for ClosureSystem<'_, '_> {
     }
 
     fn potential(&self, q: &[f64]) -> Result<f64, ModelError> {
-        let out = self
-            .potential
-            .call1((PyArray1::from_slice(self.py, q),))
-            .map_err(boxed)?;
-        out.extract::<f64>().map_err(|_| {
-            let ty = out.get_type().name().map(|n| n.to_string()).unwrap_or_default();
-            boxed(PyTypeError::new_err(format!(
-                "potential(q) must return a float, got {ty}"
-            )))
-        })
+        call_scalar(
+            self.potential.call1((PyArray1::from_slice(self.py, q),)),
+            "potential(q)",
+        )
     }
 
     fn gradient(&self, q: &[f64], grad: &mut [f64]) -> Result<(), ModelError> {
-        let Some(gradient) = &self.gradient else {
-            let mut work = self.work.borrow_mut();
-            return finite_difference::central_gradient(|x| self.potential(x), q, &mut work, grad);
-        };
-        let out = gradient.call1((PyArray1::from_slice(self.py, q),)).map_err(boxed)?;
-        let n = grad.len();
-        let wrong_length = |len: usize| {
-            boxed(PyValueError::new_err(format!(
-                "gradient(q) returned {len} values, expected {n} (one per coordinate)"
-            )))
-        };
-        // The fast path: a float64 numpy array, read in place.
-        if let Ok(arr) = out.cast::<PyArray1<f64>>() {
-            let ro = arr.readonly();
-            let view = ro.as_array();
-            if view.len() != n {
-                return Err(wrong_length(view.len()));
-            }
-            grad.iter_mut().zip(view.iter()).for_each(|(g, v)| *g = *v);
-            return Ok(());
+        match &self.gradient {
+            Some(f) => call_vector(f.call1((PyArray1::from_slice(self.py, q),)), "gradient(q)", grad),
+            None => finite_difference::central_gradient(|x| self.potential(x), q, &mut self.work.borrow_mut(), grad),
         }
-        let values: Vec<f64> = out.extract().map_err(|_| {
-            let ty = out.get_type().name().map(|n| n.to_string()).unwrap_or_default();
-            let shape = out
-                .getattr("shape")
-                .map(|s| format!(" of shape {s}"))
-                .unwrap_or_default();
-            boxed(PyTypeError::new_err(format!(
-                "gradient(q) must return a 1-d array of {n} floats, got {ty}{shape}"
-            )))
-        })?;
-        if values.len() != n {
-            return Err(wrong_length(values.len()));
-        }
-        grad.copy_from_slice(&values);
-        Ok(())
     }
 
     fn symmetries(&self) -> Vec<Generator> {
         self.model.symmetries.clone()
+    }
+}
+
+/// A [`ClosureLagrangian`] bound to the GIL: it implements the core's [`Lagrangian`] trait.
+pub struct ClosureLagrangianSystem<'a, 'py> {
+    py: Python<'py>,
+    model: &'a ClosureLagrangian,
+    lagrangian: Bound<'py, PyAny>,
+    dl_dq: Option<Bound<'py, PyAny>>,
+    dl_dv: Option<Bound<'py, PyAny>>,
+    work: RefCell<Vec<f64>>,
+}
+
+impl<'a, 'py> ClosureLagrangianSystem<'a, 'py> {
+    pub fn new(py: Python<'py>, model: &'a ClosureLagrangian) -> Self {
+        ClosureLagrangianSystem {
+            py,
+            model,
+            lagrangian: model.lagrangian.bind(py).clone(),
+            dl_dq: model.dl_dq.as_ref().map(|f| f.bind(py).clone()),
+            dl_dv: model.dl_dv.as_ref().map(|f| f.bind(py).clone()),
+            work: RefCell::new(vec![0.0; model.dim]),
+        }
+    }
+
+    fn args(&self, q: &[f64], v: &[f64], t: f64) -> (Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>, f64) {
+        (PyArray1::from_slice(self.py, q), PyArray1::from_slice(self.py, v), t)
+    }
+}
+
+impl Lagrangian for ClosureLagrangianSystem<'_, '_> {
+    fn dim(&self) -> usize {
+        self.model.dim
+    }
+
+    fn lagrangian(&self, q: &[f64], v: &[f64], t: f64) -> Result<f64, ModelError> {
+        call_scalar(self.lagrangian.call1(self.args(q, v, t)), "lagrangian(q, v, t)")
+    }
+
+    fn dl_dq(&self, q: &[f64], v: &[f64], t: f64, out: &mut [f64]) -> Result<(), ModelError> {
+        match &self.dl_dq {
+            Some(f) => call_vector(f.call1(self.args(q, v, t)), "dl_dq(q, v, t)", out),
+            None => {
+                finite_difference::central_gradient(|x| self.lagrangian(x, v, t), q, &mut self.work.borrow_mut(), out)
+            }
+        }
+    }
+
+    fn dl_dv(&self, q: &[f64], v: &[f64], t: f64, out: &mut [f64]) -> Result<(), ModelError> {
+        match &self.dl_dv {
+            Some(f) => call_vector(f.call1(self.args(q, v, t)), "dl_dv(q, v, t)", out),
+            None => {
+                finite_difference::central_gradient(|x| self.lagrangian(q, x, t), v, &mut self.work.borrow_mut(), out)
+            }
+        }
+    }
+
+    fn is_time_dependent(&self) -> bool {
+        self.model.time_dependent
     }
 }

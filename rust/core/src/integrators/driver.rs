@@ -30,9 +30,12 @@ pub trait Integrable {
 
     /// The conserved energy at (q, p), where the driver can evaluate it.
     fn energy(&self, q: &[f64], p: &[f64]) -> Option<Result<f64, ModelError>>;
+
+    /// The system as a Lagrangian, for the diagnostics (energy function, Legendre transforms).
+    fn as_lagrangian(&self) -> &dyn Lagrangian;
 }
 
-impl<S: MechanicalSystem + ?Sized> Integrable for S {
+impl<S: MechanicalSystem> Integrable for S {
     fn dim(&self) -> usize {
         MechanicalSystem::dim(self)
     }
@@ -57,12 +60,16 @@ impl<S: MechanicalSystem + ?Sized> Integrable for S {
     fn energy(&self, q: &[f64], p: &[f64]) -> Option<Result<f64, ModelError>> {
         Some(hamiltonian(self, q, p))
     }
+
+    fn as_lagrangian(&self) -> &dyn Lagrangian {
+        self
+    }
 }
 
 /// A general Lagrangian L(q, q̇, t), for the implicit variational methods.
 pub struct General<'a, L: ?Sized>(pub &'a L);
 
-impl<L: Lagrangian + ?Sized> Integrable for General<'_, L> {
+impl<L: Lagrangian> Integrable for General<'_, L> {
     fn dim(&self) -> usize {
         self.0.dim()
     }
@@ -95,6 +102,10 @@ impl<L: Lagrangian + ?Sized> Integrable for General<'_, L> {
     /// E = p·q̇ − L, unless L depends on t (then nothing is conserved to check).
     fn energy(&self, q: &[f64], p: &[f64]) -> Option<Result<f64, ModelError>> {
         (!self.0.is_time_dependent()).then(|| self.0.energy(q, p, 0.0))
+    }
+
+    fn as_lagrangian(&self) -> &dyn Lagrangian {
+        self.0
     }
 }
 

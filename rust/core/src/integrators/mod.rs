@@ -188,20 +188,4 @@ impl Integrator {
             )),
         }
     }
-
-    /// One plain step (q, p) ← Ψ_h(q, p) from t = 0, without compensated summation.
-    pub fn step<S: MechanicalSystem + ?Sized>(
-        &mut self,
-        sys: &S,
-        q: &mut [f64],
-        p: &mut [f64],
-        h: f64,
-    ) -> Result<(), StepError> {
-        let mut dq = vec![0.0; q.len()];
-        let mut dp = vec![0.0; p.len()];
-        self.increment(sys, 0.0, q, p, h, &mut dq, &mut dp)?;
-        q.iter_mut().zip(&dq).for_each(|(x, d)| *x += d);
-        p.iter_mut().zip(&dp).for_each(|(x, d)| *x += d);
-        Ok(())
-    }
 }

@@ -21,7 +21,7 @@ pub use kepler::Kepler;
 pub use nbody::NBody;
 pub use pendulum::Pendulum;
 
-use crate::model::{Generator, Mass, MechanicalSystem};
+use crate::model::{Generator, Lagrangian, Mass, MechanicalSystem};
 use crate::ModelError;
 
 /// A state (q, p) at time t.
@@ -68,7 +68,7 @@ macro_rules! dispatch {
 
 impl MechanicalSystem for Scene {
     fn dim(&self) -> usize {
-        dispatch!(self, s => s.dim())
+        dispatch!(self, s => MechanicalSystem::dim(s))
     }
     fn mass(&self) -> &Mass {
         dispatch!(self, s => s.mass())
@@ -82,5 +82,39 @@ impl MechanicalSystem for Scene {
     }
     fn symmetries(&self) -> Vec<Generator> {
         dispatch!(self, s => s.symmetries())
+    }
+}
+
+/// Any native scene that is a general Lagrangian (integrated by the implicit methods).
+#[derive(Clone, Debug)]
+pub enum LagrangianScene {
+    DoublePendulum(DoublePendulum),
+}
+
+impl Lagrangian for LagrangianScene {
+    fn dim(&self) -> usize {
+        match self {
+            LagrangianScene::DoublePendulum(s) => Lagrangian::dim(s),
+        }
+    }
+    fn lagrangian(&self, q: &[f64], v: &[f64], t: f64) -> Result<f64, ModelError> {
+        match self {
+            LagrangianScene::DoublePendulum(s) => s.lagrangian(q, v, t),
+        }
+    }
+    fn dl_dq(&self, q: &[f64], v: &[f64], t: f64, out: &mut [f64]) -> Result<(), ModelError> {
+        match self {
+            LagrangianScene::DoublePendulum(s) => s.dl_dq(q, v, t, out),
+        }
+    }
+    fn dl_dv(&self, q: &[f64], v: &[f64], t: f64, out: &mut [f64]) -> Result<(), ModelError> {
+        match self {
+            LagrangianScene::DoublePendulum(s) => s.dl_dv(q, v, t, out),
+        }
+    }
+    fn velocity(&self, q: &[f64], p: &[f64], t: f64, v: &mut [f64]) -> Result<(), ModelError> {
+        match self {
+            LagrangianScene::DoublePendulum(s) => s.velocity(q, p, t, v),
+        }
     }
 }

@@ -1,0 +1,81 @@
+"""Checks of user-supplied derivatives against differences."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from ._util import vector
+from .model import Lagrangian, MechanicalSystem, Model
+
+
+@dataclass(frozen=True)
+class DerivativeCheck:
+    """The worst mismatch between each supplied derivative and central differences.
+
+    ``mismatch`` maps a derivative's name to max |supplied − differences| / max(1, |differences|);
+    ``ok`` says whether every mismatch is below ``rtol``.
+    """
+
+    mismatch: dict[str, float]
+    rtol: float
+
+    @property
+    def ok(self) -> bool:
+        return all(m <= self.rtol for m in self.mismatch.values())
+
+    @property
+    def worst(self) -> tuple[str, float]:
+        name = max(self.mismatch, key=self.mismatch.__getitem__)
+        return name, self.mismatch[name]
+
+    def __str__(self) -> str:
+        rows = [f"  {n:<9} {m:.2e}  {'ok' if m <= self.rtol else 'MISMATCH'}" for n, m in self.mismatch.items()]
+        return "\n".join([f"Derivative check (rtol {self.rtol:g}):", *rows])
+
+
+def _central(f, x: np.ndarray) -> np.ndarray:
+    """∇f(x) by central differences with steps ε^{1/3}·max(|xᵢ|, 1)."""
+    g = np.empty_like(x)
+    for i in range(len(x)):
+        h = np.finfo(float).eps ** (1 / 3) * max(abs(x[i]), 1.0)
+        e = np.zeros_like(x)
+        e[i] = h
+        g[i] = (f(x + e) - f(x - e)) / (2 * h)
+    return g
+
+
+def _mismatch(supplied: ArrayLike, differences: np.ndarray) -> float:
+    s = np.asarray(supplied, dtype=float)
+    if s.shape != differences.shape:
+        return float("inf")
+    return float(np.max(np.abs(s - differences)) / max(1.0, float(np.max(np.abs(differences)))))
+
+
+def check_derivatives(model: Model, q: ArrayLike, v: ArrayLike | None = None, t: float = 0.0, *, rtol: float = 1e-6) -> DerivativeCheck:
+    """Compare the derivatives ``model`` supplies with central differences at (q, q̇, t).
+
+    For a :class:`~varmech.MechanicalSystem`, its ``gradient`` against differences of its
+    ``potential``; for a :class:`~varmech.Lagrangian`, its ``dl_dq`` and ``dl_dv`` against
+    differences of L. Differences are accurate to about 1e-10 relative, so a mismatch above
+    ``rtol`` (default 1e-6) means a wrong derivative.
+    """
+    n = model.dim
+    q = vector("q", q, n)
+    mismatch: dict[str, float] = {}
+    if isinstance(model, MechanicalSystem):
+        if model.gradient is not None:
+            mismatch["gradient"] = _mismatch(model.gradient(q.copy()), _central(model.potential, q))
+    elif isinstance(model, Lagrangian):
+        v = vector("v", v if v is not None else np.zeros(n), n)
+        if model.dl_dq is not None:
+            mismatch["dl_dq"] = _mismatch(model.dl_dq(q.copy(), v.copy(), t), _central(lambda x: model.lagrangian(x, v, t), q))
+        if model.dl_dv is not None:
+            mismatch["dl_dv"] = _mismatch(model.dl_dv(q.copy(), v.copy(), t), _central(lambda x: model.lagrangian(q, x, t), v))
+    else:
+        raise TypeError(f"model: expected a MechanicalSystem or Lagrangian of closures, got {type(model).__name__}")
+    if not mismatch:
+        raise ValueError("model: supplies no derivatives to check")
+    return DerivativeCheck(mismatch, rtol)

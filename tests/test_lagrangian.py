@@ -1,0 +1,103 @@
+"""General Lagrangians from Python closures with the implicit variational integrators."""
+
+import math
+
+import numpy as np
+import pytest
+
+import varmech
+from varmech import examples, scenes
+
+
+def charged_particle(B: float) -> varmech.Lagrangian:
+    """A unit charge of unit mass in the uniform field B ẑ: L = ½|v|² + A(q)·v, A = (B/2)(−y, x)."""
+
+    def lagrangian(q, v, t):
+        return 0.5 * float(v @ v) + 0.5 * B * (q[0] * v[1] - q[1] * v[0])
+
+    def dl_dq(q, v, t):
+        return 0.5 * B * np.array([v[1], -v[0]])
+
+    def dl_dv(q, v, t):
+        return v + 0.5 * B * np.array([-q[1], q[0]])
+
+    return varmech.Lagrangian(2, lagrangian, dl_dq=dl_dq, dl_dv=dl_dv, name="charged particle")
+
+
+@pytest.mark.parametrize("h", [0.1, 1.0, 3.0])
+def test_midpoint_gyration_phase_is_two_arctan_half_h_omega(h):
+    # From (1, 0) with velocity (0, −B) the exact orbit is q(t) = (cos Ωt, −sin Ωt), Ω = B; the
+    # midpoint rule turns by exactly 2·arctan(hΩ/2) a step, at every step size.
+    B, steps = 2.0, 200
+    traj = varmech.integrate(charged_particle(B), [1.0, 0.0], v0=[0.0, -B], dt=h, steps=steps, method="midpoint")
+    theta = 2 * math.atan(h * B / 2) * np.arange(steps + 1)
+    np.testing.assert_allclose(traj.q, np.column_stack([np.cos(theta), -np.sin(theta)]), atol=1e-12)
+    np.testing.assert_allclose(traj.v[:, 1], -B * np.cos(theta), atol=1e-12)
+    report = varmech.check_conservation(traj)
+    assert report.verdict == "bounded" and report.energy.max_error < 1e-13
+
+
+def test_double_pendulum_closure_reaches_the_reference_at_order_two():
+    scene = scenes.double_pendulum()
+    model = examples.double_pendulum()
+    errors = []
+    for steps in (1000, 2000, 4000):
+        traj = varmech.integrate(model, scene.q0, scene.p0, dt=scene.reference.t / steps, steps=steps, method="midpoint", save_every=steps)
+        errors.append(np.hypot(np.linalg.norm(traj.q[-1] - scene.reference.q), np.linalg.norm(traj.p[-1] - scene.reference.p)))
+    orders = np.log2(np.array(errors[:-1]) / np.array(errors[1:]))
+    assert np.all(np.abs(orders - 2) < 0.3), orders
+    e0 = varmech.integrate(scene, dt=0.01, steps=1).energy()[0]
+    assert e0 == pytest.approx(-40.218179175435154, rel=1e-13)
+
+
+def test_time_dependent_lagrangian_is_not_judged_on_its_energy():
+    # A parametrically driven oscillator: E = p·q̇ − L is not conserved.
+    omega = lambda t: 1.0 + 0.5 * math.sin(t)  # noqa: E731
+    model = varmech.Lagrangian(
+        1,
+        lambda q, v, t: 0.5 * v[0] ** 2 - 0.5 * omega(t) ** 2 * q[0] ** 2,
+        dl_dq=lambda q, v, t: np.array([-omega(t) ** 2 * q[0]]),
+        dl_dv=lambda q, v, t: v.copy(),
+        time_dependent=True,
+    )
+    traj = varmech.integrate(model, [1.0], [0.0], dt=0.05, steps=400, method="midpoint")
+    report = varmech.check_conservation(traj)
+    assert report.energy is None and report.verdict == "not conserved (L depends on t)"
+    assert "not conserved" in str(report)
+    assert np.ptp(traj.energy()) > 0.1
+    with pytest.raises(ValueError, match="^max_energy_error:"):
+        varmech.integrate(model, [1.0], [0.0], dt=0.05, steps=10, method="midpoint", max_energy_error=1.0)
+
+
+def test_check_derivatives_catches_a_wrong_derivative():
+    good = examples.double_pendulum()
+    report = varmech.check_derivatives(good, [0.3, -1.2], [0.7, 2.5])
+    assert report.ok and report.worst[1] < 1e-8
+    wrong = varmech.Lagrangian(2, good.lagrangian, dl_dq=lambda q, v, t: -good.dl_dq(q, v, t), dl_dv=good.dl_dv)
+    report = varmech.check_derivatives(wrong, [0.3, -1.2], [0.7, 2.5])
+    assert not report.ok and report.worst[0] == "dl_dq" and "MISMATCH" in str(report)
+    kepler = examples.kepler()
+    assert varmech.check_derivatives(kepler, [0.4, 0.3]).ok
+    bad = varmech.MechanicalSystem(2, kepler.potential, lambda q: 2 * kepler.gradient(q))
+    assert not varmech.check_derivatives(bad, [0.4, 0.3]).ok
+
+
+def test_lagrangian_without_derivatives_warns_and_uses_differences():
+    exact = examples.double_pendulum()
+    with pytest.warns(UserWarning, match="no dl_dq and no dl_dv"):
+        fd = varmech.Lagrangian(2, exact.lagrangian)
+    scene = scenes.double_pendulum()
+    a = varmech.integrate(exact, scene.q0, scene.p0, dt=0.01, steps=100, method="midpoint")
+    b = varmech.integrate(fd, scene.q0, scene.p0, dt=0.01, steps=100, method="midpoint")
+    assert np.max(np.abs(a.q - b.q)) < 1e-8
+
+
+def test_general_lagrangians_refuse_explicit_methods_and_name_bad_closures():
+    model = charged_particle(1.0)
+    with pytest.raises(ValueError, match="^method: verlet needs a separable mechanical system"):
+        varmech.integrate(model, [1.0, 0.0], [0.0, 1.0], dt=0.1, steps=1, method="verlet")
+    broken = varmech.Lagrangian(2, model.lagrangian, dl_dq=lambda q, v, t: np.zeros(3), dl_dv=model.dl_dv)
+    with pytest.raises(ValueError, match=r"dl_dq\(q, v, t\) returned 3 values, expected 2"):
+        varmech.integrate(broken, [1.0, 0.0], [0.0, 1.0], dt=0.1, steps=1, method="midpoint")
+    with pytest.raises(TypeError, match="^lagrangian: must be callable"):
+        varmech.Lagrangian(2, 1.0, dl_dq=model.dl_dq, dl_dv=model.dl_dv)
