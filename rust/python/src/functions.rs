@@ -130,13 +130,16 @@ fn integrate<'py>(
     }
 }
 
+/// Times, positions and a second quantity per state, as flat rows, with the dimension n.
+type States<'a> = (&'a [f64], &'a [f64], &'a [f64], usize);
+
 /// Checks that t, q and x are N times, and (N, n) arrays for the model's n, and returns them.
 fn states<'a>(
     model: &Bound<'_, PyAny>,
     t: &'a PyReadonlyArray1<'_, f64>,
     q: &'a PyReadonlyArray2<'_, f64>,
     x: &'a PyReadonlyArray2<'_, f64>,
-) -> PyResult<(&'a [f64], &'a [f64], &'a [f64], usize)> {
+) -> PyResult<States<'a>> {
     let dim = model_dim(model)?;
     let (t, (q, n), (x, m)) = (slice("t", t)?, rows("q", q)?, rows("x", x)?);
     if n != dim || m != dim || q.len() != x.len() || q.len() != t.len() * dim {
@@ -184,14 +187,13 @@ fn legendre<'py>(
             .iter()
             .zip(q.chunks_exact(n).zip(x.chunks_exact(n)))
             .zip(y.chunks_exact_mut(n));
-        rows.map(|((t, (q, x)), y)| {
+        rows.try_for_each(|((t, (q, x)), y)| {
             if inverse {
                 l.velocity(q, x, *t, y)
             } else {
                 l.dl_dv(q, x, *t, y)
             }
         })
-        .collect::<Result<(), ModelError>>()
         .map(|()| y)
     });
     convert::matrix(py, result.map_err(model_error)?, n)
