@@ -183,7 +183,7 @@ fn legendre<'py>(
     let result: Result<Vec<f64>, ModelError> = with_system!(py, model, |sys, _poll| {
         let l = sys.as_lagrangian();
         let mut y = vec![0.0; x.len()];
-        let rows = t
+        let mut rows = t
             .iter()
             .zip(q.chunks_exact(n).zip(x.chunks_exact(n)))
             .zip(y.chunks_exact_mut(n));
