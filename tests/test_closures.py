@@ -75,6 +75,8 @@ def test_implicit_methods_on_closures_match_native(method):
     native = varmech.integrate(scene, dt=scene.dt, steps=500, method=method)
     python = varmech.integrate(examples.kepler(), scene.q0, scene.p0, dt=scene.dt, steps=500, method=method)
     assert native.newton_iterations > 0 and python.newton_iterations == native.newton_iterations
+    per_step = native.newton_iterations_per_step
+    assert per_step.shape == (500,) and 1 <= per_step.min() and per_step.max() <= 6
     np.testing.assert_allclose(python.q, native.q, atol=1e-12)
     # Trapezoid is Störmer–Verlet for a separable system, solved implicitly.
     if method == "trapezoid":

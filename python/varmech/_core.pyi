@@ -96,9 +96,9 @@ def integrate(
     compensated: bool = True,
     max_energy_error: float | None = None,
     t0: float = 0.0,
-) -> tuple[FloatArray, FloatArray, FloatArray, int, int, int]:
-    """(t, q, p, steps, force_evaluations, newton_iterations); on failure the exception carries
-    ``_varmech_partial``."""
+) -> tuple[FloatArray, FloatArray, FloatArray, int, int, NDArray[np.uint64]]:
+    """(t, q, p, steps, force_evaluations, newton): ``newton`` is the cumulative count of Newton
+    iterations at each saved state; on failure the exception carries ``_varmech_partial``."""
 
 def energy(model: Model, t: FloatArray, q: FloatArray, p: FloatArray) -> FloatArray:
     """The energy function p·q̇ − L at each state."""

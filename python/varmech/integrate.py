@@ -23,7 +23,8 @@ class Trajectory:
 
     ``t`` has shape (N,), ``q`` and ``p`` shape (N, n); ``v`` = M⁻¹p is computed on demand.
     ``nfev`` counts force evaluations (for the implicit methods, evaluations of the discrete
-    Lagrangian's slot derivatives) and ``newton_iterations`` the implicit methods' iterations.
+    Lagrangian's slot derivatives); ``newton_iterations`` and ``newton_iterations_per_step``
+    count the implicit methods' iterations.
     ``status`` is 0 when the run reached its end, -1 for the partial trajectory attached to an
     error (``err.partial``); ``message`` says which.
     """
@@ -36,7 +37,7 @@ class Trajectory:
     dt: float
     steps: int
     nfev: int
-    newton_iterations: int = 0
+    newton: np.ndarray | None = field(default=None, repr=False)
     status: int = 0
     message: str = "The integration reached its final time."
     _v: np.ndarray | None = field(default=None, repr=False)
@@ -44,6 +45,17 @@ class Trajectory:
     @property
     def success(self) -> bool:
         return self.status == 0
+
+    @property
+    def newton_iterations(self) -> int:
+        """Newton iterations of the implicit methods over the run (0 for explicit methods)."""
+        return int(self.newton[-1]) if self.newton is not None and len(self.newton) else 0
+
+    @property
+    def newton_iterations_per_step(self) -> np.ndarray:
+        """Mean Newton iterations per step between consecutive saved states, shape (N − 1,)."""
+        steps = np.diff(np.rint((self.t - self.t[0]) / self.dt))
+        return np.diff(self.newton) / np.maximum(steps, 1)
 
     @property
     def v(self) -> np.ndarray:

@@ -176,6 +176,9 @@ pub struct Trajectory {
     pub force_evaluations: u64,
     /// Newton iterations made (implicit methods).
     pub newton_iterations: u64,
+    /// Newton iterations made up to each saved state (cumulative; all zero for explicit
+    /// methods): their differences give the iterations per step between saves.
+    pub newton: Vec<u64>,
 }
 
 impl Trajectory {
@@ -198,8 +201,9 @@ impl Trajectory {
         &self.p[k * self.dim..(k + 1) * self.dim]
     }
 
-    fn push(&mut self, t: f64, q: &[f64], p: &[f64]) {
+    fn push(&mut self, t: f64, q: &[f64], p: &[f64], newton: u64) {
         self.t.push(t);
+        self.newton.push(newton);
         self.q.extend_from_slice(q);
         self.p.extend_from_slice(p);
     }
@@ -303,11 +307,12 @@ where
     let saved = (steps / save_every).saturating_add(2);
     let reserved = saved.checked_mul(n).is_some_and(|len| {
         traj.t.try_reserve_exact(saved).is_ok()
+            && traj.newton.try_reserve_exact(saved).is_ok()
             && traj.q.try_reserve_exact(len).is_ok()
             && traj.p.try_reserve_exact(len).is_ok()
     });
     if !reserved {
-        let gib = saved as f64 * (2 * n + 1) as f64 * 8.0 / (1u64 << 30) as f64;
+        let gib = saved as f64 * (2 * n + 2) as f64 * 8.0 / (1u64 << 30) as f64;
         let reason =
             format!("keeping {saved} states needs {gib:.3e} GiB, more than can be allocated; raise save_every");
         return Err(fail(Error::invalid("save_every", reason), traj));
@@ -322,7 +327,7 @@ where
     let (mut eq_next, mut ep_next) = (vec![0.0; n], vec![0.0; n]);
     let mut integrator = Integrator::new(method, n);
     let mut interrupt = InterruptPoll::new();
-    traj.push(t0, &q, &p);
+    traj.push(t0, &q, &p, 0);
     let h0 = match max_energy_error.and_then(|_| sys.energy(&q, &p)) {
         None => None,
         Some(energy) => match energy {
@@ -345,7 +350,7 @@ where
         // Stops with the last good state (step − 1) kept, and the work counted.
         let stop = |error: Error, mut traj: Trajectory, q: &[f64], p: &[f64], integrator: &Integrator| {
             if traj.t.last() != Some(&time) {
-                traj.push(time, q, p);
+                traj.push(time, q, p, integrator.newton_iterations());
             }
             traj.steps = step - 1;
             traj.force_evaluations = integrator.force_evaluations();
@@ -392,7 +397,7 @@ where
         }
         if step % save_every == 0 || step == steps {
             let t = t0 + step as f64 * dt;
-            traj.push(t, &q, &p);
+            traj.push(t, &q, &p, integrator.newton_iterations());
             if let (Some(tol), Some(h0)) = (max_energy_error, h0) {
                 // The state of this step is kept: it is finite, only its energy is off.
                 let error = match sys.energy(&q, &p).expect("checked before the first step") {
