@@ -101,3 +101,41 @@ def test_general_lagrangians_refuse_explicit_methods_and_name_bad_closures():
         varmech.integrate(broken, [1.0, 0.0], [0.0, 1.0], dt=0.1, steps=1, method="midpoint")
     with pytest.raises(TypeError, match="^lagrangian: must be callable"):
         varmech.Lagrangian(2, 1.0, dl_dq=model.dl_dq, dl_dv=model.dl_dv)
+
+
+def test_forced_system_keeps_its_energy_balance_with_the_tracked_work():
+    # A damped oscillator with Rayleigh dissipation R = ½cq̇²: for the midpoint rule on this
+    # quadratic L, E changes by exactly the tracked work of the force each step.
+    c = 0.1
+    model = varmech.Lagrangian(
+        1,
+        lambda q, v, t: 0.5 * v[0] ** 2 - 0.5 * q[0] ** 2,
+        dl_dq=lambda q, v, t: -q.copy(),
+        dl_dv=lambda q, v, t: v.copy(),
+        rayleigh=c,
+    )
+    assert model.forced
+    traj = varmech.integrate(model, [1.0], [0.0], dt=0.1, steps=2000, method="midpoint", save_every=10)
+    e = traj.energy()
+    np.testing.assert_allclose(e - e[0], traj.work, atol=1e-14)
+    assert e[-1] < 0.01 * e[0]
+    report = varmech.check_conservation(traj)
+    assert report.energy is None and report.energy_balance < 1e-13
+    assert report.verdict.startswith("not conserved (forced)") and "E − E0 − W" in str(report)
+    with pytest.raises(ValueError, match="^rayleigh:"):
+        varmech.Lagrangian(1, model.lagrangian, dl_dq=model.dl_dq, dl_dv=model.dl_dv, rayleigh=[1.0, 2.0])
+
+
+def test_a_force_closure_that_raises_propagates_unchanged():
+    class Stall(Exception):
+        pass
+
+    def force(q, v, t):
+        if t > 0.5:
+            raise Stall("stalled")
+        return np.zeros(1)
+
+    model = varmech.Lagrangian(1, lambda q, v, t: 0.5 * v[0] ** 2 - 0.5 * q[0] ** 2, dl_dq=lambda q, v, t: -q.copy(), dl_dv=lambda q, v, t: v.copy(), force=force)
+    with pytest.raises(Stall) as info:
+        varmech.integrate(model, [1.0], [0.0], dt=0.1, steps=100, method="midpoint")
+    assert info.value.partial.steps == 5 and len(info.value.partial.work) == 6

@@ -37,6 +37,8 @@ class NativeModel:
     @property
     def time_dependent(self) -> bool: ...
     @property
+    def forced(self) -> bool: ...
+    @property
     def name(self) -> str: ...
     @property
     def symmetries(self) -> list[tuple[str, int, int, str]]: ...
@@ -63,6 +65,8 @@ class ClosureModel:
     def separable(self) -> bool: ...
     @property
     def time_dependent(self) -> bool: ...
+    @property
+    def forced(self) -> bool: ...
 
 class ClosureLagrangian:
     """A general Lagrangian L(q, q̇, t) from Python closures."""
@@ -73,8 +77,11 @@ class ClosureLagrangian:
         lagrangian: Callable[[FloatArray, FloatArray, float], float],
         dl_dq: Callable[[FloatArray, FloatArray, float], Any] | None,
         dl_dv: Callable[[FloatArray, FloatArray, float], Any] | None,
+        force: Callable[[FloatArray, FloatArray, float], Any] | None,
         time_dependent: bool,
     ) -> None: ...
+    @property
+    def forced(self) -> bool: ...
     @property
     def dim(self) -> int: ...
     @property
@@ -96,9 +103,10 @@ def integrate(
     compensated: bool = True,
     max_energy_error: float | None = None,
     t0: float = 0.0,
-) -> tuple[FloatArray, FloatArray, FloatArray, int, int, NDArray[np.uint64]]:
-    """(t, q, p, steps, force_evaluations, newton): ``newton`` is the cumulative count of Newton
-    iterations at each saved state; on failure the exception carries ``_varmech_partial``."""
+) -> tuple[FloatArray, FloatArray, FloatArray, int, int, NDArray[np.uint64], FloatArray]:
+    """(t, q, p, steps, force_evaluations, newton, work): the cumulative Newton iterations and
+    work of the forces at each saved state; on failure the exception carries
+    ``_varmech_partial``."""
 
 def energy(model: Model, t: FloatArray, q: FloatArray, p: FloatArray) -> FloatArray:
     """The energy function p·q̇ − L at each state."""

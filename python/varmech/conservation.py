@@ -63,6 +63,7 @@ class MomentumReport:
 
 
 NOT_CONSERVED = "not conserved (L depends on t)"
+FORCED = "not conserved (forced); see the energy balance"
 
 
 @dataclass(frozen=True)
@@ -73,20 +74,27 @@ class ConservationReport:
     method: str
     dt: float
     t_end: float
-    #: None when L depends on t: its energy function is then not conserved, so not judged.
+    #: None when L depends on t or forces act: the energy is then not conserved, so not judged.
     energy: EnergyReport | None
     momenta: tuple[MomentumReport, ...]
+    #: For forced systems, max |E(t) − E(0) − W(t)| / |E(0)| (absolute when E(0) = 0): the
+    #: discrete Lagrange–d'Alembert energy balance with the tracked work W.
+    energy_balance: float | None = None
 
     @property
     def verdict(self) -> str:
-        """The energy verdict: "bounded", "secular drift", or "not conserved (L depends on t)"."""
-        return self.energy.verdict if self.energy is not None else NOT_CONSERVED
+        """The energy verdict: "bounded", "secular drift", or why the energy is not conserved."""
+        if self.energy is not None:
+            return self.energy.verdict
+        return FORCED if self.energy_balance is not None else NOT_CONSERVED
 
     def __str__(self) -> str:
         e = self.energy
         lines = [f"Conservation report: {self.model}, {self.method}, dt = {self.dt:g}, t = 0 … {self.t_end:g}"]
         if e is None:
-            lines.append(f"  energy   {NOT_CONSERVED}")
+            lines.append(f"  energy   {self.verdict}")
+            if self.energy_balance is not None:
+                lines.append(f"           max |E − E0 − W|/|E0| = {self.energy_balance:.3e}")
         else:
             lines += [
                 f"  energy   H0 = {e.initial:.12g}",
@@ -103,16 +111,24 @@ class ConservationReport:
 def check_conservation(traj: Trajectory, generators: Sequence[Generator] | None = None) -> ConservationReport:
     """Check the energy and the Noether momenta of ``traj``.
 
-    The energy function p·q̇ − L is judged only when L does not depend on t.
+    The energy function p·q̇ − L is judged only when L does not depend on t and no forces act;
+    for forced systems the report gives the energy balance E(t) − E(0) − W(t) with the work W
+    of the forces instead.
 
     ``generators`` defaults to the symmetries the model declares; a closure generator is named
     ``xi[k]``.
     """
     if generators is None:
         generators = traj.model.symmetries
-    energy = None if traj.model.time_dependent else EnergyReport(**_core.energy_statistics(traj.t, traj.energy()))
+    model = traj.model
+    conserved = not (model.time_dependent or model.forced)
+    energy = EnergyReport(**_core.energy_statistics(traj.t, traj.energy())) if conserved else None
+    balance = None
+    if model.forced and not model.time_dependent:
+        e = traj.energy()
+        balance = float(np.max(np.abs(e - e[0] - traj.work)) / (abs(e[0]) or 1.0))
     momenta = []
     for k, g in enumerate(generators):
         name = g.name if isinstance(g, (Translation, Rotation, Cyclic)) else f"xi[{k}]"
         momenta.append(MomentumReport(name, *_core.invariant_statistics(momentum(traj, g))))
-    return ConservationReport(traj.model.name, traj.method, traj.dt, float(traj.t[-1]), energy, tuple(momenta))
+    return ConservationReport(model.name, traj.method, traj.dt, float(traj.t[-1]), energy, tuple(momenta), balance)

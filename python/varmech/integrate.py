@@ -38,6 +38,8 @@ class Trajectory:
     steps: int
     nfev: int
     newton: np.ndarray | None = field(default=None, repr=False)
+    #: Work done by the non-conservative forces up to each saved state (zeros without forces).
+    work: np.ndarray | None = field(default=None, repr=False)
     status: int = 0
     message: str = "The integration reached its final time."
     _v: np.ndarray | None = field(default=None, repr=False)
@@ -185,7 +187,7 @@ def integrate(
         raise ValueError("p0, v0: give exactly one of the initial momenta p0 and velocities v0")
     p = vector("p0", p0, n) if p0 is not None else model.momentum(q, vector("v0", v0, n), t0)
     try:
-        t, qs, ps, done, nfev, newton = _core.integrate(
+        t, qs, ps, done, nfev, newton, work = _core.integrate(
             model._core,
             q,
             p,
@@ -200,11 +202,11 @@ def integrate(
     except BaseException as err:
         raw = getattr(err, "_varmech_partial", None)
         if raw is not None:
-            t, qs, ps, done, nfev, newton = raw
+            t, qs, ps, done, nfev, newton, work = raw
             del err._varmech_partial
-            err.partial = Trajectory(t, qs, ps, model, method, dt, done, nfev, newton, status=-1, message=str(err))
+            err.partial = Trajectory(t, qs, ps, model, method, dt, done, nfev, newton, work, status=-1, message=str(err))
         raise
-    return Trajectory(t, qs, ps, model, method, dt, done, nfev, newton)
+    return Trajectory(t, qs, ps, model, method, dt, done, nfev, newton, work)
 
 
 def symplecticity_defect(model: Model, method: str, q: ArrayLike, p: ArrayLike, dt: float) -> float:

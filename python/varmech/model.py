@@ -98,6 +98,11 @@ class Model:
         """Whether L depends on t explicitly (then its energy function is not conserved)."""
         return self._core.time_dependent
 
+    @property
+    def forced(self) -> bool:
+        """Whether non-conservative forces act (then the energy changes by their work)."""
+        return self._core.forced
+
     def velocity(self, q: ArrayLike, p: ArrayLike, t: ArrayLike = 0.0) -> np.ndarray:
         """q̇ with ∂L/∂q̇(q, q̇, t) = p (M⁻¹p for mechanical systems), for one state (n,) or
         for rows (N, n)."""
@@ -197,6 +202,13 @@ class Lagrangian(Model):
         ∂L/∂q and ∂L/∂q̇ (the momentum). Optional: missing ones come from central differences
         of L (2n calls of L each, about 1e-10 relative accuracy), and a warning says so.
         :func:`varmech.check_derivatives` checks supplied ones.
+    force:
+        ``force(q, v, t) -> array (n,)``, a non-conservative generalized force (friction,
+        driving); integrated by the discrete Lagrange–d'Alembert principle, and its work is
+        tracked (``traj.work``) so that the energy balance can be checked.
+    rayleigh:
+        A Rayleigh dissipation R(q̇) = ½q̇ᵀCq̇, given by C (a scalar, a vector (n,) for a
+        diagonal, or a matrix (n, n)); adds the force −Cq̇.
     time_dependent:
         Whether L depends on t; then the energy function p·q̇ − L is not conserved and the
         conservation report says so instead of judging it.
@@ -213,6 +225,8 @@ class Lagrangian(Model):
         *,
         dl_dq: Callable[[np.ndarray, np.ndarray, float], ArrayLike] | None = None,
         dl_dv: Callable[[np.ndarray, np.ndarray, float], ArrayLike] | None = None,
+        force: Callable[[np.ndarray, np.ndarray, float], ArrayLike] | None = None,
+        rayleigh: ArrayLike | None = None,
         time_dependent: bool = False,
         symmetries: Sequence[Symmetry] = (),
         name: str = "lagrangian",
@@ -231,7 +245,15 @@ class Lagrangian(Model):
                 raise TypeError(f"symmetries: expected Translation, Rotation or Cyclic, got {s!r}")
             if max(s.spec()[1], 0) >= dim and isinstance(s, Cyclic):
                 raise ValueError(f"symmetries: {s} does not apply to {dim} coordinates")
-        self._core = _core.ClosureLagrangian(int(dim), lagrangian, dl_dq, dl_dv, bool(time_dependent))
+        total_force = force
+        if rayleigh is not None:
+            c = np.array(rayleigh, dtype=float)
+            if c.ndim > 2 or (c.ndim >= 1 and any(s != dim for s in c.shape)) or not np.all(np.isfinite(c)):
+                raise ValueError(f"rayleigh: must be a finite scalar, a vector ({dim},) or a matrix ({dim}, {dim})")
+            damping = (lambda v: c @ v) if c.ndim == 2 else (lambda v: c * v)
+            total_force = (lambda q, v, t: -damping(v)) if force is None else (lambda q, v, t: np.asarray(force(q, v, t), dtype=float) - damping(v))
+        self._core = _core.ClosureLagrangian(int(dim), lagrangian, dl_dq, dl_dv, total_force, bool(time_dependent))
+        self.force = total_force
         self.lagrangian = lagrangian
         self.dl_dq = dl_dq
         self.dl_dv = dl_dv

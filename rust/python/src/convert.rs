@@ -78,13 +78,15 @@ pub fn matrix<'py>(py: Python<'py>, data: Vec<f64>, n: usize) -> PyResult<Bound<
     Ok(PyArray1::from_vec(py, data).reshape([rows, n])?.into_any())
 }
 
-/// (t, q, p, steps, force_evaluations, newton) of a trajectory, `newton` the cumulative Newton
-/// iterations at each saved state.
+/// (t, q, p, steps, force_evaluations, newton, work) of a trajectory: `newton` the cumulative
+/// Newton iterations and `work` the cumulative work of non-conservative forces at each saved
+/// state.
 pub fn trajectory_tuple(py: Python<'_>, traj: Trajectory) -> PyResult<Bound<'_, PyTuple>> {
     let n = traj.dim;
     let t = PyArray1::from_vec(py, traj.t).into_any();
     let q = matrix(py, traj.q, n)?;
     let p = matrix(py, traj.p, n)?;
     let newton = PyArray1::from_vec(py, traj.newton).into_any();
-    (t, q, p, traj.steps, traj.force_evaluations, newton).into_pyobject(py)
+    let work = PyArray1::from_vec(py, traj.work).into_any();
+    (t, q, p, traj.steps, traj.force_evaluations, newton, work).into_pyobject(py)
 }

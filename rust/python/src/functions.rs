@@ -93,8 +93,9 @@ fn model_error(e: ModelError) -> PyErr {
     }
 }
 
-/// Integrates; returns (t, q, p, steps, force_evaluations, newton) or raises with
-/// `_varmech_partial` (`newton`: cumulative Newton iterations at each saved state).
+/// Integrates; returns (t, q, p, steps, force_evaluations, newton, work) or raises with
+/// `_varmech_partial` (`newton`, `work`: cumulative Newton iterations and work of the forces at
+/// each saved state).
 #[pyfunction]
 #[pyo3(signature = (model, q0, p0, *, dt, steps, method, save_every=1, compensated=true, max_energy_error=None, t0=0.0))]
 #[allow(clippy::too_many_arguments)]

@@ -61,6 +61,11 @@ impl NativeModel {
         false
     }
 
+    #[getter]
+    fn forced(&self) -> bool {
+        false
+    }
+
     /// (G, masses) of an N-body scene, None for the others.
     #[getter]
     fn gravity(&self) -> Option<(f64, Vec<f64>)> {
@@ -150,6 +155,11 @@ impl ClosureModel {
         false
     }
 
+    #[getter]
+    fn forced(&self) -> bool {
+        false
+    }
+
     fn __repr__(&self) -> String {
         format!("ClosureModel(dim={})", self.dim)
     }
@@ -157,25 +167,28 @@ impl ClosureModel {
 
 /// A general Lagrangian L(q, q̇, t) given by Python closures: `lagrangian(q, v, t) -> float`
 /// and, optionally, `dl_dq(q, v, t)` and `dl_dv(q, v, t)` (arrays (n,)); missing derivatives
-/// come from central differences of L.
+/// come from central differences of L. An optional `force(q, v, t)` (array (n,)) is a
+/// non-conservative generalized force.
 #[pyclass(frozen, module = "varmech._core")]
 pub struct ClosureLagrangian {
     dim: usize,
     lagrangian: Py<PyAny>,
     dl_dq: Option<Py<PyAny>>,
     dl_dv: Option<Py<PyAny>>,
+    force: Option<Py<PyAny>>,
     time_dependent: bool,
 }
 
 #[pymethods]
 impl ClosureLagrangian {
     #[new]
-    #[pyo3(signature = (dim, lagrangian, dl_dq, dl_dv, time_dependent))]
+    #[pyo3(signature = (dim, lagrangian, dl_dq, dl_dv, force, time_dependent))]
     fn new(
         dim: usize,
         lagrangian: Bound<'_, PyAny>,
         dl_dq: Option<Bound<'_, PyAny>>,
         dl_dv: Option<Bound<'_, PyAny>>,
+        force: Option<Bound<'_, PyAny>>,
         time_dependent: bool,
     ) -> PyResult<Self> {
         check_closures(
@@ -184,6 +197,7 @@ impl ClosureLagrangian {
                 ("lagrangian", Some(&lagrangian)),
                 ("dl_dq", dl_dq.as_ref()),
                 ("dl_dv", dl_dv.as_ref()),
+                ("force", force.as_ref()),
             ],
         )?;
         Ok(ClosureLagrangian {
@@ -191,6 +205,7 @@ impl ClosureLagrangian {
             lagrangian: lagrangian.unbind(),
             dl_dq: dl_dq.map(Bound::unbind),
             dl_dv: dl_dv.map(Bound::unbind),
+            force: force.map(Bound::unbind),
             time_dependent,
         })
     }
@@ -208,6 +223,11 @@ impl ClosureLagrangian {
     #[getter]
     fn time_dependent(&self) -> bool {
         self.time_dependent
+    }
+
+    #[getter]
+    fn forced(&self) -> bool {
+        self.force.is_some()
     }
 
     fn __repr__(&self) -> String {
@@ -342,6 +362,7 @@ pub struct ClosureLagrangianSystem<'a, 'py> {
     lagrangian: Bound<'py, PyAny>,
     dl_dq: Option<Bound<'py, PyAny>>,
     dl_dv: Option<Bound<'py, PyAny>>,
+    force: Option<Bound<'py, PyAny>>,
     work: RefCell<Vec<f64>>,
 }
 
@@ -353,6 +374,7 @@ impl<'a, 'py> ClosureLagrangianSystem<'a, 'py> {
             lagrangian: model.lagrangian.bind(py).clone(),
             dl_dq: model.dl_dq.as_ref().map(|f| f.bind(py).clone()),
             dl_dv: model.dl_dv.as_ref().map(|f| f.bind(py).clone()),
+            force: model.force.as_ref().map(|f| f.bind(py).clone()),
             work: RefCell::new(vec![0.0; model.dim]),
         }
     }
@@ -391,5 +413,19 @@ impl Lagrangian for ClosureLagrangianSystem<'_, '_> {
 
     fn is_time_dependent(&self) -> bool {
         self.model.time_dependent
+    }
+
+    fn is_forced(&self) -> bool {
+        self.force.is_some()
+    }
+
+    fn force(&self, q: &[f64], v: &[f64], t: f64, out: &mut [f64]) -> Result<(), ModelError> {
+        match &self.force {
+            Some(f) => call_vector(f.call1(self.args(q, v, t)), "force(q, v, t)", out),
+            None => {
+                out.fill(0.0);
+                Ok(())
+            }
+        }
     }
 }

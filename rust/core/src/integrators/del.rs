@@ -4,6 +4,7 @@ use super::StepError;
 use crate::discrete::{DiscreteLagrangian, Workspace};
 use crate::model::finite_difference::NOISE_FLOOR;
 use crate::model::Lagrangian;
+use crate::ModelError;
 
 /// Options of the Newton iteration that solves the discrete Euler–Lagrange equations.
 ///
@@ -28,7 +29,10 @@ impl Default for NewtonOptions {
 }
 
 /// The variational integrator of a discrete Lagrangian L_d in position–momentum form: from
-/// (q₀, p₀), solve p₀ + D₁L_d(q₀, q₁) = 0 for q₁ by Newton's method, then p₁ = D₂L_d(q₀, q₁).
+/// (q₀, p₀), solve p₀ + D₁L_d(q₀, q₁) + f_d⁻ = 0 for q₁ by Newton's method, then
+/// p₁ = D₂L_d(q₀, q₁) + f_d⁺ (the forced DEL equations of the discrete Lagrange–d'Alembert
+/// principle; f_d^± = (h/2)f(q̄, v, t + h/2) at the midpoint q̄ = q₀ + δq/2, v = δq/h, and zero
+/// for unforced systems). The work of the forces, f(q̄, v)·δq a step, is accumulated.
 ///
 /// The unknown is the increment δq = q₁ − q₀, and p₁ − p₀ is formed as D₁L_d + D₂L_d minus the
 /// final residual, so that both increments keep their own relative precision for the
@@ -55,6 +59,55 @@ pub struct Del<R> {
     history: usize,
     evaluations: u64,
     iterations: u64,
+    forcing: Forcing,
+    work: f64,
+}
+
+/// The generalized force at a step's midpoint, f(q₀ + δq/2, δq/h, t + h/2), with its buffers.
+#[derive(Clone, Debug)]
+struct Forcing {
+    mid: Vec<f64>,
+    vel: Vec<f64>,
+    f: Vec<f64>,
+}
+
+impl Forcing {
+    fn evaluate<S: Lagrangian + ?Sized>(
+        &mut self,
+        sys: &S,
+        q0: &[f64],
+        dq: &[f64],
+        t: f64,
+        h: f64,
+    ) -> Result<&[f64], ModelError> {
+        for (((m, v), q), d) in self.mid.iter_mut().zip(self.vel.iter_mut()).zip(q0).zip(dq) {
+            *m = q + 0.5 * d;
+            *v = d / h;
+        }
+        sys.force(&self.mid, &self.vel, t + 0.5 * h, &mut self.f)?;
+        Ok(&self.f)
+    }
+}
+
+/// Writes D₁L_d(q₀, q₀ + δq) + f_d⁻ into `out`: the left side of the forced DEL equations, less p₀.
+#[allow(clippy::too_many_arguments)]
+fn equations<R: DiscreteLagrangian, S: Lagrangian + ?Sized>(
+    rule: &R,
+    sys: &S,
+    q0: &[f64],
+    dq: &[f64],
+    t: f64,
+    h: f64,
+    out: &mut [f64],
+    ws: &mut Workspace,
+    forcing: &mut Forcing,
+) -> Result<(), ModelError> {
+    rule.d1(sys, q0, dq, t, h, out, ws)?;
+    if sys.is_forced() {
+        let f = forcing.evaluate(sys, q0, dq, t, h)?;
+        out.iter_mut().zip(f).for_each(|(o, f)| *o += 0.5 * h * f);
+    }
+    Ok(())
 }
 
 impl<R: DiscreteLagrangian> Del<R> {
@@ -74,7 +127,18 @@ impl<R: DiscreteLagrangian> Del<R> {
             history: 0,
             evaluations: 0,
             iterations: 0,
+            forcing: Forcing {
+                mid: vec![0.0; n],
+                vel: vec![0.0; n],
+                f: vec![0.0; n],
+            },
+            work: 0.0,
         }
+    }
+
+    /// The work done by the generalized forces so far, Σ f(q̄, v)·δq.
+    pub fn work(&self) -> f64 {
+        self.work
     }
 
     /// Evaluations of D₁L_d or D₂L_d made so far.
@@ -91,7 +155,7 @@ impl<R: DiscreteLagrangian> Del<R> {
         self.history = 0;
     }
 
-    /// residual = p₀ + D₁L_d(q₀, q₀ + δq); returns ‖residual‖∞.
+    /// residual = p₀ + D₁L_d(q₀, q₀ + δq) + f_d⁻; returns ‖residual‖∞.
     fn residual<S: Lagrangian + ?Sized>(
         &mut self,
         sys: &S,
@@ -101,8 +165,17 @@ impl<R: DiscreteLagrangian> Del<R> {
         h: f64,
     ) -> Result<f64, StepError> {
         self.evaluations += 1;
-        self.rule
-            .d1(sys, q0, &self.dq, t, h, self.residual.as_mut_slice(), &mut self.ws)?;
+        equations(
+            &self.rule,
+            sys,
+            q0,
+            &self.dq,
+            t,
+            h,
+            self.residual.as_mut_slice(),
+            &mut self.ws,
+            &mut self.forcing,
+        )?;
         let mut norm = 0.0_f64;
         for (r, p) in self.residual.iter_mut().zip(p0) {
             *r += p;
@@ -111,7 +184,7 @@ impl<R: DiscreteLagrangian> Del<R> {
         Ok(norm)
     }
 
-    /// ∂D₁L_d/∂q₁ at q₁ = q₀ + δq by central differences, factorised in place.
+    /// ∂(D₁L_d + f_d⁻)/∂q₁ at q₁ = q₀ + δq by central differences, factorised in place.
     fn factorise_jacobian<S: Lagrangian + ?Sized>(
         &mut self,
         sys: &S,
@@ -124,9 +197,29 @@ impl<R: DiscreteLagrangian> Del<R> {
             let d = self.dq[j];
             let e = cbrt_eps * (q0[j] + d).abs().max(1.0);
             self.dq[j] = d + e;
-            self.rule.d1(sys, q0, &self.dq, t, h, &mut self.plus, &mut self.ws)?;
+            equations(
+                &self.rule,
+                sys,
+                q0,
+                &self.dq,
+                t,
+                h,
+                &mut self.plus,
+                &mut self.ws,
+                &mut self.forcing,
+            )?;
             self.dq[j] = d - e;
-            self.rule.d1(sys, q0, &self.dq, t, h, &mut self.minus, &mut self.ws)?;
+            equations(
+                &self.rule,
+                sys,
+                q0,
+                &self.dq,
+                t,
+                h,
+                &mut self.minus,
+                &mut self.ws,
+                &mut self.forcing,
+            )?;
             self.dq[j] = d;
             self.evaluations += 2;
             for (i, (a, b)) in self.plus.iter().zip(&self.minus).enumerate() {
@@ -208,8 +301,8 @@ impl<R: DiscreteLagrangian> Del<R> {
         })
     }
 
-    /// The increments once δq is found: p₁ − p₀ = D₁L_d + D₂L_d − residual, since the last
-    /// residual evaluation left p₀ + D₁L_d in `self.residual`.
+    /// The increments once δq is found: p₁ − p₀ = D₁L_d + D₂L_d + f_d⁻ + f_d⁺ − residual, since
+    /// the last residual evaluation left p₀ + D₁L_d + f_d⁻ in `self.residual`.
     #[allow(clippy::too_many_arguments)]
     fn finish<S: Lagrangian + ?Sized>(
         &mut self,
@@ -224,6 +317,16 @@ impl<R: DiscreteLagrangian> Del<R> {
         self.rule.momentum_change(sys, q, &self.dq, t, h, dp, &mut self.ws)?;
         for (d, r) in dp.iter_mut().zip(self.residual.iter()) {
             *d -= r;
+        }
+        if sys.is_forced() {
+            // f_d⁻ + f_d⁺ = h·f(q̄, v); the work of the step, f·δq.
+            let f = self.forcing.evaluate(sys, q, &self.dq, t, h)?;
+            let mut work = 0.0;
+            for ((d, f), x) in dp.iter_mut().zip(f).zip(&self.dq) {
+                *d += h * f;
+                work += f * x;
+            }
+            self.work += work;
         }
         dq.copy_from_slice(&self.dq);
         std::mem::swap(&mut self.before_last_dq, &mut self.last_dq);

@@ -99,9 +99,9 @@ impl<L: Lagrangian> Integrable for General<'_, L> {
         integrator.increment_lagrangian(self.0, t, q, p, h, dq, dp)
     }
 
-    /// E = p·q̇ − L, unless L depends on t (then nothing is conserved to check).
+    /// E = p·q̇ − L, unless L depends on t or forces act (then it is not conserved).
     fn energy(&self, q: &[f64], p: &[f64]) -> Option<Result<f64, ModelError>> {
-        (!self.0.is_time_dependent()).then(|| self.0.energy(q, p, 0.0))
+        (!self.0.is_time_dependent() && !self.0.is_forced()).then(|| self.0.energy(q, p, 0.0))
     }
 
     fn as_lagrangian(&self) -> &dyn Lagrangian {
@@ -179,6 +179,9 @@ pub struct Trajectory {
     /// Newton iterations made up to each saved state (cumulative; all zero for explicit
     /// methods): their differences give the iterations per step between saves.
     pub newton: Vec<u64>,
+    /// Work done by non-conservative forces up to each saved state (forced systems): the
+    /// energy balance E(t) − E(0) − W(t) is the discrete Lagrange–d'Alembert check.
+    pub work: Vec<f64>,
 }
 
 impl Trajectory {
@@ -201,9 +204,10 @@ impl Trajectory {
         &self.p[k * self.dim..(k + 1) * self.dim]
     }
 
-    fn push(&mut self, t: f64, q: &[f64], p: &[f64], newton: u64) {
+    fn push(&mut self, t: f64, q: &[f64], p: &[f64], integrator: &Integrator) {
         self.t.push(t);
-        self.newton.push(newton);
+        self.newton.push(integrator.newton_iterations());
+        self.work.push(integrator.work());
         self.q.extend_from_slice(q);
         self.p.extend_from_slice(p);
     }
@@ -284,7 +288,7 @@ where
     let energy_check = match options.max_energy_error {
         Some(_) if sys.energy(q0, p0).is_none() => Err(Error::invalid(
             "max_energy_error",
-            "needs a conserved energy, and a time-dependent Lagrangian has none",
+            "needs a conserved energy, and a time-dependent or forced Lagrangian has none",
         )),
         _ => Ok(()),
     };
@@ -308,11 +312,12 @@ where
     let reserved = saved.checked_mul(n).is_some_and(|len| {
         traj.t.try_reserve_exact(saved).is_ok()
             && traj.newton.try_reserve_exact(saved).is_ok()
+            && traj.work.try_reserve_exact(saved).is_ok()
             && traj.q.try_reserve_exact(len).is_ok()
             && traj.p.try_reserve_exact(len).is_ok()
     });
     if !reserved {
-        let gib = saved as f64 * (2 * n + 2) as f64 * 8.0 / (1u64 << 30) as f64;
+        let gib = saved as f64 * (2 * n + 3) as f64 * 8.0 / (1u64 << 30) as f64;
         let reason =
             format!("keeping {saved} states needs {gib:.3e} GiB, more than can be allocated; raise save_every");
         return Err(fail(Error::invalid("save_every", reason), traj));
@@ -327,7 +332,7 @@ where
     let (mut eq_next, mut ep_next) = (vec![0.0; n], vec![0.0; n]);
     let mut integrator = Integrator::new(method, n);
     let mut interrupt = InterruptPoll::new();
-    traj.push(t0, &q, &p, 0);
+    traj.push(t0, &q, &p, &integrator);
     let h0 = match max_energy_error.and_then(|_| sys.energy(&q, &p)) {
         None => None,
         Some(energy) => match energy {
@@ -350,7 +355,7 @@ where
         // Stops with the last good state (step − 1) kept, and the work counted.
         let stop = |error: Error, mut traj: Trajectory, q: &[f64], p: &[f64], integrator: &Integrator| {
             if traj.t.last() != Some(&time) {
-                traj.push(time, q, p, integrator.newton_iterations());
+                traj.push(time, q, p, integrator);
             }
             traj.steps = step - 1;
             traj.force_evaluations = integrator.force_evaluations();
@@ -397,7 +402,7 @@ where
         }
         if step % save_every == 0 || step == steps {
             let t = t0 + step as f64 * dt;
-            traj.push(t, &q, &p, integrator.newton_iterations());
+            traj.push(t, &q, &p, &integrator);
             if let (Some(tol), Some(h0)) = (max_energy_error, h0) {
                 // The state of this step is kept: it is finite, only its energy is off.
                 let error = match sys.energy(&q, &p).expect("checked before the first step") {

@@ -138,6 +138,15 @@ impl Integrator {
         }
     }
 
+    /// The work done by non-conservative forces so far (implicit methods; 0 otherwise).
+    pub fn work(&self) -> f64 {
+        match &self.scheme {
+            Scheme::Midpoint(s) => s.work(),
+            Scheme::Trapezoid(s) => s.work(),
+            _ => 0.0,
+        }
+    }
+
     /// Newton iterations made so far (0 for the explicit methods).
     pub fn newton_iterations(&self) -> u64 {
         match &self.scheme {

@@ -34,6 +34,19 @@ pub trait Lagrangian {
         false
     }
 
+    /// Whether non-conservative generalized forces act (then the energy is not conserved, and
+    /// the integrators follow the discrete Lagrange–d'Alembert principle).
+    fn is_forced(&self) -> bool {
+        false
+    }
+
+    /// Writes the generalized force f(q, q̇, t) (friction, Rayleigh dissipation f = −∂R/∂q̇,
+    /// driving) into `out`. Default: none.
+    fn force(&self, _q: &[f64], _v: &[f64], _t: f64, out: &mut [f64]) -> Result<(), ModelError> {
+        out.fill(0.0);
+        Ok(())
+    }
+
     /// Writes the velocity q̇ with ∂L/∂q̇(q, q̇, t) = p into `v`: the inverse Legendre
     /// transform, unique for a regular Lagrangian. Default: Newton's method from `v` as given,
     /// with a difference Jacobian (exact in one step when L is quadratic in q̇), to round-off or
