@@ -8,12 +8,13 @@ from varmech import examples, scenes
 
 
 SEPARABLE = [n for n in scenes.CATALOGUE if scenes.get(n).model.separable]
+GENERAL = [n for n in scenes.CATALOGUE if not scenes.get(n).model.separable]
 
 
 @pytest.mark.parametrize(
     "name, method",
     [(n, m) for n in SEPARABLE for m in ["verlet", "kahan_li8", "rk4", "symplectic_euler", "midpoint"]]
-    + [("double_pendulum", m) for m in ["midpoint", "trapezoid"]],
+    + [(n, m) for n in GENERAL for m in ["midpoint", "trapezoid"]],
 )
 def test_closure_reproduces_native(name, method):
     scene = scenes.get(name)

@@ -139,3 +139,13 @@ def test_a_force_closure_that_raises_propagates_unchanged():
     with pytest.raises(Stall) as info:
         varmech.integrate(model, [1.0], [0.0], dt=0.1, steps=100, method="midpoint")
     assert info.value.partial.steps == 5 and len(info.value.partial.work) == 6
+
+
+def test_spherical_pendulum_declares_its_cyclic_azimuth():
+    scene = scenes.spherical_pendulum()
+    assert scene.model.symmetries == (varmech.Cyclic(1),)
+    traj = varmech.integrate(scene, dt=0.01, t_end=50.0, save_every=100)
+    report = varmech.check_conservation(traj)
+    assert report.momenta[0].name == "p[1]" and report.momenta[0].max_rel_error < 1e-13
+    assert report.verdict == "bounded"
+    assert abs(traj.q[-1, 0] - scene.reference.q[0]) < 1e-3

@@ -20,6 +20,7 @@ TOUR = [
     ("fermi_pasta_ulam", ("verlet", "mclachlan4", "rk4"), 200.0),
     ("outer_solar_system", ("verlet", "kahan_li8", "rk4"), None),
     ("double_pendulum", ("midpoint", "trapezoid"), 100.0),
+    ("spherical_pendulum", ("midpoint", "trapezoid"), 1000.0),
 ]
 
 

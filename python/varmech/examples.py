@@ -11,7 +11,7 @@ import math
 
 import numpy as np
 
-from .model import Lagrangian, MechanicalSystem, Rotation, Translation
+from .model import Cyclic, Lagrangian, MechanicalSystem, Rotation, Translation
 from .scenes import Scene
 
 
@@ -119,6 +119,25 @@ def double_pendulum(m1: float = 1.0, m2: float = 2.0, l1: float = 2.0, l2: float
     return Lagrangian(2, lagrangian, dl_dq=dl_dq, dl_dv=dl_dv, name="double_pendulum (closure)")
 
 
+def spherical_pendulum(m: float = 1.0, l: float = 1.0, g: float = 1.0) -> Lagrangian:
+    """The spherical pendulum in (θ, φ) as a general Lagrangian; φ is cyclic."""
+    ml2 = m * l * l
+
+    def lagrangian(q: np.ndarray, v: np.ndarray, t: float) -> float:
+        s = math.sin(q[0])
+        return 0.5 * ml2 * (v[0] ** 2 + s * s * v[1] ** 2) + m * g * l * math.cos(q[0])
+
+    def dl_dq(q: np.ndarray, v: np.ndarray, t: float) -> np.ndarray:
+        s, c = math.sin(q[0]), math.cos(q[0])
+        return np.array([ml2 * s * c * v[1] ** 2 - m * g * l * s, 0.0])
+
+    def dl_dv(q: np.ndarray, v: np.ndarray, t: float) -> np.ndarray:
+        s = math.sin(q[0])
+        return np.array([ml2 * v[0], ml2 * s * s * v[1]])
+
+    return Lagrangian(2, lagrangian, dl_dq=dl_dq, dl_dv=dl_dv, symmetries=[Cyclic(1)], name="spherical_pendulum (closure)")
+
+
 def closure_of(scene: Scene) -> MechanicalSystem | Lagrangian:
     """The closure version of a built-in scene (with its default parameters)."""
     gravity = scene.model._core.gravity
@@ -131,4 +150,5 @@ def closure_of(scene: Scene) -> MechanicalSystem | Lagrangian:
         "henon_heiles": henon_heiles,
         "fermi_pasta_ulam": fermi_pasta_ulam,
         "double_pendulum": double_pendulum,
+        "spherical_pendulum": spherical_pendulum,
     }[scene.name]()

@@ -97,6 +97,19 @@ def double_pendulum() -> Scene:
     return _scene("double_pendulum", "double pendulum (configuration-dependent mass)", 0.01, {"E": -40.218179175435154})
 
 
+def spherical_pendulum() -> Scene:
+    """The spherical pendulum in (θ, φ), θ from the downward vertical (m = l = g = 1), from
+    θ = 1, θ̇ = 0, φ̇ = 1.2 to T = 50 against the reference angles of reference/scenes.json. A
+    general Lagrangian whose azimuth φ is cyclic: p_φ is conserved. The reference gives the
+    angles only, so its p_θ is NaN."""
+    return _scene(
+        "spherical_pendulum",
+        "spherical pendulum in (θ, φ); φ cyclic",
+        0.01,
+        {"E": -0.030489444711168545, "p_phi": 0.8496881019282854},
+    )
+
+
 def nbody(masses: ArrayLike, positions: ArrayLike, velocities: ArrayLike, G: float = 1.0, t_end: float = 1.0, dt: float = 1e-3) -> Scene:
     """A native gravitational N-body model in 3 dimensions from masses (N,), positions and
     velocities (N, 3)."""
@@ -118,6 +131,7 @@ CATALOGUE: dict[str, Callable[[], Scene]] = {
     "fermi_pasta_ulam": fermi_pasta_ulam,
     "outer_solar_system": outer_solar_system,
     "double_pendulum": double_pendulum,
+    "spherical_pendulum": spherical_pendulum,
 }
 
 

@@ -391,6 +391,12 @@ fn scene<'py>(py: Python<'py>, name: &str, e: f64, omega: f64) -> PyResult<Scene
             |s| Native::General(LagrangianScene::DoublePendulum(s)),
             "double_pendulum",
         ),
+        "spherical_pendulum" => scene_tuple(
+            py,
+            scenes::SphericalPendulum::problem(),
+            |s| Native::General(LagrangianScene::SphericalPendulum(s)),
+            "spherical_pendulum",
+        ),
         _ => Err(PyValueError::new_err(format!("name: unknown scene {name:?}"))),
     }
 }

@@ -80,7 +80,7 @@ impl NativeModel {
     fn symmetries(&self) -> Vec<(&'static str, usize, usize, String)> {
         match &self.native {
             Native::Mechanical(s) => s.symmetries().into_iter().map(convert::generator_spec).collect(),
-            Native::General(_) => Vec::new(),
+            Native::General(s) => s.symmetries().into_iter().map(convert::generator_spec).collect(),
         }
     }
 

@@ -12,6 +12,7 @@ mod henon_heiles;
 mod kepler;
 mod nbody;
 mod pendulum;
+mod spherical_pendulum;
 
 pub use double_pendulum::DoublePendulum;
 pub use fermi_pasta_ulam::FermiPastaUlam;
@@ -20,6 +21,7 @@ pub use henon_heiles::HenonHeiles;
 pub use kepler::Kepler;
 pub use nbody::NBody;
 pub use pendulum::Pendulum;
+pub use spherical_pendulum::SphericalPendulum;
 
 use crate::model::{Generator, Lagrangian, Mass, MechanicalSystem};
 use crate::ModelError;
@@ -89,32 +91,42 @@ impl MechanicalSystem for Scene {
 #[derive(Clone, Debug)]
 pub enum LagrangianScene {
     DoublePendulum(DoublePendulum),
+    SphericalPendulum(SphericalPendulum),
+}
+
+macro_rules! dispatch_lagrangian {
+    ($self:ident, $s:ident => $e:expr) => {
+        match $self {
+            LagrangianScene::DoublePendulum($s) => $e,
+            LagrangianScene::SphericalPendulum($s) => $e,
+        }
+    };
+}
+
+impl LagrangianScene {
+    /// The symmetries the scene declares.
+    pub fn symmetries(&self) -> Vec<Generator> {
+        match self {
+            LagrangianScene::SphericalPendulum(s) => s.symmetries(),
+            LagrangianScene::DoublePendulum(_) => Vec::new(),
+        }
+    }
 }
 
 impl Lagrangian for LagrangianScene {
     fn dim(&self) -> usize {
-        match self {
-            LagrangianScene::DoublePendulum(s) => Lagrangian::dim(s),
-        }
+        dispatch_lagrangian!(self, s => Lagrangian::dim(s))
     }
     fn lagrangian(&self, q: &[f64], v: &[f64], t: f64) -> Result<f64, ModelError> {
-        match self {
-            LagrangianScene::DoublePendulum(s) => s.lagrangian(q, v, t),
-        }
+        dispatch_lagrangian!(self, s => s.lagrangian(q, v, t))
     }
     fn dl_dq(&self, q: &[f64], v: &[f64], t: f64, out: &mut [f64]) -> Result<(), ModelError> {
-        match self {
-            LagrangianScene::DoublePendulum(s) => s.dl_dq(q, v, t, out),
-        }
+        dispatch_lagrangian!(self, s => s.dl_dq(q, v, t, out))
     }
     fn dl_dv(&self, q: &[f64], v: &[f64], t: f64, out: &mut [f64]) -> Result<(), ModelError> {
-        match self {
-            LagrangianScene::DoublePendulum(s) => s.dl_dv(q, v, t, out),
-        }
+        dispatch_lagrangian!(self, s => s.dl_dv(q, v, t, out))
     }
     fn velocity(&self, q: &[f64], p: &[f64], t: f64, v: &mut [f64]) -> Result<(), ModelError> {
-        match self {
-            LagrangianScene::DoublePendulum(s) => s.velocity(q, p, t, v),
-        }
+        dispatch_lagrangian!(self, s => s.velocity(q, p, t, v))
     }
 }
