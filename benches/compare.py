@@ -166,10 +166,11 @@ def solar_system(quick: bool, repeat: int) -> list[Row]:
     return rows
 
 
-def _energies(model, q, p):
+def _energies(model, q, p, t=None):
     from varmech import _core
 
-    return _core.energy(model._core, np.ascontiguousarray(q), np.ascontiguousarray(p))
+    t = np.zeros(len(q)) if t is None else np.ascontiguousarray(t, dtype=float)
+    return _core.energy(model._core, t, np.ascontiguousarray(q), np.ascontiguousarray(p))
 
 
 # ---------------------------------------------------------------------------------- Kepler
@@ -225,6 +226,63 @@ def kepler(quick: bool, repeat: int) -> tuple[list[Row], dict[str, float]]:
     return rows, facts
 
 
+# ------------------------------------------------------------------------------- double pendulum
+
+
+def double_pendulum(quick: bool, repeat: int) -> tuple[list[Row], dict[str, float]]:
+    """varmech's midpoint rule (native and closure) against solve_ivp (DOP853, Radau) at matched
+    accuracy: each SciPy method gets the loosest tolerance of a sweep that reaches varmech's
+    final error, and the ratio of wall times is reported."""
+    from scipy.integrate import solve_ivp
+
+    scene = scenes.double_pendulum()
+    closure = examples.double_pendulum()
+    ref = scene.reference
+    m1, m2, l1, l2, g = 1.0, 2.0, 2.0, 3.0, 9.80665
+    v_ref = scene.model.velocity(ref.q, ref.p)
+    name = "double pendulum, T = 10"
+    steps = 2000 if quick else 8000
+    h = ref.t / steps
+
+    def error(q, v):
+        return float(np.sqrt(np.sum((q - ref.q) ** 2) + np.sum((v - v_ref) ** 2)))
+
+    rows = []
+    for model, label in ((scene.model, "native"), (closure, "Lagrangian closure")):
+        seconds = best_time(lambda: varmech.integrate(model, scene.q0, scene.p0, dt=h, steps=steps, method="midpoint", save_every=steps), repeat)
+        traj = varmech.integrate(model, scene.q0, scene.p0, dt=h, steps=steps, method="midpoint", save_every=max(1, steps // 500))
+        energies = traj.energy()
+        rows.append(Row(name, f"varmech midpoint ({label}), h = {h:g}", steps, seconds, max_rel(energies), error(traj.q[-1], traj.v[-1])))
+    target = rows[0].final_error
+
+    def rhs(_t, y):
+        th, w = y[:2], y[2:]
+        c, s = math.cos(th[0] - th[1]), math.sin(th[0] - th[1])
+        m = np.array([[(m1 + m2) * l1 * l1, m2 * l1 * l2 * c], [m2 * l1 * l2 * c, m2 * l2 * l2]])
+        k = m2 * l1 * l2 * s
+        dl_dq = np.array([-k * w[0] * w[1] - (m1 + m2) * g * l1 * math.sin(th[0]), k * w[0] * w[1] - m2 * g * l2 * math.sin(th[1])])
+        m_dot_w = np.array([-k * (w[0] - w[1]) * w[1], -k * (w[0] - w[1]) * w[0]])
+        return np.concatenate([w, np.linalg.solve(m, dl_dq - m_dot_w)])
+
+    y0 = np.concatenate([scene.q0, scene.model.velocity(scene.q0, scene.p0)])
+    ratios = {}
+    for method in ("DOP853", "Radau"):
+        for tol in 10.0 ** -np.arange(3, 13):
+            sol = solve_ivp(rhs, (0, ref.t), y0, method=method, rtol=tol, atol=tol)
+            err = error(sol.y[:2, -1], sol.y[2:, -1])
+            if err <= target:
+                break
+        seconds = best_time(lambda: solve_ivp(rhs, (0, ref.t), y0, method=method, rtol=tol, atol=tol), max(1, repeat // 2))
+        th, w = sol.y[:2].T, sol.y[2:].T
+        energies = _energies(scene.model, th, scene.model.momentum(th, w), sol.t)
+        rows.append(Row(name, f"solve_ivp {method} (rtol {tol:g}), nfev {sol.nfev}", sol.t.size - 1, seconds, max_rel(energies), err))
+        for k, label in ((0, "native"), (1, "closure")):
+            ratios[f"double pendulum: solve_ivp {method} / varmech midpoint ({label}), time at matched accuracy"] = (
+                seconds / rows[k].seconds
+            )
+    return rows, ratios
+
+
 def table(rows: list[Row]) -> str:
     out = ["| problem | method | steps | steps/s | max rel. energy error | final error |", "|---|---|---:|---:|---:|---:|"]
     for r in rows:
@@ -243,6 +301,7 @@ def main() -> None:
 
     sun = solar_system(args.quick, repeat)
     kep, facts = kepler(args.quick, repeat)
+    dp, dp_ratios = double_pendulum(args.quick, repeat)
     by = {r.method: r for r in sun}
     ratios = {
         "varmech verlet (native) / REBOUND leapfrog, steps/s": by["varmech verlet (native)"].steps_per_second
@@ -254,7 +313,8 @@ def main() -> None:
         "Kepler: varmech verlet (closure) / plain-Python loop, steps/s": facts["speed-up over plain-Python loop"],
         "Kepler: integrator overhead per step / closure call cost": facts["overhead per step / closure call"],
     }
-    text = [table(sun + kep), "", "| ratio | value |", "|---|---:|"]
+    ratios.update(dp_ratios)
+    text = [table(sun + kep + dp), "", "| ratio | value |", "|---|---:|"]
     text += [f"| {k} | {v:.2f} |" for k, v in ratios.items()]
     text += ["", f"Kepler closure call: {facts['closure call (s)'] * 1e9:.0f} ns; varmech step with it: {facts['varmech closure step (s)'] * 1e9:.0f} ns."]
     report = "\n".join(text)
