@@ -285,9 +285,10 @@ def double_pendulum(quick: bool, repeat: int) -> tuple[list[Row], dict[str, floa
 
 def table(rows: list[Row]) -> str:
     out = ["| problem | method | steps | steps/s | max rel. energy error | final error |", "|---|---|---:|---:|---:|---:|"]
+    cell = lambda x: "–" if math.isnan(x) else f"{x:.2e}"  # noqa: E731 (not measured: –)
     for r in rows:
         out.append(
-            f"| {r.problem} | {r.method} | {r.steps} | {r.steps_per_second:,.0f} | {r.energy_error:.2e} | {r.final_error:.2e} |"
+            f"| {r.problem} | {r.method} | {r.steps} | {r.steps_per_second:,.0f} | {cell(r.energy_error)} | {cell(r.final_error)} |"
         )
     return "\n".join(out)
 
