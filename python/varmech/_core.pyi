@@ -27,8 +27,8 @@ class ConvergenceError(VarmechError):
     iterations: int
     partial: Any
 
-class NativeModel:
-    """A native scene: evaluated in Rust with the GIL released."""
+class _ModelProperties:
+    """What every model class reports (a stub-only base: the classes do not share one)."""
 
     @property
     def dim(self) -> int: ...
@@ -38,6 +38,10 @@ class NativeModel:
     def time_dependent(self) -> bool: ...
     @property
     def forced(self) -> bool: ...
+
+class NativeModel(_ModelProperties):
+    """A native scene: evaluated in Rust with the GIL released."""
+
     @property
     def name(self) -> str: ...
     @property
@@ -46,7 +50,7 @@ class NativeModel:
     def gravity(self) -> tuple[float, list[float]] | None:
         """(G, masses) of an N-body scene, None for the others."""
 
-class ClosureModel:
+class ClosureModel(_ModelProperties):
     """L = ½q̇ᵀMq̇ − V(q) from Python closures."""
 
     def __init__(
@@ -58,17 +62,9 @@ class ClosureModel:
         symmetries: Sequence[GeneratorSpec],
     ) -> None: ...
     @property
-    def dim(self) -> int: ...
-    @property
     def has_gradient(self) -> bool: ...
-    @property
-    def separable(self) -> bool: ...
-    @property
-    def time_dependent(self) -> bool: ...
-    @property
-    def forced(self) -> bool: ...
 
-class ClosureLagrangian:
+class ClosureLagrangian(_ModelProperties):
     """A general Lagrangian L(q, q̇, t) from Python closures."""
 
     def __init__(
@@ -80,14 +76,6 @@ class ClosureLagrangian:
         force: Callable[[FloatArray, FloatArray, float], Any] | None,
         time_dependent: bool,
     ) -> None: ...
-    @property
-    def forced(self) -> bool: ...
-    @property
-    def dim(self) -> int: ...
-    @property
-    def separable(self) -> bool: ...
-    @property
-    def time_dependent(self) -> bool: ...
 
 Model = NativeModel | ClosureModel | ClosureLagrangian
 
@@ -111,11 +99,8 @@ def integrate(
 def energy(model: Model, t: FloatArray, q: FloatArray, p: FloatArray) -> FloatArray:
     """The energy function p·q̇ − L at each state."""
 
-def velocities(model: Model, t: FloatArray, q: FloatArray, p: FloatArray) -> FloatArray:
-    """q̇ with ∂L/∂q̇ = p at each state (the inverse Legendre transform)."""
-
-def momenta(model: Model, t: FloatArray, q: FloatArray, v: FloatArray) -> FloatArray:
-    """p = ∂L/∂q̇ at each state."""
+def legendre(model: Model, t: FloatArray, q: FloatArray, x: FloatArray, inverse: bool) -> FloatArray:
+    """p = ∂L/∂q̇(q, x, t) at each state, or with ``inverse`` the velocities q̇ with ∂L/∂q̇ = x."""
 
 def momentum(generator: GeneratorSpec, q: FloatArray, p: FloatArray) -> FloatArray: ...
 def energy_statistics(t: FloatArray, h: FloatArray) -> dict[str, Any]: ...

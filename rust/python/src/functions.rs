@@ -16,8 +16,7 @@ use crate::model::{ClosureLagrangian, ClosureLagrangianSystem, ClosureModel, Clo
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(integrate, m)?)?;
     m.add_function(wrap_pyfunction!(energy, m)?)?;
-    m.add_function(wrap_pyfunction!(velocities, m)?)?;
-    m.add_function(wrap_pyfunction!(momenta, m)?)?;
+    m.add_function(wrap_pyfunction!(legendre, m)?)?;
     m.add_function(wrap_pyfunction!(momentum, m)?)?;
     m.add_function(wrap_pyfunction!(energy_statistics, m)?)?;
     m.add_function(wrap_pyfunction!(invariant_statistics, m)?)?;
@@ -171,7 +170,10 @@ fn energy<'py>(
     Ok(PyArray1::from_vec(py, result.map_err(model_error)?))
 }
 
-/// Applies a Legendre transform to each state: q̇ from p (`inverse`) or p = ∂L/∂q̇ from q̇.
+/// The Legendre transform at each state: p = ∂L/∂q̇(q, x, t) from velocities x, or, with
+/// `inverse`, the velocities q̇ with ∂L/∂q̇ = x from momenta x (M⁻¹p and Mq̇ for mechanical
+/// systems).
+#[pyfunction]
 fn legendre<'py>(
     py: Python<'py>,
     model: &Bound<'py, PyAny>,
@@ -198,30 +200,6 @@ fn legendre<'py>(
         .map(|()| y)
     });
     convert::matrix(py, result.map_err(model_error)?, n)
-}
-
-/// q̇ with ∂L/∂q̇ = p at each state (M⁻¹p for mechanical systems).
-#[pyfunction]
-fn velocities<'py>(
-    py: Python<'py>,
-    model: &Bound<'py, PyAny>,
-    t: PyReadonlyArray1<'py, f64>,
-    q: PyReadonlyArray2<'py, f64>,
-    p: PyReadonlyArray2<'py, f64>,
-) -> PyResult<Bound<'py, PyAny>> {
-    legendre(py, model, t, q, p, true)
-}
-
-/// p = ∂L/∂q̇ at each state (Mq̇ for mechanical systems).
-#[pyfunction]
-fn momenta<'py>(
-    py: Python<'py>,
-    model: &Bound<'py, PyAny>,
-    t: PyReadonlyArray1<'py, f64>,
-    q: PyReadonlyArray2<'py, f64>,
-    v: PyReadonlyArray2<'py, f64>,
-) -> PyResult<Bound<'py, PyAny>> {
-    legendre(py, model, t, q, v, false)
 }
 
 /// J = p·ξ(q) of a generator spec for each row of (q, p).
