@@ -1,5 +1,5 @@
-//! The native step loop allocates nothing: a run of 100 000 steps makes exactly as many
-//! allocations as a run of 100 (the set-up's), whatever the method.
+//! The native step loop allocates nothing: a long run makes exactly as many allocations as a
+//! run of 100 steps (the set-up's), whatever the method.
 
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -49,12 +49,15 @@ fn allocations(method: Method, steps: usize, max_energy_error: Option<f64>) -> u
 #[test]
 fn the_step_loop_allocates_nothing() {
     for method in Method::ALL {
+        // Newton's difference Jacobians make the implicit methods slow on 18 coordinates; a
+        // shorter long run proves the same.
+        let long_steps = if method.info().implicit { 2_000 } else { 100_000 };
         for check in [None, Some(1.0)] {
             let short = allocations(method, 100, check);
-            let long = allocations(method, 100_000, check);
+            let long = allocations(method, long_steps, check);
             assert_eq!(
                 short, long,
-                "{method:?}: {short} allocations for 100 steps, {long} for 100 000"
+                "{method:?}: {short} allocations for 100 steps, {long} for {long_steps}"
             );
         }
     }

@@ -8,12 +8,12 @@ use crate::ModelError;
 
 /// Options of the Newton iteration that solves the discrete Euler–Lagrange equations.
 ///
-/// The iteration stops when ‖δ‖∞ ≤ tolerance·(1 + ‖q₁‖∞), or when a Newton step with a freshly
+/// The iteration stops when ‖δ‖∞ ≤ tolerance·(1 + ‖q‖∞), or when a Newton step with a freshly
 /// computed Jacobian no longer halves a correction that is already below √ε (the equations'
 /// own accuracy when derivatives come from differences).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct NewtonOptions {
-    /// Stop when the correction satisfies ‖δ‖∞ ≤ tolerance·(1 + ‖q₁‖∞).
+    /// Stop when the correction satisfies ‖δ‖∞ ≤ tolerance·(1 + ‖q‖∞).
     pub tolerance: f64,
     /// Give up (a convergence error) after this many iterations.
     pub max_iterations: usize,
@@ -28,39 +28,43 @@ impl Default for NewtonOptions {
     }
 }
 
-/// The variational integrator of a discrete Lagrangian L_d in position–momentum form: from
-/// (q₀, p₀), solve p₀ + D₁L_d(q₀, q₁) + f_d⁻ = 0 for q₁ by Newton's method, then
-/// p₁ = D₂L_d(q₀, q₁) + f_d⁺ (the forced DEL equations of the discrete Lagrange–d'Alembert
-/// principle; f_d^± = (h/2)f(q̄, v, t + h/2) at the midpoint q̄ = q₀ + δq/2, v = δq/h, and zero
-/// for unforced systems). The work of the forces, f(q̄, v)·δq a step, is accumulated.
-///
-/// The unknown is the increment δq = q₁ − q₀, and p₁ − p₀ is formed as D₁L_d + D₂L_d minus the
-/// final residual, so that both increments keep their own relative precision for the
-/// compensated summation of the driver (HLW VIII.5): round-off then does not grow with |q| and
-/// |p|, and Noether momenta stay conserved to round-off.
-///
-/// The Jacobian ∂D₁L_d/∂q₁ comes from central differences of D₁L_d, is factorised once a step
-/// and kept while the iteration contracts by at least half per step (simplified Newton),
-/// refreshed otherwise. The predictor extrapolates the last two increments.
-#[derive(Clone, Debug)]
-pub struct Del<R> {
-    rule: R,
-    options: NewtonOptions,
-    ws: Workspace,
-    dq: Vec<f64>,
-    residual: DVector<f64>,
-    plus: Vec<f64>,
-    minus: Vec<f64>,
-    jacobian: DMatrix<f64>,
-    pivots: Vec<usize>,
-    last_dq: Vec<f64>,
-    before_last_dq: Vec<f64>,
-    /// How many previous increments the predictor has (0, 1 or 2).
-    history: usize,
-    evaluations: u64,
-    iterations: u64,
-    forcing: Forcing,
-    work: f64,
+/// The implicit equations of one step of a variational integrator. The unknowns x are the
+/// increments from q₀ of every point the step solves for, n at a time; the last n are
+/// δq = q₁ − q₀. Solving for increments keeps their own relative precision for the driver's
+/// compensated summation (HLW VIII.5).
+pub trait StepEquations {
+    /// Number of unknowns for n coordinates.
+    fn unknowns(&self, n: usize) -> usize;
+
+    /// Writes F(x) into `out`; F = 0 at the step's solution.
+    #[allow(clippy::too_many_arguments)]
+    fn equations<S: Lagrangian + ?Sized>(
+        &mut self,
+        sys: &S,
+        q0: &[f64],
+        p0: &[f64],
+        t: f64,
+        h: f64,
+        x: &[f64],
+        out: &mut [f64],
+    ) -> Result<(), ModelError>;
+
+    /// Writes p₁ − p₀ at the solution x (F(x) = `residual`) into `dp`, in a form free of
+    /// cancellation, and returns the work of the non-conservative forces over the step.
+    #[allow(clippy::too_many_arguments)]
+    fn momentum_change<S: Lagrangian + ?Sized>(
+        &mut self,
+        sys: &S,
+        q0: &[f64],
+        t: f64,
+        h: f64,
+        x: &[f64],
+        residual: &[f64],
+        dp: &mut [f64],
+    ) -> Result<f64, ModelError>;
+
+    /// The predictor of all unknowns from a predicted increment δq.
+    fn predict(&self, dq: &[f64], x: &mut [f64]);
 }
 
 /// The generalized force at a step's midpoint, f(q₀ + δq/2, δq/h, t + h/2), with its buffers.
@@ -72,6 +76,14 @@ struct Forcing {
 }
 
 impl Forcing {
+    fn new(n: usize) -> Self {
+        Forcing {
+            mid: vec![0.0; n],
+            vel: vec![0.0; n],
+            f: vec![0.0; n],
+        }
+    }
+
     fn evaluate<S: Lagrangian + ?Sized>(
         &mut self,
         sys: &S,
@@ -89,59 +101,307 @@ impl Forcing {
     }
 }
 
-/// Writes D₁L_d(q₀, q₀ + δq) + f_d⁻ into `out`: the left side of the forced DEL equations, less p₀.
-#[allow(clippy::too_many_arguments)]
-fn equations<R: DiscreteLagrangian, S: Lagrangian + ?Sized>(
-    rule: &R,
-    sys: &S,
-    q0: &[f64],
-    dq: &[f64],
-    t: f64,
-    h: f64,
-    out: &mut [f64],
-    ws: &mut Workspace,
-    forcing: &mut Forcing,
-) -> Result<(), ModelError> {
-    rule.d1(sys, q0, dq, t, h, out, ws)?;
-    if sys.is_forced() {
-        let f = forcing.evaluate(sys, q0, dq, t, h)?;
-        out.iter_mut().zip(f).for_each(|(o, f)| *o += 0.5 * h * f);
-    }
-    Ok(())
+/// The variational integrator of a two-point discrete Lagrangian (midpoint, trapezoid) with
+/// forcing: F(δq) = p₀ + D₁L_d(q₀, q₀ + δq) + f_d⁻, then p₁ = D₂L_d + f_d⁺ (the forced DEL
+/// equations of the discrete Lagrange–d'Alembert principle, f_d^± = (h/2)f(q̄, v, t + h/2) at
+/// the midpoint). The work of the forces is f(q̄, v)·δq a step.
+#[derive(Clone, Debug)]
+pub struct TwoPoint<R> {
+    rule: R,
+    ws: Workspace,
+    forcing: Forcing,
 }
 
-impl<R: DiscreteLagrangian> Del<R> {
-    pub fn new(rule: R, n: usize, options: NewtonOptions) -> Self {
-        Del {
+impl<R> TwoPoint<R> {
+    pub fn new(rule: R, n: usize) -> Self {
+        TwoPoint {
             rule,
-            options,
             ws: Workspace::new(n),
-            dq: vec![0.0; n],
-            residual: DVector::zeros(n),
-            plus: vec![0.0; n],
-            minus: vec![0.0; n],
-            jacobian: DMatrix::zeros(n, n),
-            pivots: vec![0; n],
+            forcing: Forcing::new(n),
+        }
+    }
+}
+
+impl<R: DiscreteLagrangian> StepEquations for TwoPoint<R> {
+    fn unknowns(&self, n: usize) -> usize {
+        n
+    }
+
+    fn equations<S: Lagrangian + ?Sized>(
+        &mut self,
+        sys: &S,
+        q0: &[f64],
+        p0: &[f64],
+        t: f64,
+        h: f64,
+        x: &[f64],
+        out: &mut [f64],
+    ) -> Result<(), ModelError> {
+        self.rule.d1(sys, q0, x, t, h, out, &mut self.ws)?;
+        out.iter_mut().zip(p0).for_each(|(o, p)| *o += p);
+        if sys.is_forced() {
+            let f = self.forcing.evaluate(sys, q0, x, t, h)?;
+            out.iter_mut().zip(f).for_each(|(o, f)| *o += 0.5 * h * f);
+        }
+        Ok(())
+    }
+
+    /// p₁ − p₀ = D₁L_d + D₂L_d + h·f(q̄, v) − F, since F = p₀ + D₁L_d + f_d⁻.
+    fn momentum_change<S: Lagrangian + ?Sized>(
+        &mut self,
+        sys: &S,
+        q0: &[f64],
+        t: f64,
+        h: f64,
+        x: &[f64],
+        residual: &[f64],
+        dp: &mut [f64],
+    ) -> Result<f64, ModelError> {
+        self.rule.momentum_change(sys, q0, x, t, h, dp, &mut self.ws)?;
+        dp.iter_mut().zip(residual).for_each(|(d, r)| *d -= r);
+        if !sys.is_forced() {
+            return Ok(0.0);
+        }
+        let f = self.forcing.evaluate(sys, q0, x, t, h)?;
+        let mut work = 0.0;
+        for ((d, f), x) in dp.iter_mut().zip(f).zip(x) {
+            *d += h * f;
+            work += f * x;
+        }
+        Ok(work)
+    }
+
+    fn predict(&self, dq: &[f64], x: &mut [f64]) {
+        x.copy_from_slice(dq);
+    }
+}
+
+/// The Galerkin variational integrator of degree s with s-point Gauss–Legendre quadrature
+/// (Marsden & West 2001, §2.6; order 2s): q(τh) = Σⱼ ℓⱼ(τ)Qⱼ through the control points
+/// Q₀ = q₀, Q₁, …, Q_s = q₁ at τ = j/s, and L_d = h Σᵢ bᵢ L(q(cᵢh), q̇(cᵢh), t + cᵢh), made
+/// stationary in the interior points. With ∂L_d/∂Qⱼ = Σᵢ bᵢ[hℓⱼ(cᵢ)∂L/∂q + ℓⱼ'(cᵢ)∂L/∂q̇]:
+///
+/// F = (∂L_d/∂Q₁, …, ∂L_d/∂Q_{s−1}, p₀ + ∂L_d/∂Q₀),   p₁ = ∂L_d/∂Q_s,
+///
+/// and since Σⱼ ℓⱼ = 1, Σⱼ ℓⱼ' = 0, p₁ − p₀ = hΣᵢ bᵢ ∂L/∂q(cᵢ) − ΣF.
+#[derive(Clone, Debug)]
+pub struct Galerkin {
+    s: usize,
+    weights: Vec<f64>,
+    nodes: Vec<f64>,
+    /// ℓⱼ(cᵢ) and ℓⱼ'(cᵢ), row i, column j = 0..=s.
+    basis: Vec<Vec<f64>>,
+    slopes: Vec<Vec<f64>>,
+    x: Vec<f64>,
+    v: Vec<f64>,
+    lq: Vec<Vec<f64>>,
+    lv: Vec<Vec<f64>>,
+}
+
+impl Galerkin {
+    /// Degree s = 2 (order 4) or 3 (order 6).
+    pub fn new(s: usize, n: usize) -> Self {
+        let (nodes, weights): (Vec<f64>, Vec<f64>) = match s {
+            2 => {
+                let d = 3f64.sqrt() / 6.0;
+                (vec![0.5 - d, 0.5 + d], vec![0.5, 0.5])
+            }
+            3 => {
+                let d = 15f64.sqrt() / 10.0;
+                (vec![0.5 - d, 0.5, 0.5 + d], vec![5.0 / 18.0, 4.0 / 9.0, 5.0 / 18.0])
+            }
+            _ => panic!("Galerkin integrators of degree 2 and 3 only"),
+        };
+        let d: Vec<f64> = (0..=s).map(|j| j as f64 / s as f64).collect();
+        let ell = |j: usize, x: f64| {
+            (0..=s)
+                .filter(|&m| m != j)
+                .map(|m| (x - d[m]) / (d[j] - d[m]))
+                .product::<f64>()
+        };
+        let slope = |j: usize, x: f64| {
+            (0..=s)
+                .filter(|&k| k != j)
+                .map(|k| {
+                    (0..=s)
+                        .filter(|&m| m != j && m != k)
+                        .map(|m| (x - d[m]) / (d[j] - d[m]))
+                        .product::<f64>()
+                        / (d[j] - d[k])
+                })
+                .sum::<f64>()
+        };
+        let basis = nodes.iter().map(|&c| (0..=s).map(|j| ell(j, c)).collect()).collect();
+        let slopes = nodes.iter().map(|&c| (0..=s).map(|j| slope(j, c)).collect()).collect();
+        Galerkin {
+            s,
+            weights,
+            nodes,
+            basis,
+            slopes,
+            x: vec![0.0; n],
+            v: vec![0.0; n],
+            lq: vec![vec![0.0; n]; s],
+            lv: vec![vec![0.0; n]; s],
+        }
+    }
+
+    /// ∂L/∂q and ∂L/∂q̇ at every quadrature node, for the control increments x (Q₀ = q₀).
+    fn derivatives<S: Lagrangian + ?Sized>(
+        &mut self,
+        sys: &S,
+        q0: &[f64],
+        t: f64,
+        h: f64,
+        x: &[f64],
+    ) -> Result<(), ModelError> {
+        let n = q0.len();
+        for i in 0..self.s {
+            for a in 0..n {
+                let (mut pos, mut vel) = (0.0, 0.0);
+                for j in 1..=self.s {
+                    let xj = x[(j - 1) * n + a];
+                    pos += self.basis[i][j] * xj;
+                    vel += self.slopes[i][j] * xj;
+                }
+                self.x[a] = q0[a] + pos;
+                self.v[a] = vel / h;
+            }
+            let ti = t + self.nodes[i] * h;
+            sys.dl_dq(&self.x, &self.v, ti, &mut self.lq[i])?;
+            sys.dl_dv(&self.x, &self.v, ti, &mut self.lv[i])?;
+        }
+        Ok(())
+    }
+
+    /// out = ∂L_d/∂Qⱼ = Σᵢ bᵢ[hℓⱼ(cᵢ)∂L/∂q + ℓⱼ'(cᵢ)∂L/∂q̇].
+    fn slot(&self, j: usize, h: f64, out: &mut [f64]) {
+        out.fill(0.0);
+        for i in 0..self.s {
+            let (a, b) = (
+                self.weights[i] * h * self.basis[i][j],
+                self.weights[i] * self.slopes[i][j],
+            );
+            for ((o, lq), lv) in out.iter_mut().zip(&self.lq[i]).zip(&self.lv[i]) {
+                *o += a * lq + b * lv;
+            }
+        }
+    }
+}
+
+impl StepEquations for Galerkin {
+    fn unknowns(&self, n: usize) -> usize {
+        self.s * n
+    }
+
+    fn equations<S: Lagrangian + ?Sized>(
+        &mut self,
+        sys: &S,
+        q0: &[f64],
+        p0: &[f64],
+        t: f64,
+        h: f64,
+        x: &[f64],
+        out: &mut [f64],
+    ) -> Result<(), ModelError> {
+        if sys.is_forced() {
+            return Err("the Galerkin integrators do not take forces yet; use midpoint or trapezoid".into());
+        }
+        let n = q0.len();
+        self.derivatives(sys, q0, t, h, x)?;
+        for j in 1..self.s {
+            self.slot(j, h, &mut out[(j - 1) * n..j * n]);
+        }
+        let last = &mut out[(self.s - 1) * n..];
+        self.slot(0, h, last);
+        last.iter_mut().zip(p0).for_each(|(o, p)| *o += p);
+        Ok(())
+    }
+
+    fn momentum_change<S: Lagrangian + ?Sized>(
+        &mut self,
+        sys: &S,
+        q0: &[f64],
+        t: f64,
+        h: f64,
+        x: &[f64],
+        residual: &[f64],
+        dp: &mut [f64],
+    ) -> Result<f64, ModelError> {
+        let n = q0.len();
+        self.derivatives(sys, q0, t, h, x)?;
+        dp.fill(0.0);
+        for i in 0..self.s {
+            dp.iter_mut()
+                .zip(&self.lq[i])
+                .for_each(|(d, lq)| *d += h * self.weights[i] * lq);
+        }
+        for block in residual.chunks_exact(n) {
+            dp.iter_mut().zip(block).for_each(|(d, r)| *d -= r);
+        }
+        Ok(0.0)
+    }
+
+    /// The control points along the predicted increment: Qⱼ − q₀ = (j/s)·δq.
+    fn predict(&self, dq: &[f64], x: &mut [f64]) {
+        let n = dq.len();
+        for j in 1..=self.s {
+            let w = j as f64 / self.s as f64;
+            x[(j - 1) * n..j * n].iter_mut().zip(dq).for_each(|(x, d)| *x = w * d);
+        }
+    }
+}
+
+/// A variational integrator that solves its step's implicit equations (a [`StepEquations`]) by
+/// Newton's method.
+///
+/// The Jacobian comes from central differences of the equations, is factorised and kept while
+/// the iteration contracts by at least half per step (simplified Newton), refreshed otherwise.
+/// The predictor extrapolates the last two increments. p₁ − p₀ is formed by the scheme free
+/// of cancellation, so that Noether momenta stay conserved to round-off.
+#[derive(Clone, Debug)]
+pub struct Del<Sc> {
+    scheme: Sc,
+    options: NewtonOptions,
+    x: Vec<f64>,
+    residual: DVector<f64>,
+    plus: Vec<f64>,
+    minus: Vec<f64>,
+    jacobian: DMatrix<f64>,
+    pivots: Vec<usize>,
+    predicted: Vec<f64>,
+    last_dq: Vec<f64>,
+    before_last_dq: Vec<f64>,
+    /// How many previous increments the predictor has (0, 1 or 2).
+    history: usize,
+    evaluations: u64,
+    iterations: u64,
+    work: f64,
+}
+
+impl<Sc: StepEquations> Del<Sc> {
+    pub fn new(scheme: Sc, n: usize, options: NewtonOptions) -> Self {
+        let m = scheme.unknowns(n);
+        Del {
+            scheme,
+            options,
+            x: vec![0.0; m],
+            residual: DVector::zeros(m),
+            plus: vec![0.0; m],
+            minus: vec![0.0; m],
+            jacobian: DMatrix::zeros(m, m),
+            pivots: vec![0; m],
+            predicted: vec![0.0; n],
             last_dq: vec![0.0; n],
             before_last_dq: vec![0.0; n],
             history: 0,
             evaluations: 0,
             iterations: 0,
-            forcing: Forcing {
-                mid: vec![0.0; n],
-                vel: vec![0.0; n],
-                f: vec![0.0; n],
-            },
             work: 0.0,
         }
     }
 
-    /// The work done by the generalized forces so far, Σ f(q̄, v)·δq.
-    pub fn work(&self) -> f64 {
-        self.work
-    }
-
-    /// Evaluations of D₁L_d or D₂L_d made so far.
+    /// Evaluations of the step's equations so far.
     pub fn evaluations(&self) -> u64 {
         self.evaluations
     }
@@ -151,11 +411,16 @@ impl<R: DiscreteLagrangian> Del<R> {
         self.iterations
     }
 
+    /// The work done by the generalized forces so far.
+    pub fn work(&self) -> f64 {
+        self.work
+    }
+
     pub(super) fn reset(&mut self) {
         self.history = 0;
     }
 
-    /// residual = p₀ + D₁L_d(q₀, q₀ + δq) + f_d⁻; returns ‖residual‖∞.
+    /// residual = F(x); returns ‖residual‖∞.
     fn residual<S: Lagrangian + ?Sized>(
         &mut self,
         sys: &S,
@@ -165,62 +430,30 @@ impl<R: DiscreteLagrangian> Del<R> {
         h: f64,
     ) -> Result<f64, StepError> {
         self.evaluations += 1;
-        equations(
-            &self.rule,
-            sys,
-            q0,
-            &self.dq,
-            t,
-            h,
-            self.residual.as_mut_slice(),
-            &mut self.ws,
-            &mut self.forcing,
-        )?;
-        let mut norm = 0.0_f64;
-        for (r, p) in self.residual.iter_mut().zip(p0) {
-            *r += p;
-            norm = norm.max(r.abs());
-        }
-        Ok(norm)
+        self.scheme
+            .equations(sys, q0, p0, t, h, &self.x, self.residual.as_mut_slice())?;
+        Ok(self.residual.iter().fold(0.0_f64, |m, r| m.max(r.abs())))
     }
 
-    /// ∂(D₁L_d + f_d⁻)/∂q₁ at q₁ = q₀ + δq by central differences, factorised in place.
+    /// ∂F/∂x by central differences, factorised in place.
     fn factorise_jacobian<S: Lagrangian + ?Sized>(
         &mut self,
         sys: &S,
         q0: &[f64],
+        p0: &[f64],
         t: f64,
         h: f64,
     ) -> Result<bool, StepError> {
         let cbrt_eps = f64::EPSILON.cbrt();
-        for j in 0..self.dq.len() {
-            let d = self.dq[j];
-            let e = cbrt_eps * (q0[j] + d).abs().max(1.0);
-            self.dq[j] = d + e;
-            equations(
-                &self.rule,
-                sys,
-                q0,
-                &self.dq,
-                t,
-                h,
-                &mut self.plus,
-                &mut self.ws,
-                &mut self.forcing,
-            )?;
-            self.dq[j] = d - e;
-            equations(
-                &self.rule,
-                sys,
-                q0,
-                &self.dq,
-                t,
-                h,
-                &mut self.minus,
-                &mut self.ws,
-                &mut self.forcing,
-            )?;
-            self.dq[j] = d;
+        let n = q0.len();
+        for j in 0..self.x.len() {
+            let d = self.x[j];
+            let e = cbrt_eps * (q0[j % n] + d).abs().max(1.0);
+            self.x[j] = d + e;
+            self.scheme.equations(sys, q0, p0, t, h, &self.x, &mut self.plus)?;
+            self.x[j] = d - e;
+            self.scheme.equations(sys, q0, p0, t, h, &self.x, &mut self.minus)?;
+            self.x[j] = d;
             self.evaluations += 2;
             for (i, (a, b)) in self.plus.iter().zip(&self.minus).enumerate() {
                 self.jacobian[(i, j)] = (a - b) / (2.0 * e);
@@ -241,27 +474,29 @@ impl<R: DiscreteLagrangian> Del<R> {
         dp: &mut [f64],
     ) -> Result<(), StepError> {
         // Predictor: extrapolate the last two increments (second order), the last one, or rest.
-        for ((x, d1), d0) in self.dq.iter_mut().zip(&self.last_dq).zip(&self.before_last_dq) {
+        for ((x, d1), d0) in self.predicted.iter_mut().zip(&self.last_dq).zip(&self.before_last_dq) {
             *x = match self.history {
                 0 => 0.0,
                 1 => *d1,
                 _ => 2.0 * d1 - d0,
             };
         }
+        self.scheme.predict(&self.predicted, &mut self.x);
         let mut residual = self.residual(sys, q, p, t, h)?;
         if !residual.is_finite() {
             return Err(StepError::NonFinite {
                 reason: "the implicit equations are non-finite at the predictor",
             });
         }
+        let n = q.len();
         // Simplified Newton: the factorised Jacobian is kept while the corrections shrink by at
         // least half an iteration, and refreshed otherwise.
         let mut keep_jacobian = false;
         let mut last_correction = f64::INFINITY;
         for iteration in 1..=self.options.max_iterations {
             let fresh = !keep_jacobian;
-            if fresh && !self.factorise_jacobian(sys, q, t, h)? {
-                let reason = "the Jacobian ∂D₁L_d/∂q₁ is singular";
+            if fresh && !self.factorise_jacobian(sys, q, p, t, h)? {
+                let reason = "the Jacobian of the step's equations is singular";
                 return Err(StepError::Convergence {
                     residual,
                     iterations: iteration - 1,
@@ -272,10 +507,10 @@ impl<R: DiscreteLagrangian> Del<R> {
             lu_solve(&self.jacobian, &self.pivots, &mut self.residual);
             let mut correction = 0.0_f64;
             let mut scale = 1.0_f64;
-            for ((x, d), q0) in self.dq.iter_mut().zip(self.residual.iter()).zip(q) {
+            for (j, (x, d)) in self.x.iter_mut().zip(self.residual.iter()).enumerate() {
                 *x -= d;
                 correction = correction.max(d.abs());
-                scale = scale.max((q0 + *x).abs());
+                scale = scale.max((q[j % n] + *x).abs());
             }
             residual = self.residual(sys, q, p, t, h)?;
             if !(correction.is_finite() && residual.is_finite()) {
@@ -301,9 +536,7 @@ impl<R: DiscreteLagrangian> Del<R> {
         })
     }
 
-    /// The increments once δq is found: p₁ − p₀ = D₁L_d + D₂L_d + f_d⁻ + f_d⁺ − residual, since
-    /// the last residual evaluation left p₀ + D₁L_d + f_d⁻ in `self.residual`.
-    #[allow(clippy::too_many_arguments)]
+    /// The increments once the step is solved.
     fn finish<S: Lagrangian + ?Sized>(
         &mut self,
         sys: &S,
@@ -314,21 +547,10 @@ impl<R: DiscreteLagrangian> Del<R> {
         dp: &mut [f64],
     ) -> Result<(), StepError> {
         self.evaluations += 1;
-        self.rule.momentum_change(sys, q, &self.dq, t, h, dp, &mut self.ws)?;
-        for (d, r) in dp.iter_mut().zip(self.residual.iter()) {
-            *d -= r;
-        }
-        if sys.is_forced() {
-            // f_d⁻ + f_d⁺ = h·f(q̄, v); the work of the step, f·δq.
-            let f = self.forcing.evaluate(sys, q, &self.dq, t, h)?;
-            let mut work = 0.0;
-            for ((d, f), x) in dp.iter_mut().zip(f).zip(&self.dq) {
-                *d += h * f;
-                work += f * x;
-            }
-            self.work += work;
-        }
-        dq.copy_from_slice(&self.dq);
+        self.work += self
+            .scheme
+            .momentum_change(sys, q, t, h, &self.x, self.residual.as_slice(), dp)?;
+        dq.copy_from_slice(&self.x[self.x.len() - q.len()..]);
         std::mem::swap(&mut self.before_last_dq, &mut self.last_dq);
         self.last_dq.copy_from_slice(dq);
         self.history = (self.history + 1).min(2);

@@ -31,6 +31,10 @@ pub enum Method {
     /// The variational integrator of the trapezoidal discrete Lagrangian (implicit; any L;
     /// Störmer–Verlet for separable systems).
     Trapezoid,
+    /// The Galerkin variational integrator of degree 2 with 2-point Gauss quadrature (order 4).
+    Galerkin4,
+    /// The Galerkin variational integrator of degree 3 with 3-point Gauss quadrature (order 6).
+    Galerkin6,
 }
 
 /// What `varmech.methods()` lists about a method.
@@ -57,7 +61,7 @@ pub struct MethodInfo {
 
 impl Method {
     /// Every method, from the simplest.
-    pub const ALL: [Method; 13] = [
+    pub const ALL: [Method; 15] = [
         Method::ExplicitEuler,
         Method::SymplecticEuler,
         Method::Verlet,
@@ -71,6 +75,8 @@ impl Method {
         Method::Rk4,
         Method::Midpoint,
         Method::Trapezoid,
+        Method::Galerkin4,
+        Method::Galerkin6,
     ];
 
     /// The method's facts.
@@ -110,8 +116,27 @@ impl Method {
                 2.0,
                 "Marsden & West (2001); trapezoidal L_d",
             ),
+            Method::Galerkin4 => (
+                "galerkin4",
+                4,
+                true,
+                true,
+                f64::INFINITY,
+                "Marsden & West (2001), §2.6; Gauss quadrature",
+            ),
+            Method::Galerkin6 => (
+                "galerkin6",
+                6,
+                true,
+                true,
+                f64::INFINITY,
+                "Marsden & West (2001), §2.6; Gauss quadrature",
+            ),
         };
-        let implicit = matches!(self, Method::Midpoint | Method::Trapezoid);
+        let implicit = matches!(
+            self,
+            Method::Midpoint | Method::Trapezoid | Method::Galerkin4 | Method::Galerkin6
+        );
         let stages = Composition::of(self).map_or(1, |c| c.gamma().len());
         let force_evaluations = match self {
             Method::Rk4 => 4,

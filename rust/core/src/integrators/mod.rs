@@ -17,7 +17,7 @@ mod kick_drift;
 mod method;
 
 pub use composition::Composition;
-pub use del::{Del, NewtonOptions};
+pub use del::{Del, Galerkin, NewtonOptions, StepEquations, TwoPoint};
 pub use driver::{integrate, Failure, General, Integrable, Options, Trajectory};
 pub use explicit_rk::ExplicitRk;
 pub use kick_drift::KickDrift;
@@ -84,8 +84,9 @@ pub struct Integrator {
 enum Scheme {
     KickDrift(KickDrift),
     ExplicitRk(ExplicitRk),
-    Midpoint(Del<Midpoint>),
-    Trapezoid(Del<Trapezoidal>),
+    Midpoint(Del<TwoPoint<Midpoint>>),
+    Trapezoid(Del<TwoPoint<Trapezoidal>>),
+    Galerkin(Del<Galerkin>),
 }
 
 impl Integrator {
@@ -97,8 +98,10 @@ impl Integrator {
     /// As [`Integrator::new`], with the options of the implicit methods' Newton iteration.
     pub fn with_newton(method: Method, n: usize, newton: NewtonOptions) -> Self {
         let scheme = match method {
-            Method::Midpoint => Scheme::Midpoint(Del::new(Midpoint, n, newton)),
-            Method::Trapezoid => Scheme::Trapezoid(Del::new(Trapezoidal, n, newton)),
+            Method::Midpoint => Scheme::Midpoint(Del::new(TwoPoint::new(Midpoint, n), n, newton)),
+            Method::Trapezoid => Scheme::Trapezoid(Del::new(TwoPoint::new(Trapezoidal, n), n, newton)),
+            Method::Galerkin4 => Scheme::Galerkin(Del::new(Galerkin::new(2, n), n, newton)),
+            Method::Galerkin6 => Scheme::Galerkin(Del::new(Galerkin::new(3, n), n, newton)),
             Method::ExplicitEuler => Scheme::ExplicitRk(ExplicitRk::euler(n)),
             Method::Rk4 => Scheme::ExplicitRk(ExplicitRk::rk4(n)),
             Method::SymplecticEuler => Scheme::KickDrift(KickDrift::symplectic_euler(n)),
@@ -123,6 +126,7 @@ impl Integrator {
             Scheme::KickDrift(s) => s.reset(),
             Scheme::Midpoint(s) => s.reset(),
             Scheme::Trapezoid(s) => s.reset(),
+            Scheme::Galerkin(s) => s.reset(),
             Scheme::ExplicitRk(_) => {}
         }
     }
@@ -135,6 +139,7 @@ impl Integrator {
             Scheme::ExplicitRk(s) => s.force_evaluations(),
             Scheme::Midpoint(s) => s.evaluations(),
             Scheme::Trapezoid(s) => s.evaluations(),
+            Scheme::Galerkin(s) => s.evaluations(),
         }
     }
 
@@ -143,6 +148,7 @@ impl Integrator {
         match &self.scheme {
             Scheme::Midpoint(s) => s.work(),
             Scheme::Trapezoid(s) => s.work(),
+            Scheme::Galerkin(s) => s.work(),
             _ => 0.0,
         }
     }
@@ -152,6 +158,7 @@ impl Integrator {
         match &self.scheme {
             Scheme::Midpoint(s) => s.iterations(),
             Scheme::Trapezoid(s) => s.iterations(),
+            Scheme::Galerkin(s) => s.iterations(),
             _ => 0,
         }
     }
@@ -192,6 +199,7 @@ impl Integrator {
         match &mut self.scheme {
             Scheme::Midpoint(s) => s.increment(sys, t, q, p, h, dq, dp),
             Scheme::Trapezoid(s) => s.increment(sys, t, q, p, h, dq, dp),
+            Scheme::Galerkin(s) => s.increment(sys, t, q, p, h, dq, dp),
             _ => Err(StepError::Model(
                 "explicit methods integrate separable mechanical systems only".into(),
             )),
