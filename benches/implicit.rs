@@ -1,4 +1,4 @@
-//! Steps per second of the implicit variational integrators (midpoint, trapezoid) on the
+//! Steps per second of the implicit variational integrators (midpoint, trapezoid, Galerkin) on the
 //! native double pendulum, a general Lagrangian; the Newton iterations a step are printed.
 //!
 //! `cargo bench --bench implicit`
@@ -29,7 +29,7 @@ fn implicit(c: &mut Criterion) {
     };
     let mut group = c.benchmark_group("double_pendulum");
     group.throughput(Throughput::Elements(STEPS as u64));
-    for method in [Method::Midpoint, Method::Trapezoid] {
+    for method in [Method::Midpoint, Method::Trapezoid, Method::Galerkin4, Method::Galerkin6] {
         let traj = run(method).expect("h = 0.01 converges");
         println!(
             "{}: {:.2} Newton iterations a step",
