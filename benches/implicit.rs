@@ -29,7 +29,12 @@ fn implicit(c: &mut Criterion) {
     };
     let mut group = c.benchmark_group("double_pendulum");
     group.throughput(Throughput::Elements(STEPS as u64));
-    for method in [Method::Midpoint, Method::Trapezoid, Method::Galerkin4, Method::Galerkin6] {
+    for method in [
+        Method::Midpoint,
+        Method::Trapezoid,
+        Method::Galerkin4,
+        Method::Galerkin6,
+    ] {
         let traj = run(method).expect("h = 0.01 converges");
         println!(
             "{}: {:.2} Newton iterations a step",

@@ -41,6 +41,8 @@ def kepler():
         (dict(q0=[0.4, 0.0], p0=[0.0, 2.0], steps=2**62), "save_every"),
         (dict(q0=[0.4, 0.0], p0=[0.0, 2.0], save_every=0), "save_every"),
         (dict(q0=[0.4, 0.0], p0=[0.0, 2.0], max_energy_error=0.0), "max_energy_error"),
+        (dict(q0=[0.4, 0.0], p0=[0.0, 2.0], newton_tolerance=0.0), "newton_tolerance"),
+        (dict(q0=[0.4, 0.0], p0=[0.0, 2.0], newton_max_iterations=0), "newton_max_iterations"),
     ],
 )
 def test_bad_input_raises_value_error_naming_the_argument(kepler, kwargs, argument):
@@ -204,3 +206,17 @@ def test_newton_failure_raises_convergence_error_with_partial_trajectory():
     err = info.value
     assert err.step == 1 and err.time == 0.0 and err.iterations == 50 and err.residual > 0.1
     assert err.partial.steps == 0 and len(err.partial) == 1
+    # The iteration cap is the user's.
+    with pytest.raises(varmech.ConvergenceError) as info:
+        varmech.integrate(model, [0.001], [0.0], dt=1.0, steps=10, method="midpoint", newton_max_iterations=7)
+    assert info.value.iterations == 7
+
+
+def test_newton_tolerance_sets_how_far_the_implicit_equations_are_solved():
+    # A loose tolerance stops Newton earlier: fewer iterations, a larger error in L.
+    scene = scenes.kepler()
+    tight = varmech.integrate(scene, dt=scene.dt, steps=2000, method="midpoint")
+    loose = varmech.integrate(scene, dt=scene.dt, steps=2000, method="midpoint", newton_tolerance=1e-6)
+    assert loose.newton_iterations < tight.newton_iterations
+    err = lambda t: np.max(np.abs(varmech.momentum(t, varmech.Rotation(spatial_dim=2)) - 0.8))  # noqa: E731
+    assert err(tight) < 1e-14 < err(loose)

@@ -91,6 +91,8 @@ def integrate(
     compensated: bool = True,
     max_energy_error: float | None = None,
     t0: float = 0.0,
+    newton_tolerance: float = 1e-14,
+    newton_max_iterations: int = 50,
 ) -> tuple[FloatArray, FloatArray, FloatArray, int, int, NDArray[np.uint64], FloatArray]:
     """(t, q, p, steps, force_evaluations, newton, work): the cumulative Newton iterations and
     work of the forces at each saved state; on failure the exception carries

@@ -114,6 +114,8 @@ def integrate(
     compensated: bool = True,
     max_energy_error: float | None = None,
     t0: float = 0.0,
+    newton_tolerance: float = 1e-14,
+    newton_max_iterations: int = 50,
 ) -> Trajectory:
     """Integrate ``model`` from (q0, p0) with a fixed step.
 
@@ -143,6 +145,10 @@ def integrate(
         always stop the run.
     t0:
         The initial time.
+    newton_tolerance, newton_max_iterations:
+        The implicit methods' Newton iteration stops when its correction is below
+        ``newton_tolerance``·(1 + ‖q‖∞), and fails with :class:`~varmech.ConvergenceError` after
+        ``newton_max_iterations`` iterations.
 
     Raises
     ------
@@ -180,6 +186,9 @@ def integrate(
         raise ValueError(f"save_every: must be a positive integer, got {save_every!r}")
     if max_energy_error is not None:
         max_energy_error = positive("max_energy_error", max_energy_error)
+    newton_tolerance = positive("newton_tolerance", newton_tolerance)
+    if isinstance(newton_max_iterations, bool) or not isinstance(newton_max_iterations, (int, np.integer)) or newton_max_iterations < 1:
+        raise ValueError(f"newton_max_iterations: must be a positive integer, got {newton_max_iterations!r}")
     if q0 is None:
         raise ValueError("q0: the initial positions are required")
     q = vector("q0", q0, n)
@@ -198,6 +207,8 @@ def integrate(
             compensated=bool(compensated),
             max_energy_error=max_energy_error,
             t0=t0,
+            newton_tolerance=newton_tolerance,
+            newton_max_iterations=int(newton_max_iterations),
         )
     except BaseException as err:
         raw = getattr(err, "_varmech_partial", None)

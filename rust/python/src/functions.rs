@@ -5,7 +5,7 @@ use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
 use varmech::diagnostics::{self, EnergyStatistics, InvariantStatistics};
-use varmech::integrators::{self, General, Integrable, Method, Options};
+use varmech::integrators::{self, General, Integrable, Method, NewtonOptions, Options};
 use varmech::scenes::{self, LagrangianScene, Problem, Scene};
 use varmech::ModelError;
 
@@ -96,7 +96,7 @@ fn model_error(e: ModelError) -> PyErr {
 /// `_varmech_partial` (`newton`, `work`: cumulative Newton iterations and work of the forces at
 /// each saved state).
 #[pyfunction]
-#[pyo3(signature = (model, q0, p0, *, dt, steps, method, save_every=1, compensated=true, max_energy_error=None, t0=0.0))]
+#[pyo3(signature = (model, q0, p0, *, dt, steps, method, save_every=1, compensated=true, max_energy_error=None, t0=0.0, newton_tolerance=1e-14, newton_max_iterations=50))]
 #[allow(clippy::too_many_arguments)]
 fn integrate<'py>(
     py: Python<'py>,
@@ -110,8 +110,14 @@ fn integrate<'py>(
     compensated: bool,
     max_energy_error: Option<f64>,
     t0: f64,
+    newton_tolerance: f64,
+    newton_max_iterations: usize,
 ) -> PyResult<Bound<'py, PyTuple>> {
     let method = Method::from_name(method).map_err(|e| to_pyerr(py, e))?;
+    let newton = NewtonOptions {
+        tolerance: newton_tolerance,
+        max_iterations: newton_max_iterations,
+    };
     let options = Options {
         dt,
         steps,
@@ -119,6 +125,7 @@ fn integrate<'py>(
         compensated,
         max_energy_error,
         t0,
+        newton,
     };
     let (q0, p0) = (slice("q0", &q0)?.to_vec(), slice("p0", &p0)?.to_vec());
     let result = with_system!(py, model, |sys, poll| integrators::integrate(

@@ -1,6 +1,6 @@
 use std::time::{Duration, Instant};
 
-use super::{compensated, Integrator, Method, StepError};
+use super::{compensated, Integrator, Method, NewtonOptions, StepError};
 use crate::diagnostics::hamiltonian;
 use crate::error::check_vector;
 use crate::model::{Lagrangian, MechanicalSystem};
@@ -126,6 +126,8 @@ pub struct Options {
     pub max_energy_error: Option<f64>,
     /// The initial time.
     pub t0: f64,
+    /// Tolerance and iteration cap of the implicit methods' Newton iteration.
+    pub newton: NewtonOptions,
 }
 
 impl Options {
@@ -138,6 +140,7 @@ impl Options {
             compensated: true,
             max_energy_error: None,
             t0: 0.0,
+            newton: NewtonOptions::default(),
         }
     }
 
@@ -153,6 +156,19 @@ impl Options {
         }
         if !self.t0.is_finite() {
             return Err(Error::invalid("t0", "must be finite"));
+        }
+        let NewtonOptions {
+            tolerance,
+            max_iterations,
+        } = self.newton;
+        if !(tolerance.is_finite() && tolerance > 0.0) {
+            return Err(Error::invalid(
+                "newton_tolerance",
+                format!("must be finite and positive, got {tolerance}"),
+            ));
+        }
+        if max_iterations == 0 {
+            return Err(Error::invalid("newton_max_iterations", "must be at least 1"));
         }
         match self.max_energy_error {
             Some(x) if x.is_nan() || x <= 0.0 => {
@@ -307,6 +323,7 @@ where
         compensated,
         max_energy_error,
         t0,
+        newton,
     } = *options;
     let saved = (steps / save_every).saturating_add(2);
     let reserved = saved.checked_mul(n).is_some_and(|len| {
@@ -330,7 +347,7 @@ where
     // finite, so that a failing step leaves the last good state intact.
     let (mut q_next, mut p_next) = (vec![0.0; n], vec![0.0; n]);
     let (mut eq_next, mut ep_next) = (vec![0.0; n], vec![0.0; n]);
-    let mut integrator = Integrator::new(method, n);
+    let mut integrator = Integrator::with_newton(method, n, newton);
     let mut interrupt = InterruptPoll::new();
     traj.push(t0, &q, &p, &integrator);
     let h0 = match max_energy_error.and_then(|_| sys.energy(&q, &p)) {
