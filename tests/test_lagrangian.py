@@ -99,6 +99,10 @@ def test_general_lagrangians_refuse_explicit_methods_and_name_bad_closures():
     broken = varmech.Lagrangian(2, model.lagrangian, dl_dq=lambda q, v, t: np.zeros(3), dl_dv=model.dl_dv)
     with pytest.raises(ValueError, match=r"dl_dq\(q, v, t\) returned 3 values, expected 2"):
         varmech.integrate(broken, [1.0, 0.0], [0.0, 1.0], dt=0.1, steps=1, method="midpoint")
+    with pytest.raises(ValueError, match="generator"):
+        varmech.Lagrangian(3, model.lagrangian, dl_dq=model.dl_dq, dl_dv=model.dl_dv, symmetries=[varmech.Rotation(spatial_dim=2)])
+    with pytest.raises(TypeError, match="^symmetries:"):
+        varmech.Lagrangian(2, model.lagrangian, dl_dq=model.dl_dq, dl_dv=model.dl_dv, symmetries=["L"])
     with pytest.raises(TypeError, match="^lagrangian: must be callable"):
         varmech.Lagrangian(2, 1.0, dl_dq=model.dl_dq, dl_dv=model.dl_dv)
 

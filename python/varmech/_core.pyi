@@ -75,6 +75,7 @@ class ClosureLagrangian(_ModelProperties):
         dl_dv: Callable[[FloatArray, FloatArray, float], Any] | None,
         force: Callable[[FloatArray, FloatArray, float], Any] | None,
         time_dependent: bool,
+        symmetries: Sequence[GeneratorSpec],
     ) -> None: ...
 
 Model = NativeModel | ClosureModel | ClosureLagrangian

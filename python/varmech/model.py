@@ -67,6 +67,14 @@ Symmetry = Union[Translation, Rotation, Cyclic]
 Generator = Union[Symmetry, Callable[[np.ndarray], ArrayLike]]
 
 
+def _specs(symmetries: Sequence[Symmetry]) -> list[tuple[str, int, int]]:
+    """The specs the binding checks (it knows which generators apply to how many coordinates)."""
+    for s in symmetries:
+        if not isinstance(s, (Translation, Rotation, Cyclic)):
+            raise TypeError(f"symmetries: expected Translation, Rotation or Cyclic, got {s!r}")
+    return [s.spec() for s in symmetries]
+
+
 def _symmetry_from_spec(kind: str, a: int, d: int) -> Symmetry:
     return {"translation": lambda: Translation(a, d), "rotation": lambda: Rotation(a, d), "cyclic": lambda: Cyclic(a)}[kind]()
 
@@ -179,7 +187,7 @@ class MechanicalSystem(Model):
                 f"({2 * dim} potential calls per force, about 1e-10 relative accuracy)",
                 stacklevel=2,
             )
-        self._core = _core.ClosureModel(int(dim), potential, gradient, m, [s.spec() for s in symmetries])
+        self._core = _core.ClosureModel(int(dim), potential, gradient, m, _specs(symmetries))
         self.potential = potential
         self.gradient = gradient
         self.mass = m
@@ -240,11 +248,6 @@ class Lagrangian(Model):
                 f"({2 * dim} calls of L each, about 1e-10 relative accuracy)",
                 stacklevel=2,
             )
-        for s in symmetries:
-            if not isinstance(s, (Translation, Rotation, Cyclic)):
-                raise TypeError(f"symmetries: expected Translation, Rotation or Cyclic, got {s!r}")
-            if max(s.spec()[1], 0) >= dim and isinstance(s, Cyclic):
-                raise ValueError(f"symmetries: {s} does not apply to {dim} coordinates")
         total_force = force
         if rayleigh is not None:
             c = np.array(rayleigh, dtype=float)
@@ -252,7 +255,9 @@ class Lagrangian(Model):
                 raise ValueError(f"rayleigh: must be a finite scalar, a vector ({dim},) or a matrix ({dim}, {dim})")
             damping = (lambda v: c @ v) if c.ndim == 2 else (lambda v: c * v)
             total_force = (lambda q, v, t: -damping(v)) if force is None else (lambda q, v, t: np.asarray(force(q, v, t), dtype=float) - damping(v))
-        self._core = _core.ClosureLagrangian(int(dim), lagrangian, dl_dq, dl_dv, total_force, bool(time_dependent))
+        self._core = _core.ClosureLagrangian(
+            int(dim), lagrangian, dl_dq, dl_dv, total_force, bool(time_dependent), _specs(symmetries)
+        )
         self.force = total_force
         self.lagrangian = lagrangian
         self.dl_dq = dl_dq

@@ -63,6 +63,18 @@ pub fn generator(spec: (String, usize, usize)) -> PyResult<Generator> {
     }
 }
 
+/// Generators from their specs, each checked to apply to `dim` coordinates.
+pub fn generators(specs: Vec<(String, usize, usize)>, dim: usize) -> PyResult<Vec<Generator>> {
+    specs
+        .into_iter()
+        .map(|spec| {
+            let g = generator(spec)?;
+            g.check(dim).map_err(|e| PyValueError::new_err(e.to_string()))?;
+            Ok(g)
+        })
+        .collect()
+}
+
 /// The spec of a generator, as [`generator`] reads it, with its name.
 pub fn generator_spec(g: Generator) -> (&'static str, usize, usize, String) {
     match g {

@@ -71,19 +71,6 @@ macro_rules! with_system {
     }};
 }
 
-/// The number of coordinates of a model.
-fn model_dim(model: &Bound<'_, PyAny>) -> PyResult<usize> {
-    if let Ok(native) = model.cast::<NativeModel>() {
-        Ok(native.get().dim())
-    } else if let Ok(closure) = model.cast::<ClosureModel>() {
-        Ok(closure.get().dim())
-    } else if let Ok(closure) = model.cast::<ClosureLagrangian>() {
-        Ok(closure.get().dim())
-    } else {
-        Err(model_type_error(model))
-    }
-}
-
 /// A model's error as the Python exception it stands for.
 fn model_error(e: ModelError) -> PyErr {
     match e.downcast::<PyErr>() {
@@ -142,12 +129,13 @@ type States<'a> = (&'a [f64], &'a [f64], &'a [f64], usize);
 
 /// Checks that t, q and x are N times, and (N, n) arrays for the model's n, and returns them.
 fn states<'a>(
+    py: Python<'_>,
     model: &Bound<'_, PyAny>,
     t: &'a PyReadonlyArray1<'_, f64>,
     q: &'a PyReadonlyArray2<'_, f64>,
     x: &'a PyReadonlyArray2<'_, f64>,
 ) -> PyResult<States<'a>> {
-    let dim = model_dim(model)?;
+    let dim = with_system!(py, model, |sys, _poll| sys.dim());
     let (t, (q, n), (x, m)) = (slice("t", t)?, rows("q", q)?, rows("x", x)?);
     if n != dim || m != dim || q.len() != x.len() || q.len() != t.len() * dim {
         return Err(PyValueError::new_err(format!(
@@ -166,7 +154,7 @@ fn energy<'py>(
     q: PyReadonlyArray2<'py, f64>,
     p: PyReadonlyArray2<'py, f64>,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
-    let (t, q, p, n) = states(model, &t, &q, &p)?;
+    let (t, q, p, n) = states(py, model, &t, &q, &p)?;
     let result: Result<Vec<f64>, ModelError> = with_system!(py, model, |sys, _poll| {
         let l = sys.as_lagrangian();
         t.iter()
@@ -189,7 +177,7 @@ fn legendre<'py>(
     x: PyReadonlyArray2<'py, f64>,
     inverse: bool,
 ) -> PyResult<Bound<'py, PyAny>> {
-    let (t, q, x, n) = states(model, &t, &q, &x)?;
+    let (t, q, x, n) = states(py, model, &t, &q, &x)?;
     let result: Result<Vec<f64>, ModelError> = with_system!(py, model, |sys, _poll| {
         let l = sys.as_lagrangian();
         let mut y = vec![0.0; x.len()];

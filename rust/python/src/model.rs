@@ -119,13 +119,7 @@ impl ClosureModel {
                 "mass: has dimension {n}, the model has dim = {dim}"
             )));
         }
-        let symmetries = symmetries
-            .into_iter()
-            .map(convert::generator)
-            .collect::<PyResult<Vec<_>>>()?;
-        for g in &symmetries {
-            g.check(dim).map_err(|e| PyValueError::new_err(e.to_string()))?;
-        }
+        let symmetries = convert::generators(symmetries, dim)?;
         Ok(ClosureModel {
             dim,
             mass,
@@ -182,7 +176,10 @@ pub struct ClosureLagrangian {
 #[pymethods]
 impl ClosureLagrangian {
     #[new]
-    #[pyo3(signature = (dim, lagrangian, dl_dq, dl_dv, force, time_dependent))]
+    /// `symmetries` are only checked here (the core's Lagrangian trait declares none); the
+    /// Python model keeps them for the conservation report.
+    #[pyo3(signature = (dim, lagrangian, dl_dq, dl_dv, force, time_dependent, symmetries))]
+    #[allow(clippy::too_many_arguments)]
     fn new(
         dim: usize,
         lagrangian: Bound<'_, PyAny>,
@@ -190,7 +187,9 @@ impl ClosureLagrangian {
         dl_dv: Option<Bound<'_, PyAny>>,
         force: Option<Bound<'_, PyAny>>,
         time_dependent: bool,
+        symmetries: Vec<(String, usize, usize)>,
     ) -> PyResult<Self> {
+        convert::generators(symmetries, dim)?;
         check_closures(
             dim,
             [
