@@ -212,6 +212,19 @@ def test_newton_failure_raises_convergence_error_with_partial_trajectory():
     assert info.value.iterations == 7
 
 
+@pytest.mark.parametrize("native", [True, False])
+def test_a_step_beyond_a_fold_raises_spurious_branch_error(native):
+    # Pendulum from rest at q0 = 3 with h = 3: the midpoint equation's derivative
+    # -1/h - (h/4)cos(q̄) changes sign near the top, and Newton lands on a branch that jumps over
+    # it although E < 1 (tests/spurious_branch.rs has the theory).
+    model = scenes.pendulum().model if native else examples.closure_of(scenes.pendulum())
+    with pytest.raises(varmech.SpuriousBranchError, match="spurious branch at step 1 .*fold") as info:
+        varmech.integrate(model, [3.0], [0.0], dt=3.0, steps=10, method="midpoint")
+    err = info.value
+    assert isinstance(err, varmech.ConvergenceError)
+    assert err.step == 1 and err.time == 0.0 and len(err.partial) == 1
+
+
 def test_newton_tolerance_sets_how_far_the_implicit_equations_are_solved():
     # A loose tolerance stops Newton earlier: fewer iterations, a larger error in L.
     scene = scenes.kepler()

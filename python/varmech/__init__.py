@@ -17,7 +17,7 @@ Hamilton's principle, and check what it conserves::
     print(varmech.check_conservation(traj))
 """
 
-from ._core import ConvergenceError, DivergenceError, VarmechError
+from ._core import ConvergenceError, DivergenceError, SpuriousBranchError, VarmechError
 from .conservation import ConservationReport, EnergyReport, MomentumReport, check_conservation, momentum
 from .derivatives import DerivativeCheck, check_derivatives
 from .integrate import Trajectory, integrate, symplecticity_defect
@@ -41,6 +41,7 @@ __all__ = [
     "MomentumReport",
     "NativeSystem",
     "Rotation",
+    "SpuriousBranchError",
     "Trajectory",
     "Translation",
     "VarmechError",

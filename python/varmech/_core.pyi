@@ -27,6 +27,10 @@ class ConvergenceError(VarmechError):
     iterations: int
     partial: Any
 
+class SpuriousBranchError(ConvergenceError):
+    """A step was solved beyond a fold of the DEL map, on a branch that need not continue the
+    trajectory; ``residual`` and ``iterations`` are not set."""
+
 class _ModelProperties:
     """What every model class reports (a stub-only base: the classes do not share one)."""
 

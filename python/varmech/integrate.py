@@ -159,7 +159,9 @@ def integrate(
         to the last good step) are attached.
     ConvergenceError
         An implicit method's Newton iteration failed; ``err.step``, ``err.time``,
-        ``err.residual``, ``err.iterations`` and ``err.partial`` are attached.
+        ``err.residual``, ``err.iterations`` and ``err.partial`` are attached. Its subclass
+        :class:`~varmech.SpuriousBranchError` means Newton converged, but beyond a fold of the
+        DEL map where the step's solution is not unique (the step is too large there).
     Exception
         An exception raised by a closure (or KeyboardInterrupt) propagates unchanged, with
         ``err.partial``, ``err.step`` and ``err.time`` attached where the exception allows.

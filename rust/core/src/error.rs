@@ -22,6 +22,13 @@ pub enum Error {
         iterations: usize,
         reason: &'static str,
     },
+    /// The implicit equations of `step` (which starts at `time`) were solved, but on a branch
+    /// that need not continue the trajectory: the step is too large for the dynamics there.
+    SpuriousBranch {
+        step: usize,
+        time: f64,
+        reason: &'static str,
+    },
     /// The model failed while it was evaluated during `step` (which starts at `time`).
     Model { step: usize, time: f64, source: ModelError },
     /// The interrupt poll (Ctrl-C) asked the run to stop before `step`.
@@ -56,6 +63,12 @@ impl fmt::Display for Error {
                 "{reason} at step {step} (t = {time}): residual {residual:.3e} after {iterations} iterations; \
                  a smaller step usually helps"
             ),
+            Error::SpuriousBranch { step, time, reason } => {
+                write!(
+                    f,
+                    "spurious branch at step {step} (t = {time}): {reason}; take a smaller step"
+                )
+            }
             Error::Model { step, time, source } => {
                 write!(f, "model evaluation failed at step {step} (t = {time}): {source}")
             }

@@ -16,6 +16,13 @@ pyo3::create_exception!(
 );
 pyo3::create_exception!(
     _core,
+    SpuriousBranchError,
+    ConvergenceError,
+    "A step's implicit equations were solved beyond a fold of the DEL map, on a branch that need not \
+     continue the trajectory (take a smaller step)."
+);
+pyo3::create_exception!(
+    _core,
     DivergenceError,
     VarmechError,
     "The solution blew up: a non-finite state, or an energy error beyond max_energy_error."
@@ -49,6 +56,14 @@ pub fn to_pyerr(py: Python<'_>, error: Error) -> PyErr {
                 .and(value.setattr("time", time))
                 .and(value.setattr("residual", residual))
                 .and(value.setattr("iterations", iterations));
+            err
+        }
+        Error::SpuriousBranch { step, time, reason } => {
+            let err = SpuriousBranchError::new_err(format!(
+                "spurious branch at step {step} (t = {time}): {reason}; take a smaller step"
+            ));
+            let value = err.value(py);
+            let _ = value.setattr("step", step).and(value.setattr("time", time));
             err
         }
         Error::Model { step, time, source } | Error::Interrupted { step, time, source } => {

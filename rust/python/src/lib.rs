@@ -17,6 +17,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("VarmechError", py.get_type::<errors::VarmechError>())?;
     m.add("DivergenceError", py.get_type::<errors::DivergenceError>())?;
     m.add("ConvergenceError", py.get_type::<errors::ConvergenceError>())?;
+    m.add("SpuriousBranchError", py.get_type::<errors::SpuriousBranchError>())?;
     m.add_class::<model::NativeModel>()?;
     m.add_class::<model::ClosureModel>()?;
     m.add_class::<model::ClosureLagrangian>()?;

@@ -65,6 +65,10 @@ pub trait StepEquations {
 
     /// The predictor of all unknowns from a predicted increment δq.
     fn predict(&self, dq: &[f64], x: &mut [f64]);
+
+    /// The sign of det ∂F/∂x in the continuum limit h → 0, where ∂F/∂x → (1/h)·K ⊗ ∂²L/∂q̇²
+    /// for the scheme's s×s matrix K: sign(det K)ⁿ·sign(det ∂²L/∂q̇²)ˢ.
+    fn continuum_sign(&self, n: usize, hessian_sign: f64) -> f64;
 }
 
 /// The generalized force at a step's midpoint, f(q₀ + δq/2, δq/h, t + h/2), with its buffers.
@@ -174,6 +178,15 @@ impl<R: DiscreteLagrangian> StepEquations for TwoPoint<R> {
     fn predict(&self, dq: &[f64], x: &mut [f64]) {
         x.copy_from_slice(dq);
     }
+
+    /// K = (−1): ∂F/∂δq = −(1/h)∂²L/∂q̇² + O(1) for both rules.
+    fn continuum_sign(&self, n: usize, hessian_sign: f64) -> f64 {
+        if n % 2 == 0 {
+            hessian_sign
+        } else {
+            -hessian_sign
+        }
+    }
 }
 
 /// The Galerkin variational integrator of degree s with s-point Gauss–Legendre quadrature
@@ -196,6 +209,8 @@ pub struct Galerkin {
     v: Vec<f64>,
     lq: Vec<Vec<f64>>,
     lv: Vec<Vec<f64>>,
+    /// sign det K, K = (Σᵢ bᵢℓⱼ'(cᵢ)ℓₖ'(cᵢ)) over the equations' slots j and the unknowns k.
+    k_sign: f64,
 }
 
 impl Galerkin {
@@ -232,7 +247,14 @@ impl Galerkin {
                 .sum::<f64>()
         };
         let basis = nodes.iter().map(|&c| (0..=s).map(|j| ell(j, c)).collect()).collect();
-        let slopes = nodes.iter().map(|&c| (0..=s).map(|j| slope(j, c)).collect()).collect();
+        let slopes: Vec<Vec<f64>> = nodes.iter().map(|&c| (0..=s).map(|j| slope(j, c)).collect()).collect();
+        // The equations' slots are Q₁, …, Q_{s−1}, then Q₀; the unknowns Q₁, …, Q_s.
+        let slot = |r: usize| if r + 1 < s { r + 1 } else { 0 };
+        let k = DMatrix::from_fn(s, s, |r, c| {
+            (0..s)
+                .map(|i| weights[i] * slopes[i][slot(r)] * slopes[i][c + 1])
+                .sum::<f64>()
+        });
         Galerkin {
             s,
             weights,
@@ -243,6 +265,7 @@ impl Galerkin {
             v: vec![0.0; n],
             lq: vec![vec![0.0; n]; s],
             lv: vec![vec![0.0; n]; s],
+            k_sign: k.determinant().signum(),
         }
     }
 
@@ -350,6 +373,10 @@ impl StepEquations for Galerkin {
             x[(j - 1) * n..j * n].iter_mut().zip(dq).for_each(|(x, d)| *x = w * d);
         }
     }
+
+    fn continuum_sign(&self, n: usize, hessian_sign: f64) -> f64 {
+        self.k_sign.powi(n as i32) * hessian_sign.powi(self.s as i32)
+    }
 }
 
 /// A variational integrator that solves its step's implicit equations (a [`StepEquations`]) by
@@ -359,6 +386,12 @@ impl StepEquations for Galerkin {
 /// the iteration contracts by at least half per step (simplified Newton), refreshed otherwise.
 /// The predictor extrapolates the last two increments. p₁ − p₀ is formed by the scheme free
 /// of cancellation, so that Noether momenta stay conserved to round-off.
+///
+/// A step whose Jacobian at the solution has the opposite determinant sign to the continuum
+/// limit ([`StepEquations::continuum_sign`]) has crossed a fold of the DEL map: beyond it the
+/// equations have several solutions (for the midpoint rule once h²λ/4 > 1 for an unstable
+/// eigenvalue λ of −M⁻¹∂²L/∂q², e.g. h ≥ 2 at the top of the pendulum) and Newton may settle
+/// on a spurious one. Such a step is refused as [`StepError::SpuriousBranch`].
 #[derive(Clone, Debug)]
 pub struct Del<Sc> {
     scheme: Sc,
@@ -369,6 +402,12 @@ pub struct Del<Sc> {
     minus: Vec<f64>,
     jacobian: DMatrix<f64>,
     pivots: Vec<usize>,
+    /// sign det of the last factorised Jacobian.
+    jacobian_sign: f64,
+    /// sign det ∂F/∂x as h → 0 at the run's first state; 0 until computed.
+    continuum_sign: f64,
+    hessian: DMatrix<f64>,
+    velocity: Vec<f64>,
     predicted: Vec<f64>,
     last_dq: Vec<f64>,
     before_last_dq: Vec<f64>,
@@ -391,6 +430,10 @@ impl<Sc: StepEquations> Del<Sc> {
             minus: vec![0.0; m],
             jacobian: DMatrix::zeros(m, m),
             pivots: vec![0; m],
+            jacobian_sign: 0.0,
+            continuum_sign: 0.0,
+            hessian: DMatrix::zeros(n, n),
+            velocity: vec![0.0; n],
             predicted: vec![0.0; n],
             last_dq: vec![0.0; n],
             before_last_dq: vec![0.0; n],
@@ -418,6 +461,38 @@ impl<Sc: StepEquations> Del<Sc> {
 
     pub(super) fn reset(&mut self) {
         self.history = 0;
+        self.continuum_sign = 0.0;
+    }
+
+    /// sign det ∂²L/∂q̇² at (q, q̇(q, p), t), by central differences of ∂L/∂q̇: the regularity
+    /// of L, against which the DEL Jacobian's sign is judged.
+    fn hessian_sign<S: Lagrangian + ?Sized>(
+        &mut self,
+        sys: &S,
+        q: &[f64],
+        p: &[f64],
+        t: f64,
+    ) -> Result<f64, StepError> {
+        let n = q.len();
+        sys.velocity(q, p, t, &mut self.velocity)?;
+        for j in 0..n {
+            let v = self.velocity[j];
+            let e = f64::EPSILON.cbrt() * v.abs().max(1.0);
+            self.velocity[j] = v + e;
+            sys.dl_dv(q, &self.velocity, t, &mut self.plus[..n])?;
+            self.velocity[j] = v - e;
+            sys.dl_dv(q, &self.velocity, t, &mut self.minus[..n])?;
+            self.velocity[j] = v;
+            for i in 0..n {
+                self.hessian[(i, j)] = (self.plus[i] - self.minus[i]) / (2.0 * e);
+            }
+        }
+        let mut pivots = std::mem::take(&mut self.pivots);
+        let sign = lu_in_place(&mut self.hessian, &mut pivots[..n]);
+        self.pivots = pivots;
+        sign.ok_or_else(|| {
+            StepError::Model("∂²L/∂q̇² is singular at the initial state: the Lagrangian is not regular".into())
+        })
     }
 
     /// residual = F(x); returns ‖residual‖∞.
@@ -459,7 +534,17 @@ impl<Sc: StepEquations> Del<Sc> {
                 self.jacobian[(i, j)] = (a - b) / (2.0 * e);
             }
         }
-        Ok(lu_in_place(&mut self.jacobian, &mut self.pivots))
+        if !self.jacobian.iter().all(|x| x.is_finite()) {
+            let reason = "the Jacobian of the step's equations is non-finite: the solution is blowing up";
+            return Err(StepError::NonFinite { reason });
+        }
+        match lu_in_place(&mut self.jacobian, &mut self.pivots) {
+            Some(sign) => {
+                self.jacobian_sign = sign;
+                Ok(true)
+            }
+            None => Ok(false),
+        }
     }
 
     #[allow(clippy::too_many_arguments)]
@@ -473,6 +558,11 @@ impl<Sc: StepEquations> Del<Sc> {
         dq: &mut [f64],
         dp: &mut [f64],
     ) -> Result<(), StepError> {
+        let n = q.len();
+        if self.continuum_sign == 0.0 {
+            let hessian_sign = self.hessian_sign(sys, q, p, t)?;
+            self.continuum_sign = self.scheme.continuum_sign(n, hessian_sign);
+        }
         // Predictor: extrapolate the last two increments (second order), the last one, or rest.
         for ((x, d1), d0) in self.predicted.iter_mut().zip(&self.last_dq).zip(&self.before_last_dq) {
             *x = match self.history {
@@ -488,7 +578,6 @@ impl<Sc: StepEquations> Del<Sc> {
                 reason: "the implicit equations are non-finite at the predictor",
             });
         }
-        let n = q.len();
         // Simplified Newton: the factorised Jacobian is kept while the corrections shrink by at
         // least half an iteration, and refreshed otherwise.
         let mut keep_jacobian = false;
@@ -523,6 +612,13 @@ impl<Sc: StepEquations> Del<Sc> {
             // longer contracts.
             let at_floor = fresh && !contracting && correction <= NOISE_FLOOR * scale;
             if correction <= self.options.tolerance * scale || at_floor {
+                if self.jacobian_sign != self.continuum_sign {
+                    return Err(StepError::SpuriousBranch {
+                        reason: "the step's solution lies beyond a fold of the discrete Euler–Lagrange map \
+                                 (the Jacobian's determinant changed sign from its continuum limit), where \
+                                 the equations have several solutions and Newton's may be spurious",
+                    });
+                }
                 return self.finish(sys, t, q, h, dq, dp);
             }
             keep_jacobian = contracting;
@@ -559,17 +655,22 @@ impl<Sc: StepEquations> Del<Sc> {
 }
 
 /// LU factorisation with partial pivoting, in place (L below the diagonal with unit diagonal,
-/// U on and above it); `pivots[i]` is the row swapped into row i. Returns false for a singular
-/// matrix. Written out because nalgebra's `LU` allocates its permutation on every
+/// U on and above it); `pivots[i]` is the row swapped into row i. Returns the sign of the
+/// determinant, or None for a singular matrix. Written out because nalgebra's `LU` allocates its permutation on every
 /// factorisation, and the Newton loop must not allocate.
-fn lu_in_place(a: &mut DMatrix<f64>, pivots: &mut [usize]) -> bool {
+fn lu_in_place(a: &mut DMatrix<f64>, pivots: &mut [usize]) -> Option<f64> {
     let n = a.nrows();
+    let mut sign = 1.0;
     for k in 0..n {
         let piv = k + a.view_range(k.., k).iamax();
         pivots[k] = piv;
         if a[(piv, k)] == 0.0 {
-            return false;
+            return None;
         }
+        if piv != k {
+            sign = -sign;
+        }
+        sign *= a[(piv, k)].signum();
         a.swap_rows(k, piv);
         let inv = 1.0 / a[(k, k)];
         for i in k + 1..n {
@@ -580,7 +681,7 @@ fn lu_in_place(a: &mut DMatrix<f64>, pivots: &mut [usize]) -> bool {
             }
         }
     }
-    true
+    Some(sign)
 }
 
 /// Solves A x = b in place with the factors of [`lu_in_place`].

@@ -40,6 +40,8 @@ pub enum StepError {
     },
     /// The step's equations became non-finite: the solution is blowing up.
     NonFinite { reason: &'static str },
+    /// Newton's method converged to a solution the step cannot vouch for.
+    SpuriousBranch { reason: &'static str },
 }
 
 impl StepError {
@@ -63,6 +65,7 @@ impl StepError {
                 time,
                 reason: reason.to_string(),
             },
+            StepError::SpuriousBranch { reason } => crate::Error::SpuriousBranch { step, time, reason },
         }
     }
 }
