@@ -6,18 +6,18 @@
 //! is negative. For h < 2 F is monotone and the step's solution unique; for h > 2 F' changes sign
 //! where cos q̄ < −4/h², i.e. near the top, and the equation has several solutions there.
 
-use varmech::integrators::{integrate, Method, Options, Trajectory};
+use varmech::integrators::{integrate, Failure, Method, Options, Trajectory};
 use varmech::scenes::Pendulum;
 use varmech::Error;
 
 const Q0: f64 = 3.0;
 
-fn run(method: Method, h: f64, steps: usize, max_energy_error: Option<f64>) -> Result<Trajectory, (Error, Trajectory)> {
+fn run(method: Method, h: f64, steps: usize, max_energy_error: Option<f64>) -> Result<Trajectory, Box<Failure>> {
     let options = Options {
         max_energy_error,
         ..Options::new(h, steps)
     };
-    integrate(&Pendulum::new(), method, &[Q0], &[0.0], &options, || Ok(())).map_err(|f| (f.error, f.partial))
+    integrate(&Pendulum::new(), method, &[Q0], &[0.0], &options, || Ok(()))
 }
 
 #[test]
@@ -25,26 +25,32 @@ fn a_midpoint_step_beyond_the_fold_is_refused_as_a_spurious_branch() {
     for h in [2.5, 3.0, 4.0, 8.0] {
         // The first step lands beyond the fold: the pendulum would jump over the top although
         // E < 1. The run stops there and keeps the initial state.
-        match run(Method::Midpoint, h, 100, None) {
-            Err((Error::SpuriousBranch { step: 1, time, .. }, partial)) => {
+        match run(Method::Midpoint, h, 100, None).map_err(|f| *f) {
+            Err(Failure {
+                error: Error::SpuriousBranch { step: 1, time, .. },
+                partial,
+            }) => {
                 assert_eq!(time, 0.0);
                 assert_eq!(partial.len(), 1);
             }
-            Err((e, _)) => panic!("h = {h}: expected a spurious branch at step 1, got {e}"),
+            Err(Failure { error: e, .. }) => panic!("h = {h}: expected a spurious branch at step 1, got {e}"),
             Ok(traj) => panic!("h = {h}: ran silently to q = {:?}", traj.q_at(traj.len() - 1)),
         }
     }
     // At h = 2 the fold is only reached at q̄ = π exactly; Newton's method fails at the near-
     // singular Jacobian instead, and says so.
     for h in [2.0, 2.2] {
-        let result = run(Method::Midpoint, h, 100, None);
+        let result = run(Method::Midpoint, h, 100, None).map_err(|f| *f);
         assert!(
             matches!(
-                result,
-                Err((Error::Convergence { .. } | Error::SpuriousBranch { .. }, _))
+                &result,
+                Err(Failure {
+                    error: Error::Convergence { .. } | Error::SpuriousBranch { .. },
+                    ..
+                })
             ),
             "h = {h}: {:?}",
-            result.map(|t| t.len()).map_err(|(e, _)| e.to_string())
+            result.map(|t| t.len()).map_err(|f| f.error.to_string())
         );
     }
 }
@@ -55,7 +61,8 @@ fn below_the_fold_no_step_is_flagged() {
     // run ends in rotation after many steps because its energy error reaches the separatrix,
     // which only an energy threshold can tell; see the next test).
     for h in [0.1, 0.5, 1.0, 1.5] {
-        let traj = run(Method::Midpoint, h, (400.0 / h) as usize, None).unwrap_or_else(|(e, _)| panic!("h = {h}: {e}"));
+        let traj =
+            run(Method::Midpoint, h, (400.0 / h) as usize, None).unwrap_or_else(|f| panic!("h = {h}: {}", f.error));
         assert_eq!(traj.steps, (400.0 / h) as usize);
     }
 }
@@ -73,12 +80,13 @@ fn with_an_energy_threshold_no_implicit_method_silently_goes_over_the_top() {
     ] {
         for h in [0.5, 1.0, 1.5, 2.0, 2.01, 2.5, 3.0, 4.0] {
             let steps = (400.0 / h) as usize;
-            let traj = match run(method, h, steps, Some(0.01)) {
+            let traj = match run(method, h, steps, Some(0.01)).map_err(|f| *f) {
                 Ok(traj) => traj,
-                Err((Error::Divergence { .. } | Error::Convergence { .. } | Error::SpuriousBranch { .. }, partial)) => {
-                    partial
-                }
-                Err((e, _)) => panic!("{method:?}, h = {h}: {e}"),
+                Err(Failure {
+                    error: Error::Divergence { .. } | Error::Convergence { .. } | Error::SpuriousBranch { .. },
+                    partial,
+                }) => partial,
+                Err(f) => panic!("{method:?}, h = {h}: {}", f.error),
             };
             let top = (0..traj.len()).map(|k| traj.q_at(k)[0].abs()).fold(0.0, f64::max);
             assert!(top < std::f64::consts::PI, "{method:?}, h = {h}: |q| reached {top}");

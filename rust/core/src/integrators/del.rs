@@ -181,11 +181,7 @@ impl<R: DiscreteLagrangian> StepEquations for TwoPoint<R> {
 
     /// K = (−1): ∂F/∂δq = −(1/h)∂²L/∂q̇² + O(1) for both rules.
     fn continuum_sign(&self, n: usize, hessian_sign: f64) -> f64 {
-        if n % 2 == 0 {
-            hessian_sign
-        } else {
-            -hessian_sign
-        }
+        (-1f64).powi(n as i32) * hessian_sign
     }
 }
 
