@@ -3,8 +3,9 @@
 
 mod common;
 
+use nalgebra::DMatrix;
 use varmech::integrators::{integrate, General, Method, Options, Trajectory};
-use varmech::model::Lagrangian;
+use varmech::model::{Lagrangian, Natural, NaturalSystem};
 use varmech::scenes::DoublePendulum;
 use varmech::{Error, ModelError};
 
@@ -126,6 +127,86 @@ fn central_difference_derivatives_reproduce_the_exact_ones() {
     let b = run(&only, Method::Midpoint, 200, 2.0, 200).unwrap();
     let diff = common::final_error(&b, a.q_at(1), a.p_at(1));
     assert!(diff < 1e-7, "{diff:e}");
+}
+
+/// The same double pendulum as a natural system (l = (2, 3), m = (1, 2)): M(θ), V and ∇V only;
+/// ∂T/∂θ comes from the trait's differences of M.
+struct NaturalDoublePendulum;
+
+const G: f64 = 9.80665;
+
+impl NaturalSystem for NaturalDoublePendulum {
+    fn dim(&self) -> usize {
+        2
+    }
+    fn mass_matrix(&self, q: &[f64], m: &mut DMatrix<f64>) -> Result<(), ModelError> {
+        let c = 2.0 * 2.0 * 3.0 * (q[0] - q[1]).cos();
+        m.copy_from_slice(&[3.0 * 4.0, c, c, 2.0 * 9.0]);
+        Ok(())
+    }
+    fn potential(&self, q: &[f64]) -> Result<f64, ModelError> {
+        Ok(-3.0 * G * 2.0 * q[0].cos() - 2.0 * G * 3.0 * q[1].cos())
+    }
+    fn gradient(&self, q: &[f64], grad: &mut [f64]) -> Result<(), ModelError> {
+        grad[0] = 3.0 * G * 2.0 * q[0].sin();
+        grad[1] = 2.0 * G * 3.0 * q[1].sin();
+        Ok(())
+    }
+}
+
+#[test]
+fn a_natural_system_with_differenced_mass_derivative_matches_the_exact_lagrangian() {
+    let problem = DoublePendulum::problem();
+    let natural = Natural::new(NaturalDoublePendulum);
+    let (q, v, p) = ([0.3, -1.2], [0.7, 2.5], [1.5, -0.4]);
+    let (mut exact, mut got) = ([0.0; 2], [0.0; 2]);
+    problem.system.dl_dv(&q, &v, 0.0, &mut exact).unwrap();
+    natural.dl_dv(&q, &v, 0.0, &mut got).unwrap();
+    assert_eq!(exact, got, "p = M(q)q̇ exactly");
+    problem.system.velocity(&q, &p, 0.0, &mut exact).unwrap();
+    natural.velocity(&q, &p, 0.0, &mut got).unwrap();
+    assert!(
+        exact.iter().zip(&got).all(|(a, b)| (a - b).abs() < 1e-14),
+        "{exact:?} vs {got:?}"
+    );
+    problem.system.dl_dq(&q, &v, 0.0, &mut exact).unwrap();
+    natural.dl_dq(&q, &v, 0.0, &mut got).unwrap();
+    assert!(
+        exact
+            .iter()
+            .zip(&got)
+            .all(|(a, b)| (a - b).abs() < 1e-9 * a.abs().max(1.0)),
+        "{exact:?} vs {got:?}"
+    );
+    let e = |l: &dyn Lagrangian| l.energy(&problem.initial.q, &problem.initial.p, 0.0).unwrap();
+    assert!((e(&problem.system) - e(&natural)).abs() < 1e-13 * e(&problem.system).abs());
+    let a = run(&problem.system, Method::Midpoint, 200, 2.0, 200).unwrap();
+    let b = run(&natural, Method::Midpoint, 200, 2.0, 200).unwrap();
+    let diff = common::final_error(&b, a.q_at(1), a.p_at(1));
+    assert!(diff < 1e-7, "{diff:e}");
+
+    // A matrix that is not positive definite is refused by name.
+    struct Indefinite;
+    impl NaturalSystem for Indefinite {
+        fn dim(&self) -> usize {
+            1
+        }
+        fn mass_matrix(&self, _: &[f64], m: &mut DMatrix<f64>) -> Result<(), ModelError> {
+            m[(0, 0)] = -1.0;
+            Ok(())
+        }
+        fn potential(&self, _: &[f64]) -> Result<f64, ModelError> {
+            Ok(0.0)
+        }
+        fn gradient(&self, _: &[f64], grad: &mut [f64]) -> Result<(), ModelError> {
+            grad[0] = 0.0;
+            Ok(())
+        }
+    }
+    let err = Natural::new(Indefinite)
+        .velocity(&[0.0], &[1.0], 0.0, &mut [0.0])
+        .unwrap_err();
+    assert!(err.to_string().contains("not symmetric positive definite"), "{err}");
 }
 
 #[test]

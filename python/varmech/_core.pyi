@@ -68,6 +68,19 @@ class ClosureModel(_ModelProperties):
     @property
     def has_gradient(self) -> bool: ...
 
+class ClosureNatural(_ModelProperties):
+    """L = ½q̇ᵀM(q)q̇ − V(q) from Python closures (configuration-dependent mass)."""
+
+    def __init__(
+        self,
+        dim: int,
+        mass: Callable[[FloatArray], Any],
+        potential: Callable[[FloatArray], float],
+        gradient: Callable[[FloatArray], Any] | None,
+        mass_derivative: Callable[[FloatArray], Any] | None,
+        symmetries: Sequence[GeneratorSpec],
+    ) -> None: ...
+
 class ClosureLagrangian(_ModelProperties):
     """A general Lagrangian L(q, q̇, t) from Python closures."""
 
@@ -82,7 +95,7 @@ class ClosureLagrangian(_ModelProperties):
         symmetries: Sequence[GeneratorSpec],
     ) -> None: ...
 
-Model = NativeModel | ClosureModel | ClosureLagrangian
+Model = NativeModel | ClosureModel | ClosureNatural | ClosureLagrangian
 
 def integrate(
     model: Model,
@@ -115,6 +128,13 @@ def invariant_statistics(values: FloatArray) -> tuple[float, float, float]: ...
 def symplecticity_defect(model: Model, method: str, q: FloatArray, p: FloatArray, dt: float) -> float: ...
 def methods() -> list[dict[str, Any]]: ...
 def scene(
-    name: str, *, e: float = 0.6, omega: float = 1.0
+    name: str,
+    *,
+    e: float = 0.6,
+    omega: float = 1.0,
+    b: float = 1.0,
+    gamma: float = 0.5,
+    amplitude: float = 1.5,
+    drive: float = 2.0 / 3.0,
 ) -> tuple[NativeModel, FloatArray, FloatArray, float, tuple[float, FloatArray, FloatArray, str] | None]: ...
 def nbody(g: float, masses: Sequence[float]) -> NativeModel: ...

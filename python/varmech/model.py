@@ -87,7 +87,7 @@ class Model:
     implicit variational ones (``midpoint``, ``trapezoid``).
     """
 
-    _core: _core.NativeModel | _core.ClosureModel | _core.ClosureLagrangian
+    _core: _core.NativeModel | _core.ClosureModel | _core.ClosureNatural | _core.ClosureLagrangian
     symmetries: tuple[Symmetry, ...]
     name: str
 
@@ -142,7 +142,9 @@ class NativeSystem(Model):
 
 
 class MechanicalSystem(Model):
-    """A mechanical system L = ½ q̇ᵀ M q̇ − V(q) given by Python closures.
+    """A mechanical system L = ½ q̇ᵀ M q̇ − V(q) given by Python closures, with a constant mass
+    matrix (separable: every method applies) or a configuration-dependent one M(q) (a natural
+    system such as a double pendulum: the implicit variational methods apply).
 
     Parameters
     ----------
@@ -156,7 +158,13 @@ class MechanicalSystem(Model):
         a warning says so.
     mass:
         The constant mass matrix: a positive scalar (M = mI), a vector (n,) of positive
-        entries (diagonal), or a symmetric positive-definite matrix (n, n).
+        entries (diagonal), or a symmetric positive-definite matrix (n, n). Or a closure
+        ``mass(q) -> array (n, n)``, M(q) symmetric positive definite: then
+        p = M(q)q̇ exactly, q̇ = M(q)⁻¹p by Cholesky, and ∂L/∂q = ½q̇ᵀ(∂M/∂q)q̇ − ∇V.
+    mass_derivative:
+        With a ``mass`` closure: ``mass_derivative(q) -> array (n, n, n)`` whose ``[i]`` is
+        ∂M/∂qᵢ. Optional: without it, central differences of ``mass`` are used (2n calls
+        per evaluation of ∂L/∂q), and a warning says so.
     symmetries:
         Symmetries of L (:class:`Translation`, :class:`Rotation`, :class:`Cyclic`); their
         momenta are checked by :func:`varmech.check_conservation`.
@@ -170,29 +178,40 @@ class MechanicalSystem(Model):
         potential: Callable[[np.ndarray], float],
         gradient: Callable[[np.ndarray], ArrayLike] | None = None,
         *,
-        mass: ArrayLike = 1.0,
+        mass: ArrayLike | Callable[[np.ndarray], ArrayLike] = 1.0,
+        mass_derivative: Callable[[np.ndarray], ArrayLike] | None = None,
         symmetries: Sequence[Symmetry] = (),
         name: str = "mechanical system",
     ):
         if isinstance(dim, bool) or not isinstance(dim, (int, np.integer)) or dim < 1:
             raise ValueError(f"dim: must be a positive integer, got {dim!r}")
+        missing = [what for what, f in (("gradient", gradient), ("mass_derivative", mass_derivative)) if f is None]
+        if not callable(mass):
+            if mass_derivative is not None:
+                raise ValueError("mass_derivative: only with a mass closure mass(q); a constant mass has none")
+            missing.remove("mass_derivative")
+        if missing:
+            warnings.warn(
+                f"{name}: no {' and no '.join(missing)} given; central differences are used "
+                f"({2 * dim} calls each per force, about 1e-10 relative accuracy)",
+                stacklevel=2,
+            )
+        self.potential = potential
+        self.gradient = gradient
+        self.mass = mass
+        self.mass_derivative = mass_derivative
+        self.symmetries = tuple(symmetries)
+        self.name = name
+        if callable(mass):
+            self._core = _core.ClosureNatural(int(dim), mass, potential, gradient, mass_derivative, _specs(symmetries))
+            return
         m = np.array(mass, dtype=float)
         if m.ndim > 2 or (m.ndim >= 1 and any(s != dim for s in m.shape)):
             raise ValueError(f"mass: must be a scalar, a vector ({dim},) or a matrix ({dim}, {dim}), got shape {m.shape}")
         if not np.all(np.isfinite(m)):
             raise ValueError("mass: must be finite")
-        if gradient is None:
-            warnings.warn(
-                f"{name}: no gradient given; forces come from central differences of the potential "
-                f"({2 * dim} potential calls per force, about 1e-10 relative accuracy)",
-                stacklevel=2,
-            )
         self._core = _core.ClosureModel(int(dim), potential, gradient, m, _specs(symmetries))
-        self.potential = potential
-        self.gradient = gradient
         self.mass = m
-        self.symmetries = tuple(symmetries)
-        self.name = name
 
 
 class Lagrangian(Model):

@@ -6,12 +6,16 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
 use varmech::diagnostics::{self, EnergyStatistics, InvariantStatistics};
 use varmech::integrators::{self, General, Integrable, Method, NewtonOptions, Options};
+use varmech::model::Natural;
 use varmech::scenes::{self, LagrangianScene, Problem, Scene};
 use varmech::ModelError;
 
 use crate::convert::{self, rows, slice, trajectory_tuple};
 use crate::errors::{failure_to_pyerr, to_pyerr};
-use crate::model::{ClosureLagrangian, ClosureLagrangianSystem, ClosureModel, ClosureSystem, Native, NativeModel};
+use crate::model::{
+    ClosureLagrangian, ClosureLagrangianSystem, ClosureModel, ClosureNatural, ClosureNaturalSystem, ClosureSystem,
+    Native, NativeModel,
+};
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(integrate, m)?)?;
@@ -58,6 +62,11 @@ macro_rules! with_system {
             }
         } else if let Ok(closure) = $model.cast::<ClosureModel>() {
             let $sys = &ClosureSystem::new($py, closure.get());
+            let $poll = || $py.check_signals().map_err(boxed);
+            $body
+        } else if let Ok(closure) = $model.cast::<ClosureNatural>() {
+            let natural = Natural::new(ClosureNaturalSystem::new($py, closure.get()));
+            let $sys = &General(&natural);
             let $poll = || $py.check_signals().map_err(boxed);
             $body
         } else if let Ok(closure) = $model.cast::<ClosureLagrangian>() {
@@ -317,10 +326,23 @@ fn scene_tuple<'py, S>(
     ))
 }
 
-/// A native scene by name: (model, q0, p0, t_end, reference (t, q, p, source) or None).
+/// A native scene by name: (model, q0, p0, t_end, reference (t, q, p, source) or None). The
+/// keywords are the parameters of the scenes that take them: `e` (kepler), `omega`
+/// (harmonic_oscillator), `b` (charged_particle), `gamma`, `amplitude` and `drive`
+/// (damped_driven_pendulum).
 #[pyfunction]
-#[pyo3(signature = (name, *, e=0.6, omega=1.0))]
-fn scene<'py>(py: Python<'py>, name: &str, e: f64, omega: f64) -> PyResult<SceneTuple<'py>> {
+#[pyo3(signature = (name, *, e=0.6, omega=1.0, b=1.0, gamma=0.5, amplitude=1.5, drive=2.0 / 3.0))]
+#[allow(clippy::too_many_arguments)]
+fn scene<'py>(
+    py: Python<'py>,
+    name: &str,
+    e: f64,
+    omega: f64,
+    b: f64,
+    gamma: f64,
+    amplitude: f64,
+    drive: f64,
+) -> PyResult<SceneTuple<'py>> {
     let mech = |s| Native::Mechanical(s);
     let err = |e| to_pyerr(py, e);
     match name {
@@ -369,6 +391,24 @@ fn scene<'py>(py: Python<'py>, name: &str, e: f64, omega: f64) -> PyResult<Scene
             scenes::SphericalPendulum::problem(),
             |s| Native::General(LagrangianScene::SphericalPendulum(s)),
             "spherical_pendulum",
+        ),
+        "charged_particle" => scene_tuple(
+            py,
+            scenes::ChargedParticle::uniform_field(b).map_err(err)?,
+            |s| Native::General(LagrangianScene::ChargedParticle(s)),
+            "charged_particle",
+        ),
+        "charged_particle_nonuniform" => scene_tuple(
+            py,
+            scenes::ChargedParticle::nonuniform_field(),
+            |s| Native::General(LagrangianScene::ChargedParticle(s)),
+            "charged_particle_nonuniform",
+        ),
+        "damped_driven_pendulum" => scene_tuple(
+            py,
+            scenes::DampedDrivenPendulum::problem(gamma, amplitude, drive).map_err(err)?,
+            |s| Native::General(LagrangianScene::DampedDrivenPendulum(s)),
+            "damped_driven_pendulum",
         ),
         _ => Err(PyValueError::new_err(format!("name: unknown scene {name:?}"))),
     }

@@ -21,6 +21,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<model::NativeModel>()?;
     m.add_class::<model::ClosureModel>()?;
     m.add_class::<model::ClosureLagrangian>()?;
+    m.add_class::<model::ClosureNatural>()?;
     functions::register(m)?;
     Ok(())
 }

@@ -3,10 +3,13 @@
 
 use std::cell::RefCell;
 
-use numpy::{PyArray1, PyArrayMethods};
+use nalgebra::DMatrix;
+use numpy::{PyArray1, PyArrayDyn, PyArrayMethods};
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
-use varmech::model::{finite_difference, Generator, Lagrangian, Mass, MechanicalSystem};
+use varmech::model::{
+    differenced_kinetic_gradient, finite_difference, Generator, Lagrangian, Mass, MechanicalSystem, NaturalSystem,
+};
 use varmech::scenes::{LagrangianScene, Scene};
 use varmech::ModelError;
 
@@ -159,6 +162,76 @@ impl ClosureModel {
     }
 }
 
+/// A natural mechanical system L = ½q̇ᵀM(q)q̇ − V(q) given by Python closures `mass(q) -> array
+/// (n, n)`, `potential(q) -> float` and, optionally, `gradient(q) -> array (n,)` and
+/// `mass_derivative(q) -> array (n, n, n)` (∂M/∂qᵢ at index i); missing derivatives come from
+/// central differences.
+#[pyclass(frozen, module = "varmech._core")]
+pub struct ClosureNatural {
+    dim: usize,
+    mass: Py<PyAny>,
+    potential: Py<PyAny>,
+    gradient: Option<Py<PyAny>>,
+    mass_derivative: Option<Py<PyAny>>,
+}
+
+#[pymethods]
+impl ClosureNatural {
+    #[new]
+    /// `symmetries` are only checked here, as for [`ClosureLagrangian`].
+    #[pyo3(signature = (dim, mass, potential, gradient, mass_derivative, symmetries))]
+    fn new(
+        dim: usize,
+        mass: Bound<'_, PyAny>,
+        potential: Bound<'_, PyAny>,
+        gradient: Option<Bound<'_, PyAny>>,
+        mass_derivative: Option<Bound<'_, PyAny>>,
+        symmetries: Vec<(String, usize, usize)>,
+    ) -> PyResult<Self> {
+        convert::generators(symmetries, dim)?;
+        check_closures(
+            dim,
+            [
+                ("mass", Some(&mass)),
+                ("potential", Some(&potential)),
+                ("gradient", gradient.as_ref()),
+                ("mass_derivative", mass_derivative.as_ref()),
+            ],
+        )?;
+        Ok(ClosureNatural {
+            dim,
+            mass: mass.unbind(),
+            potential: potential.unbind(),
+            gradient: gradient.map(Bound::unbind),
+            mass_derivative: mass_derivative.map(Bound::unbind),
+        })
+    }
+
+    #[getter]
+    pub fn dim(&self) -> usize {
+        self.dim
+    }
+
+    #[getter]
+    fn separable(&self) -> bool {
+        false
+    }
+
+    #[getter]
+    fn time_dependent(&self) -> bool {
+        false
+    }
+
+    #[getter]
+    fn forced(&self) -> bool {
+        false
+    }
+
+    fn __repr__(&self) -> String {
+        format!("ClosureNatural(dim={})", self.dim)
+    }
+}
+
 /// A general Lagrangian L(q, q̇, t) given by Python closures: `lagrangian(q, v, t) -> float`
 /// and, optionally, `dl_dq(q, v, t)` and `dl_dv(q, v, t)` (arrays (n,)); missing derivatives
 /// come from central differences of L. An optional `force(q, v, t)` (array (n,)) is a
@@ -304,6 +377,44 @@ fn call_vector(result: PyResult<Bound<'_, PyAny>>, call: &str, out: &mut [f64]) 
     Ok(())
 }
 
+/// Reads a closure's result, a float array of `shape`, into `out` in C order: a float64 numpy
+/// array is read in place, anything else goes through `numpy.asarray`. A wrong shape is a
+/// ValueError and a wrong type a TypeError, both naming the closure as `call`.
+fn call_array(
+    result: PyResult<Bound<'_, PyAny>>,
+    call: &str,
+    shape: &[usize],
+    out: &mut [f64],
+) -> Result<(), ModelError> {
+    let result = result.map_err(boxed)?;
+    let wrong_type = || {
+        boxed(PyTypeError::new_err(format!(
+            "{call} must return an array of shape {shape:?} of floats, got {}",
+            type_name(&result)
+        )))
+    };
+    let array = match result.cast::<PyArrayDyn<f64>>() {
+        Ok(a) => a.clone(),
+        Err(_) => {
+            let numpy = result.py().import("numpy").map_err(boxed)?;
+            let converted = numpy
+                .call_method1("asarray", (&result, "float64"))
+                .map_err(|_| wrong_type())?;
+            converted.cast_into::<PyArrayDyn<f64>>().map_err(|_| wrong_type())?
+        }
+    };
+    let readonly = array.readonly();
+    let view = readonly.as_array();
+    if view.shape() != shape {
+        return Err(boxed(PyValueError::new_err(format!(
+            "{call} returned an array of shape {:?}, expected {shape:?}",
+            view.shape()
+        ))));
+    }
+    out.iter_mut().zip(view.iter()).for_each(|(o, v)| *o = *v);
+    Ok(())
+}
+
 /// A [`ClosureModel`] bound to the GIL for the duration of a call: it implements the core's
 /// model trait by calling the closures.
 pub struct ClosureSystem<'a, 'py> {
@@ -351,6 +462,92 @@ impl MechanicalSystem for ClosureSystem<'_, '_> {
 
     fn symmetries(&self) -> Vec<Generator> {
         self.model.symmetries.clone()
+    }
+}
+
+/// A [`ClosureNatural`] bound to the GIL: it implements the core's [`NaturalSystem`] trait
+/// (a [`Lagrangian`] through `varmech::model::Natural`).
+pub struct ClosureNaturalSystem<'a, 'py> {
+    py: Python<'py>,
+    model: &'a ClosureNatural,
+    mass: Bound<'py, PyAny>,
+    potential: Bound<'py, PyAny>,
+    gradient: Option<Bound<'py, PyAny>>,
+    mass_derivative: Option<Bound<'py, PyAny>>,
+    /// ∂M/∂qᵢ for i = 0..n, C order.
+    derivative: RefCell<Vec<f64>>,
+    work: RefCell<Vec<f64>>,
+}
+
+impl<'a, 'py> ClosureNaturalSystem<'a, 'py> {
+    pub fn new(py: Python<'py>, model: &'a ClosureNatural) -> Self {
+        let n = model.dim;
+        ClosureNaturalSystem {
+            py,
+            model,
+            mass: model.mass.bind(py).clone(),
+            potential: model.potential.bind(py).clone(),
+            gradient: model.gradient.as_ref().map(|f| f.bind(py).clone()),
+            mass_derivative: model.mass_derivative.as_ref().map(|f| f.bind(py).clone()),
+            derivative: RefCell::new(vec![0.0; n * n * n]),
+            work: RefCell::new(vec![0.0; n]),
+        }
+    }
+}
+
+impl NaturalSystem for ClosureNaturalSystem<'_, '_> {
+    fn dim(&self) -> usize {
+        self.model.dim
+    }
+
+    /// M(q), which must be symmetric (to 1e-12 relative): Cholesky reads one triangle only.
+    fn mass_matrix(&self, q: &[f64], m: &mut DMatrix<f64>) -> Result<(), ModelError> {
+        let n = self.model.dim;
+        let call = self.mass.call1((PyArray1::from_slice(self.py, q),));
+        call_array(call, "mass(q)", &[n, n], m.as_mut_slice())?;
+        let scale = m.amax();
+        if (0..n).any(|i| (0..i).any(|j| (m[(i, j)] - m[(j, i)]).abs() > 1e-12 * scale)) {
+            return Err(boxed(PyValueError::new_err(format!(
+                "mass(q) returned a matrix that is not symmetric at q = {q:?}"
+            ))));
+        }
+        Ok(())
+    }
+
+    fn potential(&self, q: &[f64]) -> Result<f64, ModelError> {
+        call_scalar(
+            self.potential.call1((PyArray1::from_slice(self.py, q),)),
+            "potential(q)",
+        )
+    }
+
+    fn gradient(&self, q: &[f64], grad: &mut [f64]) -> Result<(), ModelError> {
+        match &self.gradient {
+            Some(f) => call_vector(f.call1((PyArray1::from_slice(self.py, q),)), "gradient(q)", grad),
+            None => finite_difference::central_gradient(|x| self.potential(x), q, &mut self.work.borrow_mut(), grad),
+        }
+    }
+
+    /// (∂T/∂q)ᵢ = ½q̇ᵀ(∂M/∂qᵢ)q̇ from `mass_derivative`, or the trait's differences of M.
+    fn kinetic_gradient(&self, q: &[f64], v: &[f64], out: &mut [f64]) -> Result<(), ModelError> {
+        let Some(f) = &self.mass_derivative else {
+            return differenced_kinetic_gradient(self, q, v, out);
+        };
+        let n = self.model.dim;
+        let derivative = &mut *self.derivative.borrow_mut();
+        call_array(
+            f.call1((PyArray1::from_slice(self.py, q),)),
+            "mass_derivative(q)",
+            &[n, n, n],
+            derivative,
+        )?;
+        for (o, d) in out.iter_mut().zip(derivative.chunks_exact(n * n)) {
+            *o = 0.5
+                * (0..n)
+                    .map(|j| v[j] * (0..n).map(|k| d[j * n + k] * v[k]).sum::<f64>())
+                    .sum::<f64>();
+        }
+        Ok(())
     }
 }
 

@@ -3,6 +3,8 @@
 //! - [`Lagrangian`]: a Lagrangian system L(q, q̇, t) on ℝⁿ, the most general model;
 //! - [`MechanicalSystem`]: the separable case L = ½q̇ᵀMq̇ − V(q) with constant mass;
 //! - [`Mass`]: the constant mass matrix M (scalar, diagonal or full symmetric positive definite);
+//! - [`NaturalSystem`]: L = ½q̇ᵀM(q)q̇ − V(q) with configuration-dependent mass, a
+//!   [`Lagrangian`] through [`Natural`];
 //! - [`Generator`]: infinitesimal symmetries ξ(q) and their Noether momenta J = p·ξ(q);
 //! - [`finite_difference`]: derivatives a model does not supply.
 
@@ -10,9 +12,11 @@ pub mod finite_difference;
 mod lagrangian;
 mod mass;
 mod mechanical;
+mod natural;
 mod symmetry;
 
 pub use lagrangian::Lagrangian;
 pub use mass::Mass;
 pub use mechanical::MechanicalSystem;
+pub use natural::{differenced_kinetic_gradient, Natural, NaturalSystem};
 pub use symmetry::Generator;
