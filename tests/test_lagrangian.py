@@ -24,12 +24,14 @@ def charged_particle(B: float) -> varmech.Lagrangian:
     return varmech.Lagrangian(2, lagrangian, dl_dq=dl_dq, dl_dv=dl_dv, name="charged particle")
 
 
+@pytest.mark.parametrize("native", [False, True])
 @pytest.mark.parametrize("h", [0.1, 1.0, 3.0])
-def test_midpoint_gyration_phase_is_two_arctan_half_h_omega(h):
+def test_midpoint_gyration_phase_is_two_arctan_half_h_omega(h, native):
     # From (1, 0) with velocity (0, −B) the exact orbit is q(t) = (cos Ωt, −sin Ωt), Ω = B; the
     # midpoint rule turns by exactly 2·arctan(hΩ/2) a step, at every step size.
     B, steps = 2.0, 200
-    traj = varmech.integrate(charged_particle(B), [1.0, 0.0], v0=[0.0, -B], dt=h, steps=steps, method="midpoint")
+    model = scenes.charged_particle(B).model if native else charged_particle(B)
+    traj = varmech.integrate(model, [1.0, 0.0], v0=[0.0, -B], dt=h, steps=steps, method="midpoint")
     theta = 2 * math.atan(h * B / 2) * np.arange(steps + 1)
     np.testing.assert_allclose(traj.q, np.column_stack([np.cos(theta), -np.sin(theta)]), atol=1e-12)
     np.testing.assert_allclose(traj.v[:, 1], -B * np.cos(theta), atol=1e-12)
@@ -153,3 +155,60 @@ def test_spherical_pendulum_declares_its_cyclic_azimuth():
     assert report.momenta[0].name == "p[1]" and report.momenta[0].max_rel_error < 1e-13
     assert report.verdict == "bounded"
     assert abs(traj.q[-1, 0] - scene.reference.q[0]) < 1e-3
+
+
+def test_native_charged_particle_in_a_non_uniform_field_is_the_readme_closure():
+    # The README's closure: the same Lagrangian in the same gauge, with difference derivatives.
+    def A(q):
+        return 0.5 * (1 + q @ q / 8) * np.array([-q[1], q[0]])
+
+    with pytest.warns(UserWarning, match="central differences"):
+        readme = varmech.Lagrangian(2, lambda q, v, t: 0.5 * v @ v + A(q) @ v, symmetries=[varmech.Rotation(spatial_dim=2)])
+    scene = scenes.charged_particle_nonuniform()
+    assert scene.model.symmetries == readme.symmetries
+    rng = np.random.default_rng(1)
+    q, v = rng.normal(size=(20, 2)), rng.normal(size=(20, 2))
+    np.testing.assert_allclose(scene.model.momentum(q, v), v + np.array([A(x) for x in q]), rtol=1e-15, atol=1e-15)
+    assert list(scene.q0) == [1.0, 0.0]
+    np.testing.assert_allclose(scene.model.velocity(scene.q0, scene.p0), [0.0, -1.0], atol=1e-16)
+    # The closure twin with exact derivatives follows the native run to the Newton tolerance,
+    # the README closure to the accuracy of its difference derivatives.
+    native = varmech.integrate(scene, dt=0.05, steps=400, method="midpoint")
+    twin = varmech.integrate(examples.closure_of(scene), scene.q0, scene.p0, dt=0.05, steps=400, method="midpoint")
+    fd = varmech.integrate(readme, scene.q0, scene.p0, dt=0.05, steps=400, method="midpoint")
+    assert np.max(np.abs(native.q - twin.q)) <= 1e-10 and np.max(np.abs(native.p - twin.p)) <= 1e-10
+    assert np.max(np.abs(native.q - fd.q)) <= 1e-8
+    report = varmech.check_conservation(native)
+    assert report.momenta[0].name == "L" and report.momenta[0].initial == pytest.approx(-0.4375, abs=1e-15)
+    assert report.momenta[0].max_rel_error < 1e-13 and report.verdict == "bounded"
+
+
+@pytest.mark.parametrize("name", ["charged_particle", "charged_particle_nonuniform", "damped_driven_pendulum"])
+@pytest.mark.parametrize("method", ["midpoint", "trapezoid"])
+def test_new_scenes_are_in_the_catalogue_and_integrate(name, method):
+    scene = scenes.get(name)
+    assert name in scenes.CATALOGUE and not scene.model.separable
+    traj = varmech.integrate(scene, dt=scene.dt, steps=1000, method=method)
+    assert traj.status == 0 and np.all(np.isfinite(traj.q))
+    e = traj.energy()
+    if name == "damped_driven_pendulum":
+        # The energy changes by the tracked work, up to the method's own O(h²) energy error.
+        assert np.ptp(e) > 0.5 and np.max(np.abs(e - e[0] - traj.work)) < 1e-4
+    else:
+        assert e[0] == pytest.approx(scene.invariants["E"], rel=1e-15)
+        report = varmech.check_conservation(traj)
+        assert report.momenta[0].initial == pytest.approx(scene.invariants["L"], rel=1e-15)
+        assert report.momenta[0].max_rel_error < 1e-13
+
+
+def test_uniform_field_scene_reaches_its_exact_reference_and_validates_its_field():
+    scene = scenes.charged_particle(2.0)
+    ref = scene.reference
+    assert ref.source.startswith("exact")
+    traj = varmech.integrate(scene, dt=scene.t_end / 4000, t_end=scene.t_end, method="galerkin6", save_every=4000)
+    np.testing.assert_allclose(traj.q[-1], ref.q, atol=1e-11)
+    np.testing.assert_allclose(traj.p[-1], ref.p, atol=1e-11)
+    with pytest.raises(ValueError, match="^B:"):
+        scenes.charged_particle(float("nan"))
+    with pytest.raises(ValueError, match="^gamma:"):
+        scenes.damped_driven_pendulum(gamma=-1.0)

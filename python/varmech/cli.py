@@ -21,6 +21,8 @@ TOUR = [
     ("outer_solar_system", ("verlet", "kahan_li8", "rk4"), None),
     ("double_pendulum", ("midpoint", "trapezoid"), 100.0),
     ("spherical_pendulum", ("midpoint", "trapezoid"), 1000.0),
+    ("charged_particle", ("midpoint", "galerkin4"), 1000.0),
+    ("charged_particle_nonuniform", ("midpoint", "trapezoid"), 1000.0),
 ]
 
 

@@ -138,6 +138,44 @@ def spherical_pendulum(m: float = 1.0, l: float = 1.0, g: float = 1.0) -> Lagran
     return Lagrangian(2, lagrangian, dl_dq=dl_dq, dl_dv=dl_dv, symmetries=[Cyclic(1)], name="spherical_pendulum (closure)")
 
 
+def charged_particle(B: float = 1.0, kappa: float = 0.0) -> Lagrangian:
+    """A unit charge of unit mass in the plane, in the field B(q) = B(1 + κ|q|²) ẑ, in the
+    symmetric gauge: L = ½|v|² + a(|q|²)(x v_y − y v_x) with a(r²) = ½B(1 + κr²/2)."""
+
+    def gauge(q: np.ndarray) -> tuple[float, float]:
+        c = 0.5 * B
+        return c * (1.0 + 0.5 * kappa * (q[0] * q[0] + q[1] * q[1])), 0.5 * c * kappa
+
+    def lagrangian(q: np.ndarray, v: np.ndarray, t: float) -> float:
+        a, _ = gauge(q)
+        return 0.5 * (v[0] * v[0] + v[1] * v[1]) + a * (q[0] * v[1] - q[1] * v[0])
+
+    def dl_dq(q: np.ndarray, v: np.ndarray, t: float) -> np.ndarray:
+        a, da = gauge(q)
+        w = 2.0 * da * (q[0] * v[1] - q[1] * v[0])
+        return np.array([a * v[1] + w * q[0], -a * v[0] + w * q[1]])
+
+    def dl_dv(q: np.ndarray, v: np.ndarray, t: float) -> np.ndarray:
+        a, _ = gauge(q)
+        return np.array([v[0] - a * q[1], v[1] + a * q[0]])
+
+    return Lagrangian(2, lagrangian, dl_dq=dl_dq, dl_dv=dl_dv, symmetries=[Rotation(spatial_dim=2)], name="charged_particle (closure)")
+
+
+def damped_driven_pendulum(gamma: float = 0.5, amplitude: float = 1.5, drive: float = 2.0 / 3.0) -> Lagrangian:
+    """θ̈ + γθ̇ + sin θ = A cos Ωt: L = ½θ̇² + cos θ, the Rayleigh dissipation ½γθ̇² and the
+    driving torque as a force."""
+    return Lagrangian(
+        1,
+        lambda q, v, t: 0.5 * v[0] ** 2 + math.cos(q[0]),
+        dl_dq=lambda q, v, t: np.array([-math.sin(q[0])]),
+        dl_dv=lambda q, v, t: v.copy(),
+        force=lambda q, v, t: np.array([amplitude * math.cos(drive * t)]),
+        rayleigh=gamma,
+        name="damped_driven_pendulum (closure)",
+    )
+
+
 def closure_of(scene: Scene) -> MechanicalSystem | Lagrangian:
     """The closure version of a built-in scene (with its default parameters)."""
     gravity = scene.model._core.gravity
@@ -151,4 +189,7 @@ def closure_of(scene: Scene) -> MechanicalSystem | Lagrangian:
         "fermi_pasta_ulam": fermi_pasta_ulam,
         "double_pendulum": double_pendulum,
         "spherical_pendulum": spherical_pendulum,
+        "charged_particle": charged_particle,
+        "charged_particle_nonuniform": lambda: charged_particle(kappa=0.25),
+        "damped_driven_pendulum": damped_driven_pendulum,
     }[scene.name]()

@@ -110,6 +110,50 @@ def spherical_pendulum() -> Scene:
     )
 
 
+def charged_particle(B: float = 1.0) -> Scene:
+    """A unit charge of unit mass in the plane, in the uniform magnetic field B ẑ (symmetric
+    gauge): L = ½|q̇|² + (B/2)(x ẏ − y ẋ). From q = (1, 0), q̇ = (0, −B) it gyrates on the unit
+    circle at Ω = B, the exact solution at t = 10. A general Lagrangian, rotation invariant:
+    the canonical angular momentum is conserved."""
+    return _scene(
+        "charged_particle",
+        f"charged particle in the uniform field B = {B}",
+        0.05,
+        {"E": 0.5 * B * B, "L": -0.5 * B},
+        b=B,
+    )
+
+
+def charged_particle_nonuniform() -> Scene:
+    """A unit charge of unit mass in the plane, in the field B(q) = (1 + |q|²/4) ẑ (symmetric
+    gauge, as the closure example of the README): L = ½|q̇|² + A(q)·q̇ with
+    A(q) = ½(1 + |q|²/8)(−y, x). From q = (1, 0), q̇ = (0, −1) to t = 200; it gyrates and drifts
+    about the origin. Rotation invariant: the canonical angular momentum is conserved."""
+    return _scene(
+        "charged_particle_nonuniform",
+        "charged particle in the field B(q) = (1 + |q|²/4) ẑ",
+        0.05,
+        {"E": 0.5, "L": -0.4375},
+    )
+
+
+def damped_driven_pendulum(gamma: float = 0.5, amplitude: float = 1.5, drive: float = 2.0 / 3.0) -> Scene:
+    """The pendulum θ̈ + γθ̇ + sin θ = A cos Ωt (m = l = g = 1) from rest at the bottom to
+    t = 100: L = ½θ̇² + cos θ with the Rayleigh dissipation R = ½γθ̇² and the driving torque
+    A cos Ωt as a force. The defaults are Baker & Gollub's chaotic regime (q = 1/γ = 2,
+    g = A = 1.5, ω_D = Ω = 2/3). Forced, so nothing is conserved; the energy changes by the
+    tracked work ``traj.work``."""
+    return _scene(
+        "damped_driven_pendulum",
+        f"damped driven pendulum, γ = {gamma:g}, A = {amplitude:g}, Ω = {drive:g}",
+        0.01,
+        {},
+        gamma=gamma,
+        amplitude=amplitude,
+        drive=drive,
+    )
+
+
 def nbody(masses: ArrayLike, positions: ArrayLike, velocities: ArrayLike, G: float = 1.0, t_end: float = 1.0, dt: float = 1e-3) -> Scene:
     """A native gravitational N-body model in 3 dimensions from masses (N,), positions and
     velocities (N, 3)."""
@@ -132,6 +176,9 @@ CATALOGUE: dict[str, Callable[[], Scene]] = {
     "outer_solar_system": outer_solar_system,
     "double_pendulum": double_pendulum,
     "spherical_pendulum": spherical_pendulum,
+    "charged_particle": charged_particle,
+    "charged_particle_nonuniform": charged_particle_nonuniform,
+    "damped_driven_pendulum": damped_driven_pendulum,
 }
 
 

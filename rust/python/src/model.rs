@@ -61,12 +61,12 @@ impl NativeModel {
 
     #[getter]
     fn time_dependent(&self) -> bool {
-        false
+        matches!(&self.native, Native::General(s) if s.is_time_dependent())
     }
 
     #[getter]
     fn forced(&self) -> bool {
-        false
+        matches!(&self.native, Native::General(s) if s.is_forced())
     }
 
     /// (G, masses) of an N-body scene, None for the others.

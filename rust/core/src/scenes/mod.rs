@@ -5,6 +5,8 @@
 //! which names the sources; tests and benches use these problems (as diffsol ships its test
 //! problems in the library).
 
+mod charged_particle;
+mod damped_driven_pendulum;
 mod double_pendulum;
 mod fermi_pasta_ulam;
 mod harmonic_oscillator;
@@ -14,6 +16,8 @@ mod nbody;
 mod pendulum;
 mod spherical_pendulum;
 
+pub use charged_particle::ChargedParticle;
+pub use damped_driven_pendulum::DampedDrivenPendulum;
 pub use double_pendulum::DoublePendulum;
 pub use fermi_pasta_ulam::FermiPastaUlam;
 pub use harmonic_oscillator::HarmonicOscillator;
@@ -92,6 +96,9 @@ impl MechanicalSystem for Scene {
 pub enum LagrangianScene {
     DoublePendulum(DoublePendulum),
     SphericalPendulum(SphericalPendulum),
+    /// In a uniform or a non-uniform magnetic field.
+    ChargedParticle(ChargedParticle),
+    DampedDrivenPendulum(DampedDrivenPendulum),
 }
 
 macro_rules! dispatch_lagrangian {
@@ -99,6 +106,8 @@ macro_rules! dispatch_lagrangian {
         match $self {
             LagrangianScene::DoublePendulum($s) => $e,
             LagrangianScene::SphericalPendulum($s) => $e,
+            LagrangianScene::ChargedParticle($s) => $e,
+            LagrangianScene::DampedDrivenPendulum($s) => $e,
         }
     };
 }
@@ -108,7 +117,8 @@ impl LagrangianScene {
     pub fn symmetries(&self) -> Vec<Generator> {
         match self {
             LagrangianScene::SphericalPendulum(s) => s.symmetries(),
-            LagrangianScene::DoublePendulum(_) => Vec::new(),
+            LagrangianScene::ChargedParticle(s) => s.symmetries(),
+            LagrangianScene::DoublePendulum(_) | LagrangianScene::DampedDrivenPendulum(_) => Vec::new(),
         }
     }
 }
@@ -128,5 +138,14 @@ impl Lagrangian for LagrangianScene {
     }
     fn velocity(&self, q: &[f64], p: &[f64], t: f64, v: &mut [f64]) -> Result<(), ModelError> {
         dispatch_lagrangian!(self, s => s.velocity(q, p, t, v))
+    }
+    fn is_time_dependent(&self) -> bool {
+        dispatch_lagrangian!(self, s => s.is_time_dependent())
+    }
+    fn is_forced(&self) -> bool {
+        dispatch_lagrangian!(self, s => s.is_forced())
+    }
+    fn force(&self, q: &[f64], v: &[f64], t: f64, out: &mut [f64]) -> Result<(), ModelError> {
+        dispatch_lagrangian!(self, s => s.force(q, v, t, out))
     }
 }
