@@ -90,6 +90,7 @@ class ClosureLagrangian(_ModelProperties):
         lagrangian: Callable[[FloatArray, FloatArray, float], float],
         dl_dq: Callable[[FloatArray, FloatArray, float], Any] | None,
         dl_dv: Callable[[FloatArray, FloatArray, float], Any] | None,
+        hessians: Callable[[FloatArray, FloatArray, float], Any] | None,
         force: Callable[[FloatArray, FloatArray, float], Any] | None,
         time_dependent: bool,
         symmetries: Sequence[GeneratorSpec],

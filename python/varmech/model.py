@@ -229,6 +229,12 @@ class Lagrangian(Model):
         ∂L/∂q and ∂L/∂q̇ (the momentum). Optional: missing ones come from central differences
         of L (2n calls of L each, about 1e-10 relative accuracy), and a warning says so.
         :func:`varmech.check_derivatives` checks supplied ones.
+    hessians:
+        ``hessians(q, v, t) -> (L_qq, L_qv, L_vv)``, the second derivatives ∂²L/∂q²,
+        ∂²L/∂q∂q̇ (entry (i, j) is ∂²L/∂qᵢ∂q̇ⱼ) and ∂²L/∂q̇², each an array (n, n). Optional:
+        with them Newton's Jacobian of the DEL equations is assembled exactly instead of by
+        differences of the equations (2·s·n fewer evaluations of ∂L/∂q and ∂L/∂q̇ per Jacobian);
+        forced models still difference it.
     force:
         ``force(q, v, t) -> array (n,)``, a non-conservative generalized force (friction,
         driving); integrated by the discrete Lagrange–d'Alembert principle, and its work is
@@ -252,6 +258,7 @@ class Lagrangian(Model):
         *,
         dl_dq: Callable[[np.ndarray, np.ndarray, float], ArrayLike] | None = None,
         dl_dv: Callable[[np.ndarray, np.ndarray, float], ArrayLike] | None = None,
+        hessians: Callable[[np.ndarray, np.ndarray, float], tuple[ArrayLike, ArrayLike, ArrayLike]] | None = None,
         force: Callable[[np.ndarray, np.ndarray, float], ArrayLike] | None = None,
         rayleigh: ArrayLike | None = None,
         time_dependent: bool = False,
@@ -275,11 +282,12 @@ class Lagrangian(Model):
             damping = (lambda v: c @ v) if c.ndim == 2 else (lambda v: c * v)
             total_force = (lambda q, v, t: -damping(v)) if force is None else (lambda q, v, t: np.asarray(force(q, v, t), dtype=float) - damping(v))
         self._core = _core.ClosureLagrangian(
-            int(dim), lagrangian, dl_dq, dl_dv, total_force, bool(time_dependent), _specs(symmetries)
+            int(dim), lagrangian, dl_dq, dl_dv, hessians, total_force, bool(time_dependent), _specs(symmetries)
         )
         self.force = total_force
         self.lagrangian = lagrangian
         self.dl_dq = dl_dq
         self.dl_dv = dl_dv
+        self.hessians = hessians
         self.symmetries = tuple(symmetries)
         self.name = name

@@ -8,7 +8,8 @@ use numpy::{PyArray1, PyArrayDyn, PyArrayMethods};
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use varmech::model::{
-    differenced_kinetic_gradient, finite_difference, Generator, Lagrangian, Mass, MechanicalSystem, NaturalSystem,
+    differenced_kinetic_gradient, finite_difference, Generator, Hessians, Lagrangian, Mass, MechanicalSystem,
+    NaturalSystem,
 };
 use varmech::scenes::{LagrangianScene, Scene};
 use varmech::ModelError;
@@ -242,6 +243,7 @@ pub struct ClosureLagrangian {
     lagrangian: Py<PyAny>,
     dl_dq: Option<Py<PyAny>>,
     dl_dv: Option<Py<PyAny>>,
+    hessians: Option<Py<PyAny>>,
     force: Option<Py<PyAny>>,
     time_dependent: bool,
 }
@@ -251,13 +253,14 @@ impl ClosureLagrangian {
     #[new]
     /// `symmetries` are only checked here (the core's Lagrangian trait declares none); the
     /// Python model keeps them for the conservation report.
-    #[pyo3(signature = (dim, lagrangian, dl_dq, dl_dv, force, time_dependent, symmetries))]
+    #[pyo3(signature = (dim, lagrangian, dl_dq, dl_dv, hessians, force, time_dependent, symmetries))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         dim: usize,
         lagrangian: Bound<'_, PyAny>,
         dl_dq: Option<Bound<'_, PyAny>>,
         dl_dv: Option<Bound<'_, PyAny>>,
+        hessians: Option<Bound<'_, PyAny>>,
         force: Option<Bound<'_, PyAny>>,
         time_dependent: bool,
         symmetries: Vec<(String, usize, usize)>,
@@ -269,6 +272,7 @@ impl ClosureLagrangian {
                 ("lagrangian", Some(&lagrangian)),
                 ("dl_dq", dl_dq.as_ref()),
                 ("dl_dv", dl_dv.as_ref()),
+                ("hessians", hessians.as_ref()),
                 ("force", force.as_ref()),
             ],
         )?;
@@ -277,6 +281,7 @@ impl ClosureLagrangian {
             lagrangian: lagrangian.unbind(),
             dl_dq: dl_dq.map(Bound::unbind),
             dl_dv: dl_dv.map(Bound::unbind),
+            hessians: hessians.map(Bound::unbind),
             force: force.map(Bound::unbind),
             time_dependent,
         })
@@ -558,6 +563,7 @@ pub struct ClosureLagrangianSystem<'a, 'py> {
     lagrangian: Bound<'py, PyAny>,
     dl_dq: Option<Bound<'py, PyAny>>,
     dl_dv: Option<Bound<'py, PyAny>>,
+    hessians: Option<Bound<'py, PyAny>>,
     force: Option<Bound<'py, PyAny>>,
     work: RefCell<Vec<f64>>,
 }
@@ -570,6 +576,7 @@ impl<'a, 'py> ClosureLagrangianSystem<'a, 'py> {
             lagrangian: model.lagrangian.bind(py).clone(),
             dl_dq: model.dl_dq.as_ref().map(|f| f.bind(py).clone()),
             dl_dv: model.dl_dv.as_ref().map(|f| f.bind(py).clone()),
+            hessians: model.hessians.as_ref().map(|f| f.bind(py).clone()),
             force: model.force.as_ref().map(|f| f.bind(py).clone()),
             work: RefCell::new(vec![0.0; model.dim]),
         }
@@ -605,6 +612,36 @@ impl Lagrangian for ClosureLagrangianSystem<'_, '_> {
                 finite_difference::central_gradient(|x| self.lagrangian(q, x, t), v, &mut self.work.borrow_mut(), out)
             }
         }
+    }
+
+    /// `hessians(q, v, t)` returns (∂²L/∂q², ∂²L/∂q∂q̇, ∂²L/∂q̇²), each (n, n) in C order.
+    fn hessians(&self, q: &[f64], v: &[f64], t: f64, out: &mut Hessians) -> Result<bool, ModelError> {
+        let Some(f) = &self.hessians else {
+            return Ok(false);
+        };
+        let n = self.model.dim;
+        let result = f.call1(self.args(q, v, t)).map_err(boxed)?;
+        let parts: [Bound<'_, PyAny>; 3] = result.extract().map_err(|_| {
+            boxed(PyTypeError::new_err(format!(
+                "hessians(q, v, t) must return three arrays (L_qq, L_qv, L_vv), got {}",
+                type_name(&result)
+            )))
+        })?;
+        for (part, (name, m)) in
+            parts
+                .into_iter()
+                .zip([("L_qq", &mut out.qq), ("L_qv", &mut out.qv), ("L_vv", &mut out.vv)])
+        {
+            call_array(
+                Ok(part),
+                &format!("hessians(q, v, t)'s {name}"),
+                &[n, n],
+                m.as_mut_slice(),
+            )?;
+            // Read in C order into column-major storage.
+            m.transpose_mut();
+        }
+        Ok(true)
     }
 
     fn is_time_dependent(&self) -> bool {

@@ -27,6 +27,10 @@ impl Midpoint {
 }
 
 impl DiscreteLagrangian for Midpoint {
+    fn quadrature(&self) -> (&'static [f64], &'static [f64]) {
+        (&[0.5], &[1.0])
+    }
+
     fn value<S: Lagrangian + ?Sized>(
         &self,
         sys: &S,

@@ -57,6 +57,10 @@ impl Workspace {
 /// A discrete Lagrangian of a [`Lagrangian`] system, with its slot derivatives, at
 /// (q₀, q₁ = q₀ + δq) for the step [t, t + h].
 pub trait DiscreteLagrangian {
+    /// The quadrature (nodes cᵢ, weights bᵢ) that defines the rule along the straight line:
+    /// L_d = h Σᵢ bᵢ L(q₀ + cᵢδq, δq/h, t + cᵢh).
+    fn quadrature(&self) -> (&'static [f64], &'static [f64]);
+
     /// L_d(q₀, q₀ + δq, h).
     fn value<S: Lagrangian + ?Sized>(&self, sys: &S, q0: &[f64], dq: &[f64], t: f64, h: f64)
         -> Result<f64, ModelError>;

@@ -10,6 +10,10 @@ use crate::ModelError;
 pub struct Rectangle;
 
 impl DiscreteLagrangian for Rectangle {
+    fn quadrature(&self) -> (&'static [f64], &'static [f64]) {
+        (&[0.0], &[1.0])
+    }
+
     fn value<S: Lagrangian + ?Sized>(
         &self,
         sys: &S,

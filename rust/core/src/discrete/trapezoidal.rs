@@ -38,6 +38,10 @@ impl Trapezoidal {
 }
 
 impl DiscreteLagrangian for Trapezoidal {
+    fn quadrature(&self) -> (&'static [f64], &'static [f64]) {
+        (&[0.0, 1.0], &[0.5, 0.5])
+    }
+
     fn value<S: Lagrangian + ?Sized>(
         &self,
         sys: &S,

@@ -3,7 +3,7 @@ use nalgebra::{DMatrix, DVector};
 use super::StepError;
 use crate::discrete::{DiscreteLagrangian, Workspace};
 use crate::model::finite_difference::NOISE_FLOOR;
-use crate::model::Lagrangian;
+use crate::model::{Hessians, Lagrangian};
 use crate::ModelError;
 
 /// Options of the Newton iteration that solves the discrete Euler–Lagrange equations.
@@ -66,9 +66,141 @@ pub trait StepEquations {
     /// The predictor of all unknowns from a predicted increment δq.
     fn predict(&self, dq: &[f64], x: &mut [f64]);
 
-    /// The sign of det ∂F/∂x in the continuum limit h → 0, where ∂F/∂x → (1/h)·K ⊗ ∂²L/∂q̇²
-    /// for the scheme's s×s matrix K: sign(det K)ⁿ·sign(det ∂²L/∂q̇²)ˢ.
-    fn continuum_sign(&self, n: usize, hessian_sign: f64) -> f64;
+    /// The quadrature that defines the scheme's L_d.
+    fn quadrature(&mut self) -> &mut Quadrature;
+}
+
+/// L_d = h Σᵢ bᵢ L(q(cᵢh), q̇(cᵢh), t + cᵢh) along the polynomial q(τh) = Σⱼ ℓⱼ(τ)Qⱼ of degree
+/// s through the control points Q₀ = q₀, Q₁, …, Q_s = q₁ at τ = j/s. A step's equations are
+/// ∂L_d/∂Qⱼ for the slots j = 1, …, s−1 and then 0, its unknowns the increments Q₁ − q₀, …,
+/// Q_s − q₀. Degree 1 gives the two-point rules (midpoint: c = ½; trapezoid: c = 0, 1).
+#[derive(Clone, Debug)]
+pub struct Quadrature {
+    s: usize,
+    nodes: Vec<f64>,
+    weights: Vec<f64>,
+    /// ℓⱼ(cᵢ) and ℓⱼ'(cᵢ), row i, column j = 0..=s.
+    basis: Vec<Vec<f64>>,
+    slopes: Vec<Vec<f64>>,
+    /// sign det K, K = (Σᵢ bᵢℓⱼ'(cᵢ)ℓₖ'(cᵢ)) over the slots j and the unknowns k: the
+    /// Jacobian of the equations tends to (1/h)·K ⊗ ∂²L/∂q̇² as h → 0.
+    k_sign: f64,
+    pos: Vec<f64>,
+    vel: Vec<f64>,
+    hessians: Hessians,
+}
+
+impl Quadrature {
+    fn new(s: usize, nodes: &[f64], weights: &[f64], n: usize) -> Self {
+        let d: Vec<f64> = (0..=s).map(|j| j as f64 / s as f64).collect();
+        let ell = |j: usize, x: f64| {
+            (0..=s)
+                .filter(|&m| m != j)
+                .map(|m| (x - d[m]) / (d[j] - d[m]))
+                .product::<f64>()
+        };
+        let slope = |j: usize, x: f64| {
+            (0..=s)
+                .filter(|&k| k != j)
+                .map(|k| {
+                    (0..=s)
+                        .filter(|&m| m != j && m != k)
+                        .map(|m| (x - d[m]) / (d[j] - d[m]))
+                        .product::<f64>()
+                        / (d[j] - d[k])
+                })
+                .sum::<f64>()
+        };
+        let basis = nodes.iter().map(|&c| (0..=s).map(|j| ell(j, c)).collect()).collect();
+        let slopes: Vec<Vec<f64>> = nodes.iter().map(|&c| (0..=s).map(|j| slope(j, c)).collect()).collect();
+        let slot = |r: usize| if r + 1 < s { r + 1 } else { 0 };
+        let k = DMatrix::from_fn(s, s, |r, c| {
+            (0..nodes.len())
+                .map(|i| weights[i] * slopes[i][slot(r)] * slopes[i][c + 1])
+                .sum::<f64>()
+        });
+        Quadrature {
+            s,
+            nodes: nodes.to_vec(),
+            weights: weights.to_vec(),
+            basis,
+            slopes,
+            k_sign: k.determinant().signum(),
+            pos: vec![0.0; n],
+            vel: vec![0.0; n],
+            hessians: Hessians::zeros(n),
+        }
+    }
+
+    /// The slot of the r-th block of equations: Q₁, …, Q_{s−1}, then Q₀.
+    fn slot(&self, r: usize) -> usize {
+        if r + 1 < self.s {
+            r + 1
+        } else {
+            0
+        }
+    }
+
+    /// `pos` = q(cᵢh) and `vel` = q̇(cᵢh) for the control increments x.
+    fn node_state(&mut self, i: usize, q0: &[f64], h: f64, x: &[f64]) {
+        let n = q0.len();
+        for a in 0..n {
+            let (mut pos, mut vel) = (0.0, 0.0);
+            for j in 1..=self.s {
+                let xj = x[(j - 1) * n + a];
+                pos += self.basis[i][j] * xj;
+                vel += self.slopes[i][j] * xj;
+            }
+            self.pos[a] = q0[a] + pos;
+            self.vel[a] = vel / h;
+        }
+    }
+
+    /// The sign of det ∂F/∂x as h → 0: sign(det K)ⁿ·sign(det ∂²L/∂q̇²)ˢ.
+    fn continuum_sign(&self, n: usize, hessian_sign: f64) -> f64 {
+        self.k_sign.powi(n as i32) * hessian_sign.powi(self.s as i32)
+    }
+
+    /// Writes ∂F/∂x into `jac` from the model's exact second derivatives at the nodes,
+    ///
+    /// ∂F_r/∂Qₖ = Σᵢ bᵢ[hℓⱼℓₖ L_qq + ℓⱼℓₖ' L_qq̇ + ℓⱼ'ℓₖ L_q̇q + ℓⱼ'ℓₖ' L_q̇q̇/h](cᵢ), j = slot(r),
+    ///
+    /// and returns true; false when the model supplies none.
+    #[allow(clippy::too_many_arguments)]
+    fn jacobian<S: Lagrangian + ?Sized>(
+        &mut self,
+        sys: &S,
+        q0: &[f64],
+        t: f64,
+        h: f64,
+        x: &[f64],
+        jac: &mut DMatrix<f64>,
+    ) -> Result<bool, ModelError> {
+        let n = q0.len();
+        jac.fill(0.0);
+        for i in 0..self.nodes.len() {
+            self.node_state(i, q0, h, x);
+            if !sys.hessians(&self.pos, &self.vel, t + self.nodes[i] * h, &mut self.hessians)? {
+                return Ok(false);
+            }
+            let (b, hs) = (self.weights[i], &self.hessians);
+            for r in 0..self.s {
+                let j = self.slot(r);
+                let (lj, dj) = (self.basis[i][j], self.slopes[i][j]);
+                for c in 0..self.s {
+                    let (lk, dk) = (self.basis[i][c + 1], self.slopes[i][c + 1]);
+                    let (qq, qv, vq, vv) = (b * h * lj * lk, b * lj * dk, b * dj * lk, b * dj * dk / h);
+                    for a in 0..n {
+                        for e in 0..n {
+                            jac[(r * n + a, c * n + e)] +=
+                                qq * hs.qq[(a, e)] + qv * hs.qv[(a, e)] + vq * hs.qv[(e, a)] + vv * hs.vv[(a, e)];
+                        }
+                    }
+                }
+            }
+        }
+        Ok(true)
+    }
 }
 
 /// The generalized force at a step's midpoint, f(q₀ + δq/2, δq/h, t + h/2), with its buffers.
@@ -114,11 +246,14 @@ pub struct TwoPoint<R> {
     rule: R,
     ws: Workspace,
     forcing: Forcing,
+    quadrature: Quadrature,
 }
 
-impl<R> TwoPoint<R> {
+impl<R: DiscreteLagrangian> TwoPoint<R> {
     pub fn new(rule: R, n: usize) -> Self {
+        let (nodes, weights) = rule.quadrature();
         TwoPoint {
+            quadrature: Quadrature::new(1, nodes, weights, n),
             rule,
             ws: Workspace::new(n),
             forcing: Forcing::new(n),
@@ -179,9 +314,8 @@ impl<R: DiscreteLagrangian> StepEquations for TwoPoint<R> {
         x.copy_from_slice(dq);
     }
 
-    /// K = (−1): ∂F/∂δq = −(1/h)∂²L/∂q̇² + O(1) for both rules.
-    fn continuum_sign(&self, n: usize, hessian_sign: f64) -> f64 {
-        (-1f64).powi(n as i32) * hessian_sign
+    fn quadrature(&mut self) -> &mut Quadrature {
+        &mut self.quadrature
     }
 }
 
@@ -195,24 +329,15 @@ impl<R: DiscreteLagrangian> StepEquations for TwoPoint<R> {
 /// and since Σⱼ ℓⱼ = 1, Σⱼ ℓⱼ' = 0, p₁ − p₀ = hΣᵢ bᵢ ∂L/∂q(cᵢ) − ΣF.
 #[derive(Clone, Debug)]
 pub struct Galerkin {
-    s: usize,
-    weights: Vec<f64>,
-    nodes: Vec<f64>,
-    /// ℓⱼ(cᵢ) and ℓⱼ'(cᵢ), row i, column j = 0..=s.
-    basis: Vec<Vec<f64>>,
-    slopes: Vec<Vec<f64>>,
-    x: Vec<f64>,
-    v: Vec<f64>,
+    quadrature: Quadrature,
     lq: Vec<Vec<f64>>,
     lv: Vec<Vec<f64>>,
-    /// sign det K, K = (Σᵢ bᵢℓⱼ'(cᵢ)ℓₖ'(cᵢ)) over the equations' slots j and the unknowns k.
-    k_sign: f64,
 }
 
 impl Galerkin {
     /// Degree s = 2 (order 4) or 3 (order 6).
     pub fn new(s: usize, n: usize) -> Self {
-        let (nodes, weights): (Vec<f64>, Vec<f64>) = match s {
+        let (nodes, weights) = match s {
             2 => {
                 let d = 3f64.sqrt() / 6.0;
                 (vec![0.5 - d, 0.5 + d], vec![0.5, 0.5])
@@ -223,45 +348,10 @@ impl Galerkin {
             }
             _ => panic!("Galerkin integrators of degree 2 and 3 only"),
         };
-        let d: Vec<f64> = (0..=s).map(|j| j as f64 / s as f64).collect();
-        let ell = |j: usize, x: f64| {
-            (0..=s)
-                .filter(|&m| m != j)
-                .map(|m| (x - d[m]) / (d[j] - d[m]))
-                .product::<f64>()
-        };
-        let slope = |j: usize, x: f64| {
-            (0..=s)
-                .filter(|&k| k != j)
-                .map(|k| {
-                    (0..=s)
-                        .filter(|&m| m != j && m != k)
-                        .map(|m| (x - d[m]) / (d[j] - d[m]))
-                        .product::<f64>()
-                        / (d[j] - d[k])
-                })
-                .sum::<f64>()
-        };
-        let basis = nodes.iter().map(|&c| (0..=s).map(|j| ell(j, c)).collect()).collect();
-        let slopes: Vec<Vec<f64>> = nodes.iter().map(|&c| (0..=s).map(|j| slope(j, c)).collect()).collect();
-        // The equations' slots are Q₁, …, Q_{s−1}, then Q₀; the unknowns Q₁, …, Q_s.
-        let slot = |r: usize| if r + 1 < s { r + 1 } else { 0 };
-        let k = DMatrix::from_fn(s, s, |r, c| {
-            (0..s)
-                .map(|i| weights[i] * slopes[i][slot(r)] * slopes[i][c + 1])
-                .sum::<f64>()
-        });
         Galerkin {
-            s,
-            weights,
-            nodes,
-            basis,
-            slopes,
-            x: vec![0.0; n],
-            v: vec![0.0; n],
+            quadrature: Quadrature::new(s, &nodes, &weights, n),
             lq: vec![vec![0.0; n]; s],
             lv: vec![vec![0.0; n]; s],
-            k_sign: k.determinant().signum(),
         }
     }
 
@@ -274,32 +364,24 @@ impl Galerkin {
         h: f64,
         x: &[f64],
     ) -> Result<(), ModelError> {
-        let n = q0.len();
-        for i in 0..self.s {
-            for a in 0..n {
-                let (mut pos, mut vel) = (0.0, 0.0);
-                for j in 1..=self.s {
-                    let xj = x[(j - 1) * n + a];
-                    pos += self.basis[i][j] * xj;
-                    vel += self.slopes[i][j] * xj;
-                }
-                self.x[a] = q0[a] + pos;
-                self.v[a] = vel / h;
-            }
-            let ti = t + self.nodes[i] * h;
-            sys.dl_dq(&self.x, &self.v, ti, &mut self.lq[i])?;
-            sys.dl_dv(&self.x, &self.v, ti, &mut self.lv[i])?;
+        let quad = &mut self.quadrature;
+        for i in 0..quad.s {
+            quad.node_state(i, q0, h, x);
+            let ti = t + quad.nodes[i] * h;
+            sys.dl_dq(&quad.pos, &quad.vel, ti, &mut self.lq[i])?;
+            sys.dl_dv(&quad.pos, &quad.vel, ti, &mut self.lv[i])?;
         }
         Ok(())
     }
 
     /// out = ∂L_d/∂Qⱼ = Σᵢ bᵢ[hℓⱼ(cᵢ)∂L/∂q + ℓⱼ'(cᵢ)∂L/∂q̇].
     fn slot(&self, j: usize, h: f64, out: &mut [f64]) {
+        let quad = &self.quadrature;
         out.fill(0.0);
-        for i in 0..self.s {
+        for i in 0..quad.s {
             let (a, b) = (
-                self.weights[i] * h * self.basis[i][j],
-                self.weights[i] * self.slopes[i][j],
+                quad.weights[i] * h * quad.basis[i][j],
+                quad.weights[i] * quad.slopes[i][j],
             );
             for ((o, lq), lv) in out.iter_mut().zip(&self.lq[i]).zip(&self.lv[i]) {
                 *o += a * lq + b * lv;
@@ -310,7 +392,7 @@ impl Galerkin {
 
 impl StepEquations for Galerkin {
     fn unknowns(&self, n: usize) -> usize {
-        self.s * n
+        self.quadrature.s * n
     }
 
     fn equations<S: Lagrangian + ?Sized>(
@@ -328,10 +410,10 @@ impl StepEquations for Galerkin {
         }
         let n = q0.len();
         self.derivatives(sys, q0, t, h, x)?;
-        for j in 1..self.s {
+        for j in 1..self.quadrature.s {
             self.slot(j, h, &mut out[(j - 1) * n..j * n]);
         }
-        let last = &mut out[(self.s - 1) * n..];
+        let last = &mut out[(self.quadrature.s - 1) * n..];
         self.slot(0, h, last);
         last.iter_mut().zip(p0).for_each(|(o, p)| *o += p);
         Ok(())
@@ -350,10 +432,8 @@ impl StepEquations for Galerkin {
         let n = q0.len();
         self.derivatives(sys, q0, t, h, x)?;
         dp.fill(0.0);
-        for i in 0..self.s {
-            dp.iter_mut()
-                .zip(&self.lq[i])
-                .for_each(|(d, lq)| *d += h * self.weights[i] * lq);
+        for (lq, b) in self.lq.iter().zip(&self.quadrature.weights) {
+            dp.iter_mut().zip(lq).for_each(|(d, lq)| *d += h * b * lq);
         }
         for block in residual.chunks_exact(n) {
             dp.iter_mut().zip(block).for_each(|(d, r)| *d -= r);
@@ -364,14 +444,15 @@ impl StepEquations for Galerkin {
     /// The control points along the predicted increment: Qⱼ − q₀ = (j/s)·δq.
     fn predict(&self, dq: &[f64], x: &mut [f64]) {
         let n = dq.len();
-        for j in 1..=self.s {
-            let w = j as f64 / self.s as f64;
+        let s = self.quadrature.s;
+        for j in 1..=s {
+            let w = j as f64 / s as f64;
             x[(j - 1) * n..j * n].iter_mut().zip(dq).for_each(|(x, d)| *x = w * d);
         }
     }
 
-    fn continuum_sign(&self, n: usize, hessian_sign: f64) -> f64 {
-        self.k_sign.powi(n as i32) * hessian_sign.powi(self.s as i32)
+    fn quadrature(&mut self) -> &mut Quadrature {
+        &mut self.quadrature
     }
 }
 
@@ -506,7 +587,9 @@ impl<Sc: StepEquations> Del<Sc> {
         Ok(self.residual.iter().fold(0.0_f64, |m, r| m.max(r.abs())))
     }
 
-    /// ∂F/∂x by central differences, factorised in place.
+    /// ∂F/∂x from the model's second derivatives where it supplies them and no force acts (the
+    /// forces' derivatives are not supplied), by central differences otherwise; factorised in
+    /// place.
     fn factorise_jacobian<S: Lagrangian + ?Sized>(
         &mut self,
         sys: &S,
@@ -515,9 +598,14 @@ impl<Sc: StepEquations> Del<Sc> {
         t: f64,
         h: f64,
     ) -> Result<bool, StepError> {
+        let exact = !sys.is_forced()
+            && self
+                .scheme
+                .quadrature()
+                .jacobian(sys, q0, t, h, &self.x, &mut self.jacobian)?;
         let cbrt_eps = f64::EPSILON.cbrt();
         let n = q0.len();
-        for j in 0..self.x.len() {
+        for j in (0..self.x.len()).filter(|_| !exact) {
             let d = self.x[j];
             let e = cbrt_eps * (q0[j % n] + d).abs().max(1.0);
             self.x[j] = d + e;
@@ -557,7 +645,7 @@ impl<Sc: StepEquations> Del<Sc> {
         let n = q.len();
         if self.continuum_sign == 0.0 {
             let hessian_sign = self.hessian_sign(sys, q, p, t)?;
-            self.continuum_sign = self.scheme.continuum_sign(n, hessian_sign);
+            self.continuum_sign = self.scheme.quadrature().continuum_sign(n, hessian_sign);
         }
         // Predictor: extrapolate the last two increments (second order), the last one, or rest.
         for ((x, d1), d0) in self.predicted.iter_mut().zip(&self.last_dq).zip(&self.before_last_dq) {

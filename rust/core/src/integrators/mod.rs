@@ -17,7 +17,7 @@ mod kick_drift;
 mod method;
 
 pub use composition::Composition;
-pub use del::{Del, Galerkin, NewtonOptions, StepEquations, TwoPoint};
+pub use del::{Del, Galerkin, NewtonOptions, Quadrature, StepEquations, TwoPoint};
 pub use driver::{integrate, Failure, General, Integrable, Options, Trajectory};
 pub use explicit_rk::ExplicitRk;
 pub use kick_drift::KickDrift;

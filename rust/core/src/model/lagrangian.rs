@@ -1,5 +1,28 @@
+use nalgebra::DMatrix;
+
 use super::{finite_difference, MechanicalSystem};
 use crate::ModelError;
+
+/// The second derivatives of L at one point, n × n each.
+#[derive(Clone, Debug)]
+pub struct Hessians {
+    /// ∂²L/∂q².
+    pub qq: DMatrix<f64>,
+    /// ∂²L/∂q∂q̇: entry (i, j) is ∂²L/∂qᵢ∂q̇ⱼ.
+    pub qv: DMatrix<f64>,
+    /// ∂²L/∂q̇².
+    pub vv: DMatrix<f64>,
+}
+
+impl Hessians {
+    pub fn zeros(n: usize) -> Self {
+        Hessians {
+            qq: DMatrix::zeros(n, n),
+            qv: DMatrix::zeros(n, n),
+            vv: DMatrix::zeros(n, n),
+        }
+    }
+}
 
 /// A Lagrangian system L(q, q̇, t) with n generalized coordinates.
 ///
@@ -26,6 +49,13 @@ pub trait Lagrangian {
     fn dl_dv(&self, q: &[f64], v: &[f64], t: f64, out: &mut [f64]) -> Result<(), ModelError> {
         let mut work = vec![0.0; v.len()];
         finite_difference::central_gradient(|x| self.lagrangian(q, x, t), v, &mut work, out)
+    }
+
+    /// Writes the exact second derivatives of L at (q, q̇, t) into `out` and returns true, or
+    /// returns false (the default) when the model does not supply them; the implicit
+    /// integrators then difference their equations for Newton's Jacobian.
+    fn hessians(&self, _q: &[f64], _v: &[f64], _t: f64, _out: &mut Hessians) -> Result<bool, ModelError> {
+        Ok(false)
     }
 
     /// Whether L depends on t explicitly; if it does, the energy function E = p·q̇ − L is not

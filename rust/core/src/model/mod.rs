@@ -15,7 +15,7 @@ mod mechanical;
 mod natural;
 mod symmetry;
 
-pub use lagrangian::Lagrangian;
+pub use lagrangian::{Hessians, Lagrangian};
 pub use mass::Mass;
 pub use mechanical::MechanicalSystem;
 pub use natural::{differenced_kinetic_gradient, Natural, NaturalSystem};

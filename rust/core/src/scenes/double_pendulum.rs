@@ -1,5 +1,5 @@
 use super::{Problem, State};
-use crate::model::Lagrangian;
+use crate::model::{Hessians, Lagrangian};
 use crate::{Error, ModelError};
 
 /// The planar double pendulum in its two angles from the downward vertical:
@@ -92,6 +92,27 @@ impl Lagrangian for DoublePendulum {
         out[0] = a * v[0] + b * v[1];
         out[1] = b * v[0] + d * v[1];
         Ok(())
+    }
+
+    /// With δ = θ₁ − θ₂, k = m₂l₁l₂: L_qq = [[−kθ̇₁θ̇₂cos δ − (m₁+m₂)gl₁cos θ₁, kθ̇₁θ̇₂cos δ],
+    /// [kθ̇₁θ̇₂cos δ, −kθ̇₁θ̇₂cos δ − m₂gl₂cos θ₂]], L_qq̇ = k sin δ·[[−θ̇₂, −θ̇₁], [θ̇₂, θ̇₁]],
+    /// L_q̇q̇ = M(θ).
+    fn hessians(&self, q: &[f64], v: &[f64], _t: f64, out: &mut Hessians) -> Result<bool, ModelError> {
+        let k = self.m2 * self.l1 * self.l2;
+        let (s, c) = (q[0] - q[1]).sin_cos();
+        let w = k * v[0] * v[1] * c;
+        out.qq.copy_from_slice(&[
+            -w - (self.m1 + self.m2) * self.g * self.l1 * q[0].cos(),
+            w,
+            w,
+            -w - self.m2 * self.g * self.l2 * q[1].cos(),
+        ]);
+        // Column-major: (0,0), (1,0), (0,1), (1,1).
+        out.qv
+            .copy_from_slice(&[-k * s * v[1], k * s * v[1], -k * s * v[0], k * s * v[0]]);
+        let [[a, b], [_, d]] = self.mass(q);
+        out.vv.copy_from_slice(&[a, b, b, d]);
+        Ok(true)
     }
 
     /// θ̇ = M(θ)⁻¹p.

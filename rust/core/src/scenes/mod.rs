@@ -27,7 +27,7 @@ pub use nbody::NBody;
 pub use pendulum::Pendulum;
 pub use spherical_pendulum::SphericalPendulum;
 
-use crate::model::{Generator, Lagrangian, Mass, MechanicalSystem};
+use crate::model::{Generator, Hessians, Lagrangian, Mass, MechanicalSystem};
 use crate::ModelError;
 
 /// A state (q, p) at time t.
@@ -138,6 +138,9 @@ impl Lagrangian for LagrangianScene {
     }
     fn velocity(&self, q: &[f64], p: &[f64], t: f64, v: &mut [f64]) -> Result<(), ModelError> {
         dispatch_lagrangian!(self, s => s.velocity(q, p, t, v))
+    }
+    fn hessians(&self, q: &[f64], v: &[f64], t: f64, out: &mut Hessians) -> Result<bool, ModelError> {
+        dispatch_lagrangian!(self, s => s.hessians(q, v, t, out))
     }
     fn is_time_dependent(&self) -> bool {
         dispatch_lagrangian!(self, s => s.is_time_dependent())
