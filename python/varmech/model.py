@@ -84,7 +84,7 @@ class Model:
     symmetries it declares (each with a conserved Noether momentum).
 
     Separable mechanical systems (L = ½q̇ᵀMq̇ − V) take every method; general Lagrangians the
-    implicit variational ones (``midpoint``, ``trapezoid``).
+    implicit variational ones (``midpoint``, ``trapezoid``, ``galerkin4``, ``galerkin6``).
     """
 
     _core: _core.NativeModel | _core.ClosureModel | _core.ClosureNatural | _core.ClosureLagrangian
@@ -216,7 +216,7 @@ class MechanicalSystem(Model):
 
 class Lagrangian(Model):
     """A general Lagrangian L(q, q̇, t) given by Python closures, for the implicit variational
-    methods (``midpoint``, ``trapezoid``).
+    methods (``midpoint``, ``trapezoid``, ``galerkin4``, ``galerkin6``).
 
     Parameters
     ----------

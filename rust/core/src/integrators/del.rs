@@ -326,12 +326,16 @@ impl<R: DiscreteLagrangian> StepEquations for TwoPoint<R> {
 ///
 /// F = (∂L_d/∂Q₁, …, ∂L_d/∂Q_{s−1}, p₀ + ∂L_d/∂Q₀),   p₁ = ∂L_d/∂Q_s,
 ///
-/// and since Σⱼ ℓⱼ = 1, Σⱼ ℓⱼ' = 0, p₁ − p₀ = hΣᵢ bᵢ ∂L/∂q(cᵢ) − ΣF.
+/// and since Σⱼ ℓⱼ = 1, Σⱼ ℓⱼ' = 0, p₁ − p₀ = hΣᵢ bᵢ ∂L/∂q(cᵢ) − ΣF. A force f adds to ∂L/∂q
+/// at every node (forced DEL equations), and its work over the step is hΣᵢ bᵢ f(cᵢ)·q̇(cᵢ).
 #[derive(Clone, Debug)]
 pub struct Galerkin {
     quadrature: Quadrature,
     lq: Vec<Vec<f64>>,
     lv: Vec<Vec<f64>>,
+    f: Vec<f64>,
+    /// h Σᵢ bᵢ f(cᵢ)·q̇(cᵢ) at the last evaluation: the forces' work over the step.
+    work: f64,
 }
 
 impl Galerkin {
@@ -352,10 +356,14 @@ impl Galerkin {
             quadrature: Quadrature::new(s, &nodes, &weights, n),
             lq: vec![vec![0.0; n]; s],
             lv: vec![vec![0.0; n]; s],
+            f: vec![0.0; n],
+            work: 0.0,
         }
     }
 
-    /// ∂L/∂q and ∂L/∂q̇ at every quadrature node, for the control increments x (Q₀ = q₀).
+    /// ∂L/∂q + f and ∂L/∂q̇ at every quadrature node, for the control increments x (Q₀ = q₀).
+    /// A force f enters where ∂L/∂q does: the discrete Lagrange–d'Alembert principle adds the
+    /// virtual work h Σᵢ bᵢ f(cᵢ)·δq(cᵢh) to δL_d, and δq(cᵢh) = Σⱼ ℓⱼ(cᵢ)δQⱼ.
     fn derivatives<S: Lagrangian + ?Sized>(
         &mut self,
         sys: &S,
@@ -365,11 +373,21 @@ impl Galerkin {
         x: &[f64],
     ) -> Result<(), ModelError> {
         let quad = &mut self.quadrature;
+        self.work = 0.0;
         for i in 0..quad.s {
             quad.node_state(i, q0, h, x);
             let ti = t + quad.nodes[i] * h;
             sys.dl_dq(&quad.pos, &quad.vel, ti, &mut self.lq[i])?;
             sys.dl_dv(&quad.pos, &quad.vel, ti, &mut self.lv[i])?;
+            if sys.is_forced() {
+                sys.force(&quad.pos, &quad.vel, ti, &mut self.f)?;
+                let mut power = 0.0;
+                for ((lq, f), v) in self.lq[i].iter_mut().zip(&self.f).zip(&quad.vel) {
+                    *lq += f;
+                    power += f * v;
+                }
+                self.work += h * quad.weights[i] * power;
+            }
         }
         Ok(())
     }
@@ -405,9 +423,6 @@ impl StepEquations for Galerkin {
         x: &[f64],
         out: &mut [f64],
     ) -> Result<(), ModelError> {
-        if sys.is_forced() {
-            return Err("the Galerkin integrators do not take forces yet; use midpoint or trapezoid".into());
-        }
         let n = q0.len();
         self.derivatives(sys, q0, t, h, x)?;
         for j in 1..self.quadrature.s {
@@ -438,7 +453,7 @@ impl StepEquations for Galerkin {
         for block in residual.chunks_exact(n) {
             dp.iter_mut().zip(block).for_each(|(d, r)| *d -= r);
         }
-        Ok(0.0)
+        Ok(self.work)
     }
 
     /// The control points along the predicted increment: Qⱼ − q₀ = (j/s)·δq.
