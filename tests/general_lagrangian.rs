@@ -4,7 +4,7 @@
 mod common;
 
 use nalgebra::DMatrix;
-use varmech::integrators::{integrate, General, Method, Options, Trajectory};
+use varmech::integrators::{integrate, General, Method, NewtonOptions, Options, Trajectory};
 use varmech::model::{Lagrangian, Natural, NaturalSystem};
 use varmech::scenes::DoublePendulum;
 use varmech::{Error, ModelError};
@@ -16,9 +16,21 @@ fn run<L: Lagrangian>(
     t_end: f64,
     save_every: usize,
 ) -> Result<Trajectory, Error> {
+    run_with(sys, method, steps, t_end, save_every, NewtonOptions::default())
+}
+
+fn run_with<L: Lagrangian>(
+    sys: &L,
+    method: Method,
+    steps: usize,
+    t_end: f64,
+    save_every: usize,
+    newton: NewtonOptions,
+) -> Result<Trajectory, Error> {
     let problem = DoublePendulum::problem();
     let options = Options {
         save_every,
+        newton,
         ..Options::new(t_end / steps as f64, steps)
     };
     integrate(
@@ -37,7 +49,7 @@ fn galerkin_integrators_converge_at_orders_four_and_six_to_the_reference() {
     let problem = DoublePendulum::problem();
     let (reference, _) = problem.reference.as_ref().unwrap();
     // Galerkin-6 gets two halvings here: a third would end at 6e-11, against a reference
-    // accurate to about 1e-11 (its three-halving order test is the pendulum's, tests/convergence.rs).
+    // accurate to about 1e-11 (its three halvings are measured at T = 3, in the next test).
     for (method, n0, halvings) in [(Method::Galerkin4, 500, 3), (Method::Galerkin6, 500, 2)] {
         let errors: Vec<f64> = (0..=halvings)
             .map(|k| {
@@ -54,6 +66,65 @@ fn galerkin_integrators_converge_at_orders_four_and_six_to_the_reference() {
             "{method:?}: orders {orders:?} (errors {errors:?})"
         );
     }
+}
+
+#[test]
+fn galerkin6_converges_at_order_six_over_three_halvings_to_a_self_converged_reference() {
+    let problem = DoublePendulum::problem();
+    let (published, _) = problem.reference.as_ref().unwrap();
+    // The pendulum is chaotic: by T = 10 it amplifies a change of 1e-14 in the initial state to
+    // 1e-10, so round-off leaves any double-precision run about 1e-11 from the true state there,
+    // and Galerkin-6's asymptotic range (errors below about 3e-6) spans two halvings above that.
+    // At T = 3 round-off costs about 1e-12, so the order is measured there, against the state at
+    // T = 3 of a run at h = 1/800 whose state at T = 10 reproduces the published reference.
+    // Newton is solved to round-off: its default 1e-14 a step, amplified, would be felt at 1e-12.
+    let t_order = 3.0;
+    let to_round_off = NewtonOptions {
+        tolerance: 1e-16,
+        ..NewtonOptions::default()
+    };
+    let reference = run_with(&problem.system, Method::Galerkin6, 8000, 10.0, 2400, to_round_off).unwrap();
+    assert!((reference.t[1] - t_order).abs() < 1e-12, "saved at {:?}", reference.t);
+    let (q_ref, p_ref) = (reference.q_at(1), reference.p_at(1));
+
+    // (θ, θ̇) at T = 10 against the published ones (11 decimals, accurate to about 1e-11). The
+    // bound adds this run's own round-off there, which scatters up to 3e-11 with the fine step
+    // and the Newton tolerance.
+    let angles_and_rates = |q: &[f64], p: &[f64]| {
+        let mut v = vec![0.0; 2];
+        problem.system.velocity(q, p, 0.0, &mut v).unwrap();
+        [q, &v].concat()
+    };
+    let end = reference.len() - 1;
+    let deviation = angles_and_rates(reference.q_at(end), reference.p_at(end))
+        .iter()
+        .zip(angles_and_rates(&published.q, &published.p))
+        .map(|(a, b)| (a - b).abs())
+        .fold(0.0, f64::max);
+
+    // Self-convergence at T = 3: the same run at h/2.
+    let halved = run_with(&problem.system, Method::Galerkin6, 4800, t_order, 4800, to_round_off).unwrap();
+    let own = common::final_error(&halved, q_ref, p_ref);
+
+    let errors: Vec<f64> = (0..4)
+        .map(|k| {
+            let steps = 48 << k;
+            let traj = run(&problem.system, Method::Galerkin6, steps, t_order, steps).unwrap();
+            common::final_error(&traj, q_ref, p_ref)
+        })
+        .collect();
+    let orders: Vec<f64> = errors.windows(2).map(|w| (w[0] / w[1]).log2()).collect();
+    println!(
+        "Galerkin-6 reference: max |Δ(θ, θ̇)| = {deviation:.2e} from the published one at T = 10; \
+         h vs h/2 at T = {t_order}: {own:.2e}"
+    );
+    println!("Galerkin-6 at T = {t_order}, h = 1/16 to 1/128: errors {errors:?}, orders {orders:.3?}");
+    assert!(deviation <= 4e-11, "{deviation:e}");
+    assert!(own <= errors[3] / 10.0, "reference {own:e} against errors {errors:?}");
+    assert!(
+        orders.iter().all(|p| (p - 6.0).abs() <= 0.3),
+        "orders {orders:?} (errors {errors:?})"
+    );
 }
 
 #[test]
