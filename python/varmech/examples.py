@@ -99,7 +99,8 @@ def nbody(G: float, masses: np.ndarray) -> MechanicalSystem:
 
 
 def double_pendulum(m1: float = 1.0, m2: float = 2.0, l1: float = 2.0, l2: float = 3.0, g: float = 9.80665) -> Lagrangian:
-    """The planar double pendulum as a general Lagrangian with exact derivatives."""
+    """The planar double pendulum as a general Lagrangian with exact first and second
+    derivatives."""
 
     def mass(q: np.ndarray) -> np.ndarray:
         c = m2 * l1 * l2 * math.cos(q[0] - q[1])
@@ -116,7 +117,15 @@ def double_pendulum(m1: float = 1.0, m2: float = 2.0, l1: float = 2.0, l2: float
     def dl_dv(q: np.ndarray, v: np.ndarray, t: float) -> np.ndarray:
         return mass(q) @ v
 
-    return Lagrangian(2, lagrangian, dl_dq=dl_dq, dl_dv=dl_dv, name="double_pendulum (closure)")
+    def hessians(q: np.ndarray, v: np.ndarray, t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        k = m2 * l1 * l2
+        s, c = math.sin(q[0] - q[1]), math.cos(q[0] - q[1])
+        w = k * v[0] * v[1] * c
+        lqq = np.array([[-w - (m1 + m2) * g * l1 * math.cos(q[0]), w], [w, -w - m2 * g * l2 * math.cos(q[1])]])
+        lqv = k * s * np.array([[-v[1], -v[0]], [v[1], v[0]]])
+        return lqq, lqv, mass(q)
+
+    return Lagrangian(2, lagrangian, dl_dq=dl_dq, dl_dv=dl_dv, hessians=hessians, name="double_pendulum (closure)")
 
 
 def spherical_pendulum(m: float = 1.0, l: float = 1.0, g: float = 1.0) -> Lagrangian:
