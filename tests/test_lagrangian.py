@@ -84,6 +84,34 @@ def test_check_derivatives_catches_a_wrong_derivative():
     assert not varmech.check_derivatives(bad, [0.4, 0.3]).ok
 
 
+def test_check_derivatives_checks_second_derivatives_and_mass_derivatives():
+    good = examples.double_pendulum()
+    q, v = [0.3, -1.2], [0.7, 2.5]
+    report = varmech.check_derivatives(good, q, v)
+    assert set(report.mismatch) == {"dl_dq", "dl_dv", "L_qq", "L_qv", "L_vv"} and report.worst[1] < 1e-8
+
+    def transposed(q, v, t):  # a classic slip: L_qv given as ∂²L/∂q̇∂q
+        lqq, lqv, lvv = good.hessians(q, v, t)
+        return lqq, lqv.T, lvv
+
+    wrong = varmech.Lagrangian(2, good.lagrangian, dl_dq=good.dl_dq, dl_dv=good.dl_dv, hessians=transposed)
+    report = varmech.check_derivatives(wrong, q, v)
+    assert not report.ok and report.worst[0] == "L_qv"
+
+    def mass(q):
+        return np.diag([1.0, np.sin(q[0]) ** 2])
+
+    natural = [
+        varmech.MechanicalSystem(2, lambda q: -np.cos(q[0]), lambda q: np.array([np.sin(q[0]), 0.0]), mass=mass, mass_derivative=dm)
+        for dm in (
+            lambda q: np.array([np.diag([0.0, np.sin(2 * q[0])]), np.zeros((2, 2))]),
+            lambda q: np.array([np.zeros((2, 2)), np.diag([0.0, np.sin(2 * q[0])])]),  # on the wrong axis
+        )
+    ]
+    assert varmech.check_derivatives(natural[0], [1.0, 0.0]).ok
+    assert varmech.check_derivatives(natural[1], [1.0, 0.0]).worst[0] == "mass_derivative"
+
+
 def test_lagrangian_without_derivatives_warns_and_uses_differences():
     exact = examples.double_pendulum()
     with pytest.warns(UserWarning, match="no dl_dq and no dl_dv"):

@@ -37,14 +37,15 @@ class DerivativeCheck:
 
 
 def _central(f, x: np.ndarray) -> np.ndarray:
-    """∇f(x) by central differences with steps ε^{1/3}·max(|xᵢ|, 1)."""
-    g = np.empty_like(x)
+    """∂f/∂xᵢ stacked on the first axis, by central differences with steps ε^{1/3}·max(|xᵢ|, 1)
+    (f scalar or array valued)."""
+    rows = []
     for i in range(len(x)):
         h = np.finfo(float).eps ** (1 / 3) * max(abs(x[i]), 1.0)
         e = np.zeros_like(x)
         e[i] = h
-        g[i] = (f(x + e) - f(x - e)) / (2 * h)
-    return g
+        rows.append((np.asarray(f(x + e), dtype=float) - np.asarray(f(x - e), dtype=float)) / (2 * h))
+    return np.array(rows)
 
 
 def _mismatch(supplied: ArrayLike, differences: np.ndarray) -> float:
@@ -58,9 +59,11 @@ def check_derivatives(model: Model, q: ArrayLike, v: ArrayLike | None = None, t:
     """Compare the derivatives ``model`` supplies with central differences at (q, q̇, t).
 
     For a :class:`~varmech.MechanicalSystem`, its ``gradient`` against differences of its
-    ``potential``; for a :class:`~varmech.Lagrangian`, its ``dl_dq`` and ``dl_dv`` against
-    differences of L. Differences are accurate to about 1e-10 relative, so a mismatch above
-    ``rtol`` (default 1e-6) means a wrong derivative.
+    ``potential``, and its ``mass_derivative`` against differences of its ``mass`` closure; for
+    a :class:`~varmech.Lagrangian`, its ``dl_dq`` and ``dl_dv`` against differences of L, and
+    its ``hessians`` against differences of the first derivatives it supplies (second
+    differences of L would be too coarse to judge them). Differences are accurate to about
+    1e-10 relative, so a mismatch above ``rtol`` (default 1e-6) means a wrong derivative.
     """
     n = model.dim
     q = vector("q", q, n)
@@ -68,12 +71,22 @@ def check_derivatives(model: Model, q: ArrayLike, v: ArrayLike | None = None, t:
     if isinstance(model, MechanicalSystem):
         if model.gradient is not None:
             mismatch["gradient"] = _mismatch(model.gradient(q.copy()), _central(model.potential, q))
+        if model.mass_derivative is not None:
+            mismatch["mass_derivative"] = _mismatch(model.mass_derivative(q.copy()), _central(model.mass, q))
     elif isinstance(model, Lagrangian):
         v = vector("v", v if v is not None else np.zeros(n), n)
         if model.dl_dq is not None:
             mismatch["dl_dq"] = _mismatch(model.dl_dq(q.copy(), v.copy(), t), _central(lambda x: model.lagrangian(x, v, t), q))
         if model.dl_dv is not None:
             mismatch["dl_dv"] = _mismatch(model.dl_dv(q.copy(), v.copy(), t), _central(lambda x: model.lagrangian(q, x, t), v))
+        if model.hessians is not None:
+            lqq, lqv, lvv = model.hessians(q.copy(), v.copy(), t)
+            # _central stacks ∂/∂xⱼ on the first axis: the transpose of (i, j) = ∂²L/∂·ᵢ∂xⱼ.
+            if model.dl_dq is not None:
+                mismatch["L_qq"] = _mismatch(lqq, _central(lambda x: model.dl_dq(x, v, t), q).T)
+                mismatch["L_qv"] = _mismatch(lqv, _central(lambda x: model.dl_dq(q, x, t), v).T)
+            if model.dl_dv is not None:
+                mismatch["L_vv"] = _mismatch(lvv, _central(lambda x: model.dl_dv(q, x, t), v).T)
     else:
         raise TypeError(f"model: expected a MechanicalSystem or Lagrangian of closures, got {type(model).__name__}")
     if not mismatch:
