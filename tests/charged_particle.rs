@@ -103,10 +103,8 @@ fn trapezoid_has_no_parasitic_oscillation_in_a_non_uniform_field() {
         })
         .collect();
     let parts: Vec<f64> = runs.iter().map(alternating_part).collect();
-    let orders: Vec<f64> = parts.windows(2).map(|w| (w[0] / w[1]).log2()).collect();
-    println!("alternating part / h²|q̈|: {parts:?}, orders {orders:.3?}");
     assert!(parts[0] < 1e-2, "{parts:?}");
-    assert!(orders.iter().all(|p| (p - 2.0).abs() <= 0.3), "orders {orders:?}");
+    common::assert_order("alternating part / h²|q̈|", &parts, 2.0, 0.3);
     // The measure would see a period-2 mode of amplitude 1e-7 on the finest run.
     let mut planted = runs[3].clone();
     for (k, q) in planted.q.chunks_exact_mut(2).enumerate() {
@@ -172,13 +170,7 @@ fn midpoint_and_galerkin4_converge_at_orders_two_and_four_in_a_non_uniform_field
         let errors: Vec<f64> = (0..4)
             .map(|k| common::final_error(&at_end(method, n0 << k), q_ref, p_ref))
             .collect();
-        let orders: Vec<f64> = errors.windows(2).map(|w| (w[0] / w[1]).log2()).collect();
-        println!("{method:?}: errors {errors:?}, orders {orders:.3?}");
-        let order = method.info().order as f64;
-        assert!(
-            orders.iter().all(|p| (p - order).abs() <= 0.3),
-            "{method:?}: orders {orders:?} (errors {errors:?})"
-        );
+        common::assert_order(&format!("{method:?}"), &errors, method.info().order as f64, 0.3);
     }
 }
 
@@ -193,9 +185,7 @@ fn midpoint_reaches_the_exact_gyration_at_order_two() {
             common::final_error(&traj, &reference.q, &reference.p)
         })
         .collect();
-    let orders: Vec<f64> = errors.windows(2).map(|w| (w[0] / w[1]).log2()).collect();
-    println!("midpoint: errors {errors:?}, orders {orders:.3?}");
-    assert!(orders.iter().all(|p| (p - 2.0).abs() <= 0.05), "orders {orders:?}");
+    common::assert_order("midpoint", &errors, 2.0, 0.05);
 }
 
 #[test]

@@ -54,16 +54,7 @@ fn observed_orders_equal_nominal_orders() {
         let info = method.info();
         let (n0, halvings) = protocol(method);
         let errors: Vec<f64> = (0..=halvings).map(|k| error(method, n0 << k)).collect();
-        let orders: Vec<f64> = errors.windows(2).map(|w| (w[0] / w[1]).log2()).collect();
-        println!("{:>16}: errors {:?} orders {:?}", info.name, errors, orders);
-        for p in &orders {
-            assert!(
-                (p - info.order as f64).abs() <= 0.3,
-                "{}: observed order {p:.3} from {n0} to {} steps, nominal {} (errors {errors:?})",
-                info.name,
-                n0 << halvings,
-                info.order
-            );
-        }
+        let what = format!("{} from {n0} to {} steps", info.name, n0 << halvings);
+        common::assert_order(&what, &errors, info.order as f64, 0.3);
     }
 }

@@ -1,6 +1,8 @@
 //! The damped, driven pendulum scene in Baker & Gollub's chaotic regime: forced by the discrete
 //! Lagrange–d'Alembert principle, through the scene dispatch the binding uses.
 
+mod common;
+
 use varmech::integrators::{integrate, General, Method, Options, Trajectory};
 use varmech::model::Lagrangian;
 use varmech::scenes::{DampedDrivenPendulum, LagrangianScene, Problem};
@@ -50,12 +52,7 @@ fn the_tracked_work_accounts_for_the_energy_change_up_to_the_methods_own_energy_
         let defects: Vec<f64> = (0..4)
             .map(|k| balance(&p.system, &run(&p.system, method, 20.0, 500 << k, 1)).0)
             .collect();
-        let orders: Vec<f64> = defects.windows(2).map(|w| (w[0] / w[1]).log2()).collect();
-        println!("{method:?}: max |E − E₀ − W| {defects:?}, orders {orders:.3?}");
-        assert!(
-            orders.iter().all(|p| (p - 2.0).abs() <= 0.3),
-            "{method:?}: orders {orders:?}, defects {defects:?}"
-        );
+        common::assert_order(&format!("{method:?}: max |E − E₀ − W|"), &defects, 2.0, 0.3);
     }
 }
 
@@ -78,12 +75,7 @@ fn midpoint_and_trapezoid_converge_at_order_two() {
                 (y[0] - reference[0]).hypot(y[1] - reference[1])
             })
             .collect();
-        let orders: Vec<f64> = errors.windows(2).map(|w| (w[0] / w[1]).log2()).collect();
-        println!("{method:?}: errors {errors:?}, orders {orders:.3?}");
-        assert!(
-            orders.iter().all(|p| (p - 2.0).abs() <= 0.3),
-            "{method:?}: orders {orders:?}, errors {errors:?}"
-        );
+        common::assert_order(&format!("{method:?}"), &errors, 2.0, 0.3);
     }
 }
 

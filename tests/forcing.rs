@@ -1,6 +1,8 @@
 //! Forced systems by the discrete Lagrange–d'Alembert principle: a damped linear oscillator,
 //! L = ½q̇² − ½ω²q² with the Rayleigh force f = −c q̇.
 
+mod common;
+
 use varmech::integrators::{integrate, General, Method, Options, Trajectory};
 use varmech::model::Lagrangian;
 use varmech::{Error, ModelError};
@@ -94,13 +96,7 @@ fn the_discrete_energy_decay_matches_the_exact_rate_at_the_method_order() {
                 (energy(&traj, 1) - exact_energy(t_end)).abs()
             })
             .collect();
-        let orders: Vec<f64> = errors.windows(2).map(|w| (w[0] / w[1]).log2()).collect();
-        println!("{method:?}: energy errors {errors:?}, orders {orders:.2?}");
-        let order = method.info().order as f64;
-        assert!(
-            orders.iter().all(|p| (p - order).abs() <= 0.3),
-            "{method:?}: orders {orders:?}, errors {errors:?}"
-        );
+        common::assert_order(&format!("{method:?}: energy"), &errors, method.info().order as f64, 0.3);
     }
 }
 

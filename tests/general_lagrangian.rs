@@ -58,13 +58,7 @@ fn galerkin_integrators_converge_at_orders_four_and_six_to_the_reference() {
                 common::final_error(&traj, &reference.q, &reference.p)
             })
             .collect();
-        let orders: Vec<f64> = errors.windows(2).map(|w| (w[0] / w[1]).log2()).collect();
-        println!("{method:?}: errors {errors:?} orders {orders:?}");
-        let order = method.info().order as f64;
-        assert!(
-            orders.iter().all(|p| (p - order).abs() <= 0.3),
-            "{method:?}: orders {orders:?} (errors {errors:?})"
-        );
+        common::assert_order(&format!("{method:?}"), &errors, method.info().order as f64, 0.3);
     }
 }
 
@@ -116,17 +110,17 @@ fn galerkin6_converges_at_order_six_over_three_halvings_to_a_self_converged_refe
             common::final_error(&traj, q_ref, p_ref)
         })
         .collect();
-    let orders: Vec<f64> = errors.windows(2).map(|w| (w[0] / w[1]).log2()).collect();
     println!(
         "Galerkin-6 reference: max |Δ(θ, θ̇)| = {deviation:.2e} from the published one at T = 10; \
          h vs h/2 at T = {t_order}: {own:.2e}"
     );
-    println!("Galerkin-6 at T = {t_order}, h = 1/16 to 1/128: errors {errors:?}, orders {orders:.3?}");
     assert!(deviation <= 4e-11, "{deviation:e}");
     assert!(own <= errors[3] / 10.0, "reference {own:e} against errors {errors:?}");
-    assert!(
-        orders.iter().all(|p| (p - 6.0).abs() <= 0.3),
-        "orders {orders:?} (errors {errors:?})"
+    common::assert_order(
+        &format!("Galerkin-6 at T = {t_order}, h = 1/16 to 1/128"),
+        &errors,
+        6.0,
+        0.3,
     );
 }
 
@@ -149,11 +143,7 @@ fn midpoint_and_trapezoid_converge_at_order_two_to_the_reference() {
                 common::final_error(&traj, &reference.q, &reference.p)
             })
             .collect();
-        let orders: Vec<f64> = errors.windows(2).map(|w| (w[0] / w[1]).log2()).collect();
-        println!("{method:?}: errors {errors:?} orders {orders:?}");
-        for p in &orders {
-            assert!((p - 2.0).abs() <= 0.3, "{method:?}: order {p:.3} (errors {errors:?})");
-        }
+        common::assert_order(&format!("{method:?}"), &errors, 2.0, 0.3);
     }
 }
 
@@ -392,10 +382,6 @@ fn spherical_pendulum_conserves_its_azimuthal_momentum_and_reaches_the_reference
                     .sqrt()
             })
             .collect();
-        let orders: Vec<f64> = errors.windows(2).map(|w| (w[0] / w[1]).log2()).collect();
-        assert!(
-            orders.iter().all(|p| (p - 2.0).abs() <= 0.3),
-            "{method:?}: orders {orders:?}, errors {errors:?}"
-        );
+        common::assert_order(&format!("{method:?}: spherical pendulum angles"), &errors, 2.0, 0.3);
     }
 }

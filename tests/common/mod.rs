@@ -44,3 +44,15 @@ pub fn assert_within_factor(what: &str, measured: f64, published: f64, factor: f
         "{what}: measured {measured:.3e}, published {published:.3e} (allowed factor {factor})"
     );
 }
+
+/// Asserts that errors at successively halved steps fall at `order` ± `tolerance`: each
+/// observed order log₂(eₖ/eₖ₊₁) is in that band. Prints and returns the observed orders.
+pub fn assert_order(what: &str, errors: &[f64], order: f64, tolerance: f64) -> Vec<f64> {
+    let orders: Vec<f64> = errors.windows(2).map(|w| (w[0] / w[1]).log2()).collect();
+    println!("{what}: errors {errors:?}, orders {orders:.3?}");
+    assert!(
+        orders.iter().all(|p| (p - order).abs() <= tolerance),
+        "{what}: orders {orders:.3?} (errors {errors:?}), expected {order} ± {tolerance}"
+    );
+    orders
+}
