@@ -757,7 +757,7 @@ impl<Sc: StepEquations> Del<Sc> {
 /// U on and above it); `pivots[i]` is the row swapped into row i. Returns the sign of the
 /// determinant, or None for a singular matrix. Written out because nalgebra's `LU` allocates its permutation on every
 /// factorisation, and the Newton loop must not allocate.
-fn lu_in_place(a: &mut DMatrix<f64>, pivots: &mut [usize]) -> Option<f64> {
+pub(super) fn lu_in_place(a: &mut DMatrix<f64>, pivots: &mut [usize]) -> Option<f64> {
     let n = a.nrows();
     let mut sign = 1.0;
     for k in 0..n {
@@ -784,7 +784,7 @@ fn lu_in_place(a: &mut DMatrix<f64>, pivots: &mut [usize]) -> Option<f64> {
 }
 
 /// Solves A x = b in place with the factors of [`lu_in_place`].
-fn lu_solve(lu: &DMatrix<f64>, pivots: &[usize], b: &mut DVector<f64>) {
+pub(super) fn lu_solve(lu: &DMatrix<f64>, pivots: &[usize], b: &mut DVector<f64>) {
     for (k, &piv) in pivots.iter().enumerate() {
         b.swap_rows(k, piv);
     }

@@ -3,7 +3,7 @@ use std::time::{Duration, Instant};
 use super::{compensated, Integrator, Method, NewtonOptions, StepError};
 use crate::diagnostics::hamiltonian;
 use crate::error::check_vector;
-use crate::model::{Lagrangian, MechanicalSystem};
+use crate::model::{Constrained, HolonomicConstraints, Lagrangian, MechanicalSystem};
 use crate::{Error, ModelError};
 
 /// What the driver integrates: separable mechanical systems take every method; a general
@@ -14,6 +14,12 @@ pub trait Integrable {
 
     /// Whether `method` applies to this system.
     fn check_method(&self, method: Method) -> Result<(), Error>;
+
+    /// Whether (q₀, p₀) is admissible initial data (on the constraints, for constrained
+    /// systems); `q0` and `p0` are finite and of the right length here.
+    fn check_initial(&self, _q0: &[f64], _p0: &[f64]) -> Result<(), Error> {
+        Ok(())
+    }
 
     /// One step's increments, from (q, p) at time t.
     #[allow(clippy::too_many_arguments)]
@@ -40,8 +46,8 @@ impl<S: MechanicalSystem> Integrable for S {
         MechanicalSystem::dim(self)
     }
 
-    fn check_method(&self, _method: Method) -> Result<(), Error> {
-        Ok(())
+    fn check_method(&self, method: Method) -> Result<(), Error> {
+        unconstrained(method)
     }
 
     fn increment(
@@ -75,6 +81,7 @@ impl<L: Lagrangian> Integrable for General<'_, L> {
     }
 
     fn check_method(&self, method: Method) -> Result<(), Error> {
+        unconstrained(method)?;
         if method.info().implicit {
             Ok(())
         } else {
@@ -106,6 +113,76 @@ impl<L: Lagrangian> Integrable for General<'_, L> {
 
     fn as_lagrangian(&self) -> &dyn Lagrangian {
         self.0
+    }
+}
+
+/// A constrained method is refused for a system without constraints.
+fn unconstrained(method: Method) -> Result<(), Error> {
+    if method.info().constrained {
+        let reason = format!("{} integrates systems with holonomic constraints", method.info().name);
+        return Err(Error::invalid("method", reason));
+    }
+    Ok(())
+}
+
+/// A separable mechanical system on holonomic constraints, for RATTLE and SHAKE.
+impl<S: MechanicalSystem, C: HolonomicConstraints> Integrable for Constrained<S, C> {
+    fn dim(&self) -> usize {
+        MechanicalSystem::dim(&self.system)
+    }
+
+    fn check_method(&self, method: Method) -> Result<(), Error> {
+        if method.info().constrained {
+            return Ok(());
+        }
+        let reason = format!(
+            "{} would ignore the constraints; use rattle, rattle4 or shake",
+            method.info().name
+        );
+        Err(Error::invalid("method", reason))
+    }
+
+    /// |g(q₀)|∞ and |G(q₀)M⁻¹p₀|∞ within 1e-10 (relative to the state's size): RATTLE holds
+    /// the constraints where they start, and starting off them is a user error.
+    fn check_initial(&self, q0: &[f64], p0: &[f64]) -> Result<(), Error> {
+        let (position, velocity) = self
+            .residuals(q0, p0)
+            .map_err(|e| Error::invalid("q0", format!("the constraints failed to evaluate: {e}")))?;
+        let scale = q0.iter().chain(p0).fold(1.0_f64, |m, x| m.max(x.abs()));
+        if position > 1e-10 * scale {
+            return Err(Error::invalid(
+                "q0",
+                format!("is off the constraints: |g(q0)| = {position:.3e}; project the initial state first"),
+            ));
+        }
+        if velocity > 1e-10 * scale {
+            return Err(Error::invalid(
+                "p0",
+                format!("is off the hidden constraint: |G(q0)M⁻¹p0| = {velocity:.3e}; project the initial state first"),
+            ));
+        }
+        Ok(())
+    }
+
+    fn increment(
+        &self,
+        integrator: &mut Integrator,
+        _t: f64,
+        q: &[f64],
+        p: &[f64],
+        h: f64,
+        dq: &mut [f64],
+        dp: &mut [f64],
+    ) -> Result<(), StepError> {
+        integrator.increment_constrained(&self.system, &self.constraints, q, p, h, dq, dp)
+    }
+
+    fn energy(&self, q: &[f64], p: &[f64]) -> Option<Result<f64, ModelError>> {
+        Some(hamiltonian(&self.system, q, p))
+    }
+
+    fn as_lagrangian(&self) -> &dyn Lagrangian {
+        &self.system
     }
 }
 
@@ -313,6 +390,7 @@ where
         .and(options.check())
         .and(sys.check_method(method))
         .and(energy_check)
+        .and_then(|_| sys.check_initial(q0, p0))
     {
         return Err(fail(e, traj));
     }

@@ -35,6 +35,13 @@ pub enum Method {
     Galerkin4,
     /// The Galerkin variational integrator of degree 3 with 3-point Gauss quadrature (order 6).
     Galerkin6,
+    /// RATTLE for holonomic constraints (Andersen 1983), multipliers by Newton's method.
+    Rattle,
+    /// RATTLE composed by Yoshida's triple jump, order 4.
+    Rattle4,
+    /// SHAKE (Ryckaert, Ciccotti & Berendsen 1977): positions on the constraints, one
+    /// constraint at a time to the Newton tolerance; momenta off the hidden constraint.
+    Shake,
 }
 
 /// What `varmech.methods()` lists about a method.
@@ -51,6 +58,9 @@ pub struct MethodInfo {
     /// Whether each step solves implicit equations (by Newton's method); implicit methods
     /// integrate general Lagrangians, explicit ones only separable mechanical systems.
     pub implicit: bool,
+    /// Whether the method integrates separable systems on holonomic constraints (and only
+    /// those).
+    pub constrained: bool,
     pub symplectic: bool,
     pub symmetric: bool,
     /// Linear stability limit: the method is stable on q̈ = −ω²q iff hω < `h_omega_max`
@@ -78,6 +88,9 @@ impl Method {
         Method::Galerkin4,
         Method::Galerkin6,
     ];
+
+    /// The methods for holonomic constraints.
+    pub const CONSTRAINED: [Method; 3] = [Method::Rattle, Method::Rattle4, Method::Shake];
 
     /// The method's facts.
     pub fn info(self) -> MethodInfo {
@@ -132,12 +145,19 @@ impl Method {
                 f64::INFINITY,
                 "Marsden & West (2001), §2.6; Gauss quadrature",
             ),
+            Method::Rattle => ("rattle", 2, true, true, 2.0, "Andersen (1983); HLW VII.1.4"),
+            Method::Rattle4 => ("rattle4", 4, true, true, 1.5734, "RATTLE, Yoshida's triple jump"),
+            Method::Shake => ("shake", 2, false, true, 2.0, "Ryckaert, Ciccotti & Berendsen (1977)"),
         };
         let implicit = matches!(
             self,
             Method::Midpoint | Method::Trapezoid | Method::Galerkin4 | Method::Galerkin6
         );
-        let stages = Composition::of(self).map_or(1, |c| c.gamma().len());
+        let constrained = Method::CONSTRAINED.contains(&self);
+        let stages = match self {
+            Method::Rattle4 => 3,
+            _ => Composition::of(self).map_or(1, |c| c.gamma().len()),
+        };
         let force_evaluations = match self {
             Method::Rk4 => 4,
             _ if implicit => 0,
@@ -150,6 +170,7 @@ impl Method {
             stages,
             force_evaluations,
             implicit,
+            constrained,
             symplectic,
             symmetric,
             h_omega_max,
@@ -159,8 +180,9 @@ impl Method {
 
     /// The method called `name` (as listed by [`Method::info`]).
     pub fn from_name(name: &str) -> Result<Method, Error> {
-        Method::ALL.into_iter().find(|m| m.info().name == name).ok_or_else(|| {
-            let names: Vec<_> = Method::ALL.iter().map(|m| m.info().name).collect();
+        let all = || Method::ALL.into_iter().chain(Method::CONSTRAINED);
+        all().find(|m| m.info().name == name).ok_or_else(|| {
+            let names: Vec<_> = all().map(|m| m.info().name).collect();
             Error::invalid(
                 "method",
                 format!("unknown method {name:?}; choose one of {}", names.join(", ")),

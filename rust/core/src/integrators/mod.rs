@@ -15,6 +15,7 @@ mod driver;
 mod explicit_rk;
 mod kick_drift;
 mod method;
+mod rattle;
 
 pub use composition::Composition;
 pub use del::{Del, Galerkin, NewtonOptions, Quadrature, StepEquations, TwoPoint};
@@ -22,9 +23,10 @@ pub use driver::{integrate, Failure, General, Integrable, Options, Trajectory};
 pub use explicit_rk::ExplicitRk;
 pub use kick_drift::KickDrift;
 pub use method::{Method, MethodInfo};
+pub use rattle::Rattle;
 
 use crate::discrete::{Midpoint, Trapezoidal};
-use crate::model::{Lagrangian, MechanicalSystem};
+use crate::model::{HolonomicConstraints, Lagrangian, MechanicalSystem};
 use crate::ModelError;
 
 /// Why a step failed.
@@ -90,6 +92,7 @@ enum Scheme {
     Midpoint(Del<TwoPoint<Midpoint>>),
     Trapezoid(Del<TwoPoint<Trapezoidal>>),
     Galerkin(Del<Galerkin>),
+    Rattle(Rattle),
 }
 
 impl Integrator {
@@ -105,6 +108,19 @@ impl Integrator {
             Method::Trapezoid => Scheme::Trapezoid(Del::new(TwoPoint::new(Trapezoidal, n), n, newton)),
             Method::Galerkin4 => Scheme::Galerkin(Del::new(Galerkin::new(2, n), n, newton)),
             Method::Galerkin6 => Scheme::Galerkin(Del::new(Galerkin::new(3, n), n, newton)),
+            // Sized for no constraints; the first constrained step sizes the buffers.
+            Method::Rattle => Scheme::Rattle(Rattle::new(false, vec![1.0], newton, n, 0)),
+            Method::Shake => Scheme::Rattle(Rattle::new(true, vec![1.0], newton, n, 0)),
+            Method::Rattle4 => Scheme::Rattle(Rattle::new(
+                false,
+                Composition::of(Method::Yoshida4)
+                    .expect("a composition")
+                    .gamma()
+                    .to_vec(),
+                newton,
+                n,
+                0,
+            )),
             Method::ExplicitEuler => Scheme::ExplicitRk(ExplicitRk::euler(n)),
             Method::Rk4 => Scheme::ExplicitRk(ExplicitRk::rk4(n)),
             Method::SymplecticEuler => Scheme::KickDrift(KickDrift::symplectic_euler(n)),
@@ -130,6 +146,7 @@ impl Integrator {
             Scheme::Midpoint(s) => s.reset(),
             Scheme::Trapezoid(s) => s.reset(),
             Scheme::Galerkin(s) => s.reset(),
+            Scheme::Rattle(s) => s.reset(),
             Scheme::ExplicitRk(_) => {}
         }
     }
@@ -143,6 +160,7 @@ impl Integrator {
             Scheme::Midpoint(s) => s.evaluations(),
             Scheme::Trapezoid(s) => s.evaluations(),
             Scheme::Galerkin(s) => s.evaluations(),
+            Scheme::Rattle(s) => s.evaluations(),
         }
     }
 
@@ -162,6 +180,7 @@ impl Integrator {
             Scheme::Midpoint(s) => s.iterations(),
             Scheme::Trapezoid(s) => s.iterations(),
             Scheme::Galerkin(s) => s.iterations(),
+            Scheme::Rattle(s) => s.iterations(),
             _ => 0,
         }
     }
@@ -205,6 +224,34 @@ impl Integrator {
             Scheme::Galerkin(s) => s.increment(sys, t, q, p, h, dq, dp),
             _ => Err(StepError::Model(
                 "explicit methods integrate separable mechanical systems only".into(),
+            )),
+        }
+    }
+
+    /// As [`Integrator::increment`] for a separable system on holonomic constraints, which only
+    /// the constrained methods integrate (the driver refuses the others before the first step).
+    #[allow(clippy::too_many_arguments)]
+    pub fn increment_constrained<S, C>(
+        &mut self,
+        sys: &S,
+        constraints: &C,
+        q: &[f64],
+        p: &[f64],
+        h: f64,
+        dq: &mut [f64],
+        dp: &mut [f64],
+    ) -> Result<(), StepError>
+    where
+        S: MechanicalSystem + ?Sized,
+        C: HolonomicConstraints + ?Sized,
+    {
+        match &mut self.scheme {
+            Scheme::Rattle(s) => {
+                s.size_for(constraints.count());
+                s.increment(sys, constraints, q, p, h, dq, dp)
+            }
+            _ => Err(StepError::Model(
+                "only rattle, rattle4 and shake keep constraints".into(),
             )),
         }
     }

@@ -5,9 +5,12 @@
 //! - [`Mass`]: the constant mass matrix M (scalar, diagonal or full symmetric positive definite);
 //! - [`NaturalSystem`]: L = ½q̇ᵀM(q)q̇ − V(q) with configuration-dependent mass, a
 //!   [`Lagrangian`] through [`Natural`];
+//! - [`HolonomicConstraints`]: g(q) = 0 with its Jacobian, [`Distances`] for rigid links, and
+//!   [`Constrained`], a mechanical system on them;
 //! - [`Generator`]: infinitesimal symmetries ξ(q) and their Noether momenta J = p·ξ(q);
 //! - [`finite_difference`]: derivatives a model does not supply.
 
+mod constraints;
 pub mod finite_difference;
 mod lagrangian;
 mod mass;
@@ -15,6 +18,7 @@ mod mechanical;
 mod natural;
 mod symmetry;
 
+pub use constraints::{Anchor, Constrained, Distances, HolonomicConstraints, Link};
 pub use lagrangian::{Hessians, Lagrangian};
 pub use mass::Mass;
 pub use mechanical::MechanicalSystem;

@@ -6,6 +6,7 @@
 //! problems in the library).
 
 mod charged_particle;
+mod constrained;
 mod damped_driven_pendulum;
 mod double_pendulum;
 mod fermi_pasta_ulam;
@@ -17,6 +18,7 @@ mod pendulum;
 mod spherical_pendulum;
 
 pub use charged_particle::ChargedParticle;
+pub use constrained::{cartesian_pendulum, cartesian_spherical_pendulum, planar_chain, LinkedMasses, PointMasses};
 pub use damped_driven_pendulum::DampedDrivenPendulum;
 pub use double_pendulum::DoublePendulum;
 pub use fermi_pasta_ulam::FermiPastaUlam;

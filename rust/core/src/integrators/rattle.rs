@@ -1,0 +1,325 @@
+use nalgebra::{DMatrix, DVector};
+
+use super::del::{lu_in_place, lu_solve};
+use super::{NewtonOptions, StepError};
+use crate::model::{HolonomicConstraints, MechanicalSystem};
+
+/// RATTLE (Andersen 1983; HLW VII.1.4) for H = ½pᵀM⁻¹p + V(q) on g(q) = 0:
+///
+/// p½ = p₀ − (h/2)(∇V(q₀) + G(q₀)ᵀλ),   q₁ = q₀ + hM⁻¹p½,   g(q₁) = 0,
+/// p₁ = p½ − (h/2)(∇V(q₁) + G(q₁)ᵀμ),   G(q₁)M⁻¹p₁ = 0.
+///
+/// Symmetric, symplectic on the constraint manifold, order 2: the variational integrator of
+/// the trapezoidal L_d with the constraints. λ is found by Newton's method with the exact
+/// Jacobian −(h²/2)G(q₁)M⁻¹G(q₀)ᵀ, to the Newton tolerance; μ from the linear hidden
+/// constraint. SHAKE (Ryckaert, Ciccotti & Berendsen 1977) solves g(q₁) = 0 one constraint at
+/// a time until |g|∞ ≤ tolerance and keeps p₁ = p½ − (h/2)∇V(q₁), off the hidden constraint.
+/// Compositions apply the step with the fractions γ of a symmetric composition.
+#[derive(Clone, Debug)]
+pub struct Rattle {
+    shake: bool,
+    gamma: Vec<f64>,
+    options: NewtonOptions,
+    /// ∇V and G at the step's start; at its end once it is taken (first same as last).
+    grad0: Vec<f64>,
+    grad1: Vec<f64>,
+    jac0: DMatrix<f64>,
+    jac1: DMatrix<f64>,
+    cached: bool,
+    /// M⁻¹G(q₀)ᵀ (n × m), and a row of G as a contiguous vector.
+    minv_jac0t: DMatrix<f64>,
+    minv_jac1t: DMatrix<f64>,
+    row: Vec<f64>,
+    column: Vec<f64>,
+    half: Vec<f64>,
+    q1: Vec<f64>,
+    q_stage: Vec<f64>,
+    p_stage: Vec<f64>,
+    dq_stage: Vec<f64>,
+    dp_stage: Vec<f64>,
+    lambda: Vec<f64>,
+    g: DVector<f64>,
+    newton: DMatrix<f64>,
+    pivots: Vec<usize>,
+    evaluations: u64,
+    iterations: u64,
+}
+
+impl Rattle {
+    /// RATTLE (or SHAKE) composed with the fractions `gamma` (`[1.0]` for the plain step), for
+    /// n coordinates and m constraints.
+    pub fn new(shake: bool, gamma: Vec<f64>, options: NewtonOptions, n: usize, m: usize) -> Self {
+        Rattle {
+            shake,
+            gamma,
+            options,
+            grad0: vec![0.0; n],
+            grad1: vec![0.0; n],
+            jac0: DMatrix::zeros(m, n),
+            jac1: DMatrix::zeros(m, n),
+            cached: false,
+            minv_jac0t: DMatrix::zeros(n, m),
+            minv_jac1t: DMatrix::zeros(n, m),
+            row: vec![0.0; n],
+            column: vec![0.0; n],
+            half: vec![0.0; n],
+            q1: vec![0.0; n],
+            q_stage: vec![0.0; n],
+            p_stage: vec![0.0; n],
+            dq_stage: vec![0.0; n],
+            dp_stage: vec![0.0; n],
+            lambda: vec![0.0; m],
+            g: DVector::zeros(m),
+            newton: DMatrix::zeros(m, m),
+            pivots: vec![0; m],
+            evaluations: 0,
+            iterations: 0,
+        }
+    }
+
+    /// Sizes the buffers for m constraints (allocating only when m changes).
+    pub(super) fn size_for(&mut self, m: usize) {
+        let n = self.q1.len();
+        if self.lambda.len() != m {
+            *self = Rattle::new(self.shake, std::mem::take(&mut self.gamma), self.options, n, m);
+        }
+    }
+
+    /// Gradient evaluations so far.
+    pub fn evaluations(&self) -> u64 {
+        self.evaluations
+    }
+
+    /// Newton (RATTLE) or sweep (SHAKE) iterations so far.
+    pub fn iterations(&self) -> u64 {
+        self.iterations
+    }
+
+    pub(super) fn reset(&mut self) {
+        self.cached = false;
+    }
+
+    /// One composed step's increments from (q, p).
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn increment<S, C>(
+        &mut self,
+        sys: &S,
+        constraints: &C,
+        q: &[f64],
+        p: &[f64],
+        h: f64,
+        dq: &mut [f64],
+        dp: &mut [f64],
+    ) -> Result<(), StepError>
+    where
+        S: MechanicalSystem + ?Sized,
+        C: HolonomicConstraints + ?Sized,
+    {
+        dq.fill(0.0);
+        dp.fill(0.0);
+        for stage in 0..self.gamma.len() {
+            for (((qs, ps), (q, p)), (dq, dp)) in self
+                .q_stage
+                .iter_mut()
+                .zip(self.p_stage.iter_mut())
+                .zip(q.iter().zip(p))
+                .zip(dq.iter().zip(dp.iter()))
+            {
+                *qs = q + dq;
+                *ps = p + dp;
+            }
+            // The stage's start is lent to the step, which writes every other buffer.
+            let (q_stage, p_stage) = (std::mem::take(&mut self.q_stage), std::mem::take(&mut self.p_stage));
+            let result = self.step(sys, constraints, &q_stage, &p_stage, self.gamma[stage] * h);
+            (self.q_stage, self.p_stage) = (q_stage, p_stage);
+            result?;
+            for (d, s) in dq.iter_mut().zip(&self.dq_stage) {
+                *d += s;
+            }
+            for (d, s) in dp.iter_mut().zip(&self.dp_stage) {
+                *d += s;
+            }
+        }
+        Ok(())
+    }
+
+    /// M⁻¹Gᵀ (n × m) of G (m × n), column by column.
+    fn minv_transpose<S: MechanicalSystem + ?Sized>(
+        sys: &S,
+        jac: &DMatrix<f64>,
+        row: &mut [f64],
+        column: &mut [f64],
+        out: &mut DMatrix<f64>,
+    ) {
+        for k in 0..jac.nrows() {
+            row.iter_mut().zip(jac.row(k).iter()).for_each(|(r, g)| *r = *g);
+            sys.mass().velocity(row, column);
+            out.column_mut(k).copy_from_slice(column);
+        }
+    }
+
+    /// One RATTLE (or SHAKE) step of size h from (q0, p0) into (dq_stage, dp_stage).
+    fn step<S, C>(&mut self, sys: &S, constraints: &C, q0: &[f64], p0: &[f64], h: f64) -> Result<(), StepError>
+    where
+        S: MechanicalSystem + ?Sized,
+        C: HolonomicConstraints + ?Sized,
+    {
+        if !self.cached {
+            sys.gradient(q0, &mut self.grad0)?;
+            constraints.jacobian(q0, &mut self.jac0)?;
+            self.evaluations += 1;
+        }
+        Self::minv_transpose(sys, &self.jac0, &mut self.row, &mut self.column, &mut self.minv_jac0t);
+        // The unconstrained drift q̃ = q₀ + hM⁻¹(p₀ − (h/2)∇V₀); then q₁ = q̃ − (h²/2)M⁻¹G₀ᵀλ.
+        for ((hf, p), g) in self.half.iter_mut().zip(p0).zip(&self.grad0) {
+            *hf = p - 0.5 * h * g;
+        }
+        sys.mass().velocity(&self.half, &mut self.column);
+        let c = 0.5 * h * h;
+        let scale = q0.iter().fold(1.0_f64, |m, x| m.max(x.abs()));
+        // The predictor is the last step's λ (a force, smooth in time); 0 after a reset.
+        if !self.cached {
+            self.lambda.fill(0.0);
+        }
+        let position = |lambda: &[f64], q1: &mut [f64], minv: &DMatrix<f64>, drift: &[f64]| {
+            for (i, x) in q1.iter_mut().enumerate() {
+                *x = q0[i] + h * drift[i] - c * (0..lambda.len()).map(|k| minv[(i, k)] * lambda[k]).sum::<f64>();
+            }
+        };
+        position(&self.lambda, &mut self.q1, &self.minv_jac0t, &self.column);
+        let mut converged = false;
+        let mut correction = f64::INFINITY;
+        for _ in 0..self.options.max_iterations {
+            constraints.residual(&self.q1, self.g.as_mut_slice())?;
+            let residual = self.g.amax();
+            if !residual.is_finite() {
+                return Err(StepError::NonFinite {
+                    reason: "the constraints became non-finite",
+                });
+            }
+            if self.shake {
+                if residual <= self.options.tolerance {
+                    converged = true;
+                    break;
+                }
+                self.iterations += 1;
+                self.shake_sweep(constraints, h)?;
+                position(&self.lambda, &mut self.q1, &self.minv_jac0t, &self.column);
+                continue;
+            }
+            // Converged: the constraints hold to round-off, or the last correction was below
+            // the tolerance.
+            if residual <= 4.0 * f64::EPSILON || correction <= self.options.tolerance * scale {
+                converged = true;
+                break;
+            }
+            self.iterations += 1;
+            // J = −(h²/2)G(q₁)M⁻¹G₀ᵀ, exact.
+            constraints.jacobian(&self.q1, &mut self.jac1)?;
+            self.newton.gemm(-c, &self.jac1, &self.minv_jac0t, 0.0);
+            if lu_in_place(&mut self.newton, &mut self.pivots).is_none() {
+                return Err(StepError::Convergence {
+                    residual,
+                    iterations: 0,
+                    reason: "G(q₁)M⁻¹G(q₀)ᵀ is singular: the constraints are not independent here",
+                });
+            }
+            lu_solve(&self.newton, &self.pivots, &mut self.g);
+            correction = 0.0;
+            for (l, d) in self.lambda.iter_mut().zip(self.g.iter()) {
+                *l -= d;
+            }
+            for i in 0..self.q1.len() {
+                let shift: f64 = (0..self.lambda.len())
+                    .map(|k| self.minv_jac0t[(i, k)] * self.g[k])
+                    .sum();
+                correction = correction.max((c * shift).abs());
+            }
+            position(&self.lambda, &mut self.q1, &self.minv_jac0t, &self.column);
+        }
+        if !converged {
+            constraints.residual(&self.q1, self.g.as_mut_slice())?;
+            return Err(StepError::Convergence {
+                residual: self.g.amax(),
+                iterations: self.options.max_iterations,
+                reason: if self.shake {
+                    "SHAKE did not reach its tolerance on the constraints"
+                } else {
+                    "RATTLE's Newton iteration for the multipliers did not converge"
+                },
+            });
+        }
+        // δp = −(h/2)(∇V₀ + G₀ᵀλ) so far, p½ = p₀ + δp, δq = hM⁻¹p½.
+        for (j, (d, hf)) in self.dp_stage.iter_mut().zip(self.half.iter_mut()).enumerate() {
+            *d = -0.5
+                * h
+                * (self.grad0[j]
+                    + (0..self.lambda.len())
+                        .map(|k| self.jac0[(k, j)] * self.lambda[k])
+                        .sum::<f64>());
+            *hf = p0[j] + *d;
+        }
+        sys.mass().velocity(&self.half, &mut self.column);
+        for (d, v) in self.dq_stage.iter_mut().zip(&self.column) {
+            *d = h * v;
+        }
+        for (x, (q, d)) in self.q1.iter_mut().zip(q0.iter().zip(&self.dq_stage)) {
+            *x = q + d;
+        }
+        sys.gradient(&self.q1, &mut self.grad1)?;
+        constraints.jacobian(&self.q1, &mut self.jac1)?;
+        self.evaluations += 1;
+        // p̂ = p½ − (h/2)∇V₁; RATTLE projects it: p₁ = p̂ − (h/2)G₁ᵀμ with G₁M⁻¹p₁ = 0.
+        for ((hf, d), g) in self.half.iter_mut().zip(self.dp_stage.iter_mut()).zip(&self.grad1) {
+            *hf -= 0.5 * h * g;
+            *d -= 0.5 * h * g;
+        }
+        let m = self.lambda.len();
+        // μ goes to `g`, and is 0 for SHAKE, which does not project the momenta.
+        self.g.fill(0.0);
+        if !self.shake && m > 0 {
+            Self::minv_transpose(sys, &self.jac1, &mut self.row, &mut self.column, &mut self.minv_jac1t);
+            self.newton.gemm(0.5 * h, &self.jac1, &self.minv_jac1t, 0.0);
+            sys.mass().velocity(&self.half, &mut self.column);
+            for k in 0..m {
+                self.g[k] = self.jac1.row(k).iter().zip(&self.column).map(|(a, b)| a * b).sum();
+            }
+            if lu_in_place(&mut self.newton, &mut self.pivots).is_none() {
+                return Err(StepError::Convergence {
+                    residual: self.g.amax(),
+                    iterations: 0,
+                    reason: "G(q₁)M⁻¹G(q₁)ᵀ is singular: the constraints are not independent here",
+                });
+            }
+            lu_solve(&self.newton, &self.pivots, &mut self.g);
+        }
+        // δp = p₁ − p₀ as the sum of the kicks, free of cancellation.
+        for (j, d) in self.dp_stage.iter_mut().enumerate() {
+            *d -= 0.5 * h * (0..m).map(|k| self.jac1[(k, j)] * self.g[k]).sum::<f64>();
+        }
+        std::mem::swap(&mut self.grad0, &mut self.grad1);
+        std::mem::swap(&mut self.jac0, &mut self.jac1);
+        self.cached = true;
+        Ok(())
+    }
+
+    /// One SHAKE sweep: each constraint in turn, λₖ −= gₖ(q₁)/(−(h²/2)Gₖ(q₁)·M⁻¹Gₖ(q₀)ᵀ), with
+    /// q₁ moved after each.
+    fn shake_sweep<C: HolonomicConstraints + ?Sized>(&mut self, constraints: &C, h: f64) -> Result<(), StepError> {
+        let c = 0.5 * h * h;
+        for k in 0..self.lambda.len() {
+            constraints.jacobian(&self.q1, &mut self.jac1)?;
+            constraints.residual(&self.q1, self.g.as_mut_slice())?;
+            let slope: f64 = -c
+                * (0..self.q1.len())
+                    .map(|i| self.jac1[(k, i)] * self.minv_jac0t[(i, k)])
+                    .sum::<f64>();
+            let delta = self.g[k] / slope;
+            self.lambda[k] -= delta;
+            for i in 0..self.q1.len() {
+                self.q1[i] += c * self.minv_jac0t[(i, k)] * delta;
+            }
+        }
+        Ok(())
+    }
+}
