@@ -42,7 +42,8 @@ def test_cyclic_coordinate_momentum_is_conserved():
     assert report.momenta[0].max_abs_error == 0.0
 
 
-@pytest.mark.parametrize("method", [m.name for m in varmech.methods()])
+# The constrained methods are symplectic on the constraint manifold, which Hénon–Heiles has not.
+@pytest.mark.parametrize("method", [m.name for m in varmech.methods() if not m.constrained])
 def test_symplecticity_defect(method):
     info = {m.name: m for m in varmech.methods()}[method]
     scene = scenes.henon_heiles()

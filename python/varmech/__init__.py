@@ -18,6 +18,7 @@ Hamilton's principle, and check what it conserves::
 """
 
 from ._core import ConvergenceError, DivergenceError, SpuriousBranchError, VarmechError
+from .constraints import project
 from .conservation import ConservationReport, EnergyReport, MomentumReport, check_conservation, momentum
 from .derivatives import DerivativeCheck, check_derivatives
 from .integrate import Trajectory, integrate, symplecticity_defect
@@ -41,6 +42,7 @@ __all__ = [
     "MomentumReport",
     "NativeSystem",
     "Rotation",
+    "project",
     "SpuriousBranchError",
     "Trajectory",
     "Translation",

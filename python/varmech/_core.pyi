@@ -51,8 +51,13 @@ class NativeModel(_ModelProperties):
     @property
     def symmetries(self) -> list[tuple[str, int, int, str]]: ...
     @property
+    def constraints(self) -> int: ...
+    @property
     def gravity(self) -> tuple[float, list[float]] | None:
         """(G, masses) of an N-body scene, None for the others."""
+
+def constraint_residuals(model: NativeModel, q: FloatArray, p: FloatArray) -> tuple[FloatArray, FloatArray]: ...
+def project(model: NativeModel, q0: FloatArray, p0: FloatArray) -> tuple[FloatArray, FloatArray]: ...
 
 class ClosureModel(_ModelProperties):
     """L = ½q̇ᵀMq̇ − V(q) from Python closures."""

@@ -80,6 +80,8 @@ class ConservationReport:
     #: For forced systems, max |E(t) − E(0) − W(t)| / |E(0)| (absolute when E(0) = 0): the
     #: discrete Lagrange–d'Alembert energy balance with the tracked work W.
     energy_balance: float | None = None
+    #: For constrained models, max |g(q)|∞ and max |G(q)M⁻¹p|∞ over the run.
+    constraint_residuals: tuple[float, float] | None = None
 
     @property
     def verdict(self) -> str:
@@ -105,6 +107,9 @@ class ConservationReport:
             ]
         for m in self.momenta:
             lines.append(f"  momentum {m.name:<6} J0 = {m.initial:+.12g}   max |ΔJ| = {m.max_abs_error:.3e} (rel {m.max_rel_error:.3e})")
+        if self.constraint_residuals is not None:
+            g, v = self.constraint_residuals
+            lines.append(f"  constraints  max |g(q)| = {g:.3e}   max |G M⁻¹ p| = {v:.3e}")
         return "\n".join(lines)
 
 
@@ -131,4 +136,8 @@ def check_conservation(traj: Trajectory, generators: Sequence[Generator] | None 
     for k, g in enumerate(generators):
         name = g.name if isinstance(g, (Translation, Rotation, Cyclic)) else f"xi[{k}]"
         momenta.append(MomentumReport(name, *_core.invariant_statistics(momentum(traj, g))))
-    return ConservationReport(model.name, traj.method, traj.dt, float(traj.t[-1]), energy, tuple(momenta), balance)
+    residuals = None
+    if model.constraints:
+        g, v = traj.constraint_residuals()
+        residuals = (float(np.max(g)), float(np.max(v)))
+    return ConservationReport(model.name, traj.method, traj.dt, float(traj.t[-1]), energy, tuple(momenta), balance, residuals)

@@ -71,6 +71,10 @@ class Trajectory:
         saved state, shape (N,)."""
         return _core.energy(self.model._core, self.t, self.q, self.p)
 
+    def constraint_residuals(self) -> tuple[np.ndarray, np.ndarray]:
+        """|g(q)|∞ and |G(q)M⁻¹p|∞ at each saved state of a constrained model, shapes (N,)."""
+        return _core.constraint_residuals(self.model._core, self.q, self.p)
+
     def __len__(self) -> int:
         return len(self.t)
 
@@ -178,7 +182,7 @@ def integrate(
         raise TypeError(f"model: expected a varmech model or scene, got {type(model).__name__}")
     n = model.dim
     if method is None:
-        method = "verlet" if model.separable else "midpoint"
+        method = "rattle" if model.constraints else "verlet" if model.separable else "midpoint"
     dt = positive("dt", dt)
     t0 = float(t0)
     if not math.isfinite(t0):

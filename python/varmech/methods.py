@@ -15,7 +15,8 @@ class MethodInfo:
     when hω < h_omega_max (0 for explicit Euler, which is never stable).
     ``force_evaluations`` counts gradient evaluations per step, first-same-as-last reused (0 for
     the implicit methods, whose cost depends on their Newton iterations). ``implicit`` methods
-    solve each step by Newton's method.
+    solve each step by Newton's method; ``constrained`` ones (RATTLE, SHAKE) integrate systems
+    on holonomic constraints, and only those.
     """
 
     name: str
@@ -23,6 +24,7 @@ class MethodInfo:
     stages: int
     force_evaluations: int
     implicit: bool
+    constrained: bool
     symplectic: bool
     symmetric: bool
     h_omega_max: float

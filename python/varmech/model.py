@@ -111,6 +111,12 @@ class Model:
         """Whether non-conservative forces act (then the energy changes by their work)."""
         return self._core.forced
 
+    @property
+    def constraints(self) -> int:
+        """Number of holonomic constraints g(q) = 0 (0 for unconstrained models); constrained
+        models take ``rattle``, ``rattle4`` and ``shake`` only."""
+        return getattr(self._core, "constraints", 0)
+
     def velocity(self, q: ArrayLike, p: ArrayLike, t: ArrayLike = 0.0) -> np.ndarray:
         """q̇ with ∂L/∂q̇(q, q̇, t) = p (M⁻¹p for mechanical systems), for one state (n,) or
         for rows (N, n)."""

@@ -167,6 +167,34 @@ def nbody(masses: ArrayLike, positions: ArrayLike, velocities: ArrayLike, G: flo
     return Scene("nbody", f"{len(m)}-body problem", model, x.ravel().copy(), p, float(t_end), float(dt))
 
 
+def cartesian_pendulum() -> Scene:
+    """The planar pendulum in Cartesian coordinates (x, y) on x² + y² = 1 (m = l = g = 1,
+    U = gy), released from rest 2 rad from the downward vertical; RATTLE at h = 0.1 over
+    T = 10⁴ is the published protocol (reference/scenes.json)."""
+    return _scene(
+        "cartesian_pendulum", "the pendulum in Cartesian coordinates on x² + y² = 1", 0.1, {"H": -math.cos(2.0)}
+    )
+
+
+def cartesian_spherical_pendulum() -> Scene:
+    """The spherical pendulum in Cartesian coordinates on |x| = 1 from θ = 1, θ̇ = 0,
+    φ̇ = 1.2 to T = 50; the reference holds the positions of the (θ, φ) reference angles, and
+    L_z is conserved."""
+    return _scene(
+        "cartesian_spherical_pendulum",
+        "the spherical pendulum in Cartesian coordinates on |x| = 1",
+        0.01,
+        {"H": -0.030489444711168545, "L_z": 0.8496881019282854},
+    )
+
+
+def planar_chain(links: int = 8) -> Scene:
+    """A planar chain of ``links`` unit masses on unit links from the origin (g = 1), released
+    from rest straight at 1 rad from the downward vertical: 2·links coordinates and ``links``
+    constraints."""
+    return _scene("planar_chain", f"a planar chain of {links} rigid links", 0.01, {}, links=links)
+
+
 CATALOGUE: dict[str, Callable[[], Scene]] = {
     "harmonic_oscillator": harmonic_oscillator,
     "pendulum": pendulum,
@@ -179,6 +207,9 @@ CATALOGUE: dict[str, Callable[[], Scene]] = {
     "charged_particle": charged_particle,
     "charged_particle_nonuniform": charged_particle_nonuniform,
     "damped_driven_pendulum": damped_driven_pendulum,
+    "cartesian_pendulum": cartesian_pendulum,
+    "cartesian_spherical_pendulum": cartesian_spherical_pendulum,
+    "planar_chain": planar_chain,
 }
 
 

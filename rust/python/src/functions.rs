@@ -7,7 +7,7 @@ use pyo3::types::{PyDict, PyTuple};
 use varmech::diagnostics::{self, EnergyStatistics, InvariantStatistics};
 use varmech::integrators::{self, General, Integrable, Method, NewtonOptions, Options};
 use varmech::model::Natural;
-use varmech::scenes::{self, LagrangianScene, Problem, Scene};
+use varmech::scenes::{self, LagrangianScene, LinkedMasses, Problem, Scene};
 use varmech::ModelError;
 
 use crate::convert::{self, rows, slice, trajectory_tuple};
@@ -28,6 +28,8 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(methods, m)?)?;
     m.add_function(wrap_pyfunction!(scene, m)?)?;
     m.add_function(wrap_pyfunction!(nbody, m)?)?;
+    m.add_function(wrap_pyfunction!(constraint_residuals, m)?)?;
+    m.add_function(wrap_pyfunction!(project, m)?)?;
     Ok(())
 }
 
@@ -56,6 +58,11 @@ macro_rules! with_system {
                 }),
                 Native::General(scene) => $py.detach(|| {
                     let $sys = &General::<LagrangianScene>(scene);
+                    let $poll = || Python::attach(|py| py.check_signals()).map_err(boxed);
+                    $body
+                }),
+                Native::Constrained(scene) => $py.detach(|| {
+                    let $sys: &LinkedMasses = scene;
                     let $poll = || Python::attach(|py| py.check_signals()).map_err(boxed);
                     $body
                 }),
@@ -152,6 +159,57 @@ fn states<'a>(
         )));
     }
     Ok((t, q, x, dim))
+}
+
+/// Two arrays, as the constraint functions return them.
+type ArrayPair<'py> = (Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>);
+
+/// A constrained native model, or a ValueError naming `model`.
+fn constrained<'a>(model: &'a Bound<'_, NativeModel>) -> PyResult<&'a LinkedMasses> {
+    match &model.get().native {
+        Native::Constrained(s) => Ok(s),
+        _ => Err(PyValueError::new_err("model: has no holonomic constraints")),
+    }
+}
+
+/// (|g(q)|∞, |G(q)M⁻¹p|∞) at each state of a constrained model.
+#[pyfunction]
+fn constraint_residuals<'py>(
+    py: Python<'py>,
+    model: &Bound<'py, NativeModel>,
+    q: PyReadonlyArray2<'py, f64>,
+    p: PyReadonlyArray2<'py, f64>,
+) -> PyResult<ArrayPair<'py>> {
+    let sys = constrained(model)?;
+    let n = Integrable::dim(sys);
+    let ((q, nq), (p, np)) = (rows("q", &q)?, rows("p", &p)?);
+    if nq != n || np != n || q.len() != p.len() {
+        return Err(PyValueError::new_err(format!(
+            "q, p: need two (N, {n}) arrays of states"
+        )));
+    }
+    let (mut position, mut velocity) = (Vec::new(), Vec::new());
+    for (q, p) in q.chunks_exact(n).zip(p.chunks_exact(n)) {
+        let (g, v) = sys.residuals(q, p).map_err(model_error)?;
+        position.push(g);
+        velocity.push(v);
+    }
+    Ok((PyArray1::from_vec(py, position), PyArray1::from_vec(py, velocity)))
+}
+
+/// The nearest consistent state (q on the constraints, p on the hidden constraint).
+#[pyfunction]
+fn project<'py>(
+    py: Python<'py>,
+    model: &Bound<'py, NativeModel>,
+    q0: PyReadonlyArray1<'py, f64>,
+    p0: PyReadonlyArray1<'py, f64>,
+) -> PyResult<ArrayPair<'py>> {
+    let sys = constrained(model)?;
+    let (q, p) = sys
+        .project(slice("q0", &q0)?, slice("p0", &p0)?)
+        .map_err(|e| to_pyerr(py, e))?;
+    Ok((PyArray1::from_vec(py, q), PyArray1::from_vec(py, p)))
 }
 
 /// The energy function E = p·q̇ − L (= ½pᵀM⁻¹p + V for mechanical systems) at each state.
@@ -280,6 +338,7 @@ fn symplecticity_defect<'py>(
 fn methods(py: Python<'_>) -> PyResult<Vec<Bound<'_, PyDict>>> {
     Method::ALL
         .iter()
+        .chain(&Method::CONSTRAINED)
         .map(|m| {
             let i = m.info();
             let d = PyDict::new(py);
@@ -288,6 +347,7 @@ fn methods(py: Python<'_>) -> PyResult<Vec<Bound<'_, PyDict>>> {
             d.set_item("stages", i.stages)?;
             d.set_item("force_evaluations", i.force_evaluations)?;
             d.set_item("implicit", i.implicit)?;
+            d.set_item("constrained", i.constrained)?;
             d.set_item("symplectic", i.symplectic)?;
             d.set_item("symmetric", i.symmetric)?;
             d.set_item("h_omega_max", i.h_omega_max)?;
@@ -329,9 +389,9 @@ fn scene_tuple<'py, S>(
 /// A native scene by name: (model, q0, p0, t_end, reference (t, q, p, source) or None). The
 /// keywords are the parameters of the scenes that take them: `e` (kepler), `omega`
 /// (harmonic_oscillator), `b` (charged_particle), `gamma`, `amplitude` and `drive`
-/// (damped_driven_pendulum).
+/// (damped_driven_pendulum), `links` (planar_chain).
 #[pyfunction]
-#[pyo3(signature = (name, *, e=0.6, omega=1.0, b=1.0, gamma=0.5, amplitude=1.5, drive=2.0 / 3.0))]
+#[pyo3(signature = (name, *, e=0.6, omega=1.0, b=1.0, gamma=0.5, amplitude=1.5, drive=2.0 / 3.0, links=8))]
 #[allow(clippy::too_many_arguments)]
 fn scene<'py>(
     py: Python<'py>,
@@ -342,6 +402,7 @@ fn scene<'py>(
     gamma: f64,
     amplitude: f64,
     drive: f64,
+    links: usize,
 ) -> PyResult<SceneTuple<'py>> {
     let mech = |s| Native::Mechanical(s);
     let err = |e| to_pyerr(py, e);
@@ -409,6 +470,24 @@ fn scene<'py>(
             scenes::DampedDrivenPendulum::problem(gamma, amplitude, drive).map_err(err)?,
             |s| Native::General(LagrangianScene::DampedDrivenPendulum(s)),
             "damped_driven_pendulum",
+        ),
+        "cartesian_pendulum" => scene_tuple(
+            py,
+            scenes::cartesian_pendulum(),
+            Native::Constrained,
+            "cartesian_pendulum",
+        ),
+        "cartesian_spherical_pendulum" => scene_tuple(
+            py,
+            scenes::cartesian_spherical_pendulum(),
+            Native::Constrained,
+            "cartesian_spherical_pendulum",
+        ),
+        "planar_chain" => scene_tuple(
+            py,
+            scenes::planar_chain(links).map_err(err)?,
+            Native::Constrained,
+            "planar_chain",
         ),
         _ => Err(PyValueError::new_err(format!("name: unknown scene {name:?}"))),
     }

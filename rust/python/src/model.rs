@@ -8,18 +8,20 @@ use numpy::{PyArray1, PyArrayDyn, PyArrayMethods};
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use varmech::model::{
-    differenced_kinetic_gradient, finite_difference, Generator, Hessians, Lagrangian, Mass, MechanicalSystem,
-    NaturalSystem,
+    differenced_kinetic_gradient, finite_difference, Generator, Hessians, HolonomicConstraints, Lagrangian, Mass,
+    MechanicalSystem, NaturalSystem,
 };
-use varmech::scenes::{LagrangianScene, Scene};
+use varmech::scenes::{LagrangianScene, LinkedMasses, Scene};
 use varmech::ModelError;
 
 use crate::convert;
 
-/// A native scene: a separable mechanical system, or a general Lagrangian.
+/// A native scene: a separable mechanical system, a general Lagrangian, or a mechanical
+/// system on holonomic constraints.
 pub enum Native {
     Mechanical(Scene),
     General(LagrangianScene),
+    Constrained(LinkedMasses),
 }
 
 /// A native scene: every evaluation runs in Rust, with the GIL released.
@@ -38,6 +40,7 @@ impl NativeModel {
         match &self.native {
             Native::Mechanical(s) => MechanicalSystem::dim(s),
             Native::General(s) => Lagrangian::dim(s),
+            Native::Constrained(s) => MechanicalSystem::dim(&s.system),
         }
     }
 }
@@ -85,6 +88,16 @@ impl NativeModel {
         match &self.native {
             Native::Mechanical(s) => s.symmetries().into_iter().map(convert::generator_spec).collect(),
             Native::General(s) => s.symmetries().into_iter().map(convert::generator_spec).collect(),
+            Native::Constrained(s) => s.system.symmetries().into_iter().map(convert::generator_spec).collect(),
+        }
+    }
+
+    /// Number of holonomic constraints (0 for unconstrained models).
+    #[getter]
+    fn constraints(&self) -> usize {
+        match &self.native {
+            Native::Constrained(s) => s.constraints.count(),
+            _ => 0,
         }
     }
 
