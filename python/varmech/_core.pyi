@@ -56,8 +56,8 @@ class NativeModel(_ModelProperties):
     def gravity(self) -> tuple[float, list[float]] | None:
         """(G, masses) of an N-body scene, None for the others."""
 
-def constraint_residuals(model: NativeModel, q: FloatArray, p: FloatArray) -> tuple[FloatArray, FloatArray]: ...
-def project(model: NativeModel, q0: FloatArray, p0: FloatArray) -> tuple[FloatArray, FloatArray]: ...
+def constraint_residuals(model: Model, q: FloatArray, p: FloatArray) -> tuple[FloatArray, FloatArray]: ...
+def project(model: Model, q0: FloatArray, p0: FloatArray) -> tuple[FloatArray, FloatArray]: ...
 
 class ClosureModel(_ModelProperties):
     """L = ½q̇ᵀMq̇ − V(q) from Python closures."""
@@ -72,6 +72,19 @@ class ClosureModel(_ModelProperties):
     ) -> None: ...
     @property
     def has_gradient(self) -> bool: ...
+
+class ClosureConstrained(_ModelProperties):
+    """A ClosureModel on holonomic constraints g(q) = 0 from Python closures."""
+
+    def __init__(
+        self,
+        system: ClosureModel,
+        count: int,
+        constraints: Callable[[FloatArray], Any],
+        jacobian: Callable[[FloatArray], Any] | None,
+    ) -> None: ...
+    @property
+    def constraints(self) -> int: ...
 
 class ClosureNatural(_ModelProperties):
     """L = ½q̇ᵀM(q)q̇ − V(q) from Python closures (configuration-dependent mass)."""
@@ -101,7 +114,7 @@ class ClosureLagrangian(_ModelProperties):
         symmetries: Sequence[GeneratorSpec],
     ) -> None: ...
 
-Model = NativeModel | ClosureModel | ClosureNatural | ClosureLagrangian
+Model = NativeModel | ClosureModel | ClosureConstrained | ClosureNatural | ClosureLagrangian
 
 def integrate(
     model: Model,

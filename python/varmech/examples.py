@@ -185,6 +185,20 @@ def damped_driven_pendulum(gamma: float = 0.5, amplitude: float = 1.5, drive: fl
     )
 
 
+def cartesian_pendulum(m: float = 1.0, l: float = 1.0, g: float = 1.0) -> MechanicalSystem:
+    """The planar pendulum in Cartesian coordinates (x, y): V = mgy on g(q) = ½(x² + y² − l²)."""
+    return MechanicalSystem(
+        2,
+        lambda q: m * g * q[1],
+        lambda q: np.array([0.0, m * g]),
+        mass=m,
+        constraints=lambda q: np.array([0.5 * (q @ q - l * l)]),
+        constraint_jacobian=lambda q: q.reshape(1, 2),
+        constraint_count=1,
+        name="cartesian_pendulum (closure)",
+    )
+
+
 def closure_of(scene: Scene) -> MechanicalSystem | Lagrangian:
     """The closure version of a built-in scene (with its default parameters)."""
     gravity = scene.model._core.gravity
@@ -201,4 +215,5 @@ def closure_of(scene: Scene) -> MechanicalSystem | Lagrangian:
         "charged_particle": charged_particle,
         "charged_particle_nonuniform": lambda: charged_particle(kappa=0.25),
         "damped_driven_pendulum": damped_driven_pendulum,
+        "cartesian_pendulum": cartesian_pendulum,
     }[scene.name]()

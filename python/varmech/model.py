@@ -87,7 +87,7 @@ class Model:
     implicit variational ones (``midpoint``, ``trapezoid``, ``galerkin4``, ``galerkin6``).
     """
 
-    _core: _core.NativeModel | _core.ClosureModel | _core.ClosureNatural | _core.ClosureLagrangian
+    _core: _core.NativeModel | _core.ClosureModel | _core.ClosureConstrained | _core.ClosureNatural | _core.ClosureLagrangian
     symmetries: tuple[Symmetry, ...]
     name: str
 
@@ -167,6 +167,11 @@ class MechanicalSystem(Model):
         entries (diagonal), or a symmetric positive-definite matrix (n, n). Or a closure
         ``mass(q) -> array (n, n)``, M(q) symmetric positive definite: then
         p = M(q)q̇ exactly, q̇ = M(q)⁻¹p by Cholesky, and ∂L/∂q = ½q̇ᵀ(∂M/∂q)q̇ − ∇V.
+    constraints, constraint_jacobian, constraint_count:
+        Holonomic constraints g(q) = 0: ``constraints(q) -> array (m,)`` with
+        ``constraint_count`` = m, and optionally ``constraint_jacobian(q) -> array (m, n)``, G =
+        ∂g/∂q (central differences of g without it). Such a system is integrated by ``rattle``
+        (the default), ``rattle4`` or ``shake`` only; constant mass only, so far.
     mass_derivative:
         With a ``mass`` closure: ``mass_derivative(q) -> array (n, n, n)`` whose ``[i]`` is
         ∂M/∂qᵢ. Optional: without it, central differences of ``mass`` are used (2n calls
@@ -186,16 +191,25 @@ class MechanicalSystem(Model):
         *,
         mass: ArrayLike | Callable[[np.ndarray], ArrayLike] = 1.0,
         mass_derivative: Callable[[np.ndarray], ArrayLike] | None = None,
+        constraints: Callable[[np.ndarray], ArrayLike] | None = None,
+        constraint_jacobian: Callable[[np.ndarray], ArrayLike] | None = None,
+        constraint_count: int | None = None,
         symmetries: Sequence[Symmetry] = (),
         name: str = "mechanical system",
     ):
         if isinstance(dim, bool) or not isinstance(dim, (int, np.integer)) or dim < 1:
             raise ValueError(f"dim: must be a positive integer, got {dim!r}")
+        if (constraints is None) != (constraint_count is None) or (constraint_jacobian is not None and constraints is None):
+            raise ValueError("constraints: give constraints(q) with constraint_count (and optionally constraint_jacobian)")
+        if constraints is not None and callable(mass):
+            raise ValueError("constraints: with a constant mass only, so far")
         missing = [what for what, f in (("gradient", gradient), ("mass_derivative", mass_derivative)) if f is None]
         if not callable(mass):
             if mass_derivative is not None:
                 raise ValueError("mass_derivative: only with a mass closure mass(q); a constant mass has none")
             missing.remove("mass_derivative")
+        if constraints is not None and constraint_jacobian is None:
+            missing.append("constraint_jacobian")
         if missing:
             warnings.warn(
                 f"{name}: no {' and no '.join(missing)} given; central differences are used "
@@ -206,6 +220,8 @@ class MechanicalSystem(Model):
         self.gradient = gradient
         self.mass = mass
         self.mass_derivative = mass_derivative
+        self.constraints_function = constraints
+        self.constraint_jacobian = constraint_jacobian
         self.symmetries = tuple(symmetries)
         self.name = name
         if callable(mass):
@@ -218,6 +234,11 @@ class MechanicalSystem(Model):
             raise ValueError("mass: must be finite")
         self._core = _core.ClosureModel(int(dim), potential, gradient, m, _specs(symmetries))
         self.mass = m
+        if constraints is not None:
+            count = constraint_count
+            if isinstance(count, bool) or not isinstance(count, (int, np.integer)):
+                raise ValueError(f"constraint_count: must be a positive integer, got {count!r}")
+            self._core = _core.ClosureConstrained(self._core, int(count), constraints, constraint_jacobian)
 
 
 class Lagrangian(Model):

@@ -6,15 +6,15 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
 use varmech::diagnostics::{self, EnergyStatistics, InvariantStatistics};
 use varmech::integrators::{self, General, Integrable, Method, NewtonOptions, Options};
-use varmech::model::Natural;
+use varmech::model::{Constrained, Natural};
 use varmech::scenes::{self, LagrangianScene, LinkedMasses, Problem, Scene};
 use varmech::ModelError;
 
 use crate::convert::{self, rows, slice, trajectory_tuple};
 use crate::errors::{failure_to_pyerr, to_pyerr};
 use crate::model::{
-    ClosureLagrangian, ClosureLagrangianSystem, ClosureModel, ClosureNatural, ClosureNaturalSystem, ClosureSystem,
-    Native, NativeModel,
+    ClosureConstrained, ClosureConstraints, ClosureLagrangian, ClosureLagrangianSystem, ClosureModel, ClosureNatural,
+    ClosureNaturalSystem, ClosureSystem, Native, NativeModel,
 };
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
@@ -69,6 +69,14 @@ macro_rules! with_system {
             }
         } else if let Ok(closure) = $model.cast::<ClosureModel>() {
             let $sys = &ClosureSystem::new($py, closure.get());
+            let $poll = || $py.check_signals().map_err(boxed);
+            $body
+        } else if let Ok(closure) = $model.cast::<ClosureConstrained>() {
+            let closure = closure.get();
+            let $sys = &Constrained {
+                system: ClosureSystem::new($py, closure.system()),
+                constraints: ClosureConstraints::new($py, closure),
+            };
             let $poll = || $py.check_signals().map_err(boxed);
             $body
         } else if let Ok(closure) = $model.cast::<ClosureNatural>() {
@@ -164,36 +172,36 @@ fn states<'a>(
 /// Two arrays, as the constraint functions return them.
 type ArrayPair<'py> = (Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>);
 
-/// A constrained native model, or a ValueError naming `model`.
-fn constrained<'a>(model: &'a Bound<'_, NativeModel>) -> PyResult<&'a LinkedMasses> {
-    match &model.get().native {
-        Native::Constrained(s) => Ok(s),
-        _ => Err(PyValueError::new_err("model: has no holonomic constraints")),
-    }
+fn unconstrained() -> PyErr {
+    PyValueError::new_err("model: has no holonomic constraints")
 }
 
 /// (|g(q)|∞, |G(q)M⁻¹p|∞) at each state of a constrained model.
 #[pyfunction]
 fn constraint_residuals<'py>(
     py: Python<'py>,
-    model: &Bound<'py, NativeModel>,
+    model: &Bound<'py, PyAny>,
     q: PyReadonlyArray2<'py, f64>,
     p: PyReadonlyArray2<'py, f64>,
 ) -> PyResult<ArrayPair<'py>> {
-    let sys = constrained(model)?;
-    let n = Integrable::dim(sys);
+    let n = with_system!(py, model, |sys, _poll| sys.dim());
     let ((q, nq), (p, np)) = (rows("q", &q)?, rows("p", &p)?);
     if nq != n || np != n || q.len() != p.len() {
         return Err(PyValueError::new_err(format!(
             "q, p: need two (N, {n}) arrays of states"
         )));
     }
-    let (mut position, mut velocity) = (Vec::new(), Vec::new());
-    for (q, p) in q.chunks_exact(n).zip(p.chunks_exact(n)) {
-        let (g, v) = sys.residuals(q, p).map_err(model_error)?;
-        position.push(g);
-        velocity.push(v);
-    }
+    let result: Option<Result<Vec<(f64, f64)>, ModelError>> = with_system!(py, model, |sys, _poll| {
+        q.chunks_exact(n)
+            .zip(p.chunks_exact(n))
+            .map(|(q, p)| sys.constraint_residuals(q, p))
+            .collect::<Option<Result<Vec<(f64, f64)>, ModelError>>>()
+    });
+    let (position, velocity) = result
+        .ok_or_else(unconstrained)?
+        .map_err(model_error)?
+        .into_iter()
+        .unzip();
     Ok((PyArray1::from_vec(py, position), PyArray1::from_vec(py, velocity)))
 }
 
@@ -201,14 +209,13 @@ fn constraint_residuals<'py>(
 #[pyfunction]
 fn project<'py>(
     py: Python<'py>,
-    model: &Bound<'py, NativeModel>,
+    model: &Bound<'py, PyAny>,
     q0: PyReadonlyArray1<'py, f64>,
     p0: PyReadonlyArray1<'py, f64>,
 ) -> PyResult<ArrayPair<'py>> {
-    let sys = constrained(model)?;
-    let (q, p) = sys
-        .project(slice("q0", &q0)?, slice("p0", &p0)?)
-        .map_err(|e| to_pyerr(py, e))?;
+    let (q0, p0) = (slice("q0", &q0)?, slice("p0", &p0)?);
+    let result = with_system!(py, model, |sys, _poll| Integrable::project(sys, q0, p0));
+    let (q, p) = result.ok_or_else(unconstrained)?.map_err(|e| to_pyerr(py, e))?;
     Ok((PyArray1::from_vec(py, q), PyArray1::from_vec(py, p)))
 }
 

@@ -22,6 +22,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<model::ClosureModel>()?;
     m.add_class::<model::ClosureLagrangian>()?;
     m.add_class::<model::ClosureNatural>()?;
+    m.add_class::<model::ClosureConstrained>()?;
     functions::register(m)?;
     Ok(())
 }

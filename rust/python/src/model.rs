@@ -8,8 +8,8 @@ use numpy::{PyArray1, PyArrayDyn, PyArrayMethods};
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use varmech::model::{
-    differenced_kinetic_gradient, finite_difference, Generator, Hessians, HolonomicConstraints, Lagrangian, Mass,
-    MechanicalSystem, NaturalSystem,
+    differenced_jacobian, differenced_kinetic_gradient, finite_difference, Generator, Hessians, HolonomicConstraints,
+    Lagrangian, Mass, MechanicalSystem, NaturalSystem,
 };
 use varmech::scenes::{LagrangianScene, LinkedMasses, Scene};
 use varmech::ModelError;
@@ -173,6 +173,85 @@ impl ClosureModel {
 
     fn __repr__(&self) -> String {
         format!("ClosureModel(dim={})", self.dim)
+    }
+}
+
+/// A [`ClosureModel`] on holonomic constraints given by Python closures
+/// `constraints(q) -> array (m,)` and, optionally, `jacobian(q) -> array (m, n)`; without a
+/// Jacobian, central differences of g are used (2n calls of g per Jacobian).
+#[pyclass(frozen, module = "varmech._core")]
+pub struct ClosureConstrained {
+    system: Py<ClosureModel>,
+    count: usize,
+    constraints: Py<PyAny>,
+    jacobian: Option<Py<PyAny>>,
+}
+
+#[pymethods]
+impl ClosureConstrained {
+    #[new]
+    #[pyo3(signature = (system, count, constraints, jacobian))]
+    fn new(
+        system: Bound<'_, ClosureModel>,
+        count: usize,
+        constraints: Bound<'_, PyAny>,
+        jacobian: Option<Bound<'_, PyAny>>,
+    ) -> PyResult<Self> {
+        let dim = system.get().dim;
+        check_closures(
+            dim,
+            [
+                ("constraints", Some(&constraints)),
+                ("constraint_jacobian", jacobian.as_ref()),
+            ],
+        )?;
+        if count == 0 || count >= dim {
+            return Err(PyValueError::new_err(format!(
+                "constraint_count: must be between 1 and dim − 1 = {}, got {count}",
+                dim - 1
+            )));
+        }
+        Ok(ClosureConstrained {
+            system: system.unbind(),
+            count,
+            constraints: constraints.unbind(),
+            jacobian: jacobian.map(Bound::unbind),
+        })
+    }
+
+    #[getter]
+    pub fn dim(&self) -> usize {
+        self.system.get().dim
+    }
+
+    #[getter]
+    fn constraints(&self) -> usize {
+        self.count
+    }
+
+    #[getter]
+    fn separable(&self) -> bool {
+        false
+    }
+
+    #[getter]
+    fn time_dependent(&self) -> bool {
+        false
+    }
+
+    #[getter]
+    fn forced(&self) -> bool {
+        false
+    }
+
+    fn __repr__(&self) -> String {
+        format!("ClosureConstrained(dim={}, constraints={})", self.dim(), self.count)
+    }
+}
+
+impl ClosureConstrained {
+    pub fn system(&self) -> &ClosureModel {
+        self.system.get()
     }
 }
 
@@ -480,6 +559,61 @@ impl MechanicalSystem for ClosureSystem<'_, '_> {
 
     fn symmetries(&self) -> Vec<Generator> {
         self.model.symmetries.clone()
+    }
+}
+
+/// The constraints of a [`ClosureConstrained`] bound to the GIL: they implement the core's
+/// [`HolonomicConstraints`] trait.
+pub struct ClosureConstraints<'py> {
+    py: Python<'py>,
+    count: usize,
+    constraints: Bound<'py, PyAny>,
+    jacobian: Option<Bound<'py, PyAny>>,
+    rows: RefCell<Vec<f64>>,
+}
+
+impl<'py> ClosureConstraints<'py> {
+    pub fn new(py: Python<'py>, model: &ClosureConstrained) -> Self {
+        ClosureConstraints {
+            py,
+            count: model.count,
+            constraints: model.constraints.bind(py).clone(),
+            jacobian: model.jacobian.as_ref().map(|f| f.bind(py).clone()),
+            rows: RefCell::new(vec![0.0; model.count * model.dim()]),
+        }
+    }
+}
+
+impl HolonomicConstraints for ClosureConstraints<'_> {
+    fn count(&self) -> usize {
+        self.count
+    }
+
+    fn residual(&self, q: &[f64], g: &mut [f64]) -> Result<(), ModelError> {
+        call_vector(
+            self.constraints.call1((PyArray1::from_slice(self.py, q),)),
+            "constraints(q)",
+            g,
+        )
+    }
+
+    /// `jacobian(q)`, an array (m, n) in C order, or the trait's differences of g.
+    fn jacobian(&self, q: &[f64], jac: &mut DMatrix<f64>) -> Result<(), ModelError> {
+        let Some(f) = &self.jacobian else {
+            return differenced_jacobian(self, q, jac);
+        };
+        let (m, n) = jac.shape();
+        let rows = &mut *self.rows.borrow_mut();
+        call_array(
+            f.call1((PyArray1::from_slice(self.py, q),)),
+            "constraint_jacobian(q)",
+            &[m, n],
+            rows,
+        )?;
+        for (i, row) in rows.chunks_exact(n).enumerate() {
+            jac.row_mut(i).iter_mut().zip(row).for_each(|(j, r)| *j = *r);
+        }
+        Ok(())
     }
 }
 

@@ -3,7 +3,7 @@ use std::time::{Duration, Instant};
 use super::{compensated, Integrator, Method, NewtonOptions, StepError};
 use crate::diagnostics::hamiltonian;
 use crate::error::check_vector;
-use crate::model::{Constrained, HolonomicConstraints, Lagrangian, MechanicalSystem};
+use crate::model::{Constrained, HolonomicConstraints, Lagrangian, MechanicalSystem, PhaseState};
 use crate::{Error, ModelError};
 
 /// What the driver integrates: separable mechanical systems take every method; a general
@@ -39,6 +39,16 @@ pub trait Integrable {
 
     /// The system as a Lagrangian, for the diagnostics (energy function, Legendre transforms).
     fn as_lagrangian(&self) -> &dyn Lagrangian;
+
+    /// (|g(q)|∞, |G(q)M⁻¹p|∞) for a constrained system; None for the others.
+    fn constraint_residuals(&self, _q: &[f64], _p: &[f64]) -> Option<Result<(f64, f64), ModelError>> {
+        None
+    }
+
+    /// The nearest consistent state for a constrained system; None for the others.
+    fn project(&self, _q: &[f64], _p: &[f64]) -> Option<Result<PhaseState, Error>> {
+        None
+    }
 }
 
 impl<S: MechanicalSystem> Integrable for S {
@@ -183,6 +193,14 @@ impl<S: MechanicalSystem, C: HolonomicConstraints> Integrable for Constrained<S,
 
     fn as_lagrangian(&self) -> &dyn Lagrangian {
         &self.system
+    }
+
+    fn constraint_residuals(&self, q: &[f64], p: &[f64]) -> Option<Result<(f64, f64), ModelError>> {
+        Some(self.residuals(q, p))
+    }
+
+    fn project(&self, q: &[f64], p: &[f64]) -> Option<Result<PhaseState, Error>> {
+        Some(Constrained::project(self, q, p))
     }
 }
 

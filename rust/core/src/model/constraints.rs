@@ -14,26 +14,35 @@ pub trait HolonomicConstraints {
     /// Writes g(q) (m entries) into `g`.
     fn residual(&self, q: &[f64], g: &mut [f64]) -> Result<(), ModelError>;
 
-    /// Writes G(q) = ∂g/∂q (m × n) into `jac`. Default: central differences of g (2n
-    /// evaluations of g; they allocate scratch).
+    /// Writes G(q) = ∂g/∂q (m × n) into `jac`. Default: [`differenced_jacobian`].
     fn jacobian(&self, q: &[f64], jac: &mut DMatrix<f64>) -> Result<(), ModelError> {
-        let (m, n) = jac.shape();
-        let (mut work, mut row) = (vec![0.0; n], vec![0.0; n]);
-        let mut g = vec![0.0; m];
-        for i in 0..m {
-            finite_difference::central_gradient(
-                |x| {
-                    self.residual(x, &mut g)?;
-                    Ok(g[i])
-                },
-                q,
-                &mut work,
-                &mut row,
-            )?;
-            jac.row_mut(i).copy_from_slice(&row);
-        }
-        Ok(())
+        differenced_jacobian(self, q, jac)
     }
+}
+
+/// G(q) by central differences of g, row by row (2n evaluations of g per row; they allocate
+/// scratch), about 1e-10 relative accuracy.
+pub fn differenced_jacobian<C: HolonomicConstraints + ?Sized>(
+    constraints: &C,
+    q: &[f64],
+    jac: &mut DMatrix<f64>,
+) -> Result<(), ModelError> {
+    let (m, n) = jac.shape();
+    let (mut work, mut row) = (vec![0.0; n], vec![0.0; n]);
+    let mut g = vec![0.0; m];
+    for i in 0..m {
+        finite_difference::central_gradient(
+            |x| {
+                constraints.residual(x, &mut g)?;
+                Ok(g[i])
+            },
+            q,
+            &mut work,
+            &mut row,
+        )?;
+        jac.row_mut(i).copy_from_slice(&row);
+    }
+    Ok(())
 }
 
 /// Rigid distances between point bodies in d dimensions (coordinates laid out body by body),
@@ -104,6 +113,9 @@ impl HolonomicConstraints for Distances {
     }
 }
 
+/// A state (q, p), as [`Constrained::project`] returns it.
+pub type PhaseState = (Vec<f64>, Vec<f64>);
+
 /// A separable mechanical system S (H = ½pᵀM⁻¹p + V) on the constraints C: what RATTLE and
 /// SHAKE integrate.
 #[derive(Clone, Debug)]
@@ -141,7 +153,7 @@ impl<S: MechanicalSystem, C: HolonomicConstraints> Constrained<S, C> {
     /// point in the kinetic metric, to first order), then p projected onto G(q)M⁻¹p = 0
     /// M-orthogonally, p ← p − Gᵀ(GM⁻¹Gᵀ)⁻¹GM⁻¹p. Fails if Newton does not converge (no point
     /// of the constraints near q) or GM⁻¹Gᵀ is singular.
-    pub fn project(&self, q0: &[f64], p0: &[f64]) -> Result<(Vec<f64>, Vec<f64>), Error> {
+    pub fn project(&self, q0: &[f64], p0: &[f64]) -> Result<PhaseState, Error> {
         let model = |e: ModelError| Error::invalid("q0", format!("the constraints failed to evaluate: {e}"));
         let m = self.constraints.count();
         let mut q = DVector::from_column_slice(q0);

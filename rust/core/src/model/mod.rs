@@ -18,7 +18,7 @@ mod mechanical;
 mod natural;
 mod symmetry;
 
-pub use constraints::{Anchor, Constrained, Distances, HolonomicConstraints, Link};
+pub use constraints::{differenced_jacobian, Anchor, Constrained, Distances, HolonomicConstraints, Link, PhaseState};
 pub use lagrangian::{Hessians, Lagrangian};
 pub use mass::Mass;
 pub use mechanical::MechanicalSystem;
