@@ -3,7 +3,7 @@ use nalgebra::{DMatrix, DVector};
 use super::StepError;
 use crate::discrete::{DiscreteLagrangian, Workspace};
 use crate::model::finite_difference::NOISE_FLOOR;
-use crate::model::{Hessians, Lagrangian};
+use crate::model::{Hessians, HolonomicConstraints, Lagrangian};
 use crate::ModelError;
 
 /// Options of the Newton iteration that solves the discrete Euler–Lagrange equations.
@@ -480,14 +480,26 @@ impl StepEquations for Galerkin {
 /// of cancellation, so that Noether momenta stay conserved to round-off.
 ///
 /// A step whose Jacobian at the solution has the opposite determinant sign to the continuum
-/// limit ([`StepEquations::continuum_sign`]) has crossed a fold of the DEL map: beyond it the
+/// limit ([`Quadrature`]) has crossed a fold of the DEL map: beyond it the
 /// equations have several solutions (for the midpoint rule once h²λ/4 > 1 for an unstable
 /// eigenvalue λ of −M⁻¹∂²L/∂q², e.g. h ≥ 2 at the top of the pendulum) and Newton may settle
 /// on a spurious one. Such a step is refused as [`StepError::SpuriousBranch`].
+///
+/// With holonomic constraints g(q) = 0 (m of them) the unknowns grow by multipliers λ, and the
+/// step solves the constrained DEL equations (Marsden & West 2001, §3.4; RATTLE for separable
+/// systems and the trapezoidal L_d):
+///
+/// p₀ + D₁L_d(q₀, q₁) − (h/2)G(q₀)ᵀλ = 0,   g(q₁) = 0,   p₁ = D₂L_d(q₀, q₁) − (h/2)G(q₁)ᵀμ,
+///
+/// with μ such that the velocity q̇(q₁, p₁) of the inverse Legendre transform is tangent,
+/// G(q₁)q̇ = 0 (Newton's method on μ, from differences of the Legendre transform).
 #[derive(Clone, Debug)]
 pub struct Del<Sc> {
     scheme: Sc,
     options: NewtonOptions,
+    /// Number of constraints m; the unknowns are (λ, the scheme's).
+    m: usize,
+    multipliers: Multipliers,
     x: Vec<f64>,
     residual: DVector<f64>,
     plus: Vec<f64>,
@@ -510,12 +522,78 @@ pub struct Del<Sc> {
     work: f64,
 }
 
+/// The buffers of the constrained step: G(q₀) and G(q₁), q₁ and p₁, and μ's Newton iteration.
+#[derive(Clone, Debug)]
+struct Multipliers {
+    g0: DMatrix<f64>,
+    g1: DMatrix<f64>,
+    q1: Vec<f64>,
+    p1: Vec<f64>,
+    v: Vec<f64>,
+    r: DVector<f64>,
+    plus: Vec<f64>,
+    minus: Vec<f64>,
+    mu: Vec<f64>,
+    jacobian: DMatrix<f64>,
+    pivots: Vec<usize>,
+}
+
+impl Multipliers {
+    fn new(n: usize, m: usize) -> Self {
+        Multipliers {
+            g0: DMatrix::zeros(m, n),
+            g1: DMatrix::zeros(m, n),
+            q1: vec![0.0; n],
+            p1: vec![0.0; n],
+            v: vec![0.0; n],
+            r: DVector::zeros(m),
+            plus: vec![0.0; m],
+            minus: vec![0.0; m],
+            mu: vec![0.0; m],
+            jacobian: DMatrix::zeros(m, m),
+            pivots: vec![0; m],
+        }
+    }
+}
+
+/// F(x) for x = (λ, s): the scheme's equations in s with (h/2)G(q₀)ᵀλ taken from the last
+/// block (the one holding p₀), then g(q₀ + δq) with δq the last n of s.
+#[allow(clippy::too_many_arguments)]
+fn constrained_equations<Sc: StepEquations, S: Lagrangian + ?Sized>(
+    scheme: &mut Sc,
+    sys: &S,
+    constraints: Option<(&dyn HolonomicConstraints, &DMatrix<f64>, &mut [f64])>,
+    q0: &[f64],
+    p0: &[f64],
+    t: f64,
+    h: f64,
+    x: &[f64],
+    out: &mut [f64],
+) -> Result<(), ModelError> {
+    let Some((c, g0, q1)) = constraints else {
+        return scheme.equations(sys, q0, p0, t, h, x, out);
+    };
+    let (n, m) = (q0.len(), g0.nrows());
+    let (lambda, s) = x.split_at(m);
+    let u = s.len();
+    scheme.equations(sys, q0, p0, t, h, s, &mut out[..u])?;
+    for (j, o) in out[u - n..u].iter_mut().enumerate() {
+        *o -= 0.5 * h * (0..m).map(|k| g0[(k, j)] * lambda[k]).sum::<f64>();
+    }
+    for ((q1, q), d) in q1.iter_mut().zip(q0).zip(&s[u - n..]) {
+        *q1 = q + d;
+    }
+    c.residual(q1, &mut out[u..])
+}
+
 impl<Sc: StepEquations> Del<Sc> {
     pub fn new(scheme: Sc, n: usize, options: NewtonOptions) -> Self {
         let m = scheme.unknowns(n);
         Del {
             scheme,
             options,
+            m: 0,
+            multipliers: Multipliers::new(n, 0),
             x: vec![0.0; m],
             residual: DVector::zeros(m),
             plus: vec![0.0; m],
@@ -554,6 +632,23 @@ impl<Sc: StepEquations> Del<Sc> {
     pub(super) fn reset(&mut self) {
         self.history = 0;
         self.continuum_sign = 0.0;
+        self.x[..self.m].fill(0.0);
+    }
+
+    /// Sizes the buffers for m constraints (allocating only when m changes).
+    fn size_for(&mut self, n: usize, m: usize) {
+        if m == self.m {
+            return;
+        }
+        let total = self.scheme.unknowns(n) + m;
+        self.m = m;
+        self.multipliers = Multipliers::new(n, m);
+        self.x = vec![0.0; total];
+        self.residual = DVector::zeros(total);
+        self.plus = vec![0.0; total];
+        self.minus = vec![0.0; total];
+        self.jacobian = DMatrix::zeros(total, total);
+        self.pivots = vec![0; total];
     }
 
     /// sign det ∂²L/∂q̇² at (q, q̇(q, p), t), by central differences of ∂L/∂q̇: the regularity
@@ -588,45 +683,65 @@ impl<Sc: StepEquations> Del<Sc> {
     }
 
     /// residual = F(x); returns ‖residual‖∞.
+    #[allow(clippy::too_many_arguments)]
     fn residual<S: Lagrangian + ?Sized>(
         &mut self,
         sys: &S,
+        constraints: Option<&dyn HolonomicConstraints>,
         q0: &[f64],
         p0: &[f64],
         t: f64,
         h: f64,
     ) -> Result<f64, StepError> {
         self.evaluations += 1;
-        self.scheme
-            .equations(sys, q0, p0, t, h, &self.x, self.residual.as_mut_slice())?;
+        let mp = &mut self.multipliers;
+        let c = constraints.map(|c| (c, &mp.g0, mp.q1.as_mut_slice()));
+        constrained_equations(
+            &mut self.scheme,
+            sys,
+            c,
+            q0,
+            p0,
+            t,
+            h,
+            &self.x,
+            self.residual.as_mut_slice(),
+        )?;
         Ok(self.residual.iter().fold(0.0_f64, |m, r| m.max(r.abs())))
     }
 
     /// ∂F/∂x from the model's second derivatives where it supplies them and no force acts (the
     /// forces' derivatives are not supplied), by central differences otherwise; factorised in
     /// place.
+    #[allow(clippy::too_many_arguments)]
     fn factorise_jacobian<S: Lagrangian + ?Sized>(
         &mut self,
         sys: &S,
+        constraints: Option<&dyn HolonomicConstraints>,
         q0: &[f64],
         p0: &[f64],
         t: f64,
         h: f64,
     ) -> Result<bool, StepError> {
         let exact = !sys.is_forced()
+            && constraints.is_none()
             && self
                 .scheme
                 .quadrature()
                 .jacobian(sys, q0, t, h, &self.x, &mut self.jacobian)?;
         let cbrt_eps = f64::EPSILON.cbrt();
-        let n = q0.len();
+        let (n, m) = (q0.len(), self.m);
         for j in (0..self.x.len()).filter(|_| !exact) {
             let d = self.x[j];
-            let e = cbrt_eps * (q0[j % n] + d).abs().max(1.0);
+            let base = if j < m { 0.0 } else { q0[(j - m) % n] };
+            let e = cbrt_eps * (base + d).abs().max(1.0);
+            let mp = &mut self.multipliers;
             self.x[j] = d + e;
-            self.scheme.equations(sys, q0, p0, t, h, &self.x, &mut self.plus)?;
+            let c = constraints.map(|c| (c, &mp.g0, mp.q1.as_mut_slice()));
+            constrained_equations(&mut self.scheme, sys, c, q0, p0, t, h, &self.x, &mut self.plus)?;
             self.x[j] = d - e;
-            self.scheme.equations(sys, q0, p0, t, h, &self.x, &mut self.minus)?;
+            let c = constraints.map(|c| (c, &mp.g0, mp.q1.as_mut_slice()));
+            constrained_equations(&mut self.scheme, sys, c, q0, p0, t, h, &self.x, &mut self.minus)?;
             self.x[j] = d;
             self.evaluations += 2;
             for (i, (a, b)) in self.plus.iter().zip(&self.minus).enumerate() {
@@ -650,6 +765,7 @@ impl<Sc: StepEquations> Del<Sc> {
     pub(super) fn increment<S: Lagrangian + ?Sized>(
         &mut self,
         sys: &S,
+        constraints: Option<&dyn HolonomicConstraints>,
         t: f64,
         q: &[f64],
         p: &[f64],
@@ -658,6 +774,11 @@ impl<Sc: StepEquations> Del<Sc> {
         dp: &mut [f64],
     ) -> Result<(), StepError> {
         let n = q.len();
+        self.size_for(n, constraints.map_or(0, |c| c.count()));
+        let m = self.m;
+        if let Some(c) = constraints {
+            c.jacobian(q, &mut self.multipliers.g0)?;
+        }
         if self.continuum_sign == 0.0 {
             let hessian_sign = self.hessian_sign(sys, q, p, t)?;
             self.continuum_sign = self.scheme.quadrature().continuum_sign(n, hessian_sign);
@@ -670,8 +791,9 @@ impl<Sc: StepEquations> Del<Sc> {
                 _ => 2.0 * d1 - d0,
             };
         }
-        self.scheme.predict(&self.predicted, &mut self.x);
-        let mut residual = self.residual(sys, q, p, t, h)?;
+        // The multipliers keep the last step's values: a force, smooth in time.
+        self.scheme.predict(&self.predicted, &mut self.x[m..]);
+        let mut residual = self.residual(sys, constraints, q, p, t, h)?;
         if !residual.is_finite() {
             return Err(StepError::NonFinite {
                 reason: "the implicit equations are non-finite at the predictor",
@@ -683,7 +805,7 @@ impl<Sc: StepEquations> Del<Sc> {
         let mut last_correction = f64::INFINITY;
         for iteration in 1..=self.options.max_iterations {
             let fresh = !keep_jacobian;
-            if fresh && !self.factorise_jacobian(sys, q, p, t, h)? {
+            if fresh && !self.factorise_jacobian(sys, constraints, q, p, t, h)? {
                 let reason = "the Jacobian of the step's equations is singular";
                 return Err(StepError::Convergence {
                     residual,
@@ -698,9 +820,9 @@ impl<Sc: StepEquations> Del<Sc> {
             for (j, (x, d)) in self.x.iter_mut().zip(self.residual.iter()).enumerate() {
                 *x -= d;
                 correction = correction.max(d.abs());
-                scale = scale.max((q[j % n] + *x).abs());
+                scale = scale.max((if j < m { 0.0 } else { q[(j - m) % n] } + *x).abs());
             }
-            residual = self.residual(sys, q, p, t, h)?;
+            residual = self.residual(sys, constraints, q, p, t, h)?;
             if !(correction.is_finite() && residual.is_finite()) {
                 let reason = "the implicit equations became non-finite (Newton's method or the solution diverged)";
                 return Err(StepError::NonFinite { reason });
@@ -711,14 +833,15 @@ impl<Sc: StepEquations> Del<Sc> {
             // longer contracts.
             let at_floor = fresh && !contracting && correction <= NOISE_FLOOR * scale;
             if correction <= self.options.tolerance * scale || at_floor {
-                if self.jacobian_sign != self.continuum_sign {
+                // The fold test knows the unconstrained equations' continuum limit only.
+                if m == 0 && self.jacobian_sign != self.continuum_sign {
                     return Err(StepError::SpuriousBranch {
                         reason: "the step's solution lies beyond a fold of the discrete Euler–Lagrange map \
                                  (the Jacobian's determinant changed sign from its continuum limit), where \
                                  the equations have several solutions and Newton's may be spurious",
                     });
                 }
-                return self.finish(sys, t, q, h, dq, dp);
+                return self.finish(sys, constraints, t, q, p, h, dq, dp);
             }
             keep_jacobian = contracting;
             last_correction = correction;
@@ -732,23 +855,113 @@ impl<Sc: StepEquations> Del<Sc> {
     }
 
     /// The increments once the step is solved.
+    #[allow(clippy::too_many_arguments)]
     fn finish<S: Lagrangian + ?Sized>(
         &mut self,
         sys: &S,
+        constraints: Option<&dyn HolonomicConstraints>,
         t: f64,
         q: &[f64],
+        p: &[f64],
         h: f64,
         dq: &mut [f64],
         dp: &mut [f64],
     ) -> Result<(), StepError> {
         self.evaluations += 1;
+        let (n, m) = (q.len(), self.m);
+        let u = self.x.len() - m;
+        // The scheme's own residual: its last block holds (h/2)G(q₀)ᵀλ at the solution.
+        for j in 0..n {
+            let force: f64 = (0..m).map(|k| self.multipliers.g0[(k, j)] * self.x[k]).sum();
+            self.residual[u - n + j] += 0.5 * h * force;
+        }
         self.work += self
             .scheme
-            .momentum_change(sys, q, t, h, &self.x, self.residual.as_slice(), dp)?;
-        dq.copy_from_slice(&self.x[self.x.len() - q.len()..]);
+            .momentum_change(sys, q, t, h, &self.x[m..], &self.residual.as_slice()[..u], dp)?;
+        dq.copy_from_slice(&self.x[self.x.len() - n..]);
+        if let Some(c) = constraints {
+            self.project_momentum(sys, c, t + h, q, p, h, dq, dp)?;
+        }
         std::mem::swap(&mut self.before_last_dq, &mut self.last_dq);
         self.last_dq.copy_from_slice(dq);
         self.history = (self.history + 1).min(2);
+        Ok(())
+    }
+
+    /// p₁ = p₀ + δp − (h/2)G(q₁)ᵀμ with G(q₁)q̇(q₁, p₁) = 0: Newton's method on μ, its
+    /// Jacobian −(h/2)G(q₁)(∂q̇/∂p)G(q₁)ᵀ from central differences of the inverse Legendre
+    /// transform (exact in one step when L is quadratic in q̇); δp takes the projection.
+    #[allow(clippy::too_many_arguments)]
+    fn project_momentum<S: Lagrangian + ?Sized>(
+        &mut self,
+        sys: &S,
+        c: &dyn HolonomicConstraints,
+        t1: f64,
+        q: &[f64],
+        p: &[f64],
+        h: f64,
+        dq: &[f64],
+        dp: &mut [f64],
+    ) -> Result<(), StepError> {
+        let mp = &mut self.multipliers;
+        let m = mp.mu.len();
+        for ((x, q), d) in mp.q1.iter_mut().zip(q).zip(dq) {
+            *x = q + d;
+        }
+        c.jacobian(&mp.q1, &mut mp.g1)?;
+        mp.mu.fill(0.0);
+        // r(μ) = G(q₁)q̇(q₁, p₀ + δp − (h/2)G(q₁)ᵀμ).
+        let tangent = |mu: &[f64], mp_p1: &mut [f64], v: &mut [f64], out: &mut [f64], g1: &DMatrix<f64>, q1: &[f64]| {
+            for (j, x) in mp_p1.iter_mut().enumerate() {
+                *x = p[j] + dp[j] - 0.5 * h * (0..m).map(|k| g1[(k, j)] * mu[k]).sum::<f64>();
+            }
+            sys.velocity(q1, mp_p1, t1, v)?;
+            for (k, o) in out.iter_mut().enumerate() {
+                *o = g1.row(k).iter().zip(v.iter()).map(|(a, b)| a * b).sum();
+            }
+            Ok::<(), ModelError>(())
+        };
+        let scale = p.iter().fold(1.0_f64, |a, x| a.max(x.abs()));
+        let mut converged = false;
+        for _ in 0..self.options.max_iterations {
+            tangent(&mp.mu, &mut mp.p1, &mut mp.v, mp.r.as_mut_slice(), &mp.g1, &mp.q1)?;
+            let speed = mp.v.iter().fold(1.0_f64, |a, x| a.max(x.abs()));
+            if mp.r.amax() <= 4.0 * f64::EPSILON * speed {
+                converged = true;
+                break;
+            }
+            for k in 0..m {
+                let e = f64::EPSILON.cbrt() * mp.mu[k].abs().max(scale);
+                let mu = mp.mu[k];
+                mp.mu[k] = mu + e;
+                tangent(&mp.mu, &mut mp.p1, &mut mp.v, &mut mp.plus, &mp.g1, &mp.q1)?;
+                mp.mu[k] = mu - e;
+                tangent(&mp.mu, &mut mp.p1, &mut mp.v, &mut mp.minus, &mp.g1, &mp.q1)?;
+                mp.mu[k] = mu;
+                for i in 0..m {
+                    mp.jacobian[(i, k)] = (mp.plus[i] - mp.minus[i]) / (2.0 * e);
+                }
+            }
+            if lu_in_place(&mut mp.jacobian, &mut mp.pivots).is_none() {
+                return Err(StepError::Convergence {
+                    residual: mp.r.amax(),
+                    iterations: 0,
+                    reason: "G(q₁)(∂q̇/∂p)G(q₁)ᵀ is singular: the constraints are not independent here",
+                });
+            }
+            lu_solve(&mp.jacobian, &mp.pivots, &mut mp.r);
+            mp.mu.iter_mut().zip(mp.r.iter()).for_each(|(mu, d)| *mu -= d);
+        }
+        if !converged {
+            return Err(StepError::Convergence {
+                residual: mp.r.amax(),
+                iterations: self.options.max_iterations,
+                reason: "the momenta could not be put on the hidden constraint G(q₁)q̇ = 0",
+            });
+        }
+        for (j, d) in dp.iter_mut().enumerate() {
+            *d -= 0.5 * h * (0..m).map(|k| mp.g1[(k, j)] * mp.mu[k]).sum::<f64>();
+        }
         Ok(())
     }
 }

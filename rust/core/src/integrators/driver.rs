@@ -155,23 +155,10 @@ impl<S: MechanicalSystem, C: HolonomicConstraints> Integrable for Constrained<S,
     /// |g(q₀)|∞ and |G(q₀)M⁻¹p₀|∞ within 1e-10 (relative to the state's size): RATTLE holds
     /// the constraints where they start, and starting off them is a user error.
     fn check_initial(&self, q0: &[f64], p0: &[f64]) -> Result<(), Error> {
-        let (position, velocity) = self
+        let residuals = self
             .residuals(q0, p0)
             .map_err(|e| Error::invalid("q0", format!("the constraints failed to evaluate: {e}")))?;
-        let scale = q0.iter().chain(p0).fold(1.0_f64, |m, x| m.max(x.abs()));
-        if position > 1e-10 * scale {
-            return Err(Error::invalid(
-                "q0",
-                format!("is off the constraints: |g(q0)| = {position:.3e}; project the initial state first"),
-            ));
-        }
-        if velocity > 1e-10 * scale {
-            return Err(Error::invalid(
-                "p0",
-                format!("is off the hidden constraint: |G(q0)M⁻¹p0| = {velocity:.3e}; project the initial state first"),
-            ));
-        }
-        Ok(())
+        consistent(q0, p0, residuals)
     }
 
     fn increment(
@@ -202,6 +189,91 @@ impl<S: MechanicalSystem, C: HolonomicConstraints> Integrable for Constrained<S,
     fn project(&self, q: &[f64], p: &[f64]) -> Option<Result<PhaseState, Error>> {
         Some(Constrained::project(self, q, p))
     }
+}
+
+/// A general Lagrangian on holonomic constraints, for the implicit variational methods with
+/// multipliers (the constrained DEL equations; see [`super::Del`]).
+impl<L: Lagrangian, C: HolonomicConstraints> Integrable for Constrained<General<'_, L>, C> {
+    fn dim(&self) -> usize {
+        self.system.0.dim()
+    }
+
+    fn check_method(&self, method: Method) -> Result<(), Error> {
+        if method.info().implicit {
+            return Ok(());
+        }
+        let reason = format!(
+            "{} does not integrate a general Lagrangian on constraints; use trapezoid (RATTLE's \
+             L_d), midpoint, galerkin4 or galerkin6",
+            method.info().name
+        );
+        Err(Error::invalid("method", reason))
+    }
+
+    fn check_initial(&self, q0: &[f64], p0: &[f64]) -> Result<(), Error> {
+        let residuals = self
+            .residuals_general(q0, p0)
+            .map_err(|e| Error::invalid("q0", format!("the constraints failed to evaluate: {e}")))?;
+        consistent(q0, p0, residuals)
+    }
+
+    fn increment(
+        &self,
+        integrator: &mut Integrator,
+        t: f64,
+        q: &[f64],
+        p: &[f64],
+        h: f64,
+        dq: &mut [f64],
+        dp: &mut [f64],
+    ) -> Result<(), StepError> {
+        integrator.increment_constrained_lagrangian(self.system.0, &self.constraints, t, q, p, h, dq, dp)
+    }
+
+    fn energy(&self, q: &[f64], p: &[f64]) -> Option<Result<f64, ModelError>> {
+        self.system.energy(q, p)
+    }
+
+    fn as_lagrangian(&self) -> &dyn Lagrangian {
+        self.system.0
+    }
+
+    fn constraint_residuals(&self, q: &[f64], p: &[f64]) -> Option<Result<(f64, f64), ModelError>> {
+        Some(self.residuals_general(q, p))
+    }
+}
+
+impl<L: Lagrangian, C: HolonomicConstraints> Constrained<General<'_, L>, C> {
+    /// (|g(q)|∞, |G(q)q̇(q, p)|∞), with q̇ from the inverse Legendre transform.
+    pub fn residuals_general(&self, q: &[f64], p: &[f64]) -> Result<(f64, f64), ModelError> {
+        let (m, n) = (self.constraints.count(), q.len());
+        let mut g = vec![0.0; m];
+        self.constraints.residual(q, &mut g)?;
+        let mut jac = nalgebra::DMatrix::zeros(m, n);
+        self.constraints.jacobian(q, &mut jac)?;
+        let mut v = vec![0.0; n];
+        self.system.0.velocity(q, p, 0.0, &mut v)?;
+        let hidden = jac * nalgebra::DVector::from_column_slice(&v);
+        Ok((g.iter().fold(0.0, |a, x| a.max(x.abs())), hidden.amax()))
+    }
+}
+
+/// Initial data within 1e-10 (relative to the state's size) of both constraint levels.
+fn consistent(q0: &[f64], p0: &[f64], (position, velocity): (f64, f64)) -> Result<(), Error> {
+    let scale = q0.iter().chain(p0).fold(1.0_f64, |m, x| m.max(x.abs()));
+    if position > 1e-10 * scale {
+        return Err(Error::invalid(
+            "q0",
+            format!("is off the constraints: |g(q0)| = {position:.3e}; project the initial state first"),
+        ));
+    }
+    if velocity > 1e-10 * scale {
+        return Err(Error::invalid(
+            "p0",
+            format!("is off the hidden constraint: |G(q0)M⁻¹p0| = {velocity:.3e}; project the initial state first"),
+        ));
+    }
+    Ok(())
 }
 
 /// Options of a fixed-step run.

@@ -219,11 +219,40 @@ impl Integrator {
         dp: &mut [f64],
     ) -> Result<(), StepError> {
         match &mut self.scheme {
-            Scheme::Midpoint(s) => s.increment(sys, t, q, p, h, dq, dp),
-            Scheme::Trapezoid(s) => s.increment(sys, t, q, p, h, dq, dp),
-            Scheme::Galerkin(s) => s.increment(sys, t, q, p, h, dq, dp),
+            Scheme::Midpoint(s) => s.increment(sys, None, t, q, p, h, dq, dp),
+            Scheme::Trapezoid(s) => s.increment(sys, None, t, q, p, h, dq, dp),
+            Scheme::Galerkin(s) => s.increment(sys, None, t, q, p, h, dq, dp),
             _ => Err(StepError::Model(
                 "explicit methods integrate separable mechanical systems only".into(),
+            )),
+        }
+    }
+
+    /// As [`Integrator::increment_lagrangian`] on holonomic constraints: the constrained DEL
+    /// equations of the implicit methods (see [`Del`]).
+    #[allow(clippy::too_many_arguments)]
+    pub fn increment_constrained_lagrangian<S, C>(
+        &mut self,
+        sys: &S,
+        constraints: &C,
+        t: f64,
+        q: &[f64],
+        p: &[f64],
+        h: f64,
+        dq: &mut [f64],
+        dp: &mut [f64],
+    ) -> Result<(), StepError>
+    where
+        S: Lagrangian + ?Sized,
+        C: HolonomicConstraints,
+    {
+        let c: Option<&dyn HolonomicConstraints> = Some(constraints);
+        match &mut self.scheme {
+            Scheme::Midpoint(s) => s.increment(sys, c, t, q, p, h, dq, dp),
+            Scheme::Trapezoid(s) => s.increment(sys, c, t, q, p, h, dq, dp),
+            Scheme::Galerkin(s) => s.increment(sys, c, t, q, p, h, dq, dp),
+            _ => Err(StepError::Model(
+                "a general Lagrangian on constraints takes the implicit methods only".into(),
             )),
         }
     }
