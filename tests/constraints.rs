@@ -4,8 +4,9 @@
 mod common;
 
 use varmech::integrators::{integrate, General, Method, Options, Trajectory};
+use varmech::model::Lagrangian;
 use varmech::model::{Constrained, Distances};
-use varmech::scenes::{self, LinkedMasses, Pendulum, PointMasses, Problem};
+use varmech::scenes::{self, LinkedMasses, Pendulum, PointMasses, Problem, RigidBody};
 use varmech::Error;
 
 fn run(
@@ -224,15 +225,57 @@ fn the_constrained_del_equations_of_the_trapezoidal_rule_are_rattle() {
         .fold(0.0, f64::max);
     println!("trapezoid on the constraint vs RATTLE over 2000 steps: {gap:.1e}");
     assert!(gap < 1e-12, "{gap:e}");
-    for method in [Method::Midpoint, Method::Galerkin4] {
-        let traj = integrate(&sys, method, &p.initial.q, &p.initial.p, &options, || Ok(())).unwrap();
+    // Galerkin would lose its order with multipliers at the step's ends only, so it is refused.
+    let refused = integrate(&sys, Method::Galerkin4, &p.initial.q, &p.initial.p, &options, || Ok(()))
+        .unwrap_err()
+        .error;
+    assert!(refused.to_string().contains("use trapezoid"), "{refused}");
+}
+
+#[test]
+fn the_rigid_body_in_quaternions_stays_on_the_unit_sphere_at_the_orders_of_its_methods() {
+    let problem = RigidBody::problem();
+    let sys = Constrained {
+        system: General(&problem.system.system),
+        constraints: problem.system.constraints.clone(),
+    };
+    let (q0, p0) = (&problem.initial.q, &problem.initial.p);
+    let run = |method, steps: usize, t_end: f64, save_every| {
+        let options = Options {
+            save_every,
+            ..Options::new(t_end / steps as f64, steps)
+        };
+        integrate(&sys, method, q0, p0, &options, || Ok(())).unwrap_or_else(|f| panic!("{method:?}: {}", f.error))
+    };
+    // Both constraint levels and the energy over 10⁴ steps of h = 0.01.
+    for method in [Method::Trapezoid, Method::Midpoint] {
+        let traj = run(method, 10_000, 100.0, 10);
         let (position, velocity) = (0..traj.len())
             .map(|k| sys.residuals_general(traj.q_at(k), traj.p_at(k)).unwrap())
             .fold((0.0_f64, 0.0_f64), |(a, b), (g, v)| (a.max(g), b.max(v)));
-        println!("{method:?} on the constraint: |g| ≤ {position:.1e}, |Gq̇| ≤ {velocity:.1e}");
+        let e0 = problem.system.system.energy(q0, p0, 0.0).unwrap();
+        let energy = (0..traj.len())
+            .map(|k| (problem.system.system.energy(traj.q_at(k), traj.p_at(k), 0.0).unwrap() - e0).abs())
+            .fold(0.0, f64::max);
+        println!("rigid body, {method:?}: |g| ≤ {position:.1e}, |q·q̇| ≤ {velocity:.1e}, max |ΔE| = {energy:.2e}");
         assert!(
             position <= 1e-14 && velocity <= 1e-14,
             "{method:?}: {position:e}, {velocity:e}"
         );
+        assert!(energy < 1e-3 * e0.abs(), "{method:?}: {energy:e}");
+    }
+    // Order 2 at T = 2, against Richardson's extrapolation of each method at h = 1/20000 and
+    // 1/40000 (error O(h⁴), since both rules are symmetric).
+    for method in [Method::Trapezoid, Method::Midpoint] {
+        let (coarse, fine) = (run(method, 40_000, 2.0, 40_000), run(method, 80_000, 2.0, 80_000));
+        let extrapolate = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(a, b)| (4.0 * b - a) / 3.0).collect::<Vec<_>>();
+        let (q_ref, p_ref) = (
+            extrapolate(coarse.q_at(1), fine.q_at(1)),
+            extrapolate(coarse.p_at(1), fine.p_at(1)),
+        );
+        let errors: Vec<f64> = (0..4)
+            .map(|k| common::final_error(&run(method, 50 << k, 2.0, 50 << k), &q_ref, &p_ref))
+            .collect();
+        common::assert_order(&format!("rigid body, {method:?}"), &errors, 2.0, 0.3);
     }
 }

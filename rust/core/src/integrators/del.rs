@@ -819,8 +819,14 @@ impl<Sc: StepEquations> Del<Sc> {
             let mut scale = 1.0_f64;
             for (j, (x, d)) in self.x.iter_mut().zip(self.residual.iter()).enumerate() {
                 *x -= d;
-                correction = correction.max(d.abs());
-                scale = scale.max((if j < m { 0.0 } else { q[(j - m) % n] } + *x).abs());
+                // A multiplier moves q₁ by about (h²/2)M⁻¹Gᵀλ: its correction counts at that size.
+                let (weight, base) = if j < m {
+                    (0.5 * h * h, 0.0)
+                } else {
+                    (1.0, q[(j - m) % n])
+                };
+                correction = correction.max(weight * d.abs());
+                scale = scale.max(weight * (base + *x).abs());
             }
             residual = self.residual(sys, constraints, q, p, t, h)?;
             if !(correction.is_finite() && residual.is_finite()) {

@@ -15,6 +15,7 @@ mod henon_heiles;
 mod kepler;
 mod nbody;
 mod pendulum;
+mod rigid_body;
 mod spherical_pendulum;
 
 pub use charged_particle::ChargedParticle;
@@ -27,6 +28,7 @@ pub use henon_heiles::HenonHeiles;
 pub use kepler::Kepler;
 pub use nbody::NBody;
 pub use pendulum::Pendulum;
+pub use rigid_body::RigidBody;
 pub use spherical_pendulum::SphericalPendulum;
 
 use crate::model::{Generator, Hessians, Lagrangian, Mass, MechanicalSystem};
