@@ -100,3 +100,21 @@ def test_bad_constraint_closures_are_named():
     )
     with pytest.raises(ValueError, match=r"constraints\(q\) returned 2 values, expected 1"):
         varmech.integrate(wrong, scene.q0, scene.p0, dt=0.1, steps=3)
+
+
+def test_the_rigid_body_in_quaternions_and_its_closure_twin_with_configuration_dependent_mass():
+    scene = scenes.rigid_body()
+    assert scene.model.constraints == 1
+    native = varmech.integrate(scene, dt=0.01, steps=2000, save_every=10)
+    assert native.method == "trapezoid"
+    g, v = native.constraint_residuals()
+    assert np.max(g) <= 1e-14 and np.max(v) <= 1e-14
+    report = varmech.check_conservation(native)
+    assert report.verdict == "bounded" and report.energy.max_error < 1e-3
+    closure = varmech.integrate(examples.closure_of(scene), scene.q0, scene.p0, dt=0.01, steps=300, save_every=10)
+    assert closure.method == "trapezoid"
+    k = len(closure)
+    assert np.max(np.abs(closure.q - native.q[:k])) < 1e-10 and np.max(np.abs(closure.p - native.p[:k])) < 1e-10
+    assert varmech.check_derivatives(examples.rigid_body(), scene.q0).ok
+    with pytest.raises(ValueError, match="^method: rattle does not integrate a general Lagrangian on constraints"):
+        varmech.integrate(scene, dt=0.01, steps=10, method="rattle")

@@ -53,6 +53,8 @@ class NativeModel(_ModelProperties):
     @property
     def constraints(self) -> int: ...
     @property
+    def default_method(self) -> str | None: ...
+    @property
     def gravity(self) -> tuple[float, list[float]] | None:
         """(G, masses) of an N-body scene, None for the others."""
 
@@ -78,13 +80,15 @@ class ClosureConstrained(_ModelProperties):
 
     def __init__(
         self,
-        system: ClosureModel,
+        system: ClosureModel | ClosureNatural,
         count: int,
         constraints: Callable[[FloatArray], Any],
         jacobian: Callable[[FloatArray], Any] | None,
     ) -> None: ...
     @property
     def constraints(self) -> int: ...
+    @property
+    def default_method(self) -> str: ...
 
 class ClosureNatural(_ModelProperties):
     """L = ½q̇ᵀM(q)q̇ − V(q) from Python closures (configuration-dependent mass)."""

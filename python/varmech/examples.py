@@ -199,6 +199,46 @@ def cartesian_pendulum(m: float = 1.0, l: float = 1.0, g: float = 1.0) -> Mechan
     )
 
 
+def _e(q: np.ndarray) -> np.ndarray:
+    """E(q) (3 × 4) with the body angular velocity ω = 2E(q)q̇, scalar part first."""
+    s, v = q[0], q[1:]
+    cross = np.array([[0.0, -v[2], v[1]], [v[2], 0.0, -v[0]], [-v[1], v[0], 0.0]])
+    return np.column_stack([-v, s * np.eye(3) - cross])
+
+
+def rigid_body(inertia: tuple[float, float, float] = (0.5, 0.9, 1.0)) -> MechanicalSystem:
+    """The rigid body in unit quaternions as a natural system on |q| = 1:
+    M(q) = 4EᵀIE + αqqᵀ (α = 4 tr I/3 fills the direction q, which the constraint freezes),
+    U = q₁² − q₂² − q₃² + q₄²."""
+    i = np.diag(inertia)
+    alpha = 4.0 * sum(inertia) / 3.0
+    sign = np.array([1.0, -1.0, -1.0, 1.0])
+
+    def mass(q: np.ndarray) -> np.ndarray:
+        e = _e(q)
+        return 4.0 * e.T @ i @ e + alpha * np.outer(q, q)
+
+    def mass_derivative(q: np.ndarray) -> np.ndarray:
+        e = _e(q)
+        parts = []
+        for k in range(4):
+            ek, unit = _e(np.eye(4)[k]), np.eye(4)[k]
+            parts.append(4.0 * (ek.T @ i @ e + e.T @ i @ ek) + alpha * (np.outer(unit, q) + np.outer(q, unit)))
+        return np.array(parts)
+
+    return MechanicalSystem(
+        4,
+        lambda q: float(sign @ (q * q)),
+        lambda q: 2.0 * sign * q,
+        mass=mass,
+        mass_derivative=mass_derivative,
+        constraints=lambda q: np.array([0.5 * (q @ q - 1.0)]),
+        constraint_jacobian=lambda q: q.reshape(1, 4),
+        constraint_count=1,
+        name="rigid_body (closure)",
+    )
+
+
 def closure_of(scene: Scene) -> MechanicalSystem | Lagrangian:
     """The closure version of a built-in scene (with its default parameters)."""
     gravity = scene.model._core.gravity
@@ -216,4 +256,5 @@ def closure_of(scene: Scene) -> MechanicalSystem | Lagrangian:
         "charged_particle_nonuniform": lambda: charged_particle(kappa=0.25),
         "damped_driven_pendulum": damped_driven_pendulum,
         "cartesian_pendulum": cartesian_pendulum,
+        "rigid_body": rigid_body,
     }[scene.name]()

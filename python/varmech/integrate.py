@@ -182,7 +182,7 @@ def integrate(
         raise TypeError(f"model: expected a varmech model or scene, got {type(model).__name__}")
     n = model.dim
     if method is None:
-        method = "rattle" if model.constraints else "verlet" if model.separable else "midpoint"
+        method = getattr(model._core, "default_method", None) or ("verlet" if model.separable else "midpoint")
     dt = positive("dt", dt)
     t0 = float(t0)
     if not math.isfinite(t0):

@@ -170,8 +170,10 @@ class MechanicalSystem(Model):
     constraints, constraint_jacobian, constraint_count:
         Holonomic constraints g(q) = 0: ``constraints(q) -> array (m,)`` with
         ``constraint_count`` = m, and optionally ``constraint_jacobian(q) -> array (m, n)``, G =
-        ∂g/∂q (central differences of g without it). Such a system is integrated by ``rattle``
-        (the default), ``rattle4`` or ``shake`` only; constant mass only, so far.
+        ∂g/∂q (central differences of g without it). With a constant mass the system is
+        integrated by ``rattle`` (the default), ``rattle4`` or ``shake``; with a ``mass``
+        closure by the constrained DEL equations of ``trapezoid`` (the default; RATTLE's
+        discrete Lagrangian) or ``midpoint``.
     mass_derivative:
         With a ``mass`` closure: ``mass_derivative(q) -> array (n, n, n)`` whose ``[i]`` is
         ∂M/∂qᵢ. Optional: without it, central differences of ``mass`` are used (2n calls
@@ -201,8 +203,6 @@ class MechanicalSystem(Model):
             raise ValueError(f"dim: must be a positive integer, got {dim!r}")
         if (constraints is None) != (constraint_count is None) or (constraint_jacobian is not None and constraints is None):
             raise ValueError("constraints: give constraints(q) with constraint_count (and optionally constraint_jacobian)")
-        if constraints is not None and callable(mass):
-            raise ValueError("constraints: with a constant mass only, so far")
         missing = [what for what, f in (("gradient", gradient), ("mass_derivative", mass_derivative)) if f is None]
         if not callable(mass):
             if mass_derivative is not None:
@@ -226,6 +226,7 @@ class MechanicalSystem(Model):
         self.name = name
         if callable(mass):
             self._core = _core.ClosureNatural(int(dim), mass, potential, gradient, mass_derivative, _specs(symmetries))
+            self._constrain(constraints, constraint_jacobian, constraint_count)
             return
         m = np.array(mass, dtype=float)
         if m.ndim > 2 or (m.ndim >= 1 and any(s != dim for s in m.shape)):
@@ -234,11 +235,15 @@ class MechanicalSystem(Model):
             raise ValueError("mass: must be finite")
         self._core = _core.ClosureModel(int(dim), potential, gradient, m, _specs(symmetries))
         self.mass = m
-        if constraints is not None:
-            count = constraint_count
-            if isinstance(count, bool) or not isinstance(count, (int, np.integer)):
-                raise ValueError(f"constraint_count: must be a positive integer, got {count!r}")
-            self._core = _core.ClosureConstrained(self._core, int(count), constraints, constraint_jacobian)
+        self._constrain(constraints, constraint_jacobian, constraint_count)
+
+    def _constrain(self, constraints, jacobian, count) -> None:
+        """Puts the model on the constraints, if any."""
+        if constraints is None:
+            return
+        if isinstance(count, bool) or not isinstance(count, (int, np.integer)):
+            raise ValueError(f"constraint_count: must be a positive integer, got {count!r}")
+        self._core = _core.ClosureConstrained(self._core, int(count), constraints, jacobian)
 
 
 class Lagrangian(Model):

@@ -195,6 +195,14 @@ def planar_chain(links: int = 8) -> Scene:
     return _scene("planar_chain", f"a planar chain of {links} rigid links", 0.01, {}, links=links)
 
 
+def rigid_body() -> Scene:
+    """A rigid body about a fixed point in unit quaternions (scalar part first), I = (0.5, 0.9,
+    1.0), U = q₁² − q₂² − q₃² + q₄², from q₀ = (0.4, 0.2, 0.4, 0.8) with body angular momentum
+    (0.2, 1, 0.4) (HLW's rigid-body data): configuration-dependent mass on |q| = 1, integrated by
+    the constrained DEL equations of ``trapezoid`` (the default) or ``midpoint``."""
+    return _scene("rigid_body", "a rigid body in unit quaternions on |q| = 1", 0.01, {})
+
+
 CATALOGUE: dict[str, Callable[[], Scene]] = {
     "harmonic_oscillator": harmonic_oscillator,
     "pendulum": pendulum,
@@ -210,6 +218,7 @@ CATALOGUE: dict[str, Callable[[], Scene]] = {
     "cartesian_pendulum": cartesian_pendulum,
     "cartesian_spherical_pendulum": cartesian_spherical_pendulum,
     "planar_chain": planar_chain,
+    "rigid_body": rigid_body,
 }
 
 

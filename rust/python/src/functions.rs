@@ -14,7 +14,7 @@ use crate::convert::{self, rows, slice, trajectory_tuple};
 use crate::errors::{failure_to_pyerr, to_pyerr};
 use crate::model::{
     ClosureConstrained, ClosureConstraints, ClosureLagrangian, ClosureLagrangianSystem, ClosureModel, ClosureNatural,
-    ClosureNaturalSystem, ClosureSystem, Native, NativeModel,
+    ClosureNaturalSystem, ClosureSystem, ConstrainedSystem, Native, NativeModel,
 };
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
@@ -66,6 +66,14 @@ macro_rules! with_system {
                     let $poll = || Python::attach(|py| py.check_signals()).map_err(boxed);
                     $body
                 }),
+                Native::ConstrainedGeneral(scene) => $py.detach(|| {
+                    let $sys = &Constrained {
+                        system: General(&scene.system),
+                        constraints: scene.constraints.clone(),
+                    };
+                    let $poll = || Python::attach(|py| py.check_signals()).map_err(boxed);
+                    $body
+                }),
             }
         } else if let Ok(closure) = $model.cast::<ClosureModel>() {
             let $sys = &ClosureSystem::new($py, closure.get());
@@ -73,12 +81,24 @@ macro_rules! with_system {
             $body
         } else if let Ok(closure) = $model.cast::<ClosureConstrained>() {
             let closure = closure.get();
-            let $sys = &Constrained {
-                system: ClosureSystem::new($py, closure.system()),
-                constraints: ClosureConstraints::new($py, closure),
-            };
             let $poll = || $py.check_signals().map_err(boxed);
-            $body
+            match closure.system() {
+                ConstrainedSystem::Separable(system) => {
+                    let $sys = &Constrained {
+                        system: ClosureSystem::new($py, system.get()),
+                        constraints: ClosureConstraints::new($py, closure),
+                    };
+                    $body
+                }
+                ConstrainedSystem::Natural(system) => {
+                    let natural = Natural::new(ClosureNaturalSystem::new($py, system.get()));
+                    let $sys = &Constrained {
+                        system: General(&natural),
+                        constraints: ClosureConstraints::new($py, closure),
+                    };
+                    $body
+                }
+            }
         } else if let Ok(closure) = $model.cast::<ClosureNatural>() {
             let natural = Natural::new(ClosureNaturalSystem::new($py, closure.get()));
             let $sys = &General(&natural);
@@ -489,6 +509,12 @@ fn scene<'py>(
             scenes::cartesian_spherical_pendulum(),
             Native::Constrained,
             "cartesian_spherical_pendulum",
+        ),
+        "rigid_body" => scene_tuple(
+            py,
+            scenes::RigidBody::problem(),
+            Native::ConstrainedGeneral,
+            "rigid_body",
         ),
         "planar_chain" => scene_tuple(
             py,

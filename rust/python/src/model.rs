@@ -8,10 +8,10 @@ use numpy::{PyArray1, PyArrayDyn, PyArrayMethods};
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use varmech::model::{
-    differenced_jacobian, differenced_kinetic_gradient, finite_difference, Generator, Hessians, HolonomicConstraints,
-    Lagrangian, Mass, MechanicalSystem, NaturalSystem,
+    differenced_jacobian, differenced_kinetic_gradient, finite_difference, Constrained, Distances, Generator, Hessians,
+    HolonomicConstraints, Lagrangian, Mass, MechanicalSystem, NaturalSystem,
 };
-use varmech::scenes::{LagrangianScene, LinkedMasses, Scene};
+use varmech::scenes::{LagrangianScene, LinkedMasses, RigidBody, Scene};
 use varmech::ModelError;
 
 use crate::convert;
@@ -22,6 +22,8 @@ pub enum Native {
     Mechanical(Scene),
     General(LagrangianScene),
     Constrained(LinkedMasses),
+    /// A general Lagrangian on constraints (the rigid body in quaternions).
+    ConstrainedGeneral(Constrained<RigidBody, Distances>),
 }
 
 /// A native scene: every evaluation runs in Rust, with the GIL released.
@@ -41,6 +43,7 @@ impl NativeModel {
             Native::Mechanical(s) => MechanicalSystem::dim(s),
             Native::General(s) => Lagrangian::dim(s),
             Native::Constrained(s) => MechanicalSystem::dim(&s.system),
+            Native::ConstrainedGeneral(s) => Lagrangian::dim(&s.system),
         }
     }
 }
@@ -89,6 +92,17 @@ impl NativeModel {
             Native::Mechanical(s) => s.symmetries().into_iter().map(convert::generator_spec).collect(),
             Native::General(s) => s.symmetries().into_iter().map(convert::generator_spec).collect(),
             Native::Constrained(s) => s.system.symmetries().into_iter().map(convert::generator_spec).collect(),
+            Native::ConstrainedGeneral(_) => Vec::new(),
+        }
+    }
+
+    /// The method `integrate` uses when none is given, for constrained models.
+    #[getter]
+    fn default_method(&self) -> Option<&'static str> {
+        match &self.native {
+            Native::Constrained(_) => Some("rattle"),
+            Native::ConstrainedGeneral(_) => Some("trapezoid"),
+            _ => None,
         }
     }
 
@@ -97,6 +111,7 @@ impl NativeModel {
     fn constraints(&self) -> usize {
         match &self.native {
             Native::Constrained(s) => s.constraints.count(),
+            Native::ConstrainedGeneral(s) => s.constraints.count(),
             _ => 0,
         }
     }
@@ -176,12 +191,13 @@ impl ClosureModel {
     }
 }
 
-/// A [`ClosureModel`] on holonomic constraints given by Python closures
-/// `constraints(q) -> array (m,)` and, optionally, `jacobian(q) -> array (m, n)`; without a
-/// Jacobian, central differences of g are used (2n calls of g per Jacobian).
+/// A closure model (a [`ClosureModel`], or a [`ClosureNatural`] with configuration-dependent
+/// mass) on holonomic constraints given by Python closures `constraints(q) -> array (m,)` and,
+/// optionally, `jacobian(q) -> array (m, n)`; without a Jacobian, central differences of g are
+/// used (2n calls of g per Jacobian).
 #[pyclass(frozen, module = "varmech._core")]
 pub struct ClosureConstrained {
-    system: Py<ClosureModel>,
+    system: ConstrainedSystem,
     count: usize,
     constraints: Py<PyAny>,
     jacobian: Option<Py<PyAny>>,
@@ -192,12 +208,21 @@ impl ClosureConstrained {
     #[new]
     #[pyo3(signature = (system, count, constraints, jacobian))]
     fn new(
-        system: Bound<'_, ClosureModel>,
+        system: Bound<'_, PyAny>,
         count: usize,
         constraints: Bound<'_, PyAny>,
         jacobian: Option<Bound<'_, PyAny>>,
     ) -> PyResult<Self> {
-        let dim = system.get().dim;
+        let system = if let Ok(s) = system.cast::<ClosureModel>() {
+            ConstrainedSystem::Separable(s.clone().unbind())
+        } else if let Ok(s) = system.cast::<ClosureNatural>() {
+            ConstrainedSystem::Natural(s.clone().unbind())
+        } else {
+            return Err(PyTypeError::new_err(
+                "system: expected a ClosureModel or a ClosureNatural",
+            ));
+        };
+        let dim = system.dim();
         check_closures(
             dim,
             [
@@ -212,7 +237,7 @@ impl ClosureConstrained {
             )));
         }
         Ok(ClosureConstrained {
-            system: system.unbind(),
+            system,
             count,
             constraints: constraints.unbind(),
             jacobian: jacobian.map(Bound::unbind),
@@ -221,12 +246,22 @@ impl ClosureConstrained {
 
     #[getter]
     pub fn dim(&self) -> usize {
-        self.system.get().dim
+        self.system.dim()
     }
 
     #[getter]
     fn constraints(&self) -> usize {
         self.count
+    }
+
+    /// RATTLE for a separable system, the trapezoidal rule's constrained DEL equations (RATTLE's
+    /// discrete Lagrangian) for one with configuration-dependent mass.
+    #[getter]
+    fn default_method(&self) -> &'static str {
+        match self.system {
+            ConstrainedSystem::Separable(_) => "rattle",
+            ConstrainedSystem::Natural(_) => "trapezoid",
+        }
     }
 
     #[getter]
@@ -250,8 +285,24 @@ impl ClosureConstrained {
 }
 
 impl ClosureConstrained {
-    pub fn system(&self) -> &ClosureModel {
-        self.system.get()
+    pub fn system(&self) -> &ConstrainedSystem {
+        &self.system
+    }
+}
+
+/// The unconstrained model under a [`ClosureConstrained`]: RATTLE integrates a separable one,
+/// the constrained DEL equations a natural one.
+pub enum ConstrainedSystem {
+    Separable(Py<ClosureModel>),
+    Natural(Py<ClosureNatural>),
+}
+
+impl ConstrainedSystem {
+    fn dim(&self) -> usize {
+        match self {
+            ConstrainedSystem::Separable(s) => s.get().dim,
+            ConstrainedSystem::Natural(s) => s.get().dim,
+        }
     }
 }
 
