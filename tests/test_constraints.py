@@ -118,3 +118,12 @@ def test_the_rigid_body_in_quaternions_and_its_closure_twin_with_configuration_d
     assert varmech.check_derivatives(examples.rigid_body(), scene.q0).ok
     with pytest.raises(ValueError, match="^method: rattle does not integrate a general Lagrangian on constraints"):
         varmech.integrate(scene, dt=0.01, steps=10, method="rattle")
+
+
+@pytest.mark.parametrize("name, method", [("cartesian_pendulum", "rattle"), ("cartesian_pendulum", "shake"), ("rigid_body", "trapezoid")])
+def test_a_constraint_solve_that_fails_raises_convergence_error_with_the_partial_trajectory(name, method):
+    scene = scenes.get(name)
+    with pytest.raises(varmech.ConvergenceError) as info:
+        varmech.integrate(scene, dt=scene.dt, steps=100, method=method, newton_max_iterations=1, newton_tolerance=1e-16)
+    err = info.value
+    assert err.step == 1 and err.time == 0.0 and len(err.partial) == 1
