@@ -15,9 +15,29 @@ pub trait Integrable {
     /// Whether `method` applies to this system.
     fn check_method(&self, method: Method) -> Result<(), Error>;
 
-    /// Whether (q₀, p₀) is admissible initial data (on the constraints, for constrained
-    /// systems); `q0` and `p0` are finite and of the right length here.
-    fn check_initial(&self, _q0: &[f64], _p0: &[f64]) -> Result<(), Error> {
+    /// Whether (q₀, p₀) is admissible initial data: for constrained systems |g(q₀)|∞ and
+    /// |G(q₀)q̇₀|∞ within 1e-10 (relative to the state's size), since the methods hold the
+    /// constraints where they start and starting off them is a user error. `q0` and `p0` are
+    /// finite and of the right length here.
+    fn check_initial(&self, q0: &[f64], p0: &[f64]) -> Result<(), Error> {
+        let Some(residuals) = self.constraint_residuals(q0, p0) else {
+            return Ok(());
+        };
+        let (position, velocity) =
+            residuals.map_err(|e| Error::invalid("q0", format!("the constraints failed to evaluate: {e}")))?;
+        let scale = q0.iter().chain(p0).fold(1.0_f64, |m, x| m.max(x.abs()));
+        if position > 1e-10 * scale {
+            return Err(Error::invalid(
+                "q0",
+                format!("is off the constraints: |g(q0)| = {position:.3e}; project the initial state first"),
+            ));
+        }
+        if velocity > 1e-10 * scale {
+            return Err(Error::invalid(
+                "p0",
+                format!("is off the hidden constraint: |G(q0)M⁻¹p0| = {velocity:.3e}; project the initial state first"),
+            ));
+        }
         Ok(())
     }
 
@@ -152,15 +172,6 @@ impl<S: MechanicalSystem, C: HolonomicConstraints> Integrable for Constrained<S,
         Err(Error::invalid("method", reason))
     }
 
-    /// |g(q₀)|∞ and |G(q₀)M⁻¹p₀|∞ within 1e-10 (relative to the state's size): RATTLE holds
-    /// the constraints where they start, and starting off them is a user error.
-    fn check_initial(&self, q0: &[f64], p0: &[f64]) -> Result<(), Error> {
-        let residuals = self
-            .residuals(q0, p0)
-            .map_err(|e| Error::invalid("q0", format!("the constraints failed to evaluate: {e}")))?;
-        consistent(q0, p0, residuals)
-    }
-
     fn increment(
         &self,
         integrator: &mut Integrator,
@@ -213,13 +224,6 @@ impl<L: Lagrangian, C: HolonomicConstraints> Integrable for Constrained<General<
         Err(Error::invalid("method", reason))
     }
 
-    fn check_initial(&self, q0: &[f64], p0: &[f64]) -> Result<(), Error> {
-        let residuals = self
-            .residuals_general(q0, p0)
-            .map_err(|e| Error::invalid("q0", format!("the constraints failed to evaluate: {e}")))?;
-        consistent(q0, p0, residuals)
-    }
-
     fn increment(
         &self,
         integrator: &mut Integrator,
@@ -259,24 +263,6 @@ impl<L: Lagrangian, C: HolonomicConstraints> Constrained<General<'_, L>, C> {
         let hidden = jac * nalgebra::DVector::from_column_slice(&v);
         Ok((g.iter().fold(0.0, |a, x| a.max(x.abs())), hidden.amax()))
     }
-}
-
-/// Initial data within 1e-10 (relative to the state's size) of both constraint levels.
-fn consistent(q0: &[f64], p0: &[f64], (position, velocity): (f64, f64)) -> Result<(), Error> {
-    let scale = q0.iter().chain(p0).fold(1.0_f64, |m, x| m.max(x.abs()));
-    if position > 1e-10 * scale {
-        return Err(Error::invalid(
-            "q0",
-            format!("is off the constraints: |g(q0)| = {position:.3e}; project the initial state first"),
-        ));
-    }
-    if velocity > 1e-10 * scale {
-        return Err(Error::invalid(
-            "p0",
-            format!("is off the hidden constraint: |G(q0)M⁻¹p0| = {velocity:.3e}; project the initial state first"),
-        ));
-    }
-    Ok(())
 }
 
 /// Options of a fixed-step run.
