@@ -158,6 +158,28 @@ impl Rattle {
         }
     }
 
+    /// out = αAB, a column at a time. Not `gemm`: nalgebra hands products of dynamic matrices
+    /// larger than 5 × 5 to matrixmultiply, which allocates its packing buffers on every call
+    /// (three times a step on a chain of eight links). The sums are `gemm`'s own below that
+    /// size, term by term in the same order, so small systems step bit for bit as before. Terms
+    /// with a zero factor of B are skipped: B is M⁻¹Gᵀ, and a constraint moves few coordinates
+    /// (four of a chain's 2N), which makes this as fast as matrixmultiply on long chains.
+    fn product(out: &mut DMatrix<f64>, alpha: f64, a: &DMatrix<f64>, b: &DMatrix<f64>) {
+        let (m, n) = a.shape();
+        let (a, b, out) = (a.as_slice(), b.as_slice(), out.as_mut_slice());
+        for (column, b) in out.chunks_exact_mut(m).zip(b.chunks_exact(n)) {
+            column.fill(0.0);
+            for (a, &factor) in a.chunks_exact(m).zip(b) {
+                if factor == 0.0 {
+                    continue;
+                }
+                for (y, &x) in column.iter_mut().zip(a) {
+                    *y += alpha * x * factor;
+                }
+            }
+        }
+    }
+
     /// One RATTLE (or SHAKE) step of size h from (q0, p0) into (dq_stage, dp_stage).
     fn step<S, C>(&mut self, sys: &S, constraints: &C, q0: &[f64], p0: &[f64], h: f64) -> Result<(), StepError>
     where
@@ -216,7 +238,7 @@ impl Rattle {
             self.iterations += 1;
             // J = −(h²/2)G(q₁)M⁻¹G₀ᵀ, exact.
             constraints.jacobian(&self.q1, &mut self.jac1)?;
-            self.newton.gemm(-c, &self.jac1, &self.minv_jac0t, 0.0);
+            Self::product(&mut self.newton, -c, &self.jac1, &self.minv_jac0t);
             if lu_in_place(&mut self.newton, &mut self.pivots).is_none() {
                 return Err(StepError::Convergence {
                     residual,
@@ -279,7 +301,7 @@ impl Rattle {
         self.g.fill(0.0);
         if !self.shake && m > 0 {
             Self::minv_transpose(sys, &self.jac1, &mut self.row, &mut self.column, &mut self.minv_jac1t);
-            self.newton.gemm(0.5 * h, &self.jac1, &self.minv_jac1t, 0.0);
+            Self::product(&mut self.newton, 0.5 * h, &self.jac1, &self.minv_jac1t);
             sys.mass().velocity(&self.half, &mut self.column);
             for k in 0..m {
                 self.g[k] = self.jac1.row(k).iter().zip(&self.column).map(|(a, b)| a * b).sum();
