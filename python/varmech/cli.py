@@ -23,6 +23,9 @@ TOUR = [
     ("spherical_pendulum", ("midpoint", "trapezoid"), 1000.0),
     ("charged_particle", ("midpoint", "galerkin4"), 1000.0),
     ("charged_particle_nonuniform", ("midpoint", "trapezoid"), 1000.0),
+    ("cartesian_pendulum", ("rattle", "shake"), 1000.0),
+    ("planar_chain", ("rattle", "rattle4"), 100.0),
+    ("rigid_body", ("trapezoid", "midpoint"), 100.0),
 ]
 
 
