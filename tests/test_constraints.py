@@ -118,6 +118,8 @@ def test_the_rigid_body_in_quaternions_and_its_closure_twin_with_configuration_d
     assert varmech.check_derivatives(examples.rigid_body(), scene.q0).ok
     with pytest.raises(ValueError, match="^method: rattle does not integrate a general Lagrangian on constraints"):
         varmech.integrate(scene, dt=0.01, steps=10, method="rattle")
+    with pytest.raises(ValueError, match="^model: projection is implemented for constant mass only"):
+        varmech.project(scene.model, scene.q0, scene.p0)
 
 
 @pytest.mark.parametrize("name, method", [("cartesian_pendulum", "rattle"), ("cartesian_pendulum", "shake"), ("rigid_body", "trapezoid")])

@@ -248,6 +248,11 @@ impl<L: Lagrangian, C: HolonomicConstraints> Integrable for Constrained<General<
     fn constraint_residuals(&self, q: &[f64], p: &[f64]) -> Option<Result<(f64, f64), ModelError>> {
         Some(self.residuals_general(q, p))
     }
+
+    fn project(&self, _q: &[f64], _p: &[f64]) -> Option<Result<PhaseState, Error>> {
+        let reason = "projection is implemented for constant mass only; start this model on its constraints";
+        Some(Err(Error::invalid("model", reason)))
+    }
 }
 
 impl<L: Lagrangian, C: HolonomicConstraints> Constrained<General<'_, L>, C> {
