@@ -4,7 +4,7 @@
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
 
-use varmech::integrators::{integrate, Method, Options};
+use varmech::integrators::{integrate, Integrable, Method, Options};
 use varmech::scenes::{self, NBody};
 
 struct Counting;
@@ -32,6 +32,15 @@ unsafe impl GlobalAlloc for Counting {
 #[global_allocator]
 static GLOBAL: Counting = Counting;
 
+/// Allocations made by one run of `method` on `sys` from (q0, p0).
+fn counted<S: Integrable>(sys: &S, method: Method, q0: &[f64], p0: &[f64], options: &Options) -> usize {
+    let before = allocated();
+    let traj = integrate(sys, method, q0, p0, options, || Ok(())).unwrap();
+    let count = allocated() - before;
+    assert_eq!(traj.steps, options.steps);
+    count
+}
+
 fn allocations(method: Method, steps: usize, max_energy_error: Option<f64>) -> usize {
     let problem = NBody::outer_solar_system();
     let options = Options {
@@ -39,19 +48,13 @@ fn allocations(method: Method, steps: usize, max_energy_error: Option<f64>) -> u
         max_energy_error,
         ..Options::new(10.0, steps)
     };
-    let before = allocated();
-    let traj = integrate(
+    counted(
         &problem.system,
         method,
         &problem.initial.q,
         &problem.initial.p,
         &options,
-        || Ok(()),
     )
-    .unwrap();
-    let count = allocated() - before;
-    assert_eq!(traj.steps, steps);
-    count
 }
 
 #[test]
@@ -86,19 +89,13 @@ fn constrained_allocations(method: Method, steps: usize, max_energy_error: Optio
         options.newton.tolerance = 1e-10;
         options.newton.max_iterations = 1_000;
     }
-    let before = allocated();
-    let traj = integrate(
+    counted(
         &problem.system,
         method,
         &problem.initial.q,
         &problem.initial.p,
         &options,
-        || Ok(()),
     )
-    .unwrap();
-    let count = allocated() - before;
-    assert_eq!(traj.steps, steps);
-    count
 }
 
 #[test]
