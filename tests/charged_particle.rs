@@ -6,24 +6,13 @@
 mod common;
 
 use varmech::diagnostics::{EnergyStatistics, InvariantStatistics, Verdict};
-use varmech::integrators::{integrate, General, Method, Options, Trajectory};
+use varmech::integrators::{Method, Trajectory};
 use varmech::model::Lagrangian;
 use varmech::scenes::{ChargedParticle, Problem};
 
 fn run(problem: &Problem<ChargedParticle>, method: Method, h: f64, steps: usize, save_every: usize) -> Trajectory {
-    let options = Options {
-        save_every,
-        ..Options::new(h, steps)
-    };
-    integrate(
-        &General(&problem.system),
-        method,
-        &problem.initial.q,
-        &problem.initial.p,
-        &options,
-        || Ok(()),
-    )
-    .unwrap_or_else(|f| panic!("{method:?} failed: {}", f.error))
+    common::run_general(&problem.system, &problem.initial, method, h, steps, save_every)
+        .unwrap_or_else(|e| panic!("{method:?} failed: {e}"))
 }
 
 /// The largest |a − b| over all saved positions of two runs.

@@ -341,17 +341,13 @@ fn spherical_pendulum_conserves_its_azimuthal_momentum_and_reaches_the_reference
     let (reference, _) = problem.reference.as_ref().unwrap();
     let cyclic = problem.system.symmetries()[0];
     let run = |method, steps: usize, t_end: f64, save_every| {
-        let options = Options {
-            save_every,
-            ..Options::new(t_end / steps as f64, steps)
-        };
-        integrate(
-            &General(&problem.system),
+        common::run_general(
+            &problem.system,
+            &problem.initial,
             method,
-            &problem.initial.q,
-            &problem.initial.p,
-            &options,
-            || Ok(()),
+            t_end / steps as f64,
+            steps,
+            save_every,
         )
         .unwrap()
     };

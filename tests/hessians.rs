@@ -1,7 +1,9 @@
 //! Exact second derivatives: where a model supplies ∂²L/∂q², ∂²L/∂q∂q̇ and ∂²L/∂q̇², Newton's
 //! Jacobian of the DEL equations is assembled from them instead of by differences.
 
-use varmech::integrators::{integrate, General, Method, Options, Trajectory};
+mod common;
+
+use varmech::integrators::{Method, Trajectory};
 use varmech::model::{Hessians, Lagrangian};
 use varmech::scenes::DoublePendulum;
 use varmech::ModelError;
@@ -31,20 +33,8 @@ impl Lagrangian for FirstDerivativesOnly {
 type Gradient<'a> = &'a dyn Fn(&[f64], &[f64], &mut [f64]);
 
 fn run<L: Lagrangian>(sys: &L, method: Method) -> Trajectory {
-    let problem = DoublePendulum::problem();
-    let options = Options {
-        save_every: 500,
-        ..Options::new(0.01, 500)
-    };
-    integrate(
-        &General(sys),
-        method,
-        &problem.initial.q,
-        &problem.initial.p,
-        &options,
-        || Ok(()),
-    )
-    .unwrap_or_else(|f| panic!("{method:?}: {}", f.error))
+    common::run_general(sys, &DoublePendulum::problem().initial, method, 0.01, 500, 500)
+        .unwrap_or_else(|e| panic!("{method:?}: {e}"))
 }
 
 #[test]

@@ -1,9 +1,10 @@
 //! Helpers shared by the integration tests.
 #![allow(dead_code)]
 
-use varmech::integrators::{integrate, Method, Options, Trajectory};
-use varmech::model::MechanicalSystem;
-use varmech::scenes::Problem;
+use varmech::integrators::{integrate, General, Method, Options, Trajectory};
+use varmech::model::{Lagrangian, MechanicalSystem};
+use varmech::scenes::{Problem, State};
+use varmech::Error;
 
 /// Integrates `problem` from its initial state with `steps` steps to `t_end`, keeping every
 /// `save_every`-th state.
@@ -55,4 +56,21 @@ pub fn assert_order(what: &str, errors: &[f64], order: f64, tolerance: f64) -> V
         "{what}: orders {orders:.3?} (errors {errors:?}), expected {order} ± {tolerance}"
     );
     orders
+}
+
+/// Integrates the general Lagrangian `sys` from `initial` with `steps` steps of size h, keeping
+/// every `save_every`-th state.
+pub fn run_general<L: Lagrangian>(
+    sys: &L,
+    initial: &State,
+    method: Method,
+    h: f64,
+    steps: usize,
+    save_every: usize,
+) -> Result<Trajectory, Error> {
+    let options = Options {
+        save_every,
+        ..Options::new(h, steps)
+    };
+    integrate(&General(sys), method, &initial.q, &initial.p, &options, || Ok(())).map_err(|f| f.error)
 }
