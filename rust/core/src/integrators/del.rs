@@ -877,7 +877,7 @@ impl<Sc: StepEquations> Del<Sc> {
         let (n, m) = (q.len(), self.m);
         let u = self.x.len() - m;
         // The scheme's own residual: its last block holds (h/2)G(q₀)ᵀλ at the solution.
-        for j in 0..n {
+        for j in (0..n).filter(|_| m > 0) {
             let force: f64 = (0..m).map(|k| self.multipliers.g0[(k, j)] * self.x[k]).sum();
             self.residual[u - n + j] += 0.5 * h * force;
         }
