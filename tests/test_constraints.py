@@ -118,8 +118,10 @@ def test_the_rigid_body_in_quaternions_and_its_closure_twin_with_configuration_d
     assert varmech.check_derivatives(examples.rigid_body(), scene.q0).ok
     with pytest.raises(ValueError, match="^method: rattle does not integrate a general Lagrangian on constraints"):
         varmech.integrate(scene, dt=0.01, steps=10, method="rattle")
-    with pytest.raises(ValueError, match="^model: projection is implemented for constant mass only"):
-        varmech.project(scene.model, scene.q0, scene.p0)
+    # Projection with M(q): q back on |q| = 1, p on the hidden constraint q·q̇ = 0.
+    q, p = varmech.project(scene.model, 1.01 * scene.q0, scene.p0 + 0.1)
+    g, v = varmech.integrate(scene.model, q, p, dt=0.01, steps=2).constraint_residuals()
+    assert g[0] <= 1e-15 and v[0] <= 1e-15
 
 
 @pytest.mark.parametrize("name, method", [("cartesian_pendulum", "rattle"), ("cartesian_pendulum", "shake"), ("rigid_body", "trapezoid")])

@@ -3,7 +3,7 @@ use std::time::{Duration, Instant};
 use super::{compensated, Integrator, Method, NewtonOptions, StepError};
 use crate::diagnostics::hamiltonian;
 use crate::error::check_vector;
-use crate::model::{Constrained, HolonomicConstraints, Lagrangian, MechanicalSystem, PhaseState};
+use crate::model::{self, Constrained, HolonomicConstraints, Lagrangian, MechanicalSystem, PhaseState};
 use crate::{Error, ModelError};
 
 /// What the driver integrates: separable mechanical systems take every method; a general
@@ -249,24 +249,34 @@ impl<L: Lagrangian, C: HolonomicConstraints> Integrable for Constrained<General<
         Some(self.residuals_general(q, p))
     }
 
-    fn project(&self, _q: &[f64], _p: &[f64]) -> Option<Result<PhaseState, Error>> {
-        let reason = "projection is implemented for constant mass only; start this model on its constraints";
-        Some(Err(Error::invalid("model", reason)))
+    fn project(&self, q: &[f64], p: &[f64]) -> Option<Result<PhaseState, Error>> {
+        Some(self.project_general(q, p))
     }
 }
 
 impl<L: Lagrangian, C: HolonomicConstraints> Constrained<General<'_, L>, C> {
-    /// (|g(q)|∞, |G(q)q̇(q, p)|∞), with q̇ from the inverse Legendre transform.
+    /// q̇(q, p), the inverse Legendre transform.
+    fn velocity(&self) -> impl Fn(&[f64], &[f64], &mut [f64]) -> Result<(), ModelError> + '_ {
+        |q, p, v| self.system.0.velocity(q, p, 0.0, v)
+    }
+
+    /// (|g(q)|∞, |G(q)q̇(q, p)|∞).
     pub fn residuals_general(&self, q: &[f64], p: &[f64]) -> Result<(f64, f64), ModelError> {
-        let (m, n) = (self.constraints.count(), q.len());
-        let mut g = vec![0.0; m];
-        self.constraints.residual(q, &mut g)?;
-        let mut jac = nalgebra::DMatrix::zeros(m, n);
-        self.constraints.jacobian(q, &mut jac)?;
-        let mut v = vec![0.0; n];
-        self.system.0.velocity(q, p, 0.0, &mut v)?;
-        let hidden = jac * nalgebra::DVector::from_column_slice(&v);
-        Ok((g.iter().fold(0.0, |a, x| a.max(x.abs())), hidden.amax()))
+        model::residuals(&self.constraints, &self.velocity(), q, p)
+    }
+
+    /// The nearest consistent state, with M(q)⁻¹x = q̇(q, x) − q̇(q, 0) (exact for L quadratic
+    /// in q̇, whose inverse Legendre transform is affine in p).
+    pub fn project_general(&self, q0: &[f64], p0: &[f64]) -> Result<PhaseState, Error> {
+        let velocity = self.velocity();
+        let minv = |q: &[f64], x: &[f64], out: &mut [f64]| {
+            let mut rest = vec![0.0; x.len()];
+            velocity(q, &vec![0.0; x.len()], &mut rest)?;
+            velocity(q, x, out)?;
+            out.iter_mut().zip(&rest).for_each(|(o, r)| *o -= r);
+            Ok(())
+        };
+        model::project(&self.constraints, &minv, &velocity, q0, p0)
     }
 }
 

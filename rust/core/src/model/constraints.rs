@@ -124,72 +124,116 @@ pub struct Constrained<S, C> {
     pub constraints: C,
 }
 
-impl<S: MechanicalSystem, C: HolonomicConstraints> Constrained<S, C> {
-    /// G(q) and M⁻¹G(q)ᵀ, allocated (for diagnostics and set-up, not the step loop).
-    fn jacobians(&self, q: &[f64]) -> Result<(DMatrix<f64>, DMatrix<f64>), ModelError> {
-        let (m, n) = (self.constraints.count(), q.len());
-        let mut jac = DMatrix::zeros(m, n);
-        self.constraints.jacobian(q, &mut jac)?;
-        let mut minv_t = DMatrix::zeros(n, m);
-        let mut column = vec![0.0; n];
-        for k in 0..m {
-            let row: Vec<f64> = jac.row(k).iter().copied().collect();
-            self.system.mass().velocity(&row, &mut column);
-            minv_t.column_mut(k).copy_from_slice(&column);
+/// An action x ↦ f(q, x) written into `out`: M(q)⁻¹x, or the inverse Legendre transform.
+pub type Action<'a> = &'a dyn Fn(&[f64], &[f64], &mut [f64]) -> Result<(), ModelError>;
+
+/// G(q) and W = M(q)⁻¹G(q)ᵀ (n × m), allocated (for diagnostics and set-up, not the step loop).
+fn jacobians<C: HolonomicConstraints + ?Sized>(
+    constraints: &C,
+    minv: Action<'_>,
+    q: &[f64],
+) -> Result<(DMatrix<f64>, DMatrix<f64>), ModelError> {
+    let (m, n) = (constraints.count(), q.len());
+    let mut jac = DMatrix::zeros(m, n);
+    constraints.jacobian(q, &mut jac)?;
+    let mut w = DMatrix::zeros(n, m);
+    let mut column = vec![0.0; n];
+    for k in 0..m {
+        let row: Vec<f64> = jac.row(k).iter().copied().collect();
+        minv(q, &row, &mut column)?;
+        w.column_mut(k).copy_from_slice(&column);
+    }
+    Ok((jac, w))
+}
+
+/// The constraint residuals (|g(q)|∞, |G(q)q̇|∞) at one state, q̇ = `velocity`(q, p).
+pub fn residuals<C: HolonomicConstraints + ?Sized>(
+    constraints: &C,
+    velocity: Action<'_>,
+    q: &[f64],
+    p: &[f64],
+) -> Result<(f64, f64), ModelError> {
+    let (m, n) = (constraints.count(), q.len());
+    let mut g = vec![0.0; m];
+    constraints.residual(q, &mut g)?;
+    let mut jac = DMatrix::zeros(m, n);
+    constraints.jacobian(q, &mut jac)?;
+    let mut v = vec![0.0; n];
+    velocity(q, p, &mut v)?;
+    let hidden = jac * DVector::from_column_slice(&v);
+    Ok((g.iter().fold(0.0, |a, x| a.max(x.abs())), hidden.amax()))
+}
+
+/// The nearest consistent state: q on g = 0 by Newton's method along W = M⁻¹Gᵀ (the nearest
+/// point in the kinetic metric, to first order), then p ← p − Gᵀμ with (GW)μ = Gq̇(q, p), the
+/// M-orthogonal projection onto Gq̇ = 0 (exact when q̇ is affine in p, as for every L quadratic
+/// in q̇). `minv` applies M(q)⁻¹, `velocity` is the inverse Legendre transform. Fails if Newton
+/// does not converge (no point of the constraints near q) or GW is singular.
+pub fn project<C: HolonomicConstraints + ?Sized>(
+    constraints: &C,
+    minv: Action<'_>,
+    velocity: Action<'_>,
+    q0: &[f64],
+    p0: &[f64],
+) -> Result<PhaseState, Error> {
+    let model = |e: ModelError| Error::invalid("q0", format!("the constraints failed to evaluate: {e}"));
+    let singular = || Error::invalid("q0", "the constraints are not independent here (G M⁻¹ Gᵀ is singular)");
+    let m = constraints.count();
+    let mut q = DVector::from_column_slice(q0);
+    let mut g = vec![0.0; m];
+    let scale = q0.iter().fold(1.0_f64, |a, x| a.max(x.abs()));
+    let mut converged = false;
+    for _ in 0..50 {
+        constraints.residual(q.as_slice(), &mut g).map_err(model)?;
+        let (jac, w) = jacobians(constraints, minv, q.as_slice()).map_err(model)?;
+        let step = (&jac * &w)
+            .lu()
+            .solve(&DVector::from_column_slice(&g))
+            .ok_or_else(singular)?;
+        let delta = &w * step;
+        q -= &delta;
+        if !q.iter().all(|x| x.is_finite()) {
+            break;
         }
-        Ok((jac, minv_t))
+        if delta.amax() <= 4.0 * f64::EPSILON * scale {
+            converged = true;
+            break;
+        }
+    }
+    if !converged {
+        return Err(Error::invalid(
+            "q0",
+            "no point of the constraints near q0 (Newton's projection failed)",
+        ));
+    }
+    let (jac, w) = jacobians(constraints, minv, q.as_slice()).map_err(model)?;
+    let mut v = vec![0.0; q.len()];
+    velocity(q.as_slice(), p0, &mut v).map_err(model)?;
+    let mu = (&jac * &w)
+        .lu()
+        .solve(&(&jac * DVector::from_column_slice(&v)))
+        .ok_or_else(singular)?;
+    let p = DVector::from_column_slice(p0) - jac.transpose() * mu;
+    Ok((q.as_slice().to_vec(), p.as_slice().to_vec()))
+}
+
+impl<S: MechanicalSystem, C: HolonomicConstraints> Constrained<S, C> {
+    /// q̇ = M⁻¹p, the constant mass's inverse.
+    fn minv(&self) -> impl Fn(&[f64], &[f64], &mut [f64]) -> Result<(), ModelError> + '_ {
+        |_q, x, out| {
+            self.system.mass().velocity(x, out);
+            Ok(())
+        }
     }
 
     /// The constraint residuals (|g(q)|∞, |G(q)M⁻¹p|∞) at one state.
     pub fn residuals(&self, q: &[f64], p: &[f64]) -> Result<(f64, f64), ModelError> {
-        let mut g = vec![0.0; self.constraints.count()];
-        self.constraints.residual(q, &mut g)?;
-        let (_, minv_t) = self.jacobians(q)?;
-        let hidden = minv_t.transpose() * DVector::from_column_slice(p);
-        Ok((g.iter().fold(0.0, |a, x| a.max(x.abs())), hidden.amax()))
+        residuals(&self.constraints, &self.minv(), q, p)
     }
 
-    /// The nearest consistent state: q on g = 0 by Newton's method along M⁻¹Gᵀ (the nearest
-    /// point in the kinetic metric, to first order), then p projected onto G(q)M⁻¹p = 0
-    /// M-orthogonally, p ← p − Gᵀ(GM⁻¹Gᵀ)⁻¹GM⁻¹p. Fails if Newton does not converge (no point
-    /// of the constraints near q) or GM⁻¹Gᵀ is singular.
+    /// The nearest consistent state (see [`project`]).
     pub fn project(&self, q0: &[f64], p0: &[f64]) -> Result<PhaseState, Error> {
-        let model = |e: ModelError| Error::invalid("q0", format!("the constraints failed to evaluate: {e}"));
-        let m = self.constraints.count();
-        let mut q = DVector::from_column_slice(q0);
-        let mut g = vec![0.0; m];
-        let scale = q0.iter().fold(1.0_f64, |a, x| a.max(x.abs()));
-        let mut converged = false;
-        for _ in 0..50 {
-            self.constraints.residual(q.as_slice(), &mut g).map_err(model)?;
-            let (jac, minv_t) = self.jacobians(q.as_slice()).map_err(model)?;
-            let schur = (&jac * &minv_t).lu();
-            let step = schur.solve(&DVector::from_column_slice(&g)).ok_or_else(|| {
-                Error::invalid("q0", "the constraints are not independent here (G M⁻¹ Gᵀ is singular)")
-            })?;
-            let delta = &minv_t * step;
-            q -= &delta;
-            if !q.iter().all(|x| x.is_finite()) {
-                break;
-            }
-            if delta.amax() <= 4.0 * f64::EPSILON * scale {
-                converged = true;
-                break;
-            }
-        }
-        if !converged {
-            return Err(Error::invalid(
-                "q0",
-                "no point of the constraints near q0 (Newton's projection failed)",
-            ));
-        }
-        let (jac, minv_t) = self.jacobians(q.as_slice()).map_err(model)?;
-        let p = DVector::from_column_slice(p0);
-        let mu = (&jac * &minv_t)
-            .lu()
-            .solve(&(minv_t.transpose() * &p))
-            .ok_or_else(|| Error::invalid("q0", "the constraints are not independent here (G M⁻¹ Gᵀ is singular)"))?;
-        let p = p - jac.transpose() * mu;
-        Ok((q.as_slice().to_vec(), p.as_slice().to_vec()))
+        let minv = self.minv();
+        project(&self.constraints, &minv, &minv, q0, p0)
     }
 }

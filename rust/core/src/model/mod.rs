@@ -18,7 +18,10 @@ mod mechanical;
 mod natural;
 mod symmetry;
 
-pub use constraints::{differenced_jacobian, Anchor, Constrained, Distances, HolonomicConstraints, Link, PhaseState};
+pub use constraints::{
+    differenced_jacobian, project, residuals, Action, Anchor, Constrained, Distances, HolonomicConstraints, Link,
+    PhaseState,
+};
 pub use lagrangian::{Hessians, Lagrangian};
 pub use mass::Mass;
 pub use mechanical::MechanicalSystem;
