@@ -23,6 +23,7 @@ from .conservation import ConservationReport, EnergyReport, MomentumReport, chec
 from .derivatives import DerivativeCheck, check_derivatives
 from .integrate import Trajectory, integrate, symplecticity_defect
 from .methods import MethodInfo, methods
+from .reduction import cyclic_coordinates
 from .model import Cyclic, Lagrangian, MechanicalSystem, Model, NativeSystem, Rotation, Translation
 from . import scenes
 
@@ -32,6 +33,7 @@ __all__ = [
     "ConservationReport",
     "ConvergenceError",
     "Cyclic",
+    "cyclic_coordinates",
     "DerivativeCheck",
     "DivergenceError",
     "EnergyReport",

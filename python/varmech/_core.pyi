@@ -142,8 +142,9 @@ def integrate(
 def energy(model: Model, t: FloatArray, q: FloatArray, p: FloatArray) -> FloatArray:
     """The energy function p·q̇ − L at each state."""
 
-def legendre(model: Model, t: FloatArray, q: FloatArray, x: FloatArray, inverse: bool) -> FloatArray:
-    """p = ∂L/∂q̇(q, x, t) at each state, or with ``inverse`` the velocities q̇ with ∂L/∂q̇ = x."""
+def derivative(model: Model, what: str, t: FloatArray, q: FloatArray, x: FloatArray) -> FloatArray:
+    """At each state: ``"momentum"`` p = ∂L/∂q̇(q, x, t), ``"velocity"`` the q̇ with
+    ∂L/∂q̇ = x, or ``"dl_dq"`` ∂L/∂q(q, x, t)."""
 
 def momentum(generator: GeneratorSpec, q: FloatArray, p: FloatArray) -> FloatArray: ...
 def energy_statistics(t: FloatArray, h: FloatArray) -> dict[str, Any]: ...

@@ -63,7 +63,7 @@ class Trajectory:
     def v(self) -> np.ndarray:
         """Velocities q̇ (with ∂L/∂q̇ = p; M⁻¹p for mechanical systems), shape (N, n)."""
         if self._v is None:
-            self._v = _core.legendre(self.model._core, self.t, self.q, self.p, True)
+            self._v = _core.derivative(self.model._core, "velocity", self.t, self.q, self.p)
         return self._v
 
     def energy(self) -> np.ndarray:

@@ -120,18 +120,18 @@ class Model:
     def velocity(self, q: ArrayLike, p: ArrayLike, t: ArrayLike = 0.0) -> np.ndarray:
         """q̇ with ∂L/∂q̇(q, q̇, t) = p (M⁻¹p for mechanical systems), for one state (n,) or
         for rows (N, n)."""
-        return self._legendre(q, p, t, inverse=True)
+        return self._derivative("velocity", q, p, t)
 
     def momentum(self, q: ArrayLike, v: ArrayLike, t: ArrayLike = 0.0) -> np.ndarray:
         """p = ∂L/∂q̇(q, q̇, t) (Mq̇ for mechanical systems), for one state (n,) or rows (N, n)."""
-        return self._legendre(q, v, t, inverse=False)
+        return self._derivative("momentum", q, v, t)
 
-    def _legendre(self, q: ArrayLike, x: ArrayLike, t: ArrayLike, inverse: bool) -> np.ndarray:
+    def _derivative(self, what: str, q: ArrayLike, x: ArrayLike, t: ArrayLike) -> np.ndarray:
         x = np.ascontiguousarray(x, dtype=float)
         rows = np.atleast_2d(x)
         q2 = np.ascontiguousarray(np.broadcast_to(np.asarray(q, dtype=float), rows.shape))
         t1 = np.ascontiguousarray(np.broadcast_to(np.asarray(t, dtype=float), rows.shape[:1]))
-        return _core.legendre(self._core, t1, q2, rows, inverse).reshape(x.shape)
+        return _core.derivative(self._core, what, t1, q2, rows).reshape(x.shape)
 
     def __repr__(self) -> str:
         return f"{type(self).__name__}({self.name!r}, dim={self.dim})"

@@ -20,7 +20,7 @@ use crate::model::{
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(integrate, m)?)?;
     m.add_function(wrap_pyfunction!(energy, m)?)?;
-    m.add_function(wrap_pyfunction!(legendre, m)?)?;
+    m.add_function(wrap_pyfunction!(derivative, m)?)?;
     m.add_function(wrap_pyfunction!(momentum, m)?)?;
     m.add_function(wrap_pyfunction!(energy_statistics, m)?)?;
     m.add_function(wrap_pyfunction!(invariant_statistics, m)?)?;
@@ -259,18 +259,23 @@ fn energy<'py>(
     Ok(PyArray1::from_vec(py, result.map_err(model_error)?))
 }
 
-/// The Legendre transform at each state: p = ∂L/∂q̇(q, x, t) from velocities x, or, with
-/// `inverse`, the velocities q̇ with ∂L/∂q̇ = x from momenta x (M⁻¹p and Mq̇ for mechanical
-/// systems).
+/// A first derivative of L at each state (t, q, x): `"momentum"`, p = ∂L/∂q̇(q, x, t) from
+/// velocities x (Mq̇ for mechanical systems); `"velocity"`, the inverse Legendre transform,
+/// q̇ with ∂L/∂q̇ = x from momenta x (M⁻¹p); `"dl_dq"`, ∂L/∂q(q, x, t) from velocities x.
 #[pyfunction]
-fn legendre<'py>(
+fn derivative<'py>(
     py: Python<'py>,
     model: &Bound<'py, PyAny>,
+    what: &str,
     t: PyReadonlyArray1<'py, f64>,
     q: PyReadonlyArray2<'py, f64>,
     x: PyReadonlyArray2<'py, f64>,
-    inverse: bool,
 ) -> PyResult<Bound<'py, PyAny>> {
+    if !matches!(what, "momentum" | "velocity" | "dl_dq") {
+        return Err(PyValueError::new_err(format!(
+            "what: expected \"momentum\", \"velocity\" or \"dl_dq\", got {what:?}"
+        )));
+    }
     let (t, q, x, n) = states(py, model, &t, &q, &x)?;
     let result: Result<Vec<f64>, ModelError> = with_system!(py, model, |sys, _poll| {
         let l = sys.as_lagrangian();
@@ -279,12 +284,10 @@ fn legendre<'py>(
             .iter()
             .zip(q.chunks_exact(n).zip(x.chunks_exact(n)))
             .zip(y.chunks_exact_mut(n));
-        rows.try_for_each(|((t, (q, x)), y)| {
-            if inverse {
-                l.velocity(q, x, *t, y)
-            } else {
-                l.dl_dv(q, x, *t, y)
-            }
+        rows.try_for_each(|((t, (q, x)), y)| match what {
+            "velocity" => l.velocity(q, x, *t, y),
+            "momentum" => l.dl_dv(q, x, *t, y),
+            _ => l.dl_dq(q, x, *t, y),
         })
         .map(|()| y)
     });
