@@ -525,7 +525,9 @@ pub struct Del<Sc> {
 /// The buffers of the constrained step: G(q₀) and G(q₁), q₁ and p₁, and μ's Newton iteration.
 #[derive(Clone, Debug)]
 struct Multipliers {
+    /// G at the step's start; the last step's G(q₁) once a step is taken (first same as last).
     g0: DMatrix<f64>,
+    cached: bool,
     g1: DMatrix<f64>,
     q1: Vec<f64>,
     p1: Vec<f64>,
@@ -542,6 +544,7 @@ impl Multipliers {
     fn new(n: usize, m: usize) -> Self {
         Multipliers {
             g0: DMatrix::zeros(m, n),
+            cached: false,
             g1: DMatrix::zeros(m, n),
             q1: vec![0.0; n],
             p1: vec![0.0; n],
@@ -633,6 +636,7 @@ impl<Sc: StepEquations> Del<Sc> {
         self.history = 0;
         self.continuum_sign = 0.0;
         self.x[..self.m].fill(0.0);
+        self.multipliers.cached = false;
     }
 
     /// Sizes the buffers for m constraints (allocating only when m changes).
@@ -777,7 +781,9 @@ impl<Sc: StepEquations> Del<Sc> {
         self.size_for(n, constraints.map_or(0, |c| c.count()));
         let m = self.m;
         if let Some(c) = constraints {
-            c.jacobian(q, &mut self.multipliers.g0)?;
+            if !self.multipliers.cached {
+                c.jacobian(q, &mut self.multipliers.g0)?;
+            }
         }
         if self.continuum_sign == 0.0 {
             let hessian_sign = self.hessian_sign(sys, q, p, t)?;
@@ -968,6 +974,8 @@ impl<Sc: StepEquations> Del<Sc> {
         for (j, d) in dp.iter_mut().enumerate() {
             *d -= 0.5 * h * (0..m).map(|k| mp.g1[(k, j)] * mp.mu[k]).sum::<f64>();
         }
+        std::mem::swap(&mut mp.g0, &mut mp.g1);
+        mp.cached = true;
         Ok(())
     }
 }

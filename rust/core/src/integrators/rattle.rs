@@ -225,8 +225,8 @@ impl Rattle {
                     break;
                 }
                 self.iterations += 1;
+                // The sweep moves q₁ with each multiplier it changes.
                 self.shake_sweep(constraints, h)?;
-                position(&self.lambda, &mut self.q1, &self.minv_jac0t, &self.column);
                 continue;
             }
             // Converged: the constraints hold to round-off, or the last correction was below
