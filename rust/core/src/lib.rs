@@ -16,6 +16,7 @@ pub mod diagnostics;
 pub mod discrete;
 pub mod error;
 pub mod integrators;
+mod linalg;
 pub mod model;
 pub mod scenes;
 

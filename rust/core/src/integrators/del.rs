@@ -2,6 +2,7 @@ use nalgebra::{DMatrix, DVector};
 
 use super::StepError;
 use crate::discrete::{DiscreteLagrangian, Workspace};
+use crate::linalg::{lu_in_place, lu_solve};
 use crate::model::finite_difference::NOISE_FLOOR;
 use crate::model::{Hessians, HolonomicConstraints, Lagrangian};
 use crate::ModelError;
@@ -978,43 +979,4 @@ impl<Sc: StepEquations> Del<Sc> {
         mp.cached = true;
         Ok(())
     }
-}
-
-/// LU factorisation with partial pivoting, in place (L below the diagonal with unit diagonal,
-/// U on and above it); `pivots[i]` is the row swapped into row i. Returns the sign of the
-/// determinant, or None for a singular matrix. Written out because nalgebra's `LU` allocates its permutation on every
-/// factorisation, and the Newton loop must not allocate.
-pub(super) fn lu_in_place(a: &mut DMatrix<f64>, pivots: &mut [usize]) -> Option<f64> {
-    let n = a.nrows();
-    let mut sign = 1.0;
-    for k in 0..n {
-        let piv = k + a.view_range(k.., k).iamax();
-        pivots[k] = piv;
-        if a[(piv, k)] == 0.0 {
-            return None;
-        }
-        if piv != k {
-            sign = -sign;
-        }
-        sign *= a[(piv, k)].signum();
-        a.swap_rows(k, piv);
-        let inv = 1.0 / a[(k, k)];
-        for i in k + 1..n {
-            a[(i, k)] *= inv;
-            let l = a[(i, k)];
-            for j in k + 1..n {
-                a[(i, j)] -= l * a[(k, j)];
-            }
-        }
-    }
-    Some(sign)
-}
-
-/// Solves A x = b in place with the factors of [`lu_in_place`].
-pub(super) fn lu_solve(lu: &DMatrix<f64>, pivots: &[usize], b: &mut DVector<f64>) {
-    for (k, &piv) in pivots.iter().enumerate() {
-        b.swap_rows(k, piv);
-    }
-    lu.solve_lower_triangular_with_diag_mut(b, 1.0);
-    lu.solve_upper_triangular_mut(b);
 }

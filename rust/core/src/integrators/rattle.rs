@@ -1,7 +1,7 @@
 use nalgebra::{DMatrix, DVector};
 
-use super::del::{lu_in_place, lu_solve};
 use super::{NewtonOptions, StepError};
+use crate::linalg::{lu_in_place, lu_solve};
 use crate::model::{HolonomicConstraints, MechanicalSystem};
 
 /// RATTLE (Andersen 1983; HLW VII.1.4) for H = ½pᵀM⁻¹p + V(q) on g(q) = 0:

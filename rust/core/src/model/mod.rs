@@ -7,6 +7,7 @@
 //!   [`Lagrangian`] through [`Natural`];
 //! - [`HolonomicConstraints`]: g(q) = 0 with its Jacobian, [`Distances`] for rigid links, and
 //!   [`Constrained`], a mechanical system on them;
+//! - [`Routhian`]: Routh reduction, R = L − μ·ċ on the non-cyclic coordinates;
 //! - [`Generator`]: infinitesimal symmetries ξ(q) and their Noether momenta J = p·ξ(q);
 //! - [`finite_difference`]: derivatives a model does not supply.
 
@@ -16,6 +17,7 @@ mod lagrangian;
 mod mass;
 mod mechanical;
 mod natural;
+mod routh;
 mod symmetry;
 
 pub use constraints::{
@@ -26,4 +28,5 @@ pub use lagrangian::{Hessians, Lagrangian};
 pub use mass::Mass;
 pub use mechanical::MechanicalSystem;
 pub use natural::{differenced_kinetic_gradient, Natural, NaturalSystem};
+pub use routh::Routhian;
 pub use symmetry::Generator;
