@@ -5,6 +5,8 @@ import sys
 
 import pytest
 
+from varmech.cli import TOUR, TOUR_REDUCED
+
 
 def test_methods_table():
     out = subprocess.run([sys.executable, "-m", "varmech", "methods"], capture_output=True, text=True, check=True).stdout
@@ -16,11 +18,15 @@ def test_tour_prints_reports_and_writes_plots(tmp_path):
     out = subprocess.run(
         [sys.executable, "-m", "varmech", "tour", "--quick", "--out", str(tmp_path)], capture_output=True, text=True, check=True
     ).stdout
-    assert out.count("Conservation report") == 32
+    runs = sum(len(methods) for _, methods, _ in TOUR) + sum(len(methods) for _, _, methods in TOUR_REDUCED)
+    assert runs == 40 and out.count("Conservation report") == runs
     assert "max |G M⁻¹ p|" in out
     assert "verdict: secular drift" in out and "verdict: bounded" in out
     written = sorted(p.name for p in tmp_path.glob("*.png"))
-    assert written == sorted(f"{n}_energy.png" for n in ["harmonic_oscillator", "pendulum", "kepler", "henon_heiles", "fermi_pasta_ulam", "outer_solar_system", "double_pendulum", "spherical_pendulum", "charged_particle", "charged_particle_nonuniform", "cartesian_pendulum", "planar_chain", "rigid_body"])
+    assert written == sorted(f"{name}_energy.png" for name, _, _ in TOUR)
+    # The reduced runs, reconstructed: the ignored momenta are exact by construction.
+    assert out.count("Routh-reduced") == len(TOUR_REDUCED)
+    assert out.count("max |ΔJ| = 0.000e+00") >= sum(len(c) * len(m) for _, c, m in TOUR_REDUCED)
     for line in out.splitlines():
         if line.startswith("wrote "):
             assert line.split(" ", 1)[1].endswith("_energy.png")

@@ -56,3 +56,21 @@ def test_bad_arguments_are_named():
         varmech.cyclic_coordinates(model, [1.0, 0.0], spread=0.0)
     with pytest.raises(ValueError, match="^samples:"):
         varmech.cyclic_coordinates(model, [1.0, 0.0], samples=0)
+
+
+def test_native_heavy_top_and_kepler_polar_have_cyclic_angles_and_integrate_with_midpoint():
+    top, polar = scenes.heavy_top(), scenes.kepler_polar()
+    assert varmech.cyclic_coordinates(top.model, top.q0) == [1, 2]
+    assert varmech.cyclic_coordinates(polar.model, [1.0, 0.0], spread=0.5) == [1]
+    assert [top.name, polar.name] == ["heavy_top", "kepler_polar"] and not top.model.separable
+    for scene, momenta in [(top, ["p_phi", "p_psi"]), (polar, ["p_theta"])]:
+        traj = varmech.integrate(scene, dt=scene.dt, steps=1000, method="midpoint")
+        assert traj.status == 0 and np.all(np.isfinite(traj.q))
+        assert traj.energy()[0] == pytest.approx(scene.invariants["E"], rel=1e-15)
+        report = varmech.check_conservation(traj)
+        assert report.verdict == "bounded"
+        # The declared symmetries are the cyclic angles: their momenta are kept to round-off.
+        assert [m.initial for m in report.momenta] == pytest.approx([scene.invariants[k] for k in momenta], rel=1e-15)
+        assert all(m.max_rel_error < 1e-13 for m in report.momenta), report
+    assert polar.reference is not None and polar.reference.q[1] == pytest.approx(400 * math.pi, rel=1e-15)
+    assert top.reference is None

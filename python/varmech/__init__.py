@@ -23,7 +23,7 @@ from .conservation import ConservationReport, EnergyReport, MomentumReport, chec
 from .derivatives import DerivativeCheck, check_derivatives
 from .integrate import Trajectory, integrate, symplecticity_defect
 from .methods import MethodInfo, methods
-from .reduction import cyclic_coordinates
+from .reduction import ReducedModel, cyclic_coordinates, routh
 from .model import Cyclic, Lagrangian, MechanicalSystem, Model, NativeSystem, Rotation, Translation
 from . import scenes
 
@@ -45,6 +45,8 @@ __all__ = [
     "NativeSystem",
     "Rotation",
     "project",
+    "ReducedModel",
+    "routh",
     "SpuriousBranchError",
     "Trajectory",
     "Translation",

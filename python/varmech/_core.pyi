@@ -118,7 +118,33 @@ class ClosureLagrangian(_ModelProperties):
         symmetries: Sequence[GeneratorSpec],
     ) -> None: ...
 
-Model = NativeModel | ClosureModel | ClosureConstrained | ClosureNatural | ClosureLagrangian
+class RouthModel(_ModelProperties):
+    """The Routhian R = L − μ·ċ of a full model on its non-cyclic coordinates (built by
+    :func:`routh`)."""
+
+    @property
+    def full(self) -> FullModel: ...
+    @property
+    def cyclic(self) -> list[int]: ...
+    @property
+    def momenta(self) -> list[float]: ...
+
+FullModel = NativeModel | ClosureModel | ClosureConstrained | ClosureNatural | ClosureLagrangian
+Model = FullModel | RouthModel
+
+def routh(full: FullModel, cyclic: Sequence[int], momenta: Sequence[float], reference: Sequence[float]) -> RouthModel:
+    """The reduced model ignoring ``cyclic`` at momenta μ; ValueError for constrained, forced
+    or reduced models and malformed indices."""
+
+def cyclic_increments(model: RouthModel, t: FloatArray, x: FloatArray, p: FloatArray, rule: str | None) -> FloatArray:
+    """Δc between consecutive reduced states, (N − 1, m): by the discrete momentum equation of
+    ``rule`` (``"midpoint"``, ``"trapezoid"``) or Hermite–Gauss quadrature (None)."""
+
+def amended_potential(model: RouthModel, t: FloatArray, x: FloatArray) -> FloatArray:
+    """V_μ(x, t) = −R(x, 0, t) at each state, (N,)."""
+
+def cyclic_velocity(model: RouthModel, t: FloatArray, x: FloatArray, xdot: FloatArray) -> FloatArray:
+    """ċ with ∂L/∂ċ = μ at each state, (N, m)."""
 
 def integrate(
     model: Model,

@@ -144,7 +144,73 @@ def spherical_pendulum(m: float = 1.0, l: float = 1.0, g: float = 1.0) -> Lagran
         s = math.sin(q[0])
         return np.array([ml2 * v[0], ml2 * s * s * v[1]])
 
-    return Lagrangian(2, lagrangian, dl_dq=dl_dq, dl_dv=dl_dv, symmetries=[Cyclic(1)], name="spherical_pendulum (closure)")
+    def hessians(q: np.ndarray, v: np.ndarray, t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        s, c = math.sin(q[0]), math.cos(q[0])
+        qq = np.array([[ml2 * (c * c - s * s) * v[1] ** 2 - m * g * l * c, 0.0], [0.0, 0.0]])
+        qv = np.array([[0.0, 2.0 * ml2 * s * c * v[1]], [0.0, 0.0]])
+        return qq, qv, np.diag([ml2, ml2 * s * s])
+
+    return Lagrangian(
+        2, lagrangian, dl_dq=dl_dq, dl_dv=dl_dv, hessians=hessians, symmetries=[Cyclic(1)], name="spherical_pendulum (closure)"
+    )
+
+
+def heavy_top(i1: float = 1.0, i3: float = 0.5, mgl: float = 1.0) -> Lagrangian:
+    """The heavy symmetric top in Euler angles (θ, φ, ψ), θ from the upward vertical, as a
+    general Lagrangian with exact first and second derivatives; φ and ψ are cyclic."""
+
+    def lagrangian(q: np.ndarray, v: np.ndarray, t: float) -> float:
+        s, c = math.sin(q[0]), math.cos(q[0])
+        spin = v[2] + v[1] * c
+        return 0.5 * i1 * (v[0] ** 2 + s * s * v[1] ** 2) + 0.5 * i3 * spin**2 - mgl * c
+
+    def dl_dq(q: np.ndarray, v: np.ndarray, t: float) -> np.ndarray:
+        s, c = math.sin(q[0]), math.cos(q[0])
+        spin = v[2] + v[1] * c
+        return np.array([s * (i1 * v[1] ** 2 * c - i3 * spin * v[1] + mgl), 0.0, 0.0])
+
+    def dl_dv(q: np.ndarray, v: np.ndarray, t: float) -> np.ndarray:
+        s, c = math.sin(q[0]), math.cos(q[0])
+        p_psi = i3 * (v[2] + v[1] * c)
+        return np.array([i1 * v[0], i1 * s * s * v[1] + p_psi * c, p_psi])
+
+    def hessians(q: np.ndarray, v: np.ndarray, t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        s, c = math.sin(q[0]), math.cos(q[0])
+        spin = v[2] + v[1] * c
+        lqq = np.zeros((3, 3))
+        lqq[0, 0] = i1 * v[1] ** 2 * (c * c - s * s) + i3 * v[1] ** 2 * s * s - i3 * spin * v[1] * c + mgl * c
+        lqv = np.zeros((3, 3))
+        lqv[0, 1] = 2 * i1 * s * c * v[1] - i3 * s * (spin + v[1] * c)
+        lqv[0, 2] = -i3 * s * v[1]
+        lvv = np.array([[i1, 0.0, 0.0], [0.0, i1 * s * s + i3 * c * c, i3 * c], [0.0, i3 * c, i3]])
+        return lqq, lqv, lvv
+
+    return Lagrangian(
+        3, lagrangian, dl_dq=dl_dq, dl_dv=dl_dv, hessians=hessians, symmetries=[Cyclic(1), Cyclic(2)],
+        name="heavy_top (closure)",
+    )
+
+
+def kepler_polar(m: float = 1.0, k: float = 1.0) -> Lagrangian:
+    """Kepler's problem in polar coordinates (r, θ), L = ½m(ṙ² + r²θ̇²) + k/r, as a general
+    Lagrangian with exact first and second derivatives; θ is cyclic."""
+
+    def lagrangian(q: np.ndarray, v: np.ndarray, t: float) -> float:
+        return 0.5 * m * (v[0] ** 2 + q[0] ** 2 * v[1] ** 2) + k / q[0]
+
+    def dl_dq(q: np.ndarray, v: np.ndarray, t: float) -> np.ndarray:
+        return np.array([m * q[0] * v[1] ** 2 - k / q[0] ** 2, 0.0])
+
+    def dl_dv(q: np.ndarray, v: np.ndarray, t: float) -> np.ndarray:
+        return np.array([m * v[0], m * q[0] ** 2 * v[1]])
+
+    def hessians(q: np.ndarray, v: np.ndarray, t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        r = q[0]
+        lqq = np.array([[m * v[1] ** 2 + 2 * k / r**3, 0.0], [0.0, 0.0]])
+        lqv = np.array([[0.0, 2 * m * r * v[1]], [0.0, 0.0]])
+        return lqq, lqv, np.diag([m, m * r * r])
+
+    return Lagrangian(2, lagrangian, dl_dq=dl_dq, dl_dv=dl_dv, hessians=hessians, symmetries=[Cyclic(1)], name="kepler_polar (closure)")
 
 
 def charged_particle(B: float = 1.0, kappa: float = 0.0) -> Lagrangian:
@@ -252,6 +318,8 @@ def closure_of(scene: Scene) -> MechanicalSystem | Lagrangian:
         "fermi_pasta_ulam": fermi_pasta_ulam,
         "double_pendulum": double_pendulum,
         "spherical_pendulum": spherical_pendulum,
+        "heavy_top": heavy_top,
+        "kepler_polar": kepler_polar,
         "charged_particle": charged_particle,
         "charged_particle_nonuniform": lambda: charged_particle(kappa=0.25),
         "damped_driven_pendulum": damped_driven_pendulum,

@@ -110,6 +110,34 @@ def spherical_pendulum() -> Scene:
     )
 
 
+def heavy_top() -> Scene:
+    """The heavy symmetric top in Euler angles (θ, φ, ψ), θ from the upward vertical:
+    L = ½I₁(θ̇² + sin²θ φ̇²) + ½I₃(ψ̇ + φ̇ cos θ)² − Mgl cos θ with I₁ = 1, I₃ = ½, Mgl = 1. A
+    fast top (p_ψ² = 6.25 > 4I₁Mgl) released at θ = 0.3 with θ̇ = φ̇ = 0 and ψ̇ = 5, to T = 50:
+    it nutates in cusps between the turning points θ = 0.3 and 0.4794748702… A general
+    Lagrangian whose angles φ and ψ are cyclic: p_φ and p_ψ are conserved. No reference state."""
+    return _scene(
+        "heavy_top",
+        "heavy symmetric top in Euler angles (θ, φ, ψ); φ and ψ cyclic",
+        0.01,
+        {"E": 6.25 + math.cos(0.3), "p_phi": 2.5 * math.cos(0.3), "p_psi": 2.5},
+    )
+
+
+def kepler_polar(e: float = 0.6) -> Scene:
+    """Kepler's problem in polar coordinates (r, θ): L = ½(ṙ² + r²θ̇²) + 1/r, the orbit of
+    :func:`kepler` from the pericentre r = 1 − e, θ = 0, over 200 periods of 2π; exact reference
+    r = 1 − e, θ = 400π, p = (0, √(1 − e²)). A general Lagrangian whose angle θ is cyclic: p_θ is
+    conserved."""
+    return _scene(
+        "kepler_polar",
+        f"Kepler orbit in polar coordinates (r, θ), eccentricity {e}; θ cyclic",
+        2 * math.pi / 200,
+        {"E": -0.5, "p_theta": math.sqrt(1 - e * e)},
+        e=e,
+    )
+
+
 def charged_particle(B: float = 1.0) -> Scene:
     """A unit charge of unit mass in the plane, in the uniform magnetic field B ẑ (symmetric
     gauge): L = ½|q̇|² + (B/2)(x ẏ − y ẋ). From q = (1, 0), q̇ = (0, −B) it gyrates on the unit
@@ -212,6 +240,8 @@ CATALOGUE: dict[str, Callable[[], Scene]] = {
     "outer_solar_system": outer_solar_system,
     "double_pendulum": double_pendulum,
     "spherical_pendulum": spherical_pendulum,
+    "heavy_top": heavy_top,
+    "kepler_polar": kepler_polar,
     "charged_particle": charged_particle,
     "charged_particle_nonuniform": charged_particle_nonuniform,
     "damped_driven_pendulum": damped_driven_pendulum,

@@ -5,8 +5,9 @@ use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
 use varmech::diagnostics::{self, EnergyStatistics, InvariantStatistics};
+use varmech::discrete::{DiscreteLagrangian, Midpoint, Trapezoidal};
 use varmech::integrators::{self, General, Integrable, Method, NewtonOptions, Options};
-use varmech::model::{Constrained, Natural};
+use varmech::model::{Constrained, Natural, Routhian};
 use varmech::scenes::{self, LagrangianScene, LinkedMasses, Problem, Scene};
 use varmech::ModelError;
 
@@ -14,7 +15,7 @@ use crate::convert::{self, rows, slice, trajectory_tuple};
 use crate::errors::{failure_to_pyerr, to_pyerr};
 use crate::model::{
     ClosureConstrained, ClosureConstraints, ClosureLagrangian, ClosureLagrangianSystem, ClosureModel, ClosureNatural,
-    ClosureNaturalSystem, ClosureSystem, ConstrainedSystem, Native, NativeModel,
+    ClosureNaturalSystem, ClosureSystem, ConstrainedSystem, Native, NativeModel, RouthModel,
 };
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
@@ -30,6 +31,10 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(nbody, m)?)?;
     m.add_function(wrap_pyfunction!(constraint_residuals, m)?)?;
     m.add_function(wrap_pyfunction!(project, m)?)?;
+    m.add_function(wrap_pyfunction!(routh, m)?)?;
+    m.add_function(wrap_pyfunction!(cyclic_increments, m)?)?;
+    m.add_function(wrap_pyfunction!(amended_potential, m)?)?;
+    m.add_function(wrap_pyfunction!(cyclic_velocity, m)?)?;
     Ok(())
 }
 
@@ -46,8 +51,24 @@ fn model_type_error(model: &Bound<'_, PyAny>) -> PyErr {
 
 /// Runs `body` with `sys` bound to the model as an [`Integrable`], and `poll` to the Ctrl-C
 /// check: native models with the GIL released (the poll takes it back briefly), closure models
-/// with it held.
+/// with it held. A Routh-reduced model is the Routhian of its full model, built in place.
 macro_rules! with_system {
+    ($py:ident, $model:expr, |$sys:ident, $poll:ident| $body:expr) => {{
+        if let Ok(reduced) = $model.cast::<RouthModel>() {
+            let reduced = reduced.get();
+            with_full_system!($py, reduced.full.bind($py), |full, $poll| {
+                let routhian = reduced.routhian(full.as_lagrangian());
+                let $sys = &General(&routhian);
+                $body
+            })
+        } else {
+            with_full_system!($py, $model, |$sys, $poll| $body)
+        }
+    }};
+}
+
+/// [`with_system`] for the models that are not reduced.
+macro_rules! with_full_system {
     ($py:ident, $model:expr, |$sys:ident, $poll:ident| $body:expr) => {{
         if let Ok(native) = $model.cast::<NativeModel>() {
             match &native.get().native {
@@ -417,7 +438,7 @@ fn scene_tuple<'py, S>(
 }
 
 /// A native scene by name: (model, q0, p0, t_end, reference (t, q, p, source) or None). The
-/// keywords are the parameters of the scenes that take them: `e` (kepler), `omega`
+/// keywords are the parameters of the scenes that take them: `e` (kepler, kepler_polar), `omega`
 /// (harmonic_oscillator), `b` (charged_particle), `gamma`, `amplitude` and `drive`
 /// (damped_driven_pendulum), `links` (planar_chain).
 #[pyfunction]
@@ -501,6 +522,18 @@ fn scene<'py>(
             |s| Native::General(LagrangianScene::DampedDrivenPendulum(s)),
             "damped_driven_pendulum",
         ),
+        "heavy_top" => scene_tuple(
+            py,
+            scenes::HeavyTop::problem(),
+            |s| Native::General(LagrangianScene::HeavyTop(s)),
+            "heavy_top",
+        ),
+        "kepler_polar" => scene_tuple(
+            py,
+            scenes::KeplerPolar::problem(e).map_err(err)?,
+            |s| Native::General(LagrangianScene::KeplerPolar(s)),
+            "kepler_polar",
+        ),
         "cartesian_pendulum" => scene_tuple(
             py,
             scenes::cartesian_pendulum(),
@@ -534,4 +567,135 @@ fn scene<'py>(
 fn nbody(py: Python<'_>, g: f64, masses: Vec<f64>) -> PyResult<NativeModel> {
     let system = scenes::NBody::new(g, masses).map_err(|e| to_pyerr(py, e))?;
     Ok(NativeModel::new(Native::Mechanical(Scene::NBody(system)), "nbody"))
+}
+
+/// The model as a [`RouthModel`], or a TypeError.
+fn reduced<'a>(model: &'a Bound<'_, PyAny>) -> PyResult<&'a RouthModel> {
+    model
+        .cast::<RouthModel>()
+        .map(|m| m.get())
+        .map_err(|_| PyTypeError::new_err("model: expected a Routh-reduced model (varmech.routh)"))
+}
+
+/// Runs `body` with `r` bound to the [`Routhian`] of a reduced model.
+macro_rules! with_routhian {
+    ($py:ident, $reduced:expr, |$r:ident| $body:expr) => {{
+        let reduced: &RouthModel = $reduced;
+        with_full_system!($py, reduced.full.bind($py), |full, _poll| {
+            let $r = reduced.routhian(full.as_lagrangian());
+            $body
+        })
+    }};
+}
+
+/// The Routh-reduced model of `full` that ignores the coordinates `cyclic` at momenta
+/// `momenta`; `reference` holds values for those coordinates, which L does not see.
+#[pyfunction]
+fn routh(
+    py: Python<'_>,
+    full: &Bound<'_, PyAny>,
+    cyclic: Vec<usize>,
+    momenta: Vec<f64>,
+    reference: Vec<f64>,
+) -> PyResult<RouthModel> {
+    if full.cast::<RouthModel>().is_ok() {
+        return Err(PyValueError::new_err(
+            "model: is reduced already; ignore all the cyclic coordinates of the full model at once",
+        ));
+    }
+    let constraints = full
+        .getattr("constraints")
+        .and_then(|c| c.extract::<usize>())
+        .unwrap_or(0);
+    if constraints > 0 {
+        return Err(PyValueError::new_err(
+            "model: has holonomic constraints; Routh reduction needs generalized coordinates",
+        ));
+    }
+    use varmech::model::Lagrangian;
+    let result = with_full_system!(py, full, |sys, _poll| Routhian::new(
+        sys.as_lagrangian(),
+        &cyclic,
+        &momenta,
+        &reference
+    )
+    .map(|r| (r.dim(), r.is_time_dependent())));
+    let (dim, time_dependent) = result.map_err(|e| to_pyerr(py, e))?;
+    Ok(RouthModel {
+        full: full.clone().unbind(),
+        cyclic,
+        momenta,
+        reference,
+        dim,
+        time_dependent,
+    })
+}
+
+/// The increments of the ignored coordinates between consecutive states (t, x, p) of a reduced
+/// trajectory, shape (N − 1, m): by the discrete momentum equation of `rule` ("midpoint" or
+/// "trapezoid"), or by Gauss quadrature along the Hermite interpolant (`rule` None).
+#[pyfunction]
+fn cyclic_increments<'py>(
+    py: Python<'py>,
+    model: &Bound<'py, PyAny>,
+    t: PyReadonlyArray1<'py, f64>,
+    x: PyReadonlyArray2<'py, f64>,
+    p: PyReadonlyArray2<'py, f64>,
+    rule: Option<&str>,
+) -> PyResult<Bound<'py, PyAny>> {
+    let reduced = reduced(model)?;
+    let (t, x, p, _) = states(py, model, &t, &x, &p)?;
+    let rule = match rule {
+        None => None,
+        Some("midpoint") => Some(Midpoint.quadrature()),
+        Some("trapezoid") => Some(Trapezoidal.quadrature()),
+        Some(other) => {
+            return Err(PyValueError::new_err(format!(
+                "rule: expected \"midpoint\", \"trapezoid\" or None, got {other:?}"
+            )))
+        }
+    };
+    let result = with_routhian!(py, reduced, |r| r.cyclic_increments(t, x, p, rule));
+    convert::matrix(py, result.map_err(model_error)?, reduced.cyclic.len())
+}
+
+/// The amended potential V_μ(x, t) = −R(x, 0, t) at each state, shape (N,).
+#[pyfunction]
+fn amended_potential<'py>(
+    py: Python<'py>,
+    model: &Bound<'py, PyAny>,
+    t: PyReadonlyArray1<'py, f64>,
+    x: PyReadonlyArray2<'py, f64>,
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    let reduced = reduced(model)?;
+    let (t, x, _, n) = states(py, model, &t, &x, &x)?;
+    let result: Result<Vec<f64>, ModelError> = with_routhian!(py, reduced, |r| t
+        .iter()
+        .zip(x.chunks_exact(n))
+        .map(|(t, x)| r.amended_potential(x, *t))
+        .collect());
+    Ok(PyArray1::from_vec(py, result.map_err(model_error)?))
+}
+
+/// The velocities ċ of the ignored coordinates at each state (t, x, ẋ), shape (N, m).
+#[pyfunction]
+fn cyclic_velocity<'py>(
+    py: Python<'py>,
+    model: &Bound<'py, PyAny>,
+    t: PyReadonlyArray1<'py, f64>,
+    x: PyReadonlyArray2<'py, f64>,
+    xdot: PyReadonlyArray2<'py, f64>,
+) -> PyResult<Bound<'py, PyAny>> {
+    let reduced = reduced(model)?;
+    let (t, x, xdot, n) = states(py, model, &t, &x, &xdot)?;
+    let m = reduced.cyclic.len();
+    let result: Result<Vec<f64>, ModelError> = with_routhian!(py, reduced, |r| {
+        let mut out = vec![0.0; t.len() * m];
+        t.iter()
+            .zip(x.chunks_exact(n).zip(xdot.chunks_exact(n)))
+            .zip(out.chunks_exact_mut(m))
+            .try_for_each(|((t, (x, v)), c)| r.cyclic_velocity(x, v, *t, c))
+            .map(|()| out)
+    });
+    convert::matrix(py, result.map_err(model_error)?, m)
 }

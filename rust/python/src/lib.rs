@@ -23,6 +23,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<model::ClosureLagrangian>()?;
     m.add_class::<model::ClosureNatural>()?;
     m.add_class::<model::ClosureConstrained>()?;
+    m.add_class::<model::RouthModel>()?;
     functions::register(m)?;
     Ok(())
 }

@@ -9,7 +9,7 @@ use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use varmech::model::{
     differenced_jacobian, differenced_kinetic_gradient, finite_difference, Constrained, Distances, Generator, Hessians,
-    HolonomicConstraints, Lagrangian, Mass, MechanicalSystem, NaturalSystem,
+    HolonomicConstraints, Lagrangian, Mass, MechanicalSystem, NaturalSystem, Routhian,
 };
 use varmech::scenes::{LagrangianScene, LinkedMasses, RigidBody, Scene};
 use varmech::ModelError;
@@ -452,6 +452,72 @@ impl ClosureLagrangian {
 
     fn __repr__(&self) -> String {
         format!("ClosureLagrangian(dim={})", self.dim)
+    }
+}
+
+/// A Routh-reduced model: the Routhian R = L − μ·ċ of a full model (native or closures) on
+/// its non-cyclic coordinates, built by `_core.routh` (which checks it).
+#[pyclass(frozen, module = "varmech._core")]
+pub struct RouthModel {
+    pub full: Py<PyAny>,
+    pub cyclic: Vec<usize>,
+    pub momenta: Vec<f64>,
+    pub reference: Vec<f64>,
+    pub dim: usize,
+    pub time_dependent: bool,
+}
+
+impl RouthModel {
+    /// The Routhian of the full model's Lagrangian `full`.
+    pub fn routhian<'a>(&self, full: &'a dyn Lagrangian) -> Routhian<'a, dyn Lagrangian + 'a> {
+        Routhian::new(full, &self.cyclic, &self.momenta, &self.reference)
+            .expect("the arguments were checked when the model was built")
+    }
+}
+
+#[pymethods]
+impl RouthModel {
+    #[getter]
+    pub fn dim(&self) -> usize {
+        self.dim
+    }
+
+    #[getter]
+    fn separable(&self) -> bool {
+        false
+    }
+
+    #[getter]
+    fn time_dependent(&self) -> bool {
+        self.time_dependent
+    }
+
+    #[getter]
+    fn forced(&self) -> bool {
+        false
+    }
+
+    /// The model whose cyclic coordinates are ignored.
+    #[getter]
+    fn full(&self, py: Python<'_>) -> Py<PyAny> {
+        self.full.clone_ref(py)
+    }
+
+    #[getter]
+    fn cyclic(&self) -> Vec<usize> {
+        self.cyclic.clone()
+    }
+
+    #[getter]
+    fn momenta(&self) -> Vec<f64> {
+        self.momenta.clone()
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "RouthModel(cyclic={:?}, momenta={:?}, dim={})",
+            self.cyclic, self.momenta, self.dim
+        )
     }
 }
 

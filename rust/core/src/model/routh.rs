@@ -51,6 +51,11 @@ struct Scratch {
     v: Vec<f64>,
     /// The last cyclic velocity solved for, the next solve's start.
     cdot: Vec<f64>,
+    /// The point (x, ẋ, t) of the last one-node solve, while `cdot` holds its solution: the
+    /// integrators ask for ∂R/∂x and ∂R/∂ẋ at the same point in turn.
+    solved: Option<f64>,
+    solved_x: Vec<f64>,
+    solved_xdot: Vec<f64>,
     full: Vec<f64>,
     plus: Vec<f64>,
     minus: Vec<f64>,
@@ -109,6 +114,9 @@ impl<'a, L: Lagrangian + ?Sized> Routhian<'a, L> {
             q,
             v: vec![0.0; n],
             cdot: vec![0.0; m],
+            solved: None,
+            solved_x: vec![0.0; r],
+            solved_xdot: vec![0.0; r],
             full: vec![0.0; n],
             plus: vec![0.0; n],
             minus: vec![0.0; n],
@@ -252,8 +260,27 @@ impl<'a, L: Lagrangian + ?Sized> Routhian<'a, L> {
     }
 
     /// Solves Σᵢ wᵢ ∂L/∂ċ(xᵢ, ẋᵢ, ċ, tᵢ) = μ for ċ by Newton's method from the last solution,
-    /// leaving the full state of the last node in the scratch.
+    /// leaving the full state of the last node in the scratch; a one-node solve at the point
+    /// of the last one is remembered.
     fn solve(&self, s: &mut Scratch, nodes: &[Node]) -> Result<(), ModelError> {
+        if let [node] = nodes {
+            if s.solved == Some(node.t) && s.solved_x == node.x && s.solved_xdot == node.xdot {
+                self.embed(s, node.x, node.xdot);
+                return Ok(());
+            }
+        }
+        s.solved = None;
+        self.newton(s, nodes)?;
+        if let [node] = nodes {
+            s.solved = Some(node.t);
+            s.solved_x.copy_from_slice(node.x);
+            s.solved_xdot.copy_from_slice(node.xdot);
+        }
+        Ok(())
+    }
+
+    /// [`Routhian::solve`] without the memo.
+    fn newton(&self, s: &mut Scratch, nodes: &[Node]) -> Result<(), ModelError> {
         let m = self.cyclic.len();
         let mut last = f64::INFINITY;
         for _ in 0..50 {
@@ -510,6 +537,7 @@ impl<L: Lagrangian + ?Sized> Lagrangian for Routhian<'_, L> {
             .iter()
             .zip(s.cdot.iter_mut())
             .for_each(|(&i, c)| *c = s.v[i]);
+        s.solved = None;
         Ok(())
     }
 }

@@ -11,8 +11,10 @@ mod damped_driven_pendulum;
 mod double_pendulum;
 mod fermi_pasta_ulam;
 mod harmonic_oscillator;
+mod heavy_top;
 mod henon_heiles;
 mod kepler;
+mod kepler_polar;
 mod nbody;
 mod pendulum;
 mod rigid_body;
@@ -24,8 +26,10 @@ pub use damped_driven_pendulum::DampedDrivenPendulum;
 pub use double_pendulum::DoublePendulum;
 pub use fermi_pasta_ulam::FermiPastaUlam;
 pub use harmonic_oscillator::HarmonicOscillator;
+pub use heavy_top::HeavyTop;
 pub use henon_heiles::HenonHeiles;
 pub use kepler::Kepler;
+pub use kepler_polar::KeplerPolar;
 pub use nbody::NBody;
 pub use pendulum::Pendulum;
 pub use rigid_body::RigidBody;
@@ -103,6 +107,10 @@ pub enum LagrangianScene {
     /// In a uniform or a non-uniform magnetic field.
     ChargedParticle(ChargedParticle),
     DampedDrivenPendulum(DampedDrivenPendulum),
+    /// The heavy symmetric top in Euler angles; φ and ψ cyclic.
+    HeavyTop(HeavyTop),
+    /// Kepler in polar coordinates; θ cyclic.
+    KeplerPolar(KeplerPolar),
 }
 
 macro_rules! dispatch_lagrangian {
@@ -112,6 +120,8 @@ macro_rules! dispatch_lagrangian {
             LagrangianScene::SphericalPendulum($s) => $e,
             LagrangianScene::ChargedParticle($s) => $e,
             LagrangianScene::DampedDrivenPendulum($s) => $e,
+            LagrangianScene::HeavyTop($s) => $e,
+            LagrangianScene::KeplerPolar($s) => $e,
         }
     };
 }
@@ -122,6 +132,8 @@ impl LagrangianScene {
         match self {
             LagrangianScene::SphericalPendulum(s) => s.symmetries(),
             LagrangianScene::ChargedParticle(s) => s.symmetries(),
+            LagrangianScene::HeavyTop(s) => s.symmetries(),
+            LagrangianScene::KeplerPolar(s) => s.symmetries(),
             LagrangianScene::DoublePendulum(_) | LagrangianScene::DampedDrivenPendulum(_) => Vec::new(),
         }
     }

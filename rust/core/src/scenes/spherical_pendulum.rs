@@ -1,5 +1,5 @@
 use super::{Problem, State};
-use crate::model::{Generator, Lagrangian};
+use crate::model::{Generator, Hessians, Lagrangian};
 use crate::{Error, ModelError};
 
 /// The spherical pendulum in its polar angle θ from the downward vertical and its azimuth φ:
@@ -88,6 +88,21 @@ impl Lagrangian for SphericalPendulum {
         out[0] = ml2 * v[0];
         out[1] = ml2 * s * s * v[1];
         Ok(())
+    }
+
+    /// ∂²L/∂θ² = ml²cos 2θ φ̇² − mgl cos θ, ∂²L/∂θ∂φ̇ = ml² sin 2θ φ̇,
+    /// ∂²L/∂q̇² = ml² diag(1, sin²θ).
+    fn hessians(&self, q: &[f64], v: &[f64], _t: f64, out: &mut Hessians) -> Result<bool, ModelError> {
+        let ml2 = self.m * self.l * self.l;
+        let (s, c) = q[0].sin_cos();
+        out.qq.fill(0.0);
+        out.qv.fill(0.0);
+        out.vv.fill(0.0);
+        out.qq[(0, 0)] = ml2 * (c * c - s * s) * v[1] * v[1] - self.m * self.g * self.l * c;
+        out.qv[(0, 1)] = 2.0 * ml2 * s * c * v[1];
+        out.vv[(0, 0)] = ml2;
+        out.vv[(1, 1)] = ml2 * s * s;
+        Ok(true)
     }
 
     fn velocity(&self, q: &[f64], p: &[f64], _t: f64, v: &mut [f64]) -> Result<(), ModelError> {
