@@ -4,7 +4,8 @@
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
 
-use varmech::integrators::{integrate, Integrable, Method, Options};
+use varmech::integrators::{integrate, General, Integrable, Method, Options};
+use varmech::model::Routhian;
 use varmech::scenes::{self, NBody};
 
 struct Counting;
@@ -111,5 +112,24 @@ fn the_constrained_step_loop_allocates_nothing() {
                 "{method:?}: {short} allocations for 100 steps, {long} for {long_steps}"
             );
         }
+    }
+}
+
+#[test]
+fn the_routh_reduced_step_loop_allocates_nothing() {
+    // The heavy top with φ and ψ ignored: each evaluation of R solves for (φ̇, ψ̇) in place.
+    let problem = scenes::HeavyTop::problem();
+    let (q0, p0) = (&problem.initial.q, &problem.initial.p);
+    let r = Routhian::new(&problem.system, &[1, 2], &p0[1..], &[0.0, 0.0]).unwrap();
+    for method in [Method::Midpoint, Method::Trapezoid, Method::Galerkin4, Method::Galerkin6] {
+        let run = |steps| {
+            let options = Options {
+                save_every: 10,
+                ..Options::new(0.01, steps)
+            };
+            counted(&General(&r), method, &q0[..1], &p0[..1], &options)
+        };
+        let (short, long) = (run(100), run(5_000));
+        assert_eq!(short, long, "{method:?}: {short} allocations for 100 steps, {long} for 5000");
     }
 }

@@ -123,6 +123,15 @@ def test_an_exception_in_a_closure_propagates_through_the_reduced_model():
     assert info.value.partial.t[-1] <= 0.5 + 1e-12
 
 
+def test_a_scenes_cyclic_coordinates_are_found_when_not_given():
+    assert varmech.routh(scenes.heavy_top()).cyclic == (1, 2)
+    assert varmech.routh(scenes.kepler_polar()).cyclic == (1,)
+    with pytest.raises(ValueError, match="^cyclic:.*no cyclic coordinate"):
+        varmech.routh(scenes.double_pendulum())
+    with pytest.raises(ValueError, match="^cyclic:"):
+        varmech.routh(examples.spherical_pendulum())
+
+
 def test_bad_arguments_are_named():
     scene = scenes.spherical_pendulum()
     with pytest.raises(ValueError, match="^cyclic:"):

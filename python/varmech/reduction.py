@@ -157,18 +157,31 @@ class ReducedModel(Model):
         )
 
 
-def routh(model: Model | Scene, cyclic: Sequence[int], momenta: ArrayLike | None = None, *, reference: ArrayLike | None = None) -> ReducedModel:
+def routh(
+    model: Model | Scene,
+    cyclic: Sequence[int] | None = None,
+    momenta: ArrayLike | None = None,
+    *,
+    reference: ArrayLike | None = None,
+) -> ReducedModel:
     """Routh reduction: the model that ignores the cyclic coordinates ``cyclic`` of ``model`` at
     their conserved momenta ``momenta`` (μ = ∂L/∂ċ), a :class:`ReducedModel` with
     R = L − μ·ċ on the remaining coordinates.
 
-    ``model`` may be a scene, whose initial cyclic momenta are then the default μ. The
-    coordinates must be cyclic (∂L/∂c ≡ 0; :func:`cyclic_coordinates` finds candidates), the
-    model unforced and unconstrained. ``reference`` gives values for the ignored coordinates,
-    which L must not depend on (default zeros).
+    ``model`` may be a scene: its initial cyclic momenta are then the default μ, and without
+    ``cyclic`` the coordinates that :func:`cyclic_coordinates` finds around its initial state
+    are ignored. The coordinates must be cyclic (∂L/∂c ≡ 0), the model unforced and
+    unconstrained. ``reference`` gives values for the ignored coordinates, which L must not
+    depend on (default zeros).
     """
     from .scenes import Scene
 
+    if cyclic is None:
+        if not isinstance(model, Scene):
+            raise ValueError("cyclic: give the indices to ignore (cyclic_coordinates(model, q) finds candidates)")
+        cyclic = cyclic_coordinates(model.model, model.q0)
+        if not cyclic:
+            raise ValueError(f"cyclic: {model.name} has no cyclic coordinate around its initial state")
     if isinstance(model, Scene):
         if momenta is None:
             momenta = np.asarray(model.p0)[_indices(cyclic, model.model.dim)]
