@@ -24,6 +24,7 @@ from .derivatives import DerivativeCheck, check_derivatives
 from .integrate import Trajectory, integrate, symplecticity_defect
 from .methods import MethodInfo, methods
 from .reduction import ReducedModel, cyclic_coordinates, routh
+from .table import Table
 from .model import Cyclic, Lagrangian, MechanicalSystem, Model, NativeSystem, Rotation, Translation
 from . import scenes
 
@@ -58,4 +59,5 @@ __all__ = [
     "momentum",
     "scenes",
     "symplecticity_defect",
+    "Table",
 ]

@@ -1,4 +1,4 @@
-"""Charts (matplotlib, the optional extra ``varmech[charts]``)."""
+"""Energy error against time, from trajectories."""
 
 from __future__ import annotations
 
@@ -7,24 +7,14 @@ from typing import Mapping
 
 import numpy as np
 
-from .integrate import Trajectory
-
-
-def _pyplot():
-    try:
-        import matplotlib
-
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-    except ImportError as e:
-        raise ImportError("charts need matplotlib: pip install 'varmech[charts]'") from e
-    return plt
+from ..integrate import Trajectory
+from ._figure import pyplot, save
 
 
 def energy_error(trajectories: Mapping[str, Trajectory], path: str | Path, title: str = "") -> Path:
     """Plot |H(t) − H₀|/|H₀| against t on log–log axes, one line per labelled trajectory, and
     write the figure to ``path`` (PNG or SVG by its suffix)."""
-    plt = _pyplot()
+    plt = pyplot()
     fig, ax = plt.subplots(figsize=(7, 4.2), layout="constrained")
     for label, traj in trajectories.items():
         h = traj.energy()
@@ -37,8 +27,4 @@ def energy_error(trajectories: Mapping[str, Trajectory], path: str | Path, title
     ax.set_title(title)
     ax.grid(True, which="major", alpha=0.3)
     ax.legend(fontsize=8)
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-    return path
+    return save(fig, path)

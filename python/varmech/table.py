@@ -1,0 +1,99 @@
+"""Tables of measurements: what the chart data functions return, and what the CLI writes as CSV."""
+
+from __future__ import annotations
+
+import csv
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Iterator, Sequence
+
+import numpy as np
+
+
+@dataclass
+class Table:
+    """Measurements in named columns: ``rows`` are tuples in the order of ``columns``.
+
+    ``title`` says what was measured and ``meta`` how (scene, step sizes, reference values), so
+    that a chart or a CSV file carries its provenance. ``table.column(name)`` is a NumPy array,
+    ``table.where(method="verlet")`` the matching rows, and ``table.to_csv(path)`` writes it.
+    """
+
+    columns: tuple[str, ...]
+    rows: list[tuple[Any, ...]] = field(default_factory=list)
+    title: str = ""
+    meta: dict[str, Any] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        self.columns = tuple(self.columns)
+        if len(set(self.columns)) != len(self.columns):
+            raise ValueError(f"columns: names repeat in {self.columns}")
+        for row in self.rows:
+            self._check(row)
+
+    def _check(self, row: Sequence[Any]) -> None:
+        if len(row) != len(self.columns):
+            raise ValueError(f"row: has {len(row)} values for {len(self.columns)} columns {self.columns}")
+
+    def append(self, *values: Any) -> None:
+        """Add one row, its values in column order."""
+        self._check(values)
+        self.rows.append(tuple(values))
+
+    def column(self, name: str) -> np.ndarray:
+        """The values of column ``name``, as an array (float where they are numbers)."""
+        try:
+            i = self.columns.index(name)
+        except ValueError:
+            raise KeyError(f"name: no column {name!r} in {self.columns}") from None
+        values = [row[i] for row in self.rows]
+        try:
+            return np.array(values, dtype=float)
+        except (TypeError, ValueError):
+            return np.array(values, dtype=object)
+
+    def where(self, **equal: Any) -> Table:
+        """The rows whose columns equal the given values."""
+        idx = {self.columns.index(k): v for k, v in equal.items()}
+        rows = [r for r in self.rows if all(r[i] == v for i, v in idx.items())]
+        return Table(self.columns, rows, self.title, dict(self.meta))
+
+    def unique(self, name: str) -> list[Any]:
+        """The distinct values of column ``name``, in order of appearance."""
+        i = self.columns.index(name)
+        return list(dict.fromkeys(r[i] for r in self.rows))
+
+    def to_csv(self, path: str | Path) -> Path:
+        """Write the table as CSV (a header row, then the rows; the title and metadata as
+        leading ``#`` comment lines)."""
+        path = Path(path)
+        path.parent.mkdir(parents=True, exist_ok=True)
+        with path.open("w", newline="") as f:
+            if self.title:
+                f.write(f"# {self.title}\n")
+            for k, v in self.meta.items():
+                f.write(f"# {k}: {v}\n")
+            writer = csv.writer(f)
+            writer.writerow(self.columns)
+            writer.writerows(self.rows)
+        return path
+
+    def __len__(self) -> int:
+        return len(self.rows)
+
+    def __iter__(self) -> Iterator[dict[str, Any]]:
+        return (dict(zip(self.columns, r)) for r in self.rows)
+
+    def __repr__(self) -> str:
+        def fmt(x: Any) -> str:
+            if isinstance(x, float):
+                return f"{x:.4g}" if math.isfinite(x) else str(x)
+            return str(x)
+
+        lines = [self.title] if self.title else []
+        lines.append(" | ".join(self.columns))
+        lines += [" | ".join(fmt(x) for x in r) for r in self.rows[:20]]
+        if len(self.rows) > 20:
+            lines.append(f"… {len(self.rows) - 20} more rows")
+        return "\n".join(lines)
