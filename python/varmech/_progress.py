@@ -1,0 +1,17 @@
+"""Progress bars for long sweeps (tqdm), off when asked or when the output is not a terminal."""
+
+from __future__ import annotations
+
+import sys
+from typing import Iterable, Iterator, TypeVar
+
+from tqdm.auto import tqdm
+
+T = TypeVar("T")
+
+
+def progress(items: Iterable[T], *, total: int | None = None, desc: str = "", enabled: bool | None = None) -> Iterator[T]:
+    """Iterate over ``items`` with a progress bar on stderr. ``enabled=None`` shows it only on a
+    terminal. Ctrl-C stops the sweep: KeyboardInterrupt propagates from the running item."""
+    show = sys.stderr.isatty() if enabled is None else enabled
+    return iter(tqdm(items, total=total, desc=desc, disable=not show, leave=False))
