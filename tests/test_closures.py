@@ -23,10 +23,16 @@ def test_closure_reproduces_native(name, method):
     steps = 500
     native = varmech.integrate(scene, dt=scene.dt, steps=steps, method=method)
     python = varmech.integrate(closure, scene.q0, scene.p0, dt=scene.dt, steps=steps, method=method)
-    assert python.nfev == native.nfev
     # Explicit methods agree to round-off; implicit ones to their Newton tolerance, through
-    # which round-off differences between Rust and NumPy arithmetic pass.
-    tol = 1e-12 if not native.newton_iterations else 1e-10
+    # which round-off differences between Rust and NumPy arithmetic pass. Their Newton
+    # iterations stop at round-off, so those differences can add or save an iteration in a
+    # few steps.
+    if native.newton_iterations:
+        assert abs(python.nfev - native.nfev) <= 0.01 * native.nfev
+        tol = 1e-10
+    else:
+        assert python.nfev == native.nfev
+        tol = 1e-12
     for a, b in [(native.q, python.q), (native.p, python.p)]:
         scale = np.max(np.abs(a))
         assert np.max(np.abs(a - b)) <= tol * scale

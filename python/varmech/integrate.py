@@ -151,8 +151,8 @@ def integrate(
         The initial time.
     newton_tolerance, newton_max_iterations:
         The implicit methods' Newton iteration stops when its correction is below
-        ``newton_tolerance``·(1 + ‖q‖∞), and fails with :class:`~varmech.ConvergenceError` after
-        ``newton_max_iterations`` iterations.
+        ``newton_tolerance``·‖δq‖∞ (δq the step's increment) or stalls at round-off, and fails
+        with :class:`~varmech.ConvergenceError` after ``newton_max_iterations`` iterations.
 
     Raises
     ------

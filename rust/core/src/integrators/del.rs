@@ -9,12 +9,15 @@ use crate::ModelError;
 
 /// Options of the Newton iteration that solves the discrete Euler–Lagrange equations.
 ///
-/// The iteration stops when ‖δ‖∞ ≤ tolerance·(1 + ‖q‖∞), or when a Newton step with a freshly
-/// computed Jacobian no longer halves a correction that is already below √ε (the equations'
-/// own accuracy when derivatives come from differences).
+/// The iteration stops when ‖δ‖∞ ≤ tolerance·‖x‖∞, x the unknowns as increments from q₀ (the
+/// step's δq, and the Galerkin control points' offsets), or when a Newton step with a freshly
+/// computed Jacobian no longer halves a correction that is already below √ε‖x‖∞ (the
+/// equations' own accuracy when derivatives come from differences). The scale is the increment,
+/// not the position: the discrete velocity δq/h, and so p₁, carries the increment's relative
+/// precision, which a scale of ‖q‖∞ would give away as a cyclic angle grows.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct NewtonOptions {
-    /// Stop when the correction satisfies ‖δ‖∞ ≤ tolerance·(1 + ‖q‖∞).
+    /// Stop when the correction satisfies ‖δ‖∞ ≤ tolerance·‖x‖∞ (x the increments).
     pub tolerance: f64,
     /// Give up (a convergence error) after this many iterations.
     pub max_iterations: usize,
@@ -810,6 +813,7 @@ impl<Sc: StepEquations> Del<Sc> {
         // least half an iteration, and refreshed otherwise.
         let mut keep_jacobian = false;
         let mut last_correction = f64::INFINITY;
+        let mut smallest = f64::INFINITY;
         for iteration in 1..=self.options.max_iterations {
             let fresh = !keep_jacobian;
             if fresh && !self.factorise_jacobian(sys, constraints, q, p, t, h)? {
@@ -823,17 +827,13 @@ impl<Sc: StepEquations> Del<Sc> {
             self.iterations += 1;
             lu_solve(&self.jacobian, &self.pivots, &mut self.residual);
             let mut correction = 0.0_f64;
-            let mut scale = 1.0_f64;
+            let mut scale = 0.0_f64;
             for (j, (x, d)) in self.x.iter_mut().zip(self.residual.iter()).enumerate() {
                 *x -= d;
                 // A multiplier moves q₁ by about (h²/2)M⁻¹Gᵀλ: its correction counts at that size.
-                let (weight, base) = if j < m {
-                    (0.5 * h * h, 0.0)
-                } else {
-                    (1.0, q[(j - m) % n])
-                };
+                let weight = if j < m { 0.5 * h * h } else { 1.0 };
                 correction = correction.max(weight * d.abs());
-                scale = scale.max(weight * (base + *x).abs());
+                scale = scale.max(weight * x.abs());
             }
             residual = self.residual(sys, constraints, q, p, t, h)?;
             if !(correction.is_finite() && residual.is_finite()) {
@@ -841,10 +841,11 @@ impl<Sc: StepEquations> Del<Sc> {
                 return Err(StepError::NonFinite { reason });
             }
             let contracting = correction <= 0.5 * last_correction;
-            // Converged: at the tolerance, or at the noise floor of the equations (derivatives
-            // by differences are accurate to about 1e-10), where even a fresh Newton step no
-            // longer contracts.
-            let at_floor = fresh && !contracting && correction <= NOISE_FLOOR * scale;
+            // Converged: at the tolerance, or at the noise floor of the equations (round-off,
+            // or derivatives by differences, accurate to about 1e-10), where even a fresh
+            // Newton step no longer halves the smallest correction so far.
+            let at_floor = fresh && correction > 0.5 * smallest && correction <= NOISE_FLOOR * scale;
+            smallest = smallest.min(correction);
             if correction <= self.options.tolerance * scale || at_floor {
                 // The fold test knows the unconstrained equations' continuum limit only.
                 if m == 0 && self.jacobian_sign != self.continuum_sign {
