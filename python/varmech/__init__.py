@@ -25,6 +25,9 @@ from .integrate import Trajectory, integrate, symplecticity_defect
 from .methods import MethodInfo, methods
 from .reduction import ReducedModel, cyclic_coordinates, routh
 from .table import Table
+from .stability import growth_factor, growth_table, implicit_regions, stability_scan, stability_table, unstable_intervals
+from .sections import phase_portrait, poincare_section
+from . import sections, stability
 from .model import Cyclic, Lagrangian, MechanicalSystem, Model, NativeSystem, Rotation, Translation
 from . import scenes
 
@@ -59,5 +62,15 @@ __all__ = [
     "momentum",
     "scenes",
     "symplecticity_defect",
+    "growth_factor",
+    "growth_table",
+    "implicit_regions",
+    "stability_scan",
+    "stability_table",
+    "unstable_intervals",
+    "phase_portrait",
+    "poincare_section",
+    "sections",
+    "stability",
     "Table",
 ]

@@ -5,5 +5,7 @@ trajectories) and writes a PNG or SVG file; the measurements themselves need no 
 """
 
 from .energy import energy_error
+from .sections import phase_portrait_chart, poincare_chart
+from .stability import implicit_regions_chart, stability_chart
 
-__all__ = ["energy_error"]
+__all__ = ["energy_error", "implicit_regions_chart", "phase_portrait_chart", "poincare_chart", "stability_chart"]

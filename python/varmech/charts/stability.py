@@ -1,0 +1,111 @@
+"""Linear stability and the failure regions of the implicit methods, from the tables of
+:mod:`varmech.stability`."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Mapping
+
+import numpy as np
+
+from ..stability import OUTCOMES, REFERENCE_LIMITS
+from ..table import Table
+from ._figure import pyplot, save
+
+# Outcome colours of the implicit-regions map, in the order of OUTCOMES.
+_OUTCOME_COLOURS = {
+    "ok": "#4daf4a",
+    "energy": "#ffd92f",
+    "spurious branch": "#984ea3",
+    "newton failure": "#e41a1c",
+    "diverged": "#222222",
+}
+
+
+def stability_chart(
+    table: Table, path: str | Path, title: str = "", limits: Mapping[str, float] | None = None
+) -> Path:
+    """Plot the growth factor ρ against hω, one line per method, from a
+    :func:`~varmech.stability.growth_table`, on a logarithmic ρ axis (ρ = 1 is the dotted
+    horizontal line: symplectic methods lie on it inside their stability interval, RK4 dips
+    below it, everything leaves it upwards where it is unstable). Each method's stability limit
+    is a dashed vertical line in its colour: ``limits`` if given, else the table's measured
+    ``meta["limits"]``, else the reference limits (:data:`~varmech.stability.REFERENCE_LIMITS`);
+    infinite or missing limits are not drawn. Writes ``path`` (PNG or SVG)."""
+    plt = pyplot()
+    if limits is None:
+        limits = table.meta.get("limits") or REFERENCE_LIMITS
+    fig, ax = plt.subplots(figsize=(8, 4.8), layout="constrained")
+    h_all = table.column("h_omega")
+    top = float(np.nanmax(h_all)) if len(h_all) else 1.0
+    lowest = 1.0
+    for name in table.unique("method"):
+        rows = table.where(method=name)
+        h, g = rows.column("h_omega"), rows.column("growth")
+        order = np.argsort(h)
+        h, g = h[order], g[order]
+        finite = np.isfinite(g) & (g > 0)
+        if finite.any():
+            lowest = min(lowest, float(np.min(g[finite])))
+        (line,) = ax.plot(h[finite], g[finite], lw=1.0, label=name)
+        limit = limits.get(name)
+        if limit is not None and math.isfinite(limit) and 0 < limit <= top:
+            ax.axvline(limit, color=line.get_color(), ls="--", lw=0.8, alpha=0.8)
+    ax.axhline(1.0, color="0.3", ls=":", lw=0.8)
+    ax.set_yscale("log")
+    ax.set_ylim(max(min(0.9 * lowest, 0.9), 1e-3), 10.0)
+    ax.set_xlim(0.0, top)
+    ax.set_xlabel("hω")
+    ax.set_ylabel("growth factor ρ(Ψ) per step")
+    ax.set_title(title or "Linear stability on q'' = −ω²q (dashed: stability limit)")
+    ax.grid(True, which="major", alpha=0.3)
+    ax.legend(fontsize=7, ncol=2, loc="upper left")
+    return save(fig, path)
+
+
+def implicit_regions_chart(table: Table, path: str | Path, title: str = "") -> Path:
+    """A categorical map of the outcome over step size h (columns) and initial angle q₀ (rows),
+    one panel per method, from :func:`~varmech.stability.implicit_regions`. Writes ``path``
+    (PNG or SVG)."""
+    plt = pyplot()
+    from matplotlib.colors import BoundaryNorm, ListedColormap
+    from matplotlib.patches import Patch
+
+    names = table.unique("method")
+    hs = sorted(set(float(x) for x in table.column("h")))
+    q0s = sorted(set(float(x) for x in table.column("q0")))
+    code = {o: i for i, o in enumerate(OUTCOMES)}
+    cmap = ListedColormap([_OUTCOME_COLOURS[o] for o in OUTCOMES])
+    norm = BoundaryNorm(np.arange(len(OUTCOMES) + 1) - 0.5, cmap.N)
+    cols = min(len(names), 2) or 1
+    rows_n = max(1, math.ceil(len(names) / cols))
+    fig, axes = plt.subplots(rows_n, cols, figsize=(5.2 * cols, 3.6 * rows_n), layout="constrained", squeeze=False)
+    for k, ax in enumerate(axes.flat):
+        if k >= len(names):
+            ax.set_visible(False)
+            continue
+        name = names[k]
+        grid = np.full((len(q0s), len(hs)), np.nan)
+        for row in table.where(method=name):
+            grid[q0s.index(float(row["q0"])), hs.index(float(row["h"]))] = code[row["outcome"]]
+        ax.imshow(np.ma.masked_invalid(grid), cmap=cmap, norm=norm, origin="lower", aspect="auto", interpolation="nearest")
+        ax.set_xticks(range(len(hs)), [f"{h:g}" for h in hs], fontsize=7)
+        ax.set_yticks(range(len(q0s)), [f"{q:g}" for q in q0s], fontsize=7)
+        ax.set_xlabel("step h")
+        ax.set_ylabel("initial angle q₀ (from rest)")
+        ax.set_title(name, fontsize=9)
+    present = [o for o in OUTCOMES if o in set(table.column("outcome"))]
+    fig.legend(
+        handles=[Patch(color=_OUTCOME_COLOURS[o], label=o) for o in present],
+        loc="outside lower center",
+        ncol=len(present),
+        fontsize=8,
+    )
+    scene = table.meta.get("scene", "")
+    steps = table.meta.get("steps", "")
+    fig.suptitle(title or f"Implicit methods on the {scene}: outcome of {steps} steps", fontsize=10)
+    return save(fig, path)
+
+
+__all__ = ["implicit_regions_chart", "stability_chart"]

@@ -1,0 +1,545 @@
+"""Linear stability on q̈ = −ω²q, measured from the integrators themselves, and the failure
+regions of the implicit methods on the pendulum.
+
+The one-step map of every method in varmech is linear on the harmonic oscillator
+H = p²/2 + ω²q²/2. With ω = 1 (so h = hω) one step from (q, p) = (1, 0) and one from (0, 1) give
+its two columns, the step matrix
+
+    Ψ(hω) = [[q₁(1, 0), q₁(0, 1)],
+             [p₁(1, 0), p₁(0, 1)]],
+
+computed by :func:`varmech.integrate` on ``scenes.harmonic_oscillator()`` (the native model, so
+every method runs exactly as it does elsewhere, the implicit ones with their Newton solver).
+Its eigenvalues are
+
+    λ± = τ/2 ± √(τ²/4 − δ),   τ = tr Ψ,  δ = det Ψ,
+
+and the growth factor is the spectral radius ρ(Ψ) = max |λ±|: after n steps a generic state
+grows like ρⁿ. A symplectic method preserves area, δ = 1, so λ₊λ₋ = 1. Inside its stability
+interval (|τ| < 2) the eigenvalues are a complex-conjugate pair on the unit circle, e^{±iθ} with
+cos θ = τ/2: the map is conjugate to a rotation by θ, and ρ = 1 *exactly* (to round-off), with no
+damping and no growth; the invariant ellipse only gets elongated near the limit. Beyond it
+(|τ| > 2) they are real, λ and 1/λ, and ρ = |λ| > 1: the solution grows exponentially. The
+stability limit is where τ = ±2 first happens, a double eigenvalue ±1 (ρ = 1, a Jordan block).
+Non-symplectic methods have ρ ≠ 1: RK4's Ψ is R(hA) with R the degree-4 Taylor polynomial, so
+ρ = |R(iy)| = √(1 − y⁶/72 + y⁸/576) < 1 for 0 < y < 2√2 (damping); explicit Euler's
+ρ = √(1 + y²) > 1 at every y > 0.
+
+:func:`stability_scan` finds the largest hω below which ρ ≤ 1 + tol on the whole interval: a fine
+grid from 0, then bisection at the first instability. Symmetric compositions of Verlet can turn
+stable again beyond that first instability and unstable once more (resonances of the stages);
+:func:`unstable_intervals` lists those windows in a scan range. The *first* instability from 0
+is the documented limit ``MethodInfo.h_omega_max``; :func:`stability_table` compares the scan
+with reference/compositions.json.
+
+:func:`implicit_regions` maps where the implicit methods fail on the pendulum over step size
+and initial angle: Newton's iteration failing, a spurious branch beyond a fold of the discrete
+Euler–Lagrange map, a blow-up, or an energy error past a threshold.
+
+Everything returns a :class:`~varmech.Table`; :mod:`varmech.charts.stability` draws them (this
+module does not import matplotlib).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any, Iterable, Sequence, Union
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from ._core import ConvergenceError, DivergenceError, SpuriousBranchError
+from ._progress import progress as _progress
+from .integrate import integrate
+from .methods import MethodInfo, methods as _methods
+from .table import Table
+
+#: Where the reference limits come from (a file of the repository, not of the installed package).
+REFERENCE_SOURCE = "reference/compositions.json"
+
+#: The composition names of reference/compositions.json ("methods") and varmech's names for them.
+COMPOSITION_NAMES: dict[str, str] = {
+    "verlet": "verlet",
+    "yoshida_triple_jump_4": "yoshida4",
+    "suzuki_4_5stage": "suzuki4",
+    "mclachlan_4_5stage": "mclachlan4",
+    "yoshida_6_7stage": "yoshida6",
+    "kahan_li_6_9stage": "kahan_li6",
+    "suzuki_umeno_8_15stage": "suzuki_umeno8",
+    "kahan_li_8_17stage": "kahan_li8",
+}
+
+#: Linear stability limits hω_max by varmech method name, copied from reference/compositions.json
+#: (the ``h_omega_max`` of each composition in "methods", and the "other_linear_stability_facts":
+#: RK4 stable up to y = 2√2, explicit Euler never, symplectic Euler below 2, the implicit midpoint
+#: rule at every h). The JSON file lives in the repository, outside the installed package, so the
+#: numbers are embedded here; tests/test_stability.py checks them against the file.
+REFERENCE_LIMITS: dict[str, float] = {
+    "verlet": 2.0,
+    "yoshida4": 1.5734,
+    "suzuki4": 2.721,
+    "mclachlan4": 3.0182,
+    "yoshida6": 2.2691,
+    "kahan_li6": 2.5326,
+    "suzuki_umeno8": 3.3932,
+    "kahan_li8": 3.0964,
+    "rk4": 2.0 * math.sqrt(2.0),
+    "explicit_euler": 0.0,
+    "symplectic_euler": 2.0,
+    "midpoint": math.inf,
+}
+
+#: The implicit (Newton-solved) methods :func:`implicit_regions` maps by default.
+IMPLICIT_METHODS = ("midpoint", "trapezoid", "galerkin4", "galerkin6")
+
+#: The outcomes of :func:`implicit_regions`, from good to bad.
+OUTCOMES = ("ok", "energy", "spurious branch", "newton failure", "diverged")
+
+# Defaults of the scans.
+DEFAULT_SCAN_MAX = 10.0
+DEFAULT_RESOLUTION = 1e-3
+DEFAULT_TOL = 1e-9
+# Bisection stops when the bracket is this small relative to hω (or after _BISECT_MAX halvings).
+_BISECT_RTOL = 1e-13
+_BISECT_MAX = 80
+# Sweeps longer than this get a progress bar (on a terminal, unless told otherwise).
+_PROGRESS_MIN = 50
+
+_OSCILLATOR: Any = None
+
+
+def _oscillator() -> Any:
+    """The native model of q̈ = −q (built once)."""
+    global _OSCILLATOR
+    if _OSCILLATOR is None:
+        from .scenes import harmonic_oscillator
+
+        _OSCILLATOR = harmonic_oscillator(1.0).model
+    return _OSCILLATOR
+
+
+def _method(method: str) -> MethodInfo:
+    for info in _methods():
+        if info.name == method:
+            if info.constrained:
+                raise ValueError(
+                    f"method: {method!r} integrates constrained systems only, and the linear test equation has no "
+                    "constraint (its stability on the constrained manifold is that of the method it is built on)"
+                )
+            return info
+    names = ", ".join(m.name for m in _methods())
+    raise ValueError(f"method: unknown method {method!r}; one of {names}")
+
+
+def _unconstrained() -> list[str]:
+    return [m.name for m in _methods() if not m.constrained]
+
+
+def _h(name: str, x: float) -> float:
+    try:
+        v = float(x)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name}: must be a number, got {x!r}") from None
+    if not (math.isfinite(v) and v > 0):
+        raise ValueError(f"{name}: must be finite and positive, got {x!r}")
+    return v
+
+
+def _step_matrix(method: str, y: float) -> np.ndarray:
+    model = _oscillator()
+    a = integrate(model, [1.0], [0.0], dt=y, steps=1, method=method)
+    b = integrate(model, [0.0], [1.0], dt=y, steps=1, method=method)
+    return np.array([[a.q[-1, 0], b.q[-1, 0]], [a.p[-1, 0], b.p[-1, 0]]])
+
+
+def _rho(psi: np.ndarray) -> float:
+    """max |λ±| with λ± = τ/2 ± √(τ²/4 − δ)."""
+    tau = psi[0, 0] + psi[1, 1]
+    delta = psi[0, 0] * psi[1, 1] - psi[0, 1] * psi[1, 0]
+    root = np.sqrt(complex(0.25 * tau * tau - delta))
+    return float(max(abs(0.5 * tau + root), abs(0.5 * tau - root)))
+
+
+def step_matrix(method: str, h_omega: float) -> np.ndarray:
+    """The 2×2 matrix Ψ of one step of ``method`` on q̈ = −q with h = ``h_omega``: its columns are
+    (q₁, p₁) after one step from (q, p) = (1, 0) and from (0, 1)."""
+    _method(method)
+    return _step_matrix(method, _h("h_omega", h_omega))
+
+
+def growth_factor(method: str, h_omega: Union[float, ArrayLike], *, progress: bool | None = False) -> Any:
+    """The growth factor ρ(Ψ) = max |λ±| of one step of ``method`` on q̈ = −ω²q at hω.
+
+    λ± = τ/2 ± √(τ²/4 − δ) are the eigenvalues of the step matrix Ψ (:func:`step_matrix`),
+    τ = tr Ψ, δ = det Ψ. A symplectic method has δ = 1, hence ρ = 1 to round-off at every hω
+    inside its stability interval and ρ > 1 beyond it; see the module's documentation.
+
+    ``h_omega`` is a positive number (the result is a float) or an array of them (an array of the
+    same shape). ``progress`` shows a bar for long arrays (None: on a terminal only).
+    """
+    _method(method)
+    if np.ndim(h_omega) == 0:
+        return _rho(_step_matrix(method, _h("h_omega", h_omega)))  # type: ignore[arg-type]
+    ys = np.asarray(h_omega, dtype=float)
+    out = np.empty(ys.shape)
+    flat = ys.ravel()
+    for i in _progress(range(flat.size), total=flat.size, desc=f"growth {method}", enabled=_bar(progress, flat.size)):
+        out.flat[i] = _rho(_step_matrix(method, _h("h_omega", flat[i])))
+    return out
+
+
+def _bar(progress: bool | None, n: int) -> bool | None:
+    return False if n < _PROGRESS_MIN and progress is None else progress
+
+
+def _grid(h_omega_max: float, resolution: float) -> np.ndarray:
+    n = max(1, math.ceil(h_omega_max / resolution - 1e-9))
+    grid = resolution * np.arange(1, n + 1)
+    grid[-1] = h_omega_max
+    return grid
+
+
+def _bisect(method: str, stable: float, unstable: float, tol: float) -> tuple[float, float]:
+    """Shrink [stable, unstable] around the change of ρ ≤ 1 + tol; returns the final bracket."""
+    for _ in range(_BISECT_MAX):
+        if unstable - stable <= _BISECT_RTOL * unstable:
+            break
+        mid = 0.5 * (stable + unstable)
+        if _rho(_step_matrix(method, mid)) > 1.0 + tol:
+            unstable = mid
+        else:
+            stable = mid
+    return stable, unstable
+
+
+def _check_scan(h_omega_max: float, resolution: float, tol: float) -> tuple[float, float, float]:
+    h_omega_max = _h("h_omega_max", h_omega_max)
+    resolution = _h("resolution", resolution)
+    tol = _h("tol", tol)
+    if resolution > h_omega_max:
+        raise ValueError(f"resolution: must not exceed h_omega_max = {h_omega_max}, got {resolution}")
+    return h_omega_max, resolution, tol
+
+
+def stability_scan(
+    method: str,
+    *,
+    h_omega_max: float = DEFAULT_SCAN_MAX,
+    resolution: float = DEFAULT_RESOLUTION,
+    tol: float = DEFAULT_TOL,
+    progress: bool | None = None,
+) -> float:
+    """The largest hω such that ``method`` is stable on all of (0, hω]: ρ(Ψ) ≤ 1 + ``tol``.
+
+    The growth factor is evaluated on the grid ``resolution``, 2·``resolution``, … up to
+    ``h_omega_max``; at the first grid point where ρ > 1 + tol, bisection between it and the
+    point before narrows the limit to about 1e-13 relative, and the midpoint of the final
+    bracket is returned. This is the *first* instability from 0, the documented limit; windows of
+    instability further out (and stable stretches beyond them) are reported by
+    :func:`unstable_intervals`. A window narrower than ``resolution`` below the first grid
+    instability would be missed (none exists for varmech's methods: a NumPy scan of the
+    compositions at 1e-5 finds none).
+
+    Returns
+    -------
+    float
+        The limit; ``math.inf`` when no grid point up to ``h_omega_max`` is unstable (A-stable
+        methods such as ``midpoint``: inf means "stable on the whole scanned range", not the
+        scan limit); ``0.0`` when the method is already unstable at the first grid point
+        (explicit Euler: ρ = √(1 + y²) > 1 at every y > 0; its tolerance-limited interval
+        (0, √(2·tol)] lies far below any sensible resolution).
+
+    The tolerance absorbs round-off: inside the stability interval of a symplectic method ρ is 1
+    to about 1e-13, while just past the limit ρ − 1 ≈ √(τ²/4 − 1) rises like the square root of
+    the distance, so the result does not depend on ``tol`` to many digits.
+    """
+    _method(method)
+    h_omega_max, resolution, tol = _check_scan(h_omega_max, resolution, tol)
+    grid = _grid(h_omega_max, resolution)
+    previous = 0.0
+    bar = _progress(grid, total=grid.size, desc=f"stability {method}", enabled=_bar(progress, grid.size))
+    for y in bar:
+        if _rho(_step_matrix(method, float(y))) > 1.0 + tol:
+            if previous == 0.0:
+                return 0.0
+            stable, unstable = _bisect(method, previous, float(y), tol)
+            return 0.5 * (stable + unstable)
+        previous = float(y)
+    return math.inf
+
+
+def unstable_intervals(
+    method: str,
+    h_omega_max: float = DEFAULT_SCAN_MAX,
+    *,
+    resolution: float = DEFAULT_RESOLUTION,
+    tol: float = DEFAULT_TOL,
+    progress: bool | None = None,
+) -> list[tuple[float, float]]:
+    """The intervals of hω in (0, ``h_omega_max``] where ρ(Ψ) > 1 + ``tol``, as (start, end)
+    pairs with both ends refined by bisection; an interval still unstable at ``h_omega_max``
+    ends there (it may go on beyond). An empty list: stable on the whole scanned range.
+
+    The first interval starts at the stability limit (:func:`stability_scan`, 0 for a method
+    unstable from the start). Further intervals are resonance windows: the symmetric compositions
+    of Verlet become stable again past their first instability, then unstable again, where the
+    product of the stage rotations has its trace cross ±2 once more. Windows narrower than
+    ``resolution`` can be missed.
+    """
+    _method(method)
+    h_omega_max, resolution, tol = _check_scan(h_omega_max, resolution, tol)
+    grid = _grid(h_omega_max, resolution)
+    rho = growth_factor(method, grid, progress=_bar(progress, grid.size))
+    unstable = rho > 1.0 + tol
+    intervals: list[tuple[float, float]] = []
+    i, n = 0, grid.size
+    while i < n:
+        if not unstable[i]:
+            i += 1
+            continue
+        j = i
+        while j + 1 < n and unstable[j + 1]:
+            j += 1
+        if i == 0:
+            start = 0.0
+        else:
+            s, u = _bisect(method, float(grid[i - 1]), float(grid[i]), tol)
+            start = 0.5 * (s + u)
+        if j == n - 1:
+            end = h_omega_max
+        else:
+            # Between grid[j] (unstable) and grid[j + 1] (stable): bisect with the roles swapped.
+            lo, hi = float(grid[j]), float(grid[j + 1])
+            for _ in range(_BISECT_MAX):
+                if hi - lo <= _BISECT_RTOL * hi:
+                    break
+                mid = 0.5 * (lo + hi)
+                if _rho(_step_matrix(method, mid)) > 1.0 + tol:
+                    lo = mid
+                else:
+                    hi = mid
+            end = 0.5 * (lo + hi)
+        intervals.append((start, end))
+        i = j + 1
+    return intervals
+
+
+def _methods_arg(methods: Iterable[str] | str | None) -> list[str]:
+    if methods is None:
+        return _unconstrained()
+    if isinstance(methods, str):
+        methods = [methods]
+    names = list(methods)
+    for name in names:
+        _method(name)
+    return names
+
+
+def growth_table(
+    methods: Iterable[str] | str | None = None,
+    h_omega: ArrayLike | None = None,
+    *,
+    limits: bool = True,
+    tol: float = DEFAULT_TOL,
+    progress: bool | None = None,
+) -> Table:
+    """The growth factor of each method at each hω: columns ``method``, ``h_omega``, ``growth``.
+
+    ``methods`` defaults to every unconstrained method, ``h_omega`` to 0.005 … 4 in steps of
+    0.005. With ``limits`` (default), ``table.meta["limits"]`` holds each method's stability limit
+    from :func:`stability_scan` over the same range (inf: stable on all of it), which
+    :func:`varmech.charts.stability.stability_chart` marks; ``meta["reference"]`` the
+    reference limits known for these methods. Ctrl-C stops the sweep: the KeyboardInterrupt
+    propagates with the rows measured so far as ``err.partial``.
+    """
+    names = _methods_arg(methods)
+    ys = np.arange(1, 801) * 0.005 if h_omega is None else np.atleast_1d(np.asarray(h_omega, dtype=float)).ravel()
+    for y in ys:
+        _h("h_omega", y)
+    table = Table(
+        ("method", "h_omega", "growth"),
+        title="Growth factor ρ(Ψ) of one step on q'' = -ω²q",
+        meta={
+            "definition": "spectral radius of the one-step matrix Psi from (q, p) = (1, 0) and (0, 1), omega = 1",
+            "tol": tol,
+            "reference": {m: REFERENCE_LIMITS[m] for m in names if m in REFERENCE_LIMITS},
+            "reference_source": REFERENCE_SOURCE,
+        },
+    )
+    plan = [(name, float(y)) for name in names for y in ys]
+    try:
+        for name, y in _progress(plan, total=len(plan), desc="growth table", enabled=_bar(progress, len(plan))):
+            table.append(name, y, _rho(_step_matrix(name, y)))
+        if limits:
+            top = float(ys.max())
+            resolution = min(DEFAULT_RESOLUTION, top)
+            table.meta["limits"] = {
+                name: stability_scan(name, h_omega_max=top, resolution=resolution, tol=tol, progress=False)
+                for name in _progress(names, total=len(names), desc="limits", enabled=progress)
+            }
+    except KeyboardInterrupt as err:
+        err.partial = table  # type: ignore[attr-defined]
+        raise
+    return table
+
+
+def stability_table(
+    methods: Iterable[str] | str | None = None,
+    *,
+    h_omega_max: float = DEFAULT_SCAN_MAX,
+    resolution: float = DEFAULT_RESOLUTION,
+    tol: float = DEFAULT_TOL,
+    progress: bool | None = None,
+) -> Table:
+    """Measured stability limits against the reference: columns ``method``, ``h_omega_max`` (the
+    scan, :func:`stability_scan`), ``reference`` (:data:`REFERENCE_LIMITS`, from
+    reference/compositions.json; NaN where the file has no value), ``relative_difference``
+    ((measured − reference)/reference; the absolute difference when the reference is 0, 0 when
+    both are inf, NaN without a reference) and ``documented`` (``MethodInfo.h_omega_max``, the
+    methods table). ``methods`` defaults to every unconstrained method. Ctrl-C stops the sweep:
+    the KeyboardInterrupt propagates with the rows measured so far as ``err.partial``."""
+    names = _methods_arg(methods)
+    info = {m.name: m for m in _methods()}
+    table = Table(
+        ("method", "h_omega_max", "reference", "relative_difference", "documented"),
+        title="Linear stability limits hω_max on q'' = -ω²q: scan against reference",
+        meta={
+            "scan": f"grid step {resolution:g} up to hω = {h_omega_max:g}, then bisection; stable means growth <= 1 + {tol:g}",
+            "inf": f"no instability up to hω = {h_omega_max:g}",
+            "reference_source": REFERENCE_SOURCE,
+        },
+    )
+    try:
+        for name in _progress(names, total=len(names), desc="stability scans", enabled=progress):
+            measured = stability_scan(name, h_omega_max=h_omega_max, resolution=resolution, tol=tol, progress=False)
+            ref = REFERENCE_LIMITS.get(name, math.nan)
+            table.append(name, measured, ref, relative_difference(measured, ref), info[name].h_omega_max)
+    except KeyboardInterrupt as err:
+        err.partial = table  # type: ignore[attr-defined]
+        raise
+    return table
+
+
+def relative_difference(measured: float, reference: float) -> float:
+    """(measured − reference)/reference; measured − reference when the reference is 0; 0 when both
+    are inf; inf when only one is; NaN when the reference is NaN."""
+    if math.isnan(reference) or math.isnan(measured):
+        return math.nan
+    if math.isinf(reference) or math.isinf(measured):
+        return 0.0 if measured == reference else math.inf
+    if reference == 0.0:
+        return measured - reference
+    return (measured - reference) / reference
+
+
+# ------------------------------------------------------------------------- implicit methods
+
+
+DEFAULT_H_VALUES = (0.1, 0.25, 0.5, 1.0, 1.5, 2.0, 2.5, 3.0, 4.0, 6.0)
+# Initial angles from rest; π/2 is left out, where H₀ = −cos q₀ = 0 and a relative energy error
+# means nothing.
+DEFAULT_Q0_VALUES = (0.25, 0.5, 1.0, 2.0, 2.5, 2.75, 3.0, 3.1)
+
+
+def implicit_regions(
+    method: str | Sequence[str] | None = None,
+    *,
+    scene: Any = "pendulum",
+    steps: int = 20,
+    h_values: Sequence[float] = DEFAULT_H_VALUES,
+    q0_values: Sequence[float] = DEFAULT_Q0_VALUES,
+    energy_threshold: float = 0.05,
+    progress: bool | None = None,
+) -> Table:
+    """What happens to the implicit methods over step size h and initial angle q₀.
+
+    For each method (default: ``midpoint``, ``trapezoid``, ``galerkin4``, ``galerkin6``), step h
+    and initial position q₀ (the first coordinate, from rest: p₀ = 0), ``steps`` steps of
+    ``scene`` (a :mod:`varmech.scenes` name or a Scene; default the pendulum H = p²/2 − cos q,
+    whose top is q = π) are integrated with ``max_energy_error=energy_threshold`` and the
+    first thing that goes wrong is recorded in ``outcome``:
+
+    - ``"ok"``: all steps done, the relative energy error stayed within the threshold;
+    - ``"energy"``: the relative energy error |H − H₀|/|H₀| passed the threshold
+      (:class:`~varmech.DivergenceError` from ``max_energy_error``);
+    - ``"spurious branch"``: Newton converged beyond a fold of the discrete Euler–Lagrange map
+      (:class:`~varmech.SpuriousBranchError`; for the midpoint rule near the top once h ≳ 2);
+    - ``"newton failure"``: Newton's iteration did not converge (:class:`~varmech.ConvergenceError`);
+    - ``"diverged"``: the state became non-finite (:class:`~varmech.DivergenceError`).
+
+    Columns: ``method``, ``h``, ``q0``, ``outcome``, ``steps_done`` (steps completed before the
+    failure), ``energy_error`` (the largest relative energy error over the steps completed) and
+    ``newton_per_step`` (mean Newton iterations per step completed; NaN before the first).
+    The default q₀ values avoid π/2, where H₀ = 0. Each run is 20 steps by default, so the whole
+    map takes well under a second. Ctrl-C stops the sweep: the KeyboardInterrupt propagates with
+    the rows so far as ``err.partial``.
+    """
+    from .scenes import Scene, get
+
+    names = list(IMPLICIT_METHODS) if method is None else ([method] if isinstance(method, str) else list(method))
+    for name in names:
+        _method(name)
+    sc = get(scene) if isinstance(scene, str) else scene
+    if not isinstance(sc, Scene):
+        raise TypeError(f"scene: expected a scene name or a varmech Scene, got {type(scene).__name__}")
+    if isinstance(steps, bool) or not isinstance(steps, (int, np.integer)) or steps < 1:
+        raise ValueError(f"steps: must be a positive integer, got {steps!r}")
+    hs = [_h("h_values", h) for h in h_values]
+    q0s = [float(q) for q in q0_values]
+    if not hs or not q0s or not all(math.isfinite(q) for q in q0s):
+        raise ValueError("h_values, q0_values: must be non-empty, finite")
+    energy_threshold = _h("energy_threshold", energy_threshold)
+    n = sc.model.dim
+    table = Table(
+        ("method", "h", "q0", "outcome", "steps_done", "energy_error", "newton_per_step"),
+        title=f"Implicit methods on {sc.name}: outcome of {steps} steps from rest at q0",
+        meta={"scene": sc.name, "steps": int(steps), "energy_threshold": energy_threshold, "p0": 0.0},
+    )
+    plan = [(name, h, q0) for name in names for h in hs for q0 in q0s]
+    try:
+        for name, h, q0 in _progress(plan, total=len(plan), desc=f"implicit regions {sc.name}", enabled=_bar(progress, len(plan))):
+            q = np.array(sc.q0, dtype=float)
+            q[0] = q0
+            p = np.zeros(n)
+            outcome, traj = "ok", None
+            try:
+                traj = integrate(sc.model, q, p, dt=h, steps=int(steps), method=name, max_energy_error=energy_threshold)
+            except SpuriousBranchError as err:
+                outcome, traj = "spurious branch", getattr(err, "partial", None)
+            except ConvergenceError as err:
+                outcome, traj = "newton failure", getattr(err, "partial", None)
+            except DivergenceError as err:
+                outcome = "energy" if "max_energy_error" in str(err) else "diverged"
+                traj = getattr(err, "partial", None)
+            done, energy, newton = 0, math.nan, math.nan
+            if traj is not None and len(traj):
+                done = int(traj.steps)
+                e = traj.energy()
+                scale = abs(e[0]) if e[0] != 0 else 1.0
+                finite = np.isfinite(e)
+                if finite.any():
+                    energy = float(np.max(np.abs(e[finite] - e[0])) / scale)
+                if done:
+                    newton = traj.newton_iterations / done
+            table.append(name, h, q0, outcome, done, energy, newton)
+    except KeyboardInterrupt as err:
+        err.partial = table  # type: ignore[attr-defined]
+        raise
+    return table
+
+
+__all__ = [
+    "COMPOSITION_NAMES",
+    "IMPLICIT_METHODS",
+    "OUTCOMES",
+    "REFERENCE_LIMITS",
+    "REFERENCE_SOURCE",
+    "growth_factor",
+    "growth_table",
+    "implicit_regions",
+    "relative_difference",
+    "stability_scan",
+    "stability_table",
+    "step_matrix",
+    "unstable_intervals",
+]
