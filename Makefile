@@ -2,7 +2,7 @@
 # `make test` (build, run every test). PYTHON may name another interpreter.
 PYTHON ?= python3
 
-.PHONY: install tour test bench compare
+.PHONY: install tour test bench compare gallery
 
 install:
 	$(PYTHON) -m pip install -e ".[test,charts]"
@@ -20,3 +20,7 @@ bench:
 compare:
 	$(PYTHON) -m pip install -e ".[bench]"
 	$(PYTHON) benches/compare.py
+
+gallery:
+	$(PYTHON) -m pip install -e ".[bench]"
+	$(PYTHON) benches/gallery.py

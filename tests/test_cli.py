@@ -22,11 +22,33 @@ def test_tour_prints_reports_and_writes_plots(tmp_path):
     assert runs == 40 and out.count("Conservation report") == runs
     assert "max |G M⁻¹ p|" in out
     assert "verdict: secular drift" in out and "verdict: bounded" in out
-    written = sorted(p.name for p in tmp_path.glob("*.png"))
+    written = sorted(p.name for p in tmp_path.glob("*_energy.png"))
     assert written == sorted(f"{name}_energy.png" for name, _, _ in TOUR)
+    # The charts, each with its data.
+    for stem in ["work_precision_kepler", "energy_growth_kepler", "stability", "implicit_regions_pendulum", "phase_portrait_pendulum"]:
+        assert (tmp_path / f"{stem}.png").exists() and (tmp_path / f"{stem}.csv").exists()
     # The reduced runs, reconstructed: the ignored momenta are exact by construction.
     assert out.count("Routh-reduced") == len(TOUR_REDUCED)
     assert out.count("max |ΔJ| = 0.000e+00") >= sum(len(c) * len(m) for _, c, m in TOUR_REDUCED)
     for line in out.splitlines():
         if line.startswith("wrote "):
             assert line.split(" ", 1)[1].endswith("_energy.png")
+
+
+@pytest.mark.parametrize("kind", ["stability", "phase"])
+def test_chart_writes_the_files_it_names(tmp_path, kind):
+    pytest.importorskip("matplotlib")
+    out = subprocess.run(
+        [sys.executable, "-m", "varmech", "chart", kind, "--quick", "--format", "svg", "--out", str(tmp_path)],
+        capture_output=True, text=True, check=True,
+    ).stdout
+    named = [line.split(" ", 1)[1] for line in out.splitlines() if line.startswith("wrote ")]
+    assert {p.rsplit(".", 1)[1] for p in named} == {"csv", "svg"}
+    assert sorted(named) == sorted(str(p) for p in tmp_path.iterdir())
+    header = next(line for line in open(next(p for p in named if p.endswith(".csv"))) if not line.startswith("#"))
+    assert header.startswith("method," if kind == "stability" else "orbit,")
+
+
+def test_chart_refuses_an_unknown_scene():
+    result = subprocess.run([sys.executable, "-m", "varmech", "chart", "phase", "nowhere"], capture_output=True, text=True)
+    assert result.returncode != 0 and "scene:" in result.stderr

@@ -1,4 +1,4 @@
-"""The command line: ``python -m varmech tour | methods``."""
+"""The command line: ``python -m varmech tour | methods | chart <kind> [scene]``."""
 
 from __future__ import annotations
 
@@ -6,10 +6,11 @@ import argparse
 import time
 from pathlib import Path
 
-from . import scenes
+from . import charts, scenes
 from .conservation import check_conservation
 from .integrate import integrate
 from .methods import format_table
+from .chart_cli import KINDS, chart
 from .reduction import routh
 
 #: (scene, methods, horizon): each scene over a horizon long enough to tell bounded from drifting.
@@ -31,6 +32,9 @@ TOUR = [
     ("rigid_body", ("trapezoid", "midpoint"), 100.0),
 ]
 
+
+#: The charts the tour draws, each with its default scene and methods (``python -m varmech chart``).
+TOUR_CHARTS = ("work-precision", "energy", "stability", "implicit-regions", "poincare", "phase")
 
 #: (scene, ignored coordinates, methods): Routh-reduced runs, reconstructed to the full model.
 TOUR_REDUCED = [
@@ -60,11 +64,9 @@ def tour_reduced(quick: bool) -> None:
 
 def tour(out: Path, quick: bool) -> int:
     """Integrate every scene with a few methods, print their conservation reports, and write
-    energy-error plots to ``out``."""
-    try:
-        from . import charts
-    except ImportError:
-        charts = None
+    energy-error plots and the charts of :data:`TOUR_CHARTS` to ``out`` (without matplotlib,
+    the reports only)."""
+    plots = True
     for name, methods, horizon in TOUR:
         scene = scenes.get(name)
         t_end = horizon if horizon is not None else scene.t_end
@@ -81,14 +83,19 @@ def tour(out: Path, quick: bool) -> int:
             runs[method] = traj
             print(f"--- {method}: {traj.nfev} force evaluations in {elapsed:.3f} s")
             print(check_conservation(traj))
-        if charts is not None:
+        if plots:
             try:
                 path = charts.energy_error(runs, out / f"{name}_energy.png", title=f"{name}, dt = {scene.dt:g}")
                 print(f"wrote {path}")
             except ImportError as e:
                 print(f"(no plots: {e})")
-                charts = None
+                plots = False
     tour_reduced(quick)
+    if plots:
+        print("\n=== charts: accuracy against cost, energy over long runs, stability, sections")
+        for kind in TOUR_CHARTS:
+            for path in chart(kind, out=out, quick=quick):
+                print(f"wrote {path}")
     return 0
 
 
@@ -99,8 +106,24 @@ def main(argv: list[str] | None = None) -> int:
     t.add_argument("--out", type=Path, default=Path("out/tour"), help="folder for the plots (default out/tour)")
     t.add_argument("--quick", action="store_true", help="a tenth of each horizon")
     sub.add_parser("methods", help="print the table of methods")
+    c = sub.add_parser("chart", help="measure and write a chart (PNG or SVG) with its data (CSV)")
+    c.add_argument("kind", choices=sorted(KINDS), help="; ".join(f"{k}: {v.description}" for k, v in KINDS.items()))
+    c.add_argument("scene", nargs="?", help="a scene name (default: the kind's own)")
+    c.add_argument("--methods", help="comma-separated method names (default: the kind's own)")
+    c.add_argument("--out", type=Path, default=Path("out/charts"), help="folder (default out/charts)")
+    c.add_argument("--format", default="png", choices=("png", "svg"))
+    c.add_argument("--quick", action="store_true", help="shorter sweeps and horizons")
     args = parser.parse_args(argv)
     if args.command == "tour":
         return tour(args.out, args.quick)
+    if args.command == "chart":
+        methods = tuple(args.methods.split(",")) if args.methods else None
+        try:
+            paths = chart(args.kind, args.scene, methods=methods, out=args.out, fmt=args.format, quick=args.quick)
+        except ValueError as e:
+            parser.error(str(e))
+        for path in paths:
+            print(f"wrote {path}")
+        return 0
     print(format_table())
     return 0

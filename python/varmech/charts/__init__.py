@@ -7,5 +7,14 @@ trajectories) and writes a PNG or SVG file; the measurements themselves need no 
 from .energy import energy_error
 from .sections import phase_portrait_chart, poincare_chart
 from .stability import implicit_regions_chart, stability_chart
+from .work_precision import energy_growth_chart, work_precision_chart
 
-__all__ = ["energy_error", "implicit_regions_chart", "phase_portrait_chart", "poincare_chart", "stability_chart"]
+__all__ = [
+    "energy_error",
+    "energy_growth_chart",
+    "implicit_regions_chart",
+    "phase_portrait_chart",
+    "poincare_chart",
+    "stability_chart",
+    "work_precision_chart",
+]

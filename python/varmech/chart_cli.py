@@ -1,0 +1,131 @@
+"""``python -m varmech chart <kind> [scene]``: measure, then write the chart and its data (CSV)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Callable
+
+from . import charts, scenes, sections, stability, work_precision
+from .table import Table
+
+
+@dataclass(frozen=True)
+class ChartKind:
+    """A chart the command line draws: its default scene and methods, and what it shows."""
+
+    scene: str | None
+    methods: tuple[str, ...]
+    description: str
+    #: (scene, methods, quick, progress) → [(CSV name, table, {figure name: chart function})].
+    draw: Callable[[str | None, tuple[str, ...], bool, bool | None], list[tuple[str, Table, dict[str, Callable]]]]
+
+
+def _work_precision(scene, methods, quick, progress):
+    sc = scenes.get(scene)
+    table = work_precision.work_precision(
+        sc, methods, repeat=1 if quick else 3, sweep_length=4 if quick else 11, max_seconds=1.0 if quick else 5.0,
+        progress=progress,
+    )
+    title = f"{scene}: error at t = {table.meta.get('t_end', sc.t_end):g} against cost"
+    figures = {
+        "work_precision": lambda t, p: charts.work_precision_chart(t, p, x="seconds", title=title),
+        "work_precision_evaluations": lambda t, p: charts.work_precision_chart(t, p, x="evaluations", title=title),
+        "work_precision_energy": lambda t, p: charts.work_precision_chart(t, p, y="max_energy_error", title=title),
+    }
+    return [("work_precision", table, figures)]
+
+
+def _energy(scene, methods, quick, progress):
+    sc = scenes.get(scene)
+    t_end = (5 if quick else 50) * sc.t_end
+    table = work_precision.energy_growth(sc, methods, t_end=t_end, samples=500 if quick else 2000, progress=progress)
+    title = f"{scene}: energy error over t = {t_end:g}"
+    return [
+        ("energy_growth", table, {"energy_growth": lambda t, p: charts.energy_growth_chart(t, p, title=title)}),
+        ("energy_verdicts", work_precision.verdicts(table), {}),
+    ]
+
+
+def _stability(scene, methods, quick, progress):
+    table = stability.growth_table(methods, progress=progress)
+    return [
+        ("stability", table, {"stability": lambda t, p: charts.stability_chart(t, p, title="growth factor on q'' = -ω²q")}),
+        ("stability_limits", stability.stability_table(methods, progress=progress), {}),
+    ]
+
+
+def _implicit_regions(scene, methods, quick, progress):
+    table = stability.implicit_regions(methods, scene=scene, progress=progress)
+    draw = lambda t, p: charts.implicit_regions_chart(t, p, title=f"{scene}: implicit steps")  # noqa: E731
+    return [("implicit_regions", table, {"implicit_regions": draw})]
+
+
+def _poincare(scene, methods, quick, progress):
+    sc = scenes.get(scene)
+    out = []
+    for energy in sections.HENON_HEILES_ENERGIES:
+        table = sections.poincare_section(
+            sc, energy, orbits=12 if quick else 40, t_end=300.0 if quick else 2000.0, method=methods[0], progress=progress
+        )
+        label = f"{energy:.4f}".rstrip("0")
+        title = f"{scene}: Poincaré section x = 0, H = {label}"
+        name = f"poincare_H{label.replace('.', '_')}"
+        out.append((name, table, {name: lambda t, p, title=title: charts.poincare_chart(t, p, title=title)}))
+    return out
+
+
+def _phase(scene, methods, quick, progress):
+    table = sections.phase_portrait(scenes.get(scene), method=methods[0], progress=progress)
+    draw = lambda t, p: charts.phase_portrait_chart(t, p, title=f"{scene}: phase portrait")  # noqa: E731
+    return [("phase_portrait", table, {"phase_portrait": draw})]
+
+
+KINDS: dict[str, ChartKind] = {
+    "work-precision": ChartKind(
+        "kepler", ("verlet", "yoshida4", "kahan_li8", "rk4"),
+        "error at the final time (and max energy error) against wall time and force evaluations; scipy and REBOUND baselines",
+        _work_precision,
+    ),
+    "energy": ChartKind(
+        "kepler", ("verlet", "kahan_li8", "rk4"), "energy error against time, log–log, with a √t line", _energy
+    ),
+    "stability": ChartKind(
+        None, ("symplectic_euler", "verlet", "yoshida4", "mclachlan4", "kahan_li8", "rk4", "midpoint"),
+        "growth factor against hω with each stability limit", _stability,
+    ),
+    "implicit-regions": ChartKind(
+        "pendulum", ("midpoint", "trapezoid", "galerkin4", "galerkin6"),
+        "where the implicit methods' Newton iterations fail or jump branches", _implicit_regions,
+    ),
+    "poincare": ChartKind("henon_heiles", ("kahan_li6",), "Poincaré sections at H = 1/12 and 1/8", _poincare),
+    "phase": ChartKind("pendulum", ("kahan_li6",), "phase portrait: librations, separatrix, rotations", _phase),
+}
+
+
+def chart(
+    kind: str,
+    scene: str | None = None,
+    *,
+    methods: tuple[str, ...] | None = None,
+    out: Path = Path("out/charts"),
+    fmt: str = "png",
+    quick: bool = False,
+    progress: bool | None = None,
+) -> list[Path]:
+    """Measure chart ``kind`` on ``scene`` (its default when None) and write, for each figure,
+    ``<out>/<name>_<scene>.<fmt>`` and the data as ``.csv``; returns the paths written."""
+    if kind not in KINDS:
+        raise ValueError(f"kind: expected one of {', '.join(KINDS)}, got {kind!r}")
+    if fmt not in ("png", "svg"):
+        raise ValueError(f"format: expected png or svg, got {fmt!r}")
+    spec = KINDS[kind]
+    scene = scene or spec.scene
+    if scene is not None and scene not in scenes.CATALOGUE:
+        raise ValueError(f"scene: expected one of {', '.join(scenes.CATALOGUE)}, got {scene!r}")
+    stem = f"_{scene}" if scene else ""
+    written = []
+    for name, table, figures in spec.draw(scene, tuple(methods or spec.methods), quick, progress):
+        written.append(table.to_csv(out / f"{name}{stem}.csv"))
+        written += [draw(table, out / f"{figure}{stem}.{fmt}") for figure, draw in figures.items()]
+    return written

@@ -1,0 +1,109 @@
+"""Work–precision diagrams and energy growth over long runs, from the tables of
+:mod:`varmech.work_precision`."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+
+from ..table import Table
+from ._figure import pyplot, save
+
+_AXIS_LABELS = {
+    "seconds": "wall time (s)",
+    "evaluations": "force evaluations",
+    "steps": "steps",
+    "final_error": "error at the final time ‖(q, p) − reference‖",
+    "max_energy_error": "max relative energy error |ΔH/H₀|",
+}
+# Line styles by tool, so that baselines read apart from varmech's methods at a glance.
+_STYLE = {"varmech": dict(ls="-", marker="o"), "scipy": dict(ls="--", marker="s"), "rebound": dict(ls=":", marker="^")}
+
+
+def work_precision_chart(table: Table, path: str | Path, *, x: str = "seconds", y: str = "final_error", title: str = "") -> Path:
+    """Plot ``y`` (``"final_error"`` or ``"max_energy_error"``) against ``x`` (``"seconds"`` or
+    ``"evaluations"``) on log–log axes, one line per (tool, method) of a
+    :func:`~varmech.work_precision` table, and write the figure to ``path`` (PNG or SVG).
+
+    Lower left is better: less work for a smaller error. Each line follows its sweep (steps, or
+    tolerances); points with a non-finite or zero value are left out.
+    """
+    for name in (x, y):
+        if name not in table.columns:
+            raise ValueError(f"x, y: no column {name!r} in {table.columns}")
+    plt = pyplot()
+    fig, ax = plt.subplots(figsize=(8.5, 4.8), layout="constrained")
+    for tool in table.unique("tool"):
+        sub = table.where(tool=tool)
+        for method in sub.unique("method"):
+            rows = sub.where(method=method)
+            xs, ys = rows.column(x), rows.column(y)
+            keep = np.isfinite(xs) & np.isfinite(ys) & (xs > 0) & (ys > 0)
+            if not keep.any():
+                continue
+            order = np.argsort(xs[keep])
+            label = method if tool == "varmech" else f"{method} ({tool})"
+            ax.loglog(xs[keep][order], ys[keep][order], label=label, lw=1.0, ms=3.5, **_STYLE.get(tool, {}))
+    ax.set_xlabel(_AXIS_LABELS.get(x, x))
+    ax.set_ylabel(_AXIS_LABELS.get(y, y))
+    t_end = table.meta.get("t_end")
+    ax.set_title(title or (f"{table.meta.get('scene', '')}, t = 0 … {t_end:g}" if t_end else table.title), fontsize=10)
+    ax.grid(True, which="major", alpha=0.3)
+    ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0))
+    return save(fig, path)
+
+
+def energy_growth_chart(table: Table, path: str | Path, title: str = "", *, samples: bool = True) -> Path:
+    """Plot the energy error of an :func:`~varmech.energy_growth` table against t on log–log
+    axes, one line per method with its verdict in the legend, and write the figure to ``path``
+    (PNG or SVG).
+
+    Each method's line is the largest |ΔH/H₀| up to t (column ``max_energy_error``): bounded
+    methods reach their band within the first orbits and run flat; drifting ones keep climbing.
+    With ``samples`` the sampled errors themselves (column ``energy_error``, the largest in each
+    log-spaced bin) are drawn faintly behind, showing the oscillation. A dashed √t line (Brouwer's
+    law, the growth of random round-off) and a dotted ∝ t line go through the first drifting curve
+    (the first with the verdict "secular drift"), two decades before its end, so that its slope
+    reads against them.
+    """
+    plt = pyplot()
+    verdicts = table.meta.get("verdicts", {})
+    fig, ax = plt.subplots(figsize=(9.5, 4.8), layout="constrained")
+    anchor = None
+    for tool in table.unique("tool"):
+        sub = table.where(tool=tool)
+        for method in sub.unique("method"):
+            rows = sub.where(method=method)
+            t, e, m = rows.column("t"), rows.column("energy_error"), rows.column("max_energy_error")
+            keep = (t > 0) & (m > 0) & np.isfinite(m)
+            if not keep.any():
+                continue
+            v = verdicts.get(method, {})
+            label = method if tool == "varmech" else f"{method} ({tool}, rtol {v['rtol']:g})" if "rtol" in v else f"{method} ({tool})"
+            if v:
+                label += f": {v['verdict']}"
+                if v["verdict"] == "secular drift":
+                    label += f", {abs(v['drift_rate']):.1e} per unit t"
+            (line,) = ax.loglog(t[keep], m[keep], lw=1.2, label=label, ls="-" if tool == "varmech" else "--")
+            if samples:
+                faint = (t > 0) & (e > 0) & np.isfinite(e)
+                ax.loglog(t[faint], e[faint], lw=0.4, color=line.get_color(), alpha=0.3)
+            if anchor is None and v.get("verdict") == "secular drift":
+                tk, mk = t[keep], m[keep]
+                k = int(np.argmin(np.abs(np.log(tk / max(tk[0], tk[-1] / 100)))))
+                anchor = (tk[k], mk[k], tk[0], tk[-1])
+    if anchor is not None:
+        ta, ea, t0, t1 = anchor
+        tt = np.geomspace(max(t0, ta / 1e3), t1, 50)
+        ax.loglog(tt, ea * np.sqrt(tt / ta), "k--", lw=0.8, alpha=0.7, label="∝ √t (Brouwer's law)")
+        ax.loglog(tt, ea * (tt / ta), "k:", lw=0.8, alpha=0.7, label="∝ t")
+    ax.set_xlabel("t")
+    ax.set_ylabel("relative energy error |H − H₀|/|H₀|, max up to t")
+    meta = table.meta
+    default = f"{meta.get('scene', '')}, dt = {meta['dt']:g}" if "dt" in meta else table.title
+    ax.set_title(title or default, fontsize=10)
+    ax.grid(True, which="major", alpha=0.3)
+    ax.legend(fontsize=7.5, loc="upper left", bbox_to_anchor=(1.01, 1.0))
+    return save(fig, path)
