@@ -30,9 +30,8 @@ def test_tour_prints_reports_and_writes_plots(tmp_path):
     # The reduced runs, reconstructed: the ignored momenta are exact by construction.
     assert out.count("Routh-reduced") == len(TOUR_REDUCED)
     assert out.count("max |ΔJ| = 0.000e+00") >= sum(len(c) * len(m) for _, c, m in TOUR_REDUCED)
-    for line in out.splitlines():
-        if line.startswith("wrote "):
-            assert line.split(" ", 1)[1].endswith("_energy.png")
+    named = {line.split(" ", 1)[1] for line in out.splitlines() if line.startswith("wrote ")}
+    assert named == {str(p) for p in tmp_path.iterdir()}
 
 
 @pytest.mark.parametrize("kind", ["stability", "phase"])
