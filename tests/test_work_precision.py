@@ -12,9 +12,9 @@ import pytest
 import varmech
 
 from varmech import scenes
-from varmech import work_precision as wp
+from varmech import performance as wp
 from varmech.scenes import Reference
-from varmech.work_precision import energy_growth, verdicts, work_precision
+from varmech.performance import energy_growth, verdicts, work_precision
 
 PERIOD = 2 * math.pi
 

@@ -27,6 +27,7 @@ from .reduction import ReducedModel, cyclic_coordinates, routh
 from .table import Table
 from .stability import growth_factor, growth_table, implicit_regions, stability_scan, stability_table, unstable_intervals
 from .sections import phase_portrait, poincare_section
+from .performance import energy_growth, work_precision
 from . import sections, stability
 from .model import Cyclic, Lagrangian, MechanicalSystem, Model, NativeSystem, Rotation, Translation
 from . import scenes
@@ -69,6 +70,8 @@ __all__ = [
     "stability_table",
     "unstable_intervals",
     "phase_portrait",
+    "energy_growth",
+    "work_precision",
     "poincare_section",
     "sections",
     "stability",

@@ -6,7 +6,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable
 
-from . import charts, scenes, sections, stability, work_precision
+from . import charts, performance, scenes, sections, stability
 from .table import Table
 
 
@@ -23,7 +23,7 @@ class ChartKind:
 
 def _work_precision(scene, methods, quick, progress):
     sc = scenes.get(scene)
-    table = work_precision.work_precision(
+    table = performance.work_precision(
         sc, methods, repeat=1 if quick else 3, sweep_length=4 if quick else 11, max_seconds=1.0 if quick else 5.0,
         progress=progress,
     )
@@ -39,11 +39,11 @@ def _work_precision(scene, methods, quick, progress):
 def _energy(scene, methods, quick, progress):
     sc = scenes.get(scene)
     t_end = (5 if quick else 50) * sc.t_end
-    table = work_precision.energy_growth(sc, methods, t_end=t_end, samples=500 if quick else 2000, progress=progress)
+    table = performance.energy_growth(sc, methods, t_end=t_end, samples=500 if quick else 2000, progress=progress)
     title = f"{scene}: energy error over t = {t_end:g}"
     return [
         ("energy_growth", table, {"energy_growth": lambda t, p: charts.energy_growth_chart(t, p, title=title)}),
-        ("energy_verdicts", work_precision.verdicts(table), {}),
+        ("energy_verdicts", performance.verdicts(table), {}),
     ]
 
 
