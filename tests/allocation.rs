@@ -121,7 +121,12 @@ fn the_routh_reduced_step_loop_allocates_nothing() {
     let problem = scenes::HeavyTop::problem();
     let (q0, p0) = (&problem.initial.q, &problem.initial.p);
     let r = Routhian::new(&problem.system, &[1, 2], &p0[1..], &[0.0, 0.0]).unwrap();
-    for method in [Method::Midpoint, Method::Trapezoid, Method::Galerkin4, Method::Galerkin6] {
+    for method in [
+        Method::Midpoint,
+        Method::Trapezoid,
+        Method::Galerkin4,
+        Method::Galerkin6,
+    ] {
         let run = |steps| {
             let options = Options {
                 save_every: 10,
@@ -130,6 +135,9 @@ fn the_routh_reduced_step_loop_allocates_nothing() {
             counted(&General(&r), method, &q0[..1], &p0[..1], &options)
         };
         let (short, long) = (run(100), run(5_000));
-        assert_eq!(short, long, "{method:?}: {short} allocations for 100 steps, {long} for 5000");
+        assert_eq!(
+            short, long,
+            "{method:?}: {short} allocations for 100 steps, {long} for 5000"
+        );
     }
 }
