@@ -154,15 +154,7 @@ impl<'a, L: Lagrangian + ?Sized> Routhian<'a, L> {
     /// Writes ċ(x, ẋ, t) with ∂L/∂ċ = μ into `out`.
     pub fn cyclic_velocity(&self, x: &[f64], xdot: &[f64], t: f64, out: &mut [f64]) -> Result<(), ModelError> {
         let s = &mut *self.scratch.borrow_mut();
-        self.solve(
-            s,
-            &[Node {
-                x,
-                xdot,
-                t,
-                weight: 1.0,
-            }],
-        )?;
+        self.solve_at(s, x, xdot, t)?;
         out.copy_from_slice(&s.cdot);
         Ok(())
     }
@@ -173,15 +165,7 @@ impl<'a, L: Lagrangian + ?Sized> Routhian<'a, L> {
     pub fn amended_potential(&self, x: &[f64], t: f64) -> Result<f64, ModelError> {
         let zero = vec![0.0; x.len()];
         let s = &mut *self.scratch.borrow_mut();
-        self.solve(
-            s,
-            &[Node {
-                x,
-                xdot: &zero,
-                t,
-                weight: 1.0,
-            }],
-        )?;
+        self.solve_at(s, x, &zero, t)?;
         Ok(-self.value(s, t)?)
     }
 
@@ -276,6 +260,36 @@ impl<'a, L: Lagrangian + ?Sized> Routhian<'a, L> {
             s.solved_x.copy_from_slice(node.x);
             s.solved_xdot.copy_from_slice(node.xdot);
         }
+        Ok(())
+    }
+
+    /// [`Routhian::solve`] at the one point (x, ẋ, t).
+    fn solve_at(&self, s: &mut Scratch, x: &[f64], xdot: &[f64], t: f64) -> Result<(), ModelError> {
+        self.solve(
+            s,
+            &[Node {
+                x,
+                xdot,
+                t,
+                weight: 1.0,
+            }],
+        )
+    }
+
+    /// A first derivative of R: the shape entries of `derivative` (∂L/∂q or ∂L/∂q̇) of L at the
+    /// solved ċ, since ∂R/∂ċ = 0.
+    fn shape_derivative(
+        &self,
+        x: &[f64],
+        xdot: &[f64],
+        t: f64,
+        out: &mut [f64],
+        derivative: impl Fn(&L, &[f64], &[f64], f64, &mut [f64]) -> Result<(), ModelError>,
+    ) -> Result<(), ModelError> {
+        let s = &mut *self.scratch.borrow_mut();
+        self.solve_at(s, x, xdot, t)?;
+        derivative(self.full, &s.q, &s.v, t, &mut s.full)?;
+        self.gather(s, out);
         Ok(())
     }
 
@@ -410,50 +424,18 @@ impl<L: Lagrangian + ?Sized> Lagrangian for Routhian<'_, L> {
     /// R = L − μ·ċ.
     fn lagrangian(&self, x: &[f64], xdot: &[f64], t: f64) -> Result<f64, ModelError> {
         let s = &mut *self.scratch.borrow_mut();
-        self.solve(
-            s,
-            &[Node {
-                x,
-                xdot,
-                t,
-                weight: 1.0,
-            }],
-        )?;
+        self.solve_at(s, x, xdot, t)?;
         self.value(s, t)
     }
 
     /// ∂R/∂x = ∂L/∂x at the solved ċ.
     fn dl_dq(&self, x: &[f64], xdot: &[f64], t: f64, out: &mut [f64]) -> Result<(), ModelError> {
-        let s = &mut *self.scratch.borrow_mut();
-        self.solve(
-            s,
-            &[Node {
-                x,
-                xdot,
-                t,
-                weight: 1.0,
-            }],
-        )?;
-        self.full.dl_dq(&s.q, &s.v, t, &mut s.full)?;
-        self.gather(s, out);
-        Ok(())
+        self.shape_derivative(x, xdot, t, out, L::dl_dq)
     }
 
     /// ∂R/∂ẋ = ∂L/∂ẋ at the solved ċ.
     fn dl_dv(&self, x: &[f64], xdot: &[f64], t: f64, out: &mut [f64]) -> Result<(), ModelError> {
-        let s = &mut *self.scratch.borrow_mut();
-        self.solve(
-            s,
-            &[Node {
-                x,
-                xdot,
-                t,
-                weight: 1.0,
-            }],
-        )?;
-        self.full.dl_dv(&s.q, &s.v, t, &mut s.full)?;
-        self.gather(s, out);
-        Ok(())
+        self.shape_derivative(x, xdot, t, out, L::dl_dv)
     }
 
     /// The Hessians of R are Schur complements of those of L: with K = ∂²L/∂ċ² and the
@@ -461,15 +443,7 @@ impl<L: Lagrangian + ?Sized> Lagrangian for Routhian<'_, L> {
     /// R_xx = L_xx − B_qK⁻¹B_qᵀ, R_xẋ = L_xẋ − B_qK⁻¹B_vᵀ, R_ẋẋ = L_ẋẋ − B_vK⁻¹B_vᵀ.
     fn hessians(&self, x: &[f64], xdot: &[f64], t: f64, out: &mut Hessians) -> Result<bool, ModelError> {
         let s = &mut *self.scratch.borrow_mut();
-        self.solve(
-            s,
-            &[Node {
-                x,
-                xdot,
-                t,
-                weight: 1.0,
-            }],
-        )?;
+        self.solve_at(s, x, xdot, t)?;
         if !self.full.hessians(&s.q, &s.v, t, &mut s.hessians)? {
             return Ok(false);
         }
