@@ -491,21 +491,23 @@ def work_precision(
         # its step onto the sample times).
         sim2 = _rebound_sim(rb, scene, method, dt=dt, epsilon=eps)
         qs, ps, ts = [scene.q0], [scene.p0], [0.0]
-        if method == "WHFast":
-            chunk = max(1, n // 1000)  # type: ignore[operator]
-            done = 0
-            while done < n:  # type: ignore[operator]
-                k = min(chunk, n - done)  # type: ignore[operator]
-                sim2.steps(k)
-                done += k
-                a, b = _rebound_state(sim2, masses)
-                qs.append(a), ps.append(b), ts.append(sim2.t)
-        else:
-            for t in np.linspace(0, T, 1001)[1:]:
-                sim2.integrate(t, exact_finish_time=0)
-                a, b = _rebound_state(sim2, masses)
-                qs.append(a), ps.append(b), ts.append(sim2.t)
-        _restore_sigint()
+        try:
+            if method == "WHFast":
+                chunk = max(1, n // 1000)  # type: ignore[operator]
+                done = 0
+                while done < n:  # type: ignore[operator]
+                    k = min(chunk, n - done)  # type: ignore[operator]
+                    sim2.steps(k)
+                    done += k
+                    a, b = _rebound_state(sim2, masses)
+                    qs.append(a), ps.append(b), ts.append(sim2.t)
+            else:
+                for t in np.linspace(0, T, 1001)[1:]:
+                    sim2.integrate(t, exact_finish_time=0)
+                    a, b = _rebound_state(sim2, masses)
+                    qs.append(a), ps.append(b), ts.append(sim2.t)
+        finally:
+            _restore_sigint()
         energy = float(np.max(_relative(_energy(scene, np.array(ts), np.array(qs), np.array(ps)))))
         return ("rebound", method, parameter, value, taken, evaluations, best, _final_error(ref, q, p), energy)
 
@@ -731,16 +733,18 @@ def energy_growth(
         # Every saved time is a whole number of steps: evenly spaced, and log-spaced below.
         marks = np.unique(np.concatenate([np.linspace(0, n, uniform + 1).round(), np.geomspace(1, n, samples * 2).round()])).astype(np.int64)
         ts, qs, ps, done = [], [], [], 0
-        for k in marks:
-            if method == "WHFast":
-                if k > done:
-                    sim.steps(int(k - done))
-                    done = int(k)
-            else:
-                sim.integrate(k * h, exact_finish_time=1)
-            a, b = _rebound_state(sim, masses)
-            ts.append(k * h), qs.append(a), ps.append(b)
-        _restore_sigint()
+        try:
+            for k in marks:
+                if method == "WHFast":
+                    if k > done:
+                        sim.steps(int(k - done))
+                        done = int(k)
+                else:
+                    sim.integrate(k * h, exact_finish_time=1)
+                a, b = _rebound_state(sim, masses)
+                ts.append(k * h), qs.append(a), ps.append(b)
+        finally:
+            _restore_sigint()
         t = np.array(ts)
         energies = _energy(scene, t, np.array(qs), np.array(ps))
         on_grid = np.isin(marks, np.linspace(0, n, uniform + 1).round().astype(np.int64))
