@@ -16,6 +16,7 @@ mod explicit_rk;
 mod kick_drift;
 mod method;
 mod rattle;
+mod step;
 
 pub use composition::Composition;
 pub use del::{Del, Galerkin, NewtonOptions, Quadrature, StepEquations, TwoPoint};
@@ -24,6 +25,7 @@ pub use explicit_rk::ExplicitRk;
 pub use kick_drift::KickDrift;
 pub use method::{Method, MethodInfo};
 pub use rattle::Rattle;
+pub use step::{Increment, StepStart};
 
 use crate::discrete::{Midpoint, Trapezoidal};
 use crate::model::{HolonomicConstraints, Lagrangian, MechanicalSystem};
