@@ -11,7 +11,7 @@ import pytest
 
 import varmech
 from varmech import stability
-from varmech.stability import (
+from varmech.analysis.stability import (
     COMPOSITION_NAMES,
     REFERENCE_LIMITS,
     growth_factor,

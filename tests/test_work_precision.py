@@ -12,9 +12,10 @@ import pytest
 import varmech
 
 from varmech import scenes
-from varmech import performance as wp
+from varmech.analysis import baselines, work_precision as wp
 from varmech.scenes import Reference
-from varmech.performance import energy_growth, verdicts, work_precision
+from varmech.analysis.energy_growth import ENERGY_GROWTH_COLUMNS, energy_growth, verdicts
+from varmech.analysis.work_precision import work_precision
 
 PERIOD = 2 * math.pi
 
@@ -108,7 +109,7 @@ def test_scipy_baselines_sweep_tolerances():
 
 
 def test_missing_scipy_is_skipped_with_a_note(monkeypatch):
-    monkeypatch.setattr(wp, "_import_scipy", lambda: None)
+    monkeypatch.setattr(baselines, "import_scipy", lambda: None)
     scene, ref = kepler_periods(1)
     t = work_precision(scene, ["verlet"], steps=[1000], reference=ref, repeat=1, progress=False)
     assert set(t.column("tool")) == {"varmech"}
@@ -185,7 +186,7 @@ def test_long_kepler_verdicts(long_kepler):
 
 def test_energy_growth_rows_are_log_spaced_with_a_running_maximum(long_kepler):
     t = long_kepler
-    assert t.columns == wp.ENERGY_GROWTH_COLUMNS
+    assert t.columns == ENERGY_GROWTH_COLUMNS
     for method in ("verlet", "kahan_li8", "rk4", "DOP853"):
         rows = t.where(method=method)
         times, err, top = rows.column("t"), rows.column("energy_error"), rows.column("max_energy_error")

@@ -1,4 +1,4 @@
-"""Poincaré sections and phase portraits, from the tables of :mod:`varmech.sections`."""
+"""Poincaré sections and phase portraits, from the tables of :mod:`varmech.analysis.sections`."""
 
 from __future__ import annotations
 
@@ -23,7 +23,7 @@ def _henon_heiles_boundary(energy: float) -> tuple[np.ndarray, np.ndarray] | Non
 
 
 def poincare_chart(table: Union[Table, Sequence[Table]], path: str | Path, title: str = "") -> Path:
-    """Scatter the section points of :func:`varmech.sections.poincare_section` in the table's
+    """Scatter the section points of :func:`varmech.analysis.sections.poincare_section` in the table's
     plane (``meta["plane"]``, e.g. (y, p_y)), small dots, one colour per orbit, one panel per
     table (pass several tables, e.g. H = 1/12 and 1/8, for panels side by side). The boundary of
     the energy-allowed region is drawn for Hénon–Heiles' x = 0 section. Writes ``path`` (PNG or
@@ -60,7 +60,7 @@ def poincare_chart(table: Union[Table, Sequence[Table]], path: str | Path, title
 
 
 def phase_portrait_chart(table: Table, path: str | Path, title: str = "") -> Path:
-    """Draw the orbits of :func:`varmech.sections.phase_portrait` in the (q, p) plane:
+    """Draw the orbits of :func:`varmech.analysis.sections.phase_portrait` in the (q, p) plane:
     librations in blues, rotations in oranges (darker for higher energy), undetermined orbits
     in grey. When rotations are present q is taken modulo 2π into (−π, π]; for the pendulum the
     separatrix p = ±2cos(q/2) (energy 1) is drawn dashed. Writes ``path`` (PNG or SVG)."""
