@@ -311,7 +311,6 @@ def _crossings(traj: Trajectory, k: int, c: float, direction: int) -> tuple[np.n
 
 def _hermite_points(model: Model, traj: Trajectory, idx: np.ndarray, k: int, c: float, sign: np.ndarray):
     """The Hermite estimate of each crossing: (τ, q, p) at the root of q_k(τ) − c."""
-    h = traj.dt
     t0, t1 = traj.t[idx], traj.t[idx + 1]
     q0, q1, p0, p1 = traj.q[idx], traj.q[idx + 1], traj.p[idx], traj.p[idx + 1]
     v0, v1 = model.velocity(q0, p0, t0), model.velocity(q1, p1, t1)

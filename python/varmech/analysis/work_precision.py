@@ -221,7 +221,7 @@ def work_precision(
     total = sum(len(values) for _, _, values, _ in plan)
     bar = _progress(range(total), total=total, desc=f"work–precision {scene.name}", enabled=progress)
 
-    def tick(label: str) -> None:
+    def tick() -> None:
         next(bar, None)
 
     def run_varmech(method: str, n: int) -> tuple:
@@ -291,19 +291,19 @@ def work_precision(
                     row = runners[tool](method, value)
                 except (_core.DivergenceError, _core.ConvergenceError, RuntimeError) as err:
                     notes.append(f"{tool} {method} at {value:g}: failed ({type(err).__name__}: {err})")
-                    tick(method)
+                    tick()
                     continue
                 table.append(*row)
-                tick(method)
+                tick()
                 errors.append(row[7] if math.isfinite(row[7]) else row[8])
                 if max_seconds is not None and row[6] > max_seconds and k < len(values) - 1:
                     notes.append(f"{tool} {method}: stopped after {value:g} (a run took {row[6]:.1f} s > max_seconds = {max_seconds:g})")
                     for _ in values[k + 1 :]:
-                        tick(method)
+                        tick()
                     break
                 if adaptive and _done_refining(errors) and k < len(values) - 1:
                     for _ in values[k + 1 :]:
-                        tick(method)
+                        tick()
                     break
 
     return interruptible(table, body)
