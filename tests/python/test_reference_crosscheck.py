@@ -7,7 +7,6 @@ independent implementation of the method computes (see reference/README.md).
 
 import json
 import math
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -15,7 +14,7 @@ import pytest
 import varmech
 from varmech import scenes
 
-REFERENCE = Path(__file__).resolve().parent.parent / "reference"
+from conftest import REFERENCE_DIR as REFERENCE
 
 
 def numpy_composition(gradient, q, p, mass, h, steps, name):
