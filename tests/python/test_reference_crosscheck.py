@@ -12,9 +12,8 @@ import numpy as np
 import pytest
 
 import varmech
-from varmech import scenes
-
 from conftest import REFERENCE_DIR as REFERENCE
+from varmech import scenes
 
 
 def numpy_composition(gradient, q, p, mass, h, steps, name):

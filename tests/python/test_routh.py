@@ -8,6 +8,7 @@ import pytest
 import varmech
 from varmech import examples, scenes
 
+
 def test_native_and_closure_models_reduce_to_the_same_motion(spherical_natural):
     scene = scenes.spherical_pendulum()
     mu = scene.p0[1]

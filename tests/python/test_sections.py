@@ -182,7 +182,7 @@ def test_pendulum_phase_portrait_conserves_energy_and_classifies_against_the_sep
     by_orbit = {o: tab.where(orbit=o) for o in tab.unique("orbit")}
     # Each rotation gets its mirror (p < 0): 7 energies, 3 rotations.
     assert len(by_orbit) == 10
-    for o, t in by_orbit.items():
+    for t in by_orbit.values():
         e = t.rows[0][1]
         motion = t.rows[0][2]
         assert motion == ("libration" if e < 1 else "rotation"), (e, motion)

@@ -7,12 +7,12 @@ import numpy as np
 import pytest
 
 import varmech
-
 from varmech import scenes
-from varmech.analysis import baselines, work_precision as wp
-from varmech.scenes import Reference
+from varmech.analysis import baselines
+from varmech.analysis import work_precision as wp
 from varmech.analysis.energy_growth import ENERGY_GROWTH_COLUMNS, energy_growth, verdicts
 from varmech.analysis.work_precision import work_precision
+from varmech.scenes import Reference
 
 PERIOD = 2 * math.pi
 
@@ -89,7 +89,9 @@ def test_no_reference_at_the_horizon_gives_nan_and_a_note():
 def test_scipy_baselines_sweep_tolerances():
     pytest.importorskip("scipy")
     scene, ref = kepler_periods(10)
-    t = work_precision(scene, ["kahan_li8"], steps=[2**11], baselines=("RK45", "DOP853", "Radau"), rtols=(1e-4, 1e-7), reference=ref, repeat=1, progress=False)
+    t = work_precision(
+        scene, ["kahan_li8"], steps=[2**11], baselines=("RK45", "DOP853", "Radau"), rtols=(1e-4, 1e-7), reference=ref, repeat=1, progress=False
+    )
     assert {(r["tool"], r["method"], r["value"]) for r in t if r["tool"] == "scipy"} == {
         ("scipy", m, r) for m in ("RK45", "DOP853", "Radau") for r in (1e-4, 1e-7)
     }
@@ -153,7 +155,8 @@ def long_kepler():
     pytest.importorskip("scipy")
     scene = scenes.kepler()
     return energy_growth(
-        scene, ["verlet", "kahan_li8", "rk4"], t_end=500 * PERIOD, samples=400, baselines=("DOP853",), rtol=1e-7, baseline_t_end=500 * PERIOD, progress=False
+        scene, ["verlet", "kahan_li8", "rk4"], t_end=500 * PERIOD, samples=400, baselines=("DOP853",), rtol=1e-7,
+        baseline_t_end=500 * PERIOD, progress=False,
     )
 
 

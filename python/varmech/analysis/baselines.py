@@ -10,7 +10,8 @@ so that Ctrl-C keeps reaching varmech's loops.
 from __future__ import annotations
 
 import signal
-from typing import Any, Sequence
+from collections.abc import Sequence
+from typing import Any
 
 import numpy as np
 

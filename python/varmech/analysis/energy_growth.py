@@ -11,7 +11,8 @@ a sweep: the KeyboardInterrupt propagates, carrying the rows measured so far as 
 from __future__ import annotations
 
 import math
-from typing import Any, Iterable, Sequence
+from collections.abc import Iterable, Sequence
+from typing import Any
 
 import numpy as np
 
@@ -153,7 +154,8 @@ def energy_growth(
             "t_end": T,
             "baseline_t_end": Tb,
             "rtol": rtol,
-            "sampling": f"max |ΔH/H0| in each of {samples} log-spaced bins of t, and its running maximum; verdicts from {uniform} evenly spaced states",
+            "sampling": f"max |ΔH/H0| in each of {samples} log-spaced bins of t, and its running maximum; "
+            f"verdicts from {uniform} evenly spaced states",
             "verdicts": {},
             "notes": [],
         },
@@ -211,7 +213,9 @@ def energy_growth(
                 else:
                     sim.integrate(k * h, exact_finish_time=1)
                 a, b = _baselines.rebound_state(sim, masses)
-                ts.append(k * h), qs.append(a), ps.append(b)
+                ts.append(k * h)
+                qs.append(a)
+                ps.append(b)
         finally:
             _baselines.restore_sigint()
         t = np.array(ts)
@@ -238,7 +242,10 @@ def energy_growth(
 def verdicts(table: Table) -> Table:
     """The verdicts of an :func:`energy_growth` table as a small Table (tool, method, verdict,
     drift_rate, drift_rate_stderr, max_error, t_end)."""
-    out = Table(("tool", "method", "verdict", "drift_rate", "drift_rate_stderr", "max_error", "t_end"), title=f"Energy verdicts: {table.meta.get('scene', '')}")
+    out = Table(
+        ("tool", "method", "verdict", "drift_rate", "drift_rate_stderr", "max_error", "t_end"),
+        title=f"Energy verdicts: {table.meta.get('scene', '')}",
+    )
     for method, v in table.meta.get("verdicts", {}).items():
         out.append(v["tool"], method, v["verdict"], v["drift_rate"], v["drift_rate_stderr"], v["max_error"], v["t_end"])
     return out

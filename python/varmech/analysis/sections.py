@@ -37,7 +37,8 @@ the exact flow (kahan_li8, 64 substeps) from the same grid state over the same �
 from __future__ import annotations
 
 import math
-from typing import Any, Iterable, Sequence, Union
+from collections.abc import Iterable, Sequence
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -52,7 +53,7 @@ from ..table import Table
 from ._energy import energy_of
 from ._interrupt import interruptible
 
-ModelLike = Union[Model, Scene]
+ModelLike = Model | Scene
 
 #: The Hénon–Heiles energies of Hénon & Heiles (1964): mostly regular motion at 1/12,
 #: widespread chaos at 1/8 (the region stays bounded below the escape energy 1/6).
@@ -112,9 +113,9 @@ def _solve_momentum(model: Model, q: np.ndarray, p: np.ndarray, k: int, energy: 
     terms), so three evaluations give it exactly; the result is checked to 1e-12."""
     q = np.ascontiguousarray(q, dtype=float)
     rows = []
-    for s in (0.0, 1.0, -1.0):
+    for value in (0.0, 1.0, -1.0):
         pp = np.array(p, dtype=float)
-        pp[:, k] = s
+        pp[:, k] = value
         rows.append(_energy(model, q, pp))
     e0, e1, em = rows
     a = 0.5 * (e1 + em) - e0
@@ -540,7 +541,16 @@ def orbit_divergence(
     table = Table(
         ("orbit", f"{cols[j]}0", f"p_{cols[j]}0", "divergence", "chaotic"),
         title=f"Orbit divergence: {model.name}, E = {energy:.6g}, t = 0 … {t_end:g}",
-        meta={"model": model.name, "energy": energy, "method": method, "dt": dt, "t_end": t_end, "separation": separation, "threshold": threshold, "notes": []},
+        meta={
+            "model": model.name,
+            "energy": energy,
+            "method": method,
+            "dt": dt,
+            "t_end": t_end,
+            "separation": separation,
+            "threshold": threshold,
+            "notes": [],
+        },
     )
     steps = round(t_end / dt)
     save = max(1, min(10, steps))
@@ -577,7 +587,8 @@ def covered_cells(table: Table, *, bins: int = 40, extent: Any = None, points: i
     if extent is None:
         extent = ((a.min(), a.max()), (b.min(), b.max())) if len(a) else ((0, 1), (0, 1))
     (a0, a1), (b0, b1) = extent
-    out = Table(("orbit", "points", "cells", "fraction"), title=f"Covered cells ({bins} × {bins}): {table.title}", meta={"extent": extent, "bins": bins})
+    title = f"Covered cells ({bins} × {bins}): {table.title}"
+    out = Table(("orbit", "points", "cells", "fraction"), title=title, meta={"extent": extent, "bins": bins})
     for o in table.unique("orbit"):
         sel = orbit == o
         aa, bb = a[sel], b[sel]

@@ -43,7 +43,8 @@ module does not import matplotlib).
 from __future__ import annotations
 
 import math
-from typing import Any, Iterable, Sequence, Union
+from collections.abc import Iterable, Sequence
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -52,7 +53,8 @@ from .._core import ConvergenceError, DivergenceError, SpuriousBranchError
 from .._progress import progress as _progress
 from .._util import positive
 from ..integrate import integrate
-from ..methods import MethodInfo, methods as _methods
+from ..methods import MethodInfo
+from ..methods import methods as _methods
 from ..table import Table
 from ._energy import relative_error
 from ._interrupt import interruptible
@@ -161,7 +163,7 @@ def step_matrix(method: str, h_omega: float) -> np.ndarray:
     return _step_matrix(method, positive("h_omega", h_omega))
 
 
-def growth_factor(method: str, h_omega: Union[float, ArrayLike], *, progress: bool | None = False) -> Any:
+def growth_factor(method: str, h_omega: float | ArrayLike, *, progress: bool | None = False) -> Any:
     """The growth factor ρ(Ψ) = max |λ±| of one step of ``method`` on q̈ = −ω²q at hω.
 
     λ± = τ/2 ± √(τ²/4 − δ) are the eigenvalues of the step matrix Ψ (:func:`step_matrix`),

@@ -16,7 +16,8 @@ from __future__ import annotations
 
 import math
 import time
-from typing import Any, Callable, Iterable, Sequence
+from collections.abc import Callable, Iterable, Sequence
+from typing import Any
 
 import numpy as np
 
@@ -263,25 +264,30 @@ def work_precision(
         qs, ps, ts = [scene.q0], [scene.p0], [0.0]
         try:
             if method == "WHFast":
-                chunk = max(1, n // 1000)  # type: ignore[operator]
+                total = int(value)
+                chunk = max(1, total // 1000)
                 done = 0
-                while done < n:  # type: ignore[operator]
-                    k = min(chunk, n - done)  # type: ignore[operator]
+                while done < total:
+                    k = min(chunk, total - done)
                     sim2.steps(k)
                     done += k
                     a, b = _baselines.rebound_state(sim2, masses)
-                    qs.append(a), ps.append(b), ts.append(sim2.t)
+                    qs.append(a)
+                    ps.append(b)
+                    ts.append(sim2.t)
             else:
                 for t in np.linspace(0, T, 1001)[1:]:
                     sim2.integrate(t, exact_finish_time=0)
                     a, b = _baselines.rebound_state(sim2, masses)
-                    qs.append(a), ps.append(b), ts.append(sim2.t)
+                    qs.append(a)
+                    ps.append(b)
+                    ts.append(sim2.t)
         finally:
             _baselines.restore_sigint()
         energy = float(np.max(relative_error(energy_of(scene.model, np.array(ts), np.array(qs), np.array(ps)))))
         return ("rebound", method, parameter, value, taken, evaluations, best, _final_error(ref, q, p), energy)
 
-    runners = {"varmech": run_varmech, "scipy": run_scipy, "rebound": run_rebound}
+    runners: dict[str, Callable[[str, Any], tuple]] = {"varmech": run_varmech, "scipy": run_scipy, "rebound": run_rebound}
 
     def body() -> None:
         for tool, method, values, adaptive in plan:

@@ -5,9 +5,9 @@ call it."""
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Callable
 
 from .. import scenes
 from ..analysis import energy_growth, sections, stability, work_precision

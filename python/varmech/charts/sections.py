@@ -3,8 +3,8 @@
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from pathlib import Path
-from typing import Sequence, Union
 
 import numpy as np
 
@@ -22,7 +22,7 @@ def _henon_heiles_boundary(energy: float) -> tuple[np.ndarray, np.ndarray] | Non
     return np.concatenate([y, y[::-1]]), np.concatenate([py, -py[::-1]])
 
 
-def poincare_chart(table: Union[Table, Sequence[Table]], path: str | Path, title: str = "") -> Path:
+def poincare_chart(table: Table | Sequence[Table], path: str | Path, title: str = "") -> Path:
     """Scatter the section points of :func:`varmech.analysis.sections.poincare_section` in the table's
     plane (``meta["plane"]``, e.g. (y, p_y)), small dots, one colour per orbit, one panel per
     table (pass several tables, e.g. H = 1/12 and 1/8, for panels side by side). The boundary of
