@@ -541,16 +541,8 @@ def orbit_divergence(
     table = Table(
         ("orbit", f"{cols[j]}0", f"p_{cols[j]}0", "divergence", "chaotic"),
         title=f"Orbit divergence: {model.name}, E = {energy:.6g}, t = 0 … {t_end:g}",
-        meta={
-            "model": model.name,
-            "energy": energy,
-            "method": method,
-            "dt": dt,
-            "t_end": t_end,
-            "separation": separation,
-            "threshold": threshold,
-            "notes": [],
-        },
+        meta={"model": model.name, "energy": energy, "method": method, "dt": dt, "t_end": t_end, "separation": separation,
+              "threshold": threshold, "notes": []},
     )
     steps = round(t_end / dt)
     save = max(1, min(10, steps))

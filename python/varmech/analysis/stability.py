@@ -78,7 +78,7 @@ COMPOSITION_NAMES: dict[str, str] = {
 #: (the ``h_omega_max`` of each composition in "methods", and the "other_linear_stability_facts":
 #: RK4 stable up to y = 2√2, explicit Euler never, symplectic Euler below 2, the implicit midpoint
 #: rule at every h). The JSON file lives in the repository, outside the installed package, so the
-#: numbers are embedded here; tests/test_stability.py checks them against the file.
+#: numbers are embedded here; tests/python/test_stability.py checks them against the file.
 REFERENCE_LIMITS: dict[str, float] = {
     "verlet": 2.0,
     "yoshida4": 1.5734,
