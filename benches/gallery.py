@@ -13,7 +13,7 @@ import argparse
 import time
 from pathlib import Path
 
-from varmech.chart_cli import KINDS, chart
+from varmech.charts.recipes import KINDS, chart
 
 #: (kind, scene): the charts of the gallery; the work–precision chart also on the outer solar
 #: system, where REBOUND is the baseline.

@@ -15,22 +15,33 @@ Hamilton's principle, and check what it conserves::
     )
     traj = varmech.integrate(kepler, [0.4, 0.0], [0.0, 2.0], dt=0.01, t_end=100.0, method="kahan_li8")
     print(varmech.check_conservation(traj))
+
+The measurements (work–precision, energy growth, stability, sections) live in
+:mod:`varmech.analysis` and are re-exported here; :mod:`varmech.charts` draws them.
 """
 
+from . import analysis, scenes
 from ._core import ConvergenceError, DivergenceError, SpuriousBranchError, VarmechError
-from .constraints import project
+from .analysis import sections, stability
+from .analysis.energy_growth import energy_growth
+from .analysis.sections import phase_portrait, poincare_section
+from .analysis.stability import (
+    growth_factor,
+    growth_table,
+    implicit_regions,
+    stability_scan,
+    stability_table,
+    unstable_intervals,
+)
+from .analysis.work_precision import work_precision
 from .conservation import ConservationReport, EnergyReport, MomentumReport, check_conservation, momentum
+from .constraints import project
 from .derivatives import DerivativeCheck, check_derivatives
 from .integrate import Trajectory, integrate, symplecticity_defect
 from .methods import MethodInfo, methods
+from .model import Cyclic, Lagrangian, MechanicalSystem, Model, NativeSystem, Rotation, Translation
 from .reduction import ReducedModel, cyclic_coordinates, routh
 from .table import Table
-from .stability import growth_factor, growth_table, implicit_regions, stability_scan, stability_table, unstable_intervals
-from .sections import phase_portrait, poincare_section
-from .performance import energy_growth, work_precision
-from . import sections, stability
-from .model import Cyclic, Lagrangian, MechanicalSystem, Model, NativeSystem, Rotation, Translation
-from . import scenes
 
 __version__ = "0.1.0"
 
@@ -38,7 +49,6 @@ __all__ = [
     "ConservationReport",
     "ConvergenceError",
     "Cyclic",
-    "cyclic_coordinates",
     "DerivativeCheck",
     "DivergenceError",
     "EnergyReport",
@@ -48,32 +58,34 @@ __all__ = [
     "Model",
     "MomentumReport",
     "NativeSystem",
-    "Rotation",
-    "project",
     "ReducedModel",
-    "routh",
+    "Rotation",
     "SpuriousBranchError",
+    "Table",
     "Trajectory",
     "Translation",
     "VarmechError",
+    "analysis",
     "check_conservation",
     "check_derivatives",
-    "integrate",
-    "methods",
-    "momentum",
-    "scenes",
-    "symplecticity_defect",
+    "cyclic_coordinates",
+    "energy_growth",
     "growth_factor",
     "growth_table",
     "implicit_regions",
-    "stability_scan",
-    "stability_table",
-    "unstable_intervals",
+    "integrate",
+    "methods",
+    "momentum",
     "phase_portrait",
-    "energy_growth",
-    "work_precision",
     "poincare_section",
+    "project",
+    "routh",
+    "scenes",
     "sections",
     "stability",
-    "Table",
+    "stability_scan",
+    "stability_table",
+    "symplecticity_defect",
+    "unstable_intervals",
+    "work_precision",
 ]

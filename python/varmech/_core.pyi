@@ -1,6 +1,7 @@
 """Stubs of the compiled extension ``varmech._core`` (hand-written; see rust/python/src)."""
 
-from typing import Any, Callable, Sequence
+from collections.abc import Callable, Sequence
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -132,7 +133,7 @@ class RouthModel(_ModelProperties):
 FullModel = NativeModel | ClosureModel | ClosureConstrained | ClosureNatural | ClosureLagrangian
 Model = FullModel | RouthModel
 
-def routh(full: FullModel, cyclic: Sequence[int], momenta: Sequence[float], reference: Sequence[float]) -> RouthModel:
+def routh(full: Model, cyclic: Sequence[int], momenta: Sequence[float], reference: Sequence[float]) -> RouthModel:
     """The reduced model ignoring ``cyclic`` at momenta μ; ValueError for constrained, forced
     or reduced models and malformed indices."""
 

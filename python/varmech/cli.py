@@ -7,10 +7,10 @@ import time
 from pathlib import Path
 
 from . import charts, scenes
+from .charts.recipes import KINDS, chart
 from .conservation import check_conservation
 from .integrate import integrate
 from .methods import format_table
-from .chart_cli import KINDS, chart
 from .reduction import routh
 
 #: (scene, methods, horizon): each scene over a horizon long enough to tell bounded from drifting.

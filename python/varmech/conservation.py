@@ -2,8 +2,8 @@
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Sequence
 
 import numpy as np
 
@@ -133,9 +133,9 @@ def check_conservation(traj: Trajectory, generators: Sequence[Generator] | None 
         e = traj.energy()
         balance = float(np.max(np.abs(e - e[0] - traj.work)) / (abs(e[0]) or 1.0))
     momenta = []
-    for k, g in enumerate(generators):
-        name = g.name if isinstance(g, (Translation, Rotation, Cyclic)) else f"xi[{k}]"
-        momenta.append(MomentumReport(name, *_core.invariant_statistics(momentum(traj, g))))
+    for k, xi in enumerate(generators):
+        name = xi.name if isinstance(xi, (Translation, Rotation, Cyclic)) else f"xi[{k}]"
+        momenta.append(MomentumReport(name, *_core.invariant_statistics(momentum(traj, xi))))
     residuals = None
     if model.constraints:
         g, v = traj.constraint_residuals()

@@ -8,6 +8,7 @@ the closure path against the native one.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 
 import numpy as np
 
@@ -307,10 +308,10 @@ def rigid_body(inertia: tuple[float, float, float] = (0.5, 0.9, 1.0)) -> Mechani
 
 def closure_of(scene: Scene) -> MechanicalSystem | Lagrangian:
     """The closure version of a built-in scene (with its default parameters)."""
-    gravity = scene.model._core.gravity
+    gravity = getattr(scene.model._core, "gravity", None)
     if gravity is not None:
         return nbody(*gravity)
-    return {
+    makers: dict[str, Callable[[], MechanicalSystem | Lagrangian]] = {
         "harmonic_oscillator": harmonic_oscillator,
         "pendulum": pendulum,
         "kepler": kepler,
@@ -325,4 +326,5 @@ def closure_of(scene: Scene) -> MechanicalSystem | Lagrangian:
         "damped_driven_pendulum": damped_driven_pendulum,
         "cartesian_pendulum": cartesian_pendulum,
         "rigid_body": rigid_body,
-    }[scene.name]()
+    }
+    return makers[scene.name]()

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Union
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -57,7 +57,8 @@ class Trajectory:
     def newton_iterations_per_step(self) -> np.ndarray:
         """Mean Newton iterations per step between consecutive saved states, shape (N − 1,)."""
         steps = np.diff(np.rint((self.t - self.t[0]) / self.dt))
-        return np.diff(self.newton) / np.maximum(steps, 1)
+        newton = self.newton if self.newton is not None else np.zeros(len(self.t))
+        return np.diff(newton) / np.maximum(steps, 1)
 
     @property
     def v(self) -> np.ndarray:
@@ -105,7 +106,7 @@ def _steps(dt: float, t0: float, steps: int | None, t_end: float | None) -> int:
 
 
 def integrate(
-    model: Union[Model, "Scene"],
+    model: Model | Scene,
     q0: ArrayLike | None = None,
     p0: ArrayLike | None = None,
     *,
@@ -198,9 +199,12 @@ def integrate(
     if q0 is None:
         raise ValueError("q0: the initial positions are required")
     q = vector("q0", q0, n)
-    if (p0 is None) == (v0 is None):
+    if p0 is not None and v0 is None:
+        p = vector("p0", p0, n)
+    elif v0 is not None and p0 is None:
+        p = model.momentum(q, vector("v0", v0, n), t0)
+    else:
         raise ValueError("p0, v0: give exactly one of the initial momenta p0 and velocities v0")
-    p = vector("p0", p0, n) if p0 is not None else model.momentum(q, vector("v0", v0, n), t0)
     try:
         t, qs, ps, done, nfev, newton, work = _core.integrate(
             model._core,
@@ -220,8 +224,9 @@ def integrate(
         raw = getattr(err, "_varmech_partial", None)
         if raw is not None:
             t, qs, ps, done, nfev, newton, work = raw
-            del err._varmech_partial
-            err.partial = Trajectory(t, qs, ps, model, method, dt, done, nfev, newton, work, status=-1, message=str(err))
+            del err._varmech_partial  # type: ignore[attr-defined]
+            partial = Trajectory(t, qs, ps, model, method, dt, done, nfev, newton, work, status=-1, message=str(err))
+            err.partial = partial  # type: ignore[attr-defined]
         raise
     return Trajectory(t, qs, ps, model, method, dt, done, nfev, newton, work)
 

@@ -36,10 +36,6 @@ def methods() -> list[MethodInfo]:
     return [MethodInfo(**d) for d in _core.methods()]
 
 
-def method_names() -> list[str]:
-    return [m.name for m in methods()]
-
-
 def format_table() -> str:
     """The methods as a Markdown table."""
     rows = [

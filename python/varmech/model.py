@@ -3,8 +3,8 @@
 from __future__ import annotations
 
 import warnings
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from typing import Callable, Sequence, Union
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -62,9 +62,9 @@ class Cyclic:
         return ("cyclic", self.index, 0)
 
 
-Symmetry = Union[Translation, Rotation, Cyclic]
+Symmetry = Translation | Rotation | Cyclic
 #: A generator ξ(q) of a symmetry: a built-in one, or a closure returning an array (n,).
-Generator = Union[Symmetry, Callable[[np.ndarray], ArrayLike]]
+Generator = Symmetry | Callable[[np.ndarray], ArrayLike]
 
 
 def _specs(symmetries: Sequence[Symmetry]) -> list[tuple[str, int, int]]:
@@ -76,7 +76,12 @@ def _specs(symmetries: Sequence[Symmetry]) -> list[tuple[str, int, int]]:
 
 
 def _symmetry_from_spec(kind: str, a: int, d: int) -> Symmetry:
-    return {"translation": lambda: Translation(a, d), "rotation": lambda: Rotation(a, d), "cyclic": lambda: Cyclic(a)}[kind]()
+    makers: dict[str, Callable[[], Symmetry]] = {
+        "translation": lambda: Translation(a, d),
+        "rotation": lambda: Rotation(a, d),
+        "cyclic": lambda: Cyclic(a),
+    }
+    return makers[kind]()
 
 
 class Model:
@@ -87,7 +92,14 @@ class Model:
     implicit variational ones (``midpoint``, ``trapezoid``, ``galerkin4``, ``galerkin6``).
     """
 
-    _core: _core.NativeModel | _core.ClosureModel | _core.ClosureConstrained | _core.ClosureNatural | _core.ClosureLagrangian
+    _core: (
+        _core.NativeModel
+        | _core.ClosureModel
+        | _core.ClosureConstrained
+        | _core.ClosureNatural
+        | _core.ClosureLagrangian
+        | _core.RouthModel
+    )
     symmetries: tuple[Symmetry, ...]
     name: str
 
@@ -243,6 +255,8 @@ class MechanicalSystem(Model):
             return
         if isinstance(count, bool) or not isinstance(count, (int, np.integer)):
             raise ValueError(f"constraint_count: must be a positive integer, got {count!r}")
+        # The constraints wrap the unconstrained closure model this class built just before.
+        assert isinstance(self._core, (_core.ClosureModel, _core.ClosureNatural))
         self._core = _core.ClosureConstrained(self._core, int(count), constraints, jacobian)
 
 

@@ -4,7 +4,8 @@ ignores them, and the reconstruction of the full motion."""
 from __future__ import annotations
 
 import operator
-from typing import TYPE_CHECKING, Sequence
+from collections.abc import Sequence
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import ArrayLike

@@ -5,8 +5,8 @@ data, test horizon, invariants and, where known, a reference solution (sources i
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Callable
 
 import numpy as np
 from numpy.typing import ArrayLike

@@ -1,10 +1,10 @@
-"""Poincaré sections and phase portraits, from the tables of :mod:`varmech.sections`."""
+"""Poincaré sections and phase portraits, from the tables of :mod:`varmech.analysis.sections`."""
 
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from pathlib import Path
-from typing import Sequence, Union
 
 import numpy as np
 
@@ -22,8 +22,8 @@ def _henon_heiles_boundary(energy: float) -> tuple[np.ndarray, np.ndarray] | Non
     return np.concatenate([y, y[::-1]]), np.concatenate([py, -py[::-1]])
 
 
-def poincare_chart(table: Union[Table, Sequence[Table]], path: str | Path, title: str = "") -> Path:
-    """Scatter the section points of :func:`varmech.sections.poincare_section` in the table's
+def poincare_chart(table: Table | Sequence[Table], path: str | Path, title: str = "") -> Path:
+    """Scatter the section points of :func:`varmech.analysis.sections.poincare_section` in the table's
     plane (``meta["plane"]``, e.g. (y, p_y)), small dots, one colour per orbit, one panel per
     table (pass several tables, e.g. H = 1/12 and 1/8, for panels side by side). The boundary of
     the energy-allowed region is drawn for Hénon–Heiles' x = 0 section. Writes ``path`` (PNG or
@@ -60,7 +60,7 @@ def poincare_chart(table: Union[Table, Sequence[Table]], path: str | Path, title
 
 
 def phase_portrait_chart(table: Table, path: str | Path, title: str = "") -> Path:
-    """Draw the orbits of :func:`varmech.sections.phase_portrait` in the (q, p) plane:
+    """Draw the orbits of :func:`varmech.analysis.sections.phase_portrait` in the (q, p) plane:
     librations in blues, rotations in oranges (darker for higher energy), undetermined orbits
     in grey. When rotations are present q is taken modulo 2π into (−π, π]; for the pendulum the
     separatrix p = ±2cos(q/2) (energy 1) is drawn dashed. Writes ``path`` (PNG or SVG)."""

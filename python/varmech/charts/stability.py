@@ -1,15 +1,15 @@
 """Linear stability and the failure regions of the implicit methods, from the tables of
-:mod:`varmech.stability`."""
+:mod:`varmech.analysis.stability`."""
 
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from pathlib import Path
-from typing import Mapping
 
 import numpy as np
 
-from ..stability import OUTCOMES, REFERENCE_LIMITS
+from ..analysis.stability import OUTCOMES, REFERENCE_LIMITS
 from ..table import Table
 from ._figure import pyplot, save
 
@@ -27,11 +27,11 @@ def stability_chart(
     table: Table, path: str | Path, title: str = "", limits: Mapping[str, float] | None = None
 ) -> Path:
     """Plot the growth factor ρ against hω, one line per method, from a
-    :func:`~varmech.stability.growth_table`, on a logarithmic ρ axis (ρ = 1 is the dotted
+    :func:`~varmech.analysis.stability.growth_table`, on a logarithmic ρ axis (ρ = 1 is the dotted
     horizontal line: symplectic methods lie on it inside their stability interval, RK4 dips
     below it, everything leaves it upwards where it is unstable). Each method's stability limit
     is a dashed vertical line in its colour: ``limits`` if given, else the table's measured
-    ``meta["limits"]``, else the reference limits (:data:`~varmech.stability.REFERENCE_LIMITS`);
+    ``meta["limits"]``, else the reference limits (:data:`~varmech.analysis.stability.REFERENCE_LIMITS`);
     infinite or missing limits are not drawn. Writes ``path`` (PNG or SVG)."""
     plt = pyplot()
     if limits is None:
@@ -66,7 +66,7 @@ def stability_chart(
 
 def implicit_regions_chart(table: Table, path: str | Path, title: str = "") -> Path:
     """A categorical map of the outcome over step size h (columns) and initial angle q₀ (rows),
-    one panel per method, from :func:`~varmech.stability.implicit_regions`. Writes ``path``
+    one panel per method, from :func:`~varmech.analysis.stability.implicit_regions`. Writes ``path``
     (PNG or SVG)."""
     plt = pyplot()
     from matplotlib.colors import BoundaryNorm, ListedColormap

@@ -1,9 +1,9 @@
 """Work–precision diagrams and energy growth over long runs, from the tables of
-:mod:`varmech.work_precision`."""
+:mod:`varmech.analysis.work_precision` and
+:mod:`varmech.analysis.energy_growth`."""
 
 from __future__ import annotations
 
-import math
 from pathlib import Path
 
 import numpy as np

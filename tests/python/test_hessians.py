@@ -7,6 +7,7 @@ import pytest
 import varmech
 from varmech import examples, scenes
 
+
 def first_derivatives_only():
     base = examples.double_pendulum()
     return varmech.Lagrangian(2, base.lagrangian, dl_dq=base.dl_dq, dl_dv=base.dl_dv, name="differenced Jacobian")

@@ -4,14 +4,14 @@ methods' failure map has its failures where they belong (varmech.stability)."""
 
 import json
 import math
-from pathlib import Path
 
 import numpy as np
 import pytest
 
 import varmech
+from conftest import REFERENCE_DIR
 from varmech import stability
-from varmech.stability import (
+from varmech.analysis.stability import (
     COMPOSITION_NAMES,
     REFERENCE_LIMITS,
     growth_factor,
@@ -23,7 +23,7 @@ from varmech.stability import (
     unstable_intervals,
 )
 
-REFERENCE = Path(__file__).resolve().parent.parent / "reference" / "compositions.json"
+REFERENCE = REFERENCE_DIR / "compositions.json"
 DATA = json.loads(REFERENCE.read_text())
 INFO = {m.name: m for m in varmech.methods()}
 # Every finite limit lies below 3.4: scanning to 4 finds them all, and keeps the file fast.

@@ -43,16 +43,21 @@ module does not import matplotlib).
 from __future__ import annotations
 
 import math
-from typing import Any, Iterable, Sequence, Union
+from collections.abc import Iterable, Sequence
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ._core import ConvergenceError, DivergenceError, SpuriousBranchError
-from ._progress import progress as _progress
-from .integrate import integrate
-from .methods import MethodInfo, methods as _methods
-from .table import Table
+from .._core import ConvergenceError, DivergenceError, SpuriousBranchError
+from .._progress import progress as _progress
+from .._util import positive
+from ..integrate import integrate
+from ..methods import MethodInfo
+from ..methods import methods as _methods
+from ..table import Table
+from ._energy import relative_error
+from ._interrupt import interruptible
 
 #: Where the reference limits come from (a file of the repository, not of the installed package).
 REFERENCE_SOURCE = "reference/compositions.json"
@@ -73,7 +78,7 @@ COMPOSITION_NAMES: dict[str, str] = {
 #: (the ``h_omega_max`` of each composition in "methods", and the "other_linear_stability_facts":
 #: RK4 stable up to y = 2√2, explicit Euler never, symplectic Euler below 2, the implicit midpoint
 #: rule at every h). The JSON file lives in the repository, outside the installed package, so the
-#: numbers are embedded here; tests/test_stability.py checks them against the file.
+#: numbers are embedded here; tests/python/test_stability.py checks them against the file.
 REFERENCE_LIMITS: dict[str, float] = {
     "verlet": 2.0,
     "yoshida4": 1.5734,
@@ -89,8 +94,9 @@ REFERENCE_LIMITS: dict[str, float] = {
     "midpoint": math.inf,
 }
 
-#: The implicit (Newton-solved) methods :func:`implicit_regions` maps by default.
-IMPLICIT_METHODS = ("midpoint", "trapezoid", "galerkin4", "galerkin6")
+#: The implicit (Newton-solved) methods :func:`implicit_regions` maps by default: every implicit
+#: method of :func:`varmech.methods` that integrates unconstrained systems.
+IMPLICIT_METHODS = tuple(m.name for m in _methods() if m.implicit and not m.constrained)
 
 #: The outcomes of :func:`implicit_regions`, from good to bad.
 OUTCOMES = ("ok", "energy", "spurious branch", "newton failure", "diverged")
@@ -112,7 +118,7 @@ def _oscillator() -> Any:
     """The native model of q̈ = −q (built once)."""
     global _OSCILLATOR
     if _OSCILLATOR is None:
-        from .scenes import harmonic_oscillator
+        from ..scenes import harmonic_oscillator
 
         _OSCILLATOR = harmonic_oscillator(1.0).model
     return _OSCILLATOR
@@ -135,16 +141,6 @@ def _unconstrained() -> list[str]:
     return [m.name for m in _methods() if not m.constrained]
 
 
-def _h(name: str, x: float) -> float:
-    try:
-        v = float(x)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name}: must be a number, got {x!r}") from None
-    if not (math.isfinite(v) and v > 0):
-        raise ValueError(f"{name}: must be finite and positive, got {x!r}")
-    return v
-
-
 def _step_matrix(method: str, y: float) -> np.ndarray:
     model = _oscillator()
     a = integrate(model, [1.0], [0.0], dt=y, steps=1, method=method)
@@ -164,10 +160,10 @@ def step_matrix(method: str, h_omega: float) -> np.ndarray:
     """The 2×2 matrix Ψ of one step of ``method`` on q̈ = −q with h = ``h_omega``: its columns are
     (q₁, p₁) after one step from (q, p) = (1, 0) and from (0, 1)."""
     _method(method)
-    return _step_matrix(method, _h("h_omega", h_omega))
+    return _step_matrix(method, positive("h_omega", h_omega))
 
 
-def growth_factor(method: str, h_omega: Union[float, ArrayLike], *, progress: bool | None = False) -> Any:
+def growth_factor(method: str, h_omega: float | ArrayLike, *, progress: bool | None = False) -> Any:
     """The growth factor ρ(Ψ) = max |λ±| of one step of ``method`` on q̈ = −ω²q at hω.
 
     λ± = τ/2 ± √(τ²/4 − δ) are the eigenvalues of the step matrix Ψ (:func:`step_matrix`),
@@ -179,12 +175,12 @@ def growth_factor(method: str, h_omega: Union[float, ArrayLike], *, progress: bo
     """
     _method(method)
     if np.ndim(h_omega) == 0:
-        return _rho(_step_matrix(method, _h("h_omega", h_omega)))  # type: ignore[arg-type]
+        return _rho(_step_matrix(method, positive("h_omega", h_omega)))  # type: ignore[arg-type]
     ys = np.asarray(h_omega, dtype=float)
     out = np.empty(ys.shape)
     flat = ys.ravel()
     for i in _progress(range(flat.size), total=flat.size, desc=f"growth {method}", enabled=_bar(progress, flat.size)):
-        out.flat[i] = _rho(_step_matrix(method, _h("h_omega", flat[i])))
+        out.flat[i] = _rho(_step_matrix(method, positive("h_omega", flat[i])))
     return out
 
 
@@ -199,23 +195,24 @@ def _grid(h_omega_max: float, resolution: float) -> np.ndarray:
     return grid
 
 
-def _bisect(method: str, stable: float, unstable: float, tol: float) -> tuple[float, float]:
-    """Shrink [stable, unstable] around the change of ρ ≤ 1 + tol; returns the final bracket."""
+def _boundary(method: str, stable: float, unstable: float, tol: float) -> float:
+    """The hω where ρ ≤ 1 + tol changes between a ``stable`` and an ``unstable`` hω (in either
+    order), by bisection: the midpoint of the final bracket."""
     for _ in range(_BISECT_MAX):
-        if unstable - stable <= _BISECT_RTOL * unstable:
+        if abs(unstable - stable) <= _BISECT_RTOL * max(stable, unstable):
             break
         mid = 0.5 * (stable + unstable)
         if _rho(_step_matrix(method, mid)) > 1.0 + tol:
             unstable = mid
         else:
             stable = mid
-    return stable, unstable
+    return 0.5 * (stable + unstable)
 
 
 def _check_scan(h_omega_max: float, resolution: float, tol: float) -> tuple[float, float, float]:
-    h_omega_max = _h("h_omega_max", h_omega_max)
-    resolution = _h("resolution", resolution)
-    tol = _h("tol", tol)
+    h_omega_max = positive("h_omega_max", h_omega_max)
+    resolution = positive("resolution", resolution)
+    tol = positive("tol", tol)
     if resolution > h_omega_max:
         raise ValueError(f"resolution: must not exceed h_omega_max = {h_omega_max}, got {resolution}")
     return h_omega_max, resolution, tol
@@ -262,8 +259,7 @@ def stability_scan(
         if _rho(_step_matrix(method, float(y))) > 1.0 + tol:
             if previous == 0.0:
                 return 0.0
-            stable, unstable = _bisect(method, previous, float(y), tol)
-            return 0.5 * (stable + unstable)
+            return _boundary(method, previous, float(y), tol)
         previous = float(y)
     return math.inf
 
@@ -303,22 +299,12 @@ def unstable_intervals(
         if i == 0:
             start = 0.0
         else:
-            s, u = _bisect(method, float(grid[i - 1]), float(grid[i]), tol)
-            start = 0.5 * (s + u)
+            start = _boundary(method, float(grid[i - 1]), float(grid[i]), tol)
         if j == n - 1:
             end = h_omega_max
         else:
-            # Between grid[j] (unstable) and grid[j + 1] (stable): bisect with the roles swapped.
-            lo, hi = float(grid[j]), float(grid[j + 1])
-            for _ in range(_BISECT_MAX):
-                if hi - lo <= _BISECT_RTOL * hi:
-                    break
-                mid = 0.5 * (lo + hi)
-                if _rho(_step_matrix(method, mid)) > 1.0 + tol:
-                    lo = mid
-                else:
-                    hi = mid
-            end = 0.5 * (lo + hi)
+            # Between grid[j] (unstable) and grid[j + 1] (stable).
+            end = _boundary(method, float(grid[j + 1]), float(grid[j]), tol)
         intervals.append((start, end))
         i = j + 1
     return intervals
@@ -355,7 +341,7 @@ def growth_table(
     names = _methods_arg(methods)
     ys = np.arange(1, 801) * 0.005 if h_omega is None else np.atleast_1d(np.asarray(h_omega, dtype=float)).ravel()
     for y in ys:
-        _h("h_omega", y)
+        positive("h_omega", y)
     table = Table(
         ("method", "h_omega", "growth"),
         title="Growth factor ρ(Ψ) of one step on q'' = -ω²q",
@@ -367,7 +353,8 @@ def growth_table(
         },
     )
     plan = [(name, float(y)) for name in names for y in ys]
-    try:
+
+    def body() -> None:
         for name, y in _progress(plan, total=len(plan), desc="growth table", enabled=_bar(progress, len(plan))):
             table.append(name, y, _rho(_step_matrix(name, y)))
         if limits:
@@ -377,10 +364,8 @@ def growth_table(
                 name: stability_scan(name, h_omega_max=top, resolution=resolution, tol=tol, progress=False)
                 for name in _progress(names, total=len(names), desc="limits", enabled=progress)
             }
-    except KeyboardInterrupt as err:
-        err.partial = table  # type: ignore[attr-defined]
-        raise
-    return table
+
+    return interruptible(table, body)
 
 
 def stability_table(
@@ -409,15 +394,14 @@ def stability_table(
             "reference_source": REFERENCE_SOURCE,
         },
     )
-    try:
+
+    def body() -> None:
         for name in _progress(names, total=len(names), desc="stability scans", enabled=progress):
             measured = stability_scan(name, h_omega_max=h_omega_max, resolution=resolution, tol=tol, progress=False)
             ref = REFERENCE_LIMITS.get(name, math.nan)
             table.append(name, measured, ref, relative_difference(measured, ref), info[name].h_omega_max)
-    except KeyboardInterrupt as err:
-        err.partial = table  # type: ignore[attr-defined]
-        raise
-    return table
+
+    return interruptible(table, body)
 
 
 def relative_difference(measured: float, reference: float) -> float:
@@ -474,7 +458,7 @@ def implicit_regions(
     map takes well under a second. Ctrl-C stops the sweep: the KeyboardInterrupt propagates with
     the rows so far as ``err.partial``.
     """
-    from .scenes import Scene, get
+    from ..scenes import Scene, get
 
     names = list(IMPLICIT_METHODS) if method is None else ([method] if isinstance(method, str) else list(method))
     for name in names:
@@ -484,11 +468,11 @@ def implicit_regions(
         raise TypeError(f"scene: expected a scene name or a varmech Scene, got {type(scene).__name__}")
     if isinstance(steps, bool) or not isinstance(steps, (int, np.integer)) or steps < 1:
         raise ValueError(f"steps: must be a positive integer, got {steps!r}")
-    hs = [_h("h_values", h) for h in h_values]
+    hs = [positive("h_values", h) for h in h_values]
     q0s = [float(q) for q in q0_values]
     if not hs or not q0s or not all(math.isfinite(q) for q in q0s):
         raise ValueError("h_values, q0_values: must be non-empty, finite")
-    energy_threshold = _h("energy_threshold", energy_threshold)
+    energy_threshold = positive("energy_threshold", energy_threshold)
     n = sc.model.dim
     table = Table(
         ("method", "h", "q0", "outcome", "steps_done", "energy_error", "newton_per_step"),
@@ -496,7 +480,8 @@ def implicit_regions(
         meta={"scene": sc.name, "steps": int(steps), "energy_threshold": energy_threshold, "p0": 0.0},
     )
     plan = [(name, h, q0) for name in names for h in hs for q0 in q0s]
-    try:
+
+    def body() -> None:
         for name, h, q0 in _progress(plan, total=len(plan), desc=f"implicit regions {sc.name}", enabled=_bar(progress, len(plan))):
             q = np.array(sc.q0, dtype=float)
             q[0] = q0
@@ -514,18 +499,15 @@ def implicit_regions(
             done, energy, newton = 0, math.nan, math.nan
             if traj is not None and len(traj):
                 done = int(traj.steps)
-                e = traj.energy()
-                scale = abs(e[0]) if e[0] != 0 else 1.0
-                finite = np.isfinite(e)
+                error = relative_error(traj.energy())
+                finite = np.isfinite(error)
                 if finite.any():
-                    energy = float(np.max(np.abs(e[finite] - e[0])) / scale)
+                    energy = float(np.max(error[finite]))
                 if done:
                     newton = traj.newton_iterations / done
             table.append(name, h, q0, outcome, done, energy, newton)
-    except KeyboardInterrupt as err:
-        err.partial = table  # type: ignore[attr-defined]
-        raise
-    return table
+
+    return interruptible(table, body)
 
 
 __all__ = [

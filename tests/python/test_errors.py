@@ -1,8 +1,6 @@
 """Bad input gets a clear error naming the argument; failures keep the partial trajectory."""
 
 import math
-import os
-import signal
 import threading
 import time
 import traceback
@@ -12,11 +10,6 @@ import pytest
 
 import varmech
 from varmech import examples, scenes
-
-
-@pytest.fixture
-def kepler():
-    return scenes.kepler()
 
 
 @pytest.mark.parametrize(
@@ -151,24 +144,12 @@ def test_energy_threshold_raises_divergence_error():
     assert len(info.value.partial) == 71
 
 
-def _interrupt_after(delay):
-    sent = {}
-
-    def fire():
-        sent["at"] = time.perf_counter()
-        os.kill(os.getpid(), signal.SIGINT)
-
-    timer = threading.Timer(delay, fire)
-    timer.start()
-    return timer, sent
-
-
 @pytest.mark.parametrize("native", [True, False])
-def test_ctrl_c_interrupts_a_long_run_and_keeps_the_partial_trajectory(native):
+def test_ctrl_c_interrupts_a_long_run_and_keeps_the_partial_trajectory(native, interrupt_after):
     scene = scenes.kepler()
     model = scene.model if native else examples.kepler()
     steps = 10**10 if native else 10**8
-    timer, sent = _interrupt_after(0.3)
+    timer, sent = interrupt_after(0.3)
     with pytest.raises(KeyboardInterrupt) as info:
         varmech.integrate(model, scene.q0, scene.p0, dt=1e-3, steps=steps, save_every=10**5)
     latency = time.perf_counter() - sent["at"]

@@ -37,20 +37,23 @@ the exact flow (kahan_li8, 64 substeps) from the same grid state over the same �
 from __future__ import annotations
 
 import math
-from typing import Any, Iterable, Sequence, Union
+from collections.abc import Iterable, Sequence
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike
 
-from . import _core
-from ._progress import progress as _progress
-from ._util import positive
-from .integrate import Trajectory, integrate
-from .model import Model
-from .scenes import Scene
-from .table import Table
+from .. import _core
+from .._progress import progress as _progress
+from .._util import positive
+from ..integrate import Trajectory, integrate
+from ..model import Model
+from ..scenes import Scene
+from ..table import Table
+from ._energy import energy_of
+from ._interrupt import interruptible
 
-ModelLike = Union[Model, Scene]
+ModelLike = Model | Scene
 
 #: The Hénon–Heiles energies of Hénon & Heiles (1964): mostly regular motion at 1/12,
 #: widespread chaos at 1/8 (the region stays bounded below the escape energy 1/6).
@@ -88,9 +91,8 @@ def _is_pendulum(model: Model) -> bool:
 
 def _energy(model: Model, q: np.ndarray, p: np.ndarray) -> np.ndarray:
     """H(q, p) = p·q̇ − L for rows (N, n)."""
-    q = np.ascontiguousarray(np.atleast_2d(q), dtype=float)
-    p = np.ascontiguousarray(np.atleast_2d(p), dtype=float)
-    return _core.energy(model._core, np.zeros(len(q)), q, p)
+    q, p = np.atleast_2d(q), np.atleast_2d(p)
+    return energy_of(model, np.zeros(len(q)), q, p)
 
 
 def _relative(h: np.ndarray, energy: float) -> np.ndarray:
@@ -111,9 +113,9 @@ def _solve_momentum(model: Model, q: np.ndarray, p: np.ndarray, k: int, energy: 
     terms), so three evaluations give it exactly; the result is checked to 1e-12."""
     q = np.ascontiguousarray(q, dtype=float)
     rows = []
-    for s in (0.0, 1.0, -1.0):
+    for value in (0.0, 1.0, -1.0):
         pp = np.array(p, dtype=float)
-        pp[:, k] = s
+        pp[:, k] = value
         rows.append(_energy(model, q, pp))
     e0, e1, em = rows
     a = 0.5 * (e1 + em) - e0
@@ -254,14 +256,34 @@ def _seeds(
     return q, p
 
 
+def _orbits(
+    model: Model,
+    energy: float,
+    section: Sequence[Any] | None,
+    dt: float,
+    t_end: float,
+    method: str | None,
+    seeds: ArrayLike | str,
+    orbits: int,
+    box: Any,
+    seed: int,
+) -> tuple[int, float, int, float, float, str, np.ndarray, np.ndarray]:
+    """The checked set-up shared by the orbit sweeps: the section (k, c, direction), dt, t_end,
+    the method, and the seeds' initial states (q, p) on the section and the energy shell."""
+    k, c, direction = _section(model, section)
+    dt = positive("dt", dt)
+    t_end = positive("t_end", t_end)
+    method = _default_method(model, method)
+    q_seed, p_seed = _seeds(model, energy, k, c, direction, seeds, orbits, box, seed)
+    return k, c, direction, dt, t_end, method, q_seed, p_seed
+
+
 def _run(model: Model, q0: np.ndarray, p0: np.ndarray, *, dt: float, t_end: float, method: str, save_every: int = 1) -> tuple[Trajectory, str | None]:
     """One orbit; a divergent one (an orbit that escapes) returns its partial trajectory and a
     note."""
-    from ._core import DivergenceError
-
     try:
         return integrate(model, q0, p0, dt=dt, t_end=t_end, method=method, save_every=save_every), None
-    except DivergenceError as err:
+    except _core.DivergenceError as err:
         partial = getattr(err, "partial", None)
         if partial is None:
             raise
@@ -290,7 +312,6 @@ def _crossings(traj: Trajectory, k: int, c: float, direction: int) -> tuple[np.n
 
 def _hermite_points(model: Model, traj: Trajectory, idx: np.ndarray, k: int, c: float, sign: np.ndarray):
     """The Hermite estimate of each crossing: (τ, q, p) at the root of q_k(τ) − c."""
-    h = traj.dt
     t0, t1 = traj.t[idx], traj.t[idx + 1]
     q0, q1, p0, p1 = traj.q[idx], traj.q[idx + 1], traj.p[idx], traj.p[idx + 1]
     v0, v1 = model.velocity(q0, p0, t0), model.velocity(q1, p1, t1)
@@ -339,15 +360,6 @@ def _partial_step(model: Model, q0: np.ndarray, p0: np.ndarray, t0: float, h: fl
         tau = new
     g, tau, q, p = best  # type: ignore[misc]
     return tau, q, p
-
-
-def _interruptible(table: Table, body) -> Table:
-    try:
-        body()
-    except KeyboardInterrupt as err:
-        err.partial = table  # type: ignore[attr-defined]
-        raise
-    return table
 
 
 # ------------------------------------------------------------------------------ Poincaré
@@ -418,17 +430,12 @@ def poincare_section(
     energy = float(energy)
     if not math.isfinite(energy):
         raise ValueError(f"energy: must be finite, got {energy}")
-    k, c, direction = _section(model, section)
     cols = _names(model, names)
     if locate not in ("step", "hermite"):
         raise ValueError(f"locate: 'step' or 'hermite', got {locate!r}")
-    dt = positive("dt", dt)
-    t_end = positive("t_end", t_end)
-    method = _default_method(model, method)
-    n = model.dim
-    others = [i for i in range(n) if i != k]
+    k, c, direction, dt, t_end, method, q_seed, p_seed = _orbits(model, energy, section, dt, t_end, method, seeds, orbits, box, seed)
+    others = [i for i in range(model.dim) if i != k]
     plane = others[0]
-    q_seed, p_seed = _seeds(model, energy, k, c, direction, seeds, orbits, box, seed)
     columns = ("orbit", "t", *cols, *(f"p_{s}" for s in cols), "energy_error")
     arrow = {1: f"p_{cols[k]} > 0", -1: f"p_{cols[k]} < 0", 0: "both directions"}[direction]
     table = Table(
@@ -480,7 +487,7 @@ def poincare_section(
             if locate == "step":
                 table.meta["max_hermite_gap"] = worst["hermite_gap"]
 
-    return _interruptible(table, body)
+    return interruptible(table, body)
 
 
 def orbit_divergence(
@@ -518,16 +525,10 @@ def orbit_divergence(
     """
     model = _model(model_or_scene)
     energy = float(energy)
-    k, c, direction = _section(model, section)
     cols = _names(model, None)
-    dt = positive("dt", dt)
-    t_end = positive("t_end", t_end)
     separation = positive("separation", separation)
-    method = _default_method(model, method)
-    n = model.dim
-    others = [i for i in range(n) if i != k]
-    j = others[0]
-    q_seed, p_seed = _seeds(model, energy, k, c, direction, seeds, orbits, box, seed)
+    k, c, direction, dt, t_end, method, q_seed, p_seed = _orbits(model, energy, section, dt, t_end, method, seeds, orbits, box, seed)
+    j = [i for i in range(model.dim) if i != k][0]
     p_twin_in = p_seed.copy()
     p_twin_in[:, j] += separation
     p_twin, ok = _solve_momentum(model, q_seed, p_twin_in, k, energy, direction)
@@ -540,7 +541,8 @@ def orbit_divergence(
     table = Table(
         ("orbit", f"{cols[j]}0", f"p_{cols[j]}0", "divergence", "chaotic"),
         title=f"Orbit divergence: {model.name}, E = {energy:.6g}, t = 0 … {t_end:g}",
-        meta={"model": model.name, "energy": energy, "method": method, "dt": dt, "t_end": t_end, "separation": separation, "threshold": threshold, "notes": []},
+        meta={"model": model.name, "energy": energy, "method": method, "dt": dt, "t_end": t_end, "separation": separation,
+              "threshold": threshold, "notes": []},
     )
     steps = round(t_end / dt)
     save = max(1, min(10, steps))
@@ -561,7 +563,7 @@ def orbit_divergence(
             table.append(o, float(q_seed[o, j]), float(p_seed[o, j]), value, bool(value >= threshold))
             table.meta["chaotic_fraction"] = float(np.mean(table.column("chaotic").astype(bool)))
 
-    return _interruptible(table, body)
+    return interruptible(table, body)
 
 
 def covered_cells(table: Table, *, bins: int = 40, extent: Any = None, points: int | None = None) -> Table:
@@ -577,7 +579,8 @@ def covered_cells(table: Table, *, bins: int = 40, extent: Any = None, points: i
     if extent is None:
         extent = ((a.min(), a.max()), (b.min(), b.max())) if len(a) else ((0, 1), (0, 1))
     (a0, a1), (b0, b1) = extent
-    out = Table(("orbit", "points", "cells", "fraction"), title=f"Covered cells ({bins} × {bins}): {table.title}", meta={"extent": extent, "bins": bins})
+    title = f"Covered cells ({bins} × {bins}): {table.title}"
+    out = Table(("orbit", "points", "cells", "fraction"), title=title, meta={"extent": extent, "bins": bins})
     for o in table.unique("orbit"):
         sel = orbit == o
         aa, bb = a[sel], b[sel]
@@ -689,7 +692,7 @@ def phase_portrait(
                 one(o, q0, -p0)
                 o += 1
 
-    return _interruptible(table, body)
+    return interruptible(table, body)
 
 
 __all__ = [

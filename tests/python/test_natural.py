@@ -55,16 +55,9 @@ def test_mass_derivative_by_differences_warns_and_agrees():
     assert np.max(np.abs(closure.q - native.q)) < 1e-7
 
 
-def test_cyclic_coordinate_of_a_natural_system_keeps_its_momentum():
+def test_cyclic_coordinate_of_a_natural_system_keeps_its_momentum(spherical_natural):
     # The spherical pendulum, M(θ) = diag(1, sin²θ), V = −cos θ: p_φ is conserved to round-off.
-    model = varmech.MechanicalSystem(
-        2,
-        lambda q: -math.cos(q[0]),
-        lambda q: np.array([math.sin(q[0]), 0.0]),
-        mass=lambda q: np.diag([1.0, math.sin(q[0]) ** 2]),
-        mass_derivative=lambda q: np.array([np.diag([0.0, math.sin(2 * q[0])]), np.zeros((2, 2))]),
-        symmetries=[varmech.Cyclic(1)],
-    )
+    model = spherical_natural(symmetries=[varmech.Cyclic(1)])
     scene = scenes.spherical_pendulum()
     traj = varmech.integrate(model, scene.q0, scene.p0, dt=0.01, t_end=50.0, method="midpoint")
     report = varmech.check_conservation(traj)

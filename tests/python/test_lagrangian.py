@@ -169,7 +169,9 @@ def test_a_force_closure_that_raises_propagates_unchanged():
             raise Stall("stalled")
         return np.zeros(1)
 
-    model = varmech.Lagrangian(1, lambda q, v, t: 0.5 * v[0] ** 2 - 0.5 * q[0] ** 2, dl_dq=lambda q, v, t: -q.copy(), dl_dv=lambda q, v, t: v.copy(), force=force)
+    model = varmech.Lagrangian(
+        1, lambda q, v, t: 0.5 * v[0] ** 2 - 0.5 * q[0] ** 2, dl_dq=lambda q, v, t: -q.copy(), dl_dv=lambda q, v, t: v.copy(), force=force
+    )
     with pytest.raises(Stall) as info:
         varmech.integrate(model, [1.0], [0.0], dt=0.1, steps=100, method="midpoint")
     assert info.value.partial.steps == 5 and len(info.value.partial.work) == 6

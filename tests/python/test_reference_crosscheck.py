@@ -7,15 +7,13 @@ independent implementation of the method computes (see reference/README.md).
 
 import json
 import math
-from pathlib import Path
 
 import numpy as np
 import pytest
 
 import varmech
+from conftest import REFERENCE_DIR as REFERENCE
 from varmech import scenes
-
-REFERENCE = Path(__file__).resolve().parent.parent / "reference"
 
 
 def numpy_composition(gradient, q, p, mass, h, steps, name):

@@ -8,26 +8,12 @@ import pytest
 import varmech
 from varmech import examples, scenes
 
-from test_reduction import kepler_polar
 
-
-def spherical_natural():
-    """The spherical pendulum as a closure mechanical system with mass M(θ) = diag(1, sin²θ)."""
-    return varmech.MechanicalSystem(
-        2,
-        lambda q: -math.cos(q[0]),
-        lambda q: np.array([math.sin(q[0]), 0.0]),
-        mass=lambda q: np.diag([1.0, math.sin(q[0]) ** 2]),
-        mass_derivative=lambda q: np.array([np.diag([0.0, math.sin(2.0 * q[0])]), np.zeros((2, 2))]),
-        name="spherical pendulum (M(q))",
-    )
-
-
-def test_native_and_closure_models_reduce_to_the_same_motion():
+def test_native_and_closure_models_reduce_to_the_same_motion(spherical_natural):
     scene = scenes.spherical_pendulum()
     mu = scene.p0[1]
     runs = []
-    for model in [scene.model, examples.spherical_pendulum(), spherical_natural()]:
+    for model in [scene.model, examples.spherical_pendulum(), spherical_natural(name="spherical pendulum (M(q))")]:
         reduced = varmech.routh(model, [1], [mu])
         assert reduced.dim == 1 and reduced.shape == (0,) and reduced.cyclic == (1,)
         x0, px0 = reduced.reduce(scene.q0, scene.p0)
@@ -71,11 +57,11 @@ def test_the_conical_pendulum_is_a_critical_point_of_the_amended_potential():
     np.testing.assert_allclose(rebuilt.q[:, 1], phidot * traj.t, rtol=1e-13, atol=1e-13)
 
 
-def test_kepler_in_polar_coordinates_reduced_to_the_radius_reconstructs_at_order_four():
+def test_kepler_in_polar_coordinates_reduced_to_the_radius_reconstructs_at_order_four(kepler_polar):
     # R = ½ṙ² − ℓ²/(2r²) + 1/r; after one period (2π) the orbit is back at r = 1 − e, θ = 2π.
     e = 0.6
     ell = math.sqrt(1 - e * e)
-    reduced = varmech.routh(kepler_polar(), [1], [ell])
+    reduced = varmech.routh(kepler_polar, [1], [ell])
     errors = []
     for steps in [200, 400, 800]:
         traj = varmech.integrate(reduced, [1 - e], [0.0], dt=2 * math.pi / steps, steps=steps, method="galerkin4")

@@ -6,7 +6,6 @@ import pytest
 import varmech
 from varmech import examples, scenes
 
-
 SEPARABLE = [n for n in scenes.CATALOGUE if scenes.get(n).model.separable]
 # Constrained scenes have no closure twins: constraints are not yet taken from closures.
 GENERAL = [n for n in scenes.CATALOGUE if not scenes.get(n).model.separable and not scenes.get(n).model.constraints]

@@ -1,13 +1,20 @@
-"""``python -m varmech chart <kind> [scene]``: measure, then write the chart and its data (CSV)."""
+"""The chart recipes: for each kind of chart, what to measure (:mod:`varmech.analysis`) with which
+defaults, and which figures to draw from it. :func:`chart` runs one and writes the figures and
+their data (CSV); ``python -m varmech chart <kind> [scene]`` (:mod:`varmech.cli`) and the tour
+call it."""
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Callable
 
-from . import charts, performance, scenes, sections, stability
-from .table import Table
+from .. import scenes
+from ..analysis import energy_growth, sections, stability, work_precision
+from ..table import Table
+from .sections import phase_portrait_chart, poincare_chart
+from .stability import implicit_regions_chart, stability_chart
+from .work_precision import energy_growth_chart, work_precision_chart
 
 
 @dataclass(frozen=True)
@@ -23,15 +30,15 @@ class ChartKind:
 
 def _work_precision(scene, methods, quick, progress):
     sc = scenes.get(scene)
-    table = performance.work_precision(
+    table = work_precision.work_precision(
         sc, methods, repeat=1 if quick else 3, sweep_length=4 if quick else 11, max_seconds=1.0 if quick else 5.0,
         progress=progress,
     )
     title = f"{scene}: error at t = {table.meta.get('t_end', sc.t_end):g} against cost"
     figures = {
-        "work_precision": lambda t, p: charts.work_precision_chart(t, p, x="seconds", title=title),
-        "work_precision_evaluations": lambda t, p: charts.work_precision_chart(t, p, x="evaluations", title=title),
-        "work_precision_energy": lambda t, p: charts.work_precision_chart(t, p, y="max_energy_error", title=title),
+        "work_precision": lambda t, p: work_precision_chart(t, p, x="seconds", title=title),
+        "work_precision_evaluations": lambda t, p: work_precision_chart(t, p, x="evaluations", title=title),
+        "work_precision_energy": lambda t, p: work_precision_chart(t, p, y="max_energy_error", title=title),
     }
     return [("work_precision", table, figures)]
 
@@ -39,25 +46,25 @@ def _work_precision(scene, methods, quick, progress):
 def _energy(scene, methods, quick, progress):
     sc = scenes.get(scene)
     t_end = (5 if quick else 50) * sc.t_end
-    table = performance.energy_growth(sc, methods, t_end=t_end, samples=500 if quick else 2000, progress=progress)
+    table = energy_growth.energy_growth(sc, methods, t_end=t_end, samples=500 if quick else 2000, progress=progress)
     title = f"{scene}: energy error over t = {t_end:g}"
     return [
-        ("energy_growth", table, {"energy_growth": lambda t, p: charts.energy_growth_chart(t, p, title=title)}),
-        ("energy_verdicts", performance.verdicts(table), {}),
+        ("energy_growth", table, {"energy_growth": lambda t, p: energy_growth_chart(t, p, title=title)}),
+        ("energy_verdicts", energy_growth.verdicts(table), {}),
     ]
 
 
 def _stability(scene, methods, quick, progress):
     table = stability.growth_table(methods, progress=progress)
     return [
-        ("stability", table, {"stability": lambda t, p: charts.stability_chart(t, p, title="growth factor on q'' = -ω²q")}),
+        ("stability", table, {"stability": lambda t, p: stability_chart(t, p, title="growth factor on q'' = -ω²q")}),
         ("stability_limits", stability.stability_table(methods, progress=progress), {}),
     ]
 
 
 def _implicit_regions(scene, methods, quick, progress):
     table = stability.implicit_regions(methods, scene=scene, progress=progress)
-    draw = lambda t, p: charts.implicit_regions_chart(t, p, title=f"{scene}: implicit steps")  # noqa: E731
+    draw = lambda t, p: implicit_regions_chart(t, p, title=f"{scene}: implicit steps")  # noqa: E731
     return [("implicit_regions", table, {"implicit_regions": draw})]
 
 
@@ -71,13 +78,13 @@ def _poincare(scene, methods, quick, progress):
         label = f"{energy:.4f}".rstrip("0")
         title = f"{scene}: Poincaré section x = 0, H = {label}"
         name = f"poincare_H{label.replace('.', '_')}"
-        out.append((name, table, {name: lambda t, p, title=title: charts.poincare_chart(t, p, title=title)}))
+        out.append((name, table, {name: lambda t, p, title=title: poincare_chart(t, p, title=title)}))
     return out
 
 
 def _phase(scene, methods, quick, progress):
     table = sections.phase_portrait(scenes.get(scene), method=methods[0], progress=progress)
-    draw = lambda t, p: charts.phase_portrait_chart(t, p, title=f"{scene}: phase portrait")  # noqa: E731
+    draw = lambda t, p: phase_portrait_chart(t, p, title=f"{scene}: phase portrait")  # noqa: E731
     return [("phase_portrait", table, {"phase_portrait": draw})]
 
 

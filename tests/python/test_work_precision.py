@@ -2,19 +2,17 @@
 baselines (SciPy and REBOUND, optional) and the charts. Kept to a few seconds in all."""
 
 import math
-import os
-import signal
-import threading
 
 import numpy as np
 import pytest
 
 import varmech
-
 from varmech import scenes
-from varmech import performance as wp
+from varmech.analysis import baselines
+from varmech.analysis import work_precision as wp
+from varmech.analysis.energy_growth import ENERGY_GROWTH_COLUMNS, energy_growth, verdicts
+from varmech.analysis.work_precision import work_precision
 from varmech.scenes import Reference
-from varmech.performance import energy_growth, verdicts, work_precision
 
 PERIOD = 2 * math.pi
 
@@ -91,7 +89,9 @@ def test_no_reference_at_the_horizon_gives_nan_and_a_note():
 def test_scipy_baselines_sweep_tolerances():
     pytest.importorskip("scipy")
     scene, ref = kepler_periods(10)
-    t = work_precision(scene, ["kahan_li8"], steps=[2**11], baselines=("RK45", "DOP853", "Radau"), rtols=(1e-4, 1e-7), reference=ref, repeat=1, progress=False)
+    t = work_precision(
+        scene, ["kahan_li8"], steps=[2**11], baselines=("RK45", "DOP853", "Radau"), rtols=(1e-4, 1e-7), reference=ref, repeat=1, progress=False
+    )
     assert {(r["tool"], r["method"], r["value"]) for r in t if r["tool"] == "scipy"} == {
         ("scipy", m, r) for m in ("RK45", "DOP853", "Radau") for r in (1e-4, 1e-7)
     }
@@ -108,7 +108,7 @@ def test_scipy_baselines_sweep_tolerances():
 
 
 def test_missing_scipy_is_skipped_with_a_note(monkeypatch):
-    monkeypatch.setattr(wp, "_import_scipy", lambda: None)
+    monkeypatch.setattr(baselines, "import_scipy", lambda: None)
     scene, ref = kepler_periods(1)
     t = work_precision(scene, ["verlet"], steps=[1000], reference=ref, repeat=1, progress=False)
     assert set(t.column("tool")) == {"varmech"}
@@ -155,7 +155,8 @@ def long_kepler():
     pytest.importorskip("scipy")
     scene = scenes.kepler()
     return energy_growth(
-        scene, ["verlet", "kahan_li8", "rk4"], t_end=500 * PERIOD, samples=400, baselines=("DOP853",), rtol=1e-7, baseline_t_end=500 * PERIOD, progress=False
+        scene, ["verlet", "kahan_li8", "rk4"], t_end=500 * PERIOD, samples=400, baselines=("DOP853",), rtol=1e-7,
+        baseline_t_end=500 * PERIOD, progress=False,
     )
 
 
@@ -185,7 +186,7 @@ def test_long_kepler_verdicts(long_kepler):
 
 def test_energy_growth_rows_are_log_spaced_with_a_running_maximum(long_kepler):
     t = long_kepler
-    assert t.columns == wp.ENERGY_GROWTH_COLUMNS
+    assert t.columns == ENERGY_GROWTH_COLUMNS
     for method in ("verlet", "kahan_li8", "rk4", "DOP853"):
         rows = t.where(method=method)
         times, err, top = rows.column("t"), rows.column("energy_error"), rows.column("max_energy_error")
@@ -207,11 +208,10 @@ def test_energy_growth_defaults_to_ten_thousand_kepler_periods():
     assert round(50 * scene.t_end / scene.dt) * scene.dt == pytest.approx(1e4 * PERIOD)
 
 
-def test_ctrl_c_stops_a_sweep_and_keeps_the_rows_so_far():
+def test_ctrl_c_stops_a_sweep_and_keeps_the_rows_so_far(interrupt_after):
     scene, ref = kepler_periods(1)
-    timer = threading.Timer(0.5, lambda: os.kill(os.getpid(), signal.SIGINT))
     with pytest.raises(KeyboardInterrupt) as info:
-        timer.start()
+        timer, _ = interrupt_after(0.5)
         # The second setting would take minutes.
         work_precision(scene, ["verlet"], steps=[200, 2**34], baselines=(), reference=ref, repeat=1, progress=False)
     timer.join()

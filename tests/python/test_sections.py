@@ -135,15 +135,10 @@ def test_chaotic_fraction_grows_from_1_12_to_1_8():
     assert np.median(low.column("divergence")) <= 2.5
 
 
-def test_closure_model_gives_the_native_section():
+def test_closure_model_gives_the_native_section(henon_heiles_closure):
     """The general path (velocity and ∂L/∂q from the model) on a closure twin of Hénon–Heiles,
     with explicit seeds and a box-free set-up, reproduces the native section."""
-    closure = varmech.MechanicalSystem(
-        2,
-        potential=lambda q: 0.5 * (q[0] ** 2 + q[1] ** 2) + q[0] ** 2 * q[1] - q[1] ** 3 / 3,
-        gradient=lambda q: np.array([q[0] + 2 * q[0] * q[1], q[1] + q[0] ** 2 - q[1] ** 2]),
-        name="henon_heiles closure",
-    )
+    closure = henon_heiles_closure(name="henon_heiles closure")
     seeds = [(0.2, 0.1), (-0.1, 0.2)]
     a = sections.poincare_section(closure, E12, seeds=seeds, t_end=100.0)
     b = sections.poincare_section(HH, E12, seeds=seeds, t_end=100.0)
@@ -157,18 +152,16 @@ def test_closure_model_gives_the_native_section():
         sections.poincare_section(HH, E12, seeds=[(0.9, 0.0)], t_end=10.0)
 
 
-def test_a_sweep_can_be_interrupted_with_its_rows_so_far():
+def test_a_sweep_can_be_interrupted_with_its_rows_so_far(henon_heiles_closure):
     calls = {"n": 0, "limit": math.inf}
 
     def gradient(q):
         calls["n"] += 1
         if calls["n"] > calls["limit"]:
             raise KeyboardInterrupt
-        return np.array([q[0] + 2 * q[0] * q[1], q[1] + q[0] ** 2 - q[1] ** 2])
+        return henon_heiles_closure.gradient(q)
 
-    closure = varmech.MechanicalSystem(
-        2, potential=lambda q: 0.5 * (q[0] ** 2 + q[1] ** 2) + q[0] ** 2 * q[1] - q[1] ** 3 / 3, gradient=gradient
-    )
+    closure = henon_heiles_closure(gradient)
     seeds = [(0.2, 0.1), (-0.1, 0.2), (0.0, 0.0)]
     first = sections.poincare_section(closure, E12, seeds=seeds[:1], t_end=100.0, progress=False)
     # Ctrl-C (here raised by the closure) half-way through the second orbit.
@@ -189,7 +182,7 @@ def test_pendulum_phase_portrait_conserves_energy_and_classifies_against_the_sep
     by_orbit = {o: tab.where(orbit=o) for o in tab.unique("orbit")}
     # Each rotation gets its mirror (p < 0): 7 energies, 3 rotations.
     assert len(by_orbit) == 10
-    for o, t in by_orbit.items():
+    for t in by_orbit.values():
         e = t.rows[0][1]
         motion = t.rows[0][2]
         assert motion == ("libration" if e < 1 else "rotation"), (e, motion)

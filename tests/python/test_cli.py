@@ -1,23 +1,18 @@
 """The command line writes what it says."""
 
-import subprocess
-import sys
-
 import pytest
 
 from varmech.cli import TOUR, TOUR_REDUCED
 
 
-def test_methods_table():
-    out = subprocess.run([sys.executable, "-m", "varmech", "methods"], capture_output=True, text=True, check=True).stdout
+def test_methods_table(run_cli):
+    out = run_cli("methods").stdout
     assert "| `kahan_li8` | 8 | 17 |" in out
 
 
-def test_tour_prints_reports_and_writes_plots(tmp_path):
+def test_tour_prints_reports_and_writes_plots(tmp_path, run_cli):
     pytest.importorskip("matplotlib")
-    out = subprocess.run(
-        [sys.executable, "-m", "varmech", "tour", "--quick", "--out", str(tmp_path)], capture_output=True, text=True, check=True
-    ).stdout
+    out = run_cli("tour", "--quick", "--out", tmp_path).stdout
     runs = sum(len(methods) for _, methods, _ in TOUR) + sum(len(methods) for _, _, methods in TOUR_REDUCED)
     assert runs == 40 and out.count("Conservation report") == runs
     assert "max |G M⁻¹ p|" in out
@@ -35,12 +30,9 @@ def test_tour_prints_reports_and_writes_plots(tmp_path):
 
 
 @pytest.mark.parametrize("kind", ["stability", "phase"])
-def test_chart_writes_the_files_it_names(tmp_path, kind):
+def test_chart_writes_the_files_it_names(tmp_path, kind, run_cli):
     pytest.importorskip("matplotlib")
-    out = subprocess.run(
-        [sys.executable, "-m", "varmech", "chart", kind, "--quick", "--format", "svg", "--out", str(tmp_path)],
-        capture_output=True, text=True, check=True,
-    ).stdout
+    out = run_cli("chart", kind, "--quick", "--format", "svg", "--out", tmp_path).stdout
     named = [line.split(" ", 1)[1] for line in out.splitlines() if line.startswith("wrote ")]
     assert {p.rsplit(".", 1)[1] for p in named} == {"csv", "svg"}
     assert sorted(named) == sorted(str(p) for p in tmp_path.iterdir())
@@ -48,6 +40,6 @@ def test_chart_writes_the_files_it_names(tmp_path, kind):
     assert header.startswith("method," if kind == "stability" else "orbit,")
 
 
-def test_chart_refuses_an_unknown_scene():
-    result = subprocess.run([sys.executable, "-m", "varmech", "chart", "phase", "nowhere"], capture_output=True, text=True)
+def test_chart_refuses_an_unknown_scene(run_cli):
+    result = run_cli("chart", "phase", "nowhere", check=False)
     assert result.returncode != 0 and "scene:" in result.stderr

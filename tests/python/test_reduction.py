@@ -9,25 +9,10 @@ import varmech
 from varmech import examples, scenes
 
 
-def kepler_polar():
-    """Kepler in polar coordinates (r, θ): L = ½(ṙ² + r²θ̇²) + 1/r, θ cyclic."""
-
-    def lagrangian(q, v, t):
-        return 0.5 * (v[0] ** 2 + q[0] ** 2 * v[1] ** 2) + 1.0 / q[0]
-
-    def dl_dq(q, v, t):
-        return np.array([q[0] * v[1] ** 2 - 1.0 / q[0] ** 2, 0.0])
-
-    def dl_dv(q, v, t):
-        return np.array([v[0], q[0] ** 2 * v[1]])
-
-    return varmech.Lagrangian(2, lagrangian, dl_dq=dl_dq, dl_dv=dl_dv, name="kepler (polar)")
-
-
-def test_cyclic_coordinates_are_found_where_dl_dq_vanishes():
+def test_cyclic_coordinates_are_found_where_dl_dq_vanishes(kepler_polar):
     assert varmech.cyclic_coordinates(scenes.spherical_pendulum().model, [1.0, 0.0], spread=0.5) == [1]
     assert varmech.cyclic_coordinates(examples.spherical_pendulum(), [1.0, 0.0], spread=0.5) == [1]
-    assert varmech.cyclic_coordinates(kepler_polar(), [2.0, 0.0]) == [1]
+    assert varmech.cyclic_coordinates(kepler_polar, [2.0, 0.0]) == [1]
     # In Cartesian coordinates Kepler's symmetry is a rotation, and no coordinate is cyclic.
     assert varmech.cyclic_coordinates(scenes.kepler().model, [1.0, 1.0], spread=0.5) == []
     assert varmech.cyclic_coordinates(scenes.double_pendulum().model, [0.3, -0.4]) == []
@@ -36,7 +21,7 @@ def test_cyclic_coordinates_are_found_where_dl_dq_vanishes():
     assert varmech.cyclic_coordinates(free, np.zeros(3)) == [0, 1, 2]
 
 
-def test_a_dependence_through_time_or_a_differenced_derivative_is_judged_right():
+def test_a_dependence_through_time_or_a_differenced_derivative_is_judged_right(kepler_polar):
     # L = ½|q̇|² − t·q₀: q₀ is not cyclic, though ∂L/∂q₀ vanishes at t = 0.
     driven = varmech.Lagrangian(
         2, lambda q, v, t: 0.5 * v @ v - t * q[0], dl_dq=lambda q, v, t: np.array([-t, 0.0]),
@@ -44,7 +29,7 @@ def test_a_dependence_through_time_or_a_differenced_derivative_is_judged_right()
     )
     assert varmech.cyclic_coordinates(driven, [0.0, 0.0]) == [1]
     with pytest.warns(UserWarning):
-        differenced = varmech.Lagrangian(2, kepler_polar().lagrangian)
+        differenced = varmech.Lagrangian(2, kepler_polar.lagrangian)
     assert varmech.cyclic_coordinates(differenced, [2.0, 0.0]) == [1]
 
 

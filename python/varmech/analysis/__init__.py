@@ -1,0 +1,11 @@
+"""Measurement tools: each returns a :class:`~varmech.Table` that :mod:`varmech.charts` draws.
+
+- :mod:`.work_precision`: cost against accuracy over a sweep of steps and tolerances;
+- :mod:`.energy_growth`: the energy error over a long run, log-spaced in t, with verdicts;
+- :mod:`.baselines`: SciPy's ``solve_ivp`` and REBOUND driven on a varmech scene;
+- :mod:`.stability`: linear stability on q̈ = −ω²q and the implicit methods' failure regions;
+- :mod:`.sections`: Poincaré sections, orbit divergence and phase portraits.
+
+Every sweep honours Ctrl-C: the KeyboardInterrupt propagates with the rows measured so far as
+``err.partial`` (:func:`._interrupt.interruptible`).
+"""

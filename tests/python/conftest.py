@@ -1,0 +1,111 @@
+"""Shared set-up of the Python tests: the repository's reference data, the closure models that
+several tests build, and helpers to run the command line and to press Ctrl-C."""
+
+import math
+import os
+import signal
+import subprocess
+import sys
+import threading
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import varmech
+from varmech import scenes
+
+#: reference/ of the repository (published data), two levels above this folder.
+REFERENCE_DIR = Path(__file__).resolve().parents[2] / "reference"
+
+
+@pytest.fixture
+def kepler():
+    """The native Kepler scene (e = 0.6)."""
+    return scenes.kepler()
+
+
+@pytest.fixture
+def kepler_polar():
+    """Kepler in polar coordinates (r, θ) from closures: L = ½(ṙ² + r²θ̇²) + 1/r, θ cyclic."""
+
+    def lagrangian(q, v, t):
+        return 0.5 * (v[0] ** 2 + q[0] ** 2 * v[1] ** 2) + 1.0 / q[0]
+
+    def dl_dq(q, v, t):
+        return np.array([q[0] * v[1] ** 2 - 1.0 / q[0] ** 2, 0.0])
+
+    def dl_dv(q, v, t):
+        return np.array([v[0], q[0] ** 2 * v[1]])
+
+    return varmech.Lagrangian(2, lagrangian, dl_dq=dl_dq, dl_dv=dl_dv, name="kepler (polar)")
+
+
+@pytest.fixture
+def spherical_natural():
+    """Makes the spherical pendulum as a closure mechanical system with mass M(θ) = diag(1, sin²θ)
+    and V = −cos θ; keyword arguments go to :class:`varmech.MechanicalSystem`."""
+
+    def make(**kwargs):
+        return varmech.MechanicalSystem(
+            2,
+            lambda q: -math.cos(q[0]),
+            lambda q: np.array([math.sin(q[0]), 0.0]),
+            mass=lambda q: np.diag([1.0, math.sin(q[0]) ** 2]),
+            mass_derivative=lambda q: np.array([np.diag([0.0, math.sin(2.0 * q[0])]), np.zeros((2, 2))]),
+            **kwargs,
+        )
+
+    return make
+
+
+def henon_heiles_gradient(q):
+    return np.array([q[0] + 2 * q[0] * q[1], q[1] + q[0] ** 2 - q[1] ** 2])
+
+
+@pytest.fixture
+def henon_heiles_closure():
+    """Makes Hénon–Heiles from closures, V = ½(x² + y²) + x²y − y³/3, with ∇V given or
+    ``gradient``; keyword arguments go to :class:`varmech.MechanicalSystem`."""
+
+    def make(gradient=henon_heiles_gradient, **kwargs):
+        return varmech.MechanicalSystem(
+            2, potential=lambda q: 0.5 * (q[0] ** 2 + q[1] ** 2) + q[0] ** 2 * q[1] - q[1] ** 3 / 3, gradient=gradient, **kwargs
+        )
+
+    make.gradient = henon_heiles_gradient
+    return make
+
+
+@pytest.fixture
+def run_cli():
+    """Runs ``python -m varmech <args>`` in a subprocess, capturing its text output."""
+
+    def run(*args, check=True):
+        return subprocess.run([sys.executable, "-m", "varmech", *map(str, args)], capture_output=True, text=True, check=check)
+
+    return run
+
+
+@pytest.fixture
+def interrupt_after():
+    """Sends this process SIGINT (Ctrl-C) after ``delay`` seconds: returns the started timer and
+    a dict whose "at" is the perf_counter time the signal went out."""
+    timers = []
+
+    def start(delay):
+        sent = {}
+
+        def fire():
+            sent["at"] = time.perf_counter()
+            os.kill(os.getpid(), signal.SIGINT)
+
+        timer = threading.Timer(delay, fire)
+        timers.append(timer)
+        timer.start()
+        return timer, sent
+
+    yield start
+    for timer in timers:
+        timer.join()
