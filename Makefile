@@ -2,7 +2,7 @@
 # `make test` (build, run every test). PYTHON may name another interpreter.
 PYTHON ?= python3
 
-.PHONY: install tour test bench compare gallery
+.PHONY: install tour lint test bench compare gallery
 
 install:
 	$(PYTHON) -m pip install -e ".[test,charts]"
@@ -10,7 +10,14 @@ install:
 tour: install
 	$(PYTHON) -m varmech tour --out out/tour
 
-test: install
+# The guards: formatting, clippy on every target of both crates, ruff, and mypy on the package.
+lint: install
+	cargo fmt --all --check
+	cargo clippy --workspace --all-targets -- -D warnings
+	$(PYTHON) -m ruff check python tests benches
+	$(PYTHON) -m mypy
+
+test: lint
 	cargo test --release
 	$(PYTHON) -m pytest -q
 

@@ -21,7 +21,7 @@ fn initial_energy_matches_the_published_value() {
 /// The published Kahan–Li 8 figures of `reference/outer_solar_system.json` (2.1e-6 at h = 200
 /// days, energy 6.3e-11) are not reproducible with the standard Kahan–Li coefficients: an
 /// independent NumPy loop of the same composition gives 1.551e-5 and varmech agrees with it to
-/// 1e-10 (`tests/test_reference_crosscheck.py`); see reference/README.md.
+/// 1e-10 (`tests/python/test_reference_crosscheck.py`); see reference/README.md.
 #[test]
 fn kahan_li_8_converges_to_the_reference_at_order_8() {
     let problem = NBody::outer_solar_system();
