@@ -56,7 +56,7 @@ pub struct Evaluations<'a> {
 ///
 /// ∂f/∂xⱼ ≈ [f(x + hⱼeⱼ) − f(x − hⱼeⱼ)] / 2hⱼ,   hⱼ = ε^{1/3}·size(j, xⱼ),
 ///
-/// `size` the magnitude the step is relative to ([`unit`] for max(|xⱼ|, 1)). x is moved and
+/// `size` the magnitude the step is relative to ([`fn@unit`] for max(|xⱼ|, 1)). x is moved and
 /// restored in place; nothing is allocated.
 pub fn central_jacobian<E, F>(
     mut f: F,

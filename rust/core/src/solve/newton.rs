@@ -22,7 +22,8 @@ use crate::ModelError;
 /// freshly computed Jacobian no longer halves a correction that is already below √ε‖x‖∞ (the
 /// equations' own accuracy when derivatives come from differences). The scale is the increment,
 /// not the position: the discrete velocity δq/h, and so p₁, carries the increment's relative
-/// precision, which a scale of ‖q‖∞ would give away as a cyclic angle grows.
+/// precision, which a scale of ‖q‖∞ would give away as a cyclic angle grows. The other
+/// iterations measure their corrections their own way (RATTLE: the move of q₁ against ‖q₀‖∞).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct NewtonOptions {
     /// Stop when the correction satisfies ‖δ‖ ≤ tolerance·scale (the problem's measure).
