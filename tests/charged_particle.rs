@@ -179,7 +179,7 @@ fn midpoint_reaches_the_exact_gyration_at_order_two() {
 
 #[test]
 fn exact_derivatives_match_central_differences_and_the_velocity_inverts_the_momentum() {
-    use varmech::model::finite_difference::central_gradient;
+    use varmech::solve::difference::central_gradient;
     let sys = ChargedParticle::nonuniform_field().system;
     let (q, v) = ([0.7, -1.3], [0.4, 2.1]);
     let (mut exact, mut approx, mut work) = ([0.0; 2], [0.0; 2], [0.0; 2]);

@@ -2,10 +2,11 @@
 //! symplectic where they say so.
 
 use varmech::diagnostics::symplecticity_defect;
-use varmech::discrete::{increment, DiscreteLagrangian, Midpoint, Rectangle, Trapezoidal, Workspace};
+use varmech::discrete::{increment, DiscreteLagrangian, Midpoint, Rectangle, Segment, Trapezoidal, Workspace};
 use varmech::integrators::{integrate, Composition, Method, Options};
-use varmech::model::{finite_difference, Lagrangian, MechanicalSystem};
+use varmech::model::{Lagrangian, MechanicalSystem};
 use varmech::scenes::{DoublePendulum, FermiPastaUlam, HenonHeiles, Kepler, NBody};
+use varmech::solve::difference::central_gradient;
 
 fn max_diff(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).fold(0.0_f64, |m, (x, y)| m.max((x - y).abs()))
@@ -78,7 +79,15 @@ fn symplectic_euler_is_the_variational_integrator_of_the_rectangle_rule() {
 /// differences of L_d itself, on a non-separable Lagrangian (the double pendulum) and a
 /// separable one (Hénon–Heiles).
 fn check_slot_derivatives<D: DiscreteLagrangian, S: Lagrangian>(ld: &D, sys: &S, q0: [f64; 2], q1: [f64; 2], h: f64) {
-    let value = |a: &[f64], b: &[f64]| ld.value(sys, a, &increment(a, b), 0.3, h).unwrap();
+    let value = |a: &[f64], b: &[f64]| {
+        let at = Segment {
+            q0: a,
+            dq: &increment(a, b),
+            t: 0.3,
+            h,
+        };
+        ld.value(sys, at).unwrap()
+    };
     let d = |slot: usize, i: usize| {
         let e = 1e-6;
         let (mut a, mut b) = ((q0.to_vec(), q1.to_vec()), (q0.to_vec(), q1.to_vec()));
@@ -94,16 +103,14 @@ fn check_slot_derivatives<D: DiscreteLagrangian, S: Lagrangian>(ld: &D, sys: &S,
     let minus = ld.momentum_minus(sys, &q0, &q1, 0.3, h).unwrap();
     let plus = ld.momentum_plus(sys, &q0, &q1, 0.3, h).unwrap();
     let mut change = [0.0; 2];
-    ld.momentum_change(
-        sys,
-        &q0,
-        &increment(&q0, &q1),
-        0.3,
+    let at = Segment {
+        q0: &q0,
+        dq: &increment(&q0, &q1),
+        t: 0.3,
         h,
-        &mut change,
-        &mut Workspace::new(2),
-    )
-    .unwrap();
+    };
+    ld.momentum_change(sys, at, &mut change, &mut Workspace::new(2))
+        .unwrap();
     for i in 0..2 {
         let scale = minus[i].abs().max(1.0);
         assert!(
@@ -201,7 +208,7 @@ fn central_differences_reproduce_the_gradient() {
     let mut exact = vec![0.0; 6];
     fpu.system.gradient(&q, &mut exact).unwrap();
     let (mut work, mut approx) = (vec![0.0; 6], vec![0.0; 6]);
-    finite_difference::central_gradient(|x| fpu.system.potential(x), &q, &mut work, &mut approx).unwrap();
+    central_gradient(|x| fpu.system.potential(x), &q, &mut work, &mut approx).unwrap();
     let scale = exact.iter().fold(1.0_f64, |m, x| m.max(x.abs()));
     assert!(max_diff(&exact, &approx) < 1e-8 * scale, "{exact:?} vs {approx:?}");
 }

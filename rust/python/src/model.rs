@@ -8,10 +8,11 @@ use numpy::{PyArray1, PyArrayDyn, PyArrayMethods};
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use varmech::model::{
-    differenced_jacobian, differenced_kinetic_gradient, finite_difference, Constrained, Distances, Generator, Hessians,
+    differenced_jacobian, differenced_kinetic_gradient, Constrained, Distances, Generator, Hessians,
     HolonomicConstraints, Lagrangian, Mass, MechanicalSystem, NaturalSystem, Routhian,
 };
 use varmech::scenes::{LagrangianScene, LinkedMasses, RigidBody, Scene};
+use varmech::solve::difference::central_gradient;
 use varmech::ModelError;
 
 use crate::convert;
@@ -670,7 +671,7 @@ impl MechanicalSystem for ClosureSystem<'_, '_> {
     fn gradient(&self, q: &[f64], grad: &mut [f64]) -> Result<(), ModelError> {
         match &self.gradient {
             Some(f) => call_vector(f.call1((PyArray1::from_slice(self.py, q),)), "gradient(q)", grad),
-            None => finite_difference::central_gradient(|x| self.potential(x), q, &mut self.work.borrow_mut(), grad),
+            None => central_gradient(|x| self.potential(x), q, &mut self.work.borrow_mut(), grad),
         }
     }
 
@@ -793,7 +794,7 @@ impl NaturalSystem for ClosureNaturalSystem<'_, '_> {
     fn gradient(&self, q: &[f64], grad: &mut [f64]) -> Result<(), ModelError> {
         match &self.gradient {
             Some(f) => call_vector(f.call1((PyArray1::from_slice(self.py, q),)), "gradient(q)", grad),
-            None => finite_difference::central_gradient(|x| self.potential(x), q, &mut self.work.borrow_mut(), grad),
+            None => central_gradient(|x| self.potential(x), q, &mut self.work.borrow_mut(), grad),
         }
     }
 
@@ -863,18 +864,14 @@ impl Lagrangian for ClosureLagrangianSystem<'_, '_> {
     fn dl_dq(&self, q: &[f64], v: &[f64], t: f64, out: &mut [f64]) -> Result<(), ModelError> {
         match &self.dl_dq {
             Some(f) => call_vector(f.call1(self.args(q, v, t)), "dl_dq(q, v, t)", out),
-            None => {
-                finite_difference::central_gradient(|x| self.lagrangian(x, v, t), q, &mut self.work.borrow_mut(), out)
-            }
+            None => central_gradient(|x| self.lagrangian(x, v, t), q, &mut self.work.borrow_mut(), out),
         }
     }
 
     fn dl_dv(&self, q: &[f64], v: &[f64], t: f64, out: &mut [f64]) -> Result<(), ModelError> {
         match &self.dl_dv {
             Some(f) => call_vector(f.call1(self.args(q, v, t)), "dl_dv(q, v, t)", out),
-            None => {
-                finite_difference::central_gradient(|x| self.lagrangian(q, x, t), v, &mut self.work.borrow_mut(), out)
-            }
+            None => central_gradient(|x| self.lagrangian(q, x, t), v, &mut self.work.borrow_mut(), out),
         }
     }
 

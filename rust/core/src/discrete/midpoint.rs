@@ -1,4 +1,4 @@
-use super::{combine, DiscreteLagrangian, Workspace};
+use super::{combine, DiscreteLagrangian, Segment, Workspace};
 use crate::model::Lagrangian;
 use crate::ModelError;
 
@@ -12,17 +12,10 @@ pub struct Midpoint;
 
 impl Midpoint {
     /// ∂L/∂q into ws.a and ∂L/∂q̇ into ws.b, at the midpoint.
-    fn derivatives<S: Lagrangian + ?Sized>(
-        sys: &S,
-        q0: &[f64],
-        dq: &[f64],
-        t: f64,
-        h: f64,
-        ws: &mut Workspace,
-    ) -> Result<(), ModelError> {
-        ws.set(q0, dq, h, 0.5);
-        sys.dl_dq(&ws.x, &ws.v, t + 0.5 * h, &mut ws.a)?;
-        sys.dl_dv(&ws.x, &ws.v, t + 0.5 * h, &mut ws.b)
+    fn derivatives<S: Lagrangian + ?Sized>(sys: &S, at: &Segment<'_>, ws: &mut Workspace) -> Result<(), ModelError> {
+        ws.set(at, 0.5);
+        sys.dl_dq(&ws.x, &ws.v, at.t + 0.5 * at.h, &mut ws.a)?;
+        sys.dl_dv(&ws.x, &ws.v, at.t + 0.5 * at.h, &mut ws.b)
     }
 }
 
@@ -31,46 +24,33 @@ impl DiscreteLagrangian for Midpoint {
         (&[0.5], &[1.0])
     }
 
-    fn value<S: Lagrangian + ?Sized>(
-        &self,
-        sys: &S,
-        q0: &[f64],
-        dq: &[f64],
-        t: f64,
-        h: f64,
-    ) -> Result<f64, ModelError> {
-        let mut ws = Workspace::new(q0.len());
-        ws.set(q0, dq, h, 0.5);
-        Ok(h * sys.lagrangian(&ws.x, &ws.v, t + 0.5 * h)?)
+    fn value<S: Lagrangian + ?Sized>(&self, sys: &S, at: Segment<'_>) -> Result<f64, ModelError> {
+        let mut ws = Workspace::new(at.q0.len());
+        ws.set(&at, 0.5);
+        Ok(at.h * sys.lagrangian(&ws.x, &ws.v, at.t + 0.5 * at.h)?)
     }
 
     fn d1<S: Lagrangian + ?Sized>(
         &self,
         sys: &S,
-        q0: &[f64],
-        dq: &[f64],
-        t: f64,
-        h: f64,
+        at: Segment<'_>,
         out: &mut [f64],
         ws: &mut Workspace,
     ) -> Result<(), ModelError> {
-        Self::derivatives(sys, q0, dq, t, h, ws)?;
-        combine(out, 0.5 * h, &ws.a, -1.0, &ws.b);
+        Self::derivatives(sys, &at, ws)?;
+        combine(out, 0.5 * at.h, &ws.a, -1.0, &ws.b);
         Ok(())
     }
 
     fn d2<S: Lagrangian + ?Sized>(
         &self,
         sys: &S,
-        q0: &[f64],
-        dq: &[f64],
-        t: f64,
-        h: f64,
+        at: Segment<'_>,
         out: &mut [f64],
         ws: &mut Workspace,
     ) -> Result<(), ModelError> {
-        Self::derivatives(sys, q0, dq, t, h, ws)?;
-        combine(out, 0.5 * h, &ws.a, 1.0, &ws.b);
+        Self::derivatives(sys, &at, ws)?;
+        combine(out, 0.5 * at.h, &ws.a, 1.0, &ws.b);
         Ok(())
     }
 
@@ -78,16 +58,13 @@ impl DiscreteLagrangian for Midpoint {
     fn momentum_change<S: Lagrangian + ?Sized>(
         &self,
         sys: &S,
-        q0: &[f64],
-        dq: &[f64],
-        t: f64,
-        h: f64,
+        at: Segment<'_>,
         out: &mut [f64],
         ws: &mut Workspace,
     ) -> Result<(), ModelError> {
-        ws.set(q0, dq, h, 0.5);
-        sys.dl_dq(&ws.x, &ws.v, t + 0.5 * h, out)?;
-        out.iter_mut().for_each(|x| *x *= h);
+        ws.set(&at, 0.5);
+        sys.dl_dq(&ws.x, &ws.v, at.t + 0.5 * at.h, out)?;
+        out.iter_mut().for_each(|x| *x *= at.h);
         Ok(())
     }
 }

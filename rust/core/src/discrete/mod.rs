@@ -12,10 +12,12 @@
 //! The end point is passed by its increment, q₁ = q₀ + δq: the discrete velocity δq/h then
 //! carries the increment's full precision rather than the round-off of q₁ − q₀ (HLW VIII.5).
 
+mod galerkin;
 mod midpoint;
 mod rectangle;
 mod trapezoidal;
 
+pub use galerkin::{Galerkin, Quadrature};
 pub use midpoint::Midpoint;
 pub use rectangle::Rectangle;
 pub use trapezoidal::Trapezoidal;
@@ -46,12 +48,23 @@ impl Workspace {
     }
 
     /// v = δq/h and x = q₀ + s·δq.
-    fn set(&mut self, q0: &[f64], dq: &[f64], h: f64, s: f64) {
-        for (((v, x), a), d) in self.v.iter_mut().zip(self.x.iter_mut()).zip(q0).zip(dq) {
-            *v = d / h;
+    fn set(&mut self, at: &Segment<'_>, s: f64) {
+        for (((v, x), a), d) in self.v.iter_mut().zip(self.x.iter_mut()).zip(at.q0).zip(at.dq) {
+            *v = d / at.h;
             *x = a + s * d;
         }
     }
+}
+
+/// Where a discrete Lagrangian is evaluated: from q₀ at time t over a step h, with the
+/// increments of its control points from q₀ (for the two-point rules just δq = q₁ − q₀; for
+/// [`Galerkin`] Q₁ − q₀, …, Q_s − q₀).
+#[derive(Clone, Copy, Debug)]
+pub struct Segment<'a> {
+    pub q0: &'a [f64],
+    pub dq: &'a [f64],
+    pub t: f64,
+    pub h: f64,
 }
 
 /// A discrete Lagrangian of a [`Lagrangian`] system, with its slot derivatives, at
@@ -62,45 +75,32 @@ pub trait DiscreteLagrangian {
     fn quadrature(&self) -> (&'static [f64], &'static [f64]);
 
     /// L_d(q₀, q₀ + δq, h).
-    fn value<S: Lagrangian + ?Sized>(&self, sys: &S, q0: &[f64], dq: &[f64], t: f64, h: f64)
-        -> Result<f64, ModelError>;
+    fn value<S: Lagrangian + ?Sized>(&self, sys: &S, at: Segment<'_>) -> Result<f64, ModelError>;
 
     /// Writes D₁L_d(q₀, q₀ + δq, h) into `out`.
-    #[allow(clippy::too_many_arguments)]
     fn d1<S: Lagrangian + ?Sized>(
         &self,
         sys: &S,
-        q0: &[f64],
-        dq: &[f64],
-        t: f64,
-        h: f64,
+        at: Segment<'_>,
         out: &mut [f64],
         ws: &mut Workspace,
     ) -> Result<(), ModelError>;
 
     /// Writes D₂L_d(q₀, q₀ + δq, h) into `out`.
-    #[allow(clippy::too_many_arguments)]
     fn d2<S: Lagrangian + ?Sized>(
         &self,
         sys: &S,
-        q0: &[f64],
-        dq: &[f64],
-        t: f64,
-        h: f64,
+        at: Segment<'_>,
         out: &mut [f64],
         ws: &mut Workspace,
     ) -> Result<(), ModelError>;
 
     /// Writes D₁L_d + D₂L_d, the change of momentum p₁ − p₀ over the step when p₀ = −D₁L_d,
     /// in a form free of the cancellation between the two (the ∂L/∂q̇ terms drop out).
-    #[allow(clippy::too_many_arguments)]
     fn momentum_change<S: Lagrangian + ?Sized>(
         &self,
         sys: &S,
-        q0: &[f64],
-        dq: &[f64],
-        t: f64,
-        h: f64,
+        at: Segment<'_>,
         out: &mut [f64],
         ws: &mut Workspace,
     ) -> Result<(), ModelError>;
@@ -115,7 +115,9 @@ pub trait DiscreteLagrangian {
         h: f64,
     ) -> Result<Vec<f64>, ModelError> {
         let mut p = vec![0.0; q0.len()];
-        self.d1(sys, q0, &increment(q0, q1), t, h, &mut p, &mut Workspace::new(q0.len()))?;
+        let dq = increment(q0, q1);
+        let at = Segment { q0, dq: &dq, t, h };
+        self.d1(sys, at, &mut p, &mut Workspace::new(q0.len()))?;
         p.iter_mut().for_each(|x| *x = -*x);
         Ok(p)
     }
@@ -130,7 +132,9 @@ pub trait DiscreteLagrangian {
         h: f64,
     ) -> Result<Vec<f64>, ModelError> {
         let mut p = vec![0.0; q0.len()];
-        self.d2(sys, q0, &increment(q0, q1), t, h, &mut p, &mut Workspace::new(q0.len()))?;
+        let dq = increment(q0, q1);
+        let at = Segment { q0, dq: &dq, t, h };
+        self.d2(sys, at, &mut p, &mut Workspace::new(q0.len()))?;
         Ok(p)
     }
 }

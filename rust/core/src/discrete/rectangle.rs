@@ -1,4 +1,4 @@
-use super::{combine, DiscreteLagrangian, Workspace};
+use super::{combine, DiscreteLagrangian, Segment, Workspace};
 use crate::model::Lagrangian;
 use crate::ModelError;
 
@@ -14,30 +14,22 @@ impl DiscreteLagrangian for Rectangle {
         (&[0.0], &[1.0])
     }
 
-    fn value<S: Lagrangian + ?Sized>(
-        &self,
-        sys: &S,
-        q0: &[f64],
-        dq: &[f64],
-        t: f64,
-        h: f64,
-    ) -> Result<f64, ModelError> {
+    fn value<S: Lagrangian + ?Sized>(&self, sys: &S, at: Segment<'_>) -> Result<f64, ModelError> {
+        let Segment { q0, t, h, .. } = at;
         let mut ws = Workspace::new(q0.len());
-        ws.set(q0, dq, h, 0.0);
+        ws.set(&at, 0.0);
         Ok(h * sys.lagrangian(q0, &ws.v, t)?)
     }
 
     fn d1<S: Lagrangian + ?Sized>(
         &self,
         sys: &S,
-        q0: &[f64],
-        dq: &[f64],
-        t: f64,
-        h: f64,
+        at: Segment<'_>,
         out: &mut [f64],
         ws: &mut Workspace,
     ) -> Result<(), ModelError> {
-        ws.set(q0, dq, h, 0.0);
+        let Segment { q0, t, h, .. } = at;
+        ws.set(&at, 0.0);
         sys.dl_dq(q0, &ws.v, t, &mut ws.a)?;
         sys.dl_dv(q0, &ws.v, t, &mut ws.b)?;
         combine(out, h, &ws.a, -1.0, &ws.b);
@@ -47,14 +39,12 @@ impl DiscreteLagrangian for Rectangle {
     fn d2<S: Lagrangian + ?Sized>(
         &self,
         sys: &S,
-        q0: &[f64],
-        dq: &[f64],
-        t: f64,
-        h: f64,
+        at: Segment<'_>,
         out: &mut [f64],
         ws: &mut Workspace,
     ) -> Result<(), ModelError> {
-        ws.set(q0, dq, h, 0.0);
+        let Segment { q0, t, .. } = at;
+        ws.set(&at, 0.0);
         sys.dl_dv(q0, &ws.v, t, out)
     }
 
@@ -62,14 +52,12 @@ impl DiscreteLagrangian for Rectangle {
     fn momentum_change<S: Lagrangian + ?Sized>(
         &self,
         sys: &S,
-        q0: &[f64],
-        dq: &[f64],
-        t: f64,
-        h: f64,
+        at: Segment<'_>,
         out: &mut [f64],
         ws: &mut Workspace,
     ) -> Result<(), ModelError> {
-        ws.set(q0, dq, h, 0.0);
+        let Segment { q0, t, h, .. } = at;
+        ws.set(&at, 0.0);
         sys.dl_dq(q0, &ws.v, t, out)?;
         out.iter_mut().for_each(|x| *x *= h);
         Ok(())

@@ -1,4 +1,4 @@
-use super::{combine, DiscreteLagrangian, Workspace};
+use super::{combine, DiscreteLagrangian, Segment, Workspace};
 use crate::model::Lagrangian;
 use crate::ModelError;
 
@@ -12,17 +12,14 @@ pub struct Trapezoidal;
 
 impl Trapezoidal {
     /// ∂L/∂q at q₀ (`at_end` false) or q₁ into ws.a, and ½[∂L/∂q̇(q₀) + ∂L/∂q̇(q₁)] into ws.b.
-    #[allow(clippy::too_many_arguments)]
     fn derivatives<S: Lagrangian + ?Sized>(
         sys: &S,
-        q0: &[f64],
-        dq: &[f64],
-        t: f64,
-        h: f64,
+        at: &Segment<'_>,
         at_end: bool,
         ws: &mut Workspace,
     ) -> Result<(), ModelError> {
-        ws.set(q0, dq, h, 1.0);
+        let Segment { q0, t, h, .. } = *at;
+        ws.set(at, 1.0);
         if at_end {
             sys.dl_dq(&ws.x, &ws.v, t + h, &mut ws.a)?;
         } else {
@@ -42,46 +39,34 @@ impl DiscreteLagrangian for Trapezoidal {
         (&[0.0, 1.0], &[0.5, 0.5])
     }
 
-    fn value<S: Lagrangian + ?Sized>(
-        &self,
-        sys: &S,
-        q0: &[f64],
-        dq: &[f64],
-        t: f64,
-        h: f64,
-    ) -> Result<f64, ModelError> {
+    fn value<S: Lagrangian + ?Sized>(&self, sys: &S, at: Segment<'_>) -> Result<f64, ModelError> {
+        let Segment { q0, t, h, .. } = at;
         let mut ws = Workspace::new(q0.len());
-        ws.set(q0, dq, h, 1.0);
+        ws.set(&at, 1.0);
         Ok(0.5 * h * (sys.lagrangian(q0, &ws.v, t)? + sys.lagrangian(&ws.x, &ws.v, t + h)?))
     }
 
     fn d1<S: Lagrangian + ?Sized>(
         &self,
         sys: &S,
-        q0: &[f64],
-        dq: &[f64],
-        t: f64,
-        h: f64,
+        at: Segment<'_>,
         out: &mut [f64],
         ws: &mut Workspace,
     ) -> Result<(), ModelError> {
-        Self::derivatives(sys, q0, dq, t, h, false, ws)?;
-        combine(out, 0.5 * h, &ws.a, -1.0, &ws.b);
+        Self::derivatives(sys, &at, false, ws)?;
+        combine(out, 0.5 * at.h, &ws.a, -1.0, &ws.b);
         Ok(())
     }
 
     fn d2<S: Lagrangian + ?Sized>(
         &self,
         sys: &S,
-        q0: &[f64],
-        dq: &[f64],
-        t: f64,
-        h: f64,
+        at: Segment<'_>,
         out: &mut [f64],
         ws: &mut Workspace,
     ) -> Result<(), ModelError> {
-        Self::derivatives(sys, q0, dq, t, h, true, ws)?;
-        combine(out, 0.5 * h, &ws.a, 1.0, &ws.b);
+        Self::derivatives(sys, &at, true, ws)?;
+        combine(out, 0.5 * at.h, &ws.a, 1.0, &ws.b);
         Ok(())
     }
 
@@ -89,14 +74,12 @@ impl DiscreteLagrangian for Trapezoidal {
     fn momentum_change<S: Lagrangian + ?Sized>(
         &self,
         sys: &S,
-        q0: &[f64],
-        dq: &[f64],
-        t: f64,
-        h: f64,
+        at: Segment<'_>,
         out: &mut [f64],
         ws: &mut Workspace,
     ) -> Result<(), ModelError> {
-        ws.set(q0, dq, h, 1.0);
+        let Segment { q0, t, h, .. } = at;
+        ws.set(&at, 1.0);
         sys.dl_dq(q0, &ws.v, t, &mut ws.a)?;
         sys.dl_dq(&ws.x, &ws.v, t + h, &mut ws.b)?;
         combine(out, 0.5 * h, &ws.a, 0.5 * h, &ws.b);

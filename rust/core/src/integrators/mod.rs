@@ -221,9 +221,9 @@ impl Integrator {
         dp: &mut [f64],
     ) -> Result<(), StepError> {
         match &mut self.scheme {
-            Scheme::Midpoint(s) => s.increment(sys, None, t, q, p, h, dq, dp),
-            Scheme::Trapezoid(s) => s.increment(sys, None, t, q, p, h, dq, dp),
-            Scheme::Galerkin(s) => s.increment(sys, None, t, q, p, h, dq, dp),
+            Scheme::Midpoint(s) => s.increment(sys, None, StepStart { t, h, q, p }, Increment { dq, dp }),
+            Scheme::Trapezoid(s) => s.increment(sys, None, StepStart { t, h, q, p }, Increment { dq, dp }),
+            Scheme::Galerkin(s) => s.increment(sys, None, StepStart { t, h, q, p }, Increment { dq, dp }),
             _ => Err(StepError::Model(
                 "explicit methods integrate separable mechanical systems only".into(),
             )),
@@ -250,9 +250,9 @@ impl Integrator {
     {
         let c: Option<&dyn HolonomicConstraints> = Some(constraints);
         match &mut self.scheme {
-            Scheme::Midpoint(s) => s.increment(sys, c, t, q, p, h, dq, dp),
-            Scheme::Trapezoid(s) => s.increment(sys, c, t, q, p, h, dq, dp),
-            Scheme::Galerkin(s) => s.increment(sys, c, t, q, p, h, dq, dp),
+            Scheme::Midpoint(s) => s.increment(sys, c, StepStart { t, h, q, p }, Increment { dq, dp }),
+            Scheme::Trapezoid(s) => s.increment(sys, c, StepStart { t, h, q, p }, Increment { dq, dp }),
+            Scheme::Galerkin(s) => s.increment(sys, c, StepStart { t, h, q, p }, Increment { dq, dp }),
             _ => Err(StepError::Model(
                 "a general Lagrangian on constraints takes the implicit methods only".into(),
             )),
@@ -279,7 +279,7 @@ impl Integrator {
         match &mut self.scheme {
             Scheme::Rattle(s) => {
                 s.size_for(constraints.count());
-                s.increment(sys, constraints, q, p, h, dq, dp)
+                s.increment(sys, constraints, StepStart { t: 0.0, h, q, p }, Increment { dq, dp })
             }
             _ => Err(StepError::Model(
                 "only rattle, rattle4 and shake keep constraints".into(),

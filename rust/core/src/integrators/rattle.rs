@@ -1,8 +1,9 @@
 use nalgebra::{DMatrix, DVector};
 
-use super::{NewtonOptions, StepError};
-use crate::linalg::{lu_in_place, lu_solve};
+use super::{Increment, StepError, StepStart};
 use crate::model::{HolonomicConstraints, MechanicalSystem};
+use crate::solve::lu::{lu_in_place, lu_solve};
+use crate::solve::newton::{Correction, Newton, NewtonOptions, NewtonProblem, Reasons, Rules};
 
 /// RATTLE (Andersen 1983; HLW VII.1.4) for H = ½pᵀM⁻¹p + V(q) on g(q) = 0:
 ///
@@ -38,11 +39,14 @@ pub struct Rattle {
     dq_stage: Vec<f64>,
     dp_stage: Vec<f64>,
     lambda: Vec<f64>,
+    newton: Newton,
+    /// g(q₁) for SHAKE; μ for RATTLE's projection, with G(q₁)M⁻¹G(q₁)ᵀ and its LU factors.
     g: DVector<f64>,
-    newton: DMatrix<f64>,
+    gram: DMatrix<f64>,
     pivots: Vec<usize>,
     evaluations: u64,
-    iterations: u64,
+    /// SHAKE's sweeps.
+    sweeps: u64,
 }
 
 impl Rattle {
@@ -69,11 +73,12 @@ impl Rattle {
             dq_stage: vec![0.0; n],
             dp_stage: vec![0.0; n],
             lambda: vec![0.0; m],
+            newton: Newton::new(m),
             g: DVector::zeros(m),
-            newton: DMatrix::zeros(m, m),
+            gram: DMatrix::zeros(m, m),
             pivots: vec![0; m],
             evaluations: 0,
-            iterations: 0,
+            sweeps: 0,
         }
     }
 
@@ -92,29 +97,27 @@ impl Rattle {
 
     /// Newton (RATTLE) or sweep (SHAKE) iterations so far.
     pub fn iterations(&self) -> u64 {
-        self.iterations
+        self.newton.iterations() + self.sweeps
     }
 
     pub(super) fn reset(&mut self) {
         self.cached = false;
     }
 
-    /// One composed step's increments from (q, p).
-    #[allow(clippy::too_many_arguments)]
+    /// One composed step's increments from (q, p) (the system is autonomous: t is not read).
     pub(super) fn increment<S, C>(
         &mut self,
         sys: &S,
         constraints: &C,
-        q: &[f64],
-        p: &[f64],
-        h: f64,
-        dq: &mut [f64],
-        dp: &mut [f64],
+        start: StepStart<'_>,
+        out: Increment<'_>,
     ) -> Result<(), StepError>
     where
         S: MechanicalSystem + ?Sized,
         C: HolonomicConstraints + ?Sized,
     {
+        let StepStart { q, p, h, .. } = start;
+        let Increment { dq, dp } = out;
         dq.fill(0.0);
         dp.fill(0.0);
         for stage in 0..self.gamma.len() {
@@ -158,28 +161,6 @@ impl Rattle {
         }
     }
 
-    /// out = αAB, a column at a time. Not `gemm`: nalgebra hands products of dynamic matrices
-    /// larger than 5 × 5 to matrixmultiply, which allocates its packing buffers on every call
-    /// (three times a step on a chain of eight links). The sums are `gemm`'s own below that
-    /// size, term by term in the same order, so small systems step bit for bit as before. Terms
-    /// with a zero factor of B are skipped: B is M⁻¹Gᵀ, and a constraint moves few coordinates
-    /// (four of a chain's 2N), which makes this as fast as matrixmultiply on long chains.
-    fn product(out: &mut DMatrix<f64>, alpha: f64, a: &DMatrix<f64>, b: &DMatrix<f64>) {
-        let (m, n) = a.shape();
-        let (a, b, out) = (a.as_slice(), b.as_slice(), out.as_mut_slice());
-        for (column, b) in out.chunks_exact_mut(m).zip(b.chunks_exact(n)) {
-            column.fill(0.0);
-            for (a, &factor) in a.chunks_exact(m).zip(b) {
-                if factor == 0.0 {
-                    continue;
-                }
-                for (y, &x) in column.iter_mut().zip(a) {
-                    *y += alpha * x * factor;
-                }
-            }
-        }
-    }
-
     /// One RATTLE (or SHAKE) step of size h from (q0, p0) into (dq_stage, dp_stage).
     fn step<S, C>(&mut self, sys: &S, constraints: &C, q0: &[f64], p0: &[f64], h: f64) -> Result<(), StepError>
     where
@@ -197,79 +178,31 @@ impl Rattle {
             *hf = p - 0.5 * h * g;
         }
         sys.mass().velocity(&self.half, &mut self.column);
-        let c = 0.5 * h * h;
         let scale = q0.iter().fold(1.0_f64, |m, x| m.max(x.abs()));
         // The predictor is the last step's λ (a force, smooth in time); 0 after a reset.
         if !self.cached {
             self.lambda.fill(0.0);
         }
-        let position = |lambda: &[f64], q1: &mut [f64], minv: &DMatrix<f64>, drift: &[f64]| {
-            for (i, x) in q1.iter_mut().enumerate() {
-                *x = q0[i] + h * drift[i] - c * (0..lambda.len()).map(|k| minv[(i, k)] * lambda[k]).sum::<f64>();
-            }
-        };
-        position(&self.lambda, &mut self.q1, &self.minv_jac0t, &self.column);
-        let mut converged = false;
-        let mut correction = f64::INFINITY;
-        for _ in 0..self.options.max_iterations {
-            constraints.residual(&self.q1, self.g.as_mut_slice())?;
-            let residual = self.g.amax();
-            if !residual.is_finite() {
-                return Err(StepError::NonFinite {
-                    reason: "the constraints became non-finite",
-                });
-            }
-            if self.shake {
-                if residual <= self.options.tolerance {
-                    converged = true;
-                    break;
-                }
-                self.iterations += 1;
-                // The sweep moves q₁ with each multiplier it changes.
-                self.shake_sweep(constraints, h)?;
-                continue;
-            }
-            // Converged: the constraints hold to round-off, or the last correction was below
-            // the tolerance.
-            if residual <= 4.0 * f64::EPSILON || correction <= self.options.tolerance * scale {
-                converged = true;
-                break;
-            }
-            self.iterations += 1;
-            // J = −(h²/2)G(q₁)M⁻¹G₀ᵀ, exact.
-            constraints.jacobian(&self.q1, &mut self.jac1)?;
-            Self::product(&mut self.newton, -c, &self.jac1, &self.minv_jac0t);
-            if lu_in_place(&mut self.newton, &mut self.pivots).is_none() {
-                return Err(StepError::Convergence {
-                    residual,
-                    iterations: 0,
-                    reason: "G(q₁)M⁻¹G(q₀)ᵀ is singular: the constraints are not independent here",
-                });
-            }
-            lu_solve(&self.newton, &self.pivots, &mut self.g);
-            correction = 0.0;
-            for (l, d) in self.lambda.iter_mut().zip(self.g.iter()) {
-                *l -= d;
-            }
-            for i in 0..self.q1.len() {
-                let shift: f64 = (0..self.lambda.len())
-                    .map(|k| self.minv_jac0t[(i, k)] * self.g[k])
-                    .sum();
-                correction = correction.max((c * shift).abs());
-            }
-            position(&self.lambda, &mut self.q1, &self.minv_jac0t, &self.column);
-        }
-        if !converged {
-            constraints.residual(&self.q1, self.g.as_mut_slice())?;
-            return Err(StepError::Convergence {
-                residual: self.g.amax(),
-                iterations: self.options.max_iterations,
-                reason: if self.shake {
-                    "SHAKE did not reach its tolerance on the constraints"
-                } else {
-                    "RATTLE's Newton iteration for the multipliers did not converge"
-                },
-            });
+        if self.shake {
+            position(q0, h, &self.column, &self.minv_jac0t, &self.lambda, &mut self.q1);
+            self.shake(constraints, h)?;
+        } else {
+            let mut multipliers = PositionConstraint {
+                constraints,
+                q0,
+                h,
+                drift: &self.column,
+                minv_jac0t: &self.minv_jac0t,
+                jac1: &mut self.jac1,
+                lambda: &mut self.lambda,
+                q1: &mut self.q1,
+                scale,
+            };
+            let rules = Rules {
+                simplified: false,
+                noise_floor: false,
+            };
+            self.newton.solve(&mut multipliers, &self.options, rules)?;
         }
         // δp = −(h/2)(∇V₀ + G₀ᵀλ) so far, p½ = p₀ + δp, δq = hM⁻¹p½.
         for (j, (d, hf)) in self.dp_stage.iter_mut().zip(self.half.iter_mut()).enumerate() {
@@ -301,19 +234,19 @@ impl Rattle {
         self.g.fill(0.0);
         if !self.shake && m > 0 {
             Self::minv_transpose(sys, &self.jac1, &mut self.row, &mut self.column, &mut self.minv_jac1t);
-            Self::product(&mut self.newton, 0.5 * h, &self.jac1, &self.minv_jac1t);
+            product(&mut self.gram, 0.5 * h, &self.jac1, &self.minv_jac1t);
             sys.mass().velocity(&self.half, &mut self.column);
             for k in 0..m {
                 self.g[k] = self.jac1.row(k).iter().zip(&self.column).map(|(a, b)| a * b).sum();
             }
-            if lu_in_place(&mut self.newton, &mut self.pivots).is_none() {
+            if lu_in_place(&mut self.gram, &mut self.pivots).is_none() {
                 return Err(StepError::Convergence {
                     residual: self.g.amax(),
                     iterations: 0,
                     reason: "G(q₁)M⁻¹G(q₁)ᵀ is singular: the constraints are not independent here",
                 });
             }
-            lu_solve(&self.newton, &self.pivots, &mut self.g);
+            lu_solve(&self.gram, &self.pivots, &mut self.g);
         }
         // δp = p₁ − p₀ as the sum of the kicks, free of cancellation.
         for (j, d) in self.dp_stage.iter_mut().enumerate() {
@@ -323,6 +256,31 @@ impl Rattle {
         std::mem::swap(&mut self.jac0, &mut self.jac1);
         self.cached = true;
         Ok(())
+    }
+
+    /// SHAKE: sweeps until |g(q₁)|∞ ≤ tolerance.
+    fn shake<C: HolonomicConstraints + ?Sized>(&mut self, constraints: &C, h: f64) -> Result<(), StepError> {
+        for _ in 0..self.options.max_iterations {
+            constraints.residual(&self.q1, self.g.as_mut_slice())?;
+            let residual = self.g.amax();
+            if !residual.is_finite() {
+                return Err(StepError::NonFinite {
+                    reason: "the constraints became non-finite",
+                });
+            }
+            if residual <= self.options.tolerance {
+                return Ok(());
+            }
+            self.sweeps += 1;
+            // The sweep moves q₁ with each multiplier it changes.
+            self.shake_sweep(constraints, h)?;
+        }
+        constraints.residual(&self.q1, self.g.as_mut_slice())?;
+        Err(StepError::Convergence {
+            residual: self.g.amax(),
+            iterations: self.options.max_iterations,
+            reason: "SHAKE did not reach its tolerance on the constraints",
+        })
     }
 
     /// One SHAKE sweep: each constraint in turn, λₖ −= gₖ(q₁)/(−(h²/2)Gₖ(q₁)·M⁻¹Gₖ(q₀)ᵀ), with
@@ -343,5 +301,92 @@ impl Rattle {
             }
         }
         Ok(())
+    }
+}
+
+/// out = αAB, a column at a time. Not `gemm`: nalgebra hands products of dynamic matrices
+/// larger than 5 × 5 to matrixmultiply, which allocates its packing buffers on every call
+/// (three times a step on a chain of eight links). The sums are `gemm`'s own below that
+/// size, term by term in the same order, so small systems step bit for bit as before. Terms
+/// with a zero factor of B are skipped: B is M⁻¹Gᵀ, and a constraint moves few coordinates
+/// (four of a chain's 2N), which makes this as fast as matrixmultiply on long chains.
+fn product(out: &mut DMatrix<f64>, alpha: f64, a: &DMatrix<f64>, b: &DMatrix<f64>) {
+    let (m, n) = a.shape();
+    let (a, b, out) = (a.as_slice(), b.as_slice(), out.as_mut_slice());
+    for (column, b) in out.chunks_exact_mut(m).zip(b.chunks_exact(n)) {
+        column.fill(0.0);
+        for (a, &factor) in a.chunks_exact(m).zip(b) {
+            if factor == 0.0 {
+                continue;
+            }
+            for (y, &x) in column.iter_mut().zip(a) {
+                *y += alpha * x * factor;
+            }
+        }
+    }
+}
+
+/// q₁ = q₀ + h·q̇ − (h²/2)M⁻¹G(q₀)ᵀλ, q̇ = M⁻¹(p₀ − (h/2)∇V₀) the unconstrained drift.
+fn position(q0: &[f64], h: f64, drift: &[f64], minv_jac0t: &DMatrix<f64>, lambda: &[f64], q1: &mut [f64]) {
+    let c = 0.5 * h * h;
+    for (i, x) in q1.iter_mut().enumerate() {
+        *x = q0[i] + h * drift[i] - c * (0..lambda.len()).map(|k| minv_jac0t[(i, k)] * lambda[k]).sum::<f64>();
+    }
+}
+
+/// g(q₁(λ)) = 0 for RATTLE's multipliers λ, with the exact Jacobian −(h²/2)G(q₁)M⁻¹G(q₀)ᵀ.
+struct PositionConstraint<'a, C: ?Sized> {
+    constraints: &'a C,
+    q0: &'a [f64],
+    h: f64,
+    /// M⁻¹(p₀ − (h/2)∇V₀).
+    drift: &'a [f64],
+    minv_jac0t: &'a DMatrix<f64>,
+    jac1: &'a mut DMatrix<f64>,
+    lambda: &'a mut [f64],
+    q1: &'a mut [f64],
+    /// max(‖q₀‖∞, 1), the scale of the corrections of q₁.
+    scale: f64,
+}
+
+impl<C: HolonomicConstraints + ?Sized> NewtonProblem for PositionConstraint<'_, C> {
+    const REASONS: Reasons = Reasons {
+        singular: "G(q₁)M⁻¹G(q₀)ᵀ is singular: the constraints are not independent here",
+        non_finite_start: "the constraints became non-finite",
+        non_finite: "the constraints became non-finite",
+        not_converged: "RATTLE's Newton iteration for the multipliers did not converge",
+    };
+
+    fn residual(&mut self, r: &mut [f64]) -> Result<(), StepError> {
+        position(self.q0, self.h, self.drift, self.minv_jac0t, self.lambda, self.q1);
+        Ok(self.constraints.residual(self.q1, r)?)
+    }
+
+    fn jacobian(&mut self, jac: &mut DMatrix<f64>) -> Result<(), StepError> {
+        self.constraints.jacobian(self.q1, self.jac1)?;
+        product(jac, -0.5 * self.h * self.h, self.jac1, self.minv_jac0t);
+        Ok(())
+    }
+
+    /// The correction measured as the move of q₁, (h²/2)M⁻¹G(q₀)ᵀδλ, against max(‖q₀‖∞, 1).
+    fn correct(&mut self, delta: &[f64]) -> Correction {
+        let c = 0.5 * self.h * self.h;
+        for (l, d) in self.lambda.iter_mut().zip(delta) {
+            *l -= d;
+        }
+        let mut size = 0.0_f64;
+        for i in 0..self.q1.len() {
+            let shift: f64 = (0..delta.len()).map(|k| self.minv_jac0t[(i, k)] * delta[k]).sum();
+            size = size.max((c * shift).abs());
+        }
+        Correction {
+            size,
+            scale: self.scale,
+        }
+    }
+
+    /// The constraints hold to round-off.
+    fn solved(&self, residual: f64) -> bool {
+        residual <= 4.0 * f64::EPSILON
     }
 }

@@ -1,6 +1,9 @@
 use nalgebra::{DMatrix, DVector};
 
-use super::{finite_difference, MechanicalSystem};
+use super::MechanicalSystem;
+use crate::integrators::StepError;
+use crate::solve::difference::{self, central_jacobian, Evaluations};
+use crate::solve::newton::{Correction, Newton, NewtonOptions, NewtonProblem, Reasons, Rules};
 use crate::{Error, ModelError};
 
 /// Holonomic constraints g(q) = 0, m of them on n coordinates, with their Jacobian G = ∂g/∂q.
@@ -20,29 +23,26 @@ pub trait HolonomicConstraints {
     }
 }
 
-/// G(q) by central differences of g, row by row (2n evaluations of g per row; they allocate
+/// G(q) by central differences of g, column by column (2n evaluations of g; they allocate
 /// scratch), about 1e-10 relative accuracy.
 pub fn differenced_jacobian<C: HolonomicConstraints + ?Sized>(
     constraints: &C,
     q: &[f64],
     jac: &mut DMatrix<f64>,
 ) -> Result<(), ModelError> {
-    let (m, n) = jac.shape();
-    let (mut work, mut row) = (vec![0.0; n], vec![0.0; n]);
-    let mut g = vec![0.0; m];
-    for i in 0..m {
-        finite_difference::central_gradient(
-            |x| {
-                constraints.residual(x, &mut g)?;
-                Ok(g[i])
-            },
-            q,
-            &mut work,
-            &mut row,
-        )?;
-        jac.row_mut(i).copy_from_slice(&row);
-    }
-    Ok(())
+    let m = jac.nrows();
+    let (mut plus, mut minus) = (vec![0.0; m], vec![0.0; m]);
+    let at = Evaluations {
+        plus: &mut plus,
+        minus: &mut minus,
+    };
+    central_jacobian(
+        |x, g| constraints.residual(x, g),
+        &mut q.to_vec(),
+        difference::unit,
+        at,
+        jac,
+    )
 }
 
 /// Rigid distances between point bodies in d dimensions (coordinates laid out body by body),
@@ -179,33 +179,36 @@ pub fn project<C: HolonomicConstraints + ?Sized>(
     let model = |e: ModelError| Error::invalid("q0", format!("the constraints failed to evaluate: {e}"));
     let singular = || Error::invalid("q0", "the constraints are not independent here (G M⁻¹ Gᵀ is singular)");
     let m = constraints.count();
-    let mut q = DVector::from_column_slice(q0);
-    let mut g = vec![0.0; m];
-    let scale = q0.iter().fold(1.0_f64, |a, x| a.max(x.abs()));
-    let mut converged = false;
-    for _ in 0..50 {
-        constraints.residual(q.as_slice(), &mut g).map_err(model)?;
-        let (jac, w) = jacobians(constraints, minv, q.as_slice()).map_err(model)?;
-        let step = (&jac * &w)
-            .lu()
-            .solve(&DVector::from_column_slice(&g))
-            .ok_or_else(singular)?;
-        let delta = &w * step;
-        q -= &delta;
-        if !q.iter().all(|x| x.is_finite()) {
-            break;
+    let mut problem = OntoConstraints {
+        constraints,
+        minv,
+        q: DVector::from_column_slice(q0),
+        w: DMatrix::zeros(q0.len(), m),
+        scale: q0.iter().fold(1.0_f64, |a, x| a.max(x.abs())),
+    };
+    // The nearest point to round-off: |δq|∞ ≤ 4ε·max(|q₀|∞, 1).
+    let options = NewtonOptions {
+        tolerance: 4.0 * f64::EPSILON,
+        ..NewtonOptions::default()
+    };
+    let rules = Rules {
+        simplified: false,
+        noise_floor: false,
+    };
+    match Newton::new(m).solve(&mut problem, &options, rules) {
+        Ok(_) => {}
+        Err(StepError::Model(e)) => return Err(model(e)),
+        Err(StepError::Convergence { reason, .. }) if reason == OntoConstraints::<C>::REASONS.singular => {
+            return Err(singular())
         }
-        if delta.amax() <= 4.0 * f64::EPSILON * scale {
-            converged = true;
-            break;
+        Err(_) => {
+            return Err(Error::invalid(
+                "q0",
+                "no point of the constraints near q0 (Newton's projection failed)",
+            ))
         }
     }
-    if !converged {
-        return Err(Error::invalid(
-            "q0",
-            "no point of the constraints near q0 (Newton's projection failed)",
-        ));
-    }
+    let q = problem.q;
     let (jac, w) = jacobians(constraints, minv, q.as_slice()).map_err(model)?;
     let mut v = vec![0.0; q.len()];
     velocity(q.as_slice(), p0, &mut v).map_err(model)?;
@@ -215,6 +218,47 @@ pub fn project<C: HolonomicConstraints + ?Sized>(
         .ok_or_else(singular)?;
     let p = DVector::from_column_slice(p0) - jac.transpose() * mu;
     Ok((q.as_slice().to_vec(), p.as_slice().to_vec()))
+}
+
+/// g(q) = 0 by Newton's method along W = M(q)⁻¹G(q)ᵀ: q ← q − Wδ with (GW)δ = g(q). It
+/// allocates (set-up, not the step loop).
+struct OntoConstraints<'a, C: ?Sized> {
+    constraints: &'a C,
+    minv: Action<'a>,
+    q: DVector<f64>,
+    /// W at the last Jacobian.
+    w: DMatrix<f64>,
+    /// max(|q₀|∞, 1).
+    scale: f64,
+}
+
+impl<C: HolonomicConstraints + ?Sized> NewtonProblem for OntoConstraints<'_, C> {
+    const REASONS: Reasons = Reasons {
+        singular: "the constraints are not independent here (G M⁻¹ Gᵀ is singular)",
+        non_finite_start: "the constraints are non-finite at q0",
+        non_finite: "Newton's projection became non-finite",
+        not_converged: "no point of the constraints near q0 (Newton's projection failed)",
+    };
+
+    fn residual(&mut self, r: &mut [f64]) -> Result<(), StepError> {
+        Ok(self.constraints.residual(self.q.as_slice(), r)?)
+    }
+
+    fn jacobian(&mut self, jac: &mut DMatrix<f64>) -> Result<(), StepError> {
+        let (g, w) = jacobians(self.constraints, self.minv, self.q.as_slice())?;
+        jac.copy_from(&(&g * &w));
+        self.w = w;
+        Ok(())
+    }
+
+    fn correct(&mut self, delta: &[f64]) -> Correction {
+        let shift = &self.w * DVector::from_column_slice(delta);
+        self.q -= &shift;
+        Correction {
+            size: shift.amax(),
+            scale: self.scale,
+        }
+    }
 }
 
 impl<S: MechanicalSystem, C: HolonomicConstraints> Constrained<S, C> {

@@ -1,6 +1,9 @@
 use nalgebra::DMatrix;
 
-use super::{finite_difference, MechanicalSystem};
+use super::MechanicalSystem;
+use crate::integrators::StepError;
+use crate::solve::difference::{self, central_gradient, central_jacobian, Evaluations};
+use crate::solve::newton::{model_error, Correction, Newton, NewtonOptions, NewtonProblem, Reasons, Rules};
 use crate::ModelError;
 
 /// The second derivatives of L at one point, n × n each.
@@ -42,13 +45,13 @@ pub trait Lagrangian {
     /// a scratch vector; models used in long runs should supply it).
     fn dl_dq(&self, q: &[f64], v: &[f64], t: f64, out: &mut [f64]) -> Result<(), ModelError> {
         let mut work = vec![0.0; q.len()];
-        finite_difference::central_gradient(|x| self.lagrangian(x, v, t), q, &mut work, out)
+        central_gradient(|x| self.lagrangian(x, v, t), q, &mut work, out)
     }
 
     /// Writes the momentum p = ∂L/∂q̇ at (q, q̇, t) into `out`. Default: central differences.
     fn dl_dv(&self, q: &[f64], v: &[f64], t: f64, out: &mut [f64]) -> Result<(), ModelError> {
         let mut work = vec![0.0; v.len()];
-        finite_difference::central_gradient(|x| self.lagrangian(q, x, t), v, &mut work, out)
+        central_gradient(|x| self.lagrangian(q, x, t), v, &mut work, out)
     }
 
     /// Writes the exact second derivatives of L at (q, q̇, t) into `out` and returns true, or
@@ -83,43 +86,23 @@ pub trait Lagrangian {
     /// to the noise floor of difference derivatives.
     fn velocity(&self, q: &[f64], p: &[f64], t: f64, v: &mut [f64]) -> Result<(), ModelError> {
         let n = v.len();
-        let (mut r, mut plus, mut minus) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
-        let mut jacobian = nalgebra::DMatrix::zeros(n, n);
-        let mut last = f64::INFINITY;
-        for _ in 0..50 {
-            self.dl_dv(q, v, t, &mut r)?;
-            r.iter_mut().zip(p).for_each(|(r, p)| *r -= p);
-            for j in 0..n {
-                let x = v[j];
-                let e = f64::EPSILON.cbrt() * x.abs().max(1.0);
-                v[j] = x + e;
-                self.dl_dv(q, v, t, &mut plus)?;
-                v[j] = x - e;
-                self.dl_dv(q, v, t, &mut minus)?;
-                v[j] = x;
-                for i in 0..n {
-                    jacobian[(i, j)] = (plus[i] - minus[i]) / (2.0 * e);
-                }
-            }
-            let delta = jacobian
-                .clone()
-                .lu()
-                .solve(&nalgebra::DVector::from_column_slice(&r))
-                .ok_or_else(|| {
-                    ModelError::from("the Hessian ∂²L/∂q̇² is singular: the Lagrangian is not regular here")
-                })?;
-            let mut size = 0.0_f64;
-            for (x, d) in v.iter_mut().zip(delta.iter()) {
-                *x -= d;
-                size = size.max(d.abs() / x.abs().max(1.0));
-            }
-            // Converged, or at the noise floor of difference derivatives.
-            if size <= 1e-14 || (size > 0.5 * last && size <= finite_difference::NOISE_FLOOR) {
-                return Ok(());
-            }
-            last = size;
-        }
-        Err("the inverse Legendre transform ∂L/∂q̇ = p did not converge".into())
+        let mut problem = InverseLegendre {
+            sys: self,
+            q,
+            p,
+            t,
+            v,
+            plus: vec![0.0; n],
+            minus: vec![0.0; n],
+        };
+        let rules = Rules {
+            simplified: false,
+            noise_floor: true,
+        };
+        Newton::new(n)
+            .solve(&mut problem, &NewtonOptions::default(), rules)
+            .map_err(model_error)?;
+        Ok(())
     }
 
     /// The energy function E(q, p, t) = p·q̇ − L(q, q̇, t), with q̇ from [`Lagrangian::velocity`];
@@ -155,5 +138,46 @@ impl<S: MechanicalSystem + ?Sized> Lagrangian for S {
     fn velocity(&self, _q: &[f64], p: &[f64], _t: f64, v: &mut [f64]) -> Result<(), ModelError> {
         self.mass().velocity(p, v);
         Ok(())
+    }
+}
+
+/// ∂L/∂q̇(q, v, t) − p = 0 for v: the default inverse Legendre transform.
+struct InverseLegendre<'a, S: ?Sized> {
+    sys: &'a S,
+    q: &'a [f64],
+    p: &'a [f64],
+    t: f64,
+    v: &'a mut [f64],
+    plus: Vec<f64>,
+    minus: Vec<f64>,
+}
+
+impl<S: Lagrangian + ?Sized> NewtonProblem for InverseLegendre<'_, S> {
+    const REASONS: Reasons = Reasons {
+        singular: "the Hessian ∂²L/∂q̇² is singular: the Lagrangian is not regular here",
+        non_finite_start: "the inverse Legendre transform ∂L/∂q̇ = p is non-finite at the start",
+        non_finite: "the inverse Legendre transform ∂L/∂q̇ = p became non-finite",
+        not_converged: "the inverse Legendre transform ∂L/∂q̇ = p did not converge",
+    };
+
+    fn residual(&mut self, r: &mut [f64]) -> Result<(), StepError> {
+        self.sys.dl_dv(self.q, self.v, self.t, r)?;
+        r.iter_mut().zip(self.p).for_each(|(r, p)| *r -= p);
+        Ok(())
+    }
+
+    /// ∂²L/∂q̇² by central differences of ∂L/∂q̇ (exact in one step when L is quadratic in q̇).
+    fn jacobian(&mut self, jac: &mut DMatrix<f64>) -> Result<(), StepError> {
+        let (sys, q, t) = (self.sys, self.q, self.t);
+        let at = Evaluations {
+            plus: &mut self.plus,
+            minus: &mut self.minus,
+        };
+        central_jacobian(|v, out| sys.dl_dv(q, v, t, out), self.v, difference::unit, at, jac)?;
+        Ok(())
+    }
+
+    fn correct(&mut self, delta: &[f64]) -> Correction {
+        Correction::relative(self.v, delta)
     }
 }

@@ -8,11 +8,11 @@
 //! - [`HolonomicConstraints`]: g(q) = 0 with its Jacobian, [`Distances`] for rigid links, and
 //!   [`Constrained`], a mechanical system on them;
 //! - [`Routhian`]: Routh reduction, R = L − μ·ċ on the non-cyclic coordinates;
-//! - [`Generator`]: infinitesimal symmetries ξ(q) and their Noether momenta J = p·ξ(q);
-//! - [`finite_difference`]: derivatives a model does not supply.
+//! - [`Generator`]: infinitesimal symmetries ξ(q) and their Noether momenta J = p·ξ(q).
+//!
+//! Derivatives a model does not supply come from [`crate::solve::difference`].
 
 mod constraints;
-pub mod finite_difference;
 mod lagrangian;
 mod mass;
 mod mechanical;

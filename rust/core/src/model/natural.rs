@@ -2,7 +2,8 @@ use std::cell::RefCell;
 
 use nalgebra::{DMatrix, DVector};
 
-use super::{finite_difference, Lagrangian};
+use super::Lagrangian;
+use crate::solve::difference::central_gradient;
 use crate::ModelError;
 
 /// A natural mechanical system, L = ½q̇ᵀM(q)q̇ − V(q): kinetic energy a positive-definite
@@ -41,7 +42,7 @@ pub fn differenced_kinetic_gradient<S: NaturalSystem + ?Sized>(
     let mut m = DMatrix::zeros(n, n);
     let v = DVector::from_column_slice(v);
     let mut work = vec![0.0; n];
-    finite_difference::central_gradient(
+    central_gradient(
         |x| {
             sys.mass_matrix(x, &mut m)?;
             Ok(0.5 * v.dot(&(&m * &v)))

@@ -2,10 +2,19 @@ use std::cell::RefCell;
 
 use nalgebra::{DMatrix, DVector};
 
-use super::finite_difference::NOISE_FLOOR;
 use super::{Hessians, Lagrangian};
-use crate::linalg::{lu_in_place, lu_solve};
+use crate::integrators::StepError;
+use crate::solve::difference::{self, central_jacobian, Evaluations};
+use crate::solve::lu::{lu_in_place, lu_solve};
+use crate::solve::newton::{model_error, Correction, Newton, NewtonOptions, NewtonProblem, Reasons, Rules};
 use crate::{Error, ModelError};
+
+/// The Newton iteration for ċ: to a relative correction of 1e-15 (or the noise floor of a
+/// differenced ∂²L/∂ċ²), at most 50 iterations.
+const NEWTON: NewtonOptions = NewtonOptions {
+    tolerance: 1e-15,
+    max_iterations: 50,
+};
 
 /// The Routhian of a Lagrangian with cyclic coordinates, a [`Lagrangian`] on the remaining
 /// (shape) coordinates x (Routh's "ignoration of coordinates"; Marsden, Ratiu & Scheurle,
@@ -35,6 +44,7 @@ pub struct Routhian<'a, L: ?Sized> {
     shape: Vec<usize>,
     momenta: Vec<f64>,
     scratch: RefCell<Scratch>,
+    newton: RefCell<Newton>,
 }
 
 /// One point at which ∂L/∂ċ is evaluated, with its quadrature weight.
@@ -57,9 +67,13 @@ struct Scratch {
     solved_x: Vec<f64>,
     solved_xdot: Vec<f64>,
     full: Vec<f64>,
+    /// p for the inverse Legendre transform.
+    p: Vec<f64>,
+    /// The differences of ∂L/∂ċ, and one node's ∂²L/∂ċ² from them.
     plus: Vec<f64>,
     minus: Vec<f64>,
-    residual: DVector<f64>,
+    node_k: DMatrix<f64>,
+    /// K = ∂²L/∂ċ² and its LU factors, for the Schur complements.
     k: DMatrix<f64>,
     pivots: Vec<usize>,
     hessians: Hessians,
@@ -118,9 +132,10 @@ impl<'a, L: Lagrangian + ?Sized> Routhian<'a, L> {
             solved_x: vec![0.0; r],
             solved_xdot: vec![0.0; r],
             full: vec![0.0; n],
-            plus: vec![0.0; n],
-            minus: vec![0.0; n],
-            residual: DVector::zeros(m),
+            p: vec![0.0; n],
+            plus: vec![0.0; m],
+            minus: vec![0.0; m],
+            node_k: DMatrix::zeros(m, m),
             k: DMatrix::zeros(m, m),
             pivots: vec![0; m],
             hessians: Hessians::zeros(n),
@@ -133,6 +148,7 @@ impl<'a, L: Lagrangian + ?Sized> Routhian<'a, L> {
             shape,
             momenta: momenta.to_vec(),
             scratch: RefCell::new(scratch),
+            newton: RefCell::new(Newton::new(m)),
         })
     }
 
@@ -212,8 +228,15 @@ impl<'a, L: Lagrangian + ?Sized> Routhian<'a, L> {
                 None => {
                     std::mem::swap(&mut xdot0, &mut xdot1);
                     self.velocity(x1, &p[(k + 1) * r..(k + 2) * r], t[k + 1], &mut xdot1)?;
+                    let ends = Ends {
+                        h,
+                        x0,
+                        v0: &xdot0,
+                        x1,
+                        v1: &xdot1,
+                    };
                     for (i, &c) in GAUSS3.0.iter().enumerate() {
-                        hermite(c, h, x0, &xdot0, x1, &xdot1, &mut xs[i], &mut xdots[i]);
+                        ends.hermite(c, &mut xs[i], &mut xdots[i]);
                     }
                     (&GAUSS3.0, &GAUSS3.1)
                 }
@@ -295,72 +318,15 @@ impl<'a, L: Lagrangian + ?Sized> Routhian<'a, L> {
 
     /// [`Routhian::solve`] without the memo.
     fn newton(&self, s: &mut Scratch, nodes: &[Node]) -> Result<(), ModelError> {
-        let m = self.cyclic.len();
-        let mut last = f64::INFINITY;
-        for _ in 0..50 {
-            self.momenta
-                .iter()
-                .zip(s.residual.iter_mut())
-                .for_each(|(mu, r)| *r = -mu);
-            for node in nodes {
-                self.embed(s, node.x, node.xdot);
-                self.full.dl_dv(&s.q, &s.v, node.t, &mut s.full)?;
-                for (j, &c) in self.cyclic.iter().enumerate() {
-                    s.residual[j] += node.weight * s.full[c];
-                }
-            }
-            let scale = self.momenta.iter().fold(f64::MIN_POSITIVE, |a, b| a.max(b.abs()));
-            if s.residual.amax() <= 4.0 * f64::EPSILON * scale {
-                return Ok(());
-            }
-            self.jacobian(s, nodes)?;
-            if lu_in_place(&mut s.k, &mut s.pivots).is_none() {
-                return Err("∂²L/∂ċ² is singular: the cyclic velocities are not determined by their momenta".into());
-            }
-            lu_solve(&s.k, &s.pivots, &mut s.residual);
-            let mut size = 0.0_f64;
-            for j in 0..m {
-                s.cdot[j] -= s.residual[j];
-                size = size.max(s.residual[j].abs() / s.cdot[j].abs().max(1.0));
-            }
-            // Converged, or at the noise floor of a differenced Jacobian.
-            if size <= 1e-15 || (size > 0.5 * last && size <= NOISE_FLOOR) {
-                let node = nodes.last().expect("at least one node");
-                self.embed(s, node.x, node.xdot);
-                return Ok(());
-            }
-            last = size;
-        }
-        Err("the cyclic velocities did not converge: ∂L/∂ċ = μ has no nearby solution".into())
-    }
-
-    /// K = Σᵢ wᵢ ∂²L/∂ċ²(nodeᵢ), exact when L supplies its Hessians, else by central
-    /// differences of ∂L/∂ċ.
-    fn jacobian(&self, s: &mut Scratch, nodes: &[Node]) -> Result<(), ModelError> {
-        s.k.fill(0.0);
-        for node in nodes {
-            self.embed(s, node.x, node.xdot);
-            if self.full.hessians(&s.q, &s.v, node.t, &mut s.hessians)? {
-                for (j, &a) in self.cyclic.iter().enumerate() {
-                    for (l, &b) in self.cyclic.iter().enumerate() {
-                        s.k[(j, l)] += node.weight * s.hessians.vv[(a, b)];
-                    }
-                }
-                continue;
-            }
-            for (l, &b) in self.cyclic.iter().enumerate() {
-                let v = s.v[b];
-                let e = f64::EPSILON.cbrt() * v.abs().max(1.0);
-                s.v[b] = v + e;
-                self.full.dl_dv(&s.q, &s.v, node.t, &mut s.plus)?;
-                s.v[b] = v - e;
-                self.full.dl_dv(&s.q, &s.v, node.t, &mut s.minus)?;
-                s.v[b] = v;
-                for (j, &a) in self.cyclic.iter().enumerate() {
-                    s.k[(j, l)] += node.weight * (s.plus[a] - s.minus[a]) / (2.0 * e);
-                }
-            }
-        }
+        let rules = Rules {
+            simplified: false,
+            noise_floor: true,
+        };
+        let mut problem = CyclicVelocities { routh: self, s, nodes };
+        self.newton
+            .borrow_mut()
+            .solve(&mut problem, &NEWTON, rules)
+            .map_err(model_error)?;
         Ok(())
     }
 
@@ -393,26 +359,114 @@ const GAUSS3: ([f64; 3], [f64; 3]) = (
     [5.0 / 18.0, 8.0 / 18.0, 5.0 / 18.0],
 );
 
-/// The cubic Hermite interpolant through (x₀, ẋ₀) at s = 0 and (x₁, ẋ₁) at s = 1 on a step of
-/// length h: x(s) and its time derivative.
-#[allow(clippy::too_many_arguments)]
-fn hermite(s: f64, h: f64, x0: &[f64], v0: &[f64], x1: &[f64], v1: &[f64], x: &mut [f64], v: &mut [f64]) {
-    let (s2, s3) = (s * s, s * s * s);
-    let (h00, h10, h01, h11) = (
-        2.0 * s3 - 3.0 * s2 + 1.0,
-        s3 - 2.0 * s2 + s,
-        -2.0 * s3 + 3.0 * s2,
-        s3 - s2,
-    );
-    let (d00, d10, d01, d11) = (
-        6.0 * s2 - 6.0 * s,
-        3.0 * s2 - 4.0 * s + 1.0,
-        -6.0 * s2 + 6.0 * s,
-        3.0 * s2 - 2.0 * s,
-    );
-    for j in 0..x.len() {
-        x[j] = h00 * x0[j] + h10 * h * v0[j] + h01 * x1[j] + h11 * h * v1[j];
-        v[j] = (d00 * x0[j] + d01 * x1[j]) / h + d10 * v0[j] + d11 * v1[j];
+/// The ends (x₀, ẋ₀) and (x₁, ẋ₁) of a step of length h.
+struct Ends<'a> {
+    h: f64,
+    x0: &'a [f64],
+    v0: &'a [f64],
+    x1: &'a [f64],
+    v1: &'a [f64],
+}
+
+impl Ends<'_> {
+    /// The cubic Hermite interpolant through the ends, at s = 0 and s = 1: x(s) and its time
+    /// derivative.
+    fn hermite(&self, s: f64, x: &mut [f64], v: &mut [f64]) {
+        let Ends { h, x0, v0, x1, v1 } = *self;
+        let (s2, s3) = (s * s, s * s * s);
+        let (h00, h10, h01, h11) = (
+            2.0 * s3 - 3.0 * s2 + 1.0,
+            s3 - 2.0 * s2 + s,
+            -2.0 * s3 + 3.0 * s2,
+            s3 - s2,
+        );
+        let (d00, d10, d01, d11) = (
+            6.0 * s2 - 6.0 * s,
+            3.0 * s2 - 4.0 * s + 1.0,
+            -6.0 * s2 + 6.0 * s,
+            3.0 * s2 - 2.0 * s,
+        );
+        for j in 0..x.len() {
+            x[j] = h00 * x0[j] + h10 * h * v0[j] + h01 * x1[j] + h11 * h * v1[j];
+            v[j] = (d00 * x0[j] + d01 * x1[j]) / h + d10 * v0[j] + d11 * v1[j];
+        }
+    }
+}
+
+/// Σᵢ wᵢ ∂L/∂ċ(xᵢ, ẋᵢ, ċ, tᵢ) − μ = 0 for ċ (the scratch's `cdot`), from the last solution.
+struct CyclicVelocities<'p, 'a, L: ?Sized> {
+    routh: &'p Routhian<'a, L>,
+    s: &'p mut Scratch,
+    nodes: &'p [Node<'p>],
+}
+
+impl<L: Lagrangian + ?Sized> NewtonProblem for CyclicVelocities<'_, '_, L> {
+    const REASONS: Reasons = Reasons {
+        singular: "∂²L/∂ċ² is singular: the cyclic velocities are not determined by their momenta",
+        non_finite_start: "∂L/∂ċ is non-finite at the last cyclic velocities",
+        non_finite: "the cyclic velocities became non-finite",
+        not_converged: "the cyclic velocities did not converge: ∂L/∂ċ = μ has no nearby solution",
+    };
+
+    /// Leaves the full state of the last node in the scratch.
+    fn residual(&mut self, r: &mut [f64]) -> Result<(), StepError> {
+        let (routh, s) = (self.routh, &mut *self.s);
+        routh.momenta.iter().zip(r.iter_mut()).for_each(|(mu, r)| *r = -mu);
+        for node in self.nodes {
+            routh.embed(s, node.x, node.xdot);
+            routh.full.dl_dv(&s.q, &s.v, node.t, &mut s.full)?;
+            for (j, &c) in routh.cyclic.iter().enumerate() {
+                r[j] += node.weight * s.full[c];
+            }
+        }
+        Ok(())
+    }
+
+    /// K = Σᵢ wᵢ ∂²L/∂ċ²(nodeᵢ), exact when L supplies its Hessians, else by central
+    /// differences of ∂L/∂ċ.
+    fn jacobian(&mut self, k: &mut DMatrix<f64>) -> Result<(), StepError> {
+        let (routh, s) = (self.routh, &mut *self.s);
+        k.fill(0.0);
+        for node in self.nodes {
+            routh.embed(s, node.x, node.xdot);
+            if routh.full.hessians(&s.q, &s.v, node.t, &mut s.hessians)? {
+                for (j, &a) in routh.cyclic.iter().enumerate() {
+                    for (l, &b) in routh.cyclic.iter().enumerate() {
+                        k[(j, l)] += node.weight * s.hessians.vv[(a, b)];
+                    }
+                }
+                continue;
+            }
+            let Scratch {
+                q,
+                v,
+                cdot,
+                full,
+                plus,
+                minus,
+                node_k,
+                ..
+            } = s;
+            let dl_dcdot = |c: &[f64], out: &mut [f64]| {
+                routh.cyclic.iter().zip(c).for_each(|(&i, c)| v[i] = *c);
+                routh.full.dl_dv(q, v, node.t, full)?;
+                routh.cyclic.iter().zip(out.iter_mut()).for_each(|(&i, o)| *o = full[i]);
+                Ok::<(), ModelError>(())
+            };
+            central_jacobian(dl_dcdot, cdot, difference::unit, Evaluations { plus, minus }, node_k)?;
+            k.iter_mut().zip(node_k.iter()).for_each(|(k, d)| *k += node.weight * d);
+        }
+        Ok(())
+    }
+
+    fn correct(&mut self, delta: &[f64]) -> Correction {
+        Correction::relative(&mut self.s.cdot, delta)
+    }
+
+    /// ‖F‖∞ ≤ 4ε‖μ‖∞: the momenta to round-off.
+    fn solved(&self, residual: f64) -> bool {
+        let scale = self.routh.momenta.iter().fold(f64::MIN_POSITIVE, |a, b| a.max(b.abs()));
+        residual <= 4.0 * f64::EPSILON * scale
     }
 }
 
@@ -498,14 +552,14 @@ impl<L: Lagrangian + ?Sized> Lagrangian for Routhian<'_, L> {
         let s = &mut *self.scratch.borrow_mut();
         for (k, &i) in self.shape.iter().enumerate() {
             s.q[i] = x[k];
-            s.plus[i] = p[k];
+            s.p[i] = p[k];
         }
         for (k, &i) in self.cyclic.iter().enumerate() {
-            s.plus[i] = self.momenta[k];
+            s.p[i] = self.momenta[k];
             s.v[i] = s.cdot[k];
         }
-        let Scratch { q, v, plus, .. } = &mut *s;
-        self.full.velocity(q, plus, t, v)?;
+        let Scratch { q, v, p, .. } = &mut *s;
+        self.full.velocity(q, p, t, v)?;
         self.shape.iter().zip(xdot.iter_mut()).for_each(|(&i, o)| *o = s.v[i]);
         self.cyclic
             .iter()

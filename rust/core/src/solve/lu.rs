@@ -1,4 +1,4 @@
-//! Dense linear algebra that allocates nothing, for the Newton loops of the step equations.
+//! LU factorisation with partial pivoting that allocates nothing, for the Newton loops.
 
 use nalgebra::{DMatrix, DVector};
 

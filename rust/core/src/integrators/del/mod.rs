@@ -1,0 +1,369 @@
+//! The discrete Euler–Lagrange (DEL) equations of one step, solved by Newton's method: the
+//! solver [`Del`], the equations of the two-point rules ([`TwoPoint`]) and of the Galerkin
+//! integrators, and the constrained DEL equations.
+
+mod constrained;
+mod galerkin;
+mod two_point;
+
+pub use two_point::TwoPoint;
+// Where the integrators' public names that live in other layers are found.
+pub use crate::discrete::{Galerkin, Quadrature};
+pub use crate::solve::NewtonOptions;
+
+use nalgebra::DMatrix;
+
+use super::{Increment, StepError, StepStart};
+use crate::discrete::Segment;
+use crate::model::{HolonomicConstraints, Lagrangian};
+use crate::solve::difference::{self, central_jacobian, Evaluations};
+use crate::solve::lu::lu_in_place;
+use crate::solve::newton::{Correction, Newton, NewtonProblem, Reasons, Rules};
+use crate::ModelError;
+use constrained::{constrained_equations, Multipliers};
+
+/// The implicit equations of one step of a variational integrator. The unknowns x are the
+/// increments from q₀ of every point the step solves for, n at a time; the last n are
+/// δq = q₁ − q₀. Solving for increments keeps their own relative precision for the driver's
+/// compensated summation (HLW VIII.5).
+pub trait StepEquations {
+    /// Number of unknowns for n coordinates.
+    fn unknowns(&self, n: usize) -> usize;
+
+    /// Writes F(x) into `out`; F = 0 at the step's solution.
+    fn equations<S: Lagrangian + ?Sized>(
+        &mut self,
+        sys: &S,
+        start: StepStart<'_>,
+        x: &[f64],
+        out: &mut [f64],
+    ) -> Result<(), ModelError>;
+
+    /// Writes p₁ − p₀ at the solution x (F(x) = `residual`) into `dp`, in a form free of
+    /// cancellation, and returns the work of the non-conservative forces over the step.
+    fn momentum_change<S: Lagrangian + ?Sized>(
+        &mut self,
+        sys: &S,
+        start: StepStart<'_>,
+        x: &[f64],
+        residual: &[f64],
+        dp: &mut [f64],
+    ) -> Result<f64, ModelError>;
+
+    /// The predictor of all unknowns from a predicted increment δq.
+    fn predict(&self, dq: &[f64], x: &mut [f64]);
+
+    /// The quadrature that defines the scheme's L_d.
+    fn quadrature(&mut self) -> &mut Quadrature;
+}
+
+/// The discrete Lagrangian's segment of a step whose unknowns are `x`.
+fn segment<'a>(start: &StepStart<'a>, x: &'a [f64]) -> Segment<'a> {
+    Segment {
+        q0: start.q,
+        dq: x,
+        t: start.t,
+        h: start.h,
+    }
+}
+
+/// A variational integrator that solves its step's implicit equations (a [`StepEquations`]) by
+/// Newton's method.
+///
+/// The Jacobian comes from the model's exact second derivatives or from central differences of
+/// the equations, is factorised and kept while the iteration contracts by at least half per
+/// step (simplified Newton), refreshed otherwise. The iteration stops on the increment (see
+/// [`NewtonOptions`]) or at the noise floor of the equations. The predictor extrapolates the
+/// last two increments. p₁ − p₀ is formed by the scheme free of cancellation, so that Noether
+/// momenta stay conserved to round-off.
+///
+/// A step whose Jacobian at the solution has the opposite determinant sign to the continuum
+/// limit ([`Quadrature`]) has crossed a fold of the DEL map: beyond it the
+/// equations have several solutions (for the midpoint rule once h²λ/4 > 1 for an unstable
+/// eigenvalue λ of −M⁻¹∂²L/∂q², e.g. h ≥ 2 at the top of the pendulum) and Newton may settle
+/// on a spurious one. Such a step is refused as [`StepError::SpuriousBranch`].
+///
+/// With holonomic constraints g(q) = 0 (m of them) the unknowns grow by multipliers λ, and the
+/// step solves the constrained DEL equations (Marsden & West 2001, §3.4; RATTLE for separable
+/// systems and the trapezoidal L_d):
+///
+/// p₀ + D₁L_d(q₀, q₁) − (h/2)G(q₀)ᵀλ = 0,   g(q₁) = 0,   p₁ = D₂L_d(q₀, q₁) − (h/2)G(q₁)ᵀμ,
+///
+/// with μ such that the velocity q̇(q₁, p₁) of the inverse Legendre transform is tangent,
+/// G(q₁)q̇ = 0 (Newton's method on μ, from differences of the Legendre transform).
+#[derive(Clone, Debug)]
+pub struct Del<Sc> {
+    scheme: Sc,
+    options: NewtonOptions,
+    /// Number of constraints m; the unknowns are (λ, the scheme's).
+    m: usize,
+    multipliers: Multipliers,
+    x: Vec<f64>,
+    plus: Vec<f64>,
+    minus: Vec<f64>,
+    newton: Newton,
+    /// sign det ∂F/∂x as h → 0 at the run's first state; 0 until computed.
+    continuum_sign: f64,
+    hessian: DMatrix<f64>,
+    hessian_pivots: Vec<usize>,
+    velocity: Vec<f64>,
+    predicted: Vec<f64>,
+    last_dq: Vec<f64>,
+    before_last_dq: Vec<f64>,
+    /// How many previous increments the predictor has (0, 1 or 2).
+    history: usize,
+    evaluations: u64,
+    work: f64,
+}
+
+impl<Sc: StepEquations> Del<Sc> {
+    pub fn new(scheme: Sc, n: usize, options: NewtonOptions) -> Self {
+        let m = scheme.unknowns(n);
+        Del {
+            scheme,
+            options,
+            m: 0,
+            multipliers: Multipliers::new(n, 0),
+            x: vec![0.0; m],
+            plus: vec![0.0; m],
+            minus: vec![0.0; m],
+            newton: Newton::new(m),
+            continuum_sign: 0.0,
+            hessian: DMatrix::zeros(n, n),
+            hessian_pivots: vec![0; n],
+            velocity: vec![0.0; n],
+            predicted: vec![0.0; n],
+            last_dq: vec![0.0; n],
+            before_last_dq: vec![0.0; n],
+            history: 0,
+            evaluations: 0,
+            work: 0.0,
+        }
+    }
+
+    /// Evaluations of the step's equations so far.
+    pub fn evaluations(&self) -> u64 {
+        self.evaluations
+    }
+
+    /// Newton iterations made so far.
+    pub fn iterations(&self) -> u64 {
+        self.newton.iterations()
+    }
+
+    /// The work done by the generalized forces so far.
+    pub fn work(&self) -> f64 {
+        self.work
+    }
+
+    pub(in crate::integrators) fn reset(&mut self) {
+        self.history = 0;
+        self.continuum_sign = 0.0;
+        self.x[..self.m].fill(0.0);
+        self.multipliers.cached = false;
+    }
+
+    /// Sizes the buffers for m constraints (allocating only when m changes).
+    fn size_for(&mut self, n: usize, m: usize) {
+        if m == self.m {
+            return;
+        }
+        let total = self.scheme.unknowns(n) + m;
+        self.m = m;
+        self.multipliers = Multipliers::new(n, m);
+        self.x = vec![0.0; total];
+        self.plus = vec![0.0; total];
+        self.minus = vec![0.0; total];
+        self.newton.resize(total);
+    }
+
+    /// sign det ∂²L/∂q̇² at (q, q̇(q, p), t), by central differences of ∂L/∂q̇: the regularity
+    /// of L, against which the DEL Jacobian's sign is judged.
+    fn hessian_sign<S: Lagrangian + ?Sized>(&mut self, sys: &S, start: StepStart<'_>) -> Result<f64, StepError> {
+        let StepStart { t, q, p, .. } = start;
+        let n = q.len();
+        sys.velocity(q, p, t, &mut self.velocity)?;
+        let at = Evaluations {
+            plus: &mut self.plus[..n],
+            minus: &mut self.minus[..n],
+        };
+        let dl_dv = |v: &[f64], out: &mut [f64]| sys.dl_dv(q, v, t, out);
+        central_jacobian(dl_dv, &mut self.velocity, difference::unit, at, &mut self.hessian)?;
+        lu_in_place(&mut self.hessian, &mut self.hessian_pivots).ok_or_else(|| {
+            StepError::Model("∂²L/∂q̇² is singular at the initial state: the Lagrangian is not regular".into())
+        })
+    }
+
+    /// The increments of one step from `start`, on the constraints if any.
+    pub(in crate::integrators) fn increment<S: Lagrangian + ?Sized>(
+        &mut self,
+        sys: &S,
+        constraints: Option<&dyn HolonomicConstraints>,
+        start: StepStart<'_>,
+        out: Increment<'_>,
+    ) -> Result<(), StepError> {
+        let n = start.q.len();
+        self.size_for(n, constraints.map_or(0, |c| c.count()));
+        let m = self.m;
+        if let Some(c) = constraints {
+            if !self.multipliers.cached {
+                c.jacobian(start.q, &mut self.multipliers.g0)?;
+            }
+        }
+        if self.continuum_sign == 0.0 {
+            let hessian_sign = self.hessian_sign(sys, start)?;
+            self.continuum_sign = self.scheme.quadrature().continuum_sign(n, hessian_sign);
+        }
+        // Predictor: extrapolate the last two increments (second order), the last one, or rest.
+        for ((x, d1), d0) in self.predicted.iter_mut().zip(&self.last_dq).zip(&self.before_last_dq) {
+            *x = match self.history {
+                0 => 0.0,
+                1 => *d1,
+                _ => 2.0 * d1 - d0,
+            };
+        }
+        // The multipliers keep the last step's values: a force, smooth in time.
+        self.scheme.predict(&self.predicted, &mut self.x[m..]);
+        let mut equations = Equations {
+            scheme: &mut self.scheme,
+            sys,
+            constraints,
+            start,
+            m,
+            multipliers: &mut self.multipliers,
+            x: &mut self.x,
+            plus: &mut self.plus,
+            minus: &mut self.minus,
+            evaluations: &mut self.evaluations,
+        };
+        let rules = Rules {
+            simplified: true,
+            noise_floor: true,
+        };
+        self.newton.solve(&mut equations, &self.options, rules)?;
+        // The fold test knows the unconstrained equations' continuum limit only.
+        if m == 0 && self.newton.jacobian_sign() != self.continuum_sign {
+            return Err(StepError::SpuriousBranch {
+                reason: "the step's solution lies beyond a fold of the discrete Euler–Lagrange map \
+                         (the Jacobian's determinant changed sign from its continuum limit), where \
+                         the equations have several solutions and Newton's may be spurious",
+            });
+        }
+        self.finish(sys, constraints, start, out)
+    }
+
+    /// The increments once the step is solved.
+    fn finish<S: Lagrangian + ?Sized>(
+        &mut self,
+        sys: &S,
+        constraints: Option<&dyn HolonomicConstraints>,
+        start: StepStart<'_>,
+        mut out: Increment<'_>,
+    ) -> Result<(), StepError> {
+        self.evaluations += 1;
+        let (n, m) = (start.q.len(), self.m);
+        let u = self.x.len() - m;
+        let residual = self.newton.residual_mut();
+        // The scheme's own residual: its last block holds (h/2)G(q₀)ᵀλ at the solution.
+        for j in (0..n).filter(|_| m > 0) {
+            let force: f64 = (0..m).map(|k| self.multipliers.g0[(k, j)] * self.x[k]).sum();
+            residual[u - n + j] += 0.5 * start.h * force;
+        }
+        self.work += self
+            .scheme
+            .momentum_change(sys, start, &self.x[m..], &residual[..u], out.dp)?;
+        out.dq.copy_from_slice(&self.x[self.x.len() - n..]);
+        if let Some(c) = constraints {
+            self.multipliers
+                .project_momentum(sys, c, start, &mut out, &self.options)?;
+        }
+        std::mem::swap(&mut self.before_last_dq, &mut self.last_dq);
+        self.last_dq.copy_from_slice(out.dq);
+        self.history = (self.history + 1).min(2);
+        Ok(())
+    }
+}
+
+/// A step's equations F(x) = 0 as Newton's method sees them: x = (λ, the scheme's unknowns).
+struct Equations<'a, Sc, S: ?Sized> {
+    scheme: &'a mut Sc,
+    sys: &'a S,
+    constraints: Option<&'a dyn HolonomicConstraints>,
+    start: StepStart<'a>,
+    /// Number of constraints.
+    m: usize,
+    multipliers: &'a mut Multipliers,
+    x: &'a mut [f64],
+    plus: &'a mut [f64],
+    minus: &'a mut [f64],
+    evaluations: &'a mut u64,
+}
+
+impl<Sc: StepEquations, S: Lagrangian + ?Sized> NewtonProblem for Equations<'_, Sc, S> {
+    const REASONS: Reasons = Reasons {
+        singular: "the Jacobian of the step's equations is singular",
+        non_finite_start: "the implicit equations are non-finite at the predictor",
+        non_finite: "the implicit equations became non-finite (Newton's method or the solution diverged)",
+        not_converged: "Newton's method did not converge",
+    };
+
+    fn residual(&mut self, r: &mut [f64]) -> Result<(), StepError> {
+        *self.evaluations += 1;
+        let mp = &mut *self.multipliers;
+        let c = self.constraints.map(|c| (c, &mp.g0, mp.q1.as_mut_slice()));
+        Ok(constrained_equations(self.scheme, self.sys, c, self.start, self.x, r)?)
+    }
+
+    /// ∂F/∂x from the model's second derivatives where it supplies them and no force acts (the
+    /// forces' derivatives are not supplied), by central differences otherwise, each unknown's
+    /// step relative to the position it moves (λ: to itself).
+    fn jacobian(&mut self, jac: &mut DMatrix<f64>) -> Result<(), StepError> {
+        let Equations {
+            scheme,
+            sys,
+            constraints,
+            start,
+            m,
+            multipliers,
+            x,
+            plus,
+            minus,
+            evaluations,
+        } = self;
+        let (sys, constraints, start, m) = (*sys, *constraints, *start, *m);
+        let exact =
+            !sys.is_forced() && constraints.is_none() && scheme.quadrature().jacobian(sys, segment(&start, x), jac)?;
+        if !exact {
+            let n = start.q.len();
+            let equations = |x: &[f64], out: &mut [f64]| {
+                **evaluations += 1;
+                let c = constraints.map(|c| (c, &multipliers.g0, multipliers.q1.as_mut_slice()));
+                constrained_equations(&mut **scheme, sys, c, start, x, out)
+            };
+            let size = |j: usize, d: f64| {
+                let base = if j < m { 0.0 } else { start.q[(j - m) % n] };
+                (base + d).abs().max(1.0)
+            };
+            let at = Evaluations { plus, minus };
+            central_jacobian(equations, x, size, at, jac)?;
+        }
+        if !jac.iter().all(|x| x.is_finite()) {
+            let reason = "the Jacobian of the step's equations is non-finite: the solution is blowing up";
+            return Err(StepError::NonFinite { reason });
+        }
+        Ok(())
+    }
+
+    fn correct(&mut self, delta: &[f64]) -> Correction {
+        let h = self.start.h;
+        let (mut size, mut scale) = (0.0_f64, 0.0_f64);
+        for (j, (x, d)) in self.x.iter_mut().zip(delta).enumerate() {
+            *x -= d;
+            // A multiplier moves q₁ by about (h²/2)M⁻¹Gᵀλ: its correction counts at that size.
+            let weight = if j < self.m { 0.5 * h * h } else { 1.0 };
+            size = size.max(weight * d.abs());
+            scale = scale.max(weight * x.abs());
+        }
+        Correction { size, scale }
+    }
+}

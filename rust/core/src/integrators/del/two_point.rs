@@ -1,0 +1,111 @@
+use super::{segment, StepEquations};
+use crate::discrete::{DiscreteLagrangian, Quadrature, Segment, Workspace};
+use crate::integrators::StepStart;
+use crate::model::Lagrangian;
+use crate::ModelError;
+
+/// The generalized force at a step's midpoint, f(q₀ + δq/2, δq/h, t + h/2), with its buffers.
+#[derive(Clone, Debug)]
+struct Forcing {
+    mid: Vec<f64>,
+    vel: Vec<f64>,
+    f: Vec<f64>,
+}
+
+impl Forcing {
+    fn new(n: usize) -> Self {
+        Forcing {
+            mid: vec![0.0; n],
+            vel: vec![0.0; n],
+            f: vec![0.0; n],
+        }
+    }
+
+    fn evaluate<S: Lagrangian + ?Sized>(&mut self, sys: &S, at: Segment<'_>) -> Result<&[f64], ModelError> {
+        for (((m, v), q), d) in self.mid.iter_mut().zip(self.vel.iter_mut()).zip(at.q0).zip(at.dq) {
+            *m = q + 0.5 * d;
+            *v = d / at.h;
+        }
+        sys.force(&self.mid, &self.vel, at.t + 0.5 * at.h, &mut self.f)?;
+        Ok(&self.f)
+    }
+}
+
+/// The variational integrator of a two-point discrete Lagrangian (midpoint, trapezoid) with
+/// forcing: F(δq) = p₀ + D₁L_d(q₀, q₀ + δq) + f_d⁻, then p₁ = D₂L_d + f_d⁺ (the forced DEL
+/// equations of the discrete Lagrange–d'Alembert principle, f_d^± = (h/2)f(q̄, v, t + h/2) at
+/// the midpoint). The work of the forces is f(q̄, v)·δq a step.
+#[derive(Clone, Debug)]
+pub struct TwoPoint<R> {
+    rule: R,
+    ws: Workspace,
+    forcing: Forcing,
+    quadrature: Quadrature,
+}
+
+impl<R: DiscreteLagrangian> TwoPoint<R> {
+    pub fn new(rule: R, n: usize) -> Self {
+        let (nodes, weights) = rule.quadrature();
+        TwoPoint {
+            quadrature: Quadrature::new(1, nodes, weights, n),
+            rule,
+            ws: Workspace::new(n),
+            forcing: Forcing::new(n),
+        }
+    }
+}
+
+impl<R: DiscreteLagrangian> StepEquations for TwoPoint<R> {
+    fn unknowns(&self, n: usize) -> usize {
+        n
+    }
+
+    fn equations<S: Lagrangian + ?Sized>(
+        &mut self,
+        sys: &S,
+        start: StepStart<'_>,
+        x: &[f64],
+        out: &mut [f64],
+    ) -> Result<(), ModelError> {
+        let at = segment(&start, x);
+        self.rule.d1(sys, at, out, &mut self.ws)?;
+        out.iter_mut().zip(start.p).for_each(|(o, p)| *o += p);
+        if sys.is_forced() {
+            let f = self.forcing.evaluate(sys, at)?;
+            out.iter_mut().zip(f).for_each(|(o, f)| *o += 0.5 * start.h * f);
+        }
+        Ok(())
+    }
+
+    /// p₁ − p₀ = D₁L_d + D₂L_d + h·f(q̄, v) − F, since F = p₀ + D₁L_d + f_d⁻.
+    fn momentum_change<S: Lagrangian + ?Sized>(
+        &mut self,
+        sys: &S,
+        start: StepStart<'_>,
+        x: &[f64],
+        residual: &[f64],
+        dp: &mut [f64],
+    ) -> Result<f64, ModelError> {
+        let at = segment(&start, x);
+        self.rule.momentum_change(sys, at, dp, &mut self.ws)?;
+        dp.iter_mut().zip(residual).for_each(|(d, r)| *d -= r);
+        if !sys.is_forced() {
+            return Ok(0.0);
+        }
+        let f = self.forcing.evaluate(sys, at)?;
+        let mut work = 0.0;
+        for ((d, f), x) in dp.iter_mut().zip(f).zip(x) {
+            *d += start.h * f;
+            work += f * x;
+        }
+        Ok(work)
+    }
+
+    fn predict(&self, dq: &[f64], x: &mut [f64]) {
+        x.copy_from_slice(dq);
+    }
+
+    fn quadrature(&mut self) -> &mut Quadrature {
+        &mut self.quadrature
+    }
+}

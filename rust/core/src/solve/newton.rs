@@ -1,0 +1,253 @@
+//! Newton's method for the implicit equations of every layer: the step equations of the
+//! variational integrators, RATTLE's multipliers, the momentum projection onto the hidden
+//! constraint, the inverse Legendre transform, the Routhian's cyclic velocities and the
+//! projection onto the constraints.
+//!
+//! One iteration x ← x − J⁻¹F(x), with J factorised in place ([`super::lu`]) and, as an option,
+//! kept while the corrections at least halve (simplified Newton). It stops on the increment,
+//! ‖δ‖ ≤ tolerance·scale, at the noise floor of the equations, when the problem declares F
+//! small enough, or at the iteration cap.
+
+use nalgebra::{DMatrix, DVector};
+
+use super::difference::NOISE_FLOOR;
+use super::lu::{lu_in_place, lu_solve};
+use crate::integrators::StepError;
+use crate::ModelError;
+
+/// Options of a Newton iteration.
+///
+/// The implicit integrators stop when ‖δ‖∞ ≤ tolerance·‖x‖∞, x the unknowns as increments from
+/// q₀ (the step's δq, and the Galerkin control points' offsets), or when a Newton step with a
+/// freshly computed Jacobian no longer halves a correction that is already below √ε‖x‖∞ (the
+/// equations' own accuracy when derivatives come from differences). The scale is the increment,
+/// not the position: the discrete velocity δq/h, and so p₁, carries the increment's relative
+/// precision, which a scale of ‖q‖∞ would give away as a cyclic angle grows. The other
+/// iterations measure their corrections their own way (RATTLE: the move of q₁ against ‖q₀‖∞).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct NewtonOptions {
+    /// Stop when the correction satisfies ‖δ‖ ≤ tolerance·scale (the problem's measure).
+    pub tolerance: f64,
+    /// Give up (a convergence error) after this many iterations.
+    pub max_iterations: usize,
+}
+
+impl Default for NewtonOptions {
+    fn default() -> Self {
+        NewtonOptions {
+            tolerance: 1e-14,
+            max_iterations: 50,
+        }
+    }
+}
+
+/// How an iteration refreshes its Jacobian and when it may stop short of the tolerance.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Rules {
+    /// Keep the factorised Jacobian while the corrections at least halve (simplified Newton),
+    /// refresh it otherwise; false: a fresh Jacobian every iteration.
+    pub simplified: bool,
+    /// Also stop at the noise floor: when a step with a fresh Jacobian no longer halves the
+    /// smallest correction so far, and that correction is below [`NOISE_FLOOR`]·scale.
+    pub noise_floor: bool,
+}
+
+/// The size of a Newton correction and the scale the tolerance is relative to: converged when
+/// size ≤ tolerance·scale (a scale of 0 leaves convergence to [`NewtonProblem::solved`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Correction {
+    pub size: f64,
+    pub scale: f64,
+}
+
+impl Correction {
+    /// x ← x − δ, measured relative to each entry: size maxᵢ |δᵢ|/max(|xᵢ|, 1), scale 1.
+    pub fn relative(x: &mut [f64], delta: &[f64]) -> Self {
+        let mut size = 0.0_f64;
+        for (x, d) in x.iter_mut().zip(delta) {
+            *x -= d;
+            size = size.max(d.abs() / x.abs().max(1.0));
+        }
+        Correction { size, scale: 1.0 }
+    }
+}
+
+/// Why an iteration failed, in the words of its problem.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Reasons {
+    /// The Jacobian is singular.
+    pub singular: &'static str,
+    /// F is non-finite at the starting guess.
+    pub non_finite_start: &'static str,
+    /// A correction or F became non-finite.
+    pub non_finite: &'static str,
+    /// The iteration cap was reached.
+    pub not_converged: &'static str,
+}
+
+/// The equations F(x) = 0 of one Newton iteration. The problem keeps its unknowns x (the
+/// iteration only sees F, its Jacobian and the corrections), so that it may apply a correction
+/// as it must (the projection onto g(q) = 0 moves q along M⁻¹Gᵀ).
+pub(crate) trait NewtonProblem {
+    /// The messages of the failures.
+    const REASONS: Reasons;
+
+    /// Writes F(x) into `r`.
+    fn residual(&mut self, r: &mut [f64]) -> Result<(), StepError>;
+
+    /// Writes ∂F/∂x into `jac` (it is factorised in place afterwards).
+    fn jacobian(&mut self, jac: &mut DMatrix<f64>) -> Result<(), StepError>;
+
+    /// Applies x ← x − δ (or the problem's own update along δ) and measures the correction.
+    fn correct(&mut self, delta: &[f64]) -> Correction;
+
+    /// Whether F, of norm ‖F‖∞ = `residual`, is small enough to stop at (checked at the start
+    /// and after every correction). Default: never, the increment decides.
+    fn solved(&self, _residual: f64) -> bool {
+        false
+    }
+}
+
+/// What a converged iteration reports.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Solution {
+    /// Newton steps made (linear solves).
+    pub iterations: usize,
+    /// ‖F‖∞ at the solution.
+    pub residual: f64,
+}
+
+/// The buffers of Newton's method for m equations: F, its Jacobian and LU factors; sized once,
+/// so that the iteration allocates nothing.
+#[derive(Clone, Debug)]
+pub(crate) struct Newton {
+    residual: DVector<f64>,
+    jacobian: DMatrix<f64>,
+    pivots: Vec<usize>,
+    /// sign det of the last factorised Jacobian.
+    sign: f64,
+    /// Newton steps made over the workspace's life.
+    iterations: u64,
+}
+
+/// ‖r‖∞.
+fn norm(r: &DVector<f64>) -> f64 {
+    r.iter().fold(0.0_f64, |m, x| m.max(x.abs()))
+}
+
+impl Newton {
+    pub fn new(m: usize) -> Self {
+        Newton {
+            residual: DVector::zeros(m),
+            jacobian: DMatrix::zeros(m, m),
+            pivots: vec![0; m],
+            sign: 0.0,
+            iterations: 0,
+        }
+    }
+
+    /// Resizes the buffers for m equations, keeping the count of iterations.
+    pub fn resize(&mut self, m: usize) {
+        *self = Newton {
+            iterations: self.iterations,
+            ..Newton::new(m)
+        };
+    }
+
+    /// Newton steps made so far, over every solve.
+    pub fn iterations(&self) -> u64 {
+        self.iterations
+    }
+
+    /// F at the last iterate, for a caller that completes it.
+    pub fn residual_mut(&mut self) -> &mut [f64] {
+        self.residual.as_mut_slice()
+    }
+
+    /// sign det J of the last factorised Jacobian.
+    pub fn jacobian_sign(&self) -> f64 {
+        self.sign
+    }
+
+    /// Solves F(x) = 0 from the problem's current x.
+    pub fn solve<P: NewtonProblem>(
+        &mut self,
+        problem: &mut P,
+        options: &NewtonOptions,
+        rules: Rules,
+    ) -> Result<Solution, StepError> {
+        let reasons = P::REASONS;
+        problem.residual(self.residual.as_mut_slice())?;
+        let mut residual = norm(&self.residual);
+        if !residual.is_finite() {
+            return Err(StepError::NonFinite {
+                reason: reasons.non_finite_start,
+            });
+        }
+        if problem.solved(residual) {
+            return Ok(Solution {
+                iterations: 0,
+                residual,
+            });
+        }
+        let mut keep_jacobian = false;
+        let mut last = f64::INFINITY;
+        let mut smallest = f64::INFINITY;
+        for iteration in 1..=options.max_iterations {
+            let fresh = !keep_jacobian;
+            if fresh {
+                problem.jacobian(&mut self.jacobian)?;
+                self.sign = match lu_in_place(&mut self.jacobian, &mut self.pivots) {
+                    Some(sign) => sign,
+                    None => {
+                        return Err(StepError::Convergence {
+                            residual,
+                            iterations: iteration - 1,
+                            reason: reasons.singular,
+                        })
+                    }
+                };
+            }
+            self.iterations += 1;
+            lu_solve(&self.jacobian, &self.pivots, &mut self.residual);
+            let correction = problem.correct(self.residual.as_slice());
+            problem.residual(self.residual.as_mut_slice())?;
+            residual = norm(&self.residual);
+            if !(correction.size.is_finite() && residual.is_finite()) {
+                return Err(StepError::NonFinite {
+                    reason: reasons.non_finite,
+                });
+            }
+            // At the noise floor of the equations (round-off, or derivatives by differences),
+            // even a fresh Newton step no longer halves the smallest correction so far.
+            let at_floor = rules.noise_floor
+                && fresh
+                && correction.size > 0.5 * smallest
+                && correction.size <= NOISE_FLOOR * correction.scale;
+            smallest = smallest.min(correction.size);
+            if correction.size <= options.tolerance * correction.scale || at_floor || problem.solved(residual) {
+                return Ok(Solution {
+                    iterations: iteration,
+                    residual,
+                });
+            }
+            keep_jacobian = rules.simplified && correction.size <= 0.5 * last;
+            last = correction.size;
+        }
+        Err(StepError::Convergence {
+            residual,
+            iterations: options.max_iterations,
+            reason: reasons.not_converged,
+        })
+    }
+}
+
+/// A failed iteration as the model layer reports it.
+pub(crate) fn model_error(e: StepError) -> ModelError {
+    match e {
+        StepError::Model(e) => e,
+        StepError::Convergence { reason, .. }
+        | StepError::NonFinite { reason }
+        | StepError::SpuriousBranch { reason } => reason.into(),
+    }
+}
