@@ -1,13 +1,141 @@
 """Stubs of the compiled extension ``varmech._core`` (hand-written; see rust/python/src)."""
 
 from collections.abc import Callable, Sequence
-from typing import Any
+from typing import Any, ClassVar, final
 
 import numpy as np
 from numpy.typing import NDArray
+from typing_extensions import disjoint_base
 
-FloatArray = NDArray[np.float64]
-GeneratorSpec = tuple[str, int, int]
+__all__ = [
+    "VarmechError",
+    "DivergenceError",
+    "ConvergenceError",
+    "SpuriousBranchError",
+    "Generator",
+    "ModelKind",
+    "kind_of",
+    "is_time_dependent",
+    "is_forced",
+    "ClosureModel",
+    "ClosureLagrangian",
+    "ClosureNatural",
+    "ClosureConstrained",
+    "NativeModel",
+    "scene",
+    "nbody",
+    "RouthModel",
+    "routh",
+    "cyclic_increments",
+    "amended_potential",
+    "cyclic_velocity",
+    "TrajectoryRecord",
+    "MethodInfo",
+    "integrate",
+    "symplecticity_defect",
+    "methods",
+    "energy",
+    "derivative",
+    "momentum",
+    "energy_statistics",
+    "invariant_statistics",
+    "constraint_residuals",
+    "project",
+]
+
+_FloatArray = NDArray[np.float64]
+
+@disjoint_base
+class Generator:
+    """A generator ξ(q) of a symmetry: one of the variants below."""
+
+    @property
+    def name(self) -> str:
+        """The name of the conserved momentum (P_x, L, p[1], ...)."""
+
+    @final
+    class Translation(Generator):
+        __match_args__ = ("axis", "spatial_dim")
+        def __new__(cls, axis: int, spatial_dim: int) -> Generator.Translation: ...
+        @property
+        def axis(self) -> int: ...
+        @property
+        def spatial_dim(self) -> int: ...
+
+    @final
+    class Rotation(Generator):
+        __match_args__ = ("axis", "spatial_dim")
+        def __new__(cls, axis: int, spatial_dim: int) -> Generator.Rotation: ...
+        @property
+        def axis(self) -> int: ...
+        @property
+        def spatial_dim(self) -> int: ...
+
+    @final
+    class Cyclic(Generator):
+        __match_args__ = ("index",)
+        def __new__(cls, index: int) -> Generator.Cyclic: ...
+        @property
+        def index(self) -> int: ...
+
+@final
+class TrajectoryRecord:
+    """The saved states of a run (or of a failed run, up to the failure)."""
+
+    @property
+    def t(self) -> _FloatArray: ...
+    @property
+    def q(self) -> _FloatArray: ...
+    @property
+    def p(self) -> _FloatArray: ...
+    @property
+    def steps(self) -> int: ...
+    @property
+    def force_evaluations(self) -> int: ...
+    @property
+    def newton(self) -> NDArray[np.uint64]:
+        """Cumulative Newton iterations at each saved state."""
+    @property
+    def work(self) -> _FloatArray:
+        """Cumulative work of the non-conservative forces at each saved state."""
+
+@final
+class MethodInfo:
+    """Facts about one fixed-step method."""
+
+    @property
+    def name(self) -> str: ...
+    @property
+    def order(self) -> int: ...
+    @property
+    def stages(self) -> int: ...
+    @property
+    def force_evaluations(self) -> int: ...
+    @property
+    def implicit(self) -> bool: ...
+    @property
+    def constrained(self) -> bool: ...
+    @property
+    def symplectic(self) -> bool: ...
+    @property
+    def symmetric(self) -> bool: ...
+    @property
+    def h_omega_max(self) -> float: ...
+    @property
+    def reference(self) -> str: ...
+
+@final
+class ModelKind:
+    """The kind of a model, which decides which methods apply and which one is the default."""
+
+    Separable: ClassVar[ModelKind]
+    General: ClassVar[ModelKind]
+    Constrained: ClassVar[ModelKind]
+    ConstrainedGeneral: ClassVar[ModelKind]
+    @property
+    def separable(self) -> bool: ...
+    @property
+    def default_method(self) -> str: ...
 
 class VarmechError(RuntimeError):
     """Base class of varmech's errors."""
@@ -37,120 +165,123 @@ class _ModelProperties:
 
     @property
     def dim(self) -> int: ...
-    @property
-    def separable(self) -> bool: ...
-    @property
-    def time_dependent(self) -> bool: ...
-    @property
-    def forced(self) -> bool: ...
 
+@final
 class NativeModel(_ModelProperties):
     """A native scene: evaluated in Rust with the GIL released."""
 
     @property
     def name(self) -> str: ...
     @property
-    def symmetries(self) -> list[tuple[str, int, int, str]]: ...
+    def symmetries(self) -> list[Generator]: ...
     @property
     def constraints(self) -> int: ...
-    @property
-    def default_method(self) -> str | None: ...
     @property
     def gravity(self) -> tuple[float, list[float]] | None:
         """(G, masses) of an N-body scene, None for the others."""
 
-def constraint_residuals(model: Model, q: FloatArray, p: FloatArray) -> tuple[FloatArray, FloatArray]: ...
-def project(model: Model, q0: FloatArray, p0: FloatArray) -> tuple[FloatArray, FloatArray]: ...
+def constraint_residuals(model: _Model, q: _FloatArray, p: _FloatArray) -> tuple[_FloatArray, _FloatArray]: ...
+def project(model: _Model, q0: _FloatArray, p0: _FloatArray) -> tuple[_FloatArray, _FloatArray]: ...
 
+@final
 class ClosureModel(_ModelProperties):
     """L = ½q̇ᵀMq̇ − V(q) from Python closures."""
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         dim: int,
-        potential: Callable[[FloatArray], float],
-        gradient: Callable[[FloatArray], Any] | None,
-        mass: FloatArray,
-        symmetries: Sequence[GeneratorSpec],
-    ) -> None: ...
+        potential: Callable[[_FloatArray], float],
+        gradient: Callable[[_FloatArray], Any] | None,
+        mass: _FloatArray,
+        symmetries: Sequence[Generator],
+    ) -> ClosureModel: ...
     @property
     def has_gradient(self) -> bool: ...
 
+@final
 class ClosureConstrained(_ModelProperties):
     """A ClosureModel on holonomic constraints g(q) = 0 from Python closures."""
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         system: ClosureModel | ClosureNatural,
         count: int,
-        constraints: Callable[[FloatArray], Any],
-        jacobian: Callable[[FloatArray], Any] | None,
-    ) -> None: ...
+        constraints: Callable[[_FloatArray], Any],
+        jacobian: Callable[[_FloatArray], Any] | None,
+    ) -> ClosureConstrained: ...
     @property
     def constraints(self) -> int: ...
-    @property
-    def default_method(self) -> str: ...
 
+@final
 class ClosureNatural(_ModelProperties):
     """L = ½q̇ᵀM(q)q̇ − V(q) from Python closures (configuration-dependent mass)."""
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         dim: int,
-        mass: Callable[[FloatArray], Any],
-        potential: Callable[[FloatArray], float],
-        gradient: Callable[[FloatArray], Any] | None,
-        mass_derivative: Callable[[FloatArray], Any] | None,
-        symmetries: Sequence[GeneratorSpec],
-    ) -> None: ...
+        mass: Callable[[_FloatArray], Any],
+        potential: Callable[[_FloatArray], float],
+        gradient: Callable[[_FloatArray], Any] | None,
+        mass_derivative: Callable[[_FloatArray], Any] | None,
+        symmetries: Sequence[Generator],
+    ) -> ClosureNatural: ...
 
+@final
 class ClosureLagrangian(_ModelProperties):
     """A general Lagrangian L(q, q̇, t) from Python closures."""
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         dim: int,
-        lagrangian: Callable[[FloatArray, FloatArray, float], float],
-        dl_dq: Callable[[FloatArray, FloatArray, float], Any] | None,
-        dl_dv: Callable[[FloatArray, FloatArray, float], Any] | None,
-        hessians: Callable[[FloatArray, FloatArray, float], Any] | None,
-        force: Callable[[FloatArray, FloatArray, float], Any] | None,
+        lagrangian: Callable[[_FloatArray, _FloatArray, float], float],
+        dl_dq: Callable[[_FloatArray, _FloatArray, float], Any] | None,
+        dl_dv: Callable[[_FloatArray, _FloatArray, float], Any] | None,
+        hessians: Callable[[_FloatArray, _FloatArray, float], Any] | None,
+        force: Callable[[_FloatArray, _FloatArray, float], Any] | None,
         time_dependent: bool,
-        symmetries: Sequence[GeneratorSpec],
-    ) -> None: ...
+        symmetries: Sequence[Generator],
+    ) -> ClosureLagrangian: ...
 
+@final
 class RouthModel(_ModelProperties):
     """The Routhian R = L − μ·ċ of a full model on its non-cyclic coordinates (built by
     :func:`routh`)."""
 
     @property
-    def full(self) -> FullModel: ...
+    def full(self) -> _FullModel: ...
     @property
     def cyclic(self) -> list[int]: ...
     @property
     def momenta(self) -> list[float]: ...
 
-FullModel = NativeModel | ClosureModel | ClosureConstrained | ClosureNatural | ClosureLagrangian
-Model = FullModel | RouthModel
+_FullModel = NativeModel | ClosureModel | ClosureConstrained | ClosureNatural | ClosureLagrangian
+_Model = _FullModel | RouthModel
 
-def routh(full: Model, cyclic: Sequence[int], momenta: Sequence[float], reference: Sequence[float]) -> RouthModel:
+def kind_of(model: _Model) -> ModelKind: ...
+def is_time_dependent(model: _Model) -> bool:
+    """Whether L depends on t explicitly."""
+
+def is_forced(model: _Model) -> bool:
+    """Whether non-conservative forces act."""
+
+def routh(full: _Model, cyclic: Sequence[int], momenta: Sequence[float], reference: Sequence[float]) -> RouthModel:
     """The reduced model ignoring ``cyclic`` at momenta μ; ValueError for constrained, forced
     or reduced models and malformed indices."""
 
-def cyclic_increments(model: RouthModel, t: FloatArray, x: FloatArray, p: FloatArray, rule: str | None) -> FloatArray:
+def cyclic_increments(model: RouthModel, t: _FloatArray, x: _FloatArray, p: _FloatArray, rule: str | None) -> _FloatArray:
     """Δc between consecutive reduced states, (N − 1, m): by the discrete momentum equation of
     ``rule`` (``"midpoint"``, ``"trapezoid"``) or Hermite–Gauss quadrature (None)."""
 
-def amended_potential(model: RouthModel, t: FloatArray, x: FloatArray) -> FloatArray:
+def amended_potential(model: RouthModel, t: _FloatArray, x: _FloatArray) -> _FloatArray:
     """V_μ(x, t) = −R(x, 0, t) at each state, (N,)."""
 
-def cyclic_velocity(model: RouthModel, t: FloatArray, x: FloatArray, xdot: FloatArray) -> FloatArray:
+def cyclic_velocity(model: RouthModel, t: _FloatArray, x: _FloatArray, xdot: _FloatArray) -> _FloatArray:
     """ċ with ∂L/∂ċ = μ at each state, (N, m)."""
 
 def integrate(
-    model: Model,
-    q0: FloatArray,
-    p0: FloatArray,
+    model: _Model,
+    q0: _FloatArray,
+    p0: _FloatArray,
     *,
     dt: float,
     steps: int,
@@ -161,23 +292,22 @@ def integrate(
     t0: float = 0.0,
     newton_tolerance: float = 1e-14,
     newton_max_iterations: int = 50,
-) -> tuple[FloatArray, FloatArray, FloatArray, int, int, NDArray[np.uint64], FloatArray]:
-    """(t, q, p, steps, force_evaluations, newton, work): the cumulative Newton iterations and
-    work of the forces at each saved state; on failure the exception carries
-    ``_varmech_partial``."""
+) -> TrajectoryRecord:
+    """The saved states; on failure the exception carries ``_varmech_partial``, the
+    TrajectoryRecord up to the failure."""
 
-def energy(model: Model, t: FloatArray, q: FloatArray, p: FloatArray) -> FloatArray:
+def energy(model: _Model, t: _FloatArray, q: _FloatArray, p: _FloatArray) -> _FloatArray:
     """The energy function p·q̇ − L at each state."""
 
-def derivative(model: Model, what: str, t: FloatArray, q: FloatArray, x: FloatArray) -> FloatArray:
+def derivative(model: _Model, what: str, t: _FloatArray, q: _FloatArray, x: _FloatArray) -> _FloatArray:
     """At each state: ``"momentum"`` p = ∂L/∂q̇(q, x, t), ``"velocity"`` the q̇ with
     ∂L/∂q̇ = x, or ``"dl_dq"`` ∂L/∂q(q, x, t)."""
 
-def momentum(generator: GeneratorSpec, q: FloatArray, p: FloatArray) -> FloatArray: ...
-def energy_statistics(t: FloatArray, h: FloatArray) -> dict[str, Any]: ...
-def invariant_statistics(values: FloatArray) -> tuple[float, float, float]: ...
-def symplecticity_defect(model: Model, method: str, q: FloatArray, p: FloatArray, dt: float) -> float: ...
-def methods() -> list[dict[str, Any]]: ...
+def momentum(generator: Generator, q: _FloatArray, p: _FloatArray) -> _FloatArray: ...
+def energy_statistics(t: _FloatArray, h: _FloatArray) -> dict[str, Any]: ...
+def invariant_statistics(values: _FloatArray) -> tuple[float, float, float]: ...
+def symplecticity_defect(model: _Model, method: str, q: _FloatArray, p: _FloatArray, dt: float) -> float: ...
+def methods() -> list[MethodInfo]: ...
 def scene(
     name: str,
     *,
@@ -187,5 +317,6 @@ def scene(
     gamma: float = 0.5,
     amplitude: float = 1.5,
     drive: float = 2.0 / 3.0,
-) -> tuple[NativeModel, FloatArray, FloatArray, float, tuple[float, FloatArray, FloatArray, str] | None]: ...
+    links: int = 8,
+) -> tuple[NativeModel, _FloatArray, _FloatArray, float, tuple[float, _FloatArray, _FloatArray, str] | None]: ...
 def nbody(g: float, masses: Sequence[float]) -> NativeModel: ...

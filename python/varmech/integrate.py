@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any, Union
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -183,7 +183,7 @@ def integrate(
         raise TypeError(f"model: expected a varmech model or scene, got {type(model).__name__}")
     n = model.dim
     if method is None:
-        method = getattr(model._core, "default_method", None) or ("verlet" if model.separable else "midpoint")
+        method = _core.kind_of(model._core).default_method
     dt = positive("dt", dt)
     t0 = float(t0)
     if not math.isfinite(t0):
@@ -206,7 +206,7 @@ def integrate(
     else:
         raise ValueError("p0, v0: give exactly one of the initial momenta p0 and velocities v0")
     try:
-        t, qs, ps, done, nfev, newton, work = _core.integrate(
+        record = _core.integrate(
             model._core,
             q,
             p,
@@ -221,14 +221,18 @@ def integrate(
             newton_max_iterations=int(newton_max_iterations),
         )
     except BaseException as err:
-        raw = getattr(err, "_varmech_partial", None)
-        if raw is not None:
-            t, qs, ps, done, nfev, newton, work = raw
-            del err._varmech_partial  # type: ignore[attr-defined]
-            partial = Trajectory(t, qs, ps, model, method, dt, done, nfev, newton, work, status=-1, message=str(err))
-            err.partial = partial  # type: ignore[attr-defined]
+        partial = getattr(err, "_varmech_partial", None)
+        if partial is not None:
+            del err._varmech_partial
+            err.partial = _trajectory(partial, model, method, dt, status=-1, message=str(err))
         raise
-    return Trajectory(t, qs, ps, model, method, dt, done, nfev, newton, work)
+    return _trajectory(record, model, method, dt)
+
+
+def _trajectory(record: _core.TrajectoryRecord, model: Model, method: str, dt: float, **status: Any) -> Trajectory:
+    """The Trajectory of the binding's record of a run."""
+    r = record
+    return Trajectory(r.t, r.q, r.p, model, method, dt, r.steps, r.force_evaluations, r.newton, r.work, **status)
 
 
 def symplecticity_defect(model: Model, method: str, q: ArrayLike, p: ArrayLike, dt: float) -> float:

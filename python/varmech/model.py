@@ -28,8 +28,8 @@ class Translation:
     def name(self) -> str:
         return f"P_{_AXES[self.axis]}" if self.axis < 3 else f"P_{self.axis}"
 
-    def spec(self) -> tuple[str, int, int]:
-        return ("translation", self.axis, self.spatial_dim)
+    def spec(self) -> _core.Generator:
+        return _core.Generator.Translation(self.axis, self.spatial_dim)
 
 
 @dataclass(frozen=True)
@@ -44,8 +44,8 @@ class Rotation:
     def name(self) -> str:
         return "L" if self.spatial_dim == 2 else f"L_{_AXES[self.axis]}"
 
-    def spec(self) -> tuple[str, int, int]:
-        return ("rotation", self.axis, self.spatial_dim)
+    def spec(self) -> _core.Generator:
+        return _core.Generator.Rotation(self.axis, self.spatial_dim)
 
 
 @dataclass(frozen=True)
@@ -58,8 +58,8 @@ class Cyclic:
     def name(self) -> str:
         return f"p[{self.index}]"
 
-    def spec(self) -> tuple[str, int, int]:
-        return ("cyclic", self.index, 0)
+    def spec(self) -> _core.Generator:
+        return _core.Generator.Cyclic(self.index)
 
 
 Symmetry = Translation | Rotation | Cyclic
@@ -67,7 +67,7 @@ Symmetry = Translation | Rotation | Cyclic
 Generator = Symmetry | Callable[[np.ndarray], ArrayLike]
 
 
-def _specs(symmetries: Sequence[Symmetry]) -> list[tuple[str, int, int]]:
+def _specs(symmetries: Sequence[Symmetry]) -> list[_core.Generator]:
     """The specs the binding checks (it knows which generators apply to how many coordinates)."""
     for s in symmetries:
         if not isinstance(s, (Translation, Rotation, Cyclic)):
@@ -75,13 +75,15 @@ def _specs(symmetries: Sequence[Symmetry]) -> list[tuple[str, int, int]]:
     return [s.spec() for s in symmetries]
 
 
-def _symmetry_from_spec(kind: str, a: int, d: int) -> Symmetry:
-    makers: dict[str, Callable[[], Symmetry]] = {
-        "translation": lambda: Translation(a, d),
-        "rotation": lambda: Rotation(a, d),
-        "cyclic": lambda: Cyclic(a),
-    }
-    return makers[kind]()
+def _symmetry_from_spec(g: _core.Generator) -> Symmetry:
+    match g:
+        case _core.Generator.Translation(axis, spatial_dim):
+            return Translation(axis, spatial_dim)
+        case _core.Generator.Rotation(axis, spatial_dim):
+            return Rotation(axis, spatial_dim)
+        case _core.Generator.Cyclic(index):
+            return Cyclic(index)
+    raise TypeError(f"symmetries: expected a generator, got {g!r}")
 
 
 class Model:
@@ -111,17 +113,17 @@ class Model:
     @property
     def separable(self) -> bool:
         """Whether L = ½q̇ᵀMq̇ − V(q) with constant M (then explicit methods apply)."""
-        return self._core.separable
+        return _core.kind_of(self._core).separable
 
     @property
     def time_dependent(self) -> bool:
         """Whether L depends on t explicitly (then its energy function is not conserved)."""
-        return self._core.time_dependent
+        return _core.is_time_dependent(self._core)
 
     @property
     def forced(self) -> bool:
         """Whether non-conservative forces act (then the energy changes by their work)."""
-        return self._core.forced
+        return _core.is_forced(self._core)
 
     @property
     def constraints(self) -> int:
@@ -156,7 +158,7 @@ class NativeSystem(Model):
     def __init__(self, core: _core.NativeModel):
         self._core = core
         self.name = core.name
-        self.symmetries = tuple(_symmetry_from_spec(k, a, d) for k, a, d, _ in core.symmetries)
+        self.symmetries = tuple(_symmetry_from_spec(g) for g in core.symmetries)
 
 
 class MechanicalSystem(Model):

@@ -1,11 +1,11 @@
 //! Conversion of arguments and results between numpy and the core.
 
-use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2, PyUntypedArrayMethods};
+use numpy::{PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2, PyUntypedArrayMethods};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
-use pyo3::types::PyTuple;
-use varmech::integrators::Trajectory;
-use varmech::model::{Generator, Mass};
+use varmech::model::Mass;
+
+use crate::errors::to_pyerr;
 
 /// A contiguous view of a float64 vector argument.
 pub fn slice<'a>(name: &str, a: &'a PyReadonlyArray1<'_, f64>) -> PyResult<&'a [f64]> {
@@ -20,6 +20,25 @@ pub fn rows<'a>(name: &str, a: &'a PyReadonlyArray2<'_, f64>) -> PyResult<(&'a [
         .as_slice()
         .map_err(|_| PyValueError::new_err(format!("{name}: must be a C-contiguous float64 array")))?;
     Ok((s, n))
+}
+
+/// Times, positions and a second quantity per state, as flat rows.
+pub type States<'a> = (&'a [f64], &'a [f64], &'a [f64]);
+
+/// N times `t` and two (N, `dim`) arrays of states `q` and `x`, checked and read.
+pub fn states<'a>(
+    dim: usize,
+    t: &'a PyReadonlyArray1<'_, f64>,
+    q: &'a PyReadonlyArray2<'_, f64>,
+    x: &'a PyReadonlyArray2<'_, f64>,
+) -> PyResult<States<'a>> {
+    let (t, (q, n), (x, m)) = (slice("t", t)?, rows("q", q)?, rows("x", x)?);
+    if n != dim || m != dim || q.len() != x.len() || q.len() != t.len() * dim {
+        return Err(PyValueError::new_err(format!(
+            "t, q: need N times and two (N, {dim}) arrays of states"
+        )));
+    }
+    Ok((t, q, x))
 }
 
 /// The mass matrix from a scalar (0-d), a diagonal (n,) or a full (n, n) float64 array.
@@ -42,63 +61,11 @@ pub fn mass(m: &Bound<'_, PyAny>) -> PyResult<Mass> {
             )))
         }
     };
-    result.map_err(|e| PyValueError::new_err(e.to_string()))
-}
-
-/// A generator from its spec: ("translation", axis, spatial_dim), ("rotation", axis,
-/// spatial_dim) or ("cyclic", index, 0).
-pub fn generator(spec: (String, usize, usize)) -> PyResult<Generator> {
-    let (kind, a, d) = spec;
-    match kind.as_str() {
-        "translation" => Ok(Generator::Translation {
-            axis: a,
-            spatial_dim: d,
-        }),
-        "rotation" => Ok(Generator::Rotation {
-            axis: a,
-            spatial_dim: d,
-        }),
-        "cyclic" => Ok(Generator::Cyclic { index: a }),
-        _ => Err(PyValueError::new_err(format!("generator: unknown kind {kind:?}"))),
-    }
-}
-
-/// Generators from their specs, each checked to apply to `dim` coordinates.
-pub fn generators(specs: Vec<(String, usize, usize)>, dim: usize) -> PyResult<Vec<Generator>> {
-    specs
-        .into_iter()
-        .map(|spec| {
-            let g = generator(spec)?;
-            g.check(dim).map_err(|e| PyValueError::new_err(e.to_string()))?;
-            Ok(g)
-        })
-        .collect()
-}
-
-/// The spec of a generator, as [`generator`] reads it, with its name.
-pub fn generator_spec(g: Generator) -> (&'static str, usize, usize, String) {
-    match g {
-        Generator::Translation { axis, spatial_dim } => ("translation", axis, spatial_dim, g.name()),
-        Generator::Rotation { axis, spatial_dim } => ("rotation", axis, spatial_dim, g.name()),
-        Generator::Cyclic { index } => ("cyclic", index, 0, g.name()),
-    }
+    result.map_err(|e| to_pyerr(m.py(), e))
 }
 
 /// A row-major buffer of N rows as an (N, n) array.
-pub fn matrix<'py>(py: Python<'py>, data: Vec<f64>, n: usize) -> PyResult<Bound<'py, PyAny>> {
+pub fn matrix(py: Python<'_>, data: Vec<f64>, n: usize) -> PyResult<Bound<'_, PyArray2<f64>>> {
     let rows = data.len().checked_div(n).unwrap_or(0);
-    Ok(PyArray1::from_vec(py, data).reshape([rows, n])?.into_any())
-}
-
-/// (t, q, p, steps, force_evaluations, newton, work) of a trajectory: `newton` the cumulative
-/// Newton iterations and `work` the cumulative work of non-conservative forces at each saved
-/// state.
-pub fn trajectory_tuple(py: Python<'_>, traj: Trajectory) -> PyResult<Bound<'_, PyTuple>> {
-    let n = traj.dim;
-    let t = PyArray1::from_vec(py, traj.t).into_any();
-    let q = matrix(py, traj.q, n)?;
-    let p = matrix(py, traj.p, n)?;
-    let newton = PyArray1::from_vec(py, traj.newton).into_any();
-    let work = PyArray1::from_vec(py, traj.work).into_any();
-    (t, q, p, traj.steps, traj.force_evaluations, newton, work).into_pyobject(py)
+    PyArray1::from_vec(py, data).reshape([rows, n])
 }

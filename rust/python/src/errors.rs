@@ -1,11 +1,12 @@
-//! Core errors as Python exceptions, with the partial trajectory attached.
+//! Core errors as Python exceptions: the message is the core's `Display`, the data its fields,
+//! and a failed run carries its partial trajectory.
 
 use pyo3::exceptions::{PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 use varmech::integrators::Failure;
-use varmech::Error;
+use varmech::{Error, ModelError};
 
-use crate::convert::trajectory_tuple;
+use crate::trajectory::TrajectoryRecord;
 
 pyo3::create_exception!(_core, VarmechError, PyRuntimeError, "Base class of varmech's errors.");
 pyo3::create_exception!(
@@ -28,67 +29,85 @@ pyo3::create_exception!(
     "The solution blew up: a non-finite state, or an energy error beyond max_energy_error."
 );
 
-/// The Python exception for a core error: ValueError naming the argument, DivergenceError,
-/// or the model's own exception (a closure's, or KeyboardInterrupt) unchanged.
+/// The exceptions, for the module.
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    let py = m.py();
+    m.add("VarmechError", py.get_type::<VarmechError>())?;
+    m.add("DivergenceError", py.get_type::<DivergenceError>())?;
+    m.add("ConvergenceError", py.get_type::<ConvergenceError>())?;
+    m.add("SpuriousBranchError", py.get_type::<SpuriousBranchError>())?;
+    Ok(())
+}
+
+/// A Python error as the core's model error, which carries it unchanged.
+pub fn boxed(e: PyErr) -> ModelError {
+    Box::new(e)
+}
+
+/// A model's error as the Python exception it stands for (a closure's own, or a ValueError).
+pub fn model_error(e: ModelError) -> PyErr {
+    match e.downcast::<PyErr>() {
+        Ok(err) => *err,
+        Err(e) => PyValueError::new_err(e.to_string()),
+    }
+}
+
+/// The Python exception for a core error, with the core's message: ValueError (which names the
+/// argument), DivergenceError, ConvergenceError (with `residual` and `iterations`),
+/// SpuriousBranchError, or the model's own exception (a closure's, or KeyboardInterrupt)
+/// unchanged; all but the ValueError carry the `step` and `time` where they happened.
 pub fn to_pyerr(py: Python<'_>, error: Error) -> PyErr {
-    match error {
-        Error::InvalidArgument { argument, reason } => PyValueError::new_err(format!("{argument}: {reason}")),
-        Error::Divergence { step, time, ref reason } => {
-            let err = DivergenceError::new_err(format!("diverged at step {step} (t = {time}): {reason}"));
-            let value = err.value(py);
-            // Attributes of our own exception class: setting them cannot fail.
-            let _ = value.setattr("step", step).and(value.setattr("time", time));
-            err
-        }
+    let (exception, step, time) = match error {
+        Error::InvalidArgument { .. } => return PyValueError::new_err(error.to_string()),
+        Error::Divergence { step, time, .. } => (DivergenceError::new_err(error.to_string()), step, time),
         Error::Convergence {
             step,
             time,
             residual,
             iterations,
-            reason,
+            ..
         } => {
-            let err = ConvergenceError::new_err(format!(
-                "{reason} at step {step} (t = {time}): residual {residual:.3e} after {iterations} iterations; a smaller step usually helps"
-            ));
+            let err = ConvergenceError::new_err(error.to_string());
             let value = err.value(py);
+            // Attributes of our own exception class: setting them cannot fail.
             let _ = value
-                .setattr("step", step)
-                .and(value.setattr("time", time))
-                .and(value.setattr("residual", residual))
+                .setattr("residual", residual)
                 .and(value.setattr("iterations", iterations));
-            err
+            (err, step, time)
         }
-        Error::SpuriousBranch { step, time, reason } => {
-            let err = SpuriousBranchError::new_err(format!(
-                "spurious branch at step {step} (t = {time}): {reason}; take a smaller step"
-            ));
-            let value = err.value(py);
-            let _ = value.setattr("step", step).and(value.setattr("time", time));
-            err
+        Error::SpuriousBranch { step, time, .. } => (SpuriousBranchError::new_err(error.to_string()), step, time),
+        Error::Model { step, time, source } => {
+            (raised(source, |source| Error::Model { step, time, source }), step, time)
         }
-        Error::Model { step, time, source } | Error::Interrupted { step, time, source } => {
-            match source.downcast::<PyErr>() {
-                Ok(original) => {
-                    let err = *original;
-                    // Exceptions without a __dict__ keep their type and simply lack the attributes.
-                    let value = err.value(py);
-                    let _ = value.setattr("step", step).and(value.setattr("time", time));
-                    err
-                }
-                Err(other) => VarmechError::new_err(format!("model failed at step {step} (t = {time}): {other}")),
-            }
-        }
+        Error::Interrupted { step, time, source } => (
+            raised(source, |source| Error::Interrupted { step, time, source }),
+            step,
+            time,
+        ),
+    };
+    // Exceptions without a __dict__ keep their type and simply lack the attributes.
+    let value = exception.value(py);
+    let _ = value.setattr("step", step).and(value.setattr("time", time));
+    exception
+}
+
+/// The Python exception a model raised, or a VarmechError with the core's message for `error`
+/// (rebuilt around `source`) when the model's error did not come from Python.
+fn raised(source: ModelError, error: impl FnOnce(ModelError) -> Error) -> PyErr {
+    match source.downcast::<PyErr>() {
+        Ok(original) => *original,
+        Err(other) => VarmechError::new_err(error(other).to_string()),
     }
 }
 
-/// The Python exception for a failed run, carrying `_varmech_partial`, the raw partial
-/// trajectory that the Python layer turns into `err.partial`.
+/// The Python exception for a failed run, carrying `_varmech_partial`, the partial
+/// [`TrajectoryRecord`] that the Python layer turns into `err.partial`.
 pub fn failure_to_pyerr(py: Python<'_>, failure: Failure) -> PyErr {
     let Failure { error, partial } = failure;
     let invalid = matches!(error, Error::InvalidArgument { .. });
     let err = to_pyerr(py, error);
     if !invalid {
-        if let Ok(partial) = trajectory_tuple(py, partial) {
+        if let Ok(partial) = TrajectoryRecord::new(py, partial).and_then(|r| Bound::new(py, r)) {
             let _ = err.value(py).setattr("_varmech_partial", partial);
         }
     }

@@ -1,29 +1,39 @@
 //! `varmech._core`: the thin pyo3 binding of the varmech core.
 //!
-//! Argument conversion ([`convert`]), the adapter that lets Python closures implement the core's
-//! model trait ([`model`]), and the mapping of core errors to Python exceptions ([`errors`]).
-//! The Python API in `python/varmech` is built on these functions; `_core.pyi` documents them.
+//! Its remit is conversion, adapters and errors only — no physics, no policy: arguments and
+//! results are converted between numpy and the core ([`convert`], [`trajectory`],
+//! [`generator`]); Python closures are adapted to the core's model traits ([`closure`]), native
+//! scenes wrapped ([`native`], [`scenes`]), and every model resolved to the core by the one
+//! dispatch [`bind::bind_model`]; core errors become Python exceptions with the core's messages
+//! ([`errors`]). The one piece of policy, which method a kind of model takes by default, sits in
+//! [`bind::kind_of`]. The Python API in `python/varmech` is built on these functions;
+//! `_core.pyi` documents them.
 
+mod bind;
+mod closure;
+mod constraints;
 mod convert;
+mod diagnostics;
 mod errors;
-mod functions;
-mod model;
+mod generator;
+mod native;
+mod routh;
+mod run;
+mod scenes;
+mod trajectory;
 
 use pyo3::prelude::*;
 
 #[pymodule]
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
-    let py = m.py();
-    m.add("VarmechError", py.get_type::<errors::VarmechError>())?;
-    m.add("DivergenceError", py.get_type::<errors::DivergenceError>())?;
-    m.add("ConvergenceError", py.get_type::<errors::ConvergenceError>())?;
-    m.add("SpuriousBranchError", py.get_type::<errors::SpuriousBranchError>())?;
-    m.add_class::<model::NativeModel>()?;
-    m.add_class::<model::ClosureModel>()?;
-    m.add_class::<model::ClosureLagrangian>()?;
-    m.add_class::<model::ClosureNatural>()?;
-    m.add_class::<model::ClosureConstrained>()?;
-    m.add_class::<model::RouthModel>()?;
-    functions::register(m)?;
+    errors::register(m)?;
+    m.add_class::<generator::Generator>()?;
+    bind::register(m)?;
+    closure::register(m)?;
+    scenes::register(m)?;
+    routh::register(m)?;
+    run::register(m)?;
+    diagnostics::register(m)?;
+    constraints::register(m)?;
     Ok(())
 }

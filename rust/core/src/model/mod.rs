@@ -27,6 +27,6 @@ pub use constraints::{
 pub use lagrangian::{Hessians, Lagrangian};
 pub use mass::Mass;
 pub use mechanical::MechanicalSystem;
-pub use natural::{differenced_kinetic_gradient, Natural, NaturalSystem};
+pub use natural::{differenced_kinetic_gradient, kinetic_gradient_from_mass_derivative, Natural, NaturalSystem};
 pub use routh::Routhian;
 pub use symmetry::Generator;

@@ -53,6 +53,19 @@ pub fn differenced_kinetic_gradient<S: NaturalSystem + ?Sized>(
     )
 }
 
+/// ∂T/∂q from the derivatives of the mass matrix: (∂T/∂q)ᵢ = ½q̇ᵀ(∂M/∂qᵢ)q̇, with
+/// `mass_derivative` holding ∂M/∂qᵢ for i = 0..n, each n × n, stacked in C order (i first).
+pub fn kinetic_gradient_from_mass_derivative(mass_derivative: &[f64], v: &[f64], out: &mut [f64]) {
+    let n = v.len();
+    for (o, d) in out.iter_mut().zip(mass_derivative.chunks_exact(n * n)) {
+        *o = 0.5
+            * d.chunks_exact(n)
+                .zip(v)
+                .map(|(row, vj)| vj * row.iter().zip(v).map(|(a, vk)| a * vk).sum::<f64>())
+                .sum::<f64>();
+    }
+}
+
 /// The [`Lagrangian`] of a [`NaturalSystem`], with scratch for M(q). The scratch sits in
 /// `RefCell`s, so a `Natural` serves one thread (the Python closures' adapter is one).
 #[derive(Debug)]

@@ -1,0 +1,67 @@
+//! Holonomic constraints seen from Python: residuals of saved states, and projection of an
+//! initial state onto the constraints.
+
+use numpy::{PyArray1, PyReadonlyArray1, PyReadonlyArray2};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use varmech::ModelError;
+
+use crate::bind::{bind_model, dim_of};
+use crate::convert::{rows, slice};
+use crate::errors::{model_error, to_pyerr};
+
+/// Two arrays, as the constraint functions return them.
+type ArrayPair<'py> = (Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>);
+
+fn unconstrained() -> PyErr {
+    PyValueError::new_err("model: has no holonomic constraints")
+}
+
+/// (|g(q)|∞, |G(q)M⁻¹p|∞) at each state of a constrained model.
+#[pyfunction]
+fn constraint_residuals<'py>(
+    py: Python<'py>,
+    model: &Bound<'py, PyAny>,
+    q: PyReadonlyArray2<'py, f64>,
+    p: PyReadonlyArray2<'py, f64>,
+) -> PyResult<ArrayPair<'py>> {
+    let n = dim_of(py, model)?;
+    let ((q, nq), (p, np)) = (rows("q", &q)?, rows("p", &p)?);
+    if nq != n || np != n || q.len() != p.len() {
+        return Err(PyValueError::new_err(format!(
+            "q, p: need two (N, {n}) arrays of states"
+        )));
+    }
+    let result: Option<Result<Vec<(f64, f64)>, ModelError>> = bind_model(py, model, |sys, _poll| {
+        q.chunks_exact(n)
+            .zip(p.chunks_exact(n))
+            .map(|(q, p)| sys.constraint_residuals(q, p))
+            .collect()
+    })?;
+    let (position, velocity) = result
+        .ok_or_else(unconstrained)?
+        .map_err(model_error)?
+        .into_iter()
+        .unzip();
+    Ok((PyArray1::from_vec(py, position), PyArray1::from_vec(py, velocity)))
+}
+
+/// The nearest consistent state (q on the constraints, p on the hidden constraint).
+#[pyfunction]
+fn project<'py>(
+    py: Python<'py>,
+    model: &Bound<'py, PyAny>,
+    q0: PyReadonlyArray1<'py, f64>,
+    p0: PyReadonlyArray1<'py, f64>,
+) -> PyResult<ArrayPair<'py>> {
+    let (q0, p0) = (slice("q0", &q0)?, slice("p0", &p0)?);
+    let result = bind_model(py, model, |sys, _poll| sys.project(q0, p0))?;
+    let (q, p) = result.ok_or_else(unconstrained)?.map_err(|e| to_pyerr(py, e))?;
+    Ok((PyArray1::from_vec(py, q), PyArray1::from_vec(py, p)))
+}
+
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(constraint_residuals, m)?)?;
+    m.add_function(wrap_pyfunction!(project, m)?)?;
+    Ok(())
+}

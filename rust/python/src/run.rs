@@ -1,0 +1,139 @@
+//! Running the integrators: `integrate`, one step's symplecticity defect, and the catalogue of
+//! methods.
+
+use numpy::PyReadonlyArray1;
+use pyo3::prelude::*;
+use varmech::diagnostics;
+use varmech::integrators::{self, Method, NewtonOptions, Options};
+
+use crate::bind::bind_model;
+use crate::convert::slice;
+use crate::errors::{failure_to_pyerr, to_pyerr};
+use crate::trajectory::TrajectoryRecord;
+
+/// Integrates; returns the saved states as a [`TrajectoryRecord`] or raises with
+/// `_varmech_partial`, the states up to the failure.
+#[pyfunction]
+#[pyo3(signature = (model, q0, p0, *, dt, steps, method, save_every=1, compensated=true, max_energy_error=None, t0=0.0, newton_tolerance=1e-14, newton_max_iterations=50))]
+#[allow(clippy::too_many_arguments)]
+fn integrate<'py>(
+    py: Python<'py>,
+    model: &Bound<'py, PyAny>,
+    q0: PyReadonlyArray1<'py, f64>,
+    p0: PyReadonlyArray1<'py, f64>,
+    dt: f64,
+    steps: usize,
+    method: &str,
+    save_every: usize,
+    compensated: bool,
+    max_energy_error: Option<f64>,
+    t0: f64,
+    newton_tolerance: f64,
+    newton_max_iterations: usize,
+) -> PyResult<TrajectoryRecord> {
+    let method = Method::from_name(method).map_err(|e| to_pyerr(py, e))?;
+    let newton = NewtonOptions {
+        tolerance: newton_tolerance,
+        max_iterations: newton_max_iterations,
+    };
+    let options = Options {
+        dt,
+        steps,
+        save_every,
+        compensated,
+        max_energy_error,
+        t0,
+        newton,
+    };
+    let (q0, p0) = (slice("q0", &q0)?, slice("p0", &p0)?);
+    let result = bind_model(py, model, |sys, poll| {
+        integrators::integrate(sys, method, q0, p0, &options, poll)
+    })?;
+    match result {
+        Ok(traj) => TrajectoryRecord::new(py, traj),
+        Err(failure) => Err(failure_to_pyerr(py, *failure)),
+    }
+}
+
+/// ‖ΨᵀJΨ − J‖_F of one step.
+#[pyfunction]
+fn symplecticity_defect<'py>(
+    py: Python<'py>,
+    model: &Bound<'py, PyAny>,
+    method: &str,
+    q: PyReadonlyArray1<'py, f64>,
+    p: PyReadonlyArray1<'py, f64>,
+    dt: f64,
+) -> PyResult<f64> {
+    let method = Method::from_name(method).map_err(|e| to_pyerr(py, e))?;
+    let (q, p) = (slice("q", &q)?, slice("p", &p)?);
+    bind_model(py, model, |sys, _poll| {
+        diagnostics::symplecticity_defect(sys, method, q, p, dt)
+    })?
+    .map_err(|e| to_pyerr(py, e))
+}
+
+/// Facts about one fixed-step method.
+///
+/// ``h_omega_max`` is the linear stability limit: the method is stable on q'' = -ω²q exactly
+/// when hω < h_omega_max (0 for explicit Euler, which is never stable).
+/// ``force_evaluations`` counts gradient evaluations per step, first-same-as-last reused (0 for
+/// the implicit methods, whose cost depends on their Newton iterations). ``implicit`` methods
+/// solve each step by Newton's method; ``constrained`` ones (RATTLE, SHAKE) integrate systems
+/// on holonomic constraints, and only those.
+#[pyclass(frozen, get_all, module = "varmech._core")]
+pub struct MethodInfo {
+    name: &'static str,
+    order: u32,
+    stages: usize,
+    force_evaluations: usize,
+    implicit: bool,
+    constrained: bool,
+    symplectic: bool,
+    symmetric: bool,
+    h_omega_max: f64,
+    reference: &'static str,
+}
+
+impl From<integrators::MethodInfo> for MethodInfo {
+    fn from(i: integrators::MethodInfo) -> Self {
+        MethodInfo {
+            name: i.name,
+            order: i.order,
+            stages: i.stages,
+            force_evaluations: i.force_evaluations,
+            implicit: i.implicit,
+            constrained: i.constrained,
+            symplectic: i.symplectic,
+            symmetric: i.symmetric,
+            h_omega_max: i.h_omega_max,
+            reference: i.reference,
+        }
+    }
+}
+
+#[pymethods]
+impl MethodInfo {
+    fn __repr__(&self) -> String {
+        format!("MethodInfo(name={:?}, order={})", self.name, self.order)
+    }
+}
+
+/// Every method's facts, the unconstrained ones first, each from the simplest.
+#[pyfunction]
+fn methods() -> Vec<MethodInfo> {
+    Method::ALL
+        .iter()
+        .chain(&Method::CONSTRAINED)
+        .map(|m| m.info().into())
+        .collect()
+}
+
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<TrajectoryRecord>()?;
+    m.add_class::<MethodInfo>()?;
+    m.add_function(wrap_pyfunction!(integrate, m)?)?;
+    m.add_function(wrap_pyfunction!(symplecticity_defect, m)?)?;
+    m.add_function(wrap_pyfunction!(methods, m)?)?;
+    Ok(())
+}
