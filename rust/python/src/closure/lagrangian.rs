@@ -122,18 +122,14 @@ impl Lagrangian for ClosureLagrangianSystem<'_, '_> {
     fn dl_dq(&self, q: &[f64], v: &[f64], t: f64, out: &mut [f64]) -> Result<(), ModelError> {
         match &self.dl_dq {
             Some(f) => call_vector(f.call1(self.args(q, v, t)), "dl_dq(q, v, t)", out),
-            None => {
-                central_gradient(|x| self.lagrangian(x, v, t), q, &mut self.work.borrow_mut(), out)
-            }
+            None => central_gradient(|x| self.lagrangian(x, v, t), q, &mut self.work.borrow_mut(), out),
         }
     }
 
     fn dl_dv(&self, q: &[f64], v: &[f64], t: f64, out: &mut [f64]) -> Result<(), ModelError> {
         match &self.dl_dv {
             Some(f) => call_vector(f.call1(self.args(q, v, t)), "dl_dv(q, v, t)", out),
-            None => {
-                central_gradient(|x| self.lagrangian(q, x, t), v, &mut self.work.borrow_mut(), out)
-            }
+            None => central_gradient(|x| self.lagrangian(q, x, t), v, &mut self.work.borrow_mut(), out),
         }
     }
 
