@@ -223,8 +223,8 @@ def integrate(
     except BaseException as err:
         partial = getattr(err, "_varmech_partial", None)
         if partial is not None:
-            del err._varmech_partial
-            err.partial = _trajectory(partial, model, method, dt, status=-1, message=str(err))
+            delattr(err, "_varmech_partial")
+            err.partial = _trajectory(partial, model, method, dt, status=-1, message=str(err))  # type: ignore[attr-defined]
         raise
     return _trajectory(record, model, method, dt)
 

@@ -7,6 +7,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -44,7 +45,7 @@ class Scene:
     reference: Reference | None = None
 
 
-def _scene(name: str, description: str, dt: float, invariants: dict[str, float], **params: float) -> Scene:
+def _scene(name: str, description: str, dt: float, invariants: dict[str, float], **params: Any) -> Scene:
     core, q0, p0, t_end, ref = _core.scene(name, **params)
     reference = Reference(*ref) if ref is not None else None
     return Scene(name, description, NativeSystem(core), q0, p0, t_end, dt, invariants, reference)
