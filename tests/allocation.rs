@@ -4,7 +4,7 @@
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
 
-use varmech::integrators::{integrate, General, Integrable, Method, Options};
+use varmech::integrators::{integrate, Dynamics, General, Method, Options};
 use varmech::model::Routhian;
 use varmech::scenes::{self, NBody};
 
@@ -34,7 +34,7 @@ unsafe impl GlobalAlloc for Counting {
 static GLOBAL: Counting = Counting;
 
 /// Allocations made by one run of `method` on `sys` from (q0, p0).
-fn counted<S: Integrable>(sys: &S, method: Method, q0: &[f64], p0: &[f64], options: &Options) -> usize {
+fn counted<S: Dynamics>(sys: &S, method: Method, q0: &[f64], p0: &[f64], options: &Options) -> usize {
     let before = allocated();
     let traj = integrate(sys, method, q0, p0, options, || Ok(())).unwrap();
     let count = allocated() - before;

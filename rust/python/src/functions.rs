@@ -6,7 +6,7 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
 use varmech::diagnostics::{self, EnergyStatistics, InvariantStatistics};
 use varmech::discrete::{DiscreteLagrangian, Midpoint, Trapezoidal};
-use varmech::integrators::{self, General, Integrable, Method, NewtonOptions, Options};
+use varmech::integrators::{self, Dynamics, General, Method, NewtonOptions, Options};
 use varmech::model::{Constrained, Natural, Routhian};
 use varmech::scenes::{self, LagrangianScene, LinkedMasses, Problem, Scene};
 use varmech::ModelError;
@@ -49,7 +49,7 @@ fn model_type_error(model: &Bound<'_, PyAny>) -> PyErr {
     ))
 }
 
-/// Runs `body` with `sys` bound to the model as an [`Integrable`], and `poll` to the Ctrl-C
+/// Runs `body` with `sys` bound to the model as an [`Dynamics`], and `poll` to the Ctrl-C
 /// check: native models with the GIL released (the poll takes it back briefly), closure models
 /// with it held. A Routh-reduced model is the Routhian of its full model, built in place.
 macro_rules! with_system {
@@ -255,7 +255,7 @@ fn project<'py>(
     p0: PyReadonlyArray1<'py, f64>,
 ) -> PyResult<ArrayPair<'py>> {
     let (q0, p0) = (slice("q0", &q0)?, slice("p0", &p0)?);
-    let result = with_system!(py, model, |sys, _poll| Integrable::project(sys, q0, p0));
+    let result = with_system!(py, model, |sys, _poll| Dynamics::project(sys, q0, p0));
     let (q, p) = result.ok_or_else(unconstrained)?.map_err(|e| to_pyerr(py, e))?;
     Ok((PyArray1::from_vec(py, q), PyArray1::from_vec(py, p)))
 }
