@@ -9,7 +9,7 @@ pub struct StepStart<'a> {
     pub p: &'a [f64],
 }
 
-/// The increments (δq, δp) of one step, so that (q₁, p₁) = (q₀ + δq, p₀ + δp); the driver adds
+/// The increments (δq, δp) of one step, so that (q₁, p₁) = (q₀ + δq, p₀ + δp); the stepper adds
 /// them with compensated summation.
 #[derive(Debug)]
 pub struct Increment<'a> {

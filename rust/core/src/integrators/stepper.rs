@@ -61,6 +61,7 @@ where
             ));
         }
         model.check_initial(q0, p0)?;
+        let zeros = || vec![0.0; n];
         Ok(Stepper {
             integrator: Integrator::with_newton(method, n, options.newton),
             model,
@@ -70,14 +71,14 @@ where
             compensated: options.compensated,
             q: q0.to_vec(),
             p: p0.to_vec(),
-            eq: vec![0.0; n],
-            ep: vec![0.0; n],
-            dq: vec![0.0; n],
-            dp: vec![0.0; n],
-            q_next: vec![0.0; n],
-            p_next: vec![0.0; n],
-            eq_next: vec![0.0; n],
-            ep_next: vec![0.0; n],
+            eq: zeros(),
+            ep: zeros(),
+            dq: zeros(),
+            dp: zeros(),
+            q_next: zeros(),
+            p_next: zeros(),
+            eq_next: zeros(),
+            ep_next: zeros(),
             interrupt: InterruptPoll::new(),
         })
     }
