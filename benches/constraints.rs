@@ -10,7 +10,7 @@ use criterion::measurement::WallTime;
 use criterion::{criterion_group, criterion_main, BenchmarkGroup, BenchmarkId, Criterion, Throughput};
 use std::hint::black_box;
 use std::time::{Duration, Instant};
-use varmech::integrators::{integrate, Integrable, Method, Options, Trajectory};
+use varmech::integrators::{integrate, Dynamics, Method, Options, Trajectory};
 use varmech::scenes::{self, Pendulum};
 
 /// Links of the chains, and the steps (h = 0.01) of one iteration on each.
@@ -27,7 +27,7 @@ const TARGET_ERROR: f64 = 1e-4;
 const SAMPLES: usize = 30;
 
 /// `steps` steps of `dt` from (q0, p0), keeping only the initial and the final state.
-fn run<S: Integrable + ?Sized>(sys: &S, method: Method, q0: &[f64], p0: &[f64], dt: f64, steps: usize) -> Trajectory {
+fn run<S: Dynamics + ?Sized>(sys: &S, method: Method, q0: &[f64], p0: &[f64], dt: f64, steps: usize) -> Trajectory {
     let options = Options {
         save_every: steps,
         ..Options::new(dt, steps)

@@ -1,10 +1,12 @@
 //! The native step loop allocates nothing: a long run makes exactly as many allocations as a
-//! run of 100 steps (the set-up's), whatever the method, and so does RATTLE's on a chain.
+//! run of 100 steps (the set-up's), whatever the method, and so does RATTLE's on a chain; a
+//! stepper's steps make none at all.
 
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
+use std::ops::Deref;
 
-use varmech::integrators::{integrate, General, Integrable, Method, Options};
+use varmech::integrators::{integrate, Dynamics, General, Method, Options, Stepper};
 use varmech::model::Routhian;
 use varmech::scenes::{self, NBody};
 
@@ -34,7 +36,7 @@ unsafe impl GlobalAlloc for Counting {
 static GLOBAL: Counting = Counting;
 
 /// Allocations made by one run of `method` on `sys` from (q0, p0).
-fn counted<S: Integrable>(sys: &S, method: Method, q0: &[f64], p0: &[f64], options: &Options) -> usize {
+fn counted<S: Dynamics>(sys: &S, method: Method, q0: &[f64], p0: &[f64], options: &Options) -> usize {
     let before = allocated();
     let traj = integrate(sys, method, q0, p0, options, || Ok(())).unwrap();
     let count = allocated() - before;
@@ -139,5 +141,45 @@ fn the_routh_reduced_step_loop_allocates_nothing() {
             short, long,
             "{method:?}: {short} allocations for 100 steps, {long} for 5000"
         );
+    }
+}
+
+/// Allocations made by `steps` steps of `stepper` (one by `step`, the others by `advance`),
+/// after a first step that sizes what a method sizes on first use.
+fn stepper_allocations<M: Deref<Target: Dynamics>>(mut stepper: Stepper<M>, steps: usize) -> usize {
+    stepper.step().unwrap();
+    let before = allocated();
+    stepper.step().unwrap();
+    stepper.advance(steps - 1, || Ok(())).unwrap();
+    let count = allocated() - before;
+    assert_eq!(stepper.steps(), steps + 1);
+    count
+}
+
+#[test]
+fn the_stepper_allocates_nothing() {
+    let problem = NBody::outer_solar_system();
+    let (q0, p0) = (&problem.initial.q, &problem.initial.p);
+    let options = Options::new(10.0, 0);
+    for method in Method::ALL {
+        let stepper = Stepper::new(&problem.system, method, q0, p0, &options).unwrap();
+        let count = stepper_allocations(stepper, 200);
+        assert_eq!(count, 0, "{method:?}: {count} allocations in 200 steps");
+    }
+    // A stepper that owns its model.
+    let stepper = Stepper::new(Box::new(problem.system.clone()), Method::Verlet, q0, p0, &options).unwrap();
+    assert_eq!(stepper_allocations(stepper, 200), 0);
+
+    let chain = scenes::planar_chain(8).unwrap();
+    for method in Method::CONSTRAINED {
+        let mut options = Options::new(0.01, 0);
+        if method == Method::Shake {
+            // As in `constrained_allocations`.
+            options.newton.tolerance = 1e-10;
+            options.newton.max_iterations = 1_000;
+        }
+        let stepper = Stepper::new(&chain.system, method, &chain.initial.q, &chain.initial.p, &options).unwrap();
+        let count = stepper_allocations(stepper, 200);
+        assert_eq!(count, 0, "{method:?}: {count} allocations in 200 steps");
     }
 }

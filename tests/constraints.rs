@@ -39,7 +39,7 @@ fn residuals(sys: &LinkedMasses, traj: &Trajectory) -> (f64, f64) {
 /// The energy errors H − H₀ at the saved states, and their least-squares slope in t.
 fn energy_drift(sys: &LinkedMasses, traj: &Trajectory) -> (f64, f64) {
     let e: Vec<f64> = (0..traj.len())
-        .map(|k| varmech::diagnostics::hamiltonian(&sys.system, traj.q_at(k), traj.p_at(k)).unwrap())
+        .map(|k| varmech::model::hamiltonian(&sys.system, traj.q_at(k), traj.p_at(k)).unwrap())
         .collect();
     let errors: Vec<f64> = e.iter().map(|x| x - e[0]).collect();
     let n = errors.len() as f64;
@@ -143,7 +143,7 @@ fn chains_of_two_to_thirty_two_links_stay_on_their_constraints() {
         let traj = run(&p, Method::Rattle, 0.01, 10_000, 100, None);
         let (position, velocity) = residuals(&p.system, &traj);
         let energies: Vec<f64> = (0..traj.len())
-            .map(|k| varmech::diagnostics::hamiltonian(&p.system.system, traj.q_at(k), traj.p_at(k)).unwrap())
+            .map(|k| varmech::model::hamiltonian(&p.system.system, traj.q_at(k), traj.p_at(k)).unwrap())
             .collect();
         let stats = EnergyStatistics::new(&traj.t, &energies);
         println!(

@@ -11,7 +11,7 @@ use varmech::scenes::NBody;
 #[test]
 fn initial_energy_matches_the_published_value() {
     let problem = NBody::outer_solar_system();
-    let h0 = varmech::diagnostics::hamiltonian(&problem.system, &problem.initial.q, &problem.initial.p).unwrap();
+    let h0 = varmech::model::hamiltonian(&problem.system, &problem.initial.q, &problem.initial.p).unwrap();
     assert!((h0 / -3.215453183208163e-08 - 1.0).abs() < 1e-12, "E0 = {h0:e}");
 }
 

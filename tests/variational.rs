@@ -216,13 +216,13 @@ fn central_differences_reproduce_the_gradient() {
 #[test]
 fn scene_data_match_the_published_invariants() {
     let fpu = FermiPastaUlam::problem();
-    let h = varmech::diagnostics::hamiltonian(&fpu.system, &fpu.initial.q, &fpu.initial.p).unwrap();
+    let h = varmech::model::hamiltonian(&fpu.system, &fpu.initial.q, &fpu.initial.p).unwrap();
     assert!((h - 2.00120008).abs() < 1e-8, "FPU H0 = {h}");
     let i: f64 = (1..=3)
         .map(|j| fpu.system.oscillatory_energy(&fpu.initial.q, &fpu.initial.p, j))
         .sum();
     assert!((i - 1.0).abs() < 1e-8, "FPU I0 = {i}");
     let hh = HenonHeiles::problem();
-    let h = varmech::diagnostics::hamiltonian(&hh.system, &hh.initial.q, &hh.initial.p).unwrap();
+    let h = varmech::model::hamiltonian(&hh.system, &hh.initial.q, &hh.initial.p).unwrap();
     assert!((h - 0.13).abs() < 1e-15, "Hénon–Heiles H0 = {h}");
 }

@@ -1,7 +1,7 @@
 """Stubs of the compiled extension ``varmech._core`` (hand-written; see rust/python/src)."""
 
 from collections.abc import Callable, Sequence
-from typing import Any, ClassVar, final
+from typing import Any, final
 
 import numpy as np
 from numpy.typing import NDArray
@@ -126,16 +126,18 @@ class MethodInfo:
 
 @final
 class ModelKind:
-    """The kind of a model, which decides which methods apply and which one is the default."""
+    """The kind of a model: the core's table decides which methods apply and which is the default."""
 
-    Separable: ClassVar[ModelKind]
-    General: ClassVar[ModelKind]
-    Constrained: ClassVar[ModelKind]
-    ConstrainedGeneral: ClassVar[ModelKind]
+    @property
+    def name(self) -> str: ...
     @property
     def separable(self) -> bool: ...
     @property
     def default_method(self) -> str: ...
+    @property
+    def accurate_method(self) -> str: ...
+    def admits(self, method: str) -> bool:
+        """Whether `method` integrates a model of this kind."""
 
 class VarmechError(RuntimeError):
     """Base class of varmech's errors."""

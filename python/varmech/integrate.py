@@ -183,7 +183,7 @@ def integrate(
         raise TypeError(f"model: expected a varmech model or scene, got {type(model).__name__}")
     n = model.dim
     if method is None:
-        method = _core.kind_of(model._core).default_method
+        method = model.kind.default_method
     dt = positive("dt", dt)
     t0 = float(t0)
     if not math.isfinite(t0):

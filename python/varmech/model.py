@@ -10,6 +10,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from . import _core
+from ._core import ModelKind
 
 _AXES = "xyz"
 
@@ -111,9 +112,15 @@ class Model:
         return self._core.dim
 
     @property
+    def kind(self) -> ModelKind:
+        """The model's kind, which decides which methods apply (``kind.admits(method)``), the
+        default method and the most accurate one."""
+        return _core.kind_of(self._core)
+
+    @property
     def separable(self) -> bool:
         """Whether L = ½q̇ᵀMq̇ − V(q) with constant M (then explicit methods apply)."""
-        return _core.kind_of(self._core).separable
+        return self.kind.separable
 
     @property
     def time_dependent(self) -> bool:

@@ -102,7 +102,7 @@ def _relative(h: np.ndarray, energy: float) -> np.ndarray:
 def _default_method(model: Model, method: str | None) -> str:
     if method is not None:
         return method
-    return "kahan_li6" if model.separable else "galerkin6"
+    return model.kind.accurate_method
 
 
 def _solve_momentum(model: Model, q: np.ndarray, p: np.ndarray, k: int, energy: float, direction: int) -> tuple[np.ndarray, np.ndarray]:

@@ -101,3 +101,62 @@ pub(crate) fn check_vector(argument: &'static str, x: &[f64], n: usize) -> Resul
     }
     Ok(())
 }
+
+/// Why a step failed.
+#[derive(Debug)]
+pub enum StepError {
+    /// The model failed while it was evaluated.
+    Model(ModelError),
+    /// Newton's method did not solve the step's implicit equations.
+    Convergence {
+        residual: f64,
+        iterations: usize,
+        reason: &'static str,
+    },
+    /// The step's equations became non-finite: the solution is blowing up.
+    NonFinite { reason: &'static str },
+    /// Newton's method converged to a solution the step cannot vouch for.
+    SpuriousBranch { reason: &'static str },
+    /// The method does not integrate this kind of model ([`crate::integrators::ModelKind`]'s refusal); runs refuse
+    /// it before the first step.
+    Method(Error),
+}
+
+impl StepError {
+    /// The error of the run that failed at `step`, which started at `time`.
+    pub fn at(self, step: usize, time: f64) -> Error {
+        match self {
+            StepError::Model(source) => Error::Model { step, time, source },
+            StepError::Convergence {
+                residual,
+                iterations,
+                reason,
+            } => Error::Convergence {
+                step,
+                time,
+                residual,
+                iterations,
+                reason,
+            },
+            StepError::NonFinite { reason } => Error::Divergence {
+                step,
+                time,
+                reason: reason.to_string(),
+            },
+            StepError::SpuriousBranch { reason } => Error::SpuriousBranch { step, time, reason },
+            StepError::Method(error) => error,
+        }
+    }
+}
+
+impl From<ModelError> for StepError {
+    fn from(e: ModelError) -> Self {
+        StepError::Model(e)
+    }
+}
+
+impl From<Error> for StepError {
+    fn from(e: Error) -> Self {
+        StepError::Method(e)
+    }
+}

@@ -1,32 +1,30 @@
 //! The one dispatch from a Python model object to the core: [`bind_model`] resolves it to an
-//! [`Integrable`] and runs a body with it; and [`kind_of`], the one place for the policy that
-//! depends on the kind of model.
+//! [`Dynamics`] and runs a body with it; [`kind_of`] shows the core's [`ModelKind`] of a model.
 
 use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
-use varmech::integrators::{General, Integrable};
+use varmech::integrators::{Dynamics, General, Method, ModelKind};
 use varmech::model::Natural;
 use varmech::ModelError;
 
-use crate::closure::constraints::ConstrainedSystem;
 use crate::closure::{
     ClosureConstrained, ClosureLagrangian, ClosureLagrangianSystem, ClosureModel, ClosureNatural, ClosureNaturalSystem,
     ClosureSystem,
 };
-use crate::errors::boxed;
-use crate::native::{Native, NativeModel};
+use crate::errors::{boxed, to_pyerr};
+use crate::native::NativeModel;
 use crate::routh::RouthModel;
 
 /// The Ctrl-C check the driver polls: a Python error (KeyboardInterrupt) stops the run.
 pub type Poll<'a> = &'a dyn Fn() -> Result<(), ModelError>;
 
-/// Runs `body` with the model as the core's [`Integrable`] and the Ctrl-C check: native models
+/// Runs `body` with the model as the core's [`Dynamics`] and the Ctrl-C check: native models
 /// with the GIL released (the poll takes it back briefly), closure models with it held. A
 /// Routh-reduced model is the Routhian of its full model, built in place.
 pub fn bind_model<R, F>(py: Python<'_>, model: &Bound<'_, PyAny>, body: F) -> PyResult<R>
 where
     R: Send,
-    F: for<'s> FnOnce(&'s dyn Integrable, Poll<'s>) -> R + Send,
+    F: for<'s> FnOnce(&'s dyn Dynamics, Poll<'s>) -> R + Send,
 {
     match model.cast::<RouthModel>() {
         Ok(reduced) => {
@@ -43,7 +41,7 @@ where
 pub fn bind_full<R, F>(py: Python<'_>, model: &Bound<'_, PyAny>, body: F) -> PyResult<R>
 where
     R: Send,
-    F: for<'s> FnOnce(&'s dyn Integrable, Poll<'s>) -> R + Send,
+    F: for<'s> FnOnce(&'s dyn Dynamics, Poll<'s>) -> R + Send,
 {
     if let Ok(native) = model.cast::<NativeModel>() {
         let native = native.get();
@@ -73,64 +71,49 @@ pub fn dim_of(py: Python<'_>, model: &Bound<'_, PyAny>) -> PyResult<usize> {
     bind_model(py, model, |sys, _| sys.dim())
 }
 
-/// The kinds of model, which decide which methods apply and which one integrates by default.
-#[pyclass(frozen, eq, eq_int, skip_from_py_object, module = "varmech._core")]
-#[derive(Clone, Copy, PartialEq, Eq)]
-pub enum ModelKind {
-    /// L = ½q̇ᵀMq̇ − V(q) with constant M: every unconstrained method applies.
-    Separable,
-    /// A general Lagrangian (or a natural system, or a Routhian): the variational methods.
-    General,
-    /// A separable system on holonomic constraints: RATTLE and SHAKE.
-    Constrained,
-    /// A general Lagrangian on holonomic constraints: the constrained DEL equations.
-    ConstrainedGeneral,
-}
+/// A model's kind, [`varmech::integrators::ModelKind`]: the core's table decides which
+/// methods apply to it and which one integrates it by default.
+#[pyclass(frozen, name = "ModelKind", module = "varmech._core")]
+pub struct PyModelKind(ModelKind);
 
 #[pymethods]
-impl ModelKind {
-    /// Whether explicit methods apply (L = ½q̇ᵀMq̇ − V(q) with constant M, unconstrained).
+impl PyModelKind {
     #[getter]
-    fn separable(&self) -> bool {
-        *self == ModelKind::Separable
+    fn name(&self) -> &'static str {
+        self.0.name()
     }
 
-    /// The method `integrate` uses when none is given: Störmer–Verlet for separable systems, the
-    /// midpoint rule for general Lagrangians, RATTLE on constraints, and the trapezoidal rule's
-    /// constrained DEL equations (RATTLE's discrete Lagrangian) for general ones on constraints.
+    /// Whether every unconstrained method applies (L = ½q̇ᵀMq̇ − V(q) with constant M).
+    #[getter]
+    fn separable(&self) -> bool {
+        self.0 == ModelKind::Separable
+    }
+
     #[getter]
     fn default_method(&self) -> &'static str {
-        match self {
-            ModelKind::Separable => "verlet",
-            ModelKind::General => "midpoint",
-            ModelKind::Constrained => "rattle",
-            ModelKind::ConstrainedGeneral => "trapezoid",
-        }
+        self.0.default_method().info().name
+    }
+
+    #[getter]
+    fn accurate_method(&self) -> &'static str {
+        self.0.accurate_method().info().name
+    }
+
+    /// Whether `method` integrates a model of this kind.
+    fn admits(&self, py: Python<'_>, method: &str) -> PyResult<bool> {
+        let method = Method::from_name(method).map_err(|e| to_pyerr(py, e))?;
+        Ok(self.0.admits(method))
+    }
+
+    fn __repr__(&self) -> String {
+        format!("ModelKind({:?})", self.0.name())
     }
 }
 
 /// The kind of a model.
 #[pyfunction]
-pub fn kind_of(model: &Bound<'_, PyAny>) -> PyResult<ModelKind> {
-    if let Ok(native) = model.cast::<NativeModel>() {
-        return Ok(match native.get().native {
-            Native::Mechanical(_) => ModelKind::Separable,
-            Native::General(_) => ModelKind::General,
-            Native::Constrained(_) => ModelKind::Constrained,
-            Native::ConstrainedGeneral(_) => ModelKind::ConstrainedGeneral,
-        });
-    }
-    if model.cast::<ClosureModel>().is_ok() {
-        return Ok(ModelKind::Separable);
-    }
-    if let Ok(closure) = model.cast::<ClosureConstrained>() {
-        return Ok(match closure.get().system() {
-            ConstrainedSystem::Separable(_) => ModelKind::Constrained,
-            ConstrainedSystem::Natural(_) => ModelKind::ConstrainedGeneral,
-        });
-    }
-    // The others are general Lagrangians; the dispatch refuses what is no model.
-    bind_model(model.py(), model, |_, _| ModelKind::General)
+pub fn kind_of(py: Python<'_>, model: &Bound<'_, PyAny>) -> PyResult<PyModelKind> {
+    bind_model(py, model, |sys, _| PyModelKind(sys.kind()))
 }
 
 /// Whether L depends on t explicitly (then its energy function is not conserved).
@@ -146,7 +129,7 @@ fn is_forced(py: Python<'_>, model: &Bound<'_, PyAny>) -> PyResult<bool> {
 }
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
-    m.add_class::<ModelKind>()?;
+    m.add_class::<PyModelKind>()?;
     m.add_function(wrap_pyfunction!(kind_of, m)?)?;
     m.add_function(wrap_pyfunction!(is_time_dependent, m)?)?;
     m.add_function(wrap_pyfunction!(is_forced, m)?)?;

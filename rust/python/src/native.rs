@@ -1,7 +1,7 @@
 //! Native scenes: every evaluation runs in Rust, with the GIL released.
 
 use pyo3::prelude::*;
-use varmech::integrators::{General, Integrable};
+use varmech::integrators::{Dynamics, General};
 use varmech::model::{Constrained, Distances, HolonomicConstraints, MechanicalSystem};
 use varmech::scenes::{LagrangianScene, LinkedMasses, RigidBody, Scene};
 
@@ -29,9 +29,9 @@ impl NativeModel {
         NativeModel { native, name }
     }
 
-    /// Runs `body` with the scene as the core's [`Integrable`]: a general Lagrangian wrapped in
+    /// Runs `body` with the scene as the core's [`Dynamics`]: a general Lagrangian wrapped in
     /// [`General`] for the variational methods.
-    pub fn with_integrable<R>(&self, body: impl FnOnce(&dyn Integrable) -> R) -> R {
+    pub fn with_integrable<R>(&self, body: impl FnOnce(&dyn Dynamics) -> R) -> R {
         match &self.native {
             Native::Mechanical(scene) => body(scene),
             Native::General(scene) => body(&General(scene)),

@@ -1,7 +1,7 @@
 use nalgebra::DMatrix;
 
 use crate::error::check_vector;
-use crate::integrators::{Integrable, Integrator, Method};
+use crate::integrators::{Dynamics, Increment, Integrator, Method, StepStart};
 use crate::Error;
 
 /// The symplecticity defect ‖ΨᵀJΨ − J‖_F of one step of `method` from (q, p), where Ψ is the
@@ -11,7 +11,7 @@ use crate::Error;
 /// Ψ comes from fourth-order central differences, Ψeⱼ ≈ [8(Φ(x+δ) − Φ(x−δ)) − (Φ(x+2δ) −
 /// Φ(x−2δ))]/12δ with δ = 1e-3·max(|xⱼ|, 1), whose O(δ⁴) truncation and O(ε/δ) round-off both
 /// stay near 1e-12 for a smooth map of unit scale.
-pub fn symplecticity_defect<S: Integrable + ?Sized>(
+pub fn symplecticity_defect<S: Dynamics + ?Sized>(
     sys: &S,
     method: Method,
     q: &[f64],
@@ -24,12 +24,22 @@ pub fn symplecticity_defect<S: Integrable + ?Sized>(
     if !(h.is_finite() && h > 0.0) {
         return Err(Error::invalid("dt", format!("must be finite and positive, got {h}")));
     }
-    sys.check_method(method)?;
+    method.check(sys.kind())?;
     let mut integrator = Integrator::new(method, n);
     let mut flow = |x: &[f64]| -> Result<Vec<f64>, Error> {
         let (mut dq, mut dp) = (vec![0.0; n], vec![0.0; n]);
         integrator.reset();
-        sys.increment(&mut integrator, 0.0, &x[..n], &x[n..], h, &mut dq, &mut dp)
+        let start = StepStart {
+            t: 0.0,
+            h,
+            q: &x[..n],
+            p: &x[n..],
+        };
+        let mut increment = Increment {
+            dq: &mut dq,
+            dp: &mut dp,
+        };
+        sys.increment(&mut integrator, &start, &mut increment)
             .map_err(|e| e.at(1, 0.0))?;
         Ok(x.iter().zip(dq.iter().chain(&dp)).map(|(a, d)| a + d).collect())
     };

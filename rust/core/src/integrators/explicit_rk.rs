@@ -1,3 +1,4 @@
+use super::{Increment, StepStart};
 use crate::model::MechanicalSystem;
 use crate::ModelError;
 
@@ -49,12 +50,11 @@ impl ExplicitRk {
     pub(super) fn increment<S: MechanicalSystem + ?Sized>(
         &mut self,
         sys: &S,
-        q: &[f64],
-        p: &[f64],
-        h: f64,
-        dq: &mut [f64],
-        dp: &mut [f64],
+        start: &StepStart,
+        increment: &mut Increment,
     ) -> Result<(), ModelError> {
+        let StepStart { h, q, p, .. } = *start;
+        let Increment { dq, dp } = increment;
         dq.fill(0.0);
         dp.fill(0.0);
         for (&c, &w) in self.c.iter().zip(self.w) {

@@ -1,4 +1,4 @@
-use super::Composition;
+use super::{Composition, Increment, StepStart};
 use crate::model::MechanicalSystem;
 use crate::ModelError;
 
@@ -72,12 +72,11 @@ impl KickDrift {
     pub(super) fn increment<S: MechanicalSystem + ?Sized>(
         &mut self,
         sys: &S,
-        q: &[f64],
-        p: &[f64],
-        h: f64,
-        dq: &mut [f64],
-        dp: &mut [f64],
+        start: &StepStart,
+        increment: &mut Increment,
     ) -> Result<(), ModelError> {
+        let StepStart { h, q, p, .. } = *start;
+        let Increment { dq, dp } = increment;
         dq.fill(0.0);
         if !self.force_cached {
             self.q.copy_from_slice(q);

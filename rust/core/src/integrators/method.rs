@@ -1,4 +1,4 @@
-use super::Composition;
+use super::{Composition, ModelKind};
 use crate::Error;
 
 /// The fixed-step methods of varmech.
@@ -56,10 +56,11 @@ pub struct MethodInfo {
     /// implicit methods, whose cost depends on the Newton iterations).
     pub force_evaluations: usize,
     /// Whether each step solves implicit equations (by Newton's method); implicit methods
-    /// integrate general Lagrangians, explicit ones only separable mechanical systems.
+    /// integrate general Lagrangians, explicit ones only separable mechanical systems (read
+    /// from the table of [`ModelKind`]).
     pub implicit: bool,
     /// Whether the method integrates separable systems on holonomic constraints (and only
-    /// those).
+    /// those; read from the table of [`ModelKind`]).
     pub constrained: bool,
     pub symplectic: bool,
     pub symmetric: bool,
@@ -149,11 +150,8 @@ impl Method {
             Method::Rattle4 => ("rattle4", 4, true, true, 1.5734, "RATTLE, Yoshida's triple jump"),
             Method::Shake => ("shake", 2, false, true, 2.0, "Ryckaert, Ciccotti & Berendsen (1977)"),
         };
-        let implicit = matches!(
-            self,
-            Method::Midpoint | Method::Trapezoid | Method::Galerkin4 | Method::Galerkin6
-        );
-        let constrained = Method::CONSTRAINED.contains(&self);
+        let implicit = ModelKind::Lagrangian.admits(self);
+        let constrained = ModelKind::ConstrainedSeparable.admits(self);
         let stages = match self {
             Method::Rattle4 => 3,
             _ => Composition::of(self).map_or(1, |c| c.gamma().len()),

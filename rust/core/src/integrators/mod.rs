@@ -1,84 +1,53 @@
-//! One-step methods in position–momentum form, and the fixed-step driver.
+//! One-step methods in position–momentum form, the stepper that applies them, and the
+//! fixed-step run.
 //!
-//! Every method advances (qₙ, pₙ) by increments (δq, δp) computed from the step's start, so that
-//! the driver can add them with compensated summation ([`compensated`]).
+//! Every method advances (qₙ, pₙ) by increments (δq, δp) computed from the step's start
+//! ([`StepStart`] → [`Increment`]), so that the stepper can add them with compensated summation
+//! ([`compensated`]).
 //!
 //! - [`Method`]: the catalogue, with order, cost and linear stability limit of each method;
+//! - [`ModelKind`]: which method integrates which kind of model, and each kind's default;
+//! - [`Dynamics`]: what a method integrates (a separable system, a [`General`] Lagrangian, or
+//!   either on holonomic constraints);
 //! - [`KickDrift`]: Störmer–Verlet, symplectic Euler and the symmetric compositions of Verlet;
 //! - [`ExplicitRk`]: explicit Euler and classical RK4, the non-structure-preserving baselines;
-//! - [`integrate`]: the step loop with saving, divergence detection and interrupt polling.
+//! - [`Stepper`]: one model, one method and the state, advanced step by step;
+//! - [`integrate`]: a run of a [`Stepper`] with saving and an energy check, into a
+//!   [`Trajectory`].
 
 pub mod compensated;
 mod composition;
 mod del;
-mod driver;
+mod dynamics;
 mod explicit_rk;
+mod interrupt;
 mod kick_drift;
+mod kind;
 mod method;
 mod rattle;
+mod run;
 mod step;
+mod stepper;
+mod trajectory;
 
+pub use crate::discrete::{Galerkin, Quadrature};
+pub use crate::error::StepError;
+pub use crate::solve::NewtonOptions;
 pub use composition::Composition;
-pub use del::{Del, Galerkin, NewtonOptions, Quadrature, StepEquations, TwoPoint};
-pub use driver::{integrate, Failure, General, Integrable, Options, Trajectory};
+pub use del::{Del, StepEquations, TwoPoint};
+pub use dynamics::{Dynamics, General};
 pub use explicit_rk::ExplicitRk;
 pub use kick_drift::KickDrift;
+pub use kind::ModelKind;
 pub use method::{Method, MethodInfo};
 pub use rattle::Rattle;
+pub use run::{integrate, Options};
 pub use step::{Increment, StepStart};
+pub use stepper::Stepper;
+pub use trajectory::{Failure, Trajectory};
 
 use crate::discrete::{Midpoint, Trapezoidal};
 use crate::model::{HolonomicConstraints, Lagrangian, MechanicalSystem};
-use crate::ModelError;
-
-/// Why a step failed.
-#[derive(Debug)]
-pub enum StepError {
-    /// The model failed while it was evaluated.
-    Model(ModelError),
-    /// Newton's method did not solve the step's implicit equations.
-    Convergence {
-        residual: f64,
-        iterations: usize,
-        reason: &'static str,
-    },
-    /// The step's equations became non-finite: the solution is blowing up.
-    NonFinite { reason: &'static str },
-    /// Newton's method converged to a solution the step cannot vouch for.
-    SpuriousBranch { reason: &'static str },
-}
-
-impl StepError {
-    /// The error of the run that failed at `step`, which started at `time`.
-    pub fn at(self, step: usize, time: f64) -> crate::Error {
-        match self {
-            StepError::Model(source) => crate::Error::Model { step, time, source },
-            StepError::Convergence {
-                residual,
-                iterations,
-                reason,
-            } => crate::Error::Convergence {
-                step,
-                time,
-                residual,
-                iterations,
-                reason,
-            },
-            StepError::NonFinite { reason } => crate::Error::Divergence {
-                step,
-                time,
-                reason: reason.to_string(),
-            },
-            StepError::SpuriousBranch { reason } => crate::Error::SpuriousBranch { step, time, reason },
-        }
-    }
-}
-
-impl From<ModelError> for StepError {
-    fn from(e: ModelError) -> Self {
-        StepError::Model(e)
-    }
-}
 
 /// A one-step method Ψ_h: (qₙ, pₙ) ↦ (qₙ + δq, pₙ + δp) with its work buffers.
 #[derive(Clone, Debug)]
@@ -187,62 +156,46 @@ impl Integrator {
         }
     }
 
-    /// Writes the increments of one step of size h from (q, p) at time t into (dq, dp).
-    #[allow(clippy::too_many_arguments)]
+    /// Writes the increments of one step of size h from (q, p) at time t into (δq, δp).
     pub fn increment<S: MechanicalSystem + ?Sized>(
         &mut self,
         sys: &S,
-        t: f64,
-        q: &[f64],
-        p: &[f64],
-        h: f64,
-        dq: &mut [f64],
-        dp: &mut [f64],
+        start: &StepStart,
+        increment: &mut Increment,
     ) -> Result<(), StepError> {
         match &mut self.scheme {
-            Scheme::KickDrift(s) => Ok(s.increment(sys, q, p, h, dq, dp)?),
-            Scheme::ExplicitRk(s) => Ok(s.increment(sys, q, p, h, dq, dp)?),
-            _ => self.increment_lagrangian(sys, t, q, p, h, dq, dp),
+            Scheme::KickDrift(s) => Ok(s.increment(sys, start, increment)?),
+            Scheme::ExplicitRk(s) => Ok(s.increment(sys, start, increment)?),
+            Scheme::Rattle(_) => Err(self.method.refusal(ModelKind::Separable).into()),
+            _ => self.increment_lagrangian(sys, start, increment),
         }
     }
 
     /// As [`Integrator::increment`] for a general Lagrangian, which only the implicit
-    /// (variational) methods integrate; an explicit method is an error here (the driver
-    /// refuses it before the first step).
-    #[allow(clippy::too_many_arguments)]
+    /// (variational) methods integrate; another method is an error here (runs refuse it before
+    /// the first step).
     pub fn increment_lagrangian<S: Lagrangian + ?Sized>(
         &mut self,
         sys: &S,
-        t: f64,
-        q: &[f64],
-        p: &[f64],
-        h: f64,
-        dq: &mut [f64],
-        dp: &mut [f64],
+        start: &StepStart,
+        increment: &mut Increment,
     ) -> Result<(), StepError> {
         match &mut self.scheme {
-            Scheme::Midpoint(s) => s.increment(sys, None, StepStart { t, h, q, p }, Increment { dq, dp }),
-            Scheme::Trapezoid(s) => s.increment(sys, None, StepStart { t, h, q, p }, Increment { dq, dp }),
-            Scheme::Galerkin(s) => s.increment(sys, None, StepStart { t, h, q, p }, Increment { dq, dp }),
-            _ => Err(StepError::Model(
-                "explicit methods integrate separable mechanical systems only".into(),
-            )),
+            Scheme::Midpoint(s) => s.increment(sys, None, *start, increment.reborrow()),
+            Scheme::Trapezoid(s) => s.increment(sys, None, *start, increment.reborrow()),
+            Scheme::Galerkin(s) => s.increment(sys, None, *start, increment.reborrow()),
+            _ => Err(self.method.refusal(ModelKind::Lagrangian).into()),
         }
     }
 
     /// As [`Integrator::increment_lagrangian`] on holonomic constraints: the constrained DEL
     /// equations of the implicit methods (see [`Del`]).
-    #[allow(clippy::too_many_arguments)]
     pub fn increment_constrained_lagrangian<S, C>(
         &mut self,
         sys: &S,
         constraints: &C,
-        t: f64,
-        q: &[f64],
-        p: &[f64],
-        h: f64,
-        dq: &mut [f64],
-        dp: &mut [f64],
+        start: &StepStart,
+        increment: &mut Increment,
     ) -> Result<(), StepError>
     where
         S: Lagrangian + ?Sized,
@@ -250,27 +203,20 @@ impl Integrator {
     {
         let c: Option<&dyn HolonomicConstraints> = Some(constraints);
         match &mut self.scheme {
-            Scheme::Midpoint(s) => s.increment(sys, c, StepStart { t, h, q, p }, Increment { dq, dp }),
-            Scheme::Trapezoid(s) => s.increment(sys, c, StepStart { t, h, q, p }, Increment { dq, dp }),
-            Scheme::Galerkin(s) => s.increment(sys, c, StepStart { t, h, q, p }, Increment { dq, dp }),
-            _ => Err(StepError::Model(
-                "a general Lagrangian on constraints takes the implicit methods only".into(),
-            )),
+            Scheme::Midpoint(s) => s.increment(sys, c, *start, increment.reborrow()),
+            Scheme::Trapezoid(s) => s.increment(sys, c, *start, increment.reborrow()),
+            _ => Err(self.method.refusal(ModelKind::ConstrainedLagrangian).into()),
         }
     }
 
     /// As [`Integrator::increment`] for a separable system on holonomic constraints, which only
-    /// the constrained methods integrate (the driver refuses the others before the first step).
-    #[allow(clippy::too_many_arguments)]
+    /// the constrained methods integrate (runs refuse the others before the first step).
     pub fn increment_constrained<S, C>(
         &mut self,
         sys: &S,
         constraints: &C,
-        q: &[f64],
-        p: &[f64],
-        h: f64,
-        dq: &mut [f64],
-        dp: &mut [f64],
+        start: &StepStart,
+        increment: &mut Increment,
     ) -> Result<(), StepError>
     where
         S: MechanicalSystem + ?Sized,
@@ -279,11 +225,9 @@ impl Integrator {
         match &mut self.scheme {
             Scheme::Rattle(s) => {
                 s.size_for(constraints.count());
-                s.increment(sys, constraints, StepStart { t: 0.0, h, q, p }, Increment { dq, dp })
+                s.increment(sys, constraints, *start, increment.reborrow())
             }
-            _ => Err(StepError::Model(
-                "only rattle, rattle4 and shake keep constraints".into(),
-            )),
+            _ => Err(self.method.refusal(ModelKind::ConstrainedSeparable).into()),
         }
     }
 }

@@ -1,7 +1,7 @@
 use nalgebra::{DMatrix, DVector};
 
 use super::MechanicalSystem;
-use crate::integrators::StepError;
+use crate::error::StepError;
 use crate::solve::difference::{self, central_jacobian, Evaluations};
 use crate::solve::newton::{Correction, Newton, NewtonOptions, NewtonProblem, Reasons, Rules};
 use crate::{Error, ModelError};

@@ -1,7 +1,7 @@
 use nalgebra::DMatrix;
 
 use super::MechanicalSystem;
-use crate::integrators::StepError;
+use crate::error::StepError;
 use crate::solve::difference::{self, central_gradient, central_jacobian, Evaluations};
 use crate::solve::newton::{model_error, Correction, Newton, NewtonOptions, NewtonProblem, Reasons, Rules};
 use crate::ModelError;

@@ -1,7 +1,8 @@
 //! Models: what is integrated.
 //!
 //! - [`Lagrangian`]: a Lagrangian system L(q, q̇, t) on ℝⁿ, the most general model;
-//! - [`MechanicalSystem`]: the separable case L = ½q̇ᵀMq̇ − V(q) with constant mass;
+//! - [`MechanicalSystem`]: the separable case L = ½q̇ᵀMq̇ − V(q) with constant mass, and its
+//!   energy [`hamiltonian`] H = ½pᵀM⁻¹p + V(q);
 //! - [`Mass`]: the constant mass matrix M (scalar, diagonal or full symmetric positive definite);
 //! - [`NaturalSystem`]: L = ½q̇ᵀM(q)q̇ − V(q) with configuration-dependent mass, a
 //!   [`Lagrangian`] through [`Natural`];
@@ -13,6 +14,7 @@
 //! Derivatives a model does not supply come from [`crate::solve::difference`].
 
 mod constraints;
+mod energy;
 mod lagrangian;
 mod mass;
 mod mechanical;
@@ -24,6 +26,7 @@ pub use constraints::{
     differenced_jacobian, project, residuals, Action, Anchor, Constrained, Distances, HolonomicConstraints, Link,
     PhaseState,
 };
+pub use energy::hamiltonian;
 pub use lagrangian::{Hessians, Lagrangian};
 pub use mass::Mass;
 pub use mechanical::MechanicalSystem;

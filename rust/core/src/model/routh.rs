@@ -3,7 +3,7 @@ use std::cell::RefCell;
 use nalgebra::{DMatrix, DVector};
 
 use super::{Hessians, Lagrangian};
-use crate::integrators::StepError;
+use crate::error::StepError;
 use crate::solve::difference::{self, central_jacobian, Evaluations};
 use crate::solve::lu::{lu_in_place, lu_solve};
 use crate::solve::newton::{model_error, Correction, Newton, NewtonOptions, NewtonProblem, Reasons, Rules};

@@ -1,10 +1,14 @@
 //! Native test problems, each in the fewest coordinates its physics needs, with its initial
-//! data and, where one is published or exact, a reference solution.
+//! data and, where one is published or exact, a reference solution; [`CATALOGUE`] lists them
+//! by name with their parameters, descriptions, steps and invariants.
+//!
+//! Scenes use the model layer only.
 //!
 //! The data and references are copied from the literature into `reference/` of the repository,
 //! which names the sources; tests and benches use these problems (as diffsol ships its test
 //! problems in the library).
 
+mod catalogue;
 mod charged_particle;
 mod constrained;
 mod damped_driven_pendulum;
@@ -20,6 +24,7 @@ mod pendulum;
 mod rigid_body;
 mod spherical_pendulum;
 
+pub use catalogue::{lookup, CatalogueEntry, Parameter, SceneModel, Setup, CATALOGUE};
 pub use charged_particle::ChargedParticle;
 pub use constrained::{cartesian_pendulum, cartesian_spherical_pendulum, planar_chain, LinkedMasses, PointMasses};
 pub use damped_driven_pendulum::DampedDrivenPendulum;
@@ -54,6 +59,18 @@ pub struct Problem<S> {
     pub t_end: f64,
     /// The exact or published solution, and where it comes from.
     pub reference: Option<(State, &'static str)>,
+}
+
+impl<S> Problem<S> {
+    /// The same problem with the system mapped by `f` (into an enum of systems, say).
+    pub fn map<T>(self, f: impl FnOnce(S) -> T) -> Problem<T> {
+        Problem {
+            system: f(self.system),
+            initial: self.initial,
+            t_end: self.t_end,
+            reference: self.reference,
+        }
+    }
 }
 
 /// Any native scene, for callers (the Python binding) that choose one at run time.

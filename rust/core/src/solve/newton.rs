@@ -12,7 +12,7 @@ use nalgebra::{DMatrix, DVector};
 
 use super::difference::NOISE_FLOOR;
 use super::lu::{lu_in_place, lu_solve};
-use crate::integrators::StepError;
+use crate::error::StepError;
 use crate::ModelError;
 
 /// Options of a Newton iteration.
@@ -249,5 +249,6 @@ pub(crate) fn model_error(e: StepError) -> ModelError {
         StepError::Convergence { reason, .. }
         | StepError::NonFinite { reason }
         | StepError::SpuriousBranch { reason } => reason.into(),
+        StepError::Method(e) => e.to_string().into(),
     }
 }

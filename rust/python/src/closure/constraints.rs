@@ -6,7 +6,7 @@ use nalgebra::DMatrix;
 use numpy::PyArray1;
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
-use varmech::integrators::{General, Integrable};
+use varmech::integrators::{Dynamics, General};
 use varmech::model::{differenced_jacobian, Constrained, HolonomicConstraints, Natural};
 use varmech::ModelError;
 
@@ -89,7 +89,7 @@ impl ClosureConstrained {
 
     /// Runs `body` with the model bound to the GIL as the core's constrained system: RATTLE's
     /// for a separable system, the constrained DEL equations' for a natural one.
-    pub fn with_integrable<R>(&self, py: Python<'_>, body: impl FnOnce(&dyn Integrable) -> R) -> R {
+    pub fn with_integrable<R>(&self, py: Python<'_>, body: impl FnOnce(&dyn Dynamics) -> R) -> R {
         let constraints = ClosureConstraints::new(py, self);
         match &self.system {
             ConstrainedSystem::Separable(system) => body(&Constrained {

@@ -7,18 +7,17 @@ mod galerkin;
 mod two_point;
 
 pub use two_point::TwoPoint;
-// Where the integrators' public names that live in other layers are found.
-pub use crate::discrete::{Galerkin, Quadrature};
-pub use crate::solve::NewtonOptions;
 
 use nalgebra::DMatrix;
 
 use super::{Increment, StepError, StepStart};
+use crate::discrete::Quadrature;
 use crate::discrete::Segment;
 use crate::model::{HolonomicConstraints, Lagrangian};
 use crate::solve::difference::{self, central_jacobian, Evaluations};
 use crate::solve::lu::lu_in_place;
 use crate::solve::newton::{Correction, Newton, NewtonProblem, Reasons, Rules};
+use crate::solve::NewtonOptions;
 use crate::ModelError;
 use constrained::{constrained_equations, Multipliers};
 

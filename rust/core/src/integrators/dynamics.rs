@@ -1,0 +1,224 @@
+//! What a method integrates: the dynamics of a model, seen through one step's increments.
+
+use super::{Increment, Integrator, ModelKind, StepError, StepStart};
+use crate::model::{self, Constrained, HolonomicConstraints, Lagrangian, MechanicalSystem, PhaseState};
+use crate::{Error, ModelError};
+
+/// The dynamics a method integrates: separable mechanical systems take every unconstrained
+/// method; a general Lagrangian, wrapped in [`General`], takes the implicit (variational)
+/// methods; either on holonomic constraints ([`Constrained`]) takes the constrained ones. Which
+/// method fits is decided by [`ModelKind`] alone.
+pub trait Dynamics {
+    /// Number of coordinates n.
+    fn dim(&self) -> usize;
+
+    /// The kind of model, which decides the methods that apply ([`crate::integrators::Method::check`]).
+    fn kind(&self) -> ModelKind;
+
+    /// Whether (q₀, p₀) is admissible initial data: for constrained systems |g(q₀)|∞ and
+    /// |G(q₀)q̇₀|∞ within 1e-10 (relative to the state's size), since the methods hold the
+    /// constraints where they start and starting off them is a user error. `q0` and `p0` are
+    /// finite and of the right length here.
+    fn check_initial(&self, q0: &[f64], p0: &[f64]) -> Result<(), Error> {
+        let Some(residuals) = self.constraint_residuals(q0, p0) else {
+            return Ok(());
+        };
+        let (position, velocity) =
+            residuals.map_err(|e| Error::invalid("q0", format!("the constraints failed to evaluate: {e}")))?;
+        let scale = q0.iter().chain(p0).fold(1.0_f64, |m, x| m.max(x.abs()));
+        if position > 1e-10 * scale {
+            return Err(Error::invalid(
+                "q0",
+                format!("is off the constraints: |g(q0)| = {position:.3e}; project the initial state first"),
+            ));
+        }
+        if velocity > 1e-10 * scale {
+            return Err(Error::invalid(
+                "p0",
+                format!("is off the hidden constraint: |G(q0)M⁻¹p0| = {velocity:.3e}; project the initial state first"),
+            ));
+        }
+        Ok(())
+    }
+
+    /// One step's increments (δq, δp) from `start`.
+    fn increment(
+        &self,
+        integrator: &mut Integrator,
+        start: &StepStart,
+        increment: &mut Increment,
+    ) -> Result<(), StepError>;
+
+    /// The conserved energy at (q, p), where the model has one.
+    fn energy(&self, q: &[f64], p: &[f64]) -> Option<Result<f64, ModelError>>;
+
+    /// The system as a Lagrangian, for the diagnostics (energy function, Legendre transforms).
+    fn as_lagrangian(&self) -> &dyn Lagrangian;
+
+    /// (|g(q)|∞, |G(q)M⁻¹p|∞) for a constrained system; None for the others.
+    fn constraint_residuals(&self, _q: &[f64], _p: &[f64]) -> Option<Result<(f64, f64), ModelError>> {
+        None
+    }
+
+    /// The nearest consistent state for a constrained system; None for the others.
+    fn project(&self, _q: &[f64], _p: &[f64]) -> Option<Result<PhaseState, Error>> {
+        None
+    }
+}
+
+impl<S: MechanicalSystem> Dynamics for S {
+    fn dim(&self) -> usize {
+        MechanicalSystem::dim(self)
+    }
+
+    fn kind(&self) -> ModelKind {
+        ModelKind::Separable
+    }
+
+    fn increment(
+        &self,
+        integrator: &mut Integrator,
+        start: &StepStart,
+        increment: &mut Increment,
+    ) -> Result<(), StepError> {
+        integrator.increment(self, start, increment)
+    }
+
+    fn energy(&self, q: &[f64], p: &[f64]) -> Option<Result<f64, ModelError>> {
+        Some(model::hamiltonian(self, q, p))
+    }
+
+    fn as_lagrangian(&self) -> &dyn Lagrangian {
+        self
+    }
+}
+
+/// A general Lagrangian L(q, q̇, t), for the implicit variational methods.
+pub struct General<'a, L: ?Sized>(pub &'a L);
+
+impl<L: Lagrangian> Dynamics for General<'_, L> {
+    fn dim(&self) -> usize {
+        self.0.dim()
+    }
+
+    fn kind(&self) -> ModelKind {
+        ModelKind::Lagrangian
+    }
+
+    fn increment(
+        &self,
+        integrator: &mut Integrator,
+        start: &StepStart,
+        increment: &mut Increment,
+    ) -> Result<(), StepError> {
+        integrator.increment_lagrangian(self.0, start, increment)
+    }
+
+    /// E = p·q̇ − L, unless L depends on t or forces act (then it is not conserved).
+    fn energy(&self, q: &[f64], p: &[f64]) -> Option<Result<f64, ModelError>> {
+        (!self.0.is_time_dependent() && !self.0.is_forced()).then(|| self.0.energy(q, p, 0.0))
+    }
+
+    fn as_lagrangian(&self) -> &dyn Lagrangian {
+        self.0
+    }
+}
+
+/// A separable mechanical system on holonomic constraints, for RATTLE and SHAKE.
+impl<S: MechanicalSystem, C: HolonomicConstraints> Dynamics for Constrained<S, C> {
+    fn dim(&self) -> usize {
+        MechanicalSystem::dim(&self.system)
+    }
+
+    fn kind(&self) -> ModelKind {
+        ModelKind::ConstrainedSeparable
+    }
+
+    fn increment(
+        &self,
+        integrator: &mut Integrator,
+        start: &StepStart,
+        increment: &mut Increment,
+    ) -> Result<(), StepError> {
+        integrator.increment_constrained(&self.system, &self.constraints, start, increment)
+    }
+
+    fn energy(&self, q: &[f64], p: &[f64]) -> Option<Result<f64, ModelError>> {
+        Some(model::hamiltonian(&self.system, q, p))
+    }
+
+    fn as_lagrangian(&self) -> &dyn Lagrangian {
+        &self.system
+    }
+
+    fn constraint_residuals(&self, q: &[f64], p: &[f64]) -> Option<Result<(f64, f64), ModelError>> {
+        Some(self.residuals(q, p))
+    }
+
+    fn project(&self, q: &[f64], p: &[f64]) -> Option<Result<PhaseState, Error>> {
+        Some(Constrained::project(self, q, p))
+    }
+}
+
+/// A general Lagrangian on holonomic constraints, for the implicit variational methods with
+/// multipliers (the constrained DEL equations; see [`super::Del`]).
+impl<L: Lagrangian, C: HolonomicConstraints> Dynamics for Constrained<General<'_, L>, C> {
+    fn dim(&self) -> usize {
+        self.system.0.dim()
+    }
+
+    fn kind(&self) -> ModelKind {
+        ModelKind::ConstrainedLagrangian
+    }
+
+    fn increment(
+        &self,
+        integrator: &mut Integrator,
+        start: &StepStart,
+        increment: &mut Increment,
+    ) -> Result<(), StepError> {
+        integrator.increment_constrained_lagrangian(self.system.0, &self.constraints, start, increment)
+    }
+
+    fn energy(&self, q: &[f64], p: &[f64]) -> Option<Result<f64, ModelError>> {
+        self.system.energy(q, p)
+    }
+
+    fn as_lagrangian(&self) -> &dyn Lagrangian {
+        self.system.0
+    }
+
+    fn constraint_residuals(&self, q: &[f64], p: &[f64]) -> Option<Result<(f64, f64), ModelError>> {
+        Some(self.residuals_general(q, p))
+    }
+
+    fn project(&self, q: &[f64], p: &[f64]) -> Option<Result<PhaseState, Error>> {
+        Some(self.project_general(q, p))
+    }
+}
+
+impl<L: Lagrangian, C: HolonomicConstraints> Constrained<General<'_, L>, C> {
+    /// q̇(q, p), the inverse Legendre transform.
+    fn velocity(&self) -> impl Fn(&[f64], &[f64], &mut [f64]) -> Result<(), ModelError> + '_ {
+        |q, p, v| self.system.0.velocity(q, p, 0.0, v)
+    }
+
+    /// (|g(q)|∞, |G(q)q̇(q, p)|∞).
+    pub fn residuals_general(&self, q: &[f64], p: &[f64]) -> Result<(f64, f64), ModelError> {
+        model::residuals(&self.constraints, &self.velocity(), q, p)
+    }
+
+    /// The nearest consistent state, with M(q)⁻¹x = q̇(q, x) − q̇(q, 0) (exact for L quadratic
+    /// in q̇, whose inverse Legendre transform is affine in p).
+    pub fn project_general(&self, q0: &[f64], p0: &[f64]) -> Result<PhaseState, Error> {
+        let velocity = self.velocity();
+        let minv = |q: &[f64], x: &[f64], out: &mut [f64]| {
+            let mut rest = vec![0.0; x.len()];
+            velocity(q, &vec![0.0; x.len()], &mut rest)?;
+            velocity(q, x, out)?;
+            out.iter_mut().zip(&rest).for_each(|(o, r)| *o -= r);
+            Ok(())
+        };
+        model::project(&self.constraints, &minv, &velocity, q0, p0)
+    }
+}

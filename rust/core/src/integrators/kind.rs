@@ -1,0 +1,105 @@
+//! Which method integrates which kind of model: the one table that decides it, words the
+//! refusal and names each kind's default method.
+
+use super::Method;
+use crate::Error;
+
+/// The kinds of model the methods tell apart.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum ModelKind {
+    /// A separable mechanical system L = ½q̇ᵀMq̇ − V(q) with constant M: every unconstrained
+    /// method applies (the implicit ones through its Lagrangian).
+    Separable,
+    /// A general Lagrangian L(q, q̇, t), natural systems L = ½q̇ᵀM(q)q̇ − V(q) included: the
+    /// implicit (variational) methods only.
+    Lagrangian,
+    /// A separable mechanical system on holonomic constraints g(q) = 0: RATTLE and SHAKE.
+    ConstrainedSeparable,
+    /// A general Lagrangian on holonomic constraints: the constrained DEL equations of the
+    /// two-point rules.
+    ConstrainedLagrangian,
+}
+
+impl ModelKind {
+    /// Whether `method` integrates a model of this kind.
+    pub fn admits(self, method: Method) -> bool {
+        use Method::*;
+        match self {
+            ModelKind::Separable => !ModelKind::ConstrainedSeparable.admits(method),
+            ModelKind::Lagrangian => matches!(method, Midpoint | Trapezoid | Galerkin4 | Galerkin6),
+            ModelKind::ConstrainedSeparable => Method::CONSTRAINED.contains(&method),
+            // Galerkin with multipliers at the step's ends alone falls to order 2 (measured),
+            // since its interior points leave the constraints; full order needs them
+            // constrained too (Jay's SPARK methods).
+            ModelKind::ConstrainedLagrangian => matches!(method, Midpoint | Trapezoid),
+        }
+    }
+
+    /// The method a run uses when none is given: Störmer–Verlet for a separable system, the
+    /// midpoint rule for a general Lagrangian, RATTLE on constraints, and the trapezoidal rule
+    /// (RATTLE's discrete Lagrangian) for a general Lagrangian on constraints.
+    pub fn default_method(self) -> Method {
+        match self {
+            ModelKind::Separable => Method::Verlet,
+            ModelKind::Lagrangian => Method::Midpoint,
+            ModelKind::ConstrainedSeparable => Method::Rattle,
+            ModelKind::ConstrainedLagrangian => Method::Trapezoid,
+        }
+    }
+
+    /// The method a measurement uses when it wants accuracy more than speed (locating Poincaré
+    /// crossings, say): order 6, by Kahan–Li's 9-stage composition or the Galerkin integrator of
+    /// degree 3; RATTLE's order-4 composition on constraints; and the trapezoidal rule, the
+    /// best order there is, for a general Lagrangian on constraints.
+    pub fn accurate_method(self) -> Method {
+        match self {
+            ModelKind::Separable => Method::KahanLi6,
+            ModelKind::Lagrangian => Method::Galerkin6,
+            ModelKind::ConstrainedSeparable => Method::Rattle4,
+            ModelKind::ConstrainedLagrangian => Method::Trapezoid,
+        }
+    }
+
+    /// The kind's name in the Python API.
+    pub fn name(self) -> &'static str {
+        match self {
+            ModelKind::Separable => "separable",
+            ModelKind::Lagrangian => "lagrangian",
+            ModelKind::ConstrainedSeparable => "constrained separable",
+            ModelKind::ConstrainedLagrangian => "constrained lagrangian",
+        }
+    }
+}
+
+impl Method {
+    /// Whether this method integrates a model of `kind`, with the reason and the methods that
+    /// would if it does not.
+    pub fn check(self, kind: ModelKind) -> Result<(), Error> {
+        if kind.admits(self) {
+            Ok(())
+        } else {
+            Err(self.refusal(kind))
+        }
+    }
+
+    /// Why this method does not integrate a model of `kind` (whether or not it does).
+    pub(super) fn refusal(self, kind: ModelKind) -> Error {
+        let name = self.info().name;
+        let reason = match kind {
+            ModelKind::Separable | ModelKind::Lagrangian if ModelKind::ConstrainedSeparable.admits(self) => {
+                format!("{name} integrates systems with holonomic constraints")
+            }
+            ModelKind::Separable | ModelKind::Lagrangian => {
+                format!("{name} needs a separable mechanical system; use midpoint or trapezoid")
+            }
+            ModelKind::ConstrainedSeparable => {
+                format!("{name} would ignore the constraints; use rattle, rattle4 or shake")
+            }
+            ModelKind::ConstrainedLagrangian => format!(
+                "{name} does not integrate a general Lagrangian on constraints; use trapezoid (RATTLE's \
+                 discrete Lagrangian) or midpoint"
+            ),
+        };
+        Error::invalid("method", reason)
+    }
+}

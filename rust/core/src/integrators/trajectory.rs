@@ -1,0 +1,77 @@
+//! The saved states of a run, and a run that stopped early.
+
+use std::ops::Deref;
+
+use super::{Dynamics, Stepper};
+use crate::Error;
+
+/// The saved states of a run: row k is (`t[k]`, `q[k]`, `p[k]`); q and p are stored row-major.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Trajectory {
+    pub dim: usize,
+    pub t: Vec<f64>,
+    pub q: Vec<f64>,
+    pub p: Vec<f64>,
+    /// Steps completed.
+    pub steps: usize,
+    /// Force evaluations made (see [`super::Integrator::force_evaluations`]).
+    pub force_evaluations: u64,
+    /// Newton iterations made (implicit methods).
+    pub newton_iterations: u64,
+    /// Newton iterations made up to each saved state (cumulative; all zero for explicit
+    /// methods): their differences give the iterations per step between saves.
+    pub newton: Vec<u64>,
+    /// Work done by non-conservative forces up to each saved state (forced systems): the
+    /// energy balance E(t) − E(0) − W(t) is the discrete Lagrange–d'Alembert check.
+    pub work: Vec<f64>,
+}
+
+impl Trajectory {
+    /// Number of saved states.
+    pub fn len(&self) -> usize {
+        self.t.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.t.is_empty()
+    }
+
+    /// q at saved state k.
+    pub fn q_at(&self, k: usize) -> &[f64] {
+        &self.q[k * self.dim..(k + 1) * self.dim]
+    }
+
+    /// p at saved state k.
+    pub fn p_at(&self, k: usize) -> &[f64] {
+        &self.p[k * self.dim..(k + 1) * self.dim]
+    }
+
+    /// Saves the stepper's state as the state at time `t`.
+    pub(super) fn push<M>(&mut self, t: f64, stepper: &Stepper<M>)
+    where
+        M: Deref<Target: Dynamics>,
+    {
+        self.t.push(t);
+        self.newton.push(stepper.newton_iterations());
+        self.work.push(stepper.work());
+        self.q.extend_from_slice(stepper.q());
+        self.p.extend_from_slice(stepper.p());
+    }
+
+    /// Records the stepper's counts: the steps completed and the work they took.
+    pub(super) fn count<M>(&mut self, stepper: &Stepper<M>)
+    where
+        M: Deref<Target: Dynamics>,
+    {
+        self.steps = stepper.steps();
+        self.force_evaluations = stepper.force_evaluations();
+        self.newton_iterations = stepper.newton_iterations();
+    }
+}
+
+/// A run that stopped early: why, and every state saved up to the last good step.
+#[derive(Debug)]
+pub struct Failure {
+    pub error: Error,
+    pub partial: Trajectory,
+}
