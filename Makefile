@@ -10,12 +10,14 @@ install:
 tour: install
 	$(PYTHON) -m varmech tour --out out/tour
 
-# The guards: formatting, clippy on every target of both crates, ruff, and mypy on the package.
+# The guards: formatting, clippy on every target of both crates, ruff, mypy on the package, and
+# stubtest of the binding against its stub _core.pyi.
 lint: install
 	cargo fmt --all --check
 	cargo clippy --workspace --all-targets -- -D warnings
 	$(PYTHON) -m ruff check python tests benches
 	$(PYTHON) -m mypy
+	$(PYTHON) -m mypy.stubtest varmech._core
 
 test: lint
 	cargo test --release

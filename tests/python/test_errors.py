@@ -197,7 +197,7 @@ def test_newton_failure_raises_convergence_error_with_partial_trajectory():
 def test_a_step_beyond_a_fold_raises_spurious_branch_error(native):
     # Pendulum from rest at q0 = 3 with h = 3: the midpoint equation's derivative
     # -1/h - (h/4)cos(q̄) changes sign near the top, and Newton lands on a branch that jumps over
-    # it although E < 1 (tests/spurious_branch.rs has the theory).
+    # it although E < 1 (tests/rust/spurious_branch.rs has the theory).
     model = scenes.pendulum().model if native else examples.closure_of(scenes.pendulum())
     with pytest.raises(varmech.SpuriousBranchError, match="spurious branch at step 1 .*fold") as info:
         varmech.integrate(model, [3.0], [0.0], dt=3.0, steps=10, method="midpoint")

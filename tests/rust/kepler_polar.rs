@@ -2,7 +2,7 @@
 //! 200 periods (e = 0.6): its exact reference, its conserved angular momentum, and the
 //! Cartesian scene it is in other coordinates.
 
-mod common;
+use crate::common;
 
 use std::f64::consts::PI;
 use varmech::diagnostics::InvariantStatistics;

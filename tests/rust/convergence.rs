@@ -5,7 +5,7 @@
 //! against the closed-form solution (Jacobi elliptic functions), which is first checked against
 //! the published reference.
 
-mod common;
+use crate::common;
 
 use varmech::integrators::Method;
 use varmech::scenes::Pendulum;

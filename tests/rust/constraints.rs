@@ -1,7 +1,7 @@
 //! Holonomic constraints: RATTLE holds g(q) = 0 and G(q)M⁻¹p = 0 to round-off and stays
 //! symplectic; SHAKE with a loose tolerance drifts in energy; compositions raise the order.
 
-mod common;
+use crate::common;
 
 use varmech::diagnostics::{EnergyStatistics, Verdict};
 use varmech::integrators::{integrate, General, Method, Options, Trajectory};

@@ -1,7 +1,7 @@
 //! Routh reduction: the Routhian R = L − μ·ċ of a model with cyclic coordinates, integrated by
 //! the DEL integrators, against closed forms, relative equilibria and the unreduced model.
 
-mod common;
+use crate::common;
 
 use varmech::discrete::{DiscreteLagrangian, Midpoint, Trapezoidal};
 use varmech::integrators::{integrate, Method, Options, Trajectory};

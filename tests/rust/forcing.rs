@@ -1,7 +1,7 @@
 //! Forced systems by the discrete Lagrange–d'Alembert principle: a damped linear oscillator,
 //! L = ½q̇² − ½ω²q² with the Rayleigh force f = −c q̇.
 
-mod common;
+use crate::common;
 
 use varmech::integrators::{integrate, General, Method, Options, Trajectory};
 use varmech::model::Lagrangian;

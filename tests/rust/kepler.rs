@@ -1,6 +1,6 @@
 //! Kepler problem, e = 0.6, over 200 periods (HLW's work–precision protocol).
 
-mod common;
+use crate::common;
 
 use std::f64::consts::PI;
 

@@ -3,7 +3,7 @@
 //! trapezoidal rule, the discrete Noether theorem for the rotation about the origin, and the
 //! orders of the implicit methods in a non-uniform field.
 
-mod common;
+use crate::common;
 
 use varmech::diagnostics::{EnergyStatistics, InvariantStatistics, Verdict};
 use varmech::integrators::{Method, Trajectory};

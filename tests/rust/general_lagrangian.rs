@@ -1,7 +1,7 @@
 //! General Lagrangians with the implicit variational integrators: the double pendulum, whose
 //! mass matrix depends on the configuration.
 
-mod common;
+use crate::common;
 
 use nalgebra::DMatrix;
 use varmech::integrators::{integrate, General, Method, NewtonOptions, Options, Trajectory};

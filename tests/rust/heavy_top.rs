@@ -2,7 +2,7 @@
 //! Lagrangian with two cyclic angles, checked against its exact derivatives, its conserved
 //! momenta, its steady precessions and the turning points of its nutation.
 
-mod common;
+use crate::common;
 
 use varmech::diagnostics::{EnergyStatistics, InvariantStatistics, Verdict};
 use varmech::integrators::{integrate, General, Method, NewtonOptions, Options, Trajectory};

@@ -1,6 +1,6 @@
 //! The outer solar system over 500 000 days (HLW I.2.4) against the GNI reference state.
 
-mod common;
+use crate::common;
 
 use common::{assert_within_factor, run};
 use varmech::diagnostics::{energies, EnergyStatistics, InvariantStatistics};

@@ -1,7 +1,7 @@
 //! The damped, driven pendulum scene in Baker & Gollub's chaotic regime: forced by the discrete
 //! Lagrange–d'Alembert principle, through the scene dispatch the binding uses.
 
-mod common;
+use crate::common;
 
 use varmech::integrators::{integrate, General, Method, Options, Trajectory};
 use varmech::model::Lagrangian;
@@ -33,7 +33,7 @@ fn balance(sys: &DampedDrivenPendulum, traj: &Trajectory) -> (f64, f64) {
 #[test]
 fn the_tracked_work_accounts_for_the_energy_change_up_to_the_methods_own_energy_error() {
     // W sums the work f(q̄, v)·δq of each step. On a quadratic L the midpoint rule's energy
-    // changes by exactly that (tests/forcing.rs, to round-off); with the pendulum's cos θ it
+    // changes by exactly that (tests/rust/forcing.rs, to round-off); with the pendulum's cos θ it
     // does not conserve E even unforced, so E − E₀ − W is the method's own O(h²) energy error,
     // not round-off. Over 10⁴ steps of the chaotic regime E swings by 3.5 and E₀ + W follows it
     // to 4e-5, and the defect shrinks at order 2.

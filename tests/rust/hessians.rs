@@ -1,7 +1,7 @@
 //! Exact second derivatives: where a model supplies ∂²L/∂q², ∂²L/∂q∂q̇ and ∂²L/∂q̇², Newton's
 //! Jacobian of the DEL equations is assembled from them instead of by differences.
 
-mod common;
+use crate::common;
 
 use varmech::integrators::{Method, Trajectory};
 use varmech::model::{Hessians, Lagrangian};

@@ -1,5 +1,4 @@
 //! Helpers shared by the integration tests.
-#![allow(dead_code)]
 
 use varmech::integrators::{integrate, General, Method, Options, Trajectory};
 use varmech::model::{Lagrangian, MechanicalSystem};

@@ -1,0 +1,23 @@
+//! The core's integration tests, one module a subject, built as one test binary (one link
+//! instead of one a file). `allocation.rs` is a binary of its own: it installs a counting
+//! global allocator.
+
+mod common;
+
+mod catalogue;
+mod charged_particle;
+mod constraints;
+mod convergence;
+mod damped_driven_pendulum;
+mod failures;
+mod forcing;
+mod general_lagrangian;
+mod heavy_top;
+mod hessians;
+mod kepler;
+mod kepler_polar;
+mod routh;
+mod solar_system;
+mod spurious_branch;
+mod stability;
+mod variational;
