@@ -1,0 +1,69 @@
+"""Criterion benches of two builds side by side: the same bench functions of two sets of bench
+executables, interleaved, best of several rounds, reported as ratios.
+
+    cargo bench --no-run                       # in each checkout; note the executables it prints
+    python benches/criterion_ab.py --before DIR --after DIR [--rounds 5]
+
+DIR holds the bench executables `steps`, `implicit` and `constraints` of one build (copied out
+of target/release/deps). Each round runs every selected bench once in each build, alternating,
+so that the noise of a shared machine falls on both alike; a bench's figure is its best
+(smallest) criterion estimate over the rounds.
+"""
+
+from __future__ import annotations
+
+import argparse
+import re
+import subprocess
+from pathlib import Path
+
+#: (executable, criterion filter): the step loops issue 12 promised to keep as fast.
+BENCHES = [
+    ("steps", "^kepler/verlet$"),
+    ("steps", "^kepler/kahan_li8$"),
+    ("steps", "^outer_solar_system/verlet$"),
+    ("steps", "^outer_solar_system/kahan_li8$"),
+    ("implicit", "^double_pendulum/midpoint$"),
+    ("implicit", "^double_pendulum/galerkin4$"),
+    ("constraints", "^rattle_chain/8$"),
+]
+
+UNITS = {"ps": 1e-12, "ns": 1e-9, "µs": 1e-6, "us": 1e-6, "ms": 1e-3, "s": 1.0}
+TIME = re.compile(r"time:\s+\[\S+ \S+ (\S+) (\S+) \S+ \S+\]")
+
+
+def seconds(executable: Path, pattern: str) -> float:
+    out = subprocess.run(
+        [str(executable), "--bench", pattern, "--warm-up-time", "0.5", "--measurement-time", "2", "--noplot"],
+        capture_output=True,
+        text=True,
+        check=True,
+    ).stdout
+    match = TIME.search(out)
+    if match is None:
+        raise RuntimeError(f"{executable.name} {pattern}: no criterion estimate in\n{out}")
+    value, unit = match.groups()
+    return float(value) * UNITS[unit]
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--before", type=Path, required=True)
+    parser.add_argument("--after", type=Path, required=True)
+    parser.add_argument("--rounds", type=int, default=5)
+    args = parser.parse_args()
+    best: dict[tuple[str, str], float] = {}
+    for _ in range(args.rounds):
+        for exe, pattern in BENCHES:
+            for side, folder in (("before", args.before), ("after", args.after)):
+                t = seconds(folder / exe, pattern)
+                best[pattern, side] = min(best.get((pattern, side), float("inf")), t)
+    print("| bench | before | after | speed after / before |")
+    print("|---|---:|---:|---:|")
+    for _, pattern in BENCHES:
+        before, after = best[pattern, "before"], best[pattern, "after"]
+        print(f"| {pattern.strip('^$')} | {before * 1e6:.2f} µs | {after * 1e6:.2f} µs | {before / after:.3f} |")
+
+
+if __name__ == "__main__":
+    main()
