@@ -5,8 +5,8 @@
 //! [`generator`]); Python closures are adapted to the core's model traits ([`closure`]), native
 //! scenes wrapped ([`native`], [`scenes`]), and every model resolved to the core by the one
 //! dispatch [`bind::bind_model`]; core errors become Python exceptions with the core's messages
-//! ([`errors`]). The one piece of policy, which method a kind of model takes by default, sits in
-//! [`bind::kind_of`]. The Python API in `python/varmech` is built on these functions;
+//! ([`errors`]). Policy, such as which method fits which kind of model, is the core's
+//! ([`bind::kind_of`] only shows it). The Python API in `python/varmech` is built on these functions;
 //! `_core.pyi` documents them.
 
 mod bind;
