@@ -8,6 +8,7 @@ from numpy.typing import NDArray
 from typing_extensions import disjoint_base
 
 __all__ = [
+    "CatalogueEntry",
     "ClosureConstrained",
     "ClosureLagrangian",
     "ClosureModel",
@@ -19,10 +20,13 @@ __all__ = [
     "ModelKind",
     "NativeModel",
     "RouthModel",
+    "SceneRecord",
+    "SceneReference",
     "SpuriousBranchError",
     "TrajectoryRecord",
     "VarmechError",
     "amended_potential",
+    "catalogue",
     "constraint_residuals",
     "cyclic_increments",
     "cyclic_velocity",
@@ -310,15 +314,64 @@ def energy_statistics(t: _FloatArray, h: _FloatArray) -> dict[str, Any]: ...
 def invariant_statistics(values: _FloatArray) -> tuple[float, float, float]: ...
 def symplecticity_defect(model: _Model, method: str, q: _FloatArray, p: _FloatArray, dt: float) -> float: ...
 def methods() -> list[MethodInfo]: ...
-def scene(
-    name: str,
-    *,
-    e: float = 0.6,
-    omega: float = 1.0,
-    b: float = 1.0,
-    gamma: float = 0.5,
-    amplitude: float = 1.5,
-    drive: float = 2.0 / 3.0,
-    links: int = 8,
-) -> tuple[NativeModel, _FloatArray, _FloatArray, float, tuple[float, _FloatArray, _FloatArray, str] | None]: ...
+@final
+class CatalogueEntry:
+    """One scene of the core's catalogue, with its defaults."""
+
+    @property
+    def name(self) -> str: ...
+    @property
+    def parameters(self) -> dict[str, float]:
+        """The defaults of the parameters, by name (whole-number ones as ints)."""
+    @property
+    def description(self) -> str: ...
+
+@final
+class SceneReference:
+    """A scene's reference solution at time ``t``, exact or published, and where it comes from."""
+
+    @property
+    def t(self) -> float: ...
+    @property
+    def q(self) -> _FloatArray: ...
+    @property
+    def p(self) -> _FloatArray: ...
+    @property
+    def source(self) -> str: ...
+
+@final
+class SceneRecord:
+    """A scene built from the catalogue: model, initial state, horizon and reference, and the
+    catalogue's description, step, invariants and parameter values."""
+
+    @property
+    def name(self) -> str: ...
+    @property
+    def description(self) -> str: ...
+    @property
+    def model(self) -> NativeModel: ...
+    @property
+    def q0(self) -> _FloatArray: ...
+    @property
+    def p0(self) -> _FloatArray: ...
+    @property
+    def t_end(self) -> float: ...
+    @property
+    def dt(self) -> float: ...
+    @property
+    def invariants(self) -> dict[str, float]:
+        """The conserved quantities by name, with their values at t = 0."""
+    @property
+    def reference(self) -> SceneReference | None: ...
+    @property
+    def parameters(self) -> dict[str, float]:
+        """The values of the parameters the scene was built with, by name."""
+
+def scene(name: str, **parameters: float) -> SceneRecord:
+    """The catalogue scene ``name`` with ``parameters`` set by keyword; ValueError for an
+    unknown scene or parameter, or a value out of range."""
+
+def catalogue() -> list[CatalogueEntry]:
+    """Every scene of the catalogue, in the order of the tour."""
+
 def nbody(g: float, masses: Sequence[float]) -> NativeModel: ...

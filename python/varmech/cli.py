@@ -13,24 +13,38 @@ from .integrate import integrate
 from .methods import format_table
 from .reduction import routh
 
-#: (scene, methods, horizon): each scene over a horizon long enough to tell bounded from drifting.
-TOUR = [
-    ("harmonic_oscillator", ("verlet", "rk4", "symplectic_euler"), 1000.0),
-    ("pendulum", ("verlet", "yoshida4", "rk4"), 2000.0),
-    ("kepler", ("verlet", "kahan_li8", "rk4"), None),
-    ("henon_heiles", ("verlet", "kahan_li6", "rk4"), 5000.0),
-    ("fermi_pasta_ulam", ("verlet", "mclachlan4", "rk4"), 200.0),
-    ("outer_solar_system", ("verlet", "kahan_li8", "rk4"), None),
-    ("double_pendulum", ("midpoint", "trapezoid"), 100.0),
-    ("spherical_pendulum", ("midpoint", "trapezoid"), 1000.0),
-    ("heavy_top", ("midpoint", "galerkin4"), None),
-    ("kepler_polar", ("midpoint", "galerkin4"), None),
-    ("charged_particle", ("midpoint", "galerkin4"), 1000.0),
-    ("charged_particle_nonuniform", ("midpoint", "trapezoid"), 1000.0),
-    ("cartesian_pendulum", ("rattle", "shake"), 1000.0),
-    ("planar_chain", ("rattle", "rattle4"), 100.0),
-    ("rigid_body", ("trapezoid", "midpoint"), 100.0),
-]
+#: Showcase runs of the tour, scene → (methods, horizon) with None for the scene's t_end: each
+#: over a horizon long enough to tell bounded from drifting. A scene without one runs with its
+#: kind's default and accurate methods over its t_end (see :func:`tour_runs`).
+TOUR: dict[str, tuple[tuple[str, ...], float | None]] = {
+    "harmonic_oscillator": (("verlet", "rk4", "symplectic_euler"), 1000.0),
+    "pendulum": (("verlet", "yoshida4", "rk4"), 2000.0),
+    "kepler": (("verlet", "kahan_li8", "rk4"), None),
+    "henon_heiles": (("verlet", "kahan_li6", "rk4"), 5000.0),
+    "fermi_pasta_ulam": (("verlet", "mclachlan4", "rk4"), 200.0),
+    "outer_solar_system": (("verlet", "kahan_li8", "rk4"), None),
+    "double_pendulum": (("midpoint", "trapezoid"), 100.0),
+    "spherical_pendulum": (("midpoint", "trapezoid"), 1000.0),
+    "heavy_top": (("midpoint", "galerkin4"), None),
+    "kepler_polar": (("midpoint", "galerkin4"), None),
+    "charged_particle": (("midpoint", "galerkin4"), 1000.0),
+    "charged_particle_nonuniform": (("midpoint", "trapezoid"), 1000.0),
+    "cartesian_pendulum": (("rattle", "shake"), 1000.0),
+    "planar_chain": (("rattle", "rattle4"), 100.0),
+    "rigid_body": (("trapezoid", "midpoint"), 100.0),
+}
+
+
+def tour_runs() -> list[tuple[scenes.Scene, tuple[str, ...], float]]:
+    """(scene, methods, horizon) for every scene of the catalogue, in its order: the showcase
+    of :data:`TOUR`, or the kind's default and accurate methods over the scene's t_end."""
+    runs = []
+    for name in scenes.CATALOGUE:
+        scene = scenes.get(name)
+        kind = scene.model.kind
+        methods, horizon = TOUR.get(name, (tuple(dict.fromkeys((kind.default_method, kind.accurate_method))), None))
+        runs.append((scene, methods, horizon if horizon is not None else scene.t_end))
+    return runs
 
 
 #: The charts the tour draws, each with its default scene and methods (``python -m varmech chart``).
@@ -67,11 +81,9 @@ def tour(out: Path, quick: bool) -> int:
     energy-error plots and the charts of :data:`TOUR_CHARTS` to ``out`` (without matplotlib,
     the reports only)."""
     plots = True
-    for name, methods, horizon in TOUR:
-        scene = scenes.get(name)
-        t_end = horizon if horizon is not None else scene.t_end
-        if quick:
-            t_end /= 10
+    for scene, methods, horizon in tour_runs():
+        name = scene.name
+        t_end = horizon / 10 if quick else horizon
         steps = round(t_end / scene.dt)
         save_every = max(1, steps // 20000)
         print(f"\n=== {name}: {scene.description}; dt = {scene.dt:g}, {steps} steps to t = {steps * scene.dt:g}")

@@ -8,12 +8,11 @@ the closure path against the native one.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
 
 import numpy as np
 
 from .model import Cyclic, Lagrangian, MechanicalSystem, Rotation, Translation
-from .scenes import Scene
+from .scenes import CATALOGUE, Scene
 
 
 def harmonic_oscillator(omega: float = 1.0) -> MechanicalSystem:
@@ -238,6 +237,12 @@ def charged_particle(B: float = 1.0, kappa: float = 0.0) -> Lagrangian:
     return Lagrangian(2, lagrangian, dl_dq=dl_dq, dl_dv=dl_dv, symmetries=[Rotation(spatial_dim=2)], name="charged_particle (closure)")
 
 
+def charged_particle_nonuniform() -> Lagrangian:
+    """The charged particle in the non-uniform field B(q) = (1 + |q|²/4) ẑ (the native scene's
+    field): :func:`charged_particle` with B = 1, κ = 1/4."""
+    return charged_particle(kappa=0.25)
+
+
 def damped_driven_pendulum(gamma: float = 0.5, amplitude: float = 1.5, drive: float = 2.0 / 3.0) -> Lagrangian:
     """θ̈ + γθ̇ + sin θ = A cos Ωt: L = ½θ̇² + cos θ, the Rayleigh dissipation ½γθ̇² and the
     driving torque as a force."""
@@ -307,24 +312,13 @@ def rigid_body(inertia: tuple[float, float, float] = (0.5, 0.9, 1.0)) -> Mechani
 
 
 def closure_of(scene: Scene) -> MechanicalSystem | Lagrangian:
-    """The closure version of a built-in scene (with its default parameters)."""
+    """The closure twin of a built-in scene: the function of this module with the scene's name,
+    at its default parameters (an N-body scene's twin has the scene's G and masses).
+    ValueError for a scene without a twin."""
     gravity = getattr(scene.model._core, "gravity", None)
     if gravity is not None:
         return nbody(*gravity)
-    makers: dict[str, Callable[[], MechanicalSystem | Lagrangian]] = {
-        "harmonic_oscillator": harmonic_oscillator,
-        "pendulum": pendulum,
-        "kepler": kepler,
-        "henon_heiles": henon_heiles,
-        "fermi_pasta_ulam": fermi_pasta_ulam,
-        "double_pendulum": double_pendulum,
-        "spherical_pendulum": spherical_pendulum,
-        "heavy_top": heavy_top,
-        "kepler_polar": kepler_polar,
-        "charged_particle": charged_particle,
-        "charged_particle_nonuniform": lambda: charged_particle(kappa=0.25),
-        "damped_driven_pendulum": damped_driven_pendulum,
-        "cartesian_pendulum": cartesian_pendulum,
-        "rigid_body": rigid_body,
-    }
-    return makers[scene.name]()
+    twin = globals().get(scene.name) if scene.name in CATALOGUE else None
+    if twin is None:
+        raise ValueError(f"scene: {scene.name!r} has no closure twin in varmech.examples")
+    return twin()

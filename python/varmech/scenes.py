@@ -1,13 +1,14 @@
 """Built-in scenes: native models in the fewest coordinates their physics needs, with initial
 data, test horizon, invariants and, where known, a reference solution (sources in
-``reference/`` of the repository)."""
+``reference/`` of the repository).
+
+Every scene, its parameters, description, step and invariants come from the core's catalogue
+(``rust/core/src/scenes/catalogue.rs``): :func:`get` builds any of them by name, and the
+functions below name them with their parameters for the reader."""
 
 from __future__ import annotations
 
-import math
-from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -31,7 +32,8 @@ class Scene:
     """A native model with its initial state and test protocol.
 
     ``dt`` is a step that resolves the scene for a quick look (the tour uses it);
-    ``invariants`` holds the values of the conserved quantities at t = 0.
+    ``invariants`` holds the values of the conserved quantities at t = 0; ``parameters`` the
+    values the scene was built with.
     """
 
     name: str
@@ -43,51 +45,63 @@ class Scene:
     dt: float
     invariants: dict[str, float] = field(default_factory=dict)
     reference: Reference | None = None
+    parameters: dict[str, float] = field(default_factory=dict)
 
 
-def _scene(name: str, description: str, dt: float, invariants: dict[str, float], **params: Any) -> Scene:
-    core, q0, p0, t_end, ref = _core.scene(name, **params)
-    reference = Reference(*ref) if ref is not None else None
-    return Scene(name, description, NativeSystem(core), q0, p0, t_end, dt, invariants, reference)
+#: The core's catalogue of scenes by name, in the order of the tour: each entry's
+#: ``parameters`` (with their defaults) and ``description``.
+CATALOGUE: dict[str, _core.CatalogueEntry] = {entry.name: entry for entry in _core.catalogue()}
+
+
+def get(name: str, **parameters: float) -> Scene:
+    """The scene called ``name`` (one of :data:`CATALOGUE`) with ``parameters`` set by keyword
+    and the others at their defaults; ValueError for an unknown scene or parameter."""
+    record = _core.scene(name, **parameters)
+    ref = record.reference
+    reference = Reference(ref.t, ref.q, ref.p, ref.source) if ref is not None else None
+    return Scene(
+        record.name,
+        record.description,
+        NativeSystem(record.model),
+        record.q0,
+        record.p0,
+        record.t_end,
+        record.dt,
+        record.invariants,
+        reference,
+        record.parameters,
+    )
 
 
 def harmonic_oscillator(omega: float = 1.0) -> Scene:
     """H = p²/2 + ω²q²/2 from (q, p) = (0, 1); exact solution at t = 10."""
-    return _scene(
-        "harmonic_oscillator", "the linear test equation q'' = -ω²q", 0.1 / omega, {"H": 0.5}, omega=omega
-    )
+    return get("harmonic_oscillator", omega=omega)
 
 
 def pendulum() -> Scene:
     """H = p²/2 − cos q in the angle from the downward vertical, from (0, 1) to t = 2π (HLW I.1)."""
-    return _scene("pendulum", "mathematical pendulum in its angle", 2 * math.pi / 64, {"H": -0.5})
+    return get("pendulum")
 
 
 def kepler(e: float = 0.6) -> Scene:
     """H = |p|²/2 − 1/|q| in the plane, eccentricity ``e``, 200 periods of 2π (HLW I.2)."""
-    return _scene(
-        "kepler",
-        f"Kepler orbit, eccentricity {e}",
-        2 * math.pi / 200,
-        {"H": -0.5, "L": math.sqrt(1 - e * e)},
-        e=e,
-    )
+    return get("kepler", e=e)
 
 
 def henon_heiles() -> Scene:
     """The Hénon–Heiles system at H = 0.13 from q = (0.1, 0), p = (0, 0.5), to t = 5·10⁴."""
-    return _scene("henon_heiles", "Hénon–Heiles, H = 0.13", 0.1, {"H": 0.13})
+    return get("henon_heiles")
 
 
 def fermi_pasta_ulam() -> Scene:
     """The Fermi–Pasta–Ulam chain of HLW I.5: m = 3 stiff springs, ω = 50."""
-    return _scene("fermi_pasta_ulam", "Fermi–Pasta–Ulam chain, ω = 50 (HLW I.5)", 0.001, {"H": 2.00120008, "I": 1.0})
+    return get("fermi_pasta_ulam")
 
 
 def outer_solar_system() -> Scene:
     """Sun (with the inner planets), Jupiter, Saturn, Uranus, Neptune and Pluto over 500 000
     days (HLW I.2.4), against the reference state of the GNI test codes."""
-    return _scene("outer_solar_system", "outer solar system (AU, days, solar masses)", 50.0, {"H": -3.215453183208163e-08})
+    return get("outer_solar_system")
 
 
 def double_pendulum() -> Scene:
@@ -95,7 +109,7 @@ def double_pendulum() -> Scene:
     general Lagrangian (configuration-dependent mass), from θ = (π/4, π/2), θ̇ = (0, π/8) to
     T = 10 against the GeometricProblems.jl reference. Integrate it with ``midpoint`` or
     ``trapezoid``."""
-    return _scene("double_pendulum", "double pendulum (configuration-dependent mass)", 0.01, {"E": -40.218179175435154})
+    return get("double_pendulum")
 
 
 def spherical_pendulum() -> Scene:
@@ -103,12 +117,7 @@ def spherical_pendulum() -> Scene:
     θ = 1, θ̇ = 0, φ̇ = 1.2 to T = 50 against the reference angles of reference/scenes.json. A
     general Lagrangian whose azimuth φ is cyclic: p_φ is conserved. The reference gives the
     angles only, so its p_θ is NaN."""
-    return _scene(
-        "spherical_pendulum",
-        "spherical pendulum in (θ, φ); φ cyclic",
-        0.01,
-        {"E": -0.030489444711168545, "p_phi": 0.8496881019282854},
-    )
+    return get("spherical_pendulum")
 
 
 def heavy_top() -> Scene:
@@ -117,12 +126,7 @@ def heavy_top() -> Scene:
     fast top (p_ψ² = 6.25 > 4I₁Mgl) released at θ = 0.3 with θ̇ = φ̇ = 0 and ψ̇ = 5, to T = 50:
     it nutates in cusps between the turning points θ = 0.3 and 0.4794748702… A general
     Lagrangian whose angles φ and ψ are cyclic: p_φ and p_ψ are conserved. No reference state."""
-    return _scene(
-        "heavy_top",
-        "heavy symmetric top in Euler angles (θ, φ, ψ); φ and ψ cyclic",
-        0.01,
-        {"E": 6.25 + math.cos(0.3), "p_phi": 2.5 * math.cos(0.3), "p_psi": 2.5},
-    )
+    return get("heavy_top")
 
 
 def kepler_polar(e: float = 0.6) -> Scene:
@@ -130,13 +134,7 @@ def kepler_polar(e: float = 0.6) -> Scene:
     :func:`kepler` from the pericentre r = 1 − e, θ = 0, over 200 periods of 2π; exact reference
     r = 1 − e, θ = 400π, p = (0, √(1 − e²)). A general Lagrangian whose angle θ is cyclic: p_θ is
     conserved."""
-    return _scene(
-        "kepler_polar",
-        f"Kepler orbit in polar coordinates (r, θ), eccentricity {e}; θ cyclic",
-        2 * math.pi / 200,
-        {"E": -0.5, "p_theta": math.sqrt(1 - e * e)},
-        e=e,
-    )
+    return get("kepler_polar", e=e)
 
 
 def charged_particle(B: float = 1.0) -> Scene:
@@ -144,13 +142,7 @@ def charged_particle(B: float = 1.0) -> Scene:
     gauge): L = ½|q̇|² + (B/2)(x ẏ − y ẋ). From q = (1, 0), q̇ = (0, −B) it gyrates on the unit
     circle at Ω = B, the exact solution at t = 10. A general Lagrangian, rotation invariant:
     the canonical angular momentum is conserved."""
-    return _scene(
-        "charged_particle",
-        f"charged particle in the uniform field B = {B}",
-        0.05,
-        {"E": 0.5 * B * B, "L": -0.5 * B},
-        b=B,
-    )
+    return get("charged_particle", b=B)
 
 
 def charged_particle_nonuniform() -> Scene:
@@ -158,12 +150,7 @@ def charged_particle_nonuniform() -> Scene:
     gauge, as the closure example of the README): L = ½|q̇|² + A(q)·q̇ with
     A(q) = ½(1 + |q|²/8)(−y, x). From q = (1, 0), q̇ = (0, −1) to t = 200; it gyrates and drifts
     about the origin. Rotation invariant: the canonical angular momentum is conserved."""
-    return _scene(
-        "charged_particle_nonuniform",
-        "charged particle in the field B(q) = (1 + |q|²/4) ẑ",
-        0.05,
-        {"E": 0.5, "L": -0.4375},
-    )
+    return get("charged_particle_nonuniform")
 
 
 def damped_driven_pendulum(gamma: float = 0.5, amplitude: float = 1.5, drive: float = 2.0 / 3.0) -> Scene:
@@ -172,15 +159,7 @@ def damped_driven_pendulum(gamma: float = 0.5, amplitude: float = 1.5, drive: fl
     A cos Ωt as a force. The defaults are Baker & Gollub's chaotic regime (q = 1/γ = 2,
     g = A = 1.5, ω_D = Ω = 2/3). Forced, so nothing is conserved; the energy changes by the
     tracked work ``traj.work``."""
-    return _scene(
-        "damped_driven_pendulum",
-        f"damped driven pendulum, γ = {gamma:g}, A = {amplitude:g}, Ω = {drive:g}",
-        0.01,
-        {},
-        gamma=gamma,
-        amplitude=amplitude,
-        drive=drive,
-    )
+    return get("damped_driven_pendulum", gamma=gamma, amplitude=amplitude, drive=drive)
 
 
 def nbody(masses: ArrayLike, positions: ArrayLike, velocities: ArrayLike, G: float = 1.0, t_end: float = 1.0, dt: float = 1e-3) -> Scene:
@@ -200,28 +179,21 @@ def cartesian_pendulum() -> Scene:
     """The planar pendulum in Cartesian coordinates (x, y) on x² + y² = 1 (m = l = g = 1,
     U = gy), released from rest 2 rad from the downward vertical; RATTLE at h = 0.1 over
     T = 10⁴ is the published protocol (reference/scenes.json)."""
-    return _scene(
-        "cartesian_pendulum", "the pendulum in Cartesian coordinates on x² + y² = 1", 0.1, {"H": -math.cos(2.0)}
-    )
+    return get("cartesian_pendulum")
 
 
 def cartesian_spherical_pendulum() -> Scene:
     """The spherical pendulum in Cartesian coordinates on |x| = 1 from θ = 1, θ̇ = 0,
     φ̇ = 1.2 to T = 50; the reference holds the positions of the (θ, φ) reference angles, and
     L_z is conserved."""
-    return _scene(
-        "cartesian_spherical_pendulum",
-        "the spherical pendulum in Cartesian coordinates on |x| = 1",
-        0.01,
-        {"H": -0.030489444711168545, "L_z": 0.8496881019282854},
-    )
+    return get("cartesian_spherical_pendulum")
 
 
 def planar_chain(links: int = 8) -> Scene:
     """A planar chain of ``links`` unit masses on unit links from the origin (g = 1), released
     from rest straight at 1 rad from the downward vertical: 2·links coordinates and ``links``
     constraints."""
-    return _scene("planar_chain", f"a planar chain of {links} rigid links", 0.01, {}, links=links)
+    return get("planar_chain", links=links)
 
 
 def rigid_body() -> Scene:
@@ -229,33 +201,4 @@ def rigid_body() -> Scene:
     1.0), U = q₁² − q₂² − q₃² + q₄², from q₀ = (0.4, 0.2, 0.4, 0.8) with body angular momentum
     (0.2, 1, 0.4) (HLW's rigid-body data): configuration-dependent mass on |q| = 1, integrated by
     the constrained DEL equations of ``trapezoid`` (the default) or ``midpoint``."""
-    return _scene("rigid_body", "a rigid body in unit quaternions on |q| = 1", 0.01, {})
-
-
-CATALOGUE: dict[str, Callable[[], Scene]] = {
-    "harmonic_oscillator": harmonic_oscillator,
-    "pendulum": pendulum,
-    "kepler": kepler,
-    "henon_heiles": henon_heiles,
-    "fermi_pasta_ulam": fermi_pasta_ulam,
-    "outer_solar_system": outer_solar_system,
-    "double_pendulum": double_pendulum,
-    "spherical_pendulum": spherical_pendulum,
-    "heavy_top": heavy_top,
-    "kepler_polar": kepler_polar,
-    "charged_particle": charged_particle,
-    "charged_particle_nonuniform": charged_particle_nonuniform,
-    "damped_driven_pendulum": damped_driven_pendulum,
-    "cartesian_pendulum": cartesian_pendulum,
-    "cartesian_spherical_pendulum": cartesian_spherical_pendulum,
-    "planar_chain": planar_chain,
-    "rigid_body": rigid_body,
-}
-
-
-def get(name: str) -> Scene:
-    """The scene called ``name`` with its default parameters (see :data:`CATALOGUE`)."""
-    try:
-        return CATALOGUE[name]()
-    except KeyError:
-        raise ValueError(f"name: unknown scene {name!r}; choose one of {', '.join(CATALOGUE)}") from None
+    return get("rigid_body")

@@ -2,7 +2,8 @@
 
 import pytest
 
-from varmech.cli import TOUR, TOUR_REDUCED
+from varmech import scenes
+from varmech.cli import TOUR, TOUR_REDUCED, tour_runs
 
 
 def test_methods_table(run_cli):
@@ -13,12 +14,12 @@ def test_methods_table(run_cli):
 def test_tour_prints_reports_and_writes_plots(tmp_path, run_cli):
     pytest.importorskip("matplotlib")
     out = run_cli("tour", "--quick", "--out", tmp_path).stdout
-    runs = sum(len(methods) for _, methods, _ in TOUR) + sum(len(methods) for _, _, methods in TOUR_REDUCED)
-    assert runs == 40 and out.count("Conservation report") == runs
+    runs = sum(len(methods) for _, methods, _ in tour_runs()) + sum(len(methods) for _, _, methods in TOUR_REDUCED)
+    assert runs == 44 and out.count("Conservation report") == runs
     assert "max |G M⁻¹ p|" in out
     assert "verdict: secular drift" in out and "verdict: bounded" in out
     written = sorted(p.name for p in tmp_path.glob("*_energy.png"))
-    assert written == sorted(f"{name}_energy.png" for name, _, _ in TOUR)
+    assert written == sorted(f"{name}_energy.png" for name in scenes.CATALOGUE)
     # The charts, each with its data.
     for stem in ["work_precision_kepler", "energy_growth_kepler", "stability", "implicit_regions_pendulum", "phase_portrait_pendulum"]:
         assert (tmp_path / f"{stem}.png").exists() and (tmp_path / f"{stem}.csv").exists()
@@ -27,6 +28,15 @@ def test_tour_prints_reports_and_writes_plots(tmp_path, run_cli):
     assert out.count("max |ΔJ| = 0.000e+00") >= sum(len(c) * len(m) for _, c, m in TOUR_REDUCED)
     named = {line.split(" ", 1)[1] for line in out.splitlines() if line.startswith("wrote ")}
     assert named == {str(p) for p in tmp_path.iterdir()}
+
+
+def test_the_tour_runs_every_scene_with_its_showcase_or_its_kinds_methods():
+    runs = {scene.name: (methods, horizon) for scene, methods, horizon in tour_runs()}
+    assert list(runs) == list(scenes.CATALOGUE)
+    for name, (methods, horizon) in TOUR.items():
+        assert runs[name] == (methods, horizon if horizon is not None else scenes.get(name).t_end)
+    kind = scenes.damped_driven_pendulum().model.kind
+    assert runs["damped_driven_pendulum"] == ((kind.default_method, kind.accurate_method), 100.0)
 
 
 @pytest.mark.parametrize("kind", ["stability", "phase"])

@@ -2,30 +2,21 @@
 
 use pyo3::prelude::*;
 use varmech::integrators::{Dynamics, General};
-use varmech::model::{Constrained, Distances, HolonomicConstraints, MechanicalSystem};
-use varmech::scenes::{LagrangianScene, LinkedMasses, RigidBody, Scene};
+use varmech::model::{Constrained, HolonomicConstraints, MechanicalSystem};
+use varmech::scenes::{Scene, SceneModel};
 
 use crate::generator::Generator;
 
-/// A native scene: a separable mechanical system, a general Lagrangian, or a mechanical
-/// system on holonomic constraints.
-pub enum Native {
-    Mechanical(Scene),
-    General(LagrangianScene),
-    Constrained(LinkedMasses),
-    /// A general Lagrangian on constraints (the rigid body in quaternions).
-    ConstrainedGeneral(Constrained<RigidBody, Distances>),
-}
-
-/// A native scene: every evaluation runs in Rust, with the GIL released.
+/// A native scene, the core's [`SceneModel`]: every evaluation runs in Rust, with the GIL
+/// released.
 #[pyclass(frozen, module = "varmech._core")]
 pub struct NativeModel {
-    pub native: Native,
+    pub native: SceneModel,
     name: &'static str,
 }
 
 impl NativeModel {
-    pub fn new(native: Native, name: &'static str) -> Self {
+    pub fn new(native: SceneModel, name: &'static str) -> Self {
         NativeModel { native, name }
     }
 
@@ -33,10 +24,10 @@ impl NativeModel {
     /// [`General`] for the variational methods.
     pub fn with_integrable<R>(&self, body: impl FnOnce(&dyn Dynamics) -> R) -> R {
         match &self.native {
-            Native::Mechanical(scene) => body(scene),
-            Native::General(scene) => body(&General(scene)),
-            Native::Constrained(scene) => body(scene),
-            Native::ConstrainedGeneral(scene) => body(&Constrained {
+            SceneModel::Mechanical(scene) => body(scene),
+            SceneModel::General(scene) => body(&General(scene)),
+            SceneModel::Constrained(scene) => body(scene),
+            SceneModel::ConstrainedGeneral(scene) => body(&Constrained {
                 system: General(&scene.system),
                 constraints: scene.constraints.clone(),
             }),
@@ -60,7 +51,7 @@ impl NativeModel {
     #[getter]
     fn gravity(&self) -> Option<(f64, Vec<f64>)> {
         match &self.native {
-            Native::Mechanical(Scene::NBody(s)) => Some((s.gravitational_constant(), s.masses().to_vec())),
+            SceneModel::Mechanical(Scene::NBody(s)) => Some((s.gravitational_constant(), s.masses().to_vec())),
             _ => None,
         }
     }
@@ -69,10 +60,10 @@ impl NativeModel {
     #[getter]
     fn symmetries(&self) -> Vec<Generator> {
         let declared = match &self.native {
-            Native::Mechanical(s) => s.symmetries(),
-            Native::General(s) => s.symmetries(),
-            Native::Constrained(s) => s.system.symmetries(),
-            Native::ConstrainedGeneral(_) => Vec::new(),
+            SceneModel::Mechanical(s) => s.symmetries(),
+            SceneModel::General(s) => s.symmetries(),
+            SceneModel::Constrained(s) => s.system.symmetries(),
+            SceneModel::ConstrainedGeneral(_) => Vec::new(),
         };
         declared.into_iter().map(Generator::from).collect()
     }
@@ -81,8 +72,8 @@ impl NativeModel {
     #[getter]
     fn constraints(&self) -> usize {
         match &self.native {
-            Native::Constrained(s) => s.constraints.count(),
-            Native::ConstrainedGeneral(s) => s.constraints.count(),
+            SceneModel::Constrained(s) => s.constraints.count(),
+            SceneModel::ConstrainedGeneral(s) => s.constraints.count(),
             _ => 0,
         }
     }

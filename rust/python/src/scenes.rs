@@ -1,178 +1,185 @@
-//! The native scenes by name.
+//! The core's scene catalogue, as Python reads it: [`scene`] builds a scene by name with
+//! keyword parameters, [`catalogue`] lists the scenes; and [`nbody`], a custom N-body model.
 
 use numpy::PyArray1;
-use pyo3::exceptions::PyValueError;
+use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
-use pyo3::types::PyTuple;
-use varmech::scenes::{self, LagrangianScene, Problem, Scene};
+use pyo3::types::PyDict;
+use varmech::scenes::{self, Problem, Scene, SceneModel, Setup, CATALOGUE};
 
 use crate::errors::to_pyerr;
-use crate::native::{Native, NativeModel};
+use crate::native::NativeModel;
 
-type SceneTuple<'py> = (
-    NativeModel,
-    Bound<'py, PyArray1<f64>>,
-    Bound<'py, PyArray1<f64>>,
-    f64,
-    Option<Bound<'py, PyTuple>>,
-);
-
-fn scene_tuple<'py, S>(
-    py: Python<'py>,
-    p: Problem<S>,
-    wrap: impl FnOnce(S) -> Native,
-    name: &'static str,
-) -> PyResult<SceneTuple<'py>> {
-    let reference = match p.reference {
-        Some((r, source)) => {
-            Some((r.t, PyArray1::from_vec(py, r.q), PyArray1::from_vec(py, r.p), source).into_pyobject(py)?)
+/// The parameters' values by name: whole-number parameters as ints.
+fn parameters<'py>(py: Python<'py>, setup: &Setup) -> PyResult<Bound<'py, PyDict>> {
+    let values = PyDict::new(py);
+    for parameter in setup.entry().parameters {
+        let value = setup.get(parameter.name).unwrap_or(parameter.default);
+        if parameter.integer {
+            values.set_item(parameter.name, value as u64)?;
+        } else {
+            values.set_item(parameter.name, value)?;
         }
-        None => None,
-    };
-    Ok((
-        NativeModel::new(wrap(p.system), name),
-        PyArray1::from_vec(py, p.initial.q),
-        PyArray1::from_vec(py, p.initial.p),
-        p.t_end,
-        reference,
-    ))
+    }
+    Ok(values)
 }
 
-/// A native scene by name: (model, q0, p0, t_end, reference (t, q, p, source) or None). The
-/// keywords are the parameters of the scenes that take them: `e` (kepler, kepler_polar), `omega`
-/// (harmonic_oscillator), `b` (charged_particle), `gamma`, `amplitude` and `drive`
-/// (damped_driven_pendulum), `links` (planar_chain).
-#[pyfunction]
-#[pyo3(signature = (name, *, e=0.6, omega=1.0, b=1.0, gamma=0.5, amplitude=1.5, drive=2.0 / 3.0, links=8))]
-#[allow(clippy::too_many_arguments)]
-fn scene<'py>(
-    py: Python<'py>,
-    name: &str,
-    e: f64,
-    omega: f64,
-    b: f64,
-    gamma: f64,
-    amplitude: f64,
-    drive: f64,
-    links: usize,
-) -> PyResult<SceneTuple<'py>> {
-    let mech = |s| Native::Mechanical(s);
-    let err = |e| to_pyerr(py, e);
-    match name {
-        "harmonic_oscillator" => {
-            let p = scenes::HarmonicOscillator::problem(omega).map_err(err)?;
-            scene_tuple(py, p, |s| mech(Scene::HarmonicOscillator(s)), "harmonic_oscillator")
-        }
-        "pendulum" => scene_tuple(
-            py,
-            scenes::Pendulum::problem(),
-            |s| mech(Scene::Pendulum(s)),
-            "pendulum",
-        ),
-        "kepler" => scene_tuple(
-            py,
-            scenes::Kepler::problem(e).map_err(err)?,
-            |s| mech(Scene::Kepler(s)),
-            "kepler",
-        ),
-        "henon_heiles" => scene_tuple(
-            py,
-            scenes::HenonHeiles::problem(),
-            |s| mech(Scene::HenonHeiles(s)),
-            "henon_heiles",
-        ),
-        "fermi_pasta_ulam" => scene_tuple(
-            py,
-            scenes::FermiPastaUlam::problem(),
-            |s| mech(Scene::FermiPastaUlam(s)),
-            "fermi_pasta_ulam",
-        ),
-        "outer_solar_system" => scene_tuple(
-            py,
-            scenes::NBody::outer_solar_system(),
-            |s| mech(Scene::NBody(s)),
-            "outer_solar_system",
-        ),
-        "double_pendulum" => scene_tuple(
-            py,
-            scenes::DoublePendulum::problem(),
-            |s| Native::General(LagrangianScene::DoublePendulum(s)),
-            "double_pendulum",
-        ),
-        "spherical_pendulum" => scene_tuple(
-            py,
-            scenes::SphericalPendulum::problem(),
-            |s| Native::General(LagrangianScene::SphericalPendulum(s)),
-            "spherical_pendulum",
-        ),
-        "charged_particle" => scene_tuple(
-            py,
-            scenes::ChargedParticle::uniform_field(b).map_err(err)?,
-            |s| Native::General(LagrangianScene::ChargedParticle(s)),
-            "charged_particle",
-        ),
-        "charged_particle_nonuniform" => scene_tuple(
-            py,
-            scenes::ChargedParticle::nonuniform_field(),
-            |s| Native::General(LagrangianScene::ChargedParticle(s)),
-            "charged_particle_nonuniform",
-        ),
-        "damped_driven_pendulum" => scene_tuple(
-            py,
-            scenes::DampedDrivenPendulum::problem(gamma, amplitude, drive).map_err(err)?,
-            |s| Native::General(LagrangianScene::DampedDrivenPendulum(s)),
-            "damped_driven_pendulum",
-        ),
-        "heavy_top" => scene_tuple(
-            py,
-            scenes::HeavyTop::problem(),
-            |s| Native::General(LagrangianScene::HeavyTop(s)),
-            "heavy_top",
-        ),
-        "kepler_polar" => scene_tuple(
-            py,
-            scenes::KeplerPolar::problem(e).map_err(err)?,
-            |s| Native::General(LagrangianScene::KeplerPolar(s)),
-            "kepler_polar",
-        ),
-        "cartesian_pendulum" => scene_tuple(
-            py,
-            scenes::cartesian_pendulum(),
-            Native::Constrained,
-            "cartesian_pendulum",
-        ),
-        "cartesian_spherical_pendulum" => scene_tuple(
-            py,
-            scenes::cartesian_spherical_pendulum(),
-            Native::Constrained,
-            "cartesian_spherical_pendulum",
-        ),
-        "rigid_body" => scene_tuple(
-            py,
-            scenes::RigidBody::problem(),
-            Native::ConstrainedGeneral,
-            "rigid_body",
-        ),
-        "planar_chain" => scene_tuple(
-            py,
-            scenes::planar_chain(links).map_err(err)?,
-            Native::Constrained,
-            "planar_chain",
-        ),
-        _ => Err(PyValueError::new_err(format!("name: unknown scene {name:?}"))),
+/// One scene of the catalogue: its name, its parameters with their defaults, and its
+/// description with them.
+#[pyclass(frozen, name = "CatalogueEntry", module = "varmech._core")]
+pub struct PyCatalogueEntry(Setup);
+
+#[pymethods]
+impl PyCatalogueEntry {
+    #[getter]
+    fn name(&self) -> &'static str {
+        self.0.entry().name
+    }
+
+    /// The defaults of the parameters, by name.
+    #[getter]
+    fn parameters<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        parameters(py, &self.0)
+    }
+
+    #[getter]
+    fn description(&self) -> String {
+        self.0.description()
+    }
+
+    fn __repr__(&self) -> String {
+        format!("CatalogueEntry({:?})", self.0.entry().name)
     }
 }
 
-/// A native gravitational N-body model in 3 dimensions.
+/// A scene's reference solution at time `t`, exact or published, and where it comes from.
+#[pyclass(frozen, get_all, module = "varmech._core")]
+pub struct SceneReference {
+    t: f64,
+    q: Py<PyArray1<f64>>,
+    p: Py<PyArray1<f64>>,
+    source: &'static str,
+}
+
+/// A scene built from the catalogue: the model with its initial state (`q0`, `p0`), horizon
+/// `t_end` and reference, and from the catalogue its description, step `dt`, invariants at
+/// t = 0 and the values of its parameters.
+#[pyclass(frozen, module = "varmech._core")]
+pub struct SceneRecord {
+    setup: Setup,
+    #[pyo3(get)]
+    model: Py<NativeModel>,
+    #[pyo3(get)]
+    q0: Py<PyArray1<f64>>,
+    #[pyo3(get)]
+    p0: Py<PyArray1<f64>>,
+    #[pyo3(get)]
+    t_end: f64,
+    #[pyo3(get)]
+    reference: Option<Py<SceneReference>>,
+}
+
+impl SceneRecord {
+    fn new(py: Python<'_>, setup: Setup, problem: Problem<SceneModel>) -> PyResult<Self> {
+        let reference = match problem.reference {
+            Some((state, source)) => Some(Py::new(
+                py,
+                SceneReference {
+                    t: state.t,
+                    q: PyArray1::from_vec(py, state.q).unbind(),
+                    p: PyArray1::from_vec(py, state.p).unbind(),
+                    source,
+                },
+            )?),
+            None => None,
+        };
+        Ok(SceneRecord {
+            model: Py::new(py, NativeModel::new(problem.system, setup.entry().name))?,
+            q0: PyArray1::from_vec(py, problem.initial.q).unbind(),
+            p0: PyArray1::from_vec(py, problem.initial.p).unbind(),
+            t_end: problem.t_end,
+            reference,
+            setup,
+        })
+    }
+}
+
+#[pymethods]
+impl SceneRecord {
+    #[getter]
+    fn name(&self) -> &'static str {
+        self.setup.entry().name
+    }
+
+    #[getter]
+    fn description(&self) -> String {
+        self.setup.description()
+    }
+
+    #[getter]
+    fn dt(&self) -> f64 {
+        self.setup.dt()
+    }
+
+    /// The conserved quantities by name, with their values at t = 0.
+    #[getter]
+    fn invariants<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let invariants = PyDict::new(py);
+        for (name, value) in self.setup.invariants() {
+            invariants.set_item(name, value)?;
+        }
+        Ok(invariants)
+    }
+
+    /// The values of the parameters the scene was built with, by name.
+    #[getter]
+    fn parameters<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        parameters(py, &self.setup)
+    }
+
+    fn __repr__(&self) -> String {
+        format!("SceneRecord({:?})", self.setup.entry().name)
+    }
+}
+
+/// The catalogue scene `name` with its parameters set by keyword (the others at their
+/// defaults); ValueError for an unknown scene or parameter, or a value out of range.
+#[pyfunction]
+#[pyo3(signature = (name, **parameters))]
+fn scene(py: Python<'_>, name: &str, parameters: Option<&Bound<'_, PyDict>>) -> PyResult<SceneRecord> {
+    let mut setup = scenes::lookup(name).map_err(|e| to_pyerr(py, e))?.setup();
+    for (key, value) in parameters.into_iter().flat_map(|d| d.iter()) {
+        let key: String = key.extract()?;
+        let value: f64 = value
+            .extract()
+            .map_err(|_| PyTypeError::new_err(format!("{key}: must be a number")))?;
+        setup.set(&key, value).map_err(|e| to_pyerr(py, e))?;
+    }
+    let problem = setup.build().map_err(|e| to_pyerr(py, e))?;
+    SceneRecord::new(py, setup, problem)
+}
+
+/// Every scene of the catalogue, in the order of the tour, with its defaults.
+#[pyfunction]
+fn catalogue() -> Vec<PyCatalogueEntry> {
+    CATALOGUE.iter().map(|entry| PyCatalogueEntry(entry.setup())).collect()
+}
+
+/// A native gravitational N-body model in 3 dimensions (not a catalogue scene: its masses are
+/// the caller's).
 #[pyfunction]
 fn nbody(py: Python<'_>, g: f64, masses: Vec<f64>) -> PyResult<NativeModel> {
     let system = scenes::NBody::new(g, masses).map_err(|e| to_pyerr(py, e))?;
-    Ok(NativeModel::new(Native::Mechanical(Scene::NBody(system)), "nbody"))
+    Ok(NativeModel::new(SceneModel::Mechanical(Scene::NBody(system)), "nbody"))
 }
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<NativeModel>()?;
+    m.add_class::<PyCatalogueEntry>()?;
+    m.add_class::<SceneRecord>()?;
+    m.add_class::<SceneReference>()?;
     m.add_function(wrap_pyfunction!(scene, m)?)?;
+    m.add_function(wrap_pyfunction!(catalogue, m)?)?;
     m.add_function(wrap_pyfunction!(nbody, m)?)?;
     Ok(())
 }

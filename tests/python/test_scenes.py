@@ -1,0 +1,88 @@
+"""The scenes come from the core's catalogue: each builds from Python with its defaults, its
+stated invariants are the model's energy and momenta at t = 0, parameters change the model, and
+unknown names are refused by name."""
+
+import inspect
+import math
+
+import numpy as np
+import pytest
+
+from varmech import _core, examples, scenes
+from varmech.analysis._energy import energy_of
+
+#: The catalogue names cyclic momenta by their angle; the model's generators by their index.
+CYCLIC = {"p_phi": "p[1]", "p_theta": "p[1]", "p_psi": "p[2]"}
+
+
+def oscillatory_energy(q, p, omega=50.0):
+    """The Fermi–Pasta–Ulam adiabatic invariant I = Σⱼ ½(ẋⱼ² + ω²xⱼ²) with
+    xⱼ = (q₂ⱼ − q₂ⱼ₋₁)/√2 over the stiff springs (unit masses)."""
+    x = (q[1::2] - q[0::2]) / math.sqrt(2)
+    y = (p[1::2] - p[0::2]) / math.sqrt(2)
+    return float(np.sum(0.5 * (y * y + omega * omega * x * x)))
+
+
+def computed(scene, name):
+    """The invariant ``name`` computed from the scene's model at (q0, p0)."""
+    q, p = scene.q0, scene.p0
+    if name in ("H", "E"):
+        return float(energy_of(scene.model, np.zeros(1), q[None, :], p[None, :])[0])
+    if name == "I":
+        return oscillatory_energy(q, p)
+    generator = next(g for g in scene.model._core.symmetries if g.name == CYCLIC.get(name, name))
+    return float(_core.momentum(generator, q[None, :], p[None, :])[0])
+
+
+@pytest.mark.parametrize("name", list(scenes.CATALOGUE))
+def test_every_scene_builds_with_its_defaults(name):
+    entry = scenes.CATALOGUE[name]
+    scene = scenes.get(name)
+    assert scene.name == name and scene.model.name == name
+    assert scene.description == entry.description and scene.parameters == entry.parameters
+    assert scene.dt > 0 and scene.t_end > 0
+    assert scene.q0.shape == scene.p0.shape == (scene.model.dim,)
+    for invariant, stated in scene.invariants.items():
+        assert computed(scene, invariant) == pytest.approx(stated, rel=1e-12, abs=0.0), invariant
+
+
+@pytest.mark.parametrize("name", list(scenes.CATALOGUE))
+def test_the_scene_functions_are_the_catalogue_with_its_defaults(name):
+    function = getattr(scenes, name)
+    assert function().description == scenes.CATALOGUE[name].description
+    defaults = {p.name.lower(): p.default for p in inspect.signature(function).parameters.values()}
+    assert defaults == scenes.CATALOGUE[name].parameters
+
+
+def test_a_parameter_changes_the_model():
+    scene = scenes.kepler(e=0.3)
+    assert scene.parameters == {"e": 0.3} and scene.description == "Kepler orbit, eccentricity 0.3"
+    assert computed(scene, "H") == pytest.approx(-0.5, rel=1e-12)
+    assert abs(computed(scene, "L")) == pytest.approx(math.sqrt(1 - 0.3**2), rel=1e-12)
+    assert scene.invariants == {"H": -0.5, "L": math.sqrt(1 - 0.3**2)}
+    assert scene.reference is not None and scene.reference.q[0] == pytest.approx(0.7)
+    chain = scenes.planar_chain(links=3)
+    assert chain.model.dim == 6 and chain.model.constraints == 3 and chain.parameters == {"links": 3}
+
+
+def test_an_unknown_scene_is_refused_by_name():
+    with pytest.raises(ValueError, match="tippe_top") as err:
+        scenes.get("tippe_top")
+    assert all(name in str(err.value) for name in scenes.CATALOGUE)
+
+
+def test_an_unknown_parameter_is_refused_by_name():
+    with pytest.raises(ValueError, match="omega"):
+        scenes.get("kepler", omega=2.0)
+    with pytest.raises(ValueError, match="links"):
+        scenes.planar_chain(links=2.5)
+    with pytest.raises(ValueError, match="e"):
+        scenes.kepler(e=1.5)
+    with pytest.raises(TypeError, match="e: must be a number"):
+        scenes.get("kepler", e="high")
+
+
+def test_a_scene_without_a_closure_twin_is_refused_by_name():
+    assert examples.closure_of(scenes.charged_particle_nonuniform()).name == "charged_particle (closure)"
+    with pytest.raises(ValueError, match="planar_chain"):
+        examples.closure_of(scenes.planar_chain())
