@@ -41,6 +41,7 @@ from .integrate import Trajectory, integrate, symplecticity_defect
 from .methods import MethodInfo, methods
 from .model import Cyclic, Lagrangian, MechanicalSystem, Model, NativeSystem, Rotation, Translation
 from .reduction import ReducedModel, cyclic_coordinates, routh
+from .stepper import Stepper
 from .table import Table
 
 __version__ = "0.1.0"
@@ -61,6 +62,7 @@ __all__ = [
     "ReducedModel",
     "Rotation",
     "SpuriousBranchError",
+    "Stepper",
     "Table",
     "Trajectory",
     "Translation",

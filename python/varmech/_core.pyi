@@ -23,6 +23,7 @@ __all__ = [
     "SceneRecord",
     "SceneReference",
     "SpuriousBranchError",
+    "Stepper",
     "TrajectoryRecord",
     "VarmechError",
     "amended_potential",
@@ -102,6 +103,50 @@ class TrajectoryRecord:
     @property
     def work(self) -> _FloatArray:
         """Cumulative work of the non-conservative forces at each saved state."""
+
+@final
+class Stepper:
+    """One model, one method and the state, advanced step by step."""
+
+    def __new__(
+        cls,
+        model: _Model,
+        q0: _FloatArray,
+        p0: _FloatArray,
+        *,
+        dt: float,
+        method: str,
+        t0: float = 0.0,
+        compensated: bool = True,
+        newton_tolerance: float = 1e-14,
+        newton_max_iterations: int = 50,
+    ) -> Stepper: ...
+    def step(self) -> None:
+        """Advances one step."""
+    def advance(self, n: int) -> None:
+        """Advances `n` steps, checking for Ctrl-C on the way."""
+    def reset(self, q0: _FloatArray, p0: _FloatArray, t0: float) -> None:
+        """Starts afresh from (q0, p0) at t0, with the step count at 0."""
+    @property
+    def t(self) -> float: ...
+    @property
+    def q(self) -> _FloatArray: ...
+    @property
+    def p(self) -> _FloatArray: ...
+    @property
+    def steps(self) -> int: ...
+    @property
+    def dt(self) -> float: ...
+    @dt.setter
+    def dt(self, dt: float) -> None: ...
+    @property
+    def method(self) -> str: ...
+    @property
+    def force_evaluations(self) -> int: ...
+    @property
+    def newton_iterations(self) -> int: ...
+    @property
+    def work(self) -> float: ...
 
 @final
 class MethodInfo:

@@ -30,3 +30,21 @@ def positive(name: str, x: float) -> float:
     if not (math.isfinite(v) and v > 0):
         raise ValueError(f"{name}: must be finite and positive, got {x!r}")
     return v
+
+
+def finite(name: str, x: float) -> float:
+    """``x`` as a finite float, or ValueError naming ``name``."""
+    try:
+        v = float(x)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name}: must be a number, got {x!r}") from None
+    if not math.isfinite(v):
+        raise ValueError(f"{name}: must be finite, got {v}")
+    return v
+
+
+def positive_int(name: str, x: int) -> int:
+    """``x`` as a positive int, or ValueError naming ``name``."""
+    if isinstance(x, bool) or not isinstance(x, (int, np.integer)) or x < 1:
+        raise ValueError(f"{name}: must be a positive integer, got {x!r}")
+    return int(x)

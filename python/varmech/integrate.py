@@ -10,7 +10,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from . import _core
-from ._util import positive, vector
+from ._util import finite, positive, positive_int, vector
 from .model import Model
 
 if TYPE_CHECKING:
@@ -105,6 +105,41 @@ def _steps(dt: float, t0: float, steps: int | None, t_end: float | None) -> int:
     return n
 
 
+def _model_of(
+    model: Model | Scene, q0: ArrayLike | None, p0: ArrayLike | None, v0: ArrayLike | None
+) -> tuple[Model, ArrayLike | None, ArrayLike | None]:
+    """The model of a model or scene, and (q0, p0), a scene's initial state by default."""
+    from .scenes import Scene
+
+    if isinstance(model, Scene):
+        if q0 is None:
+            q0 = model.q0
+            if p0 is None and v0 is None:
+                p0 = model.p0
+        model = model.model
+    if not isinstance(model, Model):
+        raise TypeError(f"model: expected a varmech model or scene, got {type(model).__name__}")
+    return model, q0, p0
+
+
+def _initial_state(model: Model, q0: ArrayLike | None, p0: ArrayLike | None, v0: ArrayLike | None, t0: float) -> tuple[np.ndarray, np.ndarray]:
+    """(q0, p0) checked, p0 from the velocities v0 (p0 = ∂L/∂q̇(q0, v0, t0)) when given instead."""
+    n = model.dim
+    if q0 is None:
+        raise ValueError("q0: the initial positions are required")
+    q = vector("q0", q0, n)
+    if p0 is not None and v0 is None:
+        return q, vector("p0", p0, n)
+    if v0 is not None and p0 is None:
+        return q, model.momentum(q, vector("v0", v0, n), t0)
+    raise ValueError("p0, v0: give exactly one of the initial momenta p0 and velocities v0")
+
+
+def _newton(tolerance: float, max_iterations: int) -> tuple[float, int]:
+    """The implicit methods' Newton tolerance and iteration cap, checked."""
+    return positive("newton_tolerance", tolerance), positive_int("newton_max_iterations", max_iterations)
+
+
 def integrate(
     model: Model | Scene,
     q0: ArrayLike | None = None,
@@ -171,40 +206,17 @@ def integrate(
         An exception raised by a closure (or KeyboardInterrupt) propagates unchanged, with
         ``err.partial``, ``err.step`` and ``err.time`` attached where the exception allows.
     """
-    from .scenes import Scene
-
-    if isinstance(model, Scene):
-        if q0 is None:
-            q0 = model.q0
-            if p0 is None and v0 is None:
-                p0 = model.p0
-        model = model.model
-    if not isinstance(model, Model):
-        raise TypeError(f"model: expected a varmech model or scene, got {type(model).__name__}")
-    n = model.dim
+    model, q0, p0 = _model_of(model, q0, p0, v0)
     if method is None:
         method = model.kind.default_method
     dt = positive("dt", dt)
-    t0 = float(t0)
-    if not math.isfinite(t0):
-        raise ValueError(f"t0: must be finite, got {t0}")
+    t0 = finite("t0", t0)
     nsteps = _steps(dt, t0, steps, t_end)
-    if isinstance(save_every, bool) or not isinstance(save_every, (int, np.integer)) or save_every < 1:
-        raise ValueError(f"save_every: must be a positive integer, got {save_every!r}")
+    save_every = positive_int("save_every", save_every)
     if max_energy_error is not None:
         max_energy_error = positive("max_energy_error", max_energy_error)
-    newton_tolerance = positive("newton_tolerance", newton_tolerance)
-    if isinstance(newton_max_iterations, bool) or not isinstance(newton_max_iterations, (int, np.integer)) or newton_max_iterations < 1:
-        raise ValueError(f"newton_max_iterations: must be a positive integer, got {newton_max_iterations!r}")
-    if q0 is None:
-        raise ValueError("q0: the initial positions are required")
-    q = vector("q0", q0, n)
-    if p0 is not None and v0 is None:
-        p = vector("p0", p0, n)
-    elif v0 is not None and p0 is None:
-        p = model.momentum(q, vector("v0", v0, n), t0)
-    else:
-        raise ValueError("p0, v0: give exactly one of the initial momenta p0 and velocities v0")
+    newton_tolerance, newton_max_iterations = _newton(newton_tolerance, newton_max_iterations)
+    q, p = _initial_state(model, q0, p0, v0, t0)
     try:
         record = _core.integrate(
             model._core,
@@ -213,12 +225,12 @@ def integrate(
             dt=dt,
             steps=nsteps,
             method=method,
-            save_every=int(save_every),
+            save_every=save_every,
             compensated=bool(compensated),
             max_energy_error=max_energy_error,
             t0=t0,
             newton_tolerance=newton_tolerance,
-            newton_max_iterations=int(newton_max_iterations),
+            newton_max_iterations=newton_max_iterations,
         )
     except BaseException as err:
         partial = getattr(err, "_varmech_partial", None)

@@ -1,12 +1,12 @@
 //! The native step loop allocates nothing: a long run makes exactly as many allocations as a
 //! run of 100 steps (the set-up's), whatever the method, and so does RATTLE's on a chain; a
-//! stepper's steps make none at all.
+//! stepper's steps make none at all, nor does taking it apart, resuming and resetting it.
 
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
 use std::ops::Deref;
 
-use varmech::integrators::{integrate, Dynamics, General, Method, Options, Stepper};
+use varmech::integrators::{integrate, Dynamics, General, Method, Options, Stepper, StepperState};
 use varmech::model::Routhian;
 use varmech::scenes::{self, NBody};
 
@@ -181,5 +181,27 @@ fn the_stepper_allocates_nothing() {
         let stepper = Stepper::new(&chain.system, method, &chain.initial.q, &chain.initial.p, &options).unwrap();
         let count = stepper_allocations(stepper, 200);
         assert_eq!(count, 0, "{method:?}: {count} allocations in 200 steps");
+    }
+}
+
+#[test]
+fn resuming_and_resetting_a_stepper_allocates_nothing() {
+    let problem = NBody::outer_solar_system();
+    let (q0, p0) = (&problem.initial.q, &problem.initial.p);
+    for method in [Method::Verlet, Method::Midpoint] {
+        let mut first = Stepper::new(&problem.system, method, q0, p0, &Options::new(10.0, 0)).unwrap();
+        first.step().unwrap();
+        let mut state: StepperState = first.into_state();
+        let before = allocated();
+        let mut borrowed = Stepper::resume(&problem.system, &mut state).unwrap();
+        borrowed.advance(50, || Ok(())).unwrap();
+        borrowed.reset(0.0, q0, p0).unwrap();
+        borrowed.set_dt(5.0).unwrap();
+        borrowed.advance(50, || Ok(())).unwrap();
+        let mut owned = Stepper::resume(&problem.system, state).unwrap();
+        owned.step().unwrap();
+        let count = allocated() - before;
+        assert_eq!(count, 0, "{method:?}: {count} allocations");
+        assert_eq!(owned.steps(), 51);
     }
 }

@@ -31,7 +31,7 @@ size τ instead of h, local error O(τ^{p+1})), it lies on the section to round-
 ≤ 1.1e-17 measured), and its energy error is the method's own, of the same size as at the grid
 points (order 6 for kahan_li6: 1.3e-9, 2.0e-11, 3.2e-13 at h = 0.1, 0.05, 0.025). Integrating
 the exact flow (kahan_li8, 64 substeps) from the same grid state over the same τ lands within
-1.1e-12 of it, on x = 0 to 1.1e-12. The crossing costs two or three extra one-step calls.
+1.1e-12 of it, on x = 0 to 1.1e-12. The crossing costs two or three extra steps of one :class:`~varmech.Stepper`.
 """
 
 from __future__ import annotations
@@ -49,6 +49,7 @@ from .._util import positive
 from ..integrate import Trajectory, integrate
 from ..model import Model
 from ..scenes import Scene
+from ..stepper import Stepper
 from ..table import Table
 from ._energy import energy_of
 from ._interrupt import interruptible
@@ -335,12 +336,16 @@ def _hermite_points(model: Model, traj: Trajectory, idx: np.ndarray, k: int, c: 
 
 def _partial_step(model: Model, q0: np.ndarray, p0: np.ndarray, t0: float, h: float, tau: float, k: int, c: float, sign: float, method: str):
     """The crossing on the integrator's own map: τ with the step Φ_τ(q0, p0) on the section,
-    by Newton (q̇_k at the end as the slope) safeguarded by bisection on [0, h]."""
+    by Newton (q̇_k at the end as the slope) safeguarded by bisection on [0, h]. Each trial τ
+    is one step of one stepper, reset to (q0, p0) at t0."""
     lo, hi = 0.0, h
     best = None
+    stepper = Stepper(model, q0, p0, dt=tau, method=method, t0=t0)
     for _ in range(40):
-        tr = integrate(model, q0, p0, dt=tau, steps=1, method=method, t0=t0)
-        q, p = tr.q[-1], tr.p[-1]
+        stepper.reset(q0, p0, t0=t0)
+        stepper.dt = tau
+        stepper.step()
+        q, p = stepper.q, stepper.p
         g = sign * (q[k] - c)
         if best is None or abs(g) < abs(best[0]):
             best = (g, tau, q, p)

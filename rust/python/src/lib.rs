@@ -20,6 +20,7 @@ mod native;
 mod routh;
 mod run;
 mod scenes;
+mod stepper;
 mod trajectory;
 
 use pyo3::prelude::*;
@@ -33,6 +34,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     scenes::register(m)?;
     routh::register(m)?;
     run::register(m)?;
+    m.add_class::<stepper::Stepper>()?;
     diagnostics::register(m)?;
     constraints::register(m)?;
     Ok(())

@@ -11,7 +11,8 @@
 //!   either on holonomic constraints);
 //! - [`KickDrift`]: Störmer–Verlet, symplectic Euler and the symmetric compositions of Verlet;
 //! - [`ExplicitRk`]: explicit Euler and classical RK4, the non-structure-preserving baselines;
-//! - [`Stepper`]: one model, one method and the state, advanced step by step;
+//! - [`Stepper`]: one model, one method and the state, advanced step by step; its
+//!   [`StepperState`] apart from the model, to resume;
 //! - [`integrate`]: a run of a [`Stepper`] with saving and an energy check, into a
 //!   [`Trajectory`].
 
@@ -43,7 +44,7 @@ pub use method::{Method, MethodInfo};
 pub use rattle::Rattle;
 pub use run::{integrate, Options};
 pub use step::{Increment, StepStart};
-pub use stepper::Stepper;
+pub use stepper::{Stepper, StepperState};
 pub use trajectory::{Failure, Trajectory};
 
 use crate::discrete::{Midpoint, Trapezoidal};

@@ -1,5 +1,6 @@
-//! One model, one method and the state, advanced step by step.
+//! One model, one method and the state, advanced step by step; the state apart from its model.
 
+use std::borrow::{Borrow, BorrowMut};
 use std::ops::Deref;
 
 use super::interrupt::InterruptPoll;
@@ -7,17 +8,35 @@ use super::{compensated, Dynamics, Increment, Integrator, Method, Options, StepS
 use crate::error::check_vector;
 use crate::{Error, ModelError};
 
-/// A model `M` (a reference `&S` to borrow it, a `Box<S>` to own it) with a method's
-/// [`Integrator`] and the state (tₙ, qₙ, pₙ) after n steps of size h from (t₀, q₀, p₀):
-/// tₙ = t₀ + n·h, (qₙ₊₁, pₙ₊₁) = (qₙ + δq, pₙ + δp), the increments added with compensated
-/// summation (Kahan; the lost low-order bits carried in (e_q, e_p)) unless switched off.
+/// A model `M` (a reference `&S` to borrow it, a `Box<S>` to own it) with its [`StepperState`]
+/// `St`: a method's [`Integrator`] and the state (tₙ, qₙ, pₙ) after n steps of size h from
+/// (t₀, q₀, p₀): tₙ = t₀ + n·h, (qₙ₊₁, pₙ₊₁) = (qₙ + δq, pₙ + δp), the increments added with
+/// compensated summation (Kahan; the lost low-order bits carried in (e_q, e_p)) unless switched
+/// off.
+///
+/// The state is owned (`St = StepperState`, the default) or borrowed (`&mut StepperState`):
+/// [`Stepper::into_state`] takes a stepper apart and [`Stepper::resume`] puts it back together
+/// with its model, and the steps continue bit for bit as if it had never been taken apart. A
+/// stepper reads as its state ([`StepperState::t`], [`StepperState::q`], …).
 ///
 /// A step allocates nothing, and a step that fails leaves the last good state in place.
 #[derive(Debug)]
-pub struct Stepper<M> {
+pub struct Stepper<M, St = StepperState> {
     model: M,
+    state: St,
+}
+
+/// Everything of a [`Stepper`] but its model: the [`Integrator`] with its caches and Newton
+/// predictor, the time, the steps, (qₙ, pₙ), the compensated-summation carries and the work
+/// buffers. Kept between calls, it lets a stepper run on a model that is only borrowed for the
+/// length of each call.
+#[derive(Clone, Debug)]
+pub struct StepperState {
     integrator: Integrator,
+    /// tₙ = t₀ + (n − n₀)·h: the time t₀ and steps n₀ when h was last set (see
+    /// [`Stepper::set_dt`]).
     t0: f64,
+    n0: usize,
     h: f64,
     steps: usize,
     compensated: bool,
@@ -62,10 +81,10 @@ where
         }
         model.check_initial(q0, p0)?;
         let zeros = || vec![0.0; n];
-        Ok(Stepper {
+        let state = StepperState {
             integrator: Integrator::with_newton(method, n, options.newton),
-            model,
             t0: options.t0,
+            n0: 0,
             h: options.dt,
             steps: 0,
             compensated: options.compensated,
@@ -80,12 +99,123 @@ where
             eq_next: zeros(),
             ep_next: zeros(),
             interrupt: InterruptPoll::new(),
-        })
+        };
+        Ok(Stepper { model, state })
+    }
+}
+
+impl<M, St> Stepper<M, St>
+where
+    M: Deref<Target: Dynamics>,
+    St: BorrowMut<StepperState>,
+{
+    /// The stepper of `state` on `model`, continuing where [`Stepper::into_state`] left it.
+    ///
+    /// `model` must be the one the state was stepped on: a model with another number of
+    /// coordinates, or of a kind the state's method does not integrate, is refused (the state,
+    /// if owned, is dropped; pass `&mut state` to keep it whatever happens).
+    pub fn resume(model: M, state: St) -> Result<Self, Error> {
+        let s = state.borrow();
+        if model.dim() != s.q.len() {
+            let reason = format!("has {} coordinates, the stepper's state {}", model.dim(), s.q.len());
+            return Err(Error::invalid("model", reason));
+        }
+        s.method().check(model.kind())?;
+        Ok(Stepper { model, state })
+    }
+
+    /// The state without its model, to [`Stepper::resume`] later.
+    pub fn into_state(self) -> St {
+        self.state
+    }
+
+    /// The model stepped.
+    pub fn model(&self) -> &M::Target {
+        &self.model
     }
 
     /// Advances one step. On failure the state stays at the last good step, and the error
     /// names the step (counted from 1) and the time it started at.
     pub fn step(&mut self) -> Result<(), Error> {
+        self.state.borrow_mut().step(&*self.model)
+    }
+
+    /// Advances `n` steps, calling `poll` before a step every 10–40 ms of run time; an error
+    /// from it stops with [`Error::Interrupted`] (the binding checks for Ctrl-C there). On
+    /// failure the state stays at the last good step.
+    pub fn advance<P>(&mut self, n: usize, mut poll: P) -> Result<(), Error>
+    where
+        P: FnMut() -> Result<(), ModelError>,
+    {
+        let state = self.state.borrow_mut();
+        for _ in 0..n {
+            if state.interrupt.due() {
+                if let Err(source) = poll() {
+                    return Err(Error::Interrupted {
+                        step: state.steps + 1,
+                        time: state.t(),
+                        source,
+                    });
+                }
+            }
+            state.step(&*self.model)?;
+        }
+        Ok(())
+    }
+
+    /// Starts afresh from (q0, p0) at time t0, with the step count at 0: the next steps are
+    /// those of a new stepper from there (the force and Newton counts go on). The
+    /// compensated-summation carries and the integrator's caches and predictor
+    /// ([`Integrator::reset`]) are cleared, since the next step does not start where the last
+    /// one ended. Refuses, as [`Stepper::new`] does, q0 or p0 of the wrong length or not
+    /// finite, a t0 not finite and initial data off the constraints; the state is then
+    /// unchanged.
+    pub fn reset(&mut self, t0: f64, q0: &[f64], p0: &[f64]) -> Result<(), Error> {
+        let state = self.state.borrow_mut();
+        let n = state.q.len();
+        check_vector("q0", q0, n)?;
+        check_vector("p0", p0, n)?;
+        if !t0.is_finite() {
+            return Err(Error::invalid("t0", "must be finite"));
+        }
+        self.model.check_initial(q0, p0)?;
+        state.q.copy_from_slice(q0);
+        state.p.copy_from_slice(p0);
+        state.eq.fill(0.0);
+        state.ep.fill(0.0);
+        state.t0 = t0;
+        state.n0 = 0;
+        state.steps = 0;
+        state.integrator.reset();
+        Ok(())
+    }
+
+    /// Sets the step size h for the next steps, from the current time on (tₙ₊ₖ = tₙ + k·h).
+    /// Refuses an h that is not finite and positive, keeping the old one.
+    pub fn set_dt(&mut self, h: f64) -> Result<(), Error> {
+        if !(h.is_finite() && h > 0.0) {
+            return Err(Error::invalid("dt", format!("must be finite and positive, got {h}")));
+        }
+        let state = self.state.borrow_mut();
+        state.t0 = state.t();
+        state.n0 = state.steps;
+        state.h = h;
+        Ok(())
+    }
+}
+
+impl<M, St: Borrow<StepperState>> Deref for Stepper<M, St> {
+    type Target = StepperState;
+
+    fn deref(&self) -> &StepperState {
+        self.state.borrow()
+    }
+}
+
+impl StepperState {
+    /// One step of `model`, which has as many coordinates as the state (checked when the
+    /// stepper was made or resumed).
+    fn step<S: Dynamics + ?Sized>(&mut self, model: &S) -> Result<(), Error> {
         let step = self.steps + 1;
         let time = self.t();
         let start = StepStart {
@@ -98,7 +228,6 @@ where
             dq: &mut self.dq,
             dp: &mut self.dp,
         };
-        let model: &M::Target = &self.model;
         if let Err(e) = model.increment(&mut self.integrator, &start, &mut increment) {
             return Err(e.at(step, time));
         }
@@ -125,31 +254,9 @@ where
         Ok(())
     }
 
-    /// Advances `n` steps, calling `poll` before a step every 10–40 ms of run time; an error
-    /// from it stops with [`Error::Interrupted`] (the binding checks for Ctrl-C there). On
-    /// failure the state stays at the last good step.
-    pub fn advance<P>(&mut self, n: usize, mut poll: P) -> Result<(), Error>
-    where
-        P: FnMut() -> Result<(), ModelError>,
-    {
-        for _ in 0..n {
-            if self.interrupt.due() {
-                if let Err(source) = poll() {
-                    return Err(Error::Interrupted {
-                        step: self.steps + 1,
-                        time: self.t(),
-                        source,
-                    });
-                }
-            }
-            self.step()?;
-        }
-        Ok(())
-    }
-
-    /// The time tₙ = t₀ + n·h.
+    /// The time tₙ = t₀ + n·h (counted from the last change of h, see [`Stepper::set_dt`]).
     pub fn t(&self) -> f64 {
-        self.t0 + self.steps as f64 * self.h
+        self.t0 + (self.steps - self.n0) as f64 * self.h
     }
 
     /// The steps n completed.
@@ -170,11 +277,6 @@ where
     /// The momenta pₙ.
     pub fn p(&self) -> &[f64] {
         &self.p
-    }
-
-    /// The model stepped.
-    pub fn model(&self) -> &M::Target {
-        &self.model
     }
 
     /// The method applied.

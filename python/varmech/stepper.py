@@ -1,0 +1,179 @@
+"""A model, a method and the state, advanced step by step."""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from . import _core
+from ._util import finite, positive
+from .integrate import _initial_state, _model_of, _newton, _steps
+from .model import Model
+
+if TYPE_CHECKING:
+    from .scenes import Scene
+
+
+class Stepper:
+    """One model, one method and the state (t, q, p), advanced one step or n steps at a time.
+
+    :func:`varmech.integrate` is a stepper run to the end with its states saved; a stepper
+    keeps only the current state, so that a caller can look at it between steps: locate an
+    event, change the step size, start again from another state. Its steps are exactly
+    ``integrate``'s: n calls of :meth:`step` land bit for bit on the final state of
+    ``integrate(..., steps=n)`` with the same arguments.
+
+    Parameters
+    ----------
+    model, q0, p0, v0, method, t0:
+        As for :func:`varmech.integrate`: the model or scene (whose initial state is then the
+        default), the initial state (n,), with the velocities ``v0`` instead of the momenta
+        ``p0`` if given, the method (by default the model kind's) and the initial time.
+    dt:
+        The step h > 0; settable between steps (:attr:`dt`).
+    compensated, newton_tolerance, newton_max_iterations:
+        As for :func:`varmech.integrate`.
+
+    Raises
+    ------
+    ValueError
+        Malformed arguments (the message starts with the argument's name), a method that does
+        not integrate the model, or initial data off a constrained model's constraints.
+
+    Notes
+    -----
+    :meth:`step` and :meth:`advance` raise what :func:`varmech.integrate` raises
+    (:class:`~varmech.DivergenceError`, :class:`~varmech.ConvergenceError`, a closure's own
+    exception, KeyboardInterrupt on Ctrl-C during :meth:`advance`), with ``err.step`` and
+    ``err.time`` where the exception allows; the stepper then stays at the last good step.
+    Native models step with the GIL released.
+
+    Examples
+    --------
+    >>> import varmech
+    >>> kepler = varmech.scenes.kepler()
+    >>> stepper = varmech.Stepper(kepler, dt=0.01, method="verlet")
+    >>> stepper.advance(100)
+    >>> round(stepper.t, 12), stepper.steps
+    (1.0, 100)
+    >>> traj = varmech.integrate(kepler, dt=0.01, steps=100, method="verlet")
+    >>> bool((stepper.q == traj.q[-1]).all() and (stepper.p == traj.p[-1]).all())
+    True
+    >>> stepper.reset(traj.q[0], traj.p[0], t0=0.0)
+    >>> stepper.dt = 0.005
+    >>> stepper.advance(t_end=0.5)
+    >>> stepper.steps
+    100
+    """
+
+    def __init__(
+        self,
+        model: Model | Scene,
+        q0: ArrayLike | None = None,
+        p0: ArrayLike | None = None,
+        *,
+        v0: ArrayLike | None = None,
+        dt: float,
+        method: str | None = None,
+        t0: float = 0.0,
+        compensated: bool = True,
+        newton_tolerance: float = 1e-14,
+        newton_max_iterations: int = 50,
+    ) -> None:
+        model, q0, p0 = _model_of(model, q0, p0, v0)
+        if method is None:
+            method = model.kind.default_method
+        dt = positive("dt", dt)
+        t0 = finite("t0", t0)
+        newton_tolerance, newton_max_iterations = _newton(newton_tolerance, newton_max_iterations)
+        q, p = _initial_state(model, q0, p0, v0, t0)
+        self._model = model
+        self._stepper = _core.Stepper(
+            model._core,
+            q,
+            p,
+            dt=dt,
+            method=method,
+            t0=t0,
+            compensated=bool(compensated),
+            newton_tolerance=newton_tolerance,
+            newton_max_iterations=newton_max_iterations,
+        )
+
+    def step(self) -> None:
+        """Advance one step."""
+        self._stepper.step()
+
+    def advance(self, steps: int | None = None, *, t_end: float | None = None) -> None:
+        """Advance ``steps`` steps, or to ``t_end``, a whole number of steps from :attr:`t`.
+
+        Ctrl-C stops it with KeyboardInterrupt, at the last step completed."""
+        self._stepper.advance(_steps(self.dt, self.t, steps, t_end))
+
+    def reset(self, q0: ArrayLike, p0: ArrayLike | None = None, *, v0: ArrayLike | None = None, t0: float | None = None) -> None:
+        """Start afresh from (q0, p0) (or q0 and the velocities v0) at ``t0`` (default: the
+        current time), with :attr:`steps` at 0: the next steps are those of a new stepper from
+        there. The work counts go on."""
+        t0 = self.t if t0 is None else finite("t0", t0)
+        q, p = _initial_state(self._model, q0, p0, v0, t0)
+        self._stepper.reset(q, p, t0)
+
+    @property
+    def model(self) -> Model:
+        """The model stepped."""
+        return self._model
+
+    @property
+    def method(self) -> str:
+        """The method's name."""
+        return self._stepper.method
+
+    @property
+    def t(self) -> float:
+        """The time tₙ = t₀ + n·h (from the last change of :attr:`dt`)."""
+        return self._stepper.t
+
+    @property
+    def q(self) -> np.ndarray:
+        """The positions qₙ, shape (n,) (a copy)."""
+        return self._stepper.q
+
+    @property
+    def p(self) -> np.ndarray:
+        """The momenta pₙ, shape (n,) (a copy)."""
+        return self._stepper.p
+
+    @property
+    def steps(self) -> int:
+        """Steps completed since the start or the last :meth:`reset`."""
+        return self._stepper.steps
+
+    @property
+    def dt(self) -> float:
+        """The step h; set it to take the next steps with another (from the current time on)."""
+        return self._stepper.dt
+
+    @dt.setter
+    def dt(self, dt: float) -> None:
+        self._stepper.dt = positive("dt", dt)
+
+    @property
+    def force_evaluations(self) -> int:
+        """Force evaluations so far (for the implicit methods, of the discrete Lagrangian's slot
+        derivatives)."""
+        return self._stepper.force_evaluations
+
+    @property
+    def newton_iterations(self) -> int:
+        """The implicit methods' Newton iterations so far (0 for explicit methods)."""
+        return self._stepper.newton_iterations
+
+    @property
+    def work(self) -> float:
+        """Work done by the non-conservative forces so far (0 without forces)."""
+        return self._stepper.work
+
+    def __repr__(self) -> str:
+        return f"Stepper({self._model.name!r}, method={self.method!r}, dt={self.dt:g}, t={self.t:g}, steps={self.steps})"
