@@ -20,4 +20,5 @@ mod routh;
 mod solar_system;
 mod spurious_branch;
 mod stability;
+mod stepper;
 mod variational;
