@@ -24,7 +24,8 @@ from . import analysis, scenes
 from ._core import ConvergenceError, DivergenceError, SpuriousBranchError, VarmechError
 from .analysis import sections, stability
 from .analysis.energy_growth import energy_growth
-from .analysis.sections import phase_portrait, poincare_section
+from .analysis.phase_portrait import phase_portrait
+from .analysis.sections import poincare_section
 from .analysis.stability import (
     growth_factor,
     growth_table,

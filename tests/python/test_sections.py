@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 import varmech
-from varmech import sections
+from varmech import phase_portrait, sections
 
 HH = varmech.scenes.henon_heiles()
 E12, E8 = sections.HENON_HEILES_ENERGIES
@@ -176,7 +176,7 @@ def test_a_sweep_can_be_interrupted_with_its_rows_so_far(henon_heiles_closure):
 
 def test_pendulum_phase_portrait_conserves_energy_and_classifies_against_the_separatrix():
     energies = [-0.9, 0.0, 0.9, 0.999, 1.001, 1.1, 2.5]
-    tab = sections.phase_portrait(varmech.scenes.pendulum(), energies, dt=0.01, t_end=40.0)
+    tab = phase_portrait(varmech.scenes.pendulum(), energies, dt=0.01, t_end=40.0)
     # kahan_li6 at h = 0.01: energy error |H − H₀| at round-off level (measured 6e-15).
     assert tab.meta["max_energy_error"] <= 1e-12
     by_orbit = {o: tab.where(orbit=o) for o in tab.unique("orbit")}
@@ -197,7 +197,7 @@ def test_pendulum_phase_portrait_conserves_energy_and_classifies_against_the_sep
             assert abs(np.min(np.abs(p)) - math.sqrt(2 * (e - 1))) <= 1e-3
     assert {t.rows[0][2] for t in by_orbit.values()} == {"libration", "rotation"}
     with pytest.raises(ValueError, match="one degree of freedom"):
-        sections.phase_portrait(HH, [0.1])
+        phase_portrait(HH, [0.1])
 
 
 def test_charts_write_files(tmp_path, section_1_8):
@@ -207,7 +207,7 @@ def test_charts_write_files(tmp_path, section_1_8):
     low = sections.poincare_section(HH, E12, orbits=4, t_end=200.0)
     out = poincare_chart([low, section_1_8], tmp_path / "henon_heiles.png", title="Hénon–Heiles")
     assert out.exists() and out.stat().st_size > 10_000
-    pp = sections.phase_portrait(varmech.scenes.pendulum(), t_end=20.0)
+    pp = phase_portrait(varmech.scenes.pendulum(), t_end=20.0)
     out = phase_portrait_chart(pp, tmp_path / "pendulum.svg", title="pendulum")
     assert out.exists() and out.stat().st_size > 10_000
     csv = section_1_8.to_csv(tmp_path / "section.csv")

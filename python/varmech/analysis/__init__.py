@@ -4,7 +4,8 @@
 - :mod:`.energy_growth`: the energy error over a long run, log-spaced in t, with verdicts;
 - :mod:`.baselines`: SciPy's ``solve_ivp`` and REBOUND driven on a varmech scene;
 - :mod:`.stability`: linear stability on q̈ = −ω²q and the implicit methods' failure regions;
-- :mod:`.sections`: Poincaré sections, orbit divergence and phase portraits.
+- :mod:`.sections`: Poincaré sections and orbit divergence (a chaos indicator);
+- :mod:`.phase_portrait`: orbits of one degree of freedom, librations and rotations.
 
 Every sweep honours Ctrl-C: the KeyboardInterrupt propagates with the rows measured so far as
 ``err.partial`` (:func:`._interrupt.interruptible`).

@@ -4,9 +4,8 @@
 section q_k = c in a chosen direction (for Hénon–Heiles, the classic x = 0 with p_x > 0, seen in
 the (y, p_y) plane). :func:`orbit_divergence` measures, orbit by orbit, how fast a neighbour on
 the same energy shell separates: a cheap indicator of chaos. :func:`covered_cells` counts the
-grid cells an orbit's section points fall into (area-filling). :func:`phase_portrait` follows
-orbits of a one-degree-of-freedom system (the pendulum: librations, the separatrix neighbourhood,
-rotations) and classifies each from its trajectory. All return a :class:`~varmech.Table`;
+grid cells an orbit's section points fall into (area-filling). Phase portraits of one degree of
+freedom are in :mod:`varmech.analysis.phase_portrait`. All return a :class:`~varmech.Table`;
 :mod:`varmech.charts.sections` plots them.
 
 Every orbit is one native :func:`varmech.integrate` call (no Python call per step for a native
@@ -37,24 +36,20 @@ the exact flow (kahan_li8, 64 substeps) from the same grid state over the same �
 from __future__ import annotations
 
 import math
-from collections.abc import Iterable, Sequence
+from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .. import _core
 from .._progress import progress as _progress
 from .._util import positive
-from ..integrate import Trajectory, integrate
+from ..integrate import Trajectory
 from ..model import Model
-from ..scenes import Scene
 from ..stepper import Stepper
 from ..table import Table
-from ._energy import energy_of
 from ._interrupt import interruptible
-
-ModelLike = Model | Scene
+from ._orbits import ModelLike, default_method, energy_at, model_of, relative, run, solve_momentum
 
 #: The Hénon–Heiles energies of Hénon & Heiles (1964): mostly regular motion at 1/12,
 #: widespread chaos at 1/8 (the region stays bounded below the escape energy 1/6).
@@ -64,87 +59,13 @@ HENON_HEILES_ENERGIES = (1.0 / 12.0, 1.0 / 8.0)
 #: 10⁵ times farther (to 1e-4) within the run.
 CHAOS_THRESHOLD = 5.0
 
-#: The pendulum's default phase-portrait energies (H = p²/2 − cos q, separatrix at H = 1).
-PENDULUM_ENERGIES = (-0.9, -0.6, -0.2, 0.3, 0.7, 0.95, 0.995, 1.005, 1.05, 1.4, 2.0, 3.0)
 
 
 # ------------------------------------------------------------------------------------ helpers
 
 
-def _model(model_or_scene: ModelLike) -> Model:
-    model = model_or_scene.model if isinstance(model_or_scene, Scene) else model_or_scene
-    if not isinstance(model, Model):
-        raise TypeError(f"model_or_scene: expected a varmech model or scene, got {type(model_or_scene).__name__}")
-    if model.constraints:
-        raise ValueError(f"model_or_scene: {model.name} is constrained; sections need an unconstrained model")
-    if model.time_dependent or model.forced:
-        raise ValueError(f"model_or_scene: {model.name} does not conserve its energy (time-dependent or forced)")
-    return model
-
-
 def _is_henon_heiles(model: Model) -> bool:
     return model.name == "henon_heiles"
-
-
-def _is_pendulum(model: Model) -> bool:
-    return model.name == "pendulum"
-
-
-def _energy(model: Model, q: np.ndarray, p: np.ndarray) -> np.ndarray:
-    """H(q, p) = p·q̇ − L for rows (N, n)."""
-    q, p = np.atleast_2d(q), np.atleast_2d(p)
-    return energy_of(model, np.zeros(len(q)), q, p)
-
-
-def _relative(h: np.ndarray, energy: float) -> np.ndarray:
-    return (h - energy) / (abs(energy) if energy != 0 else 1.0)
-
-
-def _default_method(model: Model, method: str | None) -> str:
-    if method is not None:
-        return method
-    return model.kind.accurate_method
-
-
-def _solve_momentum(model: Model, q: np.ndarray, p: np.ndarray, k: int, energy: float, direction: int) -> tuple[np.ndarray, np.ndarray]:
-    """The momentum p_k that puts the states (q, p) (rows; p_k ignored) on H = ``energy`` with
-    q̇_k of sign ``direction`` (+ when 0), and a mask of the rows where one exists.
-
-    H is quadratic in p for every Lagrangian quadratic in q̇ (mechanical systems, magnetic
-    terms), so three evaluations give it exactly; the result is checked to 1e-12."""
-    q = np.ascontiguousarray(q, dtype=float)
-    rows = []
-    for value in (0.0, 1.0, -1.0):
-        pp = np.array(p, dtype=float)
-        pp[:, k] = value
-        rows.append(_energy(model, q, pp))
-    e0, e1, em = rows
-    a = 0.5 * (e1 + em) - e0
-    b = 0.5 * (e1 - em)
-    c = e0 - energy
-    disc = b * b - 4 * a * c
-    ok = (a > 0) & (disc > 0)
-    root = np.sqrt(np.where(ok, disc, 0.0))
-    out = np.array(p, dtype=float)
-    want = 1 if direction >= 0 else -1
-    best = np.full(len(q), np.nan)
-    for sign in (1.0, -1.0):
-        s = np.where(ok, (-b + sign * root) / np.where(ok, 2 * a, 1.0), np.nan)
-        trial = np.array(p, dtype=float)
-        trial[:, k] = np.where(ok, s, 0.0)
-        v = model.velocity(q, trial)[:, k]
-        pick = ok & np.isnan(best) & (np.sign(v) == want)
-        best = np.where(pick, s, best)
-    ok &= np.isfinite(best)
-    out[:, k] = np.where(ok, best, 0.0)
-    if ok.any():
-        err = np.abs(_energy(model, q[ok], out[ok]) - energy)
-        if np.max(err) > 1e-12 * max(1.0, abs(energy)):
-            raise ValueError(
-                f"energy: H of {model.name} is not quadratic in p_{k} (|H − E| = {np.max(err):.2e} at the seed); "
-                "give the full initial states instead"
-            )
-    return out, ok
 
 
 def _names(model: Model, names: Sequence[str] | None) -> tuple[str, ...]:
@@ -215,14 +136,14 @@ def _seeds(
             grid = np.linspace(q_lo, q_hi, 4001)
             q = np.zeros((grid.size, n))
             q[:, k], q[:, j] = c, grid
-            _, ok = _solve_momentum(model, q, np.zeros((grid.size, n)), k, energy, direction)
+            _, ok = solve_momentum(model, q, np.zeros((grid.size, n)), k, energy, direction)
             if not ok.any():
                 raise ValueError(f"energy: no allowed state on the line p_{j} = 0 at E = {energy}")
             a, b = grid[ok].min(), grid[ok].max()
             span = np.linspace(a, b, orbits + 2)[1:-1]
             q = np.zeros((orbits, n))
             q[:, k], q[:, j] = c, span
-            p, ok = _solve_momentum(model, q, np.zeros((orbits, n)), k, energy, direction)
+            p, ok = solve_momentum(model, q, np.zeros((orbits, n)), k, energy, direction)
             return q[ok], p[ok]
         rng = np.random.default_rng(seed)
         count = 0
@@ -232,7 +153,7 @@ def _seeds(
             p = np.zeros((m, n))
             q[:, k], q[:, j] = c, rng.uniform(q_lo, q_hi, m)
             p[:, j] = rng.uniform(p_lo, p_hi, m)
-            p, ok = _solve_momentum(model, q, p, k, energy, direction)
+            p, ok = solve_momentum(model, q, p, k, energy, direction)
             found_q.append(q[ok])
             found_p.append(p[ok])
             count += int(ok.sum())
@@ -250,7 +171,7 @@ def _seeds(
     q[:, k] = c
     q[:, others] = s[:, : n - 1]
     p[:, others] = s[:, n - 1 :]
-    p, ok = _solve_momentum(model, q, p, k, energy, direction)
+    p, ok = solve_momentum(model, q, p, k, energy, direction)
     if not ok.all():
         bad = s[~ok][0]
         raise ValueError(f"seeds: {bad} is outside the energy-allowed region at E = {energy} (or has no crossing in the direction asked)")
@@ -274,21 +195,9 @@ def _orbits(
     k, c, direction = _section(model, section)
     dt = positive("dt", dt)
     t_end = positive("t_end", t_end)
-    method = _default_method(model, method)
+    method = default_method(model, method)
     q_seed, p_seed = _seeds(model, energy, k, c, direction, seeds, orbits, box, seed)
     return k, c, direction, dt, t_end, method, q_seed, p_seed
-
-
-def _run(model: Model, q0: np.ndarray, p0: np.ndarray, *, dt: float, t_end: float, method: str, save_every: int = 1) -> tuple[Trajectory, str | None]:
-    """One orbit; a divergent one (an orbit that escapes) returns its partial trajectory and a
-    note."""
-    try:
-        return integrate(model, q0, p0, dt=dt, t_end=t_end, method=method, save_every=save_every), None
-    except _core.DivergenceError as err:
-        partial = getattr(err, "partial", None)
-        if partial is None:
-            raise
-        return partial, f"diverged at t = {partial.t[-1]:.6g} ({err})"
 
 
 def _hermite(x0, v0, x1, v1, h, s):
@@ -431,7 +340,7 @@ def poincare_section(
     divergence, with a note in ``meta["notes"]``. Ctrl-C raises KeyboardInterrupt with the rows
     so far as ``err.partial``.
     """
-    model = _model(model_or_scene)
+    model = model_of(model_or_scene)
     energy = float(energy)
     if not math.isfinite(energy):
         raise ValueError(f"energy: must be finite, got {energy}")
@@ -463,7 +372,7 @@ def poincare_section(
 
     def body() -> None:
         for o in _progress(range(len(q_seed)), total=len(q_seed), desc=f"section E = {energy:.4g}", enabled=progress):
-            traj, note = _run(model, q_seed[o], p_seed[o], dt=dt, t_end=t_end, method=method)
+            traj, note = run(model, q_seed[o], p_seed[o], dt=dt, t_end=t_end, method=method)
             if note:
                 table.meta["notes"].append(f"orbit {o}: {note}")
             idx, sign = _crossings(traj, k, c, direction)
@@ -482,7 +391,7 @@ def poincare_section(
                 worst["hermite_gap"] = max(worst["hermite_gap"], float(gap))
                 qs, ps, taus = np.array(rows_q), np.array(rows_p), np.array(rows_tau)
             times = traj.t[idx] + taus
-            errs = _relative(_energy(model, qs, ps), energy)
+            errs = relative(energy_at(model, qs, ps), energy)
             worst["residual"] = max(worst["residual"], float(np.max(np.abs(qs[:, k] - c))))
             worst["energy"] = max(worst["energy"], float(np.max(np.abs(errs))))
             for j in range(len(idx)):
@@ -528,7 +437,7 @@ def orbit_divergence(
     Hénon–Heiles), ``divergence``, ``chaotic``. ``meta["chaotic_fraction"]`` is the fraction of
     chaotic orbits.
     """
-    model = _model(model_or_scene)
+    model = model_of(model_or_scene)
     energy = float(energy)
     cols = _names(model, None)
     separation = positive("separation", separation)
@@ -536,11 +445,11 @@ def orbit_divergence(
     j = [i for i in range(model.dim) if i != k][0]
     p_twin_in = p_seed.copy()
     p_twin_in[:, j] += separation
-    p_twin, ok = _solve_momentum(model, q_seed, p_twin_in, k, energy, direction)
+    p_twin, ok = solve_momentum(model, q_seed, p_twin_in, k, energy, direction)
     if not ok.all():
         # Near the boundary of the allowed region the twin goes the other way in p_j.
         p_twin_in[~ok, j] -= 2 * separation
-        p_twin2, ok2 = _solve_momentum(model, q_seed[~ok], p_twin_in[~ok], k, energy, direction)
+        p_twin2, ok2 = solve_momentum(model, q_seed[~ok], p_twin_in[~ok], k, energy, direction)
         p_twin[~ok] = p_twin2
         ok[~ok] = ok2
     table = Table(
@@ -557,8 +466,8 @@ def orbit_divergence(
             if not ok[o]:
                 table.meta["notes"].append(f"orbit {o}: no twin on the energy shell")
                 continue
-            a, note_a = _run(model, q_seed[o], p_seed[o], dt=dt, t_end=t_end, method=method, save_every=save)
-            b, note_b = _run(model, q_seed[o], p_twin[o], dt=dt, t_end=t_end, method=method, save_every=save)
+            a, note_a = run(model, q_seed[o], p_seed[o], dt=dt, t_end=t_end, method=method, save_every=save)
+            b, note_b = run(model, q_seed[o], p_twin[o], dt=dt, t_end=t_end, method=method, save_every=save)
             m = min(len(a.t), len(b.t))
             d = np.sqrt(np.sum((a.q[:m] - b.q[:m]) ** 2 + (a.p[:m] - b.p[:m]) ** 2, axis=1))
             value = float(np.log10(np.max(d) / d[0]))
@@ -598,114 +507,10 @@ def covered_cells(table: Table, *, bins: int = 40, extent: Any = None, points: i
     return out
 
 
-# ------------------------------------------------------------------------------ phase portrait
-
-
-def _classify(q: np.ndarray, p: np.ndarray) -> str:
-    """'libration' when the momentum reverses and q stays within a window narrower than 2π;
-    'rotation' when it never reverses and q advances by 2π or more; 'undetermined' otherwise
-    (a run too short to tell)."""
-    reverses = bool(np.any(np.sign(p[1:]) * np.sign(p[:-1]) < 0))
-    span = float(np.max(q) - np.min(q))
-    if reverses and span < 2 * math.pi:
-        return "libration"
-    if not reverses and abs(float(q[-1] - q[0])) >= 2 * math.pi:
-        return "rotation"
-    return "undetermined"
-
-
-def phase_portrait(
-    model_or_scene: ModelLike,
-    energies: Iterable[float] | None = None,
-    *,
-    initial_states: ArrayLike | None = None,
-    q_start: float = 0.0,
-    mirror: bool = True,
-    dt: float = 0.01,
-    t_end: float = 40.0,
-    method: str | None = None,
-    save_every: int = 5,
-    progress: bool | None = None,
-) -> Table:
-    """Orbits of a one-degree-of-freedom system in its phase plane (q, p).
-
-    The orbits start from ``initial_states`` (rows (q, p)), or at q = ``q_start`` with p > 0 from
-    each of ``energies`` (default for the pendulum: :data:`PENDULUM_ENERGIES`, librations below
-    the separatrix energy 1, rotations above it, both close to it). With ``mirror``, an orbit
-    classified as a rotation gets a twin with −p (it turns the other way; a libration's mirror
-    is the same curve). Each orbit is one :func:`varmech.integrate` call (``kahan_li6`` for
-    separable models by default, ``galerkin6`` otherwise), saving every ``save_every`` steps.
-
-    One row per saved state: ``orbit``, ``energy`` (H at the start), ``motion`` (from the
-    trajectory: ``"libration"`` if p reverses and q stays within 2π, ``"rotation"`` if p never
-    reverses and q advances by 2π or more, else ``"undetermined"``), ``t``, ``q``, ``p`` and
-    ``energy_error`` = H − H₀ (absolute: a portrait's energies pass through 0).
-    ``meta["max_energy_error"]`` is its largest magnitude.
-    """
-    model = _model(model_or_scene)
-    if model.dim != 1:
-        raise ValueError(f"model_or_scene: a phase portrait needs one degree of freedom, {model.name} has {model.dim}; use poincare_section")
-    dt = positive("dt", dt)
-    t_end = positive("t_end", t_end)
-    method = _default_method(model, method)
-    if initial_states is not None:
-        if energies is not None:
-            raise ValueError("energies, initial_states: give one of them")
-        z = np.atleast_2d(np.array(initial_states, dtype=float))
-        if z.shape[1] != 2 or not np.all(np.isfinite(z)):
-            raise ValueError(f"initial_states: expected rows (q, p), got shape {z.shape}")
-        starts = [(float(a), float(b)) for a, b in z]
-    else:
-        if energies is None:
-            if not _is_pendulum(model):
-                raise ValueError("energies: give the energies (or initial_states) of the orbits")
-            energies = PENDULUM_ENERGIES
-        es = np.array(list(energies), dtype=float)
-        q = np.full((len(es), 1), float(q_start))
-        starts = []
-        for e, qi in zip(es, q):
-            p, ok = _solve_momentum(model, qi[None, :], np.zeros((1, 1)), 0, float(e), 1)
-            if not ok[0]:
-                raise ValueError(f"energies: {e} is below the potential at q = {q_start}")
-            starts.append((float(qi[0]), float(p[0, 0])))
-    table = Table(
-        ("orbit", "energy", "motion", "t", "q", "p", "energy_error"),
-        title=f"Phase portrait: {model.name}, t = 0 … {t_end:g}",
-        meta={"model": model.name, "method": method, "dt": dt, "t_end": t_end, "max_energy_error": 0.0, "notes": []},
-    )
-    if _is_pendulum(model):
-        table.meta["separatrix_energy"] = 1.0
-
-    def one(o: int, q0: float, p0: float) -> str:
-        traj, note = _run(model, np.array([q0]), np.array([p0]), dt=dt, t_end=t_end, method=method, save_every=save_every)
-        if note:
-            table.meta["notes"].append(f"orbit {o}: {note}")
-        h = traj.energy()
-        err = h - h[0]
-        motion = _classify(traj.q[:, 0], traj.p[:, 0])
-        for t, q, p, e in zip(traj.t, traj.q[:, 0], traj.p[:, 0], err):
-            table.rows.append((o, float(h[0]), motion, float(t), float(q), float(p), float(e)))
-        table.meta["max_energy_error"] = max(table.meta["max_energy_error"], float(np.max(np.abs(err))))
-        return motion
-
-    def body() -> None:
-        o = 0
-        for q0, p0 in _progress(starts, total=len(starts), desc=f"phase portrait {model.name}", enabled=progress):
-            motion = one(o, q0, p0)
-            o += 1
-            if mirror and motion == "rotation":
-                one(o, q0, -p0)
-                o += 1
-
-    return interruptible(table, body)
-
-
 __all__ = [
     "CHAOS_THRESHOLD",
     "HENON_HEILES_ENERGIES",
-    "PENDULUM_ENERGIES",
     "covered_cells",
     "orbit_divergence",
-    "phase_portrait",
     "poincare_section",
 ]

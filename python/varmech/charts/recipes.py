@@ -11,6 +11,7 @@ from pathlib import Path
 
 from .. import scenes
 from ..analysis import energy_growth, sections, stability, work_precision
+from ..analysis.phase_portrait import phase_portrait
 from ..table import Table
 from .sections import phase_portrait_chart, poincare_chart
 from .stability import implicit_regions_chart, stability_chart
@@ -83,7 +84,7 @@ def _poincare(scene, methods, quick, progress):
 
 
 def _phase(scene, methods, quick, progress):
-    table = sections.phase_portrait(scenes.get(scene), method=methods[0], progress=progress)
+    table = phase_portrait(scenes.get(scene), method=methods[0], progress=progress)
     draw = lambda t, p: phase_portrait_chart(t, p, title=f"{scene}: phase portrait")  # noqa: E731
     return [("phase_portrait", table, {"phase_portrait": draw})]
 

@@ -60,7 +60,7 @@ def poincare_chart(table: Table | Sequence[Table], path: str | Path, title: str 
 
 
 def phase_portrait_chart(table: Table, path: str | Path, title: str = "") -> Path:
-    """Draw the orbits of :func:`varmech.analysis.sections.phase_portrait` in the (q, p) plane:
+    """Draw the orbits of :func:`varmech.analysis.phase_portrait.phase_portrait` in the (q, p) plane:
     librations in blues, rotations in oranges (darker for higher energy), undetermined orbits
     in grey. When rotations are present q is taken modulo 2π into (−π, π]; for the pendulum the
     separatrix p = ±2cos(q/2) (energy 1) is drawn dashed. Writes ``path`` (PNG or SVG)."""
