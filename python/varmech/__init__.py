@@ -20,7 +20,7 @@ The measurements (work–precision, energy growth, stability, sections) live in
 :mod:`varmech.analysis` and are re-exported here; :mod:`varmech.charts` draws them.
 """
 
-from . import analysis, scenes
+from . import _errors, analysis, scenes
 from ._core import ConvergenceError, DivergenceError, SpuriousBranchError, VarmechError
 from .analysis import sections, stability
 from .analysis.energy_growth import energy_growth
@@ -92,3 +92,5 @@ __all__ = [
     "unstable_intervals",
     "work_precision",
 ]
+
+_errors.install()

@@ -31,6 +31,15 @@ def cyclic_coordinates(
     candidates (Routh reduction needs ∂L/∂qᵢ = 0 everywhere); derivatives from differences
     (closures without ``dl_dq``) are accurate to about 1e-10, within the default ``rtol``.
     """
+    relative = _relative_dl_dq(model, q, spread=spread, samples=samples, seed=seed)
+    ignorable = np.all(relative <= rtol, axis=0)
+    return [int(i) for i in np.flatnonzero(ignorable)]
+
+
+def _relative_dl_dq(model: Model, q: ArrayLike, *, spread: float, samples: int, seed: int) -> np.ndarray:
+    """|∂L/∂qᵢ|/max(1, ‖∂L/∂q‖∞) at random states around ``q`` (rows; see
+    :func:`cyclic_coordinates`). States where ∂L/∂q is not finite (off the model's domain, such
+    as r = 0) are left out: they show no dependence either way."""
     n = model.dim
     q = vector("q", q, n)
     if not (np.isfinite(spread) and spread > 0):
@@ -41,10 +50,25 @@ def cyclic_coordinates(
     qs = q + spread * rng.uniform(-1.0, 1.0, (samples, n))
     vs = spread * rng.uniform(-1.0, 1.0, (samples, n))
     ts = rng.uniform(0.0, 1.0, samples) if model.time_dependent else np.zeros(samples)
-    gradients = model._derivative("dl_dq", qs, vs, ts)
+    with np.errstate(invalid="ignore", over="ignore"):
+        gradients = model._derivative("dl_dq", qs, vs, ts)
+    gradients = gradients[np.all(np.isfinite(gradients), axis=1)]
     scale = np.maximum(1.0, np.max(np.abs(gradients), axis=1, keepdims=True))
-    ignorable = np.all(np.abs(gradients) <= rtol * scale, axis=0)
-    return [int(i) for i in np.flatnonzero(ignorable)]
+    return np.abs(gradients) / scale
+
+
+def _check_cyclic(model: Model, cyclic: list[int], q: np.ndarray) -> None:
+    """ValueError unless every coordinate in ``cyclic`` is cyclic at the states
+    :func:`cyclic_coordinates` samples around ``q``: Routh reduction of a coordinate L depends on
+    would integrate a different system without a word."""
+    relative = _relative_dl_dq(model, q, spread=1.0, samples=64, seed=0)
+    for i in cyclic:
+        found = float(np.max(relative[:, i], initial=0.0))
+        if found > 1e-9:
+            raise ValueError(
+                f"cyclic: coordinate {i} is not cyclic: |∂L/∂q{i}| reaches {found:.3e} relative to ‖∂L/∂q‖ "
+                f"at states around {q.tolist()} (cyclic_coordinates(model, q) finds the cyclic ones)"
+            )
 
 
 def _indices(cyclic: Sequence[int], n: int) -> list[int]:
@@ -171,8 +195,9 @@ def routh(
 
     ``model`` may be a scene: its initial cyclic momenta are then the default μ, and without
     ``cyclic`` the coordinates that :func:`cyclic_coordinates` finds around its initial state
-    are ignored. The coordinates must be cyclic (∂L/∂c ≡ 0), the model unforced and
-    unconstrained. ``reference`` gives values for the ignored coordinates, which L must not
+    are ignored. The coordinates must be cyclic (∂L/∂c ≡ 0, checked at the states
+    :func:`cyclic_coordinates` samples around the scene's initial state or q = 0: a ValueError
+    names a coordinate that is not), the model unforced and unconstrained. ``reference`` gives values for the ignored coordinates, which L must not
     depend on (default zeros).
     """
     from .scenes import Scene
@@ -186,7 +211,12 @@ def routh(
     if isinstance(model, Scene):
         if momenta is None:
             momenta = np.asarray(model.p0)[_indices(cyclic, model.model.dim)]
+        around = np.asarray(model.q0, dtype=float)
         model = model.model
+    else:
+        around = np.zeros(model.dim)
     if momenta is None:
         raise ValueError("momenta: the conserved momenta μ of the ignored coordinates are required")
-    return ReducedModel(model, cyclic, momenta, reference=reference)
+    reduced = ReducedModel(model, cyclic, momenta, reference=reference)
+    _check_cyclic(model, _indices(cyclic, model.dim), around)
+    return reduced

@@ -117,6 +117,8 @@ pub enum StepError {
     NonFinite { reason: &'static str },
     /// Newton's method converged to a solution the step cannot vouch for.
     SpuriousBranch { reason: &'static str },
+    /// The interrupt check ([`crate::solve::interrupt`]) stopped an iterative solve.
+    Interrupted(ModelError),
     /// The method does not integrate this kind of model ([`crate::integrators::ModelKind`]'s refusal); runs refuse
     /// it before the first step.
     Method(Error),
@@ -144,6 +146,7 @@ impl StepError {
                 reason: reason.to_string(),
             },
             StepError::SpuriousBranch { reason } => Error::SpuriousBranch { step, time, reason },
+            StepError::Interrupted(source) => Error::Interrupted { step, time, source },
             StepError::Method(error) => error,
         }
     }

@@ -16,7 +16,8 @@
 //!   defect.
 //!
 //! Beside them, [`solve`] holds the numerics every layer shares (Newton's method, central
-//! differences, the in-place LU), and [`scenes`], which use the model layer only, hold the native test problems with
+//! differences, the in-place LU, the interrupt check), [`memory`] the guard on allocations that
+//! users' arguments size, and [`scenes`], which use the model layer only, hold the native test problems with
 //! their published reference solutions and the catalogue that lists them by name.
 //!
 //! The binding crate `rust/python` adapts Python closures to [`model::MechanicalSystem`] and
@@ -26,6 +27,7 @@ pub mod diagnostics;
 pub mod discrete;
 pub mod error;
 pub mod integrators;
+pub mod memory;
 pub mod model;
 pub mod scenes;
 pub mod solve;

@@ -5,6 +5,7 @@ use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
 use varmech::integrators::{Dynamics, General, Method, ModelKind};
 use varmech::model::Natural;
+use varmech::solve::interrupt::with_interrupt_check;
 use varmech::ModelError;
 
 use crate::closure::{
@@ -17,6 +18,12 @@ use crate::routh::RouthModel;
 
 /// The Ctrl-C check the driver polls: a Python error (KeyboardInterrupt) stops the run.
 pub type Poll<'a> = &'a dyn Fn() -> Result<(), ModelError>;
+
+/// The Ctrl-C check: Python's signal handlers run, and a KeyboardInterrupt stops the run. It
+/// takes the GIL where a native run released it (a no-op where it is held).
+fn check_signals() -> Result<(), ModelError> {
+    Python::attach(|py| py.check_signals()).map_err(boxed)
+}
 
 /// Runs `body` with the model as the core's [`Dynamics`] and the Ctrl-C check: native models
 /// with the GIL released (the poll takes it back briefly), closure models with it held. A
@@ -37,16 +44,24 @@ where
     }
 }
 
-/// [`bind_model`] for the models that are not reduced.
+/// [`bind_model`] for the models that are not reduced. The iterative solves inside `body`
+/// check for Ctrl-C too ([`with_interrupt_check`]), so that one long Newton iteration stops.
 pub fn bind_full<R, F>(py: Python<'_>, model: &Bound<'_, PyAny>, body: F) -> PyResult<R>
+where
+    R: Send,
+    F: for<'s> FnOnce(&'s dyn Dynamics, Poll<'s>) -> R + Send,
+{
+    with_interrupt_check(check_signals, || dispatch(py, model, body))
+}
+
+fn dispatch<R, F>(py: Python<'_>, model: &Bound<'_, PyAny>, body: F) -> PyResult<R>
 where
     R: Send,
     F: for<'s> FnOnce(&'s dyn Dynamics, Poll<'s>) -> R + Send,
 {
     if let Ok(native) = model.cast::<NativeModel>() {
         let native = native.get();
-        let poll = || Python::attach(|py| py.check_signals()).map_err(boxed);
-        return Ok(py.detach(|| native.with_integrable(|sys| body(sys, &poll))));
+        return Ok(py.detach(|| native.with_integrable(|sys| body(sys, &check_signals))));
     }
     let poll = || py.check_signals().map_err(boxed);
     if let Ok(closure) = model.cast::<ClosureModel>() {

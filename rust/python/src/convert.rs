@@ -1,16 +1,31 @@
 //! Conversion of arguments and results between numpy and the core.
 
 use numpy::{PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2, PyUntypedArrayMethods};
-use pyo3::exceptions::PyValueError;
+use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
+use pyo3::types::PyInt;
 use varmech::model::Mass;
 
+use crate::closure::readers::type_name;
 use crate::errors::to_pyerr;
 
 /// A contiguous view of a float64 vector argument.
 pub fn slice<'a>(name: &str, a: &'a PyReadonlyArray1<'_, f64>) -> PyResult<&'a [f64]> {
     a.as_slice()
         .map_err(|_| PyValueError::new_err(format!("{name}: must be a contiguous float64 array")))
+}
+
+/// A count argument (steps, save_every, an iteration cap) as usize: a negative or huge int is a
+/// ValueError and anything else a TypeError, both naming the argument (pyo3's own extraction
+/// raises OverflowError and names the argument only in the message).
+pub fn count(name: &str, x: &Bound<'_, PyAny>) -> PyResult<usize> {
+    x.extract::<usize>().map_err(|_| {
+        if x.is_instance_of::<PyInt>() {
+            PyValueError::new_err(format!("{name}: must be an integer from 0 to {}, got {x}", usize::MAX))
+        } else {
+            PyTypeError::new_err(format!("{name}: must be an integer, got {}", type_name(x)))
+        }
+    })
 }
 
 /// Rows of a float64 (N, n) array, as one contiguous row-major slice.

@@ -8,22 +8,22 @@ use varmech::{Error, ModelError};
 
 use crate::trajectory::TrajectoryRecord;
 
-pyo3::create_exception!(_core, VarmechError, PyRuntimeError, "Base class of varmech's errors.");
+pyo3::create_exception!(varmech, VarmechError, PyRuntimeError, "Base class of varmech's errors.");
 pyo3::create_exception!(
-    _core,
+    varmech,
     ConvergenceError,
     VarmechError,
     "Newton's method did not solve a step's implicit equations (a smaller step usually helps)."
 );
 pyo3::create_exception!(
-    _core,
+    varmech,
     SpuriousBranchError,
     ConvergenceError,
     "A step's implicit equations were solved beyond a fold of the DEL map, on a branch that need not \
      continue the trajectory (take a smaller step)."
 );
 pyo3::create_exception!(
-    _core,
+    varmech,
     DivergenceError,
     VarmechError,
     "The solution blew up: a non-finite state, or an energy error beyond max_energy_error."

@@ -2,12 +2,13 @@
 //! methods.
 
 use numpy::PyReadonlyArray1;
+use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use varmech::diagnostics;
 use varmech::integrators::{self, Method, NewtonOptions, Options};
 
 use crate::bind::bind_model;
-use crate::convert::slice;
+use crate::convert::{count, slice};
 use crate::errors::{failure_to_pyerr, to_pyerr};
 use crate::trajectory::TrajectoryRecord;
 
@@ -22,20 +23,21 @@ fn integrate<'py>(
     q0: PyReadonlyArray1<'py, f64>,
     p0: PyReadonlyArray1<'py, f64>,
     dt: f64,
-    steps: usize,
+    #[pyo3(from_py_with = steps_count)] steps: usize,
     method: &str,
-    save_every: usize,
+    #[pyo3(from_py_with = save_every_count)] save_every: usize,
     compensated: bool,
     max_energy_error: Option<f64>,
     t0: f64,
     newton_tolerance: f64,
-    newton_max_iterations: usize,
+    #[pyo3(from_py_with = newton_max_iterations_count)] newton_max_iterations: usize,
 ) -> PyResult<TrajectoryRecord> {
     let method = Method::from_name(method).map_err(|e| to_pyerr(py, e))?;
     let newton = NewtonOptions {
         tolerance: newton_tolerance,
         max_iterations: newton_max_iterations,
     };
+    newton.check().map_err(|e| to_pyerr(py, e))?;
     let options = Options {
         dt,
         steps,
@@ -55,6 +57,19 @@ fn integrate<'py>(
     }
 }
 
+// The counts, each named in its errors (see [`count`]).
+fn steps_count(x: &Bound<'_, PyAny>) -> PyResult<usize> {
+    count("steps", x)
+}
+
+fn save_every_count(x: &Bound<'_, PyAny>) -> PyResult<usize> {
+    count("save_every", x)
+}
+
+fn newton_max_iterations_count(x: &Bound<'_, PyAny>) -> PyResult<usize> {
+    count("newton_max_iterations", x)
+}
+
 /// ‖ΨᵀJΨ − J‖_F of one step.
 #[pyfunction]
 fn symplecticity_defect<'py>(
@@ -67,10 +82,19 @@ fn symplecticity_defect<'py>(
 ) -> PyResult<f64> {
     let method = Method::from_name(method).map_err(|e| to_pyerr(py, e))?;
     let (q, p) = (slice("q", &q)?, slice("p", &p)?);
-    bind_model(py, model, |sys, _poll| {
+    let defect = bind_model(py, model, |sys, _poll| {
         diagnostics::symplecticity_defect(sys, method, q, p, dt)
     })?
-    .map_err(|e| to_pyerr(py, e))
+    .map_err(|e| to_pyerr(py, e))?;
+    // Finite arguments whose step (or its differences) overflows leave no defect to report.
+    if !defect.is_finite() {
+        return Err(PyValueError::new_err(format!(
+            "q, p, dt: one step of {} from this state overflows, so its symplecticity defect is undefined \
+             (got {defect}); take smaller values",
+            method.info().name
+        )));
+    }
+    Ok(defect)
 }
 
 /// Facts about one fixed-step method.

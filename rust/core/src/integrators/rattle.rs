@@ -2,6 +2,7 @@ use nalgebra::{DMatrix, DVector};
 
 use super::{Increment, StepError, StepStart};
 use crate::model::{HolonomicConstraints, MechanicalSystem};
+use crate::solve::interrupt::{check_interrupt, InterruptPoll};
 use crate::solve::lu::{lu_in_place, lu_solve};
 use crate::solve::newton::{Correction, Newton, NewtonOptions, NewtonProblem, Reasons, Rules};
 
@@ -47,6 +48,8 @@ pub struct Rattle {
     evaluations: u64,
     /// SHAKE's sweeps.
     sweeps: u64,
+    /// When SHAKE checks for interrupts between sweeps.
+    interrupt: InterruptPoll,
 }
 
 impl Rattle {
@@ -79,6 +82,7 @@ impl Rattle {
             pivots: vec![0; m],
             evaluations: 0,
             sweeps: 0,
+            interrupt: InterruptPoll::new(),
         }
     }
 
@@ -261,6 +265,9 @@ impl Rattle {
     /// SHAKE: sweeps until |g(q₁)|∞ ≤ tolerance.
     fn shake<C: HolonomicConstraints + ?Sized>(&mut self, constraints: &C, h: f64) -> Result<(), StepError> {
         for _ in 0..self.options.max_iterations {
+            if self.interrupt.due() {
+                check_interrupt().map_err(StepError::Interrupted)?;
+            }
             constraints.residual(&self.q1, self.g.as_mut_slice())?;
             let residual = self.g.amax();
             if !residual.is_finite() {

@@ -127,6 +127,17 @@ pub struct Constrained<S, C> {
 /// An action x ↦ f(q, x) written into `out`: M(q)⁻¹x, or the inverse Legendre transform.
 pub type Action<'a> = &'a dyn Fn(&[f64], &[f64], &mut [f64]) -> Result<(), ModelError>;
 
+/// Refuses, naming `argument`, m constraints on n coordinates whose dense matrices do not fit in
+/// the memory available: a step holds G and W = M⁻¹Gᵀ at both of its ends (4mn numbers), the
+/// m × m Gram matrix and the Newton Jacobian of the multipliers (2m²).
+pub fn check_dense(argument: &'static str, m: usize, n: usize) -> Result<(), Error> {
+    let numbers = m
+        .saturating_mul(n)
+        .saturating_mul(4)
+        .saturating_add(m.saturating_mul(m).saturating_mul(2));
+    crate::memory::check_allocation(argument, numbers, std::mem::size_of::<f64>())
+}
+
 /// G(q) and W = M(q)⁻¹G(q)ᵀ (n × m), allocated (for diagnostics and set-up, not the step loop).
 fn jacobians<C: HolonomicConstraints + ?Sized>(
     constraints: &C,
@@ -197,7 +208,7 @@ pub fn project<C: HolonomicConstraints + ?Sized>(
     };
     match Newton::new(m).solve(&mut problem, &options, rules) {
         Ok(_) => {}
-        Err(StepError::Model(e)) => return Err(model(e)),
+        Err(StepError::Model(e) | StepError::Interrupted(e)) => return Err(model(e)),
         Err(StepError::Convergence { reason, .. }) if reason == OntoConstraints::<C>::REASONS.singular => {
             return Err(singular())
         }
@@ -217,6 +228,19 @@ pub fn project<C: HolonomicConstraints + ?Sized>(
         .solve(&(&jac * DVector::from_column_slice(&v)))
         .ok_or_else(singular)?;
     let p = DVector::from_column_slice(p0) - jac.transpose() * mu;
+    // Finite inputs near the largest floats can still overflow on the way (GM⁻¹Gᵀ, μ).
+    if !q.iter().all(|x| x.is_finite()) {
+        return Err(Error::invalid(
+            "q0",
+            "its projection overflows: the positions are too large to project",
+        ));
+    }
+    if !p.iter().all(|x| x.is_finite()) {
+        return Err(Error::invalid(
+            "p0",
+            "its projection overflows: the momenta are too large to project",
+        ));
+    }
     Ok((q.as_slice().to_vec(), p.as_slice().to_vec()))
 }
 

@@ -23,8 +23,8 @@ mod routh;
 mod symmetry;
 
 pub use constraints::{
-    differenced_jacobian, project, residuals, Action, Anchor, Constrained, Distances, HolonomicConstraints, Link,
-    PhaseState,
+    check_dense, differenced_jacobian, project, residuals, Action, Anchor, Constrained, Distances,
+    HolonomicConstraints, Link, PhaseState,
 };
 pub use energy::hamiltonian;
 pub use lagrangian::{Hessians, Lagrangian};

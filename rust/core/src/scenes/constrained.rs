@@ -1,5 +1,5 @@
 use super::{Problem, State};
-use crate::model::{Anchor, Constrained, Distances, Generator, Link, Mass, MechanicalSystem};
+use crate::model::{check_dense, Anchor, Constrained, Distances, Generator, Link, Mass, MechanicalSystem};
 use crate::{Error, ModelError};
 
 /// Point masses in d dimensions under uniform gravity along the last axis,
@@ -71,6 +71,7 @@ fn chain(d: usize, links: usize, angle: f64) -> Result<(LinkedMasses, Vec<f64>),
     if links == 0 {
         return Err(Error::invalid("links", "must be at least 1"));
     }
+    check_dense("links", links, d.saturating_mul(links))?;
     let system = PointMasses::new(d, vec![1.0; links], 1.0)?;
     let constraints = Distances::new(
         d,

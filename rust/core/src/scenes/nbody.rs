@@ -1,4 +1,5 @@
 use super::{Problem, State};
+use crate::memory::check_allocation;
 use crate::model::{Generator, Mass, MechanicalSystem};
 use crate::{Error, ModelError};
 
@@ -21,8 +22,10 @@ impl NBody {
         if masses.len() < 2 {
             return Err(Error::invalid("masses", "need at least two bodies"));
         }
-        let mass = Mass::diagonal(masses.iter().flat_map(|m| [*m; 3]).collect())?;
+        // The table of pairs, N(N − 1)/2 products.
         let n = masses.len();
+        check_allocation("masses", n.saturating_mul(n - 1) / 2, std::mem::size_of::<f64>())?;
+        let mass = Mass::diagonal(masses.iter().flat_map(|m| [*m; 3]).collect())?;
         let gmm = (0..n)
             .flat_map(|i| (i + 1..n).map(move |j| (i, j)))
             .map(|(i, j)| g * masses[i] * masses[j])

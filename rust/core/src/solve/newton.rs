@@ -11,9 +11,10 @@
 use nalgebra::{DMatrix, DVector};
 
 use super::difference::NOISE_FLOOR;
+use super::interrupt::{check_interrupt, InterruptPoll};
 use super::lu::{lu_in_place, lu_solve};
 use crate::error::StepError;
-use crate::ModelError;
+use crate::{Error, ModelError};
 
 /// Options of a Newton iteration.
 ///
@@ -30,6 +31,35 @@ pub struct NewtonOptions {
     pub tolerance: f64,
     /// Give up (a convergence error) after this many iterations.
     pub max_iterations: usize,
+}
+
+impl NewtonOptions {
+    /// The largest iteration cap. Newton's method converges in a handful of iterations or not
+    /// at all (the default cap is 50); a cap beyond ten thousand only turns a failure into an
+    /// apparent hang, and a cap near 2⁶³ into a real one.
+    pub const MAX_ITERATIONS: usize = 10_000;
+
+    /// Checks tolerance > 0 finite and 1 ≤ max_iterations ≤ [`Self::MAX_ITERATIONS`]; the
+    /// errors name the arguments `newton_tolerance` and `newton_max_iterations`.
+    pub fn check(&self) -> Result<(), Error> {
+        let NewtonOptions {
+            tolerance,
+            max_iterations,
+        } = *self;
+        if !(tolerance.is_finite() && tolerance > 0.0) {
+            return Err(Error::invalid(
+                "newton_tolerance",
+                format!("must be finite and positive, got {tolerance}"),
+            ));
+        }
+        if !(1..=Self::MAX_ITERATIONS).contains(&max_iterations) {
+            return Err(Error::invalid(
+                "newton_max_iterations",
+                format!("must be from 1 to {}, got {max_iterations}", Self::MAX_ITERATIONS),
+            ));
+        }
+        Ok(())
+    }
 }
 
 impl Default for NewtonOptions {
@@ -128,6 +158,8 @@ pub(crate) struct Newton {
     sign: f64,
     /// Newton steps made over the workspace's life.
     iterations: u64,
+    /// When to check for interrupts between iterations (kept over solves: most take a few).
+    interrupt: InterruptPoll,
 }
 
 /// ‖r‖∞.
@@ -143,6 +175,7 @@ impl Newton {
             pivots: vec![0; m],
             sign: 0.0,
             iterations: 0,
+            interrupt: InterruptPoll::new(),
         }
     }
 
@@ -194,6 +227,9 @@ impl Newton {
         let mut last = f64::INFINITY;
         let mut smallest = f64::INFINITY;
         for iteration in 1..=options.max_iterations {
+            if self.interrupt.due() {
+                check_interrupt().map_err(StepError::Interrupted)?;
+            }
             let fresh = !keep_jacobian;
             if fresh {
                 problem.jacobian(&mut self.jacobian)?;
@@ -245,10 +281,28 @@ impl Newton {
 /// A failed iteration as the model layer reports it.
 pub(crate) fn model_error(e: StepError) -> ModelError {
     match e {
-        StepError::Model(e) => e,
+        StepError::Model(e) | StepError::Interrupted(e) => e,
         StepError::Convergence { reason, .. }
         | StepError::NonFinite { reason }
         | StepError::SpuriousBranch { reason } => reason.into(),
         StepError::Method(e) => e.to_string().into(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::NewtonOptions;
+
+    #[test]
+    fn the_iteration_cap_is_bounded_and_named() {
+        let cap = |max_iterations| NewtonOptions {
+            max_iterations,
+            ..NewtonOptions::default()
+        };
+        assert!(cap(NewtonOptions::MAX_ITERATIONS).check().is_ok());
+        for bad in [0, NewtonOptions::MAX_ITERATIONS + 1, usize::MAX] {
+            let err = cap(bad).check().unwrap_err().to_string();
+            assert!(err.starts_with("newton_max_iterations:"), "{err}");
+        }
     }
 }

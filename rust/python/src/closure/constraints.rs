@@ -7,7 +7,7 @@ use numpy::PyArray1;
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use varmech::integrators::{Dynamics, General};
-use varmech::model::{differenced_jacobian, Constrained, HolonomicConstraints, Natural};
+use varmech::model::{check_dense, differenced_jacobian, Constrained, HolonomicConstraints, Natural};
 use varmech::ModelError;
 
 use super::mechanical::{ClosureModel, ClosureSystem};
@@ -46,6 +46,7 @@ impl ClosureConstrained {
             ));
         };
         let dim = system.dim();
+        check_dense("count", count, dim).map_err(|e| PyValueError::new_err(e.to_string()))?;
         check_closures(
             dim,
             [

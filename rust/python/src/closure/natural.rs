@@ -6,6 +6,7 @@ use nalgebra::DMatrix;
 use numpy::PyArray1;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
+use varmech::memory::check_allocation;
 use varmech::model::{differenced_kinetic_gradient, kinetic_gradient_from_mass_derivative, NaturalSystem};
 use varmech::ModelError;
 
@@ -52,6 +53,14 @@ impl ClosureNatural {
                 ("mass_derivative", mass_derivative.as_ref()),
             ],
         )?;
+        if mass_derivative.is_some() {
+            check_allocation(
+                "mass_derivative",
+                dim.saturating_mul(dim).saturating_mul(dim),
+                size_of::<f64>(),
+            )
+            .map_err(|e| PyValueError::new_err(e.to_string()))?;
+        }
         Ok(ClosureNatural {
             dim,
             mass: mass.unbind(),
@@ -92,7 +101,8 @@ impl<'py> ClosureNaturalSystem<'py> {
             mass: model.mass.bind(py).clone(),
             potential: ClosurePotential::new(py, n, &model.potential, model.gradient.as_ref()),
             mass_derivative: model.mass_derivative.as_ref().map(|f| f.bind(py).clone()),
-            derivative: RefCell::new(vec![0.0; n * n * n]),
+            // Only read with `mass_derivative` (whose n³ numbers the constructor checked).
+            derivative: RefCell::new(vec![0.0; if model.mass_derivative.is_some() { n * n * n } else { 0 }]),
         }
     }
 }

@@ -1,14 +1,23 @@
 //! Calling Python closures: each result is read into the core's buffers, and a result of the
 //! wrong type or shape is an error that names the closure.
+//!
+//! A result is admitted when it converts to float64 exactly: float64, Python floats and ints,
+//! and NumPy floats of at most 64 bits and integers (upcast deliberately). Complex, bool,
+//! bytes, strings, objects and masked arrays are refused with a TypeError naming the closure:
+//! NumPy would drop an imaginary part, read bytes as their codes and a mask as nothing.
 
-use numpy::{PyArray1, PyArrayDyn, PyArrayMethods};
+use numpy::{PyArray1, PyArrayDescrMethods, PyArrayDyn, PyArrayMethods, PyUntypedArray, PyUntypedArrayMethods};
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
+use pyo3::types::{PyBool, PyFloat, PyInt, PyList, PyTuple};
 use varmech::ModelError;
+
+use varmech::memory::check_allocation;
 
 use crate::errors::boxed;
 
-/// A positive dimension and callable closures (the optional ones may be None).
+/// A positive dimension whose dense n × n matrices fit in memory (the Hessian blocks of L and
+/// the Newton Jacobian), and callable closures (the optional ones may be None).
 pub fn check_closures<const N: usize>(dim: usize, closures: [(&str, Option<&Bound<'_, PyAny>>); N]) -> PyResult<()> {
     if dim == 0 {
         return Err(PyValueError::new_err("dim: must be at least 1"));
@@ -18,7 +27,8 @@ pub fn check_closures<const N: usize>(dim: usize, closures: [(&str, Option<&Boun
             return Err(PyTypeError::new_err(format!("{name}: must be callable")));
         }
     }
-    Ok(())
+    check_allocation("dim", dim.saturating_mul(dim), 4 * std::mem::size_of::<f64>())
+        .map_err(|e| PyValueError::new_err(e.to_string()))
 }
 
 /// The name of a Python object's type, for messages.
@@ -26,57 +36,98 @@ pub fn type_name(x: &Bound<'_, PyAny>) -> String {
     x.get_type().name().map(|n| n.to_string()).unwrap_or_default()
 }
 
+/// A plain float64 ndarray (not a subclass such as a masked array), read in place.
+fn plain_float64(x: &Bound<'_, PyAny>) -> bool {
+    x.is_exact_instance_of::<PyUntypedArray>() && x.cast::<PyArrayDyn<f64>>().is_ok()
+}
+
+/// A closure's result admitted as float64 (see the module's doc): Python floats and ints as
+/// they are, anything else as a float64 ndarray. A refusal is a TypeError naming `call` and
+/// what it should return, `expected`.
+fn admit<'py>(result: Bound<'py, PyAny>, call: &str, expected: &str) -> Result<Bound<'py, PyAny>, ModelError> {
+    if result.is_instance_of::<PyFloat>() || (result.is_instance_of::<PyInt>() && !result.is_instance_of::<PyBool>()) {
+        return Ok(result);
+    }
+    let refuse = |what: String| {
+        boxed(PyTypeError::new_err(format!(
+            "{call} must return {expected}, got {what} (float64 is read as it is, ints and float32 are converted)"
+        )))
+    };
+    let numpy = result.py().import("numpy").map_err(boxed)?;
+    let masked = numpy
+        .getattr("ma")
+        .and_then(|ma| ma.getattr("MaskedArray"))
+        .map_err(boxed)?;
+    if result.is_instance(&masked).map_err(boxed)? {
+        return Err(refuse("a masked array (fill it first, numpy.ma.filled)".into()));
+    }
+    let array = numpy
+        .call_method1("asarray", (&result,))
+        .map_err(|_| refuse(type_name(&result)))?
+        .cast_into::<PyUntypedArray>()
+        .map_err(|_| refuse(type_name(&result)))?;
+    let dtype = array.dtype();
+    let (kind, size) = (dtype.kind(), dtype.itemsize());
+    if !(kind == b'i' || kind == b'u' || (kind == b'f' && size <= 8)) {
+        let name = dtype.getattr("name").map(|n| n.to_string()).unwrap_or_default();
+        let what = if result.is_instance_of::<PyUntypedArray>() {
+            format!("a {name} array")
+        } else if result.is_instance_of::<PyList>() || result.is_instance_of::<PyTuple>() {
+            format!("{} of {name}", type_name(&result))
+        } else {
+            type_name(&result)
+        };
+        return Err(refuse(what));
+    }
+    array.call_method1("astype", ("float64",)).map_err(boxed)
+}
+
 /// Reads a closure's result, a float; a wrong type is a TypeError naming the closure as `call`.
 pub fn call_scalar(result: PyResult<Bound<'_, PyAny>>, call: &str) -> Result<f64, ModelError> {
     let result = result.map_err(boxed)?;
-    result.extract::<f64>().map_err(|_| {
+    let returned = type_name(&result);
+    admit(result, call, "a float")?.extract::<f64>().map_err(|_| {
         boxed(PyTypeError::new_err(format!(
-            "{call} must return a float, got {}",
-            type_name(&result)
+            "{call} must return a float, got {returned}"
         )))
     })
 }
 
-/// Reads a closure's result, an array (n,) of floats, into `out`: a float64 numpy array is
-/// read in place, any other sequence of numbers is converted. A wrong length is a ValueError
-/// and a wrong type a TypeError, both naming the closure as `call`.
+/// Reads a closure's result, an array (n,) of floats, into `out`. A wrong length is a
+/// ValueError and a wrong type a TypeError, both naming the closure as `call`.
 pub fn call_vector(result: PyResult<Bound<'_, PyAny>>, call: &str, out: &mut [f64]) -> Result<(), ModelError> {
     let result = result.map_err(boxed)?;
     let n = out.len();
-    let wrong_length = |len: usize| {
-        boxed(PyValueError::new_err(format!(
-            "{call} returned {len} values, expected {n} (one per coordinate)"
-        )))
+    let expected = format!("a 1-d array of {n} floats");
+    let result = if plain_float64(&result) {
+        result
+    } else {
+        admit(result, call, &expected)?
     };
-    if let Ok(arr) = result.cast::<PyArray1<f64>>() {
-        let ro = arr.readonly();
-        let view = ro.as_array();
-        if view.len() != n {
-            return Err(wrong_length(view.len()));
-        }
-        out.iter_mut().zip(view.iter()).for_each(|(o, v)| *o = *v);
-        return Ok(());
-    }
-    let values: Vec<f64> = result.extract().map_err(|_| {
+    let Ok(arr) = result.cast::<PyArray1<f64>>() else {
         let shape = result
             .getattr("shape")
             .map(|s| format!(" of shape {s}"))
             .unwrap_or_default();
-        boxed(PyTypeError::new_err(format!(
-            "{call} must return a 1-d array of {n} floats, got {}{shape}",
+        return Err(boxed(PyTypeError::new_err(format!(
+            "{call} must return {expected}, got {}{shape}",
             type_name(&result)
-        )))
-    })?;
-    if values.len() != n {
-        return Err(wrong_length(values.len()));
+        ))));
+    };
+    let ro = arr.readonly();
+    let view = ro.as_array();
+    if view.len() != n {
+        return Err(boxed(PyValueError::new_err(format!(
+            "{call} returned {} values, expected {n} (one per coordinate)",
+            view.len()
+        ))));
     }
-    out.copy_from_slice(&values);
+    out.iter_mut().zip(view.iter()).for_each(|(o, v)| *o = *v);
     Ok(())
 }
 
-/// Reads a closure's result, a float array of `shape`, into `out` in C order: a float64 numpy
-/// array is read in place, anything else goes through `numpy.asarray`. A wrong shape is a
-/// ValueError and a wrong type a TypeError, both naming the closure as `call`.
+/// Reads a closure's result, a float array of `shape`, into `out` in C order. A wrong shape is
+/// a ValueError and a wrong type a TypeError, both naming the closure as `call`.
 pub fn call_array(
     result: PyResult<Bound<'_, PyAny>>,
     call: &str,
@@ -84,22 +135,18 @@ pub fn call_array(
     out: &mut [f64],
 ) -> Result<(), ModelError> {
     let result = result.map_err(boxed)?;
-    let wrong_type = || {
+    let expected = format!("an array of shape {shape:?} of floats");
+    let result = if plain_float64(&result) {
+        result
+    } else {
+        admit(result, call, &expected)?
+    };
+    let array = result.cast::<PyArrayDyn<f64>>().map_err(|_| {
         boxed(PyTypeError::new_err(format!(
-            "{call} must return an array of shape {shape:?} of floats, got {}",
+            "{call} must return {expected}, got {}",
             type_name(&result)
         )))
-    };
-    let array = match result.cast::<PyArrayDyn<f64>>() {
-        Ok(a) => a.clone(),
-        Err(_) => {
-            let numpy = result.py().import("numpy").map_err(boxed)?;
-            let converted = numpy
-                .call_method1("asarray", (&result, "float64"))
-                .map_err(|_| wrong_type())?;
-            converted.cast_into::<PyArrayDyn<f64>>().map_err(|_| wrong_type())?
-        }
-    };
+    })?;
     let readonly = array.readonly();
     let view = readonly.as_array();
     if view.shape() != shape {
