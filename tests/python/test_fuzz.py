@@ -153,11 +153,6 @@ def test_scenes_with_parameters(case):
         st.tuples(st.just("planar_chain"), st.just("links"), st.one_of(st.integers(max_value=-1), st.integers(2**64, 2**80))),
     )
 )
-@pytest.mark.xfail(
-    reason="outside this change (scenes.py, rust/python/src/scenes.rs): omega = 0 raises ZeroDivisionError, "
-    "links outside usize raises OverflowError, not a ValueError naming the argument",
-    strict=False,
-)
 def test_scenes_with_parameters_out_of_range(case):
     _scene_and_run(*case)
 

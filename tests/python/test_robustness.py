@@ -58,6 +58,8 @@ def _rss_mib():
             2000, lambda q: 0.0, lambda q: np.zeros(2000), mass=lambda q: np.eye(2000),
             mass_derivative=lambda q: np.zeros((2000,) * 3)), "mass_derivative"),
         (lambda: varmech.MechanicalSystem(10**6, lambda q: 0.0, lambda q: q), "dim"),
+        # 3·10⁹ saved states of Kepler: 168 GB, which Linux would reserve and then kill.
+        (lambda: varmech.integrate(scenes.kepler(), dt=1e-6, steps=3 * 10**9, save_every=1), "save_every"),
     ],
 )
 def test_allocations_sized_by_arguments_are_refused_before_they_are_made(make, argument):

@@ -37,7 +37,6 @@ fn integrate<'py>(
         tolerance: newton_tolerance,
         max_iterations: newton_max_iterations,
     };
-    newton.check().map_err(|e| to_pyerr(py, e))?;
     let options = Options {
         dt,
         steps,

@@ -21,7 +21,6 @@ mod composition;
 mod del;
 mod dynamics;
 mod explicit_rk;
-mod interrupt;
 mod kick_drift;
 mod kind;
 mod method;

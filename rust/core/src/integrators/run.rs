@@ -1,7 +1,7 @@
 //! The fixed-step run: a [`Stepper`] advanced to the end, its states saved on the way.
 
 use super::{Dynamics, Failure, Method, NewtonOptions, Stepper, Trajectory};
-use crate::{Error, ModelError};
+use crate::{memory, Error, ModelError};
 
 /// Options of a fixed-step run.
 #[derive(Clone, Debug, PartialEq)]
@@ -51,19 +51,7 @@ impl Options {
         if !self.t0.is_finite() {
             return Err(Error::invalid("t0", "must be finite"));
         }
-        let NewtonOptions {
-            tolerance,
-            max_iterations,
-        } = self.newton;
-        if !(tolerance.is_finite() && tolerance > 0.0) {
-            return Err(Error::invalid(
-                "newton_tolerance",
-                format!("must be finite and positive, got {tolerance}"),
-            ));
-        }
-        if max_iterations == 0 {
-            return Err(Error::invalid("newton_max_iterations", "must be at least 1"));
-        }
+        self.newton.check()?;
         match self.max_energy_error {
             Some(x) if x.is_nan() || x <= 0.0 => {
                 Err(Error::invalid("max_energy_error", format!("must be positive, got {x}")))
@@ -110,6 +98,11 @@ where
         ..
     } = *options;
     let saved = (steps / save_every).saturating_add(2);
+    // Reserving succeeds beyond the memory there is (Linux overcommits) and the run would then
+    // be killed when it fills the states: check against what is available first.
+    if let Err(e) = memory::check_allocation("save_every", saved, (2 * n + 3) * std::mem::size_of::<f64>()) {
+        return Err(fail(e, traj));
+    }
     let reserved = saved.checked_mul(n).is_some_and(|len| {
         traj.t.try_reserve_exact(saved).is_ok()
             && traj.newton.try_reserve_exact(saved).is_ok()

@@ -3,9 +3,9 @@
 use std::borrow::{Borrow, BorrowMut};
 use std::ops::Deref;
 
-use super::interrupt::InterruptPoll;
 use super::{compensated, Dynamics, Increment, Integrator, Method, Options, StepStart};
 use crate::error::check_vector;
+use crate::solve::interrupt::InterruptPoll;
 use crate::{Error, ModelError};
 
 /// A model `M` (a reference `&S` to borrow it, a `Box<S>` to own it) with its [`StepperState`]
