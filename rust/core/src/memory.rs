@@ -10,6 +10,11 @@ use crate::Error;
 /// both figures.
 pub fn check_allocation(argument: &'static str, count: usize, size: usize) -> Result<(), Error> {
     let bytes = count.checked_mul(size).filter(|&b| b <= isize::MAX as usize);
+    // Below this nothing is worth a read of /proc/meminfo (tens of µs, a short run's cost).
+    const SMALL: usize = 64 << 20;
+    if bytes.is_some_and(|b| b <= SMALL) {
+        return Ok(());
+    }
     let available = available_bytes();
     match bytes {
         Some(bytes) if available.is_none_or(|a| bytes <= a) => Ok(()),
