@@ -75,6 +75,9 @@ impl<S: MechanicalSystem> Dynamics for S {
         ModelKind::Separable
     }
 
+    // Inlined, like Integrator::increment, so that a separable step is one loop body: the
+    // calls cost a Verlet step of Kepler about 18 instructions of its 110 (callgrind).
+    #[inline(always)]
     fn increment(
         &self,
         integrator: &mut Integrator,

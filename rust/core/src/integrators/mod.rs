@@ -157,6 +157,7 @@ impl Integrator {
     }
 
     /// Writes the increments of one step of size h from (q, p) at time t into (δq, δp).
+    #[inline(always)]
     pub fn increment<S: MechanicalSystem + ?Sized>(
         &mut self,
         sys: &S,
