@@ -9,7 +9,7 @@ from .. import _core
 from ..integrate import Trajectory, integrate
 from ..model import Model
 from ..scenes import Scene
-from ._energy import energy_of
+from ._energy import conserves_energy, energy_of
 
 ModelLike = Model | Scene
 
@@ -20,7 +20,7 @@ def model_of(model_or_scene: ModelLike) -> Model:
         raise TypeError(f"model_or_scene: expected a varmech model or scene, got {type(model_or_scene).__name__}")
     if model.constraints:
         raise ValueError(f"model_or_scene: {model.name} is constrained; sections need an unconstrained model")
-    if model.time_dependent or model.forced:
+    if not conserves_energy(model):
         raise ValueError(f"model_or_scene: {model.name} does not conserve its energy (time-dependent or forced)")
     return model
 

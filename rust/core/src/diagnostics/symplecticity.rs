@@ -62,5 +62,15 @@ pub fn symplecticity_defect<S: Dynamics + ?Sized>(
         j[(i, n + i)] = 1.0;
         j[(n + i, i)] = -1.0;
     }
-    Ok((psi.transpose() * &j * &psi - j).norm())
+    let defect = (psi.transpose() * &j * &psi - j).norm();
+    // Finite arguments whose step (or its differences) overflows leave no defect to report.
+    if !defect.is_finite() {
+        let reason = format!(
+            "one step of {} from this state overflows, so its symplecticity defect is undefined (got {defect}); \
+             take smaller values",
+            method.info().name
+        );
+        return Err(Error::invalid("q, p, dt", reason));
+    }
+    Ok(defect)
 }
