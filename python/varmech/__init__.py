@@ -35,7 +35,7 @@ from .analysis.stability import (
     unstable_intervals,
 )
 from .analysis.work_precision import work_precision
-from .conservation import ConservationReport, EnergyReport, MomentumReport, check_conservation, momentum
+from .conservation import ConservationReport, InvariantStatistics, check_conservation, momentum
 from .constraints import project
 from .derivatives import DerivativeCheck, check_derivatives
 from .integrate import Trajectory, integrate, symplecticity_defect
@@ -53,12 +53,11 @@ __all__ = [
     "Cyclic",
     "DerivativeCheck",
     "DivergenceError",
-    "EnergyReport",
+    "InvariantStatistics",
     "Lagrangian",
     "MechanicalSystem",
     "MethodInfo",
     "Model",
-    "MomentumReport",
     "NativeSystem",
     "ReducedModel",
     "Rotation",

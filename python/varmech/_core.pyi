@@ -8,6 +8,9 @@ from numpy.typing import NDArray
 from typing_extensions import disjoint_base
 
 __all__ = [
+    "FAILURE",
+    "ROUND_OFF",
+    "VERDICTS",
     "CatalogueEntry",
     "ClosureConstrained",
     "ClosureLagrangian",
@@ -23,6 +26,7 @@ __all__ = [
     "SceneRecord",
     "SceneReference",
     "SpuriousBranchError",
+    "Statistics",
     "Stepper",
     "TrajectoryRecord",
     "VarmechError",
@@ -32,10 +36,9 @@ __all__ = [
     "cyclic_increments",
     "cyclic_velocity",
     "derivative",
-    "energy",
     "energy_statistics",
+    "energy_terms",
     "integrate",
-    "invariant_statistics",
     "is_forced",
     "is_time_dependent",
     "kind_of",
@@ -45,6 +48,7 @@ __all__ = [
     "project",
     "routh",
     "scene",
+    "statistics",
     "symplecticity_defect",
 ]
 
@@ -231,7 +235,10 @@ class NativeModel(_ModelProperties):
     def gravity(self) -> tuple[float, list[float]] | None:
         """(G, masses) of an N-body scene, None for the others."""
 
-def constraint_residuals(model: _Model, q: _FloatArray, p: _FloatArray) -> tuple[_FloatArray, _FloatArray]: ...
+def constraint_residuals(
+    model: _Model, q: _FloatArray, p: _FloatArray
+) -> tuple[tuple[_FloatArray, _FloatArray], tuple[_FloatArray, _FloatArray]]:
+    """((|g(q)|∞, |G(q)M⁻¹p|∞), (‖G‖∞‖q‖∞, ‖G‖∞‖M⁻¹p‖∞)) at each state."""
 def project(model: _Model, q0: _FloatArray, p0: _FloatArray) -> tuple[_FloatArray, _FloatArray]: ...
 
 @final
@@ -347,16 +354,48 @@ def integrate(
     """The saved states; on failure the exception carries ``_varmech_partial``, the
     TrajectoryRecord up to the failure."""
 
-def energy(model: _Model, t: _FloatArray, q: _FloatArray, p: _FloatArray) -> _FloatArray:
-    """The energy function p·q̇ − L at each state."""
+def energy_terms(model: _Model, t: _FloatArray, q: _FloatArray, p: _FloatArray) -> tuple[_FloatArray, _FloatArray, _FloatArray]:
+    """(E, T, V) at each state: the energy function p·q̇ − L, its kinetic term E − V and its
+    potential V = −L(q, 0, t)."""
 
 def derivative(model: _Model, what: str, t: _FloatArray, q: _FloatArray, x: _FloatArray) -> _FloatArray:
     """At each state: ``"momentum"`` p = ∂L/∂q̇(q, x, t), ``"velocity"`` the q̇ with
     ∂L/∂q̇ = x, or ``"dl_dq"`` ∂L/∂q(q, x, t)."""
 
-def momentum(generator: Generator, q: _FloatArray, p: _FloatArray) -> _FloatArray: ...
-def energy_statistics(t: _FloatArray, h: _FloatArray) -> dict[str, Any]: ...
-def invariant_statistics(values: _FloatArray) -> tuple[float, float, float]: ...
+def momentum(generator: Generator, q: _FloatArray, p: _FloatArray) -> tuple[_FloatArray, _FloatArray]:
+    """(J, Σ|pᵢξᵢ|) at each state."""
+
+VERDICTS: tuple[str, str, str, str]
+FAILURE: float
+ROUND_OFF: float
+
+@final
+class Statistics:
+    """The error of a conserved quantity against its scale, and its verdict."""
+
+    @property
+    def scale(self) -> float: ...
+    @property
+    def round_off(self) -> float: ...
+    @property
+    def max_abs_error(self) -> float: ...
+    @property
+    def max_rel_error(self) -> float: ...
+    @property
+    def band(self) -> float: ...
+    @property
+    def drift_rate(self) -> float: ...
+    @property
+    def drift_rate_stderr(self) -> float: ...
+    @property
+    def first_non_finite(self) -> int | None: ...
+    @property
+    def verdict(self) -> str: ...
+
+def energy_statistics(
+    t: _FloatArray, energy: _FloatArray, kinetic: _FloatArray, potential: _FloatArray, work: _FloatArray, steps: int
+) -> Statistics: ...
+def statistics(t: _FloatArray, error: _FloatArray, size: _FloatArray, terms: _FloatArray, steps: int) -> Statistics: ...
 def symplecticity_defect(model: _Model, method: str, q: _FloatArray, p: _FloatArray, dt: float) -> float: ...
 def methods() -> list[MethodInfo]: ...
 @final

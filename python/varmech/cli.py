@@ -12,6 +12,7 @@ from .conservation import check_conservation
 from .integrate import integrate
 from .methods import format_table
 from .reduction import routh
+from .table import Table
 
 #: Showcase runs of the tour, scene → (methods, horizon) with None for the scene's t_end: each
 #: over a horizon long enough to tell bounded from drifting. A scene without one runs with its
@@ -57,8 +58,9 @@ TOUR_REDUCED = [
 ]
 
 
-def tour_reduced(quick: bool) -> None:
-    """Integrate the Routh-reduced scenes and report on the reconstructed full motion."""
+def tour_reduced(quick: bool, summary: Table) -> None:
+    """Integrate the Routh-reduced scenes, report on the reconstructed full motion, and add
+    the reduced runs' energy verdicts to ``summary``."""
     for name, cyclic, methods in TOUR_REDUCED:
         scene = scenes.get(name)
         reduced = routh(scene, cyclic)
@@ -74,6 +76,9 @@ def tour_reduced(quick: bool) -> None:
             lo, hi = traj.q.min(axis=0), traj.q.max(axis=0)
             print(f"--- {method}: {elapsed:.3f} s with reconstruction; x ranges over {lo} … {hi}")
             print(check_conservation(full))
+            reduced_report = check_conservation(traj)
+            energy = reduced_report.energy
+            summary.append(reduced.name, method, steps, elapsed, energy.max_rel_error if energy else float("nan"), reduced_report.verdict)
 
 
 def tour(out: Path, quick: bool) -> int:
@@ -81,6 +86,10 @@ def tour(out: Path, quick: bool) -> int:
     energy-error plots and the charts of :data:`TOUR_CHARTS` to ``out`` (without matplotlib,
     the reports only)."""
     plots = True
+    summary = Table(
+        ("scene", "method", "steps", "seconds", "max_error", "verdict"),
+        title="Tour: energy error against its scale (the mean kinetic energy), and the verdict",
+    )
     for scene, methods, horizon in tour_runs():
         name = scene.name
         t_end = horizon / 10 if quick else horizon
@@ -94,7 +103,12 @@ def tour(out: Path, quick: bool) -> int:
             elapsed = time.perf_counter() - start
             runs[method] = traj
             print(f"--- {method}: {traj.nfev} force evaluations in {elapsed:.3f} s")
-            print(check_conservation(traj))
+            report = check_conservation(traj)
+            print(report)
+            stats, verdict = report.energy, report.verdict
+            if report.energy_balance is not None:
+                stats, verdict = report.energy_balance, f"balance E − W {report.energy_balance.verdict}"
+            summary.append(name, method, steps, elapsed, stats.max_rel_error if stats else float("nan"), verdict)
         if plots:
             try:
                 path = charts.energy_error(runs, out / f"{name}_energy.png", title=f"{name}, dt = {scene.dt:g}")
@@ -102,7 +116,9 @@ def tour(out: Path, quick: bool) -> int:
             except ImportError as e:
                 print(f"(no plots: {e})")
                 plots = False
-    tour_reduced(quick)
+    tour_reduced(quick, summary)
+    print()
+    print(summary.format(max_rows=None))
     if plots:
         print("\n=== charts: accuracy against cost, energy over long runs, stability, sections")
         for kind in TOUR_CHARTS:

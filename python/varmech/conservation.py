@@ -1,7 +1,13 @@
-"""What a run conserves: energy, Noether momenta, and a verdict."""
+"""What a run conserves: energy, Noether momenta, constraints, and a verdict on each.
+
+Every quantity is judged against its own scale (see :class:`InvariantStatistics`): the energy
+against the mean kinetic energy of the run, a Noether momentum J = p·ξ(q) against the mean size
+Σ|pᵢξᵢ| of its terms, the constraint residuals |g(q)| and |G(q)q̇| against ‖G‖‖q‖ and ‖G‖‖q̇‖.
+"""
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -9,7 +15,15 @@ import numpy as np
 
 from . import _core
 from .integrate import Trajectory
-from .model import Cyclic, Generator, Rotation, Translation
+from .model import Cyclic, Generator, Model, Rotation, Translation
+
+#: The verdicts, best first: "conserved to round-off", "bounded", "secular drift", "failed".
+VERDICTS: tuple[str, ...] = tuple(_core.VERDICTS)
+#: An error this large against the scale is a failure; also ``integrate``'s default
+#: ``max_energy_error``.
+FAILURE: float = _core.FAILURE
+#: Round-off is an error within ROUND_OFF · ε · (size of the terms) · √(1 + steps).
+ROUND_OFF: float = _core.ROUND_OFF
 
 
 def momentum(traj: Trajectory, generator: Generator) -> np.ndarray:
@@ -18,48 +32,112 @@ def momentum(traj: Trajectory, generator: Generator) -> np.ndarray:
     ``generator`` is a :class:`~varmech.Translation`, :class:`~varmech.Rotation` or
     :class:`~varmech.Cyclic`, or a closure ``xi(q) -> array (n,)``.
     """
+    return _momentum_terms(traj, generator)[0]
+
+
+def _momentum_terms(traj: Trajectory, generator: Generator) -> tuple[np.ndarray, np.ndarray]:
+    """J = p·ξ(q) and the size Σ|pᵢξᵢ| of its terms at every saved state."""
     if isinstance(generator, (Translation, Rotation, Cyclic)):
         return _core.momentum(generator.spec(), traj.q, traj.p)
     if not callable(generator):
         raise TypeError(f"generator: expected a Translation, Rotation, Cyclic or a callable xi(q), got {generator!r}")
     n = traj.q.shape[1]
-    out = np.empty(len(traj.t))
+    j, size = np.empty(len(traj.t)), np.empty(len(traj.t))
     for k, (q, p) in enumerate(zip(traj.q, traj.p)):
         xi = np.asarray(generator(q.copy()), dtype=float)
         if xi.shape != (n,):
             raise ValueError(f"generator: xi(q) must return shape ({n},), got {xi.shape}")
-        out[k] = p @ xi
-    return out
+        j[k], size[k] = p @ xi, np.abs(p * xi).sum()
+    return j, size
 
 
 @dataclass(frozen=True)
-class EnergyReport:
-    """The energy error e(t) = (H(t) − H₀)/|H₀| of a run (absolute when H₀ = 0).
+class InvariantStatistics:
+    """The error of one conserved quantity along a run, against its scale, and the verdict.
 
-    ``verdict`` is "secular drift" when the largest |e| over the last tenth of the run exceeds
-    twice that over the first tenth, the fitted drift rate differs from zero by more than three
-    standard errors, and the error is above round-off (``noise_floor``); otherwise "bounded".
+    The verdict is the first that applies of:
+
+    - ``"failed"``: a value is not finite (``first_non_finite`` is the first saved state where
+      it is not), or max |error| reaches :data:`FAILURE` × ``scale``: the quantity is wrong by
+      its own size;
+    - ``"conserved to round-off"``: max |error| ≤ ``round_off`` = :data:`ROUND_OFF` · ε ·
+      (largest size of the quantity's terms) · √(1 + steps), the rounding error of its terms
+      grown as a random walk (Brouwer's law);
+    - ``"secular drift"``: the error grows. Over eight batches in time, the slope of the batch
+      means differs from zero by more than four standard errors, the drift over the run exceeds
+      round-off and the 4 ε of the terms a step that biased rounding (an implicit method's
+      solve) can add, and the last batch's largest |error| is more than twice the first's. The
+      run must span several oscillations of the error: over a fraction of one, a bounded
+      error's rise cannot be told from a drift;
+    - ``"bounded"``: otherwise, a band that does not grow and stays below the failure level.
+
+    ``max_rel_error`` and ``band`` are relative to ``scale``; ``drift_rate`` and
+    ``drift_rate_stderr`` are absolute, per unit time.
     """
-
-    initial: float
-    max_error: float
-    band: float
-    max_error_first_tenth: float
-    max_error_last_tenth: float
-    drift_rate: float
-    drift_rate_stderr: float
-    verdict: str
-    noise_floor: float
-
-
-@dataclass(frozen=True)
-class MomentumReport:
-    """max |J − J₀| of a Noether momentum, absolute and relative to |J₀|."""
 
     name: str
     initial: float
+    scale: float
+    #: What the scale is: "mean kinetic energy", "mean Σ|pᵢξᵢ|", …
+    scale_name: str
+    round_off: float
     max_abs_error: float
     max_rel_error: float
+    band: float
+    drift_rate: float
+    drift_rate_stderr: float
+    first_non_finite: int | None
+    verdict: str
+    #: For a failure: where it happened, and what to do.
+    advice: str = ""
+
+    @property
+    def representative(self) -> bool:
+        """Whether |J₀| is of the order of the scale, so that an error relative to J₀ means
+        something (it does not for an energy whose zero is at the initial state)."""
+        return abs(self.initial) >= 1e-2 * self.scale
+
+    def describe(self, symbol: str, error: str | None = None) -> list[str]:
+        """The lines of a report on this quantity: ``symbol`` names its value (H, J, …) and
+        ``error`` its error (default Δ``symbol``)."""
+        error = error or f"Δ{symbol}"
+        head = f"{self.name:<12}verdict: {self.verdict}"
+        if self.advice:
+            head += f" ({self.advice})"
+        lines = [
+            head,
+            f"{'':12}{symbol}0 = {self.initial:.12g}   max |{error}| = {self.max_abs_error:.3e} = "
+            f"{self.max_rel_error:.3e} × scale {self.scale:.3e} ({self.scale_name})",
+            f"{'':12}round-off level {self.round_off:.3e}   drift rate {self.drift_rate:+.3e} ± "
+            f"{self.drift_rate_stderr:.1e} per unit time",
+        ]
+        if self.representative:
+            lines[1] += f"   (max |{error}/{symbol}0| = {self.max_abs_error / abs(self.initial):.3e})"
+        elif self.name == "energy":
+            lines.append(f"{'':12}|{symbol}0| is not representative of the energy's size: errors are against the scale")
+        return lines
+
+
+def _statistics(record: _core.Statistics, name: str, initial: float, scale_name: str, t: np.ndarray, advice: str = "") -> InvariantStatistics:
+    """The report of the core's statistics, with a failure located in time."""
+    k = record.first_non_finite
+    if k is not None:
+        advice = f"not finite from saved state {k} (t = {t[k]:.6g}) on" + (f"; {advice}" if advice else "")
+    return InvariantStatistics(
+        name,
+        float(initial),
+        record.scale,
+        scale_name,
+        record.round_off,
+        record.max_abs_error,
+        record.max_rel_error,
+        record.band,
+        record.drift_rate,
+        record.drift_rate_stderr,
+        k,
+        record.verdict,
+        advice if record.verdict == "failed" else "",
+    )
 
 
 NOT_CONSERVED = "not conserved (L depends on t)"
@@ -68,76 +146,141 @@ FORCED = "not conserved (forced); see the energy balance"
 
 @dataclass(frozen=True)
 class ConservationReport:
-    """What a run conserved: its energy statistics and the errors of its Noether momenta."""
+    """What a run conserved: its energy (or a forced run's energy balance), its Noether
+    momenta and its constraints, each with an :class:`InvariantStatistics` and its verdict."""
 
     model: str
     method: str
     dt: float
     t_end: float
-    #: None when L depends on t or forces act: the energy is then not conserved, so not judged.
-    energy: EnergyReport | None
-    momenta: tuple[MomentumReport, ...]
-    #: For forced systems, max |E(t) − E(0) − W(t)| / |E(0)| (absolute when E(0) = 0): the
-    #: discrete Lagrange–d'Alembert energy balance with the tracked work W.
-    energy_balance: float | None = None
-    #: For constrained models, max |g(q)|∞ and max |G(q)M⁻¹p|∞ over the run.
-    constraint_residuals: tuple[float, float] | None = None
+    #: None when L depends on t or forces act: the energy is then not conserved.
+    energy: InvariantStatistics | None
+    momenta: tuple[InvariantStatistics, ...]
+    #: For forced systems: the balance E(t) − W(t), W the work of the forces (the discrete
+    #: Lagrange–d'Alembert energy balance), judged as the energy is.
+    energy_balance: InvariantStatistics | None = None
+    #: For constrained models: |g(q)|∞ and |G(q)M⁻¹p|∞ over the run.
+    constraints: tuple[InvariantStatistics, InvariantStatistics] | None = None
 
     @property
     def verdict(self) -> str:
-        """The energy verdict: "bounded", "secular drift", or why the energy is not conserved."""
+        """The energy verdict (see :class:`InvariantStatistics`), or why the energy is not
+        conserved."""
         if self.energy is not None:
             return self.energy.verdict
         return FORCED if self.energy_balance is not None else NOT_CONSERVED
 
+    @property
+    def constraint_residuals(self) -> tuple[float, float] | None:
+        """max |g(q)|∞ and max |G(q)M⁻¹p|∞ over the run, for constrained models."""
+        if self.constraints is None:
+            return None
+        return self.constraints[0].max_abs_error, self.constraints[1].max_abs_error
+
+    @property
+    def quantities(self) -> tuple[InvariantStatistics, ...]:
+        """Every quantity judged: energy or balance, momenta, constraints."""
+        energy = tuple(e for e in (self.energy, self.energy_balance) if e is not None)
+        return energy + self.momenta + (self.constraints or ())
+
     def __str__(self) -> str:
-        e = self.energy
         lines = [f"Conservation report: {self.model}, {self.method}, dt = {self.dt:g}, t = 0 … {self.t_end:g}"]
-        if e is None:
-            lines.append(f"  energy   {self.verdict}")
-            if self.energy_balance is not None:
-                lines.append(f"           max |E − E0 − W|/|E0| = {self.energy_balance:.3e}")
-        else:
-            lines += [
-                f"  energy   H0 = {e.initial:.12g}",
-                f"           max |ΔH/H0| = {e.max_error:.3e}   band = {e.band:.3e}",
-                f"           first tenth {e.max_error_first_tenth:.3e}   last tenth {e.max_error_last_tenth:.3e}",
-                f"           drift rate {e.drift_rate:+.3e} ± {e.drift_rate_stderr:.1e} per unit time",
-                f"           verdict: {e.verdict}",
-            ]
+        if self.energy is None:
+            lines.append(f"  {'energy':<12}{self.verdict}")
+        for stats, symbol in [(self.energy, "H"), (self.energy_balance, "(E − W)")]:
+            if stats is not None:
+                lines += ["  " + line for line in stats.describe(symbol)]
         for m in self.momenta:
-            lines.append(f"  momentum {m.name:<6} J0 = {m.initial:+.12g}   max |ΔJ| = {m.max_abs_error:.3e} (rel {m.max_rel_error:.3e})")
-        if self.constraint_residuals is not None:
-            g, v = self.constraint_residuals
-            lines.append(f"  constraints  max |g(q)| = {g:.3e}   max |G M⁻¹ p| = {v:.3e}")
+            lines += ["  " + line for line in m.describe("J")]
+        for c, error in zip(self.constraints or (), ("g(q)", "G M⁻¹ p")):
+            lines += ["  " + line for line in c.describe("r", error)]
         return "\n".join(lines)
 
 
 def check_conservation(traj: Trajectory, generators: Sequence[Generator] | None = None) -> ConservationReport:
-    """Check the energy and the Noether momenta of ``traj``.
+    """Check the energy, the Noether momenta and the constraints of ``traj``.
 
-    The energy function p·q̇ − L is judged only when L does not depend on t and no forces act;
-    for forced systems the report gives the energy balance E(t) − E(0) − W(t) with the work W
-    of the forces instead.
+    The energy function E = p·q̇ − L is judged when L does not depend on t; with forces acting
+    the report judges the balance E − W, W the work of the forces, instead.
 
     ``generators`` defaults to the symmetries the model declares; a closure generator is named
     ``xi[k]``.
+
+    Examples
+    --------
+    >>> import varmech
+    >>> from varmech import scenes
+    >>> traj = varmech.integrate(scenes.kepler(0.6), dt=0.01, steps=20_000, save_every=10)
+    >>> report = varmech.check_conservation(traj)
+    >>> report.verdict, report.momenta[0].verdict
+    ('bounded', 'conserved to round-off')
     """
     if generators is None:
         generators = traj.model.symmetries
     model = traj.model
-    conserved = not (model.time_dependent or model.forced)
-    energy = EnergyReport(**_core.energy_statistics(traj.t, traj.energy())) if conserved else None
-    balance = None
-    if model.forced and not model.time_dependent:
-        e = traj.energy()
-        balance = float(np.max(np.abs(e - e[0] - traj.work)) / (abs(e[0]) or 1.0))
+    t, steps = traj.t, int(traj.steps)
+    energy = balance = None
+    if not model.time_dependent:
+        e, kinetic, potential = traj.energy_terms()
+        work = traj.work if traj.work is not None else np.zeros(len(t))
+        record = _core.energy_statistics(t, e, kinetic, potential, work, steps)
+        advice = _failure_advice(traj, record.max_rel_error) if record.verdict == "failed" else ""
+        stats = _statistics(record, "energy" if not model.forced else "balance", e[0] - work[0], "mean kinetic energy", t, advice)
+        energy, balance = (None, stats) if model.forced else (stats, None)
     momenta = []
     for k, xi in enumerate(generators):
         name = xi.name if isinstance(xi, (Translation, Rotation, Cyclic)) else f"xi[{k}]"
-        momenta.append(MomentumReport(name, *_core.invariant_statistics(momentum(traj, xi))))
-    residuals = None
+        j, size = _momentum_terms(traj, xi)
+        record = _core.statistics(t, j - j[0], size, size, steps)
+        momenta.append(_statistics(record, name, j[0], "mean Σ|pᵢξᵢ|", t))
+    constraints = None
     if model.constraints:
-        g, v = traj.constraint_residuals()
-        residuals = (float(np.max(g)), float(np.max(v)))
-    return ConservationReport(model.name, traj.method, traj.dt, float(traj.t[-1]), energy, tuple(momenta), balance, residuals)
+        (g, v), (g_size, v_size) = _core.constraint_residuals(model._core, traj.q, traj.p)
+        constraints = (
+            _statistics(_core.statistics(t, g, g_size, g_size, steps), "|g(q)|", g[0], "mean ‖G‖‖q‖", t),
+            _statistics(_core.statistics(t, v, v_size, v_size, steps), "|G q̇|", v[0], "mean ‖G‖‖q̇‖", t),
+        )
+    return ConservationReport(model.name, traj.method, traj.dt, float(t[-1]), energy, tuple(momenta), balance, constraints)
+
+
+def _failure_advice(traj: Trajectory, relative: float) -> str:
+    """What to do about a failed energy: the step against the method's linear stability limit
+    h·ω_max when the linearisation at the initial state gives an estimate, else reduce dt."""
+    advice = f"the error reaches {relative:.3g} × the scale; reduce dt"
+    h_omega = _h_omega(traj.model, traj.q[0], traj.dt, float(traj.t[0]))
+    info = {m.name: m for m in _core.methods()}.get(traj.method)
+    if h_omega is not None and info is not None and h_omega >= info.h_omega_max:
+        advice += (
+            f": h·ω ≈ {h_omega:.3g} at the initial state (linear estimate) is past {traj.method}'s "
+            f"stability limit h·ω = {info.h_omega_max:.3g}"
+        )
+    return advice
+
+
+def _h_omega(model: Model, q: np.ndarray, dt: float, t0: float) -> float | None:
+    """dt times the largest frequency of the linearisation about q at rest, ω² the largest
+    eigenvalue of M⁻¹K with M = ∂²L/∂q̇² and K = −∂²L/∂q², both by central differences; None
+    for constrained or large models, or when no direction oscillates."""
+    n = model.dim
+    if model.constraints or n > 64:
+        return None
+    eye, zeros = np.eye(n), np.zeros((1, n))
+    tt = np.full(1, t0)
+    try:
+        mass = np.stack([_core.derivative(model._core, "momentum", tt, q[None, :], eye[j][None, :])[0] for j in range(n)], axis=1)
+        step = 1e-5 * max(1.0, float(np.max(np.abs(q))))
+        stiffness = np.stack(
+            [
+                -(
+                    _core.derivative(model._core, "dl_dq", tt, (q + step * eye[j])[None, :], zeros)[0]
+                    - _core.derivative(model._core, "dl_dq", tt, (q - step * eye[j])[None, :], zeros)[0]
+                )
+                / (2 * step)
+                for j in range(n)
+            ],
+            axis=1,
+        )
+        omega2 = np.linalg.eigvals(np.linalg.solve(mass, stiffness)).real.max()
+    except Exception:  # the estimate only words advice: a model it cannot linearise gets none
+        return None
+    return dt * math.sqrt(omega2) if np.isfinite(omega2) and omega2 > 0 else None

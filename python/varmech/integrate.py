@@ -4,14 +4,14 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
 from numpy.typing import ArrayLike
 
 from . import _core
 from ._util import finite, positive, positive_int, vector
-from .model import Model
+from .model import Lagrangian, Model
 
 if TYPE_CHECKING:
     from .scenes import Scene
@@ -70,11 +70,18 @@ class Trajectory:
     def energy(self) -> np.ndarray:
         """The energy function E = p·q̇ − L (= ½pᵀM⁻¹p + V(q) for mechanical systems) at each
         saved state, shape (N,)."""
-        return _core.energy(self.model._core, self.t, self.q, self.p)
+        return self.energy_terms()[0]
+
+    def energy_terms(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(E, T, V) at each saved state, shapes (N,): the energy function, its kinetic term
+        T = E − V and its potential V = −L(q, 0, t), the energy of the configuration at rest
+        (½pᵀM⁻¹p and V(q) for mechanical systems). The conservation verdicts measure energy
+        errors against the mean of T."""
+        return _core.energy_terms(self.model._core, self.t, self.q, self.p)
 
     def constraint_residuals(self) -> tuple[np.ndarray, np.ndarray]:
         """|g(q)|∞ and |G(q)M⁻¹p|∞ at each saved state of a constrained model, shapes (N,)."""
-        return _core.constraint_residuals(self.model._core, self.q, self.p)
+        return _core.constraint_residuals(self.model._core, self.q, self.p)[0]
 
     def __len__(self) -> int:
         return len(self.t)
@@ -135,6 +142,37 @@ def _initial_state(model: Model, q0: ArrayLike | None, p0: ArrayLike | None, v0:
     raise ValueError("p0, v0: give exactly one of the initial momenta p0 and velocities v0")
 
 
+def _energy_threshold(model: Model, max_energy_error: float | None | Literal["auto"]) -> float | None:
+    """The run's energy threshold: ``"auto"`` is the failure level of the verdicts where the
+    model has an energy (L does not depend on t), and off where it has none."""
+    if max_energy_error is None:
+        return None
+    if isinstance(max_energy_error, str) and max_energy_error == "auto":
+        return None if model.time_dependent else _core.FAILURE
+    threshold = positive("max_energy_error", max_energy_error)
+    if model.time_dependent:
+        raise ValueError("max_energy_error: needs an energy to check, and a Lagrangian that depends on t has none")
+    return threshold
+
+
+def _check_time_independent(model: Model, q: np.ndarray, p: np.ndarray, times: tuple[float, ...]) -> None:
+    """Refuses a Lagrangian declared time-independent whose L(q0, q̇0, t) changes with t: its
+    energy would be judged as conserved while it is not."""
+    if not isinstance(model, Lagrangian) or model.time_dependent:
+        return
+    t = np.array(times[:1])
+    v = _core.derivative(model._core, "velocity", t, q[None, :], p[None, :])[0]
+    values = [float(model.lagrangian(q.copy(), v.copy(), s)) for s in times]
+    spread = max(values) - min(values)
+    size = max(abs(x) for x in values) + float(np.abs(p * v).sum())
+    if not spread <= 1e-12 * size:
+        shown = ", ".join(f"L(t = {s:.6g}) = {x:.12g}" for s, x in zip(times, values))
+        raise ValueError(
+            f"time_dependent: L(q0, q̇0, t) changes with t ({shown}), but {model.name} was not declared "
+            "time-dependent; pass time_dependent=True, or its energy would be judged as conserved"
+        )
+
+
 def _newton(tolerance: float, max_iterations: int) -> tuple[float, int]:
     """The implicit methods' Newton tolerance and iteration cap, checked."""
     return positive("newton_tolerance", tolerance), positive_int("newton_max_iterations", max_iterations)
@@ -152,7 +190,7 @@ def integrate(
     method: str | None = None,
     save_every: int = 1,
     compensated: bool = True,
-    max_energy_error: float | None = None,
+    max_energy_error: float | None | Literal["auto"] = "auto",
     t0: float = 0.0,
     newton_tolerance: float = 1e-14,
     newton_max_iterations: int = 50,
@@ -180,9 +218,15 @@ def integrate(
         Add the step increments with compensated summation (default), so that round-off grows
         like √N rather than N over N steps.
     max_energy_error:
-        Stop with :class:`~varmech.DivergenceError` when the relative energy error at a saved
-        state exceeds this (costs one potential evaluation per saved state). Non-finite states
-        always stop the run.
+        Stop with :class:`~varmech.DivergenceError` when the energy error |E − E₀| at a saved
+        state exceeds this times the energy's scale, the mean kinetic energy of the states saved
+        so far (errors at round-off never stop a run; see
+        :class:`~varmech.InvariantStatistics`), or when the energy is not finite. A forced run
+        checks its balance E − W with the work W of the forces instead. ``"auto"`` (default):
+        1 (:data:`varmech.conservation.FAILURE`), the error at which the verdict is "failed",
+        for every model with an energy, and no check for a Lagrangian that depends on t (a
+        number is refused there). ``None``: no energy check; non-finite states still stop the
+        run. The check costs one energy evaluation per saved state.
     t0:
         The initial time.
     newton_tolerance, newton_max_iterations:
@@ -193,7 +237,9 @@ def integrate(
     Raises
     ------
     ValueError
-        Malformed arguments; the message starts with the argument's name.
+        Malformed arguments; the message starts with the argument's name. Also a
+        :class:`~varmech.Lagrangian` declared time-independent whose L changes with t at the
+        initial state (probed at a few times), naming ``time_dependent``.
     DivergenceError
         The solution blew up; ``err.step``, ``err.time`` and ``err.partial`` (the trajectory up
         to the last good step) are attached.
@@ -213,10 +259,13 @@ def integrate(
     t0 = finite("t0", t0)
     nsteps = _steps(dt, t0, steps, t_end)
     save_every = positive_int("save_every", save_every)
-    if max_energy_error is not None:
-        max_energy_error = positive("max_energy_error", max_energy_error)
+    threshold = _energy_threshold(model, max_energy_error)
     newton_tolerance, newton_max_iterations = _newton(newton_tolerance, newton_max_iterations)
     q, p = _initial_state(model, q0, p0, v0, t0)
+    t_end = t0 + nsteps * dt
+    if not math.isfinite(t_end):
+        raise ValueError(f"dt: {nsteps} steps of {dt} from t0 = {t0} end past the largest float")
+    _check_time_independent(model, q, p, (t0, t0 + dt, t0 + 0.5, t0 + 1.0, t0 + 0.37 * (t_end - t0), t_end))
     try:
         record = _core.integrate(
             model._core,
@@ -227,7 +276,7 @@ def integrate(
             method=method,
             save_every=save_every,
             compensated=bool(compensated),
-            max_energy_error=max_energy_error,
+            max_energy_error=threshold,
             t0=t0,
             newton_tolerance=newton_tolerance,
             newton_max_iterations=newton_max_iterations,

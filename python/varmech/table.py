@@ -86,15 +86,22 @@ class Table:
     def __iter__(self) -> Iterator[dict[str, Any]]:
         return (dict(zip(self.columns, r)) for r in self.rows)
 
-    def __repr__(self) -> str:
+    def format(self, max_rows: int | None = 20) -> str:
+        """The title, the column names and the rows (the first ``max_rows``; None for all) as
+        text, numbers to four significant digits."""
+
         def fmt(x: Any) -> str:
             if isinstance(x, float):
                 return f"{x:.4g}" if math.isfinite(x) else str(x)
             return str(x)
 
+        shown = self.rows if max_rows is None else self.rows[:max_rows]
         lines = [self.title] if self.title else []
         lines.append(" | ".join(self.columns))
-        lines += [" | ".join(fmt(x) for x in r) for r in self.rows[:20]]
-        if len(self.rows) > 20:
-            lines.append(f"… {len(self.rows) - 20} more rows")
+        lines += [" | ".join(fmt(x) for x in r) for r in shown]
+        if len(shown) < len(self.rows):
+            lines.append(f"… {len(self.rows) - len(shown)} more rows")
         return "\n".join(lines)
+
+    def __repr__(self) -> str:
+        return self.format()

@@ -105,7 +105,8 @@ def test_scalar_closure_results_that_do_not_convert_exactly_are_refused(potentia
 )
 def test_closure_results_that_convert_exactly_are_accepted(gradient):
     model = varmech.MechanicalSystem(2, lambda q: 0.5 * q @ q, gradient)
-    traj = varmech.integrate(model, [1.0, 2.0], [0.0, 0.0], dt=0.1, steps=3, method="verlet")
+    # Truncated to integers, the gradient is not V's: the energy check would rightly stop the run.
+    traj = varmech.integrate(model, [1.0, 2.0], [0.0, 0.0], dt=0.1, steps=3, method="verlet", max_energy_error=None)
     assert np.all(np.isfinite(traj.q))
 
 

@@ -31,7 +31,7 @@ def computed(scene, name):
     if name == "I":
         return oscillatory_energy(q, p)
     generator = next(g for g in scene.model._core.symmetries if g.name == CYCLIC.get(name, name))
-    return float(_core.momentum(generator, q[None, :], p[None, :])[0])
+    return float(_core.momentum(generator, q[None, :], p[None, :])[0][0])
 
 
 @pytest.mark.parametrize("name", list(scenes.CATALOGUE))

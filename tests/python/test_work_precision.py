@@ -163,7 +163,8 @@ def long_kepler():
 def test_long_kepler_verdicts(long_kepler):
     v = long_kepler.meta["verdicts"]
     assert v["verlet"]["verdict"] == "bounded"
-    assert v["kahan_li8"]["verdict"] == "bounded"
+    # Eighth order at h = 2π/200: its truncation error is below round-off over 10⁵ steps.
+    assert v["kahan_li8"]["verdict"] == "conserved to round-off"
     assert v["rk4"]["verdict"] == "secular drift"
     assert v["DOP853"]["verdict"] == "secular drift" and v["DOP853"]["tool"] == "scipy"
     # Both drifts are many standard errors from zero and lose energy; the symplectic errors are
@@ -179,7 +180,7 @@ def test_long_kepler_verdicts(long_kepler):
     run = varmech.integrate(scene, dt=PERIOD / 200, steps=500 * 200, method="rk4", save_every=200)
     energy = run.energy()
     per_period = (energy[-1] - energy[0]) / 500
-    assert v["rk4"]["drift_rate"] * 0.5 * PERIOD == pytest.approx(per_period, rel=0.05)
+    assert v["rk4"]["drift_rate"] * PERIOD == pytest.approx(per_period, rel=0.05)
     small = verdicts(long_kepler)
     assert small.unique("method") == ["verlet", "kahan_li8", "rk4", "DOP853"]
 

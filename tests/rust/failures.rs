@@ -136,13 +136,20 @@ fn an_energy_threshold_stops_a_run_that_blows_up() {
         ..Options::new(0.1, 10_000)
     };
     let failure = integrate(&sys, Method::ExplicitEuler, &[0.0], &[1.0], &options, || Ok(())).unwrap_err();
-    // (1.01)^k > 2 first at k = 70.
+    // The documented rule, by hand: the first step k where |E_k − E₀| reaches the mean kinetic
+    // energy p²/2 of the states 0..=k (Euler: q ← q + hp, p ← p − hq).
+    let (mut q, mut p, mut kinetic, mut k) = (0.0_f64, 1.0_f64, 0.5_f64, 0_usize);
+    while (0.5 * (q * q + p * p) - 0.5).abs() < kinetic / (k + 1) as f64 {
+        (q, p, k) = (q + 0.1 * p, p - 0.1 * q, k + 1);
+        kinetic += 0.5 * p * p;
+    }
+    assert!((40..70).contains(&k), "{k}");
     assert!(
-        matches!(failure.error, Error::Divergence { step: 70, .. }),
-        "{}",
+        matches!(failure.error, Error::Divergence { step, .. } if step == k),
+        "{} (expected step {k})",
         failure.error
     );
-    assert_eq!(failure.partial.len(), 71);
+    assert_eq!(failure.partial.len(), k + 1);
 }
 
 #[test]

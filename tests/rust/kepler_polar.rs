@@ -4,8 +4,8 @@
 
 use crate::common;
 
+use common::InvariantStatistics;
 use std::f64::consts::PI;
-use varmech::diagnostics::InvariantStatistics;
 
 use varmech::integrators::{integrate, General, Method, NewtonOptions, Options, Trajectory};
 use varmech::model::{Hessians, Lagrangian};

@@ -10,8 +10,11 @@ const STEPS: usize = 200_000;
 
 fn run(method: Method, h: f64) -> Result<f64, Error> {
     let sys = HarmonicOscillator::new(1.0).unwrap();
+    // Linear stability, not accuracy: near its limit a method's energy error is many times the
+    // energy (bounded, but failed), so the energy check is off.
     let options = Options {
         save_every: STEPS,
+        max_energy_error: None,
         ..Options::new(h, STEPS)
     };
     match integrate(&sys, method, &[0.0], &[1.0], &options, || Ok(())) {
@@ -67,7 +70,18 @@ fn rk4_is_dissipative_below_its_limit() {
     let (y, steps): (f64, usize) = (1.0, 1000);
     let r2 = 1.0 - y.powi(6) / 72.0 + y.powi(8) / 576.0;
     let sys = HarmonicOscillator::new(1.0).unwrap();
-    let traj = integrate(&sys, Method::Rk4, &[0.0], &[1.0], &Options::new(y, steps), || Ok(())).unwrap();
+    let traj = integrate(
+        &sys,
+        Method::Rk4,
+        &[0.0],
+        &[1.0],
+        &Options {
+            max_energy_error: None,
+            ..Options::new(y, steps)
+        },
+        || Ok(()),
+    )
+    .unwrap();
     let amplitude = traj.q_at(steps)[0].hypot(traj.p_at(steps)[0]);
     let expected = r2.powf(steps as f64 / 2.0);
     assert!(

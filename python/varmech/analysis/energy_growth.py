@@ -16,14 +16,13 @@ from typing import Any
 
 import numpy as np
 
-from .. import _core
 from .._progress import progress as _progress
-from ..conservation import EnergyReport, check_conservation
+from ..conservation import InvariantStatistics, check_conservation
 from ..integrate import integrate
 from ..scenes import Scene
 from ..table import Table
 from . import baselines as _baselines
-from ._energy import conserves_energy, energy_of, relative_error
+from ._energy import conserves_energy, energy_of, energy_statistics, relative_error
 from ._interrupt import interruptible
 
 ENERGY_GROWTH_COLUMNS = ("tool", "method", "t", "energy_error", "max_energy_error")
@@ -59,7 +58,7 @@ def _varmech_series(scene: Scene, method: str, dt: float, n: int, uniform: int, 
     spaced states (its conservation report gives the verdict), then the first tenth, hundredth, …
     of it again with ``per_level`` states each (the same steps, so the same trajectory), until
     every step is saved. About 1.11× the cost of the run."""
-    traj = integrate(scene, dt=dt, steps=n, method=method, save_every=max(1, n // uniform))
+    traj = integrate(scene, dt=dt, steps=n, method=method, save_every=max(1, n // uniform), max_energy_error=None)
     report = check_conservation(traj)
     ts, es = [traj.t], [relative_error(traj.energy())]
     m = n
@@ -67,10 +66,17 @@ def _varmech_series(scene: Scene, method: str, dt: float, n: int, uniform: int, 
         m //= 10
         if m < 1:
             break
-        part = integrate(scene, dt=dt, steps=m, method=method, save_every=max(1, m // per_level))
+        part = integrate(scene, dt=dt, steps=m, method=method, save_every=max(1, m // per_level), max_energy_error=None)
         ts.append(part.t)
         es.append(relative_error(part.energy()))
-    return np.concatenate(ts), np.concatenate(es), report.energy
+    return np.concatenate(ts), np.concatenate(es), report.energy, es[0]
+
+
+def _tenths(uniform: np.ndarray) -> tuple[float, float]:
+    """The largest relative energy error over the first and the last tenth of an evenly
+    sampled run: a bounded error is as large at the end as at the start."""
+    k = max(1, len(uniform) // 10)
+    return float(np.max(uniform[:k])), float(np.max(uniform[-k:]))
 
 
 def energy_growth(
@@ -93,11 +99,12 @@ def energy_growth(
     log-spaced bins of t, the sample with the largest error |ΔH/H₀|, and the largest error of
     all samples up to t (a monotone envelope; the samples are the evenly spaced states below
     plus denser ones early in the run, so it can miss a peak between late samples). The verdict
-    of each method ("bounded" or "secular drift", see :class:`~varmech.EnergyReport`) comes from
-    the same run sampled evenly in time: varmech runs from :func:`~varmech.check_conservation`,
-    baselines from the same statistics of their series. ``table.meta["verdicts"]`` maps each
-    method to a dict: tool, verdict, drift_rate (of the relative error per unit time) and its
-    stderr, max_error, max_error_first_tenth, max_error_last_tenth, t_end, and dt or rtol.
+    of each method (see :class:`~varmech.InvariantStatistics`) comes from the same run sampled
+    evenly in time: varmech runs from :func:`~varmech.check_conservation`, baselines from the
+    same statistics of their series. ``table.meta["verdicts"]`` maps each method to a dict:
+    tool, verdict, drift_rate (of the energy, per unit time) and its stderr, max_error (against
+    the scale, the mean kinetic energy), scale, max_error_first_tenth and max_error_last_tenth
+    (of |ΔH/H₀|, over the first and last tenth of the run), t_end, and dt or rtol.
 
     Parameters
     ----------
@@ -170,8 +177,11 @@ def energy_growth(
         notes.append(f"solve_ivp baselines run to t = {Tb:g} (the varmech methods to {T:g})")
     rb, rebound_names = _baselines.rebound_baselines(scene, rebound_names, notes, asked=True)
 
-    def record(tool: str, method: str, t: np.ndarray, err: np.ndarray, report: EnergyReport, horizon: float, **setting: float) -> None:
+    def record(
+        tool: str, method: str, t: np.ndarray, err: np.ndarray, report: InvariantStatistics, uniform: np.ndarray, horizon: float, **setting: float
+    ) -> None:
         tb, eb, mb = _log_bins(t, err, samples, min(h, horizon / 1e6), horizon)
+        first, last = _tenths(uniform)
         for ti, ei, mi in zip(tb, eb, mb):
             table.append(tool, method, float(ti), float(ei), float(mi))
         verdicts[method] = {
@@ -179,9 +189,10 @@ def energy_growth(
             "verdict": report.verdict,
             "drift_rate": report.drift_rate,
             "drift_rate_stderr": report.drift_rate_stderr,
-            "max_error": report.max_error,
-            "max_error_first_tenth": report.max_error_first_tenth,
-            "max_error_last_tenth": report.max_error_last_tenth,
+            "max_error": report.max_rel_error,
+            "scale": report.scale,
+            "max_error_first_tenth": first,
+            "max_error_last_tenth": last,
             "t_end": horizon,
             **setting,
         }
@@ -195,8 +206,9 @@ def energy_growth(
         k = scene.model.dim
         energies = energy_of(scene.model, sol.t, sol.y[:k].T, sol.y[k:].T)
         on_grid = np.isin(sol.t, even)
-        report = EnergyReport(**_core.energy_statistics(np.ascontiguousarray(sol.t[on_grid]), np.ascontiguousarray(energies[on_grid])))
-        record("scipy", method, sol.t, relative_error(energies), report, Tb, rtol=rtol)
+        report = energy_statistics(scene.model, sol.t[on_grid], sol.y[:k, on_grid].T, sol.y[k:, on_grid].T, steps=sol.t.size)
+        err = relative_error(energies)
+        record("scipy", method, sol.t, err, report, err[on_grid], Tb, rtol=rtol)
 
     def run_rebound(method: str) -> None:
         _, masses = _baselines.gravity(scene)  # type: ignore[misc]
@@ -221,16 +233,17 @@ def energy_growth(
         t = np.array(ts)
         energies = energy_of(scene.model, t, np.array(qs), np.array(ps))
         on_grid = np.isin(marks, np.linspace(0, n, uniform + 1).round().astype(np.int64))
-        report = EnergyReport(**_core.energy_statistics(t[on_grid], energies[on_grid]))
-        record("rebound", method, t, relative_error(energies), report, T, dt=h)
+        report = energy_statistics(scene.model, t[on_grid], np.array(qs)[on_grid], np.array(ps)[on_grid], steps=n)
+        err = relative_error(energies)
+        record("rebound", method, t, err, report, err[on_grid], T, dt=h)
 
     plan = [("varmech", m) for m in methods] + [("scipy", b) for b in scipy_names] + [("rebound", b) for b in rebound_names]
 
     def body() -> None:
         for tool, method in _progress(plan, total=len(plan), desc=f"energy growth {scene.name}", enabled=progress):
             if tool == "varmech":
-                t, err, report = _varmech_series(scene, method, h, n, uniform, per_level)
-                record("varmech", method, t, err, report, T, dt=h)
+                t, err, report, even = _varmech_series(scene, method, h, n, uniform, per_level)
+                record("varmech", method, t, err, report, even, T, dt=h)
             elif tool == "scipy":
                 run_scipy(method)
             else:

@@ -7,23 +7,28 @@ from pathlib import Path
 
 import numpy as np
 
+from ..conservation import check_conservation
 from ..integrate import Trajectory
 from ._figure import pyplot, save
 
 
 def energy_error(trajectories: Mapping[str, Trajectory], path: str | Path, title: str = "") -> Path:
-    """Plot |H(t) − H₀|/|H₀| against t on log–log axes, one line per labelled trajectory, and
-    write the figure to ``path`` (PNG or SVG by its suffix)."""
+    """Plot the energy error |H(t) − H₀| against t on log–log axes, relative to the energy's
+    scale (the run's mean kinetic energy; see :class:`~varmech.InvariantStatistics`), one line
+    per labelled trajectory with its verdict in the legend, and write the figure to ``path``
+    (PNG or SVG by its suffix). A forced run's line is its balance E − W."""
     plt = pyplot()
     fig, ax = plt.subplots(figsize=(7, 4.2), layout="constrained")
     for label, traj in trajectories.items():
-        h = traj.energy()
-        scale = abs(h[0]) if h[0] != 0 else 1.0
+        report = check_conservation(traj, generators=())
+        stats = report.energy or report.energy_balance
+        h = traj.energy() - (traj.work if traj.work is not None and traj.model.forced else 0.0)
+        scale = stats.scale if stats is not None and stats.scale > 0 else 1.0
         err = np.abs(h - h[0]) / scale
         keep = (traj.t > 0) & (err > 0)
-        ax.loglog(traj.t[keep], err[keep], label=label, lw=0.8)
+        ax.loglog(traj.t[keep], err[keep], label=f"{label}: {report.verdict}", lw=0.8)
     ax.set_xlabel("t")
-    ax.set_ylabel("relative energy error |H − H₀|/|H₀|")
+    ax.set_ylabel("energy error |H − H₀| / mean kinetic energy")
     ax.set_title(title)
     ax.grid(True, which="major", alpha=0.3)
     ax.legend(fontsize=8)

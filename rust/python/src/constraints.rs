@@ -4,27 +4,26 @@
 use numpy::{PyArray1, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
+use varmech::model::Residuals;
 use varmech::ModelError;
 
 use crate::bind::{bind_model, dim_of};
-use crate::convert::{rows, slice};
+use crate::convert::{rows, slice, ArrayPair};
 use crate::errors::{model_error, to_pyerr};
-
-/// Two arrays, as the constraint functions return them.
-type ArrayPair<'py> = (Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>);
 
 fn unconstrained() -> PyErr {
     PyValueError::new_err("model: has no holonomic constraints")
 }
 
-/// (|g(q)|∞, |G(q)M⁻¹p|∞) at each state of a constrained model.
+/// |g(q)|∞, |G(q)M⁻¹p|∞ and their sizes ‖G‖∞‖q‖∞, ‖G‖∞‖M⁻¹p‖∞ at each state of a constrained
+/// model.
 #[pyfunction]
 fn constraint_residuals<'py>(
     py: Python<'py>,
     model: &Bound<'py, PyAny>,
     q: PyReadonlyArray2<'py, f64>,
     p: PyReadonlyArray2<'py, f64>,
-) -> PyResult<ArrayPair<'py>> {
+) -> PyResult<(ArrayPair<'py>, ArrayPair<'py>)> {
     let n = dim_of(py, model)?;
     let ((q, nq), (p, np)) = (rows("q", &q)?, rows("p", &p)?);
     if nq != n || np != n || q.len() != p.len() {
@@ -32,18 +31,18 @@ fn constraint_residuals<'py>(
             "q, p: need two (N, {n}) arrays of states"
         )));
     }
-    let result: Option<Result<Vec<(f64, f64)>, ModelError>> = bind_model(py, model, |sys, _poll| {
+    let result: Option<Result<Vec<Residuals>, ModelError>> = bind_model(py, model, |sys, _poll| {
         q.chunks_exact(n)
             .zip(p.chunks_exact(n))
             .map(|(q, p)| sys.constraint_residuals(q, p))
             .collect()
     })?;
-    let (position, velocity) = result
-        .ok_or_else(unconstrained)?
-        .map_err(model_error)?
-        .into_iter()
-        .unzip();
-    Ok((PyArray1::from_vec(py, position), PyArray1::from_vec(py, velocity)))
+    let residuals = result.ok_or_else(unconstrained)?.map_err(model_error)?;
+    let column = |f: fn(&Residuals) -> f64| PyArray1::from_vec(py, residuals.iter().map(f).collect());
+    Ok((
+        (column(|r| r.position), column(|r| r.velocity)),
+        (column(|r| r.position_size), column(|r| r.velocity_size)),
+    ))
 }
 
 /// The nearest consistent state (q on the constraints, p on the hidden constraint).

@@ -10,6 +10,9 @@ use crate::closure::readers::type_name;
 use crate::errors::to_pyerr;
 
 /// A contiguous view of a float64 vector argument.
+/// Two arrays of one value per state.
+pub type ArrayPair<'py> = (Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>);
+
 pub fn slice<'a>(name: &str, a: &'a PyReadonlyArray1<'_, f64>) -> PyResult<&'a [f64]> {
     a.as_slice()
         .map_err(|_| PyValueError::new_err(format!("{name}: must be a contiguous float64 array")))

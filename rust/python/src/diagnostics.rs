@@ -4,35 +4,45 @@
 use numpy::{PyArray1, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
-use pyo3::types::PyDict;
-use varmech::diagnostics::{EnergyStatistics, InvariantStatistics};
-use varmech::model;
+use pyo3::types::PyTuple;
+use varmech::diagnostics::{self, Series, Verdict};
+use varmech::model::{self, EnergyTerms, Scale};
 use varmech::ModelError;
 
 use crate::bind::{bind_model, dim_of};
-use crate::convert::{self, rows, slice, states};
+use crate::convert::{self, rows, slice, states, ArrayPair};
 use crate::errors::{model_error, to_pyerr};
 use crate::generator::Generator;
 
-/// The energy function E = p·q̇ − L (= ½pᵀM⁻¹p + V for mechanical systems) at each state.
+/// Three arrays: the energy and its two terms.
+type EnergyArrays<'py> = (
+    Bound<'py, PyArray1<f64>>,
+    Bound<'py, PyArray1<f64>>,
+    Bound<'py, PyArray1<f64>>,
+);
+
+/// The energy function E = p·q̇ − L (= ½pᵀM⁻¹p + V for mechanical systems) at each state, with
+/// its kinetic and potential terms T and V: (E, T, V).
 #[pyfunction]
-fn energy<'py>(
+fn energy_terms<'py>(
     py: Python<'py>,
     model: &Bound<'py, PyAny>,
     t: PyReadonlyArray1<'py, f64>,
     q: PyReadonlyArray2<'py, f64>,
     p: PyReadonlyArray2<'py, f64>,
-) -> PyResult<Bound<'py, PyArray1<f64>>> {
+) -> PyResult<EnergyArrays<'py>> {
     let n = dim_of(py, model)?;
     let (t, q, p) = states(n, &t, &q, &p)?;
-    let result: Result<Vec<f64>, ModelError> = bind_model(py, model, |sys, _poll| {
+    let result: Result<Vec<EnergyTerms>, ModelError> = bind_model(py, model, |sys, _poll| {
         let l = sys.as_lagrangian();
         t.iter()
             .zip(q.chunks_exact(n).zip(p.chunks_exact(n)))
-            .map(|(t, (q, p))| l.energy(q, p, *t))
+            .map(|(t, (q, p))| l.energy_terms(q, p, *t))
             .collect()
     })?;
-    Ok(PyArray1::from_vec(py, result.map_err(model_error)?))
+    let terms = result.map_err(model_error)?;
+    let column = |f: fn(&EnergyTerms) -> f64| PyArray1::from_vec(py, terms.iter().map(f).collect());
+    Ok((column(|e| e.energy), column(|e| e.kinetic), column(|e| e.potential)))
 }
 
 /// A first derivative of L at each state (t, q, x): `"momentum"`, p = ∂L/∂q̇(q, x, t) from
@@ -71,62 +81,124 @@ fn derivative<'py>(
     Ok(convert::matrix(py, result.map_err(model_error)?, n)?.into_any())
 }
 
-/// J = p·ξ(q) of a generator for each row of (q, p).
+/// J = p·ξ(q) of a generator for each row of (q, p), and the size Σ|pᵢξᵢ| of its terms.
 #[pyfunction]
 fn momentum<'py>(
     py: Python<'py>,
     generator: Generator,
     q: PyReadonlyArray2<'py, f64>,
     p: PyReadonlyArray2<'py, f64>,
-) -> PyResult<Bound<'py, PyArray1<f64>>> {
+) -> PyResult<ArrayPair<'py>> {
     let g = model::Generator::from(generator);
     let ((q, n), (p, _)) = (rows("q", &q)?, rows("p", &p)?);
     g.check(n).map_err(|e| to_pyerr(py, e))?;
-    let j = q
+    let (j, size): (Vec<f64>, Vec<f64>) = q
         .chunks_exact(n.max(1))
         .zip(p.chunks_exact(n.max(1)))
-        .map(|(q, p)| g.momentum(q, p))
-        .collect();
-    Ok(PyArray1::from_vec(py, j))
+        .map(|(q, p)| g.momentum_terms(q, p))
+        .unzip();
+    Ok((PyArray1::from_vec(py, j), PyArray1::from_vec(py, size)))
 }
 
-/// The energy statistics of a series, as a dict.
-#[pyfunction]
-fn energy_statistics<'py>(
-    py: Python<'py>,
-    t: PyReadonlyArray1<'py, f64>,
-    h: PyReadonlyArray1<'py, f64>,
-) -> PyResult<Bound<'py, PyDict>> {
-    let (t, h) = (slice("t", &t)?, slice("energy", &h)?);
-    if t.len() != h.len() || t.is_empty() {
-        return Err(PyValueError::new_err("energy: needs one value per time, at least one"));
+/// The error of a conserved quantity against its scale, and its verdict (the core's
+/// `Statistics`).
+#[pyclass(frozen, get_all, module = "varmech._core")]
+pub struct Statistics {
+    scale: f64,
+    round_off: f64,
+    max_abs_error: f64,
+    max_rel_error: f64,
+    band: f64,
+    drift_rate: f64,
+    drift_rate_stderr: f64,
+    first_non_finite: Option<usize>,
+    verdict: &'static str,
+}
+
+impl From<diagnostics::Statistics> for Statistics {
+    fn from(s: diagnostics::Statistics) -> Self {
+        Statistics {
+            scale: s.scale,
+            round_off: s.round_off,
+            max_abs_error: s.max_abs_error,
+            max_rel_error: s.max_rel_error,
+            band: s.band,
+            drift_rate: s.drift_rate,
+            drift_rate_stderr: s.drift_rate_stderr,
+            first_non_finite: s.first_non_finite,
+            verdict: s.verdict.name(),
+        }
     }
-    let s = EnergyStatistics::new(t, h);
-    let d = PyDict::new(py);
-    d.set_item("initial", s.initial)?;
-    d.set_item("max_error", s.max_error)?;
-    d.set_item("band", s.band)?;
-    d.set_item("max_error_first_tenth", s.max_error_first_tenth)?;
-    d.set_item("max_error_last_tenth", s.max_error_last_tenth)?;
-    d.set_item("drift_rate", s.drift_rate)?;
-    d.set_item("drift_rate_stderr", s.drift_rate_stderr)?;
-    d.set_item("verdict", s.verdict.to_string())?;
-    d.set_item("noise_floor", EnergyStatistics::NOISE_FLOOR)?;
-    Ok(d)
 }
 
-/// (initial, max_abs_error, max_rel_error) of a conserved quantity's series.
+/// The statistics of the energy E (with terms T and V) along a run of `steps` steps, balanced
+/// against the work W of its forces.
 #[pyfunction]
-fn invariant_statistics(values: PyReadonlyArray1<'_, f64>) -> PyResult<(f64, f64, f64)> {
-    let s = InvariantStatistics::new(slice("values", &values)?);
-    Ok((s.initial, s.max_abs_error, s.max_rel_error))
+fn energy_statistics(
+    py: Python<'_>,
+    t: PyReadonlyArray1<'_, f64>,
+    energy: PyReadonlyArray1<'_, f64>,
+    kinetic: PyReadonlyArray1<'_, f64>,
+    potential: PyReadonlyArray1<'_, f64>,
+    work: PyReadonlyArray1<'_, f64>,
+    steps: u64,
+) -> PyResult<Statistics> {
+    let (t, e, k, v) = (
+        slice("t", &t)?,
+        slice("energy", &energy)?,
+        slice("kinetic", &kinetic)?,
+        slice("potential", &potential)?,
+    );
+    if e.len() != k.len() || e.len() != v.len() {
+        return Err(PyValueError::new_err(
+            "energy, kinetic, potential: need one value each per state",
+        ));
+    }
+    let terms: Vec<EnergyTerms> = e
+        .iter()
+        .zip(k.iter().zip(v))
+        .map(|(&energy, (&kinetic, &potential))| EnergyTerms {
+            energy,
+            kinetic,
+            potential,
+        })
+        .collect();
+    let s = diagnostics::energy_statistics(t, &terms, slice("work", &work)?, steps).map_err(|e| to_pyerr(py, e))?;
+    Ok(s.into())
+}
+
+/// The statistics of a conserved quantity's `error` series with its `size` (whose mean is the
+/// scale) and the size of its `terms`, along a run of `steps` steps.
+#[pyfunction]
+fn statistics(
+    py: Python<'_>,
+    t: PyReadonlyArray1<'_, f64>,
+    error: PyReadonlyArray1<'_, f64>,
+    size: PyReadonlyArray1<'_, f64>,
+    terms: PyReadonlyArray1<'_, f64>,
+    steps: u64,
+) -> PyResult<Statistics> {
+    let series = Series {
+        t: slice("t", &t)?,
+        error: slice("error", &error)?,
+        size: slice("size", &size)?,
+        terms: slice("terms", &terms)?,
+        steps,
+    };
+    Ok(diagnostics::Statistics::new(&series)
+        .map_err(|e| to_pyerr(py, e))?
+        .into())
 }
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
-    m.add_function(wrap_pyfunction!(energy, m)?)?;
+    m.add_function(wrap_pyfunction!(energy_terms, m)?)?;
     m.add_function(wrap_pyfunction!(derivative, m)?)?;
     m.add_function(wrap_pyfunction!(momentum, m)?)?;
     m.add_function(wrap_pyfunction!(energy_statistics, m)?)?;
-    m.add_function(wrap_pyfunction!(invariant_statistics, m)?)?;
+    m.add_function(wrap_pyfunction!(statistics, m)?)?;
+    m.add_class::<Statistics>()?;
+    m.add("VERDICTS", PyTuple::new(m.py(), Verdict::ALL.map(Verdict::name))?)?;
+    m.add("FAILURE", Scale::FAILURE)?;
+    m.add("ROUND_OFF", Scale::ROUND_OFF)?;
     Ok(())
 }

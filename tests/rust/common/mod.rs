@@ -1,5 +1,6 @@
 //! Helpers shared by the integration tests.
 
+use varmech::diagnostics::{self, Statistics, Verdict};
 use varmech::integrators::{integrate, General, Method, Options, Trajectory};
 use varmech::model::{Lagrangian, MechanicalSystem};
 use varmech::scenes::{Problem, State};
@@ -72,4 +73,59 @@ pub fn run_general<L: Lagrangian>(
         ..Options::new(h, steps)
     };
     integrate(&General(sys), method, &initial.q, &initial.p, &options, || Ok(())).map_err(|f| f.error)
+}
+
+/// The statistics and verdict of the energy of `sys` along `traj`.
+pub fn energy_statistics<L: Lagrangian + ?Sized>(sys: &L, traj: &Trajectory) -> Statistics {
+    let terms = diagnostics::energy_terms(sys, traj).unwrap();
+    diagnostics::energy_statistics(&traj.t, &terms, &traj.work, traj.steps as u64).unwrap()
+}
+
+/// Whether a verdict says the quantity is conserved: to round-off, or in a bounded band.
+pub fn conserved(verdict: Verdict) -> bool {
+    matches!(verdict, Verdict::ConservedToRoundOff | Verdict::Bounded)
+}
+
+/// The relative energy error e = (H − H₀)/|H₀| of a series: its max |e|, and its max |e| over
+/// the first and the last tenth of the series (the figures the literature publishes).
+#[derive(Debug)]
+pub struct RelativeEnergyError {
+    pub initial: f64,
+    pub max: f64,
+    pub first_tenth: f64,
+    pub last_tenth: f64,
+}
+
+pub fn relative_energy_error(h: &[f64]) -> RelativeEnergyError {
+    let e: Vec<f64> = h.iter().map(|x| ((x - h[0]) / h[0]).abs()).collect();
+    let max = |s: &[f64]| s.iter().fold(0.0_f64, |m, x| m.max(*x));
+    let tenth = (e.len() / 10).max(1);
+    RelativeEnergyError {
+        initial: h[0],
+        max: max(&e),
+        first_tenth: max(&e[..tenth]),
+        last_tenth: max(&e[e.len() - tenth..]),
+    }
+}
+
+/// The error of a conserved quantity J along a run: max |J − J₀|, absolute and relative to |J₀|.
+#[derive(Debug)]
+pub struct InvariantStatistics {
+    pub initial: f64,
+    pub max_abs_error: f64,
+    /// max |J − J₀| / |J₀| (the absolute error when J₀ = 0).
+    pub max_rel_error: f64,
+}
+
+impl InvariantStatistics {
+    pub fn new(values: &[f64]) -> Self {
+        let initial = values.first().copied().unwrap_or(0.0);
+        let max_abs_error = values.iter().fold(0.0_f64, |m, x| m.max((x - initial).abs()));
+        let scale = if initial != 0.0 { initial.abs() } else { 1.0 };
+        InvariantStatistics {
+            initial,
+            max_abs_error,
+            max_rel_error: max_abs_error / scale,
+        }
+    }
 }

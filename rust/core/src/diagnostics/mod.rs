@@ -1,15 +1,16 @@
 //! What a run should conserve, and how well it did.
 //!
-//! - [`energies`]: H(q, p) = ½pᵀM⁻¹p + V(q) along a run of a mechanical system;
-//! - [`EnergyStatistics`]: band, drift rate with its uncertainty, and the verdict
-//!   ("bounded" or "secular drift") of an energy-error series;
-//! - [`InvariantStatistics`]: the error of a Noether momentum J = p·ξ(q) along a run;
+//! - [`energies`]: H(q, p) = ½pᵀM⁻¹p + V(q) along a run of a mechanical system, and
+//!   [`energy_terms`]: E = p·q̇ − L with its kinetic and potential terms along any run;
+//! - [`Statistics`]: the error of a conserved quantity against its scale, its band and drift
+//!   rate, and a [`Verdict`] ("conserved to round-off", "bounded", "secular drift",
+//!   "failed"); [`energy_statistics`] builds them for the energy or a forced run's balance;
 //! - [`symplecticity_defect`]: ‖ΨᵀJΨ − J‖ of a one-step map.
 
 mod conservation;
 mod energy;
 mod symplecticity;
 
-pub use conservation::{EnergyStatistics, InvariantStatistics, Verdict};
-pub use energy::energies;
+pub use conservation::{Series, Statistics, Verdict};
+pub use energy::{energies, energy_statistics, energy_terms};
 pub use symplecticity::symplecticity_defect;

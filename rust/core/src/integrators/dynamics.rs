@@ -1,7 +1,7 @@
 //! What a method integrates: the dynamics of a model, seen through one step's increments.
 
 use super::{Increment, Integrator, ModelKind, StepError, StepStart};
-use crate::model::{self, Constrained, HolonomicConstraints, Lagrangian, MechanicalSystem, PhaseState};
+use crate::model::{self, Constrained, EnergyTerms, HolonomicConstraints, Lagrangian, MechanicalSystem, PhaseState};
 use crate::{Error, ModelError};
 
 /// The dynamics a method integrates: separable mechanical systems take every unconstrained
@@ -23,7 +23,7 @@ pub trait Dynamics {
         let Some(residuals) = self.constraint_residuals(q0, p0) else {
             return Ok(());
         };
-        let (position, velocity) =
+        let model::Residuals { position, velocity, .. } =
             residuals.map_err(|e| Error::invalid("q0", format!("the constraints failed to evaluate: {e}")))?;
         let scale = q0.iter().chain(p0).fold(1.0_f64, |m, x| m.max(x.abs()));
         if position > 1e-10 * scale {
@@ -49,14 +49,15 @@ pub trait Dynamics {
         increment: &mut Increment,
     ) -> Result<(), StepError>;
 
-    /// The conserved energy at (q, p), where the model has one.
-    fn energy(&self, q: &[f64], p: &[f64]) -> Option<Result<f64, ModelError>>;
+    /// The energy function and its terms at (q, p, t), where L does not depend on t (forced
+    /// or not: a forced run balances it against the work done).
+    fn energy(&self, q: &[f64], p: &[f64], t: f64) -> Option<Result<EnergyTerms, ModelError>>;
 
     /// The system as a Lagrangian, for the diagnostics (energy function, Legendre transforms).
     fn as_lagrangian(&self) -> &dyn Lagrangian;
 
-    /// (|g(q)|∞, |G(q)M⁻¹p|∞) for a constrained system; None for the others.
-    fn constraint_residuals(&self, _q: &[f64], _p: &[f64]) -> Option<Result<(f64, f64), ModelError>> {
+    /// |g(q)|∞ and |G(q)M⁻¹p|∞, with their sizes, for a constrained system; None for the others.
+    fn constraint_residuals(&self, _q: &[f64], _p: &[f64]) -> Option<Result<model::Residuals, ModelError>> {
         None
     }
 
@@ -87,8 +88,8 @@ impl<S: MechanicalSystem> Dynamics for S {
         integrator.increment(self, start, increment)
     }
 
-    fn energy(&self, q: &[f64], p: &[f64]) -> Option<Result<f64, ModelError>> {
-        Some(model::hamiltonian(self, q, p))
+    fn energy(&self, q: &[f64], p: &[f64], t: f64) -> Option<Result<EnergyTerms, ModelError>> {
+        Some(self.energy_terms(q, p, t))
     }
 
     fn as_lagrangian(&self) -> &dyn Lagrangian {
@@ -117,9 +118,9 @@ impl<L: Lagrangian> Dynamics for General<'_, L> {
         integrator.increment_lagrangian(self.0, start, increment)
     }
 
-    /// E = p·q̇ − L, unless L depends on t or forces act (then it is not conserved).
-    fn energy(&self, q: &[f64], p: &[f64]) -> Option<Result<f64, ModelError>> {
-        (!self.0.is_time_dependent() && !self.0.is_forced()).then(|| self.0.energy(q, p, 0.0))
+    /// E = p·q̇ − L, unless L depends on t.
+    fn energy(&self, q: &[f64], p: &[f64], t: f64) -> Option<Result<EnergyTerms, ModelError>> {
+        (!self.0.is_time_dependent()).then(|| self.0.energy_terms(q, p, t))
     }
 
     fn as_lagrangian(&self) -> &dyn Lagrangian {
@@ -146,15 +147,15 @@ impl<S: MechanicalSystem, C: HolonomicConstraints> Dynamics for Constrained<S, C
         integrator.increment_constrained(&self.system, &self.constraints, start, increment)
     }
 
-    fn energy(&self, q: &[f64], p: &[f64]) -> Option<Result<f64, ModelError>> {
-        Some(model::hamiltonian(&self.system, q, p))
+    fn energy(&self, q: &[f64], p: &[f64], t: f64) -> Option<Result<EnergyTerms, ModelError>> {
+        Some(self.system.energy_terms(q, p, t))
     }
 
     fn as_lagrangian(&self) -> &dyn Lagrangian {
         &self.system
     }
 
-    fn constraint_residuals(&self, q: &[f64], p: &[f64]) -> Option<Result<(f64, f64), ModelError>> {
+    fn constraint_residuals(&self, q: &[f64], p: &[f64]) -> Option<Result<model::Residuals, ModelError>> {
         Some(self.residuals(q, p))
     }
 
@@ -183,15 +184,15 @@ impl<L: Lagrangian, C: HolonomicConstraints> Dynamics for Constrained<General<'_
         integrator.increment_constrained_lagrangian(self.system.0, &self.constraints, start, increment)
     }
 
-    fn energy(&self, q: &[f64], p: &[f64]) -> Option<Result<f64, ModelError>> {
-        self.system.energy(q, p)
+    fn energy(&self, q: &[f64], p: &[f64], t: f64) -> Option<Result<EnergyTerms, ModelError>> {
+        self.system.energy(q, p, t)
     }
 
     fn as_lagrangian(&self) -> &dyn Lagrangian {
         self.system.0
     }
 
-    fn constraint_residuals(&self, q: &[f64], p: &[f64]) -> Option<Result<(f64, f64), ModelError>> {
+    fn constraint_residuals(&self, q: &[f64], p: &[f64]) -> Option<Result<model::Residuals, ModelError>> {
         Some(self.residuals_general(q, p))
     }
 
@@ -206,8 +207,8 @@ impl<L: Lagrangian, C: HolonomicConstraints> Constrained<General<'_, L>, C> {
         |q, p, v| self.system.0.velocity(q, p, 0.0, v)
     }
 
-    /// (|g(q)|∞, |G(q)q̇(q, p)|∞).
-    pub fn residuals_general(&self, q: &[f64], p: &[f64]) -> Result<(f64, f64), ModelError> {
+    /// |g(q)|∞ and |G(q)q̇(q, p)|∞, with their sizes.
+    pub fn residuals_general(&self, q: &[f64], p: &[f64]) -> Result<model::Residuals, ModelError> {
         model::residuals(&self.constraints, &self.velocity(), q, p)
     }
 

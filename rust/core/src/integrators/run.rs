@@ -1,6 +1,7 @@
 //! The fixed-step run: a [`Stepper`] advanced to the end, its states saved on the way.
 
 use super::{Dynamics, Failure, Method, NewtonOptions, Stepper, Trajectory};
+use crate::model::{EnergyTerms, Scale};
 use crate::{memory, Error, ModelError};
 
 /// Options of a fixed-step run.
@@ -14,9 +15,13 @@ pub struct Options {
     pub save_every: usize,
     /// Add the increments with compensated summation (on by default, as in Hairer's GNI codes).
     pub compensated: bool,
-    /// Stop with [`Error::Divergence`] when the relative energy error |H − H₀|/|H₀| at a saved
-    /// state exceeds this (the absolute error when H₀ = 0). `None`: only non-finite states stop
-    /// the run. Checking costs one potential evaluation per saved state.
+    /// Stop with [`Error::Divergence`] when the energy error |E − E₀| at a saved state
+    /// exceeds this times the energy's scale, the mean kinetic energy over the states saved so
+    /// far ([`Scale`]; errors at round-off never stop a run), or the energy is not finite. A
+    /// forced run checks its balance E − W against the work W instead; a Lagrangian that
+    /// depends on t has no energy to check. `None`: only non-finite states stop the run.
+    /// Default [`Scale::FAILURE`] = 1: the energy is then wrong by the size of the motion.
+    /// Checking costs one energy evaluation per saved state.
     pub max_energy_error: Option<f64>,
     /// The initial time.
     pub t0: f64,
@@ -25,14 +30,15 @@ pub struct Options {
 }
 
 impl Options {
-    /// `steps` steps of size `dt`, every state kept, compensated summation on.
+    /// `steps` steps of size `dt`, every state kept, compensated summation on, the energy
+    /// checked against [`Scale::FAILURE`].
     pub fn new(dt: f64, steps: usize) -> Self {
         Options {
             dt,
             steps,
             save_every: 1,
             compensated: true,
-            max_energy_error: None,
+            max_energy_error: Some(Scale::FAILURE),
             t0: 0.0,
             newton: NewtonOptions::default(),
         }
@@ -50,6 +56,16 @@ impl Options {
         }
         if !self.t0.is_finite() {
             return Err(Error::invalid("t0", "must be finite"));
+        }
+        let t_end = self.t0 + self.dt * self.steps as f64;
+        if !t_end.is_finite() {
+            return Err(Error::invalid(
+                "dt",
+                format!(
+                    "{} steps of {} from t0 = {} end past the largest float",
+                    self.steps, self.dt, self.t0
+                ),
+            ));
         }
         self.newton.check()?;
         match self.max_energy_error {
@@ -118,21 +134,10 @@ where
     }
 
     traj.push(t0, &stepper);
-    let h0 = match max_energy_error.and_then(|_| sys.energy(stepper.q(), stepper.p())) {
+    let mut watch = match max_energy_error.and_then(|tol| EnergyWatch::new(sys, &stepper, tol)) {
         None => None,
-        Some(energy) => match energy {
-            Ok(h) => Some(h),
-            Err(source) => {
-                return Err(fail(
-                    Error::Model {
-                        step: 0,
-                        time: t0,
-                        source,
-                    },
-                    traj,
-                ))
-            }
-        },
+        Some(Ok(watch)) => Some(watch),
+        Some(Err(error)) => return Err(fail(error, traj)),
     };
 
     while stepper.steps() < steps {
@@ -149,28 +154,87 @@ where
         }
         let t = stepper.t();
         traj.push(t, &stepper);
-        if let (Some(tol), Some(h0)) = (max_energy_error, h0) {
+        if let Some(error) = watch.as_mut().and_then(|w| w.check(sys, &stepper)) {
             // The state of this step is kept: it is finite, only its energy is off.
-            let step = stepper.steps();
-            let error = match sys
-                .energy(stepper.q(), stepper.p())
-                .expect("checked before the first step")
-            {
-                Ok(h) => {
-                    let err = (h - h0).abs() / if h0 != 0.0 { h0.abs() } else { 1.0 };
-                    (err.is_nan() || err > tol).then(|| {
-                        let reason = format!("energy error {err:.3e} exceeds max_energy_error = {tol:.3e}");
-                        Error::Divergence { step, time: t, reason }
-                    })
-                }
-                Err(source) => Some(Error::Model { step, time: t, source }),
-            };
-            if let Some(error) = error {
-                traj.count(&stepper);
-                return Err(fail(error, traj));
-            }
+            traj.count(&stepper);
+            return Err(fail(error, traj));
         }
     }
     traj.count(&stepper);
     Ok(traj)
+}
+
+/// The run's energy check: E − W against its value at the start, judged by a running [`Scale`].
+struct EnergyWatch {
+    initial: f64,
+    scale: Scale,
+    tolerance: f64,
+}
+
+impl EnergyWatch {
+    /// None for a model without an energy (L depends on t); an error when the initial energy
+    /// does not evaluate or is not finite.
+    fn new<S, M>(sys: &S, stepper: &Stepper<M>, tolerance: f64) -> Option<Result<Self, Error>>
+    where
+        S: Dynamics + ?Sized,
+        M: std::ops::Deref<Target: Dynamics>,
+    {
+        let (step, time) = (0, stepper.t());
+        let terms = match sys.energy(stepper.q(), stepper.p(), time)? {
+            Ok(terms) => terms,
+            Err(source) => return Some(Err(Error::Model { step, time, source })),
+        };
+        if !terms.energy.is_finite() {
+            let reason = not_finite(&terms);
+            return Some(Err(Error::Divergence { step, time, reason }));
+        }
+        let mut watch = EnergyWatch {
+            initial: terms.energy - stepper.work(),
+            scale: Scale::default(),
+            tolerance,
+        };
+        watch.push(&terms, stepper.work());
+        Some(Ok(watch))
+    }
+
+    fn push(&mut self, terms: &EnergyTerms, work: f64) {
+        self.scale.push(terms.kinetic, terms.size() + work.abs());
+    }
+
+    /// The error that ends the run at the stepper's state, if any.
+    fn check<S, M>(&mut self, sys: &S, stepper: &Stepper<M>) -> Option<Error>
+    where
+        S: Dynamics + ?Sized,
+        M: std::ops::Deref<Target: Dynamics>,
+    {
+        let (step, time, work) = (stepper.steps(), stepper.t(), stepper.work());
+        let terms = match sys.energy(stepper.q(), stepper.p(), time)? {
+            Ok(terms) => terms,
+            Err(source) => return Some(Error::Model { step, time, source }),
+        };
+        self.push(&terms, work);
+        let error = terms.energy - work - self.initial;
+        self.scale.fails(error, step as u64, self.tolerance).then(|| {
+            let scale = self.scale.scale();
+            let reason = if error.is_finite() {
+                format!(
+                    "energy error {:.3e} is {:.3e} times the energy scale {scale:.3e} (the mean kinetic energy), \
+                     beyond max_energy_error = {:.3e}; reduce dt",
+                    error.abs(),
+                    error.abs() / scale,
+                    self.tolerance
+                )
+            } else {
+                not_finite(&terms)
+            };
+            Error::Divergence { step, time, reason }
+        })
+    }
+}
+
+fn not_finite(terms: &EnergyTerms) -> String {
+    format!(
+        "the energy is not finite (E = {}, T = {}, V = {}): the model's energy does not evaluate there",
+        terms.energy, terms.kinetic, terms.potential
+    )
 }

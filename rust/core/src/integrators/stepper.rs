@@ -64,8 +64,7 @@ where
     /// methods.
     ///
     /// Refuses, in this order: q0 or p0 of the wrong length or not finite, malformed options, a
-    /// method that does not integrate the model's kind ([`Method::check`]), an energy check
-    /// (`options.max_energy_error`) on a model without a conserved energy, and initial data off
+    /// method that does not integrate the model's kind ([`Method::check`]), and initial data off
     /// the constraints ([`Dynamics::check_initial`]).
     pub fn new(model: M, method: Method, q0: &[f64], p0: &[f64], options: &Options) -> Result<Self, Error> {
         let n = model.dim();
@@ -73,12 +72,6 @@ where
         check_vector("p0", p0, n)?;
         options.check()?;
         method.check(model.kind())?;
-        if options.max_energy_error.is_some() && model.energy(q0, p0).is_none() {
-            return Err(Error::invalid(
-                "max_energy_error",
-                "needs a conserved energy, and a time-dependent or forced Lagrangian has none",
-            ));
-        }
         model.check_initial(q0, p0)?;
         let zeros = || vec![0.0; n];
         let state = StepperState {

@@ -157,13 +157,24 @@ fn jacobians<C: HolonomicConstraints + ?Sized>(
     Ok((jac, w))
 }
 
-/// The constraint residuals (|g(q)|∞, |G(q)q̇|∞) at one state, q̇ = `velocity`(q, p).
+/// The constraint residuals at one state, with the sizes they are judged against: |g(q)|∞
+/// against ‖G(q)‖∞‖q‖∞ and |G(q)q̇|∞ against ‖G(q)‖∞‖q̇‖∞, the first-order change of g and Gq̇
+/// when q or q̇ moves by its own size (so also the scale of their rounding errors).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Residuals {
+    pub position: f64,
+    pub velocity: f64,
+    pub position_size: f64,
+    pub velocity_size: f64,
+}
+
+/// The constraint [`Residuals`] at one state, q̇ = `velocity`(q, p).
 pub fn residuals<C: HolonomicConstraints + ?Sized>(
     constraints: &C,
     velocity: Action<'_>,
     q: &[f64],
     p: &[f64],
-) -> Result<(f64, f64), ModelError> {
+) -> Result<Residuals, ModelError> {
     let (m, n) = (constraints.count(), q.len());
     let mut g = vec![0.0; m];
     constraints.residual(q, &mut g)?;
@@ -171,8 +182,18 @@ pub fn residuals<C: HolonomicConstraints + ?Sized>(
     constraints.jacobian(q, &mut jac)?;
     let mut v = vec![0.0; n];
     velocity(q, p, &mut v)?;
-    let hidden = jac * DVector::from_column_slice(&v);
-    Ok((g.iter().fold(0.0, |a, x| a.max(x.abs())), hidden.amax()))
+    let hidden = &jac * DVector::from_column_slice(&v);
+    let norm = jac
+        .row_iter()
+        .map(|row| row.iter().map(|x| x.abs()).sum::<f64>())
+        .fold(0.0, f64::max);
+    let amax = |x: &[f64]| x.iter().fold(0.0_f64, |a, y| a.max(y.abs()));
+    Ok(Residuals {
+        position: amax(&g),
+        velocity: hidden.amax(),
+        position_size: norm * amax(q),
+        velocity_size: norm * amax(&v),
+    })
 }
 
 /// The nearest consistent state: q on g = 0 by Newton's method along W = M⁻¹Gᵀ (the nearest
@@ -294,8 +315,8 @@ impl<S: MechanicalSystem, C: HolonomicConstraints> Constrained<S, C> {
         }
     }
 
-    /// The constraint residuals (|g(q)|∞, |G(q)M⁻¹p|∞) at one state.
-    pub fn residuals(&self, q: &[f64], p: &[f64]) -> Result<(f64, f64), ModelError> {
+    /// The constraint residuals |g(q)|∞ and |G(q)M⁻¹p|∞ at one state, with their sizes.
+    pub fn residuals(&self, q: &[f64], p: &[f64]) -> Result<Residuals, ModelError> {
         residuals(&self.constraints, &self.minv(), q, p)
     }
 

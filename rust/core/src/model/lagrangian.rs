@@ -1,6 +1,6 @@
 use nalgebra::DMatrix;
 
-use super::MechanicalSystem;
+use super::{EnergyTerms, MechanicalSystem};
 use crate::error::StepError;
 use crate::solve::difference::{self, central_gradient, central_jacobian, Evaluations};
 use crate::solve::newton::{model_error, Correction, Newton, NewtonOptions, NewtonProblem, Reasons, Rules};
@@ -112,6 +112,18 @@ pub trait Lagrangian {
         self.velocity(q, p, t, &mut v)?;
         Ok(p.iter().zip(&v).map(|(a, b)| a * b).sum::<f64>() - self.lagrangian(q, &v, t)?)
     }
+
+    /// E(q, p, t) with its kinetic and potential terms (see [`EnergyTerms`]); the potential is
+    /// −L(q, 0, t).
+    fn energy_terms(&self, q: &[f64], p: &[f64], t: f64) -> Result<EnergyTerms, ModelError> {
+        let energy = self.energy(q, p, t)?;
+        let potential = -self.lagrangian(q, &vec![0.0; q.len()], t)?;
+        Ok(EnergyTerms {
+            energy,
+            kinetic: energy - potential,
+            potential,
+        })
+    }
 }
 
 /// L = ½ q̇ᵀ M q̇ − V(q): ∂L/∂q = −∇V(q), ∂L/∂q̇ = M q̇.
@@ -138,6 +150,16 @@ impl<S: MechanicalSystem + ?Sized> Lagrangian for S {
     fn velocity(&self, _q: &[f64], p: &[f64], _t: f64, v: &mut [f64]) -> Result<(), ModelError> {
         self.mass().velocity(p, v);
         Ok(())
+    }
+
+    /// H = T + V with T = ½pᵀM⁻¹p and V(q), as [`super::hamiltonian`] sums them.
+    fn energy_terms(&self, q: &[f64], p: &[f64], _t: f64) -> Result<EnergyTerms, ModelError> {
+        let (kinetic, potential) = (self.mass().kinetic_energy(p), self.potential(q)?);
+        Ok(EnergyTerms {
+            energy: kinetic + potential,
+            kinetic,
+            potential,
+        })
     }
 }
 

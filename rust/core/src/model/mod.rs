@@ -9,6 +9,7 @@
 //! - [`HolonomicConstraints`]: g(q) = 0 with its Jacobian, [`Distances`] for rigid links, and
 //!   [`Constrained`], a mechanical system on them;
 //! - [`Routhian`]: Routh reduction, R = L − μ·ċ on the non-cyclic coordinates;
+//! - [`Scale`]: the size a conserved quantity's error is judged against;
 //! - [`Generator`]: infinitesimal symmetries ξ(q) and their Noether momenta J = p·ξ(q).
 //!
 //! Derivatives a model does not supply come from [`crate::solve::difference`].
@@ -20,16 +21,18 @@ mod mass;
 mod mechanical;
 mod natural;
 mod routh;
+mod scale;
 mod symmetry;
 
 pub use constraints::{
     check_dense, differenced_jacobian, project, residuals, Action, Anchor, Constrained, Distances,
-    HolonomicConstraints, Link, PhaseState,
+    HolonomicConstraints, Link, PhaseState, Residuals,
 };
-pub use energy::hamiltonian;
+pub use energy::{hamiltonian, EnergyTerms};
 pub use lagrangian::{Hessians, Lagrangian};
 pub use mass::Mass;
 pub use mechanical::MechanicalSystem;
 pub use natural::{differenced_kinetic_gradient, kinetic_gradient_from_mass_derivative, Natural, NaturalSystem};
 pub use routh::Routhian;
+pub use scale::Scale;
 pub use symmetry::Generator;

@@ -50,22 +50,28 @@ impl Generator {
 
     /// J(q, p) = p·ξ(q).
     pub fn momentum(&self, q: &[f64], p: &[f64]) -> f64 {
+        self.momentum_terms(q, p).0
+    }
+
+    /// J(q, p) = p·ξ(q) and the size Σ|pᵢξᵢ(q)| of the products it sums, which sets its
+    /// rounding error.
+    pub fn momentum_terms(&self, q: &[f64], p: &[f64]) -> (f64, f64) {
+        let sum = |terms: &mut dyn Iterator<Item = f64>| terms.fold((0.0, 0.0), |(j, size), x| (j + x, size + x.abs()));
         match *self {
-            Generator::Translation { axis, spatial_dim } => p.iter().skip(axis).step_by(spatial_dim).sum(),
-            Generator::Rotation { spatial_dim: 2, .. } => q
+            Generator::Translation { axis, spatial_dim } => sum(&mut p.iter().skip(axis).step_by(spatial_dim).copied()),
+            Generator::Rotation { spatial_dim: 2, .. } => sum(&mut q
                 .chunks_exact(2)
                 .zip(p.chunks_exact(2))
-                .map(|(x, y)| x[0] * y[1] - x[1] * y[0])
-                .sum(),
+                .flat_map(|(x, y)| [x[0] * y[1], -x[1] * y[0]])),
             Generator::Rotation { axis, .. } => {
                 // (x × p)·e_axis
                 let (a, b) = ((axis + 1) % 3, (axis + 2) % 3);
-                q.chunks_exact(3)
+                sum(&mut q
+                    .chunks_exact(3)
                     .zip(p.chunks_exact(3))
-                    .map(|(x, y)| x[a] * y[b] - x[b] * y[a])
-                    .sum()
+                    .flat_map(|(x, y)| [x[a] * y[b], -x[b] * y[a]]))
             }
-            Generator::Cyclic { index } => p[index],
+            Generator::Cyclic { index } => (p[index], p[index].abs()),
         }
     }
 }
