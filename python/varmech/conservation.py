@@ -65,8 +65,10 @@ class InvariantStatistics:
       grown as a random walk (Brouwer's law);
     - ``"secular drift"``: the error grows. Over eight batches in time, the slope of the batch
       means differs from zero by more than four standard errors, the drift over the run exceeds
-      round-off and the 4 ε of the terms a step that biased rounding (an implicit method's
-      solve) can add, and the last batch's largest |error| is more than twice the first's. The
+      round-off, the 4 ε of the terms a step that biased rounding (an implicit method's solve)
+      can add, and the error's own oscillation (the median band within a batch: a bounded
+      error that wanders with the state, as on a chaotic orbit, shifts by less than it
+      oscillates), and the last batch's largest |error| is more than twice the first's. The
       run must span several oscillations of the error: over a fraction of one, a bounded
       error's rise cannot be told from a drift;
     - ``"bounded"``: otherwise, a band that does not grow and stays below the failure level.

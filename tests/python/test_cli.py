@@ -2,6 +2,7 @@
 
 import pytest
 
+import varmech
 from varmech import scenes
 from varmech.cli import TOUR, TOUR_REDUCED, tour_runs
 
@@ -18,6 +19,18 @@ def test_tour_prints_reports_and_writes_plots(tmp_path, run_cli):
     assert runs == 44 and out.count("Conservation report") == runs
     assert "max |G M⁻¹ p|" in out
     assert "verdict: secular drift" in out and "verdict: bounded" in out
+    # The summary: every symplectic or variational run conserves its energy (or its balance),
+    # and every RK4 run drifts.
+    lines = out.splitlines()
+    start = lines.index(next(line for line in lines if line.startswith("Tour: energy error")))
+    rows = [line.split(" | ") for line in lines[start + 2 : start + 2 + runs]]
+    assert len(rows) == runs and all(len(r) == 6 for r in rows)
+    info = {m.name: m for m in varmech.methods()}
+    for scene, method, _, _, _, verdict in rows:
+        if info[method].symplectic:
+            assert verdict.removeprefix("balance E − W ") in ("conserved to round-off", "bounded"), (scene, method, verdict)
+        if method == "rk4":
+            assert verdict == "secular drift", scene
     written = sorted(p.name for p in tmp_path.glob("*_energy.png"))
     assert written == sorted(f"{name}_energy.png" for name in scenes.CATALOGUE)
     # The charts, each with its data.

@@ -69,8 +69,10 @@ pub struct Series<'a> {
 ///   errors (batch means make the standard error honest for an error that oscillates, which
 ///   successive samples are not independent of), the drift over the run exceeds both
 ///   `round_off` and what biased rounding could add ([`Scale::BIASED_ROUND_OFF`] ε of the
-///   terms a step), and the largest |error| in the last batch is more than twice that in the
-///   first. The test needs the run to span several oscillations of the error: over a fraction
+///   terms a step) and the error's oscillation (the median over the batches of the band within
+///   a batch: a bounded error that wanders with the state, as on a chaotic orbit, moves its
+///   batch means by less than it oscillates), and the largest |error| in the last batch is
+///   more than twice that in the first. The test needs the run to span several oscillations of the error: over a fraction
 ///   of one, a bounded error's rise cannot be told from a drift;
 /// - **bounded** otherwise: the band does not grow and stays below `FAILURE × scale`.
 #[derive(Clone, Debug, PartialEq)]
@@ -127,16 +129,14 @@ impl Statistics {
         let (lo, hi) = error.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &x| {
             (lo.min(x), hi.max(x))
         });
-        let (drift_rate, drift_rate_stderr, growth) = batch_drift(t, error);
-        let drift = drift_rate.abs() * (t[t.len() - 1] - t[0]);
+        let batches = Batches::new(t, error);
+        let (drift_rate, drift_rate_stderr) = batches.as_ref().map_or((0.0, f64::INFINITY), |b| (b.slope, b.stderr));
+        let floor = judge.biased_round_off(steps).max(round_off);
         let verdict = if first_non_finite.is_some() || judge.fails(max_abs_error, steps, Scale::FAILURE) {
             Verdict::Failed
         } else if max_abs_error <= round_off {
             Verdict::ConservedToRoundOff
-        } else if drift_rate.abs() > 4.0 * drift_rate_stderr
-            && drift > judge.biased_round_off(steps).max(round_off)
-            && growth > 2.0
-        {
+        } else if batches.is_some_and(|b| b.drifts(t[t.len() - 1] - t[0], floor)) {
             Verdict::SecularDrift
         } else {
             Verdict::Bounded
@@ -155,37 +155,70 @@ impl Statistics {
     }
 }
 
-/// The slope of the batch means of `y` against their mean times, its standard error, and the
-/// ratio of max |y| over the last batch to that over the first. (0, ∞, 1) when there are fewer
-/// than four samples a batch.
-fn batch_drift(t: &[f64], y: &[f64]) -> (f64, f64, f64) {
-    let k = Statistics::BATCHES;
-    if t.len() < 4 * k {
-        return (0.0, f64::INFINITY, 1.0);
-    }
-    let size = t.len() / k;
-    let batch = |j: usize| {
-        let range = j * size..if j + 1 == k { t.len() } else { (j + 1) * size };
-        (&t[range.clone()], &y[range])
-    };
-    let mean = |s: &[f64]| s.iter().sum::<f64>() / s.len() as f64;
-    let max_abs = |s: &[f64]| s.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
-    let (tb, yb): (Vec<f64>, Vec<f64>) = (0..k)
-        .map(|j| {
-            let (t, y) = batch(j);
-            (mean(t), mean(y))
+/// What the batches of an error series say about its growth.
+struct Batches {
+    /// The slope of the batch means against their mean times, and its standard error.
+    slope: f64,
+    stderr: f64,
+    /// max |y| over the last batch over max |y| over the first.
+    growth: f64,
+    /// The median over the batches of max y − min y within a batch: the error's oscillation.
+    band: f64,
+}
+
+impl Batches {
+    /// `y` at times `t` in [`Statistics::BATCHES`] batches; None with fewer than four samples a
+    /// batch.
+    fn new(t: &[f64], y: &[f64]) -> Option<Self> {
+        let k = Statistics::BATCHES;
+        if t.len() < 4 * k {
+            return None;
+        }
+        let size = t.len() / k;
+        let batch = |j: usize| {
+            let range = j * size..if j + 1 == k { t.len() } else { (j + 1) * size };
+            (&t[range.clone()], &y[range])
+        };
+        let mean = |s: &[f64]| s.iter().sum::<f64>() / s.len() as f64;
+        let max_abs = |s: &[f64]| s.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+        let spread = |s: &[f64]| {
+            let (lo, hi) = s.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &x| {
+                (lo.min(x), hi.max(x))
+            });
+            hi - lo
+        };
+        let (tb, yb): (Vec<f64>, Vec<f64>) = (0..k)
+            .map(|j| {
+                let (t, y) = batch(j);
+                (mean(t), mean(y))
+            })
+            .unzip();
+        let (slope, stderr) = linear_fit_slope(&tb, &yb);
+        let (first, last) = (max_abs(batch(0).1), max_abs(batch(k - 1).1));
+        let growth = if first > 0.0 {
+            last / first
+        } else if last > 0.0 {
+            f64::INFINITY
+        } else {
+            1.0
+        };
+        let mut bands: Vec<f64> = (0..k).map(|j| spread(batch(j).1)).collect();
+        bands.sort_by(f64::total_cmp);
+        Some(Batches {
+            slope,
+            stderr,
+            growth,
+            band: 0.5 * (bands[k / 2 - 1] + bands[k / 2]),
         })
-        .unzip();
-    let (slope, stderr) = linear_fit_slope(&tb, &yb);
-    let (first, last) = (max_abs(batch(0).1), max_abs(batch(k - 1).1));
-    let growth = if first > 0.0 {
-        last / first
-    } else if last > 0.0 {
-        f64::INFINITY
-    } else {
-        1.0
-    };
-    (slope, stderr, growth)
+    }
+
+    /// A drift: the trend is significant, carries the error past its own oscillation and past
+    /// what rounding could add (`floor`), and the band at the end is more than twice that at
+    /// the start.
+    fn drifts(&self, duration: f64, floor: f64) -> bool {
+        let drift = self.slope.abs() * duration;
+        self.slope.abs() > 4.0 * self.stderr && drift > floor.max(self.band) && self.growth > 2.0
+    }
 }
 
 /// Slope b of the least-squares line y ≈ a + b·t, and its standard error
@@ -270,6 +303,20 @@ mod tests {
             .map(|x| 1e-6 * (1.0 - (std::f64::consts::TAU * x / 4.0).cos()))
             .collect();
         assert_eq!(verdict(&t, &slow, 1.0, 399), Verdict::Bounded);
+    }
+
+    #[test]
+    fn an_error_that_shifts_by_less_than_it_oscillates_is_bounded() {
+        // As on a chaotic orbit: the band widens six-fold and the mean moves by 0.02, less than
+        // the error oscillates; with the mean moving by 1, past the oscillation, it drifts.
+        let t: Vec<f64> = (0..4000).map(|k| k as f64 * 0.025).collect();
+        let wander = |rate: f64| -> Vec<f64> {
+            t.iter()
+                .map(|x| (0.05 + 0.25 * (x / 100.0)) * (5.0 * x).sin() + rate * x)
+                .collect()
+        };
+        assert_eq!(verdict(&t, &wander(2e-4), 10.0, 3999), Verdict::Bounded);
+        assert_eq!(verdict(&t, &wander(1e-2), 10.0, 3999), Verdict::SecularDrift);
     }
 
     #[test]
