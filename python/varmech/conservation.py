@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -120,11 +120,20 @@ class InvariantStatistics:
         return lines
 
 
-def _statistics(record: _core.Statistics, name: str, initial: float, scale_name: str, t: np.ndarray, advice: str = "") -> InvariantStatistics:
+#: A bounded band above this fraction of the scale is coarse, and the advice says so.
+COARSE = 0.1
+
+
+def _statistics(record: _core.Statistics, name: str, initial: float, scale_name: str, t: np.ndarray) -> InvariantStatistics:
     """The report of the core's statistics, with a failure located in time."""
     k = record.first_non_finite
+    advice = ""
     if k is not None:
-        advice = f"not finite from saved state {k} (t = {t[k]:.6g}) on" + (f"; {advice}" if advice else "")
+        advice = f"not finite from saved state {k} (t = {t[k]:.6g}) on"
+    elif record.verdict == "failed":
+        advice = f"the error reaches {record.max_rel_error:.3g} × the scale"
+    elif record.verdict == "bounded" and record.max_rel_error > COARSE:
+        advice = f"coarse: the band reaches {record.max_rel_error:.2g} of the scale; reduce dt for accuracy"
     return InvariantStatistics(
         name,
         float(initial),
@@ -138,7 +147,7 @@ def _statistics(record: _core.Statistics, name: str, initial: float, scale_name:
         record.drift_rate_stderr,
         k,
         record.verdict,
-        advice if record.verdict == "failed" else "",
+        advice,
     )
 
 
@@ -223,11 +232,9 @@ def check_conservation(traj: Trajectory, generators: Sequence[Generator] | None 
     t, steps = traj.t, int(traj.steps)
     energy = balance = None
     if not model.time_dependent:
-        e, kinetic, potential = traj.energy_terms()
-        work = traj.work if traj.work is not None else np.zeros(len(t))
-        record = _core.energy_statistics(t, e, kinetic, potential, work, steps)
-        advice = _failure_advice(traj, record.max_rel_error) if record.verdict == "failed" else ""
-        stats = _statistics(record, "energy" if not model.forced else "balance", e[0] - work[0], "mean kinetic energy", t, advice)
+        stats = energy_statistics(model, t, traj.q, traj.p, steps=steps, work=traj.work if model.forced else None)
+        if stats.verdict == "failed":
+            stats = replace(stats, advice=f"{stats.advice}; {_failure_advice(traj)}")
         energy, balance = (None, stats) if model.forced else (stats, None)
     momenta = []
     for k, xi in enumerate(generators):
@@ -245,10 +252,23 @@ def check_conservation(traj: Trajectory, generators: Sequence[Generator] | None 
     return ConservationReport(model.name, traj.method, traj.dt, float(t[-1]), energy, tuple(momenta), balance, constraints)
 
 
-def _failure_advice(traj: Trajectory, relative: float) -> str:
-    """What to do about a failed energy: the step against the method's linear stability limit
-    h·ω_max when the linearisation at the initial state gives an estimate, else reduce dt."""
-    advice = f"the error reaches {relative:.3g} × the scale; reduce dt"
+def energy_statistics(
+    model: Model, t: np.ndarray, q: np.ndarray, p: np.ndarray, *, steps: int, work: np.ndarray | None = None
+) -> InvariantStatistics:
+    """The statistics and verdict of the energy of ``model`` at states (t, q, p) sampled from
+    a run of ``steps`` steps, by varmech or any other integrator; with ``work`` (the work of the
+    forces up to each state), of the balance E − W."""
+    t, q, p = (np.ascontiguousarray(x, dtype=float) for x in (t, q, p))
+    e, kinetic, potential = _core.energy_terms(model._core, t, q, p)
+    w = np.zeros(len(t)) if work is None else np.ascontiguousarray(work, dtype=float)
+    record = _core.energy_statistics(t, e, kinetic, potential, w, int(steps))
+    return _statistics(record, "energy" if work is None else "balance", e[0] - w[0], "mean kinetic energy", t)
+
+
+def _failure_advice(traj: Trajectory) -> str:
+    """What to do about a failed energy: reduce dt, and whether the step is past the method's
+    linear stability limit h·ω_max when the linearisation at the initial state gives an estimate."""
+    advice = "reduce dt"
     h_omega = _h_omega(traj.model, traj.q[0], traj.dt, float(traj.t[0]))
     info = {m.name: m for m in _core.methods()}.get(traj.method)
     if h_omega is not None and info is not None and h_omega >= info.h_omega_max:

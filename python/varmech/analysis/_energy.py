@@ -1,11 +1,10 @@
-"""The energy of sampled states, its relative error and its verdict, shared by the measurements."""
+"""The energy of sampled states and its relative error, shared by the measurements."""
 
 from __future__ import annotations
 
 import numpy as np
 
 from .. import _core
-from ..conservation import InvariantStatistics, _statistics
 from ..model import Model
 
 
@@ -17,15 +16,6 @@ def energy_of(model: Model, t: np.ndarray, q: np.ndarray, p: np.ndarray) -> np.n
         np.ascontiguousarray(q, dtype=float),
         np.ascontiguousarray(p, dtype=float),
     )[0]
-
-
-def energy_statistics(model: Model, t: np.ndarray, q: np.ndarray, p: np.ndarray, *, steps: int) -> InvariantStatistics:
-    """The energy's statistics and verdict for states sampled from any integrator's run of
-    ``steps`` steps (see :class:`~varmech.InvariantStatistics`)."""
-    t, q, p = (np.ascontiguousarray(x, dtype=float) for x in (t, q, p))
-    e, kinetic, potential = _core.energy_terms(model._core, t, q, p)
-    record = _core.energy_statistics(t, e, kinetic, potential, np.zeros(len(t)), int(steps))
-    return _statistics(record, "energy", e[0], "mean kinetic energy", t)
 
 
 def relative_error(h: np.ndarray) -> np.ndarray:

@@ -17,12 +17,12 @@ from typing import Any
 import numpy as np
 
 from .._progress import progress as _progress
-from ..conservation import InvariantStatistics, check_conservation
+from ..conservation import InvariantStatistics, check_conservation, energy_statistics
 from ..integrate import integrate
 from ..scenes import Scene
 from ..table import Table
 from . import baselines as _baselines
-from ._energy import conserves_energy, energy_of, energy_statistics, relative_error
+from ._energy import conserves_energy, energy_of, relative_error
 from ._interrupt import interruptible
 
 ENERGY_GROWTH_COLUMNS = ("tool", "method", "t", "energy_error", "max_energy_error")
