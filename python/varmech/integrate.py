@@ -262,10 +262,10 @@ def integrate(
     threshold = _energy_threshold(model, max_energy_error)
     newton_tolerance, newton_max_iterations = _newton(newton_tolerance, newton_max_iterations)
     q, p = _initial_state(model, q0, p0, v0, t0)
+    # A horizon past the largest float is the core's to refuse (naming dt); probe finite times.
     t_end = t0 + nsteps * dt
-    if not math.isfinite(t_end):
-        raise ValueError(f"dt: {nsteps} steps of {dt} from t0 = {t0} end past the largest float")
-    _check_time_independent(model, q, p, (t0, t0 + dt, t0 + 0.5, t0 + 1.0, t0 + 0.37 * (t_end - t0), t_end))
+    probes = (t0, t0 + dt, t0 + 0.5, t0 + 1.0, t0 + 0.37 * (t_end - t0), t_end)
+    _check_time_independent(model, q, p, tuple(s for s in probes if math.isfinite(s)))
     try:
         record = _core.integrate(
             model._core,

@@ -62,7 +62,7 @@ impl Options {
             return Err(Error::invalid(
                 "dt",
                 format!(
-                    "{} steps of {} from t0 = {} end past the largest float",
+                    "{} steps of {:?} from t0 = {:?} end past the largest float",
                     self.steps, self.dt, self.t0
                 ),
             ));
