@@ -6,18 +6,16 @@
 /// whether every entry of x_next is finite.
 #[inline]
 pub fn add(x: &[f64], err: &[f64], dx: &[f64], x_next: &mut [f64], err_next: &mut [f64]) -> bool {
+    // Indexed over slices cut to one length, so that the bounds checks fold away: a five-way
+    // zip costs a Verlet step of Kepler a fifth of its instructions (callgrind).
+    let n = x.len();
+    let (err, dx, x_next, err_next) = (&err[..n], &dx[..n], &mut x_next[..n], &mut err_next[..n]);
     let mut finite = true;
-    for ((((a, e0), d), xn), en) in x
-        .iter()
-        .zip(err)
-        .zip(dx)
-        .zip(x_next.iter_mut())
-        .zip(err_next.iter_mut())
-    {
-        let e = e0 + d;
-        *xn = a + e;
-        *en = e + (a - *xn);
-        finite &= xn.is_finite();
+    for i in 0..n {
+        let e = err[i] + dx[i];
+        x_next[i] = x[i] + e;
+        err_next[i] = e + (x[i] - x_next[i]);
+        finite &= x_next[i].is_finite();
     }
     finite
 }
@@ -25,10 +23,12 @@ pub fn add(x: &[f64], err: &[f64], dx: &[f64], x_next: &mut [f64], err_next: &mu
 /// x_next = x + δx, plainly. Returns whether every entry of x_next is finite.
 #[inline]
 pub fn add_plain(x: &[f64], dx: &[f64], x_next: &mut [f64]) -> bool {
+    let n = x.len();
+    let (dx, x_next) = (&dx[..n], &mut x_next[..n]);
     let mut finite = true;
-    for ((a, d), xn) in x.iter().zip(dx).zip(x_next.iter_mut()) {
-        *xn = a + d;
-        finite &= xn.is_finite();
+    for i in 0..n {
+        x_next[i] = x[i] + dx[i];
+        finite &= x_next[i].is_finite();
     }
     finite
 }
