@@ -10,10 +10,12 @@
 //!   [`Constrained`], a mechanical system on them;
 //! - [`Routhian`]: Routh reduction, R = L − μ·ċ on the non-cyclic coordinates;
 //! - [`Scale`]: the size a conserved quantity's error is judged against;
-//! - [`Generator`]: infinitesimal symmetries ξ(q) and their Noether momenta J = p·ξ(q).
+//! - [`Generator`]: infinitesimal symmetries ξ(q) and their Noether momenta J = p·ξ(q);
+//! - [`compiled`]: models whose functions are instruction tapes derived symbolically.
 //!
 //! Derivatives a model does not supply come from [`crate::solve::difference`].
 
+pub mod compiled;
 mod constraints;
 mod energy;
 mod lagrangian;
