@@ -10,12 +10,14 @@ from typing_extensions import disjoint_base
 __all__ = [
     "FAILURE",
     "ROUND_OFF",
+    "TAPE_OPS",
     "VERDICTS",
     "CatalogueEntry",
     "ClosureConstrained",
     "ClosureLagrangian",
     "ClosureModel",
     "ClosureNatural",
+    "CompiledModel",
     "ConvergenceError",
     "DivergenceError",
     "Generator",
@@ -300,6 +302,35 @@ class ClosureLagrangian(_ModelProperties):
         symmetries: Sequence[Generator],
     ) -> ClosureLagrangian: ...
 
+_IntArray = NDArray[np.int64]
+
+@final
+class CompiledModel(_ModelProperties):
+    """A model whose functions are instruction tapes (made by :mod:`varmech.symbolic`),
+    evaluated in the core with the GIL released."""
+
+    def __new__(
+        cls,
+        kind: str,
+        dim: int,
+        functions: dict[str, tuple[_IntArray, _FloatArray, _IntArray]],
+        parameters: _FloatArray,
+        *,
+        constraints: int = 0,
+        time_dependent: bool = False,
+        forced: bool = False,
+        symmetries: Sequence[Generator] = ...,
+        jit: bool = True,
+    ) -> CompiledModel: ...
+    @property
+    def parameters(self) -> _FloatArray: ...
+    @property
+    def jit(self) -> bool: ...
+    def with_parameters(self, values: _FloatArray) -> CompiledModel: ...
+
+#: The names of the tape's ops, by code.
+TAPE_OPS: list[str]
+
 @final
 class RouthModel(_ModelProperties):
     """The Routhian R = L − μ·ċ of a full model on its non-cyclic coordinates (built by
@@ -312,7 +343,7 @@ class RouthModel(_ModelProperties):
     @property
     def momenta(self) -> list[float]: ...
 
-_FullModel = NativeModel | ClosureModel | ClosureConstrained | ClosureNatural | ClosureLagrangian
+_FullModel = NativeModel | ClosureModel | ClosureConstrained | ClosureNatural | ClosureLagrangian | CompiledModel
 _Model = _FullModel | RouthModel
 
 def kind_of(model: _Model) -> ModelKind: ...

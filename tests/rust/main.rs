@@ -6,6 +6,7 @@ mod common;
 
 mod catalogue;
 mod charged_particle;
+mod compiled;
 mod constraints;
 mod convergence;
 mod damped_driven_pendulum;

@@ -12,6 +12,7 @@ use crate::closure::{
     ClosureConstrained, ClosureLagrangian, ClosureLagrangianSystem, ClosureModel, ClosureNatural, ClosureNaturalSystem,
     ClosureSystem,
 };
+use crate::compiled::CompiledModel;
 use crate::errors::{boxed, to_pyerr};
 use crate::native::NativeModel;
 use crate::routh::RouthModel;
@@ -25,8 +26,8 @@ fn check_signals() -> Result<(), ModelError> {
     Python::attach(|py| py.check_signals()).map_err(boxed)
 }
 
-/// Runs `body` with the model as the core's [`Dynamics`] and the Ctrl-C check: native models
-/// with the GIL released (the poll takes it back briefly), closure models with it held. A
+/// Runs `body` with the model as the core's [`Dynamics`] and the Ctrl-C check: native and
+/// compiled models with the GIL released (the poll takes it back briefly), closure models with it held. A
 /// Routh-reduced model is the Routhian of its full model, built in place.
 pub fn bind_model<R, F>(py: Python<'_>, model: &Bound<'_, PyAny>, body: F) -> PyResult<R>
 where
@@ -62,6 +63,10 @@ where
     if let Ok(native) = model.cast::<NativeModel>() {
         let native = native.get();
         return Ok(py.detach(|| native.with_integrable(|sys| body(sys, &check_signals))));
+    }
+    if let Ok(compiled) = model.cast::<CompiledModel>() {
+        let compiled = compiled.get();
+        return Ok(py.detach(|| compiled.with_integrable(|sys| body(sys, &check_signals))));
     }
     let poll = || py.check_signals().map_err(boxed);
     if let Ok(closure) = model.cast::<ClosureModel>() {

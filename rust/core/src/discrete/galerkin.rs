@@ -188,8 +188,7 @@ impl Galerkin {
         for i in 0..quad.s {
             quad.node_state(i, &at);
             let ti = at.t + quad.nodes[i] * at.h;
-            sys.dl_dq(&quad.pos, &quad.vel, ti, &mut self.lq[i])?;
-            sys.dl_dv(&quad.pos, &quad.vel, ti, &mut self.lv[i])?;
+            sys.gradients(&quad.pos, &quad.vel, ti, &mut self.lq[i], &mut self.lv[i])?;
             if sys.is_forced() {
                 sys.force(&quad.pos, &quad.vel, ti, &mut self.f)?;
                 let mut power = 0.0;

@@ -14,8 +14,7 @@ impl Midpoint {
     /// ∂L/∂q into ws.a and ∂L/∂q̇ into ws.b, at the midpoint.
     fn derivatives<S: Lagrangian + ?Sized>(sys: &S, at: &Segment<'_>, ws: &mut Workspace) -> Result<(), ModelError> {
         ws.set(at, 0.5);
-        sys.dl_dq(&ws.x, &ws.v, at.t + 0.5 * at.h, &mut ws.a)?;
-        sys.dl_dv(&ws.x, &ws.v, at.t + 0.5 * at.h, &mut ws.b)
+        sys.gradients(&ws.x, &ws.v, at.t + 0.5 * at.h, &mut ws.a, &mut ws.b)
     }
 }
 

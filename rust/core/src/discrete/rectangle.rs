@@ -30,8 +30,7 @@ impl DiscreteLagrangian for Rectangle {
     ) -> Result<(), ModelError> {
         let Segment { q0, t, h, .. } = at;
         ws.set(&at, 0.0);
-        sys.dl_dq(q0, &ws.v, t, &mut ws.a)?;
-        sys.dl_dv(q0, &ws.v, t, &mut ws.b)?;
+        sys.gradients(q0, &ws.v, t, &mut ws.a, &mut ws.b)?;
         combine(out, h, &ws.a, -1.0, &ws.b);
         Ok(())
     }

@@ -54,6 +54,14 @@ pub trait Lagrangian {
         central_gradient(|x| self.lagrangian(q, x, t), v, &mut work, out)
     }
 
+    /// Writes ∂L/∂q into `dq` and ∂L/∂q̇ into `dv`, both at (q, q̇, t): the discrete
+    /// Lagrangians need them together. Default: [`Lagrangian::dl_dq`] and
+    /// [`Lagrangian::dl_dv`] in turn; a model that computes them in one pass overrides it.
+    fn gradients(&self, q: &[f64], v: &[f64], t: f64, dq: &mut [f64], dv: &mut [f64]) -> Result<(), ModelError> {
+        self.dl_dq(q, v, t, dq)?;
+        self.dl_dv(q, v, t, dv)
+    }
+
     /// Writes the exact second derivatives of L at (q, q̇, t) into `out` and returns true, or
     /// returns false (the default) when the model does not supply them; the implicit
     /// integrators then difference their equations for Newton's Jacobian.
@@ -82,7 +90,8 @@ pub trait Lagrangian {
 
     /// Writes the velocity q̇ with ∂L/∂q̇(q, q̇, t) = p into `v`: the inverse Legendre
     /// transform, unique for a regular Lagrangian. Default: Newton's method from `v` as given,
-    /// with a difference Jacobian (exact in one step when L is quadratic in q̇), to round-off or
+    /// with the exact ∂²L/∂q̇² where [`Lagrangian::hessians`] supplies it and a difference
+    /// Jacobian otherwise (either exact in one step when L is quadratic in q̇), to round-off or
     /// to the noise floor of difference derivatives.
     fn velocity(&self, q: &[f64], p: &[f64], t: f64, v: &mut [f64]) -> Result<(), ModelError> {
         let n = v.len();
@@ -94,6 +103,7 @@ pub trait Lagrangian {
             v,
             plus: vec![0.0; n],
             minus: vec![0.0; n],
+            hessians: Some(Hessians::zeros(n)),
         };
         let rules = Rules {
             simplified: false,
@@ -172,6 +182,8 @@ struct InverseLegendre<'a, S: ?Sized> {
     v: &'a mut [f64],
     plus: Vec<f64>,
     minus: Vec<f64>,
+    /// Scratch for the exact Hessians; None once the model has said it has none.
+    hessians: Option<Hessians>,
 }
 
 impl<S: Lagrangian + ?Sized> NewtonProblem for InverseLegendre<'_, S> {
@@ -188,9 +200,17 @@ impl<S: Lagrangian + ?Sized> NewtonProblem for InverseLegendre<'_, S> {
         Ok(())
     }
 
-    /// ∂²L/∂q̇² by central differences of ∂L/∂q̇ (exact in one step when L is quadratic in q̇).
+    /// ∂²L/∂q̇², exact where the model supplies its Hessians, else by central differences of
+    /// ∂L/∂q̇ (exact in one step when L is quadratic in q̇).
     fn jacobian(&mut self, jac: &mut DMatrix<f64>) -> Result<(), StepError> {
         let (sys, q, t) = (self.sys, self.q, self.t);
+        if let Some(hessians) = &mut self.hessians {
+            if sys.hessians(q, self.v, t, hessians)? {
+                jac.copy_from(&hessians.vv);
+                return Ok(());
+            }
+            self.hessians = None;
+        }
         let at = Evaluations {
             plus: &mut self.plus,
             minus: &mut self.minus,

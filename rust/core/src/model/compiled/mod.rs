@@ -2,8 +2,63 @@
 //! constraints and their Jacobian) as instruction tapes derived symbolically, evaluated in the
 //! core with no call out per evaluation.
 //!
-//! - [`Tape`]: straight-line SSA code over the inputs (q, q̇, t) and the parameters;
+//! - [`Tape`]: straight-line SSA code over the input slots [q, q̇, t] and the parameters;
+//! - [`Function`]: one model function, a tape with its evaluator;
+//! - [`CompiledLagrangian`]: a general L(q, q̇, t) with exact derivatives and Hessians;
+//! - [`CompiledSeparable`]: L = ½q̇ᵀMq̇ − V(q) with constant M, for every method;
+//! - [`CompiledConstraints`]: g(q) = 0 with its exact Jacobian.
 
+mod constraints;
+mod function;
+mod lagrangian;
+mod separable;
 mod tape;
 
+pub use constraints::CompiledConstraints;
+pub use function::Function;
+pub use lagrangian::CompiledLagrangian;
+pub use separable::CompiledSeparable;
 pub use tape::{sign, Binary, Op, Tape, Unary};
+
+use crate::model::Constrained;
+use crate::Error;
+
+/// A compiled model of each kind the integrators know (see
+/// [`crate::integrators::ModelKind`]).
+#[derive(Clone, Debug)]
+pub enum CompiledModel {
+    Separable(CompiledSeparable),
+    Lagrangian(CompiledLagrangian),
+    ConstrainedSeparable(Constrained<CompiledSeparable, CompiledConstraints>),
+    ConstrainedLagrangian(Constrained<CompiledLagrangian, CompiledConstraints>),
+}
+
+impl CompiledModel {
+    /// The same model with another parameter vector (of the same length, finite); the tapes
+    /// and their code are shared.
+    pub fn with_parameters(&self, params: &[f64]) -> Result<Self, Error> {
+        let constrained = |c: &CompiledConstraints| c.with_parameters(params);
+        Ok(match self {
+            CompiledModel::Separable(s) => CompiledModel::Separable(s.with_parameters(params)?),
+            CompiledModel::Lagrangian(l) => CompiledModel::Lagrangian(l.with_parameters(params)?),
+            CompiledModel::ConstrainedSeparable(c) => CompiledModel::ConstrainedSeparable(Constrained {
+                system: c.system.with_parameters(params)?,
+                constraints: constrained(&c.constraints)?,
+            }),
+            CompiledModel::ConstrainedLagrangian(c) => CompiledModel::ConstrainedLagrangian(Constrained {
+                system: c.system.with_parameters(params)?,
+                constraints: constrained(&c.constraints)?,
+            }),
+        })
+    }
+
+    /// The parameter vector.
+    pub fn parameters(&self) -> &[f64] {
+        match self {
+            CompiledModel::Separable(s) => s.parameters(),
+            CompiledModel::Lagrangian(l) => l.parameters(),
+            CompiledModel::ConstrainedSeparable(c) => c.system.parameters(),
+            CompiledModel::ConstrainedLagrangian(c) => c.system.parameters(),
+        }
+    }
+}

@@ -260,6 +260,18 @@ impl Tape {
         self.params
     }
 
+    /// The highest input slot read, plus one (0 for a tape that reads none).
+    pub fn slots_read(&self) -> usize {
+        self.ops
+            .iter()
+            .map(|op| match *op {
+                Op::Input(s) => s as usize + 1,
+                _ => 0,
+            })
+            .max()
+            .unwrap_or(0)
+    }
+
     /// Runs the tape: registers in `regs` (at least as many as instructions), outputs into
     /// `out` (as many as outputs). `inputs` and `params` have the tape's lengths.
     pub fn eval(&self, inputs: &[f64], params: &[f64], regs: &mut [f64], out: &mut [f64]) {

@@ -1,0 +1,58 @@
+//! Compiled holonomic constraints g(q) = 0.
+
+use nalgebra::DMatrix;
+
+use super::function::{check, check_parameters, rows_into, Inputs};
+use super::Function;
+use crate::model::HolonomicConstraints;
+use crate::{Error, ModelError};
+
+/// g(q; parameters) (m entries) and its exact Jacobian G = ∂g/∂q (m × n, row-major) as
+/// [`Function`]s of q.
+#[derive(Clone, Debug)]
+pub struct CompiledConstraints {
+    m: usize,
+    params: Vec<f64>,
+    residual: Function,
+    jacobian: Function,
+}
+
+impl CompiledConstraints {
+    /// Refuses functions of the wrong shape, naming them.
+    pub fn new(m: usize, n: usize, params: Vec<f64>, residual: Function, jacobian: Function) -> Result<Self, Error> {
+        check("constraints", &residual, m, n, Inputs::Positions, &params)?;
+        check("constraint_jacobian", &jacobian, m * n, n, Inputs::Positions, &params)?;
+        Ok(CompiledConstraints {
+            m,
+            params,
+            residual,
+            jacobian,
+        })
+    }
+
+    /// The same functions with another parameter vector (of the same length, finite).
+    pub fn with_parameters(&self, params: &[f64]) -> Result<Self, Error> {
+        check_parameters(params, self.params.len())?;
+        Ok(CompiledConstraints {
+            params: params.to_vec(),
+            ..self.clone()
+        })
+    }
+}
+
+impl HolonomicConstraints for CompiledConstraints {
+    fn count(&self) -> usize {
+        self.m
+    }
+
+    fn residual(&self, q: &[f64], g: &mut [f64]) -> Result<(), ModelError> {
+        self.residual.eval(q, &[], 0.0, &self.params, g);
+        Ok(())
+    }
+
+    fn jacobian(&self, q: &[f64], jac: &mut DMatrix<f64>) -> Result<(), ModelError> {
+        self.jacobian
+            .eval_into(q, &[], 0.0, &self.params, |values| rows_into(values, jac));
+        Ok(())
+    }
+}

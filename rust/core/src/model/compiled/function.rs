@@ -1,0 +1,136 @@
+//! One model function: a tape, run by its machine code where it was compiled and by the
+//! interpreter otherwise.
+
+use std::cell::RefCell;
+use std::sync::Arc;
+
+use super::Tape;
+use crate::Error;
+
+/// A model function y = f(q, q̇, t; parameters) of a compiled model, its inputs in the slots
+/// [q, q̇, t]. Cloning shares the tape (and its code).
+#[derive(Clone, Debug)]
+pub struct Function {
+    tape: Arc<Tape>,
+}
+
+thread_local! {
+    /// The interpreter's registers and the input slots: grown on a thread's first evaluation
+    /// of the largest tape, then reused, so that evaluations allocate nothing.
+    static SCRATCH: RefCell<(Vec<f64>, Vec<f64>)> = const { RefCell::new((Vec::new(), Vec::new())) };
+    /// Outputs on their way to a caller's layout (matrices, split vectors).
+    static OUT: RefCell<Vec<f64>> = const { RefCell::new(Vec::new()) };
+}
+
+impl Function {
+    pub fn new(tape: Tape) -> Self {
+        Function { tape: Arc::new(tape) }
+    }
+
+    pub fn tape(&self) -> &Tape {
+        &self.tape
+    }
+
+    /// Number of outputs.
+    pub fn outputs(&self) -> usize {
+        self.tape.outputs().len()
+    }
+
+    /// f(q, q̇, t; params) into `out`; `v` may be empty for a function of q alone, whose slots
+    /// for q̇ and t it does not read.
+    pub fn eval(&self, q: &[f64], v: &[f64], t: f64, params: &[f64], out: &mut [f64]) {
+        SCRATCH.with(|scratch| {
+            let (slots, regs) = &mut *scratch.borrow_mut();
+            let n = q.len();
+            slots.resize(self.tape.inputs().max(2 * n + 1), 0.0);
+            slots[..n].copy_from_slice(q);
+            slots[n..n + v.len()].copy_from_slice(v);
+            slots[2 * n] = t;
+            if regs.len() < self.tape.ops().len() {
+                regs.resize(self.tape.ops().len(), 0.0);
+            }
+            self.tape.eval(slots, params, regs, out);
+        })
+    }
+
+    /// f(q, q̇, t; params), its outputs handed to `scatter` (which must not evaluate another
+    /// function through this method).
+    pub fn eval_into<R>(&self, q: &[f64], v: &[f64], t: f64, params: &[f64], scatter: impl FnOnce(&[f64]) -> R) -> R {
+        OUT.with(|out| {
+            let out = &mut *out.borrow_mut();
+            out.resize(self.outputs(), 0.0);
+            self.eval(q, v, t, params, out);
+            scatter(out)
+        })
+    }
+}
+
+/// Copies row-major `values` into the matrix `m`.
+pub fn rows_into(values: &[f64], m: &mut nalgebra::DMatrix<f64>) {
+    let cols = m.ncols();
+    for (i, row) in values.chunks_exact(cols).enumerate() {
+        for (j, x) in row.iter().enumerate() {
+            m[(i, j)] = *x;
+        }
+    }
+}
+
+/// What a function may read: all the slots [q, q̇, t], or q alone.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Inputs {
+    All,
+    Positions,
+}
+
+/// Refuses, naming the function, one with other than `outputs` outputs, slots other than
+/// [q, q̇, t] for n coordinates, reads beyond `inputs`, or other than the model's parameters
+/// (which must be finite).
+pub(super) fn check(
+    name: &'static str,
+    f: &Function,
+    outputs: usize,
+    n: usize,
+    inputs: Inputs,
+    params: &[f64],
+) -> Result<(), Error> {
+    let tape = f.tape();
+    if f.outputs() != outputs {
+        return Err(Error::invalid(
+            name,
+            format!("has {} outputs where {outputs} are needed for n = {n}", f.outputs()),
+        ));
+    }
+    if tape.inputs() != 2 * n + 1 || tape.params() != params.len() {
+        return Err(Error::invalid(
+            name,
+            format!(
+                "takes {} inputs and {} parameters where the model has {} ([q, q̇, t]) and {}",
+                tape.inputs(),
+                tape.params(),
+                2 * n + 1,
+                params.len()
+            ),
+        ));
+    }
+    if inputs == Inputs::Positions && tape.slots_read() > n {
+        return Err(Error::invalid(name, "must depend on the positions q alone"));
+    }
+    check_parameters(params, params.len())
+}
+
+/// Refuses a parameter vector of other than `count` values, or with one not finite.
+pub(super) fn check_parameters(params: &[f64], count: usize) -> Result<(), Error> {
+    if params.len() != count {
+        return Err(Error::invalid(
+            "parameters",
+            format!("has {} values where the model has {count} parameters", params.len()),
+        ));
+    }
+    if let Some(i) = params.iter().position(|x| !x.is_finite()) {
+        return Err(Error::invalid(
+            "parameters",
+            format!("value {i} is not finite: {}", params[i]),
+        ));
+    }
+    Ok(())
+}

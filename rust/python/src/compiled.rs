@@ -1,0 +1,210 @@
+//! Compiled models: the symbolic front end's tapes, evaluated in the core with the GIL
+//! released.
+
+use std::collections::HashMap;
+
+use numpy::{PyArray1, PyReadonlyArray1, PyReadonlyArray2, PyUntypedArrayMethods};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use varmech::integrators::{Dynamics, General};
+use varmech::model::compiled::{
+    CompiledConstraints, CompiledLagrangian, CompiledModel as Compiled, CompiledSeparable, Function, Tape,
+};
+use varmech::model::Constrained;
+
+use crate::convert::slice;
+use crate::errors::to_pyerr;
+use crate::generator::{self, Generator as Spec};
+
+/// One tape as the binding takes it: rows (code, a, b), constants, output registers.
+type Encoded<'py> = (
+    PyReadonlyArray2<'py, i64>,
+    PyReadonlyArray1<'py, f64>,
+    PyReadonlyArray1<'py, i64>,
+);
+
+/// A model whose functions are instruction tapes ([`varmech::model::compiled`]), made by
+/// `varmech.symbolic`; every evaluation runs in the core.
+#[pyclass(frozen, module = "varmech._core")]
+pub struct CompiledModel {
+    pub model: Compiled,
+}
+
+impl CompiledModel {
+    /// Runs `body` with the model as the core's [`Dynamics`].
+    pub fn with_integrable<R>(&self, body: impl FnOnce(&dyn Dynamics) -> R) -> R {
+        match &self.model {
+            Compiled::Separable(s) => body(s),
+            Compiled::Lagrangian(l) => body(&General(l)),
+            Compiled::ConstrainedSeparable(c) => body(c),
+            Compiled::ConstrainedLagrangian(c) => body(&Constrained {
+                system: General(&c.system),
+                constraints: c.constraints.clone(),
+            }),
+        }
+    }
+}
+
+/// The named function of `functions`, decoded for a model with n coordinates.
+fn function(
+    py: Python<'_>,
+    functions: &HashMap<String, Encoded<'_>>,
+    name: &'static str,
+    n: usize,
+    params: usize,
+) -> PyResult<Option<Function>> {
+    let Some((ops, constants, outputs)) = functions.get(name) else {
+        return Ok(None);
+    };
+    if ops.shape()[1] != 3 {
+        return Err(PyValueError::new_err(format!(
+            "{name}: ops must have shape (k, 3), got {:?}",
+            ops.shape()
+        )));
+    }
+    let flat = ops
+        .as_slice()
+        .map_err(|_| PyValueError::new_err(format!("{name}: ops must be a C-contiguous int64 array")))?;
+    let rows: Vec<[i64; 3]> = flat.chunks_exact(3).map(|r| [r[0], r[1], r[2]]).collect();
+    let outputs = outputs
+        .as_slice()
+        .map_err(|_| PyValueError::new_err(format!("{name}: outputs must be a contiguous int64 array")))?;
+    let tape =
+        Tape::decode(name, &rows, slice(name, constants)?, outputs, 2 * n + 1, params).map_err(|e| to_pyerr(py, e))?;
+    Ok(Some(Function::new(tape)))
+}
+
+fn required(name: &'static str, f: Option<Function>) -> PyResult<Function> {
+    f.ok_or_else(|| PyValueError::new_err(format!("functions: the model needs a {name:?} function")))
+}
+
+#[pymethods]
+impl CompiledModel {
+    #[new]
+    #[pyo3(signature = (kind, dim, functions, parameters, *, constraints=0, time_dependent=false, forced=false, symmetries=Vec::new(), jit=true))]
+    #[allow(clippy::too_many_arguments)]
+    fn new(
+        py: Python<'_>,
+        kind: &str,
+        dim: usize,
+        functions: HashMap<String, Encoded<'_>>,
+        parameters: PyReadonlyArray1<'_, f64>,
+        constraints: usize,
+        time_dependent: bool,
+        forced: bool,
+        symmetries: Vec<Spec>,
+        jit: bool,
+    ) -> PyResult<Self> {
+        let _ = jit;
+        generator::generators(py, symmetries, dim)?;
+        let params = slice("parameters", &parameters)?.to_vec();
+        let k = params.len();
+        let f = |name| function(py, &functions, name, dim, k);
+        let err = |e| to_pyerr(py, e);
+        let force = f("force")?;
+        if forced != force.is_some() {
+            return Err(PyValueError::new_err(
+                "forced: must be true exactly when a \"force\" function is given",
+            ));
+        }
+        let constraint_functions = match constraints {
+            0 => None,
+            m => Some(
+                CompiledConstraints::new(
+                    m,
+                    dim,
+                    params.clone(),
+                    required("constraints", f("constraints")?)?,
+                    required("constraint_jacobian", f("constraint_jacobian")?)?,
+                )
+                .map_err(err)?,
+            ),
+        };
+        let model = match kind {
+            "separable" => {
+                if time_dependent || forced {
+                    return Err(PyValueError::new_err(
+                        "kind: a separable model depends neither on t nor on a force",
+                    ));
+                }
+                let s = CompiledSeparable::new(
+                    dim,
+                    params,
+                    required("potential", f("potential")?)?,
+                    required("gradient", f("gradient")?)?,
+                    required("mass", f("mass")?)?,
+                )
+                .map_err(err)?;
+                match constraint_functions {
+                    None => Compiled::Separable(s),
+                    Some(c) => Compiled::ConstrainedSeparable(Constrained {
+                        system: s,
+                        constraints: c,
+                    }),
+                }
+            }
+            "lagrangian" => {
+                let l = CompiledLagrangian::new(
+                    dim,
+                    params,
+                    required("lagrangian", f("lagrangian")?)?,
+                    required("gradients", f("gradients")?)?,
+                    required("hessians", f("hessians")?)?,
+                    force,
+                    time_dependent,
+                )
+                .map_err(err)?;
+                match constraint_functions {
+                    None => Compiled::Lagrangian(l),
+                    Some(c) => Compiled::ConstrainedLagrangian(Constrained {
+                        system: l,
+                        constraints: c,
+                    }),
+                }
+            }
+            other => {
+                return Err(PyValueError::new_err(format!(
+                    "kind: must be \"separable\" or \"lagrangian\", got {other:?}"
+                )));
+            }
+        };
+        Ok(CompiledModel { model })
+    }
+
+    #[getter]
+    pub fn dim(&self) -> usize {
+        self.with_integrable(|sys| sys.dim())
+    }
+
+    /// The parameter vector.
+    #[getter]
+    fn parameters<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        PyArray1::from_slice(py, self.model.parameters())
+    }
+
+    /// Whether the tapes run as machine code (else the interpreter runs them).
+    #[getter]
+    fn jit(&self) -> bool {
+        false
+    }
+
+    /// The same model with another parameter vector; the tapes are shared.
+    fn with_parameters(&self, py: Python<'_>, values: PyReadonlyArray1<'_, f64>) -> PyResult<Self> {
+        let model = self
+            .model
+            .with_parameters(slice("values", &values)?)
+            .map_err(|e| to_pyerr(py, e))?;
+        Ok(CompiledModel { model })
+    }
+
+    fn __repr__(&self) -> String {
+        format!("CompiledModel(dim={})", self.dim())
+    }
+}
+
+/// The names of the tape's ops by code.
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<CompiledModel>()?;
+    m.add("TAPE_OPS", Tape::OPS.to_vec())?;
+    Ok(())
+}
