@@ -150,8 +150,10 @@ def mechanical(
     started = time.perf_counter()
     variables_ = variables(q, v, t)
     m = _mass_matrix(mass, variables_)
+    potential = variables_.plain(V, "V")
+    check_compilable(potential, "V")
     velocity = sp.Matrix(variables_.v)
-    L = (velocity.T * m * velocity)[0, 0] / 2 - variables_.plain(V, "V")
+    L = (velocity.T * m * velocity)[0, 0] / 2 - potential
     return _build(variables_, L, parameters, constraints, force, rayleigh, symmetries, jit, name, started)
 
 
@@ -160,11 +162,15 @@ def _mass_matrix(mass: Any, variables: Variables) -> sp.Matrix:
     a scalar or a symmetric n×n matrix."""
     n = len(variables.q)
     if not isinstance(mass, (sp.MatrixBase, list, tuple)):
-        return variables.plain(mass, "mass") * sp.eye(n)
+        scalar = variables.plain(mass, "mass")
+        check_compilable(scalar, "mass")
+        return scalar * sp.eye(n)
     m = sp.Matrix(mass)
     if m.shape != (n, n):
         raise ValueError(f"mass: must be a scalar or a {n}×{n} matrix, got shape {m.shape}")
     m = m.applyfunc(lambda x: variables.plain(x, "mass"))
+    for x in m:
+        check_compilable(x, "mass")
     if not all(vanishes(m[i, j] - m[j, i]) for i in range(n) for j in range(i)):
         raise ValueError(f"mass: must be symmetric, got {m.tolist()}")
     return m

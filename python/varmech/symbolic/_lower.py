@@ -138,7 +138,7 @@ class _Builder:
     def _add(self, expr: sp.Expr) -> int:
         """A sum as a chain of add and sub, left to right: terms with a negative coefficient
         are subtracted, and a numeric term comes last (x − 1, not −1 + x)."""
-        terms = sorted(expr.args, key=lambda term: (term.is_Number, _negative(term)))
+        terms = sorted(expr.args, key=lambda term: (bool(term.is_number), _negative(term)))
         total = None
         for term in terms:
             negative = _negative(term)
