@@ -4,7 +4,6 @@ their default values."""
 
 from __future__ import annotations
 
-import math
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 from typing import Any
@@ -12,6 +11,8 @@ from typing import Any
 import numpy as np
 import sympy as sp
 from sympy.core.function import AppliedUndef
+
+from .._util import finite
 
 
 @dataclass(frozen=True)
@@ -131,17 +132,6 @@ class Parameters:
     index: dict[sp.Symbol, int]
 
 
-def finite_value(name: str, value: Any) -> float:
-    """``value`` as a finite float; ValueError naming the parameter ``name`` otherwise."""
-    try:
-        x = float(value)
-    except (TypeError, ValueError):
-        raise ValueError(f"parameters: {name} must be a real number, got {value!r}") from None
-    if not math.isfinite(x):
-        raise ValueError(f"parameters: {name} must be finite, got {x}")
-    return x
-
-
 def parameters(given: Mapping[Any, Any] | None, symbols: Iterable[sp.Symbol], variables: Variables) -> Parameters:
     """The parameters ``given`` as {symbol or name: default value}, in their order. A name
     stands for every symbol of that name among ``symbols`` (the free symbols of the model's
@@ -167,7 +157,7 @@ def parameters(given: Mapping[Any, Any] | None, symbols: Iterable[sp.Symbol], va
             raise ValueError(f"parameters: {name} is given twice")
         if taken.intersection(stands_for):
             raise ValueError(f"parameters: {name} is a coordinate, a velocity or t, not a parameter")
-        values.append(finite_value(name, value))
+        values.append(finite(f"parameters: {name}", value))
         index.update(dict.fromkeys(stands_for, len(names)))
         names.append(name)
     return Parameters(tuple(names), np.array(values, dtype=np.float64), index)

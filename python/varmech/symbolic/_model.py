@@ -11,8 +11,8 @@ import numpy as np
 import sympy as sp
 
 from .. import _core
+from .._util import finite
 from ..model import Model, Symmetry, _specs
-from ._inputs import finite_value
 from ._lower import Tape
 
 
@@ -147,7 +147,7 @@ class SymbolicModel(Model):
             known = ", ".join(names) if names else "none"
             raise ValueError(f"parameters: {', '.join(unknown)} not a parameter of {self.name} (it has {known})")
         current = self.parameters
-        current.update({name: finite_value(name, x) for name, x in values.items()})
+        current.update({name: finite(f"parameters: {name}", x) for name, x in values.items()})
         vector = np.array([current[name] for name in names], dtype=np.float64)
         spec = replace(self._spec, parameters=vector)
         return SymbolicModel(spec, self._symbolic, core=self._core.with_parameters(vector), started=started)
