@@ -277,6 +277,16 @@ def test_rayleigh_damped_driven_oscillator_has_a_force():
     check_tapes(model, points(1))
 
 
+def test_abs_differentiates_to_sign():
+    """A V-shaped well V = k|x|: ∇V = k sign x (over real symbols, not an expression in re x)."""
+    x, v, k = sp.symbols("x v k")
+    model = symbolic.lagrangian(v**2 / 2 - k * sp.Abs(x), [x], [v], parameters={k: 2.0})
+    assert model.kind_name == "separable"
+    assert model.expressions["gradient"] == (k * sp.sign(x),)
+    assert model.q == (x,) and model.expressions["potential"][0].free_symbols == {x, k}
+    check_tapes(model, points(1))
+
+
 def test_cyclic_coordinates_need_no_force_on_them():
     x, y, vx, vy = sp.symbols("x y vx vy")
     L = (vx**2 + vy**2) / 2 - y**2

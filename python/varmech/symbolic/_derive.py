@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import random
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import sympy as sp
 
@@ -77,6 +77,43 @@ def derive(
     >>> kepler.functions["gradients"]
     (r*v_theta**2 - 1/r**2, 0, v_r, r**2*v_theta)
     """
+    # Derived over real symbols (the state and the parameters are real), so that |x|' = sign x
+    # rather than an expression in re(x) and im(x); the results are in the caller's symbols.
+    given = [L, *(force or ()), *(() if rayleigh is None else (rayleigh,)), *(constraints or ())]
+    symbols = {s for e in given for s in e.free_symbols} | {*q, *v, t}
+    real = {s: _real_twin(s, symbols) for s in symbols if not s.is_real}
+    derivation = _derive(
+        L.xreplace(real),
+        [real.get(s, s) for s in q],
+        [real.get(s, s) for s in v],
+        real.get(t, t),
+        force=None if force is None else [e.xreplace(real) for e in force],
+        rayleigh=None if rayleigh is None else rayleigh.xreplace(real),
+        constraints=None if constraints is None else [e.xreplace(real) for e in constraints],
+    )
+    back = {r: s for s, r in real.items()}
+    functions = {name: tuple(e.xreplace(back) for e in exprs) for name, exprs in derivation.functions.items()}
+    return replace(derivation, functions=functions)
+
+
+def _real_twin(s: sp.Symbol, taken: set[sp.Symbol]) -> sp.Symbol:
+    """A real symbol of the same name (printed alike in messages), or a real Dummy when the
+    expressions already hold that one."""
+    twin = sp.Symbol(s.name, real=True)
+    return twin if twin not in taken else sp.Dummy(s.name, real=True)
+
+
+def _derive(
+    L: sp.Expr,
+    q: Sequence[sp.Symbol],
+    v: Sequence[sp.Symbol],
+    t: sp.Symbol,
+    *,
+    force: Sequence[sp.Expr] | None,
+    rayleigh: sp.Expr | None,
+    constraints: Sequence[sp.Expr] | None,
+) -> Derivation:
+    """:func:`derive` over real symbols."""
     n = len(q)
     dl_dq = [sp.diff(L, s) for s in q]
     dl_dv = [sp.diff(L, s) for s in v]
