@@ -20,6 +20,9 @@ The measurements (work–precision, energy growth, stability, sections) live in
 :mod:`varmech.analysis` and are re-exported here; :mod:`varmech.charts` draws them.
 """
 
+import importlib
+from types import ModuleType
+
 from . import _errors, analysis, scenes
 from ._core import ConvergenceError, DivergenceError, SpuriousBranchError, VarmechError
 from .analysis import sections, stability
@@ -93,3 +96,10 @@ __all__ = [
 ]
 
 _errors.install()
+
+
+def __getattr__(name: str) -> ModuleType:
+    # varmech.symbolic imports SymPy (an optional extra), so it is imported on first use.
+    if name == "symbolic":
+        return importlib.import_module(".symbolic", __name__)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

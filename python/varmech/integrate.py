@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, Literal
 
@@ -194,6 +195,7 @@ def integrate(
     t0: float = 0.0,
     newton_tolerance: float = 1e-14,
     newton_max_iterations: int = 50,
+    parameters: Mapping[Any, float] | None = None,
 ) -> Trajectory:
     """Integrate ``model`` from (q0, p0) with a fixed step.
 
@@ -233,6 +235,11 @@ def integrate(
         The implicit methods' Newton iteration stops when its correction is below
         ``newton_tolerance``·‖δq‖∞ (δq the step's increment) or stalls at round-off, and fails
         with :class:`~varmech.ConvergenceError` after ``newton_max_iterations`` iterations.
+    parameters:
+        For a symbolic model (:mod:`varmech.symbolic`), parameter values by name (or symbol)
+        for this run:
+        the model of ``model.with_parameters(**parameters)`` is integrated, with the same
+        compiled code. Other models have none (TypeError naming ``parameters``).
 
     Raises
     ------
@@ -253,6 +260,11 @@ def integrate(
         ``err.partial``, ``err.step`` and ``err.time`` attached where the exception allows.
     """
     model, q0, p0 = _model_of(model, q0, p0, v0)
+    if parameters is not None:
+        if not isinstance(parameters, Mapping):
+            raise TypeError(f"parameters: expected a dict {{name: value}}, got {type(parameters).__name__}")
+        # Keys may be the model's SymPy symbols, whose str is the name.
+        model = model.with_parameters(**{str(name): value for name, value in parameters.items()})
     if method is None:
         method = model.kind.default_method
     dt = positive("dt", dt)

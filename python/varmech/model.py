@@ -154,6 +154,15 @@ class Model:
         t1 = np.ascontiguousarray(np.broadcast_to(np.asarray(t, dtype=float), rows.shape[:1]))
         return _core.derivative(self._core, what, t1, q2, rows).reshape(x.shape)
 
+    def with_parameters(self, **values: float) -> Model:
+        """The model with its parameters set by name; only symbolic models
+        (:mod:`varmech.symbolic`) have parameters to set, so this is a TypeError naming
+        ``parameters`` for every other model."""
+        raise TypeError(
+            f"parameters: {self.name} has no parameters to set ({', '.join(values)} given); "
+            "only symbolic models (varmech.symbolic) take them"
+        )
+
     def __repr__(self) -> str:
         return f"{type(self).__name__}({self.name!r}, dim={self.dim})"
 

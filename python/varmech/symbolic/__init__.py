@@ -1,0 +1,223 @@
+"""Models from SymPy: write the Lagrangian, get every derivative, run at native speed.
+
+The user gives L(q, q̇, t) (or the mechanical form: a mass matrix M and a potential V), and
+varmech derives what the integrators need (∂L/∂q, ∂L/∂q̇ and the three Hessians; or ∇V and M
+for L = ½q̇ᵀMq̇ − V(q) with M constant), the generalized force of ``force`` and ``rayleigh`` and
+the Jacobian of the constraints, finds the cyclic coordinates, and lowers every function to an
+instruction tape that the Rust core runs with no Python call per step::
+
+    import sympy as sp
+    import varmech
+
+    q1, q2, v1, v2 = sp.symbols("q1 q2 v1 v2")
+    m1, m2, l1, l2, g = sp.symbols("m1 m2 l1 l2 g", positive=True)
+    L = (sp.Rational(1, 2) * (m1 + m2) * l1**2 * v1**2 + sp.Rational(1, 2) * m2 * l2**2 * v2**2
+         + m2 * l1 * l2 * v1 * v2 * sp.cos(q1 - q2) + (m1 + m2) * g * l1 * sp.cos(q1) + m2 * g * l2 * sp.cos(q2))
+    model = varmech.symbolic.lagrangian(L, q=[q1, q2], v=[v1, v2],
+                                        parameters={m1: 1.0, m2: 2.0, l1: 2.0, l2: 3.0, g: 9.80665})
+    traj = varmech.integrate(model, [0.5, 1.0], [0.0, 0.0], dt=0.01, steps=1000, method="midpoint")
+
+Needs SymPy: ``pip install varmech[symbolic]``.
+"""
+
+from __future__ import annotations
+
+try:
+    import sympy as sp
+except ImportError as err:  # pragma: no cover - exercised without SymPy only
+    raise ImportError("varmech.symbolic needs SymPy: pip install varmech[symbolic]") from err
+
+import time
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+from ..model import Cyclic, Symmetry
+from ._derive import derive, vanishes
+from ._inputs import Variables, check_symbols, expressions, parameters, variables
+from ._lower import TAPE_OPS, check_compilable, lower
+from ._model import Spec, Symbolic, SymbolicModel
+
+__all__ = ["TAPE_OPS", "SymbolicModel", "lagrangian", "mechanical"]
+
+
+def lagrangian(
+    L: Any,
+    q: Any,
+    v: Any = None,
+    *,
+    t: Any = None,
+    parameters: Mapping[Any, float] | None = None,
+    constraints: Any = None,
+    force: Any = None,
+    rayleigh: Any = None,
+    symmetries: Sequence[Symmetry] = (),
+    jit: bool = True,
+    name: str = "symbolic lagrangian",
+) -> SymbolicModel:
+    """A compiled model of the Lagrangian ``L``.
+
+    Parameters
+    ----------
+    L:
+        L(q, q̇, t), a scalar SymPy expression.
+    q:
+        The coordinates: SymPy symbols, or ``sympy.physics.mechanics.dynamicsymbols`` (then
+        ``L`` may hold q.diff(t), and ``v`` may be omitted: fresh symbols ``<name>_dot`` stand
+        for the velocities).
+    v:
+        The velocity symbols q̇, one per coordinate.
+    t:
+        The time symbol, if ``L``, the force or the Rayleigh function depend on t (default: the
+        dynamicsymbols' time, else none).
+    parameters:
+        ``{symbol or name: default value}``: the symbols that are neither coordinates,
+        velocities nor t, in the order of the parameter vector. Change them per run with
+        :meth:`SymbolicModel.with_parameters` or ``integrate(..., parameters={...})``.
+    constraints:
+        Holonomic constraints g(q) = 0: a list of m < n expressions of q alone; their Jacobian
+        G = ∂g/∂q is derived.
+    force:
+        A generalized force Q(q, q̇, t), one expression per coordinate (friction, driving).
+    rayleigh:
+        A Rayleigh dissipation function R(q, q̇), which adds the force −∂R/∂q̇.
+    symmetries:
+        Declared symmetries (:class:`~varmech.Translation`, :class:`~varmech.Rotation`,
+        :class:`~varmech.Cyclic`); each cyclic coordinate found is added as a
+        :class:`~varmech.Cyclic`.
+    jit:
+        Compile the tapes to machine code (the interpreter runs them otherwise).
+    name:
+        A label for reports.
+
+    Raises
+    ------
+    TypeError
+        ``L`` is not a scalar expression (a Matrix, a list), or ``q``, ``v`` are not symbols.
+    ValueError
+        An expression that cannot be compiled (an unsupported function such as an undefined
+        ``sympy.Function('f')``, or a symbol that is neither a coordinate, a velocity, t nor a
+        parameter), naming it and why; constraints of the wrong number or depending on q̇ or t;
+        a force with the wrong number of components.
+
+    Examples
+    --------
+    >>> import sympy as sp
+    >>> import varmech.symbolic
+    >>> th, om, g = sp.symbols("theta omega g")
+    >>> model = varmech.symbolic.lagrangian(om**2 / 2 + g * sp.cos(th), [th], [om],
+    ...                                     parameters={g: 9.81})  # doctest: +SKIP
+    >>> model.kind_name, model.parameters  # doctest: +SKIP
+    ('separable', {'g': 9.81})
+    """
+    started = time.perf_counter()
+    variables_ = variables(q, v, t)
+    return _build(
+        variables_, variables_.plain(L, "L"), parameters, constraints, force, rayleigh, symmetries, jit, name, started
+    )
+
+
+def mechanical(
+    V: Any,
+    q: Any,
+    mass: Any,
+    *,
+    v: Any = None,
+    t: Any = None,
+    parameters: Mapping[Any, float] | None = None,
+    constraints: Any = None,
+    force: Any = None,
+    rayleigh: Any = None,
+    symmetries: Sequence[Symmetry] = (),
+    jit: bool = True,
+    name: str = "symbolic mechanical system",
+) -> SymbolicModel:
+    """A compiled model of the mechanical system L = ½q̇ᵀM(q)q̇ − V(q, t).
+
+    ``mass`` is M: a symmetric n×n SymPy Matrix or nested list, or a scalar m for M = m·I; it
+    may depend on q (then the model is a general Lagrangian, for the implicit methods). With M
+    constant, the model is separable and every method applies. The other arguments are those
+    of :func:`lagrangian`; ValueError names ``mass`` of the wrong shape or not symmetric.
+
+    Examples
+    --------
+    >>> import sympy as sp
+    >>> import varmech.symbolic
+    >>> x, y = sp.symbols("x y")
+    >>> kepler = varmech.symbolic.mechanical(-1 / sp.sqrt(x**2 + y**2), [x, y], 1)  # doctest: +SKIP
+    >>> kepler.kind_name, kepler.expressions["mass"]  # doctest: +SKIP
+    ('separable', (1,))
+    """
+    started = time.perf_counter()
+    variables_ = variables(q, v, t)
+    m = _mass_matrix(mass, variables_)
+    potential = variables_.plain(V, "V")
+    check_compilable(potential, "V")
+    velocity = sp.Matrix(variables_.v)
+    L = (velocity.T * m * velocity)[0, 0] / 2 - potential
+    return _build(variables_, L, parameters, constraints, force, rayleigh, symmetries, jit, name, started)
+
+
+def _mass_matrix(mass: Any, variables: Variables) -> sp.Matrix:
+    """M as an n×n SymPy Matrix in the plain symbols; ValueError naming ``mass`` unless it is
+    a scalar or a symmetric n×n matrix."""
+    n = len(variables.q)
+    if not isinstance(mass, (sp.MatrixBase, list, tuple)):
+        scalar = variables.plain(mass, "mass")
+        check_compilable(scalar, "mass")
+        return scalar * sp.eye(n)
+    m = sp.Matrix(mass)
+    if m.shape != (n, n):
+        raise ValueError(f"mass: must be a scalar or a {n}×{n} matrix, got shape {m.shape}")
+    m = m.applyfunc(lambda x: variables.plain(x, "mass"))
+    for x in m:
+        check_compilable(x, "mass")
+    if not all(vanishes(m[i, j] - m[j, i]) for i in range(n) for j in range(i)):
+        raise ValueError(f"mass: must be symmetric, got {m.tolist()}")
+    return m
+
+
+def _build(
+    variables: Variables,
+    L: sp.Expr,
+    given_parameters: Mapping[Any, float] | None,
+    constraints: Any,
+    force: Any,
+    rayleigh: Any,
+    symmetries: Sequence[Symmetry],
+    jit: bool,
+    name: str,
+    started: float,
+) -> SymbolicModel:
+    """Checks, derives, lowers and compiles: the common path of :func:`lagrangian` and
+    :func:`mechanical`."""
+    forces = expressions(force, "force", variables) if force is not None else None
+    dissipation = variables.plain(rayleigh, "rayleigh") if rayleigh is not None else None
+    holonomic = expressions(constraints, "constraints", variables) if constraints is not None else None
+    parts = [("L", L)] + [(f"force[{i}]", x) for i, x in enumerate(forces or [])]
+    parts += [("rayleigh", dissipation)] if dissipation is not None else []
+    parts += [(f"constraints[{i}]", x) for i, x in enumerate(holonomic or [])]
+    params = parameters(given_parameters, {s for _, x in parts for s in x.free_symbols}, variables)
+    for what, x in parts:
+        check_compilable(x, what)
+        check_symbols(x, what, variables, params.index)
+    derivation = derive(
+        L, variables.q, variables.v, variables.t, force=forces, rayleigh=dissipation, constraints=holonomic
+    )
+    slots = variables.slots
+    tapes = {fn: lower(exprs, slots, params.index) for fn, exprs in derivation.functions.items()}
+    declared = tuple(symmetries)
+    found = tuple(Cyclic(i) for i in derivation.cyclic if Cyclic(i) not in declared)
+    spec = Spec(
+        kind=derivation.kind,
+        dim=len(variables.q),
+        functions=tapes,
+        parameter_names=params.names,
+        parameters=params.values,
+        constraints=len(derivation.functions.get("constraints", ())),
+        time_dependent=derivation.time_dependent,
+        forced="force" in derivation.functions,
+        symmetries=declared + found,
+        jit=bool(jit),
+    )
+    symbolic = Symbolic(variables.q, variables.v, variables.t, L, derivation.functions, derivation.cyclic, name)
+    return SymbolicModel(spec, symbolic, started=started)

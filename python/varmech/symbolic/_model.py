@@ -1,0 +1,157 @@
+"""The compiled symbolic model: its tapes and metadata (what crosses into the core once), and
+the SymPy expressions they came from."""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, replace
+from typing import Any
+
+import numpy as np
+import sympy as sp
+
+from .. import _core
+from .._util import finite
+from ..model import Model, Symmetry, _specs
+from ._lower import Tape
+
+
+@dataclass(frozen=True)
+class Spec:
+    """Everything the core's compiled model is built from: the kind (``"lagrangian"`` or
+    ``"separable"``), n, the tape of each function by name, the parameters in order with their
+    values, the number of constraints, the flags and the symmetries."""
+
+    kind: str
+    dim: int
+    functions: dict[str, Tape]
+    parameter_names: tuple[str, ...]
+    parameters: np.ndarray
+    constraints: int
+    time_dependent: bool
+    forced: bool
+    symmetries: tuple[Symmetry, ...]
+    jit: bool
+
+
+@dataclass(frozen=True)
+class Symbolic:
+    """The symbolic side of a model: its symbols, L, the expressions of each function and the
+    cyclic coordinates found."""
+
+    q: tuple[sp.Symbol, ...]
+    v: tuple[sp.Symbol, ...]
+    t: sp.Symbol
+    L: sp.Expr
+    expressions: dict[str, tuple[sp.Expr, ...]]
+    cyclic: tuple[int, ...]
+    name: str
+
+
+def _compile(spec: Spec) -> Any:
+    """The core's compiled model of ``spec``: the one place that calls the binding."""
+    return _core.CompiledModel(  # type: ignore[attr-defined]
+        spec.kind,
+        spec.dim,
+        dict(spec.functions),
+        spec.parameters,
+        constraints=spec.constraints,
+        time_dependent=spec.time_dependent,
+        forced=spec.forced,
+        symmetries=_specs(spec.symmetries),
+        jit=spec.jit,
+    )
+
+
+class SymbolicModel(Model):
+    """A model compiled from SymPy expressions (see :func:`varmech.symbolic.lagrangian`): its
+    functions run as instruction tapes (or machine code) in the core, with no Python call per
+    step.
+
+    Attributes
+    ----------
+    q, v, t:
+        The coordinates, velocities and time as SymPy symbols.
+    L:
+        The Lagrangian L(q, v, t).
+    expressions:
+        The derived expressions of each compiled function by name (outputs row-major):
+        ``lagrangian``, ``gradients`` (∂L/∂q, ∂L/∂q̇), ``hessians`` (∂²L/∂q², ∂²L/∂q∂q̇,
+        ∂²L/∂q̇²) and ``force`` for a general Lagrangian; ``potential``, ``gradient`` (∇V) and
+        ``mass`` (1, n or n² entries) for a separable one; ``constraints`` and
+        ``constraint_jacobian`` with constraints.
+    kind_name:
+        ``"lagrangian"`` or ``"separable"``.
+    cyclic:
+        The coordinates found cyclic (∂L/∂qᵢ ≡ 0, no force on or depending on qᵢ), declared as
+        :class:`~varmech.Cyclic` symmetries.
+    build_seconds:
+        Wall time from the expressions to the ready model.
+    """
+
+    # The core's CompiledModel (typed once the binding's stub has it).
+    _core: Any
+
+    def __init__(self, spec: Spec, symbolic: Symbolic, *, core: Any = None, started: float | None = None):
+        start = time.perf_counter() if started is None else started
+        self._spec = spec
+        self._symbolic = symbolic
+        self._core = _compile(spec) if core is None else core
+        self.symmetries = spec.symmetries
+        self.name = symbolic.name
+        self.build_seconds = time.perf_counter() - start
+
+    @property
+    def q(self) -> tuple[sp.Symbol, ...]:
+        return self._symbolic.q
+
+    @property
+    def v(self) -> tuple[sp.Symbol, ...]:
+        return self._symbolic.v
+
+    @property
+    def t(self) -> sp.Symbol:
+        return self._symbolic.t
+
+    @property
+    def L(self) -> sp.Expr:
+        return self._symbolic.L
+
+    @property
+    def expressions(self) -> dict[str, tuple[sp.Expr, ...]]:
+        return dict(self._symbolic.expressions)
+
+    @property
+    def cyclic(self) -> tuple[int, ...]:
+        return self._symbolic.cyclic
+
+    @property
+    def kind_name(self) -> str:
+        return self._spec.kind
+
+    @property
+    def parameters(self) -> dict[str, float]:
+        """The parameters by name with their values, in the order of the parameter vector."""
+        return {name: float(x) for name, x in zip(self._spec.parameter_names, self._spec.parameters)}
+
+    def with_parameters(self, **values: float) -> SymbolicModel:
+        """The same model (the same derived expressions, tapes and compiled code) with the
+        parameters named by keyword set to new values and the others kept.
+
+        ValueError names an unknown parameter or a value that is not finite.
+        """
+        started = time.perf_counter()
+        names = self._spec.parameter_names
+        unknown = [name for name in values if name not in names]
+        if unknown:
+            known = ", ".join(names) if names else "none"
+            raise ValueError(f"parameters: {', '.join(unknown)} not a parameter of {self.name} (it has {known})")
+        current = self.parameters
+        current.update({name: finite(f"parameters: {name}", x) for name, x in values.items()})
+        vector = np.array([current[name] for name in names], dtype=np.float64)
+        spec = replace(self._spec, parameters=vector)
+        return SymbolicModel(spec, self._symbolic, core=self._core.with_parameters(vector), started=started)
+
+    def __reduce__(self) -> tuple[Any, ...]:
+        # The tapes and expressions, never the compiled code: unpickling compiles them again.
+        return (SymbolicModel, (self._spec, self._symbolic))

@@ -1,0 +1,128 @@
+"""Symbolic models run by the core: each twin of a native scene reproduces its trajectory with
+the same Newton iterations; parameters, pickling, invariants and the regularity check behave
+as for native models. Needs the binding's CompiledModel."""
+
+import pickle
+
+import numpy as np
+import pytest
+
+sp = pytest.importorskip("sympy")
+_core = pytest.importorskip("varmech._core")
+if not hasattr(_core, "CompiledModel"):
+    pytest.skip("the binding has no CompiledModel", allow_module_level=True)
+
+import varmech  # noqa: E402
+import varmech.symbolic as symbolic  # noqa: E402
+from symbolic_twins import DOUBLE_PENDULUM_PARAMETERS, L2, TWINS, cartesian_pendulum, double_pendulum, heavy_top  # noqa: E402
+from varmech import scenes  # noqa: E402
+
+STEPS = 1000
+
+
+def test_tape_operations_are_the_cores():
+    assert tuple(_core.TAPE_OPS) == symbolic.TAPE_OPS
+
+
+# ------------------------------------------------------------------ twins of the native scenes
+
+
+@pytest.mark.parametrize(
+    "name, method",
+    [
+        ("double_pendulum", "midpoint"),
+        ("double_pendulum", "galerkin4"),
+        ("kepler", "verlet"),
+        ("kepler", "kahan_li8"),
+        ("heavy_top", "midpoint"),
+        ("cartesian_pendulum", "rattle"),
+        ("damped_driven_pendulum", "midpoint"),
+    ],
+)
+def test_twin_reproduces_the_native_scene(name, method):
+    scene = scenes.get(name)
+    twin = TWINS[name]()
+    assert twin.kind.name == scene.model.kind.name
+    assert (twin.time_dependent, twin.forced, twin.constraints) == (
+        scene.model.time_dependent,
+        scene.model.forced,
+        scene.model.constraints,
+    )
+    assert twin.symmetries == scene.model.symmetries
+    native = varmech.integrate(scene, dt=scene.dt, steps=STEPS, method=method)
+    compiled = varmech.integrate(twin, scene.q0, scene.p0, dt=scene.dt, steps=STEPS, method=method)
+    assert compiled.nfev == native.nfev
+    if native.newton is not None:
+        np.testing.assert_array_equal(compiled.newton, native.newton)
+    for a, b in [(native.q, compiled.q), (native.p, compiled.p)]:
+        assert np.max(np.abs(a - b)) <= 1e-12 * np.max(np.abs(a))
+    if native.work is not None:
+        np.testing.assert_allclose(compiled.work, native.work, rtol=1e-12, atol=1e-12 * np.max(np.abs(native.work)))
+
+
+def test_heavy_top_momenta_are_conserved_to_round_off():
+    scene = scenes.heavy_top()
+    twin = heavy_top()
+    assert twin.cyclic == (1, 2)
+    traj = varmech.integrate(twin, scene.q0, scene.p0, dt=scene.dt, steps=STEPS, method="midpoint")
+    for k in (1, 2):
+        assert np.max(np.abs(traj.p[:, k] - traj.p[0, k])) <= 1e-13 * abs(traj.p[0, k])
+    report = varmech.check_conservation(traj)
+    assert [m.name for m in report.momenta] == ["p[1]", "p[2]"]
+    assert all(m.max_rel_error <= 1e-13 for m in report.momenta), report
+
+
+def test_cartesian_pendulum_stays_on_its_constraint():
+    scene = scenes.cartesian_pendulum()
+    traj = varmech.integrate(cartesian_pendulum(), scene.q0, scene.p0, dt=scene.dt, steps=STEPS, method="rattle")
+    position, velocity = traj.constraint_residuals()
+    assert np.max(position) <= 1e-14 and np.max(velocity) <= 1e-14
+
+
+# ------------------------------------------------------------------ parameters and pickling
+
+SCENE = scenes.double_pendulum()
+
+
+def run(model, **kwargs):
+    return varmech.integrate(model, SCENE.q0, SCENE.p0, dt=SCENE.dt, steps=STEPS, method="midpoint", **kwargs)
+
+
+def test_with_parameters_equals_a_model_built_with_those_defaults_bit_for_bit():
+    built = run(double_pendulum(DOUBLE_PENDULUM_PARAMETERS | {L2: 2.0}))
+    changed = double_pendulum().with_parameters(l2=2.0)
+    assert changed.parameters["l2"] == 2.0
+    for traj in (
+        run(changed),
+        run(double_pendulum(), parameters={"l2": 2.0}),
+        run(double_pendulum(), parameters={L2: 2.0}),
+    ):
+        np.testing.assert_array_equal(traj.q, built.q)
+        np.testing.assert_array_equal(traj.p, built.p)
+        np.testing.assert_array_equal(traj.newton, built.newton)
+    # The default model is untouched: a different run.
+    assert not np.array_equal(run(double_pendulum()).q, built.q)
+
+
+def test_interpreter_and_machine_code_agree_bit_for_bit():
+    jit, interpreted = double_pendulum(), double_pendulum(jit=False)
+    assert not interpreted._core.jit
+    a, b = run(jit), run(interpreted)
+    np.testing.assert_array_equal(a.q, b.q)
+    np.testing.assert_array_equal(a.p, b.p)
+
+
+def test_pickled_model_gives_the_same_trajectory_bit_for_bit():
+    model = double_pendulum().with_parameters(g=9.81)
+    copy = pickle.loads(pickle.dumps(model))
+    assert copy.parameters == model.parameters and copy.expressions == model.expressions
+    a, b = run(model), run(copy)
+    np.testing.assert_array_equal(a.q, b.q)
+    np.testing.assert_array_equal(a.p, b.p)
+
+
+def test_a_singular_velocity_hessian_is_the_typed_error_at_the_first_step():
+    x, y, vx, vy = sp.symbols("x y v_x v_y")
+    model = symbolic.lagrangian(vx**2 / 2 - x**2 - y**2 + vx * y, [x, y], [vx, vy])
+    with pytest.raises(ValueError, match="singular"):
+        varmech.integrate(model, [0.1, 0.2], [0.0, 0.0], dt=0.01, steps=3, method="midpoint")
