@@ -50,7 +50,7 @@ class Symbolic:
 
 def _compile(spec: Spec) -> Any:
     """The core's compiled model of ``spec``: the one place that calls the binding."""
-    return _core.CompiledModel(  # type: ignore[attr-defined]
+    return _core.CompiledModel(
         spec.kind,
         spec.dim,
         dict(spec.functions),

@@ -10,7 +10,7 @@ use varmech::integrators::{Dynamics, General};
 use varmech::model::compiled::{
     CompiledConstraints, CompiledLagrangian, CompiledModel as Compiled, CompiledSeparable, Function, Tape,
 };
-use varmech::model::Constrained;
+use varmech::model::{Constrained, HolonomicConstraints};
 
 use crate::convert::slice;
 use crate::errors::to_pyerr;
@@ -174,6 +174,16 @@ impl CompiledModel {
     #[getter]
     pub fn dim(&self) -> usize {
         self.with_integrable(|sys| sys.dim())
+    }
+
+    /// Number of holonomic constraints (0 for unconstrained models).
+    #[getter]
+    fn constraints(&self) -> usize {
+        match &self.model {
+            Compiled::ConstrainedSeparable(c) => c.constraints.count(),
+            Compiled::ConstrainedLagrangian(c) => c.constraints.count(),
+            _ => 0,
+        }
     }
 
     /// The parameter vector.
