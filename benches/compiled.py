@@ -1,0 +1,99 @@
+"""Compiled symbolic models against the hand-written native scenes and the closure path, side by
+side in one run (issue 14's targets).
+
+    python benches/compiled.py [--quick] [--markdown FILE]
+
+For each case, the same scene is integrated by four models of it: the native scene (Rust written
+by hand), its symbolic twin (``varmech.symbolic.examples``) with its tapes compiled to machine
+code, the same twin run by the tape interpreter, and the NumPy closure model of
+``varmech.examples`` (hand-derived derivatives). The runs alternate, each figure is the best of
+several, and the closure path runs fewer steps; the figures are times per step, and the ratios
+are what carries over between machines. The one-off cost from SymPy expression to a ready model
+is timed too.
+"""
+
+from __future__ import annotations
+
+import os
+
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+
+import argparse
+import math
+import time
+from pathlib import Path
+
+import varmech
+from varmech import examples, scenes
+from varmech.symbolic import examples as symbolic_examples
+
+#: (scene, method): the cases of issue 14's table.
+CASES = [
+    ("double_pendulum", "midpoint"),
+    ("double_pendulum", "galerkin4"),
+    ("kepler", "verlet"),
+    ("kepler", "kahan_li8"),
+    ("heavy_top", "midpoint"),
+    ("cartesian_pendulum", "rattle"),
+]
+
+
+def seconds_per_step(runs: dict[str, tuple[object, int]], scene: scenes.Scene, method: str, repeat: int) -> dict[str, float]:
+    """Best time per step of each model, the runs alternating."""
+    best = dict.fromkeys(runs, math.inf)
+    for _ in range(repeat):
+        for label, (model, steps) in runs.items():
+            start = time.perf_counter()
+            varmech.integrate(model, scene.q0, scene.p0, dt=scene.dt, steps=steps, method=method, save_every=steps)
+            best[label] = min(best[label], (time.perf_counter() - start) / steps)
+    return best
+
+
+def build_seconds(name: str, repeat: int) -> float:
+    """Best wall time from SymPy expression to a ready model (derivation, lowering, code)."""
+    best = math.inf
+    for _ in range(repeat):
+        start = time.perf_counter()
+        symbolic_examples.symbolic_of(scenes.get(name))
+        best = min(best, time.perf_counter() - start)
+    return best
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--quick", action="store_true", help="fewer steps and repeats")
+    parser.add_argument("--markdown", type=Path, help="also write the table to this file")
+    args = parser.parse_args()
+    repeat = 3 if args.quick else 7
+    steps = 2_000 if args.quick else 20_000
+    lines = [
+        "| case | native µs/step | compiled (JIT) | compiled (tape) | closure | JIT / native | tape / native "
+        "| closure / JIT | build s |",
+        "|---|---:|---:|---:|---:|---:|---:|---:|---:|",
+    ]
+    for name, method in CASES:
+        scene = scenes.get(name)
+        twin = symbolic_examples.symbolic_of(scene)
+        runs = {
+            "native": (scene.model, steps),
+            "jit": (twin, steps),
+            "tape": (twin.with_jit(False), steps),
+            "closure": (examples.closure_of(scene), max(steps // 20, 100)),
+        }
+        t = seconds_per_step(runs, scene, method, repeat)
+        build = build_seconds(name, 3)
+        lines.append(
+            f"| {name} {method} | {t['native'] * 1e6:.3f} | {t['jit'] * 1e6:.3f} | {t['tape'] * 1e6:.3f} "
+            f"| {t['closure'] * 1e6:.2f} | {t['jit'] / t['native']:.2f} | {t['tape'] / t['native']:.2f} "
+            f"| {t['closure'] / t['jit']:.1f} | {build:.3f} |"
+        )
+        print(lines[-1], flush=True)
+    report = "\n".join(lines)
+    print()
+    print(report)
+    if args.markdown:
+        args.markdown.write_text(report + "\n")
+
+
+if __name__ == "__main__":
+    main()
