@@ -9,7 +9,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
-from . import _core
+from . import _core, pointers
 from ._core import ModelKind
 
 _AXES = "xyz"
@@ -101,6 +101,8 @@ class Model:
         | _core.ClosureConstrained
         | _core.ClosureNatural
         | _core.ClosureLagrangian
+        | _core.PointerSystem
+        | _core.PointerLagrangian
         | _core.RouthModel
     )
     symmetries: tuple[Symmetry, ...]
@@ -178,11 +180,14 @@ class MechanicalSystem(Model):
     dim:
         Number of generalized coordinates n.
     potential:
-        ``potential(q) -> float``, V(q) for q an array (n,).
+        ``potential(q) -> float``, V(q) for q an array (n,). Or a function pointer of
+        :data:`varmech.pointers.SIGNATURE` writing V to ``out[0]`` (with a constant mass, no
+        constraints, and a pointer gradient): then the core calls it with the GIL released.
     gradient:
-        ``gradient(q) -> array (n,)``, ∇V(q). Optional: without it, central differences of the
-        potential are used (2n potential calls per force, about 1e-10 relative accuracy), and
-        a warning says so.
+        ``gradient(q) -> array (n,)``, ∇V(q), or a function pointer writing ∇V to ``out[0:n]``
+        when the potential is one. Optional for a closure potential: without it, central
+        differences of the potential are used (2n potential calls per force, about 1e-10
+        relative accuracy), and a warning says so.
     mass:
         The constant mass matrix: a positive scalar (M = mI), a vector (n,) of positive
         entries (diagonal), or a symmetric positive-definite matrix (n, n). Or a closure
@@ -224,6 +229,18 @@ class MechanicalSystem(Model):
             raise ValueError(f"dim: must be a positive integer, got {dim!r}")
         if (constraints is None) != (constraint_count is None) or (constraint_jacobian is not None and constraints is None):
             raise ValueError("constraints: give constraints(q) with constraint_count (and optionally constraint_jacobian)")
+        functions = {"potential": potential, "gradient": gradient, "mass_derivative": mass_derivative}
+        functions |= {"mass": mass} if callable(mass) else {}
+        native = pointers.addresses(
+            functions | {"constraints": constraints, "constraint_jacobian": constraint_jacobian}
+        )
+        if native is not None:
+            refused = [k for k in ("mass", "mass_derivative", "constraints", "constraint_jacobian") if k in native]
+            if refused or "gradient" not in native:
+                raise TypeError(
+                    f"{', '.join(refused or ['gradient'])}: function pointers give the potential and its gradient "
+                    "(both) of a system with constant mass and no constraints; give the rest as closures"
+                )
         missing = [what for what, f in (("gradient", gradient), ("mass_derivative", mass_derivative)) if f is None]
         if not callable(mass):
             if mass_derivative is not None:
@@ -245,7 +262,7 @@ class MechanicalSystem(Model):
         self.constraint_jacobian = constraint_jacobian
         self.symmetries = tuple(symmetries)
         self.name = name
-        if callable(mass):
+        if callable(mass) and native is None:
             self._core = _core.ClosureNatural(int(dim), mass, potential, gradient, mass_derivative, _specs(symmetries))
             self._constrain(constraints, constraint_jacobian, constraint_count)
             return
@@ -254,8 +271,11 @@ class MechanicalSystem(Model):
             raise ValueError(f"mass: must be a scalar, a vector ({dim},) or a matrix ({dim}, {dim}), got shape {m.shape}")
         if not np.all(np.isfinite(m)):
             raise ValueError("mass: must be finite")
-        self._core = _core.ClosureModel(int(dim), potential, gradient, m, _specs(symmetries))
         self.mass = m
+        if native is not None:
+            self._core = _core.PointerSystem(int(dim), native["potential"], native["gradient"], m, _specs(symmetries))
+            return
+        self._core = _core.ClosureModel(int(dim), potential, gradient, m, _specs(symmetries))
         self._constrain(constraints, constraint_jacobian, constraint_count)
 
     def _constrain(self, constraints, jacobian, count) -> None:
@@ -278,7 +298,11 @@ class Lagrangian(Model):
     dim:
         Number of generalized coordinates n.
     lagrangian:
-        ``lagrangian(q, v, t) -> float``.
+        ``lagrangian(q, v, t) -> float``. Every function of this model may instead be a function
+        pointer of :data:`varmech.pointers.SIGNATURE` (all given ones, or none; no
+        ``rayleigh`` then): L writes ``out[0]``; ``dl_dq``, ``dl_dv`` and ``force`` n numbers;
+        ``hessians`` 3n², the three matrices below one after the other, each row-major. The core
+        then calls them with the GIL released.
     dl_dq, dl_dv:
         ``dl_dq(q, v, t) -> array (n,)`` and ``dl_dv(q, v, t) -> array (n,)``, the derivatives
         ∂L/∂q and ∂L/∂q̇ (the momentum). Optional: missing ones come from central differences
@@ -322,6 +346,10 @@ class Lagrangian(Model):
     ):
         if isinstance(dim, bool) or not isinstance(dim, (int, np.integer)) or dim < 1:
             raise ValueError(f"dim: must be a positive integer, got {dim!r}")
+        functions = {"lagrangian": lagrangian, "dl_dq": dl_dq, "dl_dv": dl_dv, "hessians": hessians, "force": force}
+        native = pointers.addresses(functions)
+        if native is not None and rayleigh is not None:
+            raise TypeError("rayleigh: not with function pointers; add −Cq̇ to the force pointer instead")
         missing = [n for n, f in (("dl_dq", dl_dq), ("dl_dv", dl_dv)) if f is None]
         if missing:
             warnings.warn(
@@ -336,9 +364,21 @@ class Lagrangian(Model):
                 raise ValueError(f"rayleigh: must be a finite scalar, a vector ({dim},) or a matrix ({dim}, {dim})")
             damping = (lambda v: c @ v) if c.ndim == 2 else (lambda v: c * v)
             total_force = (lambda q, v, t: -damping(v)) if force is None else (lambda q, v, t: np.asarray(force(q, v, t), dtype=float) - damping(v))
-        self._core = _core.ClosureLagrangian(
-            int(dim), lagrangian, dl_dq, dl_dv, hessians, total_force, bool(time_dependent), _specs(symmetries)
-        )
+        if native is not None:
+            self._core = _core.PointerLagrangian(
+                int(dim),
+                native["lagrangian"],
+                native.get("dl_dq"),
+                native.get("dl_dv"),
+                native.get("hessians"),
+                native.get("force"),
+                bool(time_dependent),
+                _specs(symmetries),
+            )
+        else:
+            self._core = _core.ClosureLagrangian(
+                int(dim), lagrangian, dl_dq, dl_dv, hessians, total_force, bool(time_dependent), _specs(symmetries)
+            )
         self.force = total_force
         self.lagrangian = lagrangian
         self.dl_dq = dl_dq
