@@ -20,7 +20,7 @@ The measurements (work–precision, energy growth, stability, sections) live in
 :mod:`varmech.analysis` and are re-exported here; :mod:`varmech.charts` draws them.
 """
 
-from . import _errors, analysis, scenes
+from . import _errors, analysis, pointers, scenes
 from ._core import ConvergenceError, DivergenceError, SpuriousBranchError, VarmechError
 from .analysis import sections, stability
 from .analysis.energy_growth import energy_growth
@@ -80,6 +80,7 @@ __all__ = [
     "momentum",
     "phase_portrait",
     "poincare_section",
+    "pointers",
     "project",
     "routh",
     "scenes",

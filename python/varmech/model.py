@@ -87,6 +87,11 @@ def _symmetry_from_spec(g: _core.Generator) -> Symmetry:
     raise TypeError(f"symmetries: expected a generator, got {g!r}")
 
 
+def _handed(function: pointers.Function) -> tuple[int, pointers.Function]:
+    """A pointer as the binding takes it: its address, and the object it keeps alive."""
+    return function.address, function
+
+
 class Model:
     """A varmech model: a Lagrangian L(q, q̇, t) in n generalized coordinates, and the
     symmetries it declares (each with a conserved Noether momentum).
@@ -229,18 +234,16 @@ class MechanicalSystem(Model):
             raise ValueError(f"dim: must be a positive integer, got {dim!r}")
         if (constraints is None) != (constraint_count is None) or (constraint_jacobian is not None and constraints is None):
             raise ValueError("constraints: give constraints(q) with constraint_count (and optionally constraint_jacobian)")
-        functions = {"potential": potential, "gradient": gradient, "mass_derivative": mass_derivative}
-        functions |= {"mass": mass} if callable(mass) else {}
-        native = pointers.addresses(
-            functions | {"constraints": constraints, "constraint_jacobian": constraint_jacobian}
-        )
-        if native is not None:
-            refused = [k for k in ("mass", "mass_derivative", "constraints", "constraint_jacobian") if k in native]
-            if refused or "gradient" not in native:
-                raise TypeError(
-                    f"{', '.join(refused or ['gradient'])}: function pointers give the potential and its gradient "
-                    "(both) of a system with constant mass and no constraints; give the rest as closures"
-                )
+        native = pointers.functions({"potential": potential, "gradient": gradient}, int(dim))
+        others = {"mass": mass if callable(mass) else None, "mass_derivative": mass_derivative}
+        others |= {"constraints": constraints, "constraint_jacobian": constraint_jacobian}
+        refused = [k for k, f in others.items() if f is not None and (native is not None or pointers.is_pointer(f))]
+        refused += ["gradient"] if native is not None and "gradient" not in native else []
+        if refused:
+            raise TypeError(
+                f"{', '.join(refused)}: function pointers give the potential and its gradient (both) of a "
+                "system with constant mass and no constraints; give the rest as closures"
+            )
         missing = [what for what, f in (("gradient", gradient), ("mass_derivative", mass_derivative)) if f is None]
         if not callable(mass):
             if mass_derivative is not None:
@@ -254,6 +257,8 @@ class MechanicalSystem(Model):
                 f"({2 * dim} calls each per force, about 1e-10 relative accuracy)",
                 stacklevel=2,
             )
+        if native is not None:
+            potential, gradient = native["potential"], native["gradient"]
         self.potential = potential
         self.gradient = gradient
         self.mass = mass
@@ -273,7 +278,9 @@ class MechanicalSystem(Model):
             raise ValueError("mass: must be finite")
         self.mass = m
         if native is not None:
-            self._core = _core.PointerSystem(int(dim), native["potential"], native["gradient"], m, _specs(symmetries))
+            self._core = _core.PointerSystem(
+                int(dim), _handed(native["potential"]), _handed(native["gradient"]), m, _specs(symmetries)
+            )
             return
         self._core = _core.ClosureModel(int(dim), potential, gradient, m, _specs(symmetries))
         self._constrain(constraints, constraint_jacobian, constraint_count)
@@ -347,7 +354,7 @@ class Lagrangian(Model):
         if isinstance(dim, bool) or not isinstance(dim, (int, np.integer)) or dim < 1:
             raise ValueError(f"dim: must be a positive integer, got {dim!r}")
         functions = {"lagrangian": lagrangian, "dl_dq": dl_dq, "dl_dv": dl_dv, "hessians": hessians, "force": force}
-        native = pointers.addresses(functions)
+        native = pointers.functions(functions, int(dim))
         if native is not None and rayleigh is not None:
             raise TypeError("rayleigh: not with function pointers; add −Cq̇ to the force pointer instead")
         missing = [n for n, f in (("dl_dq", dl_dq), ("dl_dv", dl_dv)) if f is None]
@@ -365,16 +372,19 @@ class Lagrangian(Model):
             damping = (lambda v: c @ v) if c.ndim == 2 else (lambda v: c * v)
             total_force = (lambda q, v, t: -damping(v)) if force is None else (lambda q, v, t: np.asarray(force(q, v, t), dtype=float) - damping(v))
         if native is not None:
+            handed = {k: _handed(f) for k, f in native.items()}
             self._core = _core.PointerLagrangian(
                 int(dim),
-                native["lagrangian"],
-                native.get("dl_dq"),
-                native.get("dl_dv"),
-                native.get("hessians"),
-                native.get("force"),
+                handed["lagrangian"],
+                handed.get("dl_dq"),
+                handed.get("dl_dv"),
+                handed.get("hessians"),
+                handed.get("force"),
                 bool(time_dependent),
                 _specs(symmetries),
             )
+            lagrangian = native["lagrangian"]
+            dl_dq, dl_dv, hessians, total_force = (native[k] if k in native else None for k in list(functions)[1:])
         else:
             self._core = _core.ClosureLagrangian(
                 int(dim), lagrangian, dl_dq, dl_dv, hessians, total_force, bool(time_dependent), _specs(symmetries)

@@ -38,9 +38,14 @@ from __future__ import annotations
 import ctypes
 import re
 import sys
+from collections.abc import Callable
 from typing import Any
 
-__all__ = ["CFUNCTYPE", "C_SIGNATURE", "SIGNATURE", "address", "addresses", "is_pointer"]
+import numpy as np
+
+from ._core import VarmechError
+
+__all__ = ["CFUNCTYPE", "C_SIGNATURE", "SIGNATURE", "Function", "address", "functions", "is_pointer"]
 
 #: The numba signature of every pointer: ``@numba.cfunc(varmech.pointers.SIGNATURE)``.
 SIGNATURE = "int32(CPointer(float64), CPointer(float64), float64, int64, CPointer(float64))"
@@ -73,6 +78,8 @@ def _pointer_kind(obj: Any) -> str | None:
         return "int"
     if isinstance(obj, _FUNCTION_POINTER):
         return "ctypes"
+    if isinstance(obj, Function):
+        return "varmech"
     module = type(obj).__module__
     if module.startswith("numba") and type(obj).__name__ == "CFunc":
         return "numba"
@@ -119,6 +126,8 @@ def address(obj: Any, name: str) -> int:
     its signature against :data:`C_SIGNATURE`; a TypeError naming ``name`` and showing the
     expected signature otherwise."""
     kind = _pointer_kind(obj)
+    if kind == "varmech":
+        return int(obj.address)
     if kind == "numba" and _same_prototype(obj.ctypes):
         return int(obj.address)
     if kind == "ctypes" and _same_prototype(obj):
@@ -140,10 +149,11 @@ def address(obj: Any, name: str) -> int:
     raise TypeError(f"{_expected(name)}, got {got}")
 
 
-def addresses(entries: dict[str, Any]) -> dict[str, tuple[int, Any]] | None:
-    """The model functions ``entries`` (name → function or None) as (address, object) pairs when
-    every given one is a pointer, or None when none is; a TypeError naming them when pointers
-    and Python closures are mixed or a pointer's signature is wrong."""
+def functions(entries: dict[str, Any], dim: int) -> dict[str, Function] | None:
+    """The model functions ``entries`` (name → function or None) of a model with ``dim``
+    coordinates as :class:`Function` objects when every given one is a pointer, or None when none
+    is; a TypeError naming them when pointers and Python closures are mixed or a pointer's
+    signature is wrong."""
     given = {k: f for k, f in entries.items() if f is not None}
     pointers = [k for k, f in given.items() if is_pointer(f)]
     if not pointers:
@@ -154,4 +164,45 @@ def addresses(entries: dict[str, Any]) -> dict[str, tuple[int, Any]] | None:
             f"{', '.join(pointers)}: function pointers cannot be mixed with Python closures "
             f"({', '.join(closures)}); give all of them as pointers or all as closures"
         )
-    return {k: (address(f, k), f) for k, f in given.items()}
+    return {k: Function(k, f, address(f, k), dim) for k, f in given.items()}
+
+
+#: The shape of each model function's result for n coordinates.
+_RESULTS: dict[str, Callable[[int], tuple[int, ...]]] = {
+    "potential": lambda n: (),
+    "gradient": lambda n: (n,),
+    "lagrangian": lambda n: (),
+    "dl_dq": lambda n: (n,),
+    "dl_dv": lambda n: (n,),
+    "hessians": lambda n: (3, n, n),
+    "force": lambda n: (n,),
+}
+
+
+
+class Function:
+    """A model function given by a pointer, callable from Python as the closure it stands for:
+    ``f(q)`` for the potential and its gradient, ``f(q, v, t)`` for the others, returning a
+    float, an array (n,) or, for ``hessians``, the three arrays (n, n). The Python layer
+    (:func:`varmech.check_derivatives`, the time-dependence probe) calls it; the core calls
+    the pointer itself. A nonzero status is a :class:`varmech.VarmechError` naming the function.
+
+    ``pointer`` is the object the user gave (kept alive with the model), ``address`` its code.
+    """
+
+    def __init__(self, name: str, pointer: Any, address: int, dim: int):
+        self.name, self.pointer, self.address, self.dim = name, pointer, address, dim
+        self._shape = _RESULTS[name](dim)
+        self._function = CFUNCTYPE(address)
+
+    def __call__(self, q: Any, v: Any = None, t: float = 0.0) -> Any:
+        n = self.dim
+        x = [np.ascontiguousarray(np.broadcast_to(np.asarray(a, dtype=float), (n,))) for a in (q, np.zeros(n) if v is None else v)]
+        out = np.zeros(self._shape)
+        status = self._function(*(a.ctypes.data_as(_DOUBLE_P) for a in x), float(t), n, out.ctypes.data_as(_DOUBLE_P))
+        if status != 0:
+            raise VarmechError(f"the function pointer {self.name} returned status {status}")
+        return float(out) if out.ndim == 0 else tuple(out) if self.name == "hessians" else out
+
+    def __repr__(self) -> str:
+        return f"Function({self.name!r}, {self.pointer!r})"
