@@ -6,13 +6,12 @@ lets go of the GIL."""
 import ctypes
 import gc
 import math
-import threading
-import time
 
 import numpy as np
 import pytest
 
 import varmech
+from conftest import releases_the_gil
 from varmech import examples, pointers, scenes
 
 M1, M2, L1, L2, G = 1.0, 2.0, 2.0, 3.0, 9.80665
@@ -270,16 +269,6 @@ def test_a_pointer_run_releases_the_gil(numba_kepler, numba_double_pendulum, kin
         functions = dict(numba_double_pendulum)
         model = varmech.Lagrangian(2, functions.pop("lagrangian"), **functions)
         q0, p0, steps, method = scenes.double_pendulum().q0, scenes.double_pendulum().p0, 1_000_000, "midpoint"
-    done = threading.Event()
-
-    def run():
-        varmech.integrate(model, q0, p0, dt=1e-3, steps=steps, save_every=steps, method=method)
-        done.set()
-
-    worker = threading.Thread(target=run)
-    worker.start()
-    time.sleep(0.05)
-    # This line runs only if the worker let go of the GIL while integrating.
-    running_while_we_run = not done.is_set()
-    worker.join()
-    assert running_while_we_run and done.is_set()
+    assert releases_the_gil(
+        lambda: varmech.integrate(model, q0, p0, dt=1e-3, steps=steps, save_every=steps, method=method)
+    )
