@@ -121,6 +121,16 @@ def _capsule_pointer(capsule: Any, name: str) -> int:
     return int(get(capsule, name.encode()) or 0)
 
 
+def _cffi_signature(obj: Any) -> str | None:
+    """The C signature of a cffi function pointer, or None for another cffi object."""
+    ffi = sys.modules["cffi"].FFI()
+    try:
+        kind = ffi.typeof(obj)
+    except TypeError:
+        return None
+    return ffi.getctype(kind) if kind.kind == "function" else None
+
+
 def address(obj: Any, name: str) -> int:
     """The address of the function pointer ``obj`` given as argument ``name``, after checking
     its signature against :data:`C_SIGNATURE`; a TypeError naming ``name`` and showing the
@@ -136,14 +146,13 @@ def address(obj: Any, name: str) -> int:
         # scipy keeps the function as a capsule named by its signature in the tuple's item 0
         # (as its own `signature` property reads it), whatever it was made from.
         return _capsule_pointer(tuple.__getitem__(obj, 0), obj.signature)
-    if kind == "cffi":
-        ffi = sys.modules["cffi"].FFI()
-        if ffi.typeof(obj).kind == "function" and _c_signature_matches(ffi.getctype(ffi.typeof(obj))):
-            return int(ffi.cast("uintptr_t", obj))
+    if kind == "cffi" and _c_signature_matches(_cffi_signature(obj) or ""):
+        return int(sys.modules["cffi"].FFI().cast("uintptr_t", obj))
     got = {
         "numba": lambda: f"a numba cfunc of signature {obj._sig}",
         "ctypes": lambda: f"a ctypes pointer of ({obj.restype}, {obj.argtypes})",
         "scipy": lambda: f"a LowLevelCallable of signature {obj.signature!r}",
+        "cffi": lambda: f"a cffi object of type {_cffi_signature(obj) or obj!r}",
         "int": lambda: f"a raw address {obj}, whose signature cannot be checked",
     }.get(kind or "", lambda: f"{type(obj).__name__} {obj!r}")()
     raise TypeError(f"{_expected(name)}, got {got}")

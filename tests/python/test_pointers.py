@@ -213,10 +213,16 @@ def test_a_wrong_signature_is_a_type_error_naming_the_argument_when_the_model_is
         varmech.Lagrangian(2, potential, dl_dv=wrong)
 
 
-def test_a_low_level_callable_of_another_signature_is_refused():
+def test_a_low_level_callable_or_cffi_pointer_of_another_signature_is_refused():
     scipy = pytest.importorskip("scipy")
-    wrong = scipy.LowLevelCallable(ctypes.CFUNCTYPE(ctypes.c_double, ctypes.c_double)(math.sin))
+    sine = ctypes.CFUNCTYPE(ctypes.c_double, ctypes.c_double)(math.sin)
+    wrong = scipy.LowLevelCallable(sine)
     with pytest.raises(TypeError, match=r"^potential: .*got a LowLevelCallable of signature 'double \(double\)'"):
+        varmech.MechanicalSystem(1, wrong, wrong)
+    ffi = pytest.importorskip("cffi").FFI()
+    # The right parameters but an int64 status.
+    wrong = ffi.cast("int64_t(*)(double *, double *, double, int64_t, double *)", ctypes.cast(sine, ctypes.c_void_p).value)
+    with pytest.raises(TypeError, match=r"^potential: .*got a cffi object of type 'int64_t\(\*\)\(double \*"):
         varmech.MechanicalSystem(1, wrong, wrong)
 
 
