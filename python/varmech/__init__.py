@@ -23,7 +23,7 @@ The measurements (work–precision, energy growth, stability, sections) live in
 import importlib
 from types import ModuleType
 
-from . import _errors, analysis, scenes
+from . import _errors, analysis, pointers, scenes
 from ._core import ConvergenceError, DivergenceError, SpuriousBranchError, VarmechError
 from .analysis import sections, stability
 from .analysis.energy_growth import energy_growth
@@ -83,6 +83,7 @@ __all__ = [
     "momentum",
     "phase_portrait",
     "poincare_section",
+    "pointers",
     "project",
     "routh",
     "scenes",

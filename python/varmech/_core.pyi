@@ -24,6 +24,8 @@ __all__ = [
     "MethodInfo",
     "ModelKind",
     "NativeModel",
+    "PointerLagrangian",
+    "PointerSystem",
     "RouthModel",
     "SceneRecord",
     "SceneReference",
@@ -302,6 +304,35 @@ class ClosureLagrangian(_ModelProperties):
         symmetries: Sequence[Generator],
     ) -> ClosureLagrangian: ...
 
+#: A function pointer as varmech.pointers hands it over: (address, the object that owns it).
+_Pointer = tuple[int, object]
+
+@final
+class PointerSystem(_ModelProperties):
+    """L = ½q̇ᵀMq̇ − V(q) with constant M, V and ∇V function pointers (see varmech.pointers),
+    called with the GIL released."""
+
+    def __new__(
+        cls, dim: int, potential: _Pointer, gradient: _Pointer, mass: _FloatArray, symmetries: Sequence[Generator]
+    ) -> PointerSystem: ...
+
+@final
+class PointerLagrangian(_ModelProperties):
+    """A general Lagrangian L(q, q̇, t) whose functions are function pointers (see
+    varmech.pointers), called with the GIL released."""
+
+    def __new__(
+        cls,
+        dim: int,
+        lagrangian: _Pointer,
+        dl_dq: _Pointer | None,
+        dl_dv: _Pointer | None,
+        hessians: _Pointer | None,
+        force: _Pointer | None,
+        time_dependent: bool,
+        symmetries: Sequence[Generator],
+    ) -> PointerLagrangian: ...
+
 _IntArray = NDArray[np.int64]
 
 @final
@@ -345,7 +376,16 @@ class RouthModel(_ModelProperties):
     @property
     def momenta(self) -> list[float]: ...
 
-_FullModel = NativeModel | ClosureModel | ClosureConstrained | ClosureNatural | ClosureLagrangian | CompiledModel
+_FullModel = (
+    NativeModel
+    | ClosureModel
+    | ClosureConstrained
+    | ClosureNatural
+    | ClosureLagrangian
+    | CompiledModel
+    | PointerSystem
+    | PointerLagrangian
+)
 _Model = _FullModel | RouthModel
 
 def kind_of(model: _Model) -> ModelKind: ...

@@ -9,7 +9,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
-from . import _core
+from . import _core, pointers
 from ._core import ModelKind
 
 _AXES = "xyz"
@@ -87,6 +87,11 @@ def _symmetry_from_spec(g: _core.Generator) -> Symmetry:
     raise TypeError(f"symmetries: expected a generator, got {g!r}")
 
 
+def _handed(function: pointers.Function) -> tuple[int, pointers.Function]:
+    """A pointer as the binding takes it: its address, and the object it keeps alive."""
+    return function.address, function
+
+
 class Model:
     """A varmech model: a Lagrangian L(q, q̇, t) in n generalized coordinates, and the
     symmetries it declares (each with a conserved Noether momentum).
@@ -101,6 +106,8 @@ class Model:
         | _core.ClosureConstrained
         | _core.ClosureNatural
         | _core.ClosureLagrangian
+        | _core.PointerSystem
+        | _core.PointerLagrangian
         | _core.RouthModel
     )
     symmetries: tuple[Symmetry, ...]
@@ -187,11 +194,14 @@ class MechanicalSystem(Model):
     dim:
         Number of generalized coordinates n.
     potential:
-        ``potential(q) -> float``, V(q) for q an array (n,).
+        ``potential(q) -> float``, V(q) for q an array (n,). Or a function pointer of
+        :data:`varmech.pointers.SIGNATURE` writing V to ``out[0]`` (with a constant mass, no
+        constraints, and a pointer gradient): then the core calls it with the GIL released.
     gradient:
-        ``gradient(q) -> array (n,)``, ∇V(q). Optional: without it, central differences of the
-        potential are used (2n potential calls per force, about 1e-10 relative accuracy), and
-        a warning says so.
+        ``gradient(q) -> array (n,)``, ∇V(q), or a function pointer writing ∇V to ``out[0:n]``
+        when the potential is one. Optional for a closure potential: without it, central
+        differences of the potential are used (2n potential calls per force, about 1e-10
+        relative accuracy), and a warning says so.
     mass:
         The constant mass matrix: a positive scalar (M = mI), a vector (n,) of positive
         entries (diagonal), or a symmetric positive-definite matrix (n, n). Or a closure
@@ -233,6 +243,16 @@ class MechanicalSystem(Model):
             raise ValueError(f"dim: must be a positive integer, got {dim!r}")
         if (constraints is None) != (constraint_count is None) or (constraint_jacobian is not None and constraints is None):
             raise ValueError("constraints: give constraints(q) with constraint_count (and optionally constraint_jacobian)")
+        native = pointers.functions({"potential": potential, "gradient": gradient}, int(dim))
+        others = {"mass": mass if callable(mass) else None, "mass_derivative": mass_derivative}
+        others |= {"constraints": constraints, "constraint_jacobian": constraint_jacobian}
+        refused = [k for k, f in others.items() if f is not None and (native is not None or pointers.is_pointer(f))]
+        refused += ["gradient"] if native is not None and "gradient" not in native else []
+        if refused:
+            raise TypeError(
+                f"{', '.join(refused)}: function pointers give the potential and its gradient (both) of a "
+                "system with constant mass and no constraints; give the rest as closures"
+            )
         missing = [what for what, f in (("gradient", gradient), ("mass_derivative", mass_derivative)) if f is None]
         if not callable(mass):
             if mass_derivative is not None:
@@ -246,6 +266,8 @@ class MechanicalSystem(Model):
                 f"({2 * dim} calls each per force, about 1e-10 relative accuracy)",
                 stacklevel=2,
             )
+        if native is not None:
+            potential, gradient = native["potential"], native["gradient"]
         self.potential = potential
         self.gradient = gradient
         self.mass = mass
@@ -254,7 +276,7 @@ class MechanicalSystem(Model):
         self.constraint_jacobian = constraint_jacobian
         self.symmetries = tuple(symmetries)
         self.name = name
-        if callable(mass):
+        if callable(mass) and native is None:
             self._core = _core.ClosureNatural(int(dim), mass, potential, gradient, mass_derivative, _specs(symmetries))
             self._constrain(constraints, constraint_jacobian, constraint_count)
             return
@@ -263,8 +285,13 @@ class MechanicalSystem(Model):
             raise ValueError(f"mass: must be a scalar, a vector ({dim},) or a matrix ({dim}, {dim}), got shape {m.shape}")
         if not np.all(np.isfinite(m)):
             raise ValueError("mass: must be finite")
-        self._core = _core.ClosureModel(int(dim), potential, gradient, m, _specs(symmetries))
         self.mass = m
+        if native is not None:
+            self._core = _core.PointerSystem(
+                int(dim), _handed(native["potential"]), _handed(native["gradient"]), m, _specs(symmetries)
+            )
+            return
+        self._core = _core.ClosureModel(int(dim), potential, gradient, m, _specs(symmetries))
         self._constrain(constraints, constraint_jacobian, constraint_count)
 
     def _constrain(self, constraints, jacobian, count) -> None:
@@ -287,7 +314,11 @@ class Lagrangian(Model):
     dim:
         Number of generalized coordinates n.
     lagrangian:
-        ``lagrangian(q, v, t) -> float``.
+        ``lagrangian(q, v, t) -> float``. Every function of this model may instead be a function
+        pointer of :data:`varmech.pointers.SIGNATURE` (all given ones, or none; no
+        ``rayleigh`` then): L writes ``out[0]``; ``dl_dq``, ``dl_dv`` and ``force`` n numbers;
+        ``hessians`` 3n², the three matrices below one after the other, each row-major. The core
+        then calls them with the GIL released.
     dl_dq, dl_dv:
         ``dl_dq(q, v, t) -> array (n,)`` and ``dl_dv(q, v, t) -> array (n,)``, the derivatives
         ∂L/∂q and ∂L/∂q̇ (the momentum). Optional: missing ones come from central differences
@@ -331,6 +362,10 @@ class Lagrangian(Model):
     ):
         if isinstance(dim, bool) or not isinstance(dim, (int, np.integer)) or dim < 1:
             raise ValueError(f"dim: must be a positive integer, got {dim!r}")
+        functions = {"lagrangian": lagrangian, "dl_dq": dl_dq, "dl_dv": dl_dv, "hessians": hessians, "force": force}
+        native = pointers.functions(functions, int(dim))
+        if native is not None and rayleigh is not None:
+            raise TypeError("rayleigh: not with function pointers; add −Cq̇ to the force pointer instead")
         missing = [n for n, f in (("dl_dq", dl_dq), ("dl_dv", dl_dv)) if f is None]
         if missing:
             warnings.warn(
@@ -345,9 +380,24 @@ class Lagrangian(Model):
                 raise ValueError(f"rayleigh: must be a finite scalar, a vector ({dim},) or a matrix ({dim}, {dim})")
             damping = (lambda v: c @ v) if c.ndim == 2 else (lambda v: c * v)
             total_force = (lambda q, v, t: -damping(v)) if force is None else (lambda q, v, t: np.asarray(force(q, v, t), dtype=float) - damping(v))
-        self._core = _core.ClosureLagrangian(
-            int(dim), lagrangian, dl_dq, dl_dv, hessians, total_force, bool(time_dependent), _specs(symmetries)
-        )
+        if native is not None:
+            handed = {k: _handed(f) for k, f in native.items()}
+            self._core = _core.PointerLagrangian(
+                int(dim),
+                handed["lagrangian"],
+                handed.get("dl_dq"),
+                handed.get("dl_dv"),
+                handed.get("hessians"),
+                handed.get("force"),
+                bool(time_dependent),
+                _specs(symmetries),
+            )
+            lagrangian = native["lagrangian"]
+            dl_dq, dl_dv, hessians, total_force = (native[k] if k in native else None for k in list(functions)[1:])
+        else:
+            self._core = _core.ClosureLagrangian(
+                int(dim), lagrangian, dl_dq, dl_dv, hessians, total_force, bool(time_dependent), _specs(symmetries)
+            )
         self.force = total_force
         self.lagrangian = lagrangian
         self.dl_dq = dl_dq

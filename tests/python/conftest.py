@@ -1,5 +1,6 @@
 """Shared set-up of the Python tests: the repository's reference data, the closure models that
-several tests build, and helpers to run the command line and to press Ctrl-C."""
+several tests build, and helpers to run the command line, to press Ctrl-C and to see whether a
+run lets go of the GIL."""
 
 import math
 import os
@@ -109,3 +110,21 @@ def interrupt_after():
     yield start
     for timer in timers:
         timer.join()
+
+
+def releases_the_gil(run):
+    """Whether ``run()``, started in another thread, lets this one run while it is still going:
+    that is, whether it let go of the GIL. ``run`` must take well over 50 ms."""
+    done = threading.Event()
+
+    def worker():
+        run()
+        done.set()
+
+    thread = threading.Thread(target=worker)
+    thread.start()
+    time.sleep(0.05)
+    # This line runs only if the worker let go of the GIL while running.
+    running_while_we_run = not done.is_set()
+    thread.join()
+    return running_while_we_run and done.is_set()

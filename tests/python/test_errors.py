@@ -1,7 +1,6 @@
 """Bad input gets a clear error naming the argument; failures keep the partial trajectory."""
 
 import math
-import threading
 import time
 import traceback
 
@@ -9,6 +8,7 @@ import numpy as np
 import pytest
 
 import varmech
+from conftest import releases_the_gil
 from varmech import examples, scenes
 
 
@@ -174,19 +174,7 @@ def test_ctrl_c_interrupts_a_long_run_and_keeps_the_partial_trajectory(native, i
 
 def test_native_runs_release_the_gil():
     scene = scenes.outer_solar_system()
-    done = threading.Event()
-
-    def run():
-        varmech.integrate(scene, dt=1.0, steps=5_000_000, save_every=1_000_000)
-        done.set()
-
-    worker = threading.Thread(target=run)
-    worker.start()
-    time.sleep(0.05)
-    # This line runs only if the worker let go of the GIL while integrating.
-    running_while_we_run = not done.is_set()
-    worker.join()
-    assert running_while_we_run
+    assert releases_the_gil(lambda: varmech.integrate(scene, dt=1.0, steps=5_000_000, save_every=1_000_000))
 
 
 def test_newton_failure_raises_convergence_error_with_partial_trajectory():

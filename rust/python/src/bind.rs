@@ -15,6 +15,7 @@ use crate::closure::{
 use crate::compiled::CompiledModel;
 use crate::errors::{boxed, to_pyerr};
 use crate::native::NativeModel;
+use crate::pointers::{PointerLagrangian, PointerSystem};
 use crate::routh::RouthModel;
 
 /// The Ctrl-C check the driver polls: a Python error (KeyboardInterrupt) stops the run.
@@ -26,8 +27,8 @@ fn check_signals() -> Result<(), ModelError> {
     Python::attach(|py| py.check_signals()).map_err(boxed)
 }
 
-/// Runs `body` with the model as the core's [`Dynamics`] and the Ctrl-C check: native and
-/// compiled models with the GIL released (the poll takes it back briefly), closure models with it held. A
+/// Runs `body` with the model as the core's [`Dynamics`] and the Ctrl-C check: native,
+/// compiled and function-pointer models with the GIL released (the poll takes it back briefly), closure models with it held. A
 /// Routh-reduced model is the Routhian of its full model, built in place.
 pub fn bind_model<R, F>(py: Python<'_>, model: &Bound<'_, PyAny>, body: F) -> PyResult<R>
 where
@@ -67,6 +68,14 @@ where
     if let Ok(compiled) = model.cast::<CompiledModel>() {
         let compiled = compiled.get();
         return Ok(py.detach(|| compiled.with_integrable(|sys| body(sys, &check_signals))));
+    }
+    if let Ok(pointer) = model.cast::<PointerSystem>() {
+        let pointer = pointer.get();
+        return Ok(py.detach(|| body(pointer, &check_signals)));
+    }
+    if let Ok(pointer) = model.cast::<PointerLagrangian>() {
+        let pointer = pointer.get();
+        return Ok(py.detach(|| pointer.with_integrable(|sys| body(sys, &check_signals))));
     }
     let poll = || py.check_signals().map_err(boxed);
     if let Ok(closure) = model.cast::<ClosureModel>() {

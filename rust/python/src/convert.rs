@@ -59,8 +59,9 @@ pub fn states<'a>(
     Ok((t, q, x))
 }
 
-/// The mass matrix from a scalar (0-d), a diagonal (n,) or a full (n, n) float64 array.
-pub fn mass(m: &Bound<'_, PyAny>) -> PyResult<Mass> {
+/// The mass matrix of a model with `dim` coordinates from a scalar (0-d), a diagonal (n,) or a
+/// full (n, n) float64 array.
+pub fn mass(m: &Bound<'_, PyAny>, dim: usize) -> PyResult<Mass> {
     let arr = m
         .cast::<numpy::PyArrayDyn<f64>>()
         .map_err(|_| PyValueError::new_err("mass: must be a float64 array"))?;
@@ -79,7 +80,13 @@ pub fn mass(m: &Bound<'_, PyAny>) -> PyResult<Mass> {
             )))
         }
     };
-    result.map_err(|e| to_pyerr(m.py(), e))
+    let mass = result.map_err(|e| to_pyerr(m.py(), e))?;
+    match mass.dim().filter(|n| *n != dim) {
+        Some(n) => Err(PyValueError::new_err(format!(
+            "mass: has dimension {n}, the model has dim = {dim}"
+        ))),
+        None => Ok(mass),
+    }
 }
 
 /// A row-major buffer of N rows as an (N, n) array.

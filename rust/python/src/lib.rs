@@ -3,7 +3,8 @@
 //! Its remit is conversion, adapters and errors only — no physics, no policy: arguments and
 //! results are converted between numpy and the core ([`convert`], [`trajectory`],
 //! [`generator`]); Python closures are adapted to the core's model traits ([`closure`]), native
-//! scenes wrapped ([`native`], [`scenes`]), symbolic models' tapes decoded ([`compiled`]), and every model resolved to the core by the one
+//! scenes wrapped ([`native`], [`scenes`]), symbolic models' tapes decoded ([`compiled`]), function pointers called
+//! ([`pointers`]), and every model resolved to the core by the one
 //! dispatch [`bind::bind_model`]; core errors become Python exceptions with the core's messages
 //! ([`errors`]). Policy, such as which method fits which kind of model, is the core's
 //! ([`bind::kind_of`] only shows it). The Python API in `python/varmech` is built on these functions;
@@ -18,6 +19,7 @@ mod diagnostics;
 mod errors;
 mod generator;
 mod native;
+mod pointers;
 mod routh;
 mod run;
 mod scenes;
@@ -33,6 +35,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     bind::register(m)?;
     closure::register(m)?;
     compiled::register(m)?;
+    pointers::register(m)?;
     scenes::register(m)?;
     routh::register(m)?;
     run::register(m)?;

@@ -3,7 +3,6 @@
 use std::cell::RefCell;
 
 use numpy::PyArray1;
-use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use varmech::model::{Generator, Mass, MechanicalSystem};
 use varmech::solve::difference::central_gradient;
@@ -38,12 +37,7 @@ impl ClosureModel {
         symmetries: Vec<Spec>,
     ) -> PyResult<Self> {
         check_closures(dim, [("potential", Some(&potential)), ("gradient", gradient.as_ref())])?;
-        let mass = convert::mass(mass)?;
-        if let Some(n) = mass.dim().filter(|n| *n != dim) {
-            return Err(PyValueError::new_err(format!(
-                "mass: has dimension {n}, the model has dim = {dim}"
-            )));
-        }
+        let mass = convert::mass(mass, dim)?;
         let symmetries = generator::generators(py, symmetries, dim)?;
         Ok(ClosureModel {
             dim,
