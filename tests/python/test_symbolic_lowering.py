@@ -18,8 +18,8 @@ sp = pytest.importorskip("sympy")
 import varmech  # noqa: E402
 import varmech.symbolic as symbolic  # noqa: E402
 from varmech import examples, scenes  # noqa: E402
-from varmech.symbolic.examples import double_pendulum, heavy_top, kepler  # noqa: E402
 from varmech.symbolic import TAPE_OPS  # noqa: E402
+from varmech.symbolic.examples import double_pendulum, heavy_top, kepler  # noqa: E402
 
 UNARY = {
     "neg": np.negative,
@@ -369,9 +369,7 @@ def test_with_parameters_shares_the_tapes_and_checks_names_and_values():
     assert longer.parameters == {"m1": 1.0, "m2": 2.0, "l1": 2.0, "l2": 2.0, "g": 9.80665}
     assert longer._core.spec.functions is model._core.spec.functions
     assert longer.expressions == model.expressions
-    np.testing.assert_array_equal(
-        longer._core.spec.parameters, double_pendulum(l2=2.0)._core.spec.parameters
-    )
+    np.testing.assert_array_equal(longer._core.spec.parameters, double_pendulum(l2=2.0)._core.spec.parameters)
     with pytest.raises(ValueError, match="^parameters: l3, mass not a parameter"):
         model.with_parameters(l3=1.0, mass=2.0)
     with pytest.raises(ValueError, match="^parameters: g: must be finite"):
