@@ -17,6 +17,10 @@ instruction tape that the Rust core runs with no Python call per step::
                                         parameters={m1: 1.0, m2: 2.0, l1: 2.0, l2: 3.0, g: 9.80665})
     traj = varmech.integrate(model, [0.5, 1.0], [0.0, 0.0], dt=0.01, steps=1000, method="midpoint")
 
+:func:`routh` gives the Routhian of cyclic coordinates in closed form, and
+:mod:`varmech.symbolic.examples` holds the symbolic twins of the built-in scenes, the elastic
+pendulum and the bead on a rotating hoop.
+
 Needs SymPy: ``pip install varmech[symbolic]``.
 """
 
@@ -38,7 +42,7 @@ from ._lower import TAPE_OPS, check_compilable, lower
 from ._model import Spec, Symbolic, SymbolicModel
 from ._routh import routhian
 
-__all__ = ["TAPE_OPS", "SymbolicModel", "lagrangian", "mechanical", "routh"]
+__all__ = ["TAPE_OPS", "SymbolicModel", "examples", "lagrangian", "mechanical", "routh"]
 
 
 def lagrangian(
@@ -274,3 +278,7 @@ def _build(
     )
     symbolic = Symbolic(variables.q, variables.v, variables.t, L, derivation.functions, derivation.cyclic, name)
     return SymbolicModel(spec, symbolic, started=started)
+
+
+# The examples build their models with lagrangian and mechanical, so they come after them.
+from . import examples  # noqa: E402
