@@ -14,8 +14,8 @@ if not hasattr(_core, "CompiledModel"):
 
 import varmech  # noqa: E402
 import varmech.symbolic as symbolic  # noqa: E402
-from symbolic_twins import DOUBLE_PENDULUM_PARAMETERS, L2, TWINS, cartesian_pendulum, double_pendulum, heavy_top  # noqa: E402
 from varmech import scenes  # noqa: E402
+from varmech.symbolic.examples import cartesian_pendulum, double_pendulum, heavy_top, symbolic_of  # noqa: E402
 
 STEPS = 1000
 
@@ -25,6 +25,16 @@ def test_tape_operations_are_the_cores():
 
 
 # ------------------------------------------------------------------ twins of the native scenes
+
+
+#: The native charged particle supplies no Hessians (rust/core/src/scenes/charged_particle.rs):
+#: Newton's method differences its Jacobian there, with other evaluations and iterations than
+#: the twin's exact Jacobian, which converges in no more iterations.
+DIFFERENCED = {"charged_particle", "charged_particle_nonuniform"}
+#: Where the ties of Newton's stopping test do not balance within the run, the measured excess
+#: of the twin's iterations (and so evaluations) over the native scene's: kepler_polar ties at
+#: steps 135 (+1), 466 (−1) and 666 (+1).
+UNBALANCED_TIES = {"kepler_polar": 1}
 
 
 @pytest.mark.parametrize(
@@ -37,11 +47,16 @@ def test_tape_operations_are_the_cores():
         ("heavy_top", "midpoint"),
         ("cartesian_pendulum", "rattle"),
         ("damped_driven_pendulum", "midpoint"),
+        # The other twins with the scene's default method.
+        ("spherical_pendulum", None),
+        ("kepler_polar", None),
+        ("charged_particle", None),
+        ("charged_particle_nonuniform", None),
     ],
 )
 def test_twin_reproduces_the_native_scene(name, method):
     scene = scenes.get(name)
-    twin = TWINS[name]()
+    twin = symbolic_of(scene)
     assert twin.kind.name == scene.model.kind.name
     assert (twin.time_dependent, twin.forced, twin.constraints) == (
         scene.model.time_dependent,
@@ -51,17 +66,25 @@ def test_twin_reproduces_the_native_scene(name, method):
     assert twin.symmetries == scene.model.symmetries
     native = varmech.integrate(scene, dt=scene.dt, steps=STEPS, method=method)
     compiled = varmech.integrate(twin, scene.q0, scene.p0, dt=scene.dt, steps=STEPS, method=method)
-    assert compiled.nfev == native.nfev
-    if native.newton is not None:
+    assert compiled.method == native.method == (method or scene.model.kind.default_method)
+    if name in DIFFERENCED:
+        assert compiled.newton[-1] <= native.newton[-1]
+    else:
+        excess = UNBALANCED_TIES.get(name, 0)
+        assert int(compiled.nfev) - int(native.nfev) == excess
+    if native.newton is not None and name not in DIFFERENCED:
         # The tapes round differently from the hand-written code (their own operation order),
         # and where Newton's stopping test sits at its tolerance one more iteration in one run
-        # is balanced by one more in the other a few steps later: the totals agree exactly,
-        # and per step the counts differ by one at a handful of the 1 000 steps.
-        assert compiled.newton[-1] == native.newton[-1]
+        # is balanced by one more in the other a few steps later: the totals agree exactly (but
+        # where UNBALANCED_TIES says), and per step the counts differ by one at a handful of the 1 000 steps.
+        assert int(compiled.newton[-1]) - int(native.newton[-1]) == excess
         per_step = np.abs(np.diff(compiled.newton.astype(np.int64)) - np.diff(native.newton.astype(np.int64)))
         assert per_step.max() <= 1 and np.count_nonzero(per_step) <= 5, np.nonzero(per_step)
+    # Relative to the largest |q|, |p| of the run: kepler_polar's p_r drifts 2.2e-12 from the
+    # native one by the fifth orbit, against |p| ≤ 0.8 and |q| up to 31 (θ is not reduced).
+    scale = max(np.max(np.abs(native.q)), np.max(np.abs(native.p)))
     for a, b in [(native.q, compiled.q), (native.p, compiled.p)]:
-        assert np.max(np.abs(a - b)) <= 1e-12 * np.max(np.abs(a))
+        assert np.max(np.abs(a - b)) <= 1e-12 * scale
     if native.work is not None:
         np.testing.assert_allclose(compiled.work, native.work, rtol=1e-12, atol=1e-12 * np.max(np.abs(native.work)))
 
@@ -95,13 +118,13 @@ def run(model, **kwargs):
 
 
 def test_with_parameters_equals_a_model_built_with_those_defaults_bit_for_bit():
-    built = run(double_pendulum(DOUBLE_PENDULUM_PARAMETERS | {L2: 2.0}))
+    built = run(double_pendulum(l2=2.0))
     changed = double_pendulum().with_parameters(l2=2.0)
     assert changed.parameters["l2"] == 2.0
     for traj in (
         run(changed),
         run(double_pendulum(), parameters={"l2": 2.0}),
-        run(double_pendulum(), parameters={L2: 2.0}),
+        run(double_pendulum(), parameters={sp.Symbol("l2", positive=True): 2.0}),
     ):
         np.testing.assert_array_equal(traj.q, built.q)
         np.testing.assert_array_equal(traj.p, built.p)

@@ -17,21 +17,9 @@ sp = pytest.importorskip("sympy")
 
 import varmech  # noqa: E402
 import varmech.symbolic as symbolic  # noqa: E402
-from symbolic_twins import (  # noqa: E402
-    DOUBLE_PENDULUM,
-    DOUBLE_PENDULUM_PARAMETERS,
-    L2,
-    M1,
-    Q1,
-    Q2,
-    V1,
-    V2,
-    double_pendulum,
-    heavy_top,
-    kepler,
-)
 from varmech import examples, scenes  # noqa: E402
 from varmech.symbolic import TAPE_OPS  # noqa: E402
+from varmech.symbolic.examples import double_pendulum, heavy_top, kepler  # noqa: E402
 
 UNARY = {
     "neg": np.negative,
@@ -99,6 +87,18 @@ class Recorder:
 @pytest.fixture(autouse=True)
 def recorded(monkeypatch):
     monkeypatch.setattr(importlib.import_module("varmech.symbolic._model"), "_compile", Recorder)
+
+
+# The double pendulum of issue 14 (varmech.symbolic.examples): its L, symbols and parameters.
+with pytest.MonkeyPatch.context() as patch:
+    patch.setattr(importlib.import_module("varmech.symbolic._model"), "_compile", Recorder)
+    _ISSUE = double_pendulum()
+DOUBLE_PENDULUM = _ISSUE.L
+Q1, Q2 = _ISSUE.q
+V1, V2 = _ISSUE.v
+_SYMBOLS = {s.name: s for s in DOUBLE_PENDULUM.free_symbols}
+M1, L2 = _SYMBOLS["m1"], _SYMBOLS["l2"]
+DOUBLE_PENDULUM_PARAMETERS = {_SYMBOLS[name]: value for name, value in _ISSUE.parameters.items()}
 
 
 def check_tapes(model, points):
@@ -369,9 +369,7 @@ def test_with_parameters_shares_the_tapes_and_checks_names_and_values():
     assert longer.parameters == {"m1": 1.0, "m2": 2.0, "l1": 2.0, "l2": 2.0, "g": 9.80665}
     assert longer._core.spec.functions is model._core.spec.functions
     assert longer.expressions == model.expressions
-    np.testing.assert_array_equal(
-        longer._core.spec.parameters, double_pendulum(DOUBLE_PENDULUM_PARAMETERS | {L2: 2.0})._core.spec.parameters
-    )
+    np.testing.assert_array_equal(longer._core.spec.parameters, double_pendulum(l2=2.0)._core.spec.parameters)
     with pytest.raises(ValueError, match="^parameters: l3, mass not a parameter"):
         model.with_parameters(l3=1.0, mass=2.0)
     with pytest.raises(ValueError, match="^parameters: g: must be finite"):

@@ -17,6 +17,10 @@ instruction tape that the Rust core runs with no Python call per step::
                                         parameters={m1: 1.0, m2: 2.0, l1: 2.0, l2: 3.0, g: 9.80665})
     traj = varmech.integrate(model, [0.5, 1.0], [0.0, 0.0], dt=0.01, steps=1000, method="midpoint")
 
+:func:`routh` gives the Routhian of cyclic coordinates in closed form, and
+:mod:`varmech.symbolic.examples` holds the symbolic twins of the built-in scenes, the elastic
+pendulum and the bead on a rotating hoop.
+
 Needs SymPy: ``pip install varmech[symbolic]``.
 """
 
@@ -36,8 +40,9 @@ from ._derive import derive, vanishes
 from ._inputs import Variables, check_symbols, expressions, parameters, variables
 from ._lower import TAPE_OPS, check_compilable, lower
 from ._model import Spec, Symbolic, SymbolicModel
+from ._routh import routhian
 
-__all__ = ["TAPE_OPS", "SymbolicModel", "lagrangian", "mechanical"]
+__all__ = ["TAPE_OPS", "SymbolicModel", "examples", "lagrangian", "mechanical", "routh"]
 
 
 def lagrangian(
@@ -157,6 +162,58 @@ def mechanical(
     return _build(variables_, L, parameters, constraints, force, rayleigh, symmetries, jit, name, started)
 
 
+def routh(model: SymbolicModel, cyclic: Sequence[int], momenta: Any) -> SymbolicModel:
+    """The Routhian of ``model`` in closed form: a symbolic model on the coordinates that
+    remain when the cyclic coordinates ``cyclic`` are ignored at their conserved momenta
+    μ = ∂L/∂ċ.
+
+    With the sign convention of :func:`varmech.routh` (Marsden, Ratiu & Scheurle),
+
+        R(x, ẋ, t; μ) = L − μ·ċ,   ċ solving ∂L/∂ċ = μ,
+
+    R acts as a Lagrangian: x(t) solves its Euler–Lagrange equations exactly when (x, c)(t)
+    solves those of L with p_c = μ. Where ∂L/∂ċ = b + Aċ is linear in ċ (A and b free of ċ,
+    A invertible) ċ = A⁻¹(μ − b) is solved symbolically and R simplified. The momenta are
+    parameters named ``mu_<coordinate>`` with the values ``momenta`` as defaults, so they
+    change per run by :meth:`SymbolicModel.with_parameters` without rebuilding; the model's
+    own parameters are kept.
+
+    Parameters
+    ----------
+    model:
+        A :class:`SymbolicModel`, unforced and unconstrained.
+    cyclic:
+        The indices of the coordinates to ignore; each must be cyclic (``model.cyclic``).
+    momenta:
+        Their momenta μ, in the order of ``cyclic``.
+
+    Raises
+    ------
+    ValueError
+        A coordinate that is not cyclic or an index out of range, naming it; ∂L/∂ċ not linear
+        in ċ or with a singular ∂²L/∂ċ², naming the expression; a forced or constrained model;
+        ``momenta`` of the wrong length or not finite.
+    TypeError
+        ``model`` is not a :class:`SymbolicModel`.
+
+    Examples
+    --------
+    The heavy top with its precession φ and spin ψ ignored::
+
+    >>> import varmech.symbolic
+    >>> from varmech.symbolic import examples
+    >>> top = examples.heavy_top()
+    >>> reduced = varmech.symbolic.routh(top, [1, 2], [2.0, 2.5])
+    >>> reduced.q, reduced.parameters
+    ((theta,), {'I1': 1.0, 'I3': 0.5, 'Mgl': 1.0, 'mu_phi': 2.0, 'mu_psi': 2.5})
+    """
+    started = time.perf_counter()
+    reduced = routhian(model, cyclic, momenta)
+    variables_ = variables(list(reduced.q), list(reduced.v), model.t)
+    name = f"{model.name}, Routhian (ignoring {', '.join(str(model.q[i]) for i in cyclic)})"
+    return _build(variables_, reduced.R, reduced.parameters, None, None, None, (), model._spec.jit, name, started)
+
+
 def _mass_matrix(mass: Any, variables: Variables) -> sp.Matrix:
     """M as an n×n SymPy Matrix in the plain symbols; ValueError naming ``mass`` unless it is
     a scalar or a symmetric n×n matrix."""
@@ -221,3 +278,7 @@ def _build(
     )
     symbolic = Symbolic(variables.q, variables.v, variables.t, L, derivation.functions, derivation.cyclic, name)
     return SymbolicModel(spec, symbolic, started=started)
+
+
+# The examples build their models with lagrangian and mechanical, so they come after them.
+from . import examples  # noqa: E402

@@ -1,0 +1,350 @@
+"""Symbolic models: a twin of every closure example of :mod:`varmech.examples` with a
+Lagrangian (each the native scene's L in SymPy, with the scene's parameters as defaults), and
+two systems that only the symbolic path makes easy, the elastic pendulum and the bead on a
+rotating hoop.
+
+Each function returns a :class:`~varmech.symbolic.SymbolicModel` whose parameters are named
+after its symbols: change them per run with ``model.with_parameters(...)`` or
+``integrate(..., parameters={...})``. :func:`symbolic_of` gives the twin of a built-in scene.
+
+Examples
+--------
+>>> import varmech
+>>> from varmech import scenes
+>>> from varmech.symbolic import examples
+>>> scene = scenes.double_pendulum()
+>>> twin = examples.symbolic_of(scene)
+>>> twin.parameters
+{'m1': 1.0, 'm2': 2.0, 'l1': 2.0, 'l2': 3.0, 'g': 9.80665}
+>>> native = varmech.integrate(scene, dt=scene.dt, steps=100)
+>>> compiled = varmech.integrate(twin, scene.q0, scene.p0, dt=scene.dt, steps=100)
+>>> bool(abs(compiled.q - native.q).max() < 1e-12)
+True
+"""
+
+from __future__ import annotations
+
+import inspect
+
+import sympy as sp
+
+from ..model import Rotation
+from ..scenes import CATALOGUE, Scene
+from . import SymbolicModel, lagrangian, mechanical
+
+__all__ = [
+    "cartesian_pendulum",
+    "charged_particle",
+    "charged_particle_nonuniform",
+    "damped_driven_pendulum",
+    "double_pendulum",
+    "elastic_pendulum",
+    "heavy_top",
+    "kepler",
+    "kepler_polar",
+    "rotating_hoop",
+    "spherical_pendulum",
+    "symbolic_of",
+]
+
+_G = 9.80665
+
+
+def double_pendulum(
+    m1: float = 1.0, m2: float = 2.0, l1: float = 2.0, l2: float = 3.0, g: float = _G, *, jit: bool = True
+) -> SymbolicModel:
+    """The planar double pendulum in its angles θ₁, θ₂ from the downward vertical (the
+    Lagrangian of issue 14, word for word)::
+
+        L = ½(m₁+m₂)l₁²θ̇₁² + ½m₂l₂²θ̇₂² + m₂l₁l₂θ̇₁θ̇₂cos(θ₁−θ₂) + (m₁+m₂)gl₁cos θ₁ + m₂gl₂cos θ₂
+
+    with the native scene's l = (2, 3), m = (1, 2), g = 9.80665 by default. A general
+    Lagrangian (its mass matrix depends on θ₁ − θ₂).
+    """
+    q1, q2, v1, v2 = sp.symbols("q1 q2 v1 v2")
+    m1_, m2_, l1_, l2_, g_ = sp.symbols("m1 m2 l1 l2 g", positive=True)
+    L = (
+        sp.Rational(1, 2) * (m1_ + m2_) * l1_**2 * v1**2
+        + sp.Rational(1, 2) * m2_ * l2_**2 * v2**2
+        + m2_ * l1_ * l2_ * v1 * v2 * sp.cos(q1 - q2)
+        + (m1_ + m2_) * g_ * l1_ * sp.cos(q1)
+        + m2_ * g_ * l2_ * sp.cos(q2)
+    )
+    parameters = {m1_: m1, m2_: m2, l1_: l1, l2_: l2, g_: g}
+    return lagrangian(L, [q1, q2], [v1, v2], parameters=parameters, jit=jit, name="double_pendulum (symbolic)")
+
+
+def spherical_pendulum(m: float = 1.0, l: float = 1.0, g: float = 1.0, *, jit: bool = True) -> SymbolicModel:
+    """The spherical pendulum in its polar angle θ from the downward vertical and its azimuth
+    φ::
+
+        L = ½ml²(θ̇² + sin²θ φ̇²) + mgl cos θ
+
+    (m = l = g = 1 by default). φ is cyclic: p_φ = ml² sin²θ φ̇ is conserved.
+    """
+    th, ph, vth, vph = sp.symbols("theta phi v_theta v_phi")
+    m_, l_, g_ = sp.symbols("m l g", positive=True)
+    L = m_ * l_**2 / 2 * (vth**2 + sp.sin(th) ** 2 * vph**2) + m_ * g_ * l_ * sp.cos(th)
+    return lagrangian(
+        L, [th, ph], [vth, vph], parameters={m_: m, l_: l, g_: g}, jit=jit, name="spherical_pendulum (symbolic)"
+    )
+
+
+def heavy_top(I1: float = 1.0, I3: float = 0.5, Mgl: float = 1.0, *, jit: bool = True) -> SymbolicModel:
+    """The heavy symmetric top in Euler angles (θ, φ, ψ), θ from the upward vertical::
+
+        L = ½I₁(θ̇² + sin²θ φ̇²) + ½I₃(ψ̇ + φ̇ cos θ)² − Mgl cos θ
+
+    (I₁ = 1, I₃ = ½, Mgl = 1 by default). φ and ψ are cyclic: p_φ and p_ψ are conserved, and
+    :func:`varmech.symbolic.routh` ignores them in closed form.
+    """
+    th, ph, ps, vth, vph, vps = sp.symbols("theta phi psi v_theta v_phi v_psi")
+    i1, i3 = sp.symbols("I1 I3", positive=True)
+    mgl = sp.Symbol("Mgl")
+    L = i1 / 2 * (vth**2 + sp.sin(th) ** 2 * vph**2) + i3 / 2 * (vps + vph * sp.cos(th)) ** 2 - mgl * sp.cos(th)
+    return lagrangian(
+        L,
+        [th, ph, ps],
+        [vth, vph, vps],
+        parameters={i1: I1, i3: I3, mgl: Mgl},
+        jit=jit,
+        name="heavy_top (symbolic)",
+    )
+
+
+def kepler(*, jit: bool = True) -> SymbolicModel:
+    """Kepler's problem in the plane as the native scene has it, the separable mechanical
+    system with unit mass and no parameters::
+
+        L = ½|q̇|² + 1/|q|,   H = |p|²/2 − 1/|q|
+
+    rotation invariant: the angular momentum x p_y − y p_x is conserved.
+    """
+    x, y, vx, vy = sp.symbols("x y v_x v_y")
+    return mechanical(
+        -1 / sp.sqrt(x**2 + y**2),
+        [x, y],
+        1,
+        v=[vx, vy],
+        symmetries=[Rotation(spatial_dim=2)],
+        jit=jit,
+        name="kepler (symbolic)",
+    )
+
+
+def kepler_polar(m: float = 1.0, k: float = 1.0, *, jit: bool = True) -> SymbolicModel:
+    """Kepler's problem in polar coordinates (r, θ)::
+
+        L = ½m(ṙ² + r²θ̇²) + k/r
+
+    (m = k = 1 by default). θ is cyclic: p_θ = mr²θ̇ is conserved.
+    """
+    r, th, vr, vth = sp.symbols("r theta v_r v_theta")
+    m_, k_ = sp.symbols("m k", positive=True)
+    L = m_ / 2 * (vr**2 + r**2 * vth**2) + k_ / r
+    return lagrangian(L, [r, th], [vr, vth], parameters={m_: m, k_: k}, jit=jit, name="kepler_polar (symbolic)")
+
+
+def charged_particle(
+    B: float = 1.0, kappa: float = 0.0, m: float = 1.0, e: float = 1.0, *, jit: bool = True
+) -> SymbolicModel:
+    """A charge e of mass m in the plane, in the magnetic field B(q) = B(1 + κ|q|²) ẑ, in the
+    symmetric gauge::
+
+        L = ½m|q̇|² + e·a(|q|²)(x ẏ − y ẋ),   a(r²) = ½B(1 + κr²/2)
+
+    (∇×A = B(q) for A = a(|q|²)(−y, x)). κ = 0 is the uniform field, in which the particle
+    gyrates at Ω = eB/m. Rotation invariant: the canonical angular momentum x p_y − y p_x is
+    conserved. The defaults are the native scene's (m = e = B = 1, κ = 0).
+    """
+    x, y, vx, vy = sp.symbols("x y v_x v_y")
+    B_, kappa_, e_ = sp.symbols("B kappa e")
+    m_ = sp.Symbol("m", positive=True)
+    a = B_ / 2 * (1 + kappa_ * (x**2 + y**2) / 2)
+    L = m_ / 2 * (vx**2 + vy**2) + e_ * a * (x * vy - y * vx)
+    return lagrangian(
+        L,
+        [x, y],
+        [vx, vy],
+        parameters={B_: B, kappa_: kappa, m_: m, e_: e},
+        symmetries=[Rotation(spatial_dim=2)],
+        jit=jit,
+        name="charged_particle (symbolic)",
+    )
+
+
+def charged_particle_nonuniform(*, jit: bool = True) -> SymbolicModel:
+    """The charged particle in the native scene's non-uniform field B(q) = (1 + |q|²/4) ẑ:
+    :func:`charged_particle` with B = 1, κ = ¼."""
+    return charged_particle(kappa=0.25, jit=jit)
+
+
+def damped_driven_pendulum(
+    gamma: float = 0.5,
+    amplitude: float = 1.5,
+    drive: float = 2.0 / 3.0,
+    m: float = 1.0,
+    l: float = 1.0,
+    g: float = 1.0,
+    *,
+    jit: bool = True,
+) -> SymbolicModel:
+    """The damped, driven pendulum ml²θ̈ + γθ̇ + mgl sin θ = A cos Ωt::
+
+        L = ½ml²θ̇² + mgl cos θ,   R = ½γθ̇²,   Q = A cos Ωt
+
+    with the Rayleigh dissipation R and the driving torque Q as a force (``amplitude`` is A,
+    ``drive`` is Ω). The defaults are the native scene's, Baker & Gollub's chaotic regime
+    (γ = ½, A = 3/2, Ω = 2/3, m = l = g = 1).
+    """
+    th, om, t = sp.symbols("theta omega t")
+    gamma_, amplitude_, drive_ = sp.symbols("gamma amplitude drive")
+    m_, l_, g_ = sp.symbols("m l g", positive=True)
+    return lagrangian(
+        m_ * l_**2 * om**2 / 2 + m_ * g_ * l_ * sp.cos(th),
+        [th],
+        [om],
+        t=t,
+        force=[amplitude_ * sp.cos(drive_ * t)],
+        rayleigh=gamma_ * om**2 / 2,
+        parameters={gamma_: gamma, amplitude_: amplitude, drive_: drive, m_: m, l_: l, g_: g},
+        jit=jit,
+        name="damped_driven_pendulum (symbolic)",
+    )
+
+
+def cartesian_pendulum(m: float = 1.0, l: float = 1.0, g: float = 1.0, *, jit: bool = True) -> SymbolicModel:
+    """The planar pendulum in Cartesian coordinates (x, y) on its circle::
+
+        L = ½m(ẋ² + ẏ²) − mgy,   g(q) = ½(x² + y² − l²) = 0
+
+    (m = l = g = 1 by default), integrated by ``rattle``.
+    """
+    x, y, vx, vy = sp.symbols("x y v_x v_y")
+    m_, l_, g_ = sp.symbols("m l g", positive=True)
+    return mechanical(
+        m_ * g_ * y,
+        [x, y],
+        m_,
+        v=[vx, vy],
+        constraints=[(x**2 + y**2 - l_**2) / 2],
+        parameters={m_: m, l_: l, g_: g},
+        jit=jit,
+        name="cartesian_pendulum (symbolic)",
+    )
+
+
+def elastic_pendulum(
+    m: float = 1.0, k: float = 10.0, l0: float = 1.0, g: float = _G, *, jit: bool = True
+) -> SymbolicModel:
+    """The elastic (spring) pendulum: a mass m on a massless spring of stiffness k and rest
+    length l₀ swinging in a vertical plane, in polar coordinates (r, θ), θ from the downward
+    vertical::
+
+        L = ½m(ṙ² + r²θ̇²) + mgr cos θ − ½k(r − l₀)²
+
+    Its mass matrix diag(m, mr²) depends on r, so it is a general Lagrangian; nothing but the
+    energy is conserved, and the motion is chaotic at large amplitude. It hangs at rest at
+    r = l_eq = l₀ + mg/k, about which the small oscillations are the radial one at √(k/m) and
+    the swing at √(g/l_eq). Defaults: m = 1, k = 10, l₀ = 1, g = 9.80665.
+
+    Examples
+    --------
+    >>> import varmech
+    >>> from varmech.symbolic import examples
+    >>> model = examples.elastic_pendulum()
+    >>> traj = varmech.integrate(model, [1.2, 0.5], [0.0, 0.0], dt=0.01, steps=1000, method="midpoint")
+    >>> varmech.check_conservation(traj).verdict
+    'bounded'
+    """
+    r, th, vr, vth = sp.symbols("r theta v_r v_theta")
+    m_, k_, l0_, g_ = sp.symbols("m k l0 g", positive=True)
+    L = m_ / 2 * (vr**2 + r**2 * vth**2) + m_ * g_ * r * sp.cos(th) - k_ / 2 * (r - l0_) ** 2
+    return lagrangian(
+        L,
+        [r, th],
+        [vr, vth],
+        parameters={m_: m, k_: k, l0_: l0, g_: g},
+        jit=jit,
+        name="elastic_pendulum (symbolic)",
+    )
+
+
+def rotating_hoop(
+    m: float = 1.0, R: float = 1.0, Omega: float = 5.0, g: float = _G, *, jit: bool = True
+) -> SymbolicModel:
+    """A bead of mass m sliding without friction on a hoop of radius R that a motor turns
+    about its vertical diameter at the prescribed rate Ω, in the bead's angle θ from the
+    bottom of the hoop.
+
+    The Lagrangian is derived from the bead's inertial position at the hoop's azimuth
+    φ = Ωt, r(θ, t) = R(sin θ cos Ωt, sin θ sin Ωt, −cos θ), as L = ½m|ṙ|² − mgz with
+    ṙ = ∂r/∂θ θ̇ + ∂r/∂t::
+
+        L = ½mR²(θ̇² + Ω² sin²θ) + mgR cos θ
+
+    The explicit t of the inertial position cancels in |ṙ|² (the rotation is uniform about
+    the axis of gravity), so L is autonomous and separable, L = ½mR²θ̇² − V_eff(θ) with
+    V_eff = −½mR²Ω² sin²θ − mgR cos θ: its energy function, the Jacobi integral
+
+        h = p θ̇ − L = ½mR²(θ̇² − Ω² sin²θ) − mgR cos θ,
+
+    is conserved (it is the energy in the rotating frame), while the bead's inertial energy
+    T + V = h + mR²Ω² sin²θ is not: the motor works on the bead at the rate
+    d(T + V)/dt = mR²Ω² sin 2θ θ̇. For Ω² > g/R the bottom is unstable and the bead rests
+    (relative to the hoop) at cos θ* = g/(RΩ²). Defaults: m = R = 1, Ω = 5, g = 9.80665.
+
+    Examples
+    --------
+    >>> import math
+    >>> import varmech
+    >>> from varmech.symbolic import examples
+    >>> model = examples.rotating_hoop()
+    >>> model.L
+    R*m*(Omega**2*R*sin(theta)**2/2 + R*omega**2/2 + g*cos(theta))
+    >>> rest = math.acos(9.80665 / 25.0)  # cos θ* = g/(RΩ²)
+    >>> traj = varmech.integrate(model, [rest], [0.0], dt=0.01, steps=1000, method="midpoint")
+    >>> bool(abs(traj.q[-1, 0] - rest) < 1e-12)
+    True
+    """
+    th, om, t = sp.symbols("theta omega t")
+    m_, R_, Omega_, g_ = sp.symbols("m R Omega g", positive=True)
+    position = R_ * sp.Matrix([sp.sin(th) * sp.cos(Omega_ * t), sp.sin(th) * sp.sin(Omega_ * t), -sp.cos(th)])
+    velocity = position.diff(th) * om + position.diff(t)
+    L = sp.trigsimp(m_ * velocity.dot(velocity) / 2 - m_ * g_ * position[2])
+    return lagrangian(
+        L, [th], [om], t=t, parameters={m_: m, R_: R, Omega_: Omega, g_: g}, jit=jit, name="rotating_hoop (symbolic)"
+    )
+
+
+#: The twin of each built-in scene by the scene's name.
+_TWINS = {
+    f.__name__: f
+    for f in (
+        double_pendulum,
+        spherical_pendulum,
+        heavy_top,
+        kepler,
+        kepler_polar,
+        charged_particle,
+        charged_particle_nonuniform,
+        damped_driven_pendulum,
+        cartesian_pendulum,
+    )
+}
+
+
+def symbolic_of(scene: Scene, *, jit: bool = True) -> SymbolicModel:
+    """The symbolic twin of a built-in scene: the function of this module with the scene's
+    name, at the scene's parameters (a catalogue parameter is passed on when the twin has a
+    keyword of that name, compared without case — the charged particle's ``b`` is ``B``; the
+    others, such as Kepler's eccentricity ``e``, set the initial state, not the model).
+
+    ValueError for a scene without a symbolic twin.
+    """
+    twin = _TWINS.get(scene.name) if scene.name in CATALOGUE else None
+    if twin is None:
+        raise ValueError(f"scene: {scene.name!r} has no symbolic twin in varmech.symbolic.examples")
+    keywords = {name.lower(): name for name in inspect.signature(twin).parameters if name != "jit"}
+    given = {keywords[name.lower()]: value for name, value in scene.parameters.items() if name.lower() in keywords}
+    return twin(**given, jit=jit)
