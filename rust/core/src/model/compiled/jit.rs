@@ -131,8 +131,14 @@ fn define(module: &mut JITModule, tape: &Tape) -> Result<FuncId, Box<dyn std::er
     let memory = MemFlagsData::trusted();
     let offset = |index: usize| i32::try_from(index * 8).map_err(|_| format!("array index {index} too large"));
 
+    // Each output is stored as soon as its register is computed, so that it is not kept live
+    // (and spilled around every call) to the end: (register, output index) in register order.
+    let mut stores: Vec<(u32, usize)> = tape.outputs().iter().enumerate().map(|(j, &o)| (o, j)).collect();
+    stores.sort_unstable();
+    let mut stores = stores.into_iter().peekable();
+
     let mut registers: Vec<Value> = Vec::with_capacity(tape.ops().len());
-    for &op in tape.ops() {
+    for (i, &op) in tape.ops().iter().enumerate() {
         let r = |a: u32| registers[a as usize];
         let value = match op {
             Op::Const(c) => b.ins().f64const(c),
@@ -181,9 +187,9 @@ fn define(module: &mut JITModule, tape: &Tape) -> Result<FuncId, Box<dyn std::er
             }
         };
         registers.push(value);
-    }
-    for (j, &o) in tape.outputs().iter().enumerate() {
-        b.ins().store(memory, registers[o as usize], out, offset(j)?);
+        while let Some((_, j)) = stores.next_if(|&(o, _)| o as usize == i) {
+            b.ins().store(memory, value, out, offset(j)?);
+        }
     }
     b.ins().return_(&[]);
     b.finalize(module.target_config());
