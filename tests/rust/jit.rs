@@ -192,6 +192,40 @@ fn a_tape_of_thousands_of_instructions_compiles_and_agrees() {
 }
 
 #[test]
+fn a_frame_of_many_pages_compiles_and_agrees() {
+    // Every sine stays live across the later calls to its sum at the end: 3000 spills.
+    let mut b = Builder::default();
+    let x = b.push(Op::Input(0));
+    let sines: Vec<u32> = (0..3000)
+        .map(|k| {
+            let c = b.push(Op::Const(1.0 + k as f64 / 1000.0));
+            let a = b.push(Op::Binary(Binary::Mul, x, c));
+            b.push(Op::Unary(Unary::Sin, a))
+        })
+        .collect();
+    let mut sum = sines[0];
+    for &s in sines.iter().rev() {
+        sum = b.push(Op::Binary(Binary::Add, sum, s));
+    }
+    let tape = Tape::new("tape", b.0, vec![sum], 1, 0).unwrap();
+    let code = Code::compile(&tape).unwrap();
+    let mut points = Points(8);
+    for _ in 0..100 {
+        assert_agree(&tape, &code, &[points.value()], &[]);
+    }
+}
+
+#[test]
+fn code_moved_to_another_thread_runs_and_is_freed_there() {
+    let tape = long_tape(300, 2);
+    let code = Code::compile(&tape).unwrap();
+    let inputs = [0.25, -1.5, 3.0];
+    std::thread::spawn(move || assert_agree(&tape, &code, &inputs, &[0.5]))
+        .join()
+        .unwrap();
+}
+
+#[test]
 fn threads_calling_one_code_at_once_agree() {
     let tape = long_tape(600, 11);
     let code = Code::compile(&tape).unwrap();

@@ -50,6 +50,9 @@ impl Code {
             ("opt_level", "speed"),
             ("is_pic", "false"),
             ("use_colocated_libcalls", "false"),
+            // A long tape's spills can make a frame larger than the stack's guard page: probe it.
+            ("enable_probestack", "true"),
+            ("probestack_strategy", "inline"),
         ] {
             flags.set(name, value).map_err(|e| fail(&e))?;
         }
