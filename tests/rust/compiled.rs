@@ -26,13 +26,27 @@ impl Builder {
         self.op(Op::Unary(f, a))
     }
     fn function(self, outputs: Vec<u32>, n: usize, params: usize) -> Function {
-        Function::new(Tape::new("test", self.ops, outputs, 2 * n + 1, params).unwrap())
+        Function::new(self.tape(outputs, n, params))
+    }
+    /// The function compiled to machine code (interpreted without the `jit` feature).
+    fn compiled(self, outputs: Vec<u32>, n: usize, params: usize) -> Function {
+        Function::compiled(self.tape(outputs, n, params)).unwrap()
+    }
+    fn tape(self, outputs: Vec<u32>, n: usize, params: usize) -> Tape {
+        Tape::new("test", self.ops, outputs, 2 * n + 1, params).unwrap()
     }
 }
 
 /// Kepler's V = −μ/r and ∇V = μq/r³ with the native scene's operations in its order (r² =
-/// x² + y², μ/(r²·√r²)), μ a parameter, and M = 1.
-fn kepler(mu: f64) -> CompiledSeparable {
+/// x² + y², μ/(r²·√r²)), μ a parameter, and M = 1; run by machine code when `jit` holds.
+fn kepler(mu: f64, jit: bool) -> CompiledSeparable {
+    let finish = |b: Builder, outputs, n, params| {
+        if jit {
+            b.compiled(outputs, n, params)
+        } else {
+            b.function(outputs, n, params)
+        }
+    };
     let mut b = Builder::default();
     let (x, y, m) = (b.input(0), b.input(1), b.op(Op::Param(0)));
     let (xx, yy) = (b.binary(Binary::Mul, x, x), b.binary(Binary::Mul, y, y));
@@ -41,7 +55,7 @@ fn kepler(mu: f64) -> CompiledSeparable {
     let d = b.binary(Binary::Mul, r2, s);
     let k = b.binary(Binary::Div, m, d);
     let (gx, gy) = (b.binary(Binary::Mul, k, x), b.binary(Binary::Mul, k, y));
-    let gradient = b.function(vec![gx, gy], 2, 1);
+    let gradient = finish(b, vec![gx, gy], 2, 1);
 
     let mut b = Builder::default();
     let (x, y, m) = (b.input(0), b.input(1), b.op(Op::Param(0)));
@@ -50,7 +64,7 @@ fn kepler(mu: f64) -> CompiledSeparable {
     let s = b.unary(Unary::Sqrt, r2);
     let v = b.binary(Binary::Div, m, s);
     let v = b.unary(Unary::Neg, v);
-    let potential = b.function(vec![v], 2, 1);
+    let potential = finish(b, vec![v], 2, 1);
 
     let mut b = Builder::default();
     let one = b.op(Op::Const(1.0));
@@ -73,31 +87,30 @@ fn same_bits(a: &[f64], b: &[f64]) -> bool {
 fn a_kepler_tape_runs_bit_for_bit_as_the_native_scene() {
     let problem = Kepler::problem(0.6).unwrap();
     let (q0, p0) = (&problem.initial.q, &problem.initial.p);
-    for method in [Method::Verlet, Method::KahanLi8, Method::Midpoint] {
+    let cases = [Method::Verlet, Method::KahanLi8, Method::Midpoint].map(|m| [(m, false), (m, true)]);
+    for (method, jit) in cases.into_iter().flatten() {
         let o = options(2.0 * std::f64::consts::PI / 200.0, 1000);
         let native = integrate(&problem.system, method, q0, p0, &o, || Ok(()))
             .map_err(|f| f.error)
             .unwrap();
-        let compiled = integrate(&kepler(1.0), method, q0, p0, &o, || Ok(()))
+        let compiled = integrate(&kepler(1.0, jit), method, q0, p0, &o, || Ok(()))
             .map_err(|f| f.error)
             .unwrap();
+        let what = format!("{method:?}, jit {jit}");
         assert!(
             same_bits(&native.q, &compiled.q) && same_bits(&native.p, &compiled.p),
-            "{method:?}"
+            "{what}"
         );
-        assert_eq!(native.newton_iterations, compiled.newton_iterations, "{method:?}");
+        assert_eq!(native.newton_iterations, compiled.newton_iterations, "{what}");
     }
 }
 
-/// Kepler's problem with GM = μ is the GM = 1 orbit on the time scale 1/√μ: positions alike and
-/// momenta √μ times larger at steps dt/√μ. At μ = 4 every scaling is by a power of two, so a
-/// symplectic splitting reproduces it bit for bit: the parameter reaches every evaluation.
 #[test]
 fn a_parameter_rescales_time_exactly() {
     let problem = Kepler::problem(0.6).unwrap();
     let (q0, p0) = (&problem.initial.q, &problem.initial.p);
     let dt = 2.0 * std::f64::consts::PI / 200.0;
-    let one = kepler(1.0);
+    let one = kepler(1.0, true);
     let four = one.with_parameters(&[4.0]).unwrap();
     let p0_four: Vec<f64> = p0.iter().map(|p| 2.0 * p).collect();
     for method in [Method::Verlet, Method::KahanLi6] {

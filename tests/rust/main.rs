@@ -15,6 +15,8 @@ mod forcing;
 mod general_lagrangian;
 mod heavy_top;
 mod hessians;
+#[cfg(feature = "jit")]
+mod jit;
 mod kepler;
 mod kepler_polar;
 mod routh;

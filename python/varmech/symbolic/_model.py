@@ -48,7 +48,7 @@ class Symbolic:
     name: str
 
 
-def _compile(spec: Spec) -> Any:
+def _compile(spec: Spec) -> _core.CompiledModel:
     """The core's compiled model of ``spec``: the one place that calls the binding."""
     return _core.CompiledModel(
         spec.kind,
@@ -89,8 +89,7 @@ class SymbolicModel(Model):
         Wall time from the expressions to the ready model.
     """
 
-    # The core's CompiledModel (typed once the binding's stub has it).
-    _core: Any
+    _core: _core.CompiledModel
 
     def __init__(self, spec: Spec, symbolic: Symbolic, *, core: Any = None, started: float | None = None):
         start = time.perf_counter() if started is None else started
@@ -151,6 +150,18 @@ class SymbolicModel(Model):
         vector = np.array([current[name] for name in names], dtype=np.float64)
         spec = replace(self._spec, parameters=vector)
         return SymbolicModel(spec, self._symbolic, core=self._core.with_parameters(vector), started=started)
+
+    @property
+    def jit(self) -> bool:
+        """Whether the tapes run as machine code (compiled by Cranelift); else the core's tape
+        interpreter runs them."""
+        return bool(self._core.jit)
+
+    def with_jit(self, jit: bool) -> SymbolicModel:
+        """The same model with its tapes compiled to machine code (``True``) or interpreted
+        (``False``): the two agree bit for bit, the interpreter is slower and needs no compile
+        step."""
+        return SymbolicModel(replace(self._spec, jit=bool(jit)), self._symbolic)
 
     def __reduce__(self) -> tuple[Any, ...]:
         # The tapes and expressions, never the compiled code: unpickling compiles them again.

@@ -28,6 +28,8 @@ type Encoded<'py> = (
 #[pyclass(frozen, module = "varmech._core")]
 pub struct CompiledModel {
     pub model: Compiled,
+    /// Whether the tapes run as machine code.
+    jit: bool,
 }
 
 impl CompiledModel {
@@ -45,13 +47,15 @@ impl CompiledModel {
     }
 }
 
-/// The named function of `functions`, decoded for a model with n coordinates.
+/// The named function of `functions`, decoded for a model with n coordinates, and compiled
+/// to machine code when `jit` holds.
 fn function(
     py: Python<'_>,
     functions: &HashMap<String, Encoded<'_>>,
     name: &'static str,
     n: usize,
     params: usize,
+    jit: bool,
 ) -> PyResult<Option<Function>> {
     let Some((ops, constants, outputs)) = functions.get(name) else {
         return Ok(None);
@@ -71,7 +75,12 @@ fn function(
         .map_err(|_| PyValueError::new_err(format!("{name}: outputs must be a contiguous int64 array")))?;
     let tape =
         Tape::decode(name, &rows, slice(name, constants)?, outputs, 2 * n + 1, params).map_err(|e| to_pyerr(py, e))?;
-    Ok(Some(Function::new(tape)))
+    let function = if jit {
+        Function::compiled(tape)
+    } else {
+        Ok(Function::new(tape))
+    };
+    function.map(Some).map_err(|e| to_pyerr(py, e))
 }
 
 fn required(name: &'static str, f: Option<Function>) -> PyResult<Function> {
@@ -95,11 +104,15 @@ impl CompiledModel {
         symmetries: Vec<Spec>,
         jit: bool,
     ) -> PyResult<Self> {
-        let _ = jit;
         generator::generators(py, symmetries, dim)?;
         let params = slice("parameters", &parameters)?.to_vec();
         let k = params.len();
-        let f = |name| function(py, &functions, name, dim, k);
+        let compiled = std::cell::Cell::new(false);
+        let f = |name| {
+            let function = function(py, &functions, name, dim, k, jit)?;
+            compiled.set(compiled.get() || function.as_ref().is_some_and(Function::is_compiled));
+            Ok::<_, PyErr>(function)
+        };
         let err = |e| to_pyerr(py, e);
         let force = f("force")?;
         if forced != force.is_some() {
@@ -168,7 +181,10 @@ impl CompiledModel {
                 )));
             }
         };
-        Ok(CompiledModel { model })
+        Ok(CompiledModel {
+            model,
+            jit: compiled.get(),
+        })
     }
 
     #[getter]
@@ -195,7 +211,7 @@ impl CompiledModel {
     /// Whether the tapes run as machine code (else the interpreter runs them).
     #[getter]
     fn jit(&self) -> bool {
-        false
+        self.jit
     }
 
     /// The same model with another parameter vector; the tapes are shared.
@@ -204,7 +220,7 @@ impl CompiledModel {
             .model
             .with_parameters(slice("values", &values)?)
             .map_err(|e| to_pyerr(py, e))?;
-        Ok(CompiledModel { model })
+        Ok(CompiledModel { model, jit: self.jit })
     }
 
     fn __repr__(&self) -> String {

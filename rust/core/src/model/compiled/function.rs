@@ -8,10 +8,13 @@ use super::Tape;
 use crate::Error;
 
 /// A model function y = f(q, q̇, t; parameters) of a compiled model, its inputs in the slots
-/// [q, q̇, t]. Cloning shares the tape (and its code).
+/// [q, q̇, t], run by its machine code where it was compiled ([`Function::compiled`]) and by
+/// the tape's interpreter otherwise. Cloning shares the tape and its code.
 #[derive(Clone, Debug)]
 pub struct Function {
     tape: Arc<Tape>,
+    #[cfg(feature = "jit")]
+    code: Option<Arc<super::Code>>,
 }
 
 thread_local! {
@@ -23,8 +26,36 @@ thread_local! {
 }
 
 impl Function {
+    /// The function of `tape`, interpreted.
     pub fn new(tape: Tape) -> Self {
-        Function { tape: Arc::new(tape) }
+        Function {
+            tape: Arc::new(tape),
+            #[cfg(feature = "jit")]
+            code: None,
+        }
+    }
+
+    /// The function of `tape`, compiled to machine code where the crate has its `jit` feature
+    /// (and interpreted where it has not).
+    pub fn compiled(tape: Tape) -> Result<Self, Error> {
+        #[cfg(feature = "jit")]
+        {
+            let code = super::Code::compile(&tape)?;
+            Ok(Function {
+                tape: Arc::new(tape),
+                code: Some(Arc::new(code)),
+            })
+        }
+        #[cfg(not(feature = "jit"))]
+        Ok(Self::new(tape))
+    }
+
+    /// Whether machine code runs this function.
+    pub fn is_compiled(&self) -> bool {
+        #[cfg(feature = "jit")]
+        return self.code.is_some();
+        #[cfg(not(feature = "jit"))]
+        false
     }
 
     pub fn tape(&self) -> &Tape {
@@ -46,6 +77,10 @@ impl Function {
             slots[..n].copy_from_slice(q);
             slots[n..n + v.len()].copy_from_slice(v);
             slots[2 * n] = t;
+            #[cfg(feature = "jit")]
+            if let Some(code) = &self.code {
+                return code.call(slots, params, out);
+            }
             if regs.len() < self.tape.ops().len() {
                 regs.resize(self.tape.ops().len(), 0.0);
             }

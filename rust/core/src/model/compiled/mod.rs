@@ -3,19 +3,25 @@
 //! core with no call out per evaluation.
 //!
 //! - [`Tape`]: straight-line SSA code over the input slots [q, q̇, t] and the parameters;
-//! - [`Function`]: one model function, a tape with its evaluator;
+//! - `Code` (feature `jit`, on by default): a tape compiled to machine code by Cranelift, bit for
+//!   bit the interpreter's results;
+//! - [`Function`]: one model function, a tape run by its code or by the interpreter;
 //! - [`CompiledLagrangian`]: a general L(q, q̇, t) with exact derivatives and Hessians;
 //! - [`CompiledSeparable`]: L = ½q̇ᵀMq̇ − V(q) with constant M, for every method;
 //! - [`CompiledConstraints`]: g(q) = 0 with its exact Jacobian.
 
 mod constraints;
 mod function;
+#[cfg(feature = "jit")]
+mod jit;
 mod lagrangian;
 mod separable;
 mod tape;
 
 pub use constraints::CompiledConstraints;
 pub use function::Function;
+#[cfg(feature = "jit")]
+pub use jit::Code;
 pub use lagrangian::CompiledLagrangian;
 pub use separable::CompiledSeparable;
 pub use tape::{sign, Binary, Op, Tape, Unary};
