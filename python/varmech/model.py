@@ -108,6 +108,7 @@ class Model:
         | _core.ClosureLagrangian
         | _core.PointerSystem
         | _core.PointerLagrangian
+        | _core.CompiledModel
         | _core.RouthModel
     )
     symmetries: tuple[Symmetry, ...]
