@@ -16,10 +16,12 @@ from pathlib import Path
 from varmech.charts.recipes import KINDS, chart
 
 #: (kind, scene): the charts of the gallery; the work–precision chart also on the outer solar
-#: system, where REBOUND is the baseline.
+#: system, where REBOUND is the baseline, and on the symbolic elastic pendulum, against SciPy on
+#: its lambdified equations.
 GALLERY = [
     ("work-precision", "kepler"),
     ("work-precision", "outer_solar_system"),
+    ("work-precision", "elastic_pendulum"),
     ("energy", "kepler"),
     ("stability", None),
     ("implicit-regions", "pendulum"),

@@ -14,7 +14,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from . import _core
-from .model import NativeSystem
+from .model import Model, NativeSystem
 
 
 @dataclass(frozen=True)
@@ -29,7 +29,8 @@ class Reference:
 
 @dataclass(frozen=True)
 class Scene:
-    """A native model with its initial state and test protocol.
+    """A model with its initial state and test protocol: a native one of the core's catalogue
+    (:func:`get`), or a symbolic one (:func:`varmech.symbolic.examples.scene`).
 
     ``dt`` is a step that resolves the scene for a quick look (the tour uses it);
     ``invariants`` holds the values of the conserved quantities at t = 0; ``parameters`` the
@@ -38,7 +39,7 @@ class Scene:
 
     name: str
     description: str
-    model: NativeSystem
+    model: Model
     q0: np.ndarray
     p0: np.ndarray
     t_end: float
@@ -53,9 +54,21 @@ class Scene:
 CATALOGUE: dict[str, _core.CatalogueEntry] = {entry.name: entry for entry in _core.catalogue()}
 
 
+#: The symbolic scenes (:func:`varmech.symbolic.examples.scene`), which need SymPy.
+SYMBOLIC = ("elastic_pendulum",)
+
+
 def get(name: str, **parameters: float) -> Scene:
     """The scene called ``name`` (one of :data:`CATALOGUE`) with ``parameters`` set by keyword
-    and the others at their defaults; ValueError for an unknown scene or parameter."""
+    and the others at their defaults, or the symbolic scene of that name (one of
+    :data:`SYMBOLIC`, at its defaults; needs SymPy); ValueError for an unknown scene or
+    parameter."""
+    if name in SYMBOLIC and name not in CATALOGUE:
+        if parameters:
+            raise ValueError(f"parameters: the symbolic scene {name} takes none here; build its model with them")
+        from .symbolic import examples
+
+        return examples.scene(name)
     record = _core.scene(name, **parameters)
     ref = record.reference
     reference = Reference(ref.t, ref.q, ref.p, ref.source) if ref is not None else None

@@ -122,8 +122,11 @@ def default_atol(scene: Scene, rtol: float) -> np.ndarray:
 
 
 def solve(solve_ivp: Any, scene: Scene, method: str, t_end: float, rtol: float, atol: Any, t_eval: Any = None) -> tuple[Any, int]:
-    """One solve_ivp run of ``scene`` to ``t_end``: the solution and the force evaluations."""
-    rhs = Rhs(scene.model)
+    """One solve_ivp run of ``scene`` to ``t_end``: the solution and the force evaluations. A
+    symbolic model's right-hand side is its lambdified first-order system (what a SciPy user
+    would write from the same L, and faster than calling the model through the binding)."""
+    first_order = getattr(scene.model, "first_order", None)
+    rhs = (first_order() if first_order is not None else None) or Rhs(scene.model)
     y0 = np.concatenate([scene.q0, scene.p0])
     a = default_atol(scene, rtol) if atol is None else atol
     # Implicit methods get columns at once for their finite-difference Jacobians.

@@ -14,6 +14,7 @@ from .. import _core
 from .._util import finite
 from ..model import Model, Symmetry, _specs
 from ._lower import Tape
+from ._rhs import FirstOrder
 
 
 @dataclass(frozen=True)
@@ -162,6 +163,13 @@ class SymbolicModel(Model):
         (``False``): the two agree bit for bit, the interpreter is slower and needs no compile
         step."""
         return SymbolicModel(replace(self._spec, jit=bool(jit)), self._symbolic)
+
+    def first_order(self) -> FirstOrder | None:
+        """The first-order system ẏ = (q̇(q, p, t), ∂L/∂q) lambdified (see
+        :class:`~varmech.symbolic._rhs.FirstOrder`): the right-hand side a SciPy user would
+        write from this Lagrangian. None where ∂L/∂q̇ is not linear in q̇, or for a forced or
+        constrained model."""
+        return FirstOrder.build(self)
 
     def __reduce__(self) -> tuple[Any, ...]:
         # The tapes and expressions, never the compiled code: unpickling compiles them again.
