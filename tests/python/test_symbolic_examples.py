@@ -268,3 +268,4 @@ def test_the_elastic_pendulum_scene_is_the_separable_cartesian_model():
     assert e_cartesian == pytest.approx(e_polar, rel=1e-14)
     with pytest.raises(ValueError, match="no_such_scene"):
         symbolic_examples.scene("no_such_scene")
+    assert all(scenes.get(name).name == name for name in scenes.SYMBOLIC)

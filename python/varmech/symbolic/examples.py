@@ -31,7 +31,7 @@ import numpy as np
 import sympy as sp
 
 from ..model import Rotation
-from ..scenes import CATALOGUE, SYMBOLIC, Scene
+from ..scenes import CATALOGUE, Scene
 from . import SymbolicModel, lagrangian, mechanical
 
 __all__ = [
