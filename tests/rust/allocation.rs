@@ -10,6 +10,9 @@ use varmech::integrators::{integrate, Dynamics, General, Method, Options, Steppe
 use varmech::model::Routhian;
 use varmech::scenes::{self, NBody};
 
+#[path = "common/tapes.rs"]
+mod tapes;
+
 struct Counting;
 
 thread_local! {
@@ -114,6 +117,48 @@ fn the_constrained_step_loop_allocates_nothing() {
             assert_eq!(
                 short, long,
                 "{method:?}: {short} allocations for 100 steps, {long} for {long_steps}"
+            );
+        }
+    }
+}
+
+#[test]
+fn the_compiled_step_loop_allocates_nothing() {
+    // Compiled models evaluate in a thread's scratch, grown on its first evaluation: a first
+    // run warms it, and then runs of any length make the same allocations. As for every
+    // general Lagrangian, the energy check at saved states solves the inverse Legendre
+    // transform with a fresh Newton workspace; the steps are what this proves allocation-free.
+    let problem = scenes::Kepler::problem(0.6).unwrap();
+    let (q0, p0) = (&problem.initial.q, &problem.initial.p);
+    let options = |steps| Options {
+        save_every: 10,
+        max_energy_error: None,
+        ..Options::new(0.01, steps)
+    };
+    for jit in [false, true] {
+        let separable = tapes::kepler(1.0, jit);
+        let lagrangian = tapes::pendulum_lagrangian();
+        counted(&separable, Method::Verlet, q0, p0, &options(10));
+        counted(&General(&lagrangian), Method::Midpoint, &[0.0], &[1.0], &options(10));
+        for method in [Method::Verlet, Method::KahanLi8, Method::Midpoint] {
+            let (short, long) = (
+                counted(&separable, method, q0, p0, &options(100)),
+                counted(&separable, method, q0, p0, &options(10_000)),
+            );
+            assert_eq!(
+                short, long,
+                "{method:?}, jit {jit}: {short} allocations for 100 steps, {long} for 10 000"
+            );
+        }
+        for method in [Method::Midpoint, Method::Galerkin4] {
+            let sys = General(&lagrangian);
+            let (short, long) = (
+                counted(&sys, method, &[0.0], &[1.0], &options(100)),
+                counted(&sys, method, &[0.0], &[1.0], &options(10_000)),
+            );
+            assert_eq!(
+                short, long,
+                "{method:?} (Lagrangian): {short} allocations for 100 steps, {long} for 10 000"
             );
         }
     }

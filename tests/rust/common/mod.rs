@@ -6,6 +6,8 @@ use varmech::model::{Lagrangian, MechanicalSystem};
 use varmech::scenes::{Problem, State};
 use varmech::Error;
 
+pub mod tapes;
+
 /// Integrates `problem` from its initial state with `steps` steps to `t_end`, keeping every
 /// `save_every`-th state.
 pub fn run<S: MechanicalSystem>(
