@@ -141,19 +141,21 @@ def mechanical(
     ``mass`` is M: a symmetric n×n SymPy Matrix or nested list, or a scalar m for M = m·I; it
     may depend on q (then the model is a general Lagrangian, for the implicit methods). With M
     constant, the model is separable and every method applies. The other arguments are those
-    of :func:`lagrangian`; ValueError names ``mass`` of the wrong shape or not symmetric.
+    of :func:`lagrangian`, but ``v`` may be omitted (V and M hold no velocities: fresh symbols
+    ``<q>_dot`` stand for them, as in ``expressions``); ValueError names ``mass`` of the wrong
+    shape or not symmetric.
 
     Examples
     --------
     >>> import sympy as sp
     >>> import varmech.symbolic
     >>> x, y = sp.symbols("x y")
-    >>> kepler = varmech.symbolic.mechanical(-1 / sp.sqrt(x**2 + y**2), [x, y], 1)  # doctest: +SKIP
-    >>> kepler.kind_name, kepler.expressions["mass"]  # doctest: +SKIP
+    >>> kepler = varmech.symbolic.mechanical(-1 / sp.sqrt(x**2 + y**2), [x, y], 1)
+    >>> kepler.kind_name, kepler.expressions["mass"]
     ('separable', (1,))
     """
     started = time.perf_counter()
-    variables_ = variables(q, v, t)
+    variables_ = variables(q, v, t, fresh_velocities=True)
     m = _mass_matrix(mass, variables_)
     potential = variables_.plain(V, "V")
     check_compilable(potential, "V")

@@ -82,10 +82,12 @@ def _plain(x: sp.Expr) -> sp.Symbol:
     return sp.Symbol(x.func.__name__) if _dynamic(x) else x
 
 
-def variables(q: Any, v: Any, t: Any) -> Variables:
-    """The plain symbols of the coordinates ``q``, velocities ``v`` (fresh ``<name>_dot``
-    symbols for dynamicsymbols when omitted) and time ``t`` (the dynamicsymbols' time by
-    default, else a symbol that no expression holds: L does not depend on t)."""
+def variables(q: Any, v: Any, t: Any, *, fresh_velocities: bool = False) -> Variables:
+    """The plain symbols of the coordinates ``q``, velocities ``v`` and time ``t`` (the
+    dynamicsymbols' time by default, else a symbol that no expression holds: L does not depend
+    on t). Omitted velocities are fresh ``<name>_dot`` symbols, for dynamicsymbols or where
+    ``fresh_velocities`` says the expressions hold none (the mechanical form's V(q) and
+    M(q))."""
     qs = _symbols("q", q)
     times = {x.args[0] for x in qs if _dynamic(x)}
     if len(times) > 1 or (times and t is not None and t not in times):
@@ -95,9 +97,9 @@ def variables(q: Any, v: Any, t: Any) -> Variables:
     if not isinstance(t, sp.Symbol):
         raise TypeError(f"t: expected a SymPy symbol, got {type(t).__name__}: {t!r}")
     if v is None:
-        if not all(_dynamic(x) for x in qs):
+        if not (fresh_velocities or all(_dynamic(x) for x in qs)):
             raise ValueError("v: give the velocity symbols (one per coordinate), or use dynamicsymbols for q")
-        v = [sp.Symbol(f"{x.func.__name__}_dot") for x in qs]
+        v = [sp.Symbol(f"{x.func.__name__ if _dynamic(x) else x}_dot") for x in qs]
     vs = _symbols("v", v, len(qs))
     q_plain, v_plain = tuple(map(_plain, qs)), tuple(map(_plain, vs))
     every = [*q_plain, *v_plain, t]
