@@ -163,3 +163,20 @@ def test_a_singular_velocity_hessian_is_the_typed_error_at_the_first_step():
     with pytest.raises(varmech.VarmechError, match="singular") as err:
         varmech.integrate(model, [0.1, 0.2], [0.0, 0.0], dt=0.01, steps=3, method="midpoint", max_energy_error=None)
     assert err.value.step == 1
+
+
+@pytest.mark.parametrize(("method", "order"), [("midpoint", 2), ("galerkin4", 4), ("galerkin6", 6)])
+def test_compiled_double_pendulum_converges_at_the_methods_order(method, order):
+    """Errors at t = 1 against a run at a quarter of the finest step fall by 2^order a halving."""
+    model = double_pendulum()
+    q0, p0 = [0.5, 1.0], [0.0, 0.0]
+    steps = [20, 40, 80]
+
+    def final(n):
+        traj = varmech.integrate(model, q0, p0, dt=1.0 / n, steps=n, method=method, save_every=n)
+        return np.concatenate([traj.q[-1], traj.p[-1]])
+
+    reference = final(4 * steps[-1] if order < 6 else 2 * steps[-1])
+    errors = [np.max(np.abs(final(n) - reference)) for n in steps]
+    orders = np.log2(np.array(errors[:-1]) / np.array(errors[1:]))
+    assert np.all(np.abs(orders - order) <= 0.35), (errors, orders)
