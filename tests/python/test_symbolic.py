@@ -180,3 +180,33 @@ def test_compiled_double_pendulum_converges_at_the_methods_order(method, order):
     errors = [np.max(np.abs(final(n) - reference)) for n in steps]
     orders = np.log2(np.array(errors[:-1]) / np.array(errors[1:]))
     assert np.all(np.abs(orders - order) <= 0.35), (errors, orders)
+
+
+def test_the_binding_refuses_malformed_models_naming_what_is_wrong():
+    """What crosses into the core is checked there too: each refusal names the function or
+    argument."""
+    spec = double_pendulum()._spec
+    functions = dict(spec.functions)
+
+    def build(kind="lagrangian", functions=functions, **kw):
+        return _core.CompiledModel(kind, spec.dim, functions, spec.parameters, **kw)
+
+    with pytest.raises(ValueError, match='"hessian" is not a function'):
+        build(functions={**functions, "hessian": functions["hessians"]})
+    with pytest.raises(ValueError, match='needs a "hessians" function'):
+        build(functions={k: f for k, f in functions.items() if k != "hessians"})
+    with pytest.raises(ValueError, match="kind: must be"):
+        build(kind="natural")
+    ops, constants, outputs = functions["gradients"]
+    bad = ops.copy()
+    bad[-1, 0] = 99
+    with pytest.raises(ValueError, match="gradients: instruction .*unknown op code 99"):
+        build(functions={**functions, "gradients": (bad, constants, outputs)})
+    forward = ops.copy()
+    forward[-1] = [23, len(ops), 0]  # mul of a register not yet computed
+    with pytest.raises(ValueError, match="gradients: instruction"):
+        build(functions={**functions, "gradients": (forward, constants, outputs)})
+    with pytest.raises(ValueError, match="lagrangian: has 2 outputs"):
+        build(functions={**functions, "lagrangian": (ops, constants, outputs[:2])})
+    with pytest.raises(ValueError, match="parameters"):
+        double_pendulum()._core.with_parameters(np.array([1.0, np.nan, 2.0, 3.0, 9.8]))

@@ -105,6 +105,16 @@ impl CompiledModel {
         jit: bool,
     ) -> PyResult<Self> {
         generator::generators(py, symmetries, dim)?;
+        let known: &[&str] = match kind {
+            "separable" => &["potential", "gradient", "mass", "constraints", "constraint_jacobian"],
+            _ => &["lagrangian", "gradients", "hessians", "force", "constraints", "constraint_jacobian"],
+        };
+        if let Some(name) = functions.keys().find(|name| !known.contains(&name.as_str())) {
+            return Err(PyValueError::new_err(format!(
+                "functions: {name:?} is not a function of a {kind:?} model (it has {})",
+                known.join(", ")
+            )));
+        }
         let params = slice("parameters", &parameters)?.to_vec();
         let k = params.len();
         let compiled = std::cell::Cell::new(false);
