@@ -107,7 +107,14 @@ impl CompiledModel {
         generator::generators(py, symmetries, dim)?;
         let known: &[&str] = match kind {
             "separable" => &["potential", "gradient", "mass", "constraints", "constraint_jacobian"],
-            _ => &["lagrangian", "gradients", "hessians", "force", "constraints", "constraint_jacobian"],
+            _ => &[
+                "lagrangian",
+                "gradients",
+                "hessians",
+                "force",
+                "constraints",
+                "constraint_jacobian",
+            ],
         };
         if let Some(name) = functions.keys().find(|name| !known.contains(&name.as_str())) {
             return Err(PyValueError::new_err(format!(
