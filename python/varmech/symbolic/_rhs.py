@@ -23,9 +23,8 @@ class FirstOrder:
     or constrained (its first-order system is not this one).
     """
 
-    def __init__(self, function, n: int):
+    def __init__(self, function):
         self._f = function
-        self.n = n
         self.count = 0
 
     @classmethod
@@ -33,8 +32,7 @@ class FirstOrder:
         if model.forced or model.constraints:
             return None
         q, v, t, L = list(model.q), list(model.v), model.t, model.L
-        n = len(q)
-        p = sp.symbols(f"p_0:{n}")
+        p = sp.symbols(f"p_0:{len(q)}")
         momentum = sp.Matrix([sp.diff(L, x) for x in v])
         A = momentum.jacobian(v)
         if any(s in A.free_symbols for s in v):
@@ -45,7 +43,7 @@ class FirstOrder:
         values = model.parameters
         by_name = {s: values[s.name] for s in L.free_symbols if s.name in values}
         field = [sp.sympify(e).subs(by_name) for e in [*qdot, *pdot]]
-        return cls(sp.lambdify([t, *q, *p], field, modules="math", cse=True), n)
+        return cls(sp.lambdify([t, *q, *p], field, modules="math", cse=True))
 
     def __call__(self, t: float, y: np.ndarray) -> np.ndarray:
         if y.ndim == 2:

@@ -75,12 +75,11 @@ fn function(
         .map_err(|_| PyValueError::new_err(format!("{name}: outputs must be a contiguous int64 array")))?;
     let tape =
         Tape::decode(name, &rows, slice(name, constants)?, outputs, 2 * n + 1, params).map_err(|e| to_pyerr(py, e))?;
-    let function = if jit {
+    Ok(Some(if jit {
         Function::compiled(tape)
     } else {
-        Ok(Function::new(tape))
-    };
-    function.map(Some).map_err(|e| to_pyerr(py, e))
+        Function::new(tape)
+    }))
 }
 
 fn required(name: &'static str, f: Option<Function>) -> PyResult<Function> {

@@ -28,7 +28,9 @@ impl Builder {
     }
     /// The function compiled to machine code (interpreted without the `jit` feature).
     pub fn compiled(self, outputs: Vec<u32>, n: usize, params: usize) -> Function {
-        Function::compiled(self.tape(outputs, n, params)).unwrap()
+        let f = Function::compiled(self.tape(outputs, n, params));
+        assert_eq!(f.is_compiled(), cfg!(feature = "jit"));
+        f
     }
     pub fn tape(self, outputs: Vec<u32>, n: usize, params: usize) -> Tape {
         Tape::new("test", self.ops, outputs, 2 * n + 1, params).unwrap()
