@@ -289,15 +289,7 @@ impl Lagrangian for PointerLagrangianSystem<'_> {
         };
         let buffer = &mut *self.hessians.borrow_mut();
         f.call(q, v, t, buffer)?;
-        let n2 = self.model.dim * self.model.dim;
-        for (m, block) in [&mut out.qq, &mut out.qv, &mut out.vv]
-            .into_iter()
-            .zip(buffer.chunks_exact(n2))
-        {
-            m.copy_from_slice(block);
-            // Read in row-major order into column-major storage.
-            m.transpose_mut();
-        }
+        out.set_rows(buffer);
         Ok(true)
     }
 

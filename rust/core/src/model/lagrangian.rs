@@ -25,6 +25,20 @@ impl Hessians {
             vv: DMatrix::zeros(n, n),
         }
     }
+
+    /// Sets ∂²L/∂q², ∂²L/∂q∂q̇ and ∂²L/∂q̇² from 3n² values, each matrix row-major in turn:
+    /// the layout of compiled models and function pointers.
+    pub fn set_rows(&mut self, values: &[f64]) {
+        let n2 = self.qq.len();
+        for (m, block) in [&mut self.qq, &mut self.qv, &mut self.vv]
+            .into_iter()
+            .zip(values.chunks_exact(n2))
+        {
+            m.copy_from_slice(block);
+            // Row-major values into column-major storage.
+            m.transpose_mut();
+        }
+    }
 }
 
 /// A Lagrangian system L(q, q̇, t) with n generalized coordinates.

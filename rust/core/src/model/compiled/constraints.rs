@@ -20,6 +20,7 @@ pub struct CompiledConstraints {
 impl CompiledConstraints {
     /// Refuses functions of the wrong shape, naming them.
     pub fn new(m: usize, n: usize, params: Vec<f64>, residual: Function, jacobian: Function) -> Result<Self, Error> {
+        check_parameters(&params, residual.tape().params())?;
         check("constraints", &residual, m, n, Inputs::Positions, &params)?;
         check("constraint_jacobian", &jacobian, m * n, n, Inputs::Positions, &params)?;
         Ok(CompiledConstraints {

@@ -1,6 +1,6 @@
 //! A compiled general Lagrangian L(q, q̇, t).
 
-use super::function::{check, check_parameters, rows_into, Inputs};
+use super::function::{check, check_parameters, Inputs};
 use super::Function;
 use crate::model::{Hessians, Lagrangian};
 use crate::{Error, ModelError};
@@ -30,6 +30,7 @@ impl CompiledLagrangian {
         force: Option<Function>,
         time_dependent: bool,
     ) -> Result<Self, Error> {
+        check_parameters(&params, lagrangian.tape().params())?;
         check("lagrangian", &lagrangian, 1, n, Inputs::All, &params)?;
         check("gradients", &gradients, 2 * n, n, Inputs::All, &params)?;
         check("hessians", &hessians, 3 * n * n, n, Inputs::All, &params)?;
@@ -93,12 +94,7 @@ impl Lagrangian for CompiledLagrangian {
     }
 
     fn hessians(&self, q: &[f64], v: &[f64], t: f64, out: &mut Hessians) -> Result<bool, ModelError> {
-        let n = self.n;
-        self.hessians.eval_into(q, v, t, &self.params, |h| {
-            for (block, m) in h.chunks_exact(n * n).zip([&mut out.qq, &mut out.qv, &mut out.vv]) {
-                rows_into(block, m);
-            }
-        });
+        self.hessians.eval_into(q, v, t, &self.params, |h| out.set_rows(h));
         Ok(true)
     }
 

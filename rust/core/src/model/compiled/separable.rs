@@ -28,6 +28,7 @@ impl CompiledSeparable {
         gradient: Function,
         mass: Function,
     ) -> Result<Self, Error> {
+        check_parameters(&params, potential.tape().params())?;
         check("potential", &potential, 1, n, Inputs::Positions, &params)?;
         check("gradient", &gradient, n, n, Inputs::Positions, &params)?;
         let entries = mass.outputs();
