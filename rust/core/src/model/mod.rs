@@ -8,6 +8,8 @@
 //!   [`Lagrangian`] through [`Natural`];
 //! - [`HolonomicConstraints`]: g(q) = 0 with its Jacobian, [`Distances`] for rigid links, and
 //!   [`Constrained`], a mechanical system on them;
+//! - [`NBody`]: point masses under Newtonian gravity, the model of the N-body scenes and of
+//!   the Wisdom–Holman methods;
 //! - [`Routhian`]: Routh reduction, R = L − μ·ċ on the non-cyclic coordinates;
 //! - [`Scale`]: the size a conserved quantity's error is judged against;
 //! - [`Generator`]: infinitesimal symmetries ξ(q) and their Noether momenta J = p·ξ(q);
@@ -22,6 +24,7 @@ mod lagrangian;
 mod mass;
 mod mechanical;
 mod natural;
+mod nbody;
 mod routh;
 mod scale;
 mod symmetry;
@@ -35,6 +38,7 @@ pub use lagrangian::{Hessians, Lagrangian};
 pub use mass::Mass;
 pub use mechanical::MechanicalSystem;
 pub use natural::{differenced_kinetic_gradient, kinetic_gradient_from_mass_derivative, Natural, NaturalSystem};
+pub use nbody::NBody;
 pub use routh::Routhian;
 pub use scale::Scale;
 pub use symmetry::Generator;

@@ -24,6 +24,7 @@ mod pendulum;
 mod rigid_body;
 mod spherical_pendulum;
 
+pub use crate::model::NBody;
 pub use catalogue::{lookup, CatalogueEntry, Parameter, SceneModel, Setup, CATALOGUE};
 pub use charged_particle::ChargedParticle;
 pub use constrained::{cartesian_pendulum, cartesian_spherical_pendulum, planar_chain, LinkedMasses, PointMasses};
@@ -35,7 +36,6 @@ pub use heavy_top::HeavyTop;
 pub use henon_heiles::HenonHeiles;
 pub use kepler::Kepler;
 pub use kepler_polar::KeplerPolar;
-pub use nbody::NBody;
 pub use pendulum::Pendulum;
 pub use rigid_body::RigidBody;
 pub use spherical_pendulum::SphericalPendulum;
