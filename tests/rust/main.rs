@@ -4,6 +4,7 @@
 
 mod common;
 
+mod bits;
 mod catalogue;
 mod charged_particle;
 mod compiled;
