@@ -3,6 +3,10 @@
 //! `cargo bench --bench steps`; each iteration runs the public driver for a fixed number of
 //! steps, keeping only the final state, so the figure includes the driver's checks and the
 //! compensated summation, as users get them.
+//!
+//! The `overhead` group times varmech's driver against hand-written loops that do the same
+//! arithmetic (`benches/reference`, held bit-identical by `tests/rust/bits.rs`): the ratio is
+//! what the driver costs beyond the physics.
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use std::hint::black_box;
@@ -10,6 +14,8 @@ use std::time::Duration;
 use varmech::integrators::{integrate, Method, Options};
 use varmech::model::MechanicalSystem;
 use varmech::scenes::{Kepler, NBody, Problem};
+
+mod reference;
 
 const STEPS: usize = 2_000;
 
@@ -42,6 +48,36 @@ fn bench_problem<S: MechanicalSystem>(c: &mut Criterion, name: &str, problem: &P
     group.finish();
 }
 
+/// Kepler Verlet through `integrate` and through the reference loop, side by side.
+fn overhead(c: &mut Criterion) {
+    let problem = Kepler::problem(0.6).unwrap();
+    let h = 2.0 * std::f64::consts::PI / 200.0;
+    let options = Options {
+        save_every: STEPS,
+        ..Options::new(h, STEPS)
+    };
+    let (q0, p0) = (&problem.initial.q, &problem.initial.p);
+    let mut group = c.benchmark_group("overhead");
+    group.throughput(Throughput::Elements(STEPS as u64));
+    group.bench_function("kepler_verlet/varmech", |b| {
+        b.iter(|| {
+            let traj = integrate(&problem.system, Method::Verlet, q0, p0, &options, || Ok(()));
+            black_box(traj.map(|t| t.q).unwrap_or_default())
+        })
+    });
+    group.bench_function("kepler_verlet/reference", |b| {
+        b.iter(|| {
+            black_box(reference::kepler_verlet(
+                [q0[0], q0[1]],
+                [p0[0], p0[1]],
+                black_box(h),
+                STEPS,
+            ))
+        })
+    });
+    group.finish();
+}
+
 fn steps(c: &mut Criterion) {
     bench_problem(
         c,
@@ -55,6 +91,6 @@ fn steps(c: &mut Criterion) {
 criterion_group! {
     name = benches;
     config = Criterion::default().warm_up_time(Duration::from_millis(500)).measurement_time(Duration::from_secs(2)).sample_size(30);
-    targets = steps
+    targets = overhead, steps
 }
 criterion_main!(benches);

@@ -176,3 +176,28 @@ const IMPLICIT: &[(&str, u64)] = &[
     ("rigid body midpoint", 0xedc10a92a2d4d250),
     ("rigid body trapezoid", 0x71deaafb24640780),
 ];
+
+#[path = "../../benches/reference/mod.rs"]
+mod reference;
+
+/// The benches' hand-written Verlet loop does varmech's arithmetic: its final state is
+/// `integrate`'s, bit for bit, so that timing one against the other measures overhead alone.
+#[test]
+fn the_reference_verlet_loop_is_varmechs_to_the_bit() {
+    let p = Kepler::problem(0.6).unwrap();
+    let (h, steps) = (2.0 * std::f64::consts::PI / 200.0, 2000);
+    let options = Options {
+        save_every: steps,
+        ..Options::new(h, steps)
+    };
+    let traj = integrate(&p.system, Method::Verlet, &p.initial.q, &p.initial.p, &options, || {
+        Ok(())
+    })
+    .unwrap();
+    let q0 = [p.initial.q[0], p.initial.q[1]];
+    let p0 = [p.initial.p[0], p.initial.p[1]];
+    let (q, pp) = reference::kepler_verlet(q0, p0, h, steps);
+    let bits = |x: &[f64]| x.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+    assert_eq!(bits(&q), bits(traj.q_at(1)));
+    assert_eq!(bits(&pp), bits(traj.p_at(1)));
+}

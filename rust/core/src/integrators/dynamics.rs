@@ -1,6 +1,6 @@
 //! What a method integrates: the dynamics of a model, seen through one step's increments.
 
-use super::{Increment, Integrator, ModelKind, StepError, StepStart};
+use super::{Increment, Integrator, ModelKind, StepError, StepStart, StepperState};
 use crate::model::{self, Constrained, EnergyTerms, HolonomicConstraints, Lagrangian, MechanicalSystem, PhaseState};
 use crate::{Error, ModelError};
 
@@ -49,6 +49,17 @@ pub trait Dynamics {
         increment: &mut Increment,
     ) -> Result<(), StepError>;
 
+    /// Advances `state` by `steps` steps of its method on this model, stopping at the first
+    /// failure with the last good state kept. The stepper calls it for the steps between two
+    /// interrupt polls, so that a model may run them in a loop of its own, specialised to its
+    /// type and size; by default, one step after the other.
+    fn advance(&self, state: &mut StepperState, steps: usize) -> Result<(), Error> {
+        for _ in 0..steps {
+            state.step(self)?;
+        }
+        Ok(())
+    }
+
     /// The energy function and its terms at (q, p, t), where L does not depend on t (forced
     /// or not: a forced run balances it against the work done).
     fn energy(&self, q: &[f64], p: &[f64], t: f64) -> Option<Result<EnergyTerms, ModelError>>;
@@ -86,6 +97,10 @@ impl<S: MechanicalSystem> Dynamics for S {
         increment: &mut Increment,
     ) -> Result<(), StepError> {
         integrator.increment(self, start, increment)
+    }
+
+    fn advance(&self, state: &mut StepperState, steps: usize) -> Result<(), Error> {
+        state.advance_separable(self, steps)
     }
 
     fn energy(&self, q: &[f64], p: &[f64], t: f64) -> Option<Result<EnergyTerms, ModelError>> {

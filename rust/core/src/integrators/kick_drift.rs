@@ -1,6 +1,7 @@
-use super::{Composition, Increment, StepStart};
+use super::stepper::{diverged, Phase};
+use super::{compensated, Composition, Increment, StepError, StepStart};
 use crate::model::MechanicalSystem;
-use crate::ModelError;
+use crate::{Error, ModelError};
 
 /// A kick–drift splitting method for H = ½pᵀM⁻¹p + V(q):
 ///
@@ -13,6 +14,9 @@ use crate::ModelError;
 pub struct KickDrift {
     kicks: Vec<f64>,
     drifts: Vec<f64>,
+    /// a₀h, b₁h, a₁h, …, bₛh, aₛh for the step h they were computed for.
+    scaled: Vec<f64>,
+    scaled_for: f64,
     q: Vec<f64>,
     p: Vec<f64>,
     force: Vec<f64>,
@@ -24,6 +28,8 @@ impl KickDrift {
     fn new(kicks: Vec<f64>, drifts: Vec<f64>, n: usize) -> Self {
         debug_assert_eq!(kicks.len(), drifts.len() + 1);
         KickDrift {
+            scaled: vec![0.0; kicks.len() + drifts.len()],
+            scaled_for: f64::NAN,
             kicks,
             drifts,
             q: vec![0.0; n],
@@ -61,14 +67,6 @@ impl KickDrift {
         self.evaluations
     }
 
-    fn evaluate<S: MechanicalSystem + ?Sized>(&mut self, sys: &S) -> Result<(), ModelError> {
-        self.evaluations += 1;
-        let r = sys.gradient(&self.q, &mut self.force);
-        // A failed evaluation leaves no stale force behind.
-        self.force_cached = r.is_ok();
-        r
-    }
-
     pub(super) fn increment<S: MechanicalSystem + ?Sized>(
         &mut self,
         sys: &S,
@@ -77,49 +75,202 @@ impl KickDrift {
     ) -> Result<(), ModelError> {
         let StepStart { h, q, p, .. } = *start;
         let Increment { dq, dp } = increment;
-        if !self.force_cached {
-            self.q.copy_from_slice(q);
-            self.evaluate(sys)?;
-        }
-        // The first kick writes δp (and clears δq, which the drifts add to); each later one
-        // adds to it.
-        let a = self.kicks[0] * h;
-        kick(a, &self.force, p, dp, &mut self.p, Some(dq));
-        for i in 0..self.drifts.len() {
-            sys.mass().drift(self.drifts[i] * h, &self.p, q, dq, &mut self.q);
-            let a = self.kicks[i + 1] * h;
-            if a == 0.0 {
-                self.force_cached = false;
-                continue;
+        self.scale(h);
+        let stage = Stage {
+            q: &mut self.q,
+            p: &mut self.p,
+            force: &mut self.force,
+        };
+        let counts = Counts {
+            cached: &mut self.force_cached,
+            evaluations: &mut self.evaluations,
+        };
+        sequence(sys, &self.scaled, q, p, dq, dp, stage, counts)
+    }
+
+    /// The fractions times h, once per step size.
+    fn scale(&mut self, h: f64) {
+        if self.scaled_for != h {
+            let pairs = self
+                .drifts
+                .iter()
+                .zip(&self.kicks[1..])
+                .flat_map(|(b, a)| [b * h, a * h]);
+            for (x, y) in self
+                .scaled
+                .iter_mut()
+                .zip(std::iter::once(self.kicks[0] * h).chain(pairs))
+            {
+                *x = y;
             }
-            self.evaluate(sys)?;
-            kick(a, &self.force, p, dp, &mut self.p, None);
+            self.scaled_for = h;
         }
-        Ok(())
+    }
+
+    /// `steps` steps of N coordinates with the state in fixed-size arrays, one loop with no
+    /// dispatch, the step's arithmetic that of [`KickDrift::increment`] and of the stepper,
+    /// so that the results agree bit for bit. Called by the stepper for small separable
+    /// systems ([`StepperState`](super::StepperState)).
+    pub(super) fn run<S: MechanicalSystem + ?Sized, const N: usize>(
+        &mut self,
+        sys: &S,
+        state: Phase<'_>,
+        steps: usize,
+    ) -> Result<(), Error> {
+        let array = |x: &[f64]| -> [f64; N] { std::array::from_fn(|i| x[i]) };
+        let Phase {
+            q: state_q,
+            p: state_p,
+            eq: state_eq,
+            ep: state_ep,
+            compensated,
+            steps: done,
+            clock,
+        } = state;
+        self.scale(clock.h);
+        let (mut q, mut p, mut eq, mut ep) = (array(state_q), array(state_p), array(state_eq), array(state_ep));
+        let (mut stage_q, mut stage_p, mut force) = (array(&self.q), array(&self.p), array(&self.force));
+        let (mut dq, mut dp) = ([0.0; N], [0.0; N]);
+        let (mut q_next, mut p_next, mut eq_next, mut ep_next) = ([0.0; N], [0.0; N], [0.0; N], [0.0; N]);
+        // Counts in locals, written back once: through the pointers they would cost stores.
+        let (mut cached, mut evaluations, mut n) = (self.force_cached, self.evaluations, *done);
+        let mut result = Ok(());
+        for _ in 0..steps {
+            let stage = Stage {
+                q: &mut stage_q,
+                p: &mut stage_p,
+                force: &mut force,
+            };
+            let counts = Counts {
+                cached: &mut cached,
+                evaluations: &mut evaluations,
+            };
+            if let Err(e) = sequence(sys, &self.scaled, &q, &p, &mut dq, &mut dp, stage, counts) {
+                result = Err(StepError::from(e).at(n + 1, clock.at(n)));
+                break;
+            }
+            let finite = if compensated {
+                compensated::add(&q, &eq, &dq, &mut q_next, &mut eq_next)
+                    & compensated::add(&p, &ep, &dp, &mut p_next, &mut ep_next)
+            } else {
+                compensated::add_plain(&q, &dq, &mut q_next) & compensated::add_plain(&p, &dp, &mut p_next)
+            };
+            if !finite {
+                result = Err(diverged(n + 1, clock.at(n)));
+                break;
+            }
+            (q, p) = (q_next, p_next);
+            if compensated {
+                (eq, ep) = (eq_next, ep_next);
+            }
+            n += 1;
+        }
+        (self.force_cached, self.evaluations, *done) = (cached, evaluations, n);
+        state_q.copy_from_slice(&q);
+        state_p.copy_from_slice(&p);
+        state_eq.copy_from_slice(&eq);
+        state_ep.copy_from_slice(&ep);
+        self.q.copy_from_slice(&stage_q);
+        self.p.copy_from_slice(&stage_p);
+        self.force.copy_from_slice(&force);
+        result
     }
 }
 
-/// δp ← δp − a·f (δp ← −a·f, and δq ← 0, when `first` holds δq), fused with the momenta
-/// p̃ = p + δp the next drift needs. Indexed over slices cut to one length, so that the bounds
-/// checks fold away (a four-way zip costs more instructions than the arithmetic here).
+/// The stage positions and momenta a sequence moves through, and the force at the last stage.
+struct Stage<'a> {
+    q: &'a mut [f64],
+    p: &'a mut [f64],
+    force: &'a mut [f64],
+}
+
+/// Whether `Stage::force` holds ∇V at the step's start, and the evaluations made.
+struct Counts<'a> {
+    cached: &'a mut bool,
+    evaluations: &'a mut u64,
+}
+
+impl Counts<'_> {
+    /// force = ∇V(q), counted.
+    #[inline(always)]
+    fn evaluate<S: MechanicalSystem + ?Sized>(
+        &mut self,
+        sys: &S,
+        q: &[f64],
+        force: &mut [f64],
+    ) -> Result<(), ModelError> {
+        *self.evaluations += 1;
+        let r = sys.gradient(q, force);
+        // A failed evaluation leaves no stale force behind.
+        *self.cached = r.is_ok();
+        r
+    }
+}
+
+/// The increments (δq, δp) of one step from (q, p), with `scaled` = a₀h, b₁h, a₁h, …, bₛh, aₛh.
+/// Written once for both the stepper's step and the fixed-size loop; inlined, so that the
+/// latter's lengths are known.
 #[inline(always)]
-fn kick(a: f64, force: &[f64], p: &[f64], dp: &mut [f64], stage: &mut [f64], first: Option<&mut [f64]>) {
-    let n = p.len();
-    let (force, dp, stage) = (&force[..n], &mut dp[..n], &mut stage[..n]);
-    match first {
-        Some(dq) => {
-            let dq = &mut dq[..n];
-            for i in 0..n {
-                dp[i] = -a * force[i];
-                stage[i] = p[i] + dp[i];
-                dq[i] = 0.0;
-            }
+#[allow(clippy::too_many_arguments)]
+fn sequence<S: MechanicalSystem + ?Sized>(
+    sys: &S,
+    scaled: &[f64],
+    q: &[f64],
+    p: &[f64],
+    dq: &mut [f64],
+    dp: &mut [f64],
+    stage: Stage<'_>,
+    mut counts: Counts<'_>,
+) -> Result<(), ModelError> {
+    let Stage {
+        q: stage_q,
+        p: stage_p,
+        force,
+    } = stage;
+    if !*counts.cached {
+        stage_q.copy_from_slice(q);
+        counts.evaluate(sys, stage_q, force)?;
+    }
+    // The first kick writes δp (and clears δq, which the drifts add to); each later one adds
+    // to it, and the last leaves the stage momenta, which no drift reads.
+    kick(scaled[0], force, p, dp, Some(stage_p), Some(dq));
+    let stages = scaled.len() / 2;
+    for i in 0..stages {
+        sys.mass().drift(scaled[2 * i + 1], stage_p, q, dq, stage_q);
+        let a = scaled[2 * i + 2];
+        if a == 0.0 {
+            *counts.cached = false;
+            continue;
         }
-        None => {
-            for i in 0..n {
-                dp[i] -= a * force[i];
-                stage[i] = p[i] + dp[i];
-            }
+        counts.evaluate(sys, stage_q, force)?;
+        let stage = (i + 1 < stages).then_some(&mut *stage_p);
+        kick(a, force, p, dp, stage, None);
+    }
+    Ok(())
+}
+
+/// δp ← δp − a·f (δp ← −a·f, and δq ← 0, when `first` holds δq), fused with the momenta
+/// p̃ = p + δp the next drift needs, if any. Indexed over slices cut to one length, so that the
+/// bounds checks fold away (a four-way zip costs more instructions than the arithmetic here).
+#[inline(always)]
+fn kick(a: f64, force: &[f64], p: &[f64], dp: &mut [f64], stage: Option<&mut [f64]>, first: Option<&mut [f64]>) {
+    let n = p.len();
+    let (force, dp) = (&force[..n], &mut dp[..n]);
+    if let Some(dq) = first {
+        let dq = &mut dq[..n];
+        for i in 0..n {
+            dp[i] = -a * force[i];
+            dq[i] = 0.0;
+        }
+    } else {
+        for i in 0..n {
+            dp[i] -= a * force[i];
+        }
+    }
+    if let Some(stage) = stage {
+        let stage = &mut stage[..n];
+        for i in 0..n {
+            stage[i] = p[i] + dp[i];
         }
     }
 }

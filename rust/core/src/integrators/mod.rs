@@ -156,6 +156,14 @@ impl Integrator {
         }
     }
 
+    /// The kick–drift scheme, for the stepper's fixed-size loop.
+    pub(super) fn kick_drift(&mut self) -> Option<&mut KickDrift> {
+        match &mut self.scheme {
+            Scheme::KickDrift(s) => Some(s),
+            _ => None,
+        }
+    }
+
     /// Writes the increments of one step of size h from (q, p) at time t into (δq, δp).
     #[inline(always)]
     pub fn increment<S: MechanicalSystem + ?Sized>(

@@ -5,6 +5,7 @@ use std::ops::Deref;
 
 use super::{compensated, Dynamics, Increment, Integrator, Method, Options, StepStart};
 use crate::error::check_vector;
+use crate::model::MechanicalSystem;
 use crate::solve::interrupt::InterruptPoll;
 use crate::{Error, ModelError};
 
@@ -33,11 +34,7 @@ pub struct Stepper<M, St = StepperState> {
 #[derive(Clone, Debug)]
 pub struct StepperState {
     integrator: Integrator,
-    /// tₙ = t₀ + (n − n₀)·h: the time t₀ and steps n₀ when h was last set (see
-    /// [`Stepper::set_dt`]).
-    t0: f64,
-    n0: usize,
-    h: f64,
+    clock: Clock,
     steps: usize,
     compensated: bool,
     q: Vec<f64>,
@@ -76,9 +73,11 @@ where
         let zeros = || vec![0.0; n];
         let state = StepperState {
             integrator: Integrator::with_newton(method, n, options.newton),
-            t0: options.t0,
-            n0: 0,
-            h: options.dt,
+            clock: Clock {
+                t0: options.t0,
+                n0: 0,
+                h: options.dt,
+            },
             steps: 0,
             compensated: options.compensated,
             q: q0.to_vec(),
@@ -141,7 +140,8 @@ where
         P: FnMut() -> Result<(), ModelError>,
     {
         let state = self.state.borrow_mut();
-        for _ in 0..n {
+        let mut left = n;
+        while left > 0 {
             if state.interrupt.due() {
                 if let Err(source) = poll() {
                     return Err(Error::Interrupted {
@@ -151,7 +151,11 @@ where
                     });
                 }
             }
-            state.step(&*self.model)?;
+            // This step and those after it that need no poll, in one call: the model's own
+            // loop ([`Dynamics::advance`]) runs them.
+            let steps = 1 + state.interrupt.quiet(left - 1);
+            self.model.advance(state, steps)?;
+            left -= steps;
         }
         Ok(())
     }
@@ -176,8 +180,11 @@ where
         state.p.copy_from_slice(p0);
         state.eq.fill(0.0);
         state.ep.fill(0.0);
-        state.t0 = t0;
-        state.n0 = 0;
+        state.clock = Clock {
+            t0,
+            n0: 0,
+            h: state.clock.h,
+        };
         state.steps = 0;
         state.integrator.reset();
         Ok(())
@@ -190,9 +197,11 @@ where
             return Err(Error::invalid("dt", format!("must be finite and positive, got {h}")));
         }
         let state = self.state.borrow_mut();
-        state.t0 = state.t();
-        state.n0 = state.steps;
-        state.h = h;
+        state.clock = Clock {
+            t0: state.t(),
+            n0: state.steps,
+            h,
+        };
         Ok(())
     }
 }
@@ -208,12 +217,12 @@ impl<M, St: Borrow<StepperState>> Deref for Stepper<M, St> {
 impl StepperState {
     /// One step of `model`, which has as many coordinates as the state (checked when the
     /// stepper was made or resumed).
-    fn step<S: Dynamics + ?Sized>(&mut self, model: &S) -> Result<(), Error> {
+    pub(super) fn step<S: Dynamics + ?Sized>(&mut self, model: &S) -> Result<(), Error> {
         let step = self.steps + 1;
         let time = self.t();
         let start = StepStart {
             t: time,
-            h: self.h,
+            h: self.clock.h,
             q: &self.q,
             p: &self.p,
         };
@@ -232,10 +241,7 @@ impl StepperState {
                 & compensated::add_plain(&self.p, &self.dp, &mut self.p_next)
         };
         if !finite {
-            let reason =
-                "the state became non-finite (the method is unstable at this step size, or the model is singular here)"
-                    .to_string();
-            return Err(Error::Divergence { step, time, reason });
+            return Err(diverged(step, time));
         }
         std::mem::swap(&mut self.q, &mut self.q_next);
         std::mem::swap(&mut self.p, &mut self.p_next);
@@ -247,10 +253,49 @@ impl StepperState {
         Ok(())
     }
 
+    /// `steps` steps of a separable system: the kick–drift methods on up to 4 coordinates in
+    /// a loop of fixed-size arrays ([`super::KickDrift::run`]; the driver's costs, not the physics,
+    /// dominate such small steps), every other case step by step.
+    pub(super) fn advance_separable<S: MechanicalSystem>(&mut self, sys: &S, steps: usize) -> Result<(), Error> {
+        let StepperState {
+            integrator,
+            clock,
+            steps: done,
+            compensated,
+            q,
+            p,
+            eq,
+            ep,
+            ..
+        } = self;
+        if let Some(kick_drift) = integrator.kick_drift() {
+            let n = q.len();
+            let phase = Phase {
+                q,
+                p,
+                eq,
+                ep,
+                compensated: *compensated,
+                steps: done,
+                clock: *clock,
+            };
+            match n {
+                1 => return kick_drift.run::<S, 1>(sys, phase, steps),
+                2 => return kick_drift.run::<S, 2>(sys, phase, steps),
+                3 => return kick_drift.run::<S, 3>(sys, phase, steps),
+                4 => return kick_drift.run::<S, 4>(sys, phase, steps),
+                _ => {}
+            }
+        }
+        for _ in 0..steps {
+            self.step(sys)?;
+        }
+        Ok(())
+    }
+
     /// The time tₙ = t₀ + n·h (counted from the last change of h, see [`Stepper::set_dt`]).
     pub fn t(&self) -> f64 {
-        // Through i64: one instruction, where usize → f64 takes a dozen on x86-64.
-        self.t0 + (self.steps - self.n0) as i64 as f64 * self.h
+        self.clock.at(self.steps)
     }
 
     /// The steps n completed.
@@ -260,7 +305,7 @@ impl StepperState {
 
     /// The step size h.
     pub fn dt(&self) -> f64 {
-        self.h
+        self.clock.h
     }
 
     /// The positions qₙ.
@@ -291,5 +336,46 @@ impl StepperState {
     /// The work done by non-conservative forces so far (forced Lagrangians; 0 otherwise).
     pub fn work(&self) -> f64 {
         self.integrator.work()
+    }
+}
+
+/// tₙ = t₀ + (n − n₀)·h: the time t₀ and steps n₀ when the step h was last set (see
+/// [`Stepper::set_dt`]).
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Clock {
+    t0: f64,
+    n0: usize,
+    pub(super) h: f64,
+}
+
+impl Clock {
+    /// The time after `steps` steps.
+    #[inline]
+    pub(super) fn at(self, steps: usize) -> f64 {
+        // Through i64: one instruction, where usize → f64 takes a dozen on x86-64.
+        self.t0 + (steps - self.n0) as i64 as f64 * self.h
+    }
+}
+
+/// A stepper's state as a method's own loop advances it: (qₙ, pₙ), the carries (e_q, e_p) of
+/// compensated summation, and the steps done, counted up as the loop goes.
+pub(super) struct Phase<'a> {
+    pub(super) q: &'a mut [f64],
+    pub(super) p: &'a mut [f64],
+    pub(super) eq: &'a mut [f64],
+    pub(super) ep: &'a mut [f64],
+    pub(super) compensated: bool,
+    pub(super) steps: &'a mut usize,
+    pub(super) clock: Clock,
+}
+
+/// The error of a step whose state is not finite.
+pub(super) fn diverged(step: usize, time: f64) -> Error {
+    let reason =
+        "the state became non-finite (the method is unstable at this step size, or the model is singular here)";
+    Error::Divergence {
+        step,
+        time,
+        reason: reason.to_string(),
     }
 }

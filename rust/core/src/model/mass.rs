@@ -76,22 +76,38 @@ impl Mass {
 
     /// The drift of a splitting method in one pass: δq ← δq + c·M⁻¹p, then q̃ = q + δq (the
     /// position the next force is evaluated at); allocation-free.
-    #[inline]
+    #[inline(always)]
     pub fn drift(&self, c: f64, p: &[f64], q: &[f64], dq: &mut [f64], q_stage: &mut [f64]) {
-        let mut update = |i: usize, v: f64| {
-            dq[i] += c * v;
-            q_stage[i] = q[i] + dq[i];
-        };
+        // Indexed over slices cut to one length, so that the bounds checks fold away and a
+        // step loop of known length unrolls.
+        let n = p.len();
+        let (q, dq, q_stage) = (&q[..n], &mut dq[..n], &mut q_stage[..n]);
         match self {
-            Mass::Scalar(m) => p.iter().enumerate().for_each(|(i, pi)| update(i, pi / m)),
-            Mass::Diagonal { inverse, .. } => p
-                .iter()
-                .zip(inverse.as_slice())
-                .enumerate()
-                .for_each(|(i, (pi, wi))| update(i, wi * pi)),
+            // p/1 is p to the bit: unit masses skip the division.
+            Mass::Scalar(m) if *m == 1.0 => {
+                for i in 0..n {
+                    dq[i] += c * p[i];
+                    q_stage[i] = q[i] + dq[i];
+                }
+            }
+            Mass::Scalar(m) => {
+                for i in 0..n {
+                    dq[i] += c * (p[i] / m);
+                    q_stage[i] = q[i] + dq[i];
+                }
+            }
+            Mass::Diagonal { inverse, .. } => {
+                let w = &inverse.as_slice()[..n];
+                for i in 0..n {
+                    dq[i] += c * (w[i] * p[i]);
+                    q_stage[i] = q[i] + dq[i];
+                }
+            }
             Mass::Full { inverse, .. } => {
-                for i in 0..p.len() {
-                    update(i, p.iter().enumerate().map(|(j, pj)| inverse[(i, j)] * pj).sum());
+                for i in 0..n {
+                    let v: f64 = p.iter().enumerate().map(|(j, pj)| inverse[(i, j)] * pj).sum();
+                    dq[i] += c * v;
+                    q_stage[i] = q[i] + dq[i];
                 }
             }
         }

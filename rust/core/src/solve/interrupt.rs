@@ -74,4 +74,13 @@ impl InterruptPoll {
         self.countdown = self.stride;
         true
     }
+
+    /// How many of the next `wanted` steps need no poll before them, taken off the countdown:
+    /// a loop may run them without asking [`InterruptPoll::due`] each time.
+    #[inline]
+    pub(crate) fn quiet(&mut self, wanted: usize) -> usize {
+        let k = wanted.min(self.countdown - 1);
+        self.countdown -= k;
+        k
+    }
 }
