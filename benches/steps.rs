@@ -11,9 +11,9 @@
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use std::hint::black_box;
 use std::time::Duration;
-use varmech::integrators::{integrate, Method, Options};
+use varmech::integrators::{integrate, General, Method, Options};
 use varmech::model::MechanicalSystem;
-use varmech::scenes::{Kepler, NBody, Problem};
+use varmech::scenes::{DoublePendulum, Kepler, NBody, Problem};
 
 mod reference;
 
@@ -48,7 +48,8 @@ fn bench_problem<S: MechanicalSystem>(c: &mut Criterion, name: &str, problem: &P
     group.finish();
 }
 
-/// Kepler Verlet through `integrate` and through the reference loop, side by side.
+/// Kepler Verlet and the double pendulum's midpoint rule through `integrate` and through the
+/// reference loops, side by side.
 fn overhead(c: &mut Criterion) {
     let problem = Kepler::problem(0.6).unwrap();
     let h = 2.0 * std::f64::consts::PI / 200.0;
@@ -73,6 +74,31 @@ fn overhead(c: &mut Criterion) {
                 black_box(h),
                 STEPS,
             ))
+        })
+    });
+    let pendulum = DoublePendulum::problem();
+    let options = Options {
+        save_every: STEPS,
+        ..Options::new(0.01, STEPS)
+    };
+    let (q0, p0) = (&pendulum.initial.q, &pendulum.initial.p);
+    group.bench_function("double_pendulum_midpoint/varmech", |b| {
+        b.iter(|| {
+            let traj = integrate(
+                &General(&pendulum.system),
+                Method::Midpoint,
+                q0,
+                p0,
+                &options,
+                || Ok(()),
+            );
+            black_box(traj.map(|t| t.q).unwrap_or_default())
+        })
+    });
+    group.bench_function("double_pendulum_midpoint/reference", |b| {
+        b.iter(|| {
+            let (q0, p0) = ([q0[0], q0[1]], [p0[0], p0[1]]);
+            black_box(reference::midpoint(&pendulum.system, q0, p0, black_box(0.01), STEPS))
         })
     });
     group.finish();
