@@ -29,6 +29,9 @@ pub enum Method {
     /// McLachlan's 17-stage composition SS17 (McLachlan 1995), order 8: Blanes & Casas's
     /// (2016, p. 91) order-8 composition, the one of REBOUND's leapfrog with order = 8.
     McLachlan8,
+    /// McLachlan's SS17 composed of Störmer–Verlet in position form (drift–kick–drift), as
+    /// REBOUND's leapfrog with order = 8 applies it: an ABA splitting, 17 force evaluations.
+    McLachlan8Dkd,
     /// Blanes & Moan's SRKN₆ᵇ (2002), order 4: a BAB splitting with 6 force evaluations.
     BlanesMoan4,
     /// Blanes & Moan's SRKN₁₁ᵇ (2002), order 6: a BAB splitting with 11 force evaluations.
@@ -87,7 +90,7 @@ pub struct MethodInfo {
 
 impl Method {
     /// Every method, from the simplest.
-    pub const ALL: [Method; 21] = [
+    pub const ALL: [Method; 22] = [
         Method::ExplicitEuler,
         Method::SymplecticEuler,
         Method::Verlet,
@@ -100,6 +103,7 @@ impl Method {
         Method::KahanLi8,
         Method::McLachlan6,
         Method::McLachlan8,
+        Method::McLachlan8Dkd,
         Method::BlanesMoan4,
         Method::BlanesMoan6,
         Method::Aba864,
@@ -149,6 +153,14 @@ impl Method {
                 true,
                 3.0871,
                 "McLachlan, SIAM J. Sci. Comput. 16 (1995), SS17; Blanes & Casas (2016), p. 91",
+            ),
+            Method::McLachlan8Dkd => (
+                "mclachlan8_dkd",
+                8,
+                true,
+                true,
+                3.0871,
+                "McLachlan (1995), SS17 of position Verlet; Blanes & Casas (2016), p. 91; REBOUND leapfrog order=8",
             ),
             Method::BlanesMoan4 => (
                 "blanes_moan4",

@@ -42,6 +42,10 @@ impl Splitting {
         if let Some(c) = Composition::of(method) {
             return Some(Self::composition(method, &c));
         }
+        if method == Method::McLachlan8Dkd {
+            let c = Composition::of(Method::McLachlan8)?;
+            return Some(Self::position_composition(method, &c));
+        }
         let (kicks, drifts) = match method {
             // p₁ = p₀ − h∇V(q₀), q₁ = q₀ + hM⁻¹p₁.
             Method::SymplecticEuler => (vec![1.0, 0.0], vec![1.0]),
@@ -96,22 +100,24 @@ impl Splitting {
         Some(Splitting { method, kicks, drifts })
     }
 
-    /// The composition of Störmer–Verlet (kick–drift–kick) with the fractions γ of `c`: bᵢ = γᵢ,
-    /// a₀ = γ₁/2, aᵢ = (γᵢ + γᵢ₊₁)/2 and aₛ = γₛ/2, adjacent half kicks merged.
+    /// The composition of Störmer–Verlet in velocity form (kick–drift–kick) with the fractions γ
+    /// of `c`: bᵢ = γᵢ, a₀ = γ₁/2, aᵢ = (γᵢ + γᵢ₊₁)/2 and aₛ = γₛ/2, adjacent half kicks merged.
     fn composition(method: Method, c: &Composition) -> Splitting {
-        let g = c.gamma();
-        let s = g.len();
-        let kicks = (0..=s)
-            .map(|i| match i {
-                0 => 0.5 * g[0],
-                i if i == s => 0.5 * g[s - 1],
-                i => 0.5 * (g[i - 1] + g[i]),
-            })
-            .collect();
         Splitting {
             method,
-            kicks,
-            drifts: g.to_vec(),
+            kicks: merged_halves(c.gamma()),
+            drifts: c.gamma().to_vec(),
+        }
+    }
+
+    /// The composition of Störmer–Verlet in position form (drift–kick–drift), an ABA method:
+    /// kicks γᵢ between the merged half drifts γ₁/2, (γᵢ + γᵢ₊₁)/2, γₛ/2.
+    fn position_composition(method: Method, c: &Composition) -> Splitting {
+        let g = c.gamma();
+        Splitting {
+            method,
+            kicks: [0.0].into_iter().chain(g.iter().copied()).chain([0.0]).collect(),
+            drifts: merged_halves(g),
         }
     }
 
@@ -162,6 +168,18 @@ impl Splitting {
         let palindrome = |x: &[f64]| x.iter().eq(x.iter().rev());
         palindrome(&self.kicks) && palindrome(&self.drifts)
     }
+}
+
+/// γ₁/2, (γ₁ + γ₂)/2, …, (γₛ₋₁ + γₛ)/2, γₛ/2: the half steps of adjacent Verlet steps merged.
+fn merged_halves(g: &[f64]) -> Vec<f64> {
+    let s = g.len();
+    (0..=s)
+        .map(|i| match i {
+            0 => 0.5 * g[0],
+            i if i == s => 0.5 * g[s - 1],
+            i => 0.5 * (g[i - 1] + g[i]),
+        })
+        .collect()
 }
 
 /// The kicks and drifts of a symmetric method with `evaluations` force evaluations, from the
