@@ -22,6 +22,7 @@ mod kepler;
 mod kepler_polar;
 mod routh;
 mod solar_system;
+mod splitting;
 mod spurious_branch;
 mod stability;
 mod stepper;

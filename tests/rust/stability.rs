@@ -1,5 +1,6 @@
 //! Linear stability exactly at the documented limits: on q̈ = −ω²q every method is stable 1%
-//! below its hω_max (reference/compositions.json) and unstable 1% above, where the run stops
+//! below its hω_max (reference/compositions.json, reference/splittings.json) and unstable 1%
+//! above (less for the splittings whose first unstable window is narrower), where the run stops
 //! with a typed divergence error rather than producing non-finite numbers.
 
 use varmech::integrators::{integrate, Method, Options};
@@ -33,6 +34,18 @@ fn run(method: Method, h: f64) -> Result<f64, Error> {
     }
 }
 
+/// How far above its limit a method is probed for instability: 1%, except for the splittings
+/// whose first unstable window, a resonance near hω = π, is narrower than that (the scan's
+/// windows: blanes_moan6 3.14143–3.1420, blanes_moan4 3.1635–3.1685, aba1064 3.1461–3.1535,
+/// aba864 3.1422–3.1735); past it they are stable again up to the next window.
+fn margin(method: Method) -> f64 {
+    match method {
+        Method::BlanesMoan6 => 1e-4,
+        Method::BlanesMoan4 | Method::Aba864 | Method::Aba1064 => 1e-3,
+        _ => 1e-2,
+    }
+}
+
 #[test]
 fn every_method_is_stable_just_below_and_unstable_just_above_its_limit() {
     for method in Method::ALL {
@@ -51,7 +64,7 @@ fn every_method_is_stable_just_below_and_unstable_just_above_its_limit() {
             );
         }
         let h_above = if info.h_omega_max > 0.0 {
-            1.01 * info.h_omega_max
+            (1.0 + margin(method)) * info.h_omega_max
         } else {
             0.1
         };
@@ -59,6 +72,10 @@ fn every_method_is_stable_just_below_and_unstable_just_above_its_limit() {
             Err(Error::Divergence { step, time, .. }) => {
                 assert!(step > 1 && (time - (step - 1) as f64 * h_above).abs() < 1e-9 * time.max(1.0));
             }
+            // In a narrow window the growth factor is barely above 1 (blanes_moan4's 1.0023,
+            // blanes_moan6's 1.0004 a step): the orbit grows by 1e200 or 1e36 in STEPS steps, far
+            // past any bounded ellipse, without overflowing.
+            Ok(r) if margin(method) < 1e-2 && r > 1e30 => {}
             other => panic!("{} at hω = {h_above}: expected divergence, got {other:?}", info.name),
         }
     }

@@ -72,6 +72,8 @@ COMPOSITION_NAMES: dict[str, str] = {
     "kahan_li_6_9stage": "kahan_li6",
     "suzuki_umeno_8_15stage": "suzuki_umeno8",
     "kahan_li_8_17stage": "kahan_li8",
+    "mclachlan_6_9stage": "mclachlan6",
+    "mclachlan_8_17stage": "mclachlan8",
 }
 
 #: Linear stability limits hω_max by varmech method name, copied from reference/compositions.json
@@ -88,6 +90,8 @@ REFERENCE_LIMITS: dict[str, float] = {
     "kahan_li6": 2.5326,
     "suzuki_umeno8": 3.3932,
     "kahan_li8": 3.0964,
+    "mclachlan6": 2.7031,
+    "mclachlan8": 3.0871,
     "rk4": 2.0 * math.sqrt(2.0),
     "explicit_euler": 0.0,
     "symplectic_euler": 2.0,

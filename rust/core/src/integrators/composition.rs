@@ -17,7 +17,14 @@ impl Composition {
             Method::Verlet => (&[], Some(1.0)),
             Method::Yoshida4 => (&[1.3512071919596578], Some(-1.7024143839193153)),
             Method::Suzuki4 => (&[0.4144907717943757, 0.4144907717943757], Some(-0.6579630871775028)),
+            // McLachlan (1995), SS5: the free parameter of the one-parameter family, γ₁ = 0.28,
+            // is McLachlan's short value near the least error norm.
             Method::McLachlan4 => (&[0.28, 0.6254664284676701], None),
+            // McLachlan (1995), SS9, order 6 (γ₁ = 0.1867 chosen likewise); Blanes & Casas (2016), p. 89.
+            Method::McLachlan6 => (
+                &[0.1867, 0.5554970237124784, 0.12946694891347535, -0.8432656233877346],
+                None,
+            ),
             Method::Yoshida6 => (
                 &[0.7845136104775573, 0.23557321335935813, -1.177679984178871],
                 Some(1.3151863206839112),
@@ -56,9 +63,24 @@ impl Composition {
                 ],
                 Some(-0.6055085338300346),
             ),
+            // McLachlan (1995), SS17, order 8, as tabulated by Blanes & Casas (2016), p. 91 (the
+            // composition of REBOUND's leapfrog with order = 8, whose 15-digit γ agree).
+            Method::McLachlan8 => (
+                &[
+                    0.12886597938144329,
+                    0.581514087105251,
+                    -0.4101753714698501,
+                    0.18514693571658775,
+                    -0.4095523434208514,
+                    0.14440594108001203,
+                    0.27833550039367966,
+                    0.31495668391629483,
+                ],
+                None,
+            ),
             _ => return None,
         };
-        // McLachlan's middle coefficient is defined by consistency, Σγᵢ = 1.
+        // McLachlan's middle coefficients are defined by consistency, Σγᵢ = 1.
         let middle = middle.unwrap_or_else(|| 1.0 - 2.0 * half.iter().sum::<f64>());
         let gamma = half
             .iter()

@@ -1,15 +1,15 @@
 use super::stepper::{diverged, Phase};
-use super::{compensated, Composition, Increment, StepError, StepStart};
+use super::{compensated, Increment, Splitting, StepError, StepStart};
 use crate::model::MechanicalSystem;
 use crate::{Error, ModelError};
 
-/// A kick–drift splitting method for H = ½pᵀM⁻¹p + V(q):
+/// A kick–drift splitting method ([`Splitting`]) for H = ½pᵀM⁻¹p + V(q):
 ///
 /// p ← p − a₀h∇V(q); then for i = 1..s: q ← q + bᵢhM⁻¹p, p ← p − aᵢh∇V(q).
 ///
-/// A Verlet composition with fractions γ has bᵢ = γᵢ, a₀ = γ₁/2, aᵢ = (γᵢ + γᵢ₊₁)/2 and
-/// aₛ = γₛ/2: adjacent half kicks merged. The force at the end of a step is kept for the first
-/// kick of the next (first same as last), so the composition costs s force evaluations a step.
+/// A zero kick evaluates no force: an ABA method (a₀ = aₛ = 0) opens its step with a drift.
+/// The force at the end of a BAB step is kept for the first kick of the next (first same as
+/// last), so a Verlet composition of s stages costs s force evaluations a step.
 #[derive(Clone, Debug)]
 pub struct KickDrift {
     kicks: Vec<f64>,
@@ -25,38 +25,20 @@ pub struct KickDrift {
 }
 
 impl KickDrift {
-    fn new(kicks: Vec<f64>, drifts: Vec<f64>, n: usize) -> Self {
-        debug_assert_eq!(kicks.len(), drifts.len() + 1);
+    /// The integrator of `splitting` for n coordinates.
+    pub fn new(splitting: &Splitting, n: usize) -> Self {
+        let (kicks, drifts) = (splitting.kicks(), splitting.drifts());
         KickDrift {
             scaled: vec![0.0; kicks.len() + drifts.len()],
             scaled_for: f64::NAN,
-            kicks,
-            drifts,
+            kicks: kicks.to_vec(),
+            drifts: drifts.to_vec(),
             q: vec![0.0; n],
             p: vec![0.0; n],
             force: vec![0.0; n],
             force_cached: false,
             evaluations: 0,
         }
-    }
-
-    /// The composition of Störmer–Verlet with the fractions of `c`.
-    pub fn composition(c: &Composition, n: usize) -> Self {
-        let g = c.gamma();
-        let s = g.len();
-        let kicks = (0..=s)
-            .map(|i| match i {
-                0 => 0.5 * g[0],
-                i if i == s => 0.5 * g[s - 1],
-                i => 0.5 * (g[i - 1] + g[i]),
-            })
-            .collect();
-        Self::new(kicks, g.to_vec(), n)
-    }
-
-    /// Symplectic Euler: p₁ = p₀ − h∇V(q₀), q₁ = q₀ + hM⁻¹p₁.
-    pub fn symplectic_euler(n: usize) -> Self {
-        Self::new(vec![1.0, 0.0], vec![1.0], n)
     }
 
     pub(super) fn reset(&mut self) {
@@ -227,13 +209,20 @@ fn sequence<S: MechanicalSystem + ?Sized>(
         p: stage_p,
         force,
     } = stage;
-    if !*counts.cached {
-        stage_q.copy_from_slice(q);
-        counts.evaluate(sys, stage_q, force)?;
+    if scaled[0] == 0.0 {
+        // ABA: the first drift moves with the step's own momenta; no force is needed.
+        dq.fill(0.0);
+        dp.fill(0.0);
+        stage_p.copy_from_slice(p);
+    } else {
+        if !*counts.cached {
+            stage_q.copy_from_slice(q);
+            counts.evaluate(sys, stage_q, force)?;
+        }
+        // The first kick writes δp (and clears δq, which the drifts add to); each later one
+        // adds to it, and the last leaves the stage momenta, which no drift reads.
+        kick(scaled[0], force, p, dp, Some(stage_p), Some(dq));
     }
-    // The first kick writes δp (and clears δq, which the drifts add to); each later one adds
-    // to it, and the last leaves the stage momenta, which no drift reads.
-    kick(scaled[0], force, p, dp, Some(stage_p), Some(dq));
     let stages = scaled.len() / 2;
     for i in 0..stages {
         sys.mass().drift(scaled[2 * i + 1], stage_p, q, dq, stage_q);

@@ -1,4 +1,4 @@
-use super::{Composition, ModelKind};
+use super::{ModelKind, Splitting};
 use crate::Error;
 
 /// The fixed-step methods of varmech.
@@ -24,6 +24,23 @@ pub enum Method {
     SuzukiUmeno8,
     /// Kahan & Li's 17-stage composition (Kahan & Li 1997), order 8.
     KahanLi8,
+    /// McLachlan's 9-stage composition SS9 (McLachlan 1995), order 6.
+    McLachlan6,
+    /// McLachlan's 17-stage composition SS17 (McLachlan 1995), order 8: Blanes & Casas's
+    /// (2016, p. 91) order-8 composition, the one of REBOUND's leapfrog with order = 8.
+    McLachlan8,
+    /// McLachlan's SS17 composed of Störmer–Verlet in position form (drift–kick–drift), as
+    /// REBOUND's leapfrog with order = 8 applies it: an ABA splitting, 17 force evaluations.
+    McLachlan8Dkd,
+    /// Blanes & Moan's SRKN₆ᵇ (2002), order 4: a BAB splitting with 6 force evaluations.
+    BlanesMoan4,
+    /// Blanes & Moan's SRKN₁₁ᵇ (2002), order 6: a BAB splitting with 11 force evaluations.
+    BlanesMoan6,
+    /// ABA(8,6,4) of Blanes, Casas, Farrés, Laskar, Makazaga & Murua (2013), 7 force
+    /// evaluations: error O(εh⁸ + ε²h⁶ + ε³h⁴) on H = A + εB, order 4 in general.
+    Aba864,
+    /// ABA(10,6,4) of the same paper, 8 force evaluations: error O(εh¹⁰ + ε²h⁶ + ε³h⁴).
+    Aba1064,
     /// The classical Runge–Kutta method (baseline; not symplectic).
     Rk4,
     /// The variational integrator of the midpoint discrete Lagrangian (implicit; any L).
@@ -50,7 +67,8 @@ pub struct MethodInfo {
     pub method: Method,
     pub name: &'static str,
     pub order: u32,
-    /// Stages of the composition (1 for the others).
+    /// Stages: force evaluations of a kick–drift splitting (first same as last reused), the
+    /// Verlet steps of a composition; 1 for the others.
     pub stages: usize,
     /// Force evaluations ∇V per step, first-same-as-last evaluations reused (0 for the
     /// implicit methods, whose cost depends on the Newton iterations).
@@ -72,7 +90,7 @@ pub struct MethodInfo {
 
 impl Method {
     /// Every method, from the simplest.
-    pub const ALL: [Method; 15] = [
+    pub const ALL: [Method; 22] = [
         Method::ExplicitEuler,
         Method::SymplecticEuler,
         Method::Verlet,
@@ -83,6 +101,13 @@ impl Method {
         Method::KahanLi6,
         Method::SuzukiUmeno8,
         Method::KahanLi8,
+        Method::McLachlan6,
+        Method::McLachlan8,
+        Method::McLachlan8Dkd,
+        Method::BlanesMoan4,
+        Method::BlanesMoan6,
+        Method::Aba864,
+        Method::Aba1064,
         Method::Rk4,
         Method::Midpoint,
         Method::Trapezoid,
@@ -113,6 +138,62 @@ impl Method {
             Method::KahanLi6 => ("kahan_li6", 6, true, true, 2.5326, "Kahan & Li, Math. Comp. 66 (1997)"),
             Method::SuzukiUmeno8 => ("suzuki_umeno8", 8, true, true, 3.3932, "Suzuki & Umeno (1993)"),
             Method::KahanLi8 => ("kahan_li8", 8, true, true, 3.0964, "Kahan & Li, Math. Comp. 66 (1997)"),
+            Method::McLachlan6 => (
+                "mclachlan6",
+                6,
+                true,
+                true,
+                2.7031,
+                "McLachlan, SIAM J. Sci. Comput. 16 (1995), SS9",
+            ),
+            Method::McLachlan8 => (
+                "mclachlan8",
+                8,
+                true,
+                true,
+                3.0871,
+                "McLachlan, SIAM J. Sci. Comput. 16 (1995), SS17; Blanes & Casas (2016), p. 91",
+            ),
+            Method::McLachlan8Dkd => (
+                "mclachlan8_dkd",
+                8,
+                true,
+                true,
+                3.0871,
+                "McLachlan (1995), SS17 of position Verlet; Blanes & Casas (2016), p. 91; REBOUND leapfrog order=8",
+            ),
+            Method::BlanesMoan4 => (
+                "blanes_moan4",
+                4,
+                true,
+                true,
+                3.1635,
+                "Blanes & Moan, J. Comput. Appl. Math. 142 (2002), SRKN6b",
+            ),
+            Method::BlanesMoan6 => (
+                "blanes_moan6",
+                6,
+                true,
+                true,
+                3.1414,
+                "Blanes & Moan, J. Comput. Appl. Math. 142 (2002), SRKN11b",
+            ),
+            Method::Aba864 => (
+                "aba864",
+                4,
+                true,
+                true,
+                3.1422,
+                "Blanes, Casas, Farres, Laskar, Makazaga & Murua, Appl. Numer. Math. 68 (2013), ABA(8,6,4)",
+            ),
+            Method::Aba1064 => (
+                "aba1064",
+                4,
+                true,
+                true,
+                3.1461,
+                "Blanes, Casas, Farres, Laskar, Makazaga & Murua, Appl. Numer. Math. 68 (2013), ABA(10,6,4)",
+            ),
             Method::Rk4 => ("rk4", 4, false, false, 2.0 * std::f64::consts::SQRT_2, "baseline"),
             Method::Midpoint => (
                 "midpoint",
@@ -154,7 +235,7 @@ impl Method {
         let constrained = ModelKind::ConstrainedSeparable.admits(self);
         let stages = match self {
             Method::Rattle4 => 3,
-            _ => Composition::of(self).map_or(1, |c| c.gamma().len()),
+            _ => Splitting::of(self).map_or(1, |s| s.stages()),
         };
         let force_evaluations = match self {
             Method::Rk4 => 4,

@@ -9,7 +9,9 @@
 //! - [`ModelKind`]: which method integrates which kind of model, and each kind's default;
 //! - [`Dynamics`]: what a method integrates (a separable system, a [`General`] Lagrangian, or
 //!   either on holonomic constraints);
-//! - [`KickDrift`]: Störmer–Verlet, symplectic Euler and the symmetric compositions of Verlet;
+//! - [`Splitting`]: the coefficients of the kick–drift methods (symplectic Euler, Störmer–Verlet,
+//!   its symmetric compositions, the Runge–Kutta–Nyström splittings);
+//! - [`KickDrift`]: a [`Splitting`] applied to a separable system;
 //! - [`ExplicitRk`]: explicit Euler and classical RK4, the non-structure-preserving baselines;
 //! - [`Stepper`]: one model, one method and the state, advanced step by step; its
 //!   [`StepperState`] apart from the model, to resume;
@@ -26,6 +28,7 @@ mod kind;
 mod method;
 mod rattle;
 mod run;
+mod splitting;
 mod step;
 mod stepper;
 mod trajectory;
@@ -42,6 +45,7 @@ pub use kind::ModelKind;
 pub use method::{Method, MethodInfo};
 pub use rattle::Rattle;
 pub use run::{integrate, Options};
+pub use splitting::{Leading, Splitting};
 pub use step::{Increment, StepStart};
 pub use stepper::{Stepper, StepperState};
 pub use trajectory::{Failure, Trajectory};
@@ -94,9 +98,8 @@ impl Integrator {
             )),
             Method::ExplicitEuler => Scheme::ExplicitRk(ExplicitRk::euler(n)),
             Method::Rk4 => Scheme::ExplicitRk(ExplicitRk::rk4(n)),
-            Method::SymplecticEuler => Scheme::KickDrift(KickDrift::symplectic_euler(n)),
-            _ => Scheme::KickDrift(KickDrift::composition(
-                &Composition::of(method).expect("every other method is a composition of Verlet"),
+            _ => Scheme::KickDrift(KickDrift::new(
+                &Splitting::of(method).expect("every other method is a kick–drift splitting"),
                 n,
             )),
         };
