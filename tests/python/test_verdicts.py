@@ -43,11 +43,18 @@ def test_a_rotating_frame_jacobi_integral_is_conserved_to_round_off():
     assert report.energy.max_rel_error < 1e-13
 
 
+#: The splittings with small error constants (issue 15) that keep Kepler e = 0.9 bound at
+#: h = 2π/100, where every composition of the first round loses it.
+BOUND_AT_100 = ["blanes_moan6", "aba864", "aba1064"]
+
+
 @pytest.mark.parametrize("n", [50, 100])
 @pytest.mark.parametrize("method", EXPLICIT_SYMPLECTIC)
 def test_coarse_steps_on_an_eccentric_kepler_orbit_raise(method, n):
     # Kepler at e = 0.9 with h = 2π/50 or 2π/100: every explicit symplectic method loses the
     # orbit (was "bounded" with status 0); without the check, the verdict says "failed".
+    if n == 100 and method in BOUND_AT_100:
+        pytest.skip("keeps the orbit bound at h = 2π/100: see the next test")
     scene = scenes.kepler(0.9)
     dt = 2 * math.pi / n
     steps = round(scene.t_end / dt)
@@ -58,6 +65,22 @@ def test_coarse_steps_on_an_eccentric_kepler_orbit_raise(method, n):
     report = varmech.check_conservation(varmech.integrate(scene, dt=dt, steps=steps, method=method, max_energy_error=None))
     assert report.verdict == "failed" and report.energy.max_rel_error >= FAILURE
     assert "reduce dt" in report.energy.advice
+
+
+@pytest.mark.parametrize("method", BOUND_AT_100)
+def test_small_error_constants_keep_the_coarse_orbit_bound_but_not_accurate(method):
+    # The same orbit at h = 2π/100: the orbit stays bound (E_end < 0) and the energy error stays
+    # below the failure level, but at 0.27–0.73 of the scale (measured), with the energy
+    # wandering from one badly resolved pericentre passage to the next: "bounded" or "secular
+    # drift", never a small band.
+    scene = scenes.kepler(0.9)
+    dt = 2 * math.pi / 100
+    steps = round(scene.t_end / dt)
+    traj = varmech.integrate(scene, dt=dt, steps=steps, method=method)
+    assert traj.energy()[-1] < 0
+    report = varmech.check_conservation(traj)
+    assert report.verdict in ("bounded", "secular drift"), report
+    assert 0.1 < report.energy.max_rel_error < FAILURE
 
 
 @pytest.mark.parametrize("method", EXPLICIT_SYMPLECTIC)
@@ -72,8 +95,10 @@ def test_at_h_2pi_over_200_every_run_that_unbinds_the_orbit_raises(method):
             varmech.integrate(scene, dt=dt, steps=steps, method=method)
         assert report.verdict == "failed"
     else:
-        # Still bound: a band, large for the coarse step (the advice says so) but not garbage.
-        assert report.verdict in ("bounded", "failed")
+        # Still bound: a band, large for the coarse step (the advice says so) but not garbage;
+        # or, for mclachlan6, an energy that walks down at each under-resolved pericentre
+        # passage (−0.50 to −0.85 over 200 periods, measured): "secular drift" is then right.
+        assert report.verdict in ("bounded", "failed", "secular drift")
 
 
 def test_an_absurd_step_raises_at_its_first_step():
