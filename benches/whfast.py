@@ -38,11 +38,15 @@ T_END = 500_000.0
 LEVELS = [10.0**-k for k in range(3, 11)]
 #: varmech methods and REBOUND WHFast configurations (corrector, kernel).
 VARMECH = ("wh", "whc", "whckl")
-REBOUND = {"WHFast corrector=11": (11, "default"), "WHFast": (0, "default"), "WHFast corrector=17 kernel=lazy": (17, "lazy")}
+REBOUND = {
+    "WHFast corrector=11": (11, "default"),
+    "WHFast": (0, "default"),
+    "WHFast corrector=17 kernel=lazy": (17, "lazy"),
+}
 
 
-def varmech_run(scene: scenes.Scene, method: str, dt: float) -> Callable[[], np.ndarray]:
-    steps = round(T_END / dt)
+def varmech_run(scene: scenes.Scene, method: str, steps: int) -> Callable[[], np.ndarray]:
+    dt = T_END / steps
 
     def run() -> np.ndarray:
         traj = varmech.integrate(scene, method=method, dt=dt, steps=steps, save_every=steps, max_energy_error=None)
@@ -51,8 +55,8 @@ def varmech_run(scene: scenes.Scene, method: str, dt: float) -> Callable[[], np.
     return run
 
 
-def whfast_run(rebound, scene: scenes.Scene, corrector: int, kernel: str, dt: float) -> Callable[[], np.ndarray]:
-    steps = round(T_END / dt)
+def whfast_run(rebound, scene: scenes.Scene, corrector: int, kernel: str, steps: int) -> Callable[[], np.ndarray]:
+    dt = T_END / steps
     masses = scene.model._core.gravity[1]
 
     def run() -> np.ndarray:
@@ -87,10 +91,15 @@ def reference(rebound, scene: scenes.Scene) -> np.ndarray:
 
 
 def cost_at(level: float, points: list[tuple[float, float]]) -> float | None:
-    """The time at error `level`, interpolated log-log between the sweep's bracketing points."""
-    pts = sorted(points, key=lambda p: -p[0])
-    for (e1, t1), (e2, t2) in zip(pts, pts[1:]):
-        if e2 <= level <= e1 and e1 > e2:
+    """The time at error `level` along the sweep's front (the points no cheaper point beats in
+    error: round-off plateaus make the sweep non-monotone), interpolated log-log between the
+    front's points that bracket it; None when the front does not reach `level`."""
+    front: list[tuple[float, float]] = []
+    for e, t in sorted(points, key=lambda p: p[1]):
+        if not front or e < front[-1][0]:
+            front.append((e, t))
+    for (e1, t1), (e2, t2) in zip(front, front[1:]):
+        if e2 <= level <= e1:
             w = math.log(e1 / level) / math.log(e1 / e2)
             return math.exp((1 - w) * math.log(t1) + w * math.log(t2))
     return None
@@ -109,32 +118,36 @@ def main() -> None:
     scene = scenes.get("outer_solar_system")
     q_ref = reference(rebound, scene)
 
-    makers: dict[str, Callable[[float], Callable[[], np.ndarray]]] = {
-        **{f"varmech {m}": (lambda dt, m=m: varmech_run(scene, m, dt)) for m in VARMECH},
-        **{f"REBOUND {name}": (lambda dt, c=c, k=k: whfast_run(rebound, scene, c, k, dt)) for name, (c, k) in REBOUND.items()},
+    makers: dict[str, Callable[[int], Callable[[], np.ndarray]]] = {
+        **{f"varmech {m}": (lambda n, m=m: varmech_run(scene, m, n)) for m in VARMECH},
+        **{
+            f"REBOUND {name}": (lambda n, c=c, k=k: whfast_run(rebound, scene, c, k, n))
+            for name, (c, k) in REBOUND.items()
+        },
     }
-    # The accuracy pass: each method's sweep, from 800 days down until the error is below the
-    # floor (and one step more, to bracket it) or 4e6 steps.
+    # The accuracy pass: each method's sweep of whole numbers of steps to 500 000 days, from
+    # dt ≈ 800 days down by √2 until the error is below the floor (one step beyond, to bracket
+    # it) or 4e6 steps.
     configs: list[tuple[str, float]] = []
     errors: dict[tuple[str, float], float] = {}
     finest: dict[str, np.ndarray] = {}
     for name, make in makers.items():
-        dt = 800.0
-        while True:
-            q, _ = timed(make(dt))
+        for k in range(64):
+            steps = round(T_END / 800.0 * 2.0 ** (k / 2))
+            dt = T_END / steps
+            q, _ = timed(make(steps))
             err = float(np.linalg.norm(q - q_ref)) if np.all(np.isfinite(q)) else math.inf
             errors[(name, dt)] = err
             print(f"{name:40s} dt = {dt:9.4f}: error {err:.3e}", flush=True)
             if math.isfinite(err) and err < 1e-2:
                 configs.append((name, dt))
                 finest[name] = q
-            if err < 0.3 * floor or T_END / dt > 4e6:
+            if err < 0.3 * floor or steps > 4e6:
                 break
-            dt /= math.sqrt(2.0)
     best = {c: math.inf for c in configs}
     for _ in range(repeat):
         for c in configs:
-            best[c] = min(best[c], timed(makers[c[0]](c[1]))[1])
+            best[c] = min(best[c], timed(makers[c[0]](round(T_END / c[1])))[1])
 
     hlw = np.asarray(scene.reference.q) if scene.reference is not None else None
     lines = [
@@ -146,7 +159,11 @@ def main() -> None:
     ]
     if hlw is not None:
         lines.append(f"HLW's published reference state is {np.linalg.norm(hlw - q_ref):.1e} AU from it.")
-    lines += ["", f"Time: best of {repeat}, interleaved. Cost at each error, interpolated log-log along each sweep:", ""]
+    lines += [
+        "",
+        f"Time: best of {repeat}, interleaved. Cost at each error, interpolated log-log along each sweep:",
+        "",
+    ]
     names = list(makers)
     lines.append("| error | " + " | ".join(names) + " | varmech best | WHFast c11 / varmech best |")
     lines.append("|---" * (len(names) + 3) + "|")
@@ -158,7 +175,13 @@ def main() -> None:
         ratio = f"{theirs / ours[winner]:.2f}" if winner and theirs else "—"
         cells = [f"{costs[n] * 1e3:.1f} ms" if costs[n] else "—" for n in names]
         lines.append(f"| {level:.0e} | " + " | ".join(cells) + f" | {winner or '—'} | {ratio} |")
-    lines += ["", "Sweep (dt in days, error in AU, best time):", "", "| method | dt | error | time |", "|---|---|---|---|"]
+    lines += [
+        "",
+        "Sweep (dt in days, error in AU, best time):",
+        "",
+        "| method | dt | error | time |",
+        "|---|---|---|---|",
+    ]
     lines += [f"| {n} | {dt:.4g} | {errors[(n, dt)]:.2e} | {best[(n, dt)] * 1e3:.2f} ms |" for n, dt in configs]
     text = "\n".join(lines) + "\n"
     print(text)
