@@ -65,7 +65,7 @@ fn allocations(method: Method, steps: usize, max_energy_error: Option<f64>) -> u
 
 #[test]
 fn the_step_loop_allocates_nothing() {
-    for method in Method::ALL {
+    for method in Method::ALL.into_iter().chain(Method::WISDOM_HOLMAN) {
         // Newton's difference Jacobians make the implicit methods slow on 18 coordinates; a
         // shorter long run proves the same.
         let long_steps = if method.info().implicit { 2_000 } else { 100_000 };
@@ -211,7 +211,7 @@ fn the_stepper_allocates_nothing() {
     let problem = NBody::outer_solar_system();
     let (q0, p0) = (&problem.initial.q, &problem.initial.p);
     let options = Options::new(10.0, 0);
-    for method in Method::ALL {
+    for method in Method::ALL.into_iter().chain(Method::WISDOM_HOLMAN) {
         let stepper = Stepper::new(&problem.system, method, q0, p0, &options).unwrap();
         let count = stepper_allocations(stepper, 200);
         assert_eq!(count, 0, "{method:?}: {count} allocations in 200 steps");
@@ -238,7 +238,7 @@ fn the_stepper_allocates_nothing() {
 fn resuming_and_resetting_a_stepper_allocates_nothing() {
     let problem = NBody::outer_solar_system();
     let (q0, p0) = (&problem.initial.q, &problem.initial.p);
-    for method in [Method::Verlet, Method::Midpoint] {
+    for method in [Method::Verlet, Method::Midpoint, Method::WisdomHolmanCorrected] {
         let mut first = Stepper::new(&problem.system, method, q0, p0, &Options::new(10.0, 0)).unwrap();
         first.step().unwrap();
         let mut state: StepperState = first.into_state();

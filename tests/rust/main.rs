@@ -27,3 +27,4 @@ mod spurious_branch;
 mod stability;
 mod stepper;
 mod variational;
+mod wisdom_holman;

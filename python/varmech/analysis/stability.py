@@ -136,13 +136,16 @@ def _method(method: str) -> MethodInfo:
                     f"method: {method!r} integrates constrained systems only, and the linear test equation has no "
                     "constraint (its stability on the constrained manifold is that of the method it is built on)"
                 )
+            if info.nbody:
+                raise ValueError(f"method: {method!r} integrates the gravitational N-body problem only, not the linear test equation")
             return info
     names = ", ".join(m.name for m in _methods())
     raise ValueError(f"method: unknown method {method!r}; one of {names}")
 
 
 def _unconstrained() -> list[str]:
-    return [m.name for m in _methods() if not m.constrained]
+    """The methods of the linear test equation: neither constrained nor N-body only."""
+    return [m.name for m in _methods() if not m.constrained and not m.nbody]
 
 
 def _step_matrix(method: str, y: float) -> np.ndarray:

@@ -115,7 +115,7 @@ impl PyModelKind {
     /// Whether every unconstrained method applies (L = ½q̇ᵀMq̇ − V(q) with constant M).
     #[getter]
     fn separable(&self) -> bool {
-        self.0 == ModelKind::Separable
+        self.0.is_separable()
     }
 
     #[getter]

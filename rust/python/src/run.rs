@@ -94,7 +94,11 @@ fn symplecticity_defect<'py>(
 /// ``force_evaluations`` counts gradient evaluations per step, first-same-as-last reused (0 for
 /// the implicit methods, whose cost depends on their Newton iterations). ``implicit`` methods
 /// solve each step by Newton's method; ``constrained`` ones (RATTLE, SHAKE) integrate systems
-/// on holonomic constraints, and only those.
+/// on holonomic constraints, and only those; ``nbody`` ones (the Wisdom–Holman methods ``wh``
+/// and ``whc``) integrate the gravitational N-body problem, and only that (``h_omega_max`` is
+/// NaN for them). ``force_evaluations`` of the Wisdom–Holman methods counts the kicks of a step
+/// between synchronisations; ``whc``'s corrector adds 20 kicks at the start and at every saved
+/// state.
 #[pyclass(frozen, get_all, module = "varmech._core")]
 pub struct MethodInfo {
     name: &'static str,
@@ -103,6 +107,7 @@ pub struct MethodInfo {
     force_evaluations: usize,
     implicit: bool,
     constrained: bool,
+    nbody: bool,
     symplectic: bool,
     symmetric: bool,
     h_omega_max: f64,
@@ -118,6 +123,7 @@ impl From<integrators::MethodInfo> for MethodInfo {
             force_evaluations: i.force_evaluations,
             implicit: i.implicit,
             constrained: i.constrained,
+            nbody: i.nbody,
             symplectic: i.symplectic,
             symmetric: i.symmetric,
             h_omega_max: i.h_omega_max,
@@ -133,12 +139,14 @@ impl MethodInfo {
     }
 }
 
-/// Every method's facts, the unconstrained ones first, each from the simplest.
+/// Every method's facts, the unconstrained ones first, each from the simplest, then the
+/// constrained ones and the N-body ones.
 #[pyfunction]
 fn methods() -> Vec<MethodInfo> {
     Method::ALL
         .iter()
         .chain(&Method::CONSTRAINED)
+        .chain(&Method::WISDOM_HOLMAN)
         .map(|m| m.info().into())
         .collect()
 }

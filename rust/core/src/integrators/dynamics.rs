@@ -1,7 +1,9 @@
 //! What a method integrates: the dynamics of a model, seen through one step's increments.
 
 use super::{Increment, Integrator, ModelKind, StepError, StepStart, StepperState};
-use crate::model::{self, Constrained, EnergyTerms, HolonomicConstraints, Lagrangian, MechanicalSystem, PhaseState};
+use crate::model::{
+    self, Constrained, EnergyTerms, HolonomicConstraints, Lagrangian, MechanicalSystem, NBody, PhaseState,
+};
 use crate::{Error, ModelError};
 
 /// The dynamics a method integrates: separable mechanical systems take every unconstrained
@@ -76,6 +78,11 @@ pub trait Dynamics {
     fn project(&self, _q: &[f64], _p: &[f64]) -> Option<Result<PhaseState, Error>> {
         None
     }
+
+    /// The gravitational N-body problem, for the Wisdom–Holman methods; None for other models.
+    fn as_nbody(&self) -> Option<&NBody> {
+        None
+    }
 }
 
 impl<S: MechanicalSystem> Dynamics for S {
@@ -84,7 +91,11 @@ impl<S: MechanicalSystem> Dynamics for S {
     }
 
     fn kind(&self) -> ModelKind {
-        ModelKind::Separable
+        if MechanicalSystem::as_nbody(self).is_some() {
+            ModelKind::Gravitational
+        } else {
+            ModelKind::Separable
+        }
     }
 
     // Inlined, like Integrator::increment, so that a separable step is one loop body: the
@@ -109,6 +120,10 @@ impl<S: MechanicalSystem> Dynamics for S {
 
     fn as_lagrangian(&self) -> &dyn Lagrangian {
         self
+    }
+
+    fn as_nbody(&self) -> Option<&NBody> {
+        MechanicalSystem::as_nbody(self)
     }
 }
 

@@ -18,6 +18,9 @@ pub enum ModelKind {
     /// A general Lagrangian on holonomic constraints: the constrained DEL equations of the
     /// two-point rules.
     ConstrainedLagrangian,
+    /// The gravitational N-body problem ([`crate::model::NBody`]), a separable system with a
+    /// dominant central body: every method of a separable system and the Wisdom–Holman methods.
+    Gravitational,
 }
 
 impl ModelKind {
@@ -25,7 +28,10 @@ impl ModelKind {
     pub fn admits(self, method: Method) -> bool {
         use Method::*;
         match self {
-            ModelKind::Separable => !ModelKind::ConstrainedSeparable.admits(method),
+            ModelKind::Separable => {
+                !ModelKind::ConstrainedSeparable.admits(method) && !Method::WISDOM_HOLMAN.contains(&method)
+            }
+            ModelKind::Gravitational => ModelKind::Separable.admits(method) || Method::WISDOM_HOLMAN.contains(&method),
             ModelKind::Lagrangian => matches!(method, Midpoint | Trapezoid | Galerkin4 | Galerkin6),
             ModelKind::ConstrainedSeparable => Method::CONSTRAINED.contains(&method),
             // Galerkin with multipliers at the step's ends alone falls to order 2 (measured),
@@ -40,7 +46,7 @@ impl ModelKind {
     /// (RATTLE's discrete Lagrangian) for a general Lagrangian on constraints.
     pub fn default_method(self) -> Method {
         match self {
-            ModelKind::Separable => Method::Verlet,
+            ModelKind::Separable | ModelKind::Gravitational => Method::Verlet,
             ModelKind::Lagrangian => Method::Midpoint,
             ModelKind::ConstrainedSeparable => Method::Rattle,
             ModelKind::ConstrainedLagrangian => Method::Trapezoid,
@@ -53,7 +59,7 @@ impl ModelKind {
     /// best order there is, for a general Lagrangian on constraints.
     pub fn accurate_method(self) -> Method {
         match self {
-            ModelKind::Separable => Method::KahanLi6,
+            ModelKind::Separable | ModelKind::Gravitational => Method::KahanLi6,
             ModelKind::Lagrangian => Method::Galerkin6,
             ModelKind::ConstrainedSeparable => Method::Rattle4,
             ModelKind::ConstrainedLagrangian => Method::Trapezoid,
@@ -67,7 +73,14 @@ impl ModelKind {
             ModelKind::Lagrangian => "lagrangian",
             ModelKind::ConstrainedSeparable => "constrained separable",
             ModelKind::ConstrainedLagrangian => "constrained lagrangian",
+            ModelKind::Gravitational => "gravitational",
         }
+    }
+
+    /// Whether the model is a separable mechanical system L = ½q̇ᵀMq̇ − V(q) with constant M, so
+    /// that every unconstrained method applies.
+    pub fn is_separable(self) -> bool {
+        matches!(self, ModelKind::Separable | ModelKind::Gravitational)
     }
 }
 
@@ -86,10 +99,17 @@ impl Method {
     pub(super) fn refusal(self, kind: ModelKind) -> Error {
         let name = self.info().name;
         let reason = match kind {
-            ModelKind::Separable | ModelKind::Lagrangian if ModelKind::ConstrainedSeparable.admits(self) => {
+            _ if Method::WISDOM_HOLMAN.contains(&self) => format!(
+                "{name} integrates the gravitational N-body problem alone (Jacobi coordinates about a central \
+                 body); this is a {} model",
+                kind.name()
+            ),
+            ModelKind::Separable | ModelKind::Lagrangian | ModelKind::Gravitational
+                if ModelKind::ConstrainedSeparable.admits(self) =>
+            {
                 format!("{name} integrates systems with holonomic constraints")
             }
-            ModelKind::Separable | ModelKind::Lagrangian => {
+            ModelKind::Separable | ModelKind::Lagrangian | ModelKind::Gravitational => {
                 format!("{name} needs a separable mechanical system; use midpoint or trapezoid")
             }
             ModelKind::ConstrainedSeparable => {

@@ -59,6 +59,16 @@ pub enum Method {
     /// SHAKE (Ryckaert, Ciccotti & Berendsen 1977): positions on the constraints, one
     /// constraint at a time to the Newton tolerance; momenta off the hidden constraint.
     Shake,
+    /// The Wisdom–Holman method (Wisdom & Holman 1991) in Jacobi coordinates, as WHFast (Rein &
+    /// Tamayo 2015): Kepler drifts and interaction kicks, order 2 with error O(εh²).
+    WisdomHolman,
+    /// The Wisdom–Holman method with Wisdom, Holman & Touma's (1996) symplectic corrector of
+    /// order 11 (WHFast's `corrector=11`): error O(εh¹² + ε²h²).
+    WisdomHolmanCorrected,
+    /// The Wisdom–Holman method with the corrector of order 11 and the lazy implementer's
+    /// modified-kick kernel of Wisdom, Holman & Touma (1996) (Rein, Tamayo & Brown 2019's
+    /// WHCKL): error O(εh¹² + ε²h⁴), at two force evaluations a step.
+    WisdomHolmanLazyKernel,
 }
 
 /// What `varmech.methods()` lists about a method.
@@ -80,10 +90,14 @@ pub struct MethodInfo {
     /// Whether the method integrates separable systems on holonomic constraints (and only
     /// those; read from the table of [`ModelKind`]).
     pub constrained: bool,
+    /// Whether the method integrates the gravitational N-body problem only (the Wisdom–Holman
+    /// methods; read from the table of [`ModelKind`]).
+    pub nbody: bool,
     pub symplectic: bool,
     pub symmetric: bool,
     /// Linear stability limit: the method is stable on q̈ = −ω²q iff hω < `h_omega_max`
-    /// (0 for explicit Euler, which is never stable; infinite for the midpoint rule).
+    /// (0 for explicit Euler, which is never stable; infinite for the midpoint rule; NaN for the
+    /// Wisdom–Holman methods, which do not integrate the oscillator).
     pub h_omega_max: f64,
     pub reference: &'static str,
 }
@@ -117,6 +131,13 @@ impl Method {
 
     /// The methods for holonomic constraints.
     pub const CONSTRAINED: [Method; 3] = [Method::Rattle, Method::Rattle4, Method::Shake];
+
+    /// The methods for the gravitational N-body problem alone.
+    pub const WISDOM_HOLMAN: [Method; 3] = [
+        Method::WisdomHolman,
+        Method::WisdomHolmanCorrected,
+        Method::WisdomHolmanLazyKernel,
+    ];
 
     /// The method's facts.
     pub fn info(self) -> MethodInfo {
@@ -230,15 +251,41 @@ impl Method {
             Method::Rattle => ("rattle", 2, true, true, 2.0, "Andersen (1983); HLW VII.1.4"),
             Method::Rattle4 => ("rattle4", 4, true, true, 1.5734, "RATTLE, Yoshida's triple jump"),
             Method::Shake => ("shake", 2, false, true, 2.0, "Ryckaert, Ciccotti & Berendsen (1977)"),
+            Method::WisdomHolman => (
+                "wh",
+                2,
+                true,
+                true,
+                f64::NAN,
+                "Wisdom & Holman, AJ 102 (1991); Rein & Tamayo, MNRAS 452 (2015)",
+            ),
+            Method::WisdomHolmanCorrected => (
+                "whc",
+                2,
+                true,
+                true,
+                f64::NAN,
+                "Wisdom, Holman & Touma, Fields Inst. Commun. 10 (1996); Rein & Tamayo, MNRAS 452 (2015)",
+            ),
+            Method::WisdomHolmanLazyKernel => (
+                "whckl",
+                4,
+                true,
+                true,
+                f64::NAN,
+                "Wisdom, Holman & Touma (1996), §10; Rein, Tamayo & Brown, MNRAS 489 (2019)",
+            ),
         };
         let implicit = ModelKind::Lagrangian.admits(self);
         let constrained = ModelKind::ConstrainedSeparable.admits(self);
+        let nbody = !ModelKind::Separable.admits(self) && ModelKind::Gravitational.admits(self);
         let stages = match self {
             Method::Rattle4 => 3,
             _ => Splitting::of(self).map_or(1, |s| s.stages()),
         };
         let force_evaluations = match self {
             Method::Rk4 => 4,
+            Method::WisdomHolmanLazyKernel => 2,
             _ if implicit => 0,
             _ => stages,
         };
@@ -250,6 +297,7 @@ impl Method {
             force_evaluations,
             implicit,
             constrained,
+            nbody,
             symplectic,
             symmetric,
             h_omega_max,
@@ -259,7 +307,12 @@ impl Method {
 
     /// The method called `name` (as listed by [`Method::info`]).
     pub fn from_name(name: &str) -> Result<Method, Error> {
-        let all = || Method::ALL.into_iter().chain(Method::CONSTRAINED);
+        let all = || {
+            Method::ALL
+                .into_iter()
+                .chain(Method::CONSTRAINED)
+                .chain(Method::WISDOM_HOLMAN)
+        };
         all().find(|m| m.info().name == name).ok_or_else(|| {
             let names: Vec<_> = all().map(|m| m.info().name).collect();
             Error::invalid(

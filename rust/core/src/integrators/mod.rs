@@ -13,6 +13,8 @@
 //!   its symmetric compositions, the Runge–Kutta–Nyström splittings);
 //! - [`KickDrift`]: a [`Splitting`] applied to a separable system;
 //! - [`ExplicitRk`]: explicit Euler and classical RK4, the non-structure-preserving baselines;
+//! - [`wisdom_holman`]: the Wisdom–Holman methods of the N-body problem, Kepler drifts and
+//!   interaction kicks in Jacobi coordinates, with symplectic correctors ([`WisdomHolman`]);
 //! - [`Stepper`]: one model, one method and the state, advanced step by step; its
 //!   [`StepperState`] apart from the model, to resume;
 //! - [`integrate`]: a run of a [`Stepper`] with saving and an energy check, into a
@@ -32,6 +34,7 @@ mod splitting;
 mod step;
 mod stepper;
 mod trajectory;
+pub mod wisdom_holman;
 
 pub use crate::discrete::{Galerkin, Quadrature};
 pub use crate::error::StepError;
@@ -49,6 +52,7 @@ pub use splitting::{Leading, Splitting};
 pub use step::{Increment, StepStart};
 pub use stepper::{Stepper, StepperState};
 pub use trajectory::{Failure, Trajectory};
+pub use wisdom_holman::{Kernel, WisdomHolman};
 
 use crate::discrete::{Midpoint, Trapezoidal};
 use crate::model::{HolonomicConstraints, Lagrangian, MechanicalSystem};
@@ -68,6 +72,7 @@ enum Scheme {
     Trapezoid(Del<TwoPoint<Trapezoidal>>),
     Galerkin(Del<Galerkin>),
     Rattle(Rattle),
+    WisdomHolman(WisdomHolman),
 }
 
 impl Integrator {
@@ -96,6 +101,15 @@ impl Integrator {
                 n,
                 0,
             )),
+            Method::WisdomHolman => {
+                Scheme::WisdomHolman(WisdomHolman::new(Kernel::Standard, 0, n).expect("no corrector"))
+            }
+            Method::WisdomHolmanCorrected => {
+                Scheme::WisdomHolman(WisdomHolman::new(Kernel::Standard, 11, n).expect("WHFast's corrector 11"))
+            }
+            Method::WisdomHolmanLazyKernel => {
+                Scheme::WisdomHolman(WisdomHolman::new(Kernel::LazyModifiedKick, 11, n).expect("corrector 11"))
+            }
             Method::ExplicitEuler => Scheme::ExplicitRk(ExplicitRk::euler(n)),
             Method::Rk4 => Scheme::ExplicitRk(ExplicitRk::rk4(n)),
             _ => Scheme::KickDrift(KickDrift::new(
@@ -121,7 +135,18 @@ impl Integrator {
             Scheme::Trapezoid(s) => s.reset(),
             Scheme::Galerkin(s) => s.reset(),
             Scheme::Rattle(s) => s.reset(),
+            Scheme::WisdomHolman(s) => s.reset(),
             Scheme::ExplicitRk(_) => {}
+        }
+    }
+
+    /// The method's own variables, for a method that keeps them from step to step and shows
+    /// them as (q, p) only when synchronised (the Wisdom–Holman methods; see
+    /// [`Stepper::advance`]); None for the methods that step (q, p) itself.
+    pub(super) fn own_variables(&mut self) -> Option<&mut WisdomHolman> {
+        match &mut self.scheme {
+            Scheme::WisdomHolman(s) => Some(s),
+            _ => None,
         }
     }
 
@@ -135,6 +160,7 @@ impl Integrator {
             Scheme::Trapezoid(s) => s.evaluations(),
             Scheme::Galerkin(s) => s.evaluations(),
             Scheme::Rattle(s) => s.evaluations(),
+            Scheme::WisdomHolman(s) => s.force_evaluations(),
         }
     }
 
@@ -179,6 +205,10 @@ impl Integrator {
             Scheme::KickDrift(s) => Ok(s.increment(sys, start, increment)?),
             Scheme::ExplicitRk(s) => Ok(s.increment(sys, start, increment)?),
             Scheme::Rattle(_) => Err(self.method.refusal(ModelKind::Separable).into()),
+            Scheme::WisdomHolman(s) => match sys.as_nbody() {
+                Some(model) => s.increment(model, start, increment),
+                None => Err(self.method.refusal(ModelKind::Separable).into()),
+            },
             _ => self.increment_lagrangian(sys, start, increment),
         }
     }

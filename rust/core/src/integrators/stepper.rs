@@ -1,5 +1,7 @@
 //! One model, one method and the state, advanced step by step; the state apart from its model.
 
+mod own_variables;
+
 use std::borrow::{Borrow, BorrowMut};
 use std::ops::Deref;
 
@@ -129,17 +131,27 @@ where
     /// Advances one step. On failure the state stays at the last good step, and the error
     /// names the step (counted from 1) and the time it started at.
     pub fn step(&mut self) -> Result<(), Error> {
-        self.state.borrow_mut().step(&*self.model)
+        let state = self.state.borrow_mut();
+        if state.integrator.own_variables().is_some() {
+            return state.advance_own(&*self.model, 1, || Ok(()));
+        }
+        state.step(&*self.model)
     }
 
     /// Advances `n` steps, calling `poll` before a step every 10–40 ms of run time; an error
     /// from it stops with [`Error::Interrupted`] (the binding checks for Ctrl-C there). On
     /// failure the state stays at the last good step.
+    ///
+    /// A method that keeps its own variables (the Wisdom–Holman methods) takes the n steps on
+    /// them and synchronises (q, p) once, at the end (see `own_variables.rs`).
     pub fn advance<P>(&mut self, n: usize, mut poll: P) -> Result<(), Error>
     where
         P: FnMut() -> Result<(), ModelError>,
     {
         let state = self.state.borrow_mut();
+        if state.integrator.own_variables().is_some() {
+            return state.advance_own(&*self.model, n, poll);
+        }
         let mut left = n;
         while left > 0 {
             if state.interrupt.due() {

@@ -1,4 +1,4 @@
-use super::{Generator, Mass};
+use super::{Generator, Mass, NBody};
 use crate::ModelError;
 
 /// A separable mechanical system, L(q, q̇) = ½ q̇ᵀ M q̇ − V(q), with constant mass matrix M.
@@ -21,5 +21,11 @@ pub trait MechanicalSystem {
     /// The symmetries the model declares; each has a conserved Noether momentum J = p·ξ(q).
     fn symmetries(&self) -> Vec<Generator> {
         Vec::new()
+    }
+
+    /// The model as a gravitational N-body problem, for the Wisdom–Holman methods, which
+    /// integrate nothing else; None for other models.
+    fn as_nbody(&self) -> Option<&NBody> {
+        None
     }
 }

@@ -95,6 +95,9 @@ impl MechanicalSystem for NBody {
         }
         Ok(())
     }
+    fn as_nbody(&self) -> Option<&NBody> {
+        Some(self)
+    }
     fn symmetries(&self) -> Vec<Generator> {
         (0..3)
             .map(|axis| Generator::Translation { axis, spatial_dim: 3 })

@@ -114,6 +114,9 @@ impl MechanicalSystem for Scene {
     fn symmetries(&self) -> Vec<Generator> {
         dispatch!(self, s => s.symmetries())
     }
+    fn as_nbody(&self) -> Option<&NBody> {
+        dispatch!(self, s => s.as_nbody())
+    }
 }
 
 /// Any native scene that is a general Lagrangian (integrated by the implicit methods).
