@@ -19,6 +19,7 @@ mod hessians;
 mod jit;
 mod kepler;
 mod kepler_polar;
+mod nbody_kernel;
 mod routh;
 mod solar_system;
 mod spurious_branch;

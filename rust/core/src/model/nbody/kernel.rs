@@ -1,0 +1,274 @@
+//! The pair loops of Newtonian gravity, each unique pair once, over tiles of bodies in
+//! structure-of-arrays layout, with SIMD lanes chosen at run time.
+//!
+//! For bodies i < j with dᵢⱼ = xᵢ − xⱼ, rᵢⱼ² = |dᵢⱼ|² and fᵢⱼ = G mᵢ mⱼ / (rᵢⱼ² √rᵢⱼ²),
+//!
+//! ∂V/∂xᵢ = Σⱼ₍ⱼ≠ᵢ₎ fᵢⱼ (xᵢ − xⱼ),   V = −Σᵢ<ⱼ G mᵢ mⱼ / rᵢⱼ,
+//!
+//! so a pair adds +fᵢⱼ dᵢⱼ to body i's gradient and −fᵢⱼ dᵢⱼ to body j's. The bodies j are
+//! taken a tile of [`TILE`] at a time: the tile holds their x, y and z as three contiguous
+//! arrays, and their gradient accumulators likewise, so that the loop over j (for each i < j)
+//! loads, updates and stores whole vectors of consecutive bodies, with no gather or scatter;
+//! body i's own sums stay in registers. A tile lives on the stack (48 bytes a body, in L1):
+//! no allocation, nothing shared between threads.
+
+use super::lanes::Lanes;
+use std::mem::MaybeUninit;
+
+/// Bodies per tile: 12 KiB of positions and accumulators.
+const TILE: usize = 256;
+
+/// The instruction set of the pair loops.
+///
+/// Every kernel computes each pair's terms with the same IEEE operations; the vector kernels
+/// fuse the multiply–adds and sum body i's terms lane by lane, so they agree with
+/// [`PairKernel::Scalar`] to round-off, not bit for bit. The scalar kernel reproduces the
+/// loops before SIMD bit for bit for up to 256 bodies.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum PairKernel {
+    /// One pair at a time, plain f64: every target, and the reference of the others.
+    Scalar,
+    /// Four pairs at a time, AVX2 with FMA (x86-64).
+    Avx2,
+    /// Eight pairs at a time, AVX-512F (x86-64).
+    Avx512,
+}
+
+impl PairKernel {
+    pub const ALL: [PairKernel; 3] = [PairKernel::Scalar, PairKernel::Avx2, PairKernel::Avx512];
+
+    /// The widest kernel this CPU runs.
+    pub fn detect() -> Self {
+        [PairKernel::Avx512, PairKernel::Avx2]
+            .into_iter()
+            .find(|k| k.is_available())
+            .unwrap_or(PairKernel::Scalar)
+    }
+
+    /// Whether this CPU has the kernel's instructions.
+    pub fn is_available(self) -> bool {
+        match self {
+            PairKernel::Scalar => true,
+            #[cfg(target_arch = "x86_64")]
+            PairKernel::Avx2 => is_x86_feature_detected!("avx2") && is_x86_feature_detected!("fma"),
+            #[cfg(target_arch = "x86_64")]
+            PairKernel::Avx512 => is_x86_feature_detected!("avx512f"),
+            #[cfg(not(target_arch = "x86_64"))]
+            PairKernel::Avx2 | PairKernel::Avx512 => false,
+        }
+    }
+
+    /// Pairs per vector operation.
+    pub fn width(self) -> usize {
+        match self {
+            PairKernel::Scalar => 1,
+            PairKernel::Avx2 => 4,
+            PairKernel::Avx512 => 8,
+        }
+    }
+
+    /// ∇V(q) into `grad`, for gm = (G mᵢ) and m = (mᵢ); q and grad body by body.
+    ///
+    /// The kernel must be available ([`NBody`](super::NBody) only holds one that is).
+    pub(super) fn gradient(self, gm: &[f64], m: &[f64], q: &[f64], grad: &mut [f64]) {
+        debug_assert!(self.is_available());
+        match self {
+            // SAFETY: the CPU has the kernel's features (the caller's contract).
+            #[cfg(target_arch = "x86_64")]
+            PairKernel::Avx2 => unsafe { x86::gradient_avx2(gm, m, q, grad) },
+            #[cfg(target_arch = "x86_64")]
+            PairKernel::Avx512 => unsafe { x86::gradient_avx512(gm, m, q, grad) },
+            // SAFETY: one lane is plain f64.
+            _ => unsafe { gradient::<f64>(gm, m, q, grad) },
+        }
+    }
+
+    /// V(q), as [`PairKernel::gradient`].
+    pub(super) fn potential(self, gm: &[f64], m: &[f64], q: &[f64]) -> f64 {
+        debug_assert!(self.is_available());
+        match self {
+            // SAFETY: the CPU has the kernel's features (the caller's contract).
+            #[cfg(target_arch = "x86_64")]
+            PairKernel::Avx2 => unsafe { x86::potential_avx2(gm, m, q) },
+            #[cfg(target_arch = "x86_64")]
+            PairKernel::Avx512 => unsafe { x86::potential_avx512(gm, m, q) },
+            // SAFETY: one lane is plain f64.
+            _ => unsafe { potential::<f64>(gm, m, q) },
+        }
+    }
+}
+
+/// The bodies j0..j0 + len in structure-of-arrays layout: coordinate c of body j0 + k at
+/// `x[c·TILE + k]`, and its gradient accumulator at `acc[c·TILE + k]`; only the first `len`
+/// of each third are written (a small N touches a few cache lines, not 12 KiB).
+struct Tile {
+    x: [MaybeUninit<f64>; 3 * TILE],
+    acc: [MaybeUninit<f64>; 3 * TILE],
+}
+
+impl Tile {
+    #[inline(always)]
+    fn new() -> Self {
+        Tile {
+            x: [MaybeUninit::uninit(); 3 * TILE],
+            acc: [MaybeUninit::uninit(); 3 * TILE],
+        }
+    }
+
+    /// Copies the positions of `bodies` (body by body, at most TILE) and zeroes their
+    /// accumulators.
+    #[inline(always)]
+    fn fill(&mut self, bodies: &[f64]) {
+        for (k, body) in bodies.chunks_exact(3).enumerate() {
+            for c in 0..3 {
+                self.x[c * TILE + k].write(body[c]);
+                self.acc[c * TILE + k].write(0.0);
+            }
+        }
+    }
+}
+
+/// The gradient of the pairs of body i (at `xi`, with G mᵢ = `gmi`) with the tile's bodies
+/// `start..len` (m: their masses): returns body i's part, Σⱼ fᵢⱼ dᵢⱼ, and subtracts fᵢⱼ dᵢⱼ
+/// from each body j's accumulator. Vectors of `V::WIDTH` bodies, then one at a time.
+///
+/// # Safety
+/// `V`'s features are enabled; `tile` holds `len` bodies; `m` has `len` entries.
+#[inline(always)]
+unsafe fn pairs<V: Lanes>(xi: &[f64], gmi: f64, tile: &mut Tile, m: *const f64, start: usize, len: usize) -> [f64; 3] {
+    let x = tile.x.as_ptr().cast::<f64>();
+    let acc = tile.acc.as_mut_ptr().cast::<f64>();
+    unsafe {
+        let mut gi = [V::splat(0.0); 3];
+        let mut j = start;
+        while j + V::WIDTH <= len {
+            pair::<V>(xi, gmi, x, acc, m, j, &mut gi);
+            j += V::WIDTH;
+        }
+        let mut tail = [0.0; 3];
+        for j in j..len {
+            pair::<f64>(xi, gmi, x, acc, m, j, &mut tail);
+        }
+        [gi[0].sum() + tail[0], gi[1].sum() + tail[1], gi[2].sum() + tail[2]]
+    }
+}
+
+/// The pairs (i, j..j + WIDTH): gᵢ += fᵢⱼ dᵢⱼ, accⱼ −= fᵢⱼ dᵢⱼ.
+///
+/// # Safety
+/// As [`pairs`], with j + WIDTH ≤ len.
+#[inline(always)]
+unsafe fn pair<V: Lanes>(xi: &[f64], gmi: f64, x: *const f64, acc: *mut f64, m: *const f64, j: usize, gi: &mut [V; 3]) {
+    unsafe {
+        let d: [V; 3] = std::array::from_fn(|c| V::splat(xi[c]).sub(V::load(x.add(c * TILE + j))));
+        let r2 = d[2].mul_add(d[2], d[1].mul_add(d[1], d[0].mul(d[0])));
+        // G mᵢ mⱼ, the product the pair table held.
+        let k = V::splat(gmi).mul(V::load(m.add(j)));
+        let f = k.div(r2.mul(r2.sqrt()));
+        for c in 0..3 {
+            gi[c] = f.mul_add(d[c], gi[c]);
+            let a = acc.add(c * TILE + j);
+            f.neg_mul_add(d[c], V::load(a)).store(a);
+        }
+    }
+}
+
+/// ∇V(q) into `grad`: for each tile of bodies j, every body i < j against it.
+///
+/// # Safety
+/// `V`'s features are enabled; gm and m have N entries, q and grad 3N.
+#[inline(always)]
+unsafe fn gradient<V: Lanes>(gm: &[f64], m: &[f64], q: &[f64], grad: &mut [f64]) {
+    let n = m.len();
+    grad.fill(0.0);
+    let mut tile = Tile::new();
+    for j0 in (0..n).step_by(TILE) {
+        let len = TILE.min(n - j0);
+        tile.fill(&q[3 * j0..3 * (j0 + len)]);
+        for i in 0..j0 + len - 1 {
+            let start = (i + 1).saturating_sub(j0);
+            // SAFETY: the tile holds `len` bodies and m[j0..] at least `len`.
+            let gi = unsafe { pairs::<V>(&q[3 * i..3 * i + 3], gm[i], &mut tile, m[j0..].as_ptr(), start, len) };
+            for (g, v) in grad[3 * i..3 * i + 3].iter_mut().zip(gi) {
+                *g += v;
+            }
+        }
+        for (k, g) in grad[3 * j0..3 * (j0 + len)].chunks_exact_mut(3).enumerate() {
+            for (c, g) in g.iter_mut().enumerate() {
+                // SAFETY: `fill` wrote the first `len` accumulators of each coordinate.
+                *g += unsafe { tile.acc[c * TILE + k].assume_init() };
+            }
+        }
+    }
+}
+
+/// V(q) = −Σᵢ<ⱼ G mᵢ mⱼ / rᵢⱼ, summed lane by lane over the whole sweep (one lane: pair by
+/// pair, as before SIMD).
+///
+/// # Safety
+/// As [`gradient`].
+#[inline(always)]
+unsafe fn potential<V: Lanes>(gm: &[f64], m: &[f64], q: &[f64]) -> f64 {
+    let n = m.len();
+    let mut tile = Tile::new();
+    unsafe {
+        let (mut v, mut tail) = (V::splat(0.0), 0.0);
+        for j0 in (0..n).step_by(TILE) {
+            let len = TILE.min(n - j0);
+            tile.fill(&q[3 * j0..3 * (j0 + len)]);
+            let (x, m) = (tile.x.as_ptr().cast::<f64>(), m[j0..].as_ptr());
+            for i in 0..j0 + len - 1 {
+                let xi = &q[3 * i..3 * i + 3];
+                let mut j = (i + 1).saturating_sub(j0);
+                while j + V::WIDTH <= len {
+                    v = v.sub(term::<V>(xi, gm[i], x, m, j));
+                    j += V::WIDTH;
+                }
+                for j in j..len {
+                    tail -= term::<f64>(xi, gm[i], x, m, j);
+                }
+            }
+        }
+        v.sum() + tail
+    }
+}
+
+/// G mᵢ mⱼ / rᵢⱼ for the bodies j..j + WIDTH of the tile at `x`.
+///
+/// # Safety
+/// As [`pair`].
+#[inline(always)]
+unsafe fn term<V: Lanes>(xi: &[f64], gmi: f64, x: *const f64, m: *const f64, j: usize) -> V {
+    unsafe {
+        let d: [V; 3] = std::array::from_fn(|c| V::splat(xi[c]).sub(V::load(x.add(c * TILE + j))));
+        let r2 = d[2].mul_add(d[2], d[1].mul_add(d[1], d[0].mul(d[0])));
+        V::splat(gmi).mul(V::load(m.add(j))).div(r2.sqrt())
+    }
+}
+
+/// The loops instantiated with the x86 vector lanes, inside functions that enable their
+/// features so that the lanes' intrinsics inline.
+#[cfg(target_arch = "x86_64")]
+mod x86 {
+    use std::arch::x86_64::{__m256d, __m512d};
+
+    #[target_feature(enable = "avx2,fma")]
+    pub unsafe fn gradient_avx2(gm: &[f64], m: &[f64], q: &[f64], grad: &mut [f64]) {
+        unsafe { super::gradient::<__m256d>(gm, m, q, grad) }
+    }
+
+    #[target_feature(enable = "avx512f")]
+    pub unsafe fn gradient_avx512(gm: &[f64], m: &[f64], q: &[f64], grad: &mut [f64]) {
+        unsafe { super::gradient::<__m512d>(gm, m, q, grad) }
+    }
+
+    #[target_feature(enable = "avx2,fma")]
+    pub unsafe fn potential_avx2(gm: &[f64], m: &[f64], q: &[f64]) -> f64 {
+        unsafe { super::potential::<__m256d>(gm, m, q) }
+    }
+
+    #[target_feature(enable = "avx512f")]
+    pub unsafe fn potential_avx512(gm: &[f64], m: &[f64], q: &[f64]) -> f64 {
+        unsafe { super::potential::<__m512d>(gm, m, q) }
+    }
+}
