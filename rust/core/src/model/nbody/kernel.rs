@@ -130,7 +130,8 @@ impl Tile {
 
 /// The gradient of the pairs of body i (at `xi`, with G mᵢ = `gmi`) with the tile's bodies
 /// `start..len` (m: their masses): returns body i's part, Σⱼ fᵢⱼ dᵢⱼ, and subtracts fᵢⱼ dᵢⱼ
-/// from each body j's accumulator. Vectors of `V::WIDTH` bodies, then one at a time.
+/// from each body j's accumulator. Vectors of `V::WIDTH` bodies, the remainder a vector with
+/// its lanes past the end switched off.
 ///
 /// # Safety
 /// `V`'s features are enabled; `tile` holds `len` bodies; `m` has `len` entries.
@@ -142,33 +143,67 @@ unsafe fn pairs<V: Lanes>(xi: &[f64], gmi: f64, tile: &mut Tile, m: *const f64, 
         let mut gi = [V::splat(0.0); 3];
         let mut j = start;
         while j + V::WIDTH <= len {
-            pair::<V>(xi, gmi, x, acc, m, j, &mut gi);
+            pair::<V, false>(xi, gmi, x, acc, m, j, 0, &mut gi);
             j += V::WIDTH;
         }
-        let mut tail = [0.0; 3];
-        for j in j..len {
-            pair::<f64>(xi, gmi, x, acc, m, j, &mut tail);
+        if j < len {
+            pair::<V, true>(xi, gmi, x, acc, m, j, len - j, &mut gi);
         }
-        [gi[0].sum() + tail[0], gi[1].sum() + tail[1], gi[2].sum() + tail[2]]
+        [gi[0].sum(), gi[1].sum(), gi[2].sum()]
     }
 }
 
-/// The pairs (i, j..j + WIDTH): gᵢ += fᵢⱼ dᵢⱼ, accⱼ −= fᵢⱼ dᵢⱼ.
+/// The pairs (i, j..j + WIDTH): gᵢ += fᵢⱼ dᵢⱼ, accⱼ −= fᵢⱼ dᵢⱼ; with `PARTIAL`, only the first
+/// `count` < WIDTH of them: the other lanes read mass 0 and position 0, whose denominator
+/// [`Lanes::past`] keeps positive, so they add exactly 0, and store nothing.
 ///
 /// # Safety
-/// As [`pairs`], with j + WIDTH ≤ len.
+/// As [`pairs`], with j + WIDTH ≤ len, or j + count ≤ len with `PARTIAL`.
 #[inline(always)]
-unsafe fn pair<V: Lanes>(xi: &[f64], gmi: f64, x: *const f64, acc: *mut f64, m: *const f64, j: usize, gi: &mut [V; 3]) {
+#[allow(clippy::too_many_arguments)]
+unsafe fn pair<V: Lanes, const PARTIAL: bool>(
+    xi: &[f64],
+    gmi: f64,
+    x: *const f64,
+    acc: *mut f64,
+    m: *const f64,
+    j: usize,
+    count: usize,
+    gi: &mut [V; 3],
+) {
     unsafe {
-        let d: [V; 3] = std::array::from_fn(|c| V::splat(xi[c]).sub(V::load(x.add(c * TILE + j))));
-        let r2 = d[2].mul_add(d[2], d[1].mul_add(d[1], d[0].mul(d[0])));
+        let d: [V; 3] = std::array::from_fn(|c| V::splat(xi[c]).sub(load::<V, PARTIAL>(x.add(c * TILE + j), count)));
+        let mut r2 = d[2].mul_add(d[2], d[1].mul_add(d[1], d[0].mul(d[0])));
+        if PARTIAL {
+            r2 = r2.add(V::past(count));
+        }
         // G mᵢ mⱼ, the product the pair table held.
-        let k = V::splat(gmi).mul(V::load(m.add(j)));
+        let k = V::splat(gmi).mul(load::<V, PARTIAL>(m.add(j), count));
         let f = k.div(r2.mul(r2.sqrt()));
         for c in 0..3 {
             gi[c] = f.mul_add(d[c], gi[c]);
             let a = acc.add(c * TILE + j);
-            f.neg_mul_add(d[c], V::load(a)).store(a);
+            let updated = f.neg_mul_add(d[c], load::<V, PARTIAL>(a, count));
+            if PARTIAL {
+                updated.store_first(a, count)
+            } else {
+                updated.store(a)
+            }
+        }
+    }
+}
+
+/// The WIDTH f64 from `p`, or with `PARTIAL` the first `count` and zeros.
+///
+/// # Safety
+/// As [`Lanes::load`] and [`Lanes::load_first`].
+#[inline(always)]
+unsafe fn load<V: Lanes, const PARTIAL: bool>(p: *const f64, count: usize) -> V {
+    unsafe {
+        if PARTIAL {
+            V::load_first(p, count)
+        } else {
+            V::load(p)
         }
     }
 }
