@@ -1,29 +1,23 @@
-//! The pair loops of Newtonian gravity, each unique pair once, over tiles of bodies in
-//! structure-of-arrays layout, with SIMD lanes chosen at run time.
+//! The pair loops of Newtonian gravity, each unique pair once: [`PairKernel`], the
+//! instruction set chosen at run time, and the scalar loops (`tiles.rs` holds the vector ones).
 //!
 //! For bodies i < j with dᵢⱼ = xᵢ − xⱼ, rᵢⱼ² = |dᵢⱼ|² and fᵢⱼ = G mᵢ mⱼ / (rᵢⱼ² √rᵢⱼ²),
 //!
 //! ∂V/∂xᵢ = Σⱼ₍ⱼ≠ᵢ₎ fᵢⱼ (xᵢ − xⱼ),   V = −Σᵢ<ⱼ G mᵢ mⱼ / rᵢⱼ,
 //!
-//! so a pair adds +fᵢⱼ dᵢⱼ to body i's gradient and −fᵢⱼ dᵢⱼ to body j's. The bodies j are
-//! taken a tile of [`TILE`] at a time: the tile holds their x, y and z as three contiguous
-//! arrays, and their gradient accumulators likewise, so that the loop over j (for each i < j)
-//! loads, updates and stores whole vectors of consecutive bodies, with no gather or scatter;
-//! body i's own sums stay in registers. A tile lives on the stack (48 bytes a body, in L1):
-//! no allocation, nothing shared between threads.
+//! so a pair adds +fᵢⱼ dᵢⱼ to body i's gradient and −fᵢⱼ dᵢⱼ to body j's.
 
-use super::lanes::Lanes;
-use std::mem::MaybeUninit;
-
-/// Bodies per tile: 12 KiB of positions and accumulators.
-const TILE: usize = 256;
+#[cfg(target_arch = "x86_64")]
+use super::tiles::x86;
 
 /// The instruction set of the pair loops.
 ///
 /// Every kernel computes each pair's terms with the same IEEE operations; the vector kernels
 /// fuse the multiply–adds and sum body i's terms lane by lane, so they agree with
-/// [`PairKernel::Scalar`] to round-off, not bit for bit. The scalar kernel reproduces the
-/// loops before SIMD bit for bit for up to 256 bodies.
+/// [`PairKernel::Scalar`] to round-off, not bit for bit. The scalar kernel is the loop of the
+/// pair-table model, bit for bit, with each product (G mᵢ)·mⱼ formed as the pair is visited;
+/// it runs in place of a vector kernel below two vectors' width of bodies (16 for AVX-512, 8
+/// for AVX2).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum PairKernel {
     /// One pair at a time, plain f64: every target, and the reference of the others.
@@ -67,243 +61,83 @@ impl PairKernel {
         }
     }
 
+    /// The kernel that runs for `n` bodies: below two vectors' width most rows i of the pair
+    /// triangle are shorter than one vector, mostly masked lanes, and the scalar loop is faster
+    /// (the outer solar system, N = 6, would lose 20% a step to AVX-512).
+    fn for_bodies(self, n: usize) -> Self {
+        if n < 2 * self.width() {
+            PairKernel::Scalar
+        } else {
+            self
+        }
+    }
+
     /// ∇V(q) into `grad`, for gm = (G mᵢ) and m = (mᵢ); q and grad body by body.
     ///
     /// The kernel must be available ([`NBody`](super::NBody) only holds one that is).
     pub(super) fn gradient(self, gm: &[f64], m: &[f64], q: &[f64], grad: &mut [f64]) {
         debug_assert!(self.is_available());
-        match self {
+        match self.for_bodies(m.len()) {
             // SAFETY: the CPU has the kernel's features (the caller's contract).
             #[cfg(target_arch = "x86_64")]
             PairKernel::Avx2 => unsafe { x86::gradient_avx2(gm, m, q, grad) },
             #[cfg(target_arch = "x86_64")]
             PairKernel::Avx512 => unsafe { x86::gradient_avx512(gm, m, q, grad) },
-            // SAFETY: one lane is plain f64.
-            _ => unsafe { gradient::<f64>(gm, m, q, grad) },
+            _ => scalar_gradient(gm, m, q, grad),
         }
     }
 
     /// V(q), as [`PairKernel::gradient`].
     pub(super) fn potential(self, gm: &[f64], m: &[f64], q: &[f64]) -> f64 {
         debug_assert!(self.is_available());
-        match self {
+        match self.for_bodies(m.len()) {
             // SAFETY: the CPU has the kernel's features (the caller's contract).
             #[cfg(target_arch = "x86_64")]
             PairKernel::Avx2 => unsafe { x86::potential_avx2(gm, m, q) },
             #[cfg(target_arch = "x86_64")]
             PairKernel::Avx512 => unsafe { x86::potential_avx512(gm, m, q) },
-            // SAFETY: one lane is plain f64.
-            _ => unsafe { potential::<f64>(gm, m, q) },
+            _ => scalar_potential(gm, m, q),
         }
     }
 }
 
-/// The bodies j0..j0 + len in structure-of-arrays layout: coordinate c of body j0 + k at
-/// `x[c·TILE + k]`, and its gradient accumulator at `acc[c·TILE + k]`; only the first `len`
-/// of each third are written (a small N touches a few cache lines, not 12 KiB).
-struct Tile {
-    x: [MaybeUninit<f64>; 3 * TILE],
-    acc: [MaybeUninit<f64>; 3 * TILE],
-}
-
-impl Tile {
-    #[inline(always)]
-    fn new() -> Self {
-        Tile {
-            x: [MaybeUninit::uninit(); 3 * TILE],
-            acc: [MaybeUninit::uninit(); 3 * TILE],
-        }
-    }
-
-    /// Copies the positions of `bodies` (body by body, at most TILE) and zeroes their
-    /// accumulators.
-    #[inline(always)]
-    fn fill(&mut self, bodies: &[f64]) {
-        for (k, body) in bodies.chunks_exact(3).enumerate() {
-            for c in 0..3 {
-                self.x[c * TILE + k].write(body[c]);
-                self.acc[c * TILE + k].write(0.0);
-            }
-        }
-    }
-}
-
-/// The gradient of the pairs of body i (at `xi`, with G mᵢ = `gmi`) with the tile's bodies
-/// `start..len` (m: their masses): returns body i's part, Σⱼ fᵢⱼ dᵢⱼ, and subtracts fᵢⱼ dᵢⱼ
-/// from each body j's accumulator. Vectors of `V::WIDTH` bodies, the remainder a vector with
-/// its lanes past the end switched off.
-///
-/// # Safety
-/// `V`'s features are enabled; `tile` holds `len` bodies; `m` has `len` entries.
-#[inline(always)]
-unsafe fn pairs<V: Lanes>(xi: &[f64], gmi: f64, tile: &mut Tile, m: *const f64, start: usize, len: usize) -> [f64; 3] {
-    let x = tile.x.as_ptr().cast::<f64>();
-    let acc = tile.acc.as_mut_ptr().cast::<f64>();
-    unsafe {
-        let mut gi = [V::splat(0.0); 3];
-        let mut j = start;
-        while j + V::WIDTH <= len {
-            pair::<V, false>(xi, gmi, x, acc, m, j, 0, &mut gi);
-            j += V::WIDTH;
-        }
-        if j < len {
-            pair::<V, true>(xi, gmi, x, acc, m, j, len - j, &mut gi);
-        }
-        [gi[0].sum(), gi[1].sum(), gi[2].sum()]
-    }
-}
-
-/// The pairs (i, j..j + WIDTH): gᵢ += fᵢⱼ dᵢⱼ, accⱼ −= fᵢⱼ dᵢⱼ; with `PARTIAL`, only the first
-/// `count` < WIDTH of them: the other lanes read mass 0 and position 0, whose denominator
-/// [`Lanes::past`] keeps positive, so they add exactly 0, and store nothing.
-///
-/// # Safety
-/// As [`pairs`], with j + WIDTH ≤ len, or j + count ≤ len with `PARTIAL`.
-#[inline(always)]
-#[allow(clippy::too_many_arguments)]
-unsafe fn pair<V: Lanes, const PARTIAL: bool>(
-    xi: &[f64],
-    gmi: f64,
-    x: *const f64,
-    acc: *mut f64,
-    m: *const f64,
-    j: usize,
-    count: usize,
-    gi: &mut [V; 3],
-) {
-    unsafe {
-        let d: [V; 3] = std::array::from_fn(|c| V::splat(xi[c]).sub(load::<V, PARTIAL>(x.add(c * TILE + j), count)));
-        let mut r2 = d[2].mul_add(d[2], d[1].mul_add(d[1], d[0].mul(d[0])));
-        if PARTIAL {
-            r2 = r2.add(V::past(count));
-        }
-        // G mᵢ mⱼ, the product the pair table held.
-        let k = V::splat(gmi).mul(load::<V, PARTIAL>(m.add(j), count));
-        let f = k.div(r2.mul(r2.sqrt()));
-        for c in 0..3 {
-            gi[c] = f.mul_add(d[c], gi[c]);
-            let a = acc.add(c * TILE + j);
-            let updated = f.neg_mul_add(d[c], load::<V, PARTIAL>(a, count));
-            if PARTIAL {
-                updated.store_first(a, count)
-            } else {
-                updated.store(a)
-            }
-        }
-    }
-}
-
-/// The WIDTH f64 from `p`, or with `PARTIAL` the first `count` and zeros.
-///
-/// # Safety
-/// As [`Lanes::load`] and [`Lanes::load_first`].
-#[inline(always)]
-unsafe fn load<V: Lanes, const PARTIAL: bool>(p: *const f64, count: usize) -> V {
-    unsafe {
-        if PARTIAL {
-            V::load_first(p, count)
-        } else {
-            V::load(p)
-        }
-    }
-}
-
-/// ∇V(q) into `grad`: for each tile of bodies j, every body i < j against it.
-///
-/// # Safety
-/// `V`'s features are enabled; gm and m have N entries, q and grad 3N.
-#[inline(always)]
-unsafe fn gradient<V: Lanes>(gm: &[f64], m: &[f64], q: &[f64], grad: &mut [f64]) {
-    let n = m.len();
+/// ∇V(q) into `grad`, one pair at a time straight from q (body by body): body i's sums in
+/// registers, body j's in `grad`. For a few bodies a tile's copies would cost more than the
+/// pairs.
+fn scalar_gradient(gm: &[f64], m: &[f64], q: &[f64], grad: &mut [f64]) {
     grad.fill(0.0);
-    let mut tile = Tile::new();
-    for j0 in (0..n).step_by(TILE) {
-        let len = TILE.min(n - j0);
-        tile.fill(&q[3 * j0..3 * (j0 + len)]);
-        for i in 0..j0 + len - 1 {
-            let start = (i + 1).saturating_sub(j0);
-            // SAFETY: the tile holds `len` bodies and m[j0..] at least `len`.
-            let gi = unsafe { pairs::<V>(&q[3 * i..3 * i + 3], gm[i], &mut tile, m[j0..].as_ptr(), start, len) };
-            for (g, v) in grad[3 * i..3 * i + 3].iter_mut().zip(gi) {
-                *g += v;
+    for (i, &gmi) in gm.iter().enumerate() {
+        let (head, tail) = grad.split_at_mut(3 * i + 3);
+        let xi = &q[3 * i..3 * i + 3];
+        let mut gi = [0.0; 3];
+        for ((xj, gj), mj) in q[3 * i + 3..]
+            .chunks_exact(3)
+            .zip(tail.chunks_exact_mut(3))
+            .zip(&m[i + 1..])
+        {
+            let d = [xi[0] - xj[0], xi[1] - xj[1], xi[2] - xj[2]];
+            let r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+            // G mᵢ mⱼ, the product the pair table held.
+            let f = gmi * mj / (r2 * r2.sqrt());
+            for c in 0..3 {
+                gi[c] += f * d[c];
+                gj[c] -= f * d[c];
             }
         }
-        for (k, g) in grad[3 * j0..3 * (j0 + len)].chunks_exact_mut(3).enumerate() {
-            for (c, g) in g.iter_mut().enumerate() {
-                // SAFETY: `fill` wrote the first `len` accumulators of each coordinate.
-                *g += unsafe { tile.acc[c * TILE + k].assume_init() };
-            }
+        for (g, v) in head[3 * i..].iter_mut().zip(gi) {
+            *g += v;
         }
     }
 }
 
-/// V(q) = −Σᵢ<ⱼ G mᵢ mⱼ / rᵢⱼ, summed lane by lane over the whole sweep (one lane: pair by
-/// pair, as before SIMD).
-///
-/// # Safety
-/// As [`gradient`].
-#[inline(always)]
-unsafe fn potential<V: Lanes>(gm: &[f64], m: &[f64], q: &[f64]) -> f64 {
-    let n = m.len();
-    let mut tile = Tile::new();
-    unsafe {
-        let (mut v, mut tail) = (V::splat(0.0), 0.0);
-        for j0 in (0..n).step_by(TILE) {
-            let len = TILE.min(n - j0);
-            tile.fill(&q[3 * j0..3 * (j0 + len)]);
-            let (x, m) = (tile.x.as_ptr().cast::<f64>(), m[j0..].as_ptr());
-            for i in 0..j0 + len - 1 {
-                let xi = &q[3 * i..3 * i + 3];
-                let mut j = (i + 1).saturating_sub(j0);
-                while j + V::WIDTH <= len {
-                    v = v.sub(term::<V>(xi, gm[i], x, m, j));
-                    j += V::WIDTH;
-                }
-                for j in j..len {
-                    tail -= term::<f64>(xi, gm[i], x, m, j);
-                }
-            }
+/// V(q), one pair at a time, as [`scalar_gradient`].
+fn scalar_potential(gm: &[f64], m: &[f64], q: &[f64]) -> f64 {
+    let mut v = 0.0;
+    for (i, (xi, &gmi)) in q.chunks_exact(3).zip(gm).enumerate() {
+        for (xj, mj) in q[3 * i + 3..].chunks_exact(3).zip(&m[i + 1..]) {
+            let d = [xi[0] - xj[0], xi[1] - xj[1], xi[2] - xj[2]];
+            v -= gmi * mj / (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
         }
-        v.sum() + tail
     }
-}
-
-/// G mᵢ mⱼ / rᵢⱼ for the bodies j..j + WIDTH of the tile at `x`.
-///
-/// # Safety
-/// As [`pair`].
-#[inline(always)]
-unsafe fn term<V: Lanes>(xi: &[f64], gmi: f64, x: *const f64, m: *const f64, j: usize) -> V {
-    unsafe {
-        let d: [V; 3] = std::array::from_fn(|c| V::splat(xi[c]).sub(V::load(x.add(c * TILE + j))));
-        let r2 = d[2].mul_add(d[2], d[1].mul_add(d[1], d[0].mul(d[0])));
-        V::splat(gmi).mul(V::load(m.add(j))).div(r2.sqrt())
-    }
-}
-
-/// The loops instantiated with the x86 vector lanes, inside functions that enable their
-/// features so that the lanes' intrinsics inline.
-#[cfg(target_arch = "x86_64")]
-mod x86 {
-    use std::arch::x86_64::{__m256d, __m512d};
-
-    #[target_feature(enable = "avx2,fma")]
-    pub unsafe fn gradient_avx2(gm: &[f64], m: &[f64], q: &[f64], grad: &mut [f64]) {
-        unsafe { super::gradient::<__m256d>(gm, m, q, grad) }
-    }
-
-    #[target_feature(enable = "avx512f")]
-    pub unsafe fn gradient_avx512(gm: &[f64], m: &[f64], q: &[f64], grad: &mut [f64]) {
-        unsafe { super::gradient::<__m512d>(gm, m, q, grad) }
-    }
-
-    #[target_feature(enable = "avx2,fma")]
-    pub unsafe fn potential_avx2(gm: &[f64], m: &[f64], q: &[f64]) -> f64 {
-        unsafe { super::potential::<__m256d>(gm, m, q) }
-    }
-
-    #[target_feature(enable = "avx512f")]
-    pub unsafe fn potential_avx512(gm: &[f64], m: &[f64], q: &[f64]) -> f64 {
-        unsafe { super::potential::<__m512d>(gm, m, q) }
-    }
+    v
 }

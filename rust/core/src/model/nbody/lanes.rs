@@ -1,5 +1,5 @@
-//! SIMD lanes of f64: the few operations the pair loops need, for one lane (plain f64, every
-//! target), AVX2 + FMA (4 lanes) and AVX-512F (8 lanes) on x86-64.
+//! SIMD lanes of f64: the few operations the pair loops need, for AVX2 + FMA (4 lanes) and
+//! AVX-512F (8 lanes) on x86-64. Other targets run the scalar loops.
 //!
 //! The vector operations are `#[target_feature]` functions: the pair loops, generic over
 //! [`Lanes`] and `#[inline(always)]`, are instantiated inside functions that enable the same
@@ -36,66 +36,6 @@ pub(super) trait Lanes: Copy {
     /// 0 in the first `count` < WIDTH lanes, 1 after: added to a remainder's denominators, it
     /// keeps the lanes past the end finite.
     unsafe fn past(count: usize) -> Self;
-}
-
-/// One lane, the scalar path: separate multiply and add, as the code before SIMD computed.
-impl Lanes for f64 {
-    const WIDTH: usize = 1;
-    #[inline(always)]
-    unsafe fn splat(x: f64) -> Self {
-        x
-    }
-    #[inline(always)]
-    unsafe fn load(p: *const f64) -> Self {
-        unsafe { *p }
-    }
-    #[inline(always)]
-    unsafe fn store(self, p: *mut f64) {
-        unsafe { *p = self }
-    }
-    #[inline(always)]
-    unsafe fn add(self, b: Self) -> Self {
-        self + b
-    }
-    #[inline(always)]
-    unsafe fn sub(self, b: Self) -> Self {
-        self - b
-    }
-    #[inline(always)]
-    unsafe fn mul(self, b: Self) -> Self {
-        self * b
-    }
-    #[inline(always)]
-    unsafe fn div(self, b: Self) -> Self {
-        self / b
-    }
-    #[inline(always)]
-    unsafe fn sqrt(self) -> Self {
-        f64::sqrt(self)
-    }
-    #[inline(always)]
-    unsafe fn mul_add(self, b: Self, c: Self) -> Self {
-        self * b + c
-    }
-    #[inline(always)]
-    unsafe fn neg_mul_add(self, b: Self, c: Self) -> Self {
-        c - self * b
-    }
-    #[inline(always)]
-    unsafe fn sum(self) -> f64 {
-        self
-    }
-    // One lane has no remainder (count < 1).
-    #[inline(always)]
-    unsafe fn load_first(_: *const f64, _: usize) -> Self {
-        0.0
-    }
-    #[inline(always)]
-    unsafe fn store_first(self, _: *mut f64, _: usize) {}
-    #[inline(always)]
-    unsafe fn past(_: usize) -> Self {
-        1.0
-    }
 }
 
 #[cfg(target_arch = "x86_64")]

@@ -1,12 +1,16 @@
 //! The gravitational N-body problem: point masses in space under Newtonian gravity.
 //!
 //! - this file: the model, [`NBody`] (G, the masses, the diagonal mass matrix);
-//! - `kernel.rs`: the pair loops of V and ∇V over tiles of bodies in structure-of-arrays
-//!   layout, and [`PairKernel`], their instruction set (scalar, AVX2, AVX-512) chosen at run time;
-//! - `lanes.rs`: the SIMD lanes the pair loops are written over.
+//! - `kernel.rs`: [`PairKernel`], the instruction set of the pair loops of V and ∇V (scalar,
+//!   AVX2, AVX-512) chosen at run time, and the scalar loops;
+//! - `tiles.rs`: the vector loops, over tiles of bodies in structure-of-arrays layout (x86-64);
+//! - `lanes.rs`: the SIMD lanes the vector loops are written over.
 
 mod kernel;
+#[cfg(target_arch = "x86_64")]
 mod lanes;
+#[cfg(target_arch = "x86_64")]
+mod tiles;
 
 pub use kernel::PairKernel;
 
