@@ -3,24 +3,9 @@
 
 use varmech::model::compiled::{Binary, Code, Op, Tape, Unary};
 
-/// splitmix64: reproducible points without a dependency.
-struct Points(u64);
+use crate::common::Points;
 
 impl Points {
-    fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-
-    /// Uniform in [−scale, scale).
-    fn uniform(&mut self, scale: f64) -> f64 {
-        let unit = (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64;
-        scale * (2.0 * unit - 1.0)
-    }
-
     /// A value from a mix of scales: inside (−1, 1) for asin and atanh, moderate, large.
     fn value(&mut self) -> f64 {
         match self.next_u64() % 4 {

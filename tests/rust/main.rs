@@ -20,6 +20,7 @@ mod hessians;
 mod jit;
 mod kepler;
 mod kepler_polar;
+mod nbody_kernel;
 mod routh;
 mod solar_system;
 mod splitting;

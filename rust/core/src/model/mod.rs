@@ -38,7 +38,7 @@ pub use lagrangian::{Hessians, Lagrangian};
 pub use mass::Mass;
 pub use mechanical::MechanicalSystem;
 pub use natural::{differenced_kinetic_gradient, kinetic_gradient_from_mass_derivative, Natural, NaturalSystem};
-pub use nbody::NBody;
+pub use nbody::{NBody, PairKernel};
 pub use routh::Routhian;
 pub use scale::Scale;
 pub use symmetry::Generator;
