@@ -20,10 +20,10 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 import argparse
 import math
-import time
 from pathlib import Path
 
 import numpy as np
+from compare import best_times_interleaved
 
 import varmech
 from varmech import scenes
@@ -81,12 +81,7 @@ def measure(sizes: list[int], repeat: int) -> list[dict]:
         steps = max(20, round(PAIRS_PER_RUN / pairs))
         scene = scenes.nbody(m, x, v, G=1.0, dt=DT)
         runs = {"varmech": varmech_run(scene, steps), "rebound": rebound_run(rebound, m, x, v, steps)}
-        best = dict.fromkeys(runs, math.inf)
-        for _ in range(repeat):
-            for name, run in runs.items():
-                start = time.perf_counter()
-                run()
-                best[name] = min(best[name], time.perf_counter() - start)
+        best = best_times_interleaved(runs, repeat)
         ns = {name: 1e9 * t / (steps * pairs) for name, t in best.items()}
         rows.append({"N": n, "steps": steps, **ns, "ratio": ns["rebound"] / ns["varmech"]})
     return rows

@@ -23,13 +23,13 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 import argparse
 import math
-import time
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import numpy as np
+from compare import best_times_interleaved
 
 import varmech
 from varmech import scenes
@@ -164,12 +164,7 @@ def measure(problem: Problem, repeat: int) -> dict[str, list[tuple[int, float, f
     """(steps, error, best seconds) of every run of every method, timed interleaved."""
     runs = {(m, n): problem.run(m, n) for m, ns in problem.sweeps.items() for n in ns}
     errors = {key: run() for key, run in runs.items()}
-    best = dict.fromkeys(runs, math.inf)
-    for _ in range(repeat):
-        for key, run in runs.items():
-            start = time.perf_counter()
-            run()
-            best[key] = min(best[key], time.perf_counter() - start)
+    best = best_times_interleaved(runs, repeat)
     return {m: [(n, errors[m, n], best[m, n]) for n in ns] for m, ns in problem.sweeps.items()}
 
 
