@@ -12,9 +12,9 @@ use crate::{Error, ModelError};
 /// last), so a Verlet composition of s stages costs s force evaluations a step.
 #[derive(Clone, Debug)]
 pub struct KickDrift {
-    kicks: Vec<f64>,
-    drifts: Vec<f64>,
-    /// a₀h, b₁h, a₁h, …, bₛh, aₛh for the step h they were computed for.
+    /// The fractions in the order the step applies them: a₀, b₁, a₁, …, bₛ, aₛ.
+    fractions: Vec<f64>,
+    /// The fractions times the step h they were computed for.
     scaled: Vec<f64>,
     scaled_for: f64,
     q: Vec<f64>,
@@ -28,11 +28,12 @@ impl KickDrift {
     /// The integrator of `splitting` for n coordinates.
     pub fn new(splitting: &Splitting, n: usize) -> Self {
         let (kicks, drifts) = (splitting.kicks(), splitting.drifts());
+        let pairs = drifts.iter().zip(&kicks[1..]).flat_map(|(b, a)| [*b, *a]);
+        let fractions: Vec<f64> = std::iter::once(kicks[0]).chain(pairs).collect();
         KickDrift {
-            scaled: vec![0.0; kicks.len() + drifts.len()],
+            scaled: vec![0.0; fractions.len()],
             scaled_for: f64::NAN,
-            kicks: kicks.to_vec(),
-            drifts: drifts.to_vec(),
+            fractions,
             q: vec![0.0; n],
             p: vec![0.0; n],
             force: vec![0.0; n],
@@ -73,17 +74,8 @@ impl KickDrift {
     /// The fractions times h, once per step size.
     fn scale(&mut self, h: f64) {
         if self.scaled_for != h {
-            let pairs = self
-                .drifts
-                .iter()
-                .zip(&self.kicks[1..])
-                .flat_map(|(b, a)| [b * h, a * h]);
-            for (x, y) in self
-                .scaled
-                .iter_mut()
-                .zip(std::iter::once(self.kicks[0] * h).chain(pairs))
-            {
-                *x = y;
+            for (x, f) in self.scaled.iter_mut().zip(&self.fractions) {
+                *x = f * h;
             }
             self.scaled_for = h;
         }
