@@ -1,9 +1,7 @@
 //! What a method integrates: the dynamics of a model, seen through one step's increments.
 
 use super::{Increment, Integrator, ModelKind, StepError, StepStart, StepperState};
-use crate::model::{
-    self, Constrained, EnergyTerms, HolonomicConstraints, Lagrangian, MechanicalSystem, NBody, PhaseState,
-};
+use crate::model::{self, Constrained, EnergyTerms, HolonomicConstraints, Lagrangian, MechanicalSystem, PhaseState};
 use crate::{Error, ModelError};
 
 /// The dynamics a method integrates: separable mechanical systems take every unconstrained
@@ -78,11 +76,6 @@ pub trait Dynamics {
     fn project(&self, _q: &[f64], _p: &[f64]) -> Option<Result<PhaseState, Error>> {
         None
     }
-
-    /// The gravitational N-body problem, for the Wisdom–Holman methods; None for other models.
-    fn as_nbody(&self) -> Option<&NBody> {
-        None
-    }
 }
 
 impl<S: MechanicalSystem> Dynamics for S {
@@ -120,10 +113,6 @@ impl<S: MechanicalSystem> Dynamics for S {
 
     fn as_lagrangian(&self) -> &dyn Lagrangian {
         self
-    }
-
-    fn as_nbody(&self) -> Option<&NBody> {
-        MechanicalSystem::as_nbody(self)
     }
 }
 

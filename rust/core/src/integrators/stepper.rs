@@ -132,10 +132,14 @@ where
     /// names the step (counted from 1) and the time it started at.
     pub fn step(&mut self) -> Result<(), Error> {
         let state = self.state.borrow_mut();
-        if state.integrator.own_variables().is_some() {
-            return state.advance_own(&*self.model, 1, || Ok(()));
-        }
-        state.step(&*self.model)
+        let result = if state.integrator.own_variables().is_some() {
+            // The method's own loop, which a step from (q, p) would restart.
+            self.model.advance(state, 1)
+        } else {
+            state.step(&*self.model)
+        };
+        state.synchronise();
+        result
     }
 
     /// Advances `n` steps, calling `poll` before a step every 10–40 ms of run time; an error
@@ -144,32 +148,14 @@ where
     ///
     /// A method that keeps its own variables (the Wisdom–Holman methods) takes the n steps on
     /// them and synchronises (q, p) once, at the end (see `own_variables.rs`).
-    pub fn advance<P>(&mut self, n: usize, mut poll: P) -> Result<(), Error>
+    pub fn advance<P>(&mut self, n: usize, poll: P) -> Result<(), Error>
     where
         P: FnMut() -> Result<(), ModelError>,
     {
         let state = self.state.borrow_mut();
-        if state.integrator.own_variables().is_some() {
-            return state.advance_own(&*self.model, n, poll);
-        }
-        let mut left = n;
-        while left > 0 {
-            if state.interrupt.due() {
-                if let Err(source) = poll() {
-                    return Err(Error::Interrupted {
-                        step: state.steps + 1,
-                        time: state.t(),
-                        source,
-                    });
-                }
-            }
-            // This step and those after it that need no poll, in one call: the model's own
-            // loop ([`Dynamics::advance`]) runs them.
-            let steps = 1 + state.interrupt.quiet(left - 1);
-            self.model.advance(state, steps)?;
-            left -= steps;
-        }
-        Ok(())
+        let result = state.advance_polled(&*self.model, n, poll);
+        state.synchronise();
+        result
     }
 
     /// Starts afresh from (q0, p0) at time t0, with the step count at 0: the next steps are
@@ -265,10 +251,40 @@ impl StepperState {
         Ok(())
     }
 
-    /// `steps` steps of a separable system: the kick–drift methods on up to 4 coordinates in
-    /// a loop of fixed-size arrays ([`super::KickDrift::run`]; the driver's costs, not the physics,
+    /// `n` steps of `model`, `poll` called before a step when due.
+    fn advance_polled<S, P>(&mut self, model: &S, n: usize, mut poll: P) -> Result<(), Error>
+    where
+        S: Dynamics + ?Sized,
+        P: FnMut() -> Result<(), ModelError>,
+    {
+        let mut left = n;
+        while left > 0 {
+            if self.interrupt.due() {
+                if let Err(source) = poll() {
+                    return Err(Error::Interrupted {
+                        step: self.steps + 1,
+                        time: self.t(),
+                        source,
+                    });
+                }
+            }
+            // This step and those after it that need no poll, in one call: the model's own
+            // loop ([`Dynamics::advance`]) runs them.
+            let steps = 1 + self.interrupt.quiet(left - 1);
+            model.advance(self, steps)?;
+            left -= steps;
+        }
+        Ok(())
+    }
+
+    /// `steps` steps of a separable system: the methods with their own variables on them
+    /// (`own_variables.rs`), the kick–drift methods on up to 4 coordinates in a loop of
+    /// fixed-size arrays ([`super::KickDrift::run`]; the driver's costs, not the physics,
     /// dominate such small steps), every other case step by step.
     pub(super) fn advance_separable<S: MechanicalSystem>(&mut self, sys: &S, steps: usize) -> Result<(), Error> {
+        if let Some(result) = sys.as_nbody().and_then(|nbody| self.advance_own(nbody, steps)) {
+            return result;
+        }
         let StepperState {
             integrator,
             clock,

@@ -9,42 +9,38 @@
 //! ([`super::Stepper::into_state`]) keeps w with the state: the steps resume bit for bit.
 
 use super::StepperState;
-use crate::integrators::Dynamics;
-use crate::{Error, ModelError};
+use crate::model::NBody;
+use crate::Error;
 
 impl StepperState {
-    /// `n` steps of the method's own variables, `poll` called when due as in
-    /// [`super::Stepper::advance`], then (q, p) synchronised to the last good step.
-    pub(super) fn advance_own<S, P>(&mut self, model: &S, n: usize, mut poll: P) -> Result<(), Error>
-    where
-        S: Dynamics + ?Sized,
-        P: FnMut() -> Result<(), ModelError>,
-    {
-        let Some(nbody) = model.as_nbody() else {
-            return Err(self.method().refusal(model.kind()));
-        };
-        let mut result = Ok(());
-        for _ in 0..n {
-            let (step, time) = (self.steps + 1, self.t());
-            if self.interrupt.due() {
-                if let Err(source) = poll() {
-                    result = Err(Error::Interrupted { step, time, source });
-                    break;
-                }
+    /// `steps` steps of the method's own variables (the stepper polls for interrupts between
+    /// such calls, and synchronises (q, p) after the last); None for a method without
+    /// variables of its own.
+    pub(super) fn advance_own(&mut self, model: &NBody, steps: usize) -> Option<Result<(), Error>> {
+        let StepperState {
+            integrator,
+            clock,
+            steps: done,
+            compensated,
+            q,
+            p,
+            ..
+        } = self;
+        let own = integrator.own_variables()?;
+        for _ in 0..steps {
+            if let Err(e) = own.step(model, q, p, clock.h, *compensated) {
+                return Some(Err(e.at(*done + 1, clock.at(*done))));
             }
-            let stepped = match self.integrator.own_variables() {
-                Some(own) => own.step(nbody, &self.q, &self.p, self.clock.h, self.compensated),
-                None => return Err(self.method().refusal(model.kind())),
-            };
-            if let Err(e) = stepped {
-                result = Err(e.at(step, time));
-                break;
-            }
-            self.steps = step;
+            *done += 1;
         }
+        Some(Ok(()))
+    }
+
+    /// Writes (q, p) from the method's own variables, as of the last good step, if it keeps
+    /// any.
+    pub(super) fn synchronise(&mut self) {
         if let Some(own) = self.integrator.own_variables() {
             own.synchronise(&mut self.q, &mut self.p);
         }
-        result
     }
 }
