@@ -19,11 +19,12 @@ import os
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 import argparse
-import math
 import subprocess
 import sys
-import time
+from functools import partial
 from pathlib import Path
+
+from compare import best_times_interleaved
 
 import varmech
 from varmech import examples, scenes
@@ -42,13 +43,12 @@ CASES = [
 
 def seconds_per_step(runs: dict[str, tuple[object, int]], scene: scenes.Scene, method: str, repeat: int) -> dict[str, float]:
     """Best time per step of each model, the runs alternating."""
-    best = dict.fromkeys(runs, math.inf)
-    for _ in range(repeat):
-        for label, (model, steps) in runs.items():
-            start = time.perf_counter()
-            varmech.integrate(model, scene.q0, scene.p0, dt=scene.dt, steps=steps, method=method, save_every=steps)
-            best[label] = min(best[label], (time.perf_counter() - start) / steps)
-    return best
+    timed = {
+        label: partial(varmech.integrate, model, scene.q0, scene.p0, dt=scene.dt, steps=steps, method=method, save_every=steps)
+        for label, (model, steps) in runs.items()
+    }
+    best = best_times_interleaved(timed, repeat)
+    return {label: best[label] / steps for label, (_, steps) in runs.items()}
 
 
 def build_seconds(name: str) -> float:
