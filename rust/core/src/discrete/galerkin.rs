@@ -2,6 +2,7 @@ use nalgebra::DMatrix;
 
 use super::Segment;
 use crate::model::{Hessians, Lagrangian};
+use crate::solve::sized;
 use crate::ModelError;
 
 /// L_d = h Σᵢ bᵢ L(q(cᵢh), q̇(cᵢh), t + cᵢh) along the polynomial q(τh) = Σⱼ ℓⱼ(τ)Qⱼ of degree
@@ -125,17 +126,28 @@ impl Quadrature {
                 let (lj, dj) = (self.basis[i][j], self.slopes[i][j]);
                 for c in 0..self.s {
                     let (lk, dk) = (self.basis[i][c + 1], self.slopes[i][c + 1]);
-                    let (qq, qv, vq, vv) = (b * h * lj * lk, b * lj * dk, b * dj * lk, b * dj * dk / h);
-                    for a in 0..n {
-                        for e in 0..n {
-                            jac[(r * n + a, c * n + e)] +=
-                                qq * hs.qq[(a, e)] + qv * hs.qv[(a, e)] + vq * hs.qv[(e, a)] + vv * hs.vv[(a, e)];
-                        }
-                    }
+                    let weights = [b * h * lj * lk, b * lj * dk, b * dj * lk, b * dj * dk / h];
+                    let corner = c * n * jac.nrows() + r * n;
+                    let stride = jac.nrows();
+                    let jac = &mut jac.as_mut_slice()[corner..];
+                    sized!(add_block(jac, stride, weights, hs; n));
                 }
             }
         }
         Ok(true)
+    }
+}
+
+/// Adds the n×n block qq·L_qq + qv·L_qq̇ + vq·L_q̇q + vv·L_q̇q̇ to the column-major `jac` of column
+/// stride `stride`, from its first entry.
+#[inline(always)]
+fn add_block(jac: &mut [f64], stride: usize, [qq, qv, vq, vv]: [f64; 4], hs: &Hessians, n: usize) {
+    let (hqq, hqv, hvv) = (hs.qq.as_slice(), hs.qv.as_slice(), hs.vv.as_slice());
+    for e in 0..n {
+        for a in 0..n {
+            jac[e * stride + a] +=
+                qq * hqq[e * n + a] + qv * hqv[e * n + a] + vq * hqv[a * n + e] + vv * hvv[e * n + a];
+        }
     }
 }
 

@@ -97,6 +97,10 @@ pub trait DiscreteLagrangian {
 
     /// Writes D₁L_d + D₂L_d, the change of momentum p₁ − p₀ over the step when p₀ = −D₁L_d,
     /// in a form free of the cancellation between the two (the ∂L/∂q̇ terms drop out).
+    ///
+    /// `ws` must hold what [`Self::d1`] left in it at the same segment (the step solver's last
+    /// evaluation is D₁L_d at the solution): the rules reuse its ∂L/∂q instead of evaluating it
+    /// again, the same numbers.
     fn momentum_change<S: Lagrangian + ?Sized>(
         &self,
         sys: &S,

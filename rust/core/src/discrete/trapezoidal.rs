@@ -70,7 +70,7 @@ impl DiscreteLagrangian for Trapezoidal {
         Ok(())
     }
 
-    /// (h/2)[∂L/∂q(q₀) + ∂L/∂q(q₁)].
+    /// (h/2)[∂L/∂q(q₀) + ∂L/∂q(q₁)], ∂L/∂q(q₀) from D₁L_d's evaluation (ws.a).
     fn momentum_change<S: Lagrangian + ?Sized>(
         &self,
         sys: &S,
@@ -78,9 +78,7 @@ impl DiscreteLagrangian for Trapezoidal {
         out: &mut [f64],
         ws: &mut Workspace,
     ) -> Result<(), ModelError> {
-        let Segment { q0, t, h, .. } = at;
-        ws.set(&at, 1.0);
-        sys.dl_dq(q0, &ws.v, t, &mut ws.a)?;
+        let Segment { t, h, .. } = at;
         sys.dl_dq(&ws.x, &ws.v, t + h, &mut ws.b)?;
         combine(out, 0.5 * h, &ws.a, 0.5 * h, &ws.b);
         Ok(())

@@ -250,7 +250,7 @@ impl Rattle {
                     reason: "G(q₁)M⁻¹G(q₁)ᵀ is singular: the constraints are not independent here",
                 });
             }
-            lu_solve(&self.gram, &self.pivots, &mut self.g);
+            lu_solve(&self.gram, &self.pivots, self.g.as_mut_slice());
         }
         // δp = p₁ − p₀ as the sum of the kicks, free of cancellation.
         for (j, d) in self.dp_stage.iter_mut().enumerate() {

@@ -523,7 +523,7 @@ impl<L: Lagrangian + ?Sized> Lagrangian for Routhian<'_, L> {
                 for (j, &c) in self.cyclic.iter().enumerate() {
                     column[j] = h[(i, c)];
                 }
-                lu_solve(k, pivots, column);
+                lu_solve(k, pivots, column.as_mut_slice());
                 kinv_b.column_mut(block * r + col).copy_from(column);
             }
         }

@@ -6,6 +6,22 @@
 //! - `newton`: Newton's method, simplified (a kept Jacobian) or full, with [`NewtonOptions`];
 //! - [`interrupt`]: when to poll for Ctrl-C, and the check the iterative solves poll.
 
+/// Calls `$f(args…, n)` with n a literal for n ≤ 4, so that the inlined body (an
+/// `#[inline(always)]` function of n) is specialised: the small systems most steps solve then run
+/// unrolled loops, where loops of unknown length cost more than their arithmetic.
+macro_rules! sized {
+    ($f:ident($($arg:expr),*; $n:expr)) => {
+        match $n {
+            1 => $f($($arg),*, 1),
+            2 => $f($($arg),*, 2),
+            3 => $f($($arg),*, 3),
+            4 => $f($($arg),*, 4),
+            n => $f($($arg),*, n),
+        }
+    };
+}
+pub(crate) use sized;
+
 pub mod difference;
 pub mod interrupt;
 pub(crate) mod lu;

@@ -245,7 +245,7 @@ impl Newton {
                 };
             }
             self.iterations += 1;
-            lu_solve(&self.jacobian, &self.pivots, &mut self.residual);
+            lu_solve(&self.jacobian, &self.pivots, self.residual.as_mut_slice());
             let correction = problem.correct(self.residual.as_slice());
             problem.residual(self.residual.as_mut_slice())?;
             residual = norm(&self.residual);

@@ -77,7 +77,9 @@ impl<R: DiscreteLagrangian> StepEquations for TwoPoint<R> {
         Ok(())
     }
 
-    /// p₁ − p₀ = D₁L_d + D₂L_d + h·f(q̄, v) − F, since F = p₀ + D₁L_d + f_d⁻.
+    /// p₁ − p₀ = D₁L_d + D₂L_d + h·f(q̄, v) − F, since F = p₀ + D₁L_d + f_d⁻. Called after
+    /// [`Self::equations`] at the same x, as Newton's method leaves it: the rule reuses that D₁L_d's
+    /// evaluation.
     fn momentum_change<S: Lagrangian + ?Sized>(
         &mut self,
         sys: &S,
