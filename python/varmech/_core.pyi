@@ -107,10 +107,10 @@ class TrajectoryRecord:
     def force_evaluations(self) -> int: ...
     @property
     def newton(self) -> NDArray[np.uint64]:
-        """Cumulative Newton iterations at each saved state."""
+        """Cumulative Newton iterations at each saved state (zeros for the explicit methods)."""
     @property
     def work(self) -> _FloatArray:
-        """Cumulative work of the non-conservative forces at each saved state."""
+        """Cumulative work of the non-conservative forces at each saved state (zeros without forces)."""
 
 @final
 class Stepper:

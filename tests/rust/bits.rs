@@ -10,14 +10,15 @@ use varmech::scenes::{planar_chain, DampedDrivenPendulum, DoublePendulum, Kepler
 /// FNV-1a over the bits of every saved (t, q, p), the Newton counts and work per saved state,
 /// and the run's step, evaluation and iteration counts.
 fn fingerprint(traj: &Trajectory) -> u64 {
+    let (work, newton) = (traj.work_at_saves(), traj.newton_at_saves());
     let words = traj
         .t
         .iter()
         .chain(&traj.q)
         .chain(&traj.p)
-        .chain(&traj.work)
+        .chain(work.iter())
         .map(|x| x.to_bits())
-        .chain(traj.newton.iter().copied())
+        .chain(newton.iter().copied())
         .chain([traj.steps as u64, traj.force_evaluations, traj.newton_iterations]);
     let mut hash = 0xcbf2_9ce4_8422_2325_u64;
     for word in words {

@@ -10,16 +10,27 @@ use crate::convert::matrix;
 /// The saved states of a run (or of a failed run, up to the failure): times `t` (N,), positions
 /// `q` and momenta `p` (N, n), the steps completed and force evaluations made, and at each
 /// saved state the cumulative Newton iterations `newton` and work of the non-conservative
-/// forces `work` (N,).
-#[pyclass(frozen, get_all, module = "varmech._core")]
+/// forces `work` (N,). A run without Newton iterations or forces stores neither; the getters
+/// then return zeros, made when asked for.
+#[pyclass(frozen, module = "varmech._core")]
 pub struct TrajectoryRecord {
+    #[pyo3(get)]
     t: Py<PyArray1<f64>>,
+    #[pyo3(get)]
     q: Py<PyArray2<f64>>,
+    #[pyo3(get)]
     p: Py<PyArray2<f64>>,
+    #[pyo3(get)]
     steps: usize,
+    #[pyo3(get)]
     force_evaluations: u64,
-    newton: Py<PyArray1<u64>>,
-    work: Py<PyArray1<f64>>,
+    newton: Option<Py<PyArray1<u64>>>,
+    work: Option<Py<PyArray1<f64>>>,
+}
+
+/// The recorded column, or None when the run recorded none (an empty vector).
+fn recorded<'py, T: numpy::Element>(py: Python<'py>, column: Vec<T>) -> Option<Py<PyArray1<T>>> {
+    (!column.is_empty()).then(|| PyArray1::from_vec(py, column).unbind())
 }
 
 impl TrajectoryRecord {
@@ -31,14 +42,38 @@ impl TrajectoryRecord {
             p: matrix(py, traj.p, n)?.unbind(),
             steps: traj.steps,
             force_evaluations: traj.force_evaluations,
-            newton: PyArray1::from_vec(py, traj.newton).unbind(),
-            work: PyArray1::from_vec(py, traj.work).unbind(),
+            newton: recorded(py, traj.newton),
+            work: recorded(py, traj.work),
         })
+    }
+
+    /// The column, or zeros of the length of `t`.
+    fn column<'py, T: numpy::Element>(
+        &self,
+        py: Python<'py>,
+        column: &Option<Py<PyArray1<T>>>,
+    ) -> Bound<'py, PyArray1<T>> {
+        match column {
+            Some(c) => c.bind(py).clone(),
+            None => PyArray1::zeros(py, self.t.bind(py).len(), false),
+        }
     }
 }
 
 #[pymethods]
 impl TrajectoryRecord {
+    /// Cumulative Newton iterations at each saved state (zeros for the explicit methods).
+    #[getter]
+    fn newton<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<u64>> {
+        self.column(py, &self.newton)
+    }
+
+    /// Cumulative work of the non-conservative forces at each saved state (zeros without forces).
+    #[getter]
+    fn work<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        self.column(py, &self.work)
+    }
+
     fn __repr__(&self, py: Python<'_>) -> String {
         format!(
             "TrajectoryRecord(states={}, steps={})",

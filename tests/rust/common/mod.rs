@@ -99,7 +99,7 @@ pub fn run_general<L: Lagrangian>(
 /// The statistics and verdict of the energy of `sys` along `traj`.
 pub fn energy_statistics<L: Lagrangian + ?Sized>(sys: &L, traj: &Trajectory) -> Statistics {
     let terms = diagnostics::energy_terms(sys, traj).unwrap();
-    diagnostics::energy_statistics(&traj.t, &terms, &traj.work, traj.steps as u64).unwrap()
+    diagnostics::energy_statistics(&traj.t, &terms, &traj.work_at_saves(), traj.steps as u64).unwrap()
 }
 
 /// Whether a verdict says the quantity is conserved: to round-off, or in a bounded band.

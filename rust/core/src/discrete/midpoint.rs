@@ -53,8 +53,22 @@ impl DiscreteLagrangian for Midpoint {
         Ok(())
     }
 
-    /// h·∂L/∂q at the midpoint, from D₁L_d's evaluation (ws.a).
+    /// h·∂L/∂q at the midpoint.
     fn momentum_change<S: Lagrangian + ?Sized>(
+        &self,
+        sys: &S,
+        at: Segment<'_>,
+        out: &mut [f64],
+        ws: &mut Workspace,
+    ) -> Result<(), ModelError> {
+        ws.set(&at, 0.5);
+        sys.dl_dq(&ws.x, &ws.v, at.t + 0.5 * at.h, out)?;
+        out.iter_mut().for_each(|x| *x *= at.h);
+        Ok(())
+    }
+
+    /// h·∂L/∂q from D₁L_d's evaluation (ws.a).
+    fn momentum_change_after_d1<S: Lagrangian + ?Sized>(
         &self,
         _sys: &S,
         at: Segment<'_>,

@@ -97,10 +97,6 @@ pub trait DiscreteLagrangian {
 
     /// Writes D₁L_d + D₂L_d, the change of momentum p₁ − p₀ over the step when p₀ = −D₁L_d,
     /// in a form free of the cancellation between the two (the ∂L/∂q̇ terms drop out).
-    ///
-    /// `ws` must hold what [`Self::d1`] left in it at the same segment (the step solver's last
-    /// evaluation is D₁L_d at the solution): the rules reuse its ∂L/∂q instead of evaluating it
-    /// again, the same numbers.
     fn momentum_change<S: Lagrangian + ?Sized>(
         &self,
         sys: &S,
@@ -108,6 +104,19 @@ pub trait DiscreteLagrangian {
         out: &mut [f64],
         ws: &mut Workspace,
     ) -> Result<(), ModelError>;
+
+    /// [`Self::momentum_change`] right after [`Self::d1`] at the same segment, with what `d1`
+    /// left in `ws`: a step solver's last evaluation is D₁L_d at the solution, whose ∂L/∂q the
+    /// rules reuse instead of evaluating it again (the same numbers). Default: evaluate anew.
+    fn momentum_change_after_d1<S: Lagrangian + ?Sized>(
+        &self,
+        sys: &S,
+        at: Segment<'_>,
+        out: &mut [f64],
+        ws: &mut Workspace,
+    ) -> Result<(), ModelError> {
+        self.momentum_change(sys, at, out, ws)
+    }
 
     /// The discrete Legendre transform F⁻L_d: p₀ = −D₁L_d(q₀, q₁, h).
     fn momentum_minus<S: Lagrangian + ?Sized>(

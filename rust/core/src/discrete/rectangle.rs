@@ -47,15 +47,18 @@ impl DiscreteLagrangian for Rectangle {
         sys.dl_dv(q0, &ws.v, t, out)
     }
 
-    /// h·∂L/∂q(q₀), from D₁L_d's evaluation (ws.a).
+    /// h·∂L/∂q(q₀).
     fn momentum_change<S: Lagrangian + ?Sized>(
         &self,
-        _sys: &S,
+        sys: &S,
         at: Segment<'_>,
         out: &mut [f64],
         ws: &mut Workspace,
     ) -> Result<(), ModelError> {
-        out.iter_mut().zip(&ws.a).for_each(|(o, a)| *o = a * at.h);
+        let Segment { q0, t, h, .. } = at;
+        ws.set(&at, 0.0);
+        sys.dl_dq(q0, &ws.v, t, out)?;
+        out.iter_mut().for_each(|x| *x *= h);
         Ok(())
     }
 }

@@ -70,8 +70,24 @@ impl DiscreteLagrangian for Trapezoidal {
         Ok(())
     }
 
-    /// (h/2)[∂L/∂q(q₀) + ∂L/∂q(q₁)], ∂L/∂q(q₀) from D₁L_d's evaluation (ws.a).
+    /// (h/2)[∂L/∂q(q₀) + ∂L/∂q(q₁)].
     fn momentum_change<S: Lagrangian + ?Sized>(
+        &self,
+        sys: &S,
+        at: Segment<'_>,
+        out: &mut [f64],
+        ws: &mut Workspace,
+    ) -> Result<(), ModelError> {
+        let Segment { q0, t, h, .. } = at;
+        ws.set(&at, 1.0);
+        sys.dl_dq(q0, &ws.v, t, &mut ws.a)?;
+        sys.dl_dq(&ws.x, &ws.v, t + h, &mut ws.b)?;
+        combine(out, 0.5 * h, &ws.a, 0.5 * h, &ws.b);
+        Ok(())
+    }
+
+    /// (h/2)[∂L/∂q(q₀) + ∂L/∂q(q₁)], ∂L/∂q(q₀) from D₁L_d's evaluation (ws.a).
+    fn momentum_change_after_d1<S: Lagrangian + ?Sized>(
         &self,
         sys: &S,
         at: Segment<'_>,

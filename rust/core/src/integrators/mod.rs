@@ -174,15 +174,20 @@ impl Integrator {
         }
     }
 
+    /// Newton iterations made so far; None for the methods that solve no equations.
+    pub fn newton(&self) -> Option<u64> {
+        match &self.scheme {
+            Scheme::Midpoint(s) => Some(s.iterations()),
+            Scheme::Trapezoid(s) => Some(s.iterations()),
+            Scheme::Galerkin(s) => Some(s.iterations()),
+            Scheme::Rattle(s) => Some(s.iterations()),
+            _ => None,
+        }
+    }
+
     /// Newton iterations made so far (0 for the explicit methods).
     pub fn newton_iterations(&self) -> u64 {
-        match &self.scheme {
-            Scheme::Midpoint(s) => s.iterations(),
-            Scheme::Trapezoid(s) => s.iterations(),
-            Scheme::Galerkin(s) => s.iterations(),
-            Scheme::Rattle(s) => s.iterations(),
-            _ => 0,
-        }
+        self.newton().unwrap_or(0)
     }
 
     /// The kick–drift scheme, for the stepper's fixed-size loop.

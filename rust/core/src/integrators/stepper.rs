@@ -367,6 +367,18 @@ impl StepperState {
     }
 }
 
+impl<M: Deref<Target: Dynamics>> Stepper<M> {
+    /// Newton iterations made so far; None for the methods that solve no equations.
+    pub fn newton(&self) -> Option<u64> {
+        self.state.integrator.newton()
+    }
+
+    /// The work done by the non-conservative forces so far; None for a model without them.
+    pub fn forced_work(&self) -> Option<f64> {
+        self.model.as_lagrangian().is_forced().then(|| self.work())
+    }
+}
+
 /// tₙ = t₀ + (n − n₀)·h: the time t₀ and steps n₀ when the step h was last set (see
 /// [`Stepper::set_dt`]).
 #[derive(Clone, Copy, Debug)]

@@ -1,5 +1,6 @@
 //! The saved states of a run, and a run that stopped early.
 
+use std::borrow::Cow;
 use std::ops::Deref;
 
 use super::{Dynamics, Stepper};
@@ -18,11 +19,13 @@ pub struct Trajectory {
     pub force_evaluations: u64,
     /// Newton iterations made (implicit methods).
     pub newton_iterations: u64,
-    /// Newton iterations made up to each saved state (cumulative; all zero for explicit
-    /// methods): their differences give the iterations per step between saves.
+    /// Newton iterations made up to each saved state (cumulative; empty for the methods that
+    /// solve no equations, rather than zeros): their differences give the iterations per step
+    /// between saves.
     pub newton: Vec<u64>,
-    /// Work done by non-conservative forces up to each saved state (forced systems): the
-    /// energy balance E(t) − E(0) − W(t) is the discrete Lagrange–d'Alembert check.
+    /// Work done by non-conservative forces up to each saved state (forced systems; empty
+    /// without forces, rather than zeros): the energy balance E(t) − E(0) − W(t) is the discrete
+    /// Lagrange–d'Alembert check.
     pub work: Vec<f64>,
 }
 
@@ -46,14 +49,32 @@ impl Trajectory {
         &self.p[k * self.dim..(k + 1) * self.dim]
     }
 
+    /// Newton iterations up to each saved state, zeros (made now) when the run solved no equations.
+    pub fn newton_at_saves(&self) -> Cow<'_, [u64]> {
+        Self::or_zeros(&self.newton, self.len())
+    }
+
+    /// Work of the non-conservative forces up to each saved state, zeros (made now) without forces.
+    pub fn work_at_saves(&self) -> Cow<'_, [f64]> {
+        Self::or_zeros(&self.work, self.len())
+    }
+
+    fn or_zeros<T: Clone + Default>(column: &[T], len: usize) -> Cow<'_, [T]> {
+        if column.is_empty() {
+            Cow::Owned(vec![T::default(); len])
+        } else {
+            Cow::Borrowed(column)
+        }
+    }
+
     /// Saves the stepper's state as the state at time `t`.
     pub(super) fn push<M>(&mut self, t: f64, stepper: &Stepper<M>)
     where
         M: Deref<Target: Dynamics>,
     {
         self.t.push(t);
-        self.newton.push(stepper.newton_iterations());
-        self.work.push(stepper.work());
+        self.newton.extend(stepper.newton());
+        self.work.extend(stepper.forced_work());
         self.q.extend_from_slice(stepper.q());
         self.p.extend_from_slice(stepper.p());
     }

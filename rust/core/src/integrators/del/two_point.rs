@@ -89,7 +89,7 @@ impl<R: DiscreteLagrangian> StepEquations for TwoPoint<R> {
         dp: &mut [f64],
     ) -> Result<f64, ModelError> {
         let at = segment(&start, x);
-        self.rule.momentum_change(sys, at, dp, &mut self.ws)?;
+        self.rule.momentum_change_after_d1(sys, at, dp, &mut self.ws)?;
         dp.iter_mut().zip(residual).for_each(|(d, r)| *d -= r);
         if !sys.is_forced() {
             return Ok(0.0);
