@@ -1,10 +1,11 @@
 """The README's gallery: every chart of ``python -m varmech chart``, at full settings, written to
 docs/gallery/ (PNG) with its data (CSV).
 
-    python benches/gallery.py [--out docs/gallery] [--quick]
+    python benches/gallery.py [--out docs/gallery] [--quick] [--only KIND[:SCENE] ...]
 
-Needs the ``bench`` extra (matplotlib, scipy, rebound). Takes a few minutes; each chart's sweep
-shows a progress bar and Ctrl-C stops it.
+``--only`` redraws the named charts alone (``--only work-precision:kepler``; a kind without a
+scene selects every chart of that kind). Needs the ``bench`` extra (matplotlib, scipy, rebound).
+Takes a few minutes; each chart's sweep shows a progress bar and Ctrl-C stops it.
 """
 
 from __future__ import annotations
@@ -15,30 +16,45 @@ from pathlib import Path
 
 from varmech.charts.recipes import KINDS, chart
 
-#: (kind, scene): the charts of the gallery; the work–precision chart also on the outer solar
-#: system, where REBOUND is the baseline, and on the symbolic elastic pendulum, against SciPy on
-#: its lambdified equations.
+#: (kind, scene, methods): the charts of the gallery, with the kind's default methods where
+#: None. The work–precision charts of Kepler and the outer solar system add varmech's fastest
+#: splittings at matched error (benches/splitting.py), and on the outer solar system its
+#: Wisdom–Holman methods, against REBOUND's baselines (leapfrog order=8 on both; WHFast with and
+#: without corrector=11, and IAS15, on the N-body scene); the elastic pendulum's is against
+#: SciPy on its lambdified equations.
 GALLERY = [
-    ("work-precision", "kepler"),
-    ("work-precision", "outer_solar_system"),
-    ("work-precision", "elastic_pendulum"),
-    ("energy", "kepler"),
-    ("stability", None),
-    ("implicit-regions", "pendulum"),
-    ("poincare", "henon_heiles"),
-    ("phase", "pendulum"),
+    ("work-precision", "kepler", ("verlet", "yoshida4", "kahan_li8", "blanes_moan6", "mclachlan8_dkd", "rk4")),
+    ("work-precision", "outer_solar_system", ("verlet", "kahan_li8", "blanes_moan6", "mclachlan8_dkd", "whc", "whckl")),
+    ("work-precision", "elastic_pendulum", None),
+    ("energy", "kepler", None),
+    ("stability", None, None),
+    ("implicit-regions", "pendulum", None),
+    ("poincare", "henon_heiles", None),
+    ("phase", "pendulum", None),
 ]
+
+
+def selected(kind: str, scene: str | None, only: list[str]) -> bool:
+    """Whether ``--only`` picks the chart (kind, scene): every chart when ``only`` is empty."""
+    return not only or kind in only or f"{kind}:{scene}" in only
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--out", type=Path, default=Path("docs/gallery"))
     parser.add_argument("--quick", action="store_true", help="the tour's short sweeps")
+    parser.add_argument("--only", nargs="+", default=[], metavar="KIND[:SCENE]", help="redraw these charts alone")
     args = parser.parse_args()
-    for kind, scene in GALLERY:
+    known = {kind for kind, _, _ in GALLERY} | {f"{kind}:{scene}" for kind, scene, _ in GALLERY}
+    unknown = [name for name in args.only if name not in known]
+    if unknown:
+        parser.error(f"--only: no gallery chart {', '.join(unknown)}; choose from {', '.join(sorted(known))}")
+    for kind, scene, methods in GALLERY:
         assert kind in KINDS
+        if not selected(kind, scene, args.only):
+            continue
         start = time.perf_counter()
-        paths = chart(kind, scene, out=args.out, quick=args.quick, progress=True)
+        paths = chart(kind, scene, methods=methods, out=args.out, quick=args.quick, progress=True)
         print(f"{kind} {scene or ''}: {time.perf_counter() - start:.1f} s")
         for path in paths:
             print(f"  wrote {path}")

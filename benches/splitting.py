@@ -33,11 +33,12 @@ from compare import best_times_interleaved
 
 import varmech
 from varmech import scenes
-from varmech.analysis.baselines import import_rebound, rebound_sim, rebound_state, restore_sigint
+from varmech.analysis.baselines import import_rebound, rebound_advance, rebound_sim, rebound_state
 
-#: The REBOUND baseline's label; the other methods of a problem's sweeps are varmech's candidates
-#: (the best at each error is compared).
-REBOUND = "REBOUND leapfrog order=8"
+#: The REBOUND baseline (a method of varmech.analysis.baselines) and its label; the other methods
+#: of a problem's sweeps are varmech's candidates (the best at each error is compared).
+BASELINE = "leapfrog order=8"
+REBOUND = f"REBOUND {BASELINE}"
 TARGETS = [10.0**-k for k in range(2, 11)]
 
 
@@ -62,14 +63,15 @@ def order_sweeps(n: int, order8: tuple[int, int], lower: dict[str, tuple[int, in
 
 
 def runner(
+    scene: scenes.Scene,
     steps_and_h: Callable[[int], tuple[int, float]],
-    new_sim: Callable[[float], Any],
     sim_state: Callable[[Any], tuple[np.ndarray, np.ndarray]],
     varmech_state: Callable[[str, float, int], tuple[np.ndarray, np.ndarray]],
     error: Callable[[np.ndarray, np.ndarray], float],
 ) -> Callable[[str, int], Callable[[], float]]:
     """(method, sweep value) → a run returning its final error: REBOUND's leapfrog with order=8 on
-    the simulation ``new_sim(h)``, or varmech's ``method``."""
+    ``scene``, or varmech's ``method``."""
+    rebound = import_rebound()
 
     def run(method: str, n: int) -> Callable[[], float]:
         steps, h = steps_and_h(n)
@@ -77,12 +79,8 @@ def runner(
             return lambda: error(*varmech_state(method, h, steps))
 
         def go() -> float:
-            sim = new_sim(h)
-            sim.integrator.order = 8
-            try:
-                sim.steps(steps)
-            finally:
-                restore_sigint()
+            sim = rebound_sim(rebound, scene, BASELINE, dt=h)
+            rebound_advance(sim, BASELINE, steps, math.nan)
             return error(*sim_state(sim))
 
         return go
@@ -91,24 +89,9 @@ def runner(
 
 
 def kepler(quick: bool) -> Problem:
-    rebound = import_rebound()
     scene = scenes.kepler(0.6)
     periods = 100 if quick else 1000
     q0, p0 = scene.q0, scene.p0
-
-    def new_sim(h: float) -> Any:
-        sim = rebound.Simulation()
-        sim.G = 1.0
-        sim.add(m=1.0)
-        sim.add(m=0.0, x=q0[0], y=q0[1], vx=p0[0], vy=p0[1])
-        sim.N_active = 1  # the test particle pulls nothing: one force an evaluation
-        sim.integrator = "leapfrog"
-        sim.dt = h
-        return sim
-
-    def sim_state(sim: Any) -> tuple[np.ndarray, np.ndarray]:
-        pt = sim.particles[1]
-        return np.array([pt.x, pt.y]), np.array([pt.vx, pt.vy])
 
     def varmech_state(method: str, h: float, steps: int) -> tuple[np.ndarray, np.ndarray]:
         traj = varmech.integrate(scene.model, q0, p0, dt=h, steps=steps, method=method, save_every=steps, max_energy_error=None)
@@ -121,12 +104,11 @@ def kepler(quick: bool) -> Problem:
         return periods * per_period, 2 * math.pi / per_period
 
     sweeps = order_sweeps(7 if quick else 13, (24, 800), {"blanes_moan6": (24, 1600), "blanes_moan4": (40, 4000)})
-    run = runner(steps_and_h, new_sim, sim_state, varmech_state, error)
+    run = runner(scene, steps_and_h, lambda sim: rebound_state(sim, scene), varmech_state, error)
     return Problem(f"Kepler e = 0.6, {periods} periods (steps per period)", run, sweeps)
 
 
 def outer_solar_system(quick: bool) -> Problem:
-    rebound = import_rebound()
     scene = scenes.outer_solar_system()
     _, masses = scene.model._core.gravity
     m3 = np.repeat(masses, 3)
@@ -134,7 +116,7 @@ def outer_solar_system(quick: bool) -> Problem:
     v_ref = ref.p / m3
 
     def sim_state(sim: Any) -> tuple[np.ndarray, np.ndarray]:
-        q, p = rebound_state(sim, masses)
+        q, p = rebound_state(sim, scene)
         return q, p / m3
 
     def varmech_state(method: str, h: float, steps: int) -> tuple[np.ndarray, np.ndarray]:
@@ -150,13 +132,7 @@ def outer_solar_system(quick: bool) -> Problem:
     sweeps = order_sweeps(7 if quick else 11, (500, 40_000), lower)
     if quick:
         sweeps = {k: v[: len(v) - 2] for k, v in sweeps.items()}
-    run = runner(
-        lambda steps: (steps, ref.t / steps),
-        lambda h: rebound_sim(rebound, scene, "leapfrog", dt=h),
-        sim_state,
-        varmech_state,
-        error,
-    )
+    run = runner(scene, lambda steps: (steps, ref.t / steps), sim_state, varmech_state, error)
     return Problem("outer solar system, 500 000 days (steps)", run, sweeps)
 
 

@@ -57,7 +57,6 @@ def varmech_run(scene: scenes.Scene, method: str, steps: int) -> Callable[[], np
 
 def whfast_run(rebound, scene: scenes.Scene, corrector: int, kernel: str, steps: int) -> Callable[[], np.ndarray]:
     dt = T_END / steps
-    masses = scene.model._core.gravity[1]
 
     def run() -> np.ndarray:
         sim = rebound_sim(rebound, scene, "WHFast", dt=dt)
@@ -69,7 +68,7 @@ def whfast_run(rebound, scene: scenes.Scene, corrector: int, kernel: str, steps:
             sim.synchronize()
         finally:
             restore_sigint()
-        return rebound_state(sim, masses)[0]
+        return rebound_state(sim, scene)[0]
 
     return run
 
@@ -87,7 +86,7 @@ def reference(rebound, scene: scenes.Scene) -> np.ndarray:
         sim.integrate(T_END, exact_finish_time=1)
     finally:
         restore_sigint()
-    return rebound_state(sim, scene.model._core.gravity[1])[0]
+    return rebound_state(sim, scene)[0]
 
 
 def cost_at(level: float, points: list[tuple[float, float]]) -> float | None:

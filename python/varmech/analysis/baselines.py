@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import signal
 from collections.abc import Sequence
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -19,9 +20,40 @@ from .. import _core
 from ..model import Model
 from ..scenes import Scene
 
-#: solve_ivp's methods, and REBOUND's integrators this package drives.
+#: solve_ivp's methods.
 SCIPY_METHODS = ("RK23", "RK45", "DOP853", "Radau", "BDF", "LSODA")
-REBOUND_METHODS = ("WHFast", "IAS15")
+
+
+@dataclass(frozen=True)
+class ReboundMethod:
+    """A REBOUND integrator with the settings it runs with as a baseline."""
+
+    #: REBOUND's name of the integrator (``sim.integrator``).
+    integrator: str
+    #: Attributes set on ``sim.integrator``.
+    settings: tuple[tuple[str, int], ...] = ()
+    #: Swept over its precision ε (IAS15), not over step counts.
+    adaptive: bool = False
+    #: Also a baseline on the Kepler scene, as a test particle of a unit mass (WHFast's Kepler
+    #: drift would solve that scene exactly).
+    kepler: bool = False
+
+
+#: REBOUND's integrators this package drives, by name: WHFast and IAS15 at REBOUND's defaults;
+#: WHFast with Wisdom, Holman & Touma's (1996) symplectic corrector of order 11, unsynchronised
+#: between steps (``safe_mode=0``; ``keep_unsynchronized=1`` lets a run be sampled without
+#: leaving its trajectory); ``leapfrog`` with ``order=8``, McLachlan's (1995) 17-stage
+#: composition SS17 of drift–kick–drift Verlet (Blanes & Casas 2016, p. 91), varmech's
+#: ``mclachlan8_dkd``.
+REBOUND_BASELINES: dict[str, ReboundMethod] = {
+    "WHFast": ReboundMethod("whfast"),
+    "IAS15": ReboundMethod("ias15", adaptive=True),
+    "WHFast corrector=11": ReboundMethod("whfast", (("corrector", 11), ("safe_mode", 0), ("keep_unsynchronized", 1))),
+    "leapfrog order=8": ReboundMethod("leapfrog", (("order", 8),), kepler=True),
+}
+REBOUND_METHODS = tuple(REBOUND_BASELINES)
+#: The REBOUND baselines a sweep runs unless told: REBOUND's integrators at their defaults.
+REBOUND_DEFAULTS = ("WHFast", "IAS15")
 
 
 # ------------------------------------------------------------------------------------ scipy
@@ -145,6 +177,12 @@ def gravity(scene: Scene) -> tuple[float, list[float]] | None:
     return getattr(scene.model._core, "gravity", None)
 
 
+def is_kepler(scene: Scene) -> bool:
+    """Whether ``scene`` is Kepler's problem H = |p|²/2 − 1/|q| in the plane (the ``kepler``
+    scene), which REBOUND integrates as a test particle of a unit mass at rest, G = 1."""
+    return getattr(scene.model._core, "name", None) == "kepler"
+
+
 def import_rebound() -> Any | None:
     """The ``rebound`` module, or None without REBOUND."""
     try:
@@ -155,31 +193,46 @@ def import_rebound() -> Any | None:
 
 
 def rebound_baselines(scene: Scene, names: Sequence[str], notes: list[str], *, asked: bool) -> tuple[Any | None, list[str]]:
-    """``(rebound, names)`` of the REBOUND baselines that will run on ``scene``: none on a scene
-    that is not N-body (with a note when they were ``asked`` for by name), nor without REBOUND
-    (with a note)."""
+    """``(rebound, names)`` of the REBOUND baselines of ``names`` that will run on ``scene``:
+    every one on an N-body scene, the ``kepler`` ones on the Kepler scene, none elsewhere (those
+    skipped noted when they were ``asked`` for by name), and none without REBOUND (with a note)."""
     if not names:
         return None, []
-    if gravity(scene) is None:
-        if asked:
-            notes.append(f"REBOUND baselines {list(names)} skipped: {scene.name} is not an N-body scene")
+    nbody = gravity(scene) is not None
+    runs = [n for n in names if nbody or (REBOUND_BASELINES[n].kepler and is_kepler(scene))]
+    skipped = [n for n in names if n not in runs]
+    if skipped and asked:
+        why = "is not an N-body scene" if not runs else "is not an N-body scene; only the Kepler ones run"
+        notes.append(f"REBOUND baselines {skipped} skipped: {scene.name} {why}")
+    if not runs:
         return None, []
     rb = import_rebound()
     if rb is None:
         notes.append("REBOUND baselines skipped: REBOUND is not installed (pip install rebound)")
         return None, []
-    return rb, list(names)
+    return rb, runs
 
 
-def rebound_sim(rebound: Any, scene: Scene, integrator: str, *, dt: float, epsilon: float | None = None) -> Any:
-    """A REBOUND simulation of the N-body ``scene`` with ``integrator`` (WHFast or IAS15)."""
-    G, masses = gravity(scene)  # type: ignore[misc]
+def rebound_sim(rebound: Any, scene: Scene, method: str, *, dt: float, epsilon: float | None = None) -> Any:
+    """A REBOUND simulation of ``scene`` (N-body, or Kepler's test particle) with ``method``,
+    one of :data:`REBOUND_METHODS`, its settings applied."""
+    spec = REBOUND_BASELINES[method]
     sim = rebound.Simulation()
-    sim.G = G
-    for m, x, p in zip(masses, scene.q0.reshape(-1, 3), scene.p0.reshape(-1, 3)):
-        v = p / m
-        sim.add(m=m, x=x[0], y=x[1], z=x[2], vx=v[0], vy=v[1], vz=v[2])
-    sim.integrator = integrator.lower()
+    if is_kepler(scene):
+        (x, y), (vx, vy) = scene.q0, scene.p0
+        sim.G = 1.0
+        sim.add(m=1.0)
+        sim.add(m=0.0, x=x, y=y, vx=vx, vy=vy)
+        sim.N_active = 1  # the test particle pulls nothing: the unit mass stays at the origin
+    else:
+        G, masses = gravity(scene)  # type: ignore[misc]
+        sim.G = G
+        for m, x, p in zip(masses, scene.q0.reshape(-1, 3), scene.p0.reshape(-1, 3)):
+            v = p / m
+            sim.add(m=m, x=x[0], y=x[1], z=x[2], vx=v[0], vy=v[1], vz=v[2])
+    sim.integrator = spec.integrator
+    for name, value in spec.settings:
+        setattr(sim.integrator, name, value)
     sim.dt = dt
     if epsilon is not None:
         cfg = getattr(sim, "ri_ias15", None) or sim.integrator  # REBOUND 4 / 5
@@ -187,8 +240,13 @@ def rebound_sim(rebound: Any, scene: Scene, integrator: str, *, dt: float, epsil
     return sim
 
 
-def rebound_state(sim: Any, masses: Sequence[float]) -> tuple[np.ndarray, np.ndarray]:
-    """The simulation's (q, p), flattened as varmech's N-body scenes order them."""
+def rebound_state(sim: Any, scene: Scene) -> tuple[np.ndarray, np.ndarray]:
+    """The simulation's (q, p) in ``scene``'s variables: every body's, flattened as varmech's
+    N-body scenes order them, or the test particle's in the plane for Kepler (p = v)."""
+    if is_kepler(scene):
+        pt = sim.particles[1]
+        return np.array([pt.x, pt.y]), np.array([pt.vx, pt.vy])
+    _, masses = gravity(scene)  # type: ignore[misc]
     x = np.array([[pt.x, pt.y, pt.z] for pt in sim.particles])
     v = np.array([[pt.vx, pt.vy, pt.vz] for pt in sim.particles])
     return x.ravel(), (np.asarray(masses)[:, None] * v).ravel()
@@ -200,21 +258,23 @@ def restore_sigint() -> None:
     signal.signal(signal.SIGINT, signal.getsignal(signal.SIGINT))
 
 
-def rebound_advance(sim: Any, integrator: str, steps: int | None, t: float) -> None:
-    """WHFast: ``steps`` steps; IAS15: to time ``t`` exactly."""
+def rebound_advance(sim: Any, method: str, steps: int | None, t: float) -> None:
+    """The fixed-step methods: ``steps`` steps, the state synchronised at the end (WHFast with
+    ``safe_mode=0`` leaves it unsynchronised); IAS15: to time ``t`` exactly."""
     try:
-        if integrator == "WHFast":
-            sim.steps(int(steps))  # type: ignore[arg-type]
-        else:
+        if REBOUND_BASELINES[method].adaptive:
             sim.integrate(t, exact_finish_time=1)
+        else:
+            sim.steps(int(steps))  # type: ignore[arg-type]
+            sim.synchronize()
     finally:
         restore_sigint()
 
 
-def rebound_evaluations(rebound: Any, scene: Scene, integrator: str, t_end: float, dt: float, steps: int | None, epsilon: float | None) -> int:
+def rebound_evaluations(rebound: Any, scene: Scene, method: str, t_end: float, dt: float, steps: int | None, epsilon: float | None) -> int:
     """Force evaluations of a REBOUND run, counted by a no-op additional force (in a separate,
     untimed run)."""
-    sim = rebound_sim(rebound, scene, integrator, dt=dt, epsilon=epsilon)
+    sim = rebound_sim(rebound, scene, method, dt=dt, epsilon=epsilon)
     count = [0]
 
     def tally(_sim: Any) -> None:
@@ -222,5 +282,5 @@ def rebound_evaluations(rebound: Any, scene: Scene, integrator: str, t_end: floa
 
     sim.additional_forces = tally
     sim.force_is_velocity_dependent = 0
-    rebound_advance(sim, integrator, steps, t_end)
+    rebound_advance(sim, method, steps, t_end)
     return count[0]

@@ -120,9 +120,11 @@ def energy_growth(
         verdicts, at least 1000).
     baselines, rtol, atol:
         ``solve_ivp`` methods (default DOP853) at tolerance ``rtol`` (atol as in
-        :func:`~varmech.work_precision`), sampled by their dense output; and, on N-body scenes,
-        ``"WHFast"`` (step ``dt``) and ``"IAS15"`` (its default precision). Skipped with a note
-        in ``meta["notes"]`` when SciPy or REBOUND is missing.
+        :func:`~varmech.work_precision`), sampled by their dense output; and REBOUND's
+        integrators (:data:`~varmech.analysis.baselines.REBOUND_METHODS`) on N-body scenes, the
+        fixed-step ones at step ``dt`` and ``"IAS15"`` at its default precision, with
+        ``"leapfrog order=8"`` also on the Kepler scene. Skipped with a note in
+        ``meta["notes"]`` when SciPy or REBOUND is missing, or the scene is not theirs.
     baseline_t_end:
         The baselines' horizon (default ``t_end``/10: a Python-driven adaptive solver is slow
         over 10⁴ periods; ``meta["baseline_t_end"]`` records it).
@@ -211,20 +213,20 @@ def energy_growth(
         record("scipy", method, sol.t, err, report, err[on_grid], Tb, rtol=rtol)
 
     def run_rebound(method: str) -> None:
-        _, masses = _baselines.gravity(scene)  # type: ignore[misc]
         sim = _baselines.rebound_sim(rb, scene, method, dt=h, epsilon=None)
         # Every saved time is a whole number of steps: evenly spaced, and log-spaced below.
         marks = np.unique(np.concatenate([np.linspace(0, n, uniform + 1).round(), np.geomspace(1, n, samples * 2).round()])).astype(np.int64)
         ts, qs, ps, done = [], [], [], 0
         try:
             for k in marks:
-                if method == "WHFast":
+                if not _baselines.REBOUND_BASELINES[method].adaptive:
                     if k > done:
                         sim.steps(int(k - done))
+                        sim.synchronize()
                         done = int(k)
                 else:
                     sim.integrate(k * h, exact_finish_time=1)
-                a, b = _baselines.rebound_state(sim, masses)
+                a, b = _baselines.rebound_state(sim, scene)
                 ts.append(k * h)
                 qs.append(a)
                 ps.append(b)

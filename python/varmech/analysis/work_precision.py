@@ -1,8 +1,8 @@
 """Work–precision: cost against accuracy, measured in one run against the baselines.
 
 :func:`work_precision` sweeps the step of varmech's fixed-step methods, and the tolerance of
-``scipy.integrate.solve_ivp`` (RK45, DOP853, Radau), and REBOUND's WHFast and IAS15 on N-body
-scenes (:mod:`.baselines`), and measures for each setting the wall time, the force evaluations,
+``scipy.integrate.solve_ivp`` (RK45, DOP853, Radau), and REBOUND's integrators on N-body
+scenes and its leapfrog on Kepler (:mod:`.baselines`), and measures for each setting the wall time, the force evaluations,
 the error at the final time and the largest energy error. It returns a :class:`~varmech.Table`;
 :func:`varmech.charts.work_precision.work_precision_chart` plots it.
 
@@ -123,7 +123,7 @@ def work_precision(
     baselines: Iterable[str] = ("RK45", "DOP853", "Radau"),
     rtols: Sequence[float] = DEFAULT_RTOLS,
     atol: float | Sequence[float] | None = None,
-    rebound: Iterable[str] = _baselines.REBOUND_METHODS,
+    rebound: Iterable[str] = _baselines.REBOUND_DEFAULTS,
     epsilons: Sequence[float] = DEFAULT_EPSILONS,
     t_end: float | None = None,
     reference: Reference | None = None,
@@ -159,9 +159,12 @@ def work_precision(
         columns included. Skipped, with a note in ``meta["notes"]``, without SciPy, and for
         forced or constrained scenes.
     rebound, epsilons:
-        On N-body scenes, REBOUND's ``"WHFast"`` over the step sweep of ``verlet`` (or
-        ``steps["WHFast"]``) and ``"IAS15"`` over the precisions ``epsilons``; skipped with a
-        note without REBOUND. Their force evaluations are counted in a separate untimed run.
+        REBOUND's integrators (:data:`~varmech.analysis.baselines.REBOUND_METHODS`; default
+        ``"WHFast"`` and ``"IAS15"``): the fixed-step ones (``"WHFast"``, ``"WHFast
+        corrector=11"``, ``"leapfrog order=8"``) over the step sweep of ``verlet`` (or
+        ``steps[name]``), ``"IAS15"`` over the precisions ``epsilons``. They run on N-body
+        scenes, and ``"leapfrog order=8"`` also on the Kepler scene; skipped with a note without
+        REBOUND. Their force evaluations are counted in a separate untimed run.
     t_end, reference:
         The horizon, and the solution there (default: the scene's reference, and its time).
         Without a reference at ``t_end``, ``final_error`` is NaN.
@@ -215,10 +218,10 @@ def work_precision(
     for b in baselines:
         plan.append(("scipy", b, [float(r) for r in rtols], False))
     for r in rebound_methods:
-        if r == "WHFast":
-            plan.append(("rebound", r, *sweep_of("WHFast" if isinstance(steps, dict) and "WHFast" in steps else "verlet")))  # type: ignore[arg-type]
-        else:
+        if _baselines.REBOUND_BASELINES[r].adaptive:
             plan.append(("rebound", r, [float(e) for e in epsilons], False))
+        else:
+            plan.append(("rebound", r, *sweep_of(r if isinstance(steps, dict) and r in steps else "verlet")))  # type: ignore[arg-type]
     total = sum(len(values) for _, _, values, _ in plan)
     bar = _progress(range(total), total=total, desc=f"work–precision {scene.name}", enabled=progress)
 
@@ -243,11 +246,11 @@ def work_precision(
         return ("scipy", method, "rtol", rtol, sol.t.size - 1, nfev, seconds, _final_error(ref, q[-1], p[-1]), energy)
 
     def run_rebound(method: str, value: float) -> tuple:
-        _, masses = _baselines.gravity(scene)  # type: ignore[misc]
-        if method == "WHFast":
-            n, dt, eps, parameter = int(value), T / int(value), None, "steps"
-        else:
+        adaptive = _baselines.REBOUND_BASELINES[method].adaptive
+        if adaptive:
             n, dt, eps, parameter = None, scene.dt, float(value), "epsilon"
+        else:
+            n, dt, eps, parameter = int(value), T / int(value), None, "steps"
 
         def advance(sim: Any) -> Any:
             _baselines.rebound_advance(sim, method, n, T)
@@ -255,30 +258,31 @@ def work_precision(
 
         # Building the simulation is not the integrator's cost: time the advance only.
         best, sim = _best_time(advance, repeat, prepare=lambda: _baselines.rebound_sim(rb, scene, method, dt=dt, epsilon=eps))
-        q, p = _baselines.rebound_state(sim, masses)
+        q, p = _baselines.rebound_state(sim, scene)
         taken = int(sim.steps_done)
         evaluations = _baselines.rebound_evaluations(rb, scene, method, T, dt, n, eps)
-        # Energy: sample the same run ~1000 times (WHFast by whole steps; IAS15 without forcing
-        # its step onto the sample times).
+        # Energy: sample the same run ~1000 times (the fixed-step methods by whole steps; IAS15
+        # without forcing its step onto the sample times).
         sim2 = _baselines.rebound_sim(rb, scene, method, dt=dt, epsilon=eps)
         qs, ps, ts = [scene.q0], [scene.p0], [0.0]
         try:
-            if method == "WHFast":
+            if not adaptive:
                 total = int(value)
                 chunk = max(1, total // 1000)
                 done = 0
                 while done < total:
                     k = min(chunk, total - done)
                     sim2.steps(k)
+                    sim2.synchronize()
                     done += k
-                    a, b = _baselines.rebound_state(sim2, masses)
+                    a, b = _baselines.rebound_state(sim2, scene)
                     qs.append(a)
                     ps.append(b)
                     ts.append(sim2.t)
             else:
                 for t in np.linspace(0, T, 1001)[1:]:
                     sim2.integrate(t, exact_finish_time=0)
-                    a, b = _baselines.rebound_state(sim2, masses)
+                    a, b = _baselines.rebound_state(sim2, scene)
                     qs.append(a)
                     ps.append(b)
                     ts.append(sim2.t)

@@ -11,6 +11,7 @@ from pathlib import Path
 
 from .. import scenes
 from ..analysis import energy_growth, sections, stability, work_precision
+from ..analysis.baselines import REBOUND_METHODS
 from ..analysis.phase_portrait import phase_portrait
 from ..table import Table
 from .sections import phase_portrait_chart, poincare_chart
@@ -31,9 +32,10 @@ class ChartKind:
 
 def _work_precision(scene, methods, quick, progress):
     sc = scenes.get(scene)
+    # Every REBOUND baseline that applies to the scene (none but leapfrog order=8 on Kepler).
     table = work_precision.work_precision(
-        sc, methods, repeat=1 if quick else 3, sweep_length=4 if quick else 11, max_seconds=1.0 if quick else 5.0,
-        progress=progress,
+        sc, methods, rebound=REBOUND_METHODS, repeat=1 if quick else 3, sweep_length=4 if quick else 11,
+        max_seconds=1.0 if quick else 5.0, progress=progress,
     )
     title = f"{scene}: error at t = {table.meta.get('t_end', sc.t_end):g} against cost"
     energy_title = f"{scene}: max energy error over t = 0 … {table.meta.get('t_end', sc.t_end):g} against cost"
