@@ -20,30 +20,32 @@ fn factorise(a: &mut [f64], pivots: &mut [usize], n: usize) -> Option<f64> {
     let mut sign = 1.0;
     for k in 0..n {
         // The first entry of largest modulus on and below the diagonal (nalgebra's `iamax`).
+        let column = &a[k * n..(k + 1) * n];
         let mut piv = k;
         for i in k + 1..n {
-            if a[k * n + i].abs() > a[k * n + piv].abs() {
+            if column[i].abs() > column[piv].abs() {
                 piv = i;
             }
         }
         pivots[k] = piv;
-        let pivot = a[k * n + piv];
+        let pivot = column[piv];
         if pivot == 0.0 {
             return None;
         }
         if piv != k {
             sign = -sign;
-            for j in 0..n {
-                a.swap(j * n + k, j * n + piv);
-            }
+            a.chunks_exact_mut(n).for_each(|c| c.swap(k, piv));
         }
         sign *= pivot.signum();
-        let inv = 1.0 / a[k * n + k];
-        for i in k + 1..n {
-            a[k * n + i] *= inv;
-            let l = a[k * n + i];
-            for j in k + 1..n {
-                a[j * n + i] -= l * a[j * n + k];
+        // Column by column, each entry taking the same one update per k as row by row.
+        let (left, right) = a.split_at_mut((k + 1) * n);
+        let column = &mut left[k * n..];
+        let inv = 1.0 / column[k];
+        column[k + 1..].iter_mut().for_each(|l| *l *= inv);
+        for c in right.chunks_exact_mut(n) {
+            let u = c[k];
+            for (x, l) in c[k + 1..].iter_mut().zip(&column[k + 1..]) {
+                *x -= l * u;
             }
         }
     }
