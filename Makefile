@@ -2,7 +2,7 @@
 # `make test` (build, run every test). PYTHON may name another interpreter.
 PYTHON ?= python3
 
-.PHONY: install tour lint test bench compare gallery
+.PHONY: install tour lint test test-aarch64 bench compare gallery
 
 install:
 	$(PYTHON) -m pip install -e ".[test,charts]"
@@ -22,6 +22,15 @@ lint: install
 test: lint
 	cargo test --release
 	$(PYTHON) -m pytest -q
+
+# The core's tests on aarch64 (the N-body kernel's scalar path there), cross-built and run under
+# qemu: needs `rustup target add aarch64-unknown-linux-gnu` and Debian's gcc-aarch64-linux-gnu and
+# qemu-user. About 10 minutes; not part of `make test`.
+AARCH64 = CARGO_TARGET_AARCH64_UNKNOWN_LINUX_GNU_LINKER=aarch64-linux-gnu-gcc \
+	CARGO_TARGET_AARCH64_UNKNOWN_LINUX_GNU_RUNNER="qemu-aarch64 -L /usr/aarch64-linux-gnu" \
+	CC_aarch64_unknown_linux_gnu=aarch64-linux-gnu-gcc
+test-aarch64:
+	$(AARCH64) cargo test --release --target aarch64-unknown-linux-gnu --test core
 
 bench:
 	cargo bench --bench steps
