@@ -435,7 +435,7 @@ def energy_terms(model: _Model, t: _FloatArray, q: _FloatArray, p: _FloatArray) 
 
 def derivative(model: _Model, what: str, t: _FloatArray, q: _FloatArray, x: _FloatArray) -> _FloatArray:
     """At each state: ``"momentum"`` p = ∂L/∂q̇(q, x, t), ``"velocity"`` the q̇ with
-    ∂L/∂q̇ = x, or ``"dl_dq"`` ∂L/∂q(q, x, t)."""
+    ∂L/∂q̇ = x, ``"dl_dq"`` ∂L/∂q(q, x, t), or ``"dp_dt"`` ṗ = ∂L/∂q + f(q, x, t) with x = q̇."""
 
 def momentum(generator: Generator, q: _FloatArray, p: _FloatArray) -> tuple[_FloatArray, _FloatArray]:
     """(J, Σ|pᵢξᵢ|) at each state."""

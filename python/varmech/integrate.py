@@ -12,6 +12,7 @@ from numpy.typing import ArrayLike
 
 from . import _core
 from ._util import finite, positive, positive_int, vector
+from .dense import hermite
 from .model import Lagrangian, Model
 
 if TYPE_CHECKING:
@@ -67,6 +68,12 @@ class Trajectory:
         if self._v is None:
             self._v = _core.derivative(self.model._core, "velocity", self.t, self.q, self.p)
         return self._v
+
+    def sol(self, t: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
+        """(q(t), p(t)) between the saved states, by cubic Hermite interpolation from q, q̇ and
+        p, ṗ at the states on either side: error O(Δ⁴) in their spacing Δ. See
+        :func:`varmech.dense.hermite`."""
+        return hermite(self, t)
 
     def energy(self) -> np.ndarray:
         """The energy function E = p·q̇ − L (= ½pᵀM⁻¹p + V(q) for mechanical systems) at each

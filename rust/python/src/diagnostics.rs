@@ -47,7 +47,8 @@ fn energy_terms<'py>(
 
 /// A first derivative of L at each state (t, q, x): `"momentum"`, p = ∂L/∂q̇(q, x, t) from
 /// velocities x (Mq̇ for mechanical systems); `"velocity"`, the inverse Legendre transform,
-/// q̇ with ∂L/∂q̇ = x from momenta x (M⁻¹p); `"dl_dq"`, ∂L/∂q(q, x, t) from velocities x.
+/// q̇ with ∂L/∂q̇ = x from momenta x (M⁻¹p); `"dl_dq"`, ∂L/∂q(q, x, t) from velocities x;
+/// `"dp_dt"`, ṗ = ∂L/∂q + f(q, x, t) from velocities x.
 #[pyfunction]
 fn derivative<'py>(
     py: Python<'py>,
@@ -57,9 +58,9 @@ fn derivative<'py>(
     q: PyReadonlyArray2<'py, f64>,
     x: PyReadonlyArray2<'py, f64>,
 ) -> PyResult<Bound<'py, PyAny>> {
-    if !matches!(what, "momentum" | "velocity" | "dl_dq") {
+    if !matches!(what, "momentum" | "velocity" | "dl_dq" | "dp_dt") {
         return Err(PyValueError::new_err(format!(
-            "what: expected \"momentum\", \"velocity\" or \"dl_dq\", got {what:?}"
+            "what: expected \"momentum\", \"velocity\", \"dl_dq\" or \"dp_dt\", got {what:?}"
         )));
     }
     let n = dim_of(py, model)?;
@@ -74,7 +75,15 @@ fn derivative<'py>(
         rows.try_for_each(|((t, (q, x)), y)| match what {
             "velocity" => l.velocity(q, x, *t, y),
             "momentum" => l.dl_dv(q, x, *t, y),
-            _ => l.dl_dq(q, x, *t, y),
+            "dl_dq" => l.dl_dq(q, x, *t, y),
+            // ṗ = ∂L/∂q + f along the (forced) Euler–Lagrange flow.
+            _ => {
+                l.dl_dq(q, x, *t, y)?;
+                let mut f = vec![0.0; n];
+                l.force(q, x, *t, &mut f)?;
+                y.iter_mut().zip(&f).for_each(|(y, f)| *y += f);
+                Ok(())
+            }
         })
         .map(|()| y)
     })?;
