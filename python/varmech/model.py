@@ -3,8 +3,9 @@
 from __future__ import annotations
 
 import warnings
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -113,6 +114,8 @@ class Model:
     )
     symmetries: tuple[Symmetry, ...]
     name: str
+    #: The arguments the model was built with by its class's constructor: what it pickles as.
+    _arguments: dict[str, Any]
 
     @property
     def dim(self) -> int:
@@ -174,15 +177,61 @@ class Model:
     def __repr__(self) -> str:
         return f"{type(self).__name__}({self.name!r}, dim={self.dim})"
 
+    def __reduce__(self) -> tuple[Any, ...]:
+        # The constructor's arguments, never the core's memory: unpickling builds the model
+        # again. Closures pickle by reference (their module and name), so that a lambda or a
+        # local function raises pickle's own error naming it.
+        arguments = getattr(self, "_arguments", None)
+        if arguments is None:
+            raise TypeError(f"cannot pickle {type(self).__name__} {self.name!r}: it records no constructor arguments")
+        return (_rebuild, (type(self), arguments))
+
+
+def _rebuild(cls: Callable[..., Model], arguments: dict[str, Any]) -> Model:
+    """The model of a pickle: ``cls(**arguments)``, without the warnings its construction gave
+    when it was first built (about derivatives by differences, say)."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return cls(**arguments)
+
 
 class NativeSystem(Model):
     """A model evaluated natively in Rust (a built-in scene): no Python call per step, and the
-    GIL is released while it runs."""
+    GIL is released while it runs.
 
-    def __init__(self, core: _core.NativeModel):
-        self._core = core
+    ``parameters`` are the values of the catalogue scene's parameters the model was built with
+    (:func:`varmech.scenes.get`): the model pickles as its scene's name and them. A native
+    N-body model (:func:`varmech.scenes.nbody`) pickles as its G and masses.
+    """
+
+    def __init__(self, core: _core.NativeModel, parameters: Mapping[str, float] | None = None):
+        self._core: _core.NativeModel = core
         self.name = core.name
         self.symmetries = tuple(_symmetry_from_spec(g) for g in core.symmetries)
+        self.parameters = None if parameters is None else dict(parameters)
+
+    def __reduce__(self) -> tuple[Any, ...]:
+        # Rebuilt by the public constructors from the scene's name and parameters, or G and the
+        # masses: the core builds the same model, bit for bit.
+        if self.parameters is not None:
+            return (_scene_model, (self.name, self.parameters))
+        gravity = self._core.gravity
+        if gravity is not None:
+            return (_nbody_model, gravity)
+        raise TypeError(
+            f"cannot pickle NativeSystem {self.name!r} built without its parameters; "
+            "build it with varmech.scenes.get(name, **parameters)"
+        )
+
+
+def _scene_model(name: str, parameters: dict[str, float]) -> NativeSystem:
+    """The native model of catalogue scene ``name`` with ``parameters`` (a pickle's)."""
+    return NativeSystem(_core.scene(name, **parameters).model, parameters)
+
+
+def _nbody_model(gravitational_constant: float, masses: list[float]) -> NativeSystem:
+    """The native N-body model of G and ``masses`` (a pickle's)."""
+    return NativeSystem(_core.nbody(gravitational_constant, masses))
 
 
 class MechanicalSystem(Model):
@@ -240,6 +289,18 @@ class MechanicalSystem(Model):
         symmetries: Sequence[Symmetry] = (),
         name: str = "mechanical system",
     ):
+        self._arguments = {
+            "dim": dim,
+            "potential": potential,
+            "gradient": gradient,
+            "mass": mass,
+            "mass_derivative": mass_derivative,
+            "constraints": constraints,
+            "constraint_jacobian": constraint_jacobian,
+            "constraint_count": constraint_count,
+            "symmetries": symmetries,
+            "name": name,
+        }
         if isinstance(dim, bool) or not isinstance(dim, (int, np.integer)) or dim < 1:
             raise ValueError(f"dim: must be a positive integer, got {dim!r}")
         if (constraints is None) != (constraint_count is None) or (constraint_jacobian is not None and constraints is None):
@@ -361,6 +422,18 @@ class Lagrangian(Model):
         symmetries: Sequence[Symmetry] = (),
         name: str = "lagrangian",
     ):
+        self._arguments = {
+            "dim": dim,
+            "lagrangian": lagrangian,
+            "dl_dq": dl_dq,
+            "dl_dv": dl_dv,
+            "hessians": hessians,
+            "force": force,
+            "rayleigh": rayleigh,
+            "time_dependent": time_dependent,
+            "symmetries": symmetries,
+            "name": name,
+        }
         if isinstance(dim, bool) or not isinstance(dim, (int, np.integer)) or dim < 1:
             raise ValueError(f"dim: must be a positive integer, got {dim!r}")
         functions = {"lagrangian": lagrangian, "dl_dq": dl_dq, "dl_dv": dl_dv, "hessians": hessians, "force": force}

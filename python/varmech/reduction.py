@@ -110,6 +110,7 @@ class ReducedModel(Model):
             raise TypeError(f"model: expected a varmech model, got {type(full).__name__}")
         if isinstance(full, ReducedModel):
             raise ValueError("model: is reduced already; ignore all the cyclic coordinates of the full model at once")
+        self._arguments = {"full": full, "cyclic": cyclic, "momenta": momenta, "reference": reference}
         n = full.dim
         indices = _indices(cyclic, n)
         m = len(indices)

@@ -75,7 +75,7 @@ def get(name: str, **parameters: float) -> Scene:
     return Scene(
         record.name,
         record.description,
-        NativeSystem(record.model),
+        NativeSystem(record.model, record.parameters),
         record.q0,
         record.p0,
         record.t_end,

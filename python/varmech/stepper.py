@@ -175,5 +175,15 @@ class Stepper:
         """Work done by the non-conservative forces so far (0 without forces)."""
         return self._stepper.work
 
+    def __reduce__(self) -> tuple[object, ...]:
+        # The core's state (the method's caches, Newton predictor and compensated-summation
+        # carries) has no serialised form yet; a stepper rebuilt from (t, q, p) alone would not
+        # continue bit for bit, so pickling refuses rather than resume approximately.
+        raise TypeError(
+            "cannot pickle a Stepper: its state (compensated-summation carries, Newton predictor) has no "
+            "serialised form; pickle its model and (stepper.t, stepper.q, stepper.p) and start a new Stepper, "
+            "which continues the run but not bit for bit"
+        )
+
     def __repr__(self) -> str:
         return f"Stepper({self._model.name!r}, method={self.method!r}, dt={self.dt:g}, t={self.t:g}, steps={self.steps})"
