@@ -1,6 +1,6 @@
 //! LU factorisation with partial pivoting that allocates nothing, for the Newton loops.
 //!
-//! Both functions run on the column-major slice of the matrix, specialised for n ≤ 4
+//! Both functions run on the column-major slice of the matrix, specialised for n ≤ 8
 //! ([`super::sized`]).
 
 use nalgebra::DMatrix;
@@ -66,17 +66,15 @@ fn substitute(a: &[f64], pivots: &[usize], b: &mut [f64], n: usize) {
     for (k, &piv) in pivots[..n].iter().enumerate() {
         b.swap(k, piv);
     }
-    for k in 0..n {
-        let c = b[k];
-        for i in k + 1..n {
-            b[i] -= c * a[k * n + i];
-        }
+    for (k, column) in a.chunks_exact(n).enumerate() {
+        let (head, tail) = b.split_at_mut(k + 1);
+        let c = head[k];
+        tail.iter_mut().zip(&column[k + 1..]).for_each(|(x, l)| *x -= c * l);
     }
-    for k in (0..n).rev() {
-        let c = b[k] / a[k * n + k];
-        b[k] = c;
-        for i in 0..k {
-            b[i] -= c * a[k * n + i];
-        }
+    for (k, column) in a.chunks_exact(n).enumerate().rev() {
+        let (head, tail) = b.split_at_mut(k);
+        let c = tail[0] / column[k];
+        tail[0] = c;
+        head.iter_mut().zip(&column[..k]).for_each(|(x, u)| *x -= c * u);
     }
 }

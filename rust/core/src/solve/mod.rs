@@ -6,7 +6,7 @@
 //! - `newton`: Newton's method, simplified (a kept Jacobian) or full, with [`NewtonOptions`];
 //! - [`interrupt`]: when to poll for Ctrl-C, and the check the iterative solves poll.
 
-/// Calls `$f(args…, n)` with n a literal for n ≤ 4, so that the inlined body (an
+/// Calls `$f(args…, n)` with n a literal for n ≤ 8, so that the inlined body (an
 /// `#[inline(always)]` function of n) is specialised: the small systems most steps solve then run
 /// unrolled loops, where loops of unknown length cost more than their arithmetic.
 macro_rules! sized {
@@ -16,6 +16,10 @@ macro_rules! sized {
             2 => $f($($arg),*, 2),
             3 => $f($($arg),*, 3),
             4 => $f($($arg),*, 4),
+            5 => $f($($arg),*, 5),
+            6 => $f($($arg),*, 6),
+            7 => $f($($arg),*, 7),
+            8 => $f($($arg),*, 8),
             n => $f($($arg),*, n),
         }
     };
