@@ -41,6 +41,7 @@ from .analysis.work_precision import work_precision
 from .conservation import ConservationReport, InvariantStatistics, check_conservation, momentum
 from .constraints import project
 from .derivatives import DerivativeCheck, check_derivatives
+from .files import load
 from .integrate import Trajectory, integrate, symplecticity_defect
 from .methods import MethodInfo, methods
 from .model import Cyclic, Lagrangian, MechanicalSystem, Model, NativeSystem, Rotation, Translation
@@ -79,6 +80,7 @@ __all__ = [
     "growth_table",
     "implicit_regions",
     "integrate",
+    "load",
     "methods",
     "momentum",
     "phase_portrait",

@@ -3,8 +3,10 @@
 from __future__ import annotations
 
 import math
+import os
 from collections.abc import Mapping
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
@@ -68,6 +70,13 @@ class Trajectory:
         if self._v is None:
             self._v = _core.derivative(self.model._core, "velocity", self.t, self.q, self.p)
         return self._v
+
+    def save(self, path: str | os.PathLike[str], *, overwrite: bool = False) -> Path:
+        """Writes the trajectory to the HDF5 file ``path`` (h5py, the extra ``io``); read it back
+        with :func:`varmech.load`. See :mod:`varmech.files` for the layout."""
+        from . import files
+
+        return files.save(self, path, overwrite=overwrite)
 
     def sol(self, t: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
         """(q(t), p(t)) between the saved states, by cubic Hermite interpolation from q, q̇ and
