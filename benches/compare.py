@@ -173,7 +173,7 @@ def _energies(model, q, p, t=None):
     from varmech import _core
 
     t = np.zeros(len(q)) if t is None else np.ascontiguousarray(t, dtype=float)
-    return _core.energy(model._core, t, np.ascontiguousarray(q), np.ascontiguousarray(p))
+    return _core.energy_terms(model._core, t, np.ascontiguousarray(q), np.ascontiguousarray(p))[0]
 
 
 # ---------------------------------------------------------------------------------- Kepler

@@ -119,10 +119,15 @@ where
     if let Err(e) = memory::check_allocation("save_every", saved, (2 * n + 3) * std::mem::size_of::<f64>()) {
         return Err(fail(e, traj));
     }
+    // Newton counts and work only for the runs that have them (see `Trajectory::push`).
+    let (newton, work) = (
+        stepper.newton().map_or(0, |_| saved),
+        stepper.forced_work().map_or(0, |_| saved),
+    );
     let reserved = saved.checked_mul(n).is_some_and(|len| {
         traj.t.try_reserve_exact(saved).is_ok()
-            && traj.newton.try_reserve_exact(saved).is_ok()
-            && traj.work.try_reserve_exact(saved).is_ok()
+            && traj.newton.try_reserve_exact(newton).is_ok()
+            && traj.work.try_reserve_exact(work).is_ok()
             && traj.q.try_reserve_exact(len).is_ok()
             && traj.p.try_reserve_exact(len).is_ok()
     });
