@@ -80,6 +80,22 @@ def henon_heiles_closure():
 
 
 @pytest.fixture
+def damped_oscillator():
+    """Makes the oscillator L = ½q̇² − ½q² with Rayleigh dissipation R = ½cq̇² from closures."""
+
+    def make(c):
+        return varmech.Lagrangian(
+            1,
+            lambda q, v, t: 0.5 * v[0] ** 2 - 0.5 * q[0] ** 2,
+            dl_dq=lambda q, v, t: -q.copy(),
+            dl_dv=lambda q, v, t: v.copy(),
+            rayleigh=c,
+        )
+
+    return make
+
+
+@pytest.fixture
 def run_cli():
     """Runs ``python -m varmech <args>`` in a subprocess, capturing its text output."""
 

@@ -51,16 +51,9 @@ def test_the_interpolant_passes_through_the_saved_states_and_their_harmonic_valu
     assert np.max(np.abs(q[:, 0] - np.sin(t))) < 3e-7 and np.max(np.abs(p[:, 0] - np.cos(t))) < 3e-7
 
 
-def test_forced_models_interpolate_with_the_force_in_p_dot():
+def test_forced_models_interpolate_with_the_force_in_p_dot(damped_oscillator):
     """The damped oscillator q̈ = −q − cq̇: ṗ = ∂L/∂q + f, and the interpolant keeps order 4."""
-    c = 0.3
-    model = varmech.Lagrangian(
-        1,
-        lambda q, v, t: 0.5 * v[0] ** 2 - 0.5 * q[0] ** 2,
-        dl_dq=lambda q, v, t: -q.copy(),
-        dl_dv=lambda q, v, t: v.copy(),
-        rayleigh=c,
-    )
+    model = damped_oscillator(0.3)
     fine = varmech.integrate(model, [1.0], [0.0], dt=0.002, steps=2000, method="galerkin6")
     errors = []
     for every in (40, 20):

@@ -138,17 +138,10 @@ def test_general_lagrangians_refuse_explicit_methods_and_name_bad_closures():
         varmech.Lagrangian(2, 1.0, dl_dq=model.dl_dq, dl_dv=model.dl_dv)
 
 
-def test_forced_system_keeps_its_energy_balance_with_the_tracked_work():
+def test_forced_system_keeps_its_energy_balance_with_the_tracked_work(damped_oscillator):
     # A damped oscillator with Rayleigh dissipation R = ½cq̇²: for the midpoint rule on this
     # quadratic L, E changes by exactly the tracked work of the force each step.
-    c = 0.1
-    model = varmech.Lagrangian(
-        1,
-        lambda q, v, t: 0.5 * v[0] ** 2 - 0.5 * q[0] ** 2,
-        dl_dq=lambda q, v, t: -q.copy(),
-        dl_dv=lambda q, v, t: v.copy(),
-        rayleigh=c,
-    )
+    model = damped_oscillator(0.1)
     assert model.forced
     traj = varmech.integrate(model, [1.0], [0.0], dt=0.1, steps=2000, method="midpoint", save_every=10)
     e = traj.energy()
