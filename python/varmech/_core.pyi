@@ -425,9 +425,11 @@ def integrate(
     t0: float = 0.0,
     newton_tolerance: float = 1e-14,
     newton_max_iterations: int = 50,
+    progress: Callable[[int], object] | None = None,
 ) -> TrajectoryRecord:
     """The saved states; on failure the exception carries ``_varmech_partial``, the
-    TrajectoryRecord up to the failure."""
+    TrajectoryRecord up to the failure. ``progress(steps)`` is called with the steps completed at
+    the Ctrl-C check's stride; an exception from it stops the run."""
 
 def energy_terms(model: _Model, t: _FloatArray, q: _FloatArray, p: _FloatArray) -> tuple[_FloatArray, _FloatArray, _FloatArray]:
     """(E, T, V) at each state: the energy function p·q̇ − L, its kinetic term E − V and its

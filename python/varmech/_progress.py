@@ -4,15 +4,32 @@ from __future__ import annotations
 
 import sys
 from collections.abc import Iterable, Iterator
-from typing import TypeVar
+from typing import TextIO, TypeVar
 
 from tqdm.auto import tqdm
 
 T = TypeVar("T")
 
 
-def progress(items: Iterable[T], *, total: int | None = None, desc: str = "", enabled: bool | None = None) -> Iterator[T]:
+def progress(
+    items: Iterable[T], *, total: int | None = None, desc: str = "", enabled: bool | None = None
+) -> Iterator[T]:
     """Iterate over ``items`` with a progress bar on stderr. ``enabled=None`` shows it only on a
     terminal. Ctrl-C stops the sweep: KeyboardInterrupt propagates from the running item."""
     show = sys.stderr.isatty() if enabled is None else enabled
     return iter(tqdm(items, total=total, desc=desc, disable=not show, leave=False))
+
+
+def progress_bar(
+    *,
+    total: int,
+    unit: str,
+    desc: str = "",
+    enabled: bool | None = None,
+    file: TextIO | None = None,
+    delay: float = 1.0,
+) -> tqdm:
+    """A progress bar on ``file`` (stderr) that appears once its run has taken ``delay`` seconds
+    (a short run shows none). ``enabled=None`` shows it only on a terminal."""
+    show = sys.stderr.isatty() if enabled is None else enabled
+    return tqdm(total=total, unit=unit, desc=desc, disable=not show, delay=delay, leave=False, file=file)

@@ -4,17 +4,17 @@
 use numpy::PyReadonlyArray1;
 use pyo3::prelude::*;
 use varmech::diagnostics;
-use varmech::integrators::{self, Method, NewtonOptions, Options};
+use varmech::integrators::{self, Counting, Method, NewtonOptions, Options};
 
 use crate::bind::bind_model;
 use crate::convert::{count, slice};
-use crate::errors::{failure_to_pyerr, to_pyerr};
+use crate::errors::{boxed, failure_to_pyerr, to_pyerr};
 use crate::trajectory::TrajectoryRecord;
 
 /// Integrates; returns the saved states as a [`TrajectoryRecord`] or raises with
 /// `_varmech_partial`, the states up to the failure.
 #[pyfunction]
-#[pyo3(signature = (model, q0, p0, *, dt, steps, method, save_every=1, compensated=true, max_energy_error=None, t0=0.0, newton_tolerance=1e-14, newton_max_iterations=50))]
+#[pyo3(signature = (model, q0, p0, *, dt, steps, method, save_every=1, compensated=true, max_energy_error=None, t0=0.0, newton_tolerance=1e-14, newton_max_iterations=50, progress=None))]
 #[allow(clippy::too_many_arguments)]
 fn integrate<'py>(
     py: Python<'py>,
@@ -30,6 +30,7 @@ fn integrate<'py>(
     t0: f64,
     newton_tolerance: f64,
     #[pyo3(from_py_with = newton_max_iterations_count)] newton_max_iterations: usize,
+    progress: Option<Py<PyAny>>,
 ) -> PyResult<TrajectoryRecord> {
     let method = Method::from_name(method).map_err(|e| to_pyerr(py, e))?;
     let newton = NewtonOptions {
@@ -46,8 +47,16 @@ fn integrate<'py>(
         newton,
     };
     let (q0, p0) = (slice("q0", &q0)?, slice("p0", &p0)?);
+    // `progress(steps)` is called at the Ctrl-C check's stride, after it.
     let result = bind_model(py, model, |sys, poll| {
-        integrators::integrate(sys, method, q0, p0, &options, poll)
+        let report = |steps: usize| {
+            poll()?;
+            match &progress {
+                Some(progress) => Python::attach(|py| progress.call1(py, (steps,)).map(drop)).map_err(boxed),
+                None => Ok(()),
+            }
+        };
+        integrators::integrate(sys, method, q0, p0, &options, Counting(report))
     })?;
     match result {
         Ok(traj) => TrajectoryRecord::new(py, traj),

@@ -1,8 +1,8 @@
 //! The fixed-step run: a [`Stepper`] advanced to the end, its states saved on the way.
 
-use super::{Dynamics, Failure, Method, NewtonOptions, Stepper, Trajectory};
+use super::{Counting, Dynamics, Failure, Method, NewtonOptions, Poll, Stepper, Trajectory};
 use crate::model::{EnergyTerms, Scale};
-use crate::{memory, Error, ModelError};
+use crate::{memory, Error};
 
 /// Options of a fixed-step run.
 #[derive(Clone, Debug, PartialEq)]
@@ -79,8 +79,9 @@ impl Options {
 
 /// Integrates `sys` from (q0, p0) with `method` for `options.steps` steps of `options.dt`.
 ///
-/// `poll` is called every 10–40 ms of run time; an error from it stops the run with
-/// [`Error::Interrupted`] (the binding checks for Ctrl-C there). The step loop allocates
+/// `poll` ([`Poll`]) is called with the steps completed every 10–40 ms of run time; an error
+/// from it stops the run with [`Error::Interrupted`] (the binding checks for Ctrl-C there, and
+/// reports progress). The step loop allocates
 /// nothing beyond the saved states, whose storage is reserved up front.
 ///
 /// On failure the returned [`Failure`] holds every state saved so far and the last good state.
@@ -94,7 +95,7 @@ pub fn integrate<S, P>(
 ) -> Result<Trajectory, Box<Failure>>
 where
     S: Dynamics + ?Sized,
-    P: FnMut() -> Result<(), ModelError>,
+    P: Poll,
 {
     let n = sys.dim();
     let mut traj = Trajectory {
@@ -148,7 +149,7 @@ where
     while stepper.steps() < steps {
         // Every `save_every`-th state is saved, and the last.
         let save = (stepper.steps() / save_every + 1).saturating_mul(save_every).min(steps);
-        if let Err(error) = stepper.advance(save - stepper.steps(), &mut poll) {
+        if let Err(error) = stepper.advance(save - stepper.steps(), Counting(|steps| poll.poll(steps))) {
             // Stops with the last good state kept, and the work counted.
             let time = stepper.t();
             if traj.t.last() != Some(&time) {

@@ -5,11 +5,11 @@ mod own_variables;
 use std::borrow::{Borrow, BorrowMut};
 use std::ops::Deref;
 
-use super::{compensated, Dynamics, Increment, Integrator, Method, Options, StepStart};
+use super::{compensated, Dynamics, Increment, Integrator, Method, Options, Poll, StepStart};
 use crate::error::check_vector;
 use crate::model::MechanicalSystem;
 use crate::solve::interrupt::InterruptPoll;
-use crate::{Error, ModelError};
+use crate::Error;
 
 /// A model `M` (a reference `&S` to borrow it, a `Box<S>` to own it) with its [`StepperState`]
 /// `St`: a method's [`Integrator`] and the state (tₙ, qₙ, pₙ) after n steps of size h from
@@ -148,10 +148,7 @@ where
     ///
     /// A method that keeps its own variables (the Wisdom–Holman methods) takes the n steps on
     /// them and synchronises (q, p) once, at the end (see `own_variables.rs`).
-    pub fn advance<P>(&mut self, n: usize, poll: P) -> Result<(), Error>
-    where
-        P: FnMut() -> Result<(), ModelError>,
-    {
+    pub fn advance<P: Poll>(&mut self, n: usize, poll: P) -> Result<(), Error> {
         let state = self.state.borrow_mut();
         let result = state.advance_polled(&*self.model, n, poll);
         state.synchronise();
@@ -255,12 +252,12 @@ impl StepperState {
     fn advance_polled<S, P>(&mut self, model: &S, n: usize, mut poll: P) -> Result<(), Error>
     where
         S: Dynamics + ?Sized,
-        P: FnMut() -> Result<(), ModelError>,
+        P: Poll,
     {
         let mut left = n;
         while left > 0 {
             if self.interrupt.due() {
-                if let Err(source) = poll() {
+                if let Err(source) = poll.poll(self.steps) {
                     return Err(Error::Interrupted {
                         step: self.steps + 1,
                         time: self.t(),
