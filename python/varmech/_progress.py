@@ -11,13 +11,15 @@ from tqdm.auto import tqdm
 T = TypeVar("T")
 
 
-def progress(
-    items: Iterable[T], *, total: int | None = None, desc: str = "", enabled: bool | None = None
-) -> Iterator[T]:
+def _shown(enabled: bool | None) -> bool:
+    """Whether to draw a bar: as asked, or (None) when stderr is a terminal."""
+    return sys.stderr.isatty() if enabled is None else enabled
+
+
+def progress(items: Iterable[T], *, total: int | None = None, desc: str = "", enabled: bool | None = None) -> Iterator[T]:
     """Iterate over ``items`` with a progress bar on stderr. ``enabled=None`` shows it only on a
     terminal. Ctrl-C stops the sweep: KeyboardInterrupt propagates from the running item."""
-    show = sys.stderr.isatty() if enabled is None else enabled
-    return iter(tqdm(items, total=total, desc=desc, disable=not show, leave=False))
+    return iter(tqdm(items, total=total, desc=desc, disable=not _shown(enabled), leave=False))
 
 
 def progress_bar(
@@ -31,5 +33,4 @@ def progress_bar(
 ) -> tqdm:
     """A progress bar on ``file`` (stderr) that appears once its run has taken ``delay`` seconds
     (a short run shows none). ``enabled=None`` shows it only on a terminal."""
-    show = sys.stderr.isatty() if enabled is None else enabled
-    return tqdm(total=total, unit=unit, desc=desc, disable=not show, delay=delay, leave=False, file=file)
+    return tqdm(total=total, unit=unit, desc=desc, disable=not _shown(enabled), delay=delay, leave=False, file=file)

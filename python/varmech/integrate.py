@@ -12,7 +12,7 @@ from typing import TYPE_CHECKING, Any, Literal
 import numpy as np
 from numpy.typing import ArrayLike
 
-from . import _core
+from . import _core, files
 from ._progress import progress_bar
 from ._util import finite, positive, positive_int, vector
 from .dense import hermite
@@ -75,8 +75,6 @@ class Trajectory:
     def save(self, path: str | os.PathLike[str], *, overwrite: bool = False) -> Path:
         """Writes the trajectory to the HDF5 file ``path`` (h5py, the extra ``io``); read it back
         with :func:`varmech.load`. See :mod:`varmech.files` for the layout."""
-        from . import files
-
         return files.save(self, path, overwrite=overwrite)
 
     def sol(self, t: ArrayLike) -> tuple[np.ndarray, np.ndarray]:

@@ -127,9 +127,8 @@ impl Quadrature {
                 for c in 0..self.s {
                     let (lk, dk) = (self.basis[i][c + 1], self.slopes[i][c + 1]);
                     let weights = [b * h * lj * lk, b * lj * dk, b * dj * lk, b * dj * dk / h];
-                    let corner = c * n * jac.nrows() + r * n;
                     let stride = jac.nrows();
-                    let jac = &mut jac.as_mut_slice()[corner..];
+                    let jac = &mut jac.as_mut_slice()[c * n * stride + r * n..];
                     sized!(add_block(jac, stride, weights, hs; n));
                 }
             }

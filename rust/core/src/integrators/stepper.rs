@@ -358,6 +358,11 @@ impl StepperState {
         self.integrator.newton_iterations()
     }
 
+    /// Newton iterations made so far; None for the methods that solve no equations.
+    pub fn newton(&self) -> Option<u64> {
+        self.integrator.newton()
+    }
+
     /// The work done by non-conservative forces so far (forced Lagrangians; 0 otherwise).
     pub fn work(&self) -> f64 {
         self.integrator.work()
@@ -365,11 +370,6 @@ impl StepperState {
 }
 
 impl<M: Deref<Target: Dynamics>> Stepper<M> {
-    /// Newton iterations made so far; None for the methods that solve no equations.
-    pub fn newton(&self) -> Option<u64> {
-        self.state.integrator.newton()
-    }
-
     /// The work done by the non-conservative forces so far; None for a model without them.
     pub fn forced_work(&self) -> Option<f64> {
         self.model.as_lagrangian().is_forced().then(|| self.work())
