@@ -7,6 +7,7 @@ mod common;
 mod bits;
 mod catalogue;
 mod charged_particle;
+mod checkpoint;
 mod compiled;
 mod constraints;
 mod convergence;

@@ -1,4 +1,5 @@
 use nalgebra::DMatrix;
+use serde::{Deserialize, Serialize};
 
 use super::Segment;
 use crate::model::{Hessians, Lagrangian};
@@ -9,7 +10,7 @@ use crate::ModelError;
 /// s through the control points Q₀ = q₀, Q₁, …, Q_s = q₁ at τ = j/s. A step's equations are
 /// ∂L_d/∂Qⱼ for the slots j = 1, …, s−1 and then 0, its unknowns the increments Q₁ − q₀, …,
 /// Q_s − q₀. Degree 1 gives the two-point rules (midpoint: c = ½; trapezoid: c = 0, 1).
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Quadrature {
     s: usize,
     nodes: Vec<f64>,
@@ -159,7 +160,7 @@ fn add_block(jac: &mut [f64], stride: usize, [qq, qv, vq, vv]: [f64; 4], hs: &He
 ///
 /// and since Σⱼ ℓⱼ = 1, Σⱼ ℓⱼ' = 0, their sum is hΣᵢ bᵢ ∂L/∂q(cᵢ). A force f adds to ∂L/∂q at
 /// every node (forced DEL equations), and its work over the step is hΣᵢ bᵢ f(cᵢ)·q̇(cᵢ).
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Galerkin {
     pub(crate) quadrature: Quadrature,
     lq: Vec<Vec<f64>>,

@@ -1,13 +1,14 @@
 use super::{combine, DiscreteLagrangian, Segment, Workspace};
 use crate::model::Lagrangian;
 use crate::ModelError;
+use serde::{Deserialize, Serialize};
 
 /// The midpoint rule, L_d = h·L(q₀ + δq/2, δq/h, t + h/2).
 ///
 /// D₁L_d = (h/2)∂L/∂q − ∂L/∂q̇ and D₂L_d = (h/2)∂L/∂q + ∂L/∂q̇, both at the midpoint: its
 /// variational integrator is the implicit midpoint rule, symmetric and of order 2, and free of
 /// the parasitic modes of the trapezoidal rule on velocity-linear Lagrangians.
-#[derive(Clone, Copy, Debug, Default)]
+#[derive(Clone, Copy, Debug, Default, Serialize, Deserialize)]
 pub struct Midpoint;
 
 impl Midpoint {

@@ -12,6 +12,7 @@
 //! The end point is passed by its increment, q₁ = q₀ + δq: the discrete velocity δq/h then
 //! carries the increment's full precision rather than the round-off of q₁ − q₀ (HLW VIII.5).
 
+use serde::{Deserialize, Serialize};
 mod galerkin;
 mod midpoint;
 mod rectangle;
@@ -27,7 +28,7 @@ use crate::ModelError;
 
 /// Scratch space for the slot derivatives of a discrete Lagrangian, so that Newton iterations
 /// allocate nothing.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Workspace {
     v: Vec<f64>,
     x: Vec<f64>,

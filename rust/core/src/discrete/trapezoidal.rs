@@ -1,13 +1,14 @@
 use super::{combine, DiscreteLagrangian, Segment, Workspace};
 use crate::model::Lagrangian;
 use crate::ModelError;
+use serde::{Deserialize, Serialize};
 
 /// The trapezoidal rule, L_d = (h/2)[L(q₀, v, t) + L(q₁, v, t + h)] with v = δq/h.
 ///
 /// D₁L_d = (h/2)∂L/∂q(q₀) − ½[∂L/∂q̇(q₀) + ∂L/∂q̇(q₁)] and
 /// D₂L_d = (h/2)∂L/∂q(q₁) + ½[∂L/∂q̇(q₀) + ∂L/∂q̇(q₁)]. For L = ½vᵀMv − V these are
 /// p₀ = Mv + (h/2)∇V(q₀) and p₁ = Mv − (h/2)∇V(q₁): solved for (q₁, p₁), Störmer–Verlet.
-#[derive(Clone, Copy, Debug, Default)]
+#[derive(Clone, Copy, Debug, Default, Serialize, Deserialize)]
 pub struct Trapezoidal;
 
 impl Trapezoidal {

@@ -1,6 +1,7 @@
 use super::{Increment, StepStart};
 use crate::model::MechanicalSystem;
 use crate::ModelError;
+use serde::{Deserialize, Serialize};
 
 /// An explicit Runge–Kutta method whose Butcher matrix has only a subdiagonal, aᵢ,ᵢ₋₁ = cᵢ,
 /// applied to q̇ = M⁻¹p, ṗ = −∇V(q):
@@ -9,10 +10,9 @@ use crate::ModelError;
 ///
 /// This covers explicit Euler (c = 0, w = 1) and classical RK4 (c = 0, ½, ½, 1;
 /// w = ⅙, ⅓, ⅓, ⅙), the non-structure-preserving baselines.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct ExplicitRk {
-    c: &'static [f64],
-    w: &'static [f64],
+    tableau: Tableau,
     q: Vec<f64>,
     p: Vec<f64>,
     kq: Vec<f64>,
@@ -21,10 +21,9 @@ pub struct ExplicitRk {
 }
 
 impl ExplicitRk {
-    fn new(c: &'static [f64], w: &'static [f64], n: usize) -> Self {
+    fn new(tableau: Tableau, n: usize) -> Self {
         ExplicitRk {
-            c,
-            w,
+            tableau,
             q: vec![0.0; n],
             p: vec![0.0; n],
             kq: vec![0.0; n],
@@ -35,12 +34,12 @@ impl ExplicitRk {
 
     /// Explicit Euler: qₙ₊₁ = qₙ + hM⁻¹pₙ, pₙ₊₁ = pₙ − h∇V(qₙ).
     pub fn euler(n: usize) -> Self {
-        Self::new(&[0.0], &[1.0], n)
+        Self::new(Tableau::Euler, n)
     }
 
     /// The classical fourth-order Runge–Kutta method.
     pub fn rk4(n: usize) -> Self {
-        Self::new(&[0.0, 0.5, 0.5, 1.0], &[1.0 / 6.0, 1.0 / 3.0, 1.0 / 3.0, 1.0 / 6.0], n)
+        Self::new(Tableau::Rk4, n)
     }
 
     pub(super) fn force_evaluations(&self) -> u64 {
@@ -57,7 +56,8 @@ impl ExplicitRk {
         let Increment { dq, dp } = increment;
         dq.fill(0.0);
         dp.fill(0.0);
-        for (&c, &w) in self.c.iter().zip(self.w) {
+        let (c, w) = self.tableau.coefficients();
+        for (&c, &w) in c.iter().zip(w) {
             if c == 0.0 {
                 // The first stage: the previous k may hold anything, even non-finite values.
                 self.q.copy_from_slice(q);
@@ -78,5 +78,22 @@ impl ExplicitRk {
             }
         }
         Ok(())
+    }
+}
+
+/// The two tableaux, by name (so that a serialised integrator names its coefficients).
+#[derive(Clone, Copy, Debug, Serialize, Deserialize)]
+enum Tableau {
+    Euler,
+    Rk4,
+}
+
+impl Tableau {
+    /// (c, w).
+    fn coefficients(self) -> (&'static [f64], &'static [f64]) {
+        match self {
+            Tableau::Euler => (&[0.0], &[1.0]),
+            Tableau::Rk4 => (&[0.0, 0.5, 0.5, 1.0], &[1.0 / 6.0, 1.0 / 3.0, 1.0 / 3.0, 1.0 / 6.0]),
+        }
     }
 }

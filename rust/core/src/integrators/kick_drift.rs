@@ -2,6 +2,7 @@ use super::stepper::{diverged, Phase};
 use super::{compensated, Increment, Splitting, StepError, StepStart};
 use crate::model::MechanicalSystem;
 use crate::{Error, ModelError};
+use serde::{Deserialize, Serialize};
 
 /// A kick–drift splitting method ([`Splitting`]) for H = ½pᵀM⁻¹p + V(q):
 ///
@@ -10,7 +11,7 @@ use crate::{Error, ModelError};
 /// A zero kick evaluates no force: an ABA method (a₀ = aₛ = 0) opens its step with a drift.
 /// The force at the end of a BAB step is kept for the first kick of the next (first same as
 /// last), so a Verlet composition of s stages costs s force evaluations a step.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct KickDrift {
     /// The fractions in the order the step applies them: a₀, b₁, a₁, …, bₛ, aₛ.
     fractions: Vec<f64>,

@@ -1,8 +1,9 @@
 use super::{ModelKind, Splitting};
 use crate::Error;
+use serde::{Deserialize, Serialize};
 
 /// The fixed-step methods of varmech.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
 pub enum Method {
     /// Explicit Euler (baseline; not symplectic).
     ExplicitEuler,

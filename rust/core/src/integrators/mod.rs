@@ -18,8 +18,10 @@
 //! - [`Stepper`]: one model, one method and the state, advanced step by step; its
 //!   [`StepperState`] apart from the model, to resume;
 //! - [`integrate`]: a run of a [`Stepper`] with saving and an energy check, into a
-//!   [`Trajectory`].
+//!   [`Trajectory`]; [`resume`] goes on from its [`Checkpoint`], bit for bit.
 
+use serde::{Deserialize, Serialize};
+mod checkpoint;
 pub mod compensated;
 mod composition;
 mod del;
@@ -40,6 +42,7 @@ pub mod wisdom_holman;
 pub use crate::discrete::{Galerkin, Quadrature};
 pub use crate::error::StepError;
 pub use crate::solve::NewtonOptions;
+pub use checkpoint::Checkpoint;
 pub use composition::Composition;
 pub use del::{Del, StepEquations, TwoPoint};
 pub use dynamics::{Dynamics, General};
@@ -49,7 +52,7 @@ pub use kind::ModelKind;
 pub use method::{Method, MethodInfo};
 pub use poll::{Counting, Poll};
 pub use rattle::Rattle;
-pub use run::{integrate, Options};
+pub use run::{integrate, resume, Options};
 pub use splitting::{Leading, Splitting};
 pub use step::{Increment, StepStart};
 pub use stepper::{Stepper, StepperState};
@@ -60,13 +63,13 @@ use crate::discrete::{Midpoint, Trapezoidal};
 use crate::model::{HolonomicConstraints, Lagrangian, MechanicalSystem};
 
 /// A one-step method Ψ_h: (qₙ, pₙ) ↦ (qₙ + δq, pₙ + δp) with its work buffers.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Integrator {
     method: Method,
     scheme: Scheme,
 }
 
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 enum Scheme {
     KickDrift(KickDrift),
     ExplicitRk(ExplicitRk),

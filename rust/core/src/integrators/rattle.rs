@@ -1,4 +1,5 @@
 use nalgebra::{DMatrix, DVector};
+use serde::{Deserialize, Serialize};
 
 use super::{Increment, StepError, StepStart};
 use crate::model::{HolonomicConstraints, MechanicalSystem};
@@ -17,7 +18,7 @@ use crate::solve::newton::{Correction, Newton, NewtonOptions, NewtonProblem, Rea
 /// constraint. SHAKE (Ryckaert, Ciccotti & Berendsen 1977) solves g(q₁) = 0 one constraint at
 /// a time until |g|∞ ≤ tolerance and keeps p₁ = p½ − (h/2)∇V(q₁), off the hidden constraint.
 /// Compositions apply the step with the fractions γ of a symmetric composition.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Rattle {
     shake: bool,
     gamma: Vec<f64>,
@@ -49,6 +50,8 @@ pub struct Rattle {
     /// SHAKE's sweeps.
     sweeps: u64,
     /// When SHAKE checks for interrupts between sweeps.
+    // Wall-clock pacing, not state: a restored state starts a fresh one.
+    #[serde(skip)]
     interrupt: InterruptPoll,
 }
 

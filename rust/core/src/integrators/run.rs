@@ -1,6 +1,8 @@
 //! The fixed-step run: a [`Stepper`] advanced to the end, its states saved on the way.
 
-use super::{Counting, Dynamics, Failure, Method, NewtonOptions, Poll, Stepper, Trajectory};
+use serde::{Deserialize, Serialize};
+
+use super::{Checkpoint, Counting, Dynamics, Failure, Method, NewtonOptions, Poll, Stepper, Trajectory};
 use crate::model::{EnergyTerms, Scale};
 use crate::{memory, Error};
 
@@ -81,16 +83,93 @@ impl Options {
 ///
 /// `poll` ([`Poll`]) is called with the steps completed every 10–40 ms of run time; an error
 /// from it stops the run with [`Error::Interrupted`] (the binding checks for Ctrl-C there, and
-/// reports progress). The step loop allocates
-/// nothing beyond the saved states, whose storage is reserved up front.
+/// reports progress). The step loop allocates nothing beyond the saved states, whose storage
+/// is reserved up front.
 ///
-/// On failure the returned [`Failure`] holds every state saved so far and the last good state.
+/// The trajectory ends with the [`Checkpoint`] of its last state ([`Trajectory::checkpoint`]),
+/// from which [`resume`] goes on. On failure the returned [`Failure`] holds every state saved
+/// so far and the last good state, with its checkpoint.
 pub fn integrate<S, P>(
     sys: &S,
     method: Method,
     q0: &[f64],
     p0: &[f64],
     options: &Options,
+    poll: P,
+) -> Result<Trajectory, Box<Failure>>
+where
+    S: Dynamics + ?Sized,
+    P: Poll,
+{
+    let stepper = Stepper::new(sys, method, q0, p0, options).map_err(|e| fail(e, empty(sys)))?;
+    let watch = match options
+        .max_energy_error
+        .and_then(|tol| EnergyWatch::new(sys, &stepper, tol))
+    {
+        None => None,
+        Some(Ok(watch)) => Some(watch),
+        // The initial state is kept: the check failed on it.
+        Some(Err(error)) => {
+            let mut traj = empty(sys);
+            traj.push(stepper.t(), &stepper);
+            return Err(fail(error, traj));
+        }
+    };
+    run(sys, stepper, watch, options.steps, options.save_every, poll)
+}
+
+/// Goes on from `checkpoint` (of a run of `sys`) for `steps` more steps, saving every
+/// `save_every`-th state (counted from the first run's start) and the last: the states are
+/// those of one run of the whole length, bit for bit, and the first is the checkpoint's.
+///
+/// Refuses a model with another number of coordinates or of a kind the checkpoint's method
+/// does not integrate (see [`Stepper::resume`]), and `save_every` = 0.
+pub fn resume<S, P>(
+    sys: &S,
+    checkpoint: Checkpoint,
+    steps: usize,
+    save_every: usize,
+    poll: P,
+) -> Result<Trajectory, Box<Failure>>
+where
+    S: Dynamics + ?Sized,
+    P: Poll,
+{
+    if save_every == 0 {
+        return Err(fail(Error::invalid("save_every", "must be at least 1"), empty(sys)));
+    }
+    let Checkpoint { state, watch } = checkpoint;
+    let stepper = Stepper::resume(sys, state).map_err(|e| fail(e, empty(sys)))?;
+    let end = (stepper.steps().checked_add(steps)).filter(|_| (stepper.t() + steps as f64 * stepper.dt()).is_finite());
+    let Some(end) = end else {
+        let reason = format!(
+            "{steps} more steps from step {} end past the largest float",
+            stepper.steps()
+        );
+        return Err(fail(Error::invalid("steps", reason), empty(sys)));
+    };
+    run(sys, stepper, watch, end, save_every, poll)
+}
+
+fn fail(error: Error, partial: Trajectory) -> Box<Failure> {
+    Box::new(Failure { error, partial })
+}
+
+fn empty<S: Dynamics + ?Sized>(sys: &S) -> Trajectory {
+    Trajectory {
+        dim: sys.dim(),
+        ..Default::default()
+    }
+}
+
+/// Advances `stepper` to step `end`, saving every `save_every`-th state, the first and the
+/// last, with the energy checked at each saved state.
+fn run<S, P>(
+    sys: &S,
+    mut stepper: Stepper<&S>,
+    mut watch: Option<EnergyWatch>,
+    end: usize,
+    save_every: usize,
     mut poll: P,
 ) -> Result<Trajectory, Box<Failure>>
 where
@@ -98,23 +177,9 @@ where
     P: Poll,
 {
     let n = sys.dim();
-    let mut traj = Trajectory {
-        dim: n,
-        ..Default::default()
-    };
-    let fail = |error, partial| Box::new(Failure { error, partial });
-    let mut stepper = match Stepper::new(sys, method, q0, p0, options) {
-        Ok(stepper) => stepper,
-        Err(e) => return Err(fail(e, traj)),
-    };
-    let Options {
-        steps,
-        save_every,
-        max_energy_error,
-        t0,
-        ..
-    } = *options;
-    let saved = (steps / save_every).saturating_add(2);
+    let mut traj = empty(sys);
+    let start = stepper.steps();
+    let saved = ((end - start) / save_every).saturating_add(2);
     // Reserving succeeds beyond the memory there is (Linux overcommits) and the run would then
     // be killed when it fills the states: check against what is available first.
     if let Err(e) = memory::check_allocation("save_every", saved, (2 * n + 3) * std::mem::size_of::<f64>()) {
@@ -139,39 +204,42 @@ where
         return Err(fail(Error::invalid("save_every", reason), traj));
     }
 
-    traj.push(t0, &stepper);
-    let mut watch = match max_energy_error.and_then(|tol| EnergyWatch::new(sys, &stepper, tol)) {
-        None => None,
-        Some(Ok(watch)) => Some(watch),
-        Some(Err(error)) => return Err(fail(error, traj)),
-    };
-
-    while stepper.steps() < steps {
+    traj.push(stepper.t(), &stepper);
+    let mut outcome = Ok(());
+    while stepper.steps() < end {
         // Every `save_every`-th state is saved, and the last.
-        let save = (stepper.steps() / save_every + 1).saturating_mul(save_every).min(steps);
+        let save = (stepper.steps() / save_every + 1).saturating_mul(save_every).min(end);
         if let Err(error) = stepper.advance(save - stepper.steps(), Counting(|steps| poll.poll(steps))) {
             // Stops with the last good state kept, and the work counted.
             let time = stepper.t();
             if traj.t.last() != Some(&time) {
                 traj.push(time, &stepper);
             }
-            traj.count(&stepper);
-            return Err(fail(error, traj));
+            outcome = Err(error);
+            break;
         }
-        let t = stepper.t();
-        traj.push(t, &stepper);
+        traj.push(stepper.t(), &stepper);
         if let Some(error) = watch.as_mut().and_then(|w| w.check(sys, &stepper)) {
             // The state of this step is kept: it is finite, only its energy is off.
-            traj.count(&stepper);
-            return Err(fail(error, traj));
+            outcome = Err(error);
+            break;
         }
     }
     traj.count(&stepper);
-    Ok(traj)
+    traj.checkpoint = Checkpoint {
+        state: stepper.into_state(),
+        watch,
+    }
+    .to_bytes();
+    match outcome {
+        Ok(()) => Ok(traj),
+        Err(error) => Err(fail(error, traj)),
+    }
 }
 
 /// The run's energy check: E − W against its value at the start, judged by a running [`Scale`].
-struct EnergyWatch {
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub(super) struct EnergyWatch {
     initial: f64,
     scale: Scale,
     tolerance: f64,

@@ -1,5 +1,6 @@
 //! One model, one method and the state, advanced step by step; the state apart from its model.
 
+use serde::{Deserialize, Serialize};
 mod own_variables;
 
 use std::borrow::{Borrow, BorrowMut};
@@ -33,7 +34,7 @@ pub struct Stepper<M, St = StepperState> {
 /// predictor, the time, the steps, (qₙ, pₙ), the compensated-summation carries and the work
 /// buffers. Kept between calls, it lets a stepper run on a model that is only borrowed for the
 /// length of each call.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct StepperState {
     integrator: Integrator,
     clock: Clock,
@@ -51,6 +52,8 @@ pub struct StepperState {
     p_next: Vec<f64>,
     eq_next: Vec<f64>,
     ep_next: Vec<f64>,
+    // Wall-clock pacing, not state: a restored state starts a fresh one.
+    #[serde(skip)]
     interrupt: InterruptPoll,
 }
 
@@ -378,7 +381,7 @@ impl<M: Deref<Target: Dynamics>> Stepper<M> {
 
 /// tₙ = t₀ + (n − n₀)·h: the time t₀ and steps n₀ when the step h was last set (see
 /// [`Stepper::set_dt`]).
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, Serialize, Deserialize)]
 pub(super) struct Clock {
     t0: f64,
     n0: usize,

@@ -27,6 +27,9 @@ pub struct Trajectory {
     /// without forces, rather than zeros): the energy balance E(t) − E(0) − W(t) is the discrete
     /// Lagrange–d'Alembert check.
     pub work: Vec<f64>,
+    /// The [`super::Checkpoint`] of the last state, as bytes ([`super::Checkpoint::to_bytes`]):
+    /// [`super::resume`] goes on from it. Empty for a run that failed before its first state.
+    pub checkpoint: Vec<u8>,
 }
 
 impl Trajectory {

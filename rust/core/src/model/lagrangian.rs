@@ -1,4 +1,5 @@
 use nalgebra::DMatrix;
+use serde::{Deserialize, Serialize};
 
 use super::{EnergyTerms, MechanicalSystem};
 use crate::error::StepError;
@@ -7,7 +8,7 @@ use crate::solve::newton::{model_error, Correction, Newton, NewtonOptions, Newto
 use crate::ModelError;
 
 /// The second derivatives of L at one point, n × n each.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Hessians {
     /// ∂²L/∂q².
     pub qq: DMatrix<f64>,

@@ -1,5 +1,6 @@
 //! The size a conserved quantity's error is judged against.
 
+use serde::{Deserialize, Serialize};
 /// Running sizes of a conserved quantity J along a run: its scale, the mean of a size
 /// sampled at each saved state (the kinetic energy |T| for the energy, Σ|pᵢξᵢ| for a Noether
 /// momentum), and the largest size of the terms J is computed from (|T| + |V| for the energy),
@@ -12,7 +13,7 @@
 /// of the motion: |H₀| is no scale when V's zero is arbitrary (H₀ = 0 for a pendulum released
 /// at its pivot's height), and max |V| is none for orbits that dive deep into a potential well
 /// (Kepler at e = 0.9 has max |V| = 20|H₀|, where an error of |H₀| unbinds the orbit).
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct Scale {
     sum: f64,
     sum_terms: f64,

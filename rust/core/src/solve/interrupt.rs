@@ -44,6 +44,12 @@ pub(crate) struct InterruptPoll {
     last: Instant,
 }
 
+impl Default for InterruptPoll {
+    fn default() -> Self {
+        InterruptPoll::new()
+    }
+}
+
 impl InterruptPoll {
     const FAST: Duration = Duration::from_millis(10);
     const SLOW: Duration = Duration::from_millis(40);

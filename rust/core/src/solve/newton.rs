@@ -9,6 +9,7 @@
 //! small enough, or at the iteration cap.
 
 use nalgebra::{DMatrix, DVector};
+use serde::{Deserialize, Serialize};
 
 use super::difference::NOISE_FLOOR;
 use super::interrupt::{check_interrupt, InterruptPoll};
@@ -25,7 +26,7 @@ use crate::{Error, ModelError};
 /// not the position: the discrete velocity δq/h, and so p₁, carries the increment's relative
 /// precision, which a scale of ‖q‖∞ would give away as a cyclic angle grows. The other
 /// iterations measure their corrections their own way (RATTLE: the move of q₁ against ‖q₀‖∞).
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct NewtonOptions {
     /// Stop when the correction satisfies ‖δ‖ ≤ tolerance·scale (the problem's measure).
     pub tolerance: f64,
@@ -149,7 +150,7 @@ pub(crate) struct Solution {
 
 /// The buffers of Newton's method for m equations: F, its Jacobian and LU factors; sized once,
 /// so that the iteration allocates nothing.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub(crate) struct Newton {
     residual: DVector<f64>,
     jacobian: DMatrix<f64>,
@@ -159,6 +160,8 @@ pub(crate) struct Newton {
     /// Newton steps made over the workspace's life.
     iterations: u64,
     /// When to check for interrupts between iterations (kept over solves: most take a few).
+    // Wall-clock pacing, not state: a restored state starts a fresh one.
+    #[serde(skip)]
     interrupt: InterruptPoll,
 }
 

@@ -2,6 +2,7 @@
 //! among the unknowns, and the momentum put on the hidden constraint G(q₁)q̇ = 0 by μ.
 
 use nalgebra::DMatrix;
+use serde::{Deserialize, Serialize};
 
 use super::StepEquations;
 use crate::integrators::{Increment, StepError, StepStart};
@@ -40,7 +41,7 @@ pub(super) fn constrained_equations<Sc: StepEquations, S: Lagrangian + ?Sized>(
 }
 
 /// The buffers of the constrained step: G(q₀) and G(q₁), q₁ and p₁, and μ's Newton iteration.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub(super) struct Multipliers {
     /// G at the step's start; the last step's G(q₁) once a step is taken (first same as last).
     pub g0: DMatrix<f64>,

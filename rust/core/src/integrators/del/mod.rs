@@ -2,6 +2,7 @@
 //! solver [`Del`], the equations of the two-point rules ([`TwoPoint`]) and of the Galerkin
 //! integrators, and the constrained DEL equations.
 
+use serde::{Deserialize, Serialize};
 mod constrained;
 mod galerkin;
 mod two_point;
@@ -90,7 +91,7 @@ fn segment<'a>(start: &StepStart<'a>, x: &'a [f64]) -> Segment<'a> {
 ///
 /// with μ such that the velocity q̇(q₁, p₁) of the inverse Legendre transform is tangent,
 /// G(q₁)q̇ = 0 (Newton's method on μ, from differences of the Legendre transform).
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Del<Sc> {
     scheme: Sc,
     options: NewtonOptions,

@@ -3,9 +3,10 @@ use crate::discrete::{DiscreteLagrangian, Quadrature, Segment, Workspace};
 use crate::integrators::StepStart;
 use crate::model::Lagrangian;
 use crate::ModelError;
+use serde::{Deserialize, Serialize};
 
 /// The generalized force at a step's midpoint, f(q₀ + δq/2, δq/h, t + h/2), with its buffers.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 struct Forcing {
     mid: Vec<f64>,
     vel: Vec<f64>,
@@ -35,7 +36,7 @@ impl Forcing {
 /// forcing: F(δq) = p₀ + D₁L_d(q₀, q₀ + δq) + f_d⁻, then p₁ = D₂L_d + f_d⁺ (the forced DEL
 /// equations of the discrete Lagrange–d'Alembert principle, f_d^± = (h/2)f(q̄, v, t + h/2) at
 /// the midpoint). The work of the forces is f(q̄, v)·δq a step.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct TwoPoint<R> {
     rule: R,
     ws: Workspace,

@@ -24,6 +24,24 @@ pub fn corrector(order: u32) -> Option<&'static [(f64, f64)]> {
     })
 }
 
+/// The orders with coefficients.
+const ORDERS: [u32; 6] = [0, 3, 5, 7, 11, 17];
+
+/// A corrector serialised by its order (serde's `with`): the coefficients are the library's.
+pub(super) mod by_order {
+    use serde::{de, ser, Deserialize, Deserializer, Serializer};
+
+    pub fn serialize<S: Serializer>(pairs: &&'static [(f64, f64)], s: S) -> Result<S::Ok, S::Error> {
+        let order = super::ORDERS.iter().find(|&&o| super::corrector(o) == Some(*pairs));
+        s.serialize_u32(*order.ok_or_else(|| ser::Error::custom("a corrector not in the table"))?)
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<&'static [(f64, f64)], D::Error> {
+        let order = u32::deserialize(d)?;
+        super::corrector(order).ok_or_else(|| de::Error::custom(format!("no corrector of order {order}")))
+    }
+}
+
 /// aₖ = k·√(7/40).
 const A: [f64; 9] = [
     0.0,

@@ -1,6 +1,7 @@
 //! Jacobi coordinates: each body relative to the centre of mass of the bodies before it.
 
 use crate::model::NBody;
+use serde::{Deserialize, Serialize};
 
 /// Jacobi coordinates of N bodies with masses m₀ (the central body), m₁, …: with ηᵢ = m₀ + … + mᵢ
 /// and Rᵢ the centre of mass of bodies 0…i,
@@ -14,7 +15,7 @@ use crate::model::NBody;
 /// The inverse runs the recursion backwards, Rᵢ₋₁ = Rᵢ − (mᵢ/ηᵢ)x′ᵢ, xᵢ = x′ᵢ + Rᵢ₋₁, so that
 /// the round trip is exact to a few ulps per body. Holds the masses, allocates nothing after
 /// [`Jacobi::new`].
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Jacobi {
     g: f64,
     masses: Vec<f64>,

@@ -2,9 +2,10 @@
 //! interaction kick I(t) and the modified kick of Wisdom, Holman & Touma (1996).
 
 use super::{interaction_accelerations, kepler_drift, Jacobi};
+use serde::{Deserialize, Serialize};
 
 /// The kernel between two drifts: K(h/2) · kick · K(h/2).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 pub enum Kernel {
     /// The kick I(h) of Wisdom & Holman (1991): error O(εh²) (O(ε²h²) once corrected).
     Standard,
@@ -27,7 +28,7 @@ impl Kernel {
 }
 
 /// The kick's work buffers: body-by-body positions and the accelerations.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub(super) struct Work {
     pub(super) inertial: Vec<[f64; 3]>,
     pub(super) acc: Vec<[f64; 3]>,
@@ -47,7 +48,7 @@ impl Work {
 }
 
 /// Jacobi positions and velocities with their compensated-summation carries.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub(super) struct Variables {
     pub(super) x: Vec<[f64; 3]>,
     pub(super) v: Vec<[f64; 3]>,

@@ -13,6 +13,7 @@
 //! [`corrector`] of Wisdom, Holman & Touma (1996) conjugating it removes the O(εhᵏ) terms up to
 //! its order.
 
+use serde::{Deserialize, Serialize};
 mod corrector;
 mod interaction;
 mod jacobi;
@@ -45,9 +46,10 @@ use kernel::{Variables, Work};
 /// steps that follow. The increments are added with compensated summation when asked.
 ///
 /// A step allocates nothing.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct WisdomHolman {
     kernel: Kernel,
+    #[serde(with = "corrector::by_order")]
     corrector: &'static [(f64, f64)],
     /// The masses of the model the inner variables belong to; `None` until the first step.
     jacobi: Option<Jacobi>,
