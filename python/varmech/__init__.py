@@ -47,6 +47,7 @@ from .methods import MethodInfo, methods
 from .model import Cyclic, Lagrangian, MechanicalSystem, Model, NativeSystem, Rotation, Translation
 from .reduction import ReducedModel, cyclic_coordinates, routh
 from .stepper import Stepper
+from .streaming import resume
 from .table import Table
 
 __version__ = "0.1.0"
@@ -87,6 +88,7 @@ __all__ = [
     "poincare_section",
     "pointers",
     "project",
+    "resume",
     "routh",
     "scenes",
     "sections",

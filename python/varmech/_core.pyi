@@ -50,6 +50,7 @@ __all__ = [
     "momentum",
     "nbody",
     "project",
+    "resume",
     "routh",
     "scene",
     "statistics",
@@ -111,6 +112,8 @@ class TrajectoryRecord:
     @property
     def work(self) -> _FloatArray:
         """Cumulative work of the non-conservative forces at each saved state (zeros without forces)."""
+    @property
+    def checkpoint(self) -> bytes: ...
 
 @final
 class Stepper:
@@ -129,6 +132,11 @@ class Stepper:
         newton_tolerance: float = 1e-14,
         newton_max_iterations: int = 50,
     ) -> Stepper: ...
+    def checkpoint(self) -> bytes:
+        """The stepper's whole state as bytes (see [`Checkpoint`])."""
+    @staticmethod
+    def from_checkpoint(model: _Model, checkpoint: bytes) -> Stepper:
+        """The stepper of `model` at the state of `checkpoint` (from `checkpoint()`, or a run's)."""
     def step(self) -> None:
         """Advances one step."""
     def advance(self, n: int) -> None:
@@ -430,6 +438,16 @@ def integrate(
     """The saved states; on failure the exception carries ``_varmech_partial``, the
     TrajectoryRecord up to the failure. ``progress(steps)`` is called with the steps completed at
     the Ctrl-C check's stride; an exception from it stops the run."""
+
+def resume(
+    model: _Model,
+    checkpoint: bytes,
+    *,
+    steps: int,
+    save_every: int = 1,
+    progress: Callable[[int], object] | None = None,
+) -> TrajectoryRecord:
+    """Goes on from a run's checkpoint for `steps` more steps (see [`integrators::resume`])."""
 
 def energy_terms(model: _Model, t: _FloatArray, q: _FloatArray, p: _FloatArray) -> tuple[_FloatArray, _FloatArray, _FloatArray]:
     """(E, T, V) at each state: the energy function p·q̇ − L, its kinetic term E − V and its

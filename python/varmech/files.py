@@ -1,25 +1,37 @@
-"""Trajectories in HDF5 files (h5py, the optional extra ``io``): :meth:`Trajectory.save` and
-:func:`load`.
+"""Trajectories in HDF5 files (h5py, the optional extra ``io``): :meth:`Trajectory.save`,
+:func:`load`, and the files that runs stream to (``integrate(output=)``, :func:`varmech.resume`).
 
 The layout, self-describing so that any HDF5 reader can use it (``docs/file_format.md``)::
 
-    /            attrs: format = "varmech-trajectory", format_version = 1, varmech_version,
-                        method, dt, steps, nfev, status, message, dim, model (its repr)
+    /            attrs: format = "varmech-trajectory", format_version = 2, varmech_version,
+                        method, dt, dim, save_every (0: unknown), model (its repr), complete,
+                        steps, nfev, status, message
     /t           (N,)   float64   the saved times
     /q, /p       (N, n) float64   positions and momenta, one row a saved state
     /newton      (N,)   uint64    cumulative Newton iterations (only for methods that solve)
     /work        (N,)   float64   cumulative work of the forces (only for forced models)
+    /committed   (5,)   int64     rows, checkpoint slot, checkpoint length, steps, nfev
+    /checkpoint0, /checkpoint1    uint8  the last committed state's checkpoint, in the slot
+                                  /committed names (the other holds the one before)
     /model       opaque bytes     the model's pickle (what builds it: a scene's name and
                                   parameters, expressions, or closures by reference)
 
-The arrays are chunked by rows. Loading unpickles the model, as :mod:`pickle` does: open only
-files you trust, or pass ``model=`` to :func:`load` to skip the stored one.
+The arrays are chunked by rows and grow as a run appends to them. A writer appends the rows
+and the checkpoint of a chunk, flushes them, and only then updates ``/committed`` (HDF5's
+single-writer/multiple-reader mode keeps the file readable at every moment): a run killed at
+any point leaves a file whose committed rows and checkpoint are intact. The root's ``complete``
+is set when the writer closes; a file without it is a run that stopped without closing
+(``status`` -1 on loading, and :func:`varmech.resume` continues it).
+
+Loading unpickles the model, as :mod:`pickle` does: open only files you trust, or pass
+``model=`` to :func:`load` to skip the stored one.
 """
 
 from __future__ import annotations
 
 import os
 import pickle
+from collections.abc import Iterator
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -30,10 +42,11 @@ if TYPE_CHECKING:
     from .model import Model
 
 FORMAT = "varmech-trajectory"
-FORMAT_VERSION = 1
-#: Rows per chunk: about 64 kB of a (N, 2)-shaped q for the small systems, and whole arrays
-#: below it.
+FORMAT_VERSION = 2
+#: Rows per chunk: about 64 kB of a (N, 2)-shaped q for the small systems.
 CHUNK_ROWS = 4096
+_COLUMNS = ("t", "q", "p", "newton", "work")
+_DTYPES = {"newton": np.uint64}
 
 
 def _h5py() -> Any:
@@ -44,54 +57,248 @@ def _h5py() -> Any:
     return h5py
 
 
+def writable(path: str | os.PathLike[str], overwrite: bool, argument: str) -> Path:
+    """``path`` as a Path, after checking that a new file can be made there; ValueError naming
+    ``argument`` otherwise."""
+    target = Path(path)
+    if target.is_dir():
+        raise ValueError(f"{argument}: {str(target)!r} is a directory")
+    if target.exists() and not overwrite:
+        raise ValueError(f"{argument}: {str(target)!r} exists; pass overwrite=True to replace it")
+    if not target.parent.is_dir():
+        raise ValueError(f"{argument}: cannot write {str(target)!r}: its directory does not exist")
+    if not os.access(target.parent, os.W_OK):
+        raise ValueError(f"{argument}: cannot write {str(target)!r}: its directory is not writable")
+    return target
+
+
+class Writer:
+    """A trajectory file being written: :meth:`append` adds a run's rows and its checkpoint,
+    committed together; :meth:`close` records how the run ended.
+
+    ``columns`` are the optional columns the run has (``"newton"``, ``"work"``).
+    """
+
+    def __init__(
+        self,
+        path: Path,
+        *,
+        model: Model,
+        method: str,
+        dt: float,
+        columns: tuple[str, ...],
+        save_every: int = 0,
+        argument: str = "path",
+    ):
+        from . import __version__
+
+        h5py = _h5py()
+        self.path = path
+        self._argument = argument
+        n = model.dim
+        try:
+            self._file = h5py.File(path, "w", libver="latest")
+            f = self._file
+            f.attrs.update(
+                {
+                    "format": FORMAT,
+                    "format_version": FORMAT_VERSION,
+                    "varmech_version": __version__,
+                    "method": method,
+                    "dt": dt,
+                    "dim": n,
+                    "save_every": save_every,
+                    "model": repr(model),
+                    "complete": False,
+                    "steps": 0,
+                    "nfev": 0,
+                    "status": -1,
+                    "message": "The run stopped before closing its file.",
+                }
+            )
+            for name in ("t", "q", "p", *columns):
+                shape = (0, n) if name in ("q", "p") else (0,)
+                f.create_dataset(
+                    name,
+                    shape=shape,
+                    maxshape=(None, *shape[1:]),
+                    chunks=(CHUNK_ROWS, *shape[1:]),
+                    dtype=_DTYPES.get(name, np.float64),
+                )
+            for slot in (0, 1):
+                f.create_dataset(f"checkpoint{slot}", shape=(0,), maxshape=(None,), chunks=(4096,), dtype=np.uint8)
+            f.create_dataset("committed", data=np.zeros(5, dtype=np.int64))
+            f.create_dataset("model", data=np.void(pickle.dumps(model)))
+            f.swmr_mode = True
+        except OSError as e:
+            raise ValueError(f"{argument}: cannot write {str(path)!r}: {e}") from e
+        self._columns = ("t", "q", "p", *columns)
+        self.rows = 0
+        self._slot = 1
+        self.is_open = True
+
+    @classmethod
+    def reopen(cls, path: Path, stored: Trajectory) -> Writer:
+        """The writer appending to the file ``path`` (loaded as ``stored``) after its committed
+        rows, marked incomplete until it closes again."""
+        h5py = _h5py()
+        writer = cls.__new__(cls)
+        writer.path, writer._argument = path, "path"
+        try:
+            try:
+                f = h5py.File(path, "r+", libver="latest")
+            except OSError as e:
+                if "already open for write" not in str(e):
+                    raise
+                # A writer killed in SWMR mode leaves the file marked open: copy what it committed.
+                _recover(path)
+                f = h5py.File(path, "r+", libver="latest")
+            f.attrs.update({"complete": False, "status": -1, "message": "The run stopped before closing its file."})
+            rows, slot = (int(x) for x in f["committed"][:2])
+            f.swmr_mode = True
+        except OSError as e:
+            raise ValueError(f"path: cannot append to {str(path)!r}: {e}") from e
+        writer._file = f
+        writer._columns = tuple(name for name in _COLUMNS if name in f)
+        writer.rows, writer._slot, writer.is_open = rows, slot, True
+        return writer
+
+    def append(self, record: Any, *, skip_first: bool = False) -> None:
+        """Appends the rows of ``record`` (a :class:`Trajectory` or the binding's record; its
+        first row left out when it repeats the last one written) and commits them with its
+        checkpoint, its steps and its evaluations."""
+        f, start = self._file, int(skip_first)
+        added = len(record.t) - start
+        for name in self._columns:
+            data = np.asarray(getattr(record, name))[start:]
+            ds = f[name]
+            ds.resize(self.rows + added, axis=0)
+            ds[self.rows :] = data
+            ds.flush()
+        slot = 1 - self._slot
+        checkpoint = np.frombuffer(record.checkpoint or b"", dtype=np.uint8)
+        ds = f[f"checkpoint{slot}"]
+        ds.resize((len(checkpoint),))
+        ds[:] = checkpoint
+        ds.flush()
+        nfev = getattr(record, "nfev", None)
+        nfev = record.force_evaluations if nfev is None else nfev
+        committed = f["committed"]
+        committed[:] = [self.rows + added, slot, len(checkpoint), record.steps, nfev]
+        committed.flush()
+        self.rows += added
+        self._slot = slot
+
+    def close(self, status: int, message: str) -> None:
+        """Records the end of the run (``status``, ``message`` and the committed counts) and
+        closes the file."""
+        self.abandon()
+        with _h5py().File(self.path, "r+") as f:
+            rows, _, _, steps, nfev = (int(x) for x in f["committed"][()])
+            f.attrs.update({"complete": True, "status": status, "message": message, "steps": steps, "nfev": nfev})
+
+    def abandon(self) -> None:
+        """Closes the file as it is (a run stopped by an exception that could not be recorded)."""
+        self._file.close()
+        self.is_open = False
+
+
+def _recover(path: Path) -> None:
+    """Rewrites the file of a killed writer with its committed rows and checkpoint (HDF5 copies
+    the datasets chunk by chunk), replacing it atomically."""
+    h5py = _h5py()
+    part = path.with_name(path.name + ".recovering")
+    with h5py.File(path, "r", swmr=True) as src, h5py.File(part, "w", libver="latest") as dst:
+        dst.attrs.update(dict(src.attrs))
+        rows, slot, length = (int(x) for x in src["committed"][:3])
+        for name in src:
+            src.copy(src[name], dst, name=name)
+            if name in _COLUMNS:
+                dst[name].resize(rows, axis=0)
+        dst[f"checkpoint{slot}"].resize((length,))
+    os.replace(part, path)
+
+
 def save(traj: Trajectory, path: str | os.PathLike[str], *, overwrite: bool = False) -> Path:
     """Writes ``traj`` to the HDF5 file ``path`` (see the module's layout) and returns its path.
 
     Raises ValueError naming ``path`` when the file exists and ``overwrite`` is False, or when it
     cannot be written.
     """
-    from . import __version__
-
-    h5py = _h5py()
-    target = Path(path)
-    if target.exists() and not overwrite:
-        raise ValueError(f"path: {str(target)!r} exists; pass overwrite=True to replace it")
-    if target.is_dir():
-        raise ValueError(f"path: {str(target)!r} is a directory")
-    model = np.void(pickle.dumps(traj.model))
-    try:
-        with h5py.File(target, "w") as f:
-            attrs = {
-                "format": FORMAT,
-                "format_version": FORMAT_VERSION,
-                "varmech_version": __version__,
-                "method": traj.method,
-                "dt": traj.dt,
-                "steps": traj.steps,
-                "nfev": traj.nfev,
-                "status": traj.status,
-                "message": traj.message,
-                "dim": traj.q.shape[1],
-                "model": repr(traj.model),
-            }
-            f.attrs.update(attrs)
-            columns = {"t": traj.t, "q": traj.q, "p": traj.p}
-            if traj.newton is not None and np.any(traj.newton):
-                columns["newton"] = np.asarray(traj.newton, dtype=np.uint64)
-            if traj.work is not None and traj.model.forced:
-                columns["work"] = traj.work
-            for name, data in columns.items():
-                rows = max(1, min(len(data), CHUNK_ROWS))
-                f.create_dataset(name, data=data, chunks=(rows, *data.shape[1:]))
-            f.create_dataset("model", data=model)
-    except OSError as e:
-        raise ValueError(f"path: cannot write {str(target)!r}: {e}") from e
+    target = writable(path, overwrite, "path")
+    columns = columns_of(traj.model, traj.method)
+    writer = Writer(target, model=traj.model, method=traj.method, dt=traj.dt, columns=columns)
+    writer.append(traj)
+    writer.close(traj.status, traj.message)
     return target
 
 
-def load(path: str | os.PathLike[str], *, model: Model | None = None) -> Trajectory:
-    """The trajectory saved in ``path`` by :meth:`Trajectory.save`, with its model unpickled,
-    or ``model`` instead (which must have the file's dimension).
+def columns_of(model: Model, method: str) -> tuple[str, ...]:
+    """The optional columns of a run of ``method`` on ``model``: Newton counts for the methods
+    that solve equations, work for forced models."""
+    from .methods import method_info
+
+    info = method_info(method)
+    return (*(("newton",) if info.implicit or info.constrained else ()), *(("work",) if model.forced else ()))
+
+
+class Rows:
+    """A column of a trajectory file, read when used: indexing reads the rows asked for, and
+    NumPy (``np.asarray``, arithmetic) reads the whole column once and keeps it."""
+
+    __array_priority__ = 1.0
+
+    def __init__(self, path: Path, name: str, shape: tuple[int, ...], dtype: Any):
+        self._path, self._name, self.shape, self.dtype = path, name, shape, np.dtype(dtype)
+        self._data: np.ndarray | None = None
+
+    @property
+    def ndim(self) -> int:
+        return len(self.shape)
+
+    def __getitem__(self, key: Any) -> Any:
+        if self._data is not None:
+            return self._data[key]
+        if isinstance(key, (int, np.integer)) or (
+            isinstance(key, tuple) and key and isinstance(key[0], (int, np.integer))
+        ):
+            first = key[0] if isinstance(key, tuple) else key
+            row = int(first) + (self.shape[0] if first < 0 else 0)
+            if not 0 <= row < self.shape[0]:
+                raise IndexError(f"row {first} out of range for {self.shape[0]} rows")
+            with _h5py().File(self._path, "r", swmr=True) as f:
+                data = f[self._name][row]
+            return data[key[1:]] if isinstance(key, tuple) else data
+        return np.asarray(self)[key]
+
+    def __array__(self, dtype: Any = None, copy: Any = None) -> np.ndarray:
+        if self._data is None:
+            with _h5py().File(self._path, "r", swmr=True) as f:
+                self._data = f[self._name][: self.shape[0]]
+        return self._data if dtype is None else self._data.astype(dtype)
+
+    def __array_ufunc__(self, ufunc: Any, method: str, *inputs: Any, **kwargs: Any) -> Any:
+        inputs = tuple(np.asarray(x) if isinstance(x, Rows) else x for x in inputs)
+        return getattr(ufunc, method)(*inputs, **kwargs)
+
+    def __len__(self) -> int:
+        return self.shape[0]
+
+    def __iter__(self) -> Iterator[Any]:
+        return iter(np.asarray(self))
+
+    def __repr__(self) -> str:
+        return f"Rows({str(self._path)!r}, {self._name!r}, shape={self.shape})"
+
+
+def load(path: str | os.PathLike[str], *, model: Model | None = None, lazy: bool = False) -> Trajectory:
+    """The trajectory saved in ``path`` by :meth:`Trajectory.save` or streamed there by a run
+    (``integrate(output=)``), with its model unpickled, or ``model`` instead (which must have the
+    file's dimension). Only the committed rows are read; a run that stopped without closing its
+    file loads with ``status`` -1, and its checkpoint lets :func:`varmech.resume` go on.
+
+    ``lazy=True`` reads no column until it is used (each a :class:`Rows`; indexing reads only
+    the rows asked for), for files larger than memory.
 
     Raises ValueError naming ``path`` for a missing, corrupt or truncated file, or one that is not
     a varmech trajectory; ValueError naming ``model`` for a model of another dimension.
@@ -113,16 +320,25 @@ def load(path: str | os.PathLike[str], *, model: Model | None = None) -> Traject
     if not source.is_file():
         raise ValueError(f"path: no file {str(source)!r}")
     try:
-        with h5py.File(source, "r") as f:
+        with h5py.File(source, "r", swmr=True) as f:
             if f.attrs.get("format") != FORMAT:
                 raise ValueError(f"path: {str(source)!r} is not a varmech trajectory file")
             version = int(f.attrs["format_version"])
-            if version > FORMAT_VERSION:
-                raise ValueError(f"path: format version {version} is newer than this varmech reads ({FORMAT_VERSION})")
+            if version != FORMAT_VERSION:
+                raise ValueError(f"path: format version {version}; this varmech reads version {FORMAT_VERSION}")
             a = dict(f.attrs)
-            columns = {name: f[name][()] for name in ("t", "q", "p", "newton", "work") if name in f}
+            rows, slot, length, steps, nfev = (int(x) for x in f["committed"][()])
+            present = [name for name in _COLUMNS if name in f]
+            shapes = {name: (rows, *f[name].shape[1:]) for name in present}
+            if any(f[name].shape[0] < rows for name in present):
+                raise ValueError(f"path: {str(source)!r} is truncated: fewer rows than committed")
+            columns: dict[str, Any] = {
+                name: Rows(source, name, shapes[name], f[name].dtype) if lazy else f[name][:rows] for name in present
+            }
+            checkpoint = f[f"checkpoint{slot}"][:length].tobytes()
             blob: bytes = f["model"][()].tobytes() if model is None else b""
-    except (OSError, KeyError) as e:
+    except (OSError, KeyError, RuntimeError) as e:
+        # h5py raises RuntimeError for some damaged structures (a bad heap signature).
         raise ValueError(f"path: {str(source)!r} is corrupt or truncated: {e}") from e
     if model is None:
         try:
@@ -131,6 +347,7 @@ def load(path: str | os.PathLike[str], *, model: Model | None = None) -> Traject
             raise ValueError(f"path: cannot rebuild the model {a['model']!r}: {e}; pass model=") from e
     if model.dim != int(a["dim"]):
         raise ValueError(f"model: has dimension {model.dim}, the file's states {int(a['dim'])}")
+    complete = bool(a["complete"])
     return Trajectory(
         columns["t"],
         columns["q"],
@@ -138,10 +355,22 @@ def load(path: str | os.PathLike[str], *, model: Model | None = None) -> Traject
         model,
         str(a["method"]),
         float(a["dt"]),
-        int(a["steps"]),
-        int(a["nfev"]),
+        steps,
+        nfev,
         columns.get("newton"),
         columns.get("work"),
-        status=int(a["status"]),
-        message=str(a["message"]),
+        status=int(a["status"]) if complete else -1,
+        message=str(a["message"]) if complete else f"The run stopped at step {steps} without closing its file.",
+        checkpoint=checkpoint or None,
     )
+
+
+def save_every_of(path: str | os.PathLike[str]) -> int:
+    """The saving period of the run in ``path``: its ``save_every`` attribute, or (for a saved
+    trajectory, which has none) the steps between its first two states."""
+    with _h5py().File(path, "r", swmr=True) as f:
+        every = int(f.attrs.get("save_every", 0))
+        if every > 0:
+            return every
+        t, dt = f["t"][:2], float(f.attrs["dt"])
+    return max(1, round(float(t[1] - t[0]) / dt)) if len(t) > 1 else 1

@@ -2,9 +2,10 @@
 
 from __future__ import annotations
 
+import datetime
 import math
 import os
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Literal
@@ -47,6 +48,8 @@ class Trajectory:
     work: np.ndarray | None = field(default=None, repr=False)
     status: int = 0
     message: str = "The integration reached its final time."
+    #: The last state's checkpoint (bytes): ``integrate(traj, steps=)`` goes on from it, bit for bit.
+    checkpoint: bytes | None = field(default=None, repr=False)
     _v: np.ndarray | None = field(default=None, repr=False)
 
     @property
@@ -69,7 +72,7 @@ class Trajectory:
     def v(self) -> np.ndarray:
         """Velocities q̇ (with ∂L/∂q̇ = p; M⁻¹p for mechanical systems), shape (N, n)."""
         if self._v is None:
-            self._v = _core.derivative(self.model._core, "velocity", self.t, self.q, self.p)
+            self._v = _core.derivative(self.model._core, "velocity", *self._arrays())
         return self._v
 
     def save(self, path: str | os.PathLike[str], *, overwrite: bool = False) -> Path:
@@ -93,11 +96,15 @@ class Trajectory:
         T = E − V and its potential V = −L(q, 0, t), the energy of the configuration at rest
         (½pᵀM⁻¹p and V(q) for mechanical systems). The conservation verdicts measure energy
         errors against the mean of T."""
-        return _core.energy_terms(self.model._core, self.t, self.q, self.p)
+        return _core.energy_terms(self.model._core, *self._arrays())
 
     def constraint_residuals(self) -> tuple[np.ndarray, np.ndarray]:
         """|g(q)|∞ and |G(q)M⁻¹p|∞ at each saved state of a constrained model, shapes (N,)."""
-        return _core.constraint_residuals(self.model._core, self.q, self.p)[0]
+        return _core.constraint_residuals(self.model._core, *self._arrays()[1:])[0]
+
+    def _arrays(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(t, q, p) as arrays (read now from a file loaded lazily)."""
+        return np.asarray(self.t), np.asarray(self.q), np.asarray(self.p)
 
     def __len__(self) -> int:
         return len(self.t)
@@ -145,7 +152,9 @@ def _model_of(
     return model, q0, p0
 
 
-def _initial_state(model: Model, q0: ArrayLike | None, p0: ArrayLike | None, v0: ArrayLike | None, t0: float) -> tuple[np.ndarray, np.ndarray]:
+def _initial_state(
+    model: Model, q0: ArrayLike | None, p0: ArrayLike | None, v0: ArrayLike | None, t0: float
+) -> tuple[np.ndarray, np.ndarray]:
     """(q0, p0) checked, p0 from the velocities v0 (p0 = ∂L/∂q̇(q0, v0, t0)) when given instead."""
     n = model.dim
     if q0 is None:
@@ -195,23 +204,26 @@ def _newton(tolerance: float, max_iterations: int) -> tuple[float, int]:
 
 
 def integrate(
-    model: Model | Scene,
+    model: Model | Scene | Trajectory,
     q0: ArrayLike | None = None,
     p0: ArrayLike | None = None,
     *,
     v0: ArrayLike | None = None,
-    dt: float,
+    dt: float | None = None,
     steps: int | None = None,
     t_end: float | None = None,
     method: str | None = None,
     save_every: int = 1,
     compensated: bool = True,
     max_energy_error: float | None | Literal["auto"] = "auto",
-    t0: float = 0.0,
+    t0: float | None = None,
     newton_tolerance: float = 1e-14,
     newton_max_iterations: int = 50,
     parameters: Mapping[Any, float] | None = None,
     progress: bool | None = None,
+    output: str | os.PathLike[str] | None = None,
+    overwrite: bool = False,
+    checkpoint_every: int | datetime.timedelta | None = None,
 ) -> Trajectory:
     """Integrate ``model`` from (q0, p0) with a fixed step.
 
@@ -219,7 +231,12 @@ def integrate(
     ----------
     model:
         A :class:`~varmech.MechanicalSystem`, a native model, or a :class:`~varmech.scenes.Scene`
-        (whose initial state is then the default).
+        (whose initial state is then the default). Or a :class:`Trajectory`: the run goes on
+        from its last state for ``steps`` more steps (or to ``t_end``), bit for bit as if it had
+        never stopped (its checkpoint carries the compensated-summation carries, the Newton
+        predictors and every other part of the method's state); the method, step, summation,
+        Newton options and energy check are the trajectory's, and the result starts with its
+        last state.
     q0, p0, v0:
         Initial positions and momenta, arrays (n,); give the velocities ``v0`` instead of
         ``p0`` to start from p0 = ∂L/∂q̇(q0, v0, t0) (M v0 for mechanical systems).
@@ -246,7 +263,7 @@ def integrate(
         number is refused there). ``None``: no energy check; non-finite states still stop the
         run. The check costs one energy evaluation per saved state.
     t0:
-        The initial time.
+        The initial time (default 0).
     newton_tolerance, newton_max_iterations:
         The implicit methods' Newton iteration stops when its correction is below
         ``newton_tolerance``·‖δq‖∞ (δq the step's increment) or stalls at round-off, and fails
@@ -260,11 +277,22 @@ def integrate(
         Show a progress bar (tqdm, on stderr: steps, steps/s, time left) once the run has taken a
         second. ``None`` (default): only when stderr is a terminal. It is updated at the stride
         of the Ctrl-C check (every 10–40 ms), so it costs the step loop nothing measurable.
+    output, overwrite:
+        Stream the saved states to the HDF5 file ``output`` (h5py, the extra ``io``; layout in
+        :mod:`varmech.files`) as the run goes, in segments of about two seconds, each committed
+        with its checkpoint; memory stays flat whatever the number of steps. The result reads
+        lazily from the file. A run stopped by Ctrl-C, an error or a kill leaves a valid file
+        with every committed state, from which :func:`varmech.resume` goes on. An existing file
+        is refused unless ``overwrite``.
+    checkpoint_every:
+        With ``output``: commit states and a checkpoint at least every this many steps (rounded
+        down to whole ``save_every`` periods), or every :class:`datetime.timedelta` of run time.
 
     Raises
     ------
     ValueError
-        Malformed arguments; the message starts with the argument's name. Also a
+        Malformed arguments; the message starts with the argument's name (``output`` for a file
+        that cannot be written or exists without ``overwrite``). Also a
         :class:`~varmech.Lagrangian` declared time-independent whose L changes with t at the
         initial state (probed at a few times), naming ``time_dependent``.
     DivergenceError
@@ -279,6 +307,12 @@ def integrate(
         An exception raised by a closure (or KeyboardInterrupt) propagates unchanged, with
         ``err.partial``, ``err.step`` and ``err.time`` attached where the exception allows.
     """
+    if isinstance(model, Trajectory):
+        given = {"q0": q0, "p0": p0, "v0": v0, "dt": dt, "method": method, "t0": t0, "parameters": parameters}
+        named = [name for name, value in given.items() if value is not None]
+        if named:
+            raise ValueError(f"{named[0]}: a continued run keeps its trajectory's {', '.join(named)}")
+        return _go_on(model, steps, t_end, save_every, progress, output, overwrite, checkpoint_every)
     model, q0, p0 = _model_of(model, q0, p0, v0)
     if parameters is not None:
         if not isinstance(parameters, Mapping):
@@ -287,8 +321,10 @@ def integrate(
         model = model.with_parameters(**{str(name): value for name, value in parameters.items()})
     if method is None:
         method = model.kind.default_method
+    if dt is None:
+        raise ValueError("dt: the step is required")
     dt = positive("dt", dt)
-    t0 = finite("t0", t0)
+    t0 = 0.0 if t0 is None else finite("t0", t0)
     nsteps = _steps(dt, t0, steps, t_end)
     save_every = positive_int("save_every", save_every)
     threshold = _energy_threshold(model, max_energy_error)
@@ -298,14 +334,14 @@ def integrate(
     t_end = t0 + nsteps * dt
     probes = (t0, t0 + dt, t0 + 0.5, t0 + 1.0, t0 + 0.37 * (t_end - t0), t_end)
     _check_time_independent(model, q, p, tuple(s for s in probes if math.isfinite(s)))
-    bar = progress_bar(total=nsteps, unit="step", desc=method, enabled=progress)
-    try:
-        record = _core.integrate(
+
+    def first(steps: int, report: Callable[[int], None] | None) -> _core.TrajectoryRecord:
+        return _core.integrate(
             model._core,
             q,
             p,
             dt=dt,
-            steps=nsteps,
+            steps=steps,
             method=method,
             save_every=save_every,
             compensated=bool(compensated),
@@ -313,15 +349,106 @@ def integrate(
             t0=t0,
             newton_tolerance=newton_tolerance,
             newton_max_iterations=newton_max_iterations,
-            progress=None if bar.disable else lambda steps: bar.update(steps - bar.n),
+            progress=report,
         )
-        bar.update(record.steps - bar.n)
-    except BaseException as err:
-        partial = getattr(err, "_varmech_partial", None)
-        if partial is not None:
-            delattr(err, "_varmech_partial")
-            err.partial = _trajectory(partial, model, method, dt, status=-1, message=str(err))  # type: ignore[attr-defined]
-        raise
+
+    return _run(first, None, 0, model, method, dt, nsteps, save_every, progress, output, overwrite, checkpoint_every)
+
+
+def _go_on(
+    traj: Trajectory,
+    steps: int | None,
+    t_end: float | None,
+    save_every: int,
+    progress: bool | None,
+    output: str | os.PathLike[str] | None,
+    overwrite: bool,
+    checkpoint_every: int | datetime.timedelta | None,
+) -> Trajectory:
+    """``integrate(traj, steps=)``: the run of ``traj`` continued from its checkpoint."""
+    if traj.checkpoint is None:
+        raise ValueError("model: this trajectory has no checkpoint to go on from (it failed before its first state)")
+    nsteps = _steps(traj.dt, float(traj.t[-1]), steps, t_end)
+    save_every = positive_int("save_every", save_every)
+    return _run(
+        None,
+        traj.checkpoint,
+        traj.steps,
+        traj.model,
+        traj.method,
+        traj.dt,
+        nsteps,
+        save_every,
+        progress,
+        output,
+        overwrite,
+        checkpoint_every,
+    )
+
+
+def _run(
+    first: Callable[[int, Callable[[int], None] | None], _core.TrajectoryRecord] | None,
+    checkpoint: bytes | None,
+    base: int,
+    model: Model,
+    method: str,
+    dt: float,
+    nsteps: int,
+    save_every: int,
+    progress: bool | None,
+    output: str | os.PathLike[str] | None,
+    overwrite: bool,
+    checkpoint_every: int | datetime.timedelta | None,
+) -> Trajectory:
+    """Runs ``nsteps`` steps by ``first`` (a new run) or from ``checkpoint`` (after ``base``
+    steps): in memory, or streamed to ``output`` in segments (:mod:`varmech.streaming`)."""
+    from . import streaming
+
+    bar = progress_bar(total=nsteps, unit="step", desc=method, enabled=progress)
+    try:
+        if output is not None:
+            target = files.writable(output, bool(overwrite), "output")
+            streaming.checkpoint_period(checkpoint_every, save_every)
+            columns = files.columns_of(model, method)
+            writer = files.Writer(
+                target, model=model, method=method, dt=dt, columns=columns, save_every=save_every, argument="output"
+            )
+            try:
+                streaming.stream(
+                    first,
+                    writer,
+                    model,
+                    checkpoint=checkpoint,
+                    base=base,
+                    steps=nsteps,
+                    save_every=save_every,
+                    checkpoint_every=checkpoint_every,
+                    bar=bar,
+                )
+            except BaseException as err:
+                err.partial = files.load(target, model=model, lazy=True)  # type: ignore[attr-defined]
+                raise
+            return files.load(target, model=model, lazy=True)
+        if checkpoint_every is not None:
+            raise ValueError("checkpoint_every: checkpoints are written to a file; pass output=")
+
+        def report(steps: int) -> None:
+            bar.update(steps - base - bar.n)
+
+        shown = None if bar.disable else report
+        try:
+            if checkpoint is None:
+                assert first is not None
+                record = first(nsteps, shown)
+            else:
+                record = _core.resume(model._core, checkpoint, steps=nsteps, save_every=save_every, progress=shown)
+            bar.update(record.steps - base - bar.n)
+        except BaseException as err:
+            partial = getattr(err, "_varmech_partial", None)
+            if partial is not None:
+                delattr(err, "_varmech_partial")
+                err.partial = _trajectory(partial, model, method, dt, status=-1, message=str(err))  # type: ignore[attr-defined]
+            raise
     finally:
         bar.close()
     return _trajectory(record, model, method, dt)
@@ -330,7 +457,20 @@ def integrate(
 def _trajectory(record: _core.TrajectoryRecord, model: Model, method: str, dt: float, **status: Any) -> Trajectory:
     """The Trajectory of the binding's record of a run."""
     r = record
-    return Trajectory(r.t, r.q, r.p, model, method, dt, r.steps, r.force_evaluations, r.newton, r.work, **status)
+    return Trajectory(
+        r.t,
+        r.q,
+        r.p,
+        model,
+        method,
+        dt,
+        r.steps,
+        r.force_evaluations,
+        r.newton,
+        r.work,
+        checkpoint=r.checkpoint,
+        **status,
+    )
 
 
 def symplecticity_defect(model: Model, method: str, q: ArrayLike, p: ArrayLike, dt: float) -> float:

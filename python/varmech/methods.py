@@ -14,6 +14,14 @@ def methods() -> list[MethodInfo]:
     return _core.methods()
 
 
+def method_info(name: str) -> MethodInfo:
+    """The facts of the method called ``name``; ValueError naming ``method`` for another name."""
+    for m in _core.methods():
+        if m.name == name:
+            return m
+    raise ValueError(f"method: no method {name!r}; see varmech.methods()")
+
+
 def format_table() -> str:
     """The methods as a Markdown table."""
     rows = [

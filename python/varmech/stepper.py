@@ -175,15 +175,26 @@ class Stepper:
         """Work done by the non-conservative forces so far (0 without forces)."""
         return self._stepper.work
 
+    def checkpoint(self) -> bytes:
+        """The stepper's whole state as bytes: :meth:`from_checkpoint` rebuilds a stepper that
+        goes on bit for bit (its method's caches, Newton predictor and compensated-summation
+        carries included). A run's last checkpoint is :attr:`Trajectory.checkpoint`."""
+        return bytes(self._stepper.checkpoint())
+
+    @classmethod
+    def from_checkpoint(cls, model: Model | Scene, checkpoint: bytes) -> Stepper:
+        """The stepper of ``model`` at the state of ``checkpoint`` (from :meth:`checkpoint`, or a
+        trajectory's :attr:`~Trajectory.checkpoint`); ValueError naming ``checkpoint`` for bytes
+        that are not one, or ``model``/``method`` for a model it does not fit."""
+        model, _, _ = _model_of(model, None, None, None)
+        stepper = cls.__new__(cls)
+        stepper._model = model
+        stepper._stepper = _core.Stepper.from_checkpoint(model._core, bytes(checkpoint))
+        return stepper
+
     def __reduce__(self) -> tuple[object, ...]:
-        # The core's state (the method's caches, Newton predictor and compensated-summation
-        # carries) has no serialised form yet; a stepper rebuilt from (t, q, p) alone would not
-        # continue bit for bit, so pickling refuses rather than resume approximately.
-        raise TypeError(
-            "cannot pickle a Stepper: its state (compensated-summation carries, Newton predictor) has no "
-            "serialised form; pickle its model and (stepper.t, stepper.q, stepper.p) and start a new Stepper, "
-            "which continues the run but not bit for bit"
-        )
+        # By its model and checkpoint: the unpickled stepper goes on bit for bit.
+        return (Stepper.from_checkpoint, (self._model, self.checkpoint()))
 
     def __repr__(self) -> str:
         return f"Stepper({self._model.name!r}, method={self.method!r}, dt={self.dt:g}, t={self.t:g}, steps={self.steps})"

@@ -4,9 +4,10 @@
 use numpy::PyReadonlyArray1;
 use pyo3::prelude::*;
 use varmech::diagnostics;
-use varmech::integrators::{self, Counting, Method, NewtonOptions, Options};
+use varmech::integrators::{self, Checkpoint, Counting, Failure, Method, NewtonOptions, Options, Trajectory};
+use varmech::ModelError;
 
-use crate::bind::bind_model;
+use crate::bind::{bind_model, Poll};
 use crate::convert::{count, slice};
 use crate::errors::{boxed, failure_to_pyerr, to_pyerr};
 use crate::trajectory::TrajectoryRecord;
@@ -47,17 +48,43 @@ fn integrate<'py>(
         newton,
     };
     let (q0, p0) = (slice("q0", &q0)?, slice("p0", &p0)?);
-    // `progress(steps)` is called at the Ctrl-C check's stride, after it.
     let result = bind_model(py, model, |sys, poll| {
-        let report = |steps: usize| {
-            poll()?;
-            match &progress {
-                Some(progress) => Python::attach(|py| progress.call1(py, (steps,)).map(drop)).map_err(boxed),
-                None => Ok(()),
-            }
-        };
-        integrators::integrate(sys, method, q0, p0, &options, Counting(report))
+        integrators::integrate(sys, method, q0, p0, &options, reporting(poll, &progress))
     })?;
+    record(py, result)
+}
+
+/// Goes on from a run's checkpoint for `steps` more steps (see [`integrators::resume`]).
+#[pyfunction]
+#[pyo3(signature = (model, checkpoint, *, steps, save_every=1, progress=None))]
+fn resume<'py>(
+    py: Python<'py>,
+    model: &Bound<'py, PyAny>,
+    checkpoint: &[u8],
+    #[pyo3(from_py_with = steps_count)] steps: usize,
+    #[pyo3(from_py_with = save_every_count)] save_every: usize,
+    progress: Option<Py<PyAny>>,
+) -> PyResult<TrajectoryRecord> {
+    let checkpoint = Checkpoint::from_bytes(checkpoint).map_err(|e| to_pyerr(py, e))?;
+    let result = bind_model(py, model, |sys, poll| {
+        integrators::resume(sys, checkpoint, steps, save_every, reporting(poll, &progress))
+    })?;
+    record(py, result)
+}
+
+/// The poll of a run: the Ctrl-C check, then `progress(steps)` if given.
+fn reporting<'a>(poll: Poll<'a>, progress: &'a Option<Py<PyAny>>) -> Counting<impl FnMut(usize) -> Result<(), ModelError> + 'a> {
+    Counting(move |steps: usize| {
+        poll()?;
+        match progress {
+            Some(progress) => Python::attach(|py| progress.call1(py, (steps,)).map(drop)).map_err(boxed),
+            None => Ok(()),
+        }
+    })
+}
+
+/// The record of a run, or its error with the partial trajectory.
+fn record(py: Python<'_>, result: Result<Trajectory, Box<Failure>>) -> PyResult<TrajectoryRecord> {
     match result {
         Ok(traj) => TrajectoryRecord::new(py, traj),
         Err(failure) => Err(failure_to_pyerr(py, *failure)),
@@ -164,6 +191,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<TrajectoryRecord>()?;
     m.add_class::<MethodInfo>()?;
     m.add_function(wrap_pyfunction!(integrate, m)?)?;
+    m.add_function(wrap_pyfunction!(resume, m)?)?;
     m.add_function(wrap_pyfunction!(symplecticity_defect, m)?)?;
     m.add_function(wrap_pyfunction!(methods, m)?)?;
     Ok(())

@@ -3,7 +3,8 @@
 
 use numpy::{PyArray1, PyReadonlyArray1};
 use pyo3::prelude::*;
-use varmech::integrators::{self, Dynamics, Method, NewtonOptions, Options, StepperState};
+use pyo3::types::PyBytes;
+use varmech::integrators::{self, Checkpoint, Dynamics, Method, NewtonOptions, Options, StepperState};
 use varmech::Error;
 
 use crate::bind::{bind_model, Poll};
@@ -71,6 +72,25 @@ impl Stepper {
         let (q0, p0) = (slice("q0", &q0)?, slice("p0", &p0)?);
         let state = bind_model(py, model, |sys, _| {
             integrators::Stepper::new(sys, method, q0, p0, &options).map(integrators::Stepper::into_state)
+        })?
+        .map_err(|e| to_pyerr(py, e))?;
+        Ok(Stepper {
+            model: model.clone().unbind(),
+            state,
+        })
+    }
+
+    /// The stepper's whole state as bytes (see [`Checkpoint`]).
+    fn checkpoint<'py>(&self, py: Python<'py>) -> Bound<'py, PyBytes> {
+        PyBytes::new(py, &Checkpoint::of(&self.state).to_bytes())
+    }
+
+    /// The stepper of `model` at the state of `checkpoint` (from `checkpoint()`, or a run's).
+    #[staticmethod]
+    fn from_checkpoint<'py>(py: Python<'py>, model: &Bound<'py, PyAny>, checkpoint: &[u8]) -> PyResult<Self> {
+        let state = Checkpoint::from_bytes(checkpoint).map_err(|e| to_pyerr(py, e))?.into_state();
+        let state = bind_model(py, model, |sys, _| {
+            integrators::Stepper::resume(sys, state).map(integrators::Stepper::into_state)
         })?
         .map_err(|e| to_pyerr(py, e))?;
         Ok(Stepper {

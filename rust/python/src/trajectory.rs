@@ -3,6 +3,7 @@
 use numpy::{PyArray1, PyArray2, PyUntypedArrayMethods};
 
 use pyo3::prelude::*;
+use pyo3::types::PyBytes;
 use varmech::integrators::Trajectory;
 
 use crate::convert::matrix;
@@ -11,7 +12,8 @@ use crate::convert::matrix;
 /// `q` and momenta `p` (N, n), the steps completed and force evaluations made, and at each
 /// saved state the cumulative Newton iterations `newton` and work of the non-conservative
 /// forces `work` (N,). A run without Newton iterations or forces stores neither; the getters
-/// then return zeros, made when asked for.
+/// then return zeros, made when asked for. `checkpoint` is the last state's, as bytes, for
+/// `resume`.
 #[pyclass(frozen, module = "varmech._core")]
 pub struct TrajectoryRecord {
     #[pyo3(get)]
@@ -26,6 +28,8 @@ pub struct TrajectoryRecord {
     force_evaluations: u64,
     newton: Option<Py<PyArray1<u64>>>,
     work: Option<Py<PyArray1<f64>>>,
+    #[pyo3(get)]
+    checkpoint: Py<PyBytes>,
 }
 
 /// The recorded column, or None when the run recorded none (an empty vector).
@@ -44,6 +48,7 @@ impl TrajectoryRecord {
             force_evaluations: traj.force_evaluations,
             newton: recorded(py, traj.newton),
             work: recorded(py, traj.work),
+            checkpoint: PyBytes::new(py, &traj.checkpoint).unbind(),
         })
     }
 

@@ -1,0 +1,174 @@
+"""Runs in segments: streamed to a file with checkpoints (``integrate(output=)``), and resumed
+from one (:func:`resume`).
+
+A long run is cut into segments of whole saving periods; each goes on from the last one's
+checkpoint (``_core.resume``), so the states are those of one uninterrupted run, bit for bit.
+After a segment its rows and checkpoint are appended to the file and committed
+(:class:`varmech.files.Writer`) and dropped from memory, so memory stays flat whatever the
+length of the run. A segment lasts at most ``checkpoint_every`` (steps, or a
+:class:`datetime.timedelta` of run time) and by default about :data:`SEGMENT_SECONDS`.
+"""
+
+from __future__ import annotations
+
+import datetime
+import math
+import os
+import time
+from collections.abc import Callable
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from . import _core, files
+from ._progress import progress_bar
+from .integrate import Trajectory, _steps
+from .model import Model
+
+if TYPE_CHECKING:
+    from tqdm import tqdm
+
+#: The default length of a segment in run time: what a crash can lose.
+SEGMENT_SECONDS = 2.0
+#: Saved states kept in memory at most between two appends.
+SEGMENT_ROWS = 4 * files.CHUNK_ROWS
+
+Progress = Callable[[int], None] | None
+#: The first segment: ``first(steps, progress)`` runs it and returns the binding's record.
+First = Callable[[int, Progress], Any]
+
+
+def checkpoint_period(checkpoint_every: int | datetime.timedelta | None, save_every: int) -> tuple[int | None, float]:
+    """(the largest segment in steps, the target segment in seconds) of ``checkpoint_every``:
+    a number of steps (rounded down to whole saving periods, at least one), or a duration."""
+    if checkpoint_every is None:
+        return None, SEGMENT_SECONDS
+    if isinstance(checkpoint_every, datetime.timedelta):
+        seconds = checkpoint_every.total_seconds()
+        if not seconds > 0:
+            raise ValueError(f"checkpoint_every: must be a positive duration, got {checkpoint_every}")
+        return None, seconds
+    if isinstance(checkpoint_every, bool) or not isinstance(checkpoint_every, int) or checkpoint_every < 1:
+        raise ValueError(
+            f"checkpoint_every: must be a number of steps ≥ 1 or a datetime.timedelta, got {checkpoint_every!r}"
+        )
+    return max(save_every, checkpoint_every // save_every * save_every), float("inf")
+
+
+def stream(
+    first: First | None,
+    writer: files.Writer,
+    model: Model,
+    *,
+    checkpoint: bytes | None,
+    base: int,
+    steps: int,
+    save_every: int,
+    checkpoint_every: int | datetime.timedelta | None,
+    bar: tqdm[Any],
+) -> None:
+    """Runs ``steps`` steps in segments appended to ``writer``: the first by ``first`` (a new
+    run) or from ``checkpoint`` (after ``base`` steps), every other from the last checkpoint. Closes the file with the
+    run's status; an exception stops the run with every state up to it committed, and closes
+    the file saying why."""
+    cap, seconds = checkpoint_period(checkpoint_every, save_every)
+    done, rate = 0, None
+    segment = files.CHUNK_ROWS * save_every
+
+    def report(s: int) -> None:
+        bar.update(s - base - bar.n)
+
+    try:
+        while True:
+            left = steps - done
+            if rate is not None and math.isfinite(seconds):
+                segment = max(save_every, int(rate * seconds) // save_every * save_every)
+            take = min(left, segment, SEGMENT_ROWS * save_every, cap or left)
+            started = time.perf_counter()
+            try:
+                if checkpoint is None:
+                    assert first is not None
+                    record = first(take, None if bar.disable else report)
+                else:
+                    record = _core.resume(
+                        model._core,
+                        checkpoint,
+                        steps=take,
+                        save_every=save_every,
+                        progress=None if bar.disable else report,
+                    )
+            except BaseException as err:
+                partial = getattr(err, "_varmech_partial", None)
+                if partial is not None:
+                    delattr(err, "_varmech_partial")
+                    writer.append(partial, skip_first=checkpoint is not None or writer.rows > 0)
+                writer.close(-1, str(err) or type(err).__name__)
+                raise
+            elapsed = time.perf_counter() - started
+            writer.append(record, skip_first=checkpoint is not None or writer.rows > 0)
+            checkpoint = record.checkpoint
+            done += take
+            bar.update(record.steps - base - bar.n)
+            if elapsed > 0:
+                rate = take / elapsed
+            if done >= steps:
+                break
+    except BaseException:
+        if writer.is_open:
+            writer.abandon()
+        raise
+    writer.close(0, "The integration reached its final time.")
+
+
+def resume(
+    path: str | os.PathLike[str],
+    *,
+    steps: int | None = None,
+    t_end: float | None = None,
+    save_every: int | None = None,
+    checkpoint_every: int | datetime.timedelta | None = None,
+    progress: bool | None = None,
+) -> Trajectory:
+    """Goes on with the run in the file ``path`` (from ``integrate(output=)``, or
+    :meth:`Trajectory.save`) for ``steps`` more steps or to ``t_end``, appending to the file.
+
+    The run goes on from the file's last committed checkpoint, so the states are those of one
+    run of the whole length, bit for bit, whether the run ended, failed, was stopped by Ctrl-C,
+    or was killed. ``save_every`` is the file's by default (its saving period).
+
+    Returns the whole run, read lazily from the file (see :func:`varmech.load`).
+
+    Examples
+    --------
+    >>> import tempfile, pathlib, numpy as np, varmech
+    >>> s = varmech.scenes.kepler()
+    >>> path = pathlib.Path(tempfile.mkdtemp()) / "kepler.h5"
+    >>> _ = varmech.integrate(s, dt=s.dt, steps=100, save_every=10, output=path)
+    >>> traj = varmech.resume(path, steps=50)
+    >>> once = varmech.integrate(s, dt=s.dt, steps=150, save_every=10)
+    >>> traj.steps, bool(np.array_equal(traj.q, once.q))
+    (150, True)
+    """
+    stored = files.load(path, lazy=True)
+    if stored.checkpoint is None:
+        raise ValueError(f"path: {str(path)!r} has no checkpoint to resume from")
+    t_now = float(stored.t[-1])
+    more = _steps(stored.dt, t_now, steps, t_end)
+    if save_every is None:
+        save_every = files.save_every_of(path)
+    writer = files.Writer.reopen(Path(path), stored)
+    bar = progress_bar(total=more, unit="step", desc=stored.method, enabled=progress)
+    try:
+        stream(
+            None,
+            writer,
+            stored.model,
+            checkpoint=stored.checkpoint,
+            base=stored.steps,
+            steps=more,
+            save_every=save_every,
+            checkpoint_every=checkpoint_every,
+            bar=bar,
+        )
+    finally:
+        bar.close()
+    return files.load(path, model=stored.model, lazy=True)

@@ -1,0 +1,233 @@
+"""Long runs: continued in memory, streamed to a file, resumed from it, bit for bit with one
+uninterrupted run; files left by Ctrl-C and SIGKILL load and resume; bad input is named."""
+
+import os
+import signal
+import subprocess
+import sys
+import textwrap
+import time
+
+import h5py
+import numpy as np
+import pytest
+
+import varmech
+from varmech import scenes
+
+N, M, EVERY = 100, 150, 17
+
+
+def _same(a, b):
+    a, b = np.asarray(a), np.asarray(b)
+    return a.shape == b.shape and np.array_equal(a.view(np.uint64), b.view(np.uint64))
+
+
+def _routh():
+    scene = scenes.kepler_polar()
+    reduced = varmech.routh(scene)
+    x0, px0 = reduced.reduce(scene.q0, scene.p0)
+    return reduced, x0, px0, 0.01, "midpoint"
+
+
+def _case(name):
+    if name == "routh":
+        return _routh()
+    scene, method = {
+        "verlet": (scenes.kepler(0.6), "verlet"),
+        "kahan_li8": (scenes.kepler(0.6), "kahan_li8"),
+        "midpoint": (scenes.double_pendulum(), "midpoint"),
+        "galerkin4": (scenes.double_pendulum(), "galerkin4"),
+        "rattle": (scenes.cartesian_pendulum(), "rattle"),
+    }[name]
+    return scene.model, scene.q0, scene.p0, scene.dt, method
+
+
+FAMILIES = ["verlet", "kahan_li8", "midpoint", "galerkin4", "rattle", "routh"]
+
+
+def _assert_continues(whole, parts):
+    """The states of ``parts`` (runs one after another, each starting with the last one's final
+    state) are ``whole``'s at the same times, and they end on its final state and counts."""
+    t = np.asarray(whole.t)
+    for part in parts:
+        rows = np.searchsorted(t, np.asarray(part.t))
+        on_whole = (rows < len(t)) & (t[np.minimum(rows, len(t) - 1)] == np.asarray(part.t))
+        for name in ("q", "p"):
+            assert _same(np.asarray(getattr(part, name))[on_whole], np.asarray(getattr(whole, name))[rows[on_whole]]), (
+                name
+            )
+    last = parts[-1]
+    assert _same(last.q[-1], whole.q[-1]) and _same(last.p[-1], whole.p[-1])
+    assert _same(last.energy()[-1:], whole.energy()[-1:])
+    assert (last.steps, last.newton_iterations) == (whole.steps, whole.newton_iterations)
+
+
+@pytest.mark.parametrize("family", FAMILIES)
+def test_save_load_and_go_on_is_one_run_to_the_bit(tmp_path, family):
+    model, q0, p0, dt, method = _case(family)
+    whole = varmech.integrate(model, q0, p0, dt=dt, steps=N + M, save_every=EVERY, method=method)
+    first = varmech.integrate(model, q0, p0, dt=dt, steps=N, save_every=EVERY, method=method)
+    # In memory, and through a file.
+    _assert_continues(whole, [first, varmech.integrate(first, steps=M, save_every=EVERY)])
+    loaded = varmech.load(first.save(tmp_path / "first.h5"))
+    _assert_continues(whole, [loaded, varmech.integrate(loaded, steps=M, save_every=EVERY)])
+    resumed = varmech.resume(tmp_path / "first.h5", steps=M, save_every=EVERY)
+    _assert_continues(whole, [resumed])
+
+
+@pytest.mark.parametrize("family", ["verlet", "midpoint", "rattle"])
+def test_a_streamed_run_is_the_run_in_memory(tmp_path, family):
+    model, q0, p0, dt, method = _case(family)
+    whole = varmech.integrate(model, q0, p0, dt=dt, steps=N + M, save_every=EVERY, method=method)
+    # Segments of two saving periods: 8 segments, each from the last one's checkpoint.
+    streamed = varmech.integrate(
+        model,
+        q0,
+        p0,
+        dt=dt,
+        steps=N + M,
+        save_every=EVERY,
+        method=method,
+        output=tmp_path / "s.h5",
+        checkpoint_every=2 * EVERY,
+    )
+    assert isinstance(streamed.q, varmech.files.Rows)
+    for name in ("t", "q", "p"):
+        assert _same(getattr(streamed, name), getattr(whole, name)), name
+    np.testing.assert_array_equal(streamed.newton_iterations_per_step, whole.newton_iterations_per_step)
+    assert (streamed.steps, streamed.nfev, streamed.status) == (whole.steps, whole.nfev, 0)
+    with h5py.File(tmp_path / "s.h5") as f:
+        assert f.attrs["complete"] and f.attrs["save_every"] == EVERY
+
+
+def test_resume_goes_on_in_the_same_file(tmp_path):
+    s = scenes.kepler()
+    path = tmp_path / "k.h5"
+    varmech.integrate(s, dt=s.dt, steps=10 * EVERY, save_every=EVERY, output=path)
+    traj = varmech.resume(path, t_end=s.dt * 25 * EVERY)
+    whole = varmech.integrate(s, dt=s.dt, steps=25 * EVERY, save_every=EVERY)
+    # On the cadence, the file holds exactly the states of one run.
+    for name in ("t", "q", "p"):
+        assert _same(getattr(traj, name), getattr(whole, name)), name
+    assert traj.steps == 25 * EVERY and traj.status == 0
+
+
+RUN = """
+import sys, varmech
+s = varmech.scenes.kepler()
+print("started", flush=True)
+varmech.integrate(s, dt=1e-3, steps=10**10, save_every=1000, output=sys.argv[1], checkpoint_every=10**5)
+"""
+
+
+def _start(path):
+    proc = subprocess.Popen(
+        [sys.executable, "-c", textwrap.dedent(RUN), str(path)],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    assert proc.stdout.readline().strip() == "started"
+    deadline = time.monotonic() + 60
+    # Until a few segments are committed.
+    while time.monotonic() < deadline:
+        time.sleep(0.2)
+        try:
+            with h5py.File(path, "r", swmr=True) as f:
+                if f["committed"][0] >= 500:
+                    return proc
+        except (OSError, KeyError):
+            pass
+    proc.kill()
+    pytest.fail("the run committed nothing in 60 s")
+
+
+def _check_left_file(path, status, message):
+    traj = varmech.load(path)
+    assert traj.status == status and message in traj.message
+    # Killed: the committed rows, on the saving cadence. Stopped: and the last good state.
+    cadence = len(traj.t) - (traj.steps % 1000 != 0)
+    assert cadence > 500 and (cadence - 1) * 1000 <= traj.steps < (cadence + 1) * 1000
+    s = scenes.kepler()
+    # Every committed state is the uninterrupted run's, and the run resumes from the last.
+    whole = varmech.integrate(s, dt=1e-3, steps=traj.steps + 5000, save_every=1000)
+    assert _same(traj.q[:cadence], whole.q[:cadence]) and _same(traj.p[:cadence], whole.p[:cadence])
+    resumed = varmech.resume(path, steps=5000)
+    _assert_continues(whole, [resumed])
+    assert resumed.status == 0
+
+
+def test_a_run_killed_while_streaming_leaves_a_file_that_loads_and_resumes(tmp_path):
+    path = tmp_path / "killed.h5"
+    proc = _start(path)
+    proc.send_signal(signal.SIGKILL)
+    proc.wait()
+    _check_left_file(path, -1, "without closing its file")
+
+
+def test_a_run_stopped_by_ctrl_c_leaves_a_complete_file(tmp_path):
+    path = tmp_path / "interrupted.h5"
+    proc = _start(path)
+    proc.send_signal(signal.SIGINT)
+    _, err = proc.communicate(timeout=30)
+    assert "KeyboardInterrupt" in err
+    with h5py.File(path) as f:
+        assert f.attrs["complete"]
+    _check_left_file(path, -1, "KeyboardInterrupt")
+
+
+def test_bad_output_and_checkpoint_arguments_are_named(tmp_path):
+    s = scenes.harmonic_oscillator()
+    path = tmp_path / "a.h5"
+    varmech.integrate(s, dt=0.1, steps=10, output=path)
+    with pytest.raises(ValueError, match="^output: .* exists; pass overwrite=True"):
+        varmech.integrate(s, dt=0.1, steps=10, output=path)
+    varmech.integrate(s, dt=0.1, steps=10, output=path, overwrite=True)
+    with pytest.raises(ValueError, match="^output: cannot write .*its directory does not exist"):
+        varmech.integrate(s, dt=0.1, steps=10, output=tmp_path / "no" / "a.h5")
+    with pytest.raises(ValueError, match="^output: .* is a directory"):
+        varmech.integrate(s, dt=0.1, steps=10, output=tmp_path, overwrite=True)
+    if os.geteuid() != 0:  # root writes anywhere
+        locked = tmp_path / "locked"
+        locked.mkdir(mode=0o500)
+        with pytest.raises(ValueError, match="^output: cannot write"):
+            varmech.integrate(s, dt=0.1, steps=10, output=locked / "a.h5")
+    with pytest.raises(ValueError, match="^checkpoint_every: checkpoints are written to a file; pass output="):
+        varmech.integrate(s, dt=0.1, steps=10, checkpoint_every=5)
+    with pytest.raises(ValueError, match="^checkpoint_every: must be"):
+        varmech.integrate(s, dt=0.1, steps=10, output=path, overwrite=True, checkpoint_every=0)
+    traj = varmech.integrate(s, dt=0.1, steps=10)
+    with pytest.raises(ValueError, match="^dt: a continued run keeps its trajectory's dt"):
+        varmech.integrate(traj, dt=0.2, steps=10)
+
+
+def test_a_checkpoint_of_another_model_or_damaged_is_refused(tmp_path):
+    kepler = scenes.kepler()
+    traj = varmech.integrate(kepler, dt=0.01, steps=10)
+    # Another model of the same dimension, which verlet does not integrate.
+    other = varmech.load(traj.save(tmp_path / "k.h5"), model=scenes.double_pendulum().model)
+    with pytest.raises(ValueError, match="^method: "):
+        varmech.integrate(other, steps=10)
+    with pytest.raises(ValueError, match="^model: has dimension"):
+        varmech.load(tmp_path / "k.h5", model=scenes.heavy_top().model)
+    damaged = bytearray(traj.checkpoint)
+    damaged[len(damaged) // 2] ^= 1
+    with pytest.raises(ValueError, match="^checkpoint: damaged or truncated"):
+        varmech.Stepper.from_checkpoint(kepler, bytes(damaged))
+    with pytest.raises(ValueError, match="^checkpoint: not a varmech checkpoint"):
+        varmech.Stepper.from_checkpoint(kepler, b"")
+
+
+def test_a_truncated_or_corrupt_file_is_a_clear_error(tmp_path):
+    s = scenes.kepler()
+    path = varmech.integrate(s, dt=s.dt, steps=10**4, save_every=10).save(tmp_path / "k.h5")
+    data = path.read_bytes()
+    cut = tmp_path / "cut.h5"
+    cut.write_bytes(data[: len(data) // 2])
+    with pytest.raises(ValueError, match="^path: .*(corrupt or truncated|not a varmech)"):
+        varmech.load(cut)
+    garbage = tmp_path / "garbage.h5"
+    garbage.write_bytes(os.urandom(4096))
+    with pytest.raises(ValueError, match="^path: "):
+        varmech.load(garbage)
