@@ -1,6 +1,6 @@
 //! The fixed-step run: a [`Stepper`] advanced to the end, its states saved on the way.
 
-use super::{Counting, Dynamics, Failure, Method, NewtonOptions, Poll, Stepper, Trajectory};
+use super::{Counting, Detector, Dynamics, Failure, Method, NewtonOptions, Poll, Stepper, Trajectory};
 use crate::model::{EnergyTerms, Scale};
 use crate::{memory, Error};
 
@@ -91,7 +91,46 @@ pub fn integrate<S, P>(
     q0: &[f64],
     p0: &[f64],
     options: &Options,
+    poll: P,
+) -> Result<Trajectory, Box<Failure>>
+where
+    S: Dynamics + ?Sized,
+    P: Poll,
+{
+    run(sys, method, q0, p0, options, poll, None)
+}
+
+// Events: the run with a [`Detector`] (begin).
+/// As [`integrate`], watching the `events`' functions after every step (the steps are then
+/// taken one at a time): each crossing is located by a partial step of the method
+/// ([`Detector`]) and pushed to [`Trajectory::events`]. When an event reaches its terminal
+/// count, the run stops at the end of that step, its state saved, with
+/// [`Trajectory::terminated_by`] set.
+pub fn integrate_with_events<S, P>(
+    sys: &S,
+    method: Method,
+    q0: &[f64],
+    p0: &[f64],
+    options: &Options,
+    poll: P,
+    events: &mut Detector<'_>,
+) -> Result<Trajectory, Box<Failure>>
+where
+    S: Dynamics + ?Sized,
+    P: Poll,
+{
+    run(sys, method, q0, p0, options, poll, Some(events))
+}
+// Events (end).
+
+fn run<S, P>(
+    sys: &S,
+    method: Method,
+    q0: &[f64],
+    p0: &[f64],
+    options: &Options,
     mut poll: P,
+    events: Option<&mut Detector<'_>>,
 ) -> Result<Trajectory, Box<Failure>>
 where
     S: Dynamics + ?Sized,
@@ -145,11 +184,27 @@ where
         Some(Ok(watch)) => Some(watch),
         Some(Err(error)) => return Err(fail(error, traj)),
     };
+    // Events: the run's search, its scratch stepper on the same model.
+    let mut search = match events
+        .map(|detector| detector.begin(sys, &stepper, options))
+        .transpose()
+    {
+        Ok(search) => search,
+        Err(error) => return Err(fail(error, traj)),
+    };
 
     while stepper.steps() < steps {
         // Every `save_every`-th state is saved, and the last.
         let save = (stepper.steps() / save_every + 1).saturating_mul(save_every).min(steps);
-        if let Err(error) = stepper.advance(save - stepper.steps(), Counting(|steps| poll.poll(steps))) {
+        let n = save - stepper.steps();
+        let advanced = match search.as_mut() {
+            None => stepper.advance(n, Counting(|steps| poll.poll(steps))),
+            // Events: step by step, stopping after a terminal event's step.
+            Some(search) => search
+                .advance(&mut stepper, n, &mut traj.events, &mut poll)
+                .map(|stop| traj.terminated_by = stop),
+        };
+        if let Err(error) = advanced {
             // Stops with the last good state kept, and the work counted.
             let time = stepper.t();
             if traj.t.last() != Some(&time) {
@@ -165,8 +220,13 @@ where
             traj.count(&stepper);
             return Err(fail(error, traj));
         }
+        if traj.terminated_by.is_some() {
+            break;
+        }
     }
     traj.count(&stepper);
+    // Events: the partial steps' force evaluations are the run's too.
+    traj.force_evaluations += search.map_or(0, |s| s.force_evaluations());
     Ok(traj)
 }
 

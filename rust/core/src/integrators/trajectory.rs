@@ -3,7 +3,7 @@
 use std::borrow::Cow;
 use std::ops::Deref;
 
-use super::{Dynamics, Stepper};
+use super::{Dynamics, Occurrence, Stepper};
 use crate::Error;
 
 /// The saved states of a run: row k is (`t[k]`, `q[k]`, `p[k]`); q and p are stored row-major.
@@ -27,6 +27,10 @@ pub struct Trajectory {
     /// without forces, rather than zeros): the energy balance E(t) − E(0) − W(t) is the discrete
     /// Lagrange–d'Alembert check.
     pub work: Vec<f64>,
+    /// The located event crossings, in order of time ([`super::integrate_with_events`]).
+    pub events: Vec<Occurrence>,
+    /// The event whose terminal count stopped the run, if one did.
+    pub terminated_by: Option<usize>,
 }
 
 impl Trajectory {
