@@ -111,6 +111,12 @@ class TrajectoryRecord:
     @property
     def work(self) -> _FloatArray:
         """Cumulative work of the non-conservative forces at each saved state (zeros without forces)."""
+    @property
+    def events(self) -> tuple[NDArray[np.uint64], _FloatArray, _FloatArray, _FloatArray]:
+        """The located event crossings in order of time: the event's index (k,), t (k,), q and p (k, n)."""
+    @property
+    def terminated_by(self) -> int | None:
+        """The index of the event whose terminal count stopped the run, if one did."""
 
 @final
 class Stepper:
@@ -426,10 +432,14 @@ def integrate(
     newton_tolerance: float = 1e-14,
     newton_max_iterations: int = 50,
     progress: Callable[[int], object] | None = None,
+    events: list[tuple[str, int, int, str, Any]] | None = None,
 ) -> TrajectoryRecord:
     """The saved states; on failure the exception carries ``_varmech_partial``, the
     TrajectoryRecord up to the failure. ``progress(steps)`` is called with the steps completed at
-    the Ctrl-C check's stride; an exception from it stops the run."""
+    the Ctrl-C check's stride; an exception from it stops the run. ``events``: spec tuples
+    (name, direction, terminal count or 0, kind, payload), kind ``"p"``/``"v"`` (payload g(t, q,
+    p) or g(t, q, v)), ``"crossing"`` ((k, value)), ``"energy_error"`` (bound), ``"escape"``,
+    ``"encounter"`` ((radius, groups)); see varmech.events."""
 
 def energy_terms(model: _Model, t: _FloatArray, q: _FloatArray, p: _FloatArray) -> tuple[_FloatArray, _FloatArray, _FloatArray]:
     """(E, T, V) at each state: the energy function p·q̇ − L, its kinetic term E − V and its

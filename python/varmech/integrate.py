@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import math
 import os
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Literal
@@ -13,6 +13,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from . import _core, files
+from . import events as _events
 from ._progress import progress_bar
 from ._util import finite, positive, positive_int, vector
 from .dense import hermite
@@ -30,8 +31,11 @@ class Trajectory:
     ``nfev`` counts force evaluations (for the implicit methods, evaluations of the discrete
     Lagrangian's slot derivatives); ``newton_iterations`` and ``newton_iterations_per_step``
     count the implicit methods' iterations.
-    ``status`` is 0 when the run reached its end, -1 for the partial trajectory attached to an
-    error (``err.partial``); ``message`` says which.
+    ``status`` is 0 when the run reached its end, 1 when a terminal event stopped it (see
+    :mod:`varmech.events`), -1 for the partial trajectory attached to an error
+    (``err.partial``); ``message`` says which. ``events`` holds each event's located crossings
+    (:class:`varmech.events.Occurrences`, one per function given, in that order; empty without
+    events).
     """
 
     t: np.ndarray
@@ -47,6 +51,8 @@ class Trajectory:
     work: np.ndarray | None = field(default=None, repr=False)
     status: int = 0
     message: str = "The integration reached its final time."
+    #: Each event's located crossings (times and states), in the order the events were given.
+    events: tuple[_events.Occurrences, ...] = field(default=(), repr=False)
     _v: np.ndarray | None = field(default=None, repr=False)
 
     @property
@@ -212,6 +218,7 @@ def integrate(
     newton_max_iterations: int = 50,
     parameters: Mapping[Any, float] | None = None,
     progress: bool | None = None,
+    events: Sequence[_events.Event | _events.EventFunction] | None = None,
 ) -> Trajectory:
     """Integrate ``model`` from (q0, p0) with a fixed step.
 
@@ -260,6 +267,15 @@ def integrate(
         Show a progress bar (tqdm, on stderr: steps, steps/s, time left) once the run has taken a
         second. ``None`` (default): only when stderr is a terminal. It is updated at the stride
         of the Ctrl-C check (every 10–40 ms), so it costs the step loop nothing measurable.
+    events:
+        Event functions g(t, q, p) whose zero crossings are located (``traj.events``), as in
+        :func:`scipy.integrate.solve_ivp`: plain functions with optional ``direction`` and
+        ``terminal`` attributes, :class:`varmech.events.Event` (which may take the velocities,
+        g(t, q, v)), or the built-in helpers of :mod:`varmech.events` (evaluated natively).
+        Each crossing is located by a partial step of the method, to round-off; a terminal event
+        stops the run after the step of its crossing with ``status = 1``. The steps are then
+        taken one at a time (a Wisdom–Holman method synchronises, and ``whc`` applies its
+        corrector, at every step).
 
     Raises
     ------
@@ -275,9 +291,14 @@ def integrate(
         ``err.residual``, ``err.iterations`` and ``err.partial`` are attached. Its subclass
         :class:`~varmech.SpuriousBranchError` means Newton converged, but beyond a fold of the
         DEL map where the step's solution is not unique (the step is too large there).
+    TypeError
+        An event function that does not take (t, q, p), naming it (``events[i] (name)``).
+    VarmechError
+        An event function returned a value that is not finite (the message names it).
     Exception
-        An exception raised by a closure (or KeyboardInterrupt) propagates unchanged, with
-        ``err.partial``, ``err.step`` and ``err.time`` attached where the exception allows.
+        An exception raised by a closure or an event function (or KeyboardInterrupt) propagates
+        unchanged, with ``err.partial``, ``err.step`` and ``err.time`` attached where the
+        exception allows.
     """
     model, q0, p0 = _model_of(model, q0, p0, v0)
     if parameters is not None:
@@ -294,6 +315,7 @@ def integrate(
     threshold = _energy_threshold(model, max_energy_error)
     newton_tolerance, newton_max_iterations = _newton(newton_tolerance, newton_max_iterations)
     q, p = _initial_state(model, q0, p0, v0, t0)
+    watched, event_specs = _events.specs(events, model.dim) if events is not None else ([], [])
     # A horizon past the largest float is the core's to refuse (naming dt); probe finite times.
     t_end = t0 + nsteps * dt
     probes = (t0, t0 + dt, t0 + 0.5, t0 + 1.0, t0 + 0.37 * (t_end - t0), t_end)
@@ -314,23 +336,31 @@ def integrate(
             newton_tolerance=newton_tolerance,
             newton_max_iterations=newton_max_iterations,
             progress=None if bar.disable else lambda steps: bar.update(steps - bar.n),
+            events=event_specs or None,
         )
         bar.update(record.steps - bar.n)
     except BaseException as err:
         partial = getattr(err, "_varmech_partial", None)
         if partial is not None:
             delattr(err, "_varmech_partial")
-            err.partial = _trajectory(partial, model, method, dt, status=-1, message=str(err))  # type: ignore[attr-defined]
+            err.partial = _trajectory(partial, model, method, dt, watched, status=-1, message=str(err))  # type: ignore[attr-defined]
         raise
     finally:
         bar.close()
-    return _trajectory(record, model, method, dt)
+    return _trajectory(record, model, method, dt, watched)
 
 
-def _trajectory(record: _core.TrajectoryRecord, model: Model, method: str, dt: float, **status: Any) -> Trajectory:
-    """The Trajectory of the binding's record of a run."""
+def _trajectory(
+    record: _core.TrajectoryRecord, model: Model, method: str, dt: float, events: Sequence[_events.Event] = (), **status: Any
+) -> Trajectory:
+    """The Trajectory of the binding's record of a run, with its events' crossings (and the
+    status of a terminal event's stop, unless `status` is given)."""
     r = record
-    return Trajectory(r.t, r.q, r.p, model, method, dt, r.steps, r.force_evaluations, r.newton, r.work, **status)
+    found = _events.occurrences(r, events)
+    status = status or _events.termination(r, events, found)
+    return Trajectory(
+        r.t, r.q, r.p, model, method, dt, r.steps, r.force_evaluations, r.newton, r.work, events=found, **status
+    )
 
 
 def symplecticity_defect(model: Model, method: str, q: ArrayLike, p: ArrayLike, dt: float) -> float:

@@ -4,17 +4,19 @@
 use numpy::PyReadonlyArray1;
 use pyo3::prelude::*;
 use varmech::diagnostics;
-use varmech::integrators::{self, Counting, Method, NewtonOptions, Options};
+use varmech::integrators::{self, Counting, Detector, Method, NewtonOptions, Options};
 
-use crate::bind::bind_model;
+use crate::bind::{bind_model, dim_of};
 use crate::convert::{count, slice};
 use crate::errors::{boxed, failure_to_pyerr, to_pyerr};
+use crate::events::{EventTuple, Events};
 use crate::trajectory::TrajectoryRecord;
 
 /// Integrates; returns the saved states as a [`TrajectoryRecord`] or raises with
-/// `_varmech_partial`, the states up to the failure.
+/// `_varmech_partial`, the states up to the failure. With `events` (spec tuples, see
+/// [`Events::new`]) the run watches them ([`integrators::integrate_with_events`]).
 #[pyfunction]
-#[pyo3(signature = (model, q0, p0, *, dt, steps, method, save_every=1, compensated=true, max_energy_error=None, t0=0.0, newton_tolerance=1e-14, newton_max_iterations=50, progress=None))]
+#[pyo3(signature = (model, q0, p0, *, dt, steps, method, save_every=1, compensated=true, max_energy_error=None, t0=0.0, newton_tolerance=1e-14, newton_max_iterations=50, progress=None, events=None))]
 #[allow(clippy::too_many_arguments)]
 fn integrate<'py>(
     py: Python<'py>,
@@ -31,6 +33,7 @@ fn integrate<'py>(
     newton_tolerance: f64,
     #[pyo3(from_py_with = newton_max_iterations_count)] newton_max_iterations: usize,
     progress: Option<Py<PyAny>>,
+    events: Option<Vec<EventTuple<'py>>>,
 ) -> PyResult<TrajectoryRecord> {
     let method = Method::from_name(method).map_err(|e| to_pyerr(py, e))?;
     let newton = NewtonOptions {
@@ -47,6 +50,10 @@ fn integrate<'py>(
         newton,
     };
     let (q0, p0) = (slice("q0", &q0)?, slice("p0", &p0)?);
+    let events = match events {
+        Some(tuples) => Some(Events::new(py, tuples, dim_of(py, model)?)?),
+        None => None,
+    };
     // `progress(steps)` is called at the Ctrl-C check's stride, after it.
     let result = bind_model(py, model, |sys, poll| {
         let report = |steps: usize| {
@@ -56,7 +63,16 @@ fn integrate<'py>(
                 None => Ok(()),
             }
         };
-        integrators::integrate(sys, method, q0, p0, &options, Counting(report))
+        match events {
+            None => integrators::integrate(sys, method, q0, p0, &options, Counting(report)),
+            Some((functions, specs)) => {
+                let mut detector = Detector::new(Box::new(functions), specs).map_err(|error| {
+                    let partial = integrators::Trajectory::default();
+                    Box::new(integrators::Failure { error, partial })
+                })?;
+                integrators::integrate_with_events(sys, method, q0, p0, &options, Counting(report), &mut detector)
+            }
+        }
     })?;
     match result {
         Ok(traj) => TrajectoryRecord::new(py, traj),

@@ -22,9 +22,9 @@ pub enum NativeEvent {
 
 impl NativeEvent {
     /// Refuses coordinates outside 0 … n − 1, empty or unequal groups, and radii or bounds
-    /// that are not finite and positive (naming `events`).
-    pub fn check(&self, n: usize) -> Result<(), Error> {
-        let fail = |reason: String| Err(Error::invalid("events", reason));
+    /// that are not finite and positive (naming `events` and the event's `name`).
+    pub fn check(&self, name: &str, n: usize) -> Result<(), Error> {
+        let fail = |reason: String| Err(Error::invalid("events", format!("{name}: {reason}")));
         let positive = |what: &str, x: f64| {
             if x.is_finite() && x > 0.0 {
                 Ok(())
@@ -35,14 +35,14 @@ impl NativeEvent {
         match self {
             NativeEvent::Crossing { coordinate, value } => {
                 if *coordinate >= n {
-                    return fail(format!("crossing: coordinate {coordinate} is not in 0 … {}", n - 1));
+                    return fail(format!("coordinate {coordinate} is not in 0 … {}", n - 1));
                 }
                 if !value.is_finite() {
-                    return fail(format!("crossing: value must be finite, got {value}"));
+                    return fail(format!("value must be finite, got {value}"));
                 }
                 Ok(())
             }
-            NativeEvent::EnergyError { bound, .. } => positive("energy_error: bound", *bound),
+            NativeEvent::EnergyError { bound, .. } => positive("bound", *bound),
             NativeEvent::Escape { radius, groups } | NativeEvent::Encounter { radius, groups } => {
                 positive("radius", *radius)?;
                 let width = groups.first().map_or(0, Vec::len);
