@@ -29,16 +29,19 @@ pub struct TrajectoryRecord {
     /// The located event crossings in order of time: the event's index (k,), t (k,), q and p
     /// (k, n).
     #[pyo3(get)]
-    events: (
-        Py<PyArray1<usize>>,
-        Py<PyArray1<f64>>,
-        Py<PyArray2<f64>>,
-        Py<PyArray2<f64>>,
-    ),
+    events: EventArrays,
     /// The index of the event whose terminal count stopped the run, if one did.
     #[pyo3(get)]
     terminated_by: Option<usize>,
 }
+
+/// Event crossings as arrays: the event's index (k,), t (k,), q and p (k, n).
+type EventArrays = (
+    Py<PyArray1<usize>>,
+    Py<PyArray1<f64>>,
+    Py<PyArray2<f64>>,
+    Py<PyArray2<f64>>,
+);
 
 /// The recorded column, or None when the run recorded none (an empty vector).
 fn recorded<'py, T: numpy::Element>(py: Python<'py>, column: Vec<T>) -> Option<Py<PyArray1<T>>> {
