@@ -59,7 +59,8 @@ def bytes_per_state() -> None:
         traj = varmech.integrate(scene, dt=scene.dt, steps=200_000, save_every=10, method=method, output=path)
         size = path.stat().st_size
         n = scene.model.dim
-        print(f"{name} ({method}, n = {n}): {size / len(traj.t):.1f} bytes per saved state over {len(traj.t)} states (the data alone: {8 * (2 * n + 1) + 8 * (traj.newton is not None)})")
+        data = 8 * (2 * n + 1) + 8 * (traj.newton is not None)
+        print(f"{name} ({method}, n = {n}): {size / len(traj.t):.1f} bytes per saved state over {len(traj.t)} states (data: {data})")
 
 
 BILLION = """

@@ -23,7 +23,7 @@ The measurements (work–precision, energy growth, stability, sections) live in
 import importlib
 from types import ModuleType
 
-from . import _errors, analysis, pointers, scenes
+from . import _errors, analysis, events, pointers, scenes
 from ._core import ConvergenceError, DivergenceError, SpuriousBranchError, VarmechError
 from .analysis import sections, stability
 from .analysis.energy_growth import energy_growth
@@ -77,6 +77,7 @@ __all__ = [
     "check_derivatives",
     "cyclic_coordinates",
     "energy_growth",
+    "events",
     "growth_factor",
     "growth_table",
     "implicit_regions",

@@ -114,6 +114,12 @@ class TrajectoryRecord:
         """Cumulative work of the non-conservative forces at each saved state (zeros without forces)."""
     @property
     def checkpoint(self) -> bytes: ...
+    @property
+    def events(self) -> tuple[NDArray[np.uint64], _FloatArray, _FloatArray, _FloatArray]:
+        """The located event crossings in order of time: the event's index (k,), t (k,), q and p (k, n)."""
+    @property
+    def terminated_by(self) -> int | None:
+        """The index of the event whose terminal count stopped the run, if one did."""
 
 @final
 class Stepper:
@@ -434,10 +440,14 @@ def integrate(
     newton_tolerance: float = 1e-14,
     newton_max_iterations: int = 50,
     progress: Callable[[int], object] | None = None,
+    events: list[tuple[str, int, int, str, Any]] | None = None,
 ) -> TrajectoryRecord:
     """The saved states; on failure the exception carries ``_varmech_partial``, the
     TrajectoryRecord up to the failure. ``progress(steps)`` is called with the steps completed at
-    the Ctrl-C check's stride; an exception from it stops the run."""
+    the Ctrl-C check's stride; an exception from it stops the run. ``events``: spec tuples
+    (name, direction, terminal count or 0, kind, payload), kind ``"p"``/``"v"`` (payload g(t, q,
+    p) or g(t, q, v)), ``"crossing"`` ((k, value)), ``"energy_error"`` (bound), ``"escape"``,
+    ``"encounter"`` ((radius, groups)); see varmech.events."""
 
 def resume(
     model: _Model,

@@ -38,7 +38,7 @@ def momentum(traj: Trajectory, generator: Generator) -> np.ndarray:
 def _momentum_terms(traj: Trajectory, generator: Generator) -> tuple[np.ndarray, np.ndarray]:
     """J = p·ξ(q) and the size Σ|pᵢξᵢ| of its terms at every saved state."""
     if isinstance(generator, (Translation, Rotation, Cyclic)):
-        return _core.momentum(generator.spec(), traj.q, traj.p)
+        return _core.momentum(generator.spec(), *traj._arrays()[1:])
     if not callable(generator):
         raise TypeError(f"generator: expected a Translation, Rotation, Cyclic or a callable xi(q), got {generator!r}")
     n = traj.q.shape[1]
@@ -229,10 +229,10 @@ def check_conservation(traj: Trajectory, generators: Sequence[Generator] | None 
     if generators is None:
         generators = traj.model.symmetries
     model = traj.model
-    t, steps = traj.t, int(traj.steps)
+    t, steps = np.asarray(traj.t), int(traj.steps)
     energy = balance = None
     if not model.time_dependent:
-        stats = energy_statistics(model, t, traj.q, traj.p, steps=steps, work=traj.work if model.forced else None)
+        stats = energy_statistics(model, t, *traj._arrays()[1:], steps=steps, work=np.asarray(traj.work) if model.forced else None)
         if stats.verdict == "failed":
             stats = replace(stats, advice=f"{stats.advice}; {_failure_advice(traj)}")
         energy, balance = (None, stats) if model.forced else (stats, None)
@@ -244,7 +244,7 @@ def check_conservation(traj: Trajectory, generators: Sequence[Generator] | None 
         momenta.append(_statistics(record, name, j[0], "mean Σ|pᵢξᵢ|", t))
     constraints = None
     if model.constraints:
-        (g, v), (g_size, v_size) = _core.constraint_residuals(model._core, traj.q, traj.p)
+        (g, v), (g_size, v_size) = _core.constraint_residuals(model._core, *traj._arrays()[1:])
         constraints = (
             _statistics(_core.statistics(t, g, g_size, g_size, steps), "|g(q)|", g[0], "mean ‖G‖‖q‖", t),
             _statistics(_core.statistics(t, v, v_size, v_size, steps), "|G q̇|", v[0], "mean ‖G‖‖q̇‖", t),

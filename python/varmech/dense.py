@@ -53,7 +53,7 @@ def hermite(traj: Trajectory, t: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
     h00, h10 = (1 + 2 * s) * (1 - s) ** 2, s * (1 - s) ** 2
     h01, h11 = s**2 * (3 - 2 * s), s**2 * (s - 1)
     v = traj.v
-    pdot = _core.derivative(traj.model._core, "dp_dt", traj.t, traj.q, v)
+    pdot = _core.derivative(traj.model._core, "dp_dt", *traj._arrays()[:2], v)
     d = delta[:, None]
 
     def cubic(x: np.ndarray, dx: np.ndarray) -> np.ndarray:

@@ -46,6 +46,8 @@ FORMAT_VERSION = 2
 #: Rows per chunk: about 64 kB of a (N, 2)-shaped q for the small systems.
 CHUNK_ROWS = 4096
 _COLUMNS = ("t", "q", "p", "newton", "work")
+#: A streamed run's file larger than this is read back lazily (its columns when used).
+LAZY_BYTES = 256 * 2**20
 _DTYPES = {"newton": np.uint64}
 
 
@@ -374,3 +376,8 @@ def save_every_of(path: str | os.PathLike[str]) -> int:
             return every
         t, dt = f["t"][:2], float(f.attrs["dt"])
     return max(1, round(float(t[1] - t[0]) / dt)) if len(t) > 1 else 1
+
+
+def larger_than_memory(path: str | os.PathLike[str]) -> bool:
+    """Whether a run's file is to be read back lazily: larger than :data:`LAZY_BYTES`."""
+    return Path(path).stat().st_size > LAZY_BYTES

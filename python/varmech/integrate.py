@@ -5,7 +5,7 @@ from __future__ import annotations
 import datetime
 import math
 import os
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Literal
@@ -14,6 +14,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from . import _core, files
+from . import events as _events
 from ._progress import progress_bar
 from ._util import finite, positive, positive_int, vector
 from .dense import hermite
@@ -31,8 +32,11 @@ class Trajectory:
     ``nfev`` counts force evaluations (for the implicit methods, evaluations of the discrete
     Lagrangian's slot derivatives); ``newton_iterations`` and ``newton_iterations_per_step``
     count the implicit methods' iterations.
-    ``status`` is 0 when the run reached its end, -1 for the partial trajectory attached to an
-    error (``err.partial``); ``message`` says which.
+    ``status`` is 0 when the run reached its end, 1 when a terminal event stopped it (see
+    :mod:`varmech.events`), -1 for the partial trajectory attached to an error
+    (``err.partial``); ``message`` says which. ``events`` holds each event's located crossings
+    (:class:`varmech.events.Occurrences`, one per function given, in that order; empty without
+    events).
     """
 
     t: np.ndarray
@@ -50,6 +54,8 @@ class Trajectory:
     message: str = "The integration reached its final time."
     #: The last state's checkpoint (bytes): ``integrate(traj, steps=)`` goes on from it, bit for bit.
     checkpoint: bytes | None = field(default=None, repr=False)
+    #: Each event's located crossings (times and states), in the order the events were given.
+    events: tuple[_events.Occurrences, ...] = field(default=(), repr=False)
     _v: np.ndarray | None = field(default=None, repr=False)
 
     @property
@@ -224,6 +230,7 @@ def integrate(
     output: str | os.PathLike[str] | None = None,
     overwrite: bool = False,
     checkpoint_every: int | datetime.timedelta | None = None,
+    events: Sequence[_events.Event | _events.EventFunction] | None = None,
 ) -> Trajectory:
     """Integrate ``model`` from (q0, p0) with a fixed step.
 
@@ -280,13 +287,23 @@ def integrate(
     output, overwrite:
         Stream the saved states to the HDF5 file ``output`` (h5py, the extra ``io``; layout in
         :mod:`varmech.files`) as the run goes, in segments of about two seconds, each committed
-        with its checkpoint; memory stays flat whatever the number of steps. The result reads
-        lazily from the file. A run stopped by Ctrl-C, an error or a kill leaves a valid file
+        with its checkpoint; memory stays flat whatever the number of steps. The result is read
+        back from the file: lazily (:func:`varmech.load` with ``lazy=True``) when it holds more
+        than :data:`varmech.files.LAZY_BYTES`. A run stopped by Ctrl-C, an error or a kill leaves a valid file
         with every committed state, from which :func:`varmech.resume` goes on. An existing file
         is refused unless ``overwrite``.
     checkpoint_every:
         With ``output``: commit states and a checkpoint at least every this many steps (rounded
         down to whole ``save_every`` periods), or every :class:`datetime.timedelta` of run time.
+    events:
+        Event functions g(t, q, p) whose zero crossings are located (``traj.events``), as in
+        :func:`scipy.integrate.solve_ivp`: plain functions with optional ``direction`` and
+        ``terminal`` attributes, :class:`varmech.events.Event` (which may take the velocities,
+        g(t, q, v)), or the built-in helpers of :mod:`varmech.events` (evaluated natively).
+        Each crossing is located by a partial step of the method, to round-off; a terminal event
+        stops the run after the step of its crossing with ``status = 1``. The steps are then
+        taken one at a time (a Wisdom–Holman method synchronises, and ``whc`` applies its
+        corrector, at every step).
 
     Raises
     ------
@@ -303,12 +320,17 @@ def integrate(
         ``err.residual``, ``err.iterations`` and ``err.partial`` are attached. Its subclass
         :class:`~varmech.SpuriousBranchError` means Newton converged, but beyond a fold of the
         DEL map where the step's solution is not unique (the step is too large there).
+    TypeError
+        An event function that does not take (t, q, p), naming it (``events[i] (name)``).
+    VarmechError
+        An event function returned a value that is not finite (the message names it).
     Exception
-        An exception raised by a closure (or KeyboardInterrupt) propagates unchanged, with
-        ``err.partial``, ``err.step`` and ``err.time`` attached where the exception allows.
+        An exception raised by a closure or an event function (or KeyboardInterrupt) propagates
+        unchanged, with ``err.partial``, ``err.step`` and ``err.time`` attached where the
+        exception allows.
     """
     if isinstance(model, Trajectory):
-        given = {"q0": q0, "p0": p0, "v0": v0, "dt": dt, "method": method, "t0": t0, "parameters": parameters}
+        given = {"q0": q0, "p0": p0, "v0": v0, "dt": dt, "method": method, "t0": t0, "parameters": parameters, "events": events}
         named = [name for name, value in given.items() if value is not None]
         if named:
             raise ValueError(f"{named[0]}: a continued run keeps its trajectory's {', '.join(named)}")
@@ -330,6 +352,7 @@ def integrate(
     threshold = _energy_threshold(model, max_energy_error)
     newton_tolerance, newton_max_iterations = _newton(newton_tolerance, newton_max_iterations)
     q, p = _initial_state(model, q0, p0, v0, t0)
+    watched, event_specs = _events.specs(events, model.dim) if events is not None else ([], [])
     # A horizon past the largest float is the core's to refuse (naming dt); probe finite times.
     t_end = t0 + nsteps * dt
     probes = (t0, t0 + dt, t0 + 0.5, t0 + 1.0, t0 + 0.37 * (t_end - t0), t_end)
@@ -350,9 +373,10 @@ def integrate(
             newton_tolerance=newton_tolerance,
             newton_max_iterations=newton_max_iterations,
             progress=report,
+            events=event_specs or None,
         )
 
-    return _run(first, None, 0, model, method, dt, nsteps, save_every, progress, output, overwrite, checkpoint_every)
+    return _run(first, None, 0, model, method, dt, nsteps, save_every, progress, output, overwrite, checkpoint_every, watched)
 
 
 def _go_on(
@@ -383,6 +407,7 @@ def _go_on(
         output,
         overwrite,
         checkpoint_every,
+        (),
     )
 
 
@@ -399,14 +424,18 @@ def _run(
     output: str | os.PathLike[str] | None,
     overwrite: bool,
     checkpoint_every: int | datetime.timedelta | None,
+    watched: Sequence[_events.Event],
 ) -> Trajectory:
     """Runs ``nsteps`` steps by ``first`` (a new run) or from ``checkpoint`` (after ``base``
-    steps): in memory, or streamed to ``output`` in segments (:mod:`varmech.streaming`)."""
+    steps): in memory, or streamed to ``output`` in segments (:mod:`varmech.streaming`).
+    ``watched`` are the run's events, whose crossings the result reports."""
     from . import streaming
 
     bar = progress_bar(total=nsteps, unit="step", desc=method, enabled=progress)
     try:
         if output is not None:
+            if watched:
+                raise ValueError("events: not yet with output= (a streamed run's events would need a place in the file)")
             target = files.writable(output, bool(overwrite), "output")
             streaming.checkpoint_period(checkpoint_every, save_every)
             columns = files.columns_of(model, method)
@@ -428,7 +457,7 @@ def _run(
             except BaseException as err:
                 err.partial = files.load(target, model=model, lazy=True)  # type: ignore[attr-defined]
                 raise
-            return files.load(target, model=model, lazy=True)
+            return files.load(target, model=model, lazy=files.larger_than_memory(target))
         if checkpoint_every is not None:
             raise ValueError("checkpoint_every: checkpoints are written to a file; pass output=")
 
@@ -447,16 +476,21 @@ def _run(
             partial = getattr(err, "_varmech_partial", None)
             if partial is not None:
                 delattr(err, "_varmech_partial")
-                err.partial = _trajectory(partial, model, method, dt, status=-1, message=str(err))  # type: ignore[attr-defined]
+                err.partial = _trajectory(partial, model, method, dt, watched, status=-1, message=str(err))  # type: ignore[attr-defined]
             raise
     finally:
         bar.close()
-    return _trajectory(record, model, method, dt)
+    return _trajectory(record, model, method, dt, watched)
 
 
-def _trajectory(record: _core.TrajectoryRecord, model: Model, method: str, dt: float, **status: Any) -> Trajectory:
-    """The Trajectory of the binding's record of a run."""
+def _trajectory(
+    record: _core.TrajectoryRecord, model: Model, method: str, dt: float, events: Sequence[_events.Event] = (), **status: Any
+) -> Trajectory:
+    """The Trajectory of the binding's record of a run, with its events' crossings (and the
+    status of a terminal event's stop, unless `status` is given)."""
     r = record
+    found = _events.occurrences(r, events)
+    status = status or _events.termination(r, events, found)
     return Trajectory(
         r.t,
         r.q,
@@ -469,6 +503,7 @@ def _trajectory(record: _core.TrajectoryRecord, model: Model, method: str, dt: f
         r.newton,
         r.work,
         checkpoint=r.checkpoint,
+        events=found,
         **status,
     )
 

@@ -170,7 +170,7 @@ class ReducedModel(Model):
         c0 = np.zeros(m) if c0 is None else vector("c0", c0, m)
         every_step = len(traj.t) == traj.steps + 1
         rule = traj.method if every_step and traj.method in ("midpoint", "trapezoid") else None
-        increments = _core.cyclic_increments(self._core, traj.t, traj.q, traj.p, rule)
+        increments = _core.cyclic_increments(self._core, *traj._arrays(), rule)
         c = c0 + np.vstack([np.zeros((1, m)), np.cumsum(increments, axis=0)])
         n = self.full.dim
         q = np.empty((len(traj.t), n))

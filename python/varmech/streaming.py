@@ -11,11 +11,14 @@ length of the run. A segment lasts at most ``checkpoint_every`` (steps, or a
 
 from __future__ import annotations
 
+import contextlib
 import datetime
 import math
 import os
+import signal
+import threading
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -104,7 +107,8 @@ def stream(
                 writer.close(-1, str(err) or type(err).__name__)
                 raise
             elapsed = time.perf_counter() - started
-            writer.append(record, skip_first=checkpoint is not None or writer.rows > 0)
+            with _uninterrupted():
+                writer.append(record, skip_first=checkpoint is not None or writer.rows > 0)
             checkpoint = record.checkpoint
             done += take
             bar.update(record.steps - base - bar.n)
@@ -112,11 +116,29 @@ def stream(
                 rate = take / elapsed
             if done >= steps:
                 break
-    except BaseException:
+    except BaseException as err:
+        # Also a Ctrl-C between segments or inside an append: what was committed stands.
         if writer.is_open:
-            writer.abandon()
+            with _uninterrupted():
+                writer.close(-1, str(err) or type(err).__name__)
         raise
-    writer.close(0, "The integration reached its final time.")
+    with _uninterrupted():
+        writer.close(0, "The integration reached its final time.")
+
+
+@contextlib.contextmanager
+def _uninterrupted() -> Iterator[None]:
+    """Holds Ctrl-C back while the file is written, and delivers it right after: an append is
+    not cut in two, and h5py cannot swallow the KeyboardInterrupt (an exception raised while
+    h5py frees an object is only printed)."""
+    if not hasattr(signal, "pthread_sigmask") or threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    held = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, held)
 
 
 def resume(
@@ -135,7 +157,8 @@ def resume(
     run of the whole length, bit for bit, whether the run ended, failed, was stopped by Ctrl-C,
     or was killed. ``save_every`` is the file's by default (its saving period).
 
-    Returns the whole run, read lazily from the file (see :func:`varmech.load`).
+    Returns the whole run, read back from the file (lazily when it is large; see
+    :func:`varmech.files.larger_than_memory`).
 
     Examples
     --------
@@ -171,4 +194,4 @@ def resume(
         )
     finally:
         bar.close()
-    return files.load(path, model=stored.model, lazy=True)
+    return files.load(path, model=stored.model, lazy=files.larger_than_memory(path))

@@ -92,7 +92,6 @@ def test_a_streamed_run_is_the_run_in_memory(tmp_path, family):
         output=tmp_path / "s.h5",
         checkpoint_every=2 * EVERY,
     )
-    assert isinstance(streamed.q, varmech.files.Rows)
     for name in ("t", "q", "p"):
         assert _same(getattr(streamed, name), getattr(whole, name)), name
     np.testing.assert_array_equal(streamed.newton_iterations_per_step, whole.newton_iterations_per_step)
@@ -231,3 +230,14 @@ def test_a_truncated_or_corrupt_file_is_a_clear_error(tmp_path):
     garbage.write_bytes(os.urandom(4096))
     with pytest.raises(ValueError, match="^path: "):
         varmech.load(garbage)
+
+
+def test_a_file_loaded_lazily_reads_rows_when_used_and_analyses_alike(tmp_path):
+    s = scenes.kepler()
+    path = tmp_path / "k.h5"
+    eager = varmech.integrate(s, dt=s.dt, steps=2000, save_every=10, output=path)
+    lazy = varmech.load(path, lazy=True)
+    assert isinstance(lazy.q, varmech.files.Rows) and lazy.q.shape == eager.q.shape
+    assert _same(lazy.q[-1], eager.q[-1]) and _same(lazy.p[5, 1:], eager.p[5, 1:]) and _same(lazy.t[3], eager.t[3])
+    assert _same(lazy.energy(), eager.energy())
+    assert varmech.check_conservation(lazy).verdict == varmech.check_conservation(eager).verdict

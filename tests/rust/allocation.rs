@@ -1,4 +1,4 @@
-//! The native step loop allocates nothing: a long run makes exactly as many allocations as a
+//! The native step loop allocates nothing (with or without events): a long run makes exactly as many allocations as a
 //! run of 100 steps (the set-up's), whatever the method, and so does RATTLE's on a chain; a
 //! stepper's steps make none at all, nor does taking it apart, resuming and resetting it.
 
@@ -254,4 +254,41 @@ fn resuming_and_resetting_a_stepper_allocates_nothing() {
         assert_eq!(count, 0, "{method:?}: {count} allocations");
         assert_eq!(owned.steps(), 51);
     }
+}
+
+/// A run with built-in events that never occur allocates per run, not per step: the events'
+/// values, the state before each step and the partial steps' stepper are made once.
+#[test]
+fn the_event_loop_allocates_nothing() {
+    use varmech::integrators::{integrate_with_events, Detector, EventSpec, NativeEvent};
+    let problem = NBody::outer_solar_system();
+    let run = |steps: usize| {
+        let options = Options {
+            save_every: 10,
+            ..Options::new(10.0, steps)
+        };
+        let groups = (0..6).map(|b| vec![3 * b, 3 * b + 1, 3 * b + 2]).collect::<Vec<_>>();
+        let escape = vec![NativeEvent::Escape { radius: 1e6, groups }];
+        let spec = EventSpec {
+            name: "escape".into(),
+            direction: 1,
+            terminal: 1,
+        };
+        let mut detector = Detector::new(Box::new(escape), vec![spec]).unwrap();
+        let (q0, p0) = (&problem.initial.q, &problem.initial.p);
+        let before = allocated();
+        let traj = integrate_with_events(
+            &problem.system,
+            Method::Verlet,
+            q0,
+            p0,
+            &options,
+            || Ok(()),
+            &mut detector,
+        )
+        .unwrap();
+        assert!(traj.events.is_empty() && traj.steps == steps);
+        allocated() - before
+    };
+    assert_eq!(run(100), run(10_000));
 }

@@ -6,6 +6,7 @@ from __future__ import annotations
 import numpy as np
 
 from .. import _core
+from ..events import Event
 from ..integrate import Trajectory, integrate
 from ..model import Model
 from ..scenes import Scene
@@ -41,11 +42,13 @@ def default_method(model: Model, method: str | None) -> str:
     return model.kind.accurate_method
 
 
-def run(model: Model, q0: np.ndarray, p0: np.ndarray, *, dt: float, t_end: float, method: str, save_every: int = 1) -> tuple[Trajectory, str | None]:
-    """One orbit; a divergent one (an orbit that escapes) returns its partial trajectory and a
-    note."""
+def run(
+    model: Model, q0: np.ndarray, p0: np.ndarray, *, dt: float, t_end: float, method: str, save_every: int = 1, events: list[Event] | None = None
+) -> tuple[Trajectory, str | None]:
+    """One orbit, with the crossings of ``events`` located; a divergent one (an orbit that
+    escapes) returns its partial trajectory and a note."""
     try:
-        return integrate(model, q0, p0, dt=dt, t_end=t_end, method=method, save_every=save_every), None
+        return integrate(model, q0, p0, dt=dt, t_end=t_end, method=method, save_every=save_every, events=events), None
     except _core.DivergenceError as err:
         partial = getattr(err, "partial", None)
         if partial is None:

@@ -14,23 +14,26 @@ KeyboardInterrupt carries the rows measured so far as ``err.partial``.
 
 How a crossing is located
 -------------------------
-The orbit is saved at every step. Between two saved states that straddle the section, the
-motion is interpolated by a cubic Hermite polynomial in time, with the exact derivatives
-q̇ = ``model.velocity(q, p)`` and ṗ = ∂L/∂q(q, q̇) (= −∇V for a mechanical system); its root
-τ* (bisection to round-off) is the Hermite estimate of the crossing. The interpolant is
-accurate to O(h⁴): on Hénon–Heiles at E = 1/8 with kahan_li6 it is within 5.8e-7, 3.8e-8,
-2.4e-9, 1.5e-10 of the point below at h = 0.1, 0.05, 0.025, 0.0125 (ratios 15–16), and its
-energy error is 1.1e-7 at h = 0.05, where the integrator's own is 2e-11.
+Each orbit is one :func:`varmech.integrate` run with the event
+:func:`varmech.events.crossing` (k, c, direction), evaluated natively. With ``locate="step"``
+(the default) each crossing is the event's located state: a *partial step*, one step of the same
+integrator of size τ ≤ h from the state before the crossing, with τ found by the core's
+root finder (Illinois on the bracket [0, h], see :mod:`varmech.events`) until q_k(τ) = c to
+round-off. The reported state is then an actual state of the integrator (a step of size τ
+instead of h, local error O(τ^{p+1})), it lies on the section to round-off (|q_k − c| ≤ 1.1e-17
+measured), and its energy error is the method's own, of the same size as at the grid points
+(order 6 for kahan_li6: 1.3e-9, 2.0e-11, 3.2e-13 at h = 0.1, 0.05, 0.025). Integrating the
+exact flow (kahan_li8, 64 substeps) from the same grid state over the same τ lands within
+1.1e-12 of it, on x = 0 to 1.1e-12. The crossing costs a handful of extra steps in the core.
 
-With ``locate="step"`` (the default) that estimate only starts a Newton iteration on a *partial
-step*: one step of the same integrator, of size τ ≤ h, from the saved state before the crossing,
-with τ corrected by −(q_k(τ) − c)/q̇_k until it stops changing, safeguarded by bisection on
-the bracket [0, h]. The reported state is then an actual state of the integrator (a step of
-size τ instead of h, local error O(τ^{p+1})), it lies on the section to round-off (|q_k − c|
-≤ 1.1e-17 measured), and its energy error is the method's own, of the same size as at the grid
-points (order 6 for kahan_li6: 1.3e-9, 2.0e-11, 3.2e-13 at h = 0.1, 0.05, 0.025). Integrating
-the exact flow (kahan_li8, 64 substeps) from the same grid state over the same τ lands within
-1.1e-12 of it, on x = 0 to 1.1e-12. The crossing costs two or three extra steps of one :class:`~varmech.Stepper`.
+``locate="hermite"`` reports instead the root of the cubic Hermite interpolant between the saved
+states on either side (every step is saved), with the exact derivatives q̇ = ``model.velocity(q,
+p)`` and ṗ = ∂L/∂q(q, q̇) (= −∇V for a mechanical system), found by bisection: accurate to
+O(h⁴), not to the method's order. On Hénon–Heiles at E = 1/8 with kahan_li6 it is within 5.8e-7,
+3.8e-8, 2.4e-9, 1.5e-10 of the partial-step point at h = 0.1, 0.05, 0.025, 0.0125 (ratios 15–16;
+``meta["max_hermite_gap"]`` of a ``"step"`` section), and its energy error is 1.1e-7 at
+h = 0.05, where the integrator's own is 2e-11. It is kept as the interpolant's check on the
+located points.
 """
 
 from __future__ import annotations
@@ -44,9 +47,9 @@ from numpy.typing import ArrayLike
 
 from .._progress import progress as _progress
 from .._util import positive
+from ..events import crossing
 from ..integrate import Trajectory
 from ..model import Model
-from ..stepper import Stepper
 from ..table import Table
 from ._interrupt import interruptible
 from ._orbits import ModelLike, default_method, energy_at, model_of, relative, run, solve_momentum
@@ -208,18 +211,6 @@ def _hermite(x0, v0, x1, v1, h, s):
     return val, der
 
 
-def _crossings(traj: Trajectory, k: int, c: float, direction: int) -> tuple[np.ndarray, np.ndarray]:
-    """Indices i with the section crossed in (t_i, t_{i+1}] in the asked direction, and the
-    sign (+1 upward, −1 downward) of each crossing."""
-    g = traj.q[:, k] - c
-    lo, hi = g[:-1], g[1:]
-    up = (lo < 0) & (hi >= 0)
-    down = (lo > 0) & (hi <= 0)
-    mask = up if direction > 0 else down if direction < 0 else (up | down)
-    idx = np.nonzero(mask)[0]
-    return idx, np.where(up[idx], 1.0, -1.0)
-
-
 def _hermite_points(model: Model, traj: Trajectory, idx: np.ndarray, k: int, c: float, sign: np.ndarray):
     """The Hermite estimate of each crossing: (τ, q, p) at the root of q_k(τ) − c."""
     t0, t1 = traj.t[idx], traj.t[idx + 1]
@@ -241,39 +232,6 @@ def _hermite_points(model: Model, traj: Trajectory, idx: np.ndarray, k: int, c: 
     p, _ = _hermite(p0, f0, p1, f1, dt, s)
     q[:, k] = c
     return hi * dt[:, 0], q, p
-
-
-def _partial_step(model: Model, q0: np.ndarray, p0: np.ndarray, t0: float, h: float, tau: float, k: int, c: float, sign: float, method: str):
-    """The crossing on the integrator's own map: τ with the step Φ_τ(q0, p0) on the section,
-    by Newton (q̇_k at the end as the slope) safeguarded by bisection on [0, h]. Each trial τ
-    is one step of one stepper, reset to (q0, p0) at t0."""
-    lo, hi = 0.0, h
-    best = None
-    stepper = Stepper(model, q0, p0, dt=tau, method=method, t0=t0)
-    for _ in range(40):
-        stepper.reset(q0, p0, t0=t0)
-        stepper.dt = tau
-        stepper.step()
-        q, p = stepper.q, stepper.p
-        g = sign * (q[k] - c)
-        if best is None or abs(g) < abs(best[0]):
-            best = (g, tau, q, p)
-        if g == 0.0:
-            break
-        if g < 0:
-            lo = tau
-        else:
-            hi = tau
-        slope = sign * model.velocity(q, p, t0 + tau)[k]
-        step = g / slope if slope > 0 else math.inf
-        new = tau - step
-        if not (lo < new < hi) or not math.isfinite(new):
-            new = 0.5 * (lo + hi)
-        if abs(new - tau) <= 2e-16 * h:
-            break
-        tau = new
-    g, tau, q, p = best  # type: ignore[misc]
-    return tau, q, p
 
 
 # ------------------------------------------------------------------------------ Poincaré
@@ -329,8 +287,9 @@ def poincare_section(
         either way (0). Default ``(0, 0.0, +1)``, Hénon–Heiles' x = 0 with p_x > 0.
     locate:
         ``"step"`` (default): each crossing is a state of the integrator itself, a partial step
-        from the last saved state, on the section to round-off; ``"hermite"``: the cubic
-        Hermite interpolant's root (O(dt⁴), no extra integration). See the module docstring.
+        from the state before it (the event's located state, :mod:`varmech.events`), on the
+        section to round-off; ``"hermite"``: the cubic Hermite interpolant's root (O(dt⁴)). See
+        the module docstring.
     names:
         Coordinate names for the columns (default ``x, y`` for two coordinates, else ``q0`` …).
     progress:
@@ -369,28 +328,25 @@ def poincare_section(
         },
     )
     worst = {"residual": 0.0, "energy": 0.0, "hermite_gap": 0.0}
+    event = crossing(k, c, direction=direction)
 
     def body() -> None:
         for o in _progress(range(len(q_seed)), total=len(q_seed), desc=f"section E = {energy:.4g}", enabled=progress):
-            traj, note = run(model, q_seed[o], p_seed[o], dt=dt, t_end=t_end, method=method)
+            traj, note = run(model, q_seed[o], p_seed[o], dt=dt, t_end=t_end, method=method, events=[event])
             if note:
                 table.meta["notes"].append(f"orbit {o}: {note}")
-            idx, sign = _crossings(traj, k, c, direction)
-            if not len(idx):
+            found = traj.events[0]
+            if not len(found):
                 continue
+            # The step of each crossing, (t_i, t_i+1], and its sign (+1 upward, −1 downward).
+            idx = np.searchsorted(traj.t, found.t, side="left") - 1
+            sign = np.where(traj.q[idx, k] < c, 1.0, -1.0)
             taus, qs, ps = _hermite_points(model, traj, idx, k, c, sign)
-            if locate == "step":
-                rows_q, rows_p, rows_tau = [], [], []
-                for j, i in enumerate(idx):
-                    h = float(traj.t[i + 1] - traj.t[i])
-                    tau, q, p = _partial_step(model, traj.q[i], traj.p[i], float(traj.t[i]), h, float(taus[j]), k, c, float(sign[j]), method)
-                    rows_q.append(q)
-                    rows_p.append(p)
-                    rows_tau.append(tau)
-                gap = np.max(np.abs(np.concatenate([np.array(rows_q) - qs, np.array(rows_p) - ps], axis=1)))
-                worst["hermite_gap"] = max(worst["hermite_gap"], float(gap))
-                qs, ps, taus = np.array(rows_q), np.array(rows_p), np.array(rows_tau)
             times = traj.t[idx] + taus
+            if locate == "step":
+                gap = np.max(np.abs(np.concatenate([found.q - qs, found.p - ps], axis=1)))
+                worst["hermite_gap"] = max(worst["hermite_gap"], float(gap))
+                times, qs, ps = found.t, found.q, found.p
             errs = relative(energy_at(model, qs, ps), energy)
             worst["residual"] = max(worst["residual"], float(np.max(np.abs(qs[:, k] - c))))
             worst["energy"] = max(worst["energy"], float(np.max(np.abs(errs))))

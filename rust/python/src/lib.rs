@@ -17,6 +17,7 @@ mod constraints;
 mod convert;
 mod diagnostics;
 mod errors;
+mod events;
 mod generator;
 mod native;
 mod pointers;

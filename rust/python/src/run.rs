@@ -4,18 +4,20 @@
 use numpy::PyReadonlyArray1;
 use pyo3::prelude::*;
 use varmech::diagnostics;
-use varmech::integrators::{self, Checkpoint, Counting, Failure, Method, NewtonOptions, Options, Trajectory};
+use varmech::integrators::{self, Checkpoint, Counting, Detector, Failure, Method, NewtonOptions, Options, Trajectory};
 use varmech::ModelError;
 
-use crate::bind::{bind_model, Poll};
+use crate::bind::{bind_model, dim_of, Poll};
 use crate::convert::{count, slice};
 use crate::errors::{boxed, failure_to_pyerr, to_pyerr};
+use crate::events::{EventTuple, Events};
 use crate::trajectory::TrajectoryRecord;
 
 /// Integrates; returns the saved states as a [`TrajectoryRecord`] or raises with
-/// `_varmech_partial`, the states up to the failure.
+/// `_varmech_partial`, the states up to the failure. With `events` (spec tuples, see
+/// [`Events::new`]) the run watches them ([`integrators::integrate_with_events`]).
 #[pyfunction]
-#[pyo3(signature = (model, q0, p0, *, dt, steps, method, save_every=1, compensated=true, max_energy_error=None, t0=0.0, newton_tolerance=1e-14, newton_max_iterations=50, progress=None))]
+#[pyo3(signature = (model, q0, p0, *, dt, steps, method, save_every=1, compensated=true, max_energy_error=None, t0=0.0, newton_tolerance=1e-14, newton_max_iterations=50, progress=None, events=None))]
 #[allow(clippy::too_many_arguments)]
 fn integrate<'py>(
     py: Python<'py>,
@@ -32,6 +34,7 @@ fn integrate<'py>(
     newton_tolerance: f64,
     #[pyo3(from_py_with = newton_max_iterations_count)] newton_max_iterations: usize,
     progress: Option<Py<PyAny>>,
+    events: Option<Vec<EventTuple<'py>>>,
 ) -> PyResult<TrajectoryRecord> {
     let method = Method::from_name(method).map_err(|e| to_pyerr(py, e))?;
     let newton = NewtonOptions {
@@ -48,8 +51,22 @@ fn integrate<'py>(
         newton,
     };
     let (q0, p0) = (slice("q0", &q0)?, slice("p0", &p0)?);
+    let events = match events {
+        Some(tuples) => Some(Events::new(py, tuples, dim_of(py, model)?)?),
+        None => None,
+    };
     let result = bind_model(py, model, |sys, poll| {
-        integrators::integrate(sys, method, q0, p0, &options, reporting(poll, &progress))
+        let report = reporting(poll, &progress);
+        match events {
+            None => integrators::integrate(sys, method, q0, p0, &options, report),
+            Some((functions, specs)) => {
+                let mut detector = Detector::new(Box::new(functions), specs).map_err(|error| {
+                    let partial = Trajectory::default();
+                    Box::new(Failure { error, partial })
+                })?;
+                integrators::integrate_with_events(sys, method, q0, p0, &options, report, &mut detector)
+            }
+        }
     })?;
     record(py, result)
 }
@@ -73,7 +90,10 @@ fn resume<'py>(
 }
 
 /// The poll of a run: the Ctrl-C check, then `progress(steps)` if given.
-fn reporting<'a>(poll: Poll<'a>, progress: &'a Option<Py<PyAny>>) -> Counting<impl FnMut(usize) -> Result<(), ModelError> + 'a> {
+fn reporting<'a>(
+    poll: Poll<'a>,
+    progress: &'a Option<Py<PyAny>>,
+) -> Counting<impl FnMut(usize) -> Result<(), ModelError> + 'a> {
     Counting(move |steps: usize| {
         poll()?;
         match progress {

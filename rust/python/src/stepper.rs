@@ -88,7 +88,9 @@ impl Stepper {
     /// The stepper of `model` at the state of `checkpoint` (from `checkpoint()`, or a run's).
     #[staticmethod]
     fn from_checkpoint<'py>(py: Python<'py>, model: &Bound<'py, PyAny>, checkpoint: &[u8]) -> PyResult<Self> {
-        let state = Checkpoint::from_bytes(checkpoint).map_err(|e| to_pyerr(py, e))?.into_state();
+        let state = Checkpoint::from_bytes(checkpoint)
+            .map_err(|e| to_pyerr(py, e))?
+            .into_state();
         let state = bind_model(py, model, |sys, _| {
             integrators::Stepper::resume(sys, state).map(integrators::Stepper::into_state)
         })?

@@ -30,7 +30,22 @@ pub struct TrajectoryRecord {
     work: Option<Py<PyArray1<f64>>>,
     #[pyo3(get)]
     checkpoint: Py<PyBytes>,
+    /// The located event crossings in order of time: the event's index (k,), t (k,), q and p
+    /// (k, n).
+    #[pyo3(get)]
+    events: EventArrays,
+    /// The index of the event whose terminal count stopped the run, if one did.
+    #[pyo3(get)]
+    terminated_by: Option<usize>,
 }
+
+/// Event crossings as arrays: the event's index (k,), t (k,), q and p (k, n).
+type EventArrays = (
+    Py<PyArray1<usize>>,
+    Py<PyArray1<f64>>,
+    Py<PyArray2<f64>>,
+    Py<PyArray2<f64>>,
+);
 
 /// The recorded column, or None when the run recorded none (an empty vector).
 fn recorded<'py, T: numpy::Element>(py: Python<'py>, column: Vec<T>) -> Option<Py<PyArray1<T>>> {
@@ -40,6 +55,19 @@ fn recorded<'py, T: numpy::Element>(py: Python<'py>, column: Vec<T>) -> Option<P
 impl TrajectoryRecord {
     pub fn new(py: Python<'_>, traj: Trajectory) -> PyResult<Self> {
         let n = traj.dim;
+        let (mut index, mut t, mut q, mut p) = (vec![], vec![], vec![], vec![]);
+        for e in traj.events {
+            index.push(e.event);
+            t.push(e.t);
+            q.extend(e.q);
+            p.extend(e.p);
+        }
+        let events = (
+            PyArray1::from_vec(py, index).unbind(),
+            PyArray1::from_vec(py, t).unbind(),
+            matrix(py, q, n)?.unbind(),
+            matrix(py, p, n)?.unbind(),
+        );
         Ok(TrajectoryRecord {
             t: PyArray1::from_vec(py, traj.t).unbind(),
             q: matrix(py, traj.q, n)?.unbind(),
@@ -49,6 +77,8 @@ impl TrajectoryRecord {
             newton: recorded(py, traj.newton),
             work: recorded(py, traj.work),
             checkpoint: PyBytes::new(py, &traj.checkpoint).unbind(),
+            events,
+            terminated_by: traj.terminated_by,
         })
     }
 

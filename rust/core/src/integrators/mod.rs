@@ -18,7 +18,8 @@
 //! - [`Stepper`]: one model, one method and the state, advanced step by step; its
 //!   [`StepperState`] apart from the model, to resume;
 //! - [`integrate`]: a run of a [`Stepper`] with saving and an energy check, into a
-//!   [`Trajectory`]; [`resume`] goes on from its [`Checkpoint`], bit for bit.
+//!   [`Trajectory`]; [`resume`] goes on from its [`Checkpoint`], bit for bit;
+//!   [`integrate_with_events`] also watches [`events`], located by partial steps.
 
 use serde::{Deserialize, Serialize};
 mod checkpoint;
@@ -26,6 +27,7 @@ pub mod compensated;
 mod composition;
 mod del;
 mod dynamics;
+pub mod events;
 mod explicit_rk;
 mod kick_drift;
 mod kind;
@@ -46,13 +48,14 @@ pub use checkpoint::Checkpoint;
 pub use composition::Composition;
 pub use del::{Del, StepEquations, TwoPoint};
 pub use dynamics::{Dynamics, General};
+pub use events::{Detector, EventFunctions, EventSpec, NativeEvent, Occurrence};
 pub use explicit_rk::ExplicitRk;
 pub use kick_drift::KickDrift;
 pub use kind::ModelKind;
 pub use method::{Method, MethodInfo};
 pub use poll::{Counting, Poll};
 pub use rattle::Rattle;
-pub use run::{integrate, resume, Options};
+pub use run::{integrate, integrate_with_events, resume, Options};
 pub use splitting::{Leading, Splitting};
 pub use step::{Increment, StepStart};
 pub use stepper::{Stepper, StepperState};

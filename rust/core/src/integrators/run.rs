@@ -2,7 +2,8 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::{Checkpoint, Counting, Dynamics, Failure, Method, NewtonOptions, Poll, Stepper, Trajectory};
+use super::events::Search;
+use super::{Checkpoint, Counting, Detector, Dynamics, Failure, Method, NewtonOptions, Poll, Stepper, Trajectory};
 use crate::model::{EnergyTerms, Scale};
 use crate::{memory, Error};
 
@@ -101,21 +102,66 @@ where
     S: Dynamics + ?Sized,
     P: Poll,
 {
+    let (stepper, watch) = start(sys, method, q0, p0, options)?;
+    run(sys, stepper, watch, options.steps, options.save_every, poll, None)
+}
+
+// Events: the run with a [`Detector`] (begin).
+/// As [`integrate`], watching the `events`' functions after every step (the steps are then
+/// taken one at a time): each crossing is located by a partial step of the method
+/// ([`Detector`]) and pushed to [`Trajectory::events`]. When an event reaches its terminal
+/// count, the run stops at the end of that step, its state saved, with
+/// [`Trajectory::terminated_by`] set.
+pub fn integrate_with_events<S, P>(
+    sys: &S,
+    method: Method,
+    q0: &[f64],
+    p0: &[f64],
+    options: &Options,
+    poll: P,
+    events: &mut Detector<'_>,
+) -> Result<Trajectory, Box<Failure>>
+where
+    S: Dynamics + ?Sized,
+    P: Poll,
+{
+    let (stepper, watch) = start(sys, method, q0, p0, options)?;
+    // The run's search, its scratch stepper on the same model.
+    let search = match events.begin(sys, &stepper, options) {
+        Ok(search) => search,
+        Err(error) => return Err(fail(error, first_state(sys, &stepper))),
+    };
+    run(
+        sys,
+        stepper,
+        watch,
+        options.steps,
+        options.save_every,
+        poll,
+        Some(search),
+    )
+}
+// Events (end).
+
+/// The stepper of a new run and its energy check.
+#[allow(clippy::type_complexity)]
+fn start<'s, S: Dynamics + ?Sized>(
+    sys: &'s S,
+    method: Method,
+    q0: &[f64],
+    p0: &[f64],
+    options: &Options,
+) -> Result<(Stepper<&'s S>, Option<EnergyWatch>), Box<Failure>> {
     let stepper = Stepper::new(sys, method, q0, p0, options).map_err(|e| fail(e, empty(sys)))?;
-    let watch = match options
+    match options
         .max_energy_error
         .and_then(|tol| EnergyWatch::new(sys, &stepper, tol))
     {
-        None => None,
-        Some(Ok(watch)) => Some(watch),
+        None => Ok((stepper, None)),
+        Some(Ok(watch)) => Ok((stepper, Some(watch))),
         // The initial state is kept: the check failed on it.
-        Some(Err(error)) => {
-            let mut traj = empty(sys);
-            traj.push(stepper.t(), &stepper);
-            return Err(fail(error, traj));
-        }
-    };
-    run(sys, stepper, watch, options.steps, options.save_every, poll)
+        Some(Err(error)) => Err(fail(error, first_state(sys, &stepper))),
+    }
 }
 
 /// Goes on from `checkpoint` (of a run of `sys`) for `steps` more steps, saving every
@@ -148,7 +194,7 @@ where
         );
         return Err(fail(Error::invalid("steps", reason), empty(sys)));
     };
-    run(sys, stepper, watch, end, save_every, poll)
+    run(sys, stepper, watch, end, save_every, poll, None)
 }
 
 fn fail(error: Error, partial: Trajectory) -> Box<Failure> {
@@ -162,15 +208,23 @@ fn empty<S: Dynamics + ?Sized>(sys: &S) -> Trajectory {
     }
 }
 
+/// The trajectory of the stepper's (initial) state alone.
+fn first_state<S: Dynamics + ?Sized>(sys: &S, stepper: &Stepper<&S>) -> Trajectory {
+    let mut traj = empty(sys);
+    traj.push(stepper.t(), stepper);
+    traj
+}
+
 /// Advances `stepper` to step `end`, saving every `save_every`-th state, the first and the
-/// last, with the energy checked at each saved state.
-fn run<S, P>(
-    sys: &S,
-    mut stepper: Stepper<&S>,
+/// last, with the energy checked at each saved state (and the events searched, if any).
+fn run<'s, S, P>(
+    sys: &'s S,
+    mut stepper: Stepper<&'s S>,
     mut watch: Option<EnergyWatch>,
     end: usize,
     save_every: usize,
     mut poll: P,
+    mut search: Option<Search<'_, '_, &'s S>>,
 ) -> Result<Trajectory, Box<Failure>>
 where
     S: Dynamics + ?Sized,
@@ -209,7 +263,15 @@ where
     while stepper.steps() < end {
         // Every `save_every`-th state is saved, and the last.
         let save = (stepper.steps() / save_every + 1).saturating_mul(save_every).min(end);
-        if let Err(error) = stepper.advance(save - stepper.steps(), Counting(|steps| poll.poll(steps))) {
+        let n = save - stepper.steps();
+        let advanced = match search.as_mut() {
+            None => stepper.advance(n, Counting(|steps| poll.poll(steps))),
+            // Events: step by step, stopping after a terminal event's step.
+            Some(search) => search
+                .advance(&mut stepper, n, &mut traj.events, &mut poll)
+                .map(|stop| traj.terminated_by = stop),
+        };
+        if let Err(error) = advanced {
             // Stops with the last good state kept, and the work counted.
             let time = stepper.t();
             if traj.t.last() != Some(&time) {
@@ -224,8 +286,13 @@ where
             outcome = Err(error);
             break;
         }
+        if traj.terminated_by.is_some() {
+            break;
+        }
     }
     traj.count(&stepper);
+    // Events: the partial steps' force evaluations are the run's too.
+    traj.force_evaluations += search.map_or(0, |s| s.force_evaluations());
     traj.checkpoint = Checkpoint {
         state: stepper.into_state(),
         watch,

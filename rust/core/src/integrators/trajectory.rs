@@ -3,7 +3,7 @@
 use std::borrow::Cow;
 use std::ops::Deref;
 
-use super::{Dynamics, Stepper};
+use super::{Dynamics, Occurrence, Stepper};
 use crate::Error;
 
 /// The saved states of a run: row k is (`t[k]`, `q[k]`, `p[k]`); q and p are stored row-major.
@@ -30,6 +30,10 @@ pub struct Trajectory {
     /// The [`super::Checkpoint`] of the last state, as bytes ([`super::Checkpoint::to_bytes`]):
     /// [`super::resume`] goes on from it. Empty for a run that failed before its first state.
     pub checkpoint: Vec<u8>,
+    /// The located event crossings, in order of time ([`super::integrate_with_events`]).
+    pub events: Vec<Occurrence>,
+    /// The event whose terminal count stopped the run, if one did.
+    pub terminated_by: Option<usize>,
 }
 
 impl Trajectory {

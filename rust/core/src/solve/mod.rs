@@ -4,6 +4,7 @@
 //! - [`difference`]: gradients and Jacobians by central differences, and the noise floor of
 //!   equations built from them;
 //! - `newton`: Newton's method, simplified (a kept Jacobian) or full, with [`NewtonOptions`];
+//! - [`bracket`]: a root of a function on a bracket (Illinois), for locating events;
 //! - [`interrupt`]: when to poll for Ctrl-C, and the check the iterative solves poll.
 
 /// Calls `$f(args…, n)` with n a literal for n ≤ 8, so that the inlined body (an
@@ -26,6 +27,7 @@ macro_rules! sized {
 }
 pub(crate) use sized;
 
+pub mod bracket;
 pub mod difference;
 pub mod interrupt;
 pub(crate) mod lu;

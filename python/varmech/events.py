@@ -1,0 +1,318 @@
+"""Events: functions of the state whose zero crossings a run locates, and may stop at.
+
+``varmech.integrate(..., events=[...])`` follows :func:`scipy.integrate.solve_ivp`: each event is
+a function g(t, q, p) with a ``direction`` (+1: only crossings where g increases, −1: where it
+decreases, 0: both) and ``terminal`` (True: stop at the first occurrence; an integer k: at the
+k-th; False: never). A plain function with those attributes is an event, as in scipy; so is an
+:class:`Event`, which also says whether the function takes the momenta p or the velocities
+q̇ = v (``variables="v"``, g(t, q, v)). The built-in events, :func:`crossing`,
+:func:`energy_error`, :func:`escape` and :func:`encounter`, are evaluated in the Rust core with
+no Python call per step (and without the GIL for native models); a Python function is called
+once per step, and a few times more per crossing.
+
+How a crossing is located
+-------------------------
+After every step zₙ → zₙ₊₁ (the steps are taken one at a time when events are given) each g is
+evaluated; a crossing is g(zₙ) ≠ 0 with g(zₙ₊₁) of the other sign or 0. It is located on the
+method's own map: τ* ∈ (0, h] with g(Φ_τ*(zₙ)) = 0 to round-off, Φ_τ one step of size τ of the
+same method from zₙ, found by the Illinois method on the bracket [0, h] (a handful of partial
+steps). The located state is therefore a state of the integrator, with the method's own error
+(order p), not an interpolant's; its time is off the exact crossing time by O(hᵖ).
+
+A terminal event stops the run at the end of the step in which its last counted crossing
+occurred: the trajectory's last state is a state of the step grid (a continuation from it is the
+same as one longer run), the located crossing is in ``traj.events``, ``traj.status`` is 1 and
+``traj.message`` names the event.
+
+Examples
+--------
+The harmonic oscillator q = sin t falls through q = 0 at t = π and 3π:
+
+>>> import numpy as np
+>>> import varmech
+>>> from varmech.events import crossing
+>>> traj = varmech.integrate(varmech.scenes.harmonic_oscillator(), dt=0.01, t_end=10.0,
+...                          events=[crossing(0, 0.0, direction=-1)])
+>>> np.round(traj.events[0].t / np.pi, 4)
+array([1., 3.])
+>>> bool(abs(traj.events[0].q[:, 0]).max() < 1e-15)
+True
+"""
+
+from __future__ import annotations
+
+import inspect
+import math
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any, Literal
+
+import numpy as np
+
+if TYPE_CHECKING:
+    from . import _core
+
+#: An event function g(t, q, p) (or g(t, q, v), see :class:`Event`).
+EventFunction = Callable[[float, np.ndarray, np.ndarray], float]
+
+
+@dataclass(frozen=True)
+class Event:
+    """An event: the function g and how its crossings are watched.
+
+    Parameters
+    ----------
+    function:
+        g(t, q, p) → float, or g(t, q, v) with ``variables="v"`` (v = q̇, the velocities).
+        None for the built-in events, which carry a ``native`` spec instead.
+    direction:
+        +1: count only crossings where g increases (− to +); −1: where it decreases; 0: both.
+    terminal:
+        True: the run stops after the step of the first crossing; an integer k ≥ 1: of the k-th;
+        False (default): never.
+    variables:
+        ``"p"`` (default): g takes the momenta; ``"v"``: the velocities.
+    name:
+        Shown in messages (default: the function's ``__name__``).
+
+    Examples
+    --------
+    The pendulum H = p²/2 − cos q from (0, 1) swings up to q̇ = 0 at its turning point
+    q = arccos(1/2) = π/3:
+
+    >>> import numpy as np
+    >>> import varmech
+    >>> from varmech.events import Event
+    >>> turn = Event(lambda t, q, v: v[0], direction=-1, terminal=True, variables="v", name="turn")
+    >>> traj = varmech.integrate(varmech.scenes.pendulum(), dt=0.01, t_end=10.0, events=[turn])
+    >>> traj.status, traj.message
+    (1, 'A termination event occurred: turn (occurrence 1) at t = 1.68575.')
+    >>> round(float(traj.events[0].q[0, 0] / np.pi), 4)
+    0.3333
+    """
+
+    function: EventFunction | None
+    direction: int = 0
+    terminal: bool | int = False
+    variables: Literal["p", "v"] = "p"
+    name: str = ""
+    #: The built-in event's spec for the core: (kind, payload).
+    native: tuple[str, Any] | None = field(default=None, repr=False)
+
+
+@dataclass(frozen=True)
+class Occurrences:
+    """The located crossings of one event: times ``t`` (k,), positions ``q`` and momenta ``p``
+    (k, n), in order of time, each a state of the integrator (a partial step of the method)."""
+
+    name: str
+    t: np.ndarray
+    q: np.ndarray
+    p: np.ndarray
+
+    def __len__(self) -> int:
+        return len(self.t)
+
+
+def crossing(k: int, value: float = 0.0, *, direction: int = 0, terminal: bool | int = False) -> Event:
+    """The coordinate q_k crossing ``value``: g = q_k − value (evaluated natively).
+
+    Examples
+    --------
+    >>> import varmech
+    >>> traj = varmech.integrate(varmech.scenes.harmonic_oscillator(), dt=0.01, t_end=10.0,
+    ...                          events=[crossing(0, 0.5, direction=+1)])
+    >>> len(traj.events[0])   # sin t rises through 1/2 at π/6 and 2π + π/6
+    2
+    """
+    k = _index("crossing", k)
+    value = float(value)
+    if not math.isfinite(value):
+        raise ValueError(f"value: must be finite, got {value}")
+    return Event(None, direction, terminal, name=f"q[{k}] = {value:g}", native=("crossing", (k, value)))
+
+
+def energy_error(bound: float, *, terminal: bool | int = True) -> Event:
+    """The energy error growing beyond ``bound``: g = |E(q, p) − E₀| − bound, E₀ the energy at
+    the start, crossing upward (evaluated natively). Terminal by default: a run that stops when
+    its energy is off by more than it can accept.
+
+    Examples
+    --------
+    Explicit Euler multiplies the oscillator's energy ½ by 1 + h² a step: it passes ½ + 0.01
+    during step 199, log(1.02)/log(1.0001) = 198.03:
+
+    >>> import varmech
+    >>> traj = varmech.integrate(varmech.scenes.harmonic_oscillator(), dt=0.01, t_end=100.0,
+    ...                          method="explicit_euler", max_energy_error=None, events=[energy_error(0.01)])
+    >>> traj.status, round(float(traj.t[-1]), 2)
+    (1, 1.99)
+    """
+    bound = float(bound)
+    if not (math.isfinite(bound) and bound > 0):
+        raise ValueError(f"bound: must be finite and positive, got {bound}")
+    return Event(None, +1, terminal, name=f"|E - E0| > {bound:g}", native=("energy_error", bound))
+
+
+def escape(radius: float, *, groups: Sequence[Sequence[int]] | None = None, dim: int = 3, terminal: bool | int = True) -> Event:
+    """A group of coordinates (a body's position) leaving the ball of ``radius`` about the
+    origin: g = maxⱼ |x_j|² − radius², crossing upward (evaluated natively). Terminal by default.
+
+    Parameters
+    ----------
+    groups:
+        The coordinate indices of each position x_j; default: consecutive blocks of ``dim``
+        (the bodies of an N-body scene, 3 coordinates each; ``dim=2`` for the planar Kepler
+        problem).
+
+    Examples
+    --------
+    A hyperbolic Kepler orbit (E > 0) leaves r = 10:
+
+    >>> import numpy as np
+    >>> import varmech
+    >>> kepler = varmech.scenes.kepler()
+    >>> traj = varmech.integrate(kepler.model, [1.0, 0.0], [0.0, 1.6], dt=0.01, t_end=100.0,
+    ...                          events=[escape(10.0, dim=2)])
+    >>> traj.status, bool(abs(np.hypot(*traj.events[0].q[0]) - 10.0) < 1e-12)
+    (1, True)
+    """
+    return _distance("escape", radius, groups, dim, +1, terminal)
+
+
+def encounter(radius: float, *, groups: Sequence[Sequence[int]] | None = None, dim: int = 3, terminal: bool | int = True) -> Event:
+    """Two groups of coordinates (bodies' positions) coming closer than ``radius``:
+    g = min_{i<j} |x_i − x_j|² − radius², crossing downward; with a single group, its distance
+    to the origin (evaluated natively). Terminal by default. ``groups`` and ``dim`` as for
+    :func:`escape`.
+
+    Examples
+    --------
+    The Kepler orbit of eccentricity 0.6 (from pericentre r = 0.4) comes back within r = 0.5
+    once a period, 2π:
+
+    >>> import varmech
+    >>> traj = varmech.integrate(varmech.scenes.kepler(), dt=0.001, t_end=10.0,
+    ...                          events=[encounter(0.5, dim=2, terminal=False)])
+    >>> len(traj.events[0])
+    1
+    """
+    return _distance("encounter", radius, groups, dim, -1, terminal)
+
+
+def _distance(kind: str, radius: float, groups: Sequence[Sequence[int]] | None, dim: int, direction: int, terminal: bool | int) -> Event:
+    radius = float(radius)
+    if not (math.isfinite(radius) and radius > 0):
+        raise ValueError(f"radius: must be finite and positive, got {radius}")
+    if groups is not None:
+        try:
+            spec: Any = [[_index("groups", k) for k in g] for g in groups]
+        except TypeError:
+            raise TypeError(f"groups: expected sequences of coordinate indices, got {groups!r}") from None
+    else:
+        spec = _index("dim", dim)
+        if spec < 1:
+            raise ValueError(f"dim: must be a positive integer, got {dim!r}")
+    return Event(None, direction, terminal, name=f"{kind}({radius:g})", native=(kind, (radius, spec)))
+
+
+def _index(name: str, k: Any) -> int:
+    if isinstance(k, bool) or not isinstance(k, (int, np.integer)) or k < 0:
+        raise ValueError(f"{name}: must be a non-negative integer, got {k!r}")
+    return int(k)
+
+
+def _event(i: int, e: Event | EventFunction) -> Event:
+    """The Event of an events item: an Event, or a function with solve_ivp's attributes."""
+    if isinstance(e, Event):
+        return e
+    if not callable(e):
+        raise TypeError(f"events[{i}]: expected a function g(t, q, p) or a varmech.events.Event, got {type(e).__name__}")
+    return Event(e, getattr(e, "direction", 0), getattr(e, "terminal", False), getattr(e, "variables", "p"))
+
+
+def _name(i: int, e: Event) -> str:
+    return e.name or getattr(e.function, "__name__", "") or f"events[{i}]"
+
+
+def _terminal(label: str, terminal: Any) -> int:
+    """The terminal count: 0 for never."""
+    if isinstance(terminal, (bool, np.bool_)):
+        return int(terminal)
+    if isinstance(terminal, (int, np.integer)) and terminal >= 1:
+        return int(terminal)
+    raise ValueError(f"{label}: terminal must be True, False or a count ≥ 1, got {terminal!r}")
+
+
+def _direction(label: str, direction: Any) -> int:
+    try:
+        d = float(direction)
+    except (TypeError, ValueError):
+        raise ValueError(f"{label}: direction must be a number (its sign counts), got {direction!r}") from None
+    if math.isnan(d):
+        raise ValueError(f"{label}: direction must be a number (its sign counts), got {direction!r}")
+    return int(np.sign(d))
+
+
+def _check_signature(label: str, e: Event) -> None:
+    """A TypeError naming the event unless its function takes (t, q, p) positionally."""
+    try:
+        signature = inspect.signature(e.function)  # type: ignore[arg-type]
+    except (TypeError, ValueError):
+        return  # no signature to check (some builtins): the call will tell
+    try:
+        signature.bind(0.0, None, None)
+    except TypeError:
+        x = "v" if e.variables == "v" else "p"
+        raise TypeError(f"{label}: an event function takes (t, q, {x}), got {signature}") from None
+
+
+def specs(events: Sequence[Event | EventFunction], n: int) -> tuple[list[Event], list[tuple[str, int, int, str, Any]]]:
+    """The events as Events, and the spec tuples the binding takes (name, direction, terminal,
+    kind, payload) for a model of n coordinates. Malformed ones are refused naming them."""
+    if isinstance(events, (Event,)) or callable(events) or isinstance(events, (str, bytes)):
+        raise TypeError("events: expected a list of event functions or varmech.events.Event")
+    items = [_event(i, e) for i, e in enumerate(events)]
+    out = []
+    for i, e in enumerate(items):
+        name = _name(i, e)
+        label = f"events[{i}] ({name})"
+        direction, terminal = _direction(label, e.direction), _terminal(label, e.terminal)
+        if e.native is not None:
+            kind, payload = e.native
+            if kind in ("escape", "encounter") and isinstance(payload[1], int):
+                radius, dim = payload
+                if n % dim:
+                    raise ValueError(f"{label}: {n} coordinates are not blocks of dim = {dim}; pass dim or groups")
+                payload = (radius, [list(range(j, j + dim)) for j in range(0, n, dim)])
+        else:
+            if e.variables not in ("p", "v"):
+                raise ValueError(f"{label}: variables must be 'p' or 'v', got {e.variables!r}")
+            if not callable(e.function):
+                raise TypeError(f"{label}: the function must be callable, got {type(e.function).__name__}")
+            _check_signature(label, e)
+            kind, payload = e.variables, e.function
+        out.append((name, direction, terminal, kind, payload))
+    return items, out
+
+
+def occurrences(record: _core.TrajectoryRecord, events: Sequence[Event]) -> tuple[Occurrences, ...]:
+    """Each event's located crossings, from the binding's record of a run."""
+    index, t, q, p = record.events
+    return tuple(
+        Occurrences(_name(i, e), t[index == i], q[index == i], p[index == i]) for i, e in enumerate(events)
+    )
+
+
+def termination(record: _core.TrajectoryRecord, events: Sequence[Event], found: tuple[Occurrences, ...]) -> dict[str, Any]:
+    """The status and message of a run a terminal event stopped (solve_ivp's status 1), else
+    nothing."""
+    i = record.terminated_by
+    if i is None:
+        return {}
+    last = found[i]
+    message = f"A termination event occurred: {last.name} (occurrence {len(last)}) at t = {last.t[-1]:.6g}."
+    return {"status": 1, "message": message}
+
+
+__all__ = ["Event", "Occurrences", "crossing", "encounter", "energy_error", "escape"]

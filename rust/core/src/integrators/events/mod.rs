@@ -1,0 +1,71 @@
+//! Events: functions g(t, q, p) whose sign changes the run watches, located inside the step by
+//! the method's own partial step (the semantics of scipy's `solve_ivp(events=)`).
+//!
+//! - [`EventFunctions`]: the functions, all evaluated at once into a slice;
+//! - [`EventSpec`]: each one's name, direction and terminal count;
+//! - [`Detector`]: the functions with their specs, which a run given them
+//!   ([`super::integrate_with_events`]) checks after every step, locating each crossing;
+//! - [`NativeEvent`]: the built-in functions, evaluated without leaving Rust;
+//! - [`Occurrence`]: a located crossing, a state of the integrator.
+
+mod detector;
+mod native;
+
+pub use detector::Detector;
+pub(in crate::integrators) use detector::Search;
+pub use native::NativeEvent;
+
+use crate::model::Lagrangian;
+use crate::ModelError;
+
+/// Event functions g₁ … g_m of the state: a run records where each changes sign.
+pub trait EventFunctions {
+    /// The number m of functions.
+    fn len(&self) -> usize;
+
+    /// Whether there are none.
+    fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Called once at the initial state (t₀, q₀, p₀) of a run, before any evaluation (e.g. to
+    /// take the initial energy). By default nothing.
+    fn start(&mut self, _model: &dyn Lagrangian, _t: f64, _q: &[f64], _p: &[f64]) -> Result<(), ModelError> {
+        Ok(())
+    }
+
+    /// Writes gᵢ(t, q, p) into `g[i]`, i < m. `model` gives the velocities q̇(q, p, t) and the
+    /// energy where a function needs them.
+    fn evaluate(
+        &mut self,
+        model: &dyn Lagrangian,
+        t: f64,
+        q: &[f64],
+        p: &[f64],
+        g: &mut [f64],
+    ) -> Result<(), ModelError>;
+}
+
+/// How an event is watched: a crossing is a step from gₙ ≠ 0 to gₙ₊₁ of the other sign or 0.
+#[derive(Clone, Debug, PartialEq)]
+pub struct EventSpec {
+    /// Named in errors and in the terminating event's message.
+    pub name: String,
+    /// +1: only crossings where g increases (from − to +); −1: where it decreases; 0: both.
+    pub direction: i8,
+    /// Stop the run after this many occurrences (at the end of the step of the last one); 0:
+    /// never.
+    pub terminal: usize,
+}
+
+/// A located crossing of event `event`, during step `step` (counted from 1): the state
+/// (t, q, p) of one step of size τ = t − tₙ₋₁ ∈ (0, h] of the run's method from the state
+/// before the step, with gₑᵥₑₙₜ = 0 to round-off.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Occurrence {
+    pub event: usize,
+    pub step: usize,
+    pub t: f64,
+    pub q: Vec<f64>,
+    pub p: Vec<f64>,
+}

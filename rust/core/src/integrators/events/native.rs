@@ -1,0 +1,118 @@
+//! The built-in event functions, evaluated in Rust (no call out of the core per step).
+
+use super::EventFunctions;
+use crate::model::Lagrangian;
+use crate::{Error, ModelError};
+
+/// A built-in event function g(t, q, p).
+#[derive(Clone, Debug, PartialEq)]
+pub enum NativeEvent {
+    /// g = q_k − value: the coordinate k crossing a value.
+    Crossing { coordinate: usize, value: f64 },
+    /// g = |E(q, p) − E₀| − bound, E₀ the energy at the start of the run: the energy error
+    /// growing beyond a bound.
+    EnergyError { bound: f64, initial: f64 },
+    /// g = maxⱼ |x_j|² − r², x_j = q[groups[j]] (e.g. a body's position): a group leaving the
+    /// ball of radius r about the origin (escape).
+    Escape { radius: f64, groups: Vec<Vec<usize>> },
+    /// g = min_{i<j} |x_i − x_j|² − r² over the groups (e.g. bodies), or |x₀|² − r² for a single
+    /// group: two groups closer than r (a close encounter), or one closer to the origin.
+    Encounter { radius: f64, groups: Vec<Vec<usize>> },
+}
+
+impl NativeEvent {
+    /// Refuses coordinates outside 0 … n − 1, empty or unequal groups, and radii or bounds
+    /// that are not finite and positive (naming `events` and the event's `name`).
+    pub fn check(&self, name: &str, n: usize) -> Result<(), Error> {
+        let fail = |reason: String| Err(Error::invalid("events", format!("{name}: {reason}")));
+        let positive = |what: &str, x: f64| {
+            if x.is_finite() && x > 0.0 {
+                Ok(())
+            } else {
+                fail(format!("{what} must be finite and positive, got {x}"))
+            }
+        };
+        match self {
+            NativeEvent::Crossing { coordinate, value } => {
+                if *coordinate >= n {
+                    return fail(format!("coordinate {coordinate} is not in 0 … {}", n - 1));
+                }
+                if !value.is_finite() {
+                    return fail(format!("value must be finite, got {value}"));
+                }
+                Ok(())
+            }
+            NativeEvent::EnergyError { bound, .. } => positive("bound", *bound),
+            NativeEvent::Escape { radius, groups } | NativeEvent::Encounter { radius, groups } => {
+                positive("radius", *radius)?;
+                let width = groups.first().map_or(0, Vec::len);
+                if width == 0 || groups.iter().any(|g| g.len() != width) {
+                    return fail(format!("groups must be non-empty and of equal size, got {groups:?}"));
+                }
+                if let Some(k) = groups.iter().flatten().find(|&&k| k >= n) {
+                    return fail(format!("groups: coordinate {k} is not in 0 … {}", n - 1));
+                }
+                Ok(())
+            }
+        }
+    }
+
+    /// Takes E₀ for the energy error; nothing for the others.
+    pub fn start(&mut self, model: &dyn Lagrangian, t: f64, q: &[f64], p: &[f64]) -> Result<(), ModelError> {
+        if let NativeEvent::EnergyError { initial, .. } = self {
+            *initial = model.energy_terms(q, p, t)?.energy;
+        }
+        Ok(())
+    }
+
+    /// g(t, q, p).
+    pub fn value(&self, model: &dyn Lagrangian, t: f64, q: &[f64], p: &[f64]) -> Result<f64, ModelError> {
+        let squared = |x: &[usize]| x.iter().map(|&k| q[k] * q[k]).sum::<f64>();
+        let apart = |x: &[usize], y: &[usize]| x.iter().zip(y).map(|(&i, &j)| (q[i] - q[j]).powi(2)).sum::<f64>();
+        Ok(match self {
+            NativeEvent::Crossing { coordinate, value } => q[*coordinate] - value,
+            NativeEvent::EnergyError { bound, initial } => {
+                (model.energy_terms(q, p, t)?.energy - initial).abs() - bound
+            }
+            NativeEvent::Escape { radius, groups } => {
+                groups.iter().map(|g| squared(g)).fold(f64::NEG_INFINITY, f64::max) - radius * radius
+            }
+            NativeEvent::Encounter { radius, groups } => {
+                let closest = match groups.as_slice() {
+                    [only] => squared(only),
+                    _ => groups
+                        .iter()
+                        .enumerate()
+                        .flat_map(|(i, x)| groups[i + 1..].iter().map(move |y| (x, y)))
+                        .map(|(x, y)| apart(x, y))
+                        .fold(f64::INFINITY, f64::min),
+                };
+                closest - radius * radius
+            }
+        })
+    }
+}
+
+impl EventFunctions for Vec<NativeEvent> {
+    fn len(&self) -> usize {
+        Vec::len(self)
+    }
+
+    fn start(&mut self, model: &dyn Lagrangian, t: f64, q: &[f64], p: &[f64]) -> Result<(), ModelError> {
+        self.iter_mut().try_for_each(|e| e.start(model, t, q, p))
+    }
+
+    fn evaluate(
+        &mut self,
+        model: &dyn Lagrangian,
+        t: f64,
+        q: &[f64],
+        p: &[f64],
+        g: &mut [f64],
+    ) -> Result<(), ModelError> {
+        for (e, g) in self.iter().zip(g) {
+            *g = e.value(model, t, q, p)?;
+        }
+        Ok(())
+    }
+}

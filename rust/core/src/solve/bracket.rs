@@ -1,0 +1,77 @@
+//! A root of a continuous function on a bracket, by the Illinois method.
+
+/// A root x* of f on the bracket [a, b] with f(a) < 0 ≤ f(b) (or f(a) > 0 ≥ f(b)), by the
+/// Illinois method (Dowell & Jarratt 1971): regula falsi, with the function value at an end
+/// kept twice in a row halved, which restores superlinear convergence (order ≈ 1.44); a secant
+/// point that rounds onto an end of the bracket moves one ulp inside. Stops when f vanishes or
+/// the bracket is within `tolerance` ≥ 0 (at least a few ulps of its ends), or after 100
+/// evaluations (a function that is not continuous); returns the end of the final bracket with
+/// the smaller |f|, and that value.
+///
+/// `f` may fail (e.g. a model error); its first error is returned.
+pub fn illinois<E>(
+    mut f: impl FnMut(f64) -> Result<f64, E>,
+    (mut a, mut fa): (f64, f64),
+    (mut b, mut fb): (f64, f64),
+    tolerance: f64,
+) -> Result<(f64, f64), E> {
+    // The ends' values (ga, gb); (fa, fb) are their weights in the secant, halved by Illinois.
+    let (mut ga, mut gb) = (fa, fb);
+    // Which end the last new point replaced: −1 a, +1 b, 0 none yet.
+    let mut side = 0;
+    for _ in 0..MAX_EVALUATIONS {
+        if ga == 0.0 || gb == 0.0 || converged(a, b, tolerance) {
+            break;
+        }
+        let mut c = b - fb * (b - a) / (fb - fa);
+        let (lo, hi) = if a < b { (a, b) } else { (b, a) };
+        if !(lo < c && c < hi) {
+            // The secant point rounded onto an end (the root is within an ulp or so of it):
+            // one ulp inside from that end brackets it. NaN (fa = fb after halving): bisect.
+            c = if c.is_nan() {
+                0.5 * (a + b)
+            } else if (c - a).abs() < (c - b).abs() {
+                toward(a, b)
+            } else {
+                toward(b, a)
+            };
+            if !(lo < c && c < hi) {
+                break;
+            }
+        }
+        let fc = f(c)?;
+        if (fc < 0.0) == (gb < 0.0) && fc != 0.0 {
+            (b, fb, gb) = (c, fc, fc);
+            if side == 1 {
+                fa *= 0.5;
+            }
+            side = 1;
+        } else {
+            (a, fa, ga) = (c, fc, fc);
+            if side == -1 {
+                fb *= 0.5;
+            }
+            side = -1;
+        }
+    }
+    Ok(if ga.abs() < gb.abs() { (a, ga) } else { (b, gb) })
+}
+
+/// Whether [a, b] is within `tolerance`, or within 4 ulps of its larger end.
+fn converged(a: f64, b: f64, tolerance: f64) -> bool {
+    let width = (b - a).abs();
+    width <= tolerance || width <= 4.0 * f64::EPSILON * a.abs().max(b.abs())
+}
+
+/// The cap on evaluations, against a function that is not continuous: a smooth root takes a
+/// handful (superlinear convergence from the first secant step).
+const MAX_EVALUATIONS: usize = 100;
+
+/// The float next to x in the direction of y.
+fn toward(x: f64, y: f64) -> f64 {
+    if y > x {
+        x.next_up()
+    } else {
+        x.next_down()
+    }
+}

@@ -1,0 +1,125 @@
+//! Events as Python gives them: each a spec tuple `(name, direction, terminal, kind, payload)`,
+//! the built-in kinds turned into the core's [`NativeEvent`]s (evaluated without the GIL), a
+//! Python function called per evaluation with the GIL.
+
+use numpy::PyArray1;
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use varmech::integrators::{EventFunctions, EventSpec, NativeEvent};
+use varmech::model::Lagrangian;
+use varmech::ModelError;
+
+use crate::errors::{boxed, to_pyerr};
+
+/// One event function: built in, or a Python g(t, q, p) or g(t, q, v) (`velocities`).
+enum Function {
+    Native(NativeEvent),
+    Python { function: Py<PyAny>, velocities: bool },
+}
+
+/// A run's event functions, with the velocity buffer of the (t, q, v) ones.
+pub struct Events {
+    functions: Vec<Function>,
+    v: Vec<f64>,
+}
+
+/// The spec tuple Python passes: name, direction, terminal count (0: never), kind and payload.
+pub type EventTuple<'py> = (String, i8, usize, String, Bound<'py, PyAny>);
+
+impl Events {
+    /// The functions and specs of the spec tuples, for a model of n coordinates. Kinds: `"p"`,
+    /// `"v"` (payload the function), `"crossing"` ((k, value)), `"energy_error"` (bound),
+    /// `"escape"`, `"encounter"` ((radius, groups)). A malformed one is a ValueError naming
+    /// `events`.
+    pub fn new(py: Python<'_>, tuples: Vec<EventTuple<'_>>, n: usize) -> PyResult<(Self, Vec<EventSpec>)> {
+        let mut functions = Vec::with_capacity(tuples.len());
+        let mut specs = Vec::with_capacity(tuples.len());
+        for (name, direction, terminal, kind, payload) in tuples {
+            let function = match kind.as_str() {
+                "p" | "v" => Function::Python {
+                    function: payload.unbind(),
+                    velocities: kind == "v",
+                },
+                "crossing" => {
+                    let (coordinate, value) = payload.extract()?;
+                    Function::Native(NativeEvent::Crossing { coordinate, value })
+                }
+                "energy_error" => Function::Native(NativeEvent::EnergyError {
+                    bound: payload.extract()?,
+                    initial: 0.0,
+                }),
+                "escape" | "encounter" => {
+                    let (radius, groups) = payload.extract()?;
+                    Function::Native(if kind == "escape" {
+                        NativeEvent::Escape { radius, groups }
+                    } else {
+                        NativeEvent::Encounter { radius, groups }
+                    })
+                }
+                _ => {
+                    return Err(PyValueError::new_err(format!(
+                        "events: unknown kind {kind:?} of {name}"
+                    )))
+                }
+            };
+            if let Function::Native(native) = &function {
+                native.check(&name, n).map_err(|e| to_pyerr(py, e))?;
+            }
+            functions.push(function);
+            specs.push(EventSpec {
+                name,
+                direction,
+                terminal,
+            });
+        }
+        Ok((
+            Events {
+                functions,
+                v: vec![0.0; n],
+            },
+            specs,
+        ))
+    }
+}
+
+impl EventFunctions for Events {
+    fn len(&self) -> usize {
+        self.functions.len()
+    }
+
+    fn start(&mut self, model: &dyn Lagrangian, t: f64, q: &[f64], p: &[f64]) -> Result<(), ModelError> {
+        self.functions.iter_mut().try_for_each(|f| match f {
+            Function::Native(native) => native.start(model, t, q, p),
+            Function::Python { .. } => Ok(()),
+        })
+    }
+
+    fn evaluate(
+        &mut self,
+        model: &dyn Lagrangian,
+        t: f64,
+        q: &[f64],
+        p: &[f64],
+        g: &mut [f64],
+    ) -> Result<(), ModelError> {
+        for (f, g) in self.functions.iter().zip(g) {
+            *g = match f {
+                Function::Native(native) => native.value(model, t, q, p)?,
+                Function::Python { function, velocities } => {
+                    let x = if *velocities {
+                        model.velocity(q, p, t, &mut self.v)?;
+                        &self.v
+                    } else {
+                        p
+                    };
+                    Python::attach(|py| {
+                        let args = (t, PyArray1::from_slice(py, q), PyArray1::from_slice(py, x));
+                        function.call1(py, args)?.extract::<f64>(py)
+                    })
+                    .map_err(boxed)?
+                }
+            };
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,106 @@
+//! Events: the Illinois root finder, and crossings of the harmonic oscillator located by the
+//! method's partial step, at the method's order, with directions and terminal counts.
+
+use std::f64::consts::PI;
+
+use varmech::integrators::{integrate, integrate_with_events, Detector, EventSpec, Method, NativeEvent, Options};
+use varmech::scenes::HarmonicOscillator;
+use varmech::solve::bracket::illinois;
+
+#[test]
+fn illinois_finds_a_root_to_round_off_in_few_evaluations() {
+    let mut calls = 0;
+    let f = |x: f64| {
+        calls += 1;
+        Ok::<_, ()>(x.cos())
+    };
+    // cos falls through 0 at π/2 on [0, 2]: f(a) > 0 ≥ f(b) is a bracket too.
+    let (x, fx) = illinois(f, (0.0, 1.0), (2.0, 2.0_f64.cos()), 0.0).unwrap();
+    assert!((x - PI / 2.0).abs() <= 2.0 * f64::EPSILON, "{x}");
+    assert!(fx.abs() <= 2e-16);
+    assert!(calls <= 8, "{calls} evaluations");
+    // A failing function's error comes back.
+    let failing = illinois(|_| Err("model failed"), (0.0, -1.0), (1.0, 1.0), 0.0);
+    assert_eq!(failing, Err("model failed"));
+}
+
+/// The crossings of q = 0 of q = cos t (ω = 1 from q = 1, p = 0) with `method` at step h over
+/// t ∈ [0, 20]: the largest error of the located times against (k + ½)π.
+fn crossing_error(method: Method, h: f64, direction: i8) -> (usize, f64) {
+    let sys = HarmonicOscillator::new(1.0).unwrap();
+    let options = Options::new(h, (20.0 / h).round() as usize);
+    let crossing = vec![NativeEvent::Crossing {
+        coordinate: 0,
+        value: 0.0,
+    }];
+    let spec = EventSpec {
+        name: "q0 = 0".into(),
+        direction,
+        terminal: 0,
+    };
+    let mut detector = Detector::new(Box::new(crossing), vec![spec]).unwrap();
+    let traj = integrate_with_events(&sys, method, &[1.0], &[0.0], &options, || Ok(()), &mut detector).unwrap();
+    let worst = traj.events.iter().fold(0.0_f64, |m, e| {
+        // Downward crossings at (2j + ½)π, upward at (2j + 3/2)π.
+        let exact = ((e.t / PI - 0.5).round() + 0.5) * PI;
+        assert!(e.q[0].abs() <= 1e-15, "q = {} at the crossing", e.q[0]);
+        m.max((e.t - exact).abs())
+    });
+    (traj.events.len(), worst)
+}
+
+#[test]
+fn crossings_are_located_at_the_methods_order() {
+    for (method, order, h) in [
+        (Method::Verlet, 2, 0.1),
+        (Method::Yoshida4, 4, 0.1),
+        (Method::KahanLi6, 6, 0.2),
+    ] {
+        let (count, coarse) = crossing_error(method, h, 0);
+        let (_, fine) = crossing_error(method, h / 2.0, 0);
+        // q = cos t crosses 0 six times in [0, 20] (at π/2 … 11π/2).
+        assert_eq!(count, 6, "{method:?}");
+        let slope = (coarse / fine).log2();
+        assert!((slope - order as f64).abs() <= 0.3, "{method:?}: slope {slope}");
+    }
+}
+
+#[test]
+fn directions_keep_their_crossings_and_a_count_terminal_stops_after_its_step() {
+    // Downward at π/2, 5π/2, 9π/2; upward at 3π/2, 7π/2, 11π/2.
+    assert_eq!(crossing_error(Method::Verlet, 0.01, -1).0, 3);
+    assert_eq!(crossing_error(Method::Verlet, 0.01, 1).0, 3);
+
+    let sys = HarmonicOscillator::new(1.0).unwrap();
+    let options = Options::new(0.01, 2000);
+    let crossing = vec![NativeEvent::Crossing {
+        coordinate: 0,
+        value: 0.0,
+    }];
+    let spec = EventSpec {
+        name: "q0 = 0".into(),
+        direction: 0,
+        terminal: 3,
+    };
+    let mut detector = Detector::new(Box::new(crossing), vec![spec]).unwrap();
+    let traj = integrate_with_events(&sys, Method::Verlet, &[1.0], &[0.0], &options, || Ok(()), &mut detector).unwrap();
+    assert_eq!(traj.events.len(), 3);
+    assert_eq!(traj.terminated_by, Some(0));
+    // The run stops at the end of the step of the third crossing (5π/2), a state of the grid
+    // equal bit for bit to the same step of a run without events.
+    let third = &traj.events[2];
+    assert_eq!(traj.steps, third.step);
+    assert_eq!(*traj.t.last().unwrap(), 0.01 * third.step as f64);
+    assert!(traj.t[traj.len() - 2] < third.t && third.t <= *traj.t.last().unwrap());
+    let plain = integrate(
+        &sys,
+        Method::Verlet,
+        &[1.0],
+        &[0.0],
+        &Options::new(0.01, third.step),
+        || Ok(()),
+    )
+    .unwrap();
+    assert_eq!(plain.q, traj.q);
+    assert_eq!(plain.p, traj.p);
+}
