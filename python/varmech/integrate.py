@@ -13,11 +13,10 @@ from typing import TYPE_CHECKING, Any, Literal
 import numpy as np
 from numpy.typing import ArrayLike
 
-from . import _core, files
+from . import _core, dense, files
 from . import events as _events
 from ._progress import progress_bar
 from ._util import finite, positive, positive_int, vector
-from .dense import hermite
 from .model import Lagrangian, Model
 
 if TYPE_CHECKING:
@@ -90,7 +89,7 @@ class Trajectory:
         """(q(t), p(t)) between the saved states, by cubic Hermite interpolation from q, q̇ and
         p, ṗ at the states on either side: error O(Δ⁴) in their spacing Δ. See
         :func:`varmech.dense.hermite`."""
-        return hermite(self, t)
+        return dense.hermite(self, t)
 
     def energy(self) -> np.ndarray:
         """The energy function E = p·q̇ − L (= ½pᵀM⁻¹p + V(q) for mechanical systems) at each
@@ -231,6 +230,7 @@ def integrate(
     overwrite: bool = False,
     checkpoint_every: int | datetime.timedelta | None = None,
     events: Sequence[_events.Event | _events.EventFunction] | None = None,
+    t_eval: ArrayLike | None = None,
 ) -> Trajectory:
     """Integrate ``model`` from (q0, p0) with a fixed step.
 
@@ -292,6 +292,13 @@ def integrate(
         than :data:`varmech.files.LAZY_BYTES`. A run stopped by Ctrl-C, an error or a kill leaves a valid file
         with every committed state, from which :func:`varmech.resume` goes on. An existing file
         is refused unless ``overwrite``.
+    t_eval:
+        Keep the states at these times (increasing, within the run's span) instead of every
+        ``save_every``-th: each is reached from the grid state before it by one step of the same
+        method of size τ < h, so it has the method's own error (order measured in
+        ``tests/python/test_dense.py``), as ``solve_ivp(t_eval=)`` does with its dense output.
+        The run itself is unchanged (it ends on its grid, with its checkpoint); not with
+        ``save_every``, ``output`` or ``events``.
     checkpoint_every:
         With ``output``: commit states and a checkpoint at least every this many steps (rounded
         down to whole ``save_every`` periods), or every :class:`datetime.timedelta` of run time.
@@ -330,7 +337,17 @@ def integrate(
         exception allows.
     """
     if isinstance(model, Trajectory):
-        given = {"q0": q0, "p0": p0, "v0": v0, "dt": dt, "method": method, "t0": t0, "parameters": parameters, "events": events}
+        given = {
+            "q0": q0,
+            "p0": p0,
+            "v0": v0,
+            "dt": dt,
+            "method": method,
+            "t0": t0,
+            "parameters": parameters,
+            "events": events,
+            "t_eval": t_eval,
+        }
         named = [name for name, value in given.items() if value is not None]
         if named:
             raise ValueError(f"{named[0]}: a continued run keeps its trajectory's {', '.join(named)}")
@@ -376,7 +393,43 @@ def integrate(
             events=event_specs or None,
         )
 
+    if t_eval is not None:
+        return _evaluated(first, model, method, dt, t0, nsteps, dense.eval_times(t_eval, t0, t_end), save_every, progress, output, watched)
     return _run(first, None, 0, model, method, dt, nsteps, save_every, progress, output, overwrite, checkpoint_every, watched)
+
+
+def _evaluated(
+    first: Callable[[int, Callable[[int], None] | None], _core.TrajectoryRecord],
+    model: Model,
+    method: str,
+    dt: float,
+    t0: float,
+    nsteps: int,
+    times: np.ndarray,
+    save_every: int,
+    progress: bool | None,
+    output: str | os.PathLike[str] | None,
+    watched: Sequence[_events.Event],
+) -> Trajectory:
+    """``integrate(t_eval=)``: the run's states at ``times`` (:func:`varmech.dense.at_times`)."""
+    for name, given in (("save_every", save_every != 1), ("output", output is not None), ("events", bool(watched))):
+        if given:
+            raise ValueError(f"{name}: not with t_eval, which gives the states kept")
+    bar = progress_bar(total=nsteps, unit="step", desc=method, enabled=progress)
+    try:
+        columns, record = dense.at_times(lambda steps: first(steps, None), model, times, t0, dt, nsteps, lambda s: bar.update(s - bar.n))
+    except BaseException as err:
+        partial = getattr(err, "_varmech_partial", None)
+        if partial is not None:
+            delattr(err, "_varmech_partial")
+            err.partial = _trajectory(partial, model, method, dt, status=-1, message=str(err))  # type: ignore[attr-defined]
+        raise
+    finally:
+        bar.close()
+    c = columns
+    newton = c["newton"].astype(np.uint64) if files.columns_of(model, method)[:1] == ("newton",) else None
+    work = c["work"] if model.forced else None
+    return Trajectory(c["t"], c["q"], c["p"], model, method, dt, record.steps, record.force_evaluations, newton, work, checkpoint=record.checkpoint)
 
 
 def _go_on(

@@ -76,3 +76,48 @@ def test_bad_times_and_constrained_models_are_refused():
     run = varmech.integrate(pendulum, dt=pendulum.dt, steps=4)
     with pytest.raises(ValueError, match="constraint forces"):
         run.sol(pendulum.dt)
+
+
+def test_t_eval_on_the_grid_gives_the_runs_own_states_to_the_bit():
+    s = varmech.scenes.double_pendulum()
+    run = varmech.integrate(s, dt=0.01, steps=300, save_every=1)
+    picked = [0, 7, 8, 150, 300]
+    at = varmech.integrate(s, dt=0.01, steps=300, t_eval=run.t[picked])
+    np.testing.assert_array_equal(at.q, run.q[picked])
+    np.testing.assert_array_equal(at.p, run.p[picked])
+    np.testing.assert_array_equal(at.newton, run.newton[picked])
+    # The run itself goes on to its end: the same stepper state as without t_eval (the energy
+    # check, which saw other states, aside).
+    def state(traj):
+        return varmech.Stepper.from_checkpoint(s, traj.checkpoint).checkpoint()
+
+    assert at.steps == run.steps and state(at) == state(run)
+
+
+@pytest.mark.parametrize(("method", "order", "h"), [("verlet", 2, 0.02), ("kahan_li6", 6, 0.2), ("midpoint", 2, 0.02)])
+def test_t_eval_between_steps_has_the_methods_own_order(method, order, h):
+    # The harmonic oscillator from q = 0, p = 1: q = sin t, p = cos t. Times off every grid.
+    s = varmech.scenes.harmonic_oscillator()
+    times = np.linspace(0.0137, 9.9, 25)
+    errors = []
+    for dt in (h, h / 2):
+        steps = int(np.ceil(10.0 / dt))
+        traj = varmech.integrate(s, [0.0], [1.0], dt=dt, steps=steps, method=method, t_eval=times)
+        np.testing.assert_array_equal(traj.t, times)
+        errors.append(max(np.max(np.abs(traj.q[:, 0] - np.sin(times))), np.max(np.abs(traj.p[:, 0] - np.cos(times)))))
+    measured = np.log2(errors[0] / errors[1])
+    assert abs(measured - order) < 0.3, (errors, measured)
+
+
+def test_bad_t_eval_is_named():
+    s = varmech.scenes.harmonic_oscillator()
+    for bad, match in [
+        ([0.5, 0.2], "sorted"),
+        ([0.5, 20.0], "within the run's span"),
+        ([np.nan], "finite"),
+        ([], "non-empty"),
+    ]:
+        with pytest.raises(ValueError, match=f"^t_eval: .*{match}"):
+            varmech.integrate(s, dt=0.1, steps=100, t_eval=bad)
+    with pytest.raises(ValueError, match="^save_every: not with t_eval"):
+        varmech.integrate(s, dt=0.1, steps=100, save_every=10, t_eval=[0.5])
