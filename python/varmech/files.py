@@ -13,6 +13,7 @@ The layout, self-describing so that any HDF5 reader can use it (``docs/file_form
     /committed   (5,)   int64     rows, checkpoint slot, checkpoint length, steps, nfev
     /checkpoint0, /checkpoint1    uint8  the last committed state's checkpoint, in the slot
                                   /committed names (the other holds the one before)
+    /events/<k>  attr name; t (k,), q, p (k, n): event k's crossings (saved trajectories)
     /model       opaque bytes     the model's pickle (what builds it: a scene's name and
                                   parameters, expressions, or closures by reference)
 
@@ -31,11 +32,13 @@ from __future__ import annotations
 
 import os
 import pickle
-from collections.abc import Iterator
+from collections.abc import Iterator, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
+
+from .events import Occurrences
 
 if TYPE_CHECKING:
     from .integrate import Trajectory
@@ -168,28 +171,52 @@ class Writer:
     def append(self, record: Any, *, skip_first: bool = False) -> None:
         """Appends the rows of ``record`` (a :class:`Trajectory` or the binding's record; its
         first row left out when it repeats the last one written) and commits them with its
-        checkpoint, its steps and its evaluations."""
+        checkpoint, its steps and its evaluations: rows and checkpoint are written and flushed
+        first, ``/committed`` last.
+
+        Through h5py's low-level API (extent, hyperslab, write): about 0.2 ms a commit, where
+        the high-level indexing took 1.5 ms."""
+        h5py = _h5py()
         f, start = self._file, int(skip_first)
         added = len(record.t) - start
-        for name in self._columns:
-            data = np.asarray(getattr(record, name))[start:]
-            ds = f[name]
-            ds.resize(self.rows + added, axis=0)
-            ds[self.rows :] = data
-            ds.flush()
+        if added > 0:
+            for name in self._columns:
+                ds = f[name]
+                data = np.ascontiguousarray(np.asarray(getattr(record, name))[start:], dtype=ds.dtype)
+                ds.id.set_extent((self.rows + added, *ds.shape[1:]))
+                space = ds.id.get_space()
+                space.select_hyperslab((self.rows, *(0,) * (data.ndim - 1)), data.shape)
+                ds.id.write(h5py.h5s.create_simple(data.shape), space, data)
         slot = 1 - self._slot
         checkpoint = np.frombuffer(record.checkpoint or b"", dtype=np.uint8)
         ds = f[f"checkpoint{slot}"]
-        ds.resize((len(checkpoint),))
-        ds[:] = checkpoint
-        ds.flush()
+        ds.id.set_extent((len(checkpoint),))
+        if len(checkpoint):
+            ds.id.write(h5py.h5s.ALL, h5py.h5s.ALL, checkpoint)
+        f.flush()
         nfev = getattr(record, "nfev", None)
         nfev = record.force_evaluations if nfev is None else nfev
         committed = f["committed"]
-        committed[:] = [self.rows + added, slot, len(checkpoint), record.steps, nfev]
-        committed.flush()
+        row = np.array([self.rows + added, slot, len(checkpoint), record.steps, nfev], dtype=np.int64)
+        committed.id.write(h5py.h5s.ALL, h5py.h5s.ALL, row)
+        committed.id.flush()
         self.rows += added
         self._slot = slot
+
+    def add_events(self, events: Sequence[Occurrences]) -> None:
+        """Writes each event's crossings as the group ``/events/<k>`` (attr ``name``; datasets
+        t, q, p), in the order of the run's events."""
+        if not events:
+            return
+        self._file.close()
+        with _h5py().File(self.path, "r+", libver="latest") as f:
+            group = f.create_group("events")
+            for k, occurrences in enumerate(events):
+                g = group.create_group(str(k))
+                g.attrs["name"] = occurrences.name
+                for name in ("t", "q", "p"):
+                    g.create_dataset(name, data=np.asarray(getattr(occurrences, name)))
+        self._file = _h5py().File(self.path, "r+", libver="latest")
 
     def close(self, status: int, message: str) -> None:
         """Records the end of the run (``status``, ``message`` and the committed counts) and
@@ -231,6 +258,7 @@ def save(traj: Trajectory, path: str | os.PathLike[str], *, overwrite: bool = Fa
     columns = columns_of(traj.model, traj.method)
     writer = Writer(target, model=traj.model, method=traj.method, dt=traj.dt, columns=columns)
     writer.append(traj)
+    writer.add_events(traj.events)
     writer.close(traj.status, traj.message)
     return target
 
@@ -338,6 +366,10 @@ def load(path: str | os.PathLike[str], *, model: Model | None = None, lazy: bool
                 name: Rows(source, name, shapes[name], f[name].dtype) if lazy else f[name][:rows] for name in present
             }
             checkpoint = f[f"checkpoint{slot}"][:length].tobytes()
+            events = tuple(
+                Occurrences(str(g.attrs["name"]), g["t"][()], g["q"][()], g["p"][()])
+                for g in (f["events"][str(k)] for k in range(len(f["events"])))
+            ) if "events" in f else ()
             blob: bytes = f["model"][()].tobytes() if model is None else b""
     except (OSError, KeyError, RuntimeError) as e:
         # h5py raises RuntimeError for some damaged structures (a bad heap signature).
@@ -364,6 +396,7 @@ def load(path: str | os.PathLike[str], *, model: Model | None = None, lazy: bool
         status=int(a["status"]) if complete else -1,
         message=str(a["message"]) if complete else f"The run stopped at step {steps} without closing its file.",
         checkpoint=checkpoint or None,
+        events=events,
     )
 
 

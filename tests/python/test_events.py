@@ -202,3 +202,13 @@ def test_henon_heiles_sections_match_the_partial_step_locator_they_replaced():
         want = np.array(case["rows"])
         assert got.shape == want.shape
         np.testing.assert_allclose(got, want, rtol=0, atol=1e-12)
+
+
+def test_a_saved_trajectory_keeps_its_events(tmp_path):
+    s = varmech.scenes.harmonic_oscillator()
+    traj = varmech.integrate(s, dt=0.01, t_end=10.0, events=[crossing(0, 0.5, direction=+1), crossing(0, 0.0)])
+    back = varmech.load(traj.save(tmp_path / "e.h5"))
+    assert [o.name for o in back.events] == [o.name for o in traj.events]
+    for a, b in zip(back.events, traj.events):
+        for name in ("t", "q", "p"):
+            np.testing.assert_array_equal(getattr(a, name), getattr(b, name))
