@@ -349,6 +349,8 @@ def integrate(
             "t_eval": t_eval,
         }
         named = [name for name, value in given.items() if value is not None]
+        if named and named[0] in ("events", "t_eval"):
+            raise ValueError(f"{named[0]}: not with a continued run (start a new run from its last state)")
         if named:
             raise ValueError(f"{named[0]}: a continued run keeps its trajectory's {', '.join(named)}")
         return _go_on(model, steps, t_end, save_every, progress, output, overwrite, checkpoint_every)

@@ -199,6 +199,11 @@ def test_bad_output_and_checkpoint_arguments_are_named(tmp_path):
     traj = varmech.integrate(s, dt=0.1, steps=10)
     with pytest.raises(ValueError, match="^dt: a continued run keeps its trajectory's dt"):
         varmech.integrate(traj, dt=0.2, steps=10)
+    zero = varmech.events.crossing(0, 0.0)
+    with pytest.raises(ValueError, match="^events: not with a continued run"):
+        varmech.integrate(traj, steps=10, events=[zero])
+    with pytest.raises(ValueError, match="^events: not yet with output="):
+        varmech.integrate(s, dt=0.1, steps=10, output=path, overwrite=True, events=[zero])
 
 
 def test_a_checkpoint_of_another_model_or_damaged_is_refused(tmp_path):
