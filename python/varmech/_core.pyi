@@ -456,8 +456,10 @@ def resume(
     steps: int,
     save_every: int = 1,
     progress: Callable[[int], object] | None = None,
+    events: list[tuple[str, int, int, str, Any]] | None = None,
 ) -> TrajectoryRecord:
-    """Goes on from a run's checkpoint for `steps` more steps (see [`integrators::resume`])."""
+    """Goes on from a run's checkpoint for `steps` more steps (see [`integrators::resume`]),
+    watching `events` (as `integrate`'s) if given."""
 
 def energy_terms(model: _Model, t: _FloatArray, q: _FloatArray, p: _FloatArray) -> tuple[_FloatArray, _FloatArray, _FloatArray]:
     """(E, T, V) at each state: the energy function p·q̇ − L, its kinetic term E − V and its

@@ -304,6 +304,23 @@ def occurrences(record: _core.TrajectoryRecord, events: Sequence[Event]) -> tupl
     )
 
 
+def occurrences_of(events: Sequence[Event]) -> tuple[Occurrences, ...]:
+    """No crossings yet of each event (their names)."""
+    empty = np.empty(0)
+    return tuple(Occurrences(_name(i, e), empty, empty, empty) for i, e in enumerate(events))
+
+
+def going_on(specs: list[Any], found: Sequence[int], initial_energy: float) -> list[Any]:
+    """The spec tuples of a run resumed after ``found`` crossings of each event: terminal
+    counts less those found, and the energy error measured from the whole run's E₀."""
+    out = []
+    for (name, direction, terminal, kind, payload), k in zip(specs, found):
+        if kind == "energy_error":
+            payload = (payload[0] if isinstance(payload, tuple) else payload, initial_energy)
+        out.append((name, direction, terminal - k if terminal else 0, kind, payload))
+    return out
+
+
 def termination(record: _core.TrajectoryRecord, events: Sequence[Event], found: tuple[Occurrences, ...]) -> dict[str, Any]:
     """The status and message of a run a terminal event stopped (solve_ivp's status 1), else
     nothing."""

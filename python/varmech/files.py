@@ -13,7 +13,7 @@ The layout, self-describing so that any HDF5 reader can use it (``docs/file_form
     /committed   (5,)   int64     rows, checkpoint slot, checkpoint length, steps, nfev
     /checkpoint0, /checkpoint1    uint8  the last committed state's checkpoint, in the slot
                                   /committed names (the other holds the one before)
-    /events/<k>  attr name; t (k,), q, p (k, n): event k's crossings (saved trajectories)
+    /events/<k>  attr name; t (k,), q, p (k, n): the crossings of the run's k-th event
     /model       opaque bytes     the model's pickle (what builds it: a scene's name and
                                   parameters, expressions, or closures by reference)
 
@@ -93,6 +93,7 @@ class Writer:
         dt: float,
         columns: tuple[str, ...],
         save_every: int = 0,
+        events: Sequence[str] = (),
         argument: str = "path",
     ):
         from . import __version__
@@ -134,6 +135,7 @@ class Writer:
                 f.create_dataset(f"checkpoint{slot}", shape=(0,), maxshape=(None,), chunks=(4096,), dtype=np.uint8)
             f.create_dataset("committed", data=np.zeros(5, dtype=np.int64))
             f.create_dataset("model", data=np.void(pickle.dumps(model)))
+            _create_events(f, events, n)
             f.swmr_mode = True
         except OSError as e:
             raise ValueError(f"{argument}: cannot write {str(path)!r}: {e}") from e
@@ -144,9 +146,10 @@ class Writer:
         self._datasets: dict[str, Any] | None = None
 
     @classmethod
-    def reopen(cls, path: Path, stored: Trajectory) -> Writer:
+    def reopen(cls, path: Path, stored: Trajectory, events: Sequence[str] = ()) -> Writer:
         """The writer appending to the file ``path`` (loaded as ``stored``) after its committed
-        rows, marked incomplete until it closes again."""
+        rows, marked incomplete until it closes again, with the crossings of ``events`` (named
+        as the file's, if it has any)."""
         h5py = _h5py()
         writer = cls.__new__(cls)
         writer.path, writer._argument = path, "path"
@@ -161,6 +164,12 @@ class Writer:
                 f = h5py.File(path, "r+", libver="latest")
             f.attrs.update({"complete": False, "status": -1, "message": "The run stopped before closing its file."})
             rows, slot = (int(x) for x in f["committed"][:2])
+            stored_names = [o.name for o in stored.events]
+            if events and stored_names and list(events) != stored_names:
+                f.close()
+                raise ValueError(f"events: the file's events are {stored_names}, not {list(events)}")
+            if events and "events" not in f:
+                _create_events(f, events, int(f.attrs["dim"]))
             f.swmr_mode = True
         except OSError as e:
             raise ValueError(f"path: cannot append to {str(path)!r}: {e}") from e
@@ -170,7 +179,7 @@ class Writer:
         writer._datasets = None
         return writer
 
-    def append(self, record: Any, *, skip_first: bool = False) -> None:
+    def append(self, record: Any, *, skip_first: bool = False, events: Sequence[Occurrences] = ()) -> None:
         """Appends the rows of ``record`` (a :class:`Trajectory` or the binding's record; its
         first row left out when it repeats the last one written) and commits them with its
         checkpoint, its steps and its evaluations: rows and checkpoint are written and flushed
@@ -194,6 +203,14 @@ class Writer:
                 space = ds.id.get_space()
                 space.select_hyperslab((self.rows, *(0,) * (data.ndim - 1)), data.shape)
                 ds.id.write(h5py.h5s.create_simple(data.shape), space, data)
+        for k, occurrences in enumerate(events):
+            group = f["events"][str(k)]
+            for name in ("t", "q", "p"):
+                ds, data = group[name], np.asarray(getattr(occurrences, name), dtype=np.float64)
+                if len(data):
+                    start = ds.shape[0]
+                    ds.resize(start + len(data), axis=0)
+                    ds[start:] = data
         slot = 1 - self._slot
         checkpoint = np.frombuffer(record.checkpoint or b"", dtype=np.uint8)
         ds = datasets[f"checkpoint{slot}"]
@@ -210,22 +227,6 @@ class Writer:
         self.rows += added
         self._slot = slot
 
-    def add_events(self, events: Sequence[Occurrences]) -> None:
-        """Writes each event's crossings as the group ``/events/<k>`` (attr ``name``; datasets
-        t, q, p), in the order of the run's events."""
-        if not events:
-            return
-        self._file.close()
-        with _h5py().File(self.path, "r+", libver="latest") as f:
-            group = f.create_group("events")
-            for k, occurrences in enumerate(events):
-                g = group.create_group(str(k))
-                g.attrs["name"] = occurrences.name
-                for name in ("t", "q", "p"):
-                    g.create_dataset(name, data=np.asarray(getattr(occurrences, name)))
-        self._file = _h5py().File(self.path, "r+", libver="latest")
-        self._datasets = None
-
     def close(self, status: int, message: str) -> None:
         """Records the end of the run (``status``, ``message`` and the committed counts) and
         closes the file."""
@@ -238,6 +239,18 @@ class Writer:
         """Closes the file as it is (a run stopped by an exception that could not be recorded)."""
         self._file.close()
         self.is_open = False
+
+
+def _create_events(f: Any, names: Sequence[str], n: int) -> None:
+    """The groups ``/events/<k>`` of the events ``names``, empty and growing."""
+    if not names:
+        return
+    group = f.create_group("events")
+    for k, name in enumerate(names):
+        g = group.create_group(str(k))
+        g.attrs["name"] = name
+        for column, shape in (("t", (0,)), ("q", (0, n)), ("p", (0, n))):
+            g.create_dataset(column, shape=shape, maxshape=(None, *shape[1:]), chunks=(256, *shape[1:]), dtype=np.float64)
 
 
 def _recover(path: Path) -> None:
@@ -263,10 +276,9 @@ def save(traj: Trajectory, path: str | os.PathLike[str], *, overwrite: bool = Fa
     cannot be written.
     """
     target = writable(path, overwrite, "path")
-    columns = columns_of(traj.model, traj.method)
-    writer = Writer(target, model=traj.model, method=traj.method, dt=traj.dt, columns=columns)
-    writer.append(traj)
-    writer.add_events(traj.events)
+    columns, names = columns_of(traj.model, traj.method), [o.name for o in traj.events]
+    writer = Writer(target, model=traj.model, method=traj.method, dt=traj.dt, columns=columns, events=names)
+    writer.append(traj, events=traj.events)
     writer.close(traj.status, traj.message)
     return target
 
@@ -374,10 +386,9 @@ def load(path: str | os.PathLike[str], *, model: Model | None = None, lazy: bool
                 name: Rows(source, name, shapes[name], f[name].dtype) if lazy else f[name][:rows] for name in present
             }
             checkpoint = f[f"checkpoint{slot}"][:length].tobytes()
-            events = tuple(
-                Occurrences(str(g.attrs["name"]), g["t"][()], g["q"][()], g["p"][()])
-                for g in (f["events"][str(k)] for k in range(len(f["events"])))
-            ) if "events" in f else ()
+            # Crossings after the last committed state are a killed run's uncommitted segment's.
+            t_last = float(f["t"][rows - 1]) if rows else -np.inf
+            events = tuple(_occurrences(f["events"][str(k)], t_last) for k in range(len(f["events"]))) if "events" in f else ()
             blob: bytes = f["model"][()].tobytes() if model is None else b""
     except (OSError, KeyError, RuntimeError) as e:
         # h5py raises RuntimeError for some damaged structures (a bad heap signature).
@@ -417,6 +428,13 @@ def save_every_of(path: str | os.PathLike[str]) -> int:
             return every
         t, dt = f["t"][:2], float(f.attrs["dt"])
     return max(1, round(float(t[1] - t[0]) / dt)) if len(t) > 1 else 1
+
+
+def _occurrences(group: Any, t_last: float) -> Occurrences:
+    """An event's crossings in the file, up to the committed time ``t_last``."""
+    t = group["t"][()]
+    keep = int(np.searchsorted(t, t_last, side="right"))
+    return Occurrences(str(group.attrs["name"]), t[:keep], group["q"][:keep], group["p"][:keep])
 
 
 def larger_than_memory(path: str | os.PathLike[str]) -> bool:

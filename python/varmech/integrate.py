@@ -397,7 +397,9 @@ def integrate(
 
     if t_eval is not None:
         return _evaluated(first, model, method, dt, t0, nsteps, dense.eval_times(t_eval, t0, t_end), save_every, progress, output, watched)
-    return _run(first, None, 0, model, method, dt, nsteps, save_every, progress, output, overwrite, checkpoint_every, watched)
+    return _run(
+        first, None, 0, model, method, dt, nsteps, save_every, progress, output, overwrite, checkpoint_every, watched, event_specs
+    )
 
 
 def _evaluated(
@@ -463,6 +465,7 @@ def _go_on(
         overwrite,
         checkpoint_every,
         (),
+        [],
     )
 
 
@@ -480,22 +483,30 @@ def _run(
     overwrite: bool,
     checkpoint_every: int | datetime.timedelta | None,
     watched: Sequence[_events.Event],
+    event_specs: list[Any],
 ) -> Trajectory:
     """Runs ``nsteps`` steps by ``first`` (a new run) or from ``checkpoint`` (after ``base``
     steps): in memory, or streamed to ``output`` in segments (:mod:`varmech.streaming`).
-    ``watched`` are the run's events, whose crossings the result reports."""
+    ``watched`` are the run's events (``event_specs`` the binding's), whose crossings the result
+    reports."""
     from . import streaming
 
     bar = progress_bar(total=nsteps, unit="step", desc=method, enabled=progress)
     try:
         if output is not None:
-            if watched:
-                raise ValueError("events: not yet with output= (a streamed run's events would need a place in the file)")
             target = files.writable(output, bool(overwrite), "output")
             streaming.checkpoint_period(checkpoint_every, save_every)
             columns = files.columns_of(model, method)
+            names = [o.name for o in _events.occurrences_of(watched)]
             writer = files.Writer(
-                target, model=model, method=method, dt=dt, columns=columns, save_every=save_every, argument="output"
+                target,
+                model=model,
+                method=method,
+                dt=dt,
+                columns=columns,
+                save_every=save_every,
+                events=names,
+                argument="output",
             )
             try:
                 streaming.stream(
@@ -508,6 +519,8 @@ def _run(
                     save_every=save_every,
                     checkpoint_every=checkpoint_every,
                     bar=bar,
+                    watched=watched,
+                    event_specs=event_specs,
                 )
             except BaseException as err:
                 err.partial = files.load(target, model=model, lazy=True)  # type: ignore[attr-defined]

@@ -18,11 +18,14 @@ import os
 import signal
 import threading
 import time
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterator, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+import numpy as np
+
 from . import _core, files
+from . import events as _events
 from ._progress import progress_bar
 from .integrate import Trajectory, _steps
 from .model import Model
@@ -68,12 +71,21 @@ def stream(
     save_every: int,
     checkpoint_every: int | datetime.timedelta | None,
     bar: tqdm[Any],
+    watched: Sequence[_events.Event] = (),
+    event_specs: list[Any] | None = None,
+    initial_energy: float | None = None,
+    found: Sequence[int] = (),
 ) -> None:
     """Runs ``steps`` steps in segments appended to ``writer``: the first by ``first`` (a new
-    run) or from ``checkpoint`` (after ``base`` steps), every other from the last checkpoint. Closes the file with the
+    run) or from ``checkpoint`` (after ``base`` steps), every other from the last checkpoint.
+    With events (``watched``, the binding's ``event_specs``), each segment watches them from
+    its start, their crossings are committed with the segment's rows, terminal counts run over
+    the whole run, and an energy error is measured from ``initial_energy`` (the run's first
+    energy; by default taken at its first state) after the ``found`` crossings of each so far. Closes the file with the
     run's status; an exception stops the run with every state up to it committed, and closes
     the file saying why."""
     cap, seconds = checkpoint_period(checkpoint_every, save_every)
+    found = list(found) or [0] * len(watched)
     done, rate = 0, None
     segment = files.CHUNK_ROWS * save_every
 
@@ -92,12 +104,17 @@ def stream(
                     assert first is not None
                     record = first(take, None if bar.disable else report)
                 else:
+                    specs = None
+                    if watched:
+                        assert event_specs is not None and initial_energy is not None
+                        specs = _events.going_on(event_specs, found, initial_energy)
                     record = _core.resume(
                         model._core,
                         checkpoint,
                         steps=take,
                         save_every=save_every,
                         progress=None if bar.disable else report,
+                        events=specs,
                     )
             except BaseException as err:
                 partial = getattr(err, "_varmech_partial", None)
@@ -107,9 +124,20 @@ def stream(
                 writer.close(-1, str(err) or type(err).__name__)
                 raise
             elapsed = time.perf_counter() - started
+            crossings = _events.occurrences(record, watched)
             with _uninterrupted():
-                writer.append(record, skip_first=checkpoint is not None or writer.rows > 0)
+                writer.append(record, skip_first=checkpoint is not None or writer.rows > 0, events=crossings)
+            if watched and initial_energy is None:
+                initial_energy = float(_core.energy_terms(model._core, record.t[:1], record.q[:1], record.p[:1])[0][0])
+            found = [k + len(o) for k, o in zip(found, crossings)]
             checkpoint = record.checkpoint
+            if record.terminated_by is not None:
+                i = record.terminated_by
+                last = crossings[i]
+                message = f"A termination event occurred: {last.name} (occurrence {found[i]}) at t = {last.t[-1]:.6g}."
+                with _uninterrupted():
+                    writer.close(1, message)
+                return
             done += take
             bar.update(record.steps - base - bar.n)
             if elapsed > 0:
@@ -149,13 +177,17 @@ def resume(
     save_every: int | None = None,
     checkpoint_every: int | datetime.timedelta | None = None,
     progress: bool | None = None,
+    events: Sequence[_events.Event | _events.EventFunction] | None = None,
 ) -> Trajectory:
     """Goes on with the run in the file ``path`` (from ``integrate(output=)``, or
     :meth:`Trajectory.save`) for ``steps`` more steps or to ``t_end``, appending to the file.
 
     The run goes on from the file's last committed checkpoint, so the states are those of one
     run of the whole length, bit for bit, whether the run ended, failed, was stopped by Ctrl-C,
-    or was killed. ``save_every`` is the file's by default (its saving period).
+    or was killed. ``save_every`` is the file's by default (its saving period). ``events`` (as
+    :func:`varmech.integrate`'s; the same as the file's, if it has any) are watched from the
+    checkpoint on, with terminal counts over the whole run and an energy error measured from the
+    file's first state.
 
     Returns the whole run, read back from the file (lazily when it is large; see
     :func:`varmech.files.larger_than_memory`).
@@ -178,7 +210,11 @@ def resume(
     more = _steps(stored.dt, t_now, steps, t_end)
     if save_every is None:
         save_every = files.save_every_of(path)
-    writer = files.Writer.reopen(Path(path), stored)
+    watched, specs = _events.specs(events, stored.model.dim) if events is not None else ([], [])
+    names = [o.name for o in _events.occurrences_of(watched)]
+    writer = files.Writer.reopen(Path(path), stored, names)
+    initial = float(_core.energy_terms(stored.model._core, *(np.asarray(x[:1]) for x in (stored.t, stored.q, stored.p)))[0][0])
+    counts = [len(o) for o in stored.events] if stored.events and watched else []
     bar = progress_bar(total=more, unit="step", desc=stored.method, enabled=progress)
     try:
         stream(
@@ -191,6 +227,10 @@ def resume(
             save_every=save_every,
             checkpoint_every=checkpoint_every,
             bar=bar,
+            watched=watched,
+            event_specs=specs,
+            initial_energy=initial,
+            found=counts,
         )
     finally:
         bar.close()

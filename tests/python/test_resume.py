@@ -202,8 +202,6 @@ def test_bad_output_and_checkpoint_arguments_are_named(tmp_path):
     zero = varmech.events.crossing(0, 0.0)
     with pytest.raises(ValueError, match="^events: not with a continued run"):
         varmech.integrate(traj, steps=10, events=[zero])
-    with pytest.raises(ValueError, match="^events: not yet with output="):
-        varmech.integrate(s, dt=0.1, steps=10, output=path, overwrite=True, events=[zero])
 
 
 def test_a_checkpoint_of_another_model_or_damaged_is_refused(tmp_path):
@@ -246,3 +244,43 @@ def test_a_file_loaded_lazily_reads_rows_when_used_and_analyses_alike(tmp_path):
     assert _same(lazy.q[-1], eager.q[-1]) and _same(lazy.p[5, 1:], eager.p[5, 1:]) and _same(lazy.t[3], eager.t[3])
     assert _same(lazy.energy(), eager.energy())
     assert varmech.check_conservation(lazy).verdict == varmech.check_conservation(eager).verdict
+
+
+def test_a_streamed_run_watches_its_events_across_segments(tmp_path):
+    from varmech.events import crossing, energy_error
+
+    s = scenes.pendulum()
+    events = [crossing(0, 0.0, direction=+1), crossing(0, 0.0, direction=-1, terminal=7)]
+    memory = varmech.integrate(s, dt=0.01, steps=10**5, save_every=50, events=events)
+    # Segments of 500 steps: crossings in every segment, the terminal count over the whole run.
+    streamed = varmech.integrate(s, dt=0.01, steps=10**5, save_every=50, events=events, output=tmp_path / "e.h5", checkpoint_every=500)
+    assert streamed.status == memory.status == 1 and streamed.message == memory.message
+    assert streamed.steps == memory.steps and _same(streamed.q, memory.q)
+    for a, b in zip(streamed.events, memory.events):
+        assert a.name == b.name and len(a) == len(b) > 0
+        for name in ("t", "q", "p"):
+            assert _same(getattr(a, name), getattr(b, name)), name
+    # The energy error is measured from the run's first energy in every segment.
+    e = scenes.harmonic_oscillator()
+    bound = [energy_error(0.05)]
+    memory = varmech.integrate(e, dt=0.01, steps=10**5, method="explicit_euler", max_energy_error=None, events=bound)
+    streamed = varmech.integrate(
+        e, dt=0.01, steps=10**5, method="explicit_euler", max_energy_error=None, events=bound, output=tmp_path / "f.h5", checkpoint_every=100
+    )
+    assert streamed.status == memory.status == 1 and streamed.steps == memory.steps > 100
+    assert _same(streamed.events[0].t, memory.events[0].t)
+
+
+def test_resume_watches_the_files_events_on(tmp_path):
+    from varmech.events import crossing
+
+    s = scenes.pendulum()
+    events = [crossing(0, 0.0, direction=+1)]
+    path = tmp_path / "p.h5"
+    varmech.integrate(s, dt=0.01, steps=4000, save_every=50, events=events, output=path)
+    resumed = varmech.resume(path, steps=6000, events=events)
+    whole = varmech.integrate(s, dt=0.01, steps=10000, save_every=50, events=events)
+    assert len(resumed.events[0]) == len(whole.events[0]) > 3
+    assert _same(resumed.events[0].t, whole.events[0].t)
+    with pytest.raises(ValueError, match="^events: the file's events are"):
+        varmech.resume(path, steps=10, events=[crossing(0, 0.5)])

@@ -44,10 +44,13 @@ impl Events {
                     let (coordinate, value) = payload.extract()?;
                     Function::Native(NativeEvent::Crossing { coordinate, value })
                 }
-                "energy_error" => Function::Native(NativeEvent::EnergyError {
-                    bound: payload.extract()?,
-                    initial: 0.0,
-                }),
+                "energy_error" => {
+                    // (bound, E₀) for a resumed run; bound alone, E₀ taken at the start.
+                    let (bound, initial) = payload
+                        .extract::<(f64, f64)>()
+                        .or_else(|_| payload.extract::<f64>().map(|bound| (bound, f64::NAN)))?;
+                    Function::Native(NativeEvent::EnergyError { bound, initial })
+                }
                 "escape" | "encounter" => {
                     let (radius, groups) = payload.extract()?;
                     Function::Native(if kind == "escape" {

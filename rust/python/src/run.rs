@@ -4,7 +4,9 @@
 use numpy::PyReadonlyArray1;
 use pyo3::prelude::*;
 use varmech::diagnostics;
-use varmech::integrators::{self, Checkpoint, Counting, Detector, Failure, Method, NewtonOptions, Options, Trajectory};
+use varmech::integrators::{
+    self, Checkpoint, Counting, Detector, EventSpec, Failure, Method, NewtonOptions, Options, Trajectory,
+};
 use varmech::ModelError;
 
 use crate::bind::{bind_model, dim_of, Poll};
@@ -51,19 +53,13 @@ fn integrate<'py>(
         newton,
     };
     let (q0, p0) = (slice("q0", &q0)?, slice("p0", &p0)?);
-    let events = match events {
-        Some(tuples) => Some(Events::new(py, tuples, dim_of(py, model)?)?),
-        None => None,
-    };
+    let events = detector_parts(py, model, events)?;
     let result = bind_model(py, model, |sys, poll| {
         let report = reporting(poll, &progress);
         match events {
             None => integrators::integrate(sys, method, q0, p0, &options, report),
             Some((functions, specs)) => {
-                let mut detector = Detector::new(Box::new(functions), specs).map_err(|error| {
-                    let partial = Trajectory::default();
-                    Box::new(Failure { error, partial })
-                })?;
+                let mut detector = detector(functions, specs)?;
                 integrators::integrate_with_events(sys, method, q0, p0, &options, report, &mut detector)
             }
         }
@@ -71,9 +67,29 @@ fn integrate<'py>(
     record(py, result)
 }
 
-/// Goes on from a run's checkpoint for `steps` more steps (see [`integrators::resume`]).
+/// The event functions and specs of `events`, checked against the model.
+fn detector_parts<'py>(
+    py: Python<'py>,
+    model: &Bound<'py, PyAny>,
+    events: Option<Vec<EventTuple<'py>>>,
+) -> PyResult<Option<(Events, Vec<EventSpec>)>> {
+    events
+        .map(|tuples| Events::new(py, tuples, dim_of(py, model)?))
+        .transpose()
+}
+
+/// The run's detector, or the failure of a run that never started.
+fn detector<'f>(functions: Events, specs: Vec<EventSpec>) -> Result<Detector<'f>, Box<Failure>> {
+    Detector::new(Box::new(functions), specs).map_err(|error| {
+        let partial = Trajectory::default();
+        Box::new(Failure { error, partial })
+    })
+}
+
+/// Goes on from a run's checkpoint for `steps` more steps (see [`integrators::resume`]),
+/// watching `events` (as `integrate`'s) if given.
 #[pyfunction]
-#[pyo3(signature = (model, checkpoint, *, steps, save_every=1, progress=None))]
+#[pyo3(signature = (model, checkpoint, *, steps, save_every=1, progress=None, events=None))]
 fn resume<'py>(
     py: Python<'py>,
     model: &Bound<'py, PyAny>,
@@ -81,10 +97,19 @@ fn resume<'py>(
     #[pyo3(from_py_with = steps_count)] steps: usize,
     #[pyo3(from_py_with = save_every_count)] save_every: usize,
     progress: Option<Py<PyAny>>,
+    events: Option<Vec<EventTuple<'py>>>,
 ) -> PyResult<TrajectoryRecord> {
     let checkpoint = Checkpoint::from_bytes(checkpoint).map_err(|e| to_pyerr(py, e))?;
+    let events = detector_parts(py, model, events)?;
     let result = bind_model(py, model, |sys, poll| {
-        integrators::resume(sys, checkpoint, steps, save_every, reporting(poll, &progress))
+        let report = reporting(poll, &progress);
+        match events {
+            None => integrators::resume(sys, checkpoint, steps, save_every, report),
+            Some((functions, specs)) => {
+                let mut detector = detector(functions, specs)?;
+                integrators::resume_with_events(sys, checkpoint, steps, save_every, report, &mut detector)
+            }
+        }
     })?;
     record(py, result)
 }

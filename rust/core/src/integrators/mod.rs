@@ -55,7 +55,7 @@ pub use kind::ModelKind;
 pub use method::{Method, MethodInfo};
 pub use poll::{Counting, Poll};
 pub use rattle::Rattle;
-pub use run::{integrate, integrate_with_events, resume, Options};
+pub use run::{integrate, integrate_with_events, resume, resume_with_events, Options};
 pub use splitting::{Leading, Splitting};
 pub use step::{Increment, StepStart};
 pub use stepper::{Stepper, StepperState};

@@ -127,7 +127,7 @@ where
 {
     let (stepper, watch) = start(sys, method, q0, p0, options)?;
     // The run's search, its scratch stepper on the same model.
-    let search = match events.begin(sys, &stepper, options) {
+    let search = match events.begin(sys, &stepper) {
         Ok(search) => search,
         Err(error) => return Err(fail(error, first_state(sys, &stepper))),
     };
@@ -181,6 +181,41 @@ where
     S: Dynamics + ?Sized,
     P: Poll,
 {
+    let (stepper, watch, end) = resumed(sys, checkpoint, steps, save_every)?;
+    run(sys, stepper, watch, end, save_every, poll, None)
+}
+
+/// As [`resume`], watching the `events` as [`integrate_with_events`] does, from the
+/// checkpoint's state on (crossings before it are the first run's; a terminal count is this
+/// run's).
+pub fn resume_with_events<S, P>(
+    sys: &S,
+    checkpoint: Checkpoint,
+    steps: usize,
+    save_every: usize,
+    poll: P,
+    events: &mut Detector<'_>,
+) -> Result<Trajectory, Box<Failure>>
+where
+    S: Dynamics + ?Sized,
+    P: Poll,
+{
+    let (stepper, watch, end) = resumed(sys, checkpoint, steps, save_every)?;
+    let search = match events.begin(sys, &stepper) {
+        Ok(search) => search,
+        Err(error) => return Err(fail(error, first_state(sys, &stepper))),
+    };
+    run(sys, stepper, watch, end, save_every, poll, Some(search))
+}
+
+/// The stepper of a checkpoint, its energy check and the step to reach.
+#[allow(clippy::type_complexity)]
+fn resumed<S: Dynamics + ?Sized>(
+    sys: &S,
+    checkpoint: Checkpoint,
+    steps: usize,
+    save_every: usize,
+) -> Result<(Stepper<&S>, Option<EnergyWatch>, usize), Box<Failure>> {
     if save_every == 0 {
         return Err(fail(Error::invalid("save_every", "must be at least 1"), empty(sys)));
     }
@@ -194,7 +229,7 @@ where
         );
         return Err(fail(Error::invalid("steps", reason), empty(sys)));
     };
-    run(sys, stepper, watch, end, save_every, poll, None)
+    Ok((stepper, watch, end))
 }
 
 fn fail(error: Error, partial: Trajectory) -> Box<Failure> {

@@ -4,7 +4,7 @@
 use std::ops::Deref;
 
 use super::{EventFunctions, EventSpec, Occurrence};
-use crate::integrators::{Counting, Dynamics, Options, Poll, Stepper};
+use crate::integrators::{Counting, Dynamics, Poll, Stepper, StepperState};
 use crate::solve::bracket::illinois;
 use crate::{Error, ModelError};
 
@@ -42,14 +42,14 @@ impl<'f> Detector<'f> {
         &self.specs
     }
 
-    /// A run's search from the state of `stepper` (its initial state), on `model` stepped with
-    /// `options`: the functions started and evaluated there, the scratch stepper of the partial
-    /// steps made, and the buffers of the state before a step, once per run.
+    /// A run's search from the state of `stepper` (where the run starts or resumes), on
+    /// `model`: the functions started and evaluated there, the scratch stepper of the partial
+    /// steps made (a copy of the stepper: its method, summation and Newton options), and the
+    /// buffers of the state before a step, once per run.
     pub(in crate::integrators) fn begin<'d, M>(
         &'d mut self,
         model: M,
         stepper: &Stepper<M>,
-        options: &Options,
     ) -> Result<Search<'d, 'f, M>, Error>
     where
         M: Deref<Target: Dynamics>,
@@ -69,9 +69,10 @@ impl<'f> Detector<'f> {
             .evaluate(model.as_lagrangian(), t, q, p, &mut g)
             .map_err(model_error)?;
         check_finite(&self.specs, &g, 0, t)?;
-        let scratch = Stepper::new(model, stepper.method(), q, p, options)?;
+        let scratch = Stepper::resume(model, StepperState::clone(stepper))?;
         Ok(Search {
             detector: self,
+            counted: scratch.force_evaluations(),
             scratch,
             t: 0.0,
             q: q.to_vec(),
@@ -89,6 +90,8 @@ impl<'f> Detector<'f> {
 pub(in crate::integrators) struct Search<'d, 'f, M> {
     detector: &'d mut Detector<'f>,
     scratch: Stepper<M>,
+    /// The scratch's force evaluations when it was made (the run's so far).
+    counted: u64,
     t: f64,
     q: Vec<f64>,
     p: Vec<f64>,
@@ -187,7 +190,7 @@ impl<M: Deref<Target: Dynamics>> Search<'_, '_, M> {
 
     /// Force evaluations of the partial steps.
     pub(in crate::integrators) fn force_evaluations(&self) -> u64 {
-        self.scratch.force_evaluations()
+        self.scratch.force_evaluations() - self.counted
     }
 }
 

@@ -9,8 +9,8 @@ use crate::{Error, ModelError};
 pub enum NativeEvent {
     /// g = q_k − value: the coordinate k crossing a value.
     Crossing { coordinate: usize, value: f64 },
-    /// g = |E(q, p) − E₀| − bound, E₀ the energy at the start of the run: the energy error
-    /// growing beyond a bound.
+    /// g = |E(q, p) − E₀| − bound, E₀ the energy at the start of the run (NaN until the run
+    /// starts; a resumed run is given its first run's): the energy error growing beyond a bound.
     EnergyError { bound: f64, initial: f64 },
     /// g = maxⱼ |x_j|² − r², x_j = q[groups[j]] (e.g. a body's position): a group leaving the
     /// ball of radius r about the origin (escape).
@@ -59,8 +59,11 @@ impl NativeEvent {
 
     /// Takes E₀ for the energy error; nothing for the others.
     pub fn start(&mut self, model: &dyn Lagrangian, t: f64, q: &[f64], p: &[f64]) -> Result<(), ModelError> {
+        // E₀ given (a resumed run's, the whole run's first energy) is kept; NaN is computed here.
         if let NativeEvent::EnergyError { initial, .. } = self {
-            *initial = model.energy_terms(q, p, t)?.energy;
+            if initial.is_nan() {
+                *initial = model.energy_terms(q, p, t)?.energy;
+            }
         }
         Ok(())
     }
