@@ -345,15 +345,14 @@ def integrate(
             "method": method,
             "t0": t0,
             "parameters": parameters,
-            "events": events,
             "t_eval": t_eval,
         }
         named = [name for name, value in given.items() if value is not None]
-        if named and named[0] in ("events", "t_eval"):
+        if named and named[0] == "t_eval":
             raise ValueError(f"{named[0]}: not with a continued run (start a new run from its last state)")
         if named:
             raise ValueError(f"{named[0]}: a continued run keeps its trajectory's {', '.join(named)}")
-        return _go_on(model, steps, t_end, save_every, progress, output, overwrite, checkpoint_every)
+        return _go_on(model, steps, t_end, save_every, progress, output, overwrite, checkpoint_every, events)
     model, q0, p0 = _model_of(model, q0, p0, v0)
     if parameters is not None:
         if not isinstance(parameters, Mapping):
@@ -445,12 +444,20 @@ def _go_on(
     output: str | os.PathLike[str] | None,
     overwrite: bool,
     checkpoint_every: int | datetime.timedelta | None,
+    events: Sequence[_events.Event | _events.EventFunction] | None,
 ) -> Trajectory:
-    """``integrate(traj, steps=)``: the run of ``traj`` continued from its checkpoint."""
+    """``integrate(traj, steps=)``: the run of ``traj`` continued from its checkpoint, watching
+    ``events`` from there (terminal counts after ``traj``'s crossings of the same events, an
+    energy error from ``traj``'s first energy)."""
     if traj.checkpoint is None:
         raise ValueError("model: this trajectory has no checkpoint to go on from (it failed before its first state)")
     nsteps = _steps(traj.dt, float(traj.t[-1]), steps, t_end)
     save_every = positive_int("save_every", save_every)
+    watched, specs = _events.specs(events, traj.model.dim) if events is not None else ([], [])
+    names = [o.name for o in _events.occurrences_of(watched)]
+    found = [len(o) for o in traj.events] if [o.name for o in traj.events] == names else [0] * len(names)
+    first_state = (np.asarray(x[:1]) for x in (traj.t, traj.q, traj.p))
+    initial = float(_core.energy_terms(traj.model._core, *first_state)[0][0]) if watched else None
     return _run(
         None,
         traj.checkpoint,
@@ -464,8 +471,10 @@ def _go_on(
         output,
         overwrite,
         checkpoint_every,
-        (),
-        [],
+        watched,
+        specs,
+        initial,
+        found,
     )
 
 
@@ -484,11 +493,14 @@ def _run(
     checkpoint_every: int | datetime.timedelta | None,
     watched: Sequence[_events.Event],
     event_specs: list[Any],
+    initial_energy: float | None = None,
+    found: Sequence[int] = (),
 ) -> Trajectory:
     """Runs ``nsteps`` steps by ``first`` (a new run) or from ``checkpoint`` (after ``base``
     steps): in memory, or streamed to ``output`` in segments (:mod:`varmech.streaming`).
     ``watched`` are the run's events (``event_specs`` the binding's), whose crossings the result
-    reports."""
+    reports; a continued run's are watched after ``found`` crossings of each, an energy error
+    measured from ``initial_energy``."""
     from . import streaming
 
     bar = progress_bar(total=nsteps, unit="step", desc=method, enabled=progress)
@@ -521,6 +533,8 @@ def _run(
                     bar=bar,
                     watched=watched,
                     event_specs=event_specs,
+                    initial_energy=initial_energy,
+                    found=found,
                 )
             except BaseException as err:
                 err.partial = files.load(target, model=model, lazy=True)  # type: ignore[attr-defined]
@@ -538,7 +552,9 @@ def _run(
                 assert first is not None
                 record = first(nsteps, shown)
             else:
-                record = _core.resume(model._core, checkpoint, steps=nsteps, save_every=save_every, progress=shown)
+                assert not watched or initial_energy is not None
+                specs = _events.going_on(event_specs, found, initial_energy) if watched and initial_energy is not None else None
+                record = _core.resume(model._core, checkpoint, steps=nsteps, save_every=save_every, progress=shown, events=specs)
             bar.update(record.steps - base - bar.n)
         except BaseException as err:
             partial = getattr(err, "_varmech_partial", None)

@@ -199,9 +199,8 @@ def test_bad_output_and_checkpoint_arguments_are_named(tmp_path):
     traj = varmech.integrate(s, dt=0.1, steps=10)
     with pytest.raises(ValueError, match="^dt: a continued run keeps its trajectory's dt"):
         varmech.integrate(traj, dt=0.2, steps=10)
-    zero = varmech.events.crossing(0, 0.0)
-    with pytest.raises(ValueError, match="^events: not with a continued run"):
-        varmech.integrate(traj, steps=10, events=[zero])
+    with pytest.raises(ValueError, match="^t_eval: not with a continued run"):
+        varmech.integrate(traj, steps=10, t_eval=[1.5])
 
 
 def test_a_checkpoint_of_another_model_or_damaged_is_refused(tmp_path):
@@ -284,3 +283,18 @@ def test_resume_watches_the_files_events_on(tmp_path):
     assert _same(resumed.events[0].t, whole.events[0].t)
     with pytest.raises(ValueError, match="^events: the file's events are"):
         varmech.resume(path, steps=10, events=[crossing(0, 0.5)])
+
+
+def test_a_run_continued_in_memory_watches_events_on():
+    from varmech.events import crossing
+
+    s = scenes.pendulum()
+    events = [crossing(0, 0.0, direction=+1, terminal=5)]
+    whole = varmech.integrate(s, dt=0.01, steps=10**5, events=events)
+    first = varmech.integrate(s, dt=0.01, steps=1500, events=events)
+    assert first.status == 0 and 0 < len(first.events[0]) < 5
+    rest = varmech.integrate(first, steps=10**5 - 1500, events=events)
+    # The fifth crossing of the whole run stops the continuation, at the same step.
+    assert rest.status == 1 and rest.steps == whole.steps
+    both = np.concatenate([first.events[0].t, rest.events[0].t])
+    assert _same(both, whole.events[0].t)
