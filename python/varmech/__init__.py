@@ -42,6 +42,7 @@ from .conservation import ConservationReport, InvariantStatistics, check_conserv
 from .constraints import project
 from .derivatives import DerivativeCheck, check_derivatives
 from .files import load
+from .impulses import Engagement, Impulse, ImpulseResponse, engage, impulse_response
 from .integrate import Trajectory, integrate, symplecticity_defect
 from .methods import MethodInfo, methods
 from .model import Cyclic, Lagrangian, MechanicalSystem, Model, NativeSystem, Rotation, Translation
@@ -58,6 +59,9 @@ __all__ = [
     "Cyclic",
     "DerivativeCheck",
     "DivergenceError",
+    "Engagement",
+    "Impulse",
+    "ImpulseResponse",
     "InvariantStatistics",
     "Lagrangian",
     "MechanicalSystem",
@@ -77,10 +81,12 @@ __all__ = [
     "check_derivatives",
     "cyclic_coordinates",
     "energy_growth",
+    "engage",
     "events",
     "growth_factor",
     "growth_table",
     "implicit_regions",
+    "impulse_response",
     "integrate",
     "load",
     "methods",

@@ -1,4 +1,5 @@
-"""The docstring examples of the symbolic front end run as written (numpydoc ``Examples``)."""
+"""The docstring examples run as written (numpydoc ``Examples``): the symbolic front end, events,
+files, long runs, dense output, impulses, the stepper and the conservation report."""
 
 import doctest
 import importlib
@@ -9,7 +10,20 @@ pytest.importorskip("sympy")
 
 
 @pytest.mark.parametrize(
-    "name", ["varmech.symbolic", "varmech.symbolic.examples", "varmech.symbolic._lower", "varmech.symbolic._derive", "varmech.events"]
+    "name",
+    [
+        "varmech.symbolic",
+        "varmech.symbolic.examples",
+        "varmech.symbolic._lower",
+        "varmech.symbolic._derive",
+        "varmech.events",
+        "varmech.files",
+        "varmech.streaming",
+        "varmech.dense",
+        "varmech.impulses",
+        "varmech.stepper",
+        "varmech.conservation",
+    ],
 )
 def test_examples_run(name):
     result = doctest.testmod(importlib.import_module(name), optionflags=doctest.ELLIPSIS)

@@ -1,0 +1,249 @@
+"""Impulsive forces and sudden constraints (Byerly 1916, ch. III): the state just after a blow,
+and just after constraints engage.
+
+A blow changes the generalized momenta at once and the positions not at all (Byerly, Arts.
+26–28):
+
+    Δ(∂L/∂q̇ᵣ) = P_r,   P_r = I · ∂x/∂qᵣ,
+
+P_r the *component of impulse* on qᵣ of an impulse I applied at the point x(q). For
+L = ½q̇ᵀM(q)q̇ + … this is M Δq̇ = Jᵀ I, J = ∂x/∂q. :func:`impulse_response` gives the momenta
+and velocities after an :class:`Impulse` and the change of kinetic energy, which answers
+Byerly's "find the initial motion" problems.
+
+Constraints A(q)q̇ = 0 that engage suddenly (a body set down, a rolling contact that grips;
+holonomic g(q) = 0 with A = ∂g/∂q, or velocity constraints given as A(q)) act by an impulse
+Aᵀλ: Lagrange's impulsive equations Δp = Aᵀλ with A q̇⁺ = 0, whose solution is the M-orthogonal
+projection of the velocity (the one :func:`varmech.project` uses). :func:`engage` gives the
+state after, and the kinetic energy lost, which equals Carnot's ½Δq̇ᵀMΔq̇ for any such
+perfectly inelastic engagement.
+
+The metric M⁻¹ is the model's inverse Legendre transform: q̇(q, p) = M⁻¹(p − a(q)) for a
+Lagrangian quadratic in q̇ (kinetic energy, gyroscopic terms); its columns are differences
+q̇(q, eᵢ) − q̇(q, 0), exact for such Lagrangians.
+"""
+
+from __future__ import annotations
+
+import warnings
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from . import _core
+from ._util import vector
+from .model import Model
+
+
+@dataclass(frozen=True)
+class Impulse:
+    """A blow: its components P on the generalized coordinates (``generalized``, an array (n,)
+    or a function of q), or an impulse vector ``impulse`` applied at the point ``point(q)``, with
+    P = (∂x/∂q)ᵀ I (``jacobian(q)`` the (d, n) matrix ∂x/∂q, or central differences, with a
+    warning). ``t`` is when it acts (for the runs that take impulses).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> end = Impulse(point=lambda q: q[:2] + np.array([np.cos(q[2]), np.sin(q[2])]),
+    ...               jacobian=lambda q: np.array([[1.0, 0.0, -np.sin(q[2])], [0.0, 1.0, np.cos(q[2])]]),
+    ...               impulse=[0.0, 1.0])
+    >>> end.components(np.zeros(3)).tolist()   # a rod's end struck across it: P = (0, 1, 1)
+    [0.0, 1.0, 1.0]
+    """
+
+    generalized: ArrayLike | Callable[[np.ndarray], ArrayLike] | None = None
+    point: Callable[[np.ndarray], ArrayLike] | None = None
+    impulse: ArrayLike | None = None
+    jacobian: Callable[[np.ndarray], ArrayLike] | None = None
+    t: float = 0.0
+
+    def components(self, q: np.ndarray) -> np.ndarray:
+        """P_r at the configuration q, shape (n,)."""
+        n = len(q)
+        if (self.generalized is None) == (self.point is None):
+            raise ValueError("impulse: give exactly one of generalized= and point= (with impulse=)")
+        if self.generalized is not None:
+            given = self.generalized(q.copy()) if callable(self.generalized) else self.generalized
+            return vector("generalized", given, n)
+        if self.impulse is None:
+            raise ValueError("impulse: a point struck needs the impulse vector, impulse=")
+        blow = np.asarray(self.impulse, dtype=float).reshape(-1)
+        x = np.asarray(self.point(q.copy()), dtype=float).reshape(-1)  # type: ignore[misc]
+        if x.shape != blow.shape:
+            raise ValueError(f"impulse: the point has {x.size} coordinates and the impulse {blow.size}")
+        if self.jacobian is not None:
+            jac = np.asarray(self.jacobian(q.copy()), dtype=float)
+            if jac.shape != (x.size, n):
+                raise ValueError(f"jacobian: expected shape {(x.size, n)}, got {jac.shape}")
+        else:
+            warnings.warn("impulse: no jacobian of the point given; central differences are used", stacklevel=3)
+            jac = _differences(lambda y: np.asarray(self.point(y), dtype=float).reshape(-1), q)  # type: ignore[misc]
+        return np.asarray(jac.T @ blow)
+
+
+def _differences(f: Callable[[np.ndarray], np.ndarray], q: np.ndarray) -> np.ndarray:
+    """∂f/∂q by central differences, shape (len f, len q)."""
+    columns = []
+    for i in range(len(q)):
+        h = np.finfo(float).eps ** (1 / 3) * max(abs(q[i]), 1.0)
+        up, down = q.copy(), q.copy()
+        up[i] += h
+        down[i] -= h
+        columns.append((f(up) - f(down)) / (2 * h))
+    return np.stack(columns, axis=1)
+
+
+@dataclass(frozen=True)
+class ImpulseResponse:
+    """The state just after a blow: momenta ``p`` and velocities ``v`` (n,), and the change of
+    kinetic energy ``kinetic_change`` = T⁺ − T⁻; ``p_before``, ``v_before`` the state before."""
+
+    p: np.ndarray
+    v: np.ndarray
+    kinetic_change: float
+    p_before: np.ndarray
+    v_before: np.ndarray
+
+
+@dataclass(frozen=True)
+class Engagement:
+    """The state just after constraints engage: momenta ``p`` and velocities ``v``, the
+    multipliers λ of the impulse Aᵀλ, the kinetic energy lost, and Carnot's ½Δq̇ᵀMΔq̇, which it
+    equals for a perfectly inelastic engagement."""
+
+    p: np.ndarray
+    v: np.ndarray
+    multipliers: np.ndarray
+    energy_lost: float
+    carnot: float
+
+
+def _state(model: Model, q: ArrayLike, p: ArrayLike | None, v: ArrayLike | None, t: float) -> tuple[np.ndarray, np.ndarray]:
+    n = model.dim
+    qq = vector("q", q, n)
+    if (p is None) == (v is None):
+        raise ValueError("p, v: give exactly one of the momenta p and the velocities v")
+    if p is not None:
+        return qq, vector("p", p, n)
+    assert v is not None
+    return qq, model.momentum(qq, vector("v", v, n), t)
+
+
+def _velocity(model: Model, q: np.ndarray, p: np.ndarray, t: float) -> np.ndarray:
+    return np.asarray(_core.derivative(model._core, "velocity", np.array([t]), q[None, :], p[None, :])[0])
+
+
+def _kinetic(model: Model, q: np.ndarray, p: np.ndarray, t: float) -> float:
+    """T = E − V at (q, p)."""
+    return float(_core.energy_terms(model._core, np.array([t]), q[None, :], p[None, :])[1][0])
+
+
+def inverse_mass(model: Model, q: ArrayLike, t: float = 0.0) -> np.ndarray:
+    """M(q)⁻¹, the metric of the inverse Legendre transform q̇ = M⁻¹(p − a(q)): columns
+    q̇(q, eᵢ) − q̇(q, 0), shape (n, n)."""
+    n = model.dim
+    qq = vector("q", q, n)
+    zero = _velocity(model, qq, np.zeros(n), t)
+    return np.stack([_velocity(model, qq, np.eye(n)[i], t) - zero for i in range(n)], axis=1)
+
+
+def impulse_response(
+    model: Model,
+    q: ArrayLike,
+    p: ArrayLike | None = None,
+    impulse: Impulse | None = None,
+    *,
+    v: ArrayLike | None = None,
+    t: float = 0.0,
+) -> ImpulseResponse:
+    """The state just after ``impulse`` strikes ``model`` at (q, p) (or the velocities v):
+    p⁺ = p + P(q), q̇⁺ = q̇(q, p⁺), and the change of kinetic energy.
+
+    Examples
+    --------
+    A uniform rod of mass 1 and length 2 (k² = 1/3) on a smooth table, struck across one end by a
+    unit impulse: its centre moves off at 1, it turns at ω = 3P/(ma) = 3 (Byerly, Art. 27).
+
+    >>> import numpy as np, varmech
+    >>> rod = varmech.MechanicalSystem(3, lambda q: 0.0, lambda q: np.zeros(3), mass=[1.0, 1.0, 1.0 / 3.0])
+    >>> end = varmech.Impulse(point=lambda q: q[:2] + np.array([np.cos(q[2]), np.sin(q[2])]),
+    ...                       jacobian=lambda q: np.array([[1.0, 0.0, -np.sin(q[2])], [0.0, 1.0, np.cos(q[2])]]),
+    ...                       impulse=[0.0, 1.0])
+    >>> after = varmech.impulse_response(rod, np.zeros(3), np.zeros(3), end)
+    >>> after.v.round(12).tolist(), round(after.kinetic_change, 12)
+    ([0.0, 1.0, 3.0], 2.0)
+    """
+    if not isinstance(impulse, Impulse):
+        raise TypeError(f"impulse: expected a varmech.Impulse, got {type(impulse).__name__}")
+    qq, before = _state(model, q, p, v, t)
+    after = before + impulse.components(qq)
+    return ImpulseResponse(
+        after,
+        _velocity(model, qq, after, t),
+        _kinetic(model, qq, after, t) - _kinetic(model, qq, before, t),
+        before,
+        _velocity(model, qq, before, t),
+    )
+
+
+def engage(
+    model: Model,
+    q: ArrayLike,
+    p: ArrayLike | None = None,
+    *,
+    v: ArrayLike | None = None,
+    constraints: Callable[[np.ndarray], ArrayLike] | None = None,
+    jacobian: Callable[[np.ndarray], ArrayLike] | None = None,
+    velocity_constraints: Callable[[np.ndarray], ArrayLike] | None = None,
+    t: float = 0.0,
+) -> Engagement:
+    """The state just after constraints engage impulsively at (q, p): holonomic g(q) = 0
+    (``constraints``, with ``jacobian`` ∂g/∂q or central differences), or velocity constraints
+    A(q)q̇ = 0 (``velocity_constraints`` giving A, for rolling), by Lagrange's impulsive equations
+    Δp = Aᵀλ, A q̇⁺ = 0: λ = −(A M⁻¹ Aᵀ)⁻¹ A q̇⁻. Reports the kinetic energy lost and Carnot's
+    ½Δq̇ᵀMΔq̇.
+
+    Examples
+    --------
+    A particle moving at (1, 1) meets the constraint y = 0 (a smooth floor that grips): the normal
+    velocity is lost, and with it ½ of kinetic energy, Carnot's ½·1².
+
+    >>> import numpy as np, varmech
+    >>> free = varmech.MechanicalSystem(2, lambda q: 0.0, lambda q: np.zeros(2))
+    >>> after = varmech.engage(free, [0.0, 0.0], [1.0, 1.0], constraints=lambda q: [q[1]], jacobian=lambda q: [[0.0, 1.0]])
+    >>> after.v.tolist(), after.energy_lost, after.carnot
+    ([1.0, 0.0], 0.5, 0.5)
+    """
+    qq, before = _state(model, q, p, v, t)
+    n = model.dim
+    if (constraints is None) == (velocity_constraints is None):
+        raise ValueError("constraints, velocity_constraints: give exactly one")
+    if velocity_constraints is not None:
+        a = np.atleast_2d(np.asarray(velocity_constraints(qq.copy()), dtype=float))
+        name = "velocity_constraints"
+    else:
+        assert constraints is not None
+        if jacobian is not None:
+            a = np.atleast_2d(np.asarray(jacobian(qq.copy()), dtype=float))
+        else:
+            warnings.warn("engage: no jacobian of the constraints given; central differences are used", stacklevel=2)
+            a = _differences(lambda y: np.asarray(constraints(y), dtype=float).reshape(-1), qq)
+        name = "jacobian"
+    if a.ndim != 2 or a.shape[1] != n:
+        raise ValueError(f"{name}: expected a matrix with {n} columns, got shape {a.shape}")
+    minv = inverse_mass(model, qq, t)
+    v_before = _velocity(model, qq, before, t)
+    gram = a @ minv @ a.T
+    try:
+        multipliers = -np.linalg.solve(gram, a @ v_before)
+    except np.linalg.LinAlgError as e:
+        raise ValueError(f"{name}: the constraints are dependent here (A M⁻¹ Aᵀ is singular)") from e
+    after = before + a.T @ multipliers
+    v_after = _velocity(model, qq, after, t)
+    jump = v_after - v_before
+    carnot = 0.5 * float(jump @ np.linalg.solve(minv, jump))
+    lost = _kinetic(model, qq, before, t) - _kinetic(model, qq, after, t)
+    return Engagement(after, v_after, multipliers, lost, carnot)

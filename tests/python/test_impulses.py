@@ -1,0 +1,133 @@
+"""Impulses and sudden constraints against Byerly's closed forms (Generalized Coordinates, 1916,
+ch. III; reference/impulses_and_rolling.md): a rod struck at one end, a lamina's centre of
+percussion, a spinning sphere set down on a rough wedge, and Carnot's theorem."""
+
+import math
+
+import numpy as np
+import pytest
+
+import varmech
+
+
+def _body(m, k2):
+    """A lamina (or rod) on a smooth table: (x, y, φ), T = ½m(ẋ² + ẏ²) + ½mk²φ̇²."""
+    return varmech.MechanicalSystem(3, lambda q: 0.0, lambda q: np.zeros(3), mass=[m, m, m * k2])
+
+
+def _point(r, beta):
+    """The body point at distance r and angle β from the centre, in the body frame, and its
+    Jacobian."""
+
+    def x(q):
+        return q[:2] + r * np.array([math.cos(q[2] + beta), math.sin(q[2] + beta)])
+
+    def jac(q):
+        s, c = math.sin(q[2] + beta), math.cos(q[2] + beta)
+        return np.array([[1.0, 0.0, -r * s], [0.0, 1.0, r * c]])
+
+    return x, jac
+
+
+def _velocity_of(v, q, r, beta):
+    """The velocity of the body point (r, β): v_c + ω × r."""
+    angle = q[2] + beta
+    return v[:2] + v[2] * r * np.array([-math.sin(angle), math.cos(angle)])
+
+
+def test_a_rod_struck_at_one_end_moves_off_as_byerly_says():
+    # Rod of length 2a along its body x-axis, at angle φ₀, struck at the end (a, 0) by P across it.
+    m, a, p_blow, phi0 = 2.0, 1.5, 0.7, 0.4
+    rod = _body(m, a * a / 3)
+    q = np.array([0.3, -0.2, phi0])
+    x, jac = _point(a, 0.0)
+    across = p_blow * np.array([-math.sin(phi0), math.cos(phi0)])
+    after = varmech.impulse_response(rod, q, np.zeros(3), varmech.Impulse(point=x, jacobian=jac, impulse=across))
+    np.testing.assert_allclose(after.v[:2], across / m, rtol=0, atol=1e-15)
+    assert after.v[2] == pytest.approx(3 * p_blow / (m * a), rel=1e-14)
+    # The struck end at 4P/m, the other at −2P/m, both across the rod.
+    unit = across / p_blow
+    assert _velocity_of(after.v, q, a, 0.0) @ unit == pytest.approx(4 * p_blow / m, rel=1e-14)
+    assert _velocity_of(after.v, q, a, math.pi) @ unit == pytest.approx(-2 * p_blow / m, rel=1e-14)
+    expected = 0.5 * m * (p_blow / m) ** 2 + 0.5 * m * (a * a / 3) * (3 * p_blow / (m * a)) ** 2
+    assert after.kinetic_change == pytest.approx(expected, rel=1e-14)
+
+
+@pytest.mark.parametrize(("b", "k2"), [(0.3, 0.25), (0.8, (1.2**2 + 0.5**2) / 12), (1.1, 0.05)])
+def test_the_centre_of_percussion_is_at_k2_over_b_and_does_not_move(b, k2):
+    # An impulse along y acting on the line x = b (body frame, φ = 0): the point (−k²/b, 0) on
+    # the far side of the centre starts at rest.
+    m, p_blow = 1.7, 0.9
+    body = _body(m, k2)
+    q = np.zeros(3)
+    x, jac = _point(b, 0.0)
+    after = varmech.impulse_response(body, q, np.zeros(3), varmech.Impulse(point=x, jacobian=jac, impulse=[0.0, p_blow]))
+    assert after.v[2] == pytest.approx(p_blow * b / (m * k2), rel=1e-14)
+    still = _velocity_of(after.v, q, k2 / b, math.pi)
+    assert np.max(np.abs(still)) <= 1e-15 * p_blow / m
+
+
+@pytest.mark.parametrize("alpha", [0.3, math.pi / 4, 1.1])
+def test_a_spinning_sphere_set_down_on_a_rough_wedge_rolls_off_as_byerly_says(alpha):
+    # Byerly Art. 28 (b): wedge of mass M on a smooth plane (x), the contact point down the face
+    # (y), the sphere's rotation (θ); T = ½Mẋ² + ½m[(ẋ − ẏ cos α)² + ẏ² sin² α] + ½mk²θ̇².
+    big, m, a, spin = 3.0, 1.2, 0.4, 5.0
+    k2 = 2 * a * a / 5
+    c = math.cos(alpha)
+    mass = np.array([[big + m, -m * c, 0.0], [-m * c, m, 0.0], [0.0, 0.0, m * k2]])
+    model = varmech.MechanicalSystem(3, lambda q: 0.0, lambda q: np.zeros(3), mass=mass)
+    q = np.zeros(3)
+    before = np.array([0.0, 0.0, spin])
+    # Rolling without slipping engages: ẏ − aθ̇ = 0.
+    after = varmech.engage(model, q, v=before, velocity_constraints=lambda q: [[0.0, 1.0, -a]])
+    ydot = 2 * a * spin * (big + m) / (7 * big + 2 * m + 5 * m * math.sin(alpha) ** 2)
+    assert after.v[1] == pytest.approx(ydot, rel=1e-13)
+    assert after.v[0] == pytest.approx(m * ydot * c / (big + m), rel=1e-13)
+    assert after.v[1] == pytest.approx(a * after.v[2], rel=1e-14)
+    # Horizontal momentum stays zero; the energy lost is Carnot's, to round-off.
+    assert abs(after.p[0]) <= 1e-15 * m * spin * a
+    assert after.energy_lost > 0
+    assert after.energy_lost == pytest.approx(after.carnot, rel=1e-13)
+
+
+def test_carnots_theorem_holds_for_holonomic_constraints_on_a_general_lagrangian():
+    # The double pendulum (mass matrix depending on q): engaging "the two rods stay aligned",
+    # g = θ₂ − θ₁, loses exactly ½Δq̇ᵀMΔq̇, and the momenta jump along Gᵀ only.
+    s = varmech.scenes.double_pendulum()
+    q, v = np.array([0.7, -0.4]), np.array([1.3, -0.8])
+    after = varmech.engage(s.model, q, v=v, constraints=lambda q: [q[1] - q[0]], jacobian=lambda q: [[-1.0, 1.0]])
+    assert after.v[0] == pytest.approx(after.v[1], rel=1e-13)
+    assert after.energy_lost == pytest.approx(after.carnot, rel=1e-12)
+    jump = after.p - s.model.momentum(q, v, 0.0)
+    assert jump[0] == pytest.approx(-jump[1], rel=1e-13)
+
+
+def test_an_impulse_on_a_general_lagrangian_solves_m_dv_equals_p():
+    s = varmech.scenes.double_pendulum()
+    q, p = np.array([0.7, -0.4]), np.array([0.2, 0.1])
+    blow = np.array([0.5, -0.3])
+    after = varmech.impulse_response(s.model, q, p, varmech.Impulse(generalized=blow))
+    minv = varmech.impulses.inverse_mass(s.model, q)
+    np.testing.assert_allclose(np.linalg.solve(minv, after.v - after.v_before), blow, rtol=1e-12, atol=1e-14)
+
+
+def test_bad_impulses_are_named():
+    rod = _body(1.0, 1 / 3)
+    q = np.zeros(3)
+    with pytest.raises(ValueError, match="^impulse: give exactly one"):
+        varmech.impulse_response(rod, q, np.zeros(3), varmech.Impulse())
+    with pytest.raises(ValueError, match="^impulse: a point struck needs"):
+        varmech.impulse_response(rod, q, np.zeros(3), varmech.Impulse(point=lambda q: q[:2]))
+    with pytest.raises(ValueError, match="^generalized: "):
+        varmech.impulse_response(rod, q, np.zeros(3), varmech.Impulse(generalized=[1.0, 2.0]))
+    with pytest.raises(ValueError, match="^jacobian: expected shape"):
+        varmech.impulse_response(rod, q, np.zeros(3), varmech.Impulse(point=lambda q: q[:2], jacobian=lambda q: np.eye(3), impulse=[1.0, 0.0]))
+    with pytest.raises(TypeError, match="^impulse: expected a varmech.Impulse"):
+        varmech.impulse_response(rod, q, np.zeros(3), [1.0, 0.0, 0.0])
+    with pytest.warns(UserWarning, match="central differences"):
+        after = varmech.impulse_response(rod, q, np.zeros(3), varmech.Impulse(point=lambda q: q[:2], impulse=[0.0, 1.0]))
+    np.testing.assert_allclose(after.v, [0.0, 1.0, 0.0], atol=1e-9)
+    with pytest.raises(ValueError, match="^constraints, velocity_constraints: give exactly one"):
+        varmech.engage(rod, q, np.zeros(3))
+    with pytest.raises(ValueError, match="^velocity_constraints: expected a matrix with 3 columns"):
+        varmech.engage(rod, q, np.zeros(3), velocity_constraints=lambda q: [[1.0, 0.0]])
