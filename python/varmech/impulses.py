@@ -28,6 +28,7 @@ from __future__ import annotations
 import warnings
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -247,3 +248,99 @@ def engage(
     carnot = 0.5 * float(jump @ np.linalg.solve(minv, jump))
     lost = _kinetic(model, qq, before, t) - _kinetic(model, qq, after, t)
     return Engagement(after, v_after, multipliers, lost, carnot)
+
+
+@dataclass
+class Joined:
+    """A run in pieces, joined: the columns and counts ``integrate`` makes a Trajectory of."""
+
+    t: np.ndarray
+    q: np.ndarray
+    p: np.ndarray
+    newton: np.ndarray
+    work: np.ndarray
+    steps: int
+    force_evaluations: int
+    checkpoint: bytes
+
+
+Start = Callable[[np.ndarray, np.ndarray, float, int, Callable[[int], None] | None], Any]
+
+
+def run(start: Start, model: Model, q0: np.ndarray, p0: np.ndarray, t0: float, dt: float, steps: int, impulses: list[Impulse]) -> Joined:
+    """A run of ``steps`` steps of ``dt`` from (t0, q0, p0) with ``impulses`` (``start(q, p, t0,
+    steps, progress)`` runs a piece): pieces from grid state to grid state, each impulse between
+    them. One between tₙ and tₙ₊₁ splits the step: Φ_τ, the jump p += P(q), Φ_{h−τ}, all steps of
+    the run's method, so the run keeps its order; on a constrained model the jump is followed by
+    the workless constraint impulse (the momenta projected, :func:`varmech.project`)."""
+    from .constraints import project
+
+    for i, imp in enumerate(impulses):
+        if not isinstance(imp, Impulse):
+            raise TypeError(f"impulses[{i}]: expected a varmech.Impulse, got {type(imp).__name__}")
+    t_end = t0 + steps * dt
+    ordered = sorted(impulses, key=lambda imp: imp.t)
+    for imp in ordered:
+        if not (np.isfinite(imp.t) and t0 <= imp.t <= t_end):
+            raise ValueError(f"impulses: a time {imp.t} outside the run's span [{t0}, {t_end}]")
+    rows: dict[str, list[np.ndarray]] = {"t": [], "q": [], "p": [], "newton": [], "work": []}
+    counts: dict[str, Any] = {"steps": 0, "nfev": 0, "newton": 0, "work": 0.0}
+
+    def add(record: Any, skip_first: bool) -> None:
+        k = int(skip_first)
+        rows["t"].append(np.asarray(record.t)[k:])
+        rows["q"].append(np.asarray(record.q)[k:])
+        rows["p"].append(np.asarray(record.p)[k:])
+        rows["newton"].append(np.asarray(record.newton)[k:] + counts["newton"])
+        rows["work"].append(np.asarray(record.work)[k:] + counts["work"])
+
+    def row(t: float, q: np.ndarray, p: np.ndarray) -> None:
+        rows["t"].append(np.array([t]))
+        rows["q"].append(q[None, :])
+        rows["p"].append(p[None, :])
+        rows["newton"].append(rows["newton"][-1][-1:])
+        rows["work"].append(rows["work"][-1][-1:])
+
+    def piece(q: np.ndarray, p: np.ndarray, t: float, n: int) -> Any:
+        record = start(q, p, t, n, None)
+        add(record, skip_first=bool(rows["t"]))
+        counts["steps"] += n
+        counts["nfev"] += record.force_evaluations
+        return record
+
+    q, p, t, done = q0, p0, t0, 0
+    for imp in ordered:
+        n = min(int(np.floor((imp.t - t0) / dt)), steps)
+        while n > done and t0 + n * dt > imp.t:
+            n -= 1
+        n = max(n, done)
+        record = piece(q, p, t, n - done)
+        counts["newton"] = int(rows["newton"][-1][-1])
+        counts["work"] = float(rows["work"][-1][-1])
+        tau = imp.t - float(record.t[-1])
+        stepper = None
+        if tau > 0:
+            stepper = _core.Stepper.from_checkpoint(model._core, record.checkpoint)
+            stepper.dt = tau
+            stepper.step()
+            q_at, p_at = np.asarray(stepper.q), np.asarray(stepper.p)
+            row(imp.t, q_at, p_at)
+        else:
+            q_at, p_at = np.asarray(record.q[-1]), np.asarray(record.p[-1])
+        p_jump = p_at + imp.components(q_at)
+        if model.constraints:
+            q_at, p_jump = project(model, q_at, p_jump)
+        row(imp.t, q_at, p_jump)
+        if stepper is not None:
+            stepper.reset(q_at, p_jump, imp.t)
+            stepper.dt = dt - tau
+            stepper.step()
+            counts["nfev"] += stepper.force_evaluations
+            q, p, t, done = np.asarray(stepper.q), np.asarray(stepper.p), t0 + (n + 1) * dt, n + 1
+            counts["steps"] += 1
+            row(t, q, p)
+        else:
+            q, p, t, done = q_at, p_jump, imp.t, n
+    record = piece(q, p, t, steps - done)
+    t_all, q_all, p_all, newton, work = (np.concatenate(rows[name]) for name in ("t", "q", "p", "newton", "work"))
+    return Joined(t_all, q_all, p_all, newton, work, counts["steps"], counts["nfev"], record.checkpoint)

@@ -15,6 +15,7 @@ from numpy.typing import ArrayLike
 
 from . import _core, dense, files
 from . import events as _events
+from . import impulses as _impulses
 from ._progress import progress_bar
 from ._util import finite, positive, positive_int, vector
 from .model import Lagrangian, Model
@@ -231,6 +232,7 @@ def integrate(
     checkpoint_every: int | datetime.timedelta | None = None,
     events: Sequence[_events.Event | _events.EventFunction] | None = None,
     t_eval: ArrayLike | None = None,
+    impulses: Sequence[_impulses.Impulse] | None = None,
 ) -> Trajectory:
     """Integrate ``model`` from (q0, p0) with a fixed step.
 
@@ -299,6 +301,13 @@ def integrate(
         ``tests/python/test_dense.py``), as ``solve_ivp(t_eval=)`` does with its dense output.
         The run itself is unchanged (it ends on its grid, with its checkpoint); not with
         ``save_every``, ``output`` or ``events``.
+    impulses:
+        Blows (:class:`varmech.Impulse`) at their times ``impulse.t`` within the run: the momenta
+        jump by P(q) there. An impulse between grid points splits its step: a step of the same
+        method to tₙ + τ, the jump, a step of h − τ back onto the grid, so the method keeps its
+        order (``tests/python/test_impulses.py``). The saved states include those just before and
+        just after each jump (one time, two rows), and saving restarts from the grid state after
+        it. Not yet with ``t_eval``, ``output`` or ``events``.
     checkpoint_every:
         With ``output``: commit states and a checkpoint at least every this many steps (rounded
         down to whole ``save_every`` periods), or every :class:`datetime.timedelta` of run time.
@@ -346,9 +355,10 @@ def integrate(
             "t0": t0,
             "parameters": parameters,
             "t_eval": t_eval,
+            "impulses": impulses,
         }
         named = [name for name, value in given.items() if value is not None]
-        if named and named[0] == "t_eval":
+        if named and named[0] in ("t_eval", "impulses"):
             raise ValueError(f"{named[0]}: not with a continued run (start a new run from its last state)")
         if named:
             raise ValueError(f"{named[0]}: a continued run keeps its trajectory's {', '.join(named)}")
@@ -376,7 +386,9 @@ def integrate(
     probes = (t0, t0 + dt, t0 + 0.5, t0 + 1.0, t0 + 0.37 * (t_end - t0), t_end)
     _check_time_independent(model, q, p, tuple(s for s in probes if math.isfinite(s)))
 
-    def first(steps: int, report: Callable[[int], None] | None) -> _core.TrajectoryRecord:
+    def start(
+        q: np.ndarray, p: np.ndarray, t0: float, steps: int, report: Callable[[int], None] | None
+    ) -> _core.TrajectoryRecord:
         return _core.integrate(
             model._core,
             q,
@@ -394,6 +406,16 @@ def integrate(
             events=event_specs or None,
         )
 
+    def first(steps: int, report: Callable[[int], None] | None) -> _core.TrajectoryRecord:
+        return start(q, p, t0, steps, report)
+
+    if impulses is not None:
+        for name, clash in (("t_eval", t_eval is not None), ("output", output is not None), ("events", bool(watched))):
+            if clash:
+                raise ValueError(f"impulses: not yet with {name}")
+        j = _impulses.run(start, model, q, p, t0, dt, nsteps, list(impulses))
+        work = j.work if model.forced else None
+        return Trajectory(j.t, j.q, j.p, model, method, dt, j.steps, j.force_evaluations, j.newton, work, checkpoint=j.checkpoint)
     if t_eval is not None:
         return _evaluated(first, model, method, dt, t0, nsteps, dense.eval_times(t_eval, t0, t_end), save_every, progress, output, watched)
     return _run(

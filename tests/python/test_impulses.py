@@ -131,3 +131,58 @@ def test_bad_impulses_are_named():
         varmech.engage(rod, q, np.zeros(3))
     with pytest.raises(ValueError, match="^velocity_constraints: expected a matrix with 3 columns"):
         varmech.engage(rod, q, np.zeros(3), velocity_constraints=lambda q: [[1.0, 0.0]])
+
+
+def _oscillator_after_blow(t, t_star, blow):
+    """The harmonic oscillator from q = 0, p = 1, struck at t* by Δp = blow: exact (q, p) at t."""
+    q_star, p_star = math.sin(t_star), math.cos(t_star) + blow
+    s = t - t_star
+    return q_star * math.cos(s) + p_star * math.sin(s), -q_star * math.sin(s) + p_star * math.cos(s)
+
+
+@pytest.mark.parametrize(("method", "order", "h"), [("verlet", 2, 0.02), ("kahan_li6", 6, 0.2), ("midpoint", 2, 0.02)])
+def test_an_impulse_between_grid_points_keeps_the_methods_order(method, order, h):
+    s = varmech.scenes.harmonic_oscillator()
+    t_star, blow, t_end = 1.2345, 0.7, 6.0
+    exact = _oscillator_after_blow(t_end, t_star, blow)
+    errors = []
+    for dt in (h, h / 2, h / 4):
+        steps = round(t_end / dt)
+        traj = varmech.integrate(s, [0.0], [1.0], dt=dt, steps=steps, method=method, impulses=[varmech.Impulse(generalized=[blow], t=t_star)])
+        assert traj.t[-1] == pytest.approx(t_end, abs=1e-12) and traj.steps == steps
+        errors.append(max(abs(traj.q[-1, 0] - exact[0]), abs(traj.p[-1, 0] - exact[1])))
+        # The jump is saved: two rows at t*, the momenta differing by the blow.
+        at = np.flatnonzero(traj.t == t_star)
+        assert len(at) == 2 and traj.p[at[1], 0] - traj.p[at[0], 0] == pytest.approx(blow, rel=1e-14)
+    orders = np.log2(np.array(errors[:-1]) / errors[1:])
+    assert np.all(np.abs(orders - order) < 0.3), (errors, orders)
+
+
+def test_an_impulse_on_the_grid_jumps_there_and_the_run_goes_on_as_a_new_one():
+    s = varmech.scenes.harmonic_oscillator()
+    dt, blow = 0.05, [0.4]
+    traj = varmech.integrate(s, [0.0], [1.0], dt=dt, steps=200, impulses=[varmech.Impulse(generalized=blow, t=40 * dt)])
+    before = varmech.integrate(s, [0.0], [1.0], dt=dt, steps=40)
+    after = varmech.integrate(s, before.q[-1], before.p[-1] + blow, dt=dt, steps=160, t0=float(before.t[-1]))
+    np.testing.assert_array_equal(traj.q[:41], before.q)
+    np.testing.assert_array_equal(traj.q[-1], after.q[-1])
+    np.testing.assert_array_equal(traj.p[-1], after.p[-1])
+
+
+def test_an_impulse_on_a_constrained_model_keeps_the_constraints():
+    # A blow on the Cartesian pendulum's bob: the rod's constraint impulse takes the radial part.
+    s = varmech.scenes.cartesian_pendulum()
+    blow = varmech.Impulse(generalized=[0.3, 0.2], t=0.5)
+    traj = varmech.integrate(s, dt=0.01, steps=200, impulses=[blow])
+    g, gv = traj.constraint_residuals()
+    assert np.max(g) < 1e-12 and np.max(gv) < 1e-12
+
+
+def test_bad_impulse_times_are_named():
+    s = varmech.scenes.harmonic_oscillator()
+    with pytest.raises(ValueError, match="^impulses: a time 50.0 outside"):
+        varmech.integrate(s, dt=0.1, steps=100, impulses=[varmech.Impulse(generalized=[1.0], t=50.0)])
+    with pytest.raises(TypeError, match=r"^impulses\[0\]: expected a varmech.Impulse"):
+        varmech.integrate(s, dt=0.1, steps=100, impulses=[[1.0]])
+    with pytest.raises(ValueError, match="^impulses: not yet with t_eval"):
+        varmech.integrate(s, dt=0.1, steps=100, impulses=[varmech.Impulse(generalized=[1.0], t=1.0)], t_eval=[1.0])
