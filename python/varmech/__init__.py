@@ -42,6 +42,7 @@ from .conservation import ConservationReport, InvariantStatistics, check_conserv
 from .constraints import project
 from .derivatives import DerivativeCheck, check_derivatives
 from .files import load
+from .impacts import Contact
 from .impulses import Engagement, Impulse, ImpulseResponse, engage, impulse_response
 from .integrate import Trajectory, integrate, symplecticity_defect
 from .methods import MethodInfo, methods
@@ -55,6 +56,7 @@ __version__ = "0.1.0"
 
 __all__ = [
     "ConservationReport",
+    "Contact",
     "ConvergenceError",
     "Cyclic",
     "DerivativeCheck",

@@ -15,6 +15,7 @@ from numpy.typing import ArrayLike
 
 from . import _core, dense, files
 from . import events as _events
+from . import impacts as _impacts
 from . import impulses as _impulses
 from ._progress import progress_bar
 from ._util import finite, positive, positive_int, vector
@@ -233,6 +234,7 @@ def integrate(
     events: Sequence[_events.Event | _events.EventFunction] | None = None,
     t_eval: ArrayLike | None = None,
     impulses: Sequence[_impulses.Impulse] | None = None,
+    contacts: Sequence[_impacts.Contact] | None = None,
 ) -> Trajectory:
     """Integrate ``model`` from (q0, p0) with a fixed step.
 
@@ -308,6 +310,11 @@ def integrate(
         order (``tests/python/test_impulses.py``). The saved states include those just before and
         just after each jump (one time, two rows), and saving restarts from the grid state after
         it. Not yet with ``t_eval``, ``output`` or ``events``.
+    contacts:
+        Unilateral constraints φ(q) ≥ 0 (:class:`varmech.Contact`): the run goes through their
+        impacts, each step that crosses a surface split at the contact configuration (see
+        :mod:`varmech.impacts`); the impacts are each contact's occurrences in ``traj.events``.
+        Not yet with ``t_eval``, ``output``, ``events`` or ``impulses``.
     checkpoint_every:
         With ``output``: commit states and a checkpoint at least every this many steps (rounded
         down to whole ``save_every`` periods), or every :class:`datetime.timedelta` of run time.
@@ -356,9 +363,10 @@ def integrate(
             "parameters": parameters,
             "t_eval": t_eval,
             "impulses": impulses,
+            "contacts": contacts,
         }
         named = [name for name, value in given.items() if value is not None]
-        if named and named[0] in ("t_eval", "impulses"):
+        if named and named[0] in ("t_eval", "impulses", "contacts"):
             raise ValueError(f"{named[0]}: not with a continued run (start a new run from its last state)")
         if named:
             raise ValueError(f"{named[0]}: a continued run keeps its trajectory's {', '.join(named)}")
@@ -387,7 +395,7 @@ def integrate(
     _check_time_independent(model, q, p, tuple(s for s in probes if math.isfinite(s)))
 
     def start(
-        q: np.ndarray, p: np.ndarray, t0: float, steps: int, report: Callable[[int], None] | None
+        q: np.ndarray, p: np.ndarray, t0: float, steps: int, report: Callable[[int], None] | None, events: Any = None
     ) -> _core.TrajectoryRecord:
         return _core.integrate(
             model._core,
@@ -403,12 +411,24 @@ def integrate(
             newton_tolerance=newton_tolerance,
             newton_max_iterations=newton_max_iterations,
             progress=report,
-            events=event_specs or None,
+            events=events if events is not None else (event_specs or None),
         )
 
     def first(steps: int, report: Callable[[int], None] | None) -> _core.TrajectoryRecord:
         return start(q, p, t0, steps, report)
 
+    if contacts is not None:
+        for name, clash in (
+            ("t_eval", t_eval is not None),
+            ("output", output is not None),
+            ("events", bool(watched)),
+            ("impulses", impulses is not None),
+        ):
+            if clash:
+                raise ValueError(f"contacts: not yet with {name}")
+        j, hits = _impacts.run(start, model, q, p, t0, dt, nsteps, list(contacts))
+        work = j.work if model.forced else None
+        return Trajectory(j.t, j.q, j.p, model, method, dt, j.steps, j.force_evaluations, j.newton, work, checkpoint=j.checkpoint, events=hits)
     if impulses is not None:
         for name, clash in (("t_eval", t_eval is not None), ("output", output is not None), ("events", bool(watched))):
             if clash:

@@ -21,6 +21,7 @@ pytest.importorskip("sympy")
         "varmech.streaming",
         "varmech.dense",
         "varmech.impulses",
+        "varmech.impacts",
         "varmech.stepper",
         "varmech.conservation",
     ],

@@ -1,0 +1,123 @@
+"""Impacts with unilateral constraints (reference/impulses_and_rolling.md): the bouncing ball's
+exact bounce times and heights, its restitution law, and the elliptic billiard's focal invariant."""
+
+import math
+
+import numpy as np
+import pytest
+
+import varmech
+
+G = 9.81
+
+
+def _ball():
+    return varmech.MechanicalSystem(1, lambda q: G * q[0], lambda q: np.array([G]), name="ball")
+
+
+def test_an_elastic_ball_bounces_at_the_exact_times_for_ten_thousand_bounces():
+    # Dropped from h₀: impacts at t₁(2k + 1), t₁ = √(2h₀/g). Verlet is exact on the parabolas
+    # between impacts, and each impact is located to round-off.
+    h0, dt = 1.0, 1e-3
+    t1 = math.sqrt(2 * h0 / G)
+    floor = varmech.Contact(lambda q: q[0], lambda q: [1.0], name="floor")
+    steps = round((t1 * 2e4 + t1 / 2) / dt)
+    traj = varmech.integrate(_ball(), [h0], [0.0], dt=dt, steps=steps, save_every=10**9, contacts=[floor])
+    hits = traj.events[0]
+    k = np.arange(len(hits))
+    assert len(hits) == 10_000
+    assert np.max(np.abs(hits.t - t1 * (2 * k + 1))) < 1e-9 * hits.t[-1]
+    # On the floor to round-off, and the energy at every impact h₀ (T + V with V = 0 there).
+    assert np.max(np.abs(hits.q)) < 1e-12
+    assert np.max(np.abs(0.5 * hits.p[:, 0] ** 2 - G * h0)) < 1e-10 * G * h0
+
+
+def test_an_elastic_balls_bounce_times_converge_at_order_two_under_a_varying_force():
+    # A spring floor force makes the flight non-parabolic: V = gy + ½κy², no closed form; the
+    # time of the fifth impact converges at Verlet's order against a fine run.
+    kappa = 4.0
+    model = varmech.MechanicalSystem(1, lambda q: G * q[0] + 0.5 * kappa * q[0] ** 2, lambda q: np.array([G + kappa * q[0]]))
+    floor = varmech.Contact(lambda q: q[0], lambda q: [1.0])
+
+    def fifth(dt):
+        traj = varmech.integrate(model, [1.0], [0.0], dt=dt, steps=round(4.0 / dt), save_every=10**9, contacts=[floor])
+        return traj.events[0].t[4]
+
+    reference = fifth(1e-5)
+    errors = [abs(fifth(dt) - reference) for dt in (4e-3, 2e-3, 1e-3)]
+    orders = np.log2(np.array(errors[:-1]) / errors[1:])
+    assert np.all(np.abs(orders - 2.0) < 0.3), (errors, orders)
+
+
+@pytest.mark.parametrize("e", [0.9, 0.5])
+def test_an_inelastic_balls_heights_fall_by_e_squared_per_bounce(e):
+    floor = varmech.Contact(lambda q: q[0], lambda q: [1.0], restitution=e)
+    traj = varmech.integrate(_ball(), [1.0], [0.0], dt=1e-3, steps=3000, contacts=[floor])
+    hits = traj.events[0]
+    speeds = np.abs(hits.p[:, 0])
+    assert len(hits) >= 4
+    # Apex heights v⁺²/2g after the k-th impact: v⁺ = e v⁻, and v⁻ of the next is v⁺ of this.
+    heights = (e * speeds) ** 2 / (2 * G)
+    np.testing.assert_allclose(heights[1:] / heights[:-1], e**2, rtol=1e-12)
+
+
+def test_the_elliptic_billiard_keeps_its_focal_invariant_over_ten_thousand_impacts():
+    # x²/A² + y²/B² ≤ 1; L₁L₂ with Lᵢ = (x ∓ c)ẏ − yẋ is conserved across elastic impacts.
+    a, b = 2.0, 1.0
+    c = math.sqrt(a * a - b * b)
+    free = varmech.MechanicalSystem(2, lambda q: 0.0, lambda q: np.zeros(2), name="billiard")
+    wall = varmech.Contact(lambda q: 1 - (q[0] / a) ** 2 - (q[1] / b) ** 2, lambda q: [-2 * q[0] / a**2, -2 * q[1] / b**2], name="wall")
+    q0, p0 = np.array([0.3, 0.1]), np.array([0.6, 0.8])
+
+    def invariant(q, p):
+        return ((q[:, 0] - c) * p[:, 1] - q[:, 1] * p[:, 0]) * ((q[:, 0] + c) * p[:, 1] - q[:, 1] * p[:, 0])
+
+    traj = varmech.integrate(free, q0, p0, dt=0.2, steps=105_000, save_every=97, contacts=[wall])
+    hits = traj.events[0]
+    assert len(hits) > 10_000
+    start = invariant(q0[None, :], p0[None, :])[0]
+    assert np.max(np.abs(invariant(traj.q, traj.p) - start)) < 1e-10
+    assert np.max(np.abs(0.5 * np.sum(traj.p**2, axis=1) - 0.5)) < 1e-12
+    assert np.max((traj.q[:, 0] / a) ** 2 + (traj.q[:, 1] / b) ** 2) < 1 + 1e-12
+
+
+def test_bad_contacts_are_named():
+    floor = varmech.Contact(lambda q: q[0], lambda q: [1.0])
+    with pytest.raises(ValueError, match="^q0: outside the contact"):
+        varmech.integrate(_ball(), [-0.1], [0.0], dt=1e-3, steps=10, contacts=[floor])
+    with pytest.raises(ValueError, match="^restitution: must lie in"):
+        varmech.Contact(lambda q: q[0], lambda q: [1.0], restitution=1.5)
+    with pytest.raises(TypeError, match=r"^contacts\[0\]: expected a varmech.Contact"):
+        varmech.integrate(_ball(), [1.0], [0.0], dt=1e-3, steps=10, contacts=[lambda q: q[0]])
+
+
+def test_a_step_across_an_impact_is_symplectic_only_to_the_methods_order():
+    # Documents what is built: not the variational collision integrator (which is symplectic).
+    # A particle in a harmonic trap under gravity, an oblique floor y + 0.3x ≥ 0, the impact
+    # at about 0.4 of the step: the defect of verlet's step falls as h².
+    kappa = 4.0
+    model = varmech.MechanicalSystem(
+        2, lambda q: G * q[1] + 0.5 * kappa * (q[0] ** 2 + q[1] ** 2), lambda q: np.array([kappa * q[0], G + kappa * q[1]])
+    )
+    floor = varmech.Contact(lambda q: q[1] + 0.3 * q[0], lambda q: [0.3, 1.0])
+    j = np.block([[np.zeros((2, 2)), np.eye(2)], [-np.eye(2), np.zeros((2, 2))]])
+
+    def step(z, h):
+        traj = varmech.integrate(model, z[:2], z[2:], dt=h, steps=1, contacts=[floor], max_energy_error=None)
+        assert len(traj.events[0]) == 1
+        return np.concatenate([traj.q[-1], traj.p[-1]])
+
+    defects = []
+    for h in (0.1, 0.05, 0.025):
+        z0 = np.array([0.2, -0.06 + 0.4 * h, 0.3, -1.0])
+        eps = 1e-6
+        psi = np.stack(
+            [
+                (-step(z0 + 2 * e, h) + 8 * step(z0 + e, h) - 8 * step(z0 - e, h) + step(z0 - 2 * e, h)) / (12 * eps)
+                for e in np.eye(4) * eps
+            ],
+            axis=1,
+        )
+        defects.append(np.linalg.norm(psi.T @ j @ psi - j))
+    orders = np.log2(np.array(defects[:-1]) / defects[1:])
+    assert defects[0] > 1e-3 and np.all(np.abs(orders - 2.0) < 0.3), (defects, orders)
