@@ -59,10 +59,35 @@ class Contact:
     gradient: Callable[[np.ndarray], ArrayLike]
     restitution: float = 1.0
     name: str = "contact"
+    #: The coordinate k and value c of a wall q_k ≥ c, watched natively (see :meth:`wall`).
+    coordinate: tuple[int, float] | None = None
 
     def __post_init__(self) -> None:
         if not (isinstance(self.restitution, (int, float)) and 0.0 <= float(self.restitution) <= 1.0):
             raise ValueError(f"restitution: must lie in [0, 1], got {self.restitution!r}")
+
+    @classmethod
+    def wall(cls, k: int, value: float = 0.0, *, restitution: float = 1.0, name: str | None = None) -> Contact:
+        """The wall q_k ≥ ``value`` (a floor, a side of a box): φ = q_k − value, watched in the
+        core (the native ``crossing`` event), with no Python call per step.
+
+        Examples
+        --------
+        >>> import numpy as np, varmech
+        >>> ball = varmech.MechanicalSystem(1, lambda q: 9.81 * q[0], lambda q: np.array([9.81]))
+        >>> traj = varmech.integrate(ball, [1.0], [0.0], dt=1e-3, steps=3000, contacts=[varmech.Contact.wall(0)])
+        >>> len(traj.events[0])
+        3
+        """
+
+        def phi(q: np.ndarray) -> float:
+            return float(q[k] - value)
+
+        def gradient(q: np.ndarray) -> np.ndarray:
+            return np.eye(len(q))[k]
+
+        label = name if name is not None else f"q[{k}] ≥ {value:g}"
+        return cls(phi, gradient, restitution, label, (int(k), float(value)))
 
 
 def reflect(model: Model, contact: Contact, q: np.ndarray, p: np.ndarray, t: float) -> np.ndarray:
@@ -84,7 +109,10 @@ def check(model: Model, contacts: list[Contact], q0: np.ndarray) -> list[Any]:
         value = float(c.phi(q0.copy()))
         if not value >= 0.0:
             raise ValueError(f"q0: outside the contact {c.name!r}: φ(q0) = {value} < 0")
-        watched.append(_events.Event(_surface(c), direction=-1, terminal=1, name=c.name))
+        if c.coordinate is not None:
+            watched.append(_events.Event(None, -1, 1, name=c.name, native=("crossing", c.coordinate)))
+        else:
+            watched.append(_events.Event(_surface(c), direction=-1, terminal=1, name=c.name))
     return _events.specs(watched, model.dim)[1]
 
 
