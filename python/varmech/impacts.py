@@ -35,7 +35,7 @@ from numpy.typing import ArrayLike
 
 from . import _core
 from . import events as _events
-from .impulses import Joined, inverse_mass
+from .impulses import Joined, Pieces, inverse_mass
 from .model import Model
 
 
@@ -135,44 +135,26 @@ def run(
     (``start(q, p, t0, steps, progress, events)`` runs a piece up to the first impact), and the
     impacts of each contact."""
     specs = check(model, contacts, q0)
-    rows: dict[str, list[np.ndarray]] = {"t": [], "q": [], "p": [], "newton": [], "work": []}
     hits: list[list[tuple[float, np.ndarray, np.ndarray]]] = [[] for _ in contacts]
-    counts: dict[str, Any] = {"steps": 0, "nfev": 0, "newton": 0, "work": 0.0}
-
-    def add(record: Any, first: int, last: int) -> None:
-        for name in ("t", "q", "p"):
-            rows[name].append(np.asarray(getattr(record, name))[first:last])
-        rows["newton"].append(np.asarray(record.newton)[first:last] + counts["newton"])
-        rows["work"].append(np.asarray(record.work)[first:last] + counts["work"])
-
-    def row(t: float, q: np.ndarray, p: np.ndarray) -> None:
-        for name, value in (("t", np.array([t])), ("q", q[None, :]), ("p", p[None, :])):
-            rows[name].append(value)
-        rows["newton"].append(np.array([counts["newton"]]))
-        rows["work"].append(np.array([counts["work"]]))
-
+    pieces = Pieces()
     q, p, t, done = q0, p0, t0, 0
     record = None
     while True:
         record = start(q, p, t, steps - done, None, specs)
-        counts["nfev"] += record.force_evaluations
         i = record.terminated_by
-        skip = int(bool(rows["t"]))
         if i is None:
-            add(record, skip, len(record.t))
-            counts["steps"] = done + record.steps
+            pieces.add(record)
+            done += record.steps
             break
         # The step of the impact ends past the surface: its saved end is replaced.
-        add(record, skip, len(record.t) - 1)
-        counts["newton"] = int(np.asarray(record.newton)[-1]) + counts["newton"]
-        counts["work"] = float(np.asarray(record.work)[-1]) + counts["work"]
+        pieces.add(record, drop_last=True)
         index, te, qe, pe = record.events
         k = int(np.flatnonzero(index == i)[-1])
         t_hit, q_hit, p_hit = float(te[k]), np.asarray(qe[k]), np.asarray(pe[k])
         p_after = reflect(model, contacts[i], q_hit, p_hit, t_hit)
         hits[i].append((t_hit, q_hit, p_hit))
-        row(t_hit, q_hit, p_hit)
-        row(t_hit, q_hit, p_after)
+        pieces.row(t_hit, q_hit, p_hit)
+        pieces.row(t_hit, q_hit, p_after)
         done += record.steps
         t_grid = t0 + done * dt
         stepper = _core.Stepper.from_checkpoint(model._core, record.checkpoint)
@@ -180,15 +162,13 @@ def run(
         if t_grid > t_hit:
             stepper.dt = t_grid - t_hit
             stepper.step()
-            counts["nfev"] += stepper.force_evaluations
+            pieces.nfev += stepper.force_evaluations
         q, p, t = np.asarray(stepper.q), np.asarray(stepper.p), t_grid
-        row(t, q, p)
-        counts["steps"] = done
+        pieces.row(t, q, p)
         if done >= steps:
             break
     assert record is not None
-    t_all, q_all, p_all, newton, work = (np.concatenate(rows[name]) for name in ("t", "q", "p", "newton", "work"))
-    joined = Joined(t_all, q_all, p_all, newton, work, counts["steps"], counts["nfev"], record.checkpoint)
+    joined = pieces.joined(done, record.checkpoint)
     n = model.dim
     found = tuple(
         _events.Occurrences(

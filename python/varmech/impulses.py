@@ -264,6 +264,42 @@ class Joined:
     checkpoint: bytes
 
 
+class Pieces:
+    """A run assembled from pieces (core runs between impulses or impacts) and single states (at
+    a jump): the saved rows, the Newton counts and work made cumulative over the pieces, and the
+    force evaluations."""
+
+    def __init__(self) -> None:
+        self.rows: dict[str, list[np.ndarray]] = {name: [] for name in ("t", "q", "p", "newton", "work")}
+        self.nfev = 0
+        self._newton, self._work = 0, 0.0
+
+    def add(self, record: Any, *, drop_last: bool = False) -> None:
+        """A piece's rows (its first left out after the first piece: it repeats the last row;
+        its last too with ``drop_last``) and its counts."""
+        first, last = int(bool(self.rows["t"])), len(record.t) - int(drop_last)
+        for name in ("t", "q", "p"):
+            self.rows[name].append(np.asarray(getattr(record, name))[first:last])
+        newton, work = np.asarray(record.newton), np.asarray(record.work)
+        self.rows["newton"].append(newton[first:last] + self._newton)
+        self.rows["work"].append(work[first:last] + self._work)
+        self._newton += int(newton[-1])
+        self._work += float(work[-1])
+        self.nfev += record.force_evaluations
+
+    def row(self, t: float, q: np.ndarray, p: np.ndarray) -> None:
+        """A single state, with the counts so far."""
+        for name, value in (("t", np.array([t])), ("q", q[None, :]), ("p", p[None, :])):
+            self.rows[name].append(value)
+        self.rows["newton"].append(np.array([self._newton]))
+        self.rows["work"].append(np.array([self._work]))
+
+    def joined(self, steps: int, checkpoint: bytes) -> Joined:
+        """The whole run, of ``steps`` steps, ending with ``checkpoint``."""
+        t, q, p, newton, work = (np.concatenate(self.rows[name]) for name in ("t", "q", "p", "newton", "work"))
+        return Joined(t, q, p, newton, work, steps, self.nfev, checkpoint)
+
+
 Start = Callable[[np.ndarray, np.ndarray, float, int, Callable[[int], None] | None], Any]
 
 
@@ -283,29 +319,11 @@ def run(start: Start, model: Model, q0: np.ndarray, p0: np.ndarray, t0: float, d
     for imp in ordered:
         if not (np.isfinite(imp.t) and t0 <= imp.t <= t_end):
             raise ValueError(f"impulses: a time {imp.t} outside the run's span [{t0}, {t_end}]")
-    rows: dict[str, list[np.ndarray]] = {"t": [], "q": [], "p": [], "newton": [], "work": []}
-    counts: dict[str, Any] = {"steps": 0, "nfev": 0, "newton": 0, "work": 0.0}
-
-    def add(record: Any, skip_first: bool) -> None:
-        k = int(skip_first)
-        rows["t"].append(np.asarray(record.t)[k:])
-        rows["q"].append(np.asarray(record.q)[k:])
-        rows["p"].append(np.asarray(record.p)[k:])
-        rows["newton"].append(np.asarray(record.newton)[k:] + counts["newton"])
-        rows["work"].append(np.asarray(record.work)[k:] + counts["work"])
-
-    def row(t: float, q: np.ndarray, p: np.ndarray) -> None:
-        rows["t"].append(np.array([t]))
-        rows["q"].append(q[None, :])
-        rows["p"].append(p[None, :])
-        rows["newton"].append(rows["newton"][-1][-1:])
-        rows["work"].append(rows["work"][-1][-1:])
+    pieces = Pieces()
 
     def piece(q: np.ndarray, p: np.ndarray, t: float, n: int) -> Any:
         record = start(q, p, t, n, None)
-        add(record, skip_first=bool(rows["t"]))
-        counts["steps"] += n
-        counts["nfev"] += record.force_evaluations
+        pieces.add(record)
         return record
 
     q, p, t, done = q0, p0, t0, 0
@@ -315,8 +333,6 @@ def run(start: Start, model: Model, q0: np.ndarray, p0: np.ndarray, t0: float, d
             n -= 1
         n = max(n, done)
         record = piece(q, p, t, n - done)
-        counts["newton"] = int(rows["newton"][-1][-1])
-        counts["work"] = float(rows["work"][-1][-1])
         tau = imp.t - float(record.t[-1])
         stepper = None
         if tau > 0:
@@ -324,23 +340,21 @@ def run(start: Start, model: Model, q0: np.ndarray, p0: np.ndarray, t0: float, d
             stepper.dt = tau
             stepper.step()
             q_at, p_at = np.asarray(stepper.q), np.asarray(stepper.p)
-            row(imp.t, q_at, p_at)
+            pieces.row(imp.t, q_at, p_at)
         else:
             q_at, p_at = np.asarray(record.q[-1]), np.asarray(record.p[-1])
         p_jump = p_at + imp.components(q_at)
         if model.constraints:
             q_at, p_jump = project(model, q_at, p_jump)
-        row(imp.t, q_at, p_jump)
+        pieces.row(imp.t, q_at, p_jump)
         if stepper is not None:
             stepper.reset(q_at, p_jump, imp.t)
             stepper.dt = dt - tau
             stepper.step()
-            counts["nfev"] += stepper.force_evaluations
+            pieces.nfev += stepper.force_evaluations
             q, p, t, done = np.asarray(stepper.q), np.asarray(stepper.p), t0 + (n + 1) * dt, n + 1
-            counts["steps"] += 1
-            row(t, q, p)
+            pieces.row(t, q, p)
         else:
             q, p, t, done = q_at, p_jump, imp.t, n
     record = piece(q, p, t, steps - done)
-    t_all, q_all, p_all, newton, work = (np.concatenate(rows[name]) for name in ("t", "q", "p", "newton", "work"))
-    return Joined(t_all, q_all, p_all, newton, work, counts["steps"], counts["nfev"], record.checkpoint)
+    return pieces.joined(steps, record.checkpoint)
