@@ -99,6 +99,8 @@ def stream(
                 segment = max(save_every, int(rate * seconds) // save_every * save_every)
             take = min(left, segment, SEGMENT_ROWS * save_every, cap or left)
             started = time.perf_counter()
+            # Every segment after a new run's first starts with the state the last one ended on.
+            repeats = checkpoint is not None or writer.rows > 0
             try:
                 if checkpoint is None:
                     assert first is not None
@@ -117,16 +119,18 @@ def stream(
                         events=specs,
                     )
             except BaseException as err:
+                # The segment's states and crossings up to the stop are committed; the file is
+                # closed below.
                 partial = getattr(err, "_varmech_partial", None)
                 if partial is not None:
                     delattr(err, "_varmech_partial")
-                    writer.append(partial, skip_first=checkpoint is not None or writer.rows > 0)
-                writer.close(-1, str(err) or type(err).__name__)
+                    with _uninterrupted():
+                        writer.append(partial, skip_first=repeats, events=_events.occurrences(partial, watched))
                 raise
             elapsed = time.perf_counter() - started
             crossings = _events.occurrences(record, watched)
             with _uninterrupted():
-                writer.append(record, skip_first=checkpoint is not None or writer.rows > 0, events=crossings)
+                writer.append(record, skip_first=repeats, events=crossings)
             if watched and initial_energy is None:
                 initial_energy = float(_core.energy_terms(model._core, record.t[:1], record.q[:1], record.p[:1])[0][0])
             found = [k + len(o) for k, o in zip(found, crossings)]
@@ -145,7 +149,7 @@ def stream(
             if done >= steps:
                 break
     except BaseException as err:
-        # Also a Ctrl-C between segments or inside an append: what was committed stands.
+        # A segment's error, or a Ctrl-C between segments: what was committed stands.
         if writer.is_open:
             with _uninterrupted():
                 writer.close(-1, str(err) or type(err).__name__)

@@ -298,3 +298,19 @@ def test_a_run_continued_in_memory_watches_events_on():
     assert rest.status == 1 and rest.steps == whole.steps
     both = np.concatenate([first.events[0].t, rest.events[0].t])
     assert _same(both, whole.events[0].t)
+
+
+def test_a_streamed_run_that_fails_commits_its_last_segments_crossings(tmp_path):
+    from varmech.events import crossing
+
+    # Explicit Euler on the pendulum: crossings, then the energy check stops the run mid-segment.
+    s = scenes.pendulum()
+    events = [crossing(0, 0.0)]
+    kwargs = dict(dt=0.05, steps=10**5, method="explicit_euler", events=events)
+    with pytest.raises(varmech.DivergenceError) as memory:
+        varmech.integrate(s, **kwargs)
+    with pytest.raises(varmech.DivergenceError) as streamed:
+        varmech.integrate(s, **kwargs, output=tmp_path / "d.h5", checkpoint_every=10**6)
+    a, b = memory.value.partial, streamed.value.partial
+    assert len(b.events[0]) == len(a.events[0]) > 0
+    assert _same(b.events[0].t, a.events[0].t) and _same(b.q[-1], a.q[-1])
