@@ -67,6 +67,15 @@ def hermite(traj: Trajectory, t: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
     return cubic(traj.q, v).reshape(shape), cubic(traj.p, pdot).reshape(shape)
 
 
+def grid_step(t: float, t0: float, dt: float, steps: int, at_least: int = 0) -> int:
+    """The last grid step n ≤ ``steps`` (and ≥ ``at_least``) whose time tₙ = t0 + n·dt, as the
+    core's clock computes it, is at or before t."""
+    n = min(int(np.floor((t - t0) / dt)), steps)
+    while n > at_least and t0 + n * dt > t:
+        n -= 1
+    return max(n, at_least)
+
+
 def eval_times(t_eval: ArrayLike, t0: float, t_end: float) -> np.ndarray:
     """``t_eval`` checked: finite, increasing, within [t0, t_end] (ValueError naming it)."""
     times = np.asarray(t_eval, dtype=float).reshape(-1)
@@ -93,10 +102,7 @@ def at_times(
     rows: dict[str, list[Any]] = {"t": [], "q": [], "p": [], "newton": [], "work": []}
     at = 0
     for t in times:
-        n = min(int(np.floor((t - t0) / dt)), steps)
-        # The grid state at or before t: tₙ = t0 + n·dt as the core's clock computes it.
-        while n > 0 and t0 + n * dt > t:
-            n -= 1
+        n = grid_step(t, t0, dt, steps)
         if n > at:
             record = _core.resume(model._core, record.checkpoint, steps=n - at, save_every=n - at)
             at = n

@@ -45,12 +45,11 @@ import inspect
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any, Literal
+from typing import Any, Literal
 
 import numpy as np
 
-if TYPE_CHECKING:
-    from . import _core
+from . import _core
 
 #: An event function g(t, q, p) (or g(t, q, v), see :class:`Event`).
 EventFunction = Callable[[float, np.ndarray, np.ndarray], float]
@@ -328,8 +327,27 @@ def termination(record: _core.TrajectoryRecord, events: Sequence[Event], found: 
     if i is None:
         return {}
     last = found[i]
-    message = f"A termination event occurred: {last.name} (occurrence {len(last)}) at t = {last.t[-1]:.6g}."
-    return {"status": 1, "message": message}
+    return {"status": 1, "message": termination_message(last, len(last))}
+
+
+def termination_message(last: Occurrences, count: int) -> str:
+    """What stopped a run: the ``count``-th crossing of an event, the last of ``last``."""
+    return f"A termination event occurred: {last.name} (occurrence {count}) at t = {last.t[-1]:.6g}."
+
+
+def found_before(previous: Sequence[Occurrences], events: Sequence[Event]) -> list[int]:
+    """The crossings of each of ``events`` in a run gone on from, ``previous``: its counts when
+    they are the same events (by name), none otherwise."""
+    names = [o.name for o in occurrences_of(events)]
+    return [len(o) for o in previous] if [o.name for o in previous] == names else [0] * len(names)
+
+
+def first_energy(model: Any, run: Any) -> float:
+    """E at the first state of ``run`` (a trajectory, lazy or not, or the binding's record): the
+    E₀ an energy-error event measures from, read as one row."""
+    t = np.array([float(run.t[0])])
+    q, p = (np.atleast_2d(np.asarray(x[0], dtype=float)) for x in (run.q, run.p))
+    return float(_core.energy_terms(model._core, t, q, p)[0][0])
 
 
 __all__ = ["Event", "Occurrences", "crossing", "encounter", "energy_error", "escape"]

@@ -35,6 +35,7 @@ from numpy.typing import ArrayLike
 
 from . import _core
 from ._util import vector
+from .dense import grid_step
 from .model import Model
 
 
@@ -328,10 +329,7 @@ def run(start: Start, model: Model, q0: np.ndarray, p0: np.ndarray, t0: float, d
 
     q, p, t, done = q0, p0, t0, 0
     for imp in ordered:
-        n = min(int(np.floor((imp.t - t0) / dt)), steps)
-        while n > done and t0 + n * dt > imp.t:
-            n -= 1
-        n = max(n, done)
+        n = grid_step(imp.t, t0, dt, steps, done)
         record = piece(q, p, t, n - done)
         tau = imp.t - float(record.t[-1])
         stepper = None

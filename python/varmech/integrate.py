@@ -464,9 +464,8 @@ def _evaluated(
     try:
         columns, record = dense.at_times(lambda steps: first(steps, None), model, times, t0, dt, nsteps, lambda s: bar.update(s - bar.n))
     except BaseException as err:
-        partial = getattr(err, "_varmech_partial", None)
+        partial = take_partial(err)
         if partial is not None:
-            delattr(err, "_varmech_partial")
             err.partial = _trajectory(partial, model, method, dt, status=-1, message=str(err))  # type: ignore[attr-defined]
         raise
     finally:
@@ -496,10 +495,8 @@ def _go_on(
     nsteps = _steps(traj.dt, float(traj.t[-1]), steps, t_end)
     save_every = positive_int("save_every", save_every)
     watched, specs = _events.specs(events, traj.model.dim) if events is not None else ([], [])
-    names = [o.name for o in _events.occurrences_of(watched)]
-    found = [len(o) for o in traj.events] if [o.name for o in traj.events] == names else [0] * len(names)
-    first_state = (np.asarray(x[:1]) for x in (traj.t, traj.q, traj.p))
-    initial = float(_core.energy_terms(traj.model._core, *first_state)[0][0]) if watched else None
+    found = _events.found_before(traj.events, watched)
+    initial = _events.first_energy(traj.model, traj) if watched else None
     return _run(
         None,
         traj.checkpoint,
@@ -599,14 +596,22 @@ def _run(
                 record = _core.resume(model._core, checkpoint, steps=nsteps, save_every=save_every, progress=shown, events=specs)
             bar.update(record.steps - base - bar.n)
         except BaseException as err:
-            partial = getattr(err, "_varmech_partial", None)
+            partial = take_partial(err)
             if partial is not None:
-                delattr(err, "_varmech_partial")
                 err.partial = _trajectory(partial, model, method, dt, watched, status=-1, message=str(err))  # type: ignore[attr-defined]
             raise
     finally:
         bar.close()
     return _trajectory(record, model, method, dt, watched)
+
+
+def take_partial(err: BaseException) -> _core.TrajectoryRecord | None:
+    """The binding's record of a failed run's states, taken off the exception it rides on
+    (``_varmech_partial``), to be given as ``err.partial`` in the user's terms."""
+    partial = getattr(err, "_varmech_partial", None)
+    if partial is not None:
+        delattr(err, "_varmech_partial")
+    return partial
 
 
 def _trajectory(

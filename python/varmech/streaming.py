@@ -22,12 +22,10 @@ from collections.abc import Callable, Iterator, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-import numpy as np
-
 from . import _core, files
 from . import events as _events
 from ._progress import progress_bar
-from .integrate import Trajectory, _steps
+from .integrate import Trajectory, _steps, take_partial
 from .model import Model
 
 if TYPE_CHECKING:
@@ -121,9 +119,8 @@ def stream(
             except BaseException as err:
                 # The segment's states and crossings up to the stop are committed; the file is
                 # closed below.
-                partial = getattr(err, "_varmech_partial", None)
+                partial = take_partial(err)
                 if partial is not None:
-                    delattr(err, "_varmech_partial")
                     with _uninterrupted():
                         writer.append(partial, skip_first=repeats, events=_events.occurrences(partial, watched))
                 raise
@@ -132,15 +129,14 @@ def stream(
             with _uninterrupted():
                 writer.append(record, skip_first=repeats, events=crossings)
             if watched and initial_energy is None:
-                initial_energy = float(_core.energy_terms(model._core, record.t[:1], record.q[:1], record.p[:1])[0][0])
+                initial_energy = _events.first_energy(model, record)
             found = [k + len(o) for k, o in zip(found, crossings)]
             checkpoint = record.checkpoint
             if record.terminated_by is not None:
                 i = record.terminated_by
                 last = crossings[i]
-                message = f"A termination event occurred: {last.name} (occurrence {found[i]}) at t = {last.t[-1]:.6g}."
                 with _uninterrupted():
-                    writer.close(1, message)
+                    writer.close(1, _events.termination_message(last, found[i]))
                 return
             done += take
             bar.update(record.steps - base - bar.n)
@@ -217,8 +213,8 @@ def resume(
     watched, specs = _events.specs(events, stored.model.dim) if events is not None else ([], [])
     names = [o.name for o in _events.occurrences_of(watched)]
     writer = files.Writer.reopen(Path(path), stored, names)
-    initial = float(_core.energy_terms(stored.model._core, *(np.asarray(x[:1]) for x in (stored.t, stored.q, stored.p)))[0][0])
-    counts = [len(o) for o in stored.events] if stored.events and watched else []
+    initial = _events.first_energy(stored.model, stored)
+    counts = _events.found_before(stored.events, watched)
     bar = progress_bar(total=more, unit="step", desc=stored.method, enabled=progress)
     try:
         stream(
