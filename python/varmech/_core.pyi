@@ -196,6 +196,9 @@ class MethodInfo:
     def h_omega_max(self) -> float: ...
     @property
     def reference(self) -> str: ...
+    @property
+    def splitting(self) -> tuple[list[float], list[float]] | None:
+        """The kick fractions a₀, …, aₛ and drift fractions b₁, …, bₛ of a kick–drift method."""
 
 @final
 class ModelKind:

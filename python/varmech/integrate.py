@@ -426,7 +426,7 @@ def integrate(
         ):
             if clash:
                 raise ValueError(f"contacts: not yet with {name}")
-        j, hits = _impacts.run(start, model, q, p, t0, dt, nsteps, list(contacts))
+        j, hits = _impacts.run(start, model, method, q, p, t0, dt, nsteps, list(contacts))
         work = j.work if model.forced else None
         return Trajectory(j.t, j.q, j.p, model, method, dt, j.steps, j.force_evaluations, j.newton, work, checkpoint=j.checkpoint, events=hits)
     if impulses is not None:

@@ -5,7 +5,7 @@ use numpy::PyReadonlyArray1;
 use pyo3::prelude::*;
 use varmech::diagnostics;
 use varmech::integrators::{
-    self, Checkpoint, Counting, Detector, EventSpec, Failure, Method, NewtonOptions, Options, Trajectory,
+    self, Checkpoint, Counting, Detector, EventSpec, Failure, Method, NewtonOptions, Options, Splitting, Trajectory,
 };
 use varmech::ModelError;
 
@@ -179,7 +179,8 @@ fn symplecticity_defect<'py>(
 /// and ``whc``) integrate the gravitational N-body problem, and only that (``h_omega_max`` is
 /// NaN for them). ``force_evaluations`` of the Wisdom–Holman methods counts the kicks of a step
 /// between synchronisations; ``whc``'s corrector adds 20 kicks at the start and at every saved
-/// state.
+/// state. ``splitting`` is (a₀, …, aₛ; b₁, …, bₛ), the kick and drift fractions of a kick–drift
+/// method, Ψ_h = φ^V_{aₛh} ∘ φ^T_{bₛh} ∘ … ∘ φ^T_{b₁h} ∘ φ^V_{a₀h}; None for the others.
 #[pyclass(frozen, get_all, module = "varmech._core")]
 pub struct MethodInfo {
     name: &'static str,
@@ -193,6 +194,7 @@ pub struct MethodInfo {
     symmetric: bool,
     h_omega_max: f64,
     reference: &'static str,
+    splitting: Option<(Vec<f64>, Vec<f64>)>,
 }
 
 impl From<integrators::MethodInfo> for MethodInfo {
@@ -209,6 +211,7 @@ impl From<integrators::MethodInfo> for MethodInfo {
             symmetric: i.symmetric,
             h_omega_max: i.h_omega_max,
             reference: i.reference,
+            splitting: Splitting::of(i.method).map(|s| (s.kicks().to_vec(), s.drifts().to_vec())),
         }
     }
 }
