@@ -5,7 +5,8 @@ docs/gallery/ (PNG) with its data (CSV).
 
 ``--only`` redraws the named charts alone (``--only work-precision:kepler``; a kind without a
 scene selects every chart of that kind). Needs the ``bench`` extra (matplotlib, scipy, rebound).
-Takes a few minutes; each chart's sweep shows a progress bar and Ctrl-C stops it.
+Takes a few minutes; each chart's sweep shows a progress bar and Ctrl-C stops it. The impact
+chart (``--only impacts``) races a rival that is no library code, so benches/impacts.py draws it.
 """
 
 from __future__ import annotations
@@ -13,6 +14,8 @@ from __future__ import annotations
 import argparse
 import time
 from pathlib import Path
+
+from impacts import billiard_chart
 
 from varmech.charts.recipes import KINDS, chart
 
@@ -32,6 +35,9 @@ GALLERY = [
     ("poincare", "henon_heiles", None),
     ("phase", "pendulum", None),
 ]
+#: (kind, scene, draw(out, quick) → paths): charts drawn by a bench script, for their rival is
+#: no library code (the naive "reflect at the end of the step" scheme).
+BENCHED = [("impacts", "billiard", billiard_chart)]
 
 
 def selected(kind: str, scene: str | None, only: list[str]) -> bool:
@@ -45,7 +51,7 @@ def main() -> None:
     parser.add_argument("--quick", action="store_true", help="the tour's short sweeps")
     parser.add_argument("--only", nargs="+", default=[], metavar="KIND[:SCENE]", help="redraw these charts alone")
     args = parser.parse_args()
-    known = {kind for kind, _, _ in GALLERY} | {f"{kind}:{scene}" for kind, scene, _ in GALLERY}
+    known = {kind for kind, _, _ in GALLERY + BENCHED} | {f"{kind}:{scene}" for kind, scene, _ in GALLERY + BENCHED}
     unknown = [name for name in args.only if name not in known]
     if unknown:
         parser.error(f"--only: no gallery chart {', '.join(unknown)}; choose from {', '.join(sorted(known))}")
@@ -54,10 +60,18 @@ def main() -> None:
         if not selected(kind, scene, args.only):
             continue
         start = time.perf_counter()
-        paths = chart(kind, scene, methods=methods, out=args.out, quick=args.quick, progress=True)
-        print(f"{kind} {scene or ''}: {time.perf_counter() - start:.1f} s")
-        for path in paths:
-            print(f"  wrote {path}")
+        report(kind, scene, start, chart(kind, scene, methods=methods, out=args.out, quick=args.quick, progress=True))
+    for kind, scene, draw in BENCHED:
+        if selected(kind, scene, args.only):
+            start = time.perf_counter()
+            report(kind, scene, start, draw(args.out, args.quick))
+
+
+def report(kind: str, scene: str | None, start: float, paths: list[Path]) -> None:
+    """Print a chart's time since ``start`` and the files it wrote."""
+    print(f"{kind} {scene or ''}: {time.perf_counter() - start:.1f} s")
+    for path in paths:
+        print(f"  wrote {path}")
 
 
 if __name__ == "__main__":
