@@ -76,6 +76,39 @@ def test_an_elastic_ball_under_the_variational_impact_keeps_a_bounded_energy_ove
     assert np.max(np.abs(hits.q)) < 1e-12
 
 
+@pytest.mark.parametrize("method", ["yoshida4", "suzuki4", "mclachlan4", "kahan_li6"])
+def test_a_composition_of_order_four_or_more_keeps_a_balls_energy_to_round_off_through_its_impacts(method):
+    # On a parabola a Verlet substep of γτ has E_d = H − g²γ²τ²/8, so a composition's
+    # E_d = Σγᵢ E_dᵢ = H − g²τ²Σγᵢ³/8, and Σγᵢ³ = 0 is an order condition of order 4: the discrete
+    # energy the VCI keeps is H itself.
+    t1 = math.sqrt(2 / G)
+    steps = round(2000 * t1 / 1e-2)
+    traj = varmech.integrate(_ball(), [1.0], [0.0], dt=1e-2, steps=steps, save_every=10**9, method=method, contacts=[varmech.Contact.wall(0)])
+    hits = traj.events[0]
+    assert len(hits) == 1000
+    assert np.max(np.abs(0.5 * hits.p[:, 0] ** 2 - G)) < 1e-12 * G
+    assert np.max(np.abs(hits.t - t1 * (2 * np.arange(1000) + 1))) < 1e-9
+
+
+@pytest.mark.parametrize(("method", "order", "steps"), [("verlet", 2, (40, 80, 160)), ("yoshida4", 4, (10, 20, 40)), ("kahan_li6", 6, (5, 10, 20))])
+def test_the_methods_order_survives_an_impact(method, order, steps):
+    # Dropped from rest at y = 1 onto a spring floor force, ÿ = −g − κy: y = −g/κ + (1 + g/κ)cos ωt
+    # meets the floor at t = arccos(g/(g + κ))/ω. With the impact at the fraction 0.3 of every
+    # run's step, H just after it errs at the method's order (E_d − H = O(h^r) on each side).
+    kappa = 4.0
+    model = varmech.MechanicalSystem(1, lambda q: G * q[0] + 0.5 * kappa * q[0] ** 2, lambda q: np.array([G + kappa * q[0]]))
+    t_hit = math.acos(G / (G + kappa)) / math.sqrt(kappa)
+    errors = []
+    for m in steps:
+        dt = t_hit / (m + 0.3)
+        traj = varmech.integrate(model, [1.0], [0.0], dt=dt, steps=m + 3, method=method, contacts=[varmech.Contact.wall(0)], max_energy_error=None)
+        assert len(traj.events[0]) == 1
+        q, p = traj.q[-1, 0], traj.p[-1, 0]
+        errors.append(abs(0.5 * p * p + G * q + 0.5 * kappa * q * q - (G + 0.5 * kappa)))
+    orders = np.log2(np.array(errors[:-1]) / errors[1:])
+    assert abs(orders[-1] - order) < 0.5, (errors, orders)
+
+
 def test_an_elastic_balls_bounce_times_converge_at_order_two_under_a_varying_force():
     # A spring floor force makes the flight non-parabolic: V = gy + ½κy², no closed form; the
     # time of the fifth impact converges at Verlet's order against a fine run. With the exact
