@@ -104,3 +104,31 @@ fn directions_keep_their_crossings_and_a_count_terminal_stops_after_its_step() {
     assert_eq!(plain.q, traj.q);
     assert_eq!(plain.p, traj.p);
 }
+
+#[test]
+fn each_crossing_carries_the_state_at_the_start_of_its_step() {
+    // The start of the partial step located, for the implicit midpoint rule too: the saved state
+    // of the step before, bit for bit (every step saved).
+    let sys = HarmonicOscillator::new(1.0).unwrap();
+    for method in [Method::Verlet, Method::Midpoint] {
+        let options = Options::new(0.1, 200);
+        let crossing = vec![NativeEvent::Crossing {
+            coordinate: 0,
+            value: 0.0,
+        }];
+        let spec = EventSpec {
+            name: "q0 = 0".into(),
+            direction: 0,
+            terminal: 0,
+        };
+        let mut detector = Detector::new(Box::new(crossing), vec![spec]).unwrap();
+        let traj = integrate_with_events(&sys, method, &[1.0], &[0.0], &options, || Ok(()), &mut detector).unwrap();
+        assert_eq!(traj.events.len(), 6, "{method:?}");
+        for e in &traj.events {
+            let k = e.step - 1;
+            assert_eq!(e.q_start, traj.q[k..k + 1], "{method:?} step {}", e.step);
+            assert_eq!(e.p_start, traj.p[k..k + 1], "{method:?} step {}", e.step);
+            assert!(traj.t[k] < e.t && e.t <= traj.t[k + 1]);
+        }
+    }
+}
