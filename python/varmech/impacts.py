@@ -16,7 +16,9 @@ time tₙ₊₁. The contact's ``law`` fixes λ:
   moves by O(h²) at an impact and stays bounded over many. The two-point rules replay the
   core's own partial steps (:class:`TwoPoint`) from the start of the crossing step, which each
   located crossing carries; they need a conservative, autonomous, unconstrained model (the
-  energy balance is E_d's alone).
+  energy balance is E_d's alone). Their E_d takes the velocities from the momenta, so an impact
+  at a fraction α = 1e-9 or 1 − 1e-9 of a step keeps H's jump to round-off (position differences
+  would lose all but τ|v|/|q| of the digits).
 - ``"reflect"`` (any method): the exact reflection in the metric of the kinetic energy,
 
       p⁺ = p⁻ − (1 + e) (∇φ·q̇⁻) / (∇φᵀM⁻¹∇φ) ∇φ,
