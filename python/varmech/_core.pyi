@@ -115,8 +115,9 @@ class TrajectoryRecord:
     @property
     def checkpoint(self) -> bytes: ...
     @property
-    def events(self) -> tuple[NDArray[np.uint64], _FloatArray, _FloatArray, _FloatArray]:
-        """The located event crossings in order of time: the event's index (k,), t (k,), q and p (k, n)."""
+    def events(self) -> tuple[NDArray[np.uint64], _FloatArray, _FloatArray, _FloatArray, _FloatArray, _FloatArray]:
+        """The located event crossings in order of time: the event's index (k,), t (k,), q and p
+        (k, n), and the state (q, p) at the start of each one's step (k, n)."""
     @property
     def terminated_by(self) -> int | None:
         """The index of the event whose terminal count stopped the run, if one did."""

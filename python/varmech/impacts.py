@@ -6,12 +6,19 @@ from (qₙ, pₙ) to the contact configuration q̃ on φ = 0 (α found to round-
 search), the jump p⁺ = p⁻ + λ∇φ(q̃), and the method's partial step of size (1 − α)h to the grid
 time tₙ₊₁. The contact's ``law`` fixes λ:
 
-- ``"variational"`` (the default; kick–drift methods, ``MethodInfo.splitting``): the variational
-  collision integrator of Fetecau, Marsden, Ortiz & West (2003), :func:`collide`. The discrete
-  energy E_d = −∂L_d/∂τ is the same on both sides of the impact, which makes the action of the
-  two partial steps stationary in the contact point and the fraction, so **the step across an
-  impact is symplectic** (measured defect ≤ 1e-9, round-off of the differences, for every
-  kick–drift method). H itself moves by O(h²) at an impact and stays bounded over many.
+- ``"variational"`` (the default; kick–drift methods, ``MethodInfo.splitting``, and the implicit
+  two-point rules ``midpoint`` and ``trapezoid``): the variational collision integrator of
+  Fetecau, Marsden, Ortiz & West (2003), :func:`collide`. The discrete energy E_d = −∂L_d/∂τ is
+  the same on both sides of the impact, which makes the action of the two partial steps
+  stationary in the contact point and the fraction, so **the step across an impact is
+  symplectic** (measured defect ≤ 1e-9, round-off of the differences, for every kick–drift
+  method, and for midpoint and trapezoid on separable and on natural systems M(q)). H itself
+  moves by O(h²) at an impact and stays bounded over many. The two-point rules replay the
+  core's own partial steps (:class:`TwoPoint`) from the start of the crossing step, which each
+  located crossing carries; they need a conservative, autonomous, unconstrained model (the
+  energy balance is E_d's alone). Their E_d takes the velocities from the momenta, so an impact
+  at a fraction α = 1e-9 or 1 − 1e-9 of a step keeps H's jump to round-off (position differences
+  would lose all but τ|v|/|q| of the digits).
 - ``"reflect"`` (any method): the exact reflection in the metric of the kinetic energy,
 
       p⁺ = p⁻ − (1 + e) (∇φ·q̇⁻) / (∇φᵀM⁻¹∇φ) ∇φ,
@@ -34,8 +41,10 @@ impacts.
 from __future__ import annotations
 
 import warnings
+from abc import ABC, abstractmethod
 from collections.abc import Callable
 from dataclasses import dataclass
+from functools import partial
 from typing import Any, Literal
 
 import numpy as np
@@ -71,8 +80,9 @@ class Contact:
     #: The coordinate k and value c of a wall q_k ≥ c, watched natively (see :meth:`wall`).
     coordinate: tuple[int, float] | None = None
     #: The impact law: ``"variational"``, the variational collision integrator (:func:`collide`;
-    #: kick–drift methods), or ``"reflect"``, the exact reflection of the momenta between the
-    #: method's partial steps (any method; symplectic across an impact only to the method's order).
+    #: kick–drift methods and the two-point rules ``midpoint`` and ``trapezoid``), or
+    #: ``"reflect"``, the exact reflection of the momenta between the method's partial steps (any
+    #: method; symplectic across an impact only to the method's order).
     law: Literal["variational", "reflect"] = "variational"
 
     def __post_init__(self) -> None:
@@ -122,7 +132,27 @@ def reflect(model: Model, contact: Contact, q: np.ndarray, p: np.ndarray, t: flo
     return np.asarray(p - (1.0 + contact.restitution) * (normal @ v) / (normal @ minv @ normal) * normal)
 
 
-class Splitting:
+class Flow(ABC):
+    """A method's step of any size τ from a state, replayed at time t for an impact, with the
+    discrete energy E_d = −∂L_d/∂τ of the step (``forward``) and the force evaluations made."""
+
+    def __init__(self, model: Model, t: float) -> None:
+        self.model, self.t = model, t
+        self.evaluations = 0
+
+    def _calls(self, what: str, q: np.ndarray, x: np.ndarray) -> np.ndarray:
+        """``_core.derivative`` ``what`` at the states (q, x), rows, at time t."""
+        return np.asarray(_core.derivative(self.model._core, what, np.full(len(q), self.t), q, x))
+
+    def _call(self, what: str, q: np.ndarray, x: np.ndarray) -> np.ndarray:
+        return self._calls(what, q[None, :], x[None, :])[0]
+
+    @abstractmethod
+    def forward(self, q: np.ndarray, p: np.ndarray, tau: float) -> tuple[np.ndarray, np.ndarray, float]:
+        """Ψ_τ(q, p) and E_d of that step."""
+
+
+class Splitting(Flow):
     """A kick–drift method's step of any size τ replayed from its fractions (``MethodInfo.splitting``),
     forward or undone, with its discrete energy: the step's discrete Lagrangian is
 
@@ -135,11 +165,8 @@ class Splitting:
     with pᵢ the momenta of the i-th drift (for Verlet, T(p_½) + ½(V(q₀) + V(q₁)))."""
 
     def __init__(self, model: Model, kicks: list[float], drifts: list[float], t: float) -> None:
-        self.model, self.kicks, self.drifts, self.t = model, kicks, drifts, t
-        self.evaluations = 0
-
-    def _call(self, what: str, q: np.ndarray, x: np.ndarray) -> np.ndarray:
-        return np.asarray(_core.derivative(self.model._core, what, np.array([self.t]), q[None, :], x[None, :])[0])
+        super().__init__(model, t)
+        self.kicks, self.drifts = kicks, drifts
 
     def _force(self, q: np.ndarray) -> np.ndarray:
         self.evaluations += 1
@@ -186,12 +213,101 @@ class Splitting:
         return self._energy(kinetic, points)
 
 
+#: The implicit two-point rules whose impacts the variational collision integrator takes (:class:`TwoPoint`).
+TWO_POINT = ("midpoint", "trapezoid")
+
+
+class TwoPoint(Flow):
+    """An implicit two-point rule's step of any size τ (``midpoint``, ``trapezoid``), the core's
+    own (its :class:`varmech._core.Stepper` from a run's checkpoint), with its discrete energy
+    E_d = −∂L_d/∂τ at fixed ends, for an autonomous L. With v = (q₁ − q₀)/τ and the energy
+    function E(q, v) = v·∂L/∂q̇ − L:
+
+    - midpoint, L_d = τL(q̄, v) at q̄ = (q₀ + q₁)/2: E_d = E(q̄, v). Its momenta
+      p₀,₁ = ∂L/∂q̇ ∓ (τ/2)∂L/∂q (at q̄, v) have the half-sum p̄ = ∂L/∂q̇(q̄, v), so
+      E_d = H(q̄, p̄), the Hamiltonian at the mean of the two states;
+    - trapezoid, L_d = (τ/2)[L(q₀, v) + L(q₁, v)]: E_d = ½[E(q₀, v) + E(q₁, v)], with v solved
+      from the half-sum of its momenta, ½[∂L/∂q̇(q₀, v) + ∂L/∂q̇(q₁, v)] = p̄ + (τ/4)[∂L/∂q(q₀, v)
+      − ∂L/∂q(q₁, v)] (by the inverse Legendre map at q̄, iterated: a contraction by O(τ‖q₁ − q₀‖)
+      and O(‖q₁ − q₀‖²); one pass for a constant mass).
+
+    v comes from the momenta, not from (q₁ − q₀)/τ: the core steps δq = τv itself, and a
+    difference of the saved positions keeps only a fraction τ‖v‖/‖q‖ of the digits of v, none as
+    τ → 0 (an impact at a fraction α or 1 − α of the step near 0).
+
+    Examples
+    --------
+    The ball's midpoint step is exact on its parabola, and E_d = H − g²τ²/8:
+
+    >>> import numpy as np, varmech
+    >>> ball = varmech.MechanicalSystem(1, lambda q: 9.81 * q[0], lambda q: np.array([9.81]))
+    >>> stepper = varmech._core.Stepper(ball._core, np.array([1.0]), np.array([0.0]), dt=0.1, method="midpoint")
+    >>> flow = TwoPoint(ball, stepper.checkpoint(), 0.0)
+    >>> q1, p1, energy = flow.forward(np.array([1.0]), np.array([0.0]), 0.1)
+    >>> bool(abs(energy - (9.81 - 9.81**2 * 0.1**2 / 8)) < 1e-14)
+    True
+    """
+
+    def __init__(self, model: Model, checkpoint: bytes, t: float) -> None:
+        super().__init__(model, t)
+        self.stepper = _core.Stepper.from_checkpoint(model._core, checkpoint)
+        self.rule = self.stepper.method
+        if self.rule not in TWO_POINT:
+            raise ValueError(f"method: the two-point rules are {TWO_POINT}, not {self.rule!r}")
+
+    def forward(self, q: np.ndarray, p: np.ndarray, tau: float) -> tuple[np.ndarray, np.ndarray, float]:
+        """Ψ_τ(q, p), the core's step, and E_d of that step (of H(q, p) for τ = 0)."""
+        q1, p1 = q, p
+        if tau > 0.0:
+            s = self.stepper
+            counted = s.force_evaluations
+            s.reset(q, p, self.t)
+            s.dt = tau
+            s.step()
+            self.evaluations += s.force_evaluations - counted
+            q1, p1 = np.asarray(s.q), np.asarray(s.p)
+        return q1, p1, self.energy(q, p, q1, p1, tau)
+
+    def energy(self, q0: np.ndarray, p0: np.ndarray, q1: np.ndarray, p1: np.ndarray, tau: float) -> float:
+        """E_d of the rule's step of size τ from (q0, p0) to (q1, p1)."""
+        mean, p = 0.5 * (q0 + q1), 0.5 * (p0 + p1)
+        if self.rule == "midpoint":
+            return float(self._hamiltonian(mean[None, :], p[None, :])[0])
+        ends = np.stack([q0, q1])
+        v, step = self._call("velocity", mean, p), np.inf
+        for _ in range(50):
+            both = np.stack([v, v])
+            momenta = self._calls("momentum", ends, both)
+            forces = self._calls("dl_dq", ends, both)
+            self.evaluations += 2
+            shift = 0.25 * tau * (forces[0] - forces[1]) + self._call("momentum", mean, v) - momenta.mean(axis=0)
+            new = self._call("velocity", mean, p + shift)
+            last, step = step, float(np.max(np.abs(new - v)))
+            v = new
+            # Converged to round-off: no change, or no more progress.
+            if step == 0.0 or step >= last:
+                break
+        both = np.stack([v, v])
+        return float(self._hamiltonian(ends, self._calls("momentum", ends, both)).mean())
+
+    def _hamiltonian(self, q: np.ndarray, p: np.ndarray) -> np.ndarray:
+        """E = p·q̇ − L at each state (q, p)."""
+        return np.asarray(_core.energy_terms(self.model._core, np.full(len(q), self.t), q, p)[0])
+
+
 def collide(
-    flows: Splitting, normal: np.ndarray, q: np.ndarray, p: np.ndarray, before: float, after: float, restitution: float
+    flows: Flow,
+    normal: np.ndarray,
+    q: np.ndarray,
+    p: np.ndarray,
+    first: Callable[[], float],
+    after: float,
+    restitution: float,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, bool]:
     """The step through an impact at the contact configuration q on φ = 0, reached with momenta p
-    by a step of ``before`` from the grid state, with ``after`` left to the next grid time: the
-    momenta just after, p⁺ = p + λ∇φ, and the state at the grid time Ψ_after(q, p⁺).
+    by the method's partial step from the grid state, whose discrete energy is ``first()``
+    (called for e = 1 only), with ``after`` left to the next grid time: the momenta just after,
+    p⁺ = p + λ∇φ, and the state at the grid time Ψ_after(q, p⁺) of ``flows``.
 
     Elastic (e = 1): the variational collision integrator (Fetecau, Marsden, Ortiz & West 2003).
     The contact point and the fraction of the step make the action of the two partial steps
@@ -215,14 +331,18 @@ def collide(
     if restitution < 1.0:
         q1, p1, _ = state(exact)
         return p + exact * normal, q1, p1, True
-    target = flows.undone(q, p, before)
+    target = first()
+    # The round-off of the energies: an implicit rule's E_d(λ), from a Newton solve, can stall
+    # a few ulps from the root, where the secant sees no slope.
+    eps = np.finfo(float).eps
+    noise = 16.0 * eps * (abs(target) + abs(float(p @ v)))
     lam0, lam1 = exact, exact * (1.0 + 1e-6)
     f0 = state(lam0)[2] - target
     found = None
     for _ in range(40):
         q1, p1, e1 = state(lam1)
         f1 = e1 - target
-        if f1 == 0.0 or abs(lam1 - lam0) <= 4.0 * np.finfo(float).eps * abs(lam1):
+        if f1 == 0.0 or abs(lam1 - lam0) <= 4.0 * eps * abs(lam1) or (f1 == f0 and abs(f1) <= noise):
             found = (lam1, q1, p1)
             break
         if f1 == f0 or not np.isfinite(f1):
@@ -277,15 +397,23 @@ def run(
 ) -> tuple[Joined, tuple[_events.Occurrences, ...]]:
     """A run of ``steps`` steps of ``dt`` of ``method`` from (t0, q0, p0) through the impacts on
     ``contacts`` (``start(q, p, t0, steps, progress, events)`` runs a piece up to the first
-    impact), and the impacts of each contact. A kick–drift method goes through each impact by
-    :func:`collide`; the others reflect the momenta (:func:`reflect`) between their own partial
-    steps."""
+    impact), and the impacts of each contact. Under the variational law a kick–drift method
+    (:class:`Splitting`) or a two-point rule (:class:`TwoPoint`) goes through each impact by
+    :func:`collide`; under ``"reflect"`` the momenta are reflected (:func:`reflect`) between the
+    method's own partial steps."""
     split = method_info(method).splitting
     for i, c in enumerate(contacts):
-        if isinstance(c, Contact) and c.law == "variational" and split is None:
+        if not (isinstance(c, Contact) and c.law == "variational"):
+            continue
+        if split is None and method not in TWO_POINT:
             raise ValueError(
-                f"contacts[{i}]: the variational collision integrator needs a kick–drift method, not {method!r};"
-                " give the contact law='reflect' or use such a method (MethodInfo.splitting)"
+                f"contacts[{i}]: the variational collision integrator needs a kick–drift method (MethodInfo.splitting)"
+                f" or a two-point rule {TWO_POINT}, not {method!r}; give the contact law='reflect' or use such a method"
+            )
+        if model.forced or model.time_dependent or model.constraints:
+            raise ValueError(
+                f"contacts[{i}]: the variational collision integrator keeps the discrete energy, which needs a"
+                " conservative, autonomous, unconstrained model; give the contact law='reflect'"
             )
     specs = check(model, contacts, q0)
     grazing = 0
@@ -302,18 +430,25 @@ def run(
             break
         # The step of the impact ends past the surface: its saved end is replaced.
         pieces.add(record, drop_last=True)
-        index, te, qe, pe = record.events
+        index, te, qe, pe, q_start, p_start = record.events
         k = int(np.flatnonzero(index == i)[-1])
         t_hit, q_hit, p_hit = float(te[k]), np.asarray(qe[k]), np.asarray(pe[k])
         hits[i].append((t_hit, q_hit, p_hit))
         done += record.steps
         t_grid = t0 + done * dt
         if contacts[i].law == "variational":
-            assert split is not None
-            flows = Splitting(model, *split, t_hit)
             normal = np.asarray(contacts[i].gradient(q_hit.copy()), dtype=float).reshape(-1)
             before = t_hit - (t_grid - dt)
-            p_after, q, p, ok = collide(flows, normal, q_hit, p_hit, before, dt - before, contacts[i].restitution)
+            # The first partial step's E_d: a splitting's undone from its end, a two-point
+            # rule's from both ends (the crossing carries the state its step started from).
+            flows: Flow
+            if split is not None:
+                flows = Splitting(model, *split, t_hit)
+                first = partial(flows.undone, q_hit, p_hit, before)
+            else:
+                flows = TwoPoint(model, record.checkpoint, t_hit)
+                first = partial(flows.energy, np.asarray(q_start[k]), np.asarray(p_start[k]), q_hit, p_hit, before)
+            p_after, q, p, ok = collide(flows, normal, q_hit, p_hit, first, dt - before, contacts[i].restitution)
             grazing += not ok
             pieces.nfev += flows.evaluations
         else:

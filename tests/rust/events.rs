@@ -24,11 +24,8 @@ fn illinois_finds_a_root_to_round_off_in_few_evaluations() {
     assert_eq!(failing, Err("model failed"));
 }
 
-/// The crossings of q = 0 of q = cos t (ω = 1 from q = 1, p = 0) with `method` at step h over
-/// t ∈ [0, 20]: the largest error of the located times against (k + ½)π.
-fn crossing_error(method: Method, h: f64, direction: i8) -> (usize, f64) {
-    let sys = HarmonicOscillator::new(1.0).unwrap();
-    let options = Options::new(h, (20.0 / h).round() as usize);
+/// The detector of q₀ = 0 crossed in `direction`, terminal after `terminal` crossings (0: never).
+fn crossing(direction: i8, terminal: usize) -> Detector<'static> {
     let crossing = vec![NativeEvent::Crossing {
         coordinate: 0,
         value: 0.0,
@@ -36,9 +33,17 @@ fn crossing_error(method: Method, h: f64, direction: i8) -> (usize, f64) {
     let spec = EventSpec {
         name: "q0 = 0".into(),
         direction,
-        terminal: 0,
+        terminal,
     };
-    let mut detector = Detector::new(Box::new(crossing), vec![spec]).unwrap();
+    Detector::new(Box::new(crossing), vec![spec]).unwrap()
+}
+
+/// The crossings of q = 0 of q = cos t (ω = 1 from q = 1, p = 0) with `method` at step h over
+/// t ∈ [0, 20]: the largest error of the located times against (k + ½)π.
+fn crossing_error(method: Method, h: f64, direction: i8) -> (usize, f64) {
+    let sys = HarmonicOscillator::new(1.0).unwrap();
+    let options = Options::new(h, (20.0 / h).round() as usize);
+    let mut detector = crossing(direction, 0);
     let traj = integrate_with_events(&sys, method, &[1.0], &[0.0], &options, || Ok(()), &mut detector).unwrap();
     let worst = traj.events.iter().fold(0.0_f64, |m, e| {
         // Downward crossings at (2j + ½)π, upward at (2j + 3/2)π.
@@ -73,16 +78,7 @@ fn directions_keep_their_crossings_and_a_count_terminal_stops_after_its_step() {
 
     let sys = HarmonicOscillator::new(1.0).unwrap();
     let options = Options::new(0.01, 2000);
-    let crossing = vec![NativeEvent::Crossing {
-        coordinate: 0,
-        value: 0.0,
-    }];
-    let spec = EventSpec {
-        name: "q0 = 0".into(),
-        direction: 0,
-        terminal: 3,
-    };
-    let mut detector = Detector::new(Box::new(crossing), vec![spec]).unwrap();
+    let mut detector = crossing(0, 3);
     let traj = integrate_with_events(&sys, Method::Verlet, &[1.0], &[0.0], &options, || Ok(()), &mut detector).unwrap();
     assert_eq!(traj.events.len(), 3);
     assert_eq!(traj.terminated_by, Some(0));
@@ -103,4 +99,23 @@ fn directions_keep_their_crossings_and_a_count_terminal_stops_after_its_step() {
     .unwrap();
     assert_eq!(plain.q, traj.q);
     assert_eq!(plain.p, traj.p);
+}
+
+#[test]
+fn each_crossing_carries_the_state_at_the_start_of_its_step() {
+    // The start of the partial step located, for the implicit midpoint rule too: the saved state
+    // of the step before, bit for bit (every step saved).
+    let sys = HarmonicOscillator::new(1.0).unwrap();
+    for method in [Method::Verlet, Method::Midpoint] {
+        let options = Options::new(0.1, 200);
+        let mut detector = crossing(0, 0);
+        let traj = integrate_with_events(&sys, method, &[1.0], &[0.0], &options, || Ok(()), &mut detector).unwrap();
+        assert_eq!(traj.events.len(), 6, "{method:?}");
+        for e in &traj.events {
+            let k = e.step - 1;
+            assert_eq!(e.q_start, traj.q[k..k + 1], "{method:?} step {}", e.step);
+            assert_eq!(e.p_start, traj.p[k..k + 1], "{method:?} step {}", e.step);
+            assert!(traj.t[k] < e.t && e.t <= traj.t[k + 1]);
+        }
+    }
 }

@@ -31,7 +31,7 @@ pub struct TrajectoryRecord {
     #[pyo3(get)]
     checkpoint: Py<PyBytes>,
     /// The located event crossings in order of time: the event's index (k,), t (k,), q and p
-    /// (k, n).
+    /// (k, n), and the state (q, p) at the start of each one's step (k, n).
     #[pyo3(get)]
     events: EventArrays,
     /// The index of the event whose terminal count stopped the run, if one did.
@@ -39,10 +39,13 @@ pub struct TrajectoryRecord {
     terminated_by: Option<usize>,
 }
 
-/// Event crossings as arrays: the event's index (k,), t (k,), q and p (k, n).
+/// Event crossings as arrays: the event's index (k,), t (k,), q and p (k, n), and the start of
+/// each one's step, q and p (k, n).
 type EventArrays = (
     Py<PyArray1<usize>>,
     Py<PyArray1<f64>>,
+    Py<PyArray2<f64>>,
+    Py<PyArray2<f64>>,
     Py<PyArray2<f64>>,
     Py<PyArray2<f64>>,
 );
@@ -56,17 +59,22 @@ impl TrajectoryRecord {
     pub fn new(py: Python<'_>, traj: Trajectory) -> PyResult<Self> {
         let n = traj.dim;
         let (mut index, mut t, mut q, mut p) = (vec![], vec![], vec![], vec![]);
+        let (mut q_start, mut p_start) = (vec![], vec![]);
         for e in traj.events {
             index.push(e.event);
             t.push(e.t);
             q.extend(e.q);
             p.extend(e.p);
+            q_start.extend(e.q_start);
+            p_start.extend(e.p_start);
         }
         let events = (
             PyArray1::from_vec(py, index).unbind(),
             PyArray1::from_vec(py, t).unbind(),
             matrix(py, q, n)?.unbind(),
             matrix(py, p, n)?.unbind(),
+            matrix(py, q_start, n)?.unbind(),
+            matrix(py, p_start, n)?.unbind(),
         );
         Ok(TrajectoryRecord {
             t: PyArray1::from_vec(py, traj.t).unbind(),

@@ -165,6 +165,8 @@ impl<M: Deref<Target: Dynamics>> Search<'_, '_, M> {
             t: self.t + tau,
             q: self.scratch.q().to_vec(),
             p: self.scratch.p().to_vec(),
+            q_start: self.q.clone(),
+            p_start: self.p.clone(),
         })
     }
 

@@ -60,7 +60,12 @@ pub struct EventSpec {
 
 /// A located crossing of event `event`, during step `step` (counted from 1): the state
 /// (t, q, p) of one step of size τ = t − tₙ₋₁ ∈ (0, h] of the run's method from the state
-/// before the step, with gₑᵥₑₙₜ = 0 to round-off.
+/// (q_start, p_start) before the step, with gₑᵥₑₙₜ = 0 to round-off.
+///
+/// The start is kept because a run stopped by a terminal event ends after the step of the
+/// crossing, and the partial step (q_start, p_start) → (q, p) is then known whole only here: an
+/// impact's variational collision integrator needs the discrete energy of that partial step,
+/// which for an implicit rule cannot be had from its end alone without solving it backwards.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Occurrence {
     pub event: usize,
@@ -68,4 +73,6 @@ pub struct Occurrence {
     pub t: f64,
     pub q: Vec<f64>,
     pub p: Vec<f64>,
+    pub q_start: Vec<f64>,
+    pub p_start: Vec<f64>,
 }
