@@ -42,7 +42,7 @@ from .conservation import ConservationReport, InvariantStatistics, check_conserv
 from .constraints import project
 from .derivatives import DerivativeCheck, check_derivatives
 from .files import load
-from .impacts import Contact
+from .impacts import Contact, ContactError
 from .impulses import Engagement, Impulse, ImpulseResponse, engage, impulse_response
 from .integrate import Trajectory, integrate, symplecticity_defect
 from .methods import MethodInfo, methods
@@ -57,6 +57,7 @@ __version__ = "0.1.0"
 __all__ = [
     "ConservationReport",
     "Contact",
+    "ContactError",
     "ConvergenceError",
     "Cyclic",
     "DerivativeCheck",

@@ -8,7 +8,7 @@ time tₙ₊₁. The contact's ``law`` fixes λ:
 
 - ``"variational"`` (the default; kick–drift methods, ``MethodInfo.splitting``, and the implicit
   two-point rules ``midpoint`` and ``trapezoid``): the variational collision integrator of
-  Fetecau, Marsden, Ortiz & West (2003), :func:`collide`. The discrete energy E_d = −∂L_d/∂τ is
+  Fetecau, Marsden, Ortiz & West (2003), :func:`variational_jump`. The discrete energy E_d = −∂L_d/∂τ is
   the same on both sides of the impact, which makes the action of the two partial steps
   stationary in the contact point and the fraction, so **the step across an impact is
   symplectic** (measured defect ≤ 1e-9, round-off of the differences, for every kick–drift
@@ -33,9 +33,15 @@ variational law's elastic limit differs from it by O(h²)). The impacts are the 
 occurrences in ``traj.events`` (time, contact configuration, momenta just before), and the saved
 states hold the state just before and just after each impact (one time, two rows).
 
-Only the first contact crossed in a step is handled in that step, and a second crossing inside
-the rest of the step, (1 − α)h, is not looked for: steps must be short against the time between
-impacts.
+After a jump the rest of the step is checked against every contact: one crossed before its end
+(a corner, or a ball's next bounce within the step) is located on that piece (:func:`crossing`)
+and taken in turn (:func:`through`), up to :data:`MAX_IMPACTS` in one step. Under the variational
+law each jump keeps E_d equal across it, piece by piece, so the step stays symplectic. A body
+that cannot leave a surface (a resting contact: e = 0 under a force pressing it on, or a ball
+whose bounces accumulate) raises :class:`ContactError` with the step, the time and the run up to
+that step. A piece is checked at its end only: a contact entered and left again within one piece
+is missed, so steps must be short against the time a body spends beyond a curved surface's
+chord.
 """
 
 from __future__ import annotations
@@ -52,7 +58,7 @@ from numpy.typing import ArrayLike
 
 from . import _core
 from . import events as _events
-from .impulses import Joined, Pieces, inverse_mass
+from .impulses import Joined, Pieces, _velocity
 from .methods import method_info
 from .model import Model
 
@@ -123,13 +129,18 @@ class Contact:
         return cls(phi, gradient, restitution, label, (int(k), float(value)), law)
 
 
+def exact_jump(model: Model, t: float, normal: np.ndarray, q: np.ndarray, p: np.ndarray, restitution: float) -> float:
+    """λ of the exact reflection p⁺ = p + λ∇φ in the metric of the kinetic energy:
+    λ = −(1 + e)(∇φ·q̇)/(∇φᵀM⁻¹∇φ), so the normal velocity goes to −e times itself."""
+    metric = _velocity(model, q, normal, t) - _velocity(model, q, np.zeros_like(p), t)
+    return -(1.0 + restitution) * float(normal @ _velocity(model, q, p, t)) / float(normal @ metric)
+
+
 def reflect(model: Model, contact: Contact, q: np.ndarray, p: np.ndarray, t: float) -> np.ndarray:
     """The momenta just after an impact on ``contact`` at (q, p): the normal velocity reversed and
-    scaled by e, in the metric of the kinetic energy."""
+    scaled by e, in the metric of the kinetic energy (:func:`exact_jump`)."""
     normal = np.asarray(contact.gradient(q.copy()), dtype=float).reshape(-1)
-    minv = inverse_mass(model, q, t)
-    v = np.asarray(_core.derivative(model._core, "velocity", np.array([t]), q[None, :], p[None, :])[0])
-    return np.asarray(p - (1.0 + contact.restitution) * (normal @ v) / (normal @ minv @ normal) * normal)
+    return np.asarray(p + exact_jump(model, t, normal, q, p, contact.restitution) * normal)
 
 
 class Flow(ABC):
@@ -217,7 +228,33 @@ class Splitting(Flow):
 TWO_POINT = ("midpoint", "trapezoid")
 
 
-class TwoPoint(Flow):
+class CoreStep(Flow):
+    """Any method's step of size τ, the core's own: its :class:`varmech._core.Stepper` from a run's
+    checkpoint (``law="reflect"``). It has no discrete energy here (NaN)."""
+
+    def __init__(self, model: Model, checkpoint: bytes, t: float) -> None:
+        super().__init__(model, t)
+        self.stepper = _core.Stepper.from_checkpoint(model._core, checkpoint)
+
+    def forward(self, q: np.ndarray, p: np.ndarray, tau: float) -> tuple[np.ndarray, np.ndarray, float]:
+        """Ψ_τ(q, p), the core's step, and E_d of that step (of H(q, p) for τ = 0)."""
+        q1, p1 = q, p
+        if tau > 0.0:
+            s = self.stepper
+            counted = s.force_evaluations
+            s.reset(q, p, self.t)
+            s.dt = tau
+            s.step()
+            self.evaluations += s.force_evaluations - counted
+            q1, p1 = np.asarray(s.q), np.asarray(s.p)
+        return q1, p1, self.energy(q, p, q1, p1, tau)
+
+    def energy(self, q0: np.ndarray, p0: np.ndarray, q1: np.ndarray, p1: np.ndarray, tau: float) -> float:
+        """E_d of the step of size τ from (q0, p0) to (q1, p1): none for a method in general."""
+        return float("nan")
+
+
+class TwoPoint(CoreStep):
     """An implicit two-point rule's step of any size τ (``midpoint``, ``trapezoid``), the core's
     own (its :class:`varmech._core.Stepper` from a run's checkpoint), with its discrete energy
     E_d = −∂L_d/∂τ at fixed ends, for an autonomous L. With v = (q₁ − q₀)/τ and the energy
@@ -249,24 +286,10 @@ class TwoPoint(Flow):
     """
 
     def __init__(self, model: Model, checkpoint: bytes, t: float) -> None:
-        super().__init__(model, t)
-        self.stepper = _core.Stepper.from_checkpoint(model._core, checkpoint)
+        super().__init__(model, checkpoint, t)
         self.rule = self.stepper.method
         if self.rule not in TWO_POINT:
             raise ValueError(f"method: the two-point rules are {TWO_POINT}, not {self.rule!r}")
-
-    def forward(self, q: np.ndarray, p: np.ndarray, tau: float) -> tuple[np.ndarray, np.ndarray, float]:
-        """Ψ_τ(q, p), the core's step, and E_d of that step (of H(q, p) for τ = 0)."""
-        q1, p1 = q, p
-        if tau > 0.0:
-            s = self.stepper
-            counted = s.force_evaluations
-            s.reset(q, p, self.t)
-            s.dt = tau
-            s.step()
-            self.evaluations += s.force_evaluations - counted
-            q1, p1 = np.asarray(s.q), np.asarray(s.p)
-        return q1, p1, self.energy(q, p, q1, p1, tau)
 
     def energy(self, q0: np.ndarray, p0: np.ndarray, q1: np.ndarray, p1: np.ndarray, tau: float) -> float:
         """E_d of the rule's step of size τ from (q0, p0) to (q1, p1)."""
@@ -295,64 +318,141 @@ class TwoPoint(Flow):
         return np.asarray(_core.energy_terms(self.model._core, np.full(len(q), self.t), q, p)[0])
 
 
-def collide(
-    flows: Flow,
-    normal: np.ndarray,
-    q: np.ndarray,
-    p: np.ndarray,
-    first: Callable[[], float],
-    after: float,
-    restitution: float,
-) -> tuple[np.ndarray, np.ndarray, np.ndarray, bool]:
-    """The step through an impact at the contact configuration q on φ = 0, reached with momenta p
-    by the method's partial step from the grid state, whose discrete energy is ``first()``
-    (called for e = 1 only), with ``after`` left to the next grid time: the momenta just after,
-    p⁺ = p + λ∇φ, and the state at the grid time Ψ_after(q, p⁺) of ``flows``.
+class ContactError(_core.VarmechError):
+    """An impact could not be resolved: a non-finite state through it, or more than
+    :data:`MAX_IMPACTS` impacts in one step (an accumulation of impacts, as of a ball coming to
+    rest). ``step``, ``time`` and ``partial`` (the run up to the impact) are attached."""
 
-    Elastic (e = 1): the variational collision integrator (Fetecau, Marsden, Ortiz & West 2003).
-    The contact point and the fraction of the step make the action of the two partial steps
-    stationary: the first partial step is the method's (so φ(q) = 0 fixes the fraction), and the
-    jump and the second satisfy D₂L_d(q_k, q, τ₁) + D₁L_d(q, q_{k+1}, τ₂) = λ∇φ(q) and
-    E_d(q_k, q, τ₁) = E_d(q, q_{k+1}, τ₂), solved for λ by secants from the exact reflection's
-    λ (O(τ²) away). The discrete energy, not H, is continuous across the impact: that is what
-    makes the step symplectic. Inelastic (e < 1): no symplectic structure is left to keep, and
-    Newton's law applies at q: the normal velocity ∇φ·q̇ goes to −e times itself.
+    step: int
+    time: float
+    partial: Any
 
-    The last value is False where the discrete energy equation has no root near the exact
-    reflection (a grazing impact, |∇φ·q̇| of order τ): that impact takes Newton's law with e = 1."""
-    zero = np.zeros_like(p)
-    metric = flows._call("velocity", q, normal) - flows._call("velocity", q, zero)
-    v = flows._call("velocity", q, p)
-    exact = -(1.0 + restitution) * float(normal @ v) / float(normal @ metric)
 
-    def state(lam: float) -> tuple[np.ndarray, np.ndarray, float]:
-        return flows.forward(q, p + lam * normal, after)
+#: Impacts resolved in one step at most.
+MAX_IMPACTS = 64
 
-    if restitution < 1.0:
-        q1, p1, _ = state(exact)
-        return p + exact * normal, q1, p1, True
-    target = first()
-    # The round-off of the energies: an implicit rule's E_d(λ), from a Newton solve, can stall
-    # a few ulps from the root, where the secant sees no slope.
+#: A piece of a step after a jump: (the state where it ends, its discrete energy, its length,
+#: and the contact crossed where it ends, or None at the end of the step).
+Piece = tuple[np.ndarray, np.ndarray, float, float, int | None]
+
+
+
+
+def variational_jump(piece: Callable[[float], Piece], exact: float, target: float, scale: float) -> tuple[float, bool]:
+    """λ of the variational collision integrator (Fetecau, Marsden, Ortiz & West 2003): the
+    discrete energy of the piece after the jump, ``piece(λ)``, equal to ``target``, that of the
+    piece before. The contact point and the fraction of the step then make the action of the two
+    pieces stationary, D₂L_d(q_k, q̃, τ₁) + D₁L_d(q̃, q_{k+1}, τ₂) = λ∇φ(q̃) and E_d(q_k, q̃, τ₁) =
+    E_d(q̃, q_{k+1}, τ₂), so the step across the impact is symplectic. Solved by secants from the
+    exact reflection's λ, O(τ²) away; False (and ``exact``) where there is no root near it (a
+    grazing impact, |∇φ·q̇| of order τ). ``scale`` sizes the energies' round-off."""
+    # An implicit rule's E_d(λ), from a Newton solve, can stall a few ulps from the root, where
+    # the secant sees no slope.
     eps = np.finfo(float).eps
-    noise = 16.0 * eps * (abs(target) + abs(float(p @ v)))
+    noise = 16.0 * eps * (abs(target) + abs(scale))
     lam0, lam1 = exact, exact * (1.0 + 1e-6)
-    f0 = state(lam0)[2] - target
-    found = None
+    f0 = piece(lam0)[2] - target
     for _ in range(40):
-        q1, p1, e1 = state(lam1)
-        f1 = e1 - target
+        f1 = piece(lam1)[2] - target
         if f1 == 0.0 or abs(lam1 - lam0) <= 4.0 * eps * abs(lam1) or (f1 == f0 and abs(f1) <= noise):
-            found = (lam1, q1, p1)
-            break
+            near = 0.5 * exact <= lam1 <= 1.5 * exact if exact > 0 else 1.5 * exact <= lam1 <= 0.5 * exact
+            return (lam1, True) if near else (exact, False)
         if f1 == f0 or not np.isfinite(f1):
             break
         lam0, lam1, f0 = lam1, lam1 - f1 * (lam1 - lam0) / (f1 - f0), f1
-    if found is None or not (0.5 * exact <= found[0] <= 1.5 * exact if exact > 0 else 1.5 * exact <= found[0] <= 0.5 * exact):
-        q1, p1, _ = state(exact)
-        return p + exact * normal, q1, p1, False
-    lam, q1, p1 = found
-    return p + lam * normal, q1, p1, True
+    return exact, False
+
+
+def crossing(g: Callable[[float], float], tau: float, leaving: bool) -> float:
+    """The first s in (0, τ] where g(s) = φ(q(s)) falls through 0, given g(τ) < 0 (``leaving``:
+    the piece starts on that surface, g(0) = 0, and moves in): bracketed by samples (refined
+    towards 0 for a piece leaving the surface), then regula falsi (Illinois) to round-off."""
+    lo, g_lo, hi = 0.0, (0.0 if leaving else g(0.0)), tau
+    for _ in range(4):
+        xs = lo + (hi - lo) * np.arange(1, 9) / 8
+        values = [g(x) for x in xs]
+        k = next(k for k, v in enumerate(values) if v < 0.0)
+        if k > 0:
+            lo, g_lo = xs[k - 1], values[k - 1]
+        if k > 0 or not leaving:
+            hi, g_hi = xs[k], values[k]
+            break
+        hi = xs[0]
+    else:
+        raise ContactError(
+            "a body leaving a surface crosses it again at once (a resting or grazing contact, such as e = 0 under"
+            " a force pressing on it), which impacts cannot resolve"
+        )
+    side = 0
+    for _ in range(200):
+        if hi - lo <= 4.0 * np.finfo(float).eps * tau:
+            break
+        x = (lo * g_hi - hi * g_lo) / (g_hi - g_lo)
+        if not lo < x < hi:
+            break
+        gx = g(x)
+        if gx == 0.0:
+            return float(x)
+        if gx > 0.0:
+            lo, g_lo = x, gx
+            g_hi, side = (0.5 * g_hi if side == -1 else g_hi), -1
+        else:
+            hi, g_hi = x, gx
+            g_lo, side = (0.5 * g_lo if side == 1 else g_lo), 1
+    return float(lo if abs(g_lo) <= abs(g_hi) else hi)
+
+
+def through(
+    flows: Flow, contacts: list[Contact], i: int, t: float, q: np.ndarray, p: np.ndarray, tau: float, first: Callable[[], float]
+) -> tuple[np.ndarray, np.ndarray, list[tuple[int, float, np.ndarray, np.ndarray, np.ndarray]], int]:
+    """The rest τ of a step from an impact on ``contacts[i]`` at (t, q, p), whose first piece had
+    the discrete energy ``first()``: each jump, then the piece to the next contact crossed within
+    the step (several contacts in one step, a corner), to the step's end. Returns the end state,
+    the impacts (contact, time, configuration, momenta before and after) and how many took
+    Newton's law for want of a discrete-energy root (grazing)."""
+    impacts: list[tuple[int, float, np.ndarray, np.ndarray, np.ndarray]] = []
+    grazing = 0
+    while True:
+        contact = contacts[i]
+        normal = np.asarray(contact.gradient(q.copy()), dtype=float).reshape(-1)
+        lam = exact_jump(flows.model, t, normal, q, p, contact.restitution)
+
+        def piece(lam: float, q: np.ndarray = q, p: np.ndarray = p, normal: np.ndarray = normal, i: int = i, tau: float = tau) -> Piece:
+            return _piece(flows, contacts, i, q, p + lam * normal, tau)
+
+        if contact.law == "variational" and contact.restitution == 1.0:
+            lam, ok = variational_jump(piece, lam, first(), float(p @ _velocity(flows.model, q, p, t)))
+            grazing += not ok
+        q1, p1, energy, s, j = piece(lam)
+        impacts.append((i, t, q, p, p + lam * normal))
+        if not (np.all(np.isfinite(q1)) and np.all(np.isfinite(p1))):
+            raise ContactError(f"a non-finite state after the impact on {contact.name!r} at t = {t}")
+        if j is None:
+            return q1, p1, impacts, grazing
+        if len(impacts) == MAX_IMPACTS:
+            raise ContactError(
+                f"more than {MAX_IMPACTS} impacts in the step of the impact at t = {t} (an accumulation of"
+                " impacts, as of a body coming to rest on a surface); shorten the step or stop the run before"
+            )
+        i, t, q, p, tau = j, t + s, q1, p1, tau - s
+        first = partial(float, energy)
+
+
+def _piece(flows: Flow, contacts: list[Contact], i: int, q: np.ndarray, p: np.ndarray, tau: float) -> Piece:
+    """The piece of a step from (q, p) just after a jump on ``contacts[i]``: to the end τ, or to the
+    first contact crossed before it."""
+    q1, p1, energy = flows.forward(q, p, tau)
+    below = [j for j, c in enumerate(contacts) if c.phi(q1.copy()) < 0.0]
+    if not below:
+        return q1, p1, energy, tau, None
+
+    def surface(c: Contact) -> Callable[[float], float]:
+        """φ along the piece, s ↦ φ(q(s))."""
+        return lambda s: float(c.phi(flows.forward(q, p, s)[0]))
+
+    s, j = min((crossing(surface(contacts[j]), tau, j == i), j) for j in below)
+    q1, p1, energy = flows.forward(q, p, s)
+    return q1, p1, energy, s, j
 
 
 def check(model: Model, contacts: list[Contact], q0: np.ndarray) -> list[Any]:
@@ -419,10 +519,34 @@ def run(
     grazing = 0
     hits: list[list[tuple[float, np.ndarray, np.ndarray]]] = [[] for _ in contacts]
     pieces = Pieces()
+
+    def occurrences() -> tuple[_events.Occurrences, ...]:
+        """The impacts so far, as each contact's occurrences."""
+        n = model.dim
+        return tuple(
+            _events.Occurrences(
+                c.name,
+                np.array([h[0] for h in hits[j]]),
+                np.array([h[1] for h in hits[j]]).reshape(-1, n),
+                np.array([h[2] for h in hits[j]]).reshape(-1, n),
+            )
+            for j, c in enumerate(contacts)
+        )
+
     q, p, t, done = q0, p0, t0, 0
     record = None
     while True:
-        record = start(q, p, t, steps - done, None, specs)
+        try:
+            record = start(q, p, t, steps - done, None, specs)
+        except BaseException as err:
+            # The run so far is the error's partial trajectory, with the piece's own.
+            from .integrate import take_partial
+
+            piece = take_partial(err)
+            if piece is not None:
+                pieces.add(piece)
+                err._varmech_joined = (pieces.joined(done + piece.steps, piece.checkpoint), occurrences())  # type: ignore[attr-defined]
+            raise
         i = record.terminated_by
         if i is None:
             pieces.add(record)
@@ -433,35 +557,37 @@ def run(
         index, te, qe, pe, q_start, p_start = record.events
         k = int(np.flatnonzero(index == i)[-1])
         t_hit, q_hit, p_hit = float(te[k]), np.asarray(qe[k]), np.asarray(pe[k])
-        hits[i].append((t_hit, q_hit, p_hit))
         done += record.steps
         t_grid = t0 + done * dt
-        if contacts[i].law == "variational":
-            normal = np.asarray(contacts[i].gradient(q_hit.copy()), dtype=float).reshape(-1)
-            before = t_hit - (t_grid - dt)
-            # The first partial step's E_d: a splitting's undone from its end, a two-point
-            # rule's from both ends (the crossing carries the state its step started from).
-            flows: Flow
-            if split is not None:
-                flows = Splitting(model, *split, t_hit)
-                first = partial(flows.undone, q_hit, p_hit, before)
-            else:
-                flows = TwoPoint(model, record.checkpoint, t_hit)
-                first = partial(flows.energy, np.asarray(q_start[k]), np.asarray(p_start[k]), q_hit, p_hit, before)
-            p_after, q, p, ok = collide(flows, normal, q_hit, p_hit, first, dt - before, contacts[i].restitution)
-            grazing += not ok
-            pieces.nfev += flows.evaluations
+        before = t_hit - (t_grid - dt)
+        # The first partial step's E_d: a splitting's undone from its end, a two-point rule's from
+        # both ends (the crossing carries the state its step started from).
+        flows: Flow
+        first: Callable[[], float]
+        if contacts[i].law == "reflect":
+            flows = CoreStep(model, record.checkpoint, t_hit)
+            first = partial(float, "nan")
+        elif split is not None:
+            flows = Splitting(model, *split, t_hit)
+            first = partial(flows.undone, q_hit, p_hit, before)
         else:
-            p_after = reflect(model, contacts[i], q_hit, p_hit, t_hit)
+            flows = TwoPoint(model, record.checkpoint, t_hit)
+            first = partial(flows.energy, np.asarray(q_start[k]), np.asarray(p_start[k]), q_hit, p_hit, before)
+        try:
+            q, p, impacts, grazed = through(flows, contacts, i, t_hit, q_hit, p_hit, dt - before, first)
+        except ContactError as err:
+            # The run up to the step of the impact, ending with that step's start.
+            err.step, err.time = done, t_hit
             stepper = _core.Stepper.from_checkpoint(model._core, record.checkpoint)
-            stepper.reset(q_hit, p_after, t_hit)
-            if t_grid > t_hit:
-                stepper.dt = t_grid - t_hit
-                stepper.step()
-                pieces.nfev += stepper.force_evaluations
-            q, p = np.asarray(stepper.q), np.asarray(stepper.p)
-        pieces.row(t_hit, q_hit, p_hit)
-        pieces.row(t_hit, q_hit, p_after)
+            stepper.reset(np.asarray(q_start[k]), np.asarray(p_start[k]), t_grid - dt)
+            err._varmech_joined = (pieces.joined(done - 1, stepper.checkpoint()), occurrences())  # type: ignore[attr-defined]
+            raise
+        grazing += grazed
+        pieces.nfev += flows.evaluations
+        for j, t_j, q_j, before_j, after_j in impacts:
+            hits[j].append((t_j, q_j, before_j))
+            pieces.row(t_j, q_j, before_j)
+            pieces.row(t_j, q_j, after_j)
         t = t_grid
         pieces.row(t, q, p)
         if done >= steps:
@@ -473,15 +599,4 @@ def run(
             RuntimeWarning,
             stacklevel=3,
         )
-    joined = pieces.joined(done, record.checkpoint)
-    n = model.dim
-    found = tuple(
-        _events.Occurrences(
-            c.name,
-            np.array([h[0] for h in hits[j]]),
-            np.array([h[1] for h in hits[j]]).reshape(-1, n),
-            np.array([h[2] for h in hits[j]]).reshape(-1, n),
-        )
-        for j, c in enumerate(contacts)
-    )
-    return joined, found
+    return pieces.joined(done, record.checkpoint), occurrences()

@@ -426,7 +426,20 @@ def integrate(
         ):
             if clash:
                 raise ValueError(f"contacts: not yet with {name}")
-        j, hits = _impacts.run(start, model, method, q, p, t0, dt, nsteps, list(contacts))
+        try:
+            j, hits = _impacts.run(start, model, method, q, p, t0, dt, nsteps, list(contacts))
+        except BaseException as err:
+            # The whole run up to the failure, not only its last piece.
+            so_far = getattr(err, "_varmech_joined", None)
+            if so_far is not None:
+                del err._varmech_joined  # type: ignore[attr-defined]
+                j, hits = so_far
+                work = j.work if model.forced else None
+                err.partial = Trajectory(  # type: ignore[attr-defined]
+                    j.t, j.q, j.p, model, method, dt, j.steps, j.force_evaluations, j.newton, work,
+                    status=-1, message=str(err), checkpoint=j.checkpoint, events=hits,
+                )
+            raise
         work = j.work if model.forced else None
         return Trajectory(j.t, j.q, j.p, model, method, dt, j.steps, j.force_evaluations, j.newton, work, checkpoint=j.checkpoint, events=hits)
     if impulses is not None:

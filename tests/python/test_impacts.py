@@ -134,14 +134,63 @@ def test_an_elastic_balls_bounce_times_converge_at_order_two_under_a_varying_for
 
 @pytest.mark.parametrize("e", [0.9, 0.5])
 def test_an_inelastic_balls_heights_fall_by_e_squared_per_bounce(e):
+    # Up to 0.97 of the time t₁(1 + 2e/(1 − e)) at which the bounces accumulate (the ball comes
+    # to rest): the last steps each hold several impacts.
     floor = varmech.Contact(lambda q: q[0], lambda q: [1.0], restitution=e)
-    traj = varmech.integrate(_ball(), [1.0], [0.0], dt=1e-3, steps=3000, contacts=[floor])
+    rest = math.sqrt(2 / G) * (1 + 2 * e / (1 - e))
+    traj = varmech.integrate(_ball(), [1.0], [0.0], dt=1e-3, steps=min(3000, round(0.97 * rest / 1e-3)), contacts=[floor])
     hits = traj.events[0]
     speeds = np.abs(hits.p[:, 0])
     assert len(hits) >= 4
     # Apex heights v⁺²/2g after the k-th impact: v⁺ = e v⁻, and v⁻ of the next is v⁺ of this.
     heights = (e * speeds) ** 2 / (2 * G)
     np.testing.assert_allclose(heights[1:] / heights[:-1], e**2, rtol=1e-12)
+
+
+def test_a_ball_coming_to_rest_stops_the_run_with_a_contact_error_and_keeps_its_impacts():
+    # Past the accumulation time the impacts cannot go on (a resting contact): a typed error with
+    # the step and time, and the whole run up to that step, impacts included.
+    e = 0.5
+    rest = math.sqrt(2 / G) * (1 + 2 * e / (1 - e))
+    floor = varmech.Contact(lambda q: q[0], lambda q: [1.0], restitution=e)
+    with pytest.raises(varmech.ContactError, match="cannot resolve|more than 64 impacts") as info:
+        varmech.integrate(_ball(), [1.0], [0.0], dt=1e-3, steps=3000, contacts=[floor])
+    err = info.value
+    assert 0.97 * rest < err.time < rest + 1e-3 and err.step == math.ceil(err.time / 1e-3)
+    partial = err.partial
+    assert partial.status == -1 and partial.t[-1] <= err.time and len(partial.events[0]) > 10
+    np.testing.assert_allclose(partial.events[0].t[:3], math.sqrt(2 / G) * np.array([1, 1 + 2 * e, 1 + 2 * e + 2 * e * e]), rtol=1e-12)
+    assert np.min(partial.q) > -1e-12
+
+
+def test_a_particle_in_a_box_crosses_two_walls_in_one_step_at_its_corners():
+    # A free particle in the unit square, steps of 0.5 against flights of about 1: many steps
+    # cross two walls. The exact motion unfolds to a straight line: x = fold(x₀ + vt), with
+    # fold(u) = 1 − |1 − (u mod 2)|, and each wall is met where u crosses an integer.
+    walls = [
+        varmech.Contact.wall(0, name="left"),
+        varmech.Contact(lambda q: 1 - q[0], lambda q: [-1.0, 0.0], name="right"),
+        varmech.Contact.wall(1, name="bottom"),
+        varmech.Contact(lambda q: 1 - q[1], lambda q: [0.0, -1.0], name="top"),
+    ]
+    free = varmech.MechanicalSystem(2, lambda q: 0.0, lambda q: np.zeros(2), name="free")
+    q0, v = np.array([0.3, 0.6]), np.array([0.9 * math.sqrt(2), 0.7 * math.sqrt(3)])
+    dt, steps = 0.5, 2000
+    traj = varmech.integrate(free, q0, v, dt=dt, steps=steps, save_every=1, contacts=walls)
+    grid = np.isclose((traj.t / dt) % 1, 0) | np.isclose((traj.t / dt) % 1, 1)
+    t = traj.t[grid][::1]
+    t, index = np.unique(t, return_index=True)
+    q = traj.q[grid][index]
+    u = q0 + np.outer(t, v)
+    exact = 1 - np.abs(1 - np.mod(u, 2))
+    assert np.max(np.abs(q - exact)) < 1e-9
+    crossings = np.floor(q0 + v * dt * steps)
+    assert len(traj.events[0]) + len(traj.events[1]) == int(crossings[0])
+    assert len(traj.events[2]) + len(traj.events[3]) == int(crossings[1])
+    both = sum(np.sum(np.diff(np.floor(u[:, k])) > 0) for k in (0, 1))
+    assert both == int(crossings.sum())
+    steps_with_two = np.sum((np.diff(np.floor(u[:, 0])) > 0) & (np.diff(np.floor(u[:, 1])) > 0))
+    assert steps_with_two > 100
 
 
 def _billiard(steps, **options):
