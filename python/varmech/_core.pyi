@@ -450,8 +450,9 @@ def integrate(
     TrajectoryRecord up to the failure. ``progress(steps)`` is called with the steps completed at
     the Ctrl-C check's stride; an exception from it stops the run. ``events``: spec tuples
     (name, direction, terminal count or 0, kind, payload), kind ``"p"``/``"v"`` (payload g(t, q,
-    p) or g(t, q, v)), ``"crossing"`` ((k, value)), ``"energy_error"`` (bound), ``"escape"``,
-    ``"encounter"`` ((radius, groups)); see varmech.events."""
+    p) or g(t, q, v)), ``"crossing"`` ((k, value)), ``"ellipsoid"`` ((coordinates, centre,
+    semi_axes, inside)), ``"energy_error"`` (bound), ``"escape"``, ``"encounter"`` ((radius,
+    groups)); see varmech.events and varmech.surfaces."""
 
 def resume(
     model: _Model,

@@ -33,6 +33,8 @@ TOUR: dict[str, tuple[tuple[str, ...], float | None]] = {
     "cartesian_pendulum": (("rattle", "shake"), 1000.0),
     "planar_chain": (("rattle", "rattle4"), 100.0),
     "rigid_body": (("trapezoid", "midpoint"), 100.0),
+    # A hundred bounces and more, where the variational impacts' O(h²) energy jumps stay bounded.
+    "bouncing_ball": (("verlet", "kahan_li6"), 1000.0),
 }
 
 

@@ -112,6 +112,13 @@ class Occurrences:
     def __len__(self) -> int:
         return len(self.t)
 
+    def __eq__(self, other: object) -> bool:
+        """Equal names and arrays (the generated comparison would ask arrays for one truth value)."""
+        if not isinstance(other, Occurrences):
+            return NotImplemented
+        pairs = ((self.t, other.t), (self.q, other.q), (self.p, other.p))
+        return self.name == other.name and all(np.array_equal(a, b) for a, b in pairs)
+
 
 def crossing(k: int, value: float = 0.0, *, direction: int = 0, terminal: bool | int = False) -> Event:
     """The coordinate q_k crossing ``value``: g = q_k − value (evaluated natively).

@@ -311,6 +311,17 @@ def rigid_body(inertia: tuple[float, float, float] = (0.5, 0.9, 1.0)) -> Mechani
     )
 
 
+def bouncing_ball(g: float = 9.81) -> MechanicalSystem:
+    """The ball above its floor, H = p²/2 + gq (the floor is a contact: in the closure twin,
+    ``Contact(lambda q: q[0], lambda q: [1.0])``)."""
+    return MechanicalSystem(1, lambda q: g * q[0], lambda q: np.array([g]), name="bouncing_ball (closure)")
+
+
+def elliptic_billiard() -> MechanicalSystem:
+    """The billiard's free particle, H = |p|²/2 (the table x²/A² + y²/B² ≤ 1 is a contact)."""
+    return MechanicalSystem(2, lambda q: 0.0, lambda q: np.zeros(2), name="elliptic_billiard (closure)")
+
+
 def closure_of(scene: Scene) -> MechanicalSystem | Lagrangian:
     """The closure twin of a built-in scene: the function of this module with the scene's name,
     at its default parameters (an N-body scene's twin has the scene's G and masses).

@@ -58,6 +58,7 @@ from numpy.typing import ArrayLike
 
 from . import _core
 from . import events as _events
+from . import surfaces as _surfaces
 from .impulses import Joined, Pieces, _velocity
 from .methods import method_info
 from .model import Model
@@ -83,8 +84,6 @@ class Contact:
     gradient: Callable[[np.ndarray], ArrayLike]
     restitution: float = 1.0
     name: str = "contact"
-    #: The coordinate k and value c of a wall q_k ≥ c, watched natively (see :meth:`wall`).
-    coordinate: tuple[int, float] | None = None
     #: The impact law: ``"variational"``, the variational collision integrator (:func:`collide`;
     #: kick–drift methods and the two-point rules ``midpoint`` and ``trapezoid``), or
     #: ``"reflect"``, the exact reflection of the momenta between the method's partial steps (any
@@ -108,7 +107,8 @@ class Contact:
         law: Literal["variational", "reflect"] = "variational",
     ) -> Contact:
         """The wall q_k ≥ ``value`` (a floor, a side of a box): φ = q_k − value, watched in the
-        core (the native ``crossing`` event), with no Python call per step.
+        core (the native ``crossing`` event), with no Python call per step; φ and ∇φ are
+        :class:`varmech.surfaces.Wall` (they pickle and compare by k and the value).
 
         Examples
         --------
@@ -119,14 +119,48 @@ class Contact:
         3
         """
 
-        def phi(q: np.ndarray) -> float:
-            return float(q[k] - value)
-
-        def gradient(q: np.ndarray) -> np.ndarray:
-            return np.eye(len(q))[k]
-
+        surface = _surfaces.Wall(int(k), float(value))
         label = name if name is not None else f"q[{k}] ≥ {value:g}"
-        return cls(phi, gradient, restitution, label, (int(k), float(value)), law)
+        return cls(surface, _surfaces.Gradient(surface), restitution, label, law)
+
+    @classmethod
+    def ellipsoid(
+        cls,
+        semi_axes: ArrayLike,
+        coordinates: ArrayLike | None = None,
+        centre: ArrayLike | None = None,
+        *,
+        inside: bool = True,
+        restitution: float = 1.0,
+        name: str | None = None,
+        law: Literal["variational", "reflect"] = "variational",
+    ) -> Contact:
+        """The ellipsoid Σᵢ ((q_{kᵢ} − cᵢ)/aᵢ)² ≤ 1 in the ``coordinates`` kᵢ (default the first
+        len(semi_axes)) about the ``centre`` c (default the origin), with ``semi_axes`` a:
+
+            φ(q) = 1 − Σᵢ ((q_{kᵢ} − cᵢ)/aᵢ)²  (``inside``: a billiard table or a bowl),
+
+        or −φ (``inside=False``: an obstacle the state stays out of). Watched in the core (the
+        native ``ellipsoid`` event), with no Python call per step; an ellipse is two semi-axes,
+        a circle or sphere equal ones.
+
+        Examples
+        --------
+        The elliptic billiard x²/4 + y² ≤ 1: a free particle stays inside.
+
+        >>> import numpy as np, varmech
+        >>> free = varmech.MechanicalSystem(2, lambda q: 0.0, lambda q: np.zeros(2))
+        >>> table = varmech.Contact.ellipsoid([2.0, 1.0], name="table")
+        >>> traj = varmech.integrate(free, [0.3, 0.1], [0.6, 0.8], dt=0.1, steps=1000, contacts=[table])
+        >>> len(traj.events[0]) > 20, min(table.phi(q) for q in traj.q) > -1e-12
+        (True, True)
+        """
+        axes = tuple(float(a) for a in np.atleast_1d(np.asarray(semi_axes, dtype=float)))
+        ks = tuple(range(len(axes))) if coordinates is None else tuple(int(k) for k in np.atleast_1d(coordinates))
+        c = (0.0,) * len(ks) if centre is None else tuple(float(x) for x in np.atleast_1d(np.asarray(centre, dtype=float)))
+        surface = _surfaces.Ellipsoid(ks, c, axes, bool(inside))
+        label = name if name is not None else ("ellipsoid" if inside else "outside an ellipsoid")
+        return cls(surface, _surfaces.Gradient(surface), restitution, label, law)
 
 
 def exact_jump(model: Model, t: float, normal: np.ndarray, q: np.ndarray, p: np.ndarray, restitution: float) -> float:
@@ -462,11 +496,13 @@ def check(model: Model, contacts: list[Contact], q0: np.ndarray) -> list[Any]:
     for i, c in enumerate(contacts):
         if not isinstance(c, Contact):
             raise TypeError(f"contacts[{i}]: expected a varmech.Contact, got {type(c).__name__}")
+        if isinstance(c.phi, _surfaces.Surface) and max(c.phi.coordinates) >= len(q0):
+            raise ValueError(f"contacts[{i}]: coordinates {c.phi.coordinates} not all in 0 … {len(q0) - 1}")
         value = float(c.phi(q0.copy()))
         if not value >= 0.0:
             raise ValueError(f"q0: outside the contact {c.name!r}: φ(q0) = {value} < 0")
-        if c.coordinate is not None:
-            watched.append(_events.Event(None, -1, 1, name=c.name, native=("crossing", c.coordinate)))
+        if isinstance(c.phi, _surfaces.Surface):
+            watched.append(_events.Event(None, -1, 1, name=c.name, native=c.phi.native))
         else:
             watched.append(_events.Event(_surface(c), direction=-1, terminal=1, name=c.name))
     return _events.specs(watched, model.dim)[1]

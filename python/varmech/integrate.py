@@ -314,7 +314,8 @@ def integrate(
         Unilateral constraints φ(q) ≥ 0 (:class:`varmech.Contact`): the run goes through their
         impacts, each step that crosses a surface split at the contact configuration (see
         :mod:`varmech.impacts`); the impacts are each contact's occurrences in ``traj.events``.
-        Not yet with ``t_eval``, ``output``, ``events`` or ``impulses``.
+        Default: a scene's ``contacts`` (an impact scene's floor or wall); ``contacts=[]``
+        runs without them. Not yet with ``t_eval``, ``output``, ``events`` or ``impulses``.
     checkpoint_every:
         With ``output``: commit states and a checkpoint at least every this many steps (rounded
         down to whole ``save_every`` periods), or every :class:`datetime.timedelta` of run time.
@@ -371,6 +372,10 @@ def integrate(
         if named:
             raise ValueError(f"{named[0]}: a continued run keeps its trajectory's {', '.join(named)}")
         return _go_on(model, steps, t_end, save_every, progress, output, overwrite, checkpoint_every, events)
+    from .scenes import Scene
+
+    # A scene's contacts by default; none given (``[]``) is a run without contacts.
+    contacts = (model.contacts if contacts is None and isinstance(model, Scene) else contacts) or None
     model, q0, p0 = _model_of(model, q0, p0, v0)
     if parameters is not None:
         if not isinstance(parameters, Mapping):

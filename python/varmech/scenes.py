@@ -8,12 +8,14 @@ functions below name them with their parameters for the reader."""
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import ArrayLike
 
 from . import _core
+from .impacts import Contact
 from .model import Model, NativeSystem
 
 
@@ -34,7 +36,8 @@ class Scene:
 
     ``dt`` is a step that resolves the scene for a quick look (the tour uses it);
     ``invariants`` holds the values of the conserved quantities at t = 0; ``parameters`` the
-    values the scene was built with.
+    values the scene was built with; ``contacts`` the contact surfaces φ(q) ≥ 0 of an impact
+    scene (:class:`varmech.Contact`), which :func:`varmech.integrate` goes through by default.
     """
 
     name: str
@@ -47,11 +50,20 @@ class Scene:
     invariants: dict[str, float] = field(default_factory=dict)
     reference: Reference | None = None
     parameters: dict[str, float] = field(default_factory=dict)
+    contacts: tuple[Contact, ...] = ()
 
 
 #: The core's catalogue of scenes by name, in the order of the tour: each entry's
 #: ``parameters`` (with their defaults) and ``description``.
 CATALOGUE: dict[str, _core.CatalogueEntry] = {entry.name: entry for entry in _core.catalogue()}
+
+
+#: The contact surfaces of the impact scenes from their parameters: the core's scenes use the
+#: model layer only, so the surfaces are attached here (watched natively all the same).
+CONTACTS: dict[str, Callable[[dict[str, float]], tuple[Contact, ...]]] = {
+    "bouncing_ball": lambda p: (Contact.wall(0, restitution=p["restitution"], name="floor"),),
+    "elliptic_billiard": lambda p: (Contact.ellipsoid((p["a"], p["b"]), name="wall"),),
+}
 
 
 #: The symbolic scenes (:func:`varmech.symbolic.examples.scene`), which need SymPy.
@@ -83,6 +95,7 @@ def get(name: str, **parameters: float) -> Scene:
         record.invariants,
         reference,
         record.parameters,
+        CONTACTS[name](record.parameters) if name in CONTACTS else (),
     )
 
 
@@ -215,3 +228,42 @@ def rigid_body() -> Scene:
     (0.2, 1, 0.4) (HLW's rigid-body data): configuration-dependent mass on |q| = 1, integrated by
     the constrained DEL equations of ``trapezoid`` (the default) or ``midpoint``."""
     return get("rigid_body")
+
+
+def bouncing_ball(g: float = 9.81, h0: float = 1.0, restitution: float = 1.0) -> Scene:
+    """A ball of unit mass dropped from rest at height ``h0`` above the floor q ≥ 0 under
+    gravity ``g`` (H = p²/2 + gq), with the coefficient of ``restitution`` e ∈ (0, 1]: the
+    floor is ``contacts[0]``, a native wall. It hits the floor first at t₁ = √(2h₀/g), rises to
+    h₀e²ᵏ after the k-th bounce, and is at the apex after the tenth at t_end, the exact
+    reference (q = h₀e²⁰, p = 0). Elastic (e = 1), H = gh₀ is conserved.
+
+    Examples
+    --------
+    >>> import varmech
+    >>> scene = varmech.scenes.bouncing_ball(restitution=0.9)
+    >>> traj = varmech.integrate(scene, dt=scene.dt, t_end=scene.t_end)
+    >>> len(traj.events[0]), round(float(traj.q[-1, 0]), 6) == round(0.9**20, 6)
+    (10, True)
+    """
+    return get("bouncing_ball", g=g, h0=h0, restitution=restitution)
+
+
+def elliptic_billiard(A: float = 2.0, B: float = 1.0, x0: float = 0.3, y0: float = 0.1, px0: float = 0.6, py0: float = 0.8) -> Scene:
+    """A free particle of unit mass in the elliptic billiard x²/A² + y²/B² ≤ 1 (A ≥ B), from
+    (x0, y0) inside with momenta (px0, py0), to t = 100: the wall is ``contacts[0]``, a native
+    ellipse. Integrable: besides E = |p|²/2, the product L₁L₂ of the angular momenta about the
+    foci (±c, 0), c² = A² − B², Lᵢ = (x ∓ c)p_y − y p_x, is conserved between and across the
+    impacts (invariant ``"L1L2"``).
+
+    Examples
+    --------
+    >>> import numpy as np, varmech
+    >>> scene = varmech.scenes.elliptic_billiard()
+    >>> traj = varmech.integrate(scene, dt=scene.dt, t_end=scene.t_end)
+    >>> c = np.sqrt(3.0)
+    >>> focal = ((traj.q[:, 0] - c) * traj.p[:, 1] - traj.q[:, 1] * traj.p[:, 0]) * (
+    ...     (traj.q[:, 0] + c) * traj.p[:, 1] - traj.q[:, 1] * traj.p[:, 0])
+    >>> len(traj.events[0]), bool(np.max(np.abs(focal - scene.invariants["L1L2"])) < 1e-12)
+    (50, True)
+    """
+    return get("elliptic_billiard", a=A, b=B, x0=x0, y0=y0, px0=px0, py0=py0)

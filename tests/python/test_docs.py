@@ -1,5 +1,6 @@
 """The docstring examples run as written (numpydoc ``Examples``): the symbolic front end, events,
-files, long runs, dense output, impulses, the stepper and the conservation report."""
+files, long runs, dense output, impulses, impacts and their surfaces, the scenes, the stepper and
+the conservation report."""
 
 import doctest
 import importlib
@@ -22,6 +23,8 @@ pytest.importorskip("sympy")
         "varmech.dense",
         "varmech.impulses",
         "varmech.impacts",
+        "varmech.surfaces",
+        "varmech.scenes",
         "varmech.stepper",
         "varmech.conservation",
     ],

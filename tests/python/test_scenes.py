@@ -30,6 +30,10 @@ def computed(scene, name):
         return float(energy_of(scene.model, np.zeros(1), q[None, :], p[None, :])[0])
     if name == "I":
         return oscillatory_energy(q, p)
+    if name == "L1L2":
+        # The elliptic billiard's product of the angular momenta about its foci (±c, 0).
+        c = math.sqrt(scene.parameters["a"] ** 2 - scene.parameters["b"] ** 2)
+        return ((q[0] - c) * p[1] - q[1] * p[0]) * ((q[0] + c) * p[1] - q[1] * p[0])
     generator = next(g for g in scene.model._core.symmetries if g.name == CYCLIC.get(name, name))
     return float(_core.momentum(generator, q[None, :], p[None, :])[0][0])
 

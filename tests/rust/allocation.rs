@@ -256,8 +256,8 @@ fn resuming_and_resetting_a_stepper_allocates_nothing() {
     }
 }
 
-/// A run with built-in events that never occur allocates per run, not per step: the events'
-/// values, the state before each step and the partial steps' stepper are made once.
+/// A run with built-in events (an escape, an ellipsoid) that never occur allocates per run, not
+/// per step: the events' values, the state before each step and the partial steps' stepper are made once.
 #[test]
 fn the_event_loop_allocates_nothing() {
     use varmech::integrators::{integrate_with_events, Detector, EventSpec, NativeEvent};
@@ -268,13 +268,21 @@ fn the_event_loop_allocates_nothing() {
             ..Options::new(10.0, steps)
         };
         let groups = (0..6).map(|b| vec![3 * b, 3 * b + 1, 3 * b + 2]).collect::<Vec<_>>();
-        let escape = vec![NativeEvent::Escape { radius: 1e6, groups }];
-        let spec = EventSpec {
-            name: "escape".into(),
-            direction: 1,
+        let escape = NativeEvent::Escape { radius: 1e6, groups };
+        // The Sun's position leaving a large ellipsoid about the origin.
+        let ellipsoid = NativeEvent::Ellipsoid {
+            coordinates: vec![0, 1, 2],
+            centre: vec![0.0; 3],
+            semi_axes: vec![1e6, 2e6, 3e6],
+            inside: true,
+        };
+        let spec = |name: &str, direction| EventSpec {
+            name: name.into(),
+            direction,
             terminal: 1,
         };
-        let mut detector = Detector::new(Box::new(escape), vec![spec]).unwrap();
+        let specs = vec![spec("escape", 1), spec("ellipsoid", -1)];
+        let mut detector = Detector::new(Box::new(vec![escape, ellipsoid]), specs).unwrap();
         let (q0, p0) = (&problem.initial.q, &problem.initial.p);
         let before = allocated();
         let traj = integrate_with_events(

@@ -30,6 +30,7 @@ fn computed(model: &SceneModel, name: &str, q: &[f64], p: &[f64]) -> Option<f64>
         SceneModel::Mechanical(Scene::FermiPastaUlam(s)) if name == "I" => {
             Some((1..=3).map(|j| s.oscillatory_energy(q, p, j)).sum())
         }
+        SceneModel::Mechanical(Scene::EllipticBilliard(s)) if name == "L1L2" => Some(s.focal_product(q, p)),
         SceneModel::Mechanical(s) if energy => Some(hamiltonian(s, q, p).unwrap()),
         SceneModel::Mechanical(s) => momentum(varmech::model::MechanicalSystem::symmetries(s)),
         SceneModel::General(s) if energy => {
@@ -82,6 +83,9 @@ fn invariants_follow_the_parameters() {
         ("kepler_polar", "e", 0.1),
         ("charged_particle", "b", 2.5),
         ("harmonic_oscillator", "omega", 3.0),
+        ("bouncing_ball", "h0", 2.5),
+        ("elliptic_billiard", "a", 3.0),
+        ("elliptic_billiard", "px0", -0.2),
     ] {
         let mut setup = lookup(scene).unwrap().setup();
         setup.set(parameter, value).unwrap();

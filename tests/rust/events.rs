@@ -1,10 +1,11 @@
 //! Events: the Illinois root finder, and crossings of the harmonic oscillator located by the
-//! method's partial step, at the method's order, with directions and terminal counts.
+//! method's partial step, at the method's order, with directions and terminal counts; a
+//! billiard's ellipse located at the exact time.
 
 use std::f64::consts::PI;
 
 use varmech::integrators::{integrate, integrate_with_events, Detector, EventSpec, Method, NativeEvent, Options};
-use varmech::scenes::HarmonicOscillator;
+use varmech::scenes::{EllipticBilliard, HarmonicOscillator};
 use varmech::solve::bracket::illinois;
 
 #[test]
@@ -118,4 +119,89 @@ fn each_crossing_carries_the_state_at_the_start_of_its_step() {
             assert!(traj.t[k] < e.t && e.t <= traj.t[k + 1]);
         }
     }
+}
+
+/// The free particle of the elliptic billiard x²/4 + y² ≤ 1 from (0.3, 0.1) with p = (0.6, 0.8)
+/// reaches the wall at the root τ of |q₀ + τp|²_A = 1, a quadratic; Verlet is exact on the
+/// straight line, so the native ellipsoid event locates it to round-off, and the same ellipse
+/// moved to a centre and in other coordinates gives the same time.
+#[test]
+fn the_ellipsoid_event_finds_a_free_particle_at_the_wall_at_the_exact_time() {
+    let sys = EllipticBilliard::new(2.0, 1.0).unwrap();
+    let (q0, p0) = ([0.3, 0.1], [0.6, 0.8]);
+    // (q₀ + τp)ᵀD(q₀ + τp) = 1, D = diag(1/4, 1): aτ² + bτ + c = 0, the positive root.
+    let (a, b, c): (f64, f64, f64) = (
+        0.09 + 0.64,
+        2.0 * (0.3 * 0.6 / 4.0 + 0.1 * 0.8),
+        0.09 / 4.0 + 0.01 - 1.0,
+    );
+    let exact = (-b + (b * b - 4.0 * a * c).sqrt()) / (2.0 * a);
+    let run = |wall: NativeEvent, q0: &[f64], p0: &[f64]| {
+        wall.check("wall", q0.len()).unwrap();
+        let spec = EventSpec {
+            name: "wall".into(),
+            direction: -1,
+            terminal: 1,
+        };
+        let mut detector = Detector::new(Box::new(vec![wall]), vec![spec]).unwrap();
+        let options = Options::new(0.01, 1000);
+        let traj = integrate_with_events(&sys, Method::Verlet, q0, p0, &options, || Ok(()), &mut detector).unwrap();
+        assert_eq!((traj.events.len(), traj.terminated_by), (1, Some(0)));
+        traj.events[0].clone()
+    };
+    let table = NativeEvent::Ellipsoid {
+        coordinates: vec![0, 1],
+        centre: vec![0.0, 0.0],
+        semi_axes: vec![2.0, 1.0],
+        inside: true,
+    };
+    let hit = run(table, &q0, &p0);
+    assert!(
+        (hit.t - exact).abs() <= 4.0 * f64::EPSILON * exact,
+        "{} against {exact}",
+        hit.t
+    );
+    assert!(sys.inside(&hit.q).abs() <= 4.0 * f64::EPSILON);
+    // The ellipse about (1, −2) in the coordinates (1, 0), the particle moved with it.
+    let moved = NativeEvent::Ellipsoid {
+        coordinates: vec![1, 0],
+        centre: vec![1.0, -2.0],
+        semi_axes: vec![2.0, 1.0],
+        inside: true,
+    };
+    let shifted = run(moved, &[q0[1] - 2.0, q0[0] + 1.0], &[p0[1], p0[0]]);
+    assert!(
+        (shifted.t - exact).abs() <= 16.0 * f64::EPSILON * exact,
+        "{} against {exact}",
+        shifted.t
+    );
+}
+
+#[test]
+fn the_ellipsoid_event_refuses_bad_shapes_by_name() {
+    let shape = |coordinates: Vec<usize>, centre: Vec<f64>, semi_axes: Vec<f64>| NativeEvent::Ellipsoid {
+        coordinates,
+        centre,
+        semi_axes,
+        inside: false,
+    };
+    for (bad, says) in [
+        (shape(vec![0, 2], vec![0.0, 0.0], vec![1.0, 1.0]), "coordinate 2"),
+        (shape(vec![0, 1], vec![0.0], vec![1.0, 1.0]), "equal length"),
+        (shape(vec![], vec![], vec![]), "non-empty"),
+        (shape(vec![0, 1], vec![0.0, 0.0], vec![1.0, 0.0]), "semi-axis"),
+        (shape(vec![0, 1], vec![f64::NAN, 0.0], vec![1.0, 1.0]), "centre"),
+    ] {
+        match bad.check("obstacle", 2) {
+            Err(varmech::Error::InvalidArgument { argument, reason }) => {
+                assert_eq!(argument, "events");
+                assert!(reason.starts_with("obstacle: ") && reason.contains(says), "{reason}");
+            }
+            other => panic!("expected an invalid argument, got {other:?}"),
+        }
+    }
+    // Outside an obstacle the sign is reversed: g = Σu² − 1.
+    let sys = EllipticBilliard::new(2.0, 1.0).unwrap();
+    let obstacle = shape(vec![0, 1], vec![0.0, 0.0], vec![2.0, 1.0]);
+    assert_eq!(obstacle.value(&sys, 0.0, &[2.0, 1.0], &[0.0, 0.0]).unwrap(), 1.0);
 }

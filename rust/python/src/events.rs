@@ -28,7 +28,8 @@ pub type EventTuple<'py> = (String, i8, usize, String, Bound<'py, PyAny>);
 
 impl Events {
     /// The functions and specs of the spec tuples, for a model of n coordinates. Kinds: `"p"`,
-    /// `"v"` (payload the function), `"crossing"` ((k, value)), `"energy_error"` (bound),
+    /// `"v"` (payload the function), `"crossing"` ((k, value)), `"ellipsoid"` ((coordinates,
+    /// centre, semi_axes, inside)), `"energy_error"` (bound),
     /// `"escape"`, `"encounter"` ((radius, groups)). A malformed one is a ValueError naming
     /// `events`.
     pub fn new(py: Python<'_>, tuples: Vec<EventTuple<'_>>, n: usize) -> PyResult<(Self, Vec<EventSpec>)> {
@@ -43,6 +44,15 @@ impl Events {
                 "crossing" => {
                     let (coordinate, value) = payload.extract()?;
                     Function::Native(NativeEvent::Crossing { coordinate, value })
+                }
+                "ellipsoid" => {
+                    let (coordinates, centre, semi_axes, inside) = payload.extract()?;
+                    Function::Native(NativeEvent::Ellipsoid {
+                        coordinates,
+                        centre,
+                        semi_axes,
+                        inside,
+                    })
                 }
                 "energy_error" => {
                     // (bound, E₀) for a resumed run; bound alone, E₀ taken at the start.

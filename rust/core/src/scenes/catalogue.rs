@@ -5,9 +5,9 @@
 use std::f64::consts::PI;
 
 use super::{
-    cartesian_pendulum, cartesian_spherical_pendulum, planar_chain, ChargedParticle, DampedDrivenPendulum,
-    DoublePendulum, FermiPastaUlam, HarmonicOscillator, HeavyTop, HenonHeiles, Kepler, KeplerPolar, LagrangianScene,
-    LinkedMasses, NBody, Pendulum, Problem, RigidBody, Scene, SphericalPendulum,
+    cartesian_pendulum, cartesian_spherical_pendulum, planar_chain, BouncingBall, ChargedParticle,
+    DampedDrivenPendulum, DoublePendulum, EllipticBilliard, FermiPastaUlam, HarmonicOscillator, HeavyTop, HenonHeiles,
+    Kepler, KeplerPolar, LagrangianScene, LinkedMasses, NBody, Pendulum, Problem, RigidBody, Scene, SphericalPendulum,
 };
 use crate::model::{Constrained, Distances, Lagrangian, MechanicalSystem};
 use crate::Error;
@@ -185,6 +185,12 @@ fn general(x: f64) -> String {
     }
 }
 
+/// The fewest whole steps of at most `most` to `t_end` (so that a run to t_end at the scene's
+/// step t_end/N ends there).
+fn steps_to(t_end: f64, most: f64) -> u64 {
+    (t_end / most).ceil() as u64
+}
+
 fn mechanical(s: Scene) -> SceneModel {
     SceneModel::Mechanical(s)
 }
@@ -196,7 +202,7 @@ fn general_lagrangian(s: LagrangianScene) -> SceneModel {
 const E: Parameter = real("e", 0.6);
 
 /// Every native scene, in the order of the tour.
-pub static CATALOGUE: [CatalogueEntry; 17] = [
+pub static CATALOGUE: [CatalogueEntry; 19] = [
     CatalogueEntry {
         name: "harmonic_oscillator",
         parameters: &[real("omega", 1.0)],
@@ -362,6 +368,76 @@ pub static CATALOGUE: [CatalogueEntry; 17] = [
         dt: |_| 0.01,
         invariants: |_| Vec::new(),
         build: |_| Ok(RigidBody::problem().map(SceneModel::ConstrainedGeneral)),
+    },
+    CatalogueEntry {
+        name: "bouncing_ball",
+        parameters: &[real("g", 9.81), real("h0", 1.0), real("restitution", 1.0)],
+        description: |s| {
+            format!(
+                "a ball bouncing on a floor, g = {}, h₀ = {}, e = {}",
+                general(s.value("g")),
+                general(s.value("h0")),
+                general(s.value("restitution"))
+            )
+        },
+        // At most a fiftieth of the shortest flight, 2e⁹t₁ before the final apex, in N ≡ 5 (mod 10)
+        // steps: at e = 1 the k-th impact is then at (2k + 1)N/20 steps, at the fractions α = ¼
+        // and ¾ of a step in turn, where the variational law's energy jumps g²h²(1 − 2α)/8 cancel
+        // in pairs. A step commensurate with the flight would put every impact at one fraction,
+        // and the jumps would add up.
+        dt: |s| {
+            let (g, h0, e) = (s.value("g"), s.value("h0"), s.value("restitution"));
+            let t_end = BouncingBall::horizon(g, h0, e);
+            let flight = 2.0 * e.powi(9) * (2.0 * h0 / g).sqrt();
+            let n = (steps_to(t_end, flight / 50.0)..).find(|n| n % 10 == 5);
+            t_end / n.unwrap_or(1) as f64
+        },
+        invariants: |s| {
+            if s.value("restitution") == 1.0 {
+                vec![("H", s.value("g") * s.value("h0"))]
+            } else {
+                Vec::new()
+            }
+        },
+        build: |s| {
+            let p = BouncingBall::problem(s.value("g"), s.value("h0"), s.value("restitution"))?;
+            Ok(p.map(|s| mechanical(Scene::BouncingBall(s))))
+        },
+    },
+    CatalogueEntry {
+        name: "elliptic_billiard",
+        parameters: &[
+            real("a", 2.0),
+            real("b", 1.0),
+            real("x0", 0.3),
+            real("y0", 0.1),
+            real("px0", 0.6),
+            real("py0", 0.8),
+        ],
+        description: |s| {
+            format!(
+                "a free particle in the elliptic billiard x²/A² + y²/B² ≤ 1, A = {}, B = {}",
+                general(s.value("a")),
+                general(s.value("b"))
+            )
+        },
+        // At most a twentieth of the time to cross the short axis.
+        dt: |s| {
+            let speed = s.value("px0").hypot(s.value("py0"));
+            let most = 0.1 * s.value("b") / if speed > 0.0 { speed } else { 1.0 };
+            EllipticBilliard::HORIZON / steps_to(EllipticBilliard::HORIZON, most) as f64
+        },
+        invariants: |s| {
+            let (q, p) = ([s.value("x0"), s.value("y0")], [s.value("px0"), s.value("py0")]);
+            let table = EllipticBilliard::new(s.value("a"), s.value("b"));
+            let focal = table.map_or(f64::NAN, |t| t.focal_product(&q, &p));
+            vec![("E", 0.5 * (p[0] * p[0] + p[1] * p[1])), ("L1L2", focal)]
+        },
+        build: |s| {
+            let (q0, p0) = ([s.value("x0"), s.value("y0")], [s.value("px0"), s.value("py0")]);
+            let p = EllipticBilliard::problem(s.value("a"), s.value("b"), q0, p0)?;
+            Ok(p.map(|s| mechanical(Scene::EllipticBilliard(s))))
+        },
     },
 ];
 

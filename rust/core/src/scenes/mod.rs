@@ -2,17 +2,20 @@
 //! data and, where one is published or exact, a reference solution; [`CATALOGUE`] lists them
 //! by name with their parameters, descriptions, steps and invariants.
 //!
-//! Scenes use the model layer only.
+//! Scenes use the model layer only: the contact surfaces of the impact scenes (the bouncing
+//! ball's floor, the billiard's wall) are attached where the runs are, in Python.
 //!
 //! The data and references are copied from the literature into `reference/` of the repository,
 //! which names the sources; tests and benches use these problems (as diffsol ships its test
 //! problems in the library).
 
+mod bouncing_ball;
 mod catalogue;
 mod charged_particle;
 mod constrained;
 mod damped_driven_pendulum;
 mod double_pendulum;
+mod elliptic_billiard;
 mod fermi_pasta_ulam;
 mod harmonic_oscillator;
 mod heavy_top;
@@ -25,11 +28,13 @@ mod rigid_body;
 mod spherical_pendulum;
 
 pub use crate::model::NBody;
+pub use bouncing_ball::BouncingBall;
 pub use catalogue::{lookup, CatalogueEntry, Parameter, SceneModel, Setup, CATALOGUE};
 pub use charged_particle::ChargedParticle;
 pub use constrained::{cartesian_pendulum, cartesian_spherical_pendulum, planar_chain, LinkedMasses, PointMasses};
 pub use damped_driven_pendulum::DampedDrivenPendulum;
 pub use double_pendulum::DoublePendulum;
+pub use elliptic_billiard::EllipticBilliard;
 pub use fermi_pasta_ulam::FermiPastaUlam;
 pub use harmonic_oscillator::HarmonicOscillator;
 pub use heavy_top::HeavyTop;
@@ -82,6 +87,10 @@ pub enum Scene {
     HenonHeiles(HenonHeiles),
     FermiPastaUlam(FermiPastaUlam),
     NBody(NBody),
+    /// The ball above its floor (the floor a contact, attached in Python).
+    BouncingBall(BouncingBall),
+    /// The free particle of an elliptic billiard (the wall a contact, attached in Python).
+    EllipticBilliard(EllipticBilliard),
 }
 
 macro_rules! dispatch {
@@ -93,6 +102,8 @@ macro_rules! dispatch {
             Scene::HenonHeiles($s) => $e,
             Scene::FermiPastaUlam($s) => $e,
             Scene::NBody($s) => $e,
+            Scene::BouncingBall($s) => $e,
+            Scene::EllipticBilliard($s) => $e,
         }
     };
 }

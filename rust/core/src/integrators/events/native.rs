@@ -9,6 +9,16 @@ use crate::{Error, ModelError};
 pub enum NativeEvent {
     /// g = q_k − value: the coordinate k crossing a value.
     Crossing { coordinate: usize, value: f64 },
+    /// g = s(1 − Σᵢ ((q_{kᵢ} − cᵢ)/aᵢ)²), kᵢ the `coordinates`, c the `centre`, a the
+    /// `semi_axes`, s = +1 `inside` (g ≥ 0 in the ellipsoid: a billiard table) and −1 outside
+    /// (an obstacle): the state crossing the ellipsoid's surface. The sum runs in the order of
+    /// the coordinates from 0, so a function written the same way agrees to the bit.
+    Ellipsoid {
+        coordinates: Vec<usize>,
+        centre: Vec<f64>,
+        semi_axes: Vec<f64>,
+        inside: bool,
+    },
     /// g = |E(q, p) − E₀| − bound, E₀ the energy at the start of the run (NaN until the run
     /// starts; a resumed run is given its first run's): the energy error growing beyond a bound.
     EnergyError { bound: f64, initial: f64 },
@@ -21,8 +31,8 @@ pub enum NativeEvent {
 }
 
 impl NativeEvent {
-    /// Refuses coordinates outside 0 … n − 1, empty or unequal groups, and radii or bounds
-    /// that are not finite and positive (naming `events` and the event's `name`).
+    /// Refuses coordinates outside 0 … n − 1, empty or unequal groups, and radii, bounds or
+    /// semi-axes that are not finite and positive (naming `events` and the event's `name`).
     pub fn check(&self, name: &str, n: usize) -> Result<(), Error> {
         let fail = |reason: String| Err(Error::invalid("events", format!("{name}: {reason}")));
         let positive = |what: &str, x: f64| {
@@ -41,6 +51,28 @@ impl NativeEvent {
                     return fail(format!("value must be finite, got {value}"));
                 }
                 Ok(())
+            }
+            NativeEvent::Ellipsoid {
+                coordinates,
+                centre,
+                semi_axes,
+                ..
+            } => {
+                let m = coordinates.len();
+                if m == 0 || centre.len() != m || semi_axes.len() != m {
+                    return fail(format!(
+                        "coordinates, centre and semi_axes must be non-empty and of equal length, got {m}, {} and {}",
+                        centre.len(),
+                        semi_axes.len()
+                    ));
+                }
+                if let Some(k) = coordinates.iter().find(|&&k| k >= n) {
+                    return fail(format!("coordinate {k} is not in 0 … {}", n - 1));
+                }
+                if let Some(c) = centre.iter().find(|c| !c.is_finite()) {
+                    return fail(format!("centre must be finite, got {c}"));
+                }
+                semi_axes.iter().try_for_each(|&a| positive("semi-axis", a))
             }
             NativeEvent::EnergyError { bound, .. } => positive("bound", *bound),
             NativeEvent::Escape { radius, groups } | NativeEvent::Encounter { radius, groups } => {
@@ -74,6 +106,26 @@ impl NativeEvent {
         let apart = |x: &[usize], y: &[usize]| x.iter().zip(y).map(|(&i, &j)| (q[i] - q[j]).powi(2)).sum::<f64>();
         Ok(match self {
             NativeEvent::Crossing { coordinate, value } => q[*coordinate] - value,
+            NativeEvent::Ellipsoid {
+                coordinates,
+                centre,
+                semi_axes,
+                inside,
+            } => {
+                let sum = coordinates
+                    .iter()
+                    .zip(centre)
+                    .zip(semi_axes)
+                    .fold(0.0, |s, ((&k, c), a)| {
+                        let u = (q[k] - c) / a;
+                        s + u * u
+                    });
+                if *inside {
+                    1.0 - sum
+                } else {
+                    sum - 1.0
+                }
+            }
             NativeEvent::EnergyError { bound, initial } => {
                 (model.energy_terms(q, p, t)?.energy - initial).abs() - bound
             }
