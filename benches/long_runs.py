@@ -14,11 +14,13 @@ import subprocess
 import sys
 import tempfile
 import textwrap
+import time
 from pathlib import Path
 
 from compare import best_times_interleaved
 
 import varmech
+from varmech import _core, streaming
 
 
 def ratios(steps: int) -> None:
@@ -45,6 +47,39 @@ def ratios(steps: int) -> None:
         "checkpoints every 10⁶ steps / every 2 s (both streamed, save_every = 10⁴): "
         f"{best['file, checkpoint every 10⁶'] / best['file, save_every=10⁴']:.3f}"
     )
+
+
+def gaps(steps: int) -> None:
+    """The main thread's time between two segments' core runs (checkpoints every 10⁶ steps):
+    what a checkpoint adds to the run's time when the commit thread has a core of its own. The
+    core runs are timed by wrapping ``_core.resume`` as ``streaming`` calls it."""
+    s = varmech.scenes.kepler()
+    path = Path(tempfile.mkdtemp()) / "run.h5"
+    spans: list[tuple[float, float]] = []
+
+    class Timed:
+        def __getattr__(self, name: str) -> object:
+            return getattr(_core, name)
+
+        def resume(self, *args: object, **kwargs: object) -> object:
+            started = time.perf_counter()
+            record = _core.resume(*args, **kwargs)
+            spans.append((started, time.perf_counter()))
+            return record
+
+    streaming._core = Timed()  # type: ignore[assignment]
+    try:
+        medians = []
+        for _ in range(3):
+            spans.clear()
+            varmech.integrate(s, dt=s.dt, steps=steps, save_every=10_000, output=path, overwrite=True, checkpoint_every=10**6)
+            between = sorted(b[0] - a[1] for a, b in zip(spans, spans[1:]))
+            segment = sorted(b - a for a, b in spans)
+            medians.append((between[len(between) // 2], segment[len(segment) // 2]))
+    finally:
+        streaming._core = _core
+    gap, segment = min(medians)
+    print(f"main thread between segments: {gap * 1e3:.3f} ms against {segment * 1e3:.1f} ms a segment of 10⁶ steps ({gap / segment:.2%})")
 
 
 def bytes_per_state() -> None:
@@ -90,6 +125,7 @@ def main() -> None:
     parser.add_argument("--billion", action="store_true")
     args = parser.parse_args()
     ratios(args.steps)
+    gaps(min(args.steps, 30_000_000))
     bytes_per_state()
     if args.billion:
         billion()
