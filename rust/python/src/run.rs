@@ -39,10 +39,6 @@ fn integrate<'py>(
     events: Option<Vec<EventTuple<'py>>>,
 ) -> PyResult<TrajectoryRecord> {
     let method = Method::from_name(method).map_err(|e| to_pyerr(py, e))?;
-    let newton = NewtonOptions {
-        tolerance: newton_tolerance,
-        max_iterations: newton_max_iterations,
-    };
     let options = Options {
         dt,
         steps,
@@ -50,7 +46,10 @@ fn integrate<'py>(
         compensated,
         max_energy_error,
         t0,
-        newton,
+        newton: NewtonOptions {
+            tolerance: newton_tolerance,
+            max_iterations: newton_max_iterations,
+        },
     };
     let (q0, p0) = (slice("q0", &q0)?, slice("p0", &p0)?);
     let events = detector_parts(py, model, events)?;
@@ -115,7 +114,7 @@ fn resume<'py>(
 }
 
 /// The poll of a run: the Ctrl-C check, then `progress(steps)` if given.
-fn reporting<'a>(
+pub(crate) fn reporting<'a>(
     poll: Poll<'a>,
     progress: &'a Option<Py<PyAny>>,
 ) -> Counting<impl FnMut(usize) -> Result<(), ModelError> + 'a> {
@@ -137,15 +136,15 @@ fn record(py: Python<'_>, result: Result<Trajectory, Box<Failure>>) -> PyResult<
 }
 
 // The counts, each named in its errors (see [`count`]).
-fn steps_count(x: &Bound<'_, PyAny>) -> PyResult<usize> {
+pub(crate) fn steps_count(x: &Bound<'_, PyAny>) -> PyResult<usize> {
     count("steps", x)
 }
 
-fn save_every_count(x: &Bound<'_, PyAny>) -> PyResult<usize> {
+pub(crate) fn save_every_count(x: &Bound<'_, PyAny>) -> PyResult<usize> {
     count("save_every", x)
 }
 
-fn newton_max_iterations_count(x: &Bound<'_, PyAny>) -> PyResult<usize> {
+pub(crate) fn newton_max_iterations_count(x: &Bound<'_, PyAny>) -> PyResult<usize> {
     count("newton_max_iterations", x)
 }
 
