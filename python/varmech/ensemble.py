@@ -8,6 +8,7 @@ Python per step). Closure models hold the GIL, so they run member by member, ser
 
 from __future__ import annotations
 
+import math
 from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, Literal
@@ -175,6 +176,7 @@ def ensemble(
     newton_tolerance: float = 1e-14,
     newton_max_iterations: int = 50,
     workers: int | None = None,
+    client: Any = None,
     chunk_size: int | None = None,
     progress: bool | None = True,
 ) -> Ensemble:
@@ -203,9 +205,19 @@ def ensemble(
     dt, steps, t_end, method, save_every, compensated, max_energy_error, t0, newton_tolerance, newton_max_iterations:
         As in :func:`varmech.integrate`, for every member.
     workers:
-        The most threads to use; default: one a core.
+        The most threads to use; default: one a core (with ``client``: on each Dask worker, its
+        own thread count).
+    client:
+        A :class:`dask.distributed.Client`: the members run on its cluster in chunks of
+        ``chunk_size``, each chunk one task that runs this same parallel loop in a worker
+        process, and the results are gathered in member order (needs the extra ``cluster``;
+        the README's *Ensembles and clusters* gives the costs). The model is shipped by pickling (a native scene
+        as its name and parameters, a symbolic model as its expressions, a closure model by
+        cloudpickle); one that cannot be is a TypeError naming ``model``. A task lost with its
+        worker is run again by Dask, bit for bit the same.
     chunk_size:
-        Members a task runs one after the other (default 1: the threads balance the load).
+        Members a task runs one after the other (default 1: the threads balance the load; with
+        ``client``, about four chunks a worker thread).
     progress:
         A progress bar of the steps of all members (tqdm, on stderr) once the run has taken a
         second; ``None``: only when stderr is a terminal.
@@ -264,6 +276,9 @@ def ensemble(
     run: dict[str, Any] = dict(dt=dt, steps=nsteps, method=method, save_every=save_every, compensated=bool(compensated), t0=t0)
     newton_tolerance, newton_max_iterations = _newton(newton_tolerance, newton_max_iterations)
     newton: dict[str, Any] = dict(newton_tolerance=newton_tolerance, newton_max_iterations=newton_max_iterations)
+    if client is not None:
+        settings = run | newton | dict(max_energy_error=max_energy_error, workers=workers)
+        return _on_cluster(client, model, q, p, values, settings, chunk_size, progress)
     cores = [m._core for m in (models if values else models[:1])]
     released = [c for c in cores if isinstance(c, (_core.NativeModel, _core.CompiledModel))]
     if len(released) == len(cores):
@@ -287,6 +302,68 @@ def ensemble(
             raise interrupted
         return result
     return _serial(models, q, p, values, run, newton, max_energy_error, progress)
+
+
+def _on_cluster(
+    client: Any,
+    model: Model,
+    q: np.ndarray,
+    p: np.ndarray,
+    values: dict[str, np.ndarray],
+    settings: dict[str, Any],
+    chunk_size: int | None,
+    progress: bool | None,
+) -> Ensemble:
+    """The ensemble on a Dask cluster: chunks of members as tasks (:func:`_chunk`), gathered in
+    member order."""
+    import cloudpickle
+    from distributed import as_completed
+
+    try:
+        cloudpickle.dumps(model)
+    except Exception as err:
+        raise TypeError(f"model: {model.name} cannot be shipped to the cluster ({err})") from err
+    members = len(q)
+    if chunk_size is None:
+        threads = sum(client.nthreads().values()) or 1
+        chunk_size = max(1, math.ceil(members / (4 * threads)))
+    starts = range(0, members, chunk_size)
+    futures = [
+        client.submit(
+            _chunk, model, q[a : a + chunk_size], p[a : a + chunk_size],
+            {k: v[a : a + chunk_size] for k, v in values.items()}, settings, pure=False,
+        )
+        for a in starts
+    ]
+    order = {future.key: i for i, future in enumerate(futures)}
+    chunks: list[Any] = [None] * len(futures)
+    bar = progress_bar(total=members, unit="member", desc=f"{settings['method']} on {client.id}", enabled=progress)
+    try:
+        for future, result in as_completed(futures, with_results=True):
+            chunks[order[future.key]] = result
+            bar.update(len(result[0]))
+    except BaseException:
+        client.cancel(futures)
+        raise
+    finally:
+        bar.close()
+    trajs = [tr for chunk, _ in chunks for tr in chunk]
+    errors = [e for _, chunk in chunks for e in chunk]
+    return Ensemble(trajs, errors, values)
+
+
+def _chunk(
+    model: Model, q: np.ndarray, p: np.ndarray, values: dict[str, np.ndarray], settings: dict[str, Any]
+) -> tuple[list[Trajectory], list[BaseException | None]]:
+    """One cluster task: :func:`ensemble` of a chunk of members in the worker process, on the
+    worker's threads unless ``workers`` says otherwise."""
+    from distributed import get_worker
+
+    settings = dict(settings)
+    if settings["workers"] is None:
+        settings["workers"] = get_worker().state.nthreads
+    run = ensemble(model, q, p, parameters=values or None, progress=False, **settings)
+    return run.trajectories, run.errors
 
 
 def _serial(

@@ -1,6 +1,11 @@
 """Ensembles: every member bit for bit its single ``integrate`` run, failures per member,
 parameter sweeps, Ctrl-C, and bad input named."""
 
+import os
+import signal
+import threading
+import time
+
 import numpy as np
 import pytest
 
@@ -157,3 +162,66 @@ def test_to_xarray_labels_members_times_and_parameters():
     data = runs.to_xarray()
     assert isinstance(data, xarray.Dataset) and data["q"].dims == ("member", "time", "coordinate")
     assert list(data["omega"].values) == [1.0, 2.0] and np.array_equal(data["q"].values, runs.q)
+
+
+@pytest.fixture(scope="module")
+def cluster_client():
+    distributed = pytest.importorskip("distributed")
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cluster:
+        with distributed.Client(cluster) as client:
+            yield client
+
+
+@pytest.mark.parametrize("chunk_size", [None, 7])
+def test_a_dask_cluster_gives_every_member_bit_for_bit(cluster_client, chunk_size):
+    scene, q0, p0 = _double_pendulum_rows(20)
+    run = dict(dt=0.01, steps=300, method="midpoint", save_every=7)
+    runs = varmech.ensemble(scene, q0, p0, client=cluster_client, chunk_size=chunk_size, progress=False, **run)
+    for i in range(20):
+        assert _same(runs[i], varmech.integrate(scene.model, q0[i], p0[i], **run)), f"member {i}"
+    swept = varmech.ensemble(
+        scenes.harmonic_oscillator(), np.zeros((3, 1)), np.ones((3, 1)), parameters={"omega": [1.0, 30.0, 2.0]},
+        dt=0.1, steps=200, method="verlet", client=cluster_client, chunk_size=chunk_size, progress=False,
+    )
+    assert swept.failed == [1] and isinstance(swept.errors[1], varmech.DivergenceError) and swept.errors[1].step >= 1
+
+
+def test_a_model_that_cannot_be_shipped_is_named(cluster_client):
+    class Local:
+        def __reduce__(self):
+            raise TypeError("not picklable")
+
+    local = Local()
+    model = varmech.MechanicalSystem(1, potential=lambda q: local and 0.5 * q[0] ** 2, gradient=lambda q: q.copy())
+    with pytest.raises(TypeError, match="^model"):
+        varmech.ensemble(model, [[1.0]], [[0.0]], dt=0.1, steps=10, client=cluster_client, progress=False)
+
+
+def test_a_killed_dask_worker_is_retried_and_the_ensemble_is_complete_and_equal(cluster_client):
+    scene, q0, p0 = _double_pendulum_rows(8)
+    run = dict(dt=1e-3, steps=1_000_000, method="midpoint", save_every=10_000)
+    address, victim = sorted(cluster_client.run(os.getpid).items())[0]
+    killed = {}
+    done = threading.Event()
+
+    def kill():
+        # Once the victim runs a chunk: its task is lost with it, and Dask runs it again.
+        while not done.is_set() and not cluster_client.processing().get(address):
+            time.sleep(0.01)
+        time.sleep(0.2)
+        killed["while_running"] = not done.is_set()
+        os.kill(victim, signal.SIGKILL)
+
+    killer = threading.Thread(target=kill)
+    killer.start()
+    try:
+        runs = varmech.ensemble(scene, q0, p0, client=cluster_client, chunk_size=1, progress=False, **run)
+    finally:
+        done.set()
+        killer.join()
+    assert killed["while_running"], "the worker was killed during the run"
+    assert victim not in cluster_client.run(os.getpid).values()
+    local = varmech.ensemble(scene, q0, p0, workers=2, progress=False, **run)
+    assert runs.failed == [] and len(runs) == 8
+    for i in range(8):
+        assert _same(runs[i], local[i]), f"member {i}"
