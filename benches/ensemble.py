@@ -1,12 +1,14 @@
 """The ensemble's parallel speed-up: a 256-member double-pendulum ensemble (native, ``midpoint``)
-with ``workers`` = 1 and 2 against a Python loop of ``integrate`` calls, in one run.
+with ``workers`` = 1 and 2, through a Dask ``LocalCluster(n_workers=2, threads_per_worker=1,
+processes=True)``, and a Python loop of ``integrate`` calls, in one run.
 
     PYTHONPATH=$PWD/python python benches/ensemble.py [--members 256] [--steps 10000] [--repeat 3] [--markdown FILE]
 
 Every configuration is timed best of ``--repeat``, all interleaved so that machine noise hits
 them alike; the ratios are what to read (the machine is shared). The load average before and
 after the timing is printed with them. Every member of every configuration is checked bit for
-bit against the loop's.
+bit against the loop's. Then the cluster's costs: the per-task overhead (256 one-step members,
+one a task), and the bytes shipped per task and per result (cloudpickle, Dask's serialiser).
 """
 
 from __future__ import annotations
@@ -17,6 +19,7 @@ import os
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 import argparse
+import time
 from pathlib import Path
 
 import numpy as np
@@ -24,6 +27,7 @@ from compare import best_times_interleaved
 
 import varmech
 from varmech import scenes
+from varmech.ensemble import _chunk
 
 
 def main() -> None:
@@ -50,12 +54,41 @@ def main() -> None:
 
         return go
 
-    runs = {"Python loop of integrate": loop, "ensemble, workers = 1": parallel(1), "ensemble, workers = 2": parallel(2)}
+    import cloudpickle
+    from distributed import Client, LocalCluster
+
+    cluster = LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None)
+    client = Client(cluster)
+
+    def dask() -> None:
+        results["dask"] = list(varmech.ensemble(scene, q0, p0, client=client, progress=False, **run))
+
+    runs = {
+        "Python loop of integrate": loop,
+        "ensemble, workers = 1": parallel(1),
+        "ensemble, workers = 2": parallel(2),
+        "ensemble, LocalCluster 2 processes × 1 thread": dask,
+    }
     load_before = os.getloadavg()
     best = best_times_interleaved(runs, args.repeat)
     load_after = os.getloadavg()
     for name, trajs in results.items():
         assert all(np.array_equal(a.q, b.q) and np.array_equal(a.p, b.p) for a, b in zip(trajs, results["loop"])), name
+
+    # The cluster's costs: one-step members one a task, and the bytes of a default chunk.
+    tiny = dict(run, steps=1, save_every=1)
+    overhead = np.inf
+    for _ in range(args.repeat):
+        start = time.perf_counter()
+        varmech.ensemble(scene, q0, p0, client=client, chunk_size=1, progress=False, **tiny)
+        overhead = min(overhead, (time.perf_counter() - start) / args.members)
+    chunk = -(-args.members // 8)
+    settings = dict(run, compensated=True, t0=0.0, newton_tolerance=1e-14, newton_max_iterations=50, max_energy_error="auto", workers=1)
+    task = (scene.model, q0[:chunk], p0[:chunk], {}, settings)
+    sent = len(cloudpickle.dumps(task))
+    received = len(cloudpickle.dumps(_chunk(*task[:4], dict(settings, workers=1))))
+    client.close()
+    cluster.close()
 
     w1 = best["ensemble, workers = 1"]
     lines = [
@@ -69,6 +102,14 @@ def main() -> None:
     ]
     for name, seconds in best.items():
         lines.append(f"| {name} | {seconds:.3f} | {w1 / seconds:.2f} | {best['Python loop of integrate'] / seconds:.2f} |")
+    lines += [
+        "",
+        f"Dask time / local workers = 2: {best['ensemble, LocalCluster 2 processes × 1 thread'] / best['ensemble, workers = 2']:.3f} "
+        f"(the default chunks: {chunk} members a task, 8 tasks).",
+        f"Per-task overhead on the LocalCluster: {overhead * 1e3:.2f} ms (one-step members, one a task, best of {args.repeat}).",
+        f"Bytes shipped per task of {chunk} members: {sent} (model, initial rows, settings); per result: {received} "
+        f"({received / chunk:.0f} a member of {args.steps // 100 + 1} saved states of n = 2).",
+    ]
     text = "\n".join(lines)
     print(text)
     if args.markdown:
