@@ -256,6 +256,8 @@ def ensemble(
     >>> bool(np.array_equal(runs[1].q, single.q))
     True
     """
+    if getattr(model, "contacts", ()):
+        raise ValueError(f"model: the scene {model.name}'s contacts do not run in ensembles yet; pass scene.model without them")
     model, _, _ = _model_of(model, None, None, None)
     n = model.dim
     q = np.array(q0, dtype=float)

@@ -115,6 +115,19 @@ def test_a_drive_amplitude_sweep_equals_separate_runs():
     assert list(runs.parameters["amplitude"]) == list(amplitudes)
 
 
+def test_a_symbolic_models_parameter_sweep_equals_separate_runs():
+    pytest.importorskip("sympy")
+    from varmech.symbolic import examples
+
+    scene = examples.scene("elastic_pendulum")
+    stiffness = [10.0, 12.5, 40.0]
+    q0, p0 = np.tile(scene.q0, (3, 1)), np.tile(scene.p0, (3, 1))
+    runs = varmech.ensemble(scene.model, q0, p0, parameters={"k": stiffness}, dt=0.01, steps=500, workers=2, progress=False)
+    for i, k in enumerate(stiffness):
+        assert _same(runs[i], varmech.integrate(scene.model, scene.q0, scene.p0, dt=0.01, steps=500, parameters={"k": k}))
+    assert not np.array_equal(runs.q[0], runs.q[2])
+
+
 def test_ctrl_c_stops_every_member_and_keeps_what_was_computed(interrupt_after):
     scene, q0, p0 = _double_pendulum_rows(3)
     run = dict(dt=1e-4, save_every=1000, method="midpoint")
@@ -144,14 +157,15 @@ def test_ctrl_c_stops_every_member_and_keeps_what_was_computed(interrupt_after):
         (dict(workers=0), "workers"),
         (dict(workers=-2), "workers"),
         (dict(chunk_size=0), "chunk_size"),
+        (dict(model=scenes.bouncing_ball(), q0=np.ones((4, 1)), p0=np.zeros((4, 1))), "model"),
         (dict(steps=10**12, dt=1e-12, q0=np.zeros((10**4, 2)), p0=np.zeros((10**4, 2))), "save_every"),
     ],
 )
 def test_bad_input_is_a_value_error_naming_the_argument(change, argument):
     scene, q0, p0 = _double_pendulum_rows(4)
-    args = dict(q0=q0, p0=p0, dt=0.01, steps=10, progress=False) | change
+    args = dict(model=scene, q0=q0, p0=p0, dt=0.01, steps=10, progress=False) | change
     with pytest.raises(ValueError, match=f"^{argument}"):
-        varmech.ensemble(scene, **args)
+        varmech.ensemble(**args)
 
 
 def test_to_xarray_labels_members_times_and_parameters():

@@ -5,14 +5,14 @@
 use numpy::PyReadonlyArray2;
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
-use varmech::integrators::{self, Dynamics, Members, Method, NewtonOptions, Options, Parallel};
+use varmech::integrators::{self, Dynamics, Members, Parallel};
 
 use crate::bind::check_signals;
 use crate::compiled::CompiledModel;
 use crate::convert::rows;
 use crate::errors::{model_error, to_pyerr};
 use crate::native::NativeModel;
-use crate::run::{newton_max_iterations_count, reporting, save_every_count, steps_count};
+use crate::run::{method_and_options, newton_max_iterations_count, reporting, save_every_count, steps_count};
 use crate::trajectory::TrajectoryRecord;
 
 /// A model the core evaluates without the GIL.
@@ -79,19 +79,18 @@ fn ensemble<'py>(
     chunk_size: Option<usize>,
     progress: Option<Py<PyAny>>,
 ) -> PyResult<(Vec<MemberResult>, Option<Py<PyAny>>)> {
-    let method = Method::from_name(method).map_err(|e| to_pyerr(py, e))?;
-    let options = Options {
+    let (method, options) = method_and_options(
+        py,
+        method,
         dt,
         steps,
         save_every,
         compensated,
         max_energy_error,
         t0,
-        newton: NewtonOptions {
-            tolerance: newton_tolerance,
-            max_iterations: newton_max_iterations,
-        },
-    };
+        newton_tolerance,
+        newton_max_iterations,
+    )?;
     let ((q0, _), (p0, _)) = (rows("q0", &q0)?, rows("p0", &p0)?);
     let models = Models(
         models

@@ -38,19 +38,18 @@ fn integrate<'py>(
     progress: Option<Py<PyAny>>,
     events: Option<Vec<EventTuple<'py>>>,
 ) -> PyResult<TrajectoryRecord> {
-    let method = Method::from_name(method).map_err(|e| to_pyerr(py, e))?;
-    let options = Options {
+    let (method, options) = method_and_options(
+        py,
+        method,
         dt,
         steps,
         save_every,
         compensated,
         max_energy_error,
         t0,
-        newton: NewtonOptions {
-            tolerance: newton_tolerance,
-            max_iterations: newton_max_iterations,
-        },
-    };
+        newton_tolerance,
+        newton_max_iterations,
+    )?;
     let (q0, p0) = (slice("q0", &q0)?, slice("p0", &p0)?);
     let events = detector_parts(py, model, events)?;
     let result = bind_model(py, model, |sys, poll| {
@@ -64,6 +63,37 @@ fn integrate<'py>(
         }
     })?;
     record(py, result)
+}
+
+/// A run's method and [`Options`] from the binding's arguments (`integrate`'s and `ensemble`'s).
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn method_and_options(
+    py: Python<'_>,
+    method: &str,
+    dt: f64,
+    steps: usize,
+    save_every: usize,
+    compensated: bool,
+    max_energy_error: Option<f64>,
+    t0: f64,
+    newton_tolerance: f64,
+    newton_max_iterations: usize,
+) -> PyResult<(Method, Options)> {
+    let method = Method::from_name(method).map_err(|e| to_pyerr(py, e))?;
+    let newton = NewtonOptions {
+        tolerance: newton_tolerance,
+        max_iterations: newton_max_iterations,
+    };
+    let options = Options {
+        dt,
+        steps,
+        save_every,
+        compensated,
+        max_energy_error,
+        t0,
+        newton,
+    };
+    Ok((method, options))
 }
 
 /// The event functions and specs of `events`, checked against the model.
