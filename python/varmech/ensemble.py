@@ -51,7 +51,7 @@ class EnsembleConservation:
         )
 
 
-@dataclass
+@dataclass(eq=False)
 class Ensemble:
     """The members' runs of :func:`ensemble`, stacked.
 
