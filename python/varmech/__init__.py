@@ -41,6 +41,7 @@ from .analysis.work_precision import work_precision
 from .conservation import ConservationReport, InvariantStatistics, check_conservation, momentum
 from .constraints import project
 from .derivatives import DerivativeCheck, check_derivatives
+from .ensemble import Ensemble, EnsembleConservation, ensemble
 from .files import load
 from .impacts import Contact, ContactError
 from .impulses import Engagement, Impulse, ImpulseResponse, engage, impulse_response
@@ -63,6 +64,8 @@ __all__ = [
     "DerivativeCheck",
     "DivergenceError",
     "Engagement",
+    "Ensemble",
+    "EnsembleConservation",
     "Impulse",
     "ImpulseResponse",
     "InvariantStatistics",
@@ -85,6 +88,7 @@ __all__ = [
     "cyclic_coordinates",
     "energy_growth",
     "engage",
+    "ensemble",
     "events",
     "growth_factor",
     "growth_table",

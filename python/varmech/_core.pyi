@@ -42,6 +42,7 @@ __all__ = [
     "derivative",
     "energy_statistics",
     "energy_terms",
+    "ensemble",
     "integrate",
     "is_forced",
     "is_time_dependent",
@@ -428,6 +429,29 @@ def amended_potential(model: RouthModel, t: _FloatArray, x: _FloatArray) -> _Flo
 
 def cyclic_velocity(model: RouthModel, t: _FloatArray, x: _FloatArray, xdot: _FloatArray) -> _FloatArray:
     """ċ with ∂L/∂ċ = μ at each state, (N, m)."""
+
+def ensemble(
+    models: list[NativeModel | CompiledModel],
+    q0: _FloatArray,
+    p0: _FloatArray,
+    *,
+    dt: float,
+    steps: int,
+    method: str,
+    save_every: int = 1,
+    compensated: bool = True,
+    max_energy_error: float | None = None,
+    t0: float = 0.0,
+    newton_tolerance: float = 1e-14,
+    newton_max_iterations: int = 50,
+    workers: int | None = None,
+    chunk_size: int | None = None,
+    progress: Callable[[int], object] | None = None,
+) -> tuple[list[tuple[TrajectoryRecord, BaseException | None]], BaseException | None]:
+    """Members (rows of q0 and p0, (members, n)) integrated in parallel with the GIL released,
+    with one shared model or one a member: each member's record (the partial one of a failure)
+    and exception, and the exception (KeyboardInterrupt) that stopped the ensemble, if any.
+    ``progress(steps)`` gets the steps of all members every 10 ms."""
 
 def integrate(
     model: _Model,

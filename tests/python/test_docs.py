@@ -27,6 +27,7 @@ pytest.importorskip("sympy")
         "varmech.scenes",
         "varmech.stepper",
         "varmech.conservation",
+        "varmech.ensemble",
     ],
 )
 def test_examples_run(name):

@@ -12,6 +12,7 @@ mod compiled;
 mod constraints;
 mod convergence;
 mod damped_driven_pendulum;
+mod ensemble;
 mod events;
 mod failures;
 mod forcing;

@@ -9,12 +9,14 @@ from collections.abc import Iterable
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .._progress import progress as _progress
+from .. import _core
 from .._util import positive
+from ..ensemble import ensemble
+from ..integrate import Trajectory
 from ..model import Model
 from ..table import Table
 from ._interrupt import interruptible
-from ._orbits import ModelLike, default_method, model_of, run, solve_momentum
+from ._orbits import ModelLike, default_method, model_of, solve_momentum
 
 #: The pendulum's default phase-portrait energies (H = p²/2 − cos q, separatrix at H = 1).
 PENDULUM_ENERGIES = (-0.9, -0.6, -0.2, 0.3, 0.7, 0.95, 0.995, 1.005, 1.05, 1.4, 2.0, 3.0)
@@ -55,8 +57,9 @@ def phase_portrait(
     each of ``energies`` (default for the pendulum: :data:`PENDULUM_ENERGIES`, librations below
     the separatrix energy 1, rotations above it, both close to it). With ``mirror``, an orbit
     classified as a rotation gets a twin with −p (it turns the other way; a libration's mirror
-    is the same curve). Each orbit is one :func:`varmech.integrate` call (``kahan_li6`` for
-    separable models by default, ``galerkin6`` otherwise), saving every ``save_every`` steps.
+    is the same curve). The orbits are one :func:`varmech.ensemble` (each bit for bit its
+    :func:`varmech.integrate` call; ``kahan_li6`` for separable models by default, ``galerkin6``
+    otherwise), and their mirrors another, saving every ``save_every`` steps.
 
     One row per saved state: ``orbit``, ``energy`` (H at the start), ``motion`` (from the
     trajectory: ``"libration"`` if p reverses and q stays within 2π, ``"rotation"`` if p never
@@ -98,8 +101,21 @@ def phase_portrait(
     if _is_pendulum(model):
         table.meta["separatrix_energy"] = 1.0
 
-    def one(o: int, q0: float, p0: float) -> str:
-        traj, note = run(model, np.array([q0]), np.array([p0]), dt=dt, t_end=t_end, method=method, save_every=save_every)
+    def orbits(states: list[tuple[float, float]]) -> list[tuple[Trajectory, str | None]]:
+        """Each orbit from (q0, p0) of ``states``, a divergent one (an orbit that escapes) with
+        its partial trajectory and a note."""
+        if not states:
+            return []
+        z = np.array(states)
+        runs = ensemble(model, z[:, :1], z[:, 1:], dt=dt, t_end=t_end, method=method, save_every=save_every, progress=progress)
+        out: list[tuple[Trajectory, str | None]] = []
+        for traj, err in zip(runs, runs.errors):
+            if err is not None and not (isinstance(err, _core.DivergenceError) and len(traj)):
+                raise err
+            out.append((traj, None if err is None else f"diverged at t = {traj.t[-1]:.6g} ({err})"))
+        return out
+
+    def add(o: int, traj: Trajectory, note: str | None) -> str:
         if note:
             table.meta["notes"].append(f"orbit {o}: {note}")
         h = traj.energy()
@@ -111,12 +127,15 @@ def phase_portrait(
         return motion
 
     def body() -> None:
+        first = orbits(starts)
+        turning = [mirror and _classify(traj.q[:, 0], traj.p[:, 0]) == "rotation" for traj, _ in first]
+        mirrors = iter(orbits([(q0, -p0) for (q0, p0), turns in zip(starts, turning) if turns]))
         o = 0
-        for q0, p0 in _progress(starts, total=len(starts), desc=f"phase portrait {model.name}", enabled=progress):
-            motion = one(o, q0, p0)
+        for (traj, note), turns in zip(first, turning):
+            add(o, traj, note)
             o += 1
-            if mirror and motion == "rotation":
-                one(o, q0, -p0)
+            if turns:
+                add(o, *next(mirrors))
                 o += 1
 
     return interruptible(table, body)

@@ -23,7 +23,7 @@ pub type Poll<'a> = &'a dyn Fn() -> Result<(), ModelError>;
 
 /// The Ctrl-C check: Python's signal handlers run, and a KeyboardInterrupt stops the run. It
 /// takes the GIL where a native run released it (a no-op where it is held).
-fn check_signals() -> Result<(), ModelError> {
+pub(crate) fn check_signals() -> Result<(), ModelError> {
     Python::attach(|py| py.check_signals()).map_err(boxed)
 }
 

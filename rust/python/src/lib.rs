@@ -4,7 +4,7 @@
 //! results are converted between numpy and the core ([`convert`], [`trajectory`],
 //! [`generator`]); Python closures are adapted to the core's model traits ([`closure`]), native
 //! scenes wrapped ([`native`], [`scenes`]), symbolic models' tapes decoded ([`compiled`]), function pointers called
-//! ([`pointers`]), and every model resolved to the core by the one
+//! ([`pointers`]), ensembles of native and compiled models run in parallel ([`ensemble`]), and every model resolved to the core by the one
 //! dispatch [`bind::bind_model`]; core errors become Python exceptions with the core's messages
 //! ([`errors`]). Policy, such as which method fits which kind of model, is the core's
 //! ([`bind::kind_of`] only shows it). The Python API in `python/varmech` is built on these functions;
@@ -16,6 +16,7 @@ mod compiled;
 mod constraints;
 mod convert;
 mod diagnostics;
+mod ensemble;
 mod errors;
 mod events;
 mod generator;
@@ -40,6 +41,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     scenes::register(m)?;
     routh::register(m)?;
     run::register(m)?;
+    ensemble::register(m)?;
     m.add_class::<stepper::Stepper>()?;
     diagnostics::register(m)?;
     constraints::register(m)?;

@@ -38,6 +38,47 @@ fn integrate<'py>(
     progress: Option<Py<PyAny>>,
     events: Option<Vec<EventTuple<'py>>>,
 ) -> PyResult<TrajectoryRecord> {
+    let (method, options) = method_and_options(
+        py,
+        method,
+        dt,
+        steps,
+        save_every,
+        compensated,
+        max_energy_error,
+        t0,
+        newton_tolerance,
+        newton_max_iterations,
+    )?;
+    let (q0, p0) = (slice("q0", &q0)?, slice("p0", &p0)?);
+    let events = detector_parts(py, model, events)?;
+    let result = bind_model(py, model, |sys, poll| {
+        let report = reporting(poll, &progress);
+        match events {
+            None => integrators::integrate(sys, method, q0, p0, &options, report),
+            Some((functions, specs)) => {
+                let mut detector = detector(functions, specs)?;
+                integrators::integrate_with_events(sys, method, q0, p0, &options, report, &mut detector)
+            }
+        }
+    })?;
+    record(py, result)
+}
+
+/// A run's method and [`Options`] from the binding's arguments (`integrate`'s and `ensemble`'s).
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn method_and_options(
+    py: Python<'_>,
+    method: &str,
+    dt: f64,
+    steps: usize,
+    save_every: usize,
+    compensated: bool,
+    max_energy_error: Option<f64>,
+    t0: f64,
+    newton_tolerance: f64,
+    newton_max_iterations: usize,
+) -> PyResult<(Method, Options)> {
     let method = Method::from_name(method).map_err(|e| to_pyerr(py, e))?;
     let newton = NewtonOptions {
         tolerance: newton_tolerance,
@@ -52,19 +93,7 @@ fn integrate<'py>(
         t0,
         newton,
     };
-    let (q0, p0) = (slice("q0", &q0)?, slice("p0", &p0)?);
-    let events = detector_parts(py, model, events)?;
-    let result = bind_model(py, model, |sys, poll| {
-        let report = reporting(poll, &progress);
-        match events {
-            None => integrators::integrate(sys, method, q0, p0, &options, report),
-            Some((functions, specs)) => {
-                let mut detector = detector(functions, specs)?;
-                integrators::integrate_with_events(sys, method, q0, p0, &options, report, &mut detector)
-            }
-        }
-    })?;
-    record(py, result)
+    Ok((method, options))
 }
 
 /// The event functions and specs of `events`, checked against the model.
@@ -115,7 +144,7 @@ fn resume<'py>(
 }
 
 /// The poll of a run: the Ctrl-C check, then `progress(steps)` if given.
-fn reporting<'a>(
+pub(crate) fn reporting<'a>(
     poll: Poll<'a>,
     progress: &'a Option<Py<PyAny>>,
 ) -> Counting<impl FnMut(usize) -> Result<(), ModelError> + 'a> {
@@ -137,15 +166,15 @@ fn record(py: Python<'_>, result: Result<Trajectory, Box<Failure>>) -> PyResult<
 }
 
 // The counts, each named in its errors (see [`count`]).
-fn steps_count(x: &Bound<'_, PyAny>) -> PyResult<usize> {
+pub(crate) fn steps_count(x: &Bound<'_, PyAny>) -> PyResult<usize> {
     count("steps", x)
 }
 
-fn save_every_count(x: &Bound<'_, PyAny>) -> PyResult<usize> {
+pub(crate) fn save_every_count(x: &Bound<'_, PyAny>) -> PyResult<usize> {
     count("save_every", x)
 }
 
-fn newton_max_iterations_count(x: &Bound<'_, PyAny>) -> PyResult<usize> {
+pub(crate) fn newton_max_iterations_count(x: &Bound<'_, PyAny>) -> PyResult<usize> {
     count("newton_max_iterations", x)
 }
 

@@ -19,7 +19,9 @@
 //!   [`StepperState`] apart from the model, to resume;
 //! - [`integrate`]: a run of a [`Stepper`] with saving and an energy check, into a
 //!   [`Trajectory`]; [`resume`] goes on from its [`Checkpoint`], bit for bit;
-//!   [`integrate_with_events`] also watches [`events`], located by partial steps.
+//!   [`integrate_with_events`] also watches [`events`], located by partial steps;
+//! - [`integrate_ensemble`]: many such runs in parallel ([`Ensemble`]), each bit for bit its
+//!   single run.
 
 use serde::{Deserialize, Serialize};
 mod checkpoint;
@@ -27,6 +29,7 @@ pub mod compensated;
 mod composition;
 mod del;
 mod dynamics;
+mod ensemble;
 pub mod events;
 mod explicit_rk;
 mod kick_drift;
@@ -48,6 +51,7 @@ pub use checkpoint::Checkpoint;
 pub use composition::Composition;
 pub use del::{Del, StepEquations, TwoPoint};
 pub use dynamics::{Dynamics, General};
+pub use ensemble::{integrate_ensemble, Ensemble, Members, Outcome, Parallel, Shared, Stopped};
 pub use events::{Detector, EventFunctions, EventSpec, NativeEvent, Occurrence};
 pub use explicit_rk::ExplicitRk;
 pub use kick_drift::KickDrift;

@@ -1,0 +1,463 @@
+"""Ensembles: many runs of one model (or of one model at many parameter values) at once.
+
+Member i of an ensemble is :func:`varmech.integrate` of its model from row i of ``q0`` and
+``p0``, bit for bit, whatever the number of threads or the chunking. Native and compiled
+models run in the Rust core on every core of the machine (Rayon threads, the GIL released, no
+Python per step). Closure models hold the GIL, so they run member by member, serially.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterator, Mapping, Sequence
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any, Literal
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from . import _core
+from ._progress import progress_bar
+from ._util import finite, positive, positive_int
+from .conservation import VERDICTS, ConservationReport, check_conservation
+from .integrate import Trajectory, _energy_threshold, _model_of, _newton, _steps, _trajectory, integrate
+from .model import Model, NativeSystem, _scene_model
+
+if TYPE_CHECKING:
+    import xarray
+
+    from .scenes import Scene
+
+
+@dataclass
+class EnsembleConservation:
+    """The conservation reports of an ensemble's members and their summary.
+
+    ``reports[i]`` is :func:`varmech.check_conservation` of member i (None for a member that
+    saved fewer than two states); ``worst_energy_error`` is the largest max |ΔE| / scale over the
+    members (of the balance E − W for forced models); ``not_bounded`` lists the members whose
+    energy verdict is worse than ``"bounded"`` (a secular drift or a failure).
+    """
+
+    reports: list[ConservationReport | None]
+    worst_energy_error: float
+    not_bounded: list[int]
+
+    def __str__(self) -> str:
+        judged = sum(r is not None for r in self.reports)
+        return (
+            f"Ensemble conservation: {judged} of {len(self.reports)} members judged, worst energy error "
+            f"{self.worst_energy_error:.3e} × scale, not bounded: {self.not_bounded or 'none'}"
+        )
+
+
+@dataclass(eq=False)
+class Ensemble:
+    """The members' runs of :func:`ensemble`, stacked.
+
+    ``q`` and ``p`` have shape (members, saved, n) and ``t`` shape (saved,): the saved times of a
+    complete member. A member that stopped early (``status`` -1, see ``failed``) has NaN rows
+    after its last state; its own states, its ``message`` and its exception (``errors[i]``, with
+    ``step`` and ``time``) are kept, and ``ensemble[i]`` is its :class:`~varmech.Trajectory`
+    (the partial one of a failure). ``parameters`` holds each member's parameter values by
+    name.
+    """
+
+    trajectories: list[Trajectory]
+    errors: list[BaseException | None]
+    parameters: dict[str, np.ndarray]
+    t: np.ndarray = field(init=False, repr=False)
+    q: np.ndarray = field(init=False, repr=False)
+    p: np.ndarray = field(init=False, repr=False)
+    status: np.ndarray = field(init=False, repr=False)
+    messages: list[str] = field(init=False, repr=False)
+
+    def __post_init__(self) -> None:
+        trajs = self.trajectories
+        saved = max((len(tr) for tr in trajs), default=0)
+        n = trajs[0].model.dim if trajs else 0
+        self.q = np.full((len(trajs), saved, n), np.nan)
+        self.p = np.full((len(trajs), saved, n), np.nan)
+        for i, tr in enumerate(trajs):
+            self.q[i, : len(tr)] = tr.q
+            self.p[i, : len(tr)] = tr.p
+        longest = max(trajs, key=len, default=None)
+        self.t = np.asarray(longest.t) if longest is not None else np.empty(0)
+        self.status = np.array([tr.status for tr in trajs], dtype=int)
+        self.messages = [tr.message for tr in trajs]
+
+    @property
+    def failed(self) -> list[int]:
+        """The members that did not reach the end (status -1), in member order."""
+        return [i for i, s in enumerate(self.status) if s != 0]
+
+    def __getitem__(self, i: int) -> Trajectory:
+        return self.trajectories[i]
+
+    def __len__(self) -> int:
+        return len(self.trajectories)
+
+    def __iter__(self) -> Iterator[Trajectory]:
+        return iter(self.trajectories)
+
+    def energy(self) -> np.ndarray:
+        """The energy function E at every saved state, shape (members, saved); NaN after a
+        member's last state."""
+        out = np.full(self.q.shape[:2], np.nan)
+        for i, tr in enumerate(self.trajectories):
+            if len(tr):
+                out[i, : len(tr)] = tr.energy()
+        return out
+
+    def check_conservation(self) -> EnsembleConservation:
+        """:func:`varmech.check_conservation` of every member, and the summary
+        (:class:`EnsembleConservation`).
+
+        Examples
+        --------
+        >>> import numpy as np, varmech
+        >>> from varmech import scenes
+        >>> q0 = np.array([[0.5, 0.0], [0.6, 0.0]])
+        >>> p0 = np.array([[0.0, 1.5], [0.0, 1.4]])
+        >>> runs = varmech.ensemble(scenes.kepler(), q0, p0, dt=0.01, steps=20_000, method="verlet", progress=False)
+        >>> summary = runs.check_conservation()
+        >>> summary.not_bounded, summary.worst_energy_error < 1e-2
+        ([], True)
+        """
+        reports = [check_conservation(tr) if len(tr) >= 2 else None for tr in self.trajectories]
+        worst, not_bounded = 0.0, []
+        for i, report in enumerate(reports):
+            stats = None if report is None else report.energy or report.energy_balance
+            if stats is None:
+                continue
+            worst = max(worst, stats.max_rel_error)
+            if VERDICTS.index(stats.verdict) > VERDICTS.index("bounded"):
+                not_bounded.append(i)
+        return EnsembleConservation(reports, worst, not_bounded)
+
+    def to_xarray(self) -> xarray.Dataset:
+        """A labelled :class:`xarray.Dataset`: ``q`` and ``p`` with dims (member, time,
+        coordinate), ``status`` by member, the parameters as coordinates of ``member``
+        (needs xarray, the extra ``xarray``)."""
+        try:
+            import xarray
+        except ImportError as err:
+            raise ImportError("to_xarray needs xarray: pip install 'varmech[xarray]'") from err
+        dims = ("member", "time", "coordinate")
+        coords: dict[str, Any] = {
+            "member": np.arange(len(self)),
+            "time": self.t,
+            "coordinate": np.arange(self.q.shape[2]),
+        }
+        coords.update({name: ("member", values) for name, values in self.parameters.items()})
+        data = {"q": (dims, self.q), "p": (dims, self.p), "status": ("member", self.status)}
+        return xarray.Dataset(data, coords=coords)
+
+    def __repr__(self) -> str:
+        shape = "×".join(map(str, self.q.shape))
+        return f"Ensemble(members={len(self)}, q: {shape}, failed={len(self.failed)})"
+
+
+def ensemble(
+    model: Model | Scene,
+    q0: ArrayLike,
+    p0: ArrayLike | None = None,
+    *,
+    v0: ArrayLike | None = None,
+    parameters: Mapping[str, ArrayLike] | None = None,
+    dt: float,
+    steps: int | None = None,
+    t_end: float | None = None,
+    method: str | None = None,
+    save_every: int = 1,
+    compensated: bool = True,
+    max_energy_error: float | None | Literal["auto"] = "auto",
+    t0: float | None = None,
+    newton_tolerance: float = 1e-14,
+    newton_max_iterations: int = 50,
+    workers: int | None = None,
+    client: Any = None,
+    chunk_size: int | None = None,
+    progress: bool | None = True,
+) -> Ensemble:
+    """Integrate many members of ``model`` at once: member i from (``q0[i]``, ``p0[i]``).
+
+    Each member is exactly :func:`varmech.integrate` of its model and initial state with the
+    other arguments, which mean what they mean there: its result is bit for bit the single
+    run's, whatever ``workers`` or ``chunk_size``.
+
+    Native and compiled models run in the Rust core on ``workers`` threads with the GIL
+    released. Closure models (:class:`~varmech.MechanicalSystem`, :class:`~varmech.Lagrangian`)
+    call Python at every step and hold the GIL, so they run member by member, serially.
+
+    Parameters
+    ----------
+    model:
+        A model or a :class:`~varmech.scenes.Scene` (its model).
+    q0, p0, v0:
+        Initial positions (members, n), and momenta ``p0`` or velocities ``v0`` of the same
+        shape (exactly one of them).
+    parameters:
+        Per-member values of the model's named parameters, ``{name: array (members,)}`` (a
+        scalar is every member's): the parameters of a native scene
+        (:func:`varmech.scenes.get`) or of a symbolic model (:mod:`varmech.symbolic`); the
+        others keep the model's values.
+    dt, steps, t_end, method, save_every, compensated, max_energy_error, t0, newton_tolerance, newton_max_iterations:
+        As in :func:`varmech.integrate`, for every member.
+    workers:
+        The most threads to use; default: one a core (with ``client``: on each Dask worker, its
+        own thread count).
+    client:
+        A :class:`dask.distributed.Client`: the members run on its cluster in chunks of
+        ``chunk_size``, each chunk one task that runs this same parallel loop in a worker
+        process, and the results are gathered in member order (needs the extra ``cluster``;
+        the README's *Ensembles and clusters* gives the costs). The model is shipped by pickling (a native scene
+        as its name and parameters, a symbolic model as its expressions, a closure model by
+        cloudpickle); one that cannot be is a TypeError naming ``model``. A task lost with its
+        worker is run again by Dask, bit for bit the same.
+    chunk_size:
+        Members a task runs one after the other (default 1: the threads balance the load; with
+        ``client``, about four chunks a worker thread).
+    progress:
+        A progress bar of the steps of all members (tqdm, on stderr) once the run has taken a
+        second; ``None``: only when stderr is a terminal.
+
+    Returns
+    -------
+    Ensemble
+        The stacked states; a member that failed (diverged, failed Newton, met bad data) is in
+        ``ensemble.failed``, with its message, exception and partial trajectory, and the other
+        members are complete. The memory for every saved state is checked before the run: an
+        ensemble that cannot fit is a ValueError naming ``save_every``.
+
+    Raises
+    ------
+    ValueError
+        Naming ``q0`` (not (members, n)), ``p0`` or ``v0`` (another shape), ``parameters`` (a name
+        the model does not have, or not one value a member), ``workers`` or ``chunk_size``
+        (not a positive integer), ``save_every`` (the output would not fit in memory), or an
+        argument of :func:`varmech.integrate`.
+    KeyboardInterrupt
+        Ctrl-C stops every member within about 0.1 s; ``err.partial`` is the
+        :class:`Ensemble` of what was computed (the stopped members have status -1).
+
+    Examples
+    --------
+    >>> import numpy as np, varmech
+    >>> from varmech import scenes
+    >>> scene = scenes.damped_driven_pendulum()
+    >>> amplitudes = np.array([0.9, 1.07, 1.5])
+    >>> runs = varmech.ensemble(scene, np.zeros((3, 1)), np.zeros((3, 1)), dt=0.05, steps=400,
+    ...                         parameters={"amplitude": amplitudes}, save_every=10, progress=False)
+    >>> runs.q.shape, runs.failed
+    ((3, 41, 1), [])
+    >>> single = varmech.integrate(scenes.damped_driven_pendulum(amplitude=1.07), [0.0], [0.0],
+    ...                            dt=0.05, steps=400, save_every=10)
+    >>> bool(np.array_equal(runs[1].q, single.q))
+    True
+    """
+    if getattr(model, "contacts", ()):
+        raise ValueError(f"model: the scene {model.name}'s contacts do not run in ensembles yet; pass scene.model without them")
+    model, _, _ = _model_of(model, None, None, None)
+    n = model.dim
+    q = np.array(q0, dtype=float)
+    if q.ndim != 2 or q.shape[1] != n or q.shape[0] == 0:
+        raise ValueError(f"q0: must have shape (members, {n}) with at least one member, got shape {q.shape}")
+    members = q.shape[0]
+    values = _parameter_values(model, parameters, members)
+    models = _member_models(model, values, members)
+    t0 = 0.0 if t0 is None else finite("t0", t0)
+    p = _momenta(models, q, p0, v0, t0)
+    if method is None:
+        method = model.kind.default_method
+    dt = positive("dt", dt)
+    nsteps = _steps(dt, t0, steps, t_end)
+    save_every = positive_int("save_every", save_every)
+    workers = None if workers is None else positive_int("workers", workers)
+    chunk_size = None if chunk_size is None else positive_int("chunk_size", chunk_size)
+    run: dict[str, Any] = dict(dt=dt, steps=nsteps, method=method, save_every=save_every, compensated=bool(compensated), t0=t0)
+    newton_tolerance, newton_max_iterations = _newton(newton_tolerance, newton_max_iterations)
+    newton: dict[str, Any] = dict(newton_tolerance=newton_tolerance, newton_max_iterations=newton_max_iterations)
+    if client is not None:
+        settings = run | newton | dict(max_energy_error=max_energy_error, workers=workers)
+        return _on_cluster(client, model, q, p, values, settings, chunk_size, progress)
+    cores = [m._core for m in (models if values else models[:1])]
+    released = [c for c in cores if isinstance(c, (_core.NativeModel, _core.CompiledModel))]
+    if len(released) == len(cores):
+        threshold = _energy_threshold(model, max_energy_error)
+        bar = progress_bar(total=nsteps * members, unit="step", desc=f"{method} ×{members}", enabled=progress)
+        try:
+            report = None if bar.disable else (lambda done: bar.update(done - bar.n))
+            results, interrupted = _core.ensemble(
+                released, q, p, **run, **newton, max_energy_error=threshold, workers=workers, chunk_size=chunk_size, progress=report
+            )
+        finally:
+            bar.close()
+        trajs, errors = [], []
+        for i, (record, error) in enumerate(results):
+            status: dict[str, Any] = {} if error is None else {"status": -1, "message": str(error)}
+            trajs.append(_trajectory(record, models[i], method, dt, **status))
+            errors.append(error)
+        result = Ensemble(trajs, errors, values)
+        if interrupted is not None:
+            interrupted.partial = result  # type: ignore[attr-defined]
+            raise interrupted
+        return result
+    return _serial(models, q, p, values, run, newton, max_energy_error, progress)
+
+
+def _on_cluster(
+    client: Any,
+    model: Model,
+    q: np.ndarray,
+    p: np.ndarray,
+    values: dict[str, np.ndarray],
+    settings: dict[str, Any],
+    chunk_size: int | None,
+    progress: bool | None,
+) -> Ensemble:
+    """The ensemble on a Dask cluster: chunks of members as tasks (:func:`_chunk`), gathered in
+    member order."""
+    import cloudpickle
+    from distributed import as_completed
+
+    try:
+        cloudpickle.dumps(model)
+    except Exception as err:
+        raise TypeError(f"model: {model.name} cannot be shipped to the cluster ({err})") from err
+    members = len(q)
+    if chunk_size is None:
+        threads = sum(client.nthreads().values()) or 1
+        chunk_size = max(1, math.ceil(members / (4 * threads)))
+    starts = range(0, members, chunk_size)
+    futures = [
+        client.submit(
+            _chunk, model, q[a : a + chunk_size], p[a : a + chunk_size],
+            {k: v[a : a + chunk_size] for k, v in values.items()}, settings, pure=False,
+        )
+        for a in starts
+    ]
+    order = {future.key: i for i, future in enumerate(futures)}
+    chunks: list[Any] = [None] * len(futures)
+    bar = progress_bar(total=members, unit="member", desc=f"{settings['method']} on {client.id}", enabled=progress)
+    try:
+        for future, result in as_completed(futures, with_results=True):
+            chunks[order[future.key]] = result
+            bar.update(len(result[0]))
+    except BaseException:
+        client.cancel(futures)
+        raise
+    finally:
+        bar.close()
+    trajs = [tr for chunk, _ in chunks for tr in chunk]
+    errors = [e for _, chunk in chunks for e in chunk]
+    return Ensemble(trajs, errors, values)
+
+
+def _chunk(
+    model: Model, q: np.ndarray, p: np.ndarray, values: dict[str, np.ndarray], settings: dict[str, Any]
+) -> tuple[list[Trajectory], list[BaseException | None]]:
+    """One cluster task: :func:`ensemble` of a chunk of members in the worker process, on the
+    worker's threads unless ``workers`` says otherwise."""
+    from distributed import get_worker
+
+    settings = dict(settings)
+    if settings["workers"] is None:
+        settings["workers"] = get_worker().state.nthreads
+    run = ensemble(model, q, p, parameters=values or None, progress=False, **settings)
+    return run.trajectories, run.errors
+
+
+def _serial(
+    models: Sequence[Model],
+    q: np.ndarray,
+    p: np.ndarray,
+    values: dict[str, np.ndarray],
+    run: dict[str, Any],
+    newton: dict[str, Any],
+    max_energy_error: float | None | Literal["auto"],
+    progress: bool | None,
+) -> Ensemble:
+    """A closure model's ensemble: :func:`varmech.integrate` member by member (the closures
+    hold the GIL, so threads would not run them in parallel)."""
+    trajs: list[Trajectory] = []
+    errors: list[BaseException | None] = []
+    bar = progress_bar(total=len(q), unit="member", desc=f"{run['method']} (serial)", enabled=progress)
+    try:
+        for i, model in enumerate(models):
+            try:
+                trajs.append(integrate(model, q[i], p[i], **run, **newton, max_energy_error=max_energy_error, progress=False))
+                errors.append(None)
+            except Exception as err:
+                partial = getattr(err, "partial", None) or _empty(model, run, str(err))
+                trajs.append(partial)
+                errors.append(err)
+            except KeyboardInterrupt as err:
+                partial = getattr(err, "partial", None)
+                rest = [_empty(m, run, "interrupted before it started") for m in models[len(trajs) + (partial is not None) :]]
+                stopped = [partial] if partial is not None else []
+                err.partial = Ensemble(trajs + stopped + rest, errors + [err] * (len(stopped) + len(rest)), values)  # type: ignore[attr-defined]
+                raise
+            bar.update(1)
+    finally:
+        bar.close()
+    return Ensemble(trajs, errors, values)
+
+
+def _empty(model: Model, run: dict[str, Any], message: str) -> Trajectory:
+    """The trajectory of a member that saved no state."""
+    n = model.dim
+    empty = np.empty((0, n))
+    return Trajectory(np.empty(0), empty, empty.copy(), model, run["method"], run["dt"], 0, 0, status=-1, message=message)
+
+
+def _parameter_values(model: Model, parameters: Mapping[str, ArrayLike] | None, members: int) -> dict[str, np.ndarray]:
+    """Each named parameter's value per member, checked against the model's parameters."""
+    if parameters is None:
+        return {}
+    if not isinstance(parameters, Mapping):
+        raise ValueError(f"parameters: expected a dict {{name: values}}, got {type(parameters).__name__}")
+    known = getattr(model, "parameters", None) or {}
+    values = {}
+    for name, given in parameters.items():
+        name = str(name)
+        if name not in known:
+            has = ", ".join(known) if known else "none"
+            raise ValueError(f"parameters: {name} is not a parameter of {model.name} (it has {has})")
+        x = np.broadcast_to(np.asarray(given, dtype=float), (members,)) if np.ndim(given) == 0 else np.asarray(given, dtype=float)
+        if x.shape != (members,) or not np.all(np.isfinite(x)):
+            raise ValueError(f"parameters: {name} needs one finite value a member ({members}), got shape {x.shape}")
+        values[name] = np.array(x)
+    return values
+
+
+def _member_models(model: Model, values: dict[str, np.ndarray], members: int) -> list[Model]:
+    """One model shared by all members, or each member's model at its parameter values: a
+    native scene built again by the core, a symbolic model with its compiled code kept."""
+    if not values:
+        return [model] * members
+    if isinstance(model, NativeSystem):
+        assert model.parameters is not None
+        base = model.parameters
+        return [_scene_model(model.name, {**base, **{k: float(v[i]) for k, v in values.items()}}) for i in range(members)]
+    return [model.with_parameters(**{k: float(v[i]) for k, v in values.items()}) for i in range(members)]
+
+
+def _momenta(models: Sequence[Model], q: np.ndarray, p0: ArrayLike | None, v0: ArrayLike | None, t0: float) -> np.ndarray:
+    """p0 checked against q0, or p0 = ∂L/∂q̇(q0, v0, t0) of each member's model."""
+    if (p0 is None) == (v0 is None):
+        raise ValueError("p0, v0: give exactly one of the initial momenta p0 and velocities v0")
+    name, given = ("p0", p0) if p0 is not None else ("v0", v0)
+    x = np.array(given, dtype=float)
+    if x.ndim != 2 or x.shape[1] != q.shape[1]:
+        raise ValueError(f"{name}: must have shape (members, {q.shape[1]}), got shape {x.shape}")
+    if x.shape[0] != q.shape[0]:
+        raise ValueError(f"{name}: {x.shape[0]} members, but q0 has {q.shape[0]}")
+    if name == "p0":
+        return x
+    if all(m is models[0] for m in models):
+        return np.ascontiguousarray(models[0].momentum(q, x, t0))
+    return np.array([m.momentum(qi, vi, t0) for m, qi, vi in zip(models, q, x)])
+
+
+__all__ = ["Ensemble", "EnsembleConservation", "ensemble"]

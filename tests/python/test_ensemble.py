@@ -1,0 +1,241 @@
+"""Ensembles: every member bit for bit its single ``integrate`` run, failures per member,
+parameter sweeps, Ctrl-C, and bad input named."""
+
+import os
+import signal
+import threading
+import time
+
+import numpy as np
+import pytest
+
+import varmech
+from varmech import scenes
+
+
+def _same(a, b):
+    """Bit for bit: the saved states, the steps, the force evaluations and the checkpoint."""
+    return (
+        np.array_equal(a.t, b.t)
+        and np.array_equal(a.q, b.q)
+        and np.array_equal(a.p, b.p)
+        and a.steps == b.steps
+        and a.nfev == b.nfev
+        and a.checkpoint == b.checkpoint
+    )
+
+
+def _double_pendulum_rows(members):
+    scene = scenes.double_pendulum()
+    rng = np.random.default_rng(19)
+    q0 = scene.q0 + 0.1 * rng.standard_normal((members, 2))
+    p0 = scene.p0 + 0.1 * rng.standard_normal((members, 2))
+    return scene, q0, p0
+
+
+@pytest.mark.parametrize("workers", [1, 2])
+@pytest.mark.parametrize("chunk_size", [1, 7, 64])
+def test_every_member_is_bit_for_bit_its_single_integrate(workers, chunk_size):
+    scene, q0, p0 = _double_pendulum_rows(20)
+    run = dict(dt=0.01, steps=300, method="midpoint", save_every=7)
+    runs = varmech.ensemble(scene, q0, p0, workers=workers, chunk_size=chunk_size, progress=False, **run)
+    assert runs.q.shape == (20, 300 // 7 + 2, 2) and runs.failed == []
+    for i in range(20):
+        single = varmech.integrate(scene.model, q0[i], p0[i], **run)
+        assert _same(runs[i], single), f"member {i}"
+        assert np.array_equal(runs.q[i], single.q) and np.array_equal(runs.p[i], single.p)
+    assert np.array_equal(runs.t, runs[0].t)
+
+
+def test_a_closure_model_runs_member_by_member_bit_for_bit():
+    pendulum = varmech.MechanicalSystem(1, potential=lambda q: -np.cos(q[0]), gradient=lambda q: np.sin(q))
+    q0 = np.array([[0.1], [1.0], [2.5]])
+    p0 = np.zeros((3, 1))
+    runs = varmech.ensemble(pendulum, q0, p0, dt=0.05, steps=200, method="verlet", workers=2, progress=False)
+    for i in range(3):
+        assert _same(runs[i], varmech.integrate(pendulum, q0[i], p0[i], dt=0.05, steps=200, method="verlet"))
+
+
+def test_velocities_give_each_members_momenta():
+    scene, q0, p0 = _double_pendulum_rows(4)
+    v0 = scene.model.velocity(q0, p0)
+    runs = varmech.ensemble(scene, q0, v0=v0, dt=0.01, steps=50, method="midpoint", progress=False)
+    for i in range(4):
+        assert _same(runs[i], varmech.integrate(scene.model, q0[i], v0=v0[i], dt=0.01, steps=50, method="midpoint"))
+
+
+def test_a_member_past_its_stability_limit_fails_alone_with_its_step_and_partial_trajectory():
+    # Verlet is stable on q'' = −ω²q for hω < 2: at h = 0.1, ω = 30 (hω = 3) grows by ≈ 6.85 a
+    # step and trips the energy check within a few steps; the others run to the end.
+    omegas = np.array([1.0, 30.0, 2.0])
+    scene = scenes.harmonic_oscillator()
+    run = dict(dt=0.1, steps=200, method="verlet")
+    runs = varmech.ensemble(scene, np.zeros((3, 1)), np.ones((3, 1)), parameters={"omega": omegas}, progress=False, **run)
+    assert runs.failed == [1]
+    assert list(runs.status) == [0, -1, 0]
+    error = runs.errors[1]
+    assert isinstance(error, varmech.DivergenceError) and 1 <= error.step < 20
+    partial = runs[1]
+    assert len(partial) == error.step + 1 and np.all(np.isnan(runs.q[1, error.step + 1 :]))
+    with pytest.raises(varmech.DivergenceError) as single:
+        varmech.integrate(scenes.harmonic_oscillator(30.0), [0.0], [1.0], **run)
+    assert _same(partial, single.value.partial)
+    for i in (0, 2):
+        assert runs[i].steps == 200 and _same(runs[i], varmech.integrate(scenes.harmonic_oscillator(omegas[i]), [0.0], [1.0], **run))
+    summary = runs.check_conservation()
+    assert summary.not_bounded == [1] and summary.worst_energy_error >= 1.0
+    assert summary.reports[0].verdict in ("bounded", "conserved to round-off")
+
+
+def test_a_closure_members_failure_leaves_the_others_complete():
+    def gradient(q):
+        if abs(q[0]) > 2.0:
+            raise ValueError("left the chart")
+        return q.copy()
+
+    oscillator = varmech.MechanicalSystem(1, potential=lambda q: 0.5 * q[0] ** 2, gradient=gradient)
+    runs = varmech.ensemble(oscillator, [[0.5], [3.0], [1.0]], [[0.0], [0.0], [0.0]], dt=0.1, steps=100, progress=False)
+    assert runs.failed == [1] and isinstance(runs.errors[1], ValueError)
+    assert runs[0].steps == runs[2].steps == 100
+
+
+def test_a_drive_amplitude_sweep_equals_separate_runs():
+    amplitudes = np.array([0.9, 1.07, 1.15, 1.35, 1.45, 1.5])
+    scene = scenes.damped_driven_pendulum()
+    members = len(amplitudes)
+    run = dict(dt=0.05, steps=2000, save_every=10, method="midpoint")
+    runs = varmech.ensemble(
+        scene, np.zeros((members, 1)), np.zeros((members, 1)), parameters={"amplitude": amplitudes}, workers=2, progress=False, **run
+    )
+    for i, a in enumerate(amplitudes):
+        assert _same(runs[i], varmech.integrate(scenes.damped_driven_pendulum(amplitude=a), [0.0], [0.0], **run))
+    # The drive matters: the members end apart.
+    final = runs.q[:, -1, 0]
+    assert np.min(np.abs(np.subtract.outer(final, final)) + np.eye(members)) > 1e-3
+    assert list(runs.parameters["amplitude"]) == list(amplitudes)
+
+
+def test_a_symbolic_models_parameter_sweep_equals_separate_runs():
+    pytest.importorskip("sympy")
+    from varmech.symbolic import examples
+
+    scene = examples.scene("elastic_pendulum")
+    stiffness = [10.0, 12.5, 40.0]
+    q0, p0 = np.tile(scene.q0, (3, 1)), np.tile(scene.p0, (3, 1))
+    runs = varmech.ensemble(scene.model, q0, p0, parameters={"k": stiffness}, dt=0.01, steps=500, workers=2, progress=False)
+    for i, k in enumerate(stiffness):
+        assert _same(runs[i], varmech.integrate(scene.model, scene.q0, scene.p0, dt=0.01, steps=500, parameters={"k": k}))
+    assert not np.array_equal(runs.q[0], runs.q[2])
+
+
+def test_ctrl_c_stops_every_member_and_keeps_what_was_computed(interrupt_after):
+    scene, q0, p0 = _double_pendulum_rows(3)
+    run = dict(dt=1e-4, save_every=1000, method="midpoint")
+    timer, _ = interrupt_after(0.3)
+    with pytest.raises(KeyboardInterrupt) as stopped:
+        varmech.ensemble(scene, q0, p0, steps=10**9, workers=2, progress=False, **run)
+    timer.join()
+    partial = stopped.value.partial
+    assert len(partial) == 3 and partial.failed == [0, 1, 2]
+    started = [tr for tr in partial if len(tr) > 1]
+    assert started, "the running members kept their states"
+    for i, tr in enumerate(partial):
+        if len(tr) > 1:
+            # The states so far, the last where the member stopped: a run to that step's.
+            single = varmech.integrate(scene.model, q0[i], p0[i], steps=tr.steps, **run)
+            assert np.array_equal(tr.q, single.q) and np.array_equal(tr.p, single.p)
+
+
+@pytest.mark.parametrize(
+    "change, argument",
+    [
+        (dict(q0=np.zeros((4, 3))), "q0"),
+        (dict(q0=np.zeros(2)), "q0"),
+        (dict(p0=np.zeros((3, 2))), "p0"),
+        (dict(parameters={"stiffness": [1.0] * 4}), "parameters"),
+        (dict(parameters={"m1": [1.0] * 3}), "parameters"),
+        (dict(workers=0), "workers"),
+        (dict(workers=-2), "workers"),
+        (dict(chunk_size=0), "chunk_size"),
+        (dict(model=scenes.bouncing_ball(), q0=np.ones((4, 1)), p0=np.zeros((4, 1))), "model"),
+        (dict(steps=10**12, dt=1e-12, q0=np.zeros((10**4, 2)), p0=np.zeros((10**4, 2))), "save_every"),
+    ],
+)
+def test_bad_input_is_a_value_error_naming_the_argument(change, argument):
+    scene, q0, p0 = _double_pendulum_rows(4)
+    args = dict(model=scene, q0=q0, p0=p0, dt=0.01, steps=10, progress=False) | change
+    with pytest.raises(ValueError, match=f"^{argument}"):
+        varmech.ensemble(**args)
+
+
+def test_to_xarray_labels_members_times_and_parameters():
+    xarray = pytest.importorskip("xarray")
+    runs = varmech.ensemble(
+        scenes.harmonic_oscillator(), np.zeros((2, 1)), np.ones((2, 1)), parameters={"omega": [1.0, 2.0]}, dt=0.1, steps=10, progress=False
+    )
+    data = runs.to_xarray()
+    assert isinstance(data, xarray.Dataset) and data["q"].dims == ("member", "time", "coordinate")
+    assert list(data["omega"].values) == [1.0, 2.0] and np.array_equal(data["q"].values, runs.q)
+
+
+@pytest.fixture(scope="module")
+def cluster_client():
+    distributed = pytest.importorskip("distributed")
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cluster:
+        with distributed.Client(cluster) as client:
+            yield client
+
+
+@pytest.mark.parametrize("chunk_size", [None, 7])
+def test_a_dask_cluster_gives_every_member_bit_for_bit(cluster_client, chunk_size):
+    scene, q0, p0 = _double_pendulum_rows(20)
+    run = dict(dt=0.01, steps=300, method="midpoint", save_every=7)
+    runs = varmech.ensemble(scene, q0, p0, client=cluster_client, chunk_size=chunk_size, progress=False, **run)
+    for i in range(20):
+        assert _same(runs[i], varmech.integrate(scene.model, q0[i], p0[i], **run)), f"member {i}"
+    swept = varmech.ensemble(
+        scenes.harmonic_oscillator(), np.zeros((3, 1)), np.ones((3, 1)), parameters={"omega": [1.0, 30.0, 2.0]},
+        dt=0.1, steps=200, method="verlet", client=cluster_client, chunk_size=chunk_size, progress=False,
+    )
+    assert swept.failed == [1] and isinstance(swept.errors[1], varmech.DivergenceError) and swept.errors[1].step >= 1
+
+
+def test_a_model_that_cannot_be_shipped_is_named(cluster_client):
+    class Local:
+        def __reduce__(self):
+            raise TypeError("not picklable")
+
+    local = Local()
+    model = varmech.MechanicalSystem(1, potential=lambda q: local and 0.5 * q[0] ** 2, gradient=lambda q: q.copy())
+    with pytest.raises(TypeError, match="^model"):
+        varmech.ensemble(model, [[1.0]], [[0.0]], dt=0.1, steps=10, client=cluster_client, progress=False)
+
+
+def test_a_killed_dask_worker_is_retried_and_the_ensemble_is_complete_and_equal(cluster_client):
+    scene, q0, p0 = _double_pendulum_rows(8)
+    run = dict(dt=1e-3, steps=1_000_000, method="midpoint", save_every=10_000)
+    address, victim = sorted(cluster_client.run(os.getpid).items())[0]
+    killed = {}
+    done = threading.Event()
+
+    def kill():
+        # Once the victim runs a chunk: its task is lost with it, and Dask runs it again.
+        while not done.is_set() and not cluster_client.processing().get(address):
+            time.sleep(0.01)
+        time.sleep(0.2)
+        killed["while_running"] = not done.is_set()
+        os.kill(victim, signal.SIGKILL)
+
+    killer = threading.Thread(target=kill)
+    killer.start()
+    try:
+        runs = varmech.ensemble(scene, q0, p0, client=cluster_client, chunk_size=1, progress=False, **run)
+    finally:
+        done.set()
+        killer.join()
+    assert killed["while_running"], "the worker was killed during the run"
+    assert victim not in cluster_client.run(os.getpid).values()
+    local = varmech.ensemble(scene, q0, p0, workers=2, progress=False, **run)
+    assert runs.failed == [] and len(runs) == 8
+    for i in range(8):
+        assert _same(runs[i], local[i]), f"member {i}"
