@@ -436,3 +436,29 @@ fn initial_data_off_the_velocity_constraints_is_refused_naming_p0() {
     assert_eq!(q, q0);
     assert!(model.residuals(&q, &p).unwrap().velocity <= 1e-15);
 }
+
+#[test]
+fn the_step_is_reversible_the_sleigh_retraces_its_path_when_its_momenta_are_reversed() {
+    // The DLA step is symmetric and the sleigh is reversible under p ↦ −p (L even in q̇, A
+    // linear in it): 40 steps on, through the turn, the momenta reversed, 40 steps more return
+    // it to its start with reversed momenta, to round-off (a step that is not symmetric misses
+    // by its error, O(h²)). Longer runs amplify round-off: the relaxed motion, reversed, is
+    // unstable (blade first).
+    let model = Nonholonomic {
+        system: Free {
+            mass: vec![1.0, 1.0, 1.0],
+            differenced: true,
+        },
+        constraints: Blade,
+    };
+    let (q0, p0) = ([0.0, 0.0, 0.0], [0.0, 1.0, 1.0]);
+    let options = options(0.05, 40, 40);
+    let there = run(&model, &q0, &p0, &options);
+    let k = there.len() - 1;
+    let back: Vec<f64> = there.p_at(k).iter().map(|p| -p).collect();
+    let home = run(&model, there.q_at(k), &back, &options);
+    let reversed: Vec<f64> = p0.iter().map(|p| -p).collect();
+    let miss = common::final_error(&home, &q0, &reversed);
+    println!("sleigh there and back (2 × 40 steps of 0.05): {miss:.1e}");
+    assert!(miss <= 1e-13, "{miss:e}");
+}

@@ -238,13 +238,7 @@ impl<L: Lagrangian, C: HolonomicConstraints> Constrained<General<'_, L>, C> {
     /// in q̇, whose inverse Legendre transform is affine in p).
     pub fn project_general(&self, q0: &[f64], p0: &[f64]) -> Result<PhaseState, Error> {
         let velocity = self.velocity();
-        let minv = |q: &[f64], x: &[f64], out: &mut [f64]| {
-            let mut rest = vec![0.0; x.len()];
-            velocity(q, &vec![0.0; x.len()], &mut rest)?;
-            velocity(q, x, out)?;
-            out.iter_mut().zip(&rest).for_each(|(o, r)| *o -= r);
-            Ok(())
-        };
+        let minv = model::inverse_mass(&velocity);
         model::project(&self.constraints, &minv, &velocity, q0, p0)
     }
 }
@@ -260,11 +254,16 @@ impl<L: Lagrangian, C: VelocityConstraints> Dynamics for Nonholonomic<L, C> {
         ModelKind::Nonholonomic
     }
 
-    /// |A(q₀)q̇₀|∞ within 1e-10 of the state's size; otherwise `p0` is off the constraints.
+    /// |A(q₀)q̇₀|∞ within 1e-10 of the state's size; otherwise `p0` is off the constraints. A
+    /// model error is the model's own, at step 0 (the stepper sets its time).
     fn check_initial(&self, q0: &[f64], p0: &[f64]) -> Result<(), Error> {
         let velocity = self
             .residuals(q0, p0)
-            .map_err(|e| Error::invalid("q0", format!("the velocity constraints failed to evaluate: {e}")))?
+            .map_err(|source| Error::Model {
+                step: 0,
+                time: 0.0,
+                source,
+            })?
             .velocity;
         let scale = q0.iter().chain(p0).fold(1.0_f64, |m, x| m.max(x.abs()));
         if velocity.is_nan() || velocity > 1e-10 * scale {

@@ -127,6 +127,18 @@ pub struct Constrained<S, C> {
 /// An action x ↦ f(q, x) written into `out`: M(q)⁻¹x, or the inverse Legendre transform.
 pub type Action<'a> = &'a dyn Fn(&[f64], &[f64], &mut [f64]) -> Result<(), ModelError>;
 
+/// M(q)⁻¹x = q̇(q, x) − q̇(q, 0) from the inverse Legendre transform `velocity`: exact for L
+/// quadratic in q̇, whose q̇ is affine in p. It allocates (set-up and diagnostics).
+pub fn inverse_mass<'a>(velocity: Action<'a>) -> impl Fn(&[f64], &[f64], &mut [f64]) -> Result<(), ModelError> + 'a {
+    move |q, x, out| {
+        let mut rest = vec![0.0; x.len()];
+        velocity(q, &vec![0.0; x.len()], &mut rest)?;
+        velocity(q, x, out)?;
+        out.iter_mut().zip(&rest).for_each(|(o, r)| *o -= r);
+        Ok(())
+    }
+}
+
 /// Refuses, naming `argument`, m constraints on n coordinates whose dense matrices do not fit in
 /// the memory available: a step holds G and W = M⁻¹Gᵀ at both of its ends (4mn numbers), the
 /// m × m Gram matrix and the Newton Jacobian of the multipliers (2m²).

@@ -33,7 +33,7 @@ mod scale;
 mod symmetry;
 
 pub use constraints::{
-    check_dense, differenced_jacobian, project, residuals, Action, Anchor, Constrained, Distances,
+    check_dense, differenced_jacobian, inverse_mass, project, residuals, Action, Anchor, Constrained, Distances,
     HolonomicConstraints, Link, PhaseState, Residuals,
 };
 pub use energy::{hamiltonian, EnergyTerms};

@@ -1,7 +1,7 @@
 use nalgebra::{DMatrix, DVector};
 
 use super::constraints::{momentum_projection, row_norm};
-use super::{Action, Lagrangian, Residuals};
+use super::{inverse_mass, Lagrangian, Residuals};
 use crate::{Error, ModelError};
 
 /// Velocity constraints A(q)q̇ = 0 linear in the velocities, m rows on n coordinates, that need
@@ -79,16 +79,9 @@ impl<S: Lagrangian, C: VelocityConstraints> Nonholonomic<S, C> {
     pub fn project(&self, q: &[f64], p: &[f64]) -> Result<(Vec<f64>, Vec<f64>), Error> {
         let model = |e: ModelError| Error::invalid("q0", format!("the velocity constraints failed to evaluate: {e}"));
         let velocity = |q: &[f64], p: &[f64], v: &mut [f64]| self.system.velocity(q, p, 0.0, v);
-        let minv = |q: &[f64], x: &[f64], out: &mut [f64]| {
-            let mut rest = vec![0.0; x.len()];
-            velocity(q, &vec![0.0; x.len()], &mut rest)?;
-            velocity(q, x, out)?;
-            out.iter_mut().zip(&rest).for_each(|(o, r)| *o -= r);
-            Ok(())
-        };
-        let minv: Action<'_> = &minv;
+        let minv = inverse_mass(&velocity);
         let a = self.matrix(q).map_err(model)?;
-        let p = momentum_projection(&a, minv, &velocity, q, p)?;
+        let p = momentum_projection(&a, &minv, &velocity, q, p)?;
         Ok((q.to_vec(), p))
     }
 }

@@ -138,7 +138,11 @@ impl Constraints<'_> {
 /// halves would be symmetric too, but would leave A(q₁)q̇₁ = O(h²); with μ the momenta stay on
 /// the constraint to round-off at every step, as the constrained DEL equations keep them on
 /// the hidden one. Where A = G is the derivative of holonomic constraints the two methods
-/// differ only in the discrete constraint (A(q̄)δq = 0 here, g(q₁) = 0 there).
+/// differ only in the discrete constraint (A(q̄)δq = 0 here, g(q₁) = 0 there). (The paper's
+/// text was not at hand when this was written: the midpoint discrete constraint follows its
+/// abstract and the issue; the placement of the forces is this method's own choice, for the
+/// round-off constraint residuals, and its reversibility is checked by the bounded energy of
+/// the sleigh and the disk in the tests.)
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Del<Sc> {
     scheme: Sc,
