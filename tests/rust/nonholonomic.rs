@@ -142,12 +142,13 @@ fn off_the_circle(model: &Nonholonomic<Free, Rolling>, q0: &[f64], p0: &[f64], h
 
 #[test]
 fn the_rolling_disk_turns_and_rolls_at_constant_rates_on_a_circle() {
-    // θ̇ and φ̇ stay constant, the energy too, and A(q)q̇ = 0 holds, all to round-off over 10⁵
-    // steps: the angles grow to θ = 3.5e3 and φ = 1e4 rad, so that their rounding (ε|θ| ≈
-    // 8e-13) sets the level, random-walking φ̇ by 2e-10 (the method's error is O(h²) = 2.5e-3).
+    // θ̇ and φ̇ stay constant, the energy too, and A(q)q̇ = 0 holds, all to round-off over 10⁶
+    // steps: the angles grow to θ = 3.5e4 and φ = 1e5 rad, whose rounding (ε|φ| ≈ 2e-11 a
+    // step) random-walks φ̇ and E by 4e-8 over the run (1.7e-10 after 10⁵ steps, as √N; the
+    // method's own error is O(h²) = 2.5e-3).
     let (model, q0, p0) = disk(false);
-    let (h, steps) = (0.05, 100_000);
-    let traj = run(&model, &q0, &p0, &options(h, steps, 10));
+    let (h, steps) = (0.05, 1_000_000);
+    let traj = run(&model, &q0, &p0, &options(h, steps, 100));
     let (omega, spin) = (0.7, 2.0);
     let rates = (0..traj.len()).map(|k| traj.p_at(k)).fold(0.0_f64, |a, p| {
         a.max((p[2] / 0.25 - omega).abs()).max((p[3] / 0.5 - spin).abs())
@@ -156,9 +157,9 @@ fn the_rolling_disk_turns_and_rolls_at_constant_rates_on_a_circle() {
     let energy = e.iter().fold(0.0_f64, |a, x| a.max((x - e[0]).abs() / e[0]));
     let constraint = residual(&model, &traj);
     println!("disk: |Δθ̇|, |Δφ̇| ≤ {rates:.1e}, |ΔE|/E ≤ {energy:.1e}, |A q̇| ≤ {constraint:.1e} ‖A‖‖q̇‖");
-    assert!(rates <= 1e-9, "{rates:e}");
-    assert!(energy <= 1e-9, "{energy:e}");
-    assert!(constraint <= 1e-12, "{constraint:e}");
+    assert!(rates <= 1e-7, "{rates:e}");
+    assert!(energy <= 1e-7, "{energy:e}");
+    assert!(constraint <= 1e-11, "{constraint:e}");
     // The contact point stays on the circle of radius Rφ̇/θ̇ to order 2 (over T = 100).
     let circle: Vec<f64> = (0..3)
         .map(|k| {
@@ -392,7 +393,7 @@ impl VelocityConstraints for Blade {
 fn the_chaplygin_sleigh_keeps_its_energy_and_relaxes_to_a_straight_line() {
     // From a spin with no forward speed, E = ½(u² + (I + mb²)ω²) = 1 with u = 0, ω = 1 (the
     // sideways speed is bω). It relaxes to ω = 0, |u| = √(2E/m) = √2; the energy error stays
-    // bounded, with no drift, over 10⁵ steps, and A(q)q̇ = 0 to round-off.
+    // bounded, with no drift, over 10⁶ steps, and A(q)q̇ = 0 to round-off.
     let model = Nonholonomic {
         system: Free {
             mass: vec![1.0, 1.0, 1.0],
@@ -401,7 +402,7 @@ fn the_chaplygin_sleigh_keeps_its_energy_and_relaxes_to_a_straight_line() {
         constraints: Blade,
     };
     let (q0, p0) = ([0.0, 0.0, 0.0], [0.0, 1.0, 1.0]);
-    let steps = 100_000;
+    let steps = 1_000_000;
     let traj = run(&model, &q0, &p0, &options(0.01, steps, 100));
     let e = energies(&model, &traj);
     let stats = common::energy_statistics(&model.system, &traj);
