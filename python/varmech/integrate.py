@@ -106,7 +106,8 @@ class Trajectory:
         return _core.energy_terms(self.model._core, *self._arrays())
 
     def constraint_residuals(self) -> tuple[np.ndarray, np.ndarray]:
-        """|g(q)|∞ and |G(q)M⁻¹p|∞ at each saved state of a constrained model, shapes (N,)."""
+        """|g(q)|∞ and |G(q)M⁻¹p|∞ at each saved state of a constrained model, shapes (N,); 0
+        and |A(q)q̇|∞ with velocity constraints."""
         return _core.constraint_residuals(self.model._core, *self._arrays()[1:])[0]
 
     def _arrays(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
