@@ -7,13 +7,13 @@ use numpy::PyArray1;
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use varmech::integrators::Dynamics;
-use varmech::model::{check_dense, Natural, Nonholonomic, VelocityConstraints};
+use varmech::model::{Natural, Nonholonomic, VelocityConstraints};
 use varmech::ModelError;
 
 use super::lagrangian::{ClosureLagrangian, ClosureLagrangianSystem};
 use super::mechanical::{ClosureModel, ClosureSystem};
 use super::natural::{ClosureNatural, ClosureNaturalSystem};
-use super::readers::{call_array, check_closures};
+use super::readers::{call_array, check_closures, check_count};
 use crate::errors::boxed;
 
 /// A closure model (separable [`ClosureModel`], natural [`ClosureNatural`] or general
@@ -49,14 +49,8 @@ impl ClosureNonholonomic {
                 "system: expected a ClosureModel, a ClosureNatural or a ClosureLagrangian",
             ));
         };
-        check_dense("velocity_constraint_count", count, dim).map_err(|e| PyValueError::new_err(e.to_string()))?;
         check_closures(dim, [("velocity_constraints", Some(&matrix))])?;
-        if count == 0 || count >= dim {
-            return Err(PyValueError::new_err(format!(
-                "velocity_constraint_count: must be between 1 and dim − 1 = {}, got {count}",
-                dim - 1
-            )));
-        }
+        check_count("velocity_constraint_count", count, dim)?;
         Ok(ClosureNonholonomic {
             system,
             count,
