@@ -17,6 +17,7 @@ __all__ = [
     "ClosureLagrangian",
     "ClosureModel",
     "ClosureNatural",
+    "ClosureNonholonomic",
     "CompiledModel",
     "ConvergenceError",
     "DivergenceError",
@@ -296,6 +297,19 @@ class ClosureConstrained(_ModelProperties):
     def constraints(self) -> int: ...
 
 @final
+class ClosureNonholonomic(_ModelProperties):
+    """A closure model with velocity constraints A(q)q̇ = 0 from a Python closure."""
+
+    def __new__(
+        cls,
+        system: ClosureModel | ClosureNatural | ClosureLagrangian,
+        count: int,
+        matrix: Callable[[_FloatArray], Any],
+    ) -> ClosureNonholonomic: ...
+    @property
+    def velocity_constraints(self) -> int: ...
+
+@final
 class ClosureNatural(_ModelProperties):
     """L = ½q̇ᵀM(q)q̇ − V(q) from Python closures (configuration-dependent mass)."""
 
@@ -401,6 +415,7 @@ _FullModel = (
     NativeModel
     | ClosureModel
     | ClosureConstrained
+    | ClosureNonholonomic
     | ClosureNatural
     | ClosureLagrangian
     | CompiledModel

@@ -2,7 +2,8 @@
 
 Every quantity is judged against its own scale (see :class:`InvariantStatistics`): the energy
 against the mean kinetic energy of the run, a Noether momentum J = p·ξ(q) against the mean size
-Σ|pᵢξᵢ| of its terms, the constraint residuals |g(q)| and |G(q)q̇| against ‖G‖‖q‖ and ‖G‖‖q̇‖.
+Σ|pᵢξᵢ| of its terms, the constraint residuals |g(q)| and |G(q)q̇| against ‖G‖‖q‖ and ‖G‖‖q̇‖
+(|A(q)q̇| against ‖A‖‖q̇‖ for velocity constraints).
 """
 
 from __future__ import annotations
@@ -170,8 +171,9 @@ class ConservationReport:
     #: For forced systems: the balance E(t) − W(t), W the work of the forces (the discrete
     #: Lagrange–d'Alembert energy balance), judged as the energy is.
     energy_balance: InvariantStatistics | None = None
-    #: For constrained models: |g(q)|∞ and |G(q)M⁻¹p|∞ over the run.
-    constraints: tuple[InvariantStatistics, InvariantStatistics] | None = None
+    #: For constrained models: |g(q)|∞ and |G(q)M⁻¹p|∞ over the run; with velocity constraints
+    #: |A(q)q̇|∞ alone.
+    constraints: tuple[InvariantStatistics, ...] | None = None
 
     @property
     def verdict(self) -> str:
@@ -183,9 +185,12 @@ class ConservationReport:
 
     @property
     def constraint_residuals(self) -> tuple[float, float] | None:
-        """max |g(q)|∞ and max |G(q)M⁻¹p|∞ over the run, for constrained models."""
+        """max |g(q)|∞ and max |G(q)M⁻¹p|∞ over the run, for constrained models (0 and max
+        |A(q)q̇|∞ with velocity constraints)."""
         if self.constraints is None:
             return None
+        if len(self.constraints) == 1:
+            return 0.0, self.constraints[0].max_abs_error
         return self.constraints[0].max_abs_error, self.constraints[1].max_abs_error
 
     @property
@@ -203,7 +208,8 @@ class ConservationReport:
                 lines += ["  " + line for line in stats.describe(symbol)]
         for m in self.momenta:
             lines += ["  " + line for line in m.describe("J")]
-        for c, error in zip(self.constraints or (), ("g(q)", "G M⁻¹ p")):
+        residuals = ("g(q)", "G M⁻¹ p") if len(self.constraints or ()) == 2 else ("A q̇",)
+        for c, error in zip(self.constraints or (), residuals):
             lines += ["  " + line for line in c.describe("r", error)]
         return "\n".join(lines)
 
@@ -242,13 +248,16 @@ def check_conservation(traj: Trajectory, generators: Sequence[Generator] | None 
         j, size = _momentum_terms(traj, xi)
         record = _core.statistics(t, j - j[0], size, size, steps)
         momenta.append(_statistics(record, name, j[0], "mean Σ|pᵢξᵢ|", t))
-    constraints = None
+    constraints: tuple[InvariantStatistics, ...] | None = None
     if model.constraints:
         (g, v), (g_size, v_size) = _core.constraint_residuals(model._core, *traj._arrays()[1:])
         constraints = (
             _statistics(_core.statistics(t, g, g_size, g_size, steps), "|g(q)|", g[0], "mean ‖G‖‖q‖", t),
             _statistics(_core.statistics(t, v, v_size, v_size, steps), "|G q̇|", v[0], "mean ‖G‖‖q̇‖", t),
         )
+    elif model.velocity_constraints:
+        (_, v), (_, v_size) = _core.constraint_residuals(model._core, *traj._arrays()[1:])
+        constraints = (_statistics(_core.statistics(t, v, v_size, v_size, steps), "|A q̇|", v[0], "mean ‖A‖‖q̇‖", t),)
     return ConservationReport(model.name, traj.method, traj.dt, float(t[-1]), energy, tuple(momenta), balance, constraints)
 
 

@@ -106,7 +106,8 @@ class Trajectory:
         return _core.energy_terms(self.model._core, *self._arrays())
 
     def constraint_residuals(self) -> tuple[np.ndarray, np.ndarray]:
-        """|g(q)|∞ and |G(q)M⁻¹p|∞ at each saved state of a constrained model, shapes (N,)."""
+        """|g(q)|∞ and |G(q)M⁻¹p|∞ at each saved state of a constrained model, shapes (N,); 0
+        and |A(q)q̇|∞ with velocity constraints."""
         return _core.constraint_residuals(self.model._core, *self._arrays()[1:])[0]
 
     def _arrays(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -170,8 +171,24 @@ def _initial_state(
     if p0 is not None and v0 is None:
         return q, vector("p0", p0, n)
     if v0 is not None and p0 is None:
-        return q, model.momentum(q, vector("v0", v0, n), t0)
+        v = vector("v0", v0, n)
+        p = model.momentum(q, v, t0)
+        if model.velocity_constraints:
+            _check_rolling(model, q, v, p)
+        return q, p
     raise ValueError("p0, v0: give exactly one of the initial momenta p0 and velocities v0")
+
+
+def _check_rolling(model: Model, q: np.ndarray, v: np.ndarray, p: np.ndarray) -> None:
+    """Refuses velocities ``v0`` off the velocity constraints, |A(q0)v0|∞ above 1e-10 of the
+    state's size, as the core refuses momenta off them (naming ``p0``)."""
+    (_, off), _ = _core.constraint_residuals(model._core, q[None], p[None])
+    scale = max(1.0, float(np.max(np.abs(q))), float(np.max(np.abs(p))))
+    if off[0] > 1e-10 * scale:
+        raise ValueError(
+            f"v0: is off the velocity constraints: |A(q0)v0| = {off[0]:.3e}; project the initial state first "
+            "(varmech.project)"
+        )
 
 
 def _energy_threshold(model: Model, max_energy_error: float | None | Literal["auto"]) -> float | None:

@@ -105,6 +105,7 @@ class Model:
         _core.NativeModel
         | _core.ClosureModel
         | _core.ClosureConstrained
+        | _core.ClosureNonholonomic
         | _core.ClosureNatural
         | _core.ClosureLagrangian
         | _core.PointerSystem
@@ -148,6 +149,12 @@ class Model:
         """Number of holonomic constraints g(q) = 0 (0 for unconstrained models); constrained
         models take ``rattle``, ``rattle4`` and ``shake`` only."""
         return getattr(self._core, "constraints", 0)
+
+    @property
+    def velocity_constraints(self) -> int:
+        """Number of velocity constraints A(q)q̇ = 0 (0 for models without them); such
+        (nonholonomic) models take the discrete Lagrange–d'Alembert integrator, ``midpoint``."""
+        return getattr(self._core, "velocity_constraints", 0)
 
     def velocity(self, q: ArrayLike, p: ArrayLike, t: ArrayLike = 0.0) -> np.ndarray:
         """q̇ with ∂L/∂q̇(q, q̇, t) = p (M⁻¹p for mechanical systems), for one state (n,) or
@@ -264,6 +271,12 @@ class MechanicalSystem(Model):
         integrated by ``rattle`` (the default), ``rattle4`` or ``shake``; with a ``mass``
         closure by the constrained DEL equations of ``trapezoid`` (the default; RATTLE's
         discrete Lagrangian) or ``midpoint``.
+    velocity_constraints, velocity_constraint_count:
+        Velocity constraints A(q)q̇ = 0 that need not come from constraints on q (rolling
+        without slipping, a skate's blade): ``velocity_constraints(q) -> array (m, n)``, A(q),
+        with ``velocity_constraint_count`` = m. Integrated by the reversible discrete
+        Lagrange–d'Alembert integrator, ``midpoint`` (see the README, "Rolling and other
+        nonholonomic constraints"); not together with holonomic ``constraints``.
     mass_derivative:
         With a ``mass`` closure: ``mass_derivative(q) -> array (n, n, n)`` whose ``[i]`` is
         ∂M/∂qᵢ. Optional: without it, central differences of ``mass`` are used (2n calls
@@ -286,6 +299,8 @@ class MechanicalSystem(Model):
         constraints: Callable[[np.ndarray], ArrayLike] | None = None,
         constraint_jacobian: Callable[[np.ndarray], ArrayLike] | None = None,
         constraint_count: int | None = None,
+        velocity_constraints: Callable[[np.ndarray], ArrayLike] | None = None,
+        velocity_constraint_count: int | None = None,
         symmetries: Sequence[Symmetry] = (),
         name: str = "mechanical system",
     ):
@@ -298,6 +313,8 @@ class MechanicalSystem(Model):
             "constraints": constraints,
             "constraint_jacobian": constraint_jacobian,
             "constraint_count": constraint_count,
+            "velocity_constraints": velocity_constraints,
+            "velocity_constraint_count": velocity_constraint_count,
             "symmetries": symmetries,
             "name": name,
         }
@@ -305,9 +322,13 @@ class MechanicalSystem(Model):
             raise ValueError(f"dim: must be a positive integer, got {dim!r}")
         if (constraints is None) != (constraint_count is None) or (constraint_jacobian is not None and constraints is None):
             raise ValueError("constraints: give constraints(q) with constraint_count (and optionally constraint_jacobian)")
+        _check_velocity_constraints(velocity_constraints, velocity_constraint_count)
+        if constraints is not None and velocity_constraints is not None:
+            raise ValueError("velocity_constraints: not together with holonomic constraints (yet); give one kind")
         native = pointers.functions({"potential": potential, "gradient": gradient}, int(dim))
         others = {"mass": mass if callable(mass) else None, "mass_derivative": mass_derivative}
         others |= {"constraints": constraints, "constraint_jacobian": constraint_jacobian}
+        others |= {"velocity_constraints": velocity_constraints}
         refused = [k for k, f in others.items() if f is not None and (native is not None or pointers.is_pointer(f))]
         refused += ["gradient"] if native is not None and "gradient" not in native else []
         if refused:
@@ -336,11 +357,13 @@ class MechanicalSystem(Model):
         self.mass_derivative = mass_derivative
         self.constraints_function = constraints
         self.constraint_jacobian = constraint_jacobian
+        self.velocity_constraints_function = velocity_constraints
         self.symmetries = tuple(symmetries)
         self.name = name
         if callable(mass) and native is None:
             self._core = _core.ClosureNatural(int(dim), mass, potential, gradient, mass_derivative, _specs(symmetries))
             self._constrain(constraints, constraint_jacobian, constraint_count)
+            self._core = _roll(self._core, velocity_constraints, velocity_constraint_count)
             return
         m = np.array(mass, dtype=float)
         if m.ndim > 2 or (m.ndim >= 1 and any(s != dim for s in m.shape)):
@@ -355,6 +378,7 @@ class MechanicalSystem(Model):
             return
         self._core = _core.ClosureModel(int(dim), potential, gradient, m, _specs(symmetries))
         self._constrain(constraints, constraint_jacobian, constraint_count)
+        self._core = _roll(self._core, velocity_constraints, velocity_constraint_count)
 
     def _constrain(self, constraints, jacobian, count) -> None:
         """Puts the model on the constraints, if any."""
@@ -365,6 +389,22 @@ class MechanicalSystem(Model):
         # The constraints wrap the unconstrained closure model this class built just before.
         assert isinstance(self._core, (_core.ClosureModel, _core.ClosureNatural))
         self._core = _core.ClosureConstrained(self._core, int(count), constraints, jacobian)
+
+
+def _check_velocity_constraints(matrix: Callable[[np.ndarray], ArrayLike] | None, count: int | None) -> None:
+    """Refuses velocity constraints without their count or a count without them."""
+    if (matrix is None) != (count is None):
+        raise ValueError("velocity_constraints: give velocity_constraints(q) with velocity_constraint_count")
+    if count is not None and (isinstance(count, bool) or not isinstance(count, (int, np.integer))):
+        raise ValueError(f"velocity_constraint_count: must be a positive integer, got {count!r}")
+
+
+def _roll(core: Any, matrix: Callable[[np.ndarray], ArrayLike] | None, count: int | None) -> Any:
+    """The unconstrained closure model ``core`` with the velocity constraints A(q)q̇ = 0 of
+    ``matrix`` (m = ``count`` rows), if any."""
+    if matrix is None or count is None:
+        return core
+    return _core.ClosureNonholonomic(core, int(count), matrix)
 
 
 class Lagrangian(Model):
@@ -402,6 +442,9 @@ class Lagrangian(Model):
     time_dependent:
         Whether L depends on t; then the energy function p·q̇ − L is not conserved and the
         conservation report says so instead of judging it.
+    velocity_constraints, velocity_constraint_count:
+        Velocity constraints A(q)q̇ = 0, ``velocity_constraints(q) -> array (m, n)`` with
+        ``velocity_constraint_count`` = m, as for :class:`MechanicalSystem`; closures only.
     symmetries:
         Symmetries of L whose Noether momenta :func:`varmech.check_conservation` checks.
     name:
@@ -419,6 +462,8 @@ class Lagrangian(Model):
         force: Callable[[np.ndarray, np.ndarray, float], ArrayLike] | None = None,
         rayleigh: ArrayLike | None = None,
         time_dependent: bool = False,
+        velocity_constraints: Callable[[np.ndarray], ArrayLike] | None = None,
+        velocity_constraint_count: int | None = None,
         symmetries: Sequence[Symmetry] = (),
         name: str = "lagrangian",
     ):
@@ -431,13 +476,18 @@ class Lagrangian(Model):
             "force": force,
             "rayleigh": rayleigh,
             "time_dependent": time_dependent,
+            "velocity_constraints": velocity_constraints,
+            "velocity_constraint_count": velocity_constraint_count,
             "symmetries": symmetries,
             "name": name,
         }
         if isinstance(dim, bool) or not isinstance(dim, (int, np.integer)) or dim < 1:
             raise ValueError(f"dim: must be a positive integer, got {dim!r}")
+        _check_velocity_constraints(velocity_constraints, velocity_constraint_count)
         functions = {"lagrangian": lagrangian, "dl_dq": dl_dq, "dl_dv": dl_dv, "hessians": hessians, "force": force}
         native = pointers.functions(functions, int(dim))
+        if velocity_constraints is not None and (native is not None or pointers.is_pointer(velocity_constraints)):
+            raise TypeError("velocity_constraints: only with closures (not with function pointers), and as a closure")
         if native is not None and rayleigh is not None:
             raise TypeError("rayleigh: not with function pointers; add −Cq̇ to the force pointer instead")
         missing = [n for n, f in (("dl_dq", dl_dq), ("dl_dv", dl_dv)) if f is None]
@@ -469,8 +519,12 @@ class Lagrangian(Model):
             lagrangian = native["lagrangian"]
             dl_dq, dl_dv, hessians, total_force = (native[k] if k in native else None for k in list(functions)[1:])
         else:
-            self._core = _core.ClosureLagrangian(
-                int(dim), lagrangian, dl_dq, dl_dv, hessians, total_force, bool(time_dependent), _specs(symmetries)
+            self._core = _roll(
+                _core.ClosureLagrangian(
+                    int(dim), lagrangian, dl_dq, dl_dv, hessians, total_force, bool(time_dependent), _specs(symmetries)
+                ),
+                velocity_constraints,
+                velocity_constraint_count,
             )
         self.force = total_force
         self.lagrangian = lagrangian

@@ -24,6 +24,7 @@ mod jit;
 mod kepler;
 mod kepler_polar;
 mod nbody_kernel;
+mod nonholonomic;
 mod routh;
 mod solar_system;
 mod splitting;

@@ -10,7 +10,7 @@ use varmech::ModelError;
 
 use crate::closure::{
     ClosureConstrained, ClosureLagrangian, ClosureLagrangianSystem, ClosureModel, ClosureNatural, ClosureNaturalSystem,
-    ClosureSystem,
+    ClosureNonholonomic, ClosureSystem,
 };
 use crate::compiled::CompiledModel;
 use crate::errors::{boxed, to_pyerr};
@@ -81,6 +81,8 @@ where
     if let Ok(closure) = model.cast::<ClosureModel>() {
         Ok(body(&ClosureSystem::new(py, closure.get()), &poll))
     } else if let Ok(closure) = model.cast::<ClosureConstrained>() {
+        Ok(closure.get().with_integrable(py, |sys| body(sys, &poll)))
+    } else if let Ok(closure) = model.cast::<ClosureNonholonomic>() {
         Ok(closure.get().with_integrable(py, |sys| body(sys, &poll)))
     } else if let Ok(closure) = model.cast::<ClosureNatural>() {
         let natural = Natural::new(ClosureNaturalSystem::new(py, closure.get()));

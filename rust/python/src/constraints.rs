@@ -1,5 +1,5 @@
-//! Holonomic constraints seen from Python: residuals of saved states, and projection of an
-//! initial state onto the constraints.
+//! Holonomic and velocity constraints seen from Python: residuals of saved states, and
+//! projection of an initial state onto the constraints.
 
 use numpy::{PyArray1, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::exceptions::PyValueError;
@@ -12,11 +12,11 @@ use crate::convert::{rows, slice, ArrayPair};
 use crate::errors::{model_error, to_pyerr};
 
 fn unconstrained() -> PyErr {
-    PyValueError::new_err("model: has no holonomic constraints")
+    PyValueError::new_err("model: has no holonomic constraints (nor velocity constraints)")
 }
 
 /// |g(q)|∞, |G(q)M⁻¹p|∞ and their sizes ‖G‖∞‖q‖∞, ‖G‖∞‖M⁻¹p‖∞ at each state of a constrained
-/// model.
+/// model; 0, |A(q)q̇|∞, 0 and ‖A‖∞‖q̇‖∞ with velocity constraints.
 #[pyfunction]
 fn constraint_residuals<'py>(
     py: Python<'py>,
@@ -45,7 +45,8 @@ fn constraint_residuals<'py>(
     ))
 }
 
-/// The nearest consistent state (q on the constraints, p on the hidden constraint).
+/// The nearest consistent state (q on the constraints, p on the hidden constraint; with velocity
+/// constraints q as it is, p on A(q)q̇ = 0).
 #[pyfunction]
 fn project<'py>(
     py: Python<'py>,

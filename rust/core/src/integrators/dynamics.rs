@@ -1,7 +1,10 @@
 //! What a method integrates: the dynamics of a model, seen through one step's increments.
 
 use super::{Increment, Integrator, ModelKind, StepError, StepStart, StepperState};
-use crate::model::{self, Constrained, EnergyTerms, HolonomicConstraints, Lagrangian, MechanicalSystem, PhaseState};
+use crate::model::{
+    self, Constrained, EnergyTerms, HolonomicConstraints, Lagrangian, MechanicalSystem, Nonholonomic, PhaseState,
+    VelocityConstraints,
+};
 use crate::{Error, ModelError};
 
 /// The dynamics a method integrates: separable mechanical systems take every unconstrained
@@ -235,13 +238,66 @@ impl<L: Lagrangian, C: HolonomicConstraints> Constrained<General<'_, L>, C> {
     /// in q̇, whose inverse Legendre transform is affine in p).
     pub fn project_general(&self, q0: &[f64], p0: &[f64]) -> Result<PhaseState, Error> {
         let velocity = self.velocity();
-        let minv = |q: &[f64], x: &[f64], out: &mut [f64]| {
-            let mut rest = vec![0.0; x.len()];
-            velocity(q, &vec![0.0; x.len()], &mut rest)?;
-            velocity(q, x, out)?;
-            out.iter_mut().zip(&rest).for_each(|(o, r)| *o -= r);
-            Ok(())
-        };
+        let minv = model::inverse_mass(&velocity);
         model::project(&self.constraints, &minv, &velocity, q0, p0)
+    }
+}
+
+/// A Lagrangian with velocity constraints A(q)q̇ = 0, for the discrete Lagrange–d'Alembert
+/// integrator (see [`super::Del`]).
+impl<L: Lagrangian, C: VelocityConstraints> Dynamics for Nonholonomic<L, C> {
+    fn dim(&self) -> usize {
+        self.system.dim()
+    }
+
+    fn kind(&self) -> ModelKind {
+        ModelKind::Nonholonomic
+    }
+
+    /// |A(q₀)q̇₀|∞ within 1e-10 of the state's size; otherwise `p0` is off the constraints. A
+    /// model error is the model's own, at step 0 (the stepper sets its time).
+    fn check_initial(&self, q0: &[f64], p0: &[f64]) -> Result<(), Error> {
+        let velocity = self
+            .residuals(q0, p0)
+            .map_err(|source| Error::Model {
+                step: 0,
+                time: 0.0,
+                source,
+            })?
+            .velocity;
+        let scale = q0.iter().chain(p0).fold(1.0_f64, |m, x| m.max(x.abs()));
+        if velocity.is_nan() || velocity > 1e-10 * scale {
+            return Err(Error::invalid(
+                "p0",
+                format!("is off the velocity constraints: |A(q0)q̇0| = {velocity:.3e}; project the initial state first"),
+            ));
+        }
+        Ok(())
+    }
+
+    fn increment(
+        &self,
+        integrator: &mut Integrator,
+        start: &StepStart,
+        increment: &mut Increment,
+    ) -> Result<(), StepError> {
+        integrator.increment_nonholonomic(&self.system, &self.constraints, start, increment)
+    }
+
+    /// E = p·q̇ − L, unless L depends on t: the constraint forces do no work.
+    fn energy(&self, q: &[f64], p: &[f64], t: f64) -> Option<Result<EnergyTerms, ModelError>> {
+        (!self.system.is_time_dependent()).then(|| self.system.energy_terms(q, p, t))
+    }
+
+    fn as_lagrangian(&self) -> &dyn Lagrangian {
+        &self.system
+    }
+
+    fn constraint_residuals(&self, q: &[f64], p: &[f64]) -> Option<Result<model::Residuals, ModelError>> {
+        Some(self.residuals(q, p))
+    }
+
+    fn project(&self, q: &[f64], p: &[f64]) -> Option<Result<PhaseState, Error>> {
+        Some(Nonholonomic::project(self, q, p))
     }
 }

@@ -18,6 +18,9 @@ pub enum ModelKind {
     /// A general Lagrangian on holonomic constraints: the constrained DEL equations of the
     /// two-point rules.
     ConstrainedLagrangian,
+    /// A Lagrangian (separable, natural or general) with velocity constraints A(q)q̇ = 0: the
+    /// discrete Lagrange–d'Alembert integrator on the midpoint rule (see [`super::Del`]).
+    Nonholonomic,
     /// The gravitational N-body problem ([`crate::model::NBody`]), a separable system with a
     /// dominant central body: every method of a separable system and the Wisdom–Holman methods.
     Gravitational,
@@ -38,16 +41,20 @@ impl ModelKind {
             // since its interior points leave the constraints; full order needs them
             // constrained too (Jay's SPARK methods).
             ModelKind::ConstrainedLagrangian => matches!(method, Midpoint | Trapezoid),
+            // Its reversibility needs the constraint at the midpoint, where the midpoint rule
+            // evaluates L; the trapezoidal rule's ends would take another discrete constraint.
+            ModelKind::Nonholonomic => method == Midpoint,
         }
     }
 
     /// The method a run uses when none is given: Störmer–Verlet for a separable system, the
     /// midpoint rule for a general Lagrangian, RATTLE on constraints, and the trapezoidal rule
-    /// (RATTLE's discrete Lagrangian) for a general Lagrangian on constraints.
+    /// (RATTLE's discrete Lagrangian) for a general Lagrangian on constraints; the discrete
+    /// Lagrange–d'Alembert integrator (midpoint) on velocity constraints.
     pub fn default_method(self) -> Method {
         match self {
             ModelKind::Separable | ModelKind::Gravitational => Method::Verlet,
-            ModelKind::Lagrangian => Method::Midpoint,
+            ModelKind::Lagrangian | ModelKind::Nonholonomic => Method::Midpoint,
             ModelKind::ConstrainedSeparable => Method::Rattle,
             ModelKind::ConstrainedLagrangian => Method::Trapezoid,
         }
@@ -56,11 +63,13 @@ impl ModelKind {
     /// The method a measurement uses when it wants accuracy more than speed (locating Poincaré
     /// crossings, say): order 6, by Kahan–Li's 9-stage composition or the Galerkin integrator of
     /// degree 3; RATTLE's order-4 composition on constraints; and the trapezoidal rule, the
-    /// best order there is, for a general Lagrangian on constraints.
+    /// best order there is, for a general Lagrangian on constraints; the midpoint rule, the only
+    /// one there is, on velocity constraints.
     pub fn accurate_method(self) -> Method {
         match self {
             ModelKind::Separable | ModelKind::Gravitational => Method::KahanLi6,
             ModelKind::Lagrangian => Method::Galerkin6,
+            ModelKind::Nonholonomic => Method::Midpoint,
             ModelKind::ConstrainedSeparable => Method::Rattle4,
             ModelKind::ConstrainedLagrangian => Method::Trapezoid,
         }
@@ -74,6 +83,7 @@ impl ModelKind {
             ModelKind::ConstrainedSeparable => "constrained separable",
             ModelKind::ConstrainedLagrangian => "constrained lagrangian",
             ModelKind::Gravitational => "gravitational",
+            ModelKind::Nonholonomic => "nonholonomic",
         }
     }
 
@@ -118,6 +128,10 @@ impl Method {
             ModelKind::ConstrainedLagrangian => format!(
                 "{name} does not integrate a general Lagrangian on constraints; use trapezoid (RATTLE's \
                  discrete Lagrangian) or midpoint"
+            ),
+            ModelKind::Nonholonomic => format!(
+                "{name} does not integrate velocity constraints; use midpoint (the discrete \
+                 Lagrange–d'Alembert integrator)"
             ),
         };
         Error::invalid("method", reason)

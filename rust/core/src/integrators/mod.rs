@@ -7,8 +7,8 @@
 //!
 //! - [`Method`]: the catalogue, with order, cost and linear stability limit of each method;
 //! - [`ModelKind`]: which method integrates which kind of model, and each kind's default;
-//! - [`Dynamics`]: what a method integrates (a separable system, a [`General`] Lagrangian, or
-//!   either on holonomic constraints);
+//! - [`Dynamics`]: what a method integrates (a separable system, a [`General`] Lagrangian,
+//!   either on holonomic constraints, or a Lagrangian with velocity constraints);
 //! - [`Splitting`]: the coefficients of the kick–drift methods (symplectic Euler, Störmer–Verlet,
 //!   its symmetric compositions, the Runge–Kutta–Nyström splittings);
 //! - [`KickDrift`]: a [`Splitting`] applied to a separable system;
@@ -49,6 +49,7 @@ pub use crate::error::StepError;
 pub use crate::solve::NewtonOptions;
 pub use checkpoint::Checkpoint;
 pub use composition::Composition;
+use del::Constraints;
 pub use del::{Del, StepEquations, TwoPoint};
 pub use dynamics::{Dynamics, General};
 pub use ensemble::{integrate_ensemble, Ensemble, Members, Outcome, Parallel, Shared, Stopped};
@@ -67,7 +68,7 @@ pub use trajectory::{Failure, Trajectory};
 pub use wisdom_holman::{Kernel, WisdomHolman};
 
 use crate::discrete::{Midpoint, Trapezoidal};
-use crate::model::{HolonomicConstraints, Lagrangian, MechanicalSystem};
+use crate::model::{HolonomicConstraints, Lagrangian, MechanicalSystem, VelocityConstraints};
 
 /// A one-step method Ψ_h: (qₙ, pₙ) ↦ (qₙ + δq, pₙ + δp) with its work buffers.
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -240,9 +241,9 @@ impl Integrator {
         increment: &mut Increment,
     ) -> Result<(), StepError> {
         match &mut self.scheme {
-            Scheme::Midpoint(s) => s.increment(sys, None, *start, increment.reborrow()),
-            Scheme::Trapezoid(s) => s.increment(sys, None, *start, increment.reborrow()),
-            Scheme::Galerkin(s) => s.increment(sys, None, *start, increment.reborrow()),
+            Scheme::Midpoint(s) => s.increment(sys, Constraints::None, *start, increment.reborrow()),
+            Scheme::Trapezoid(s) => s.increment(sys, Constraints::None, *start, increment.reborrow()),
+            Scheme::Galerkin(s) => s.increment(sys, Constraints::None, *start, increment.reborrow()),
             _ => Err(self.method.refusal(ModelKind::Lagrangian).into()),
         }
     }
@@ -260,11 +261,30 @@ impl Integrator {
         S: Lagrangian + ?Sized,
         C: HolonomicConstraints,
     {
-        let c: Option<&dyn HolonomicConstraints> = Some(constraints);
+        let c = Constraints::Holonomic(constraints);
         match &mut self.scheme {
             Scheme::Midpoint(s) => s.increment(sys, c, *start, increment.reborrow()),
             Scheme::Trapezoid(s) => s.increment(sys, c, *start, increment.reborrow()),
             _ => Err(self.method.refusal(ModelKind::ConstrainedLagrangian).into()),
+        }
+    }
+
+    /// As [`Integrator::increment_lagrangian`] with velocity constraints: the reversible
+    /// discrete Lagrange–d'Alembert equations of the midpoint rule (see [`Del`]).
+    pub fn increment_nonholonomic<S, C>(
+        &mut self,
+        sys: &S,
+        constraints: &C,
+        start: &StepStart,
+        increment: &mut Increment,
+    ) -> Result<(), StepError>
+    where
+        S: Lagrangian + ?Sized,
+        C: VelocityConstraints,
+    {
+        match &mut self.scheme {
+            Scheme::Midpoint(s) => s.increment(sys, Constraints::Velocity(constraints), *start, increment.reborrow()),
+            _ => Err(self.method.refusal(ModelKind::Nonholonomic).into()),
         }
     }
 

@@ -74,7 +74,7 @@ where
         check_vector("p0", p0, n)?;
         options.check()?;
         method.check(model.kind())?;
-        model.check_initial(q0, p0)?;
+        check_initial(&*model, q0, p0, options.t0)?;
         let zeros = || vec![0.0; n];
         let state = StepperState {
             integrator: Integrator::with_newton(method, n, options.newton),
@@ -173,7 +173,7 @@ where
         if !t0.is_finite() {
             return Err(Error::invalid("t0", "must be finite"));
         }
-        self.model.check_initial(q0, p0)?;
+        check_initial(&*self.model, q0, p0, t0)?;
         state.q.copy_from_slice(q0);
         state.p.copy_from_slice(p0);
         state.eq.fill(0.0);
@@ -407,6 +407,14 @@ pub(super) struct Phase<'a> {
     pub(super) compensated: bool,
     pub(super) steps: &'a mut usize,
     pub(super) clock: Clock,
+}
+
+/// [`Dynamics::check_initial`], a model's error dated at t0.
+fn check_initial<S: Dynamics + ?Sized>(model: &S, q0: &[f64], p0: &[f64], t0: f64) -> Result<(), Error> {
+    model.check_initial(q0, p0).map_err(|e| match e {
+        Error::Model { step, source, .. } => Error::Model { step, time: t0, source },
+        e => e,
+    })
 }
 
 /// The error of a step whose state is not finite.

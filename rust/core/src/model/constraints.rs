@@ -127,6 +127,18 @@ pub struct Constrained<S, C> {
 /// An action x ↦ f(q, x) written into `out`: M(q)⁻¹x, or the inverse Legendre transform.
 pub type Action<'a> = &'a dyn Fn(&[f64], &[f64], &mut [f64]) -> Result<(), ModelError>;
 
+/// M(q)⁻¹x = q̇(q, x) − q̇(q, 0) from the inverse Legendre transform `velocity`: exact for L
+/// quadratic in q̇, whose q̇ is affine in p. It allocates (set-up and diagnostics).
+pub fn inverse_mass<'a>(velocity: Action<'a>) -> impl Fn(&[f64], &[f64], &mut [f64]) -> Result<(), ModelError> + 'a {
+    move |q, x, out| {
+        let mut rest = vec![0.0; x.len()];
+        velocity(q, &vec![0.0; x.len()], &mut rest)?;
+        velocity(q, x, out)?;
+        out.iter_mut().zip(&rest).for_each(|(o, r)| *o -= r);
+        Ok(())
+    }
+}
+
 /// Refuses, naming `argument`, m constraints on n coordinates whose dense matrices do not fit in
 /// the memory available: a step holds G and W = M⁻¹Gᵀ at both of its ends (4mn numbers), the
 /// m × m Gram matrix and the Newton Jacobian of the multipliers (2m²).
@@ -144,9 +156,15 @@ fn jacobians<C: HolonomicConstraints + ?Sized>(
     minv: Action<'_>,
     q: &[f64],
 ) -> Result<(DMatrix<f64>, DMatrix<f64>), ModelError> {
-    let (m, n) = (constraints.count(), q.len());
-    let mut jac = DMatrix::zeros(m, n);
+    let mut jac = DMatrix::zeros(constraints.count(), q.len());
     constraints.jacobian(q, &mut jac)?;
+    let w = weighted(&jac, minv, q)?;
+    Ok((jac, w))
+}
+
+/// W = M(q)⁻¹Gᵀ (n × m) for a constraint matrix G (m × n), allocated.
+fn weighted(jac: &DMatrix<f64>, minv: Action<'_>, q: &[f64]) -> Result<DMatrix<f64>, ModelError> {
+    let (m, n) = jac.shape();
     let mut w = DMatrix::zeros(n, m);
     let mut column = vec![0.0; n];
     for k in 0..m {
@@ -154,7 +172,14 @@ fn jacobians<C: HolonomicConstraints + ?Sized>(
         minv(q, &row, &mut column)?;
         w.column_mut(k).copy_from_slice(&column);
     }
-    Ok((jac, w))
+    Ok(w)
+}
+
+/// ‖G‖∞, the largest row sum of |Gᵢⱼ|.
+pub(super) fn row_norm(jac: &DMatrix<f64>) -> f64 {
+    jac.row_iter()
+        .map(|row| row.iter().map(|x| x.abs()).sum::<f64>())
+        .fold(0.0, f64::max)
 }
 
 /// The constraint residuals at one state, with the sizes they are judged against: |g(q)|∞
@@ -183,10 +208,7 @@ pub fn residuals<C: HolonomicConstraints + ?Sized>(
     let mut v = vec![0.0; n];
     velocity(q, p, &mut v)?;
     let hidden = &jac * DVector::from_column_slice(&v);
-    let norm = jac
-        .row_iter()
-        .map(|row| row.iter().map(|x| x.abs()).sum::<f64>())
-        .fold(0.0, f64::max);
+    let norm = row_norm(&jac);
     let amax = |x: &[f64]| x.iter().fold(0.0_f64, |a, y| a.max(y.abs()));
     Ok(Residuals {
         position: amax(&g),
@@ -241,14 +263,8 @@ pub fn project<C: HolonomicConstraints + ?Sized>(
         }
     }
     let q = problem.q;
-    let (jac, w) = jacobians(constraints, minv, q.as_slice()).map_err(model)?;
-    let mut v = vec![0.0; q.len()];
-    velocity(q.as_slice(), p0, &mut v).map_err(model)?;
-    let mu = (&jac * &w)
-        .lu()
-        .solve(&(&jac * DVector::from_column_slice(&v)))
-        .ok_or_else(singular)?;
-    let p = DVector::from_column_slice(p0) - jac.transpose() * mu;
+    let mut jac = DMatrix::zeros(m, q.len());
+    constraints.jacobian(q.as_slice(), &mut jac).map_err(model)?;
     // Finite inputs near the largest floats can still overflow on the way (GM⁻¹Gᵀ, μ).
     if !q.iter().all(|x| x.is_finite()) {
         return Err(Error::invalid(
@@ -256,13 +272,37 @@ pub fn project<C: HolonomicConstraints + ?Sized>(
             "its projection overflows: the positions are too large to project",
         ));
     }
+    let p = momentum_projection(&jac, minv, velocity, q.as_slice(), p0)?;
+    Ok((q.as_slice().to_vec(), p))
+}
+
+/// p ← p − Gᵀμ with (GW)μ = Gq̇(q, p), W = M⁻¹Gᵀ: the M-orthogonal projection of the momenta
+/// onto G(q)q̇ = 0 for the constraint matrix G (m × n) at q. Errors name `q0` (the constraints
+/// not independent, or failing to evaluate) and `p0` (overflow).
+pub(super) fn momentum_projection(
+    jac: &DMatrix<f64>,
+    minv: Action<'_>,
+    velocity: Action<'_>,
+    q: &[f64],
+    p0: &[f64],
+) -> Result<Vec<f64>, Error> {
+    let model = |e: ModelError| Error::invalid("q0", format!("the constraints failed to evaluate: {e}"));
+    let singular = || Error::invalid("q0", "the constraints are not independent here (G M⁻¹ Gᵀ is singular)");
+    let w = weighted(jac, minv, q).map_err(model)?;
+    let mut v = vec![0.0; q.len()];
+    velocity(q, p0, &mut v).map_err(model)?;
+    let mu = (jac * &w)
+        .lu()
+        .solve(&(jac * DVector::from_column_slice(&v)))
+        .ok_or_else(singular)?;
+    let p = DVector::from_column_slice(p0) - jac.transpose() * mu;
     if !p.iter().all(|x| x.is_finite()) {
         return Err(Error::invalid(
             "p0",
             "its projection overflows: the momenta are too large to project",
         ));
     }
-    Ok((q.as_slice().to_vec(), p.as_slice().to_vec()))
+    Ok(p.as_slice().to_vec())
 }
 
 /// g(q) = 0 by Newton's method along W = M(q)⁻¹G(q)ᵀ: q ← q − Wδ with (GW)δ = g(q). It

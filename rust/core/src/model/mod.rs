@@ -8,6 +8,8 @@
 //!   [`Lagrangian`] through [`Natural`];
 //! - [`HolonomicConstraints`]: g(q) = 0 with its Jacobian, [`Distances`] for rigid links, and
 //!   [`Constrained`], a mechanical system on them;
+//! - [`VelocityConstraints`]: nonholonomic constraints A(q)q̇ = 0, and [`Nonholonomic`], a
+//!   Lagrangian system on them;
 //! - [`NBody`]: point masses under Newtonian gravity, the model of the N-body scenes and of
 //!   the Wisdom–Holman methods;
 //! - [`Routhian`]: Routh reduction, R = L − μ·ċ on the non-cyclic coordinates;
@@ -25,12 +27,13 @@ mod mass;
 mod mechanical;
 mod natural;
 mod nbody;
+mod nonholonomic;
 mod routh;
 mod scale;
 mod symmetry;
 
 pub use constraints::{
-    check_dense, differenced_jacobian, project, residuals, Action, Anchor, Constrained, Distances,
+    check_dense, differenced_jacobian, inverse_mass, project, residuals, Action, Anchor, Constrained, Distances,
     HolonomicConstraints, Link, PhaseState, Residuals,
 };
 pub use energy::{hamiltonian, EnergyTerms};
@@ -39,6 +42,7 @@ pub use mass::Mass;
 pub use mechanical::MechanicalSystem;
 pub use natural::{differenced_kinetic_gradient, kinetic_gradient_from_mass_derivative, Natural, NaturalSystem};
 pub use nbody::{NBody, PairKernel};
+pub use nonholonomic::{differenced_derivative, Nonholonomic, VelocityConstraints};
 pub use routh::Routhian;
 pub use scale::Scale;
 pub use symmetry::Generator;

@@ -4,15 +4,15 @@ use std::cell::RefCell;
 
 use nalgebra::DMatrix;
 use numpy::PyArray1;
-use pyo3::exceptions::{PyTypeError, PyValueError};
+use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
 use varmech::integrators::{Dynamics, General};
-use varmech::model::{check_dense, differenced_jacobian, Constrained, HolonomicConstraints, Natural};
+use varmech::model::{differenced_jacobian, Constrained, HolonomicConstraints, Natural};
 use varmech::ModelError;
 
 use super::mechanical::{ClosureModel, ClosureSystem};
 use super::natural::{ClosureNatural, ClosureNaturalSystem};
-use super::readers::{call_array, call_vector, check_closures};
+use super::readers::{call_array, call_vector, check_closures, check_count};
 
 /// A closure model (a [`ClosureModel`], or a [`ClosureNatural`] with configuration-dependent
 /// mass) on holonomic constraints given by Python closures `constraints(q) -> array (m,)` and,
@@ -46,7 +46,6 @@ impl ClosureConstrained {
             ));
         };
         let dim = system.dim();
-        check_dense("count", count, dim).map_err(|e| PyValueError::new_err(e.to_string()))?;
         check_closures(
             dim,
             [
@@ -54,12 +53,7 @@ impl ClosureConstrained {
                 ("constraint_jacobian", jacobian.as_ref()),
             ],
         )?;
-        if count == 0 || count >= dim {
-            return Err(PyValueError::new_err(format!(
-                "constraint_count: must be between 1 and dim − 1 = {}, got {count}",
-                dim - 1
-            )));
-        }
+        check_count("constraint_count", count, dim)?;
         Ok(ClosureConstrained {
             system,
             count,

@@ -5,12 +5,14 @@ pub mod constraints;
 pub mod lagrangian;
 pub mod mechanical;
 pub mod natural;
+pub mod nonholonomic;
 pub mod readers;
 
 pub use constraints::ClosureConstrained;
 pub use lagrangian::{ClosureLagrangian, ClosureLagrangianSystem};
 pub use mechanical::{ClosureModel, ClosureSystem};
 pub use natural::{ClosureNatural, ClosureNaturalSystem};
+pub use nonholonomic::ClosureNonholonomic;
 
 use pyo3::prelude::*;
 
@@ -20,5 +22,6 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<ClosureLagrangian>()?;
     m.add_class::<ClosureNatural>()?;
     m.add_class::<ClosureConstrained>()?;
+    m.add_class::<ClosureNonholonomic>()?;
     Ok(())
 }

@@ -13,6 +13,7 @@ use pyo3::types::{PyBool, PyFloat, PyInt, PyList, PyTuple};
 use varmech::ModelError;
 
 use varmech::memory::check_allocation;
+use varmech::model::check_dense;
 
 use crate::errors::boxed;
 
@@ -29,6 +30,18 @@ pub fn check_closures<const N: usize>(dim: usize, closures: [(&str, Option<&Boun
     }
     check_allocation("dim", dim.saturating_mul(dim), 4 * std::mem::size_of::<f64>())
         .map_err(|e| PyValueError::new_err(e.to_string()))
+}
+
+/// A number of constraints m on `dim` coordinates: 1 ≤ m < dim, and their dense matrices within
+/// the memory available ([`check_dense`]); errors name `argument`.
+pub fn check_count(argument: &'static str, count: usize, dim: usize) -> PyResult<()> {
+    if count == 0 || count >= dim {
+        return Err(PyValueError::new_err(format!(
+            "{argument}: must be between 1 and dim − 1 = {}, got {count}",
+            dim.saturating_sub(1)
+        )));
+    }
+    check_dense(argument, count, dim).map_err(|e| PyValueError::new_err(e.to_string()))
 }
 
 /// The name of a Python object's type, for messages.

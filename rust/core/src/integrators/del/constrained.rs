@@ -4,43 +4,50 @@
 use nalgebra::DMatrix;
 use serde::{Deserialize, Serialize};
 
-use super::StepEquations;
+use super::{nonholonomic, Constraints, StepEquations};
 use crate::integrators::{Increment, StepError, StepStart};
-use crate::model::{HolonomicConstraints, Lagrangian};
+use crate::model::Lagrangian;
 use crate::solve::difference::{central_jacobian, Evaluations};
 use crate::solve::newton::{Correction, Newton, NewtonOptions, NewtonProblem, Reasons, Rules};
 use crate::ModelError;
 
-/// The constraints of a step with G(q₀), and a buffer for q₁.
-pub(super) type Holonomic<'a> = (&'a dyn HolonomicConstraints, &'a DMatrix<f64>, &'a mut [f64]);
-
 /// F(x) for x = (λ, s): the scheme's equations in s with (h/2)G(q₀)ᵀλ taken from the last
-/// block (the one holding p₀), then g(q₀ + δq) with δq the last n of s.
+/// block (the one holding p₀), then the discrete constraint on δq, the last n of s: g(q₀ + δq)
+/// for holonomic constraints, A(q̄)δq for velocity ones ([`nonholonomic::discrete_constraint`]).
 pub(super) fn constrained_equations<Sc: StepEquations, S: Lagrangian + ?Sized>(
     scheme: &mut Sc,
     sys: &S,
-    constraints: Option<Holonomic<'_>>,
+    constraints: Constraints<'_>,
+    mp: &mut Multipliers,
     start: StepStart<'_>,
     x: &[f64],
     out: &mut [f64],
 ) -> Result<(), ModelError> {
-    let Some((c, g0, q1)) = constraints else {
+    if let Constraints::None = constraints {
         return scheme.equations(sys, start, x, out);
-    };
-    let (n, m) = (start.q.len(), g0.nrows());
+    }
+    let (n, m) = (start.q.len(), mp.g0.nrows());
     let (lambda, s) = x.split_at(m);
     let u = s.len();
     scheme.equations(sys, start, s, &mut out[..u])?;
     for (j, o) in out[u - n..u].iter_mut().enumerate() {
-        *o -= 0.5 * start.h * (0..m).map(|k| g0[(k, j)] * lambda[k]).sum::<f64>();
+        *o -= 0.5 * start.h * (0..m).map(|k| mp.g0[(k, j)] * lambda[k]).sum::<f64>();
     }
-    for ((q1, q), d) in q1.iter_mut().zip(start.q).zip(&s[u - n..]) {
-        *q1 = q + d;
+    let dq = &s[u - n..];
+    match constraints {
+        Constraints::Velocity(c) => nonholonomic::discrete_constraint(c, mp, start.q, dq, &mut out[u..]),
+        Constraints::Holonomic(c) => {
+            for ((q1, q), d) in mp.q1.iter_mut().zip(start.q).zip(dq) {
+                *q1 = q + d;
+            }
+            c.residual(&mp.q1, &mut out[u..])
+        }
+        Constraints::None => Ok(()),
     }
-    c.residual(q1, &mut out[u..])
 }
 
-/// The buffers of the constrained step: G(q₀) and G(q₁), q₁ and p₁, and μ's Newton iteration.
+/// The buffers of the constrained step: G(q₀) and G(q₁) (or A), q₁ and p₁, and μ's Newton
+/// iteration; for velocity constraints also q̄, A(q̄) and ∂A/∂qᵢ.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub(super) struct Multipliers {
     /// G at the step's start; the last step's G(q₁) once a step is taken (first same as last).
@@ -48,6 +55,9 @@ pub(super) struct Multipliers {
     pub cached: bool,
     g1: DMatrix<f64>,
     pub q1: Vec<f64>,
+    pub midpoint: Vec<f64>,
+    pub a_mid: DMatrix<f64>,
+    pub da: DMatrix<f64>,
     p1: Vec<f64>,
     v: Vec<f64>,
     plus: Vec<f64>,
@@ -63,6 +73,9 @@ impl Multipliers {
             cached: false,
             g1: DMatrix::zeros(m, n),
             q1: vec![0.0; n],
+            midpoint: vec![0.0; n],
+            a_mid: DMatrix::zeros(m, n),
+            da: DMatrix::zeros(m, n),
             p1: vec![0.0; n],
             v: vec![0.0; n],
             plus: vec![0.0; m],
@@ -72,13 +85,14 @@ impl Multipliers {
         }
     }
 
-    /// p₁ = p₀ + δp − (h/2)G(q₁)ᵀμ with G(q₁)q̇(q₁, p₁) = 0: Newton's method on μ, its
+    /// p₁ = p₀ + δp − (h/2)G(q₁)ᵀμ with G(q₁)q̇(q₁, p₁) = 0 (G the constraints' Jacobian, or
+    /// the matrix A of velocity constraints, [`Constraints::matrix`]): Newton's method on μ, its
     /// Jacobian −(h/2)G(q₁)(∂q̇/∂p)G(q₁)ᵀ from central differences of the inverse Legendre
     /// transform (exact in one step when L is quadratic in q̇); δp takes the projection.
     pub fn project_momentum<S: Lagrangian + ?Sized>(
         &mut self,
         sys: &S,
-        c: &dyn HolonomicConstraints,
+        c: Constraints<'_>,
         start: StepStart<'_>,
         step: &mut Increment<'_>,
         options: &NewtonOptions,
@@ -87,7 +101,7 @@ impl Multipliers {
         for ((x, q), d) in self.q1.iter_mut().zip(q).zip(step.dq.iter()) {
             *x = q + d;
         }
-        c.jacobian(&self.q1, &mut self.g1)?;
+        c.matrix(&self.q1, &mut self.g1)?;
         self.mu.fill(0.0);
         let mut problem = OntoHiddenConstraint {
             tangent: Tangent {

@@ -1,0 +1,87 @@
+use nalgebra::{DMatrix, DVector};
+
+use super::constraints::{momentum_projection, row_norm};
+use super::{inverse_mass, Lagrangian, Residuals};
+use crate::{Error, ModelError};
+
+/// Velocity constraints A(q)q̇ = 0 linear in the velocities, m rows on n coordinates, that need
+/// not integrate to constraints on the positions (nonholonomic: rolling without slipping, a
+/// skate's blade). The constraint forces are Aᵀλ, by the Lagrange–d'Alembert principle.
+pub trait VelocityConstraints {
+    /// Number of constraints m.
+    fn count(&self) -> usize;
+
+    /// Writes A(q) (m × n) into `a`.
+    fn matrix(&self, q: &[f64], a: &mut DMatrix<f64>) -> Result<(), ModelError>;
+
+    /// Writes ∂A/∂qᵢ (m × n) into `out`: with it Newton's method assembles the exact Jacobian of
+    /// the discrete Lagrange–d'Alembert equations. Default: [`differenced_derivative`].
+    fn derivative(&self, q: &[f64], i: usize, out: &mut DMatrix<f64>) -> Result<(), ModelError> {
+        differenced_derivative(self, q, i, out)
+    }
+}
+
+/// ∂A/∂qᵢ by a central difference of A, with the step ε^{1/3}·max(|qᵢ|, 1) (two evaluations of
+/// A; they allocate scratch), about 1e-10 relative accuracy.
+pub fn differenced_derivative<C: VelocityConstraints + ?Sized>(
+    constraints: &C,
+    q: &[f64],
+    i: usize,
+    out: &mut DMatrix<f64>,
+) -> Result<(), ModelError> {
+    let h = f64::EPSILON.cbrt() * q[i].abs().max(1.0);
+    let mut x = q.to_vec();
+    let mut minus = DMatrix::zeros(out.nrows(), out.ncols());
+    x[i] = q[i] + h;
+    constraints.matrix(&x, out)?;
+    x[i] = q[i] - h;
+    constraints.matrix(&x, &mut minus)?;
+    *out -= minus;
+    *out /= 2.0 * h;
+    Ok(())
+}
+
+/// A Lagrangian system S with velocity constraints C: what the discrete Lagrange–d'Alembert
+/// integrator ([`crate::integrators::Del`] with the midpoint rule) integrates. S is any
+/// [`Lagrangian`]: a separable or natural mechanical system, or a general L(q, q̇, t).
+#[derive(Clone, Debug)]
+pub struct Nonholonomic<S, C> {
+    pub system: S,
+    pub constraints: C,
+}
+
+impl<S: Lagrangian, C: VelocityConstraints> Nonholonomic<S, C> {
+    /// A(q), allocated (diagnostics and set-up).
+    fn matrix(&self, q: &[f64]) -> Result<DMatrix<f64>, ModelError> {
+        let mut a = DMatrix::zeros(self.constraints.count(), q.len());
+        self.constraints.matrix(q, &mut a)?;
+        Ok(a)
+    }
+
+    /// |A(q)q̇|∞ with q̇ = q̇(q, p) (as `velocity`), judged against ‖A(q)‖∞‖q̇‖∞; the
+    /// position entries are 0 (there is no constraint on q).
+    pub fn residuals(&self, q: &[f64], p: &[f64]) -> Result<Residuals, ModelError> {
+        let a = self.matrix(q)?;
+        let mut v = vec![0.0; q.len()];
+        self.system.velocity(q, p, 0.0, &mut v)?;
+        let v = DVector::from_column_slice(&v);
+        Ok(Residuals {
+            position: 0.0,
+            velocity: (&a * &v).amax(),
+            position_size: 0.0,
+            velocity_size: row_norm(&a) * v.amax(),
+        })
+    }
+
+    /// The nearest consistent state: q unchanged, p ← p − Aᵀμ with (AM⁻¹Aᵀ)μ = Aq̇(q, p), the
+    /// M-orthogonal projection onto A(q)q̇ = 0, M(q)⁻¹x = q̇(q, x) − q̇(q, 0) (exact for L
+    /// quadratic in q̇).
+    pub fn project(&self, q: &[f64], p: &[f64]) -> Result<(Vec<f64>, Vec<f64>), Error> {
+        let model = |e: ModelError| Error::invalid("q0", format!("the velocity constraints failed to evaluate: {e}"));
+        let velocity = |q: &[f64], p: &[f64], v: &mut [f64]| self.system.velocity(q, p, 0.0, v);
+        let minv = inverse_mass(&velocity);
+        let a = self.matrix(q).map_err(model)?;
+        let p = momentum_projection(&a, &minv, &velocity, q, p)?;
+        Ok((q.to_vec(), p))
+    }
+}
