@@ -344,11 +344,23 @@ def _on_cluster(
         for future, result in as_completed(futures, with_results=True):
             chunks[order[future.key]] = result
             bar.update(len(result[0]))
-    except BaseException:
+    except BaseException as err:
         client.cancel(futures)
+        if isinstance(err, KeyboardInterrupt):
+            # What the cluster finished is kept; the chunks it had not are members that saved no state.
+            for k, a in enumerate(starts):
+                if chunks[k] is None:
+                    size = min(chunk_size, members - a)
+                    chunks[k] = ([_empty(model, settings, "interrupted before it finished")] * size, [err] * size)
+            err.partial = _gathered(chunks, values)  # type: ignore[attr-defined]
         raise
     finally:
         bar.close()
+    return _gathered(chunks, values)
+
+
+def _gathered(chunks: list[Any], values: dict[str, np.ndarray]) -> Ensemble:
+    """The ensemble of the chunks' (trajectories, errors), in member order."""
     trajs = [tr for chunk, _ in chunks for tr in chunk]
     errors = [e for _, chunk in chunks for e in chunk]
     return Ensemble(trajs, errors, values)

@@ -3,6 +3,7 @@ parameter sweeps, Ctrl-C, and bad input named."""
 
 import os
 import signal
+import sys
 import threading
 import time
 
@@ -198,6 +199,33 @@ def test_a_dask_cluster_gives_every_member_bit_for_bit(cluster_client, chunk_siz
         dt=0.1, steps=200, method="verlet", client=cluster_client, chunk_size=chunk_size, progress=False,
     )
     assert swept.failed == [1] and isinstance(swept.errors[1], varmech.DivergenceError) and swept.errors[1].step >= 1
+
+
+def test_ctrl_c_on_a_cluster_keeps_the_chunks_it_finished(cluster_client, monkeypatch):
+    # Ctrl-C arriving as the first chunk is gathered (raised from the progress bar's update): the
+    # KeyboardInterrupt carries the ensemble so far, the finished chunk's members bit for bit,
+    # the rest marked interrupted with no state.
+    ensemble_module = sys.modules["varmech.ensemble"]  # the module, which varmech.ensemble (the function) shadows
+
+    class Interrupted:
+        def update(self, n):
+            raise KeyboardInterrupt
+
+        def close(self):
+            pass
+
+    monkeypatch.setattr(ensemble_module, "progress_bar", lambda **kwargs: Interrupted())
+    scene, q0, p0 = _double_pendulum_rows(12)
+    run = dict(dt=0.01, steps=200, method="midpoint", save_every=7)
+    with pytest.raises(KeyboardInterrupt) as info:
+        varmech.ensemble(scene, q0, p0, client=cluster_client, chunk_size=4, **run)
+    partial = info.value.partial
+    done = [i for i in range(12) if partial.errors[i] is None]
+    assert len(done) == 4 and done[0] % 4 == 0 and done == list(range(done[0], done[0] + 4))
+    for i in done:
+        assert _same(partial[i], varmech.integrate(scene.model, q0[i], p0[i], **run)), f"member {i}"
+    assert sorted(partial.failed) == sorted(set(range(12)) - set(done))
+    assert all(len(partial[i].t) == 0 and partial[i].status == -1 for i in partial.failed)
 
 
 def test_a_model_that_cannot_be_shipped_is_named(cluster_client):
