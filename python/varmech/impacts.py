@@ -84,7 +84,7 @@ class Contact:
     gradient: Callable[[np.ndarray], ArrayLike]
     restitution: float = 1.0
     name: str = "contact"
-    #: The impact law: ``"variational"``, the variational collision integrator (:func:`collide`;
+    #: The impact law: ``"variational"``, the variational collision integrator (:func:`variational_jump`;
     #: kick–drift methods and the two-point rules ``midpoint`` and ``trapezoid``), or
     #: ``"reflect"``, the exact reflection of the momenta between the method's partial steps (any
     #: method; symplectic across an impact only to the method's order).
@@ -535,8 +535,8 @@ def run(
     ``contacts`` (``start(q, p, t0, steps, progress, events)`` runs a piece up to the first
     impact), and the impacts of each contact. Under the variational law a kick–drift method
     (:class:`Splitting`) or a two-point rule (:class:`TwoPoint`) goes through each impact by
-    :func:`collide`; under ``"reflect"`` the momenta are reflected (:func:`reflect`) between the
-    method's own partial steps."""
+    :func:`through` with :func:`variational_jump`; under ``"reflect"`` the momenta jump by
+    :func:`exact_jump` between the method's own partial steps (:class:`CoreStep`)."""
     split = method_info(method).splitting
     for i, c in enumerate(contacts):
         if not (isinstance(c, Contact) and c.law == "variational"):
