@@ -3,12 +3,15 @@
 Member i of an ensemble is :func:`varmech.integrate` of its model from row i of ``q0`` and
 ``p0``, bit for bit, whatever the number of threads or the chunking. Native and compiled
 models run in the Rust core on every core of the machine (Rayon threads, the GIL released, no
-Python per step). Closure models hold the GIL, so they run member by member, serially.
+Python per step). Closure models hold the GIL: they run member by member, serially, or, with
+``workers`` given, in that many processes.
 """
 
 from __future__ import annotations
 
 import math
+import multiprocessing
+import signal
 from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, Literal
@@ -188,7 +191,11 @@ def ensemble(
 
     Native and compiled models run in the Rust core on ``workers`` threads with the GIL
     released. Closure models (:class:`~varmech.MechanicalSystem`, :class:`~varmech.Lagrangian`)
-    call Python at every step and hold the GIL, so they run member by member, serially.
+    call Python at every step and hold the GIL, so threads would only take turns: they run
+    member by member, serially, unless ``workers`` is given; then they run in that many
+    processes (the model shipped by cloudpickle), which pays off once the serial run would take
+    more than about a second (the README's *Ensembles and clusters* gives the figures). As with
+    any process pool, a script that does this needs the ``if __name__ == "__main__":`` guard.
 
     Parameters
     ----------
@@ -206,7 +213,8 @@ def ensemble(
         As in :func:`varmech.integrate`, for every member.
     workers:
         The most threads to use; default: one a core (with ``client``: on each Dask worker, its
-        own thread count).
+        own thread count). For a closure model, the number of processes; default: none, the
+        members run serially in this process.
     client:
         A :class:`dask.distributed.Client`: the members run on its cluster in chunks of
         ``chunk_size``, each chunk one task that runs this same parallel loop in a worker
@@ -217,7 +225,7 @@ def ensemble(
         worker is run again by Dask, bit for bit the same.
     chunk_size:
         Members a task runs one after the other (default 1: the threads balance the load; with
-        ``client``, about four chunks a worker thread).
+        ``client`` or closure processes, about four chunks a worker thread or process).
     progress:
         A progress bar of the steps of all members (tqdm, on stderr) once the run has taken a
         second; ``None``: only when stderr is a terminal.
@@ -303,7 +311,10 @@ def ensemble(
             interrupted.partial = result  # type: ignore[attr-defined]
             raise interrupted
         return result
-    return _serial(models, q, p, values, run, newton, max_energy_error, progress)
+    settings = run | newton | dict(max_energy_error=max_energy_error)
+    if workers is not None and workers > 1 and members > 1:
+        return _in_processes(model, q, p, values, settings, workers, chunk_size, progress)
+    return _serial(models, q, p, values, settings, progress)
 
 
 def _on_cluster(
@@ -347,23 +358,85 @@ def _on_cluster(
     except BaseException as err:
         client.cancel(futures)
         if isinstance(err, KeyboardInterrupt):
-            # What the cluster finished is kept; the chunks it had not are members that saved no state.
-            for k, a in enumerate(starts):
-                if chunks[k] is None:
-                    size = min(chunk_size, members - a)
-                    chunks[k] = ([_empty(model, settings, "interrupted before it finished")] * size, [err] * size)
-            err.partial = _gathered(chunks, values)  # type: ignore[attr-defined]
+            err.partial = _gathered(chunks, values, _unfinished(model, settings, members, chunk_size, err))  # type: ignore[attr-defined]
         raise
     finally:
         bar.close()
     return _gathered(chunks, values)
 
 
-def _gathered(chunks: list[Any], values: dict[str, np.ndarray]) -> Ensemble:
-    """The ensemble of the chunks' (trajectories, errors), in member order."""
+def _gathered(chunks: list[Any], values: dict[str, np.ndarray], unfinished: Any = None) -> Ensemble:
+    """The ensemble of the chunks' (trajectories, errors), in member order; a chunk not gathered
+    (None) is ``unfinished(k)``."""
+    chunks = [unfinished(k) if chunk is None else chunk for k, chunk in enumerate(chunks)]
     trajs = [tr for chunk, _ in chunks for tr in chunk]
     errors = [e for _, chunk in chunks for e in chunk]
     return Ensemble(trajs, errors, values)
+
+
+def _unfinished(model: Model, settings: dict[str, Any], members: int, chunk_size: int, err: BaseException) -> Any:
+    """Chunk k as Ctrl-C left it before it was gathered: members that saved no state."""
+
+    def chunk(k: int) -> tuple[list[Trajectory], list[BaseException | None]]:
+        size = min(chunk_size, members - k * chunk_size)
+        return [_empty(model, settings, "interrupted before it finished")] * size, [err] * size
+
+    return chunk
+
+
+def _in_processes(
+    model: Model,
+    q: np.ndarray,
+    p: np.ndarray,
+    values: dict[str, np.ndarray],
+    settings: dict[str, Any],
+    workers: int,
+    chunk_size: int | None,
+    progress: bool | None,
+) -> Ensemble:
+    """A closure model's ensemble in ``workers`` processes: chunks of members, each one task
+    (:func:`_closure_chunk`), gathered in member order. The processes start clean (forkserver or
+    spawn: forking a process that runs threads is unsafe) and ignore SIGINT: Ctrl-C reaches this
+    process, which stops them and keeps the chunks gathered."""
+    import cloudpickle
+
+    try:
+        shipped = cloudpickle.dumps(model)
+    except Exception as err:
+        raise TypeError(f"model: {model.name} cannot be shipped to worker processes ({err})") from err
+    members = len(q)
+    workers = min(workers, members)
+    if chunk_size is None:
+        chunk_size = max(1, math.ceil(members / (4 * workers)))
+    tasks = [(shipped, q[a : a + chunk_size], p[a : a + chunk_size], settings) for a in range(0, members, chunk_size)]
+    chunks: list[Any] = [None] * len(tasks)
+    start = "forkserver" if "forkserver" in multiprocessing.get_all_start_methods() else "spawn"
+    pool = multiprocessing.get_context(start).Pool(workers, initializer=signal.signal, initargs=(signal.SIGINT, signal.SIG_IGN))
+    bar = progress_bar(total=members, unit="member", desc=f"{settings['method']} ({workers} processes)", enabled=progress)
+    try:
+        for k, result in enumerate(pool.imap(_closure_chunk, tasks)):
+            chunks[k] = cloudpickle.loads(result)
+            bar.update(len(chunks[k][0]))
+    except BaseException as err:
+        if isinstance(err, KeyboardInterrupt):
+            err.partial = _gathered(chunks, values, _unfinished(model, settings, members, chunk_size, err))  # type: ignore[attr-defined]
+        raise
+    finally:
+        pool.terminate()
+        pool.join()
+        bar.close()
+    return _gathered(chunks, values)
+
+
+def _closure_chunk(task: tuple[bytes, np.ndarray, np.ndarray, dict[str, Any]]) -> bytes:
+    """One process task: the members of a chunk, serially; the result by cloudpickle (a
+    user's exception class may live in ``__main__``)."""
+    import cloudpickle
+
+    shipped, q, p, settings = task
+    model = cloudpickle.loads(shipped)
+    run = _serial([model] * len(q), q, p, {}, settings, False)
+    return cloudpickle.dumps((run.trajectories, run.errors))
 
 
 def _chunk(
@@ -385,28 +458,26 @@ def _serial(
     q: np.ndarray,
     p: np.ndarray,
     values: dict[str, np.ndarray],
-    run: dict[str, Any],
-    newton: dict[str, Any],
-    max_energy_error: float | None | Literal["auto"],
+    settings: dict[str, Any],
     progress: bool | None,
 ) -> Ensemble:
     """A closure model's ensemble: :func:`varmech.integrate` member by member (the closures
     hold the GIL, so threads would not run them in parallel)."""
     trajs: list[Trajectory] = []
     errors: list[BaseException | None] = []
-    bar = progress_bar(total=len(q), unit="member", desc=f"{run['method']} (serial)", enabled=progress)
+    bar = progress_bar(total=len(q), unit="member", desc=f"{settings['method']} (serial)", enabled=progress)
     try:
         for i, model in enumerate(models):
             try:
-                trajs.append(integrate(model, q[i], p[i], **run, **newton, max_energy_error=max_energy_error, progress=False))
+                trajs.append(integrate(model, q[i], p[i], **settings, progress=False))
                 errors.append(None)
             except Exception as err:
-                partial = getattr(err, "partial", None) or _empty(model, run, str(err))
+                partial = getattr(err, "partial", None) or _empty(model, settings, str(err))
                 trajs.append(partial)
                 errors.append(err)
             except KeyboardInterrupt as err:
                 partial = getattr(err, "partial", None)
-                rest = [_empty(m, run, "interrupted before it started") for m in models[len(trajs) + (partial is not None) :]]
+                rest = [_empty(m, settings, "interrupted before it started") for m in models[len(trajs) + (partial is not None) :]]
                 stopped = [partial] if partial is not None else []
                 err.partial = Ensemble(trajs + stopped + rest, errors + [err] * (len(stopped) + len(rest)), values)  # type: ignore[attr-defined]
                 raise

@@ -48,13 +48,25 @@ def test_every_member_is_bit_for_bit_its_single_integrate(workers, chunk_size):
     assert np.array_equal(runs.t, runs[0].t)
 
 
-def test_a_closure_model_runs_member_by_member_bit_for_bit():
+@pytest.mark.parametrize("workers, chunk_size", [(None, None), (2, None), (2, 1), (3, 2)])
+def test_a_closure_model_runs_bit_for_bit_serially_or_in_processes(workers, chunk_size):
     pendulum = varmech.MechanicalSystem(1, potential=lambda q: -np.cos(q[0]), gradient=lambda q: np.sin(q))
-    q0 = np.array([[0.1], [1.0], [2.5]])
-    p0 = np.zeros((3, 1))
-    runs = varmech.ensemble(pendulum, q0, p0, dt=0.05, steps=200, method="verlet", workers=2, progress=False)
-    for i in range(3):
-        assert _same(runs[i], varmech.integrate(pendulum, q0[i], p0[i], dt=0.05, steps=200, method="verlet"))
+    q0 = np.array([[0.1], [1.0], [2.5], [3.0], [-1.0]])
+    p0 = np.zeros((5, 1))
+    run = dict(dt=0.05, steps=200, method="verlet")
+    runs = varmech.ensemble(pendulum, q0, p0, workers=workers, chunk_size=chunk_size, progress=False, **run)
+    for i in range(5):
+        assert _same(runs[i], varmech.integrate(pendulum, q0[i], p0[i], **run))
+
+
+class LeftTheChart(Exception):
+    """A user's own exception, raised in a closure."""
+
+
+def _gradient_off_the_chart(q):
+    if abs(q[0]) > 2.0:
+        raise LeftTheChart(f"left the chart at q = {q[0]}")
+    return q.copy()
 
 
 def test_velocities_give_each_members_momenta():
@@ -88,16 +100,54 @@ def test_a_member_past_its_stability_limit_fails_alone_with_its_step_and_partial
     assert summary.reports[0].verdict in ("bounded", "conserved to round-off")
 
 
-def test_a_closure_members_failure_leaves_the_others_complete():
-    def gradient(q):
-        if abs(q[0]) > 2.0:
-            raise ValueError("left the chart")
-        return q.copy()
+@pytest.mark.parametrize("workers", [None, 2])
+def test_a_closure_members_failure_leaves_the_others_complete(workers):
+    # The user's exception comes back as itself, with the step, the time and the states so far,
+    # also from a worker process.
+    oscillator = varmech.MechanicalSystem(1, potential=lambda q: 0.5 * q[0] ** 2, gradient=_gradient_off_the_chart)
+    q0, p0 = [[0.5], [1.0], [1.0], [1.5]], [[0.0], [0.0], [2.0], [0.0]]
+    run = dict(dt=0.1, steps=100)
+    runs = varmech.ensemble(oscillator, q0, p0, workers=workers, chunk_size=1, progress=False, **run)
+    assert runs.failed == [2] and type(runs.errors[2]) is LeftTheChart and "left the chart" in str(runs.errors[2])
+    assert runs[0].steps == runs[1].steps == runs[3].steps == 100
+    with pytest.raises(LeftTheChart) as single:
+        varmech.integrate(oscillator, q0[2], p0[2], **run)
+    assert runs.errors[2].step == single.value.step > 0
+    assert _same(runs[2], single.value.partial)
 
-    oscillator = varmech.MechanicalSystem(1, potential=lambda q: 0.5 * q[0] ** 2, gradient=gradient)
-    runs = varmech.ensemble(oscillator, [[0.5], [3.0], [1.0]], [[0.0], [0.0], [0.0]], dt=0.1, steps=100, progress=False)
-    assert runs.failed == [1] and isinstance(runs.errors[1], ValueError)
-    assert runs[0].steps == runs[2].steps == 100
+
+def test_a_closure_model_that_cannot_go_to_processes_is_named():
+    class Local:
+        def __reduce__(self):
+            raise TypeError("not picklable")
+
+    local = Local()
+    model = varmech.MechanicalSystem(1, potential=lambda q: local and 0.5 * q[0] ** 2, gradient=lambda q: q.copy())
+    with pytest.raises(TypeError, match="^model: .* cannot be shipped to worker processes"):
+        varmech.ensemble(model, [[1.0], [2.0]], [[0.0], [0.0]], dt=0.1, steps=10, workers=2, progress=False)
+    # Serially it needs no shipping.
+    assert varmech.ensemble(model, [[1.0], [2.0]], [[0.0], [0.0]], dt=0.1, steps=10, progress=False).failed == []
+
+
+def test_ctrl_c_stops_closure_processes_and_keeps_the_chunks_gathered(interrupt_after):
+    # Members at q0 = 100 sleep at every evaluation: they cannot finish before the interrupt; the
+    # members at rest at 0 finish first and are kept, bit for bit.
+    def gradient(q):
+        if q[0] > 50.0:
+            time.sleep(1e-3)
+        return np.zeros(1)
+
+    free = varmech.MechanicalSystem(1, potential=lambda q: 0.0, gradient=gradient)
+    q0, p0 = np.array([[0.0], [0.0], [100.0], [100.0]]), np.zeros((4, 1))
+    run = dict(dt=0.1, steps=20_000, method="verlet", save_every=1000)
+    timer, _ = interrupt_after(3.0)
+    with pytest.raises(KeyboardInterrupt) as stopped:
+        varmech.ensemble(free, q0, p0, workers=2, chunk_size=1, progress=False, **run)
+    timer.join()
+    partial = stopped.value.partial
+    assert partial.failed == [2, 3] and [len(tr) for tr in partial][2:] == [0, 0]
+    for i in (0, 1):
+        assert _same(partial[i], varmech.integrate(free, q0[i], p0[i], **run))
 
 
 def test_a_drive_amplitude_sweep_equals_separate_runs():
