@@ -462,11 +462,13 @@ def ensemble(
     workers: int | None = None,
     chunk_size: int | None = None,
     progress: Callable[[int], object] | None = None,
+    events: list[tuple[str, int, int, str, Any]] | None = None,
 ) -> tuple[list[tuple[TrajectoryRecord, BaseException | None]], BaseException | None]:
     """Members (rows of q0 and p0, (members, n)) integrated in parallel with the GIL released,
-    with one shared model or one a member: each member's record (the partial one of a failure)
-    and exception, and the exception (KeyboardInterrupt) that stopped the ensemble, if any.
-    ``progress(steps)`` gets the steps of all members every 10 ms."""
+    with one shared model or one a member, each watching the built-in ``events``: each member's
+    record (the partial one of a failure) and exception, and the exception (KeyboardInterrupt)
+    that stopped the ensemble, if any. ``progress(steps)`` gets the steps of all members every
+    10 ms."""
 
 def integrate(
     model: _Model,

@@ -20,6 +20,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from . import _core
+from . import events as _events
 from ._progress import progress_bar
 from ._util import finite, positive, positive_int
 from .conservation import VERDICTS, ConservationReport, check_conservation
@@ -91,8 +92,9 @@ class Ensemble:
 
     @property
     def failed(self) -> list[int]:
-        """The members that did not reach the end (status -1), in member order."""
-        return [i for i, s in enumerate(self.status) if s != 0]
+        """The members that failed (status -1: diverged, failed Newton, met bad data or were
+        interrupted), in member order; a member a terminal event stopped (status 1) did not."""
+        return [i for i, s in enumerate(self.status) if s < 0]
 
     def __getitem__(self, i: int) -> Trajectory:
         return self.trajectories[i]
@@ -178,6 +180,7 @@ def ensemble(
     t0: float | None = None,
     newton_tolerance: float = 1e-14,
     newton_max_iterations: int = 50,
+    events: Sequence[_events.Event | _events.EventFunction] | None = None,
     workers: int | None = None,
     client: Any = None,
     chunk_size: int | None = None,
@@ -211,6 +214,12 @@ def ensemble(
         others keep the model's values.
     dt, steps, t_end, method, save_every, compensated, max_energy_error, t0, newton_tolerance, newton_max_iterations:
         As in :func:`varmech.integrate`, for every member.
+    events:
+        Event functions every member watches, as in :func:`varmech.integrate` (each member's
+        crossings in ``ensemble[i].events``, a terminal one stopping that member alone). The
+        built-in ones (:func:`varmech.events.crossing`, ``energy_error``, ``escape``,
+        ``encounter``) run in the core's parallel loop, a copy for each member; a Python
+        function holds the GIL, so with one the members run as a closure model's do.
     workers:
         The most threads to use; default: one a core (with ``client``: on each Dask worker, its
         own thread count). For a closure model, the number of processes; default: none, the
@@ -286,32 +295,33 @@ def ensemble(
     run: dict[str, Any] = dict(dt=dt, steps=nsteps, method=method, save_every=save_every, compensated=bool(compensated), t0=t0)
     newton_tolerance, newton_max_iterations = _newton(newton_tolerance, newton_max_iterations)
     newton: dict[str, Any] = dict(newton_tolerance=newton_tolerance, newton_max_iterations=newton_max_iterations)
+    watched, event_specs = _events.specs(events, n) if events is not None else ([], [])
+    settings = run | newton | dict(max_energy_error=max_energy_error, events=events)
     if client is not None:
-        settings = run | newton | dict(max_energy_error=max_energy_error, workers=workers)
-        return _on_cluster(client, model, q, p, values, settings, chunk_size, progress)
+        return _on_cluster(client, model, q, p, values, settings | dict(workers=workers), chunk_size, progress)
     cores = [m._core for m in (models if values else models[:1])]
     released = [c for c in cores if isinstance(c, (_core.NativeModel, _core.CompiledModel))]
-    if len(released) == len(cores):
+    if len(released) == len(cores) and all(spec[3] not in ("p", "v") for spec in event_specs):
         threshold = _energy_threshold(model, max_energy_error)
         bar = progress_bar(total=nsteps * members, unit="step", desc=f"{method} ×{members}", enabled=progress)
         try:
             report = None if bar.disable else (lambda done: bar.update(done - bar.n))
             results, interrupted = _core.ensemble(
-                released, q, p, **run, **newton, max_energy_error=threshold, workers=workers, chunk_size=chunk_size, progress=report
+                released, q, p, **run, **newton, max_energy_error=threshold, workers=workers, chunk_size=chunk_size, progress=report,
+                events=event_specs or None,
             )
         finally:
             bar.close()
         trajs, errors = [], []
         for i, (record, error) in enumerate(results):
             status: dict[str, Any] = {} if error is None else {"status": -1, "message": str(error)}
-            trajs.append(_trajectory(record, models[i], method, dt, **status))
+            trajs.append(_trajectory(record, models[i], method, dt, watched, **status))
             errors.append(error)
         result = Ensemble(trajs, errors, values)
         if interrupted is not None:
             interrupted.partial = result  # type: ignore[attr-defined]
             raise interrupted
         return result
-    settings = run | newton | dict(max_energy_error=max_energy_error)
     if workers is not None and workers > 1 and members > 1:
         return _in_processes(model, q, p, values, settings, workers, chunk_size, progress)
     return _serial(models, q, p, values, settings, progress)
@@ -401,14 +411,14 @@ def _in_processes(
     import cloudpickle
 
     try:
-        shipped = cloudpickle.dumps(model)
+        shipped = cloudpickle.dumps((model, settings))
     except Exception as err:
-        raise TypeError(f"model: {model.name} cannot be shipped to worker processes ({err})") from err
+        raise TypeError(f"model: {model.name} or its events cannot be shipped to worker processes ({err})") from err
     members = len(q)
     workers = min(workers, members)
     if chunk_size is None:
         chunk_size = max(1, math.ceil(members / (4 * workers)))
-    tasks = [(shipped, q[a : a + chunk_size], p[a : a + chunk_size], settings) for a in range(0, members, chunk_size)]
+    tasks = [(shipped, q[a : a + chunk_size], p[a : a + chunk_size]) for a in range(0, members, chunk_size)]
     chunks: list[Any] = [None] * len(tasks)
     start = "forkserver" if "forkserver" in multiprocessing.get_all_start_methods() else "spawn"
     pool = multiprocessing.get_context(start).Pool(workers, initializer=signal.signal, initargs=(signal.SIGINT, signal.SIG_IGN))
@@ -428,13 +438,13 @@ def _in_processes(
     return _gathered(chunks, values)
 
 
-def _closure_chunk(task: tuple[bytes, np.ndarray, np.ndarray, dict[str, Any]]) -> bytes:
+def _closure_chunk(task: tuple[bytes, np.ndarray, np.ndarray]) -> bytes:
     """One process task: the members of a chunk, serially; the result by cloudpickle (a
     user's exception class may live in ``__main__``)."""
     import cloudpickle
 
-    shipped, q, p, settings = task
-    model = cloudpickle.loads(shipped)
+    shipped, q, p = task
+    model, settings = cloudpickle.loads(shipped)
     run = _serial([model] * len(q), q, p, {}, settings, False)
     return cloudpickle.dumps((run.trajectories, run.errors))
 

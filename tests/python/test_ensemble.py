@@ -69,6 +69,35 @@ def _gradient_off_the_chart(q):
     return q.copy()
 
 
+@pytest.mark.parametrize("workers", [1, 2])
+def test_members_watching_events_have_their_single_runs_crossings_and_stops(workers):
+    # The built-in crossing runs in the core's parallel loop; a Python event function holds the
+    # GIL and runs member by member; either way member i is its single run, crossings included,
+    # and a terminal event stops that member alone.
+    from varmech.events import Event, crossing
+
+    scene, q0, p0 = _double_pendulum_rows(5)
+    q0[4] = [0.01, 0.0]
+    p0[4] = [0.0, 0.0]
+    run = dict(dt=0.01, steps=2000, method="midpoint", save_every=50)
+    lower = Event(lambda t, q, p: q[1] - 0.2, name="lower", terminal=2)
+    for events in ([crossing(0, 0.0, direction=1)], [crossing(0, 0.0, direction=1), lower]):
+        runs = varmech.ensemble(scene, q0, p0, events=events, workers=workers, progress=False, **run)
+        assert runs.failed == []
+        for i in range(5):
+            single = varmech.integrate(scene.model, q0[i], p0[i], events=events, **run)
+            assert _same(runs[i], single), f"member {i}"
+            assert runs[i].status == single.status
+            for a, b in zip(runs[i].events, single.events):
+                assert np.array_equal(a.t, b.t) and np.array_equal(a.q, b.q) and np.array_equal(a.p, b.p)
+        if len(events) == 1:
+            assert min(len(tr.events[0]) for tr in runs) >= 5, "every member crosses the vertical upward"
+        else:
+            stopped = [i for i in range(5) if runs[i].status == 1]
+            assert 0 < len(stopped) < 5, "the terminal event stops some members, not the small swing"
+            assert runs[4].status == 0 and runs[4].steps == 2000
+
+
 def test_velocities_give_each_members_momenta():
     scene, q0, p0 = _double_pendulum_rows(4)
     v0 = scene.model.velocity(q0, p0)

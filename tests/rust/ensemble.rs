@@ -2,7 +2,8 @@
 //! and interrupts per member; bad input refused before any member starts.
 
 use varmech::integrators::{
-    integrate, integrate_ensemble, Failure, General, Method, Options, Outcome, Parallel, Shared, Trajectory,
+    integrate, integrate_ensemble, integrate_with_events, Detector, EventSpec, Failure, General, MemberEvents, Method,
+    NativeEvent, Options, Outcome, Parallel, Shared, Trajectory,
 };
 use varmech::scenes::{DampedDrivenPendulum, DoublePendulum, HarmonicOscillator};
 use varmech::{Error, ModelError};
@@ -61,7 +62,7 @@ fn every_member_is_bit_for_bit_its_single_run_whatever_the_threads_and_chunks() 
                 chunk_size: Some(chunk_size),
             };
             let ensemble =
-                integrate_ensemble(&Shared(&sys), Method::Midpoint, &q0, &p0, &options, parallel, never).unwrap();
+                integrate_ensemble(&Shared(&sys), Method::Midpoint, &q0, &p0, &options, parallel, &MemberEvents::default(), never).unwrap();
             assert!(ensemble.interrupted.is_none());
             assert_eq!(ensemble.members.len(), members);
             for (i, (member, single)) in ensemble.members.iter().zip(&singles).enumerate() {
@@ -90,6 +91,7 @@ fn a_member_past_its_stability_limit_fails_alone_with_its_step_and_partial_traje
         &p0,
         &options,
         Parallel::default(),
+        &MemberEvents::default(),
         never,
     )
     .unwrap();
@@ -135,7 +137,7 @@ fn a_drive_amplitude_sweep_equals_its_separate_runs() {
         chunk_size: Some(4),
     };
     let ensemble =
-        integrate_ensemble(models.as_slice(), Method::Midpoint, &q0, &p0, &options, parallel, never).unwrap();
+        integrate_ensemble(models.as_slice(), Method::Midpoint, &q0, &p0, &options, parallel, &MemberEvents::default(), never).unwrap();
     let finals: Vec<f64> = ensemble
         .members
         .iter()
@@ -169,7 +171,7 @@ fn an_interrupt_stops_every_member_keeping_a_prefix_of_its_run() {
         chunk_size: None,
     };
     let stop = || Err::<(), ModelError>("stop".into());
-    let ensemble = integrate_ensemble(&Shared(&sys), Method::Midpoint, &q0, &p0, &options, parallel, stop).unwrap();
+    let ensemble = integrate_ensemble(&Shared(&sys), Method::Midpoint, &q0, &p0, &options, parallel, &MemberEvents::default(), stop).unwrap();
     assert_eq!(ensemble.interrupted.unwrap().to_string(), "stop");
     for (i, member) in ensemble.members.iter().enumerate() {
         let Failure { error, partial } = failure(member);
@@ -206,7 +208,7 @@ fn bad_input_is_refused_naming_the_argument() {
     };
     let shared = Shared(&sys);
     let run = |q0: &[f64], p0: &[f64], options: &Options, parallel| {
-        integrate_ensemble(&shared, Method::Midpoint, q0, p0, options, parallel, never).map(|_| ())
+        integrate_ensemble(&shared, Method::Midpoint, q0, p0, options, parallel, &MemberEvents::default(), never).map(|_| ())
     };
     let default = Parallel::default();
     assert_eq!(named(run(&q0[..5], &p0[..5], &options, default)), "q0");
@@ -225,6 +227,7 @@ fn bad_input_is_refused_naming_the_argument() {
         &[1.0, 0.0],
         &options,
         default,
+        &MemberEvents::default(),
         never,
     );
     assert_eq!(named(two.map(|_| ())), "models");
@@ -236,4 +239,51 @@ fn bad_input_is_refused_naming_the_argument() {
         err.starts_with("save_every:") && err.contains("raise save_every"),
         "{err}"
     );
+}
+
+#[test]
+fn members_watching_native_events_are_bit_for_bit_their_single_runs_with_events() {
+    // The double pendulum's upper arm through the vertical, upward (an orbit's section), and a
+    // terminal count of 3 on the lower arm's crossings: each member's crossings and its stop
+    // are those of its single run, on 1 and 2 threads.
+    let p = DoublePendulum::problem();
+    let sys = General(&p.system);
+    let members = 6;
+    let q0: Vec<f64> = (0..members).flat_map(|i| [0.4 + 0.1 * i as f64, -0.3]).collect();
+    let p0 = vec![0.0; 2 * members];
+    let options = Options::new(0.01, 3000);
+    let events = MemberEvents {
+        functions: vec![
+            NativeEvent::Crossing { coordinate: 0, value: 0.0 },
+            NativeEvent::Crossing { coordinate: 1, value: 0.0 },
+        ],
+        specs: vec![
+            EventSpec { name: "upper".into(), direction: 1, terminal: 0 },
+            EventSpec { name: "lower".into(), direction: 0, terminal: 3 },
+        ],
+    };
+    for workers in [1, 2] {
+        let parallel = Parallel { workers: Some(workers), chunk_size: None };
+        let ensemble =
+            integrate_ensemble(&Shared(&sys), Method::Midpoint, &q0, &p0, &options, parallel, &events, never).unwrap();
+        for (i, member) in ensemble.members.iter().enumerate() {
+            let mut detector = Detector::new(Box::new(events.functions.clone()), events.specs.clone()).unwrap();
+            let rows = 2 * i..2 * i + 2;
+            let single =
+                integrate_with_events(&sys, Method::Midpoint, &q0[rows.clone()], &p0[rows], &options, never, &mut detector)
+                    .unwrap();
+            let member = member.as_ref().unwrap();
+            assert_eq!(member.events, single.events, "member {i}");
+            assert_eq!((&member.q, &member.p, member.steps), (&single.q, &single.p, single.steps), "member {i}");
+            assert!(single.terminated_by.is_some() && single.steps < 3000, "member {i} stops at its third crossing");
+            assert!(member.events.iter().any(|o| o.event == 0) || i < 2, "member {i} crossed the vertical upward");
+        }
+    }
+    // An event on a coordinate the model does not have is refused before anything runs.
+    let bad = MemberEvents {
+        functions: vec![NativeEvent::Crossing { coordinate: 2, value: 0.0 }],
+        specs: vec![EventSpec { name: "third".into(), direction: 0, terminal: 0 }],
+    };
+    let err = integrate_ensemble(&Shared(&sys), Method::Midpoint, &q0, &p0, &options, Parallel::default(), &bad, never);
+    assert!(matches!(err, Err(Error::InvalidArgument { argument: "events", .. })), "{err:?}");
 }

@@ -1,13 +1,15 @@
 """What the phase-space tools share: the model a section or portrait may take, its energy, the
-method it runs by default, and one orbit that keeps its partial trajectory when it escapes."""
+method it runs by default, and its orbits, one ensemble in which an orbit that escapes keeps its
+partial trajectory."""
 
 from __future__ import annotations
 
 import numpy as np
 
 from .. import _core
+from ..ensemble import Ensemble, ensemble
 from ..events import Event
-from ..integrate import Trajectory, integrate
+from ..integrate import Trajectory
 from ..model import Model
 from ..scenes import Scene
 from ._energy import conserves_energy, energy_of
@@ -42,18 +44,47 @@ def default_method(model: Model, method: str | None) -> str:
     return model.kind.accurate_method
 
 
-def run(
-    model: Model, q0: np.ndarray, p0: np.ndarray, *, dt: float, t_end: float, method: str, save_every: int = 1, events: list[Event] | None = None
-) -> tuple[Trajectory, str | None]:
-    """One orbit, with the crossings of ``events`` located; a divergent one (an orbit that
-    escapes) returns its partial trajectory and a note."""
+def run_orbits(
+    model: Model,
+    q0: np.ndarray,
+    p0: np.ndarray,
+    *,
+    dt: float,
+    t_end: float,
+    method: str,
+    save_every: int = 1,
+    events: list[Event] | None = None,
+    progress: bool | None = None,
+) -> list[tuple[Trajectory, str | None]]:
+    """The orbits from the rows of ``q0`` and ``p0``, one :func:`varmech.ensemble` (each bit for
+    bit its :func:`varmech.integrate` call, on every core for native models), with the crossings
+    of ``events`` located: each with None, or its partial trajectory and a note if it diverged
+    (an orbit that escapes). Ctrl-C raises KeyboardInterrupt with the orbits so far as
+    ``err.partial`` (the interrupted ones partial, noted)."""
+    if len(q0) == 0:
+        return []
     try:
-        return integrate(model, q0, p0, dt=dt, t_end=t_end, method=method, save_every=save_every, events=events), None
-    except _core.DivergenceError as err:
-        partial = getattr(err, "partial", None)
-        if partial is None:
-            raise
-        return partial, f"diverged at t = {partial.t[-1]:.6g} ({err})"
+        runs = ensemble(model, q0, p0, dt=dt, t_end=t_end, method=method, save_every=save_every, events=events, progress=progress)
+    except KeyboardInterrupt as err:
+        err.partial = _outcomes(err.partial)  # type: ignore[attr-defined]
+        raise
+    return _outcomes(runs)
+
+
+def _outcomes(runs: Ensemble) -> list[tuple[Trajectory, str | None]]:
+    """Each member with None, or a note on why it stopped early; a failure other than a
+    divergence or an interrupt is raised."""
+    out: list[tuple[Trajectory, str | None]] = []
+    for traj, err in zip(runs, runs.errors):
+        if err is None:
+            out.append((traj, None))
+        elif isinstance(err, KeyboardInterrupt):
+            out.append((traj, "interrupted"))
+        elif isinstance(err, _core.DivergenceError) and len(traj):
+            out.append((traj, f"diverged at t = {traj.t[-1]:.6g} ({err})"))
+        else:
+            raise err
+    return out
 
 
 def solve_momentum(model: Model, q: np.ndarray, p: np.ndarray, k: int, energy: float, direction: int) -> tuple[np.ndarray, np.ndarray]:

@@ -9,14 +9,12 @@ from collections.abc import Iterable
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .. import _core
 from .._util import positive
-from ..ensemble import ensemble
 from ..integrate import Trajectory
 from ..model import Model
 from ..table import Table
 from ._interrupt import interruptible
-from ._orbits import ModelLike, default_method, model_of, solve_momentum
+from ._orbits import ModelLike, default_method, model_of, run_orbits, solve_momentum
 
 #: The pendulum's default phase-portrait energies (H = p²/2 − cos q, separatrix at H = 1).
 PENDULUM_ENERGIES = (-0.9, -0.6, -0.2, 0.3, 0.7, 0.95, 0.995, 1.005, 1.05, 1.4, 2.0, 3.0)
@@ -101,20 +99,6 @@ def phase_portrait(
     if _is_pendulum(model):
         table.meta["separatrix_energy"] = 1.0
 
-    def orbits(states: list[tuple[float, float]]) -> list[tuple[Trajectory, str | None]]:
-        """Each orbit from (q0, p0) of ``states``, a divergent one (an orbit that escapes) with
-        its partial trajectory and a note."""
-        if not states:
-            return []
-        z = np.array(states)
-        runs = ensemble(model, z[:, :1], z[:, 1:], dt=dt, t_end=t_end, method=method, save_every=save_every, progress=progress)
-        out: list[tuple[Trajectory, str | None]] = []
-        for traj, err in zip(runs, runs.errors):
-            if err is not None and not (isinstance(err, _core.DivergenceError) and len(traj)):
-                raise err
-            out.append((traj, None if err is None else f"diverged at t = {traj.t[-1]:.6g} ({err})"))
-        return out
-
     def add(o: int, traj: Trajectory, note: str | None) -> str:
         if note:
             table.meta["notes"].append(f"orbit {o}: {note}")
@@ -126,10 +110,14 @@ def phase_portrait(
         table.meta["max_energy_error"] = max(table.meta["max_energy_error"], float(np.max(np.abs(err))))
         return motion
 
+    def run(states: list[tuple[float, float]]) -> list[tuple[Trajectory, str | None]]:
+        z = np.array(states).reshape(-1, 2)
+        return run_orbits(model, z[:, :1], z[:, 1:], dt=dt, t_end=t_end, method=method, save_every=save_every, progress=progress)
+
     def body() -> None:
-        first = orbits(starts)
+        first = run(starts)
         turning = [mirror and _classify(traj.q[:, 0], traj.p[:, 0]) == "rotation" for traj, _ in first]
-        mirrors = iter(orbits([(q0, -p0) for (q0, p0), turns in zip(starts, turning) if turns]))
+        mirrors = iter(run([(q0, -p0) for (q0, p0), turns in zip(starts, turning) if turns]))
         o = 0
         for (traj, note), turns in zip(first, turning):
             add(o, traj, note)

@@ -45,14 +45,13 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .._progress import progress as _progress
 from .._util import positive
 from ..events import crossing
 from ..integrate import Trajectory
 from ..model import Model
 from ..table import Table
 from ._interrupt import interruptible
-from ._orbits import ModelLike, default_method, energy_at, model_of, relative, run, solve_momentum
+from ._orbits import ModelLike, default_method, energy_at, model_of, relative, run_orbits, solve_momentum
 
 #: The Hénon–Heiles energies of Hénon & Heiles (1964): mostly regular motion at 1/12,
 #: widespread chaos at 1/8 (the region stays bounded below the escape energy 1/6).
@@ -330,32 +329,43 @@ def poincare_section(
     worst = {"residual": 0.0, "energy": 0.0, "hermite_gap": 0.0}
     event = crossing(k, c, direction=direction)
 
+    def add(o: int, traj: Trajectory, note: str | None) -> None:
+        """Orbit o's crossings."""
+        if note:
+            table.meta["notes"].append(f"orbit {o}: {note}")
+        found = traj.events[0]
+        if not len(found):
+            return
+        # The step of each crossing, (t_i, t_i+1], and its sign (+1 upward, −1 downward).
+        idx = np.searchsorted(traj.t, found.t, side="left") - 1
+        sign = np.where(traj.q[idx, k] < c, 1.0, -1.0)
+        taus, qs, ps = _hermite_points(model, traj, idx, k, c, sign)
+        times = traj.t[idx] + taus
+        if locate == "step":
+            gap = np.max(np.abs(np.concatenate([found.q - qs, found.p - ps], axis=1)))
+            worst["hermite_gap"] = max(worst["hermite_gap"], float(gap))
+            times, qs, ps = found.t, found.q, found.p
+        errs = relative(energy_at(model, qs, ps), energy)
+        worst["residual"] = max(worst["residual"], float(np.max(np.abs(qs[:, k] - c))))
+        worst["energy"] = max(worst["energy"], float(np.max(np.abs(errs))))
+        for j in range(len(idx)):
+            table.rows.append((o, float(times[j]), *map(float, qs[j]), *map(float, ps[j]), float(errs[j])))
+        table.meta["max_section_residual"] = worst["residual"]
+        table.meta["max_energy_error"] = worst["energy"]
+        if locate == "step":
+            table.meta["max_hermite_gap"] = worst["hermite_gap"]
+
     def body() -> None:
-        for o in _progress(range(len(q_seed)), total=len(q_seed), desc=f"section E = {energy:.4g}", enabled=progress):
-            traj, note = run(model, q_seed[o], p_seed[o], dt=dt, t_end=t_end, method=method, events=[event])
-            if note:
-                table.meta["notes"].append(f"orbit {o}: {note}")
-            found = traj.events[0]
-            if not len(found):
-                continue
-            # The step of each crossing, (t_i, t_i+1], and its sign (+1 upward, −1 downward).
-            idx = np.searchsorted(traj.t, found.t, side="left") - 1
-            sign = np.where(traj.q[idx, k] < c, 1.0, -1.0)
-            taus, qs, ps = _hermite_points(model, traj, idx, k, c, sign)
-            times = traj.t[idx] + taus
-            if locate == "step":
-                gap = np.max(np.abs(np.concatenate([found.q - qs, found.p - ps], axis=1)))
-                worst["hermite_gap"] = max(worst["hermite_gap"], float(gap))
-                times, qs, ps = found.t, found.q, found.p
-            errs = relative(energy_at(model, qs, ps), energy)
-            worst["residual"] = max(worst["residual"], float(np.max(np.abs(qs[:, k] - c))))
-            worst["energy"] = max(worst["energy"], float(np.max(np.abs(errs))))
-            for j in range(len(idx)):
-                table.rows.append((o, float(times[j]), *map(float, qs[j]), *map(float, ps[j]), float(errs[j])))
-            table.meta["max_section_residual"] = worst["residual"]
-            table.meta["max_energy_error"] = worst["energy"]
-            if locate == "step":
-                table.meta["max_hermite_gap"] = worst["hermite_gap"]
+        try:
+            found = run_orbits(model, q_seed, p_seed, dt=dt, t_end=t_end, method=method, events=[event], progress=progress)
+        except KeyboardInterrupt as err:
+            # The orbits that ran to their end (or diverged) keep their rows.
+            for o, (traj, note) in enumerate(err.partial):  # type: ignore[attr-defined]
+                if note != "interrupted":
+                    add(o, traj, note)
+            raise
+        for o, (traj, note) in enumerate(found):
+            add(o, traj, note)
 
     return interruptible(table, body)
 
@@ -418,12 +428,26 @@ def orbit_divergence(
     save = max(1, min(10, steps))
 
     def body() -> None:
-        for o in _progress(range(len(q_seed)), total=len(q_seed), desc=f"divergence E = {energy:.4g}", enabled=progress):
+        # Every orbit and its twin, one ensemble: the orbits with a twin, then their twins.
+        paired = np.flatnonzero(ok)
+        q_all = np.concatenate([q_seed[paired], q_seed[paired]])
+        p_all = np.concatenate([p_seed[paired], p_twin[paired]])
+        try:
+            found = run_orbits(model, q_all, p_all, dt=dt, t_end=t_end, method=method, save_every=save, progress=progress)
+        except KeyboardInterrupt as err:
+            rows(dict(zip(paired, zip(err.partial[: len(paired)], err.partial[len(paired) :]))))  # type: ignore[attr-defined]
+            raise
+        rows(dict(zip(paired, zip(found[: len(paired)], found[len(paired) :]))))
+
+    def rows(runs: dict[int, Any]) -> None:
+        """A row for each orbit whose pair ran to its end (or diverged), in orbit order."""
+        for o in range(len(q_seed)):
             if not ok[o]:
                 table.meta["notes"].append(f"orbit {o}: no twin on the energy shell")
                 continue
-            a, note_a = run(model, q_seed[o], p_seed[o], dt=dt, t_end=t_end, method=method, save_every=save)
-            b, note_b = run(model, q_seed[o], p_twin[o], dt=dt, t_end=t_end, method=method, save_every=save)
+            (a, note_a), (b, note_b) = runs[o]
+            if "interrupted" in (note_a, note_b):
+                continue
             m = min(len(a.t), len(b.t))
             d = np.sqrt(np.sum((a.q[:m] - b.q[:m]) ** 2 + (a.p[:m] - b.p[:m]) ** 2, axis=1))
             value = float(np.log10(np.max(d) / d[0]))

@@ -5,12 +5,13 @@
 use numpy::PyReadonlyArray2;
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
-use varmech::integrators::{self, Dynamics, Members, Parallel};
+use varmech::integrators::{self, Dynamics, MemberEvents, Members, Parallel};
 
 use crate::bind::check_signals;
 use crate::compiled::CompiledModel;
 use crate::convert::rows;
 use crate::errors::{model_error, to_pyerr};
+use crate::events::{EventTuple, Events};
 use crate::native::NativeModel;
 use crate::run::{method_and_options, newton_max_iterations_count, reporting, save_every_count, steps_count};
 use crate::trajectory::TrajectoryRecord;
@@ -55,11 +56,12 @@ type MemberResult = (TrajectoryRecord, Option<Py<PyAny>>);
 
 /// Integrates the members (rows of `q0` and `p0`, (members, n)) with `models` (one shared, or
 /// one a member) on at most `workers` threads in tasks of `chunk_size` members, the GIL
-/// released; `progress(steps)` gets the steps of all members so far. Returns each member's
+/// released, each watching `events` (spec tuples of built-in events, see [`Events::new`]);
+/// `progress(steps)` gets the steps of all members so far. Returns each member's
 /// record and exception (None when it completed), and the exception (KeyboardInterrupt) that
 /// stopped the ensemble, if one did: the members then stopped where they were.
 #[pyfunction]
-#[pyo3(signature = (models, q0, p0, *, dt, steps, method, save_every=1, compensated=true, max_energy_error=None, t0=0.0, newton_tolerance=1e-14, newton_max_iterations=50, workers=None, chunk_size=None, progress=None))]
+#[pyo3(signature = (models, q0, p0, *, dt, steps, method, save_every=1, compensated=true, max_energy_error=None, t0=0.0, newton_tolerance=1e-14, newton_max_iterations=50, workers=None, chunk_size=None, progress=None, events=None))]
 #[allow(clippy::too_many_arguments)]
 fn ensemble<'py>(
     py: Python<'py>,
@@ -78,6 +80,7 @@ fn ensemble<'py>(
     workers: Option<usize>,
     chunk_size: Option<usize>,
     progress: Option<Py<PyAny>>,
+    events: Option<Vec<EventTuple<'py>>>,
 ) -> PyResult<(Vec<MemberResult>, Option<Py<PyAny>>)> {
     let (method, options) = method_and_options(
         py,
@@ -102,10 +105,19 @@ fn ensemble<'py>(
     if models.0.is_empty() {
         return Err(PyValueError::new_err("models: at least one model is needed"));
     }
+    let n = models.with_model(0, |sys| sys.dim());
+    let events = match events {
+        Some(tuples) => {
+            let (functions, specs) = Events::new(py, tuples, n)?;
+            let functions = functions.into_native(&specs)?;
+            MemberEvents { functions, specs }
+        }
+        None => MemberEvents::default(),
+    };
     let parallel = Parallel { workers, chunk_size };
     let run = py.detach(|| {
         let report = reporting(&check_signals, &progress);
-        integrators::integrate_ensemble(&models, method, q0, p0, &options, parallel, report)
+        integrators::integrate_ensemble(&models, method, q0, p0, &options, parallel, &events, report)
     });
     let run = run.map_err(|e| to_pyerr(py, e))?;
     let members = run

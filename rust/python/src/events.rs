@@ -95,6 +95,24 @@ impl Events {
     }
 }
 
+impl Events {
+    /// The functions as the core's native events, for runs without the GIL (ensembles); a
+    /// Python function among them is a ValueError naming `events` and it.
+    pub fn into_native(self, specs: &[EventSpec]) -> PyResult<Vec<NativeEvent>> {
+        self.functions
+            .into_iter()
+            .zip(specs)
+            .map(|(f, spec)| match f {
+                Function::Native(native) => Ok(native),
+                Function::Python { .. } => Err(PyValueError::new_err(format!(
+                    "events: {} is a Python function; the parallel ensemble watches only the built-in events",
+                    spec.name
+                ))),
+            })
+            .collect()
+    }
+}
+
 impl EventFunctions for Events {
     fn len(&self) -> usize {
         self.functions.len()

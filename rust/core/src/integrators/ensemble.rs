@@ -3,13 +3,18 @@
 //! Member i is [`integrate`] of its model from its row (q0ᵢ, p0ᵢ) with the shared [`Options`]:
 //! one run on one thread, its state touched by no other, so its trajectory is bit for bit that
 //! of the single run whatever the number of threads or the chunking. A member that fails keeps
-//! its [`Failure`] (error and partial trajectory) and the others go on.
+//! its [`Failure`] (error and partial trajectory) and the others go on. Members may watch
+//! native events ([`MemberEvents`]), each with its own copy of the functions, as
+//! [`integrate_with_events`] does.
 
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering::Relaxed};
 use std::sync::mpsc::{self, RecvTimeoutError};
 use std::time::{Duration, Instant};
 
-use super::{integrate, Counting, Dynamics, Failure, Method, Options, Poll, Trajectory};
+use super::{
+    integrate, integrate_with_events, Counting, Detector, Dynamics, EventSpec, Failure, Method, NativeEvent, Options,
+    Poll, Trajectory,
+};
 use crate::{memory, Error, ModelError};
 
 /// The members' models: one shared by all, or one each (a parameter sweep).
@@ -65,6 +70,22 @@ impl Parallel {
     }
 }
 
+/// The native events every member watches, with their specs: each member runs
+/// [`integrate_with_events`] with its own copy of the functions (an event may keep state, such
+/// as the energy at the start of the run). None (the default): the members run [`integrate`].
+#[derive(Clone, Debug, Default)]
+pub struct MemberEvents {
+    pub functions: Vec<NativeEvent>,
+    pub specs: Vec<EventSpec>,
+}
+
+impl MemberEvents {
+    /// A member's detector.
+    fn detector(&self) -> Result<Detector<'static>, Error> {
+        Detector::new(Box::new(self.functions.clone()), self.specs.clone())
+    }
+}
+
 /// A member's run: its trajectory, or its failure with the states up to it.
 pub type Outcome = Result<Trajectory, Box<Failure>>;
 
@@ -95,14 +116,16 @@ const POLL: Duration = Duration::from_millis(10);
 
 /// Integrates every member: member i is [`integrate`] of `models`' member i from row i of
 /// `q0` and `p0` (each members × n, row by row) with `options`, run on at most
-/// `parallel.workers` threads in tasks of `parallel.chunk_size` members.
+/// `parallel.workers` threads in tasks of `parallel.chunk_size` members, each member watching
+/// `events` (none when empty).
 ///
 /// `poll` is called on the calling thread every 10 ms with the steps completed by all members
 /// so far; an error from it stops every member at its next poll (within 40 ms of run time) with
 /// [`Error::Interrupted`], keeping its states, and is returned in [`Ensemble::interrupted`].
 ///
 /// Refuses (before any member starts) rows that are not whole, a `p0` of another size than
-/// `q0`, models not one a member, `workers` or `chunk_size` of 0, invalid options, and an
+/// `q0`, models not one a member, `workers` or `chunk_size` of 0, invalid options or events
+/// (checked against the model's n, naming `events`), and an
 /// ensemble whose saved states, twice over (the records and the stacked arrays made of them),
 /// would not fit in the memory available (naming `save_every`).
 pub fn integrate_ensemble<M, P>(
@@ -112,6 +135,7 @@ pub fn integrate_ensemble<M, P>(
     p0: &[f64],
     options: &Options,
     parallel: Parallel,
+    events: &MemberEvents,
     mut poll: P,
 ) -> Result<Ensemble, Error>
 where
@@ -142,6 +166,10 @@ where
         return Err(Error::invalid("models", reason));
     }
     check_memory(members, n, options)?;
+    events.detector()?;
+    for (event, spec) in events.functions.iter().zip(&events.specs) {
+        event.check(&spec.name, n)?;
+    }
 
     let workers = parallel
         .workers
@@ -166,7 +194,7 @@ where
                     let i = c * chunk + k;
                     let rows = i * n..(i + 1) * n;
                     let (q0, p0) = (&q0[rows.clone()], &p0[rows]);
-                    *slot = Some(models.with_model(i, |sys| member(sys, method, q0, p0, options, stop, steps)));
+                    *slot = Some(models.with_model(i, |sys| member(sys, method, (q0, p0), options, events, stop, steps)));
                     // The receiver waits until every member is done.
                     let _ = sender.send(());
                 }
@@ -197,28 +225,31 @@ where
     Ok(Ensemble { members, interrupted })
 }
 
-/// One member: [`integrate`], its poll counting its steps into `steps` and stopping when `stop`
-/// is set; a member not started before the stop is interrupted at its initial state.
+/// One member: [`integrate`] (or [`integrate_with_events`] watching `events`), its poll
+/// counting its steps into `steps` and stopping when `stop` is set; a member not started
+/// before the stop is interrupted at its initial state.
 fn member(
     sys: &dyn Dynamics,
     method: Method,
-    q0: &[f64],
-    p0: &[f64],
+    (q0, p0): (&[f64], &[f64]),
     options: &Options,
+    events: &MemberEvents,
     stop: &AtomicBool,
     steps: &AtomicUsize,
 ) -> Outcome {
-    if stop.load(Relaxed) {
-        let error = Error::Interrupted {
-            step: 0,
-            time: options.t0,
-            source: Box::new(Stopped),
-        };
+    let unstarted = |error| {
         let partial = Trajectory {
             dim: sys.dim(),
             ..Default::default()
         };
-        return Err(Box::new(Failure { error, partial }));
+        Err(Box::new(Failure { error, partial }))
+    };
+    if stop.load(Relaxed) {
+        return unstarted(Error::Interrupted {
+            step: 0,
+            time: options.t0,
+            source: Box::new(Stopped),
+        });
     }
     let mut counted = 0;
     let poll = Counting(|done: usize| {
@@ -229,7 +260,14 @@ fn member(
             false => Ok(()),
         }
     });
-    let outcome = integrate(sys, method, q0, p0, options, poll);
+    let outcome = if events.functions.is_empty() {
+        integrate(sys, method, q0, p0, options, poll)
+    } else {
+        match events.detector() {
+            Ok(mut detector) => integrate_with_events(sys, method, q0, p0, options, poll, &mut detector),
+            Err(error) => return unstarted(error),
+        }
+    };
     steps.fetch_add(options.steps.saturating_sub(counted), Relaxed);
     outcome
 }

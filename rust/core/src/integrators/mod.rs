@@ -52,7 +52,7 @@ pub use composition::Composition;
 use del::Constraints;
 pub use del::{Del, StepEquations, TwoPoint};
 pub use dynamics::{Dynamics, General};
-pub use ensemble::{integrate_ensemble, Ensemble, Members, Outcome, Parallel, Shared, Stopped};
+pub use ensemble::{integrate_ensemble, Ensemble, MemberEvents, Members, Outcome, Parallel, Shared, Stopped};
 pub use events::{Detector, EventFunctions, EventSpec, NativeEvent, Occurrence};
 pub use explicit_rk::ExplicitRk;
 pub use kick_drift::KickDrift;
