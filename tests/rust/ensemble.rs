@@ -61,8 +61,17 @@ fn every_member_is_bit_for_bit_its_single_run_whatever_the_threads_and_chunks() 
                 workers: Some(workers),
                 chunk_size: Some(chunk_size),
             };
-            let ensemble =
-                integrate_ensemble(&Shared(&sys), Method::Midpoint, &q0, &p0, &options, parallel, &MemberEvents::default(), never).unwrap();
+            let ensemble = integrate_ensemble(
+                &Shared(&sys),
+                Method::Midpoint,
+                &q0,
+                &p0,
+                &options,
+                parallel,
+                &MemberEvents::default(),
+                never,
+            )
+            .unwrap();
             assert!(ensemble.interrupted.is_none());
             assert_eq!(ensemble.members.len(), members);
             for (i, (member, single)) in ensemble.members.iter().zip(&singles).enumerate() {
@@ -136,8 +145,17 @@ fn a_drive_amplitude_sweep_equals_its_separate_runs() {
         workers: Some(2),
         chunk_size: Some(4),
     };
-    let ensemble =
-        integrate_ensemble(models.as_slice(), Method::Midpoint, &q0, &p0, &options, parallel, &MemberEvents::default(), never).unwrap();
+    let ensemble = integrate_ensemble(
+        models.as_slice(),
+        Method::Midpoint,
+        &q0,
+        &p0,
+        &options,
+        parallel,
+        &MemberEvents::default(),
+        never,
+    )
+    .unwrap();
     let finals: Vec<f64> = ensemble
         .members
         .iter()
@@ -171,7 +189,17 @@ fn an_interrupt_stops_every_member_keeping_a_prefix_of_its_run() {
         chunk_size: None,
     };
     let stop = || Err::<(), ModelError>("stop".into());
-    let ensemble = integrate_ensemble(&Shared(&sys), Method::Midpoint, &q0, &p0, &options, parallel, &MemberEvents::default(), stop).unwrap();
+    let ensemble = integrate_ensemble(
+        &Shared(&sys),
+        Method::Midpoint,
+        &q0,
+        &p0,
+        &options,
+        parallel,
+        &MemberEvents::default(),
+        stop,
+    )
+    .unwrap();
     assert_eq!(ensemble.interrupted.unwrap().to_string(), "stop");
     for (i, member) in ensemble.members.iter().enumerate() {
         let Failure { error, partial } = failure(member);
@@ -208,7 +236,17 @@ fn bad_input_is_refused_naming_the_argument() {
     };
     let shared = Shared(&sys);
     let run = |q0: &[f64], p0: &[f64], options: &Options, parallel| {
-        integrate_ensemble(&shared, Method::Midpoint, q0, p0, options, parallel, &MemberEvents::default(), never).map(|_| ())
+        integrate_ensemble(
+            &shared,
+            Method::Midpoint,
+            q0,
+            p0,
+            options,
+            parallel,
+            &MemberEvents::default(),
+            never,
+        )
+        .map(|_| ())
     };
     let default = Parallel::default();
     assert_eq!(named(run(&q0[..5], &p0[..5], &options, default)), "q0");
@@ -254,36 +292,98 @@ fn members_watching_native_events_are_bit_for_bit_their_single_runs_with_events(
     let options = Options::new(0.01, 3000);
     let events = MemberEvents {
         functions: vec![
-            NativeEvent::Crossing { coordinate: 0, value: 0.0 },
-            NativeEvent::Crossing { coordinate: 1, value: 0.0 },
+            NativeEvent::Crossing {
+                coordinate: 0,
+                value: 0.0,
+            },
+            NativeEvent::Crossing {
+                coordinate: 1,
+                value: 0.0,
+            },
         ],
         specs: vec![
-            EventSpec { name: "upper".into(), direction: 1, terminal: 0 },
-            EventSpec { name: "lower".into(), direction: 0, terminal: 3 },
+            EventSpec {
+                name: "upper".into(),
+                direction: 1,
+                terminal: 0,
+            },
+            EventSpec {
+                name: "lower".into(),
+                direction: 0,
+                terminal: 3,
+            },
         ],
     };
     for workers in [1, 2] {
-        let parallel = Parallel { workers: Some(workers), chunk_size: None };
-        let ensemble =
-            integrate_ensemble(&Shared(&sys), Method::Midpoint, &q0, &p0, &options, parallel, &events, never).unwrap();
+        let parallel = Parallel {
+            workers: Some(workers),
+            chunk_size: None,
+        };
+        let ensemble = integrate_ensemble(
+            &Shared(&sys),
+            Method::Midpoint,
+            &q0,
+            &p0,
+            &options,
+            parallel,
+            &events,
+            never,
+        )
+        .unwrap();
         for (i, member) in ensemble.members.iter().enumerate() {
             let mut detector = Detector::new(Box::new(events.functions.clone()), events.specs.clone()).unwrap();
             let rows = 2 * i..2 * i + 2;
-            let single =
-                integrate_with_events(&sys, Method::Midpoint, &q0[rows.clone()], &p0[rows], &options, never, &mut detector)
-                    .unwrap();
+            let single = integrate_with_events(
+                &sys,
+                Method::Midpoint,
+                &q0[rows.clone()],
+                &p0[rows],
+                &options,
+                never,
+                &mut detector,
+            )
+            .unwrap();
             let member = member.as_ref().unwrap();
             assert_eq!(member.events, single.events, "member {i}");
-            assert_eq!((&member.q, &member.p, member.steps), (&single.q, &single.p, single.steps), "member {i}");
-            assert!(single.terminated_by.is_some() && single.steps < 3000, "member {i} stops at its third crossing");
-            assert!(member.events.iter().any(|o| o.event == 0) || i < 2, "member {i} crossed the vertical upward");
+            assert_eq!(
+                (&member.q, &member.p, member.steps),
+                (&single.q, &single.p, single.steps),
+                "member {i}"
+            );
+            assert!(
+                single.terminated_by.is_some() && single.steps < 3000,
+                "member {i} stops at its third crossing"
+            );
+            assert!(
+                member.events.iter().any(|o| o.event == 0) || i < 2,
+                "member {i} crossed the vertical upward"
+            );
         }
     }
     // An event on a coordinate the model does not have is refused before anything runs.
     let bad = MemberEvents {
-        functions: vec![NativeEvent::Crossing { coordinate: 2, value: 0.0 }],
-        specs: vec![EventSpec { name: "third".into(), direction: 0, terminal: 0 }],
+        functions: vec![NativeEvent::Crossing {
+            coordinate: 2,
+            value: 0.0,
+        }],
+        specs: vec![EventSpec {
+            name: "third".into(),
+            direction: 0,
+            terminal: 0,
+        }],
     };
-    let err = integrate_ensemble(&Shared(&sys), Method::Midpoint, &q0, &p0, &options, Parallel::default(), &bad, never);
-    assert!(matches!(err, Err(Error::InvalidArgument { argument: "events", .. })), "{err:?}");
+    let err = integrate_ensemble(
+        &Shared(&sys),
+        Method::Midpoint,
+        &q0,
+        &p0,
+        &options,
+        Parallel::default(),
+        &bad,
+        never,
+    );
+    assert!(
+        matches!(err, Err(Error::InvalidArgument { argument: "events", .. })),
+        "{err:?}"
+    );
 }

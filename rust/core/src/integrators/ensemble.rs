@@ -128,6 +128,7 @@ const POLL: Duration = Duration::from_millis(10);
 /// (checked against the model's n, naming `events`), and an
 /// ensemble whose saved states, twice over (the records and the stacked arrays made of them),
 /// would not fit in the memory available (naming `save_every`).
+#[allow(clippy::too_many_arguments)]
 pub fn integrate_ensemble<M, P>(
     models: &M,
     method: Method,
@@ -194,7 +195,8 @@ where
                     let i = c * chunk + k;
                     let rows = i * n..(i + 1) * n;
                     let (q0, p0) = (&q0[rows.clone()], &p0[rows]);
-                    *slot = Some(models.with_model(i, |sys| member(sys, method, (q0, p0), options, events, stop, steps)));
+                    *slot =
+                        Some(models.with_model(i, |sys| member(sys, method, (q0, p0), options, events, stop, steps)));
                     // The receiver waits until every member is done.
                     let _ = sender.send(());
                 }
