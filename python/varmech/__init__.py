@@ -39,7 +39,7 @@ from .analysis.stability import (
 )
 from .analysis.work_precision import work_precision
 from .conservation import ConservationReport, InvariantStatistics, check_conservation, momentum
-from .constraints import project
+from .constraints import IntegrableConstraintsWarning, project
 from .derivatives import DerivativeCheck, check_derivatives
 from .ensemble import Ensemble, EnsembleConservation, ensemble
 from .files import load
@@ -68,6 +68,7 @@ __all__ = [
     "EnsembleConservation",
     "Impulse",
     "ImpulseResponse",
+    "IntegrableConstraintsWarning",
     "InvariantStatistics",
     "Lagrangian",
     "MechanicalSystem",

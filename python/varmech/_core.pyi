@@ -37,6 +37,7 @@ __all__ = [
     "VarmechError",
     "amended_potential",
     "catalogue",
+    "constraint_curvature",
     "constraint_residuals",
     "cyclic_increments",
     "cyclic_velocity",
@@ -265,6 +266,9 @@ def constraint_residuals(
     model: _Model, q: _FloatArray, p: _FloatArray
 ) -> tuple[tuple[_FloatArray, _FloatArray], tuple[_FloatArray, _FloatArray]]:
     """((|g(q)|∞, |G(q)M⁻¹p|∞), (‖G‖∞‖q‖∞, ‖G‖∞‖M⁻¹p‖∞)) at each state."""
+def constraint_curvature(model: _Model, q: _FloatArray) -> list[float] | None:
+    """Frobenius' test of the velocity constraints at each row of q: the curvature of ker A(q)
+    relative to ∂A/∂q (round-off where they integrate); None without velocity constraints."""
 def project(model: _Model, q0: _FloatArray, p0: _FloatArray) -> tuple[_FloatArray, _FloatArray]: ...
 
 @final

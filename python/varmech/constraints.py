@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 from numpy.typing import ArrayLike
 
@@ -41,3 +43,49 @@ def project(model: Model, q0: ArrayLike, p0: ArrayLike | None = None, *, v0: Arr
         raise ValueError("p0, v0: give one of them")
     p0 = model.momentum(q0, vector("v0", v0, n)) if v0 is not None else vector("p0", p0 if p0 is not None else np.zeros(n), n)
     return _core.project(model._core, q0, p0)
+
+
+class IntegrableConstraintsWarning(UserWarning):
+    """Velocity constraints that integrate to holonomic ones near the initial state: give them
+    as g(q) = 0 (``constraints=``), for RATTLE or the constrained DEL step."""
+
+
+#: Frobenius' test calls the constraints integrable below this relative curvature: far above
+#: the accuracy of a differenced ∂A/∂q (about 1e-10), far below rolling's order 1.
+INTEGRABLE_CURVATURE = 1e-6
+
+
+def integrable_near(model: Model, q0: ArrayLike) -> bool:
+    """Whether the velocity constraints A(q)q̇ = 0 of ``model`` integrate to holonomic ones
+    near ``q0``, by Frobenius' test: each constraint form ω_k = A_k·dq has dω_k = 0 on ker A,
+    Nᵀ(∂A_kj/∂qᵢ − ∂A_ki/∂qⱼ)N = 0 for a basis N of ker A(q), at q0 and at three points
+    about it (0.1·max(1, |q0|) away). Rolling twists ker A and is not integrable; x ẋ + y ẏ = 0
+    is the circle's derivative.
+
+    Examples
+    --------
+    >>> import numpy as np, varmech
+    >>> circle = varmech.MechanicalSystem(2, lambda q: 0.0, lambda q: np.zeros(2),
+    ...     velocity_constraints=lambda q: np.array([[q[0], q[1]]]), velocity_constraint_count=1)
+    >>> varmech.constraints.integrable_near(circle, [1.0, 0.0])
+    True
+    """
+    q0 = vector("q0", q0, model.dim)
+    rng = np.random.default_rng(0)
+    points = q0 + 0.1 * max(1.0, float(np.max(np.abs(q0)))) * np.vstack([np.zeros(model.dim), rng.standard_normal((3, model.dim))])
+    curvature = _core.constraint_curvature(model._core, points)
+    if curvature is None:
+        raise ValueError(f"model: {model.name} has no velocity constraints")
+    return bool(np.all(np.asarray(curvature) < INTEGRABLE_CURVATURE))
+
+
+def warn_if_integrable(model: Model, q0: np.ndarray) -> None:
+    """An :class:`IntegrableConstraintsWarning` if the model's velocity constraints are
+    holonomic in disguise near ``q0`` (:func:`integrable_near`)."""
+    if integrable_near(model, q0):
+        warnings.warn(
+            f"velocity_constraints: the constraints of {model.name} integrate to holonomic ones near q0 (Frobenius: "
+            "dω vanishes on ker A); give them as g(q) = 0 with constraints= for RATTLE or the constrained DEL step",
+            IntegrableConstraintsWarning,
+            stacklevel=3,
+        )

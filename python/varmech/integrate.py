@@ -19,6 +19,7 @@ from . import impacts as _impacts
 from . import impulses as _impulses
 from ._progress import progress_bar
 from ._util import finite, positive, positive_int, vector
+from .constraints import warn_if_integrable
 from .model import Lagrangian, Model
 
 if TYPE_CHECKING:
@@ -410,6 +411,8 @@ def integrate(
     threshold = _energy_threshold(model, max_energy_error)
     newton_tolerance, newton_max_iterations = _newton(newton_tolerance, newton_max_iterations)
     q, p = _initial_state(model, q0, p0, v0, t0)
+    if model.velocity_constraints:
+        warn_if_integrable(model, q)
     watched, event_specs = _events.specs(events, model.dim) if events is not None else ([], [])
     # A horizon past the largest float is the core's to refuse (naming dt); probe finite times.
     t_end = t0 + nsteps * dt

@@ -1,6 +1,6 @@
 """The docstring examples run as written (numpydoc ``Examples``): the symbolic front end, events,
-files, long runs, dense output, impulses, impacts and their surfaces, the scenes, the stepper and
-the conservation report."""
+files, long runs, dense output, impulses, impacts and their surfaces, the scenes, the stepper, the
+conservation report, ensembles and constraints."""
 
 import doctest
 import importlib
@@ -28,6 +28,7 @@ pytest.importorskip("sympy")
         "varmech.stepper",
         "varmech.conservation",
         "varmech.ensemble",
+        "varmech.constraints",
     ],
 )
 def test_examples_run(name):

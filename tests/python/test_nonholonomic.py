@@ -95,6 +95,8 @@ def test_the_sphere_on_a_rough_incline_runs_down_a_parabola_at_order_two():
     assert errors[-1] < 2e-5
 
 
+# Integrable on purpose (the circle's derivative): the warning that says so is tested below.
+@pytest.mark.filterwarnings("ignore::varmech.IntegrableConstraintsWarning")
 def test_a_particle_held_to_a_circle_by_x_xdot_plus_y_ydot_matches_rattle_to_order_two():
     def potential(q):
         return q[1] + q[0] ** 2
@@ -180,3 +182,37 @@ def test_bad_velocity_constraints_are_named():
     assert info.value.step >= 2 and len(info.value.partial) == info.value.step
     with pytest.raises(Boom, match="no more rolling"):
         varmech.integrate(disk(raising), [0.0, 0.0, THETA0, 1.0], v0=V0, dt=0.1, steps=3)
+
+
+def test_frobenius_tells_integrable_velocity_constraints_from_rolling():
+    # x ẋ + y ẏ = 0 is the circle's derivative and a constant A integrates to A q = const: both
+    # warn (give g(q) = 0); the disk, the sphere and the sleigh twist ker A and do not.
+    import warnings
+
+    circle = varmech.MechanicalSystem(
+        2, lambda q: q[1], lambda q: np.array([0.0, 1.0]),
+        velocity_constraints=lambda q: np.array([[q[0], q[1]]]), velocity_constraint_count=1, name="circle",
+    )
+    constant = varmech.MechanicalSystem(
+        3, lambda q: 0.0, lambda q: np.zeros(3),
+        velocity_constraints=lambda q: np.array([[1.0, 2.0, 0.5]]), velocity_constraint_count=1,
+    )
+    sleigh = varmech.MechanicalSystem(
+        3, lambda q: 0.0, lambda q: np.zeros(3),
+        velocity_constraints=lambda q: np.array([[-np.sin(q[2]), np.cos(q[2]), -1.0]]), velocity_constraint_count=1,
+    )
+    for model, q0 in ((circle, [1.0, 0.0]), (constant, [0.3, -0.2, 1.0])):
+        assert varmech.constraints.integrable_near(model, q0)
+        with pytest.warns(varmech.IntegrableConstraintsWarning, match="^velocity_constraints: .* integrate to holonomic"):
+            varmech.integrate(model, q0, np.zeros(model.dim), dt=0.1, steps=3)
+    # Rolling's curvature is of order one: sin of the angle between ker A and its bracket.
+    assert varmech._core.constraint_curvature(disk()._core, np.array([[0.0, 0.0, 0.3, 0.0]]))[0] > 0.5
+    for model, q0, v0 in ((disk(), [0, 0, THETA0, 0], V0), (sphere(), [0.0, 0.0, np.pi, np.pi / 2, 0.0], [1.0, 0.3, 0.0, 0.3, 1.0]),
+                          (sleigh, [0.0, 0.0, 0.0], [0.0, 1.0, 1.0])):
+        assert not varmech.constraints.integrable_near(model, q0)
+        with warnings.catch_warnings():
+            warnings.simplefilter("error", varmech.IntegrableConstraintsWarning)
+            varmech.integrate(model, q0, v0=v0, dt=0.1, steps=3)
+    # A model without velocity constraints has nothing to test.
+    with pytest.raises(ValueError, match="^model"):
+        varmech.constraints.integrable_near(varmech.scenes.pendulum().model, [0.1])

@@ -199,7 +199,35 @@ fn statistics(
         .into())
 }
 
+/// Frobenius' test of a nonholonomic model's velocity constraints at each row of `q`
+/// ([`model::curvature`]): the curvature of ker A(q) relative to ∂A/∂q, round-off where the
+/// constraints integrate to holonomic ones. None for a model without velocity constraints.
+#[pyfunction]
+fn constraint_curvature(
+    py: Python<'_>,
+    model: &Bound<'_, PyAny>,
+    q: PyReadonlyArray2<'_, f64>,
+) -> PyResult<Option<Vec<f64>>> {
+    let n = dim_of(py, model)?;
+    let (q, width) = rows("q", &q)?;
+    if width != n {
+        return Err(PyValueError::new_err(format!(
+            "q: rows of {n} coordinates expected, got {width}"
+        )));
+    }
+    let result: Option<Result<Vec<f64>, ModelError>> = bind_model(py, model, |sys, _poll| {
+        let constraints = sys.velocity_constraints()?;
+        Some(
+            q.chunks_exact(n.max(1))
+                .map(|q| model::curvature(constraints, q))
+                .collect(),
+        )
+    })?;
+    result.transpose().map_err(model_error)
+}
+
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(constraint_curvature, m)?)?;
     m.add_function(wrap_pyfunction!(energy_terms, m)?)?;
     m.add_function(wrap_pyfunction!(derivative, m)?)?;
     m.add_function(wrap_pyfunction!(momentum, m)?)?;

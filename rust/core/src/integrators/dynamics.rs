@@ -79,6 +79,11 @@ pub trait Dynamics {
     fn project(&self, _q: &[f64], _p: &[f64]) -> Option<Result<PhaseState, Error>> {
         None
     }
+
+    /// The velocity constraints A(q)q̇ = 0 of a nonholonomic system; None for the others.
+    fn velocity_constraints(&self) -> Option<&dyn VelocityConstraints> {
+        None
+    }
 }
 
 impl<S: MechanicalSystem> Dynamics for S {
@@ -295,6 +300,10 @@ impl<L: Lagrangian, C: VelocityConstraints> Dynamics for Nonholonomic<L, C> {
 
     fn constraint_residuals(&self, q: &[f64], p: &[f64]) -> Option<Result<model::Residuals, ModelError>> {
         Some(self.residuals(q, p))
+    }
+
+    fn velocity_constraints(&self) -> Option<&dyn VelocityConstraints> {
+        Some(&self.constraints)
     }
 
     fn project(&self, q: &[f64], p: &[f64]) -> Option<Result<PhaseState, Error>> {

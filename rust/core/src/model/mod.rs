@@ -9,7 +9,7 @@
 //! - [`HolonomicConstraints`]: g(q) = 0 with its Jacobian, [`Distances`] for rigid links, and
 //!   [`Constrained`], a mechanical system on them;
 //! - [`VelocityConstraints`]: nonholonomic constraints A(q)q̇ = 0, and [`Nonholonomic`], a
-//!   Lagrangian system on them;
+//!   Lagrangian system on them; [`curvature`], Frobenius' test of whether they integrate;
 //! - [`NBody`]: point masses under Newtonian gravity, the model of the N-body scenes and of
 //!   the Wisdom–Holman methods;
 //! - [`Routhian`]: Routh reduction, R = L − μ·ċ on the non-cyclic coordinates;
@@ -22,6 +22,7 @@
 pub mod compiled;
 mod constraints;
 mod energy;
+mod frobenius;
 mod lagrangian;
 mod mass;
 mod mechanical;
@@ -37,6 +38,7 @@ pub use constraints::{
     HolonomicConstraints, Link, PhaseState, Residuals,
 };
 pub use energy::{hamiltonian, EnergyTerms};
+pub use frobenius::curvature;
 pub use lagrangian::{Hessians, Lagrangian};
 pub use mass::Mass;
 pub use mechanical::MechanicalSystem;
