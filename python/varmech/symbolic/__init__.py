@@ -200,7 +200,7 @@ def routh(model: SymbolicModel, cyclic: Sequence[int], momenta: Any) -> Symbolic
 
     Examples
     --------
-    The heavy top with its precession φ and spin ψ ignored::
+    The heavy top with its precession φ and spin ψ ignored:
 
     >>> import varmech.symbolic
     >>> from varmech.symbolic import examples
