@@ -61,6 +61,36 @@ class Ensemble:
     ``step`` and ``time``) are kept, and ``ensemble[i]`` is its :class:`~varmech.Trajectory`
     (the partial one of a failure). ``parameters`` holds each member's parameter values by
     name.
+
+    Attributes
+    ----------
+    trajectories : list of Trajectory
+        Each member's run (the partial one of a failure).
+    errors : list of BaseException or None
+        Each member's exception, with ``step`` and ``time`` (None for a member that finished).
+    parameters : dict of str to ndarray
+        Each member's parameter values by name.
+    t : ndarray, shape (saved,)
+        The saved times of a complete member.
+    q, p : ndarray, shape (members, saved, n)
+        The members' states, NaN after the last state of a member that stopped early.
+    status : ndarray of int, shape (members,)
+        Each member's status (0 finished, -1 failed or interrupted).
+    messages : list of str
+        Each member's message.
+    failed : list of int
+        The members that did not reach the end.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import varmech
+    >>> runs = varmech.ensemble(varmech.scenes.pendulum(), np.zeros((4, 1)), [[0.5], [1.0], [1.5], [2.5]],
+    ...                         dt=0.01, steps=1000, save_every=100)
+    >>> runs.q.shape, runs.failed, len(runs)
+    ((4, 11, 1), [], 4)
+    >>> runs[3].method
+    'verlet'
     """
 
     trajectories: list[Trajectory]
@@ -192,22 +222,22 @@ def ensemble(
 
     Parameters
     ----------
-    model:
+    model
         A model or a :class:`~varmech.scenes.Scene` (its model).
-    q0, p0, v0:
+    q0, p0, v0
         Initial positions (members, n), and momenta ``p0`` or velocities ``v0`` of the same
         shape (exactly one of them).
-    parameters:
+    parameters
         Per-member values of the model's named parameters, ``{name: array (members,)}`` (a
         scalar is every member's): the parameters of a native scene
         (:func:`varmech.scenes.get`) or of a symbolic model (:mod:`varmech.symbolic`); the
         others keep the model's values.
-    dt, steps, t_end, method, save_every, compensated, max_energy_error, t0, newton_tolerance, newton_max_iterations:
+    dt, steps, t_end, method, save_every, compensated, max_energy_error, t0, newton_tolerance, newton_max_iterations
         As in :func:`varmech.integrate`, for every member.
-    workers:
+    workers
         The most threads to use; default: one a core (with ``client``: on each Dask worker, its
         own thread count).
-    client:
+    client
         A :class:`dask.distributed.Client`: the members run on its cluster in chunks of
         ``chunk_size``, each chunk one task that runs this same parallel loop in a worker
         process, and the results are gathered in member order (needs the extra ``cluster``;
@@ -215,10 +245,10 @@ def ensemble(
         as its name and parameters, a symbolic model as its expressions, a closure model by
         cloudpickle); one that cannot be is a TypeError naming ``model``. A task lost with its
         worker is run again by Dask, bit for bit the same.
-    chunk_size:
+    chunk_size
         Members a task runs one after the other (default 1: the threads balance the load; with
         ``client``, about four chunks a worker thread).
-    progress:
+    progress
         A progress bar of the steps of all members (tqdm, on stderr) once the run has taken a
         second; ``None``: only when stderr is a terminal.
 
