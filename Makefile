@@ -2,7 +2,7 @@
 # `make test` (build, run every test). PYTHON may name another interpreter.
 PYTHON ?= python3
 
-.PHONY: install tour lint test test-aarch64 bench compare gallery
+.PHONY: install tour lint test docs test-aarch64 bench compare gallery
 
 install:
 	$(PYTHON) -m pip install -e ".[test,charts]"
@@ -15,13 +15,20 @@ tour: install
 lint: install
 	cargo fmt --all --check
 	cargo clippy --workspace --all-targets -- -D warnings
-	$(PYTHON) -m ruff check python tests benches
+	$(PYTHON) -m ruff check python tests benches docs
 	$(PYTHON) -m mypy
 	$(PYTHON) -m mypy.stubtest varmech._core
+
+# The documentation site (Sphinx, numpydoc, pydata theme, MyST pages, a sphinx-gallery whose
+# examples run now): docs/_build/html. Warnings are errors; `make test` builds it afresh.
+SPHINX = $(PYTHON) -m sphinx -b html -W --keep-going docs docs/_build/html
+docs: install
+	$(SPHINX)
 
 test: lint
 	cargo test --release
 	$(PYTHON) -m pytest -q
+	$(SPHINX) -E -a
 
 # The core's tests on aarch64 (the N-body kernel's scalar path there), cross-built and run under
 # qemu: needs `rustup target add aarch64-unknown-linux-gnu` and Debian's gcc-aarch64-linux-gnu and

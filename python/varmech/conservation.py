@@ -30,8 +30,32 @@ ROUND_OFF: float = _core.ROUND_OFF
 def momentum(traj: Trajectory, generator: Generator) -> np.ndarray:
     """The Noether momentum J = p·ξ(q) at every saved state of ``traj``, shape (N,).
 
-    ``generator`` is a :class:`~varmech.Translation`, :class:`~varmech.Rotation` or
-    :class:`~varmech.Cyclic`, or a closure ``xi(q) -> array (n,)``.
+    Parameters
+    ----------
+    traj : Trajectory
+        A run.
+    generator : Translation, Rotation, Cyclic or callable
+        The symmetry's generator: a :class:`~varmech.Translation`, :class:`~varmech.Rotation` or
+        :class:`~varmech.Cyclic`, or a closure ``xi(q) -> array (n,)``.
+
+    Returns
+    -------
+    ndarray, shape (N,)
+        J at each saved state.
+
+    Raises
+    ------
+    TypeError
+        ``generator`` is none of these, naming it.
+    ValueError
+        ``xi(q)`` returned another shape than (n,).
+
+    Examples
+    --------
+    >>> import varmech
+    >>> traj = varmech.integrate(varmech.scenes.kepler(0.6), dt=0.01, steps=1000, save_every=500)
+    >>> varmech.momentum(traj, varmech.Rotation(spatial_dim=2)).round(12)
+    array([0.8, 0.8, 0.8])
     """
     return _momentum_terms(traj, generator)[0]
 
@@ -56,6 +80,8 @@ def _momentum_terms(traj: Trajectory, generator: Generator) -> tuple[np.ndarray,
 class InvariantStatistics:
     """The error of one conserved quantity along a run, against its scale, and the verdict.
 
+    A field of :class:`ConservationReport` (``report.energy``, ``report.momenta[k]``, …).
+
     The verdict is the first that applies of:
 
     - ``"failed"``: a value is not finite (``first_non_finite`` is the first saved state where
@@ -76,6 +102,49 @@ class InvariantStatistics:
 
     ``max_rel_error`` and ``band`` are relative to ``scale``; ``drift_rate`` and
     ``drift_rate_stderr`` are absolute, per unit time.
+
+    Attributes
+    ----------
+    name : str
+        The quantity: ``"energy"``, ``"energy balance"``, a momentum (``"L"``, ``"P_x"``,
+        ``"p[0]"``, ``"xi[k]"``) or a constraint level (``"|g(q)|"``, ``"|G q̇|"``, ``"|A q̇|"``).
+    initial : float
+        Its value at the first saved state (H₀, J₀; 0 for a constraint residual).
+    scale : float
+        What the error is measured against: the mean kinetic energy for the energy, the mean
+        Σ|pᵢξᵢ| for a momentum, the mean ‖G‖‖q‖ or ‖G‖‖q̇‖ for a constraint.
+    scale_name : str
+        What the scale is, in words: ``"mean kinetic energy"``, ``"mean Σ|pᵢξᵢ|"``, …
+    round_off : float
+        The round-off level: 10 ε × (largest size of the terms) × √(1 + steps), absolute.
+    max_abs_error : float
+        The largest |error| over the saved states, absolute (max |ΔH| for the energy).
+    max_rel_error : float
+        ``max_abs_error / scale``.
+    band : float
+        The median oscillation of the error within a batch of the run, relative to the scale.
+    drift_rate : float
+        The slope of the error's batch means, absolute, per unit time.
+    drift_rate_stderr : float
+        The standard error of ``drift_rate``.
+    first_non_finite : int or None
+        The first saved state where the quantity is not finite (None: it is finite throughout).
+    verdict : str
+        ``"conserved to round-off"``, ``"bounded"``, ``"secular drift"`` or ``"failed"``.
+    advice : str
+        For a failure, where it happened and what to do; for a coarse band, to reduce dt;
+        otherwise empty.
+    representative : bool
+        Whether |initial| is of the order of the scale, so that an error relative to it means
+        something.
+
+    Examples
+    --------
+    >>> import varmech
+    >>> traj = varmech.integrate(varmech.scenes.kepler(0.6), dt=0.01, steps=20_000, save_every=10)
+    >>> energy = varmech.check_conservation(traj).energy
+    >>> energy.verdict, energy.scale_name, energy.max_rel_error < 1e-2
+    ('bounded', 'mean kinetic energy', True)
     """
 
     name: str
@@ -159,7 +228,50 @@ FORCED = "not conserved (forced); see the energy balance"
 @dataclass(frozen=True)
 class ConservationReport:
     """What a run conserved: its energy (or a forced run's energy balance), its Noether
-    momenta and its constraints, each with an :class:`InvariantStatistics` and its verdict."""
+    momenta and its constraints, each with an :class:`InvariantStatistics` and its verdict.
+
+    :func:`check_conservation` returns it; ``print(report)`` gives the table the user guide's verdicts page shows.
+
+    Attributes
+    ----------
+    model : str
+        The model's name.
+    method : str
+        The method's name.
+    dt : float
+        The step.
+    t_end : float
+        The last saved time.
+    energy : InvariantStatistics or None
+        The energy E = p·q̇ − L; None when L depends on t or forces act (the energy is then not
+        conserved; see ``energy_balance``).
+    momenta : tuple of InvariantStatistics
+        Each Noether momentum judged, in the order of the generators.
+    energy_balance : InvariantStatistics or None
+        For forced systems: the balance E(t) − W(t), W the work of the forces (the discrete
+        Lagrange–d'Alembert energy balance), judged as the energy is.
+    constraints : tuple of InvariantStatistics or None
+        For constrained models: |g(q)|∞ and |G(q)M⁻¹p|∞ over the run; with velocity
+        constraints |A(q)q̇|∞ alone.
+    verdict : str
+        The energy's verdict, or why the energy is not conserved (L depends on t, or forces
+        act: then see ``energy_balance``).
+    constraint_residuals : tuple of float or None
+        max |g(q)|∞ and max |G(q)M⁻¹p|∞ over the run, for constrained models (0 and max
+        |A(q)q̇|∞ with velocity constraints); None without constraints.
+    quantities : tuple of InvariantStatistics
+        Every quantity judged: energy or balance, momenta, constraints.
+
+    Examples
+    --------
+    >>> import varmech
+    >>> traj = varmech.integrate(varmech.scenes.kepler(0.6), dt=0.01, steps=20_000, save_every=10)
+    >>> report = varmech.check_conservation(traj)
+    >>> report.verdict, [m.name for m in report.momenta]
+    ('bounded', ['L'])
+    >>> f"{report.energy.max_abs_error:.1e}"
+    '...e-0...'
+    """
 
     model: str
     method: str
@@ -218,10 +330,33 @@ def check_conservation(traj: Trajectory, generators: Sequence[Generator] | None 
     """Check the energy, the Noether momenta and the constraints of ``traj``.
 
     The energy function E = p·q̇ − L is judged when L does not depend on t; with forces acting
-    the report judges the balance E − W, W the work of the forces, instead.
+    the report judges the balance E − W, W the work of the forces, instead. Each quantity's
+    error is measured against a scale (the mean kinetic energy for the energy), and judged
+    "conserved to round-off", "bounded", "secular drift" or "failed"
+    (:class:`InvariantStatistics` says how).
 
-    ``generators`` defaults to the symmetries the model declares; a closure generator is named
-    ``xi[k]``.
+    Parameters
+    ----------
+    traj : Trajectory
+        A run, as :func:`varmech.integrate` returns it.
+    generators : sequence of Translation, Rotation, Cyclic or callable, optional
+        The symmetries whose momenta J = p·ξ(q) are judged. Default: those the model declares;
+        a closure generator ``xi(q)`` is named ``xi[k]``.
+
+    Returns
+    -------
+    ConservationReport
+        The energy (or balance), each momentum and each constraint level, with their
+        statistics and verdicts; ``print(report)`` shows them.
+
+    Raises
+    ------
+    TypeError, ValueError
+        A generator that is not one, or whose ``xi(q)`` has the wrong shape (see :func:`momentum`).
+
+    See Also
+    --------
+    ConservationReport, InvariantStatistics
 
     Examples
     --------

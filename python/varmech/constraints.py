@@ -19,8 +19,27 @@ def project(model: Model, q0: ArrayLike, p0: ArrayLike | None = None, *, v0: Arr
     on them by the same projection with A for G. Give the momenta ``p0`` or the velocities
     ``v0`` (default: at rest).
 
-    Raises ValueError naming ``q0`` when no point of the constraints is near (Newton fails) or
-    the constraints are not independent there, and ``model`` when it has no constraints.
+    Parameters
+    ----------
+    model : Model
+        A model with holonomic constraints or velocity constraints.
+    q0 : array_like, shape (n,)
+        The positions, near the constraints.
+    p0, v0 : array_like, shape (n,), optional
+        The momenta, or the velocities (one of them; default: at rest).
+
+    Returns
+    -------
+    q, p : ndarray, shape (n,)
+        A state on the constraints (and on the hidden constraint), from which
+        :func:`varmech.integrate` starts.
+
+    Raises
+    ------
+    ValueError
+        Naming ``q0`` when no point of the constraints is near (Newton fails) or the constraints
+        are not independent there, ``model`` when it has no constraints, ``p0, v0`` when both are
+        given, or an argument of the wrong shape.
 
     Examples
     --------

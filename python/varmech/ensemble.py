@@ -65,6 +65,36 @@ class Ensemble:
     ``step`` and ``time``) are kept, and ``ensemble[i]`` is its :class:`~varmech.Trajectory`
     (the partial one of a failure). ``parameters`` holds each member's parameter values by
     name.
+
+    Attributes
+    ----------
+    trajectories : list of Trajectory
+        Each member's run (the partial one of a failure).
+    errors : list of BaseException or None
+        Each member's exception, with ``step`` and ``time`` (None for a member that finished).
+    parameters : dict of str to ndarray
+        Each member's parameter values by name.
+    t : ndarray, shape (saved,)
+        The saved times of a complete member.
+    q, p : ndarray, shape (members, saved, n)
+        The members' states, NaN after the last state of a member that stopped early.
+    status : ndarray of int, shape (members,)
+        Each member's status (0 finished, -1 failed or interrupted).
+    messages : list of str
+        Each member's message.
+    failed : list of int
+        The members that did not reach the end.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import varmech
+    >>> runs = varmech.ensemble(varmech.scenes.pendulum(), np.zeros((4, 1)), [[0.5], [1.0], [1.5], [2.5]],
+    ...                         dt=0.01, steps=1000, save_every=100)
+    >>> runs.q.shape, runs.failed, len(runs)
+    ((4, 11, 1), [], 4)
+    >>> runs[3].method
+    'verlet'
     """
 
     trajectories: list[Trajectory]
@@ -197,45 +227,45 @@ def ensemble(
     call Python at every step and hold the GIL, so threads would only take turns: they run
     member by member, serially, unless ``workers`` is given; then they run in that many
     processes (the model shipped by cloudpickle), which pays off once the serial run would take
-    more than about a second (the README's *Ensembles and clusters* gives the figures). As with
+    more than about a second (the user guide's *Ensembles* page gives the figures). As with
     any process pool, a script that does this needs the ``if __name__ == "__main__":`` guard.
 
     Parameters
     ----------
-    model:
+    model
         A model or a :class:`~varmech.scenes.Scene` (its model).
-    q0, p0, v0:
+    q0, p0, v0
         Initial positions (members, n), and momenta ``p0`` or velocities ``v0`` of the same
         shape (exactly one of them).
-    parameters:
+    parameters
         Per-member values of the model's named parameters, ``{name: array (members,)}`` (a
         scalar is every member's): the parameters of a native scene
         (:func:`varmech.scenes.get`) or of a symbolic model (:mod:`varmech.symbolic`); the
         others keep the model's values.
-    dt, steps, t_end, method, save_every, compensated, max_energy_error, t0, newton_tolerance, newton_max_iterations:
+    dt, steps, t_end, method, save_every, compensated, max_energy_error, t0, newton_tolerance, newton_max_iterations
         As in :func:`varmech.integrate`, for every member.
-    events:
+    events
         Event functions every member watches, as in :func:`varmech.integrate` (each member's
         crossings in ``ensemble[i].events``, a terminal one stopping that member alone). The
         built-in ones (:func:`varmech.events.crossing`, ``energy_error``, ``escape``,
         ``encounter``) run in the core's parallel loop, a copy for each member; a Python
         function holds the GIL, so with one the members run as a closure model's do.
-    workers:
+    workers
         The most threads to use; default: one a core (with ``client``: on each Dask worker, its
         own thread count). For a closure model, the number of processes; default: none, the
         members run serially in this process.
-    client:
+    client
         A :class:`dask.distributed.Client`: the members run on its cluster in chunks of
         ``chunk_size``, each chunk one task that runs this same parallel loop in a worker
         process, and the results are gathered in member order (needs the extra ``cluster``;
-        the README's *Ensembles and clusters* gives the costs). The model is shipped by pickling (a native scene
+        the user guide's *Ensembles* page gives the costs). The model is shipped by pickling (a native scene
         as its name and parameters, a symbolic model as its expressions, a closure model by
         cloudpickle); one that cannot be is a TypeError naming ``model``. A task lost with its
         worker is run again by Dask, bit for bit the same.
-    chunk_size:
+    chunk_size
         Members a task runs one after the other (default 1: the threads balance the load; with
         ``client`` or closure processes, about four chunks a worker thread or process).
-    progress:
+    progress
         A progress bar of the steps of all members (tqdm, on stderr) once the run has taken a
         second; ``None``: only when stderr is a terminal.
 

@@ -61,17 +61,17 @@ class Event:
 
     Parameters
     ----------
-    function:
+    function
         g(t, q, p) → float, or g(t, q, v) with ``variables="v"`` (v = q̇, the velocities).
         None for the built-in events, which carry a ``native`` spec instead.
-    direction:
+    direction
         +1: count only crossings where g increases (− to +); −1: where it decreases; 0: both.
-    terminal:
+    terminal
         True: the run stops after the step of the first crossing; an integer k ≥ 1: of the k-th;
         False (default): never.
-    variables:
+    variables
         ``"p"`` (default): g takes the momenta; ``"v"``: the velocities.
-    name:
+    name
         Shown in messages (default: the function's ``__name__``).
 
     Examples
@@ -166,7 +166,7 @@ def escape(radius: float, *, groups: Sequence[Sequence[int]] | None = None, dim:
 
     Parameters
     ----------
-    groups:
+    groups
         The coordinate indices of each position x_j; default: consecutive blocks of ``dim``
         (the bodies of an N-body scene, 3 coordinates each; ``dim=2`` for the planar Kepler
         problem).

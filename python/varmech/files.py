@@ -350,8 +350,26 @@ def load(path: str | os.PathLike[str], *, model: Model | None = None, lazy: bool
     ``lazy=True`` reads no column until it is used (each a :class:`Rows`; indexing reads only
     the rows asked for), for files larger than memory.
 
-    Raises ValueError naming ``path`` for a missing, corrupt or truncated file, or one that is not
-    a varmech trajectory; ValueError naming ``model`` for a model of another dimension.
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The HDF5 file.
+    model : Model, optional
+        The model to attach instead of the file's pickled one (needed for a closure model whose
+        closures do not unpickle).
+    lazy : bool, default False
+        Read each column only when used.
+
+    Returns
+    -------
+    Trajectory
+        The run in the file, with its checkpoint.
+
+    Raises
+    ------
+    ValueError
+        Naming ``path`` for a missing, corrupt or truncated file, or one that is not a varmech
+        trajectory; naming ``model`` for a model of another dimension.
 
     Examples
     --------

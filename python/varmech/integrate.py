@@ -28,7 +28,7 @@ if TYPE_CHECKING:
 
 @dataclass
 class Trajectory:
-    """The saved states of a run (scipy-style result).
+    """The saved states of a run (scipy-style result), as :func:`integrate` returns it.
 
     ``t`` has shape (N,), ``q`` and ``p`` shape (N, n); ``v`` = M⁻¹p is computed on demand.
     ``nfev`` counts force evaluations (for the implicit methods, evaluations of the discrete
@@ -39,6 +39,55 @@ class Trajectory:
     (``err.partial``); ``message`` says which. ``events`` holds each event's located crossings
     (:class:`varmech.events.Occurrences`, one per function given, in that order; empty without
     events).
+
+    Attributes
+    ----------
+    t : ndarray, shape (N,)
+        The saved times.
+    q, p : ndarray, shape (N, n)
+        The positions and the momenta p = ∂L/∂q̇ at the saved times.
+    v : ndarray, shape (N, n)
+        The velocities q̇ (M⁻¹p for mechanical systems), computed on first use.
+    model : Model
+        The model integrated.
+    method : str
+        The method's name (see :func:`varmech.methods`).
+    dt : float
+        The step h.
+    steps : int
+        Steps taken from the initial state.
+    nfev : int
+        Force evaluations made (the implicit methods: evaluations of the discrete Lagrangian's
+        slot derivatives).
+    newton : ndarray, shape (N,) or None
+        Cumulative Newton iterations at each saved state (None for explicit methods).
+    newton_iterations : int
+        Newton iterations over the run (0 for explicit methods).
+    newton_iterations_per_step : ndarray, shape (N − 1,)
+        Mean Newton iterations a step between consecutive saved states.
+    work : ndarray, shape (N,) or None
+        Work done by the non-conservative forces up to each saved state.
+    status : int
+        0: the run reached its end; 1: a terminal event stopped it; -1: the partial trajectory
+        of a failed run (``err.partial``).
+    success : bool
+        ``status == 0``.
+    message : str
+        Why the run stopped.
+    checkpoint : bytes or None
+        The last state's checkpoint: ``integrate(traj, steps=)`` goes on from it, bit for bit.
+    events : tuple of Occurrences
+        Each event's located crossings, in the order the events were given.
+
+    Examples
+    --------
+    >>> import varmech
+    >>> traj = varmech.integrate(varmech.scenes.pendulum(), dt=0.01, steps=1000, save_every=100)
+    >>> traj.t.shape, traj.q.shape, traj.method, traj.status
+    ((11,), (11, 1), 'verlet', 0)
+    >>> more = varmech.integrate(traj, steps=1000)    # goes on, bit for bit
+    >>> float(more.t[-1])
+    20.0
     """
 
     t: np.ndarray
@@ -258,7 +307,7 @@ def integrate(
 
     Parameters
     ----------
-    model:
+    model
         A :class:`~varmech.MechanicalSystem`, a native model, or a :class:`~varmech.scenes.Scene`
         (whose initial state is then the default). Or a :class:`Trajectory`: the run goes on
         from its last state for ``steps`` more steps (or to ``t_end``), bit for bit as if it had
@@ -266,22 +315,22 @@ def integrate(
         predictors and every other part of the method's state); the method, step, summation,
         Newton options and energy check are the trajectory's, and the result starts with its
         last state.
-    q0, p0, v0:
+    q0, p0, v0
         Initial positions and momenta, arrays (n,); give the velocities ``v0`` instead of
         ``p0`` to start from p0 = ∂L/∂q̇(q0, v0, t0) (M v0 for mechanical systems).
-    dt:
+    dt
         The step h > 0.
-    steps, t_end:
+    steps, t_end
         How far: a number of steps, or a final time that is a whole number of steps.
-    method:
+    method
         A name from :func:`varmech.methods`. Default: ``"verlet"`` for separable mechanical
         systems, ``"midpoint"`` for general Lagrangians.
-    save_every:
+    save_every
         Keep every k-th state; the initial and final states are always kept.
-    compensated:
+    compensated
         Add the step increments with compensated summation (default), so that round-off grows
         like √N rather than N over N steps.
-    max_energy_error:
+    max_energy_error
         Stop with :class:`~varmech.DivergenceError` when the energy error |E − E₀| at a saved
         state exceeds this times the energy's scale, the mean kinetic energy of the states saved
         so far (errors at round-off never stop a run; see
@@ -291,22 +340,22 @@ def integrate(
         for every model with an energy, and no check for a Lagrangian that depends on t (a
         number is refused there). ``None``: no energy check; non-finite states still stop the
         run. The check costs one energy evaluation per saved state.
-    t0:
+    t0
         The initial time (default 0).
-    newton_tolerance, newton_max_iterations:
+    newton_tolerance, newton_max_iterations
         The implicit methods' Newton iteration stops when its correction is below
         ``newton_tolerance``·‖δq‖∞ (δq the step's increment) or stalls at round-off, and fails
         with :class:`~varmech.ConvergenceError` after ``newton_max_iterations`` iterations.
-    parameters:
+    parameters
         For a symbolic model (:mod:`varmech.symbolic`), parameter values by name (or symbol)
         for this run:
         the model of ``model.with_parameters(**parameters)`` is integrated, with the same
         compiled code. Other models have none (TypeError naming ``parameters``).
-    progress:
+    progress
         Show a progress bar (tqdm, on stderr: steps, steps/s, time left) once the run has taken a
         second. ``None`` (default): only when stderr is a terminal. It is updated at the stride
         of the Ctrl-C check (every 10–40 ms), so it costs the step loop nothing measurable.
-    output, overwrite:
+    output, overwrite
         Stream the saved states to the HDF5 file ``output`` (h5py, the extra ``io``; layout in
         :mod:`varmech.files`) as the run goes, in segments of about two seconds, each committed
         with its checkpoint; memory stays flat whatever the number of steps. The result is read
@@ -314,30 +363,30 @@ def integrate(
         than :data:`varmech.files.LAZY_BYTES`. A run stopped by Ctrl-C, an error or a kill leaves a valid file
         with every committed state, from which :func:`varmech.resume` goes on. An existing file
         is refused unless ``overwrite``.
-    t_eval:
+    t_eval
         Keep the states at these times (increasing, within the run's span) instead of every
         ``save_every``-th: each is reached from the grid state before it by one step of the same
         method of size τ < h, so it has the method's own error (order measured in
         ``tests/python/test_dense.py``), as ``solve_ivp(t_eval=)`` does with its dense output.
         The run itself is unchanged (it ends on its grid, with its checkpoint); not with
         ``save_every``, ``output`` or ``events``.
-    impulses:
+    impulses
         Blows (:class:`varmech.Impulse`) at their times ``impulse.t`` within the run: the momenta
         jump by P(q) there. An impulse between grid points splits its step: a step of the same
         method to tₙ + τ, the jump, a step of h − τ back onto the grid, so the method keeps its
         order (``tests/python/test_impulses.py``). The saved states include those just before and
         just after each jump (one time, two rows), and saving restarts from the grid state after
         it. Not yet with ``t_eval``, ``output`` or ``events``.
-    contacts:
+    contacts
         Unilateral constraints φ(q) ≥ 0 (:class:`varmech.Contact`): the run goes through their
         impacts, each step that crosses a surface split at the contact configuration (see
         :mod:`varmech.impacts`); the impacts are each contact's occurrences in ``traj.events``.
         Default: a scene's ``contacts`` (an impact scene's floor or wall); ``contacts=[]``
         runs without them. Not yet with ``t_eval``, ``output``, ``events`` or ``impulses``.
-    checkpoint_every:
+    checkpoint_every
         With ``output``: commit states and a checkpoint at least every this many steps (rounded
         down to whole ``save_every`` periods), or every :class:`datetime.timedelta` of run time.
-    events:
+    events
         Event functions g(t, q, p) whose zero crossings are located (``traj.events``), as in
         :func:`scipy.integrate.solve_ivp`: plain functions with optional ``direction`` and
         ``terminal`` attributes, :class:`varmech.events.Event` (which may take the velocities,
@@ -346,6 +395,12 @@ def integrate(
         stops the run after the step of its crossing with ``status = 1``. The steps are then
         taken one at a time (a Wisdom–Holman method synchronises, and ``whc`` applies its
         corrector, at every step).
+
+    Returns
+    -------
+    Trajectory
+        The saved states (``t``, ``q``, ``p``; ``v`` on demand), the counts, ``status`` and
+        ``message``, the located events, and the checkpoint to go on from.
 
     Raises
     ------
@@ -370,6 +425,36 @@ def integrate(
         An exception raised by a closure or an event function (or KeyboardInterrupt) propagates
         unchanged, with ``err.partial``, ``err.step`` and ``err.time`` attached where the
         exception allows.
+
+    See Also
+    --------
+    check_conservation : the verdict on what the run conserved.
+    varmech.ensemble : many runs of one model at once.
+
+    Examples
+    --------
+    Kepler's problem (e = 0.6) from closures, 10 periods at 200 steps a period:
+
+    >>> import numpy as np
+    >>> import varmech
+    >>> kepler = varmech.MechanicalSystem(
+    ...     2,
+    ...     potential=lambda q: -1.0 / np.hypot(q[0], q[1]),
+    ...     gradient=lambda q: q / np.hypot(q[0], q[1]) ** 3,
+    ...     symmetries=[varmech.Rotation(spatial_dim=2)],
+    ... )
+    >>> traj = varmech.integrate(kepler, [0.4, 0.0], [0.0, 2.0], dt=2 * np.pi / 200, steps=2000,
+    ...                          method="kahan_li8", save_every=100)
+    >>> traj.q.shape, traj.nfev
+    ((21, 2), 34001)
+    >>> print(varmech.check_conservation(traj).verdict)
+    bounded
+
+    A built-in scene carries its initial state, and the default method is its kind's:
+
+    >>> traj = varmech.integrate(varmech.scenes.double_pendulum(), dt=0.01, t_end=1.0)
+    >>> traj.method, traj.t[-1]
+    ('midpoint', np.float64(1.0))
     """
     if isinstance(model, Trajectory):
         given = {

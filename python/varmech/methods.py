@@ -10,7 +10,23 @@ MethodInfo = _core.MethodInfo
 
 
 def methods() -> list[MethodInfo]:
-    """Every method varmech integrates with, from the simplest."""
+    """Every method varmech integrates with, from the simplest.
+
+    Returns
+    -------
+    list of MethodInfo
+        One record a method: ``name``, ``order``, ``stages``, ``force_evaluations`` a step,
+        ``implicit``, ``constrained``, ``nbody``, ``symplectic``, ``symmetric``, the linear
+        stability limit ``h_omega_max`` on q̈ = −ω²q (inf: none; nan: not defined), and its
+        ``reference``.
+
+    Examples
+    --------
+    >>> import varmech
+    >>> verlet = {m.name: m for m in varmech.methods()}["verlet"]
+    >>> verlet.order, verlet.force_evaluations, verlet.symplectic, verlet.h_omega_max
+    (2, 1, True, 2.0)
+    """
     return _core.methods()
 
 

@@ -248,44 +248,89 @@ class MechanicalSystem(Model):
 
     Parameters
     ----------
-    dim:
+    dim
         Number of generalized coordinates n.
-    potential:
+    potential
         ``potential(q) -> float``, V(q) for q an array (n,). Or a function pointer of
         :data:`varmech.pointers.SIGNATURE` writing V to ``out[0]`` (with a constant mass, no
         constraints, and a pointer gradient): then the core calls it with the GIL released.
-    gradient:
+    gradient
         ``gradient(q) -> array (n,)``, ∇V(q), or a function pointer writing ∇V to ``out[0:n]``
         when the potential is one. Optional for a closure potential: without it, central
         differences of the potential are used (2n potential calls per force, about 1e-10
         relative accuracy), and a warning says so.
-    mass:
+    mass
         The constant mass matrix: a positive scalar (M = mI), a vector (n,) of positive
         entries (diagonal), or a symmetric positive-definite matrix (n, n). Or a closure
         ``mass(q) -> array (n, n)``, M(q) symmetric positive definite: then
         p = M(q)q̇ exactly, q̇ = M(q)⁻¹p by Cholesky, and ∂L/∂q = ½q̇ᵀ(∂M/∂q)q̇ − ∇V.
-    constraints, constraint_jacobian, constraint_count:
+    constraints, constraint_jacobian, constraint_count
         Holonomic constraints g(q) = 0: ``constraints(q) -> array (m,)`` with
         ``constraint_count`` = m, and optionally ``constraint_jacobian(q) -> array (m, n)``, G =
         ∂g/∂q (central differences of g without it). With a constant mass the system is
         integrated by ``rattle`` (the default), ``rattle4`` or ``shake``; with a ``mass``
         closure by the constrained DEL equations of ``trapezoid`` (the default; RATTLE's
         discrete Lagrangian) or ``midpoint``.
-    velocity_constraints, velocity_constraint_count:
+    velocity_constraints, velocity_constraint_count
         Velocity constraints A(q)q̇ = 0 that need not come from constraints on q (rolling
         without slipping, a skate's blade): ``velocity_constraints(q) -> array (m, n)``, A(q),
         with ``velocity_constraint_count`` = m. Integrated by the reversible discrete
-        Lagrange–d'Alembert integrator, ``midpoint`` (see the README, "Rolling and other
+        Lagrange–d'Alembert integrator, ``midpoint`` (see the user guide, "Rolling and other
         nonholonomic constraints"); not together with holonomic ``constraints``.
-    mass_derivative:
+    mass_derivative
         With a ``mass`` closure: ``mass_derivative(q) -> array (n, n, n)`` whose ``[i]`` is
         ∂M/∂qᵢ. Optional: without it, central differences of ``mass`` are used (2n calls
         per evaluation of ∂L/∂q), and a warning says so.
-    symmetries:
+    symmetries
         Symmetries of L (:class:`Translation`, :class:`Rotation`, :class:`Cyclic`); their
         momenta are checked by :func:`varmech.check_conservation`.
-    name:
+    name
         A label for reports.
+
+    Raises
+    ------
+    ValueError
+        A malformed argument, named: ``dim`` not positive, a ``mass`` that is not positive
+        (definite) or of the wrong shape, a count without its constraints or constraints
+        without their count, velocity and holonomic constraints together.
+    TypeError
+        A function pointer with another signature than :data:`varmech.pointers.SIGNATURE`, or
+        pointers and closures mixed in one model, naming the argument.
+
+    See Also
+    --------
+    Lagrangian : any L(q, q̇, t) from closures.
+    varmech.symbolic.mechanical : the same model from SymPy expressions, compiled.
+
+    Examples
+    --------
+    A harmonic oscillator, separable: Verlet is the default.
+
+    >>> import numpy as np
+    >>> import varmech
+    >>> oscillator = varmech.MechanicalSystem(1, lambda q: 0.5 * q @ q, lambda q: q, name="oscillator")
+    >>> traj = varmech.integrate(oscillator, [1.0], [0.0], dt=2 * np.pi / 1000, steps=1000)
+    >>> traj.method, bool(abs(traj.q[-1, 0] - 1.0) < 1e-4)
+    ('verlet', True)
+
+    A pendulum on a cart, whose mass matrix M(q) depends on the angle: the implicit midpoint
+    rule is the default, and the cart's momentum (x is cyclic) is conserved to round-off.
+
+    >>> def mass(q):
+    ...     c = np.cos(q[1])
+    ...     return np.array([[3.0, c], [c, 1.0]])
+    >>> def mass_derivative(q):
+    ...     dM = np.zeros((2, 2, 2))
+    ...     dM[1] = [[0.0, -np.sin(q[1])], [-np.sin(q[1]), 0.0]]
+    ...     return dM
+    >>> cart = varmech.MechanicalSystem(2, lambda q: -9.81 * np.cos(q[1]),
+    ...                                 lambda q: np.array([0.0, 9.81 * np.sin(q[1])]),
+    ...                                 mass=mass, mass_derivative=mass_derivative,
+    ...                                 symmetries=[varmech.Cyclic(0)])
+    >>> traj = varmech.integrate(cart, [0.0, 2.5], v0=[1.0, 0.0], dt=0.01, t_end=10.0)
+    >>> report = varmech.check_conservation(traj)
+    >>> traj.method, report.verdict, report.momenta[0].verdict
+    ('midpoint', 'bounded', 'conserved to round-off')
     """
 
     def __init__(
@@ -413,42 +458,74 @@ class Lagrangian(Model):
 
     Parameters
     ----------
-    dim:
+    dim
         Number of generalized coordinates n.
-    lagrangian:
+    lagrangian
         ``lagrangian(q, v, t) -> float``. Every function of this model may instead be a function
         pointer of :data:`varmech.pointers.SIGNATURE` (all given ones, or none; no
         ``rayleigh`` then): L writes ``out[0]``; ``dl_dq``, ``dl_dv`` and ``force`` n numbers;
         ``hessians`` 3n², the three matrices below one after the other, each row-major. The core
         then calls them with the GIL released.
-    dl_dq, dl_dv:
+    dl_dq, dl_dv
         ``dl_dq(q, v, t) -> array (n,)`` and ``dl_dv(q, v, t) -> array (n,)``, the derivatives
         ∂L/∂q and ∂L/∂q̇ (the momentum). Optional: missing ones come from central differences
         of L (2n calls of L each, about 1e-10 relative accuracy), and a warning says so.
         :func:`varmech.check_derivatives` checks supplied ones.
-    hessians:
+    hessians
         ``hessians(q, v, t) -> (L_qq, L_qv, L_vv)``, the second derivatives ∂²L/∂q²,
         ∂²L/∂q∂q̇ (entry (i, j) is ∂²L/∂qᵢ∂q̇ⱼ) and ∂²L/∂q̇², each an array (n, n). Optional:
         with them Newton's Jacobian of the DEL equations is assembled exactly instead of by
         differences of the equations (2·s·n fewer evaluations of ∂L/∂q and ∂L/∂q̇ per Jacobian);
         forced models still difference it.
-    force:
+    force
         ``force(q, v, t) -> array (n,)``, a non-conservative generalized force (friction,
         driving); integrated by the discrete Lagrange–d'Alembert principle, and its work is
         tracked (``traj.work``) so that the energy balance can be checked.
-    rayleigh:
+    rayleigh
         A Rayleigh dissipation R(q̇) = ½q̇ᵀCq̇, given by C (a scalar, a vector (n,) for a
         diagonal, or a matrix (n, n)); adds the force −Cq̇.
-    time_dependent:
+    time_dependent
         Whether L depends on t; then the energy function p·q̇ − L is not conserved and the
         conservation report says so instead of judging it.
-    velocity_constraints, velocity_constraint_count:
+    velocity_constraints, velocity_constraint_count
         Velocity constraints A(q)q̇ = 0, ``velocity_constraints(q) -> array (m, n)`` with
         ``velocity_constraint_count`` = m, as for :class:`MechanicalSystem`; closures only.
-    symmetries:
+    symmetries
         Symmetries of L whose Noether momenta :func:`varmech.check_conservation` checks.
-    name:
+    name
         A label for reports.
+
+    Raises
+    ------
+    ValueError
+        A malformed argument, named: ``dim`` not positive, a ``rayleigh`` matrix of the wrong
+        shape, a count without its velocity constraints or constraints without their count.
+    TypeError
+        A function pointer with another signature than :data:`varmech.pointers.SIGNATURE`,
+        pointers and closures mixed, or a pointer model with ``rayleigh``, naming the argument.
+
+    See Also
+    --------
+    MechanicalSystem : L = ½q̇ᵀMq̇ − V(q) from closures, for every method when M is constant.
+    varmech.symbolic.lagrangian : the same model from a SymPy expression, every derivative derived.
+
+    Examples
+    --------
+    A charged particle in a uniform magnetic field B = 1 (symmetric gauge), with its derivatives:
+    it gyrates on the unit circle, and the midpoint rule keeps its energy to round-off.
+
+    >>> import numpy as np
+    >>> import varmech
+    >>> def A(q):
+    ...     return 0.5 * np.array([-q[1], q[0]])
+    >>> particle = varmech.Lagrangian(
+    ...     2, lambda q, v, t: 0.5 * v @ v + A(q) @ v,
+    ...     dl_dq=lambda q, v, t: 0.5 * np.array([v[1], -v[0]]),
+    ...     dl_dv=lambda q, v, t: v + A(q),
+    ...     symmetries=[varmech.Rotation(spatial_dim=2)], name="charged particle")
+    >>> traj = varmech.integrate(particle, [1.0, 0.0], v0=[0.0, -1.0], dt=0.05, t_end=10.0)
+    >>> traj.method, varmech.check_conservation(traj).verdict
+    ('midpoint', 'conserved to round-off')
     """
 
     def __init__(

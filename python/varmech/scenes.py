@@ -38,6 +38,37 @@ class Scene:
     ``invariants`` holds the values of the conserved quantities at t = 0; ``parameters`` the
     values the scene was built with; ``contacts`` the contact surfaces φ(q) ≥ 0 of an impact
     scene (:class:`varmech.Contact`), which :func:`varmech.integrate` goes through by default.
+
+    Attributes
+    ----------
+    name : str
+        The scene's name in the catalogue.
+    description : str
+        What it is, in a line.
+    model : Model
+        The model integrated.
+    q0, p0 : ndarray, shape (n,)
+        The initial state, which :func:`varmech.integrate` takes by default.
+    t_end : float
+        The horizon of its test protocol.
+    dt : float
+        A step that resolves the scene for a quick look.
+    invariants : dict of str to float
+        The conserved quantities' values at t = 0 (``"H"``, ``"L"``, …).
+    reference : Reference or None
+        A reference state (``t``, ``q``, ``p``) and its ``source``, where one is known.
+    parameters : dict of str to float
+        The values the scene was built with.
+    contacts : tuple of Contact
+        The contact surfaces of an impact scene (empty otherwise).
+
+    Examples
+    --------
+    >>> import varmech
+    >>> scene = varmech.scenes.kepler()
+    >>> scene.q0, scene.reference.source
+    (array([0.4, 0. ]), 'exact: 200 whole periods')
+    >>> traj = varmech.integrate(scene, dt=scene.dt, steps=100)
     """
 
     name: str
@@ -73,8 +104,32 @@ SYMBOLIC = ("elastic_pendulum",)
 def get(name: str, **parameters: float) -> Scene:
     """The scene called ``name`` (one of :data:`CATALOGUE`) with ``parameters`` set by keyword
     and the others at their defaults, or the symbolic scene of that name (one of
-    :data:`SYMBOLIC`, at its defaults; needs SymPy); ValueError for an unknown scene or
-    parameter."""
+    :data:`SYMBOLIC`, at its defaults; needs SymPy).
+
+    Parameters
+    ----------
+    name : str
+        The scene's name.
+    **parameters : float
+        The catalogue parameters to set (``e`` for Kepler, …).
+
+    Returns
+    -------
+    Scene
+        The model with its initial state, step, horizon, invariants and reference.
+
+    Raises
+    ------
+    ValueError
+        An unknown scene (naming ``name`` and listing the scenes) or parameter.
+
+    Examples
+    --------
+    >>> import varmech
+    >>> scene = varmech.scenes.get("kepler", e=0.3)
+    >>> scene.parameters, scene.invariants["H"]
+    ({'e': 0.3}, -0.5)
+    """
     if name in SYMBOLIC and name not in CATALOGUE:
         if parameters:
             raise ValueError(f"parameters: the symbolic scene {name} takes none here; build its model with them")
@@ -173,7 +228,7 @@ def charged_particle(B: float = 1.0) -> Scene:
 
 def charged_particle_nonuniform() -> Scene:
     """A unit charge of unit mass in the plane, in the field B(q) = (1 + |q|²/4) ẑ (symmetric
-    gauge, as the closure example of the README): L = ½|q̇|² + A(q)·q̇ with
+    gauge, as the closure example of the user guide's models page): L = ½|q̇|² + A(q)·q̇ with
     A(q) = ½(1 + |q|²/8)(−y, x). From q = (1, 0), q̇ = (0, −1) to t = 200; it gyrates and drifts
     about the origin. Rotation invariant: the canonical angular momentum is conserved."""
     return get("charged_particle_nonuniform")

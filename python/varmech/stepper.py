@@ -27,13 +27,13 @@ class Stepper:
 
     Parameters
     ----------
-    model, q0, p0, v0, method, t0:
+    model, q0, p0, v0, method, t0
         As for :func:`varmech.integrate`: the model or scene (whose initial state is then the
         default), the initial state (n,), with the velocities ``v0`` instead of the momenta
         ``p0`` if given, the method (by default the model kind's) and the initial time.
-    dt:
+    dt
         The step h > 0; settable between steps (:attr:`dt`).
-    compensated, newton_tolerance, newton_max_iterations:
+    compensated, newton_tolerance, newton_max_iterations
         As for :func:`varmech.integrate`.
 
     Raises

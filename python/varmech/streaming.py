@@ -218,8 +218,32 @@ def resume(
     checkpoint on, with terminal counts over the whole run and an energy error measured from the
     file's first state.
 
-    Returns the whole run, read back from the file (lazily when it is large; see
-    :func:`varmech.files.larger_than_memory`).
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The run's HDF5 file.
+    steps, t_end : int or float, optional
+        How much further: a number of steps, or a final time that is a whole number of steps.
+    save_every : int, optional
+        The saving period; default the file's.
+    checkpoint_every : int or datetime.timedelta, optional
+        Commit at least this often, as in :func:`varmech.integrate`.
+    progress : bool, optional
+        A progress bar, as in :func:`varmech.integrate`.
+    events : sequence of Event or callable, optional
+        Event functions, as in :func:`varmech.integrate`.
+
+    Returns
+    -------
+    Trajectory
+        The whole run, read back from the file (lazily when it is large; see
+        :func:`varmech.files.larger_than_memory`).
+
+    Raises
+    ------
+    ValueError
+        Naming ``path`` for a file without a checkpoint, or a missing or damaged one; the
+        arguments of :func:`varmech.integrate` as it names them.
 
     Examples
     --------

@@ -28,7 +28,12 @@ pytest.importorskip("sympy")
         "varmech.stepper",
         "varmech.conservation",
         "varmech.ensemble",
+        "varmech.integrate",
+        "varmech.model",
         "varmech.constraints",
+        "varmech.reduction",
+        "varmech.methods",
+        "varmech.analysis.work_precision",
     ],
 )
 def test_examples_run(name):

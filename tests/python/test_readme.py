@@ -1,4 +1,5 @@
-"""The README's quickstart runs as written, and prints the verdicts the README shows."""
+"""The README's code blocks run as they stand, each on its own, and print the verdicts the README
+shows; the full quickstart (now the docs' getting-started page) runs as written too."""
 
 import contextlib
 import io
@@ -9,11 +10,27 @@ import pytest
 
 pytest.importorskip("sympy")
 
-README = Path(__file__).resolve().parents[2] / "README.md"
+ROOT = Path(__file__).resolve().parents[2]
+README = ROOT / "README.md"
+GETTING_STARTED = ROOT / "docs" / "getting_started.md"
+
+
+def blocks(text: str) -> list[tuple[str, str, str]]:
+    """Each ```python block with the plain block right after it, if any (the output shown)."""
+    found = re.findall(r"```(\w*)\n(.*?)```", text, flags=re.S)
+    return [
+        (code, following_lang, shown)
+        for (lang, code), (following_lang, shown) in zip(found, [*found[1:], ("python", "")])
+        if lang == "python"
+    ]
+
+
+def verdicts(text: str) -> list[str]:
+    return re.findall(r"(?:verdict: |^\w+ +)(conserved to round-off|bounded|secular drift|failed)", text, flags=re.M)
 
 
 def quickstart() -> str:
-    text = README.read_text()
+    text = GETTING_STARTED.read_text()
     return text[text.index("## Quickstart") : text.index("### API in brief")]
 
 
@@ -26,9 +43,25 @@ def test_the_quickstart_runs_and_prints_the_verdicts_shown():
             continue
         out = io.StringIO()
         with contextlib.redirect_stdout(out):
-            exec(compile(code, str(README), "exec"), namespace)
+            exec(compile(code, str(GETTING_STARTED), "exec"), namespace)
         if not following:  # the output the README shows for this block
             verdicts = re.findall(r"verdict: [a-z -]+", shown)
             assert re.findall(r"verdict: [a-z -]+", out.getvalue()) == verdicts, code
             compared += len(verdicts)
     assert compared == 5
+
+
+@pytest.mark.parametrize("index", range(len(blocks(README.read_text()))))
+def test_every_readme_block_runs_as_it_stands(index, tmp_path, monkeypatch):
+    code, following_lang, shown = blocks(README.read_text())[index]
+    monkeypatch.chdir(tmp_path)
+    out = io.StringIO()
+    with contextlib.redirect_stdout(out):
+        exec(compile(code, f"{README}, python block {index}", "exec"), {"__name__": "__readme__"})
+    if not following_lang:  # the output the README shows: the same verdicts, in order
+        assert verdicts(out.getvalue()) == verdicts(shown), out.getvalue()
+
+
+def test_the_readme_shows_output_for_its_blocks():
+    shown = [verdicts(s) for _, lang, s in blocks(README.read_text()) if not lang]
+    assert sum(len(v) for v in shown) == 8 and len(shown) == 4

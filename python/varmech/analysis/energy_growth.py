@@ -108,27 +108,27 @@ def energy_growth(
 
     Parameters
     ----------
-    scene:
+    scene
         A :class:`~varmech.scenes.Scene` whose energy is conserved.
-    methods:
+    methods
         varmech method names.
-    t_end, dt:
+    t_end, dt
         The horizon (default 50 × ``scene.t_end``: 10⁴ periods for :func:`~varmech.scenes.kepler`)
         and the step (default ``scene.dt``); the horizon is rounded to whole steps.
-    samples:
+    samples
         Log-spaced bins of t per method (and the number of evenly spaced states for the
         verdicts, at least 1000).
-    baselines, rtol, atol:
+    baselines, rtol, atol
         ``solve_ivp`` methods (default DOP853) at tolerance ``rtol`` (atol as in
         :func:`~varmech.work_precision`), sampled by their dense output; and REBOUND's
         integrators (:data:`~varmech.analysis.baselines.REBOUND_METHODS`) on N-body scenes, the
         fixed-step ones at step ``dt`` and ``"IAS15"`` at its default precision, with
         ``"leapfrog order=8"`` also on the Kepler scene. Skipped with a note in
         ``meta["notes"]`` when SciPy or REBOUND is missing, or the scene is not theirs.
-    baseline_t_end:
+    baseline_t_end
         The baselines' horizon (default ``t_end``/10: a Python-driven adaptive solver is slow
         over 10⁴ periods; ``meta["baseline_t_end"]`` records it).
-    progress:
+    progress
         Show a progress bar: None on a terminal only, True or False to force it.
 
     Ctrl-C raises KeyboardInterrupt with the rows measured so far as ``err.partial``.

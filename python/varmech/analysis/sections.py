@@ -263,12 +263,12 @@ def poincare_section(
 
     Parameters
     ----------
-    model_or_scene:
+    model_or_scene
         An unconstrained, conservative model or scene, e.g. :func:`varmech.scenes.henon_heiles`
         (H = ½(p_x² + p_y²) + ½(x² + y²) + x²y − y³/3).
-    energy:
+    energy
         The energy shell, e.g. 1/12 or 1/8 (:data:`HENON_HEILES_ENERGIES`).
-    orbits, seeds, box, seed:
+    orbits, seeds, box, seed
         Where the orbits start, on the section: ``seeds="random"`` draws ``orbits`` points
         uniformly (``numpy.random.default_rng(seed)``) from the energy-allowed part of the
         plane box ``box = ((q_min, q_max), (p_min, p_max))`` (Hénon–Heiles: the region
@@ -276,22 +276,22 @@ def poincare_section(
         it; an array gives them explicitly, rows of the other coordinates then their momenta
         (for Hénon–Heiles, rows (y, p_y)). The section's own momentum comes from the energy
         (p_x = √(2(E − V) − p_y²) for Hénon–Heiles), with q̇_k of the section's direction.
-    dt, t_end, method:
+    dt, t_end, method
         Each orbit is one :func:`varmech.integrate` call to ``t_end`` with step ``dt``
         (default ``kahan_li6`` for separable models, ``galerkin6`` otherwise), saving every step.
         Hénon–Heiles at h = 0.05 with kahan_li6: |ΔH|/E ≲ 2e-11; an orbit crosses x = 0 upward
         about once per 2π.
-    section:
+    section
         ``(k, c, direction)``: the section q_k = c crossed with q̇_k > 0 (+1), < 0 (−1) or
         either way (0). Default ``(0, 0.0, +1)``, Hénon–Heiles' x = 0 with p_x > 0.
-    locate:
+    locate
         ``"step"`` (default): each crossing is a state of the integrator itself, a partial step
         from the state before it (the event's located state, :mod:`varmech.events`), on the
         section to round-off; ``"hermite"``: the cubic Hermite interpolant's root (O(dt⁴)). See
         the module docstring.
-    names:
+    names
         Coordinate names for the columns (default ``x, y`` for two coordinates, else ``q0`` …).
-    progress:
+    progress
         Show a progress bar: None on a terminal only, True or False to force it.
 
     An orbit that diverges (above Hénon–Heiles' escape energy 1/6) keeps its crossings up to the

@@ -143,42 +143,64 @@ def work_precision(
 
     Parameters
     ----------
-    scene:
+    scene
         A :class:`~varmech.scenes.Scene`.
-    methods:
+    methods
         varmech method names (``"verlet"``, ``"kahan_li8"``, ``"rk4"``, ...).
-    steps:
+    steps
         The step counts over the horizon: one list for every method, or a dict by method.
         Default: powers of 2 from a quarter of the scene's own step (``scene.dt``), up to
         ``sweep_length`` settings, stopping early at round-off (the error no longer falls).
-    baselines:
+    baselines, rtols, atol
         ``solve_ivp`` methods (``"RK45"``, ``"DOP853"``, ``"Radau"``, ...), run on the first-order
         system q̇ = q̇(q, p), ṗ = ∂L/∂q(q, q̇) (vectorized, so Radau's finite-difference
         Jacobian is one call) over ``rtols``, with ``atol`` (default rtol·10⁻³ times the largest
         initial |q| and |p|). ``evaluations`` counts every right-hand side column, Jacobian
         columns included. Skipped, with a note in ``meta["notes"]``, without SciPy, and for
         forced or constrained scenes.
-    rebound, epsilons:
+    rebound, epsilons
         REBOUND's integrators (:data:`~varmech.analysis.baselines.REBOUND_METHODS`; default
         ``"WHFast"`` and ``"IAS15"``): the fixed-step ones (``"WHFast"``, ``"WHFast
         corrector=11"``, ``"leapfrog order=8"``) over the step sweep of ``verlet`` (or
         ``steps[name]``), ``"IAS15"`` over the precisions ``epsilons``. They run on N-body
         scenes, and ``"leapfrog order=8"`` also on the Kepler scene; skipped with a note without
         REBOUND. Their force evaluations are counted in a separate untimed run.
-    t_end, reference:
+    t_end, reference
         The horizon, and the solution there (default: the scene's reference, and its time).
         Without a reference at ``t_end``, ``final_error`` is NaN.
-    repeat:
+    sweep_length
+        The most settings of a default sweep of steps.
+    repeat
         Wall time is the best of ``repeat`` runs that save only the final state (fewer once two
         seconds went into a setting); the energy error comes from a separate run saving up to
         20 000 states (solve_ivp's and REBOUND's from their accepted steps or samples).
-    max_seconds:
+    max_seconds
         A method's sweep stops after a run slower than this (noted in ``meta["notes"]``); None
         never stops it.
-    progress:
+    progress
         Show a progress bar: None on a terminal only, True or False to force it.
 
-    Ctrl-C raises KeyboardInterrupt with the rows measured so far as ``err.partial``.
+    Returns
+    -------
+    Table
+        One row a run, with the columns above; ``meta["notes"]`` says what was skipped and why.
+        :func:`varmech.charts.work_precision_chart` draws it.
+
+    Raises
+    ------
+    ValueError
+        An unknown method or baseline, or a method that does not fit the scene's model, named.
+    KeyboardInterrupt
+        On Ctrl-C, with the rows measured so far as ``err.partial``.
+
+    Examples
+    --------
+    >>> import varmech
+    >>> table = varmech.work_precision(varmech.scenes.harmonic_oscillator(), ["verlet", "kahan_li6"],
+    ...                                steps=[64, 128], baselines=(), rebound=(), repeat=1)
+    >>> error = table.column("final_error")      # verlet at 64 and 128 steps, then kahan_li6
+    >>> round(float(error[0] / error[1]), 1)         # order 2: half the step, a quarter the error
+    4.0
     """
     methods = list(methods)
     baselines = list(baselines)

@@ -63,35 +63,35 @@ def lagrangian(
 
     Parameters
     ----------
-    L:
+    L
         L(q, q̇, t), a scalar SymPy expression.
-    q:
+    q
         The coordinates: SymPy symbols, or ``sympy.physics.mechanics.dynamicsymbols`` (then
         ``L`` may hold q.diff(t), and ``v`` may be omitted: fresh symbols ``<name>_dot`` stand
         for the velocities).
-    v:
+    v
         The velocity symbols q̇, one per coordinate.
-    t:
+    t
         The time symbol, if ``L``, the force or the Rayleigh function depend on t (default: the
         dynamicsymbols' time, else none).
-    parameters:
+    parameters
         ``{symbol or name: default value}``: the symbols that are neither coordinates,
         velocities nor t, in the order of the parameter vector. Change them per run with
         :meth:`SymbolicModel.with_parameters` or ``integrate(..., parameters={...})``.
-    constraints:
+    constraints
         Holonomic constraints g(q) = 0: a list of m < n expressions of q alone; their Jacobian
         G = ∂g/∂q is derived.
-    force:
+    force
         A generalized force Q(q, q̇, t), one expression per coordinate (friction, driving).
-    rayleigh:
+    rayleigh
         A Rayleigh dissipation function R(q, q̇), which adds the force −∂R/∂q̇.
-    symmetries:
+    symmetries
         Declared symmetries (:class:`~varmech.Translation`, :class:`~varmech.Rotation`,
         :class:`~varmech.Cyclic`); each cyclic coordinate found is added as a
         :class:`~varmech.Cyclic`.
-    jit:
+    jit
         Compile the tapes to machine code (the interpreter runs them otherwise).
-    name:
+    name
         A label for reports.
 
     Raises
@@ -182,11 +182,11 @@ def routh(model: SymbolicModel, cyclic: Sequence[int], momenta: Any) -> Symbolic
 
     Parameters
     ----------
-    model:
+    model
         A :class:`SymbolicModel`, unforced and unconstrained.
-    cyclic:
+    cyclic
         The indices of the coordinates to ignore; each must be cyclic (``model.cyclic``).
-    momenta:
+    momenta
         Their momenta μ, in the order of ``cyclic``.
 
     Raises
@@ -200,7 +200,7 @@ def routh(model: SymbolicModel, cyclic: Sequence[int], momenta: Any) -> Symbolic
 
     Examples
     --------
-    The heavy top with its precession φ and spin ψ ignored::
+    The heavy top with its precession φ and spin ψ ignored:
 
     >>> import varmech.symbolic
     >>> from varmech.symbolic import examples

@@ -71,22 +71,22 @@ class SymbolicModel(Model):
 
     Attributes
     ----------
-    q, v, t:
+    q, v, t
         The coordinates, velocities and time as SymPy symbols.
-    L:
+    L
         The Lagrangian L(q, v, t).
-    expressions:
+    expressions
         The derived expressions of each compiled function by name (outputs row-major):
         ``lagrangian``, ``gradients`` (∂L/∂q, ∂L/∂q̇), ``hessians`` (∂²L/∂q², ∂²L/∂q∂q̇,
         ∂²L/∂q̇²) and ``force`` for a general Lagrangian; ``potential``, ``gradient`` (∇V) and
         ``mass`` (1, n or n² entries) for a separable one; ``constraints`` and
         ``constraint_jacobian`` with constraints.
-    kind_name:
+    kind_name
         ``"lagrangian"`` or ``"separable"``.
-    cyclic:
+    cyclic
         The coordinates found cyclic (∂L/∂qᵢ ≡ 0, no force on or depending on qᵢ), declared as
         :class:`~varmech.Cyclic` symmetries.
-    build_seconds:
+    build_seconds
         Wall time from the expressions to the ready model.
     """
 
