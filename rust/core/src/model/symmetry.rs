@@ -53,25 +53,36 @@ impl Generator {
         self.momentum_terms(q, p).0
     }
 
-    /// J(q, p) = p·ξ(q) and the size Σ|pᵢξᵢ(q)| of the products it sums, which sets its
-    /// rounding error.
+    /// J(q, p) = p·ξ(q) and its size, which sets its rounding error and the scale its error is
+    /// judged against: the larger of Σ|pᵢξᵢ(q)|, the products it sums, and ‖p‖∞‖ξ(q)‖∞. The
+    /// second matters where J is one term or its terms vanish: a cart's momentum p_x at rest
+    /// under a swinging bob is computed from the whole motion (p_x = (M + m)ẋ + ml cos θ θ̇),
+    /// whose size its rounding error has, not that of p_x ≈ 0.
     pub fn momentum_terms(&self, q: &[f64], p: &[f64]) -> (f64, f64) {
         let sum = |terms: &mut dyn Iterator<Item = f64>| terms.fold((0.0, 0.0), |(j, size), x| (j + x, size + x.abs()));
-        match *self {
-            Generator::Translation { axis, spatial_dim } => sum(&mut p.iter().skip(axis).step_by(spatial_dim).copied()),
-            Generator::Rotation { spatial_dim: 2, .. } => sum(&mut q
-                .chunks_exact(2)
-                .zip(p.chunks_exact(2))
-                .flat_map(|(x, y)| [x[0] * y[1], -x[1] * y[0]])),
+        let largest = |x: &[f64]| x.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+        let ((j, terms), xi) = match *self {
+            Generator::Translation { axis, spatial_dim } => {
+                (sum(&mut p.iter().skip(axis).step_by(spatial_dim).copied()), 1.0)
+            }
+            Generator::Rotation { spatial_dim: 2, .. } => (
+                sum(&mut q
+                    .chunks_exact(2)
+                    .zip(p.chunks_exact(2))
+                    .flat_map(|(x, y)| [x[0] * y[1], -x[1] * y[0]])),
+                largest(q),
+            ),
             Generator::Rotation { axis, .. } => {
                 // (x × p)·e_axis
                 let (a, b) = ((axis + 1) % 3, (axis + 2) % 3);
-                sum(&mut q
+                let terms = sum(&mut q
                     .chunks_exact(3)
                     .zip(p.chunks_exact(3))
-                    .flat_map(|(x, y)| [x[a] * y[b], -x[b] * y[a]]))
+                    .flat_map(|(x, y)| [x[a] * y[b], -x[b] * y[a]]));
+                (terms, largest(q))
             }
-            Generator::Cyclic { index } => (p[index], p[index].abs()),
-        }
+            Generator::Cyclic { index } => ((p[index], p[index].abs()), 1.0),
+        };
+        (j, terms.max(largest(p) * xi))
     }
 }
