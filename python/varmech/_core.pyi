@@ -387,6 +387,7 @@ class CompiledModel(_ModelProperties):
         parameters: _FloatArray,
         *,
         constraints: int = 0,
+        velocity_constraints: int = 0,
         time_dependent: bool = False,
         forced: bool = False,
         symmetries: Sequence[Generator] = ...,
@@ -394,6 +395,8 @@ class CompiledModel(_ModelProperties):
     ) -> CompiledModel: ...
     @property
     def constraints(self) -> int: ...
+    @property
+    def velocity_constraints(self) -> int: ...
     @property
     def parameters(self) -> _FloatArray: ...
     @property

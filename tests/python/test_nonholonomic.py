@@ -216,3 +216,51 @@ def test_frobenius_tells_integrable_velocity_constraints_from_rolling():
     # A model without velocity constraints has nothing to test.
     with pytest.raises(ValueError, match="^model"):
         varmech.constraints.integrable_near(varmech.scenes.pendulum().model, [0.1])
+
+
+def test_symbolic_velocity_constraints_derive_a_and_run_natively_as_the_closures_do():
+    # The disk from SymPy: A = ∂c/∂q̇ and ∂A/∂q derived, compiled; θ's column of A is 0, so its
+    # momentum (the spin about the vertical) is cyclic, while x, y, φ are moved by the rolling.
+    sp = pytest.importorskip("sympy")
+    import varmech.symbolic
+
+    x, y, th, ph, R = sp.symbols("x y theta phi R")
+    q = [x, y, th, ph]
+    v = sp.symbols("v_x v_y v_theta v_phi")
+    T = (v[0] ** 2 + v[1] ** 2) / 2 + MASS[2] * v[2] ** 2 / 2 + MASS[3] * v[3] ** 2 / 2
+    rolling_rows = [v[0] - R * sp.cos(th) * v[3], v[1] - R * sp.sin(th) * v[3]]
+    model = varmech.symbolic.lagrangian(T, q, v, velocity_constraints=rolling_rows, parameters={R: 1.0})
+    assert model.velocity_constraints == 2 and model.kind.name == "nonholonomic" and model.cyclic == (2,)
+    assert model.expressions["velocity_constraints"] == (1, 0, 0, -R * sp.cos(th), 0, 1, 0, -R * sp.sin(th))
+    run = dict(dt=0.05, steps=2000, save_every=100)
+    compiled = varmech.integrate(model, [0, 0, THETA0, 0], v0=V0, **run)
+    closure = varmech.integrate(disk(), [0, 0, THETA0, 0], v0=V0, **run)
+    assert np.max(np.abs(compiled.q - closure.q)) < 1e-12 and np.max(np.abs(compiled.p - closure.p)) < 1e-12
+    assert np.max(compiled.constraint_residuals()[1]) < 1e-13  # Newton's tolerance 1e-14 on O(1) momenta
+    report = varmech.check_conservation(compiled)
+    assert report.verdict in ("bounded", "conserved to round-off") and report.momenta[0].name == "p[2]"
+    assert report.momenta[0].verdict == "conserved to round-off"
+    # Frobenius with the exact ∂A: the rolling twists; a radius 2 disk is another run.
+    assert not varmech.constraints.integrable_near(model, [0, 0, THETA0, 0])
+    bigger = varmech.integrate(model.with_parameters(R=2.0), [0, 0, THETA0, 0], v0=[2 * V0[0], 2 * V0[1], OMEGA, SPIN], **run)
+    assert np.max(bigger.constraint_residuals()[1]) < 1e-13
+
+
+@pytest.mark.parametrize(
+    "rows, message",
+    [
+        (lambda v, q, t: [v[0] ** 2 - v[1]], "not linear in the velocities"),
+        (lambda v, q, t: [v[0] - q[1] * v[2] + 1], "part free of the velocities"),
+        (lambda v, q, t: [v[0] - t * v[2]], "depends on t"),
+    ],
+)
+def test_symbolic_velocity_constraints_that_are_not_a_q_qdot_are_named(rows, message):
+    sp = pytest.importorskip("sympy")
+    import varmech.symbolic
+
+    q, v, t = sp.symbols("x y z"), sp.symbols("u v w"), sp.Symbol("t")
+    T = sum(s**2 for s in v) / 2
+    with pytest.raises(ValueError, match=rf"^velocity_constraints\[0\]: .*{message}"):
+        varmech.symbolic.lagrangian(T, q, v, t=t, velocity_constraints=rows(v, q, t))
+    with pytest.raises(ValueError, match="^velocity_constraints: not together with holonomic constraints"):
+        varmech.symbolic.lagrangian(T, q, v, constraints=[q[0]], velocity_constraints=[v[1] - q[0] * v[2]])

@@ -53,6 +53,7 @@ def lagrangian(
     t: Any = None,
     parameters: Mapping[Any, float] | None = None,
     constraints: Any = None,
+    velocity_constraints: Any = None,
     force: Any = None,
     rayleigh: Any = None,
     symmetries: Sequence[Symmetry] = (),
@@ -81,6 +82,12 @@ def lagrangian(
     constraints
         Holonomic constraints g(q) = 0: a list of m < n expressions of q alone; their Jacobian
         G = ∂g/∂q is derived.
+    velocity_constraints
+        Nonholonomic constraints A(q)q̇ = 0 (rolling without slipping, a skate's blade): a list
+        of m < n expressions linear in the velocities; A = ∂c/∂q̇ and its derivatives ∂A/∂q are
+        derived, and the model takes the discrete Lagrange–d'Alembert integrator. A coordinate
+        they move (its column of A not ≡ 0) is not cyclic: the constraint force acts on it. Not
+        together with ``constraints`` (yet).
     force
         A generalized force Q(q, q̇, t), one expression per coordinate (friction, driving).
     rayleigh
@@ -102,7 +109,8 @@ def lagrangian(
         An expression that cannot be compiled (an unsupported function such as an undefined
         ``sympy.Function('f')``, or a symbol that is neither a coordinate, a velocity, t nor a
         parameter), naming it and why; constraints of the wrong number or depending on q̇ or t;
-        a force with the wrong number of components.
+        velocity constraints not linear in q̇, with a part free of q̇, depending on t or given
+        with ``constraints``, naming them; a force with the wrong number of components.
 
     Examples
     --------
@@ -117,7 +125,8 @@ def lagrangian(
     started = time.perf_counter()
     variables_ = variables(q, v, t)
     return _build(
-        variables_, variables_.plain(L, "L"), parameters, constraints, force, rayleigh, symmetries, jit, name, started
+        variables_, variables_.plain(L, "L"), parameters, (constraints, velocity_constraints), force, rayleigh, symmetries,
+        jit, name, started,
     )
 
 
@@ -130,6 +139,7 @@ def mechanical(
     t: Any = None,
     parameters: Mapping[Any, float] | None = None,
     constraints: Any = None,
+    velocity_constraints: Any = None,
     force: Any = None,
     rayleigh: Any = None,
     symmetries: Sequence[Symmetry] = (),
@@ -161,7 +171,7 @@ def mechanical(
     check_compilable(potential, "V")
     velocity = sp.Matrix(variables_.v)
     L = (velocity.T * m * velocity)[0, 0] / 2 - potential
-    return _build(variables_, L, parameters, constraints, force, rayleigh, symmetries, jit, name, started)
+    return _build(variables_, L, parameters, (constraints, velocity_constraints), force, rayleigh, symmetries, jit, name, started)
 
 
 def routh(model: SymbolicModel, cyclic: Sequence[int], momenta: Any) -> SymbolicModel:
@@ -213,7 +223,7 @@ def routh(model: SymbolicModel, cyclic: Sequence[int], momenta: Any) -> Symbolic
     reduced = routhian(model, cyclic, momenta)
     variables_ = variables(list(reduced.q), list(reduced.v), model.t)
     name = f"{model.name}, Routhian (ignoring {', '.join(str(model.q[i]) for i in cyclic)})"
-    return _build(variables_, reduced.R, reduced.parameters, None, None, None, (), model._spec.jit, name, started)
+    return _build(variables_, reduced.R, reduced.parameters, (None, None), None, None, (), model._spec.jit, name, started)
 
 
 def _mass_matrix(mass: Any, variables: Variables) -> sp.Matrix:
@@ -239,7 +249,7 @@ def _build(
     variables: Variables,
     L: sp.Expr,
     given_parameters: Mapping[Any, float] | None,
-    constraints: Any,
+    all_constraints: tuple[Any, Any],
     force: Any,
     rayleigh: Any,
     symmetries: Sequence[Symmetry],
@@ -251,16 +261,22 @@ def _build(
     :func:`mechanical`."""
     forces = expressions(force, "force", variables) if force is not None else None
     dissipation = variables.plain(rayleigh, "rayleigh") if rayleigh is not None else None
+    constraints, rolling = all_constraints
+    if constraints is not None and rolling is not None:
+        raise ValueError("velocity_constraints: not together with holonomic constraints (yet); give one kind")
     holonomic = expressions(constraints, "constraints", variables) if constraints is not None else None
+    nonholonomic = expressions(rolling, "velocity_constraints", variables) if rolling is not None else None
     parts = [("L", L)] + [(f"force[{i}]", x) for i, x in enumerate(forces or [])]
     parts += [("rayleigh", dissipation)] if dissipation is not None else []
     parts += [(f"constraints[{i}]", x) for i, x in enumerate(holonomic or [])]
+    parts += [(f"velocity_constraints[{i}]", x) for i, x in enumerate(nonholonomic or [])]
     params = parameters(given_parameters, {s for _, x in parts for s in x.free_symbols}, variables)
     for what, x in parts:
         check_compilable(x, what)
         check_symbols(x, what, variables, params.index)
     derivation = derive(
-        L, variables.q, variables.v, variables.t, force=forces, rayleigh=dissipation, constraints=holonomic
+        L, variables.q, variables.v, variables.t, force=forces, rayleigh=dissipation, constraints=holonomic,
+        velocity_constraints=nonholonomic,
     )
     slots = variables.slots
     tapes = {fn: lower(exprs, slots, params.index) for fn, exprs in derivation.functions.items()}
@@ -273,6 +289,7 @@ def _build(
         parameter_names=params.names,
         parameters=params.values,
         constraints=len(derivation.functions.get("constraints", ())),
+        velocity_constraints=len(nonholonomic or ()),
         time_dependent=derivation.time_dependent,
         forced="force" in derivation.functions,
         symmetries=declared + found,

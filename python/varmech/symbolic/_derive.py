@@ -60,9 +60,11 @@ def derive(
     force: Sequence[sp.Expr] | None = None,
     rayleigh: sp.Expr | None = None,
     constraints: Sequence[sp.Expr] | None = None,
+    velocity_constraints: Sequence[sp.Expr] | None = None,
 ) -> Derivation:
     """The functions of L(q, q̇, t) for the core, with the generalized force
-    Q = ``force`` − ∂R/∂q̇ (R the Rayleigh function ``rayleigh``) and the constraints g(q) = 0.
+    Q = ``force`` − ∂R/∂q̇ (R the Rayleigh function ``rayleigh``), the constraints g(q) = 0
+    and the velocity constraints A(q)q̇ = 0 (see :func:`velocity_constraint_functions`).
 
     ``L`` is a scalar expression, ``force`` has n components, and ``constraints`` m < n
     components free of q̇ and t (see :func:`constraint_functions`).
@@ -79,7 +81,7 @@ def derive(
     """
     # Derived over real symbols (the state and the parameters are real), so that |x|' = sign x
     # rather than an expression in re(x) and im(x); the results are in the caller's symbols.
-    given = [L, *(force or ()), *(() if rayleigh is None else (rayleigh,)), *(constraints or ())]
+    given = [L, *(force or ()), *(() if rayleigh is None else (rayleigh,)), *(constraints or ()), *(velocity_constraints or ())]
     symbols = {s for e in given for s in e.free_symbols} | {*q, *v, t}
     real = {s: _real_twin(s, symbols) for s in symbols if not s.is_real}
     derivation = _derive(
@@ -90,6 +92,7 @@ def derive(
         force=None if force is None else [e.xreplace(real) for e in force],
         rayleigh=None if rayleigh is None else rayleigh.xreplace(real),
         constraints=None if constraints is None else [e.xreplace(real) for e in constraints],
+        velocity_constraints=None if velocity_constraints is None else [e.xreplace(real) for e in velocity_constraints],
     )
     back = {r: s for s, r in real.items()}
     functions = {name: tuple(e.xreplace(back) for e in exprs) for name, exprs in derivation.functions.items()}
@@ -112,6 +115,7 @@ def _derive(
     force: Sequence[sp.Expr] | None,
     rayleigh: sp.Expr | None,
     constraints: Sequence[sp.Expr] | None,
+    velocity_constraints: Sequence[sp.Expr] | None,
 ) -> Derivation:
     """:func:`derive` over real symbols."""
     n = len(q)
@@ -136,7 +140,13 @@ def _derive(
         functions["mass"] = mass
     if constraints is not None:
         functions.update(constraint_functions(constraints, q, v, t))
-    cyclic = tuple(i for i, s in enumerate(q) if _cyclic(i, s, dl_dq[i], generalized, constraints))
+    if velocity_constraints is not None:
+        functions.update(velocity_constraint_functions(velocity_constraints, q, v, t))
+    cyclic = tuple(
+        i for i, s in enumerate(q) if _cyclic(i, s, dl_dq[i], generalized, constraints)
+        # The coordinates a velocity constraint moves take its force Aᵀλ: their momenta change.
+        and all(_free_of(c, [v[i]]) for c in velocity_constraints or ())
+    )
     return Derivation("lagrangian" if mass is None else "separable", functions, cyclic, time_dependent)
 
 
@@ -206,6 +216,53 @@ def constraint_functions(
             )
     jacobian = tuple(sp.diff(g, s) for g in constraints for s in q)
     return {"constraints": tuple(constraints), "constraint_jacobian": jacobian}
+
+
+def velocity_constraint_functions(
+    constraints: Sequence[sp.Expr], q: Sequence[sp.Symbol], v: Sequence[sp.Symbol], t: sp.Symbol
+) -> dict[str, tuple[sp.Expr, ...]]:
+    """A(q) (m·n, row-major) of m velocity constraints A(q)q̇ = 0, 0 < m < n, given as
+    expressions linear in q̇ (A = ∂c/∂q̇), and its derivatives ∂A/∂qᵢ (n blocks of m·n) for
+    Newton's exact Jacobian.
+
+    ValueError names the constraint that is not linear in q̇, has a part free of q̇ (A q̇ + b
+    with b ≠ 0), or depends on t, and the constraints when there are none or too many.
+
+    Examples
+    --------
+    >>> import sympy as sp
+    >>> x, y, th, vx, vy, vth, t = sp.symbols("x y theta v_x v_y v_theta t")
+    >>> blade = -sp.sin(th) * vx + sp.cos(th) * vy - vth   # the Chaplygin sleigh
+    >>> velocity_constraint_functions([blade], [x, y, th], [vx, vy, vth], t)["velocity_constraints"]
+    (-sin(theta), cos(theta), -1)
+    """
+    n, m = len(q), len(constraints)
+    if not 0 < m < n:
+        raise ValueError(
+            f"velocity_constraints: need between 1 and {n - 1} constraints A(q)q̇ = 0 on {n} coordinates, "
+            f"got {m}: {list(constraints)}"
+        )
+    rows = []
+    for k, c in enumerate(constraints):
+        what = f"velocity_constraints[{k}]"
+        if not _free_of(c, [t]):
+            raise ValueError(f"{what}: {c} depends on {t}; only constraints A(q)q̇ = 0 free of t are supported")
+        row = [sp.diff(c, s) for s in v]
+        bent = [s for s in v if any(not _free_of(a, [s]) for a in row)]
+        if bent:
+            raise ValueError(
+                f"{what}: {c} is not linear in the velocities (its coefficients depend on {', '.join(map(str, bent))}); "
+                "Lagrange–d'Alembert needs constraints A(q)q̇ = 0"
+            )
+        rest = c - sum(a * s for a, s in zip(row, v))
+        if not vanishes(rest):
+            raise ValueError(
+                f"{what}: {c} has a part free of the velocities ({sp.simplify(rest)}); only A(q)q̇ = 0 is supported"
+            )
+        rows.append(row)
+    matrix = tuple(a for row in rows for a in row)
+    derivative = tuple(sp.diff(a, s) for s in q for a in matrix)
+    return {"velocity_constraints": matrix, "velocity_constraint_derivative": derivative}
 
 
 def _cyclic(

@@ -21,7 +21,8 @@ from ._rhs import FirstOrder
 class Spec:
     """Everything the core's compiled model is built from: the kind (``"lagrangian"`` or
     ``"separable"``), n, the tape of each function by name, the parameters in order with their
-    values, the number of constraints, the flags and the symmetries."""
+    values, the numbers of constraints and velocity constraints, the flags and the
+    symmetries."""
 
     kind: str
     dim: int
@@ -33,6 +34,7 @@ class Spec:
     forced: bool
     symmetries: tuple[Symmetry, ...]
     jit: bool
+    velocity_constraints: int = 0
 
 
 @dataclass(frozen=True)
@@ -57,6 +59,7 @@ def _compile(spec: Spec) -> _core.CompiledModel:
         dict(spec.functions),
         spec.parameters,
         constraints=spec.constraints,
+        velocity_constraints=spec.velocity_constraints,
         time_dependent=spec.time_dependent,
         forced=spec.forced,
         symmetries=_specs(spec.symmetries),
@@ -80,7 +83,8 @@ class SymbolicModel(Model):
         ``lagrangian``, ``gradients`` (∂L/∂q, ∂L/∂q̇), ``hessians`` (∂²L/∂q², ∂²L/∂q∂q̇,
         ∂²L/∂q̇²) and ``force`` for a general Lagrangian; ``potential``, ``gradient`` (∇V) and
         ``mass`` (1, n or n² entries) for a separable one; ``constraints`` and
-        ``constraint_jacobian`` with constraints.
+        ``constraint_jacobian`` with constraints; ``velocity_constraints`` (A, m·n) and
+        ``velocity_constraint_derivative`` (∂A/∂qᵢ, n blocks) with velocity constraints.
     kind_name
         ``"lagrangian"`` or ``"separable"``.
     cyclic

@@ -8,9 +8,10 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use varmech::integrators::{Dynamics, General};
 use varmech::model::compiled::{
-    CompiledConstraints, CompiledLagrangian, CompiledModel as Compiled, CompiledSeparable, Function, Tape,
+    CompiledConstraints, CompiledLagrangian, CompiledModel as Compiled, CompiledSeparable, CompiledVelocityConstraints,
+    Function, Tape,
 };
-use varmech::model::{Constrained, HolonomicConstraints};
+use varmech::model::{Constrained, HolonomicConstraints, Nonholonomic, VelocityConstraints};
 
 use crate::convert::slice;
 use crate::errors::to_pyerr;
@@ -43,6 +44,8 @@ impl CompiledModel {
                 system: General(&c.system),
                 constraints: c.constraints.clone(),
             }),
+            Compiled::NonholonomicSeparable(c) => body(c),
+            Compiled::NonholonomicLagrangian(c) => body(c),
         }
     }
 }
@@ -89,7 +92,7 @@ fn required(name: &'static str, f: Option<Function>) -> PyResult<Function> {
 #[pymethods]
 impl CompiledModel {
     #[new]
-    #[pyo3(signature = (kind, dim, functions, parameters, *, constraints=0, time_dependent=false, forced=false, symmetries=Vec::new(), jit=true))]
+    #[pyo3(signature = (kind, dim, functions, parameters, *, constraints=0, velocity_constraints=0, time_dependent=false, forced=false, symmetries=Vec::new(), jit=true))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         py: Python<'_>,
@@ -98,6 +101,7 @@ impl CompiledModel {
         functions: HashMap<String, Encoded<'_>>,
         parameters: PyReadonlyArray1<'_, f64>,
         constraints: usize,
+        velocity_constraints: usize,
         time_dependent: bool,
         forced: bool,
         symmetries: Vec<Spec>,
@@ -105,7 +109,15 @@ impl CompiledModel {
     ) -> PyResult<Self> {
         generator::generators(py, symmetries, dim)?;
         let known: &[&str] = match kind {
-            "separable" => &["potential", "gradient", "mass", "constraints", "constraint_jacobian"],
+            "separable" => &[
+                "potential",
+                "gradient",
+                "mass",
+                "constraints",
+                "constraint_jacobian",
+                "velocity_constraints",
+                "velocity_constraint_derivative",
+            ],
             _ => &[
                 "lagrangian",
                 "gradients",
@@ -113,6 +125,8 @@ impl CompiledModel {
                 "force",
                 "constraints",
                 "constraint_jacobian",
+                "velocity_constraints",
+                "velocity_constraint_derivative",
             ],
         };
         if let Some(name) = functions.keys().find(|name| !known.contains(&name.as_str())) {
@@ -149,6 +163,24 @@ impl CompiledModel {
                 .map_err(err)?,
             ),
         };
+        if constraints > 0 && velocity_constraints > 0 {
+            return Err(PyValueError::new_err(
+                "velocity_constraints: not together with holonomic constraints (yet); give one kind",
+            ));
+        }
+        let rolling = match velocity_constraints {
+            0 => None,
+            m => Some(
+                CompiledVelocityConstraints::new(
+                    m,
+                    dim,
+                    params.clone(),
+                    required("velocity_constraints", f("velocity_constraints")?)?,
+                    required("velocity_constraint_derivative", f("velocity_constraint_derivative")?)?,
+                )
+                .map_err(err)?,
+            ),
+        };
         let model = match kind {
             "separable" => {
                 if time_dependent || forced {
@@ -164,12 +196,16 @@ impl CompiledModel {
                     required("mass", f("mass")?)?,
                 )
                 .map_err(err)?;
-                match constraint_functions {
-                    None => Compiled::Separable(s),
-                    Some(c) => Compiled::ConstrainedSeparable(Constrained {
+                match (constraint_functions, rolling) {
+                    (Some(c), _) => Compiled::ConstrainedSeparable(Constrained {
                         system: s,
                         constraints: c,
                     }),
+                    (None, Some(c)) => Compiled::NonholonomicSeparable(Nonholonomic {
+                        system: s,
+                        constraints: c,
+                    }),
+                    (None, None) => Compiled::Separable(s),
                 }
             }
             "lagrangian" => {
@@ -183,12 +219,16 @@ impl CompiledModel {
                     time_dependent,
                 )
                 .map_err(err)?;
-                match constraint_functions {
-                    None => Compiled::Lagrangian(l),
-                    Some(c) => Compiled::ConstrainedLagrangian(Constrained {
+                match (constraint_functions, rolling) {
+                    (Some(c), _) => Compiled::ConstrainedLagrangian(Constrained {
                         system: l,
                         constraints: c,
                     }),
+                    (None, Some(c)) => Compiled::NonholonomicLagrangian(Nonholonomic {
+                        system: l,
+                        constraints: c,
+                    }),
+                    (None, None) => Compiled::Lagrangian(l),
                 }
             }
             other => {
@@ -214,6 +254,16 @@ impl CompiledModel {
         match &self.model {
             Compiled::ConstrainedSeparable(c) => c.constraints.count(),
             Compiled::ConstrainedLagrangian(c) => c.constraints.count(),
+            _ => 0,
+        }
+    }
+
+    /// Number of velocity constraints A(q)q̇ = 0 (0 for holonomic or unconstrained models).
+    #[getter]
+    fn velocity_constraints(&self) -> usize {
+        match &self.model {
+            Compiled::NonholonomicSeparable(c) => c.constraints.count(),
+            Compiled::NonholonomicLagrangian(c) => c.constraints.count(),
             _ => 0,
         }
     }

@@ -8,7 +8,8 @@
 //! - [`Function`]: one model function, a tape run by its code or by the interpreter;
 //! - [`CompiledLagrangian`]: a general L(q, q̇, t) with exact derivatives and Hessians;
 //! - [`CompiledSeparable`]: L = ½q̇ᵀMq̇ − V(q) with constant M, for every method;
-//! - [`CompiledConstraints`]: g(q) = 0 with its exact Jacobian.
+//! - [`CompiledConstraints`]: g(q) = 0 with its exact Jacobian;
+//! - [`CompiledVelocityConstraints`]: A(q)q̇ = 0 with its exact derivatives ∂A/∂q.
 
 mod constraints;
 mod function;
@@ -17,6 +18,7 @@ mod jit;
 mod lagrangian;
 mod separable;
 mod tape;
+mod velocity_constraints;
 
 pub use constraints::CompiledConstraints;
 pub use function::Function;
@@ -25,8 +27,9 @@ pub use jit::Code;
 pub use lagrangian::CompiledLagrangian;
 pub use separable::CompiledSeparable;
 pub use tape::{sign, Binary, Op, Tape, Unary};
+pub use velocity_constraints::CompiledVelocityConstraints;
 
-use crate::model::Constrained;
+use crate::model::{Constrained, Nonholonomic};
 use crate::Error;
 
 /// A compiled model of each kind the integrators know (see
@@ -37,6 +40,8 @@ pub enum CompiledModel {
     Lagrangian(CompiledLagrangian),
     ConstrainedSeparable(Constrained<CompiledSeparable, CompiledConstraints>),
     ConstrainedLagrangian(Constrained<CompiledLagrangian, CompiledConstraints>),
+    NonholonomicSeparable(Nonholonomic<CompiledSeparable, CompiledVelocityConstraints>),
+    NonholonomicLagrangian(Nonholonomic<CompiledLagrangian, CompiledVelocityConstraints>),
 }
 
 impl CompiledModel {
@@ -55,6 +60,14 @@ impl CompiledModel {
                 system: c.system.with_parameters(params)?,
                 constraints: constrained(&c.constraints)?,
             }),
+            CompiledModel::NonholonomicSeparable(c) => CompiledModel::NonholonomicSeparable(Nonholonomic {
+                system: c.system.with_parameters(params)?,
+                constraints: c.constraints.with_parameters(params)?,
+            }),
+            CompiledModel::NonholonomicLagrangian(c) => CompiledModel::NonholonomicLagrangian(Nonholonomic {
+                system: c.system.with_parameters(params)?,
+                constraints: c.constraints.with_parameters(params)?,
+            }),
         })
     }
 
@@ -65,6 +78,8 @@ impl CompiledModel {
             CompiledModel::Lagrangian(l) => l.parameters(),
             CompiledModel::ConstrainedSeparable(c) => c.system.parameters(),
             CompiledModel::ConstrainedLagrangian(c) => c.system.parameters(),
+            CompiledModel::NonholonomicSeparable(c) => c.system.parameters(),
+            CompiledModel::NonholonomicLagrangian(c) => c.system.parameters(),
         }
     }
 }
