@@ -113,20 +113,42 @@ def tour(out: Path, quick: bool) -> int:
             summary.append(name, method, steps, elapsed, stats.max_rel_error if stats else float("nan"), verdict)
         if plots:
             try:
-                path = charts.energy_error(runs, out / f"{name}_energy.png", title=f"{name}, dt = {scene.dt:g}")
+                path = charts.energy_error(
+                    runs, out / f"{name}_energy.png", title=f"{name}: energy error, dt = {scene.dt:g} {scene.time_unit}", time_unit=scene.time_unit
+                )
                 print(f"wrote {path}")
             except ImportError as e:
                 print(f"(no plots: {e})")
                 plots = False
     tour_reduced(quick, summary)
-    print()
-    print(summary.format(max_rows=None))
     if plots:
         print("\n=== charts: accuracy against cost, energy over long runs, stability, sections")
         for kind in TOUR_CHARTS:
-            for path in chart(kind, out=out, quick=quick):
+            for path in chart(kind, out=out, quick=quick, say=_note):
                 print(f"wrote {path}")
+    # The summary last, where the reader's eye lands.
+    print()
+    print(summary.format(max_rows=None))
     return 0
+
+
+def _note(note: str) -> None:
+    """Say a measurement's note (a skipped baseline, a stopped sweep) on screen."""
+    print(f"note: {note}")
+
+
+def _floats(text: str) -> tuple[float, ...]:
+    try:
+        return tuple(float(x) for x in text.split(","))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected comma-separated numbers, got {text!r}") from None
+
+
+def _box(text: str) -> tuple[tuple[float, float], tuple[float, float]]:
+    values = _floats(text)
+    if len(values) != 4:
+        raise argparse.ArgumentTypeError(f"expected QMIN,QMAX,PMIN,PMAX, got {text!r}")
+    return (values[0], values[1]), (values[2], values[3])
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -138,8 +160,21 @@ def main(argv: list[str] | None = None) -> int:
     sub.add_parser("methods", help="print the table of methods")
     c = sub.add_parser("chart", help="measure and write a chart (PNG or SVG) with its data (CSV)")
     c.add_argument("kind", choices=sorted(KINDS), help="; ".join(f"{k}: {v.description}" for k, v in KINDS.items()))
-    c.add_argument("scene", nargs="?", help="a scene name (default: the kind's own)")
-    c.add_argument("--methods", help="comma-separated method names (default: the kind's own)")
+    c.add_argument(
+        "scene", nargs="?", help="a scene name (default: the kind's own; varmech.charts.recipes.scenes_for(kind) lists those it takes)"
+    )
+    c.add_argument(
+        "--methods", help="comma-separated method names (default: the kind's own that fit the scene, else the scene's kind's)"
+    )
+    c.add_argument(
+        "--energy", type=_floats, help="poincare: energy shells (default 1/12,1/8 on henon_heiles, else the scene's); phase: the orbits' energies"
+    )
+    c.add_argument(
+        "--box",
+        type=_box,
+        metavar="QMIN,QMAX,PMIN,PMAX",
+        help="poincare: the plane box to seed orbits in (default: about the scene's state); --box=-1,… below 0",
+    )
     c.add_argument("--out", type=Path, default=Path("out/charts"), help="folder (default out/charts)")
     c.add_argument("--format", default="png", choices=("png", "svg"))
     c.add_argument("--quick", action="store_true", help="shorter sweeps and horizons")
@@ -149,7 +184,10 @@ def main(argv: list[str] | None = None) -> int:
     if args.command == "chart":
         methods = tuple(args.methods.split(",")) if args.methods else None
         try:
-            paths = chart(args.kind, args.scene, methods=methods, out=args.out, fmt=args.format, quick=args.quick)
+            paths = chart(
+                args.kind, args.scene, methods=methods, out=args.out, fmt=args.format, quick=args.quick, energies=args.energy,
+                box=args.box, say=_note,
+            )  # fmt: skip
         except ValueError as e:
             parser.error(str(e))
         for path in paths:

@@ -37,7 +37,8 @@ class Scene:
     ``dt`` is a step that resolves the scene for a quick look (the tour uses it);
     ``invariants`` holds the values of the conserved quantities at t = 0; ``parameters`` the
     values the scene was built with; ``contacts`` the contact surfaces φ(q) ≥ 0 of an impact
-    scene (:class:`varmech.Contact`), which :func:`varmech.integrate` goes through by default.
+    scene (:class:`varmech.Contact`), which :func:`varmech.integrate` goes through by default;
+    ``time_unit`` the unit of t that charts label their axes with (:data:`TIME_UNITS`).
 
     Attributes
     ----------
@@ -61,6 +62,9 @@ class Scene:
         The values the scene was built with.
     contacts : tuple of Contact
         The contact surfaces of an impact scene (empty otherwise).
+    time_unit : str
+        The unit of t on charts' axes: ``"days"`` for the outer solar system, else
+        ``"time units"``.
 
     Examples
     --------
@@ -82,6 +86,7 @@ class Scene:
     reference: Reference | None = None
     parameters: dict[str, float] = field(default_factory=dict)
     contacts: tuple[Contact, ...] = ()
+    time_unit: str = "time units"
 
 
 #: The core's catalogue of scenes by name, in the order of the tour: each entry's
@@ -95,6 +100,11 @@ CONTACTS: dict[str, Callable[[dict[str, float]], tuple[Contact, ...]]] = {
     "bouncing_ball": lambda p: (Contact.wall(0, restitution=p["restitution"], name="floor"),),
     "elliptic_billiard": lambda p: (Contact.ellipsoid((p["a"], p["b"]), name="wall"),),
 }
+
+
+#: The unit of t of the scenes that have one, by name; every other scene is in the model's own
+#: (dimensionless) "time units".
+TIME_UNITS: dict[str, str] = {"outer_solar_system": "days"}
 
 
 #: The symbolic scenes (:func:`varmech.symbolic.examples.scene`), which need SymPy.
@@ -151,6 +161,7 @@ def get(name: str, **parameters: float) -> Scene:
         reference,
         record.parameters,
         CONTACTS[name](record.parameters) if name in CONTACTS else (),
+        TIME_UNITS.get(name, "time units"),
     )
 
 

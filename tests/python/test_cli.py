@@ -4,6 +4,7 @@ import pytest
 
 import varmech
 from varmech import scenes
+from varmech.charts.recipes import KINDS, chart, fitting_methods, scenes_for
 from varmech.cli import TOUR, TOUR_REDUCED, tour_runs
 
 
@@ -66,3 +67,83 @@ def test_chart_writes_the_files_it_names(tmp_path, kind, run_cli):
 def test_chart_refuses_an_unknown_scene(run_cli):
     result = run_cli("chart", "phase", "nowhere", check=False)
     assert result.returncode != 0 and "scene:" in result.stderr
+
+
+def svg_texts(path):
+    """The texts of a matplotlib SVG (each drawn text is preceded by a comment holding it)."""
+    import re
+
+    return re.findall(r"<!-- (.*?) -->", path.read_text(), flags=re.S)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("kind", sorted(KINDS))
+def test_every_chart_runs_with_its_defaults_on_every_scene_it_lists(tmp_path, kind):
+    """Every scene the kind applies to, with the default methods (from the scene's kind):
+    none is refused for its method. The sweeps are the quick ones, shortened further."""
+    pytest.importorskip("matplotlib")
+    for name in scenes_for(kind) or [None]:  # [None]: a chart of no scene (stability)
+        if name is not None:
+            scene = scenes.get(name)
+            assert all(scene.model.kind.admits(m) for m in fitting_methods(KINDS[kind].methods, scene)), name
+        if kind in ("work-precision", "energy") and name not in ("kepler", "double_pendulum", "outer_solar_system"):
+            continue  # the rest by their methods alone: their sweeps take minutes
+        written = chart(kind, name, out=tmp_path, quick=True, fmt="svg", progress=False)
+        assert written and all(p.exists() for p in written), (kind, name)
+
+
+def test_the_refused_scenes_are_those_a_chart_cannot_show():
+    assert "kepler" not in scenes_for("phase") and "pendulum" in scenes_for("phase")
+    assert set(scenes_for("poincare")) >= {"henon_heiles", "kepler", "double_pendulum"}
+    assert not {"cartesian_pendulum", "elliptic_billiard", "damped_driven_pendulum"} & set(scenes_for("poincare"))
+    assert fitting_methods(KINDS["energy"].methods, scenes.get("double_pendulum")) == ("galerkin6", "midpoint")
+    assert fitting_methods(KINDS["energy"].methods, scenes.get("kepler")) == KINDS["energy"].methods
+
+
+def test_energy_and_work_precision_default_to_the_scenes_kind(tmp_path, run_cli):
+    pytest.importorskip("matplotlib")
+    out = run_cli("chart", "energy", "double_pendulum", "--quick", "--format", "svg", "--out", tmp_path).stdout
+    texts = svg_texts(tmp_path / "energy_growth_double_pendulum.svg")
+    assert "double_pendulum: max energy error up to t, over t = 0 … 50 time units" in texts
+    assert "t (time units)" in texts and any(t.startswith("galerkin6: ") for t in texts), texts
+    # SciPy's baselines ran to a shorter horizon: said on screen.
+    assert "note: solve_ivp baselines run to t = 5" in out
+
+
+def test_work_precision_titles_and_units_in_days(tmp_path, run_cli):
+    pytest.importorskip("matplotlib")
+    run_cli("chart", "work-precision", "outer_solar_system", "--quick", "--format", "svg", "--out", tmp_path)
+    energy = svg_texts(tmp_path / "work_precision_energy_outer_solar_system.svg")
+    assert any(t.startswith("outer_solar_system: max energy error over t = 0 … ") and t.endswith(" days against cost") for t in energy), energy
+    assert "max relative energy error |ΔH/H₀|" in energy and "wall time (s)" in energy
+    error = svg_texts(tmp_path / "work_precision_outer_solar_system.svg")
+    assert any(t.startswith("outer_solar_system: error in (q, p) at t = ") and t.endswith(" days against cost") for t in error)
+
+
+def test_skipped_baselines_are_said_on_screen_and_drawn_on_the_chart(tmp_path, run_cli):
+    pytest.importorskip("matplotlib")
+    out = run_cli("chart", "energy", "cartesian_pendulum", "--quick", "--format", "svg", "--out", tmp_path).stdout
+    # solve_ivp does not integrate a constrained scene (a DAE).
+    note = "solve_ivp baselines skipped: the scene is constrained (a DAE; solve_ivp baselines do not apply)"
+    assert f"note: {note}" in out.splitlines()
+    texts = svg_texts(tmp_path / "energy_growth_cartesian_pendulum.svg")
+    # Drawn wrapped, a text per line.
+    assert f"note: {note}" in " ".join(" ".join(t.split()) for t in texts) and "t (time units)" in texts, texts
+
+
+def test_the_stability_chart_labels_its_limits_and_its_coincident_curves(tmp_path):
+    pytest.importorskip("matplotlib")
+    chart("stability", out=tmp_path, quick=True, fmt="svg", progress=False)
+    texts = svg_texts(tmp_path / "stability.svg")
+    assert "verlet (the same ρ as symplectic_euler)" in texts and "midpoint: stable for every hω" in texts
+    assert "symplectic_euler, verlet 2" in texts and "yoshida4 1.5734" in texts
+    assert "hω (step × angular frequency, dimensionless)" in texts and "growth factor ρ(Ψ) per step" in texts
+
+
+def test_poincare_takes_its_energy_and_box_on_the_command_line(tmp_path, run_cli):
+    pytest.importorskip("matplotlib")
+    # A box that starts below 0 takes "=" (argparse reads "-1,…" as an option).
+    run_cli("chart", "poincare", "kepler", "--quick", "--energy", "-0.5", "--box=-0.1,0.1,1.5,2", "--out", tmp_path)
+    assert (tmp_path / "poincare_H-0_5_kepler.png").exists()
+    bad = run_cli("chart", "poincare", "kepler", "--box", "1,2", check=False)
+    assert bad.returncode != 0 and "QMIN,QMAX,PMIN,PMAX" in bad.stderr

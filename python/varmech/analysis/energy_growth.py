@@ -159,6 +159,7 @@ def energy_growth(
         title=f"Energy error against time: {scene.name}, dt = {h:g}, t = 0 … {T:g}",
         meta={
             "scene": scene.name,
+            "time_unit": scene.time_unit,
             "dt": h,
             "t_end": T,
             "baseline_t_end": Tb,

@@ -484,7 +484,7 @@ def implicit_regions(
     table = Table(
         ("method", "h", "q0", "outcome", "steps_done", "energy_error", "newton_per_step"),
         title=f"Implicit methods on {sc.name}: outcome of {steps} steps from rest at q0",
-        meta={"scene": sc.name, "steps": int(steps), "energy_threshold": energy_threshold, "p0": 0.0},
+        meta={"scene": sc.name, "time_unit": sc.time_unit, "steps": int(steps), "energy_threshold": energy_threshold, "p0": 0.0},
     )
     plan = [(name, h, q0) for name in names for h in hs for q0 in q0s]
 

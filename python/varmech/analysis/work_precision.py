@@ -208,7 +208,7 @@ def work_precision(
     table = Table(
         WORK_PRECISION_COLUMNS,
         title=f"Work–precision: {scene.name}, t = 0 … {T:g}",
-        meta={"scene": scene.name, "t_end": T, "reference": ref.source if ref is not None else None, "notes": []},
+        meta={"scene": scene.name, "time_unit": scene.time_unit, "t_end": T, "reference": ref.source if ref is not None else None, "notes": []},
     )
     notes: list[str] = table.meta["notes"]
     if ref_note:

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import textwrap
 from pathlib import Path
 from typing import Any
 
@@ -28,3 +29,18 @@ def save(fig: Any, path: str | Path) -> Path:
     fig.savefig(path, dpi=120)
     pyplot().close(fig)
     return path
+
+
+def time_label(meta: dict[str, Any], name: str = "t") -> str:
+    """The axis label of a time (or step) ``name`` in the unit of its table's scene:
+    ``meta["time_unit"]`` (:data:`varmech.scenes.TIME_UNITS`), "time units" without one."""
+    return f"{name} ({meta.get('time_unit', 'time units')})"
+
+
+def skipped_note(ax: Any, notes: list[str]) -> None:
+    """Write the notes of baselines that were skipped (``meta["notes"]`` entries that say
+    "skipped") under the legend at the right of ``ax``, so that the chart says what it lacks."""
+    skipped = [note for note in notes if "skipped" in note]
+    if skipped:
+        text = "\n".join(textwrap.fill(f"note: {note}", 38) for note in skipped)
+        ax.text(1.01, 0.0, text, transform=ax.transAxes, fontsize=6.5, va="bottom", ha="left", color="0.25")

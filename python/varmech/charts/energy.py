@@ -9,14 +9,15 @@ import numpy as np
 
 from ..conservation import check_conservation
 from ..integrate import Trajectory
-from ._figure import pyplot, save
+from ._figure import pyplot, save, time_label
 
 
-def energy_error(trajectories: Mapping[str, Trajectory], path: str | Path, title: str = "") -> Path:
+def energy_error(trajectories: Mapping[str, Trajectory], path: str | Path, title: str = "", time_unit: str = "time units") -> Path:
     """Plot the energy error |H(t) − H₀| against t on log–log axes, relative to the energy's
     scale (the run's mean kinetic energy; see :class:`~varmech.InvariantStatistics`), one line
     per labelled trajectory with its verdict in the legend, and write the figure to ``path``
-    (PNG or SVG by its suffix). A forced run's line is its balance E − W."""
+    (PNG or SVG by its suffix). A forced run's line is its balance E − W. The t axis is in
+    ``time_unit`` (a scene's :attr:`~varmech.scenes.Scene.time_unit`)."""
     plt = pyplot()
     fig, ax = plt.subplots(figsize=(7, 4.2), layout="constrained")
     for label, traj in trajectories.items():
@@ -27,7 +28,7 @@ def energy_error(trajectories: Mapping[str, Trajectory], path: str | Path, title
         err = np.abs(h - h[0]) / scale
         keep = (traj.t > 0) & (err > 0)
         ax.loglog(traj.t[keep], err[keep], label=f"{label}: {report.verdict}", lw=0.8)
-    ax.set_xlabel("t")
+    ax.set_xlabel(time_label({"time_unit": time_unit}))
     ax.set_ylabel("energy error |H − H₀| / mean kinetic energy")
     ax.set_title(title)
     ax.grid(True, which="major", alpha=0.3)

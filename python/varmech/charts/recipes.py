@@ -11,6 +11,7 @@ from pathlib import Path
 
 from .. import scenes
 from ..analysis import energy_growth, sections, stability, work_precision
+from ..analysis._orbits import energy_at
 from ..analysis.baselines import REBOUND_METHODS
 from ..analysis.phase_portrait import phase_portrait
 from ..table import Table
@@ -26,19 +27,63 @@ class ChartKind:
     scene: str | None
     methods: tuple[str, ...]
     description: str
-    #: (scene, methods, quick, progress) → [(CSV name, table, {figure name: chart function})].
-    draw: Callable[[str | None, tuple[str, ...], bool, bool | None], list[tuple[str, Table, dict[str, Callable]]]]
+    #: (scene, methods, quick, progress, options) → [(CSV name, table, {figure name: chart function})].
+    draw: Callable[..., list[tuple[str, Table, dict[str, Callable]]]]
+    #: Whether the chart applies to a scene: None if it does, else why not.
+    refuses: Callable[[scenes.Scene], str | None] = lambda scene: None
 
 
-def _work_precision(scene, methods, quick, progress):
+def fitting_methods(methods: tuple[str, ...], scene: scenes.Scene) -> tuple[str, ...]:
+    """The methods of ``methods`` that integrate ``scene``'s model, or, if none does, its kind's
+    accurate and default methods (the core's table, :class:`varmech.ModelKind`)."""
+    kind = scene.model.kind
+    return tuple(m for m in methods if kind.admits(m)) or tuple(dict.fromkeys((kind.accurate_method, kind.default_method)))
+
+
+def _unconstrained(scene: scenes.Scene) -> str | None:
+    model = scene.model
+    if model.kind.name.startswith("constrained") or model.kind.name == "nonholonomic" or scene.contacts:
+        return f"{scene.name} is a {model.kind.name} model{' with contacts' if scene.contacts else ''}; the sections need a free one"
+    if model.forced or model.time_dependent:
+        return f"{scene.name} has no conserved energy; the sections need one"
+    return None
+
+
+def _one_freedom(scene: scenes.Scene) -> str | None:
+    if scene.model.dim != 1:
+        return f"a phase portrait needs one degree of freedom, {scene.name} has {scene.model.dim}; use poincare"
+    return _unconstrained(scene)
+
+
+def _implicit(scene: scenes.Scene) -> str | None:
+    if scene.model.kind.name.startswith("constrained"):
+        return f"{scene.name} is a {scene.model.kind.name} model: the map's initial angles q₀ would leave its constraints"
+    if not any(scene.model.kind.admits(m) for m in stability.IMPLICIT_METHODS):
+        methods = ", ".join(stability.IMPLICIT_METHODS)
+        return f"{scene.name} is a {scene.model.kind.name} model, which none of the implicit methods {methods} integrates"
+    return None
+
+
+def _no_scene(scene: scenes.Scene) -> str | None:
+    return "the stability chart is of the linear test equation q'' = −ω²q; it takes no scene"
+
+
+def _two_freedoms(scene: scenes.Scene) -> str | None:
+    if scene.model.dim != 2:
+        return f"a Poincaré section in a plane needs two degrees of freedom, {scene.name} has {scene.model.dim}"
+    return _unconstrained(scene)
+
+
+def _work_precision(scene, methods, quick, progress, options):
     sc = scenes.get(scene)
     # Every REBOUND baseline that applies to the scene (none but leapfrog order=8 on Kepler).
     table = work_precision.work_precision(
         sc, methods, rebound=REBOUND_METHODS, repeat=1 if quick else 3, sweep_length=4 if quick else 11,
         max_seconds=1.0 if quick else 5.0, progress=progress,
     )
-    title = f"{scene}: error at t = {table.meta.get('t_end', sc.t_end):g} against cost"
-    energy_title = f"{scene}: max energy error over t = 0 … {table.meta.get('t_end', sc.t_end):g} against cost"
+    horizon = f"{table.meta.get('t_end', sc.t_end):g} {sc.time_unit}"
+    title = f"{scene}: error in (q, p) at t = {horizon} against cost"
+    energy_title = f"{scene}: max energy error over t = 0 … {horizon} against cost"
     figures = {
         "work_precision": lambda t, p: work_precision_chart(t, p, x="seconds", title=title),
         "work_precision_evaluations": lambda t, p: work_precision_chart(t, p, x="evaluations", title=title),
@@ -51,47 +96,69 @@ def _work_precision(scene, methods, quick, progress):
     return [("work_precision", table, figures)]
 
 
-def _energy(scene, methods, quick, progress):
+def _energy(scene, methods, quick, progress, options):
     sc = scenes.get(scene)
     t_end = (5 if quick else 50) * sc.t_end
     table = energy_growth.energy_growth(sc, methods, t_end=t_end, samples=500 if quick else 2000, progress=progress)
-    title = f"{scene}: energy error over t = {t_end:g}"
+    title = f"{scene}: max energy error up to t, over t = 0 … {t_end:g} {sc.time_unit}"
     return [
         ("energy_growth", table, {"energy_growth": lambda t, p: energy_growth_chart(t, p, title=title)}),
         ("energy_verdicts", energy_growth.verdicts(table), {}),
     ]
 
 
-def _stability(scene, methods, quick, progress):
+def _stability(scene, methods, quick, progress, options):
     table = stability.growth_table(methods, progress=progress)
     return [
-        ("stability", table, {"stability": lambda t, p: stability_chart(t, p, title="growth factor on q'' = -ω²q")}),
+        ("stability", table, {"stability": lambda t, p: stability_chart(t, p)}),
         ("stability_limits", stability.stability_table(methods, progress=progress), {}),
     ]
 
 
-def _implicit_regions(scene, methods, quick, progress):
+def _implicit_regions(scene, methods, quick, progress, options):
     table = stability.implicit_regions(methods, scene=scene, progress=progress)
-    draw = lambda t, p: implicit_regions_chart(t, p, title=f"{scene}: implicit steps")  # noqa: E731
+    draw = lambda t, p: implicit_regions_chart(t, p, title=f"{scene}: outcome of the implicit steps by step and initial angle")  # noqa: E731
     return [("implicit_regions", table, {"implicit_regions": draw})]
 
 
-def _poincare(scene, methods, quick, progress):
+def _poincare(scene, methods, quick, progress, options):
     sc = scenes.get(scene)
     out = []
-    for energy in sections.HENON_HEILES_ENERGIES:
+    box = options.get("box")
+    section = (0, 0.0, 1)
+    if scene != "henon_heiles":
+        # The section through the scene's own state, q₀ = q₀(0), and a box about the state's
+        # (q₁, p₁), a quarter of its size: the seeds find the energy shell there.
+        section = (0, float(sc.q0[0]), 1)
+        if box is None:
+            q, p = float(sc.q0[1]), float(sc.p0[1])
+            dq, dp = max(0.05, abs(q) / 4), max(0.05, abs(p) / 4)
+            box = ((q - dq, q + dq), (p - dp, p + dp))
+    energies = options.get("energies")
+    if energies is None:
+        energies = sections.HENON_HEILES_ENERGIES if scene == "henon_heiles" else (float(energy_at(sc.model, sc.q0, sc.p0)[0]),)
+    dt = 0.05 if scene == "henon_heiles" else sc.dt
+    t_end = dt * round((300.0 if quick else 2000.0) / dt)
+    for energy in energies:
         table = sections.poincare_section(
-            sc, energy, orbits=12 if quick else 40, t_end=300.0 if quick else 2000.0, method=methods[0], progress=progress
-        )
+            sc, energy, orbits=12 if quick else 40, t_end=t_end, dt=dt, method=methods[0], box=box, section=section,
+            progress=progress,
+        )  # fmt: skip
         label = f"{energy:.4f}".rstrip("0")
-        title = f"{scene}: Poincaré section x = 0, H = {label}"
+        title = f"{scene}: Poincaré section x = {section[1]:.4g} (p_x > 0), H = {label}"
         name = f"poincare_H{label.replace('.', '_')}"
         out.append((name, table, {name: lambda t, p, title=title: poincare_chart(t, p, title=title)}))
     return out
 
 
-def _phase(scene, methods, quick, progress):
-    table = phase_portrait(scenes.get(scene), method=methods[0], progress=progress)
+def _phase(scene, methods, quick, progress, options):
+    sc = scenes.get(scene)
+    energies = options.get("energies")
+    if energies is None and scene != "pendulum":
+        # Orbits about the scene's own, from a quarter of its energy to four times it.
+        e0 = float(energy_at(sc.model, sc.q0, sc.p0)[0])
+        energies = tuple(e0 * f for f in (0.25, 0.5, 1.0, 2.0, 4.0)) if e0 > 0 else (e0,)
+    table = phase_portrait(sc, energies=energies, method=methods[0], progress=progress)
     draw = lambda t, p: phase_portrait_chart(t, p, title=f"{scene}: phase portrait")  # noqa: E731
     return [("phase_portrait", table, {"phase_portrait": draw})]
 
@@ -107,14 +174,17 @@ KINDS: dict[str, ChartKind] = {
     ),
     "stability": ChartKind(
         None, ("symplectic_euler", "verlet", "yoshida4", "mclachlan4", "kahan_li8", "rk4", "midpoint"),
-        "growth factor against hω with each stability limit", _stability,
+        "growth factor against hω with each stability limit", _stability, _no_scene,
     ),
     "implicit-regions": ChartKind(
         "pendulum", ("midpoint", "trapezoid", "galerkin4", "galerkin6"),
-        "where the implicit methods' Newton iterations fail or jump branches", _implicit_regions,
+        "where the implicit methods' Newton iterations fail or jump branches", _implicit_regions, _implicit,
     ),
-    "poincare": ChartKind("henon_heiles", ("kahan_li6",), "Poincaré sections at H = 1/12 and 1/8", _poincare),
-    "phase": ChartKind("pendulum", ("kahan_li6",), "phase portrait: librations, separatrix, rotations", _phase),
+    "poincare": ChartKind(
+        "henon_heiles", ("kahan_li6",), "Poincaré sections (Hénon–Heiles: at H = 1/12 and 1/8; else the scene's energy)", _poincare,
+        _two_freedoms,
+    ),
+    "phase": ChartKind("pendulum", ("kahan_li6",), "phase portrait: librations, separatrix, rotations", _phase, _one_freedom),
 }
 
 
@@ -127,9 +197,22 @@ def chart(
     fmt: str = "png",
     quick: bool = False,
     progress: bool | None = None,
+    energies: tuple[float, ...] | None = None,
+    box: tuple[tuple[float, float], tuple[float, float]] | None = None,
+    say: Callable[[str], object] | None = None,
 ) -> list[Path]:
     """Measure chart ``kind`` on ``scene`` (its default when None) and write, for each figure,
-    ``<out>/<name>_<scene>.<fmt>`` and the data as ``.csv``; returns the paths written."""
+    ``<out>/<name>_<scene>.<fmt>`` and the data as ``.csv``; returns the paths written.
+
+    ``methods`` default to the kind's own that integrate the scene, or else the scene's kind's
+    accurate and default methods (:func:`fitting_methods`). ``energies`` are the Poincaré
+    sections' energy shells (default: Hénon–Heiles' 1/12 and 1/8, another scene's own energy)
+    or the phase portrait's orbits (default: the pendulum's own, another scene's energy times
+    1/4 … 4); ``box`` the sections' seeding box (Hénon–Heiles: its allowed region; another
+    scene: a box twice its initial state's size). A scene the kind does not apply to
+    (:func:`scenes_for`) is a ValueError naming ``scene``.
+    ``say`` is called with each note of the measurements (skipped baselines, stopped sweeps),
+    which the charts draw too."""
     if kind not in KINDS:
         raise ValueError(f"kind: expected one of {', '.join(KINDS)}, got {kind!r}")
     if fmt not in ("png", "svg"):
@@ -139,9 +222,26 @@ def chart(
     known = (*scenes.CATALOGUE, *scenes.SYMBOLIC)
     if scene is not None and scene not in known:
         raise ValueError(f"scene: expected one of {', '.join(known)}, got {scene!r}")
+    if scene is not None:
+        sc = scenes.get(scene)
+        why = spec.refuses(sc)
+        if why is not None:
+            raise ValueError(f"scene: {why}")
+        methods = methods or fitting_methods(spec.methods, sc)
     stem = f"_{scene}" if scene else ""
     written = []
-    for name, table, figures in spec.draw(scene, tuple(methods or spec.methods), quick, progress):
+    options = {"energies": energies, "box": box}
+    for name, table, figures in spec.draw(scene, tuple(methods or spec.methods), quick, progress, options):
+        if say is not None:
+            for note in table.meta.get("notes", []):
+                say(note)
         written.append(table.to_csv(out / f"{name}{stem}.csv"))
         written += [draw(table, out / f"{figure}{stem}.{fmt}") for figure, draw in figures.items()]
     return written
+
+
+def scenes_for(kind: str) -> list[str]:
+    """The scenes chart ``kind`` applies to (every scene of the catalogue and the symbolic ones,
+    less those it refuses, such as a phase portrait of two degrees of freedom)."""
+    refuses = KINDS[kind].refuses
+    return [name for name in (*scenes.CATALOGUE, *scenes.SYMBOLIC) if refuses(scenes.get(name)) is None]

@@ -41,13 +41,14 @@ def poincare_chart(table: Table | Sequence[Table], path: str | Path, title: str 
             sel = orbit == o
             ax.scatter(a[sel], b[sel], s=0.6, color=cmap(i % cmap.N), linewidths=0, rasterized=True)
         energy = tab.meta.get("energy")
+        ax.set_xlabel(a_name)
+        ax.set_ylabel(b_name)
         if tab.meta.get("model") == "henon_heiles" and tuple(tab.meta.get("section", ()))[:2] == (0, 0.0) and energy is not None:
             curve = _henon_heiles_boundary(float(energy))
             if curve is not None:
                 ax.plot(*curve, color="0.3", lw=0.6)
-        ax.set_xlabel(a_name)
-        ax.set_ylabel(b_name)
-        ax.set_aspect("equal", adjustable="datalim")
+            # y and p_y on one scale there, the allowed region's true shape.
+            ax.set_aspect("equal", adjustable="datalim")
         label = f"E = {energy:.4g}" if energy is not None else ""
         if energy is not None:
             for frac in (12, 8, 6):
@@ -55,7 +56,7 @@ def poincare_chart(table: Table | Sequence[Table], path: str | Path, title: str 
                     label = f"E = 1/{frac}"
         ax.set_title(label, fontsize=10)
     if title:
-        fig.suptitle(title)
+        fig.suptitle(title, fontsize=10)
     return save(fig, path)
 
 

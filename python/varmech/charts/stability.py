@@ -11,7 +11,7 @@ import numpy as np
 
 from ..analysis.stability import OUTCOMES, REFERENCE_LIMITS
 from ..table import Table
-from ._figure import pyplot, save
+from ._figure import pyplot, save, time_label
 
 # Outcome colours of the implicit-regions map, in the order of OUTCOMES.
 _OUTCOME_COLOURS = {
@@ -23,24 +23,37 @@ _OUTCOME_COLOURS = {
 }
 
 
+#: Markers of the growth chart's methods, in turn: staggered along coincident curves (every
+#: symplectic method on ρ = 1), they tell each apart.
+_MARKERS = "osD^vPX*<>"
+_LINESTYLES = ("-", "--", "-.", (0, (3, 1, 1, 1, 1, 1)), ":")
+
+
 def stability_chart(
     table: Table, path: str | Path, title: str = "", limits: Mapping[str, float] | None = None
 ) -> Path:
     """Plot the growth factor ρ against hω, one line per method, from a
     :func:`~varmech.analysis.stability.growth_table`, on a logarithmic ρ axis (ρ = 1 is the dotted
     horizontal line: symplectic methods lie on it inside their stability interval, RK4 dips
-    below it, everything leaves it upwards where it is unstable). Each method's stability limit
-    is a dashed vertical line in its colour: ``limits`` if given, else the table's measured
-    ``meta["limits"]``, else the reference limits (:data:`~varmech.analysis.stability.REFERENCE_LIMITS`);
-    infinite or missing limits are not drawn. Writes ``path`` (PNG or SVG)."""
+    below it, everything leaves it upwards where it is unstable). Each method has its own
+    colour, line style and markers, the markers staggered so that coincident curves (every
+    stable symplectic method on ρ = 1) stay apart; a method whose curve is another's throughout
+    says so in the legend (symplectic Euler's is Verlet's). Each stability limit is a dashed
+    vertical line in its method's colour, labelled with the methods and hω on a top axis: ``limits``
+    if given, else the table's measured ``meta["limits"]``, else the reference limits
+    (:data:`~varmech.analysis.stability.REFERENCE_LIMITS`); an infinite limit is said in the
+    legend ("stable for every hω"). Writes ``path`` (PNG or SVG)."""
     plt = pyplot()
     if limits is None:
         limits = table.meta.get("limits") or REFERENCE_LIMITS
-    fig, ax = plt.subplots(figsize=(8, 4.8), layout="constrained")
+    fig, ax = plt.subplots(figsize=(9.5, 5.2), layout="constrained")
     h_all = table.column("h_omega")
     top = float(np.nanmax(h_all)) if len(h_all) else 1.0
     lowest = 1.0
-    for name in table.unique("method"):
+    names = table.unique("method")
+    curves: dict[str, tuple[np.ndarray, np.ndarray]] = {}
+    at_limit: dict[float, list[tuple[str, str]]] = {}
+    for i, name in enumerate(names):
         rows = table.where(method=name)
         h, g = rows.column("h_omega"), rows.column("growth")
         order = np.argsort(h)
@@ -48,19 +61,37 @@ def stability_chart(
         finite = np.isfinite(g) & (g > 0)
         if finite.any():
             lowest = min(lowest, float(np.min(g[finite])))
-        (line,) = ax.plot(h[finite], g[finite], lw=1.0, label=name)
+        twin = next((m for m, (hh, gg) in curves.items() if hh.shape == h.shape and np.allclose(gg, g, rtol=1e-9, equal_nan=True)), None)
+        curves[name] = (h, g)
         limit = limits.get(name)
+        label = name + (f" (the same ρ as {twin})" if twin else "")
+        if limit is not None and math.isinf(limit):
+            label += ": stable for every hω"
+        every = max(1, int(finite.sum()) // 6)
+        (line,) = ax.plot(
+            h[finite], g[finite], lw=1.1, label=label, ls=_LINESTYLES[i % len(_LINESTYLES)],
+            marker=_MARKERS[i % len(_MARKERS)], ms=4.5, markevery=(i * every // max(1, len(names)), every), mfc="none",
+        )  # fmt: skip
         if limit is not None and math.isfinite(limit) and 0 < limit <= top:
-            ax.axvline(limit, color=line.get_color(), ls="--", lw=0.8, alpha=0.8)
+            at_limit.setdefault(round(limit, 4), []).append((name, line.get_color()))
+    # The limits' labels on a top axis, tilted, clear of the curves.
+    top_axis = ax.secondary_xaxis("top")
+    ticks = sorted(at_limit)
+    words = [f"{', '.join(m for m, _ in at_limit[x])} {x:g}" for x in ticks]
+    top_axis.set_xticks(ticks, words, rotation=75, ha="left", rotation_mode="anchor", fontsize=7)
+    for x, tick in zip(ticks, top_axis.get_xticklabels()):
+        tick.set_color(at_limit[x][0][1])
+        ax.axvline(x, color=at_limit[x][0][1], ls="--", lw=0.8, alpha=0.8)
     ax.axhline(1.0, color="0.3", ls=":", lw=0.8)
     ax.set_yscale("log")
     ax.set_ylim(max(min(0.9 * lowest, 0.9), 1e-3), 10.0)
     ax.set_xlim(0.0, top)
-    ax.set_xlabel("hω")
+    ax.set_xlabel("hω (step × angular frequency, dimensionless)")
     ax.set_ylabel("growth factor ρ(Ψ) per step")
-    ax.set_title(title or "Linear stability on q'' = −ω²q (dashed: stability limit)")
+    default = "Linear stability on q'' = −ω²q: growth factor ρ per step against hω (dashed: stability limits)"
+    ax.set_title(title or default, fontsize=10, pad=10)
     ax.grid(True, which="major", alpha=0.3)
-    ax.legend(fontsize=7, ncol=2, loc="upper left")
+    ax.legend(fontsize=7.5, loc="upper left", bbox_to_anchor=(1.01, 1.0))
     return save(fig, path)
 
 
@@ -92,7 +123,7 @@ def implicit_regions_chart(table: Table, path: str | Path, title: str = "") -> P
         ax.imshow(np.ma.masked_invalid(grid), cmap=cmap, norm=norm, origin="lower", aspect="auto", interpolation="nearest")
         ax.set_xticks(range(len(hs)), [f"{h:g}" for h in hs], fontsize=7)
         ax.set_yticks(range(len(q0s)), [f"{q:g}" for q in q0s], fontsize=7)
-        ax.set_xlabel("step h")
+        ax.set_xlabel(time_label(table.meta, "step h"))
         ax.set_ylabel("initial angle q₀ (from rest)")
         ax.set_title(name, fontsize=9)
     present = [o for o in OUTCOMES if o in set(table.column("outcome"))]

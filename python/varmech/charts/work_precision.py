@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 
 from ..table import Table
-from ._figure import pyplot, save
+from ._figure import pyplot, save, skipped_note, time_label
 
 _AXIS_LABELS = {
     "seconds": "wall time (s)",
@@ -49,9 +49,11 @@ def work_precision_chart(table: Table, path: str | Path, *, x: str = "seconds", 
     ax.set_xlabel(_AXIS_LABELS.get(x, x))
     ax.set_ylabel(_AXIS_LABELS.get(y, y))
     t_end = table.meta.get("t_end")
-    ax.set_title(title or (f"{table.meta.get('scene', '')}, t = 0 … {t_end:g}" if t_end else table.title), fontsize=10)
+    unit = table.meta.get("time_unit", "time units")
+    ax.set_title(title or (f"{table.meta.get('scene', '')}, t = 0 … {t_end:g} {unit}" if t_end else table.title), fontsize=10)
     ax.grid(True, which="major", alpha=0.3)
     ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0))
+    skipped_note(ax, table.meta.get("notes", []))
     return save(fig, path)
 
 
@@ -85,7 +87,7 @@ def energy_growth_chart(table: Table, path: str | Path, title: str = "", *, samp
             if v:
                 label += f": {v['verdict']}"
                 if v["verdict"] == "secular drift":
-                    label += f", {abs(v['drift_rate']):.1e} per unit t"
+                    label += f", {abs(v['drift_rate']):.1e} per {table.meta.get('time_unit', 'time unit').removesuffix('s')}"
             (line,) = ax.loglog(t[keep], m[keep], lw=1.2, label=label, ls="-" if tool == "varmech" else "--")
             if samples:
                 faint = (t > 0) & (e > 0) & np.isfinite(e)
@@ -99,11 +101,12 @@ def energy_growth_chart(table: Table, path: str | Path, title: str = "", *, samp
         tt = np.geomspace(max(t0, ta / 1e3), t1, 50)
         ax.loglog(tt, ea * np.sqrt(tt / ta), "k--", lw=0.8, alpha=0.7, label="∝ √t (Brouwer's law)")
         ax.loglog(tt, ea * (tt / ta), "k:", lw=0.8, alpha=0.7, label="∝ t")
-    ax.set_xlabel("t")
-    ax.set_ylabel("relative energy error |H − H₀|/|H₀|, max up to t")
     meta = table.meta
-    default = f"{meta.get('scene', '')}, dt = {meta['dt']:g}" if "dt" in meta else table.title
+    ax.set_xlabel(time_label(meta))
+    ax.set_ylabel("relative energy error |H − H₀|/|H₀|, max up to t")
+    default = f"{meta.get('scene', '')}, dt = {meta['dt']:g} {meta.get('time_unit', 'time units')}" if "dt" in meta else table.title
     ax.set_title(title or default, fontsize=10)
     ax.grid(True, which="major", alpha=0.3)
     ax.legend(fontsize=7.5, loc="upper left", bbox_to_anchor=(1.01, 1.0))
+    skipped_note(ax, meta.get("notes", []))
     return save(fig, path)
