@@ -46,6 +46,7 @@ __all__ = [
     "energy_terms",
     "ensemble",
     "integrate",
+    "is_affine",
     "is_forced",
     "is_time_dependent",
     "kind_of",
@@ -259,6 +260,8 @@ class NativeModel(_ModelProperties):
     @property
     def constraints(self) -> int: ...
     @property
+    def velocity_constraints(self) -> int: ...
+    @property
     def gravity(self) -> tuple[float, list[float]] | None:
         """(G, masses) of an N-body scene, None for the others."""
 
@@ -309,6 +312,7 @@ class ClosureNonholonomic(_ModelProperties):
         system: ClosureModel | ClosureNatural | ClosureLagrangian,
         count: int,
         matrix: Callable[[_FloatArray], Any],
+        offset: Callable[[_FloatArray], Any] | None = None,
     ) -> ClosureNonholonomic: ...
     @property
     def velocity_constraints(self) -> int: ...
@@ -432,6 +436,9 @@ _FullModel = (
 _Model = _FullModel | RouthModel
 
 def kind_of(model: _Model) -> ModelKind: ...
+def is_affine(model: _Model) -> bool:
+    """Whether the model's velocity constraints are affine, A(q)q̇ + b(q) = 0 with b ≠ 0."""
+
 def is_time_dependent(model: _Model) -> bool:
     """Whether L depends on t explicitly."""
 

@@ -225,6 +225,7 @@ def _statistics(record: _core.Statistics, name: str, initial: float, scale_name:
 
 NOT_CONSERVED = "not conserved (L depends on t)"
 FORCED = "not conserved (forced); see the energy balance"
+AFFINE = "not conserved (affine velocity constraints: the moving surface does work)"
 
 
 @dataclass(frozen=True)
@@ -286,8 +287,10 @@ class ConservationReport:
     #: Lagrange–d'Alembert energy balance), judged as the energy is.
     energy_balance: InvariantStatistics | None = None
     #: For constrained models: |g(q)|∞ and |G(q)M⁻¹p|∞ over the run; with velocity constraints
-    #: |A(q)q̇|∞ alone.
+    #: |A(q)q̇ + b(q)|∞ alone.
     constraints: tuple[InvariantStatistics, ...] | None = None
+    #: Whether the velocity constraints are affine (b ≠ 0): then the energy is not judged.
+    affine: bool = False
 
     @property
     def verdict(self) -> str:
@@ -295,6 +298,8 @@ class ConservationReport:
         conserved."""
         if self.energy is not None:
             return self.energy.verdict
+        if self.affine:
+            return AFFINE
         return FORCED if self.energy_balance is not None else NOT_CONSERVED
 
     @property
@@ -322,7 +327,7 @@ class ConservationReport:
                 lines += ["  " + line for line in stats.describe(symbol)]
         for m in self.momenta:
             lines += ["  " + line for line in m.describe("J")]
-        residuals = ("g(q)", "G M⁻¹ p") if len(self.constraints or ()) == 2 else ("A q̇",)
+        residuals = ("g(q)", "G M⁻¹ p") if len(self.constraints or ()) == 2 else ("A q̇ + b" if self.affine else "A q̇",)
         for c, error in zip(self.constraints or (), residuals):
             lines += ["  " + line for line in c.describe("r", error)]
         return "\n".join(lines)
@@ -331,11 +336,14 @@ class ConservationReport:
 def check_conservation(traj: Trajectory, generators: Sequence[Generator] | None = None) -> ConservationReport:
     """Check the energy, the Noether momenta and the constraints of ``traj``.
 
-    The energy function E = p·q̇ − L is judged when L does not depend on t; with forces acting
-    the report judges the balance E − W, W the work of the forces, instead. Each quantity's
-    error is measured against a scale (the mean kinetic energy for the energy), and judged
-    "conserved to round-off", "bounded", "secular drift" or "failed"
-    (:class:`InvariantStatistics` says how).
+    The energy function E = p·q̇ − L is judged when L does not depend on t and no constraint
+    does work (affine velocity constraints A(q)q̇ + b(q) = 0 do); with forces acting the report
+    judges the balance E − W, W the work of the forces, instead. With velocity constraints the
+    report judges the residuals |A(q)q̇ + b(q)| and only the momenta of the symmetries the
+    model declares: a nonholonomic system need not conserve the momenta of the symmetries of
+    its L (the native scenes declare those they conserve). Each quantity's error is measured
+    against a scale (the mean kinetic energy for the energy), and judged "conserved to
+    round-off", "bounded", "secular drift" or "failed" (:class:`InvariantStatistics` says how).
 
     Parameters
     ----------
@@ -374,7 +382,8 @@ def check_conservation(traj: Trajectory, generators: Sequence[Generator] | None 
     model = traj.model
     t, steps = np.asarray(traj.t), int(traj.steps)
     energy = balance = None
-    if not model.time_dependent:
+    affine = bool(model.velocity_constraints) and model.affine
+    if not model.time_dependent and not affine:
         stats = energy_statistics(model, t, *traj._arrays()[1:], steps=steps, work=np.asarray(traj.work) if model.forced else None)
         if stats.verdict == "failed":
             stats = replace(stats, advice=f"{stats.advice}; {_failure_advice(traj)}")
@@ -394,8 +403,9 @@ def check_conservation(traj: Trajectory, generators: Sequence[Generator] | None 
         )
     elif model.velocity_constraints:
         (_, v), (_, v_size) = _core.constraint_residuals(model._core, *traj._arrays()[1:])
-        constraints = (_statistics(_core.statistics(t, v, v_size, v_size, steps), "|A q̇|", v[0], "mean ‖A‖‖q̇‖", t),)
-    return ConservationReport(model.name, traj.method, traj.dt, float(t[-1]), energy, tuple(momenta), balance, constraints)
+        name, scale = ("|A q̇ + b|", "mean ‖A‖‖q̇‖ + |b|") if affine else ("|A q̇|", "mean ‖A‖‖q̇‖")
+        constraints = (_statistics(_core.statistics(t, v, v_size, v_size, steps), name, v[0], scale, t),)
+    return ConservationReport(model.name, traj.method, traj.dt, float(t[-1]), energy, tuple(momenta), balance, constraints, affine)
 
 
 def energy_statistics(

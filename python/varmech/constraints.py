@@ -16,7 +16,8 @@ def project(model: Model, q0: ArrayLike, p0: ArrayLike | None = None, *, v0: Arr
     """The nearest consistent state (q, p) of a constrained model: q on g(q) = 0 by Newton's
     method along M⁻¹Gᵀ, then p on the hidden constraint G(q)M⁻¹p = 0 by the M-orthogonal
     projection p − Gᵀ(GM⁻¹Gᵀ)⁻¹GM⁻¹p. With velocity constraints A(q)q̇ = 0, q as it is and p
-    on them by the same projection with A for G. Give the momenta ``p0`` or the velocities
+    on them by the same projection with A for G (onto A(q)q̇ + b(q) = 0 for affine ones:
+    p − Aᵀ(AM⁻¹Aᵀ)⁻¹(AM⁻¹p + b)). Give the momenta ``p0`` or the velocities
     ``v0`` (default: at rest).
 
     Parameters

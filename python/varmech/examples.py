@@ -322,6 +322,71 @@ def elliptic_billiard() -> MechanicalSystem:
     return MechanicalSystem(2, lambda q: 0.0, lambda q: np.zeros(2), name="elliptic_billiard (closure)")
 
 
+def rolling_disk(radius: float = 1.0) -> MechanicalSystem:
+    """The vertical disk of radius R rolling on a plane, q = (x, y, θ, φ), mass
+    diag(1, 1, R²/4, R²/2), with ẋ = Rφ̇cosθ, ẏ = Rφ̇sinθ as velocity constraints."""
+    r2 = radius * radius
+
+    def rolling(q: np.ndarray) -> np.ndarray:
+        s, c = math.sin(q[2]), math.cos(q[2])
+        return np.array([[1.0, 0.0, 0.0, -radius * c], [0.0, 1.0, 0.0, -radius * s]])
+
+    return MechanicalSystem(
+        4, lambda q: 0.0, lambda q: np.zeros(4), mass=np.array([1.0, 1.0, 0.25 * r2, 0.5 * r2]),
+        velocity_constraints=rolling, velocity_constraint_count=2, symmetries=[Cyclic(2), Cyclic(3)],
+        name="rolling_disk (closure)",
+    )
+
+
+def chaplygin_sleigh(inertia: float = 1.0, blade: float = 1.0) -> MechanicalSystem:
+    """The Chaplygin sleigh, q = (x, y, θ), mass diag(1, 1, I), its blade b behind the centre:
+    −ẋsinθ + ẏcosθ − bθ̇ = 0."""
+
+    def no_slip(q: np.ndarray) -> np.ndarray:
+        return np.array([[-math.sin(q[2]), math.cos(q[2]), -blade]])
+
+    return MechanicalSystem(
+        3, lambda q: 0.0, lambda q: np.zeros(3), mass=np.array([1.0, 1.0, inertia]),
+        velocity_constraints=no_slip, velocity_constraint_count=1, name="chaplygin_sleigh (closure)",
+    )
+
+
+def rolling_sphere(alpha: float = 0.5, g: float = 9.81, radius: float = 1.0, omega: float = 0.0, name: str = "rolling_sphere") -> Lagrangian:
+    """The ball (unit mass, I = 2a²/5) on a rough plane inclined at α, or on a level table
+    turning at Ω, q = (x, y, φ, θ, ψ) in ZXZ Euler angles: L = ½(ẋ² + ẏ²) +
+    ½I(φ̇² + θ̇² + ψ̇² + 2φ̇ψ̇cosθ) + g sinα x, with ẋ − aω_y + Ωy = 0, ẏ + aω_x − Ωx = 0
+    (affine for Ω ≠ 0)."""
+    inertia, slope = 0.4 * radius * radius, g * math.sin(alpha)
+
+    def lagrangian(q: np.ndarray, v: np.ndarray, t: float) -> float:
+        spin = v[2] * v[2] + v[3] * v[3] + v[4] * v[4] + 2.0 * v[2] * v[4] * math.cos(q[3])
+        return 0.5 * (v[0] * v[0] + v[1] * v[1]) + 0.5 * inertia * spin + slope * q[0]
+
+    def dl_dq(q: np.ndarray, v: np.ndarray, t: float) -> np.ndarray:
+        return np.array([slope, 0.0, 0.0, -(inertia * v[2] * v[4] * math.sin(q[3])), 0.0])
+
+    def dl_dv(q: np.ndarray, v: np.ndarray, t: float) -> np.ndarray:
+        c = math.cos(q[3])
+        return np.array([v[0], v[1], inertia * (v[2] + v[4] * c), inertia * v[3], inertia * (v[4] + v[2] * c)])
+
+    def contact(q: np.ndarray) -> np.ndarray:
+        sp, cp, st = math.sin(q[2]), math.cos(q[2]), math.sin(q[3])
+        return np.array([[1.0, 0.0, 0.0, -radius * sp, radius * (st * cp)], [0.0, 1.0, 0.0, radius * cp, radius * (st * sp)]])
+
+    def table(q: np.ndarray) -> np.ndarray:
+        return np.array([omega * q[1], -(omega * q[0])])
+
+    return Lagrangian(
+        5, lagrangian, dl_dq=dl_dq, dl_dv=dl_dv, velocity_constraints=contact, velocity_constraint_count=2,
+        velocity_constraint_offset=table if omega != 0.0 else None, symmetries=[Cyclic(2)], name=f"{name} (closure)",
+    )
+
+
+def ball_on_turntable(omega: float = 1.0, radius: float = 1.0) -> Lagrangian:
+    """The ball of :func:`rolling_sphere` on a level table turning at Ω: affine constraints."""
+    return rolling_sphere(alpha=0.0, radius=radius, omega=omega, name="ball_on_turntable")
+
+
 def closure_of(scene: Scene) -> MechanicalSystem | Lagrangian:
     """The closure twin of a built-in scene: the function of this module with the scene's name,
     at its default parameters (an N-body scene's twin has the scene's G and masses).

@@ -156,6 +156,13 @@ class Model:
         (nonholonomic) models take the discrete Lagrange–d'Alembert integrator, ``midpoint``."""
         return getattr(self._core, "velocity_constraints", 0)
 
+    @property
+    def affine(self) -> bool:
+        """Whether its velocity constraints are affine, A(q)q̇ + b(q) = 0 with b ≠ 0 (a moving
+        surface, such as a turntable): their forces then do work, and the energy is not
+        conserved."""
+        return _core.is_affine(self._core)
+
     def velocity(self, q: ArrayLike, p: ArrayLike, t: ArrayLike = 0.0) -> np.ndarray:
         """q̇ with ∂L/∂q̇(q, q̇, t) = p (M⁻¹p for mechanical systems), for one state (n,) or
         for rows (N, n)."""
@@ -277,6 +284,13 @@ class MechanicalSystem(Model):
         with ``velocity_constraint_count`` = m. Integrated by the reversible discrete
         Lagrange–d'Alembert integrator, ``midpoint`` (see the user guide, "Rolling and other
         nonholonomic constraints"); not together with holonomic ``constraints``.
+    velocity_constraint_offset
+        With ``velocity_constraints``: ``velocity_constraint_offset(q) -> array (m,)``, the
+        affine term b(q) of affine constraints A(q)q̇ + b(q) = 0 (a moving surface: on a table
+        turning at Ω about the origin, b = (Ωy, −Ωx) for a ball's contact). The discrete
+        constraint is A(q̄)δq + h b(q̄) = 0 at the step's midpoint q̄. The constraint forces
+        then do work: the energy is not conserved, and :func:`varmech.check_conservation` does
+        not judge it.
     mass_derivative
         With a ``mass`` closure: ``mass_derivative(q) -> array (n, n, n)`` whose ``[i]`` is
         ∂M/∂qᵢ. Optional: without it, central differences of ``mass`` are used (2n calls
@@ -346,6 +360,7 @@ class MechanicalSystem(Model):
         constraint_count: int | None = None,
         velocity_constraints: Callable[[np.ndarray], ArrayLike] | None = None,
         velocity_constraint_count: int | None = None,
+        velocity_constraint_offset: Callable[[np.ndarray], ArrayLike] | None = None,
         symmetries: Sequence[Symmetry] = (),
         name: str = "mechanical system",
     ):
@@ -360,6 +375,7 @@ class MechanicalSystem(Model):
             "constraint_count": constraint_count,
             "velocity_constraints": velocity_constraints,
             "velocity_constraint_count": velocity_constraint_count,
+            "velocity_constraint_offset": velocity_constraint_offset,
             "symmetries": symmetries,
             "name": name,
         }
@@ -367,13 +383,13 @@ class MechanicalSystem(Model):
             raise ValueError(f"dim: must be a positive integer, got {dim!r}")
         if (constraints is None) != (constraint_count is None) or (constraint_jacobian is not None and constraints is None):
             raise ValueError("constraints: give constraints(q) with constraint_count (and optionally constraint_jacobian)")
-        _check_velocity_constraints(velocity_constraints, velocity_constraint_count)
+        _check_velocity_constraints(velocity_constraints, velocity_constraint_count, velocity_constraint_offset)
         if constraints is not None and velocity_constraints is not None:
             raise ValueError("velocity_constraints: not together with holonomic constraints (yet); give one kind")
         native = pointers.functions({"potential": potential, "gradient": gradient}, int(dim))
         others = {"mass": mass if callable(mass) else None, "mass_derivative": mass_derivative}
         others |= {"constraints": constraints, "constraint_jacobian": constraint_jacobian}
-        others |= {"velocity_constraints": velocity_constraints}
+        others |= {"velocity_constraints": velocity_constraints, "velocity_constraint_offset": velocity_constraint_offset}
         refused = [k for k, f in others.items() if f is not None and (native is not None or pointers.is_pointer(f))]
         refused += ["gradient"] if native is not None and "gradient" not in native else []
         if refused:
@@ -408,7 +424,7 @@ class MechanicalSystem(Model):
         if callable(mass) and native is None:
             self._core = _core.ClosureNatural(int(dim), mass, potential, gradient, mass_derivative, _specs(symmetries))
             self._constrain(constraints, constraint_jacobian, constraint_count)
-            self._core = _roll(self._core, velocity_constraints, velocity_constraint_count)
+            self._core = _roll(self._core, velocity_constraints, velocity_constraint_count, velocity_constraint_offset)
             return
         m = np.array(mass, dtype=float)
         if m.ndim > 2 or (m.ndim >= 1 and any(s != dim for s in m.shape)):
@@ -423,7 +439,7 @@ class MechanicalSystem(Model):
             return
         self._core = _core.ClosureModel(int(dim), potential, gradient, m, _specs(symmetries))
         self._constrain(constraints, constraint_jacobian, constraint_count)
-        self._core = _roll(self._core, velocity_constraints, velocity_constraint_count)
+        self._core = _roll(self._core, velocity_constraints, velocity_constraint_count, velocity_constraint_offset)
 
     def _constrain(self, constraints, jacobian, count) -> None:
         """Puts the model on the constraints, if any."""
@@ -436,20 +452,27 @@ class MechanicalSystem(Model):
         self._core = _core.ClosureConstrained(self._core, int(count), constraints, jacobian)
 
 
-def _check_velocity_constraints(matrix: Callable[[np.ndarray], ArrayLike] | None, count: int | None) -> None:
-    """Refuses velocity constraints without their count or a count without them."""
+def _check_velocity_constraints(
+    matrix: Callable[[np.ndarray], ArrayLike] | None, count: int | None, offset: Callable[[np.ndarray], ArrayLike] | None
+) -> None:
+    """Refuses velocity constraints without their count, a count without them, and an affine
+    term without either."""
     if (matrix is None) != (count is None):
         raise ValueError("velocity_constraints: give velocity_constraints(q) with velocity_constraint_count")
+    if offset is not None and matrix is None:
+        raise ValueError("velocity_constraint_offset: only with velocity_constraints(q) and velocity_constraint_count")
     if count is not None and (isinstance(count, bool) or not isinstance(count, (int, np.integer))):
         raise ValueError(f"velocity_constraint_count: must be a positive integer, got {count!r}")
 
 
-def _roll(core: Any, matrix: Callable[[np.ndarray], ArrayLike] | None, count: int | None) -> Any:
-    """The unconstrained closure model ``core`` with the velocity constraints A(q)q̇ = 0 of
-    ``matrix`` (m = ``count`` rows), if any."""
+def _roll(
+    core: Any, matrix: Callable[[np.ndarray], ArrayLike] | None, count: int | None, offset: Callable[[np.ndarray], ArrayLike] | None
+) -> Any:
+    """The unconstrained closure model ``core`` with the velocity constraints A(q)q̇ + b(q) = 0
+    of ``matrix`` (m = ``count`` rows) and ``offset`` (b; 0 without it), if any."""
     if matrix is None or count is None:
         return core
-    return _core.ClosureNonholonomic(core, int(count), matrix)
+    return _core.ClosureNonholonomic(core, int(count), matrix, offset)
 
 
 class Lagrangian(Model):
@@ -490,6 +513,9 @@ class Lagrangian(Model):
     velocity_constraints, velocity_constraint_count
         Velocity constraints A(q)q̇ = 0, ``velocity_constraints(q) -> array (m, n)`` with
         ``velocity_constraint_count`` = m, as for :class:`MechanicalSystem`; closures only.
+    velocity_constraint_offset
+        The affine term b(q) of constraints A(q)q̇ + b(q) = 0, ``velocity_constraint_offset(q)
+        -> array (m,)``, as for :class:`MechanicalSystem`.
     symmetries
         Symmetries of L whose Noether momenta :func:`varmech.check_conservation` checks.
     name
@@ -541,6 +567,7 @@ class Lagrangian(Model):
         time_dependent: bool = False,
         velocity_constraints: Callable[[np.ndarray], ArrayLike] | None = None,
         velocity_constraint_count: int | None = None,
+        velocity_constraint_offset: Callable[[np.ndarray], ArrayLike] | None = None,
         symmetries: Sequence[Symmetry] = (),
         name: str = "lagrangian",
     ):
@@ -555,16 +582,18 @@ class Lagrangian(Model):
             "time_dependent": time_dependent,
             "velocity_constraints": velocity_constraints,
             "velocity_constraint_count": velocity_constraint_count,
+            "velocity_constraint_offset": velocity_constraint_offset,
             "symmetries": symmetries,
             "name": name,
         }
         if isinstance(dim, bool) or not isinstance(dim, (int, np.integer)) or dim < 1:
             raise ValueError(f"dim: must be a positive integer, got {dim!r}")
-        _check_velocity_constraints(velocity_constraints, velocity_constraint_count)
+        _check_velocity_constraints(velocity_constraints, velocity_constraint_count, velocity_constraint_offset)
         functions = {"lagrangian": lagrangian, "dl_dq": dl_dq, "dl_dv": dl_dv, "hessians": hessians, "force": force}
         native = pointers.functions(functions, int(dim))
-        if velocity_constraints is not None and (native is not None or pointers.is_pointer(velocity_constraints)):
-            raise TypeError("velocity_constraints: only with closures (not with function pointers), and as a closure")
+        for key, f in (("velocity_constraints", velocity_constraints), ("velocity_constraint_offset", velocity_constraint_offset)):
+            if f is not None and (native is not None or pointers.is_pointer(f)):
+                raise TypeError(f"{key}: only with closures (not with function pointers), and as a closure")
         if native is not None and rayleigh is not None:
             raise TypeError("rayleigh: not with function pointers; add −Cq̇ to the force pointer instead")
         missing = [n for n, f in (("dl_dq", dl_dq), ("dl_dv", dl_dv)) if f is None]
@@ -602,6 +631,7 @@ class Lagrangian(Model):
                 ),
                 velocity_constraints,
                 velocity_constraint_count,
+                velocity_constraint_offset,
             )
         self.force = total_force
         self.lagrangian = lagrangian

@@ -333,3 +333,57 @@ def elliptic_billiard(A: float = 2.0, B: float = 1.0, x0: float = 0.3, y0: float
     (50, True)
     """
     return get("elliptic_billiard", a=A, b=B, x0=x0, y0=y0, px0=px0, py0=py0)
+
+
+def rolling_disk(radius: float = 1.0, turn: float = 0.7, roll: float = 2.0) -> Scene:
+    """A thin uniform disk (a coin) of unit mass and radius R rolling upright without slipping,
+    q = (x, y, θ, φ): contact point, heading, rolling angle; L = ½(ẋ² + ẏ²) + ½Iθ̇² + ½Jφ̇²
+    (I = R²/4, J = R²/2) with ẋ = Rφ̇cosθ, ẏ = Rφ̇sinθ. From θ₀ = 0.3 turning at θ̇ = ``turn``
+    and rolling at φ̇ = ``roll``, to T = 100. Exact: θ̇, φ̇ and E constant, the contact point on
+    the circle of radius Rφ̇/θ̇ (the reference). Conserved momenta: p_θ = Iθ̇ and p_φ = Jφ̇
+    (invariants ``"p[2]"``, ``"p[3]"``); p_x and p_y are not, though L does not depend on x, y.
+
+    Examples
+    --------
+    >>> import varmech
+    >>> scene = varmech.scenes.rolling_disk()
+    >>> traj = varmech.integrate(scene, dt=scene.dt, t_end=scene.t_end, save_every=10)
+    >>> report = varmech.check_conservation(traj)
+    >>> report.verdict, [m.name for m in report.momenta], report.constraints[0].verdict
+    ('conserved to round-off', ['p[2]', 'p[3]'], 'conserved to round-off')
+    """
+    return get("rolling_disk", radius=radius, turn=turn, roll=roll)
+
+
+def chaplygin_sleigh(inertia: float = 1.0, blade: float = 1.0, spin: float = 1.0) -> Scene:
+    """The Chaplygin sleigh: a body of unit mass, q = (x, y, θ) of its centre and heading, moment
+    of inertia ``inertia`` about the centre, whose blade a distance b = ``blade`` behind the
+    centre does not slip sideways: −ẋsinθ + ẏcosθ − bθ̇ = 0. Spinning in place at θ̇ = ``spin``
+    from the origin, to T = 40, it relaxes to straight-line motion: u = U tanh κt,
+    ω = ω₀ sech κt, U = √(2E), κ = bU/(I + b²) (the reference holds θ and the momenta at T).
+    Energy conserved; no momentum is (the blade's force turns them all)."""
+    return get("chaplygin_sleigh", inertia=inertia, blade=blade, spin=spin)
+
+
+def rolling_sphere(alpha: float = 0.5, g: float = 9.81, radius: float = 1.0, vx0: float = 1.0, vy0: float = 0.3, spin: float = 1.0) -> Scene:
+    """A homogeneous ball of unit mass (I = 2a²/5) rolling on a rough plane inclined at α, x
+    down the slope, q = (x, y, φ, θ, ψ): its centre and ZXZ Euler angles. From the origin with
+    centre velocity (vx0, vy0) and ``spin`` ω_z about the normal, to T = 1: Byerly's exact solution,
+    the centre accelerating at (5/7)g sin α down the slope and moving uniformly across it, on
+    a parabola (the reference holds the centre and p_x, p_y, p_φ). Conserved: E and p_φ = Iω_z
+    (``"p[2]"``); p_y = ẏ by the exact motion but only to O(h²) by the discrete one, so it is
+    not declared; p_x is not."""
+    return get("rolling_sphere", alpha=alpha, g=g, radius=radius, vx0=vx0, vy0=vy0, spin=spin)
+
+
+def ball_on_turntable(
+    omega: float = 1.0, radius: float = 1.0, x0: float = 1.0, y0: float = 0.0, vx0: float = 0.0, vy0: float = 0.2, spin: float = 1.0
+) -> Scene:
+    """The ball of :func:`rolling_sphere` on a level table turning at Ω = ``omega`` about the
+    origin: no slip relative to the table, affine constraints A(q)q̇ + b(q) = 0 with
+    b = (Ωy, −Ωx). From centre (x0, y0) with velocity (vx0, vy0) and ``spin`` ω_z about the normal,
+    its centre's velocity turns at ν = (2/7)Ω: it circles about r + (−ẏ, ẋ)/ν, back to its
+    start at T = 14π/Ω (the reference). The table does work: E is not conserved (unless the
+    circle is centred on the axis); the Jacobi integral J = E − Ω(x p_y − y p_x) is, with
+    p_φ = Iω_z (invariants ``"J"``, ``"p[2]"``), the speed |ṙ| and the circle's centre."""
+    return get("ball_on_turntable", omega=omega, radius=radius, x0=x0, y0=y0, vx0=vx0, vy0=vy0, spin=spin)

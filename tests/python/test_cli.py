@@ -17,7 +17,7 @@ def test_tour_prints_reports_and_writes_plots(tmp_path, run_cli):
     pytest.importorskip("matplotlib")
     out = run_cli("tour", "--quick", "--out", tmp_path).stdout
     runs = sum(len(methods) for _, methods, _ in tour_runs()) + sum(len(methods) for _, _, methods in TOUR_REDUCED)
-    assert runs == 48 and out.count("Conservation report") == runs
+    assert runs == 52 and out.count("Conservation report") == runs
     assert "max |G M⁻¹ p|" in out
     assert "verdict: secular drift" in out and "verdict: bounded" in out
     # The summary: every symplectic or variational run conserves its energy (or its balance),
@@ -27,8 +27,12 @@ def test_tour_prints_reports_and_writes_plots(tmp_path, run_cli):
     rows = [line.split(" | ") for line in lines[start + 2 : start + 2 + runs]]
     assert len(rows) == runs and all(len(r) == 6 for r in rows)
     info = {m.name: m for m in varmech.methods()}
+    rolling = {name for name in scenes.CATALOGUE if scenes.get(name).model.velocity_constraints}
     for scene, method, _, _, _, verdict in rows:
-        if info[method].symplectic:
+        # The discrete Lagrange–d'Alembert step is not symplectic (nonholonomic flows are not):
+        # the ball on the incline accelerates (its energy error grows with it over its t_end)
+        # and the turntable's energy is not conserved.
+        if info[method].symplectic and scene.strip("| `") not in rolling:
             assert verdict.removeprefix("balance E − W ") in ("conserved to round-off", "bounded"), (scene, method, verdict)
         if method == "rk4":
             assert verdict == "secular drift", scene

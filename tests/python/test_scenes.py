@@ -30,6 +30,10 @@ def computed(scene, name):
         return float(energy_of(scene.model, np.zeros(1), q[None, :], p[None, :])[0])
     if name == "I":
         return oscillatory_energy(q, p)
+    if name == "J":
+        # The turntable ball's Jacobi integral E − Ω(x p_y − y p_x).
+        energy = float(energy_of(scene.model, np.zeros(1), q[None, :], p[None, :])[0])
+        return energy - scene.parameters["omega"] * (q[0] * p[1] - q[1] * p[0])
     if name == "L1L2":
         # The elliptic billiard's product of the angular momenta about its foci (±c, 0).
         c = math.sqrt(scene.parameters["a"] ** 2 - scene.parameters["b"] ** 2)

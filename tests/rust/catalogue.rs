@@ -2,7 +2,7 @@
 //! its invariants are the model's energy and momenta at t = 0.
 
 use varmech::model::{hamiltonian, Generator, Lagrangian};
-use varmech::scenes::{lookup, Scene, SceneModel, Setup, CATALOGUE};
+use varmech::scenes::{lookup, NonholonomicScene, Scene, SceneModel, Setup, CATALOGUE};
 use varmech::Error;
 
 /// Relative agreement of a catalogue value with the value computed from the initial state.
@@ -42,6 +42,16 @@ fn computed(model: &SceneModel, name: &str, q: &[f64], p: &[f64]) -> Option<f64>
         SceneModel::Constrained(s) => momentum(varmech::model::MechanicalSystem::symmetries(&s.system)),
         SceneModel::ConstrainedGeneral(s) if energy => Some(s.system.energy(q, p, 0.0).unwrap()),
         SceneModel::ConstrainedGeneral(_) => None,
+        // The ball on the turntable's Jacobi integral J = E − Ω(x p_y − y p_x).
+        SceneModel::Nonholonomic(NonholonomicScene::RollingSphere(s)) if name == "J" => {
+            Some(s.system.jacobi_integral(s.constraints.rate(), q, p).unwrap())
+        }
+        SceneModel::Nonholonomic(s) if energy => Some(match s {
+            NonholonomicScene::RollingDisk(s) => s.system.energy(q, p, 0.0).unwrap(),
+            NonholonomicScene::ChaplyginSleigh(s) => s.system.energy(q, p, 0.0).unwrap(),
+            NonholonomicScene::RollingSphere(s) => s.system.energy(q, p, 0.0).unwrap(),
+        }),
+        SceneModel::Nonholonomic(s) => momentum(s.symmetries()),
     }
 }
 

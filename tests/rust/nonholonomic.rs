@@ -4,6 +4,7 @@
 //! RATTLE, and the Chaplygin sleigh.
 
 use crate::common;
+use crate::nonholonomic_scenes::{ball, build};
 
 use nalgebra::DMatrix;
 use varmech::integrators::{integrate, Dynamics, General, Method, Options, Trajectory};
@@ -11,6 +12,7 @@ use varmech::model::{
     Anchor, Constrained, Distances, Hessians, Lagrangian, Link, Mass, MechanicalSystem, Nonholonomic,
     VelocityConstraints,
 };
+use varmech::scenes::{Blade, FreeBody, NonholonomicScene, SceneModel};
 use varmech::{Error, ModelError};
 
 /// L = ½q̇ᵀ diag(m) q̇, a free body, with its exact second derivatives unless `differenced`.
@@ -128,7 +130,13 @@ fn disk(differenced: bool) -> (Nonholonomic<Free, Rolling>, Vec<f64>, Vec<f64>) 
 
 /// The largest relative distance of the disk's contact point from the circle of radius Rφ̇/θ̇
 /// about its centre, over a run of `steps` steps of h.
-fn off_the_circle(model: &Nonholonomic<Free, Rolling>, q0: &[f64], p0: &[f64], h: f64, steps: usize) -> f64 {
+fn off_the_circle<L: Lagrangian, C: VelocityConstraints>(
+    model: &Nonholonomic<L, C>,
+    q0: &[f64],
+    p0: &[f64],
+    h: f64,
+    steps: usize,
+) -> f64 {
     let traj = run(model, q0, p0, &options(h, steps, 1));
     let radius = 2.0 / 0.7;
     let centre = (-radius * q0[2].sin(), radius * q0[2].cos());
@@ -146,7 +154,11 @@ fn the_rolling_disk_turns_and_rolls_at_constant_rates_on_a_circle() {
     // steps: the angles grow to θ = 3.5e4 and φ = 1e5 rad, whose rounding (ε|φ| ≈ 2e-11 a
     // step) random-walks φ̇ and E by 4e-8 over the run (1.7e-10 after 10⁵ steps, as √N; the
     // method's own error is O(h²) = 2.5e-3).
-    let (model, q0, p0) = disk(false);
+    let problem = build("rolling_disk", &[]);
+    let SceneModel::Nonholonomic(NonholonomicScene::RollingDisk(model)) = problem.system else {
+        panic!("not the disk")
+    };
+    let (q0, p0) = (problem.initial.q, problem.initial.p);
     let (h, steps) = (0.05, 1_000_000);
     let traj = run(&model, &q0, &p0, &options(h, steps, 100));
     let (omega, spin) = (0.7, 2.0);
@@ -186,77 +198,11 @@ fn the_exact_jacobian_and_the_differenced_one_take_the_same_steps() {
     assert!(gap <= 1e-11, "{gap:e}");
 }
 
-/// A homogeneous sphere (m = 1, radius a = 1, I = 2/5) on a rough plane inclined at α, with
-/// x down the slope: q = (x, y, φ, θ, ψ) with ZXZ Euler angles, whose space-frame angular
-/// velocity is ω = (θ̇cosφ + ψ̇sinθsinφ, θ̇sinφ − ψ̇sinθcosφ, φ̇ + ψ̇cosθ), so that
-/// L = ½(ẋ² + ẏ²) + ½I(φ̇² + θ̇² + ψ̇² + 2φ̇ψ̇cosθ) + g sinα x. Rolling: ẋ = aω_y, ẏ = −aω_x.
-struct Sphere {
-    slope: f64,
-}
-
-const INERTIA: f64 = 0.4;
-
-impl Lagrangian for Sphere {
-    fn dim(&self) -> usize {
-        5
-    }
-
-    fn lagrangian(&self, q: &[f64], v: &[f64], _t: f64) -> Result<f64, ModelError> {
-        let spin = v[2] * v[2] + v[3] * v[3] + v[4] * v[4] + 2.0 * v[2] * v[4] * q[3].cos();
-        Ok(0.5 * (v[0] * v[0] + v[1] * v[1]) + 0.5 * INERTIA * spin + self.slope * q[0])
-    }
-
-    fn dl_dq(&self, q: &[f64], v: &[f64], _t: f64, out: &mut [f64]) -> Result<(), ModelError> {
-        out.fill(0.0);
-        out[0] = self.slope;
-        out[3] = -INERTIA * v[2] * v[4] * q[3].sin();
-        Ok(())
-    }
-
-    fn dl_dv(&self, q: &[f64], v: &[f64], _t: f64, out: &mut [f64]) -> Result<(), ModelError> {
-        let c = q[3].cos();
-        out.copy_from_slice(&[
-            v[0],
-            v[1],
-            INERTIA * (v[2] + v[4] * c),
-            INERTIA * v[3],
-            INERTIA * (v[4] + v[2] * c),
-        ]);
-        Ok(())
-    }
-}
-
-struct RollingSphere;
-
-impl VelocityConstraints for RollingSphere {
-    fn count(&self) -> usize {
-        2
-    }
-
-    fn matrix(&self, q: &[f64], a: &mut DMatrix<f64>) -> Result<(), ModelError> {
-        let ((sp, cp), st) = (q[2].sin_cos(), q[3].sin());
-        a.fill(0.0);
-        (a[(0, 0)], a[(0, 3)], a[(0, 4)]) = (1.0, -sp, st * cp);
-        (a[(1, 1)], a[(1, 3)], a[(1, 4)]) = (1.0, cp, st * sp);
-        Ok(())
-    }
-}
-
-/// The sphere's centre at T = 1 with steps of h, from (0, 0) with velocity (1, 0.3) and no
-/// spin about the normal, the body's axis along the y axis (φ = π, θ = π/2).
+/// The centre of the ball of the scene `rolling_sphere` at T = 1 with steps of h (from (0, 0)
+/// with velocity (1, 0.3) and no spin about the normal, on the incline α = 0.5), and the
+/// largest constraint residual.
 fn sphere_centre(h: f64) -> ([f64; 2], f64) {
-    let model = Nonholonomic {
-        system: Sphere {
-            slope: 9.81 * 0.5_f64.sin(),
-        },
-        constraints: RollingSphere,
-    };
-    let (vx, vy) = (1.0, 0.3);
-    let q0 = [0.0, 0.0, std::f64::consts::PI, std::f64::consts::FRAC_PI_2, 0.0];
-    // ω = (−vy, vx, 0): θ̇ = −ω_x, ψ̇ = ω_y, φ̇ = ω_z − ψ̇cosθ at φ = π, θ = π/2.
-    let v0 = [vx, vy, 0.0, vy, vx];
-    let mut p0 = [0.0; 5];
-    model.system.dl_dv(&q0, &v0, 0.0, &mut p0).unwrap();
+    let (model, q0, p0, _) = ball("rolling_sphere", &[]);
     let steps = (1.0 / h).round() as usize;
     let traj = run(&model, &q0, &p0, &options(h, steps, steps));
     let q = traj.q_at(traj.len() - 1);
@@ -372,34 +318,14 @@ fn a_particle_held_to_a_circle_by_a_velocity_constraint_is_the_pendulum() {
     common::assert_order("DLA against RATTLE at T = 10", &gaps, 2.0, 0.15);
 }
 
-/// The Chaplygin sleigh, q = (x, y, θ) of its centre of mass and heading (m = 1, I = 1 about
-/// the centre), its blade b = 1 behind the centre: no sideways slip there,
-/// −ẋ sinθ + ẏ cosθ − bθ̇ = 0.
-struct Blade;
-
-impl VelocityConstraints for Blade {
-    fn count(&self) -> usize {
-        1
+/// The sleigh of the scene `chaplygin_sleigh` (m = I = 1, blade b = 1 behind the centre)
+/// spinning in place, ω = 1 and u = 0 (its centre moving sideways at bω).
+fn sleigh() -> (Nonholonomic<FreeBody, Blade>, Vec<f64>, Vec<f64>) {
+    let problem = build("chaplygin_sleigh", &[]);
+    match problem.system {
+        SceneModel::Nonholonomic(NonholonomicScene::ChaplyginSleigh(s)) => (s, problem.initial.q, problem.initial.p),
+        other => panic!("not the sleigh: {other:?}"),
     }
-
-    fn matrix(&self, q: &[f64], a: &mut DMatrix<f64>) -> Result<(), ModelError> {
-        let (s, c) = q[2].sin_cos();
-        (a[(0, 0)], a[(0, 1)], a[(0, 2)]) = (-s, c, -1.0);
-        Ok(())
-    }
-}
-
-/// The sleigh (Newton's Jacobian by differences) spinning in place, ω = 1 and u = 0 (its
-/// centre moving sideways at bω).
-fn sleigh() -> (Nonholonomic<Free, Blade>, [f64; 3], [f64; 3]) {
-    let model = Nonholonomic {
-        system: Free {
-            mass: vec![1.0, 1.0, 1.0],
-            differenced: true,
-        },
-        constraints: Blade,
-    };
-    (model, [0.0, 0.0, 0.0], [0.0, 1.0, 1.0])
 }
 
 #[test]

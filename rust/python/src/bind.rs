@@ -159,8 +159,16 @@ fn is_forced(py: Python<'_>, model: &Bound<'_, PyAny>) -> PyResult<bool> {
     bind_model(py, model, |sys, _| sys.as_lagrangian().is_forced())
 }
 
+/// Whether the model's velocity constraints are affine, A(q)q̇ + b(q) = 0 with b ≠ 0 (then
+/// their forces do work and the energy is not conserved).
+#[pyfunction]
+fn is_affine(py: Python<'_>, model: &Bound<'_, PyAny>) -> PyResult<bool> {
+    bind_model(py, model, |sys, _| sys.is_affine())
+}
+
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PyModelKind>()?;
+    m.add_function(wrap_pyfunction!(is_affine, m)?)?;
     m.add_function(wrap_pyfunction!(kind_of, m)?)?;
     m.add_function(wrap_pyfunction!(is_time_dependent, m)?)?;
     m.add_function(wrap_pyfunction!(is_forced, m)?)?;

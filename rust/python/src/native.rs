@@ -3,7 +3,7 @@
 use pyo3::prelude::*;
 use varmech::integrators::{Dynamics, General};
 use varmech::model::{Constrained, HolonomicConstraints, MechanicalSystem};
-use varmech::scenes::{Scene, SceneModel};
+use varmech::scenes::{NonholonomicScene, Scene, SceneModel};
 
 use crate::generator::Generator;
 
@@ -31,6 +31,9 @@ impl NativeModel {
                 system: General(&scene.system),
                 constraints: scene.constraints.clone(),
             }),
+            SceneModel::Nonholonomic(NonholonomicScene::RollingDisk(scene)) => body(scene),
+            SceneModel::Nonholonomic(NonholonomicScene::ChaplyginSleigh(scene)) => body(scene),
+            SceneModel::Nonholonomic(NonholonomicScene::RollingSphere(scene)) => body(scene),
         }
     }
 }
@@ -64,6 +67,7 @@ impl NativeModel {
             SceneModel::General(s) => s.symmetries(),
             SceneModel::Constrained(s) => s.system.symmetries(),
             SceneModel::ConstrainedGeneral(_) => Vec::new(),
+            SceneModel::Nonholonomic(s) => s.symmetries(),
         };
         declared.into_iter().map(Generator::from).collect()
     }
@@ -74,6 +78,15 @@ impl NativeModel {
         match &self.native {
             SceneModel::Constrained(s) => s.constraints.count(),
             SceneModel::ConstrainedGeneral(s) => s.constraints.count(),
+            _ => 0,
+        }
+    }
+
+    /// Number of velocity constraints A(q)q̇ + b(q) = 0 (0 for models without them).
+    #[getter]
+    fn velocity_constraints(&self) -> usize {
+        match &self.native {
+            SceneModel::Nonholonomic(s) => s.count(),
             _ => 0,
         }
     }

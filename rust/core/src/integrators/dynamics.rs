@@ -63,12 +63,18 @@ pub trait Dynamics {
         Ok(())
     }
 
-    /// The energy function and its terms at (q, p, t), where L does not depend on t (forced
-    /// or not: a forced run balances it against the work done).
+    /// The energy function and its terms at (q, p, t), where L does not depend on t and no
+    /// constraint does work (forced or not: a forced run balances it against the work done).
     fn energy(&self, q: &[f64], p: &[f64], t: f64) -> Option<Result<EnergyTerms, ModelError>>;
 
     /// The system as a Lagrangian, for the diagnostics (energy function, Legendre transforms).
     fn as_lagrangian(&self) -> &dyn Lagrangian;
+
+    /// Whether the model has affine velocity constraints A(q)q̇ + b(q) = 0, b ≠ 0: their
+    /// forces do work, so that the energy function is not conserved.
+    fn is_affine(&self) -> bool {
+        false
+    }
 
     /// |g(q)|∞ and |G(q)M⁻¹p|∞, with their sizes, for a constrained system; None for the others.
     fn constraint_residuals(&self, _q: &[f64], _p: &[f64]) -> Option<Result<model::Residuals, ModelError>> {
@@ -289,13 +295,20 @@ impl<L: Lagrangian, C: VelocityConstraints> Dynamics for Nonholonomic<L, C> {
         integrator.increment_nonholonomic(&self.system, &self.constraints, start, increment)
     }
 
-    /// E = p·q̇ − L, unless L depends on t: the constraint forces do no work.
+    /// E = p·q̇ − L, unless L depends on t or the constraints are affine
+    /// ([`Dynamics::is_affine`]): linear constraints' forces do no work, affine ones' do, so
+    /// that their runs have no energy to watch.
     fn energy(&self, q: &[f64], p: &[f64], t: f64) -> Option<Result<EnergyTerms, ModelError>> {
-        (!self.system.is_time_dependent()).then(|| self.system.energy_terms(q, p, t))
+        let conserved = !self.system.is_time_dependent() && !self.constraints.is_affine();
+        conserved.then(|| self.system.energy_terms(q, p, t))
     }
 
     fn as_lagrangian(&self) -> &dyn Lagrangian {
         &self.system
+    }
+
+    fn is_affine(&self) -> bool {
+        self.constraints.is_affine()
     }
 
     fn constraint_residuals(&self, q: &[f64], p: &[f64]) -> Option<Result<model::Residuals, ModelError>> {

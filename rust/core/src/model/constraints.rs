@@ -272,15 +272,17 @@ pub fn project<C: HolonomicConstraints + ?Sized>(
             "its projection overflows: the positions are too large to project",
         ));
     }
-    let p = momentum_projection(&jac, minv, velocity, q.as_slice(), p0)?;
+    let p = momentum_projection(&jac, &DVector::zeros(m), minv, velocity, q.as_slice(), p0)?;
     Ok((q.as_slice().to_vec(), p))
 }
 
-/// p ← p − Gᵀμ with (GW)μ = Gq̇(q, p), W = M⁻¹Gᵀ: the M-orthogonal projection of the momenta
-/// onto G(q)q̇ = 0 for the constraint matrix G (m × n) at q. Errors name `q0` (the constraints
-/// not independent, or failing to evaluate) and `p0` (overflow).
+/// p ← p − Gᵀμ with (GW)μ = Gq̇(q, p) + b, W = M⁻¹Gᵀ: the M-orthogonal projection of the
+/// momenta onto G(q)q̇ + b = 0 for the constraint matrix G (m × n) at q and the affine term b
+/// (0 but for affine velocity constraints). Errors name `q0` (the constraints not independent,
+/// or failing to evaluate) and `p0` (overflow).
 pub(super) fn momentum_projection(
     jac: &DMatrix<f64>,
+    offset: &DVector<f64>,
     minv: Action<'_>,
     velocity: Action<'_>,
     q: &[f64],
@@ -293,7 +295,7 @@ pub(super) fn momentum_projection(
     velocity(q, p0, &mut v).map_err(model)?;
     let mu = (jac * &w)
         .lu()
-        .solve(&(jac * DVector::from_column_slice(&v)))
+        .solve(&(jac * DVector::from_column_slice(&v) + offset))
         .ok_or_else(singular)?;
     let p = DVector::from_column_slice(p0) - jac.transpose() * mu;
     if !p.iter().all(|x| x.is_finite()) {

@@ -4,9 +4,13 @@ use super::constraints::{momentum_projection, row_norm};
 use super::{inverse_mass, Lagrangian, Residuals};
 use crate::{Error, ModelError};
 
-/// Velocity constraints A(q)q̇ = 0 linear in the velocities, m rows on n coordinates, that need
-/// not integrate to constraints on the positions (nonholonomic: rolling without slipping, a
-/// skate's blade). The constraint forces are Aᵀλ, by the Lagrange–d'Alembert principle.
+/// Velocity constraints A(q)q̇ + b(q) = 0 affine in the velocities, m rows on n coordinates,
+/// that need not integrate to constraints on the positions (nonholonomic: rolling without
+/// slipping, a skate's blade). The constraint forces are Aᵀλ, by the Lagrange–d'Alembert
+/// principle. Mostly b = 0 (linear constraints, the default); an affine term b(q), the
+/// inhomogeneous part of *affine nonholonomic constraints* (Bloch, *Nonholonomic Mechanics and
+/// Control*, §5.2), is the velocity of a moving surface at the contact, e.g. a turntable's
+/// Ω ẑ × r. With b ≠ 0 the constraint forces do work, λ·b, and the energy is not conserved.
 pub trait VelocityConstraints {
     /// Number of constraints m.
     fn count(&self) -> usize;
@@ -18,6 +22,36 @@ pub trait VelocityConstraints {
     /// the discrete Lagrange–d'Alembert equations. Default: [`differenced_derivative`].
     fn derivative(&self, q: &[f64], i: usize, out: &mut DMatrix<f64>) -> Result<(), ModelError> {
         differenced_derivative(self, q, i, out)
+    }
+
+    /// Whether the constraints have an affine term b(q) ≠ 0 ([`Self::offset`]).
+    fn is_affine(&self) -> bool {
+        false
+    }
+
+    /// Writes the affine term b(q) (m entries) into `b`. Default: 0, linear constraints.
+    fn offset(&self, _q: &[f64], b: &mut [f64]) -> Result<(), ModelError> {
+        b.fill(0.0);
+        Ok(())
+    }
+
+    /// Writes ∂b/∂qᵢ (m entries) into `out`, for Newton's exact Jacobian. Default: 0 for
+    /// linear constraints, a central difference of b (as [`differenced_derivative`]) for affine
+    /// ones.
+    fn offset_derivative(&self, q: &[f64], i: usize, out: &mut [f64]) -> Result<(), ModelError> {
+        if !self.is_affine() {
+            out.fill(0.0);
+            return Ok(());
+        }
+        let h = f64::EPSILON.cbrt() * q[i].abs().max(1.0);
+        let mut x = q.to_vec();
+        let mut minus = vec![0.0; out.len()];
+        x[i] = q[i] + h;
+        self.offset(&x, out)?;
+        x[i] = q[i] - h;
+        self.offset(&x, &mut minus)?;
+        out.iter_mut().zip(&minus).for_each(|(o, m)| *o = (*o - m) / (2.0 * h));
+        Ok(())
     }
 }
 
@@ -58,30 +92,37 @@ impl<S: Lagrangian, C: VelocityConstraints> Nonholonomic<S, C> {
         Ok(a)
     }
 
-    /// |A(q)q̇|∞ with q̇ = q̇(q, p) (as `velocity`), judged against ‖A(q)‖∞‖q̇‖∞; the
-    /// position entries are 0 (there is no constraint on q).
+    /// b(q), allocated (diagnostics and set-up).
+    fn offset(&self, q: &[f64]) -> Result<DVector<f64>, ModelError> {
+        let mut b = DVector::zeros(self.constraints.count());
+        self.constraints.offset(q, b.as_mut_slice())?;
+        Ok(b)
+    }
+
+    /// |A(q)q̇ + b(q)|∞ with q̇ = q̇(q, p) (as `velocity`), judged against
+    /// ‖A(q)‖∞‖q̇‖∞ + |b(q)|∞; the position entries are 0 (there is no constraint on q).
     pub fn residuals(&self, q: &[f64], p: &[f64]) -> Result<Residuals, ModelError> {
-        let a = self.matrix(q)?;
+        let (a, b) = (self.matrix(q)?, self.offset(q)?);
         let mut v = vec![0.0; q.len()];
         self.system.velocity(q, p, 0.0, &mut v)?;
         let v = DVector::from_column_slice(&v);
         Ok(Residuals {
             position: 0.0,
-            velocity: (&a * &v).amax(),
+            velocity: (&a * &v + &b).amax(),
             position_size: 0.0,
-            velocity_size: row_norm(&a) * v.amax(),
+            velocity_size: row_norm(&a) * v.amax() + b.amax(),
         })
     }
 
-    /// The nearest consistent state: q unchanged, p ← p − Aᵀμ with (AM⁻¹Aᵀ)μ = Aq̇(q, p), the
-    /// M-orthogonal projection onto A(q)q̇ = 0, M(q)⁻¹x = q̇(q, x) − q̇(q, 0) (exact for L
-    /// quadratic in q̇).
+    /// The nearest consistent state: q unchanged, p ← p − Aᵀμ with (AM⁻¹Aᵀ)μ = Aq̇(q, p) + b(q),
+    /// the M-orthogonal projection onto A(q)q̇ + b(q) = 0, M(q)⁻¹x = q̇(q, x) − q̇(q, 0) (exact
+    /// for L quadratic in q̇).
     pub fn project(&self, q: &[f64], p: &[f64]) -> Result<(Vec<f64>, Vec<f64>), Error> {
         let model = |e: ModelError| Error::invalid("q0", format!("the velocity constraints failed to evaluate: {e}"));
         let velocity = |q: &[f64], p: &[f64], v: &mut [f64]| self.system.velocity(q, p, 0.0, v);
         let minv = inverse_mass(&velocity);
-        let a = self.matrix(q).map_err(model)?;
-        let p = momentum_projection(&a, &minv, &velocity, q, p)?;
+        let (a, b) = (self.matrix(q).map_err(model)?, self.offset(q).map_err(model)?);
+        let p = momentum_projection(&a, &b, &minv, &velocity, q, p)?;
         Ok((q.to_vec(), p))
     }
 }

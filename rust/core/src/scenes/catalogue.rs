@@ -5,15 +5,16 @@
 use std::f64::consts::PI;
 
 use super::{
-    cartesian_pendulum, cartesian_spherical_pendulum, planar_chain, BouncingBall, ChargedParticle,
+    cartesian_pendulum, cartesian_spherical_pendulum, planar_chain, BouncingBall, ChaplyginSleigh, ChargedParticle,
     DampedDrivenPendulum, DoublePendulum, EllipticBilliard, FermiPastaUlam, HarmonicOscillator, HeavyTop, HenonHeiles,
-    Kepler, KeplerPolar, LagrangianScene, LinkedMasses, NBody, Pendulum, Problem, RigidBody, Scene, SphericalPendulum,
+    Kepler, KeplerPolar, LagrangianScene, LinkedMasses, NBody, NonholonomicScene, Pendulum, Problem, RigidBody,
+    RollingDisk, RollingSphere, Scene, SphericalPendulum,
 };
 use crate::model::{Constrained, Distances, Lagrangian, MechanicalSystem};
 use crate::Error;
 
-/// A native scene's model: a separable mechanical system, a general Lagrangian, or either on
-/// holonomic constraints.
+/// A native scene's model: a separable mechanical system, a general Lagrangian, either on
+/// holonomic constraints, or a Lagrangian with velocity constraints.
 #[derive(Clone, Debug)]
 pub enum SceneModel {
     Mechanical(Scene),
@@ -21,6 +22,8 @@ pub enum SceneModel {
     Constrained(LinkedMasses),
     /// A general Lagrangian on constraints (the rigid body in quaternions).
     ConstrainedGeneral(Constrained<RigidBody, Distances>),
+    /// A Lagrangian with velocity constraints (rolling, a blade).
+    Nonholonomic(NonholonomicScene),
 }
 
 impl SceneModel {
@@ -31,6 +34,9 @@ impl SceneModel {
             SceneModel::General(s) => Lagrangian::dim(s),
             SceneModel::Constrained(s) => MechanicalSystem::dim(&s.system),
             SceneModel::ConstrainedGeneral(s) => Lagrangian::dim(&s.system),
+            SceneModel::Nonholonomic(NonholonomicScene::RollingDisk(s)) => MechanicalSystem::dim(&s.system),
+            SceneModel::Nonholonomic(NonholonomicScene::ChaplyginSleigh(s)) => MechanicalSystem::dim(&s.system),
+            SceneModel::Nonholonomic(NonholonomicScene::RollingSphere(s)) => Lagrangian::dim(&s.system),
         }
     }
 }
@@ -201,8 +207,32 @@ fn general_lagrangian(s: LagrangianScene) -> SceneModel {
 
 const E: Parameter = real("e", 0.6);
 
+fn nonholonomic(s: NonholonomicScene) -> SceneModel {
+    SceneModel::Nonholonomic(s)
+}
+
+/// J = E − Ω(x v_y − y v_x) at t = 0 of the ball (I = 2a²/5) on the turntable, E = ½|v|² +
+/// ½I|ω|² with aω = (Ωx − v_y, v_x + Ωy, aω_z) from the rolling.
+fn turntable_jacobi(s: &Setup) -> f64 {
+    let (omega, x, y, vx, vy) = (
+        s.value("omega"),
+        s.value("x0"),
+        s.value("y0"),
+        s.value("vx0"),
+        s.value("vy0"),
+    );
+    let rolling = (omega * x - vy).powi(2) + (vx + omega * y).powi(2);
+    let spin = 0.2 * (s.value("radius") * s.value("spin")).powi(2);
+    0.5 * (vx * vx + vy * vy) + 0.2 * rolling + spin - omega * (x * vy - y * vx)
+}
+
+/// p_φ = Iω_z = (2/5)a²ω_z of a ball scene.
+fn ball_spin(s: &Setup) -> f64 {
+    0.4 * s.value("radius").powi(2) * s.value("spin")
+}
+
 /// Every native scene, in the order of the tour.
-pub static CATALOGUE: [CatalogueEntry; 19] = [
+pub static CATALOGUE: [CatalogueEntry; 23] = [
     CatalogueEntry {
         name: "harmonic_oscillator",
         parameters: &[real("omega", 1.0)],
@@ -437,6 +467,110 @@ pub static CATALOGUE: [CatalogueEntry; 19] = [
             let (q0, p0) = ([s.value("x0"), s.value("y0")], [s.value("px0"), s.value("py0")]);
             let p = EllipticBilliard::problem(s.value("a"), s.value("b"), q0, p0)?;
             Ok(p.map(|s| mechanical(Scene::EllipticBilliard(s))))
+        },
+    },
+    CatalogueEntry {
+        name: "rolling_disk",
+        parameters: &[real("radius", 1.0), real("turn", 0.7), real("roll", 2.0)],
+        description: |s| {
+            format!(
+                "a vertical disk (a coin) rolling without slipping, R = {}, θ̇ = {}, φ̇ = {}; E, p_θ, p_φ conserved, not p_x, p_y",
+                general(s.value("radius")),
+                general(s.value("turn")),
+                general(s.value("roll"))
+            )
+        },
+        dt: |_| 0.05,
+        invariants: |s| {
+            let (r, turn, roll) = (s.value("radius"), s.value("turn"), s.value("roll"));
+            vec![
+                ("E", RollingDisk::energy(r, turn, roll)),
+                ("p[2]", 0.25 * r * r * turn),
+                ("p[3]", 0.5 * r * r * roll),
+            ]
+        },
+        build: |s| {
+            let p = RollingDisk::problem(s.value("radius"), s.value("turn"), s.value("roll"))?;
+            Ok(p.map(|s| nonholonomic(NonholonomicScene::RollingDisk(s))))
+        },
+    },
+    CatalogueEntry {
+        name: "chaplygin_sleigh",
+        parameters: &[real("inertia", 1.0), real("blade", 1.0), real("spin", 1.0)],
+        description: |s| {
+            format!(
+                "the Chaplygin sleigh, I = {}, blade b = {} behind the centre, spinning at ω₀ = {}; E conserved, no momentum",
+                general(s.value("inertia")),
+                general(s.value("blade")),
+                general(s.value("spin"))
+            )
+        },
+        dt: |_| 0.01,
+        invariants: |s| {
+            let total = s.value("inertia") + s.value("blade").powi(2);
+            vec![("E", 0.5 * total * s.value("spin").powi(2))]
+        },
+        build: |s| {
+            let p = ChaplyginSleigh::problem(s.value("inertia"), s.value("blade"), s.value("spin"))?;
+            Ok(p.map(|s| nonholonomic(NonholonomicScene::ChaplyginSleigh(s))))
+        },
+    },
+    CatalogueEntry {
+        name: "rolling_sphere",
+        parameters: &[
+            real("alpha", 0.5),
+            real("g", 9.81),
+            real("radius", 1.0),
+            real("vx0", 1.0),
+            real("vy0", 0.3),
+            real("spin", 1.0),
+        ],
+        description: |s| {
+            format!(
+                "a ball rolling on a rough plane inclined at α = {} (Byerly): its centre runs down a parabola at (5/7)g sin α; E, p_φ conserved, not p_x",
+                general(s.value("alpha"))
+            )
+        },
+        dt: |_| 0.01,
+        invariants: |s| {
+            let (vx, vy) = (s.value("vx0"), s.value("vy0"));
+            let spin = 0.2 * (s.value("radius") * s.value("spin")).powi(2);
+            vec![("E", 0.7 * (vx * vx + vy * vy) + spin), ("p[2]", ball_spin(s))]
+        },
+        build: |s| {
+            let velocity = [s.value("vx0"), s.value("vy0")];
+            let (alpha, g, radius) = (s.value("alpha"), s.value("g"), s.value("radius"));
+            let p = RollingSphere::incline(alpha, g, radius, velocity, s.value("spin"))?;
+            Ok(p.map(|s| nonholonomic(NonholonomicScene::RollingSphere(s))))
+        },
+    },
+    CatalogueEntry {
+        name: "ball_on_turntable",
+        parameters: &[
+            real("omega", 1.0),
+            real("radius", 1.0),
+            real("x0", 1.0),
+            real("y0", 0.0),
+            real("vx0", 0.0),
+            real("vy0", 0.2),
+            real("spin", 1.0),
+        ],
+        description: |s| {
+            format!(
+                "a ball rolling on a table turning at Ω = {} (affine constraints): its centre circles at 2Ω/7; J = E − Ω(x p_y − y p_x) and p_φ conserved, not E",
+                general(s.value("omega"))
+            )
+        },
+        // About 0.05/Ω, a whole number of steps to t_end = 14π/Ω.
+        dt: |s| {
+            let t_end = 14.0 * PI / s.value("omega");
+            t_end / steps_to(t_end, 0.05 / s.value("omega")) as f64
+        },
+        invariants: |s| vec![("J", turntable_jacobi(s)), ("p[2]", ball_spin(s))],
+        build: |s| {
+            let (centre, velocity) = ([s.value("x0"), s.value("y0")], [s.value("vx0"), s.value("vy0")]);
+            let p = RollingSphere::turntable(s.value("omega"), s.value("radius"), centre, velocity, s.value("spin"))?;
+            Ok(p.map(|s| nonholonomic(NonholonomicScene::RollingSphere(s))))
         },
     },
 ];

@@ -11,12 +11,14 @@
 
 mod bouncing_ball;
 mod catalogue;
+mod chaplygin_sleigh;
 mod charged_particle;
 mod constrained;
 mod damped_driven_pendulum;
 mod double_pendulum;
 mod elliptic_billiard;
 mod fermi_pasta_ulam;
+mod free_body;
 mod harmonic_oscillator;
 mod heavy_top;
 mod henon_heiles;
@@ -25,17 +27,21 @@ mod kepler_polar;
 mod nbody;
 mod pendulum;
 mod rigid_body;
+mod rolling_disk;
+mod rolling_sphere;
 mod spherical_pendulum;
 
 pub use crate::model::NBody;
 pub use bouncing_ball::BouncingBall;
 pub use catalogue::{lookup, CatalogueEntry, Parameter, SceneModel, Setup, CATALOGUE};
+pub use chaplygin_sleigh::{Blade, ChaplyginSleigh};
 pub use charged_particle::ChargedParticle;
 pub use constrained::{cartesian_pendulum, cartesian_spherical_pendulum, planar_chain, LinkedMasses, PointMasses};
 pub use damped_driven_pendulum::DampedDrivenPendulum;
 pub use double_pendulum::DoublePendulum;
 pub use elliptic_billiard::EllipticBilliard;
 pub use fermi_pasta_ulam::FermiPastaUlam;
+pub use free_body::FreeBody;
 pub use harmonic_oscillator::HarmonicOscillator;
 pub use heavy_top::HeavyTop;
 pub use henon_heiles::HenonHeiles;
@@ -43,9 +49,11 @@ pub use kepler::Kepler;
 pub use kepler_polar::KeplerPolar;
 pub use pendulum::Pendulum;
 pub use rigid_body::RigidBody;
+pub use rolling_disk::{Rolling, RollingDisk};
+pub use rolling_sphere::{sphere_symmetries, RollingSphere, SphereContact};
 pub use spherical_pendulum::SphericalPendulum;
 
-use crate::model::{Generator, Hessians, Lagrangian, Mass, MechanicalSystem};
+use crate::model::{Generator, Hessians, Lagrangian, Mass, MechanicalSystem, Nonholonomic, VelocityConstraints};
 use crate::ModelError;
 
 /// A state (q, p) at time t.
@@ -197,5 +205,39 @@ impl Lagrangian for LagrangianScene {
     }
     fn force(&self, q: &[f64], v: &[f64], t: f64, out: &mut [f64]) -> Result<(), ModelError> {
         dispatch_lagrangian!(self, s => s.force(q, v, t, out))
+    }
+}
+
+/// Any native scene with velocity constraints A(q)q̇ + b(q) = 0, integrated by the discrete
+/// Lagrange–d'Alembert integrator. Such systems conserve their energy when L and the
+/// constraints do not depend on t and b = 0, but not, in general, the momenta of the
+/// symmetries of L: each declares the momenta it does conserve.
+#[derive(Clone, Debug)]
+pub enum NonholonomicScene {
+    /// The vertical disk (a coin) rolling on a plane; p_θ, p_φ conserved.
+    RollingDisk(Nonholonomic<FreeBody, Rolling>),
+    /// The Chaplygin sleigh; no momentum conserved.
+    ChaplyginSleigh(Nonholonomic<FreeBody, Blade>),
+    /// The ball on a rough incline or on a turntable (affine constraints).
+    RollingSphere(Nonholonomic<RollingSphere, SphereContact>),
+}
+
+impl NonholonomicScene {
+    /// The symmetries whose momenta the scene conserves (not every symmetry of its L).
+    pub fn symmetries(&self) -> Vec<Generator> {
+        match self {
+            NonholonomicScene::RollingDisk(_) => RollingDisk::symmetries(),
+            NonholonomicScene::ChaplyginSleigh(_) => Vec::new(),
+            NonholonomicScene::RollingSphere(s) => sphere_symmetries(&s.constraints),
+        }
+    }
+
+    /// Number of velocity constraints m.
+    pub fn count(&self) -> usize {
+        match self {
+            NonholonomicScene::RollingDisk(s) => s.constraints.count(),
+            NonholonomicScene::ChaplyginSleigh(s) => s.constraints.count(),
+            NonholonomicScene::RollingSphere(s) => s.constraints.count(),
+        }
     }
 }

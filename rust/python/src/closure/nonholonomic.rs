@@ -1,4 +1,5 @@
-//! A closure model with velocity constraints A(q)q̇ = 0 given by a Python closure.
+//! A closure model with velocity constraints A(q)q̇ + b(q) = 0 given by Python closures (b
+//! optional: linear constraints without it).
 
 use std::cell::RefCell;
 
@@ -17,13 +18,15 @@ use super::readers::{call_array, check_closures, check_count};
 use crate::errors::boxed;
 
 /// A closure model (separable [`ClosureModel`], natural [`ClosureNatural`] or general
-/// [`ClosureLagrangian`]) with m velocity constraints A(q)q̇ = 0, `matrix(q) -> array (m, n)`:
-/// the discrete Lagrange–d'Alembert integrator's model.
+/// [`ClosureLagrangian`]) with m velocity constraints A(q)q̇ + b(q) = 0, `matrix(q) -> array
+/// (m, n)` and optionally the affine term `offset(q) -> array (m,)`: the discrete
+/// Lagrange–d'Alembert integrator's model.
 #[pyclass(frozen, module = "varmech._core")]
 pub struct ClosureNonholonomic {
     system: Unconstrained,
     count: usize,
     matrix: Py<PyAny>,
+    offset: Option<Py<PyAny>>,
 }
 
 /// The model under a [`ClosureNonholonomic`].
@@ -36,8 +39,13 @@ enum Unconstrained {
 #[pymethods]
 impl ClosureNonholonomic {
     #[new]
-    #[pyo3(signature = (system, count, matrix))]
-    fn new(system: Bound<'_, PyAny>, count: usize, matrix: Bound<'_, PyAny>) -> PyResult<Self> {
+    #[pyo3(signature = (system, count, matrix, offset=None))]
+    fn new(
+        system: Bound<'_, PyAny>,
+        count: usize,
+        matrix: Bound<'_, PyAny>,
+        offset: Option<Bound<'_, PyAny>>,
+    ) -> PyResult<Self> {
         let (system, dim) = if let Ok(s) = system.cast::<ClosureModel>() {
             (Unconstrained::Separable(s.clone().unbind()), s.get().dim())
         } else if let Ok(s) = system.cast::<ClosureNatural>() {
@@ -49,12 +57,19 @@ impl ClosureNonholonomic {
                 "system: expected a ClosureModel, a ClosureNatural or a ClosureLagrangian",
             ));
         };
-        check_closures(dim, [("velocity_constraints", Some(&matrix))])?;
+        check_closures(
+            dim,
+            [
+                ("velocity_constraints", Some(&matrix)),
+                ("velocity_constraint_offset", offset.as_ref()),
+            ],
+        )?;
         check_count("velocity_constraint_count", count, dim)?;
         Ok(ClosureNonholonomic {
             system,
             count,
             matrix: matrix.unbind(),
+            offset: offset.map(Bound::unbind),
         })
     }
 
@@ -88,6 +103,7 @@ impl ClosureNonholonomic {
             py,
             count: self.count,
             matrix: self.matrix.bind(py).clone(),
+            offset: self.offset.as_ref().map(|b| b.bind(py).clone()),
             rows: RefCell::new(vec![0.0; self.count * self.dim()]),
         };
         match &self.system {
@@ -108,12 +124,24 @@ impl ClosureNonholonomic {
 }
 
 /// The velocity constraints of a [`ClosureNonholonomic`] bound to the GIL: they implement the
-/// core's [`VelocityConstraints`] (∂A/∂q by the trait's differences).
+/// core's [`VelocityConstraints`] (∂A/∂q and ∂b/∂q by the trait's differences).
 struct ClosureVelocityConstraints<'py> {
     py: Python<'py>,
     count: usize,
     matrix: Bound<'py, PyAny>,
+    offset: Option<Bound<'py, PyAny>>,
     rows: RefCell<Vec<f64>>,
+}
+
+/// A closure's values are finite, or its error names the call and q.
+fn finite(values: &[f64], call: &str, q: &[f64]) -> Result<(), ModelError> {
+    if values.iter().all(|x| x.is_finite()) {
+        Ok(())
+    } else {
+        Err(boxed(PyValueError::new_err(format!(
+            "{call} returned non-finite values at q = {q:?}"
+        ))))
+    }
 }
 
 impl VelocityConstraints for ClosureVelocityConstraints<'_> {
@@ -132,14 +160,25 @@ impl VelocityConstraints for ClosureVelocityConstraints<'_> {
             &[m, n],
             rows,
         )?;
-        if !rows.iter().all(|x| x.is_finite()) {
-            return Err(boxed(PyValueError::new_err(format!(
-                "{call} returned non-finite values at q = {q:?}"
-            ))));
-        }
+        finite(rows, call, q)?;
         for (i, row) in rows.chunks_exact(n).enumerate() {
             a.row_mut(i).iter_mut().zip(row).for_each(|(x, r)| *x = *r);
         }
         Ok(())
+    }
+
+    fn is_affine(&self) -> bool {
+        self.offset.is_some()
+    }
+
+    /// `velocity_constraint_offset(q)`, an array (m,), finite; 0 without it.
+    fn offset(&self, q: &[f64], b: &mut [f64]) -> Result<(), ModelError> {
+        let Some(offset) = &self.offset else {
+            b.fill(0.0);
+            return Ok(());
+        };
+        let call = "velocity_constraint_offset(q)";
+        call_array(offset.call1((PyArray1::from_slice(self.py, q),)), call, &[b.len()], b)?;
+        finite(b, call, q)
     }
 }

@@ -35,7 +35,7 @@ pub(super) fn constrained_equations<Sc: StepEquations, S: Lagrangian + ?Sized>(
     }
     let dq = &s[u - n..];
     match constraints {
-        Constraints::Velocity(c) => nonholonomic::discrete_constraint(c, mp, start.q, dq, &mut out[u..]),
+        Constraints::Velocity(c) => nonholonomic::discrete_constraint(c, mp, (start.q, start.h), dq, &mut out[u..]),
         Constraints::Holonomic(c) => {
             for ((q1, q), d) in mp.q1.iter_mut().zip(start.q).zip(dq) {
                 *q1 = q + d;
@@ -47,7 +47,8 @@ pub(super) fn constrained_equations<Sc: StepEquations, S: Lagrangian + ?Sized>(
 }
 
 /// The buffers of the constrained step: G(q₀) and G(q₁) (or A), q₁ and p₁, and μ's Newton
-/// iteration; for velocity constraints also q̄, A(q̄) and ∂A/∂qᵢ.
+/// iteration; for velocity constraints also q̄, A(q̄), ∂A/∂qᵢ and the affine term's b(q̄),
+/// ∂b/∂qᵢ and b(q₁).
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub(super) struct Multipliers {
     /// G at the step's start; the last step's G(q₁) once a step is taken (first same as last).
@@ -58,6 +59,9 @@ pub(super) struct Multipliers {
     pub midpoint: Vec<f64>,
     pub a_mid: DMatrix<f64>,
     pub da: DMatrix<f64>,
+    pub b_mid: Vec<f64>,
+    pub db: Vec<f64>,
+    b1: Vec<f64>,
     p1: Vec<f64>,
     v: Vec<f64>,
     plus: Vec<f64>,
@@ -76,6 +80,9 @@ impl Multipliers {
             midpoint: vec![0.0; n],
             a_mid: DMatrix::zeros(m, n),
             da: DMatrix::zeros(m, n),
+            b_mid: vec![0.0; m],
+            db: vec![0.0; m],
+            b1: vec![0.0; m],
             p1: vec![0.0; n],
             v: vec![0.0; n],
             plus: vec![0.0; m],
@@ -85,8 +92,9 @@ impl Multipliers {
         }
     }
 
-    /// p₁ = p₀ + δp − (h/2)G(q₁)ᵀμ with G(q₁)q̇(q₁, p₁) = 0 (G the constraints' Jacobian, or
-    /// the matrix A of velocity constraints, [`Constraints::matrix`]): Newton's method on μ, its
+    /// p₁ = p₀ + δp − (h/2)G(q₁)ᵀμ with G(q₁)q̇(q₁, p₁) + b(q₁) = 0 (G the constraints' Jacobian,
+    /// or the matrix A of velocity constraints, [`Constraints::matrix`]; b = 0 but for affine
+    /// velocity constraints, [`Constraints::offset`]): Newton's method on μ, its
     /// Jacobian −(h/2)G(q₁)(∂q̇/∂p)G(q₁)ᵀ from central differences of the inverse Legendre
     /// transform (exact in one step when L is quadratic in q̇); δp takes the projection.
     pub fn project_momentum<S: Lagrangian + ?Sized>(
@@ -102,11 +110,13 @@ impl Multipliers {
             *x = q + d;
         }
         c.matrix(&self.q1, &mut self.g1)?;
+        c.offset(&self.q1, &mut self.b1)?;
         self.mu.fill(0.0);
         let mut problem = OntoHiddenConstraint {
             tangent: Tangent {
                 sys,
                 g1: &self.g1,
+                b1: &self.b1,
                 q1: &self.q1,
                 p,
                 dp: step.dp,
@@ -136,11 +146,12 @@ impl Multipliers {
     }
 }
 
-/// r(μ) = G(q₁)q̇(q₁, p₁(μ)), p₁(μ) = p₀ + δp − (h/2)G(q₁)ᵀμ, the inverse Legendre transform
-/// q̇ taken at t₁ = t + h.
+/// r(μ) = G(q₁)q̇(q₁, p₁(μ)) + b(q₁), p₁(μ) = p₀ + δp − (h/2)G(q₁)ᵀμ, the inverse Legendre
+/// transform q̇ taken at t₁ = t + h.
 struct Tangent<'a, S: ?Sized> {
     sys: &'a S,
     g1: &'a DMatrix<f64>,
+    b1: &'a [f64],
     q1: &'a [f64],
     p: &'a [f64],
     dp: &'a [f64],
@@ -157,13 +168,13 @@ impl<S: Lagrangian + ?Sized> Tangent<'_, S> {
         }
         self.sys.velocity(self.q1, p1, self.t1, v)?;
         for (k, o) in out.iter_mut().enumerate() {
-            *o = g1.row(k).iter().zip(v.iter()).map(|(a, b)| a * b).sum();
+            *o = g1.row(k).iter().zip(v.iter()).map(|(a, b)| a * b).sum::<f64>() + self.b1[k];
         }
         Ok(())
     }
 }
 
-/// r(μ) = 0, solved to round-off in the velocity: ‖r‖∞ ≤ 4ε·max(‖q̇‖∞, 1).
+/// r(μ) = 0, solved to round-off in the velocity: ‖r‖∞ ≤ 4ε·max(‖q̇‖∞, |b(q₁)|∞, 1).
 struct OntoHiddenConstraint<'a, S: ?Sized> {
     tangent: Tangent<'a, S>,
     mu: &'a mut [f64],
@@ -173,7 +184,7 @@ struct OntoHiddenConstraint<'a, S: ?Sized> {
     minus: &'a mut [f64],
     /// max(‖p₀‖∞, 1), the least size μ's difference steps are relative to.
     scale: f64,
-    /// max(‖q̇‖∞, 1) at the last residual.
+    /// max(‖q̇‖∞, |b(q₁)|∞, 1) at the last residual.
     speed: f64,
 }
 
@@ -187,7 +198,11 @@ impl<S: Lagrangian + ?Sized> NewtonProblem for OntoHiddenConstraint<'_, S> {
 
     fn residual(&mut self, r: &mut [f64]) -> Result<(), StepError> {
         self.tangent.evaluate(self.mu, self.p1, self.v, r)?;
-        self.speed = self.v.iter().fold(1.0_f64, |a, x| a.max(x.abs()));
+        self.speed = self
+            .v
+            .iter()
+            .chain(self.tangent.b1)
+            .fold(1.0_f64, |a, x| a.max(x.abs()));
         Ok(())
     }
 

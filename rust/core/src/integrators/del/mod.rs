@@ -89,6 +89,18 @@ impl Constraints<'_> {
         }
     }
 
+    /// Writes the affine term b(q) of velocity constraints A(q)q̇ + b(q) = 0 into `out`: 0 for
+    /// holonomic (their hidden constraint is G(q)q̇ = 0) and linear velocity constraints.
+    fn offset(&self, q: &[f64], out: &mut [f64]) -> Result<(), ModelError> {
+        match self {
+            Constraints::Velocity(c) => c.offset(q, out),
+            Constraints::None | Constraints::Holonomic(_) => {
+                out.fill(0.0);
+                Ok(())
+            }
+        }
+    }
+
     /// Number of constraints m.
     fn count(&self) -> usize {
         match self {
@@ -130,11 +142,16 @@ impl Constraints<'_> {
 /// their reversible integrators, and the constraint forces shared by the step's ends as RATTLE
 /// shares them:
 ///
-/// p₀ + D₁L_d(q₀, q₁) − (h/2)A(q₀)ᵀλ = 0,   A(q̄)(q₁ − q₀) = 0,   q̄ = (q₀ + q₁)/2,
-/// p₁ = D₂L_d(q₀, q₁) − (h/2)A(q₁)ᵀμ,   A(q₁)q̇(q₁, p₁) = 0.
+/// p₀ + D₁L_d(q₀, q₁) − (h/2)A(q₀)ᵀλ = 0,   A(q̄)(q₁ − q₀) + h b(q̄) = 0,   q̄ = (q₀ + q₁)/2,
+/// p₁ = D₂L_d(q₀, q₁) − (h/2)A(q₁)ᵀμ,   A(q₁)q̇(q₁, p₁) + b(q₁) = 0,
 ///
-/// It is symmetric: from (q₁, p₁) with −h it steps back to (q₀, p₀), λ and μ trading places,
-/// so reversible systems keep a bounded energy error. Forces A(q̄)ᵀλ at the midpoint on both
+/// b the affine term of affine constraints A(q)q̇ + b(q) = 0 (0 for linear ones).
+///
+/// It is symmetric: from (q₁, p₁) with −h it steps back to (q₀, p₀), λ and μ trading places
+/// (the discrete constraint changes sign as a whole under δq ↦ −δq, h ↦ −h, b included), so
+/// reversible systems keep a bounded energy error. Affine constraints are not reversible
+/// under p ↦ −p alone (the moving surface does not reverse): the turntable's ball is
+/// reversible under p ↦ −p with a mirror of the plane, which turns the table back. Forces A(q̄)ᵀλ at the midpoint on both
 /// halves would be symmetric too, but would leave A(q₁)q̇₁ = O(h²); with μ the momenta stay on
 /// the constraint to round-off at every step, as the constrained DEL equations keep them on
 /// the hidden one. Where A = G is the derivative of holonomic constraints the two methods
