@@ -1,3 +1,5 @@
+use std::cell::RefCell;
+
 use nalgebra::{DMatrix, DVector};
 
 use super::constraints::{momentum_projection, row_norm};
@@ -44,19 +46,23 @@ pub trait VelocityConstraints {
             return Ok(());
         }
         let h = f64::EPSILON.cbrt() * q[i].abs().max(1.0);
-        let mut x = q.to_vec();
-        let mut minus = vec![0.0; out.len()];
-        x[i] = q[i] + h;
-        self.offset(&x, out)?;
-        x[i] = q[i] - h;
-        self.offset(&x, &mut minus)?;
-        out.iter_mut().zip(&minus).for_each(|(o, m)| *o = (*o - m) / (2.0 * h));
-        Ok(())
+        with_scratch(q, |x, scratch| {
+            let minus = &mut scratch.offset;
+            minus.resize(out.len(), 0.0);
+            x[i] = q[i] + h;
+            self.offset(x, out)?;
+            x[i] = q[i] - h;
+            self.offset(x, minus)?;
+            out.iter_mut()
+                .zip(minus.iter())
+                .for_each(|(o, m)| *o = (*o - m) / (2.0 * h));
+            Ok(())
+        })
     }
 }
 
 /// ∂A/∂qᵢ by a central difference of A, with the step ε^{1/3}·max(|qᵢ|, 1) (two evaluations of
-/// A; they allocate scratch), about 1e-10 relative accuracy.
+/// A), about 1e-10 relative accuracy.
 pub fn differenced_derivative<C: VelocityConstraints + ?Sized>(
     constraints: &C,
     q: &[f64],
@@ -64,15 +70,48 @@ pub fn differenced_derivative<C: VelocityConstraints + ?Sized>(
     out: &mut DMatrix<f64>,
 ) -> Result<(), ModelError> {
     let h = f64::EPSILON.cbrt() * q[i].abs().max(1.0);
-    let mut x = q.to_vec();
-    let mut minus = DMatrix::zeros(out.nrows(), out.ncols());
-    x[i] = q[i] + h;
-    constraints.matrix(&x, out)?;
-    x[i] = q[i] - h;
-    constraints.matrix(&x, &mut minus)?;
-    *out -= minus;
-    *out /= 2.0 * h;
-    Ok(())
+    with_scratch(q, |x, scratch| {
+        let minus = &mut scratch.matrix;
+        if minus.shape() != out.shape() {
+            *minus = DMatrix::zeros(out.nrows(), out.ncols());
+        }
+        x[i] = q[i] + h;
+        constraints.matrix(x, out)?;
+        x[i] = q[i] - h;
+        constraints.matrix(x, minus)?;
+        *out -= &*minus;
+        *out /= 2.0 * h;
+        Ok(())
+    })
+}
+
+/// The differences' scratch: the values at q − hεᵢ, kept per thread so that the step loop
+/// allocates nothing once they have their size.
+#[derive(Default)]
+struct Scratch {
+    point: Vec<f64>,
+    matrix: DMatrix<f64>,
+    offset: Vec<f64>,
+}
+
+thread_local! {
+    static SCRATCH: RefCell<Scratch> = RefCell::new(Scratch::default());
+}
+
+/// Runs `body` with a copy of q (to shift) and the scratch; a nested call (constraints whose
+/// evaluation differences constraints again) gets fresh scratch rather than a busy one.
+fn with_scratch<R>(q: &[f64], body: impl FnOnce(&mut [f64], &mut Scratch) -> R) -> R {
+    SCRATCH.with(|cell| match cell.try_borrow_mut() {
+        Ok(mut scratch) => {
+            let mut point = std::mem::take(&mut scratch.point);
+            point.clear();
+            point.extend_from_slice(q);
+            let result = body(&mut point, &mut scratch);
+            scratch.point = point;
+            result
+        }
+        Err(_) => body(&mut q.to_vec(), &mut Scratch::default()),
+    })
 }
 
 /// A Lagrangian system S with velocity constraints C: what the discrete Lagrange–d'Alembert
