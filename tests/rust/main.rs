@@ -25,6 +25,7 @@ mod kepler;
 mod kepler_polar;
 mod nbody_kernel;
 mod nonholonomic;
+mod nonholonomic_variants;
 mod routh;
 mod solar_system;
 mod splitting;

@@ -253,12 +253,13 @@ impl MethodInfo {
 }
 
 /// Every method's facts, the unconstrained ones first, each from the simplest, then the
-/// constrained ones and the N-body ones.
+/// constrained ones, the nonholonomic ones and the N-body ones.
 #[pyfunction]
 fn methods() -> Vec<MethodInfo> {
     Method::ALL
         .iter()
         .chain(&Method::CONSTRAINED)
+        .chain(&Method::NONHOLONOMIC)
         .chain(&Method::WISDOM_HOLMAN)
         .map(|m| m.info().into())
         .collect()
