@@ -17,6 +17,7 @@ def test_the_variants_are_listed_and_take_velocity_constraints_alone():
     info = {m.name: m for m in varmech.methods()}
     assert (info["cortes_martinez"].order, info["cortes_martinez"].symmetric) == (1, False)
     assert (info["dla4"].order, info["dla4"].symmetric, info["dla4"].stages) == (4, True, 3)
+    assert {m.name for m in info.values() if m.nonholonomic} == {"cortes_martinez", "dla4"}
     assert rolling_disk().kind.accurate_method == "dla4"
     free = varmech.MechanicalSystem(1, lambda q: 0.5 * q[0] ** 2, lambda q: q, mass=[1.0])
     for method in ("cortes_martinez", "dla4"):

@@ -99,6 +99,9 @@ pub struct MethodInfo {
     /// Whether the method integrates separable systems on holonomic constraints (and only
     /// those; read from the table of [`ModelKind`]).
     pub constrained: bool,
+    /// Whether the method integrates velocity constraints A(q)q̇ = 0 and only those (read from
+    /// the table of [`ModelKind`]; `midpoint`, which integrates them too, is not among these).
+    pub nonholonomic: bool,
     /// Whether the method integrates the gravitational N-body problem only (the Wisdom–Holman
     /// methods; read from the table of [`ModelKind`]).
     pub nbody: bool,
@@ -309,6 +312,7 @@ impl Method {
         };
         let implicit = ModelKind::Lagrangian.admits(self) || ModelKind::Nonholonomic.admits(self);
         let constrained = ModelKind::ConstrainedSeparable.admits(self);
+        let nonholonomic = !ModelKind::Lagrangian.admits(self) && ModelKind::Nonholonomic.admits(self);
         let nbody = !ModelKind::Separable.admits(self) && ModelKind::Gravitational.admits(self);
         let stages = match self {
             Method::Rattle4 | Method::Dla4 => 3,
@@ -328,6 +332,7 @@ impl Method {
             force_evaluations,
             implicit,
             constrained,
+            nonholonomic,
             nbody,
             symplectic,
             symmetric,
