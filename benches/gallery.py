@@ -34,6 +34,7 @@ GALLERY = [
     ("implicit-regions", "pendulum", None),
     ("poincare", "henon_heiles", None),
     ("phase", "pendulum", None),
+    ("nonholonomic", None, None),
 ]
 #: (kind, scene, draw(out, quick) → paths): charts drawn by a bench script, for their rival is
 #: no library code (the naive "reflect at the end of the step" scheme).

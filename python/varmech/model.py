@@ -153,7 +153,9 @@ class Model:
     @property
     def velocity_constraints(self) -> int:
         """Number of velocity constraints A(q)q̇ = 0 (0 for models without them); such
-        (nonholonomic) models take the discrete Lagrange–d'Alembert integrator, ``midpoint``."""
+        (nonholonomic) models take the discrete Lagrange–d'Alembert integrators: ``midpoint``
+        (reversible, the default), ``dla4`` (its order-4 composition) and ``cortes_martinez``
+        (not reversible, the contrast)."""
         return getattr(self._core, "velocity_constraints", 0)
 
     @property
@@ -282,7 +284,8 @@ class MechanicalSystem(Model):
         Velocity constraints A(q)q̇ = 0 that need not come from constraints on q (rolling
         without slipping, a skate's blade): ``velocity_constraints(q) -> array (m, n)``, A(q),
         with ``velocity_constraint_count`` = m. Integrated by the reversible discrete
-        Lagrange–d'Alembert integrator, ``midpoint`` (see the user guide, "Rolling and other
+        Lagrange–d'Alembert integrator, ``midpoint`` (the default), its order-4 composition
+        ``dla4``, or the non-reversible ``cortes_martinez`` (see the user guide, "Rolling and other
         nonholonomic constraints"); not together with holonomic ``constraints``.
     velocity_constraint_offset
         With ``velocity_constraints``: ``velocity_constraint_offset(q) -> array (m,)``, the

@@ -20,7 +20,7 @@ FUZZ = settings(max_examples=150, deadline=2000, suppress_health_check=[HealthCh
 #: The runs' hard step limit: the valid counts stay below it, the invalid ones go far beyond.
 MAX_STEPS = 200
 
-UNCONSTRAINED = [m.name for m in varmech.methods() if not m.constrained and not m.nbody]
+UNCONSTRAINED = [m.name for m in varmech.methods() if not m.constrained and not m.nonholonomic and not m.nbody]
 
 floats = st.one_of(
     st.floats(allow_nan=True, allow_infinity=True),

@@ -26,6 +26,7 @@ mod kepler_polar;
 mod nbody_kernel;
 mod nonholonomic;
 mod nonholonomic_scenes;
+mod nonholonomic_variants;
 mod routh;
 mod solar_system;
 mod splitting;

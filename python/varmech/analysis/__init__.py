@@ -5,7 +5,9 @@
 - :mod:`.baselines`: SciPy's ``solve_ivp`` and REBOUND driven on a varmech scene;
 - :mod:`.stability`: linear stability on q̈ = −ω²q and the implicit methods' failure regions;
 - :mod:`.sections`: Poincaré sections and orbit divergence (a chaos indicator);
-- :mod:`.phase_portrait`: orbits of one degree of freedom, librations and rotations.
+- :mod:`.phase_portrait`: orbits of one degree of freedom, librations and rotations;
+- :mod:`.nonholonomic`: a rolling disk's energy over a long run, the discrete
+  Lagrange–d'Alembert integrators against RK4 with a velocity projection.
 
 Every sweep honours Ctrl-C: the KeyboardInterrupt propagates with the rows measured so far as
 ``err.partial`` (:func:`._interrupt.interruptible`).

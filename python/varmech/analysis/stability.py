@@ -100,7 +100,7 @@ REFERENCE_LIMITS: dict[str, float] = {
 
 #: The implicit (Newton-solved) methods :func:`implicit_regions` maps by default: every implicit
 #: method of :func:`varmech.methods` that integrates unconstrained systems.
-IMPLICIT_METHODS = tuple(m.name for m in _methods() if m.implicit and not m.constrained)
+IMPLICIT_METHODS = tuple(m.name for m in _methods() if m.implicit and not m.constrained and not m.nonholonomic)
 
 #: The outcomes of :func:`implicit_regions`, from good to bad.
 OUTCOMES = ("ok", "energy", "spurious branch", "newton failure", "diverged")
@@ -131,7 +131,7 @@ def _oscillator() -> Any:
 def _method(method: str) -> MethodInfo:
     for info in _methods():
         if info.name == method:
-            if info.constrained:
+            if info.constrained or info.nonholonomic:
                 raise ValueError(
                     f"method: {method!r} integrates constrained systems only, and the linear test equation has no "
                     "constraint (its stability on the constrained manifold is that of the method it is built on)"
@@ -144,8 +144,9 @@ def _method(method: str) -> MethodInfo:
 
 
 def _unconstrained() -> list[str]:
-    """The methods of the linear test equation: neither constrained nor N-body only."""
-    return [m.name for m in _methods() if not m.constrained and not m.nbody]
+    """The methods of the linear test equation: neither constrained (holonomic or velocity
+    constraints) nor N-body only."""
+    return [m.name for m in _methods() if not m.constrained and not m.nonholonomic and not m.nbody]
 
 
 def _step_matrix(method: str, y: float) -> np.ndarray:

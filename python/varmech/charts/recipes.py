@@ -13,8 +13,10 @@ from .. import scenes
 from ..analysis import energy_growth, sections, stability, work_precision
 from ..analysis._orbits import energy_at
 from ..analysis.baselines import REBOUND_METHODS
+from ..analysis.nonholonomic import nonholonomic_energy
 from ..analysis.phase_portrait import phase_portrait
 from ..table import Table
+from .nonholonomic import nonholonomic_energy_chart
 from .sections import phase_portrait_chart, poincare_chart
 from .stability import implicit_regions_chart, stability_chart
 from .work_precision import energy_growth_chart, work_precision_chart
@@ -163,6 +165,16 @@ def _phase(scene, methods, quick, progress, options):
     return [("phase_portrait", table, {"phase_portrait": draw})]
 
 
+def _disk_only(scene: scenes.Scene) -> str | None:
+    return "the nonholonomic chart is of the rolling disk (its closure model and RK4 with a projection); it takes no scene"
+
+
+def _nonholonomic(scene, methods, quick, progress, options):
+    table = nonholonomic_energy(methods, steps=5_000 if quick else 100_000, progress=progress)
+    draw = lambda t, p: nonholonomic_energy_chart(t, p)  # noqa: E731
+    return [("nonholonomic_energy", table, {"nonholonomic_energy": draw})]
+
+
 KINDS: dict[str, ChartKind] = {
     "work-precision": ChartKind(
         "kepler", ("verlet", "yoshida4", "kahan_li8", "rk4"),
@@ -185,6 +197,11 @@ KINDS: dict[str, ChartKind] = {
         _two_freedoms,
     ),
     "phase": ChartKind("pendulum", ("kahan_li6",), "phase portrait: librations, separatrix, rotations", _phase, _one_freedom),
+    "nonholonomic": ChartKind(
+        None, ("midpoint", "cortes_martinez", "rk4_projection"),
+        "a rolling disk's energy error against time: the discrete Lagrange–d'Alembert integrators and RK4 with a "
+        "velocity projection", _nonholonomic, _disk_only,
+    ),
 }
 
 

@@ -204,7 +204,8 @@ fn symplecticity_defect<'py>(
 /// ``force_evaluations`` counts gradient evaluations per step, first-same-as-last reused (0 for
 /// the implicit methods, whose cost depends on their Newton iterations). ``implicit`` methods
 /// solve each step by Newton's method; ``constrained`` ones (RATTLE, SHAKE) integrate systems
-/// on holonomic constraints, and only those; ``nbody`` ones (the Wisdom–Holman methods ``wh``
+/// on holonomic constraints, and only those; ``nonholonomic`` ones (``cortes_martinez``,
+/// ``dla4``) integrate velocity constraints, and only those; ``nbody`` ones (the Wisdom–Holman methods ``wh``
 /// and ``whc``) integrate the gravitational N-body problem, and only that (``h_omega_max`` is
 /// NaN for them). ``force_evaluations`` of the Wisdom–Holman methods counts the kicks of a step
 /// between synchronisations; ``whc``'s corrector adds 20 kicks at the start and at every saved
@@ -218,6 +219,7 @@ pub struct MethodInfo {
     force_evaluations: usize,
     implicit: bool,
     constrained: bool,
+    nonholonomic: bool,
     nbody: bool,
     symplectic: bool,
     symmetric: bool,
@@ -235,6 +237,7 @@ impl From<integrators::MethodInfo> for MethodInfo {
             force_evaluations: i.force_evaluations,
             implicit: i.implicit,
             constrained: i.constrained,
+            nonholonomic: i.nonholonomic,
             nbody: i.nbody,
             symplectic: i.symplectic,
             symmetric: i.symmetric,
@@ -253,12 +256,13 @@ impl MethodInfo {
 }
 
 /// Every method's facts, the unconstrained ones first, each from the simplest, then the
-/// constrained ones and the N-body ones.
+/// constrained ones, the nonholonomic ones and the N-body ones.
 #[pyfunction]
 fn methods() -> Vec<MethodInfo> {
     Method::ALL
         .iter()
         .chain(&Method::CONSTRAINED)
+        .chain(&Method::NONHOLONOMIC)
         .chain(&Method::WISDOM_HOLMAN)
         .map(|m| m.info().into())
         .collect()

@@ -19,7 +19,8 @@ pub enum ModelKind {
     /// two-point rules.
     ConstrainedLagrangian,
     /// A Lagrangian (separable, natural or general) with velocity constraints A(q)q̇ = 0: the
-    /// discrete Lagrange–d'Alembert integrator on the midpoint rule (see [`super::Del`]).
+    /// discrete Lagrange–d'Alembert integrators on the midpoint rule (see [`super::Del`]), the
+    /// reversible one, its order-4 composition, and Cortés–Martínez's non-reversible one.
     Nonholonomic,
     /// The gravitational N-body problem ([`crate::model::NBody`]), a separable system with a
     /// dominant central body: every method of a separable system and the Wisdom–Holman methods.
@@ -32,7 +33,9 @@ impl ModelKind {
         use Method::*;
         match self {
             ModelKind::Separable => {
-                !ModelKind::ConstrainedSeparable.admits(method) && !Method::WISDOM_HOLMAN.contains(&method)
+                !ModelKind::ConstrainedSeparable.admits(method)
+                    && !Method::WISDOM_HOLMAN.contains(&method)
+                    && !Method::NONHOLONOMIC.contains(&method)
             }
             ModelKind::Gravitational => ModelKind::Separable.admits(method) || Method::WISDOM_HOLMAN.contains(&method),
             ModelKind::Lagrangian => matches!(method, Midpoint | Trapezoid | Galerkin4 | Galerkin6),
@@ -43,7 +46,8 @@ impl ModelKind {
             ModelKind::ConstrainedLagrangian => matches!(method, Midpoint | Trapezoid),
             // Its reversibility needs the constraint at the midpoint, where the midpoint rule
             // evaluates L; the trapezoidal rule's ends would take another discrete constraint.
-            ModelKind::Nonholonomic => method == Midpoint,
+            // Cortés–Martínez's constraint at the start is the non-reversible contrast.
+            ModelKind::Nonholonomic => matches!(method, Midpoint | Dla4 | CortesMartinez),
         }
     }
 
@@ -63,13 +67,13 @@ impl ModelKind {
     /// The method a measurement uses when it wants accuracy more than speed (locating Poincaré
     /// crossings, say): order 6, by Kahan–Li's 9-stage composition or the Galerkin integrator of
     /// degree 3; RATTLE's order-4 composition on constraints; and the trapezoidal rule, the
-    /// best order there is, for a general Lagrangian on constraints; the midpoint rule, the only
-    /// one there is, on velocity constraints.
+    /// best order there is, for a general Lagrangian on constraints; Yoshida's triple jump of
+    /// the reversible discrete Lagrange–d'Alembert step (order 4) on velocity constraints.
     pub fn accurate_method(self) -> Method {
         match self {
             ModelKind::Separable | ModelKind::Gravitational => Method::KahanLi6,
             ModelKind::Lagrangian => Method::Galerkin6,
-            ModelKind::Nonholonomic => Method::Midpoint,
+            ModelKind::Nonholonomic => Method::Dla4,
             ModelKind::ConstrainedSeparable => Method::Rattle4,
             ModelKind::ConstrainedLagrangian => Method::Trapezoid,
         }
@@ -114,6 +118,10 @@ impl Method {
                  body); this is a {} model",
                 kind.name()
             ),
+            _ if Method::NONHOLONOMIC.contains(&self) => format!(
+                "{name} integrates velocity constraints A(q)q̇ = 0 alone; this is a {} model",
+                kind.name()
+            ),
             ModelKind::Separable | ModelKind::Lagrangian | ModelKind::Gravitational
                 if ModelKind::ConstrainedSeparable.admits(self) =>
             {
@@ -130,8 +138,8 @@ impl Method {
                  discrete Lagrangian) or midpoint"
             ),
             ModelKind::Nonholonomic => format!(
-                "{name} does not integrate velocity constraints; use midpoint (the discrete \
-                 Lagrange–d'Alembert integrator)"
+                "{name} does not integrate velocity constraints; use midpoint (the reversible discrete \
+                 Lagrange–d'Alembert integrator), dla4 (its order-4 composition) or cortes_martinez"
             ),
         };
         Error::invalid("method", reason)

@@ -60,6 +60,14 @@ pub enum Method {
     /// SHAKE (Ryckaert, Ciccotti & Berendsen 1977): positions on the constraints, one
     /// constraint at a time to the Newton tolerance; momenta off the hidden constraint.
     Shake,
+    /// The discrete Lagrange–d'Alembert integrator of the midpoint L_d with the discrete
+    /// constraint at the step's start, A(q₀)(q₁ − q₀) = 0 (Cortés & Martínez 2001): not
+    /// reversible, order 1. The contrast McLachlan & Perlmutter (2006) draw with the reversible
+    /// step (`midpoint`); not a default.
+    CortesMartinez,
+    /// The reversible discrete Lagrange–d'Alembert step (`midpoint`) composed by Yoshida's
+    /// triple jump, order 4, every stage on the velocity constraints.
+    Dla4,
     /// The Wisdom–Holman method (Wisdom & Holman 1991) in Jacobi coordinates, as WHFast (Rein &
     /// Tamayo 2015): Kepler drifts and interaction kicks, order 2 with error O(εh²).
     WisdomHolman,
@@ -91,6 +99,9 @@ pub struct MethodInfo {
     /// Whether the method integrates separable systems on holonomic constraints (and only
     /// those; read from the table of [`ModelKind`]).
     pub constrained: bool,
+    /// Whether the method integrates velocity constraints A(q)q̇ = 0 and only those (read from
+    /// the table of [`ModelKind`]; `midpoint`, which integrates them too, is not among these).
+    pub nonholonomic: bool,
     /// Whether the method integrates the gravitational N-body problem only (the Wisdom–Holman
     /// methods; read from the table of [`ModelKind`]).
     pub nbody: bool,
@@ -132,6 +143,10 @@ impl Method {
 
     /// The methods for holonomic constraints.
     pub const CONSTRAINED: [Method; 3] = [Method::Rattle, Method::Rattle4, Method::Shake];
+
+    /// The methods for velocity constraints alone (the reversible discrete Lagrange–d'Alembert
+    /// step itself is `midpoint`).
+    pub const NONHOLONOMIC: [Method; 2] = [Method::CortesMartinez, Method::Dla4];
 
     /// The methods for the gravitational N-body problem alone.
     pub const WISDOM_HOLMAN: [Method; 3] = [
@@ -252,6 +267,24 @@ impl Method {
             Method::Rattle => ("rattle", 2, true, true, 2.0, "Andersen (1983); HLW VII.1.4"),
             Method::Rattle4 => ("rattle4", 4, true, true, 1.5734, "RATTLE, Yoshida's triple jump"),
             Method::Shake => ("shake", 2, false, true, 2.0, "Ryckaert, Ciccotti & Berendsen (1977)"),
+            // Not symplectic: nonholonomic flows have no symplectic form to keep.
+            Method::CortesMartinez => (
+                "cortes_martinez",
+                1,
+                false,
+                false,
+                f64::INFINITY,
+                "Cortés & Martínez, Nonlinearity 14 (2001); McLachlan & Perlmutter, J. Nonlinear Sci. 16 (2006)",
+            ),
+            Method::Dla4 => (
+                "dla4",
+                4,
+                false,
+                true,
+                // The midpoint rule rotates the oscillator's phase at any hω; so do its compositions.
+                f64::INFINITY,
+                "McLachlan & Perlmutter (2006), midpoint DLA; Yoshida's triple jump",
+            ),
             Method::WisdomHolman => (
                 "wh",
                 2,
@@ -277,11 +310,12 @@ impl Method {
                 "Wisdom, Holman & Touma (1996), §10; Rein, Tamayo & Brown, MNRAS 489 (2019)",
             ),
         };
-        let implicit = ModelKind::Lagrangian.admits(self);
+        let implicit = ModelKind::Lagrangian.admits(self) || ModelKind::Nonholonomic.admits(self);
         let constrained = ModelKind::ConstrainedSeparable.admits(self);
+        let nonholonomic = !ModelKind::Lagrangian.admits(self) && ModelKind::Nonholonomic.admits(self);
         let nbody = !ModelKind::Separable.admits(self) && ModelKind::Gravitational.admits(self);
         let stages = match self {
-            Method::Rattle4 => 3,
+            Method::Rattle4 | Method::Dla4 => 3,
             _ => Splitting::of(self).map_or(1, |s| s.stages()),
         };
         let force_evaluations = match self {
@@ -298,6 +332,7 @@ impl Method {
             force_evaluations,
             implicit,
             constrained,
+            nonholonomic,
             nbody,
             symplectic,
             symmetric,
@@ -312,6 +347,7 @@ impl Method {
             Method::ALL
                 .into_iter()
                 .chain(Method::CONSTRAINED)
+                .chain(Method::NONHOLONOMIC)
                 .chain(Method::WISDOM_HOLMAN)
         };
         all().find(|m| m.info().name == name).ok_or_else(|| {

@@ -49,8 +49,8 @@ pub use crate::error::StepError;
 pub use crate::solve::NewtonOptions;
 pub use checkpoint::Checkpoint;
 pub use composition::Composition;
-use del::Constraints;
-pub use del::{Del, StepEquations, TwoPoint};
+pub use del::{Composed, Del, StepEquations, TwoPoint};
+use del::{Constraints, DiscreteConstraint};
 pub use dynamics::{Dynamics, General};
 pub use ensemble::{integrate_ensemble, Ensemble, MemberEvents, Members, Outcome, Parallel, Shared, Stopped};
 pub use events::{Detector, EventFunctions, EventSpec, NativeEvent, Occurrence};
@@ -84,6 +84,7 @@ enum Scheme {
     Midpoint(Del<TwoPoint<Midpoint>>),
     Trapezoid(Del<TwoPoint<Trapezoidal>>),
     Galerkin(Del<Galerkin>),
+    ComposedMidpoint(Composed<TwoPoint<Midpoint>>),
     Rattle(Rattle),
     WisdomHolman(WisdomHolman),
 }
@@ -97,7 +98,19 @@ impl Integrator {
     /// As [`Integrator::new`], with the options of the implicit methods' Newton iteration.
     pub fn with_newton(method: Method, n: usize, newton: NewtonOptions) -> Self {
         let scheme = match method {
-            Method::Midpoint => Scheme::Midpoint(Del::new(TwoPoint::new(Midpoint, n), n, newton)),
+            // Cortés–Martínez's step differs only in its discrete constraint (see increment_nonholonomic).
+            Method::Midpoint | Method::CortesMartinez => {
+                Scheme::Midpoint(Del::new(TwoPoint::new(Midpoint, n), n, newton))
+            }
+            Method::Dla4 => Scheme::ComposedMidpoint(Composed::new(
+                TwoPoint::new(Midpoint, n),
+                Composition::of(Method::Yoshida4)
+                    .expect("a composition")
+                    .gamma()
+                    .to_vec(),
+                n,
+                newton,
+            )),
             Method::Trapezoid => Scheme::Trapezoid(Del::new(TwoPoint::new(Trapezoidal, n), n, newton)),
             Method::Galerkin4 => Scheme::Galerkin(Del::new(Galerkin::new(2, n), n, newton)),
             Method::Galerkin6 => Scheme::Galerkin(Del::new(Galerkin::new(3, n), n, newton)),
@@ -147,6 +160,7 @@ impl Integrator {
             Scheme::Midpoint(s) => s.reset(),
             Scheme::Trapezoid(s) => s.reset(),
             Scheme::Galerkin(s) => s.reset(),
+            Scheme::ComposedMidpoint(s) => s.reset(),
             Scheme::Rattle(s) => s.reset(),
             Scheme::WisdomHolman(s) => s.reset(),
             Scheme::ExplicitRk(_) => {}
@@ -172,6 +186,7 @@ impl Integrator {
             Scheme::Midpoint(s) => s.evaluations(),
             Scheme::Trapezoid(s) => s.evaluations(),
             Scheme::Galerkin(s) => s.evaluations(),
+            Scheme::ComposedMidpoint(s) => s.evaluations(),
             Scheme::Rattle(s) => s.evaluations(),
             Scheme::WisdomHolman(s) => s.force_evaluations(),
         }
@@ -183,6 +198,7 @@ impl Integrator {
             Scheme::Midpoint(s) => s.work(),
             Scheme::Trapezoid(s) => s.work(),
             Scheme::Galerkin(s) => s.work(),
+            Scheme::ComposedMidpoint(s) => s.work(),
             _ => 0.0,
         }
     }
@@ -193,6 +209,7 @@ impl Integrator {
             Scheme::Midpoint(s) => Some(s.iterations()),
             Scheme::Trapezoid(s) => Some(s.iterations()),
             Scheme::Galerkin(s) => Some(s.iterations()),
+            Scheme::ComposedMidpoint(s) => Some(s.iterations()),
             Scheme::Rattle(s) => Some(s.iterations()),
             _ => None,
         }
@@ -269,8 +286,10 @@ impl Integrator {
         }
     }
 
-    /// As [`Integrator::increment_lagrangian`] with velocity constraints: the reversible
-    /// discrete Lagrange–d'Alembert equations of the midpoint rule (see [`Del`]).
+    /// As [`Integrator::increment_lagrangian`] with velocity constraints: the discrete
+    /// Lagrange–d'Alembert equations of the midpoint rule (see [`Del`]), with the discrete
+    /// constraint at the midpoint (reversible; `midpoint`, and composed, `dla4`) or at the
+    /// step's start (`cortes_martinez`).
     pub fn increment_nonholonomic<S, C>(
         &mut self,
         sys: &S,
@@ -282,8 +301,14 @@ impl Integrator {
         S: Lagrangian + ?Sized,
         C: VelocityConstraints,
     {
+        let at = match self.method {
+            Method::CortesMartinez => DiscreteConstraint::Start,
+            _ => DiscreteConstraint::Midpoint,
+        };
+        let c = Constraints::Velocity(constraints, at);
         match &mut self.scheme {
-            Scheme::Midpoint(s) => s.increment(sys, Constraints::Velocity(constraints), *start, increment.reborrow()),
+            Scheme::Midpoint(s) => s.increment(sys, c, *start, increment.reborrow()),
+            Scheme::ComposedMidpoint(s) => s.increment(sys, c, *start, increment.reborrow()),
             _ => Err(self.method.refusal(ModelKind::Nonholonomic).into()),
         }
     }

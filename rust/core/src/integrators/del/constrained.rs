@@ -13,7 +13,7 @@ use crate::ModelError;
 
 /// F(x) for x = (λ, s): the scheme's equations in s with (h/2)G(q₀)ᵀλ taken from the last
 /// block (the one holding p₀), then the discrete constraint on δq, the last n of s: g(q₀ + δq)
-/// for holonomic constraints, A(q̄)δq for velocity ones ([`nonholonomic::discrete_constraint`]).
+/// for holonomic constraints, A(q̃)δq for velocity ones ([`nonholonomic::discrete_constraint`]).
 pub(super) fn constrained_equations<Sc: StepEquations, S: Lagrangian + ?Sized>(
     scheme: &mut Sc,
     sys: &S,
@@ -35,7 +35,9 @@ pub(super) fn constrained_equations<Sc: StepEquations, S: Lagrangian + ?Sized>(
     }
     let dq = &s[u - n..];
     match constraints {
-        Constraints::Velocity(c) => nonholonomic::discrete_constraint(c, mp, (start.q, start.h), dq, &mut out[u..]),
+        Constraints::Velocity(c, at) => {
+            nonholonomic::discrete_constraint((c, at), mp, (start.q, start.h), dq, &mut out[u..])
+        }
         Constraints::Holonomic(c) => {
             for ((q1, q), d) in mp.q1.iter_mut().zip(start.q).zip(dq) {
                 *q1 = q + d;
