@@ -1,14 +1,15 @@
 //! The native step loop allocates nothing (with or without events): a long run makes exactly as many allocations as a
-//! run of 100 steps (the set-up's), whatever the method, and so does RATTLE's on a chain; a
+//! run of 100 steps (the set-up's), whatever the method, and so does RATTLE's on a chain and the
+//! discrete Lagrange–d'Alembert step's on the rolling scenes; a
 //! stepper's steps make none at all, nor does taking it apart, resuming and resetting it.
 
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
 use std::ops::Deref;
 
-use varmech::integrators::{integrate, Dynamics, General, Method, Options, Stepper, StepperState};
+use varmech::integrators::{integrate, Dynamics, General, Method, ModelKind, Options, Stepper, StepperState};
 use varmech::model::Routhian;
-use varmech::scenes::{self, NBody};
+use varmech::scenes::{self, NBody, NonholonomicScene, SceneModel};
 
 #[path = "common/tapes.rs"]
 mod tapes;
@@ -299,4 +300,45 @@ fn the_event_loop_allocates_nothing() {
         allocated() - before
     };
     assert_eq!(run(100), run(10_000));
+}
+
+/// As [`counted`], for a nonholonomic catalogue scene (its ∂A/∂q by central differences, on
+/// per-thread scratch).
+fn nonholonomic_allocations(name: &str, method: Method, steps: usize) -> usize {
+    let problem = scenes::lookup(name).unwrap().setup().build().unwrap();
+    let options = Options {
+        save_every: 10,
+        ..Options::new(0.01, steps)
+    };
+    let (q0, p0) = (&problem.initial.q, &problem.initial.p);
+    match &problem.system {
+        SceneModel::Nonholonomic(NonholonomicScene::RollingDisk(s)) => counted(s, method, q0, p0, &options),
+        SceneModel::Nonholonomic(NonholonomicScene::ChaplyginSleigh(s)) => counted(s, method, q0, p0, &options),
+        SceneModel::Nonholonomic(NonholonomicScene::RollingSphere(s)) => counted(s, method, q0, p0, &options),
+        other => panic!("{name} is not nonholonomic: {other:?}"),
+    }
+}
+
+#[test]
+fn the_nonholonomic_step_loop_allocates_nothing() {
+    let methods = Method::ALL.into_iter().filter(|&m| ModelKind::Nonholonomic.admits(m));
+    for method in methods {
+        for name in [
+            "rolling_disk",
+            "chaplygin_sleigh",
+            "rolling_sphere",
+            "ball_on_turntable",
+        ] {
+            // A first run sizes the per-thread scratch of the differences and the Legendre transform.
+            nonholonomic_allocations(name, method, 10);
+            let (short, long) = (
+                nonholonomic_allocations(name, method, 100),
+                nonholonomic_allocations(name, method, 5_000),
+            );
+            assert_eq!(
+                short, long,
+                "{name}, {method:?}: {short} allocations for 100 steps, {long} for 5000"
+            );
+        }
+    }
 }

@@ -1,3 +1,5 @@
+use std::cell::RefCell;
+
 use nalgebra::DMatrix;
 use serde::{Deserialize, Serialize};
 
@@ -109,40 +111,48 @@ pub trait Lagrangian {
     /// Jacobian otherwise (either exact in one step when L is quadratic in q̇), to round-off or
     /// to the noise floor of difference derivatives.
     fn velocity(&self, q: &[f64], p: &[f64], t: f64, v: &mut [f64]) -> Result<(), ModelError> {
-        let n = v.len();
-        let mut problem = InverseLegendre {
-            sys: self,
-            q,
-            p,
-            t,
-            v,
-            plus: vec![0.0; n],
-            minus: vec![0.0; n],
-            hessians: Some(Hessians::zeros(n)),
-        };
-        let rules = Rules {
-            simplified: false,
-            noise_floor: true,
-        };
-        Newton::new(n)
-            .solve(&mut problem, &NewtonOptions::default(), rules)
-            .map_err(model_error)?;
-        Ok(())
+        with_legendre_scratch(v.len(), |scratch| {
+            let LegendreScratch {
+                newton,
+                plus,
+                minus,
+                hessians,
+            } = scratch;
+            let mut problem = InverseLegendre {
+                sys: self,
+                q,
+                p,
+                t,
+                v,
+                plus,
+                minus,
+                hessians: Some(hessians),
+            };
+            let rules = Rules {
+                simplified: false,
+                noise_floor: true,
+            };
+            newton
+                .solve(&mut problem, &NewtonOptions::default(), rules)
+                .map_err(model_error)?;
+            Ok(())
+        })
     }
 
     /// The energy function E(q, p, t) = p·q̇ − L(q, q̇, t), with q̇ from [`Lagrangian::velocity`];
     /// conserved when L does not depend on t.
     fn energy(&self, q: &[f64], p: &[f64], t: f64) -> Result<f64, ModelError> {
-        let mut v = vec![0.0; q.len()];
-        self.velocity(q, p, t, &mut v)?;
-        Ok(p.iter().zip(&v).map(|(a, b)| a * b).sum::<f64>() - self.lagrangian(q, &v, t)?)
+        with_zeros(q.len(), |v| {
+            self.velocity(q, p, t, v)?;
+            Ok(p.iter().zip(v.iter()).map(|(a, b)| a * b).sum::<f64>() - self.lagrangian(q, v, t)?)
+        })
     }
 
     /// E(q, p, t) with its kinetic and potential terms (see [`EnergyTerms`]); the potential is
     /// −L(q, 0, t).
     fn energy_terms(&self, q: &[f64], p: &[f64], t: f64) -> Result<EnergyTerms, ModelError> {
         let energy = self.energy(q, p, t)?;
-        let potential = -self.lagrangian(q, &vec![0.0; q.len()], t)?;
+        let potential = -with_zeros(q.len(), |rest| self.lagrangian(q, rest, t))?;
         Ok(EnergyTerms {
             energy,
             kinetic: energy - potential,
@@ -195,10 +205,66 @@ struct InverseLegendre<'a, S: ?Sized> {
     p: &'a [f64],
     t: f64,
     v: &'a mut [f64],
+    plus: &'a mut [f64],
+    minus: &'a mut [f64],
+    /// Scratch for the exact Hessians; None once the model has said it has none.
+    hessians: Option<&'a mut Hessians>,
+}
+
+/// The inverse Legendre transform's workspace for n coordinates, kept per thread so that a
+/// step that needs q̇(q, p) (the nonholonomic end condition, the energy check) allocates
+/// nothing once it has its size.
+struct LegendreScratch {
+    newton: Newton,
     plus: Vec<f64>,
     minus: Vec<f64>,
-    /// Scratch for the exact Hessians; None once the model has said it has none.
-    hessians: Option<Hessians>,
+    hessians: Hessians,
+}
+
+impl LegendreScratch {
+    fn new(n: usize) -> Self {
+        LegendreScratch {
+            newton: Newton::new(n),
+            plus: vec![0.0; n],
+            minus: vec![0.0; n],
+            hessians: Hessians::zeros(n),
+        }
+    }
+}
+
+thread_local! {
+    static LEGENDRE: RefCell<Option<LegendreScratch>> = const { RefCell::new(None) };
+    static ZEROS: RefCell<Vec<f64>> = const { RefCell::new(Vec::new()) };
+}
+
+/// Runs `body` with n zeros (a velocity to fill, or q̇ = 0), kept per thread so that the
+/// energy check at saved states allocates nothing; a nested call gets its own.
+fn with_zeros<R>(n: usize, body: impl FnOnce(&mut [f64]) -> R) -> R {
+    ZEROS.with(|cell| match cell.try_borrow_mut() {
+        Ok(mut buffer) => {
+            buffer.clear();
+            buffer.resize(n, 0.0);
+            body(&mut buffer)
+        }
+        Err(_) => body(&mut vec![0.0; n]),
+    })
+}
+
+/// Runs `body` with the workspace for n coordinates; a nested transform (a model whose
+/// ∂L/∂q̇ inverts another's) gets a fresh one rather than the busy one.
+fn with_legendre_scratch<R>(n: usize, body: impl FnOnce(&mut LegendreScratch) -> R) -> R {
+    LEGENDRE.with(|cell| match cell.try_borrow_mut() {
+        Ok(mut slot) => {
+            if slot.as_ref().is_none_or(|s| s.plus.len() != n) {
+                *slot = Some(LegendreScratch::new(n));
+            }
+            match slot.as_mut() {
+                Some(scratch) => body(scratch),
+                None => body(&mut LegendreScratch::new(n)),
+            }
+        }
+        Err(_) => body(&mut LegendreScratch::new(n)),
+    })
 }
 
 impl<S: Lagrangian + ?Sized> NewtonProblem for InverseLegendre<'_, S> {
@@ -227,8 +293,8 @@ impl<S: Lagrangian + ?Sized> NewtonProblem for InverseLegendre<'_, S> {
             self.hessians = None;
         }
         let at = Evaluations {
-            plus: &mut self.plus,
-            minus: &mut self.minus,
+            plus: self.plus,
+            minus: self.minus,
         };
         central_jacobian(|v, out| sys.dl_dv(q, v, t, out), self.v, difference::unit, at, jac)?;
         Ok(())
