@@ -17,7 +17,7 @@ def test_tour_prints_reports_and_writes_plots(tmp_path, run_cli):
     pytest.importorskip("matplotlib")
     out = run_cli("tour", "--quick", "--out", tmp_path).stdout
     runs = sum(len(methods) for _, methods, _ in tour_runs()) + sum(len(methods) for _, _, methods in TOUR_REDUCED)
-    assert runs == 52 and out.count("Conservation report") == runs
+    assert runs == 56 and out.count("Conservation report") == runs  # the rolling scenes: midpoint and dla4
     assert "max |G M⁻¹ p|" in out
     assert "verdict: secular drift" in out and "verdict: bounded" in out
     # The summary: every symplectic or variational run conserves its energy (or its balance),
