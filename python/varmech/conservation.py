@@ -255,10 +255,13 @@ class ConservationReport:
         Lagrange–d'Alembert energy balance), judged as the energy is.
     constraints : tuple of InvariantStatistics or None
         For constrained models: |g(q)|∞ and |G(q)M⁻¹p|∞ over the run; with velocity
-        constraints |A(q)q̇|∞ alone.
+        constraints |A(q)q̇ + b(q)|∞ alone.
+    affine : bool
+        Whether the velocity constraints are affine (b ≠ 0, a moving surface): their forces do
+        work, and the energy is not judged.
     verdict : str
-        The energy's verdict, or why the energy is not conserved (L depends on t, or forces
-        act: then see ``energy_balance``).
+        The energy's verdict, or why the energy is not conserved (L depends on t, forces act:
+        then see ``energy_balance``, or affine constraints do work).
     constraint_residuals : tuple of float or None
         max |g(q)|∞ and max |G(q)M⁻¹p|∞ over the run, for constrained models (0 and max
         |A(q)q̇|∞ with velocity constraints); None without constraints.

@@ -145,13 +145,19 @@ def test_a_closure_members_failure_leaves_the_others_complete(workers):
     assert _same(runs[2], single.value.partial)
 
 
-def test_a_closure_model_that_cannot_go_to_processes_is_named():
+def _unshippable():
+    """An oscillator whose potential holds an object that refuses to be pickled."""
+
     class Local:
         def __reduce__(self):
             raise TypeError("not picklable")
 
     local = Local()
-    model = varmech.MechanicalSystem(1, potential=lambda q: local and 0.5 * q[0] ** 2, gradient=lambda q: q.copy())
+    return varmech.MechanicalSystem(1, potential=lambda q: local and 0.5 * q[0] ** 2, gradient=lambda q: q.copy())
+
+
+def test_a_closure_model_that_cannot_go_to_processes_is_named():
+    model = _unshippable()
     with pytest.raises(TypeError, match="^model: .* cannot be shipped to worker processes"):
         varmech.ensemble(model, [[1.0], [2.0]], [[0.0], [0.0]], dt=0.1, steps=10, workers=2, progress=False)
     # Serially it needs no shipping.
@@ -308,12 +314,7 @@ def test_ctrl_c_on_a_cluster_keeps_the_chunks_it_finished(cluster_client, monkey
 
 
 def test_a_model_that_cannot_be_shipped_is_named(cluster_client):
-    class Local:
-        def __reduce__(self):
-            raise TypeError("not picklable")
-
-    local = Local()
-    model = varmech.MechanicalSystem(1, potential=lambda q: local and 0.5 * q[0] ** 2, gradient=lambda q: q.copy())
+    model = _unshippable()
     with pytest.raises(TypeError, match="^model"):
         varmech.ensemble(model, [[1.0]], [[0.0]], dt=0.1, steps=10, client=cluster_client, progress=False)
 

@@ -134,7 +134,8 @@ def test_the_chaplygin_sleigh_keeps_a_bounded_energy_and_relaxes_to_a_straight_l
     assert report.verdict == "bounded" and report.energy.max_abs_error < 1e-5
     speed = np.hypot(traj.p[-1, 0], traj.p[-1, 1])
     assert abs(traj.p[-1, 2]) < 1e-10 and abs(speed - np.sqrt(2.0)) < 1e-5  # E = 1 all forward
-    assert np.max(traj.constraint_residuals()[1]) < 1e-15
+    # Round-off: the end condition is solved to 4ε of the size of |A q̇|'s terms (about 2.8 here).
+    assert np.max(traj.constraint_residuals()[1]) < 4 * np.finfo(float).eps * 2.8
     # The report judges |A(q)q̇| against ‖A‖‖q̇‖: at round-off.
     assert report.constraint_residuals == (0.0, np.max(traj.constraint_residuals()[1]))
     assert report.constraints[0].verdict == "conserved to round-off" and "max |A q̇|" in str(report)
