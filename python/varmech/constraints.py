@@ -82,6 +82,24 @@ def integrable_near(model: Model, q0: ArrayLike) -> bool:
     about it (0.1·max(1, |q0|) away). Rolling twists ker A and is not integrable; x ẋ + y ẏ = 0
     is the circle's derivative.
 
+    Parameters
+    ----------
+    model
+        A model with velocity constraints.
+    q0
+        The configuration near which to test, shape (n,).
+
+    Returns
+    -------
+    bool
+        True when the relative curvature of ker A (the core's ``model::curvature``) is below
+        :data:`INTEGRABLE_CURVATURE` at all four points.
+
+    Raises
+    ------
+    ValueError
+        ``q0`` of the wrong shape or not finite, or a ``model`` without velocity constraints.
+
     Examples
     --------
     >>> import numpy as np, varmech

@@ -64,6 +64,42 @@ def check_derivatives(model: Model, q: ArrayLike, v: ArrayLike | None = None, t:
     its ``hessians`` against differences of the first derivatives it supplies (second
     differences of L would be too coarse to judge them). Differences are accurate to about
     1e-10 relative, so a mismatch above ``rtol`` (default 1e-6) means a wrong derivative.
+
+    Parameters
+    ----------
+    model
+        A closure model that supplies some of its derivatives.
+    q
+        The configuration, shape (n,).
+    v
+        The velocities for a Lagrangian's derivatives (default: zeros).
+    t
+        The time.
+    rtol
+        The largest mismatch, relative to max(1, |differences|), called a match.
+
+    Returns
+    -------
+    DerivativeCheck
+        Each supplied derivative's worst mismatch (``mismatch``), ``ok``, ``worst``; printing
+        it gives the table.
+
+    Raises
+    ------
+    TypeError
+        ``model`` is not a closure model.
+    ValueError
+        ``model`` supplies no derivatives, or ``q``, ``v`` of the wrong shape.
+
+    Examples
+    --------
+    A gradient with a sign error is caught:
+
+    >>> import numpy as np, varmech
+    >>> wrong = varmech.MechanicalSystem(1, lambda q: 0.5 * q[0] ** 2, lambda q: -q.copy())
+    >>> check = varmech.check_derivatives(wrong, [0.3])
+    >>> check.ok, check.worst[0]
+    (False, 'gradient')
     """
     n = model.dim
     q = vector("q", q, n)

@@ -123,6 +123,30 @@ class Occurrences:
 def crossing(k: int, value: float = 0.0, *, direction: int = 0, terminal: bool | int = False) -> Event:
     """The coordinate q_k crossing ``value``: g = q_k − value (evaluated natively).
 
+    Parameters
+    ----------
+    k
+        The coordinate's index.
+    value
+        The level it crosses.
+    direction
+        +1: only upward crossings (g from − to +); −1: only downward; 0: both.
+    terminal
+        Stop the run at the end of the step of the first crossing (True), of the k-th (an
+        integer k), or never (False).
+
+    Returns
+    -------
+    Event
+        The event, for ``integrate(..., events=[...])``: its crossings are located by a partial
+        step of the method and kept in ``traj.events``.
+
+    Raises
+    ------
+    ValueError
+        ``k`` not a non-negative integer, or ``value`` not finite, naming it (an index beyond
+        the model's coordinates is refused by ``integrate``, naming ``events``).
+
     Examples
     --------
     >>> import varmech
@@ -142,6 +166,25 @@ def energy_error(bound: float, *, terminal: bool | int = True) -> Event:
     """The energy error growing beyond ``bound``: g = |E(q, p) − E₀| − bound, E₀ the energy at
     the start, crossing upward (evaluated natively). Terminal by default: a run that stops when
     its energy is off by more than it can accept.
+
+    Parameters
+    ----------
+    bound
+        The largest acceptable |E − E₀|, absolute.
+    terminal
+        Stop the run at the end of the step of the first crossing (True), of the k-th (an
+        integer k), or never (False).
+
+    Returns
+    -------
+    Event
+        The event, for ``integrate(..., events=[...])``: its crossings are located by a partial
+        step of the method and kept in ``traj.events``.
+
+    Raises
+    ------
+    ValueError
+        ``bound`` not finite and positive, naming it.
 
     Examples
     --------
@@ -166,10 +209,29 @@ def escape(radius: float, *, groups: Sequence[Sequence[int]] | None = None, dim:
 
     Parameters
     ----------
+    radius
+        The ball's radius.
     groups
         The coordinate indices of each position x_j; default: consecutive blocks of ``dim``
         (the bodies of an N-body scene, 3 coordinates each; ``dim=2`` for the planar Kepler
         problem).
+    dim
+        The size of each block when ``groups`` is not given.
+    terminal
+        Stop the run at the end of the step of the first crossing (True), of the k-th (an
+        integer k), or never (False).
+
+    Returns
+    -------
+    Event
+        The event, for ``integrate(..., events=[...])``: its crossings are located by a partial
+        step of the method and kept in ``traj.events``.
+
+    Raises
+    ------
+    ValueError
+        ``radius`` not finite and positive, or ``groups`` not lists of indices of one length,
+        naming it.
 
     Examples
     --------
@@ -189,8 +251,29 @@ def escape(radius: float, *, groups: Sequence[Sequence[int]] | None = None, dim:
 def encounter(radius: float, *, groups: Sequence[Sequence[int]] | None = None, dim: int = 3, terminal: bool | int = True) -> Event:
     """Two groups of coordinates (bodies' positions) coming closer than ``radius``:
     g = min_{i<j} |x_i − x_j|² − radius², crossing downward; with a single group, its distance
-    to the origin (evaluated natively). Terminal by default. ``groups`` and ``dim`` as for
-    :func:`escape`.
+    to the origin (evaluated natively). Terminal by default.
+
+    Parameters
+    ----------
+    radius
+        The distance below which the groups have met.
+    groups, dim
+        The positions, as for :func:`escape`.
+    terminal
+        Stop the run at the end of the step of the first crossing (True), of the k-th (an
+        integer k), or never (False).
+
+    Returns
+    -------
+    Event
+        The event, for ``integrate(..., events=[...])``: its crossings are located by a partial
+        step of the method and kept in ``traj.events``.
+
+    Raises
+    ------
+    ValueError
+        ``radius`` not finite and positive, or ``groups`` not lists of indices of one length,
+        naming it.
 
     Examples
     --------

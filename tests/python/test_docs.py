@@ -31,6 +31,7 @@ pytest.importorskip("sympy")
         "varmech.integrate",
         "varmech.model",
         "varmech.constraints",
+        "varmech.derivatives",
         "varmech.reduction",
         "varmech.methods",
         "varmech.analysis.work_precision",

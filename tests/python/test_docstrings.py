@@ -22,6 +22,16 @@ FUNCTIONS = [
     "varmech.streaming.resume",
     "varmech.scenes.get",
     "varmech.methods.methods",
+    "varmech.events.crossing",
+    "varmech.events.energy_error",
+    "varmech.events.escape",
+    "varmech.events.encounter",
+    "varmech.constraints.integrable_near",
+    "varmech.symbolic.lagrangian",
+    "varmech.symbolic.mechanical",
+    "varmech.symbolic.routh",
+    "varmech.derivatives.check_derivatives",
+    "varmech.integrate.symplecticity_defect",
 ]
 #: Functions that raise nothing of their own.
 NO_RAISES = {"varmech.methods.methods"}

@@ -101,6 +101,12 @@ def lagrangian(
     name
         A label for reports.
 
+    Returns
+    -------
+    SymbolicModel
+        The compiled model: its kind (``kind_name``, ``kind``), expressions, parameters and
+        cyclic coordinates; it integrates like any model, with no Python call per step.
+
     Raises
     ------
     TypeError
@@ -150,10 +156,35 @@ def mechanical(
 
     ``mass`` is M: a symmetric n×n SymPy Matrix or nested list, or a scalar m for M = m·I; it
     may depend on q (then the model is a general Lagrangian, for the implicit methods). With M
-    constant, the model is separable and every method applies. The other arguments are those
-    of :func:`lagrangian`, but ``v`` may be omitted (V and M hold no velocities: fresh symbols
-    ``<q>_dot`` stand for them, as in ``expressions``); ValueError names ``mass`` of the wrong
-    shape or not symmetric.
+    constant, the model is separable and every method applies.
+
+    Parameters
+    ----------
+    V
+        The potential V(q, t), a scalar SymPy expression.
+    q
+        The coordinates, as for :func:`lagrangian`.
+    mass
+        M: a symmetric n×n matrix (SymPy or nested lists) or a scalar m for M = m·I.
+    v
+        The velocity symbols; may be omitted (V and M hold no velocities: fresh symbols
+        ``<q>_dot`` stand for them, as in ``expressions``).
+    t, parameters, constraints, velocity_constraints, force, rayleigh, symmetries, jit, name
+        As for :func:`lagrangian`.
+
+    Returns
+    -------
+    SymbolicModel
+        The compiled model: its kind (``kind_name``, ``kind``), expressions, parameters and
+        cyclic coordinates; it integrates like any model, with no Python call per step.
+
+    Raises
+    ------
+    ValueError
+        ``mass`` of the wrong shape or not symmetric, naming it; and what :func:`lagrangian`
+        refuses.
+    TypeError
+        ``q`` or ``v`` not symbols.
 
     Examples
     --------
@@ -198,6 +229,12 @@ def routh(model: SymbolicModel, cyclic: Sequence[int], momenta: Any) -> Symbolic
         The indices of the coordinates to ignore; each must be cyclic (``model.cyclic``).
     momenta
         Their momenta μ, in the order of ``cyclic``.
+
+    Returns
+    -------
+    SymbolicModel
+        The reduced model on the remaining coordinates, with the momenta as parameters
+        ``mu_<coordinate>``.
 
     Raises
     ------
