@@ -58,8 +58,8 @@ def _one_freedom(scene: scenes.Scene) -> str | None:
 
 
 def _implicit(scene: scenes.Scene) -> str | None:
-    if scene.model.kind.name.startswith("constrained"):
-        return f"{scene.name} is a {scene.model.kind.name} model: the map's initial angles q₀ would leave its constraints"
+    if scene.model.kind.name.startswith("constrained") or scene.model.velocity_constraints:
+        return f"{scene.name} is a {scene.model.kind.name} model: the map's initial states would leave its constraints"
     if not any(scene.model.kind.admits(m) for m in stability.IMPLICIT_METHODS):
         methods = ", ".join(stability.IMPLICIT_METHODS)
         return f"{scene.name} is a {scene.model.kind.name} model, which none of the implicit methods {methods} integrates"
