@@ -79,11 +79,12 @@ class Ensemble:
     q, p : ndarray, shape (members, saved, n)
         The members' states, NaN after the last state of a member that stopped early.
     status : ndarray of int, shape (members,)
-        Each member's status (0 finished, -1 failed or interrupted).
+        Each member's status (0 finished, 1 stopped by a terminal event, -1 failed or
+        interrupted).
     messages : list of str
         Each member's message.
     failed : list of int
-        The members that did not reach the end.
+        The members that failed (status -1).
 
     Examples
     --------
@@ -331,7 +332,7 @@ def ensemble(
         return _on_cluster(client, model, q, p, values, settings | dict(workers=workers), chunk_size, progress)
     cores = [m._core for m in (models if values else models[:1])]
     released = [c for c in cores if isinstance(c, (_core.NativeModel, _core.CompiledModel))]
-    if len(released) == len(cores) and all(spec[3] not in ("p", "v") for spec in event_specs):
+    if len(released) == len(cores) and all(e.native is not None for e in watched):
         threshold = _energy_threshold(model, max_energy_error)
         bar = progress_bar(total=nsteps * members, unit="step", desc=f"{method} ×{members}", enabled=progress)
         try:
@@ -369,17 +370,12 @@ def _on_cluster(
 ) -> Ensemble:
     """The ensemble on a Dask cluster: chunks of members as tasks (:func:`_chunk`), gathered in
     member order."""
-    import cloudpickle
     from distributed import as_completed
 
-    try:
-        cloudpickle.dumps(model)
-    except Exception as err:
-        raise TypeError(f"model: {model.name} cannot be shipped to the cluster ({err})") from err
+    _shipped(model, settings, "the cluster")
     members = len(q)
     if chunk_size is None:
-        threads = sum(client.nthreads().values()) or 1
-        chunk_size = max(1, math.ceil(members / (4 * threads)))
+        chunk_size = _default_chunk(members, sum(client.nthreads().values()) or 1)
     starts = range(0, members, chunk_size)
     futures = [
         client.submit(
@@ -403,6 +399,23 @@ def _on_cluster(
     finally:
         bar.close()
     return _gathered(chunks, values)
+
+
+def _shipped(model: Model, settings: dict[str, Any], where: str) -> bytes:
+    """The model and the run's settings (its events among them) pickled by cloudpickle, as they
+    go to worker processes; one that cannot be is a TypeError naming ``model``."""
+    import cloudpickle
+
+    try:
+        return cloudpickle.dumps((model, settings))
+    except Exception as err:
+        raise TypeError(f"model: {model.name} or its events cannot be shipped to {where} ({err})") from err
+
+
+def _default_chunk(members: int, workers: int) -> int:
+    """Members a task runs when ``chunk_size`` is not given to a cluster or to processes: about
+    four tasks a worker, so that the faster ones take more."""
+    return max(1, math.ceil(members / (4 * workers)))
 
 
 def _gathered(chunks: list[Any], values: dict[str, np.ndarray], unfinished: Any = None) -> Ensemble:
@@ -440,14 +453,11 @@ def _in_processes(
     process, which stops them and keeps the chunks gathered."""
     import cloudpickle
 
-    try:
-        shipped = cloudpickle.dumps((model, settings))
-    except Exception as err:
-        raise TypeError(f"model: {model.name} or its events cannot be shipped to worker processes ({err})") from err
+    shipped = _shipped(model, settings, "worker processes")
     members = len(q)
     workers = min(workers, members)
     if chunk_size is None:
-        chunk_size = max(1, math.ceil(members / (4 * workers)))
+        chunk_size = _default_chunk(members, workers)
     tasks = [(shipped, q[a : a + chunk_size], p[a : a + chunk_size]) for a in range(0, members, chunk_size)]
     chunks: list[Any] = [None] * len(tasks)
     start = "forkserver" if "forkserver" in multiprocessing.get_all_start_methods() else "spawn"
