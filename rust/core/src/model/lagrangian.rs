@@ -7,6 +7,7 @@ use super::{EnergyTerms, MechanicalSystem};
 use crate::error::StepError;
 use crate::solve::difference::{self, central_gradient, central_jacobian, Evaluations};
 use crate::solve::newton::{model_error, Correction, Newton, NewtonOptions, NewtonProblem, Reasons, Rules};
+use crate::solve::scratch::with_scratch;
 use crate::ModelError;
 
 /// The second derivatives of L at one point, n × n each.
@@ -237,34 +238,28 @@ thread_local! {
     static ZEROS: RefCell<Vec<f64>> = const { RefCell::new(Vec::new()) };
 }
 
-/// Runs `body` with n zeros (a velocity to fill, or q̇ = 0), kept per thread so that the
-/// energy check at saved states allocates nothing; a nested call gets its own.
+/// Runs `body` with n zeros (a velocity to fill, or q̇ = 0) from this thread's workspace
+/// ([`with_scratch`]), so that the energy check at saved states allocates nothing.
 fn with_zeros<R>(n: usize, body: impl FnOnce(&mut [f64]) -> R) -> R {
-    ZEROS.with(|cell| match cell.try_borrow_mut() {
-        Ok(mut buffer) => {
-            buffer.clear();
-            buffer.resize(n, 0.0);
-            body(&mut buffer)
-        }
-        Err(_) => body(&mut vec![0.0; n]),
+    with_scratch(&ZEROS, Vec::new, |buffer| {
+        buffer.clear();
+        buffer.resize(n, 0.0);
+        body(buffer)
     })
 }
 
-/// Runs `body` with the workspace for n coordinates; a nested transform (a model whose
-/// ∂L/∂q̇ inverts another's) gets a fresh one rather than the busy one.
+/// Runs `body` with the workspace for n coordinates from this thread's ([`with_scratch`]).
 fn with_legendre_scratch<R>(n: usize, body: impl FnOnce(&mut LegendreScratch) -> R) -> R {
-    LEGENDRE.with(|cell| match cell.try_borrow_mut() {
-        Ok(mut slot) => {
-            if slot.as_ref().is_none_or(|s| s.plus.len() != n) {
-                *slot = Some(LegendreScratch::new(n));
+    with_scratch(
+        &LEGENDRE,
+        || None,
+        |slot| {
+            if slot.as_ref().is_some_and(|s| s.plus.len() != n) {
+                *slot = None;
             }
-            match slot.as_mut() {
-                Some(scratch) => body(scratch),
-                None => body(&mut LegendreScratch::new(n)),
-            }
-        }
-        Err(_) => body(&mut LegendreScratch::new(n)),
-    })
+            body(slot.get_or_insert_with(|| LegendreScratch::new(n)))
+        },
+    )
 }
 
 impl<S: Lagrangian + ?Sized> NewtonProblem for InverseLegendre<'_, S> {

@@ -4,6 +4,7 @@ use nalgebra::{DMatrix, DVector};
 
 use super::constraints::{momentum_projection, row_norm};
 use super::{inverse_mass, Lagrangian, Residuals};
+use crate::solve::scratch::with_scratch;
 use crate::{Error, ModelError};
 
 /// Velocity constraints A(q)q̇ + b(q) = 0 affine in the velocities, m rows on n coordinates,
@@ -46,8 +47,7 @@ pub trait VelocityConstraints {
             return Ok(());
         }
         let h = f64::EPSILON.cbrt() * q[i].abs().max(1.0);
-        with_scratch(q, |x, scratch| {
-            let minus = &mut scratch.offset;
+        shifted(q, |x, _, minus| {
             minus.resize(out.len(), 0.0);
             x[i] = q[i] + h;
             self.offset(x, out)?;
@@ -70,8 +70,7 @@ pub fn differenced_derivative<C: VelocityConstraints + ?Sized>(
     out: &mut DMatrix<f64>,
 ) -> Result<(), ModelError> {
     let h = f64::EPSILON.cbrt() * q[i].abs().max(1.0);
-    with_scratch(q, |x, scratch| {
-        let minus = &mut scratch.matrix;
+    shifted(q, |x, minus, _| {
         if minus.shape() != out.shape() {
             *minus = DMatrix::zeros(out.nrows(), out.ncols());
         }
@@ -85,8 +84,7 @@ pub fn differenced_derivative<C: VelocityConstraints + ?Sized>(
     })
 }
 
-/// The differences' scratch: the values at q − hεᵢ, kept per thread so that the step loop
-/// allocates nothing once they have their size.
+/// The differences' workspace: the shifted point and the values of A and b at q − hεᵢ.
 #[derive(Default)]
 struct Scratch {
     point: Vec<f64>,
@@ -98,19 +96,14 @@ thread_local! {
     static SCRATCH: RefCell<Scratch> = RefCell::new(Scratch::default());
 }
 
-/// Runs `body` with a copy of q (to shift) and the scratch; a nested call (constraints whose
-/// evaluation differences constraints again) gets fresh scratch rather than a busy one.
-fn with_scratch<R>(q: &[f64], body: impl FnOnce(&mut [f64], &mut Scratch) -> R) -> R {
-    SCRATCH.with(|cell| match cell.try_borrow_mut() {
-        Ok(mut scratch) => {
-            let mut point = std::mem::take(&mut scratch.point);
-            point.clear();
-            point.extend_from_slice(q);
-            let result = body(&mut point, &mut scratch);
-            scratch.point = point;
-            result
-        }
-        Err(_) => body(&mut q.to_vec(), &mut Scratch::default()),
+/// Runs `body` with a copy of q to shift and the buffers for A and b there, from this
+/// thread's workspace ([`with_scratch`]).
+fn shifted<R>(q: &[f64], body: impl FnOnce(&mut [f64], &mut DMatrix<f64>, &mut Vec<f64>) -> R) -> R {
+    with_scratch(&SCRATCH, Scratch::default, |scratch| {
+        let Scratch { point, matrix, offset } = scratch;
+        point.clear();
+        point.extend_from_slice(q);
+        body(point, matrix, offset)
     })
 }
 

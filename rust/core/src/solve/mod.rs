@@ -5,7 +5,8 @@
 //!   equations built from them;
 //! - `newton`: Newton's method, simplified (a kept Jacobian) or full, with [`NewtonOptions`];
 //! - [`bracket`]: a root of a function on a bracket (Illinois), for locating events;
-//! - [`interrupt`]: when to poll for Ctrl-C, and the check the iterative solves poll.
+//! - [`interrupt`]: when to poll for Ctrl-C, and the check the iterative solves poll;
+//! - `scratch`: per-thread workspaces, for functions whose signatures take none.
 
 /// Calls `$f(args…, n)` with n a literal for n ≤ 8, so that the inlined body (an
 /// `#[inline(always)]` function of n) is specialised: the small systems most steps solve then run
@@ -32,5 +33,6 @@ pub mod difference;
 pub mod interrupt;
 pub(crate) mod lu;
 pub(crate) mod newton;
+pub(crate) mod scratch;
 
 pub use newton::NewtonOptions;
