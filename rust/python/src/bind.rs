@@ -163,7 +163,9 @@ fn is_forced(py: Python<'_>, model: &Bound<'_, PyAny>) -> PyResult<bool> {
 /// their forces do work and the energy is not conserved).
 #[pyfunction]
 fn is_affine(py: Python<'_>, model: &Bound<'_, PyAny>) -> PyResult<bool> {
-    bind_model(py, model, |sys, _| sys.is_affine())
+    bind_model(py, model, |sys, _| {
+        sys.velocity_constraints().is_some_and(|c| c.is_affine())
+    })
 }
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {

@@ -70,12 +70,6 @@ pub trait Dynamics {
     /// The system as a Lagrangian, for the diagnostics (energy function, Legendre transforms).
     fn as_lagrangian(&self) -> &dyn Lagrangian;
 
-    /// Whether the model has affine velocity constraints A(q)q̇ + b(q) = 0, b ≠ 0: their
-    /// forces do work, so that the energy function is not conserved.
-    fn is_affine(&self) -> bool {
-        false
-    }
-
     /// |g(q)|∞ and |G(q)M⁻¹p|∞, with their sizes, for a constrained system; None for the others.
     fn constraint_residuals(&self, _q: &[f64], _p: &[f64]) -> Option<Result<model::Residuals, ModelError>> {
         None
@@ -296,8 +290,8 @@ impl<L: Lagrangian, C: VelocityConstraints> Dynamics for Nonholonomic<L, C> {
     }
 
     /// E = p·q̇ − L, unless L depends on t or the constraints are affine
-    /// ([`Dynamics::is_affine`]): linear constraints' forces do no work, affine ones' do, so
-    /// that their runs have no energy to watch.
+    /// ([`VelocityConstraints::is_affine`]): linear constraints' forces do no work, affine
+    /// ones' do, so that their runs have no energy to watch.
     fn energy(&self, q: &[f64], p: &[f64], t: f64) -> Option<Result<EnergyTerms, ModelError>> {
         let conserved = !self.system.is_time_dependent() && !self.constraints.is_affine();
         conserved.then(|| self.system.energy_terms(q, p, t))
@@ -305,10 +299,6 @@ impl<L: Lagrangian, C: VelocityConstraints> Dynamics for Nonholonomic<L, C> {
 
     fn as_lagrangian(&self) -> &dyn Lagrangian {
         &self.system
-    }
-
-    fn is_affine(&self) -> bool {
-        self.constraints.is_affine()
     }
 
     fn constraint_residuals(&self, q: &[f64], p: &[f64]) -> Option<Result<model::Residuals, ModelError>> {
