@@ -131,8 +131,8 @@ def lagrangian(
     started = time.perf_counter()
     variables_ = variables(q, v, t)
     return _build(
-        variables_, variables_.plain(L, "L"), parameters, (constraints, velocity_constraints), force, rayleigh, symmetries,
-        jit, name, started,
+        variables_, variables_.plain(L, "L"), parameters, constraints, force, rayleigh, symmetries, jit, name, started,
+        velocity_constraints=velocity_constraints,
     )
 
 
@@ -202,7 +202,9 @@ def mechanical(
     check_compilable(potential, "V")
     velocity = sp.Matrix(variables_.v)
     L = (velocity.T * m * velocity)[0, 0] / 2 - potential
-    return _build(variables_, L, parameters, (constraints, velocity_constraints), force, rayleigh, symmetries, jit, name, started)
+    return _build(
+        variables_, L, parameters, constraints, force, rayleigh, symmetries, jit, name, started, velocity_constraints=velocity_constraints
+    )
 
 
 def routh(model: SymbolicModel, cyclic: Sequence[int], momenta: Any) -> SymbolicModel:
@@ -260,7 +262,7 @@ def routh(model: SymbolicModel, cyclic: Sequence[int], momenta: Any) -> Symbolic
     reduced = routhian(model, cyclic, momenta)
     variables_ = variables(list(reduced.q), list(reduced.v), model.t)
     name = f"{model.name}, Routhian (ignoring {', '.join(str(model.q[i]) for i in cyclic)})"
-    return _build(variables_, reduced.R, reduced.parameters, (None, None), None, None, (), model._spec.jit, name, started)
+    return _build(variables_, reduced.R, reduced.parameters, None, None, None, (), model._spec.jit, name, started)
 
 
 def _mass_matrix(mass: Any, variables: Variables) -> sp.Matrix:
@@ -286,23 +288,26 @@ def _build(
     variables: Variables,
     L: sp.Expr,
     given_parameters: Mapping[Any, float] | None,
-    all_constraints: tuple[Any, Any],
+    constraints: Any,
     force: Any,
     rayleigh: Any,
     symmetries: Sequence[Symmetry],
     jit: bool,
     name: str,
     started: float,
+    *,
+    velocity_constraints: Any = None,
 ) -> SymbolicModel:
     """Checks, derives, lowers and compiles: the common path of :func:`lagrangian` and
     :func:`mechanical`."""
     forces = expressions(force, "force", variables) if force is not None else None
     dissipation = variables.plain(rayleigh, "rayleigh") if rayleigh is not None else None
-    constraints, rolling = all_constraints
-    if constraints is not None and rolling is not None:
+    if constraints is not None and velocity_constraints is not None:
         raise ValueError("velocity_constraints: not together with holonomic constraints (yet); give one kind")
     holonomic = expressions(constraints, "constraints", variables) if constraints is not None else None
-    nonholonomic = expressions(rolling, "velocity_constraints", variables) if rolling is not None else None
+    nonholonomic = None
+    if velocity_constraints is not None:
+        nonholonomic = expressions(velocity_constraints, "velocity_constraints", variables)
     parts = [("L", L)] + [(f"force[{i}]", x) for i, x in enumerate(forces or [])]
     parts += [("rayleigh", dissipation)] if dissipation is not None else []
     parts += [(f"constraints[{i}]", x) for i, x in enumerate(holonomic or [])]
