@@ -387,6 +387,8 @@ def specs(events: Sequence[Event | EventFunction], n: int) -> tuple[list[Event],
 
 def occurrences(record: _core.TrajectoryRecord, events: Sequence[Event]) -> tuple[Occurrences, ...]:
     """Each event's located crossings, from the binding's record of a run."""
+    if not events:
+        return ()
     index, t, q, p = record.events[:4]
     return tuple(
         Occurrences(_name(i, e), t[index == i], q[index == i], p[index == i]) for i, e in enumerate(events)

@@ -100,7 +100,11 @@ def stream(
     def committed() -> None:
         """Waits for the last segment's commit (Ctrl-C held back meanwhile), raising its error."""
         nonlocal pending
-        if pending is not None:
+        if pending is not None and pending.done():
+            # Nothing to wait for: read the result without masking Ctrl-C (two system calls a segment).
+            done, pending = pending, None
+            done.result()
+        elif pending is not None:
             with _uninterrupted():
                 done, pending = pending, None
                 done.result()
