@@ -63,6 +63,9 @@ from .impulses import Joined, Pieces, _velocity
 from .methods import method_info
 from .model import Model
 
+#: The public API; the rest serves :func:`varmech.integrate`.
+__all__ = ["Contact", "ContactError"]
+
 
 @dataclass(frozen=True)
 class Contact:

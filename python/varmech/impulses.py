@@ -38,6 +38,9 @@ from ._util import vector
 from .dense import grid_step
 from .model import Model
 
+#: The public API; the rest serves :func:`varmech.integrate`.
+__all__ = ["Engagement", "Impulse", "ImpulseResponse", "engage", "impulse_response"]
+
 
 @dataclass(frozen=True)
 class Impulse:
