@@ -52,6 +52,7 @@ __all__ = [
     "kind_of",
     "methods",
     "momentum",
+    "momentum_along",
     "nbody",
     "project",
     "resume",
@@ -533,6 +534,9 @@ def derivative(model: _Model, what: str, t: _FloatArray, q: _FloatArray, x: _Flo
 
 def momentum(generator: Generator, q: _FloatArray, p: _FloatArray) -> tuple[_FloatArray, _FloatArray]:
     """(J, Σ|pᵢξᵢ|) at each state."""
+
+def momentum_along(xi: _FloatArray, p: _FloatArray) -> tuple[_FloatArray, _FloatArray]:
+    """(J = p·ξ, its size) at each state, from ξ(q) evaluated there."""
 
 VERDICTS: tuple[str, str, str, str]
 FAILURE: float

@@ -61,21 +61,20 @@ def momentum(traj: Trajectory, generator: Generator) -> np.ndarray:
 
 
 def _momentum_terms(traj: Trajectory, generator: Generator) -> tuple[np.ndarray, np.ndarray]:
-    """J = p·ξ(q) and its size at every saved state: the larger of Σ|pᵢξᵢ|, its terms, and
-    ‖p‖∞‖ξ‖∞ (as the core's ``Generator.momentum_terms``: a momentum at rest under a moving
-    system has the rounding error of the whole motion)."""
+    """J = p·ξ(q) and its size at every saved state, by the core's rule (``Generator::momentum_terms``:
+    the larger of Σ|pᵢξᵢ| and ‖p‖∞‖ξ‖∞)."""
     if isinstance(generator, (Translation, Rotation, Cyclic)):
         return _core.momentum(generator.spec(), *traj._arrays()[1:])
     if not callable(generator):
         raise TypeError(f"generator: expected a Translation, Rotation, Cyclic or a callable xi(q), got {generator!r}")
     n = traj.q.shape[1]
-    j, size = np.empty(len(traj.t)), np.empty(len(traj.t))
-    for k, (q, p) in enumerate(zip(traj.q, traj.p)):
-        xi = np.asarray(generator(q.copy()), dtype=float)
-        if xi.shape != (n,):
-            raise ValueError(f"generator: xi(q) must return shape ({n},), got {xi.shape}")
-        j[k], size[k] = p @ xi, max(np.abs(p * xi).sum(), np.max(np.abs(p)) * np.max(np.abs(xi)))
-    return j, size
+    xi = np.empty_like(traj.q)
+    for k, q in enumerate(traj.q):
+        row = np.asarray(generator(q.copy()), dtype=float)
+        if row.shape != (n,):
+            raise ValueError(f"generator: xi(q) must return shape ({n},), got {row.shape}")
+        xi[k] = row
+    return _core.momentum_along(xi, np.ascontiguousarray(traj.p, dtype=float))
 
 
 @dataclass(frozen=True)

@@ -109,6 +109,22 @@ fn momentum<'py>(
     Ok((PyArray1::from_vec(py, j), PyArray1::from_vec(py, size)))
 }
 
+/// J = p·ξ for each row of (ξ, p), a field ξ(q) evaluated at the states, and its size.
+#[pyfunction]
+fn momentum_along<'py>(
+    py: Python<'py>,
+    xi: PyReadonlyArray2<'py, f64>,
+    p: PyReadonlyArray2<'py, f64>,
+) -> PyResult<ArrayPair<'py>> {
+    let ((xi, n), (p, _)) = (rows("xi", &xi)?, rows("p", &p)?);
+    let (j, size): (Vec<f64>, Vec<f64>) = xi
+        .chunks_exact(n.max(1))
+        .zip(p.chunks_exact(n.max(1)))
+        .map(|(xi, p)| model::momentum_along(xi, p))
+        .unzip();
+    Ok((PyArray1::from_vec(py, j), PyArray1::from_vec(py, size)))
+}
+
 /// The error of a conserved quantity against its scale, and its verdict (the core's
 /// `Statistics`).
 #[pyclass(frozen, get_all, module = "varmech._core")]
@@ -231,6 +247,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(energy_terms, m)?)?;
     m.add_function(wrap_pyfunction!(derivative, m)?)?;
     m.add_function(wrap_pyfunction!(momentum, m)?)?;
+    m.add_function(wrap_pyfunction!(momentum_along, m)?)?;
     m.add_function(wrap_pyfunction!(energy_statistics, m)?)?;
     m.add_function(wrap_pyfunction!(statistics, m)?)?;
     m.add_class::<Statistics>()?;

@@ -47,4 +47,4 @@ pub use nbody::{NBody, PairKernel};
 pub use nonholonomic::{differenced_derivative, Nonholonomic, VelocityConstraints};
 pub use routh::Routhian;
 pub use scale::Scale;
-pub use symmetry::Generator;
+pub use symmetry::{momentum_along, Generator};

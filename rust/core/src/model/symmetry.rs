@@ -59,8 +59,6 @@ impl Generator {
     /// under a swinging bob is computed from the whole motion (p_x = (M + m)ẋ + ml cos θ θ̇),
     /// whose size its rounding error has, not that of p_x ≈ 0.
     pub fn momentum_terms(&self, q: &[f64], p: &[f64]) -> (f64, f64) {
-        let sum = |terms: &mut dyn Iterator<Item = f64>| terms.fold((0.0, 0.0), |(j, size), x| (j + x, size + x.abs()));
-        let largest = |x: &[f64]| x.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
         let ((j, terms), xi) = match *self {
             Generator::Translation { axis, spatial_dim } => {
                 (sum(&mut p.iter().skip(axis).step_by(spatial_dim).copied()), 1.0)
@@ -83,6 +81,28 @@ impl Generator {
             }
             Generator::Cyclic { index } => ((p[index], p[index].abs()), 1.0),
         };
-        (j, terms.max(largest(p) * xi))
+        (j, size(terms, p, xi))
     }
+}
+
+/// J = p·ξ and its size, as [`Generator::momentum_terms`] gives them, for a field ξ given at q
+/// (a user's ξ(q)).
+pub fn momentum_along(xi: &[f64], p: &[f64]) -> (f64, f64) {
+    let (j, terms) = sum(&mut p.iter().zip(xi).map(|(p, x)| p * x));
+    (j, size(terms, p, largest(xi)))
+}
+
+/// (Σ xᵢ, Σ|xᵢ|).
+fn sum(terms: &mut dyn Iterator<Item = f64>) -> (f64, f64) {
+    terms.fold((0.0, 0.0), |(j, size), x| (j + x, size + x.abs()))
+}
+
+/// ‖x‖∞.
+fn largest(x: &[f64]) -> f64 {
+    x.iter().fold(0.0_f64, |m, x| m.max(x.abs()))
+}
+
+/// The size of J: the larger of Σ|pᵢξᵢ| (`terms`) and ‖p‖∞‖ξ‖∞ (`xi`: ‖ξ‖∞).
+fn size(terms: f64, p: &[f64], xi: f64) -> f64 {
+    terms.max(largest(p) * xi)
 }
