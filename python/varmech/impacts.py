@@ -353,9 +353,40 @@ class TwoPoint(CoreStep):
 
 
 class ContactError(_core.VarmechError):
-    """An impact could not be resolved: a non-finite state through it, or more than
+    """An impact could not be resolved: a non-finite state through it, a body that crosses the
+    surface again at once after leaving it (a resting or grazing contact), or more than
     :data:`MAX_IMPACTS` impacts in one step (an accumulation of impacts, as of a ball coming to
-    rest). ``step``, ``time`` and ``partial`` (the run up to the impact) are attached."""
+    rest).
+
+    Impacts model collisions, not resting contact: a ball with e < 1 bounces ever lower and
+    faster, and its impacts accumulate at a finite time; stop the run before it (a terminal
+    event) or model the resting phase as a constraint.
+
+    Attributes
+    ----------
+    step : int
+        The step in which the impact failed (1 for the first).
+    time : float
+        The time tₙ at the start of that step.
+    partial : Trajectory
+        The run up to the last good step (``status`` -1), with the impacts resolved so far in
+        its ``events``.
+
+    See Also
+    --------
+    Contact : the surfaces and their coefficients of restitution.
+
+    Examples
+    --------
+    A ball with e = 0.5 comes to rest on the floor at t = (1 + 2e/(1 − e))√(2h₀/g) ≈ 1.35:
+
+    >>> import varmech
+    >>> try:
+    ...     varmech.integrate(varmech.scenes.bouncing_ball(restitution=0.5), dt=0.01, t_end=2.0)
+    ... except varmech.ContactError as err:
+    ...     print(err.step, round(err.time, 2), len(err.partial.events[0]), err.partial.status)
+    136 1.35 8 -1
+    """
 
     step: int
     time: float

@@ -35,6 +35,7 @@ pytest.importorskip("sympy")
         "varmech.reduction",
         "varmech.methods",
         "varmech.analysis.work_precision",
+        "varmech._errors",
     ],
 )
 def test_examples_run(name):
