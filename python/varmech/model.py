@@ -175,10 +175,13 @@ class Model:
         return self._derivative("momentum", q, v, t)
 
     def _derivative(self, what: str, q: ArrayLike, x: ArrayLike, t: ArrayLike) -> np.ndarray:
+        # x is the momenta p for the velocity, else the velocities v.
+        name = "p" if what == "velocity" else "v"
         x = np.ascontiguousarray(x, dtype=float)
         rows = np.atleast_2d(x)
-        q2 = np.ascontiguousarray(np.broadcast_to(np.asarray(q, dtype=float), rows.shape))
-        t1 = np.ascontiguousarray(np.broadcast_to(np.asarray(t, dtype=float), rows.shape[:1]))
+        if rows.ndim != 2 or rows.shape[1] != self.dim:
+            raise ValueError(f"{name}: expected shape ({self.dim},) or (N, {self.dim}), got {x.shape}")
+        q2, t1 = _broadcast("q", q, rows.shape), _broadcast("t", t, rows.shape[:1])
         return _core.derivative(self._core, what, t1, q2, rows).reshape(x.shape)
 
     def with_parameters(self, **values: float) -> Model:
@@ -201,6 +204,16 @@ class Model:
         if arguments is None:
             raise TypeError(f"cannot pickle {type(self).__name__} {self.name!r}: it records no constructor arguments")
         return (_rebuild, (type(self), arguments))
+
+
+def _broadcast(name: str, value: ArrayLike, shape: tuple[int, ...]) -> np.ndarray:
+    """``value`` as a contiguous float array of ``shape``; ValueError naming it when it does not
+    broadcast to the states' shape."""
+    array = np.asarray(value, dtype=float)
+    try:
+        return np.ascontiguousarray(np.broadcast_to(array, shape))
+    except ValueError:
+        raise ValueError(f"{name}: shape {array.shape} does not fit the states' {shape}") from None
 
 
 def _rebuild(cls: Callable[..., Model], arguments: dict[str, Any]) -> Model:
