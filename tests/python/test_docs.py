@@ -17,6 +17,7 @@ pytest.importorskip("sympy")
         "varmech.symbolic.examples",
         "varmech.symbolic._lower",
         "varmech.symbolic._derive",
+        "varmech.symbolic._model",
         "varmech.events",
         "varmech.files",
         "varmech.streaming",
