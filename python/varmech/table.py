@@ -42,12 +42,16 @@ class Table:
         self._check(values)
         self.rows.append(tuple(values))
 
+    def _index(self, name: str, argument: str) -> int:
+        """The position of column ``name``; KeyError naming ``argument`` when there is none."""
+        try:
+            return self.columns.index(name)
+        except ValueError:
+            raise KeyError(f"{argument}: no column {name!r} in {self.columns}") from None
+
     def column(self, name: str) -> np.ndarray:
         """The values of column ``name``, as an array (float where they are numbers)."""
-        try:
-            i = self.columns.index(name)
-        except ValueError:
-            raise KeyError(f"name: no column {name!r} in {self.columns}") from None
+        i = self._index(name, "name")
         values = [row[i] for row in self.rows]
         try:
             return np.array(values, dtype=float)
@@ -56,13 +60,13 @@ class Table:
 
     def where(self, **equal: Any) -> Table:
         """The rows whose columns equal the given values."""
-        idx = {self.columns.index(k): v for k, v in equal.items()}
+        idx = {self._index(k, k): v for k, v in equal.items()}
         rows = [r for r in self.rows if all(r[i] == v for i, v in idx.items())]
         return Table(self.columns, rows, self.title, dict(self.meta))
 
     def unique(self, name: str) -> list[Any]:
         """The distinct values of column ``name``, in order of appearance."""
-        i = self.columns.index(name)
+        i = self._index(name, "name")
         return list(dict.fromkeys(r[i] for r in self.rows))
 
     def to_csv(self, path: str | Path) -> Path:
