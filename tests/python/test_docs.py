@@ -37,6 +37,7 @@ pytest.importorskip("sympy")
         "varmech.methods",
         "varmech.analysis.work_precision",
         "varmech._errors",
+        "varmech.table",
     ],
 )
 def test_examples_run(name):
