@@ -15,6 +15,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from . import _core
+from ._util import positive
 from .impacts import Contact
 from .model import Model, NativeSystem
 
@@ -626,9 +627,15 @@ def nbody(masses: ArrayLike, positions: ArrayLike, velocities: ArrayLike, G: flo
     v = np.asarray(velocities, dtype=float)
     if m.ndim != 1 or x.shape != (len(m), 3) or v.shape != (len(m), 3):
         raise ValueError(f"positions, velocities: must have shape ({len(m)}, 3) to match masses")
-    model = NativeSystem(_core.nbody(float(G), [float(mi) for mi in m]))
+    bad = np.flatnonzero(~(np.isfinite(m) & (m > 0)))
+    if bad.size:
+        raise ValueError(f"masses: must be finite and positive, got masses[{bad[0]}] = {m[bad[0]]}")
+    if not (np.all(np.isfinite(x)) and np.all(np.isfinite(v))):
+        raise ValueError("positions, velocities: must be finite")
+    G, t_end, dt = positive("G", G), positive("t_end", t_end), positive("dt", dt)
+    model = NativeSystem(_core.nbody(G, [float(mi) for mi in m]))
     p = (m[:, None] * v).ravel()
-    return Scene("nbody", f"{len(m)}-body problem", model, x.ravel().copy(), p, float(t_end), float(dt))
+    return Scene("nbody", f"{len(m)}-body problem", model, x.ravel().copy(), p, t_end, dt)
 
 
 def cartesian_pendulum() -> Scene:
