@@ -22,7 +22,27 @@ from .model import Model, NativeSystem
 
 @dataclass(frozen=True)
 class Reference:
-    """The solution at time ``t``, exact or published, and where it comes from."""
+    """The solution at time ``t``, exact or published, and where it comes from.
+
+    Attributes
+    ----------
+    t : float
+        The time of the reference state.
+    q, p : ndarray, shape (n,)
+        The positions and momenta there (NaN where the source gives none, as the spherical
+        pendulum's p_θ).
+    source : str
+        Where it comes from: "exact: …", a publication, or a file of ``reference/``.
+
+    Examples
+    --------
+    >>> import varmech
+    >>> scene = varmech.scenes.pendulum()
+    >>> ref = scene.reference
+    >>> traj = varmech.integrate(scene, dt=scene.dt / 8, t_end=ref.t, method="kahan_li8")
+    >>> bool(abs(traj.q[-1, 0] - ref.q[0]) < 1e-12), ref.source
+    (True, 'Hairer, Lubich & Wanner, GNI I.1; GNI test codes')
+    """
 
     t: float
     q: np.ndarray
@@ -621,7 +641,52 @@ def damped_driven_pendulum(gamma: float = 0.5, amplitude: float = 1.5, drive: fl
 
 def nbody(masses: ArrayLike, positions: ArrayLike, velocities: ArrayLike, G: float = 1.0, t_end: float = 1.0, dt: float = 1e-3) -> Scene:
     """A native gravitational N-body model in 3 dimensions from masses (N,), positions and
-    velocities (N, 3)."""
+    velocities (N, 3).
+
+    H = Σᵢ \\|pᵢ\\|²/2mᵢ − G Σ_{i<j} mᵢmⱼ/\\|qᵢ − qⱼ\\| in the coordinates of the bodies, one after
+    the other (n = 3N); evaluated in O(N) memory, so that 10⁵ bodies fit. The model declares
+    the translations and rotations (total linear and angular momentum).
+
+    Parameters
+    ----------
+    masses : array_like, shape (N,)
+        The masses, finite and positive; at least two bodies.
+    positions, velocities : array_like, shape (N, 3)
+        The initial positions and velocities (finite); the momenta are pᵢ = mᵢvᵢ.
+    G : float, default 1.0
+        The gravitational constant, positive.
+    t_end : float, default 1.0
+        The scene's horizon, positive.
+    dt : float, default 1e-3
+        The scene's step, positive.
+
+    Returns
+    -------
+    Scene
+        The model with its initial state, horizon and step; no invariants or reference.
+
+    Raises
+    ------
+    ValueError
+        Naming the argument: shapes that do not match ``masses``, masses not finite and
+        positive (or fewer than two), positions or velocities not finite, or ``G``,
+        ``t_end`` or ``dt`` not finite and positive.
+
+    See Also
+    --------
+    outer_solar_system : the outer planets.
+
+    Examples
+    --------
+    A light body on a circular orbit of radius 1 about a heavy one:
+
+    >>> import varmech
+    >>> scene = varmech.scenes.nbody([1.0, 1e-3], [[0, 0, 0], [1, 0, 0]], [[0, 0, 0], [0, 1, 0]], dt=0.01)
+    >>> traj = varmech.integrate(scene, dt=scene.dt, steps=100)
+    >>> E = traj.energy()
+    >>> round(float(E[-1]), 6), traj.method
+    (-0.0005, 'verlet')
+    """
     m = np.asarray(masses, dtype=float)
     x = np.asarray(positions, dtype=float)
     v = np.asarray(velocities, dtype=float)
