@@ -54,7 +54,7 @@ _VARMECH_ERROR = """Base class of varmech's errors: catch it to catch any of the
 
 _DIVERGENCE_ERROR = """The solution blew up: a non-finite state, or an energy error beyond ``max_energy_error``.
 
-    :func:`varmech.integrate` checks the energy error \\|E − E₀\\| at each saved state against
+    :func:`varmech.integrate` checks the energy error |E − E₀| at each saved state against
     ``max_energy_error`` times the energy's scale (the mean kinetic energy so far); a state that
     is not finite always stops the run. The usual cure is a smaller step.
 

@@ -225,8 +225,8 @@ class Trajectory:
         Returns
         -------
         position, velocity : ndarray, shape (N,)
-            \\|g(q)\\|∞ and \\|G(q)M⁻¹p\\|∞ (the hidden constraint) for holonomic constraints;
-            0 and \\|A(q)q̇\\|∞ for velocity constraints.
+            |g(q)|∞ and |G(q)M⁻¹p|∞ (the hidden constraint) for holonomic constraints;
+            0 and |A(q)q̇|∞ for velocity constraints.
 
         Raises
         ------

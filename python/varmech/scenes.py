@@ -254,7 +254,7 @@ def pendulum() -> Scene:
 
 
 def kepler(e: float = 0.6) -> Scene:
-    """The Kepler problem H = \\|p\\|²/2 − 1/\\|q\\| in the plane, q = (x, y).
+    """The Kepler problem H = |p|²/2 − 1/|q| in the plane, q = (x, y).
 
     Hairer, Lubich & Wanner's work–precision protocol [1]_: from the pericentre q = (1 − e, 0),
     p = (0, √((1 + e)/(1 − e))), an orbit of semi-major axis 1 and period 2π, over 200 periods.
@@ -365,7 +365,7 @@ def outer_solar_system() -> Scene:
     """The outer solar system of Hairer, Lubich & Wanner [1]_ as a gravitational 6-body problem.
 
     The Sun (with the inner planets' masses), Jupiter, Saturn, Uranus, Neptune and Pluto in
-    3 dimensions, H = Σ\\|pᵢ\\|²/2mᵢ − G Σ_{i<j} mᵢmⱼ/\\|qᵢ − qⱼ\\|, in AU, days and solar
+    3 dimensions, H = Σ|pᵢ|²/2mᵢ − G Σ_{i<j} mᵢmⱼ/|qᵢ − qⱼ|, in AU, days and solar
     masses, over 500 000 days against the reference state of the GNI test codes
     (``reference/outer_solar_system.json``).
 
@@ -438,7 +438,7 @@ def spherical_pendulum() -> Scene:
 
     See Also
     --------
-    cartesian_spherical_pendulum : the same pendulum in (x, y, z) on \\|x\\| = 1.
+    cartesian_spherical_pendulum : the same pendulum in (x, y, z) on the unit sphere.
     varmech.routh : the pendulum reduced by its cyclic φ.
 
     Examples
@@ -527,9 +527,9 @@ def kepler_polar(e: float = 0.6) -> Scene:
 def charged_particle(B: float = 1.0) -> Scene:
     """A unit charge of unit mass in the plane, in the uniform magnetic field B ẑ.
 
-    In the symmetric gauge, L = ½\\|q̇\\|² + (B/2)(x ẏ − y ẋ). From q = (1, 0), q̇ = (0, −B) it
+    In the symmetric gauge, L = ½|q̇|² + (B/2)(x ẏ − y ẋ). From q = (1, 0), q̇ = (0, −B) it
     gyrates on the unit circle at Ω = B, the exact solution at t = 10. A general Lagrangian,
-    rotation invariant: the energy ½\\|q̇\\|² and the canonical angular momentum
+    rotation invariant: the energy ½|q̇|² and the canonical angular momentum
     x p_y − y p_x are conserved.
 
     Parameters
@@ -564,10 +564,10 @@ def charged_particle(B: float = 1.0) -> Scene:
 
 
 def charged_particle_nonuniform() -> Scene:
-    """A unit charge of unit mass in the plane, in the field B(q) = (1 + \\|q\\|²/4) ẑ.
+    """A unit charge of unit mass in the plane, in the field B(q) = (1 + |q|²/4) ẑ.
 
     In the symmetric gauge (the closure example of the user guide's models page),
-    L = ½\\|q̇\\|² + A(q)·q̇ with A(q) = ½(1 + \\|q\\|²/8)(−y, x). From q = (1, 0), q̇ = (0, −1)
+    L = ½|q̇|² + A(q)·q̇ with A(q) = ½(1 + |q|²/8)(−y, x). From q = (1, 0), q̇ = (0, −1)
     to t = 200 it gyrates and drifts about the origin. Rotation invariant: the energy and the
     canonical angular momentum are conserved. No reference state.
 
@@ -643,7 +643,7 @@ def nbody(masses: ArrayLike, positions: ArrayLike, velocities: ArrayLike, G: flo
     """A native gravitational N-body model in 3 dimensions from masses (N,), positions and
     velocities (N, 3).
 
-    H = Σᵢ \\|pᵢ\\|²/2mᵢ − G Σ_{i<j} mᵢmⱼ/\\|qᵢ − qⱼ\\| in the coordinates of the bodies, one after
+    H = Σᵢ |pᵢ|²/2mᵢ − G Σ_{i<j} mᵢmⱼ/|qᵢ − qⱼ| in the coordinates of the bodies, one after
     the other (n = 3N); evaluated in O(N) memory, so that 10⁵ bodies fit. The model declares
     the translations and rotations (total linear and angular momentum).
 
@@ -739,9 +739,9 @@ def cartesian_pendulum() -> Scene:
 
 
 def cartesian_spherical_pendulum() -> Scene:
-    """The spherical pendulum in Cartesian coordinates on \\|x\\| = 1 (m = l = g = 1).
+    """The spherical pendulum in Cartesian coordinates on |x| = 1 (m = l = g = 1).
 
-    L = ½\\|ẋ\\|² − z on g(x) = \\|x\\|² − 1 = 0, from θ = 1, θ̇ = 0, φ̇ = 1.2 (θ from the
+    L = ½|ẋ|² − z on g(x) = |x|² − 1 = 0, from θ = 1, θ̇ = 0, φ̇ = 1.2 (θ from the
     downward vertical) to T = 50: the initial state of :func:`spherical_pendulum`. The
     reference holds the positions of that scene's reference angles; the angular momentum
     L_z = x p_y − y p_x about the vertical is conserved.
@@ -772,8 +772,8 @@ def cartesian_spherical_pendulum() -> Scene:
 def planar_chain(links: int = 8) -> Scene:
     """A planar chain of ``links`` unit masses on unit links hanging from the origin (g = 1).
 
-    L = ½Σ\\|ẋᵢ\\|² − Σyᵢ in the positions xᵢ = (xᵢ, yᵢ) of the masses, subject to
-    \\|x₁\\|² = 1 and \\|xᵢ − xᵢ₋₁\\|² = 1: 2·links coordinates and ``links`` constraints.
+    L = ½Σ|ẋᵢ|² − Σyᵢ in the positions xᵢ = (xᵢ, yᵢ) of the masses, subject to
+    |x₁|² = 1 and |xᵢ − xᵢ₋₁|² = 1: 2·links coordinates and ``links`` constraints.
     Released from rest straight at 1 rad from the downward vertical, to t = 100. No reference
     state; the energy is the invariant to check.
 
@@ -808,7 +808,7 @@ def planar_chain(links: int = 8) -> Scene:
 def rigid_body() -> Scene:
     """A rigid body about a fixed point in unit quaternions, Hairer, Lubich & Wanner's example [1]_.
 
-    q = (q₁, q₂, q₃, q₄), scalar part first, on the constraint \\|q\\|² = 1; principal moments
+    q = (q₁, q₂, q₃, q₄), scalar part first, on the constraint |q|² = 1; principal moments
     I = (0.5, 0.9, 1.0) and the potential U = q₁² − q₂² − q₃² + q₄², from q = (0.4, 0.2, 0.4,
     0.8) with body angular momentum (0.2, 1, 0.4), to t = 10. The kinetic energy's mass
     depends on q, so its discrete Euler–Lagrange equations are solved with the constraint by
@@ -886,7 +886,7 @@ def bouncing_ball(g: float = 9.81, h0: float = 1.0, restitution: float = 1.0) ->
 
 
 def elliptic_billiard(A: float = 2.0, B: float = 1.0, x0: float = 0.3, y0: float = 0.1, px0: float = 0.6, py0: float = 0.8) -> Scene:
-    """A free particle of unit mass in the elliptic billiard x²/A² + y²/B² ≤ 1, H = \\|p\\|²/2.
+    """A free particle of unit mass in the elliptic billiard x²/A² + y²/B² ≤ 1, H = |p|²/2.
 
     From (x0, y0) inside with momenta (px0, py0), to t = 100: the wall is ``contacts[0]``, a
     native ellipse, with elastic impacts. Integrable: besides E, the product L₁L₂ of the
@@ -1092,7 +1092,7 @@ def ball_on_turntable(
     normal, its centre's velocity turns at ν = (2/7)Ω: it circles about r + (−ẏ, ẋ)/ν, back to
     its start at T = 14π/Ω (the reference). The table does work: E is not conserved (unless
     the circle is centred on the axis); the Jacobi integral J = E − Ω(x p_y − y p_x) is, with
-    p_φ = Iω_z, the speed \\|ṙ\\| and the circle's centre.
+    p_φ = Iω_z, the speed |ṙ| and the circle's centre.
 
     Parameters
     ----------
