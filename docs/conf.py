@@ -84,15 +84,17 @@ def _escape_bars(app, what, name, obj, options, lines):
     """The docstrings write absolute values and norms as |x| (plain text for help()); reST reads
     |x| as a substitution, so the bars are escaped outside literals, doctests and tables."""
     literal_indent = None
+    in_doctest = False  # a doctest block runs from its first >>> to the next blank line
     for i, line in enumerate(lines):
         stripped = line.lstrip()
         indent = len(line) - len(stripped)
+        in_doctest = bool(stripped) and (in_doctest or stripped.startswith(">>>"))
         if literal_indent is not None:
             if stripped and indent <= literal_indent:
                 literal_indent = None
             else:
                 continue
-        if stripped.startswith((">>>", "...", "| ", "+-", "+=")) or "|" not in line:
+        if in_doctest or stripped.startswith(("| ", "+-", "+=")) or "|" not in line:
             if line.rstrip().endswith("::"):
                 literal_indent = indent
             continue

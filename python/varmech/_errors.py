@@ -1,15 +1,169 @@
-"""Pickling of varmech's exceptions (defined in the core binding, module ``varmech``): an error
-keeps its message and its attributes (``step``, ``time``, ``residual``, ``iterations`` and the
-partial trajectory ``partial``), so that it crosses process boundaries (multiprocessing,
-concurrent.futures). The partial trajectory travels without its model: models hold native
-objects or closures, which do not pickle; its states, times and counts are all kept."""
+"""Pickling and documentation of varmech's exceptions (defined in the core binding, module
+``varmech``).
+
+Pickling: an error keeps its message and its attributes (``step``, ``time``, ``residual``,
+``iterations`` and the partial trajectory ``partial``), so that it crosses process boundaries
+(multiprocessing, concurrent.futures). The partial trajectory travels without its model: models
+hold native objects or closures, which do not pickle; its states, times and counts are all kept.
+
+Documentation: the binding gives each class a one-line docstring; the numpydoc docstrings below
+(attributes and a run that fails) replace them when :func:`install` runs, at import, and are
+the doctests of this module (``__test__``).
+"""
 
 from __future__ import annotations
 
 import dataclasses
 from typing import Any
 
-from ._core import VarmechError
+from ._core import ConvergenceError, DivergenceError, SpuriousBranchError, VarmechError
+
+_VARMECH_ERROR = """Base class of varmech's errors: catch it to catch any of them.
+
+    A run that fails raises a subclass (:class:`DivergenceError`, :class:`ConvergenceError`,
+    :class:`SpuriousBranchError`, :class:`~varmech.ContactError`); a VarmechError itself means
+    a model's evaluation failed in the core without a Python exception of its own, or an event
+    function returned a value that is not finite. Bad arguments are ValueError or TypeError,
+    never a VarmechError. It is a :class:`RuntimeError`.
+
+    Attributes
+    ----------
+    step : int
+        The step that failed (1 for the first), where a run failed.
+    time : float
+        The time tₙ at the start of that step.
+    partial : Trajectory
+        The run up to the last good step, with ``status`` -1 and the error's message as its
+        ``message``.
+
+    See Also
+    --------
+    varmech.integrate : what raises them, with the attributes each carries.
+
+    Examples
+    --------
+    The pendulum with a step of half its period blows up at once:
+
+    >>> import varmech
+    >>> try:
+    ...     varmech.integrate(varmech.scenes.pendulum(), dt=3.0, steps=100)
+    ... except varmech.VarmechError as err:
+    ...     print(type(err).__name__, err.step, err.partial.status, len(err.partial))
+    DivergenceError 1 -1 2
+    """
+
+_DIVERGENCE_ERROR = """The solution blew up: a non-finite state, or an energy error beyond ``max_energy_error``.
+
+    :func:`varmech.integrate` checks the energy error |E − E₀| at each saved state against
+    ``max_energy_error`` times the energy's scale (the mean kinetic energy so far); a state that
+    is not finite always stops the run. The usual cure is a smaller step.
+
+    Attributes
+    ----------
+    step : int
+        The step that failed (1 for the first).
+    time : float
+        The time tₙ at the start of that step.
+    partial : Trajectory
+        The run up to the last good step (``status`` -1): the states before the blow-up, to
+        look at or to go on from with a smaller step.
+
+    See Also
+    --------
+    varmech.conservation.FAILURE : the default threshold, the error of a "failed" verdict.
+
+    Examples
+    --------
+    Verlet at h = 3 on the pendulum (period ≈ 6.7): the energy error after one step is 4.4
+    times the kinetic energy.
+
+    >>> import varmech
+    >>> try:
+    ...     varmech.integrate(varmech.scenes.pendulum(), dt=3.0, steps=100)
+    ... except varmech.DivergenceError as err:
+    ...     print(err.step, err.time, err.partial.t)
+    1 3.0 [0. 3.]
+    """
+
+_CONVERGENCE_ERROR = """Newton's method did not solve a step's implicit equations (a smaller step usually helps).
+
+    The implicit methods (``midpoint``, ``trapezoid``, the Galerkin and constrained ones) solve
+    each step's discrete Euler–Lagrange equations D₂L_d(qₙ₋₁, qₙ) + D₁L_d(qₙ, qₙ₊₁) = 0 by
+    Newton's method; it fails after ``newton_max_iterations`` iterations without reaching
+    ``newton_tolerance`` (arguments of :func:`varmech.integrate`).
+
+    Attributes
+    ----------
+    step : int
+        The step that failed (1 for the first).
+    time : float
+        The time tₙ at the start of that step.
+    residual : float
+        ‖F‖∞, the max-norm of the step's equations F(qₙ₊₁) = 0 at the last iterate.
+    iterations : int
+        The iterations made.
+    partial : Trajectory
+        The run up to the last good step (``status`` -1).
+
+    See Also
+    --------
+    SpuriousBranchError : Newton converged, but beyond a fold of the discrete map.
+
+    Examples
+    --------
+    One Newton iteration a step is too few for the double pendulum:
+
+    >>> import varmech
+    >>> try:
+    ...     varmech.integrate(varmech.scenes.double_pendulum(), dt=0.1, steps=10, newton_max_iterations=1)
+    ... except varmech.ConvergenceError as err:
+    ...     print(err.step, err.iterations, f"{err.residual:.1e}", len(err.partial))
+    1 1 3.1e-02 1
+    """
+
+_SPURIOUS_BRANCH_ERROR = """A step's implicit equations were solved beyond a fold of the DEL map (take a smaller step).
+
+    The solution found lies on a branch that need not continue the trajectory. Near a fold the
+    derivative of the discrete Euler–Lagrange equations in qₙ₊₁ changes sign, and Newton's
+    method can converge to a solution qₙ₊₁ that is not the continuation of the trajectory (a
+    pendulum jumping over the top with too little energy). A subclass of
+    :class:`ConvergenceError`, whose ``residual`` and ``iterations`` it does not set.
+
+    Attributes
+    ----------
+    step : int
+        The step that failed (1 for the first).
+    time : float
+        The time tₙ at the start of that step.
+    partial : Trajectory
+        The run up to the last good step (``status`` -1).
+
+    See Also
+    --------
+    ConvergenceError : Newton's method did not converge at all.
+
+    Examples
+    --------
+    The pendulum from rest at q = 3 (E = −cos 3 < 1) with the midpoint rule at h = 3:
+
+    >>> import varmech
+    >>> try:
+    ...     varmech.integrate(varmech.scenes.pendulum(), [3.0], [0.0], dt=3.0, steps=10, method="midpoint")
+    ... except varmech.SpuriousBranchError as err:
+    ...     print(err.step, err.time, len(err.partial))
+    1 0.0 1
+    """
+
+#: The numpydoc docstrings of the binding's exceptions, which :func:`install` sets.
+DOCSTRINGS: dict[type[BaseException], str] = {
+    VarmechError: _VARMECH_ERROR,
+    DivergenceError: _DIVERGENCE_ERROR,
+    ConvergenceError: _CONVERGENCE_ERROR,
+    SpuriousBranchError: _SPURIOUS_BRANCH_ERROR,
+}
+
+#: The docstrings' examples, for doctest (the classes belong to module ``varmech``).
+__test__ = {cls.__name__: doc for cls, doc in DOCSTRINGS.items()}
 
 
 def _reduce(error: BaseException) -> tuple[Any, ...]:
@@ -21,5 +175,8 @@ def _reduce(error: BaseException) -> tuple[Any, ...]:
 
 
 def install() -> None:
-    """Makes VarmechError and its subclasses pickle with their attributes."""
+    """Makes VarmechError and its subclasses pickle with their attributes, and gives them their
+    numpydoc docstrings."""
     VarmechError.__reduce__ = _reduce  # type: ignore[assignment,method-assign]
+    for cls, doc in DOCSTRINGS.items():
+        cls.__doc__ = doc

@@ -67,7 +67,30 @@ def project(model: Model, q0: ArrayLike, p0: ArrayLike | None = None, *, v0: Arr
 
 class IntegrableConstraintsWarning(UserWarning):
     """Velocity constraints that integrate to holonomic ones near the initial state: give them
-    as g(q) = 0 (``constraints=``), for RATTLE or the constrained DEL step."""
+    as g(q) = 0 (``constraints=``), for RATTLE or the constrained DEL step.
+
+    :func:`varmech.integrate` warns so when Frobenius' test (:func:`integrable_near`) finds
+    the distribution ker A(q) flat at the initial state: the constraints A(q)q̇ = 0 are then
+    the derivative of some g(q) = 0, and the nonholonomic integrators would keep g only to
+    their order, where RATTLE keeps it to round-off.
+
+    See Also
+    --------
+    integrable_near : the test itself.
+
+    Examples
+    --------
+    x ẋ + y ẏ = 0 is the derivative of the circle x² + y² = 1:
+
+    >>> import warnings, numpy as np, varmech
+    >>> circle = varmech.MechanicalSystem(2, lambda q: 0.0, lambda q: np.zeros(2),
+    ...     velocity_constraints=lambda q: np.array([[q[0], q[1]]]), velocity_constraint_count=1)
+    >>> with warnings.catch_warnings(record=True) as caught:
+    ...     warnings.simplefilter("always")
+    ...     traj = varmech.integrate(circle, [1.0, 0.0], v0=[0.0, 1.0], dt=0.01, steps=10)
+    >>> [w.category.__name__ for w in caught]
+    ['IntegrableConstraintsWarning']
+    """
 
 
 #: Frobenius' test calls the constraints integrable below this relative curvature: far above

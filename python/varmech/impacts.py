@@ -72,6 +72,43 @@ class Contact:
     """A unilateral constraint φ(q) ≥ 0 with its gradient ∇φ(q) and the coefficient of
     restitution ``restitution`` e ∈ [0, 1] (1: elastic).
 
+    :func:`varmech.integrate` (``contacts=``) splits each step that crosses φ = 0 at the
+    contact configuration and applies the impact there: p⁺ = p⁻ + λ∇φ(q), with λ such that the
+    normal velocity ∇φ·q̇ goes to −e times itself (the exact reflection), or, for elastic
+    contacts under ``law="variational"``, such that the discrete energy is continuous (the
+    variational collision integrator of Fetecau, Marsden, Ortiz & West [1]_).
+
+    Attributes
+    ----------
+    phi : callable
+        φ(q) -> float, positive on the allowed side.
+    gradient : callable
+        ∇φ(q) -> array_like, shape (n,).
+    restitution : float, default 1.0
+        The coefficient of restitution e ∈ [0, 1].
+    name : str, default "contact"
+        The contact's name (its events' name in ``traj.events``).
+    law : {"variational", "reflect"}, default "variational"
+        The impact law: the variational collision integrator (:func:`variational_jump`; for
+        kick–drift methods and the two-point rules ``midpoint`` and ``trapezoid``, elastic
+        contacts only), or the exact reflection of the momenta between the method's partial
+        steps (any method; symplectic across an impact only to the method's order).
+
+    Raises
+    ------
+    ValueError
+        ``restitution`` not in [0, 1], or an unknown ``law``.
+
+    See Also
+    --------
+    varmech.surfaces : the native surfaces of :meth:`wall` and :meth:`ellipsoid`.
+    ContactError : an impact that cannot be resolved.
+
+    References
+    ----------
+    .. [1] R. C. Fetecau, J. E. Marsden, M. Ortiz and M. West, "Nonsmooth Lagrangian mechanics
+       and variational collision integrators", *SIAM J. Appl. Dyn. Syst.* 2 (2003) 381–416.
+
     Examples
     --------
     >>> import numpy as np, varmech
@@ -113,6 +150,29 @@ class Contact:
         core (the native ``crossing`` event), with no Python call per step; φ and ∇φ are
         :class:`varmech.surfaces.Wall` (they pickle and compare by k and the value).
 
+        Parameters
+        ----------
+        k : int
+            The coordinate bounded.
+        value : float, default 0.0
+            The wall's position.
+        restitution : float, default 1.0
+            The coefficient of restitution e ∈ [0, 1].
+        name : str, optional
+            The contact's name (default ``"q[k] ≥ value"``).
+        law : {"variational", "reflect"}, default "variational"
+            The impact law (see :class:`Contact`).
+
+        Returns
+        -------
+        Contact
+            The wall, watched natively.
+
+        Raises
+        ------
+        ValueError
+            ``restitution`` not in [0, 1], or an unknown ``law``.
+
         Examples
         --------
         >>> import numpy as np, varmech
@@ -146,6 +206,35 @@ class Contact:
         or −φ (``inside=False``: an obstacle the state stays out of). Watched in the core (the
         native ``ellipsoid`` event), with no Python call per step; an ellipse is two semi-axes,
         a circle or sphere equal ones.
+
+        Parameters
+        ----------
+        semi_axes : array_like, shape (m,)
+            The semi-axes aᵢ, finite and positive.
+        coordinates : array_like of int, shape (m,), optional
+            The coordinates kᵢ (default 0, …, m − 1).
+        centre : array_like, shape (m,), optional
+            The centre c (default the origin).
+        inside : bool, default True
+            Keep the state inside (a table) or, if False, outside (an obstacle).
+        restitution : float, default 1.0
+            The coefficient of restitution e ∈ [0, 1].
+        name : str, optional
+            The contact's name (default ``"ellipsoid"`` or ``"outside an ellipsoid"``).
+        law : {"variational", "reflect"}, default "variational"
+            The impact law (see :class:`Contact`).
+
+        Returns
+        -------
+        Contact
+            The ellipsoid, watched natively (:class:`varmech.surfaces.Ellipsoid`).
+
+        Raises
+        ------
+        ValueError
+            ``semi_axes``, ``coordinates`` and ``centre`` of different lengths, semi-axes not
+            finite and positive, a centre not finite, a negative coordinate, ``restitution``
+            not in [0, 1], or an unknown ``law``.
 
         Examples
         --------
@@ -356,9 +445,40 @@ class TwoPoint(CoreStep):
 
 
 class ContactError(_core.VarmechError):
-    """An impact could not be resolved: a non-finite state through it, or more than
+    """An impact could not be resolved: a non-finite state through it, a body that crosses the
+    surface again at once after leaving it (a resting or grazing contact), or more than
     :data:`MAX_IMPACTS` impacts in one step (an accumulation of impacts, as of a ball coming to
-    rest). ``step``, ``time`` and ``partial`` (the run up to the impact) are attached."""
+    rest).
+
+    Impacts model collisions, not resting contact: a ball with e < 1 bounces ever lower and
+    faster, and its impacts accumulate at a finite time; stop the run before it (a terminal
+    event) or model the resting phase as a constraint.
+
+    Attributes
+    ----------
+    step : int
+        The step in which the impact failed (1 for the first).
+    time : float
+        The time tₙ at the start of that step.
+    partial : Trajectory
+        The run up to the last good step (``status`` -1), with the impacts resolved so far in
+        its ``events``.
+
+    See Also
+    --------
+    Contact : the surfaces and their coefficients of restitution.
+
+    Examples
+    --------
+    A ball with e = 0.5 comes to rest on the floor at t = (1 + 2e/(1 − e))√(2h₀/g) ≈ 1.35:
+
+    >>> import varmech
+    >>> try:
+    ...     varmech.integrate(varmech.scenes.bouncing_ball(restitution=0.5), dt=0.01, t_end=2.0)
+    ... except varmech.ContactError as err:
+    ...     print(err.step, round(err.time, 2), len(err.partial.events[0]), err.partial.status)
+    136 1.35 8 -1
+    """
 
     step: int
     time: float

@@ -134,30 +134,105 @@ class Trajectory:
 
     def save(self, path: str | os.PathLike[str], *, overwrite: bool = False) -> Path:
         """Writes the trajectory to the HDF5 file ``path`` (h5py, the extra ``io``); read it back
-        with :func:`varmech.load`. See :mod:`varmech.files` for the layout."""
+        with :func:`varmech.load`. See :mod:`varmech.files` for the layout.
+
+        Parameters
+        ----------
+        path : str or os.PathLike
+            The file to write.
+        overwrite : bool, default False
+            Replace an existing file.
+
+        Returns
+        -------
+        pathlib.Path
+            The path written.
+
+        Raises
+        ------
+        ValueError
+            Naming ``path``: the file exists and ``overwrite`` is False, or it cannot be written.
+        ImportError
+            h5py is not installed.
+
+        See Also
+        --------
+        varmech.load : read it back (lazily, for runs larger than memory).
+        """
         return files.save(self, path, overwrite=overwrite)
 
     def sol(self, t: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
         """(q(t), p(t)) between the saved states, by cubic Hermite interpolation from q, q̇ and
         p, ṗ at the states on either side: error O(Δ⁴) in their spacing Δ. See
-        :func:`varmech.dense.hermite`."""
+        :func:`varmech.dense.hermite`.
+
+        Parameters
+        ----------
+        t : float or array_like
+            Times within the saved span [t[0], t[-1]].
+
+        Returns
+        -------
+        q, p : ndarray, shape t.shape + (n,)
+            The interpolated positions and momenta.
+
+        Raises
+        ------
+        ValueError
+            Naming ``t``: times not finite or outside the saved span, fewer than two saved
+            states, or a constrained model (whose ṗ holds the constraint forces).
+        """
         return dense.hermite(self, t)
 
     def energy(self) -> np.ndarray:
         """The energy function E = p·q̇ − L (= ½pᵀM⁻¹p + V(q) for mechanical systems) at each
-        saved state, shape (N,)."""
+        saved state.
+
+        Returns
+        -------
+        ndarray, shape (N,)
+            E at each saved state (computed for any model; conserved only when L does not
+            depend on t and no forces act).
+
+        Raises
+        ------
+        Exception
+            What a closure of the model raises, unchanged.
+        """
         return self.energy_terms()[0]
 
     def energy_terms(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """(E, T, V) at each saved state, shapes (N,): the energy function, its kinetic term
-        T = E − V and its potential V = −L(q, 0, t), the energy of the configuration at rest
-        (½pᵀM⁻¹p and V(q) for mechanical systems). The conservation verdicts measure energy
-        errors against the mean of T."""
+        """(E, T, V) at each saved state: the energy function, its kinetic term T = E − V and its
+        potential V = −L(q, 0, t), the energy of the configuration at rest (½pᵀM⁻¹p and V(q)
+        for mechanical systems). The conservation verdicts measure energy errors against the
+        mean of T.
+
+        Returns
+        -------
+        E, T, V : ndarray, shape (N,)
+            The energy and its kinetic and potential terms at each saved state.
+
+        Raises
+        ------
+        Exception
+            What a closure of the model raises, unchanged.
+        """
         return _core.energy_terms(self.model._core, *self._arrays())
 
     def constraint_residuals(self) -> tuple[np.ndarray, np.ndarray]:
-        """|g(q)|∞ and |G(q)M⁻¹p|∞ at each saved state of a constrained model, shapes (N,); 0
-        and |A(q)q̇|∞ with velocity constraints."""
+        """How far each saved state is off the constraints.
+
+        Returns
+        -------
+        position, velocity : ndarray, shape (N,)
+            |g(q)|∞ and |G(q)M⁻¹p|∞ (the hidden constraint) for holonomic constraints;
+            0 and |A(q)q̇|∞ for velocity constraints.
+
+        Raises
+        ------
+        ValueError
+            Naming ``model``: it has no constraints.
+        """
         return _core.constraint_residuals(self.model._core, *self._arrays()[1:])[0]
 
     def _arrays(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -20,7 +20,33 @@ _AXES = "xyz"
 class Translation:
     """Every body moves along ``axis``: J is the total linear momentum along it.
 
-    Coordinates are laid out body by body, each body with ``spatial_dim`` coordinates.
+    Coordinates are laid out body by body, each body with ``spatial_dim`` coordinates. The
+    generator is ξ(q) = Σ_b e_axis (one unit vector per body), and Noether's momentum
+    J = p·ξ(q) = Σ_b p_b,axis is conserved when L is invariant under the shift.
+
+    Attributes
+    ----------
+    axis : int
+        The axis (0, 1, 2 for x, y, z).
+    spatial_dim : int, default 3
+        The coordinates per body.
+    name : str
+        ``"P_x"``, ``"P_y"``, ``"P_z"`` (``"P_k"`` beyond 3 dimensions), as reports name J.
+
+    See Also
+    --------
+    varmech.momentum : J along a trajectory.
+
+    Examples
+    --------
+    Two free bodies on a line, pulled together by a spring: the total momentum stays.
+
+    >>> import numpy as np, varmech
+    >>> spring = varmech.MechanicalSystem(2, lambda q: 0.5 * (q[0] - q[1]) ** 2,
+    ...     lambda q: np.array([q[0] - q[1], q[1] - q[0]]), symmetries=[varmech.Translation(0, spatial_dim=1)])
+    >>> traj = varmech.integrate(spring, [0.0, 1.0], [0.3, 0.0], dt=0.1, steps=100)
+    >>> varmech.momentum(traj, spring.symmetries[0])[-1].round(12), spring.symmetries[0].name
+    (np.float64(0.3), 'P_x')
     """
 
     axis: int
@@ -28,39 +54,119 @@ class Translation:
 
     @property
     def name(self) -> str:
+        """The momentum's name in reports."""
         return f"P_{_AXES[self.axis]}" if self.axis < 3 else f"P_{self.axis}"
 
     def spec(self) -> _core.Generator:
+        """The core's generator of this symmetry, as the binding takes it.
+
+        Returns
+        -------
+        varmech._core.Generator
+            The generator's kind and data, checked against the model's dimension when a model
+            is built with it.
+        """
         return _core.Generator.Translation(self.axis, self.spatial_dim)
 
 
 @dataclass(frozen=True)
 class Rotation:
     """Every body turns about ``axis`` (in the plane when ``spatial_dim`` is 2): J is the total
-    angular momentum about it."""
+    angular momentum about it.
+
+    The generator is ξ(q) = e_axis × q_b for each body b (in the plane, (−y_b, x_b)), so
+    J = p·ξ(q) = Σ_b (q_b × p_b)·e_axis.
+
+    Attributes
+    ----------
+    axis : int, default 2
+        The axis of rotation (0, 1, 2 for x, y, z; ignored in the plane).
+    spatial_dim : int, default 3
+        The coordinates per body, 2 or 3.
+    name : str
+        ``"L"`` in the plane, else ``"L_x"``, ``"L_y"``, ``"L_z"``.
+
+    See Also
+    --------
+    varmech.momentum : J along a trajectory.
+
+    Examples
+    --------
+    >>> import varmech
+    >>> kepler = varmech.scenes.kepler()
+    >>> kepler.model.symmetries
+    (Rotation(axis=2, spatial_dim=2),)
+    >>> traj = varmech.integrate(kepler, dt=kepler.dt, steps=100)
+    >>> varmech.momentum(traj, kepler.model.symmetries[0])[-1].round(12)
+    np.float64(0.8)
+    """
 
     axis: int = 2
     spatial_dim: int = 3
 
     @property
     def name(self) -> str:
+        """The momentum's name in reports."""
         return "L" if self.spatial_dim == 2 else f"L_{_AXES[self.axis]}"
 
     def spec(self) -> _core.Generator:
+        """The core's generator of this symmetry, as the binding takes it.
+
+        Returns
+        -------
+        varmech._core.Generator
+            The generator's kind and data, checked against the model's dimension when a model
+            is built with it.
+        """
         return _core.Generator.Rotation(self.axis, self.spatial_dim)
 
 
 @dataclass(frozen=True)
 class Cyclic:
-    """Coordinate ``index`` is cyclic (∂L/∂q_index = 0): J = p_index."""
+    """Coordinate ``index`` is cyclic (∂L/∂q_index = 0): J = p_index.
+
+    The generator is the unit vector ξ = e_index; Routh's method (:func:`varmech.routh`)
+    removes such a coordinate.
+
+    Attributes
+    ----------
+    index : int
+        The cyclic coordinate.
+    name : str
+        ``"p[index]"``, as reports name J.
+
+    See Also
+    --------
+    varmech.momentum : J along a trajectory.
+    varmech.routh : the model reduced by its cyclic coordinates.
+
+    Examples
+    --------
+    >>> import varmech
+    >>> top = varmech.scenes.heavy_top()
+    >>> [s.name for s in top.model.symmetries]
+    ['p[1]', 'p[2]']
+    >>> traj = varmech.integrate(top, dt=top.dt, steps=100)
+    >>> varmech.momentum(traj, varmech.Cyclic(2))[-1].round(12)
+    np.float64(2.5)
+    """
 
     index: int
 
     @property
     def name(self) -> str:
+        """The momentum's name in reports."""
         return f"p[{self.index}]"
 
     def spec(self) -> _core.Generator:
+        """The core's generator of this symmetry, as the binding takes it.
+
+        Returns
+        -------
+        varmech._core.Generator
+            The generator's kind and data, checked against the model's dimension when a model
+            is built with it.
+        """
         return _core.Generator.Cyclic(self.index)
 
 
@@ -99,6 +205,22 @@ class Model:
 
     Separable mechanical systems (L = ½q̇ᵀMq̇ − V) take every method; general Lagrangians the
     implicit variational ones (``midpoint``, ``trapezoid``, ``galerkin4``, ``galerkin6``).
+    The concrete classes are :class:`~varmech.MechanicalSystem`, :class:`~varmech.Lagrangian`,
+    :class:`NativeSystem` (the scenes), the symbolic models and Routh-reduced ones.
+
+    See Also
+    --------
+    varmech.MechanicalSystem : a model from closures V(q), ∇V(q) and a mass matrix.
+    varmech.Lagrangian : a general L(q, q̇, t) from closures.
+
+    Examples
+    --------
+    >>> import varmech
+    >>> model = varmech.scenes.double_pendulum().model
+    >>> model.dim, model.kind.default_method, model.separable
+    (2, 'midpoint', False)
+    >>> model.momentum([0.1, 0.2], [1.0, 0.0]).round(6).tolist()    # M(θ)θ̇
+    [12.0, 11.94005]
     """
 
     _core: (
@@ -167,24 +289,84 @@ class Model:
 
     def velocity(self, q: ArrayLike, p: ArrayLike, t: ArrayLike = 0.0) -> np.ndarray:
         """q̇ with ∂L/∂q̇(q, q̇, t) = p (M⁻¹p for mechanical systems), for one state (n,) or
-        for rows (N, n)."""
+        for rows (N, n): the inverse Legendre transform.
+
+        Parameters
+        ----------
+        q : array_like, shape (n,) or (N, n)
+            The positions (one row for all momenta, or one per row).
+        p : array_like, shape (n,) or (N, n)
+            The momenta.
+        t : float or array_like, shape (N,), default 0.0
+            The time (for a Lagrangian that depends on it).
+
+        Returns
+        -------
+        ndarray, the shape of p
+            The velocities.
+
+        Raises
+        ------
+        ValueError
+            Naming the argument whose shape does not fit (``q``, ``p`` or ``t``), or a
+            general Lagrangian whose Newton solve of ∂L/∂q̇ = p fails.
+        """
         return self._derivative("velocity", q, p, t)
 
     def momentum(self, q: ArrayLike, v: ArrayLike, t: ArrayLike = 0.0) -> np.ndarray:
-        """p = ∂L/∂q̇(q, q̇, t) (Mq̇ for mechanical systems), for one state (n,) or rows (N, n)."""
+        """p = ∂L/∂q̇(q, q̇, t) (Mq̇ for mechanical systems), for one state (n,) or rows (N, n):
+        the Legendre transform.
+
+        Parameters
+        ----------
+        q : array_like, shape (n,) or (N, n)
+            The positions (one row for all velocities, or one per row).
+        v : array_like, shape (n,) or (N, n)
+            The velocities q̇.
+        t : float or array_like, shape (N,), default 0.0
+            The time (for a Lagrangian that depends on it).
+
+        Returns
+        -------
+        ndarray, the shape of v
+            The momenta.
+
+        Raises
+        ------
+        ValueError
+            Naming the argument whose shape does not fit (``q``, ``v`` or ``t``).
+        """
         return self._derivative("momentum", q, v, t)
 
     def _derivative(self, what: str, q: ArrayLike, x: ArrayLike, t: ArrayLike) -> np.ndarray:
+        # x is the momenta p for the velocity, else the velocities v.
+        name = "p" if what == "velocity" else "v"
         x = np.ascontiguousarray(x, dtype=float)
         rows = np.atleast_2d(x)
-        q2 = np.ascontiguousarray(np.broadcast_to(np.asarray(q, dtype=float), rows.shape))
-        t1 = np.ascontiguousarray(np.broadcast_to(np.asarray(t, dtype=float), rows.shape[:1]))
+        if rows.ndim != 2 or rows.shape[1] != self.dim:
+            raise ValueError(f"{name}: expected shape ({self.dim},) or (N, {self.dim}), got {x.shape}")
+        q2, t1 = _broadcast("q", q, rows.shape), _broadcast("t", t, rows.shape[:1])
         return _core.derivative(self._core, what, t1, q2, rows).reshape(x.shape)
 
     def with_parameters(self, **values: float) -> Model:
         """The model with its parameters set by name; only symbolic models
-        (:mod:`varmech.symbolic`) have parameters to set, so this is a TypeError naming
-        ``parameters`` for every other model."""
+        (:mod:`varmech.symbolic`) have parameters to set.
+
+        Parameters
+        ----------
+        **values : float
+            The parameters' new values by name.
+
+        Returns
+        -------
+        Model
+            The model with those values (symbolic models only).
+
+        Raises
+        ------
+        TypeError
+            Naming ``parameters``, for every model but a symbolic one.
+        """
         raise TypeError(
             f"parameters: {self.name} has no parameters to set ({', '.join(values)} given); "
             "only symbolic models (varmech.symbolic) take them"
@@ -203,6 +385,16 @@ class Model:
         return (_rebuild, (type(self), arguments))
 
 
+def _broadcast(name: str, value: ArrayLike, shape: tuple[int, ...]) -> np.ndarray:
+    """``value`` as a contiguous float array of ``shape``; ValueError naming it when it does not
+    broadcast to the states' shape."""
+    array = np.asarray(value, dtype=float)
+    try:
+        return np.ascontiguousarray(np.broadcast_to(array, shape))
+    except ValueError:
+        raise ValueError(f"{name}: shape {array.shape} does not fit the states' {shape}") from None
+
+
 def _rebuild(cls: Callable[..., Model], arguments: dict[str, Any]) -> Model:
     """The model of a pickle: ``cls(**arguments)``, without the warnings its construction gave
     when it was first built (about derivatives by differences, say)."""
@@ -217,7 +409,24 @@ class NativeSystem(Model):
 
     ``parameters`` are the values of the catalogue scene's parameters the model was built with
     (:func:`varmech.scenes.get`): the model pickles as its scene's name and them. A native
-    N-body model (:func:`varmech.scenes.nbody`) pickles as its G and masses.
+    N-body model (:func:`varmech.scenes.nbody`) pickles as its G and masses. Users get these
+    from the scenes rather than build them.
+
+    Parameters
+    ----------
+    core : varmech._core.NativeModel
+        The core's model.
+    parameters : mapping of str to float, optional
+        The catalogue parameters it was built with (None for an N-body model).
+
+    Examples
+    --------
+    >>> import pickle, varmech
+    >>> model = varmech.scenes.kepler(e=0.3).model
+    >>> model, model.parameters
+    (NativeSystem('kepler', dim=2), {'e': 0.3})
+    >>> pickle.loads(pickle.dumps(model)).parameters
+    {'e': 0.3}
     """
 
     def __init__(self, core: _core.NativeModel, parameters: Mapping[str, float] | None = None):

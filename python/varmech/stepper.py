@@ -103,19 +103,70 @@ class Stepper:
         )
 
     def step(self) -> None:
-        """Advance one step."""
+        """Advance one step, from tₙ to tₙ₊₁ = tₙ + h.
+
+        Raises
+        ------
+        DivergenceError
+            The new state is not finite; the stepper stays at tₙ.
+        ConvergenceError
+            An implicit method's Newton iteration failed (or, as
+            :class:`~varmech.SpuriousBranchError`, converged beyond a fold); the stepper stays
+            at tₙ.
+        Exception
+            A closure's own exception, unchanged.
+        """
         self._stepper.step()
 
     def advance(self, steps: int | None = None, *, t_end: float | None = None) -> None:
         """Advance ``steps`` steps, or to ``t_end``, a whole number of steps from :attr:`t`.
 
-        Ctrl-C stops it with KeyboardInterrupt, at the last step completed."""
+        Ctrl-C stops it with KeyboardInterrupt, at the last step completed.
+
+        Parameters
+        ----------
+        steps : int, optional
+            How many steps to take.
+        t_end : float, optional
+            The time to reach instead, a whole number of steps h from :attr:`t`.
+
+        Raises
+        ------
+        ValueError
+            Naming ``steps, t_end`` when not exactly one is given, ``steps`` when it is not a
+            non-negative integer, or ``t_end`` when it is before :attr:`t` or not a whole number
+            of steps away.
+        DivergenceError, ConvergenceError
+            As :meth:`step`, with ``err.step`` and ``err.time``; the stepper stays at the last
+            good step.
+        KeyboardInterrupt
+            Ctrl-C, at the last step completed.
+        """
         self._stepper.advance(_steps(self.dt, self.t, steps, t_end))
 
     def reset(self, q0: ArrayLike, p0: ArrayLike | None = None, *, v0: ArrayLike | None = None, t0: float | None = None) -> None:
         """Start afresh from (q0, p0) (or q0 and the velocities v0) at ``t0`` (default: the
         current time), with :attr:`steps` at 0: the next steps are those of a new stepper from
-        there. The work counts go on."""
+        there. The work counts go on.
+
+        Parameters
+        ----------
+        q0 : array_like, shape (n,)
+            The positions.
+        p0 : array_like, shape (n,), optional
+            The momenta (or give ``v0``).
+        v0 : array_like, shape (n,), optional
+            The velocities, p0 = ∂L/∂q̇(q0, v0, t0) (M v0 for mechanical systems).
+        t0 : float, optional
+            The time (default: the current :attr:`t`).
+
+        Raises
+        ------
+        ValueError
+            Naming the argument: a state of the wrong shape or not finite, both or neither of
+            ``p0`` and ``v0``, ``t0`` not finite, or velocities off a model's velocity
+            constraints (a state off holonomic constraints names ``q0`` or ``p0``).
+        """
         t0 = self.t if t0 is None else finite("t0", t0)
         q, p = _initial_state(self._model, q0, p0, v0, t0)
         self._stepper.reset(q, p, t0)
@@ -178,14 +229,39 @@ class Stepper:
     def checkpoint(self) -> bytes:
         """The stepper's whole state as bytes: :meth:`from_checkpoint` rebuilds a stepper that
         goes on bit for bit (its method's caches, Newton predictor and compensated-summation
-        carries included). A run's last checkpoint is :attr:`Trajectory.checkpoint`."""
+        carries included). A run's last checkpoint is :attr:`Trajectory.checkpoint`.
+
+        Returns
+        -------
+        bytes
+            The checkpoint (it records the model's kind and the method, not the model itself).
+        """
         return bytes(self._stepper.checkpoint())
 
     @classmethod
     def from_checkpoint(cls, model: Model | Scene, checkpoint: bytes) -> Stepper:
-        """The stepper of ``model`` at the state of ``checkpoint`` (from :meth:`checkpoint`, or a
-        trajectory's :attr:`~Trajectory.checkpoint`); ValueError naming ``checkpoint`` for bytes
-        that are not one, or ``model``/``method`` for a model it does not fit."""
+        """The stepper of ``model`` at the state of ``checkpoint``.
+
+        Parameters
+        ----------
+        model : Model or Scene
+            The model the checkpoint was taken of (or its scene).
+        checkpoint : bytes
+            From :meth:`checkpoint`, or a trajectory's :attr:`~Trajectory.checkpoint`.
+
+        Returns
+        -------
+        Stepper
+            A stepper that goes on bit for bit as the one checkpointed would have.
+
+        Raises
+        ------
+        ValueError
+            Naming ``checkpoint`` for bytes that are not one, or ``model``/``method`` for a
+            model it does not fit.
+        TypeError
+            Naming ``model``: not a varmech model or scene.
+        """
         model, _, _ = _model_of(model, None, None, None)
         stepper = cls.__new__(cls)
         stepper._model = model

@@ -28,7 +28,31 @@ import numpy as np
 @dataclass(frozen=True)
 class Wall:
     """φ(q) = q_k − ``value``: a wall, floor or side of a box, q_k ≥ ``value`` (the core's
-    ``crossing`` event)."""
+    ``crossing`` event).
+
+    Attributes
+    ----------
+    k : int
+        The coordinate bounded.
+    value : float
+        The wall's position.
+    coordinates : tuple of int
+        The coordinates φ depends on, ``(k,)``.
+    native : tuple
+        The core's event kind and payload, ``("crossing", (k, value))``.
+
+    See Also
+    --------
+    varmech.Contact.wall : the contact built on it.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from varmech.surfaces import Wall
+    >>> floor = Wall(1, 0.5)                      # y ≥ 0.5
+    >>> floor(np.array([3.0, 2.0])), floor.gradient(np.array([3.0, 2.0]))
+    (1.5, array([0., 1.]))
+    """
 
     k: int
     value: float
@@ -42,7 +66,18 @@ class Wall:
         return (self.k,)
 
     def gradient(self, q: np.ndarray) -> np.ndarray:
-        """∇φ = e_k."""
+        """∇φ = e_k.
+
+        Parameters
+        ----------
+        q : ndarray, shape (n,)
+            The configuration.
+
+        Returns
+        -------
+        ndarray, shape (n,)
+            The unit vector along coordinate k.
+        """
         return np.eye(len(q))[self.k]
 
     @property
@@ -56,7 +91,42 @@ class Ellipsoid:
     """φ(q) = s(1 − Σᵢ uᵢ²), uᵢ = (q_{kᵢ} − cᵢ)/aᵢ, over the ``coordinates`` kᵢ with the
     ``centre`` c and ``semi_axes`` a, s = +1 ``inside`` (a billiard table, φ ≥ 0 within) and −1
     outside (an obstacle): the core's ``ellipsoid`` event. The sum runs in the order of the
-    coordinates, from 0."""
+    coordinates, from 0.
+
+    Attributes
+    ----------
+    coordinates : tuple of int
+        The coordinates kᵢ it bounds (non-negative).
+    centre : tuple of float
+        The centre c, one entry per coordinate.
+    semi_axes : tuple of float
+        The semi-axes a, finite and positive, one per coordinate.
+    inside : bool, default True
+        The side kept: inside (a table, a bowl) or outside (an obstacle).
+    native : tuple
+        The core's event kind and payload, ``("ellipsoid", (coordinates, centre, semi_axes,
+        inside))``.
+
+    Raises
+    ------
+    ValueError
+        ``semi_axes`` not of the length of ``coordinates`` and ``centre`` (or empty), or not
+        finite and positive; ``centre`` not finite; ``coordinates`` negative.
+
+    See Also
+    --------
+    varmech.Contact.ellipsoid : the contact built on it.
+
+    Examples
+    --------
+    A round obstacle of radius 1 about (2, 0), in coordinates 0 and 1:
+
+    >>> import numpy as np
+    >>> from varmech.surfaces import Ellipsoid
+    >>> post = Ellipsoid((0, 1), (2.0, 0.0), (1.0, 1.0), inside=False)
+    >>> post(np.array([0.0, 0.0])), post.gradient(np.array([0.0, 0.0]))
+    (3.0, array([-4.,  0.]))
+    """
 
     coordinates: tuple[int, ...]
     centre: tuple[float, ...]
@@ -87,7 +157,18 @@ class Ellipsoid:
         return 1.0 - total if self.inside else total - 1.0
 
     def gradient(self, q: np.ndarray) -> np.ndarray:
-        """∂φ/∂q_{kᵢ} = −2s uᵢ/aᵢ, zero in the other coordinates."""
+        """∂φ/∂q_{kᵢ} = −2s uᵢ/aᵢ, zero in the other coordinates.
+
+        Parameters
+        ----------
+        q : ndarray, shape (n,)
+            The configuration.
+
+        Returns
+        -------
+        ndarray, shape (n,)
+            ∇φ(q).
+        """
         out = np.zeros(len(q))
         sign = -2.0 if self.inside else 2.0
         for k, u, a in zip(self.coordinates, self._scaled(q), self.semi_axes):
@@ -106,7 +187,21 @@ Surface = Wall | Ellipsoid
 
 @dataclass(frozen=True)
 class Gradient:
-    """∇φ of a native surface as a function of q, which compares and pickles by its surface."""
+    """∇φ of a native surface as a function of q, which compares and pickles by its surface.
+
+    Attributes
+    ----------
+    surface : Wall or Ellipsoid
+        The surface whose gradient it evaluates.
+
+    Examples
+    --------
+    >>> import pickle, numpy as np
+    >>> from varmech.surfaces import Gradient, Wall
+    >>> grad = Gradient(Wall(0, 0.0))
+    >>> grad(np.zeros(2)), pickle.loads(pickle.dumps(grad)) == grad
+    (array([1., 0.]), True)
+    """
 
     surface: Surface
 

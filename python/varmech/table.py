@@ -19,6 +19,39 @@ class Table:
     ``title`` says what was measured and ``meta`` how (scene, step sizes, reference values), so
     that a chart or a CSV file carries its provenance. ``table.column(name)`` is a NumPy array,
     ``table.where(method="verlet")`` the matching rows, and ``table.to_csv(path)`` writes it.
+    Iterating gives each row as a dict by column name.
+
+    Attributes
+    ----------
+    columns : tuple of str
+        The column names, distinct.
+    rows : list of tuple
+        The rows, each with one value per column, in column order.
+    title : str, default ""
+        What was measured.
+    meta : dict, default {}
+        How it was measured: scene, steps, reference values, notes.
+
+    Raises
+    ------
+    ValueError
+        Naming ``columns`` when names repeat, or ``row`` for a row of the wrong length.
+
+    Examples
+    --------
+    >>> from varmech.table import Table
+    >>> table = Table(("method", "h", "error"), title="Energy error", meta={"scene": "kepler"})
+    >>> table.append("verlet", 0.1, 3.2e-3)
+    >>> table.append("verlet", 0.05, 8.1e-4)
+    >>> table.append("midpoint", 0.1, 1.6e-3)
+    >>> table.column("error").max(), table.unique("method"), len(table.where(method="verlet"))
+    (np.float64(0.0032), ['verlet', 'midpoint'], 2)
+    >>> print(table.format(max_rows=2))
+    Energy error
+    method | h | error
+    verlet | 0.1 | 0.0032
+    verlet | 0.05 | 0.00081
+    … 1 more rows
     """
 
     columns: tuple[str, ...]
@@ -38,16 +71,47 @@ class Table:
             raise ValueError(f"row: has {len(row)} values for {len(self.columns)} columns {self.columns}")
 
     def append(self, *values: Any) -> None:
-        """Add one row, its values in column order."""
+        """Add one row, its values in column order.
+
+        Parameters
+        ----------
+        *values
+            One value per column.
+
+        Raises
+        ------
+        ValueError
+            Naming ``row``: not one value per column.
+        """
         self._check(values)
         self.rows.append(tuple(values))
 
-    def column(self, name: str) -> np.ndarray:
-        """The values of column ``name``, as an array (float where they are numbers)."""
+    def _index(self, name: str, argument: str) -> int:
+        """The position of column ``name``; KeyError naming ``argument`` when there is none."""
         try:
-            i = self.columns.index(name)
+            return self.columns.index(name)
         except ValueError:
-            raise KeyError(f"name: no column {name!r} in {self.columns}") from None
+            raise KeyError(f"{argument}: no column {name!r} in {self.columns}") from None
+
+    def column(self, name: str) -> np.ndarray:
+        """The values of column ``name``, as an array (float where they are numbers).
+
+        Parameters
+        ----------
+        name : str
+            The column.
+
+        Returns
+        -------
+        ndarray, shape (len(rows),)
+            Its values, as floats, or as objects where they are not all numbers.
+
+        Raises
+        ------
+        KeyError
+            Naming ``name``: no such column.
+        """
+        i = self._index(name, "name")
         values = [row[i] for row in self.rows]
         try:
             return np.array(values, dtype=float)
@@ -55,19 +119,67 @@ class Table:
             return np.array(values, dtype=object)
 
     def where(self, **equal: Any) -> Table:
-        """The rows whose columns equal the given values."""
-        idx = {self.columns.index(k): v for k, v in equal.items()}
+        """The rows whose columns equal the given values.
+
+        Parameters
+        ----------
+        **equal
+            Values by column name.
+
+        Returns
+        -------
+        Table
+            The matching rows, with the same columns, title and (a copy of the) metadata.
+
+        Raises
+        ------
+        KeyError
+            Naming the keyword that is not a column.
+        """
+        idx = {self._index(k, k): v for k, v in equal.items()}
         rows = [r for r in self.rows if all(r[i] == v for i, v in idx.items())]
         return Table(self.columns, rows, self.title, dict(self.meta))
 
     def unique(self, name: str) -> list[Any]:
-        """The distinct values of column ``name``, in order of appearance."""
-        i = self.columns.index(name)
+        """The distinct values of column ``name``, in order of appearance.
+
+        Parameters
+        ----------
+        name : str
+            The column.
+
+        Returns
+        -------
+        list
+            Its distinct values.
+
+        Raises
+        ------
+        KeyError
+            Naming ``name``: no such column.
+        """
+        i = self._index(name, "name")
         return list(dict.fromkeys(r[i] for r in self.rows))
 
     def to_csv(self, path: str | Path) -> Path:
         """Write the table as CSV (a header row, then the rows; the title and metadata as
-        leading ``#`` comment lines)."""
+        leading ``#`` comment lines).
+
+        Parameters
+        ----------
+        path : str or pathlib.Path
+            The file to write; its folder is created if needed, an existing file replaced.
+
+        Returns
+        -------
+        pathlib.Path
+            The path written.
+
+        Raises
+        ------
+        OSError
+            The file cannot be written.
+        """
         path = Path(path)
         path.parent.mkdir(parents=True, exist_ok=True)
         with path.open("w", newline="") as f:
@@ -87,8 +199,19 @@ class Table:
         return (dict(zip(self.columns, r)) for r in self.rows)
 
     def format(self, max_rows: int | None = 20) -> str:
-        """The title, the column names and the rows (the first ``max_rows``; None for all) as
-        text, numbers to four significant digits."""
+        """The title, the column names and the rows as text, numbers to four significant digits.
+
+        Parameters
+        ----------
+        max_rows : int or None, default 20
+            The rows shown (the first ones); None for all.
+
+        Returns
+        -------
+        str
+            One line for the title, one for the column names, one per row (" | " between
+            values), and a last line counting the rows left out.
+        """
 
         def fmt(x: Any) -> str:
             if isinstance(x, float):

@@ -130,3 +130,19 @@ def test_a_native_forced_scene_reports_its_energy_balance_not_a_verdict():
     assert balances[1] < 1e-3 * abs(reports[1].energy_balance.initial)
     assert 3.5 < balances[0] / balances[1] < 4.5
     assert reports[1].energy_balance.verdict == "bounded"
+
+
+def test_velocity_and_momentum_name_the_argument_of_the_wrong_shape():
+    # The Legendre transform and its inverse check their inputs, naming the one that does not fit
+    # rather than failing in NumPy's broadcasting or blaming the core's (t, q).
+    model = scenes.kepler().model
+    with pytest.raises(ValueError, match=r"^p: expected shape \(2,\) or \(N, 2\), got \(3,\)"):
+        model.velocity([1.0, 0.0], [1.0, 2.0, 3.0])
+    with pytest.raises(ValueError, match=r"^v: expected shape"):
+        model.momentum([1.0, 0.0], [[1.0], [2.0]])
+    with pytest.raises(ValueError, match=r"^q: shape \(3,\) does not fit"):
+        model.momentum([1.0, 0.0, 0.0], [1.0, 2.0])
+    with pytest.raises(ValueError, match=r"^t: shape \(2,\) does not fit"):
+        model.velocity(np.zeros((3, 2)), np.ones((3, 2)), t=[0.0, 1.0])
+    # What fits still works: one q for many rows, one t for all.
+    np.testing.assert_array_equal(model.momentum([1.0, 0.0], np.ones((3, 2))), np.ones((3, 2)))

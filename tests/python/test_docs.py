@@ -17,6 +17,7 @@ pytest.importorskip("sympy")
         "varmech.symbolic.examples",
         "varmech.symbolic._lower",
         "varmech.symbolic._derive",
+        "varmech.symbolic._model",
         "varmech.events",
         "varmech.files",
         "varmech.streaming",
@@ -35,6 +36,8 @@ pytest.importorskip("sympy")
         "varmech.reduction",
         "varmech.methods",
         "varmech.analysis.work_precision",
+        "varmech._errors",
+        "varmech.table",
     ],
 )
 def test_examples_run(name):

@@ -94,3 +94,22 @@ def test_a_scene_without_a_closure_twin_is_refused_by_name():
     assert examples.closure_of(scenes.charged_particle_nonuniform()).name == "charged_particle (closure)"
     with pytest.raises(ValueError, match="planar_chain"):
         examples.closure_of(scenes.planar_chain())
+
+
+@pytest.mark.parametrize(
+    "change, argument",
+    [
+        ({"masses": [1.0, -1.0]}, r"masses: must be finite and positive, got masses\[1\] = -1"),
+        ({"positions": [[0, 0, np.nan], [1, 0, 0]]}, "positions, velocities: must be finite"),
+        ({"velocities": [[0, 0, np.inf], [0, 0, 0]]}, "positions, velocities: must be finite"),
+        ({"G": 0.0}, "G: must be finite and positive"),
+        ({"t_end": np.nan}, "t_end: must be finite and positive"),
+        ({"dt": -1.0}, "dt: must be finite and positive"),
+    ],
+)
+def test_nbody_refuses_bad_data_naming_the_argument(change, argument):
+    # A step or horizon the scene would carry to integrate, and masses named as the caller gave
+    # them (the core's check counts coordinates, not bodies).
+    data = {"masses": [1.0, 1.0], "positions": [[0, 0, 0], [1, 0, 0]], "velocities": [[0, 0, 0], [0, 1, 0]]}
+    with pytest.raises(ValueError, match=f"^{argument}"):
+        scenes.nbody(**{**data, **change})

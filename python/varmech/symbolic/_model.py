@@ -92,6 +92,39 @@ class SymbolicModel(Model):
         :class:`~varmech.Cyclic` symmetries.
     build_seconds
         Wall time from the expressions to the ready model.
+    parameters
+        The parameters by name with their values.
+    jit
+        Whether the tapes run as machine code.
+
+    Parameters
+    ----------
+    spec : Spec
+        What the core's model is built from (tapes, parameters, flags, symmetries).
+    symbolic : Symbolic
+        The symbols, L and the derived expressions.
+    core : varmech._core.CompiledModel, optional
+        The core's model, when it is already built (default: compile ``spec``).
+    started : float, optional
+        The :func:`time.perf_counter` value the build started at, for ``build_seconds``.
+
+    See Also
+    --------
+    varmech.symbolic.lagrangian : build one from L(q, q̇, t).
+    varmech.symbolic.mechanical : build one from V(q) and a mass.
+
+    Examples
+    --------
+    Users build it with :func:`varmech.symbolic.lagrangian` or :func:`~varmech.symbolic.mechanical`:
+
+    >>> import sympy as sp, varmech, varmech.symbolic
+    >>> th, om, g = sp.symbols("theta omega g")
+    >>> model = varmech.symbolic.lagrangian(om**2 / 2 + g * sp.cos(th), [th], [om], parameters={g: 9.81})
+    >>> model.kind_name, model.parameters, model.L
+    ('separable', {'g': 9.81}, g*cos(theta) + omega**2/2)
+    >>> traj = varmech.integrate(model.with_parameters(g=1.0), [0.0], [1.0], dt=0.01, steps=100)
+    >>> round(float(traj.energy()[-1]), 4)
+    -0.5
     """
 
     _core: _core.CompiledModel
@@ -107,30 +140,37 @@ class SymbolicModel(Model):
 
     @property
     def q(self) -> tuple[sp.Symbol, ...]:
+        """The coordinates as SymPy symbols."""
         return self._symbolic.q
 
     @property
     def v(self) -> tuple[sp.Symbol, ...]:
+        """The velocities as SymPy symbols."""
         return self._symbolic.v
 
     @property
     def t(self) -> sp.Symbol:
+        """The time symbol."""
         return self._symbolic.t
 
     @property
     def L(self) -> sp.Expr:
+        """The Lagrangian L(q, v, t)."""
         return self._symbolic.L
 
     @property
     def expressions(self) -> dict[str, tuple[sp.Expr, ...]]:
+        """The derived expressions of each compiled function by name (a copy)."""
         return dict(self._symbolic.expressions)
 
     @property
     def cyclic(self) -> tuple[int, ...]:
+        """The coordinates found cyclic."""
         return self._symbolic.cyclic
 
     @property
     def kind_name(self) -> str:
+        """``"lagrangian"`` or ``"separable"``."""
         return self._spec.kind
 
     @property
@@ -142,7 +182,20 @@ class SymbolicModel(Model):
         """The same model (the same derived expressions, tapes and compiled code) with the
         parameters named by keyword set to new values and the others kept.
 
-        ValueError names an unknown parameter or a value that is not finite.
+        Parameters
+        ----------
+        **values : float
+            The new values by parameter name.
+
+        Returns
+        -------
+        SymbolicModel
+            A new model; this one is unchanged.
+
+        Raises
+        ------
+        ValueError
+            Naming ``parameters``: an unknown parameter, or a value that is not finite.
         """
         started = time.perf_counter()
         names = self._spec.parameter_names
@@ -165,14 +218,31 @@ class SymbolicModel(Model):
     def with_jit(self, jit: bool) -> SymbolicModel:
         """The same model with its tapes compiled to machine code (``True``) or interpreted
         (``False``): the two agree bit for bit, the interpreter is slower and needs no compile
-        step."""
+        step.
+
+        Parameters
+        ----------
+        jit : bool
+            Compile the tapes (Cranelift) or interpret them.
+
+        Returns
+        -------
+        SymbolicModel
+            A new model built from the same tapes; this one is unchanged.
+        """
         return SymbolicModel(replace(self._spec, jit=bool(jit)), self._symbolic)
 
     def first_order(self) -> FirstOrder | None:
         """The first-order system ẏ = (q̇(q, p, t), ∂L/∂q) lambdified (see
         :class:`~varmech.symbolic._rhs.FirstOrder`): the right-hand side a SciPy user would
-        write from this Lagrangian. None where ∂L/∂q̇ is not linear in q̇, or for a forced or
-        constrained model."""
+        write from this Lagrangian.
+
+        Returns
+        -------
+        FirstOrder or None
+            f(t, y) for y = (q, p), as :func:`scipy.integrate.solve_ivp` takes it; None where
+            ∂L/∂q̇ is not linear in q̇, or for a forced or constrained model.
+        """
         return FirstOrder.build(self)
 
     def __reduce__(self) -> tuple[Any, ...]:
