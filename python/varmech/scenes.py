@@ -119,7 +119,7 @@ CATALOGUE: dict[str, _core.CatalogueEntry] = {entry.name: entry for entry in _co
 #: model layer only, so the surfaces are attached here (watched natively all the same).
 CONTACTS: dict[str, Callable[[dict[str, float]], tuple[Contact, ...]]] = {
     "bouncing_ball": lambda p: (Contact.wall(0, restitution=p["restitution"], name="floor"),),
-    "elliptic_billiard": lambda p: (Contact.ellipsoid((p["a"], p["b"]), name="wall"),),
+    "elliptic_billiard": lambda p: (Contact.ellipsoid((p["A"], p["B"]), name="wall"),),
 }
 
 
@@ -560,7 +560,7 @@ def charged_particle(B: float = 1.0) -> Scene:
     >>> round(float(traj.energy()[-1]), 12)
     2.0
     """
-    return get("charged_particle", b=B)
+    return get("charged_particle", B=B)
 
 
 def charged_particle_nonuniform() -> Scene:
@@ -911,9 +911,8 @@ def elliptic_billiard(A: float = 2.0, B: float = 1.0, x0: float = 0.3, y0: float
     Raises
     ------
     ValueError
-        ``B`` not finite and positive, ``A`` below ``B``, (x0, y0) not strictly inside (the
-        message names ``x0``), or momenta not finite (naming ``px0``); the semi-axes are
-        named ``a`` and ``b``, as in the catalogue.
+        ``B`` not finite and positive, ``A`` below ``B``, a start value not finite (naming
+        it), or (x0, y0) not strictly inside (naming ``x0``).
 
     See Also
     --------
@@ -935,7 +934,7 @@ def elliptic_billiard(A: float = 2.0, B: float = 1.0, x0: float = 0.3, y0: float
     >>> len(traj.events[0]), bool(np.max(np.abs(focal - scene.invariants["L1L2"])) < 1e-12)
     (50, True)
     """
-    return get("elliptic_billiard", a=A, b=B, x0=x0, y0=y0, px0=px0, py0=py0)
+    return get("elliptic_billiard", A=A, B=B, x0=x0, y0=y0, px0=px0, py0=py0)
 
 
 def rolling_disk(radius: float = 1.0, turn: float = 0.7, roll: float = 2.0) -> Scene:
@@ -1059,8 +1058,8 @@ def rolling_sphere(alpha: float = 0.5, g: float = 9.81, radius: float = 1.0, vx0
     Raises
     ------
     ValueError
-        ``alpha`` not in [0, π/2), ``g`` not finite, ``radius`` not finite and positive, or
-        an initial velocity or spin not finite (the message names ``velocity``).
+        ``alpha`` not in [0, π/2), ``radius`` not finite and positive, or ``g``, ``vx0``,
+        ``vy0`` or ``spin`` not finite (naming it).
 
     See Also
     --------
@@ -1116,8 +1115,8 @@ def ball_on_turntable(
     Raises
     ------
     ValueError
-        ``omega`` or ``radius`` not finite and positive, or an initial position, velocity or
-        spin not finite (the message names ``velocity``).
+        ``omega`` or ``radius`` not finite and positive, or ``x0``, ``y0``, ``vx0``, ``vy0``
+        or ``spin`` not finite (naming it).
 
     References
     ----------

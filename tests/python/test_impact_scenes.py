@@ -41,7 +41,7 @@ def test_the_native_elliptic_billiard_is_its_closure_twin_to_the_bit():
     # φ = 1 − (u² + v²) with u = x/A, v = y/B, and ∇φ = −2(u/A, v/B): the native ellipse's
     # arithmetic in the same order (the core sums from 0), so the runs agree to the bit.
     scene = scenes.elliptic_billiard()
-    a, b = scene.parameters["a"], scene.parameters["b"]
+    a, b = scene.parameters["A"], scene.parameters["B"]
 
     def phi(q):
         u, v = q[0] / a, q[1] / b
@@ -151,7 +151,7 @@ def test_bad_impact_scenes_and_shapes_are_named():
         scenes.bouncing_ball(h0=-1.0)
     with pytest.raises(ValueError, match="^x0: "):
         scenes.elliptic_billiard(x0=2.0)
-    with pytest.raises(ValueError, match="^a: must be finite and at least b"):
+    with pytest.raises(ValueError, match="^A: must be finite and at least B"):
         scenes.elliptic_billiard(A=1.0, B=2.0)
     with pytest.raises(ValueError, match="^semi_axes: must be finite and positive"):
         varmech.Contact.ellipsoid([1.0, -1.0])

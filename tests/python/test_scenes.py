@@ -36,7 +36,7 @@ def computed(scene, name):
         return energy - scene.parameters["omega"] * (q[0] * p[1] - q[1] * p[0])
     if name == "L1L2":
         # The elliptic billiard's product of the angular momenta about its foci (±c, 0).
-        c = math.sqrt(scene.parameters["a"] ** 2 - scene.parameters["b"] ** 2)
+        c = math.sqrt(scene.parameters["A"] ** 2 - scene.parameters["B"] ** 2)
         return ((q[0] - c) * p[1] - q[1] * p[0]) * ((q[0] + c) * p[1] - q[1] * p[0])
     generator = next(g for g in scene.model._core.symmetries if g.name == CYCLIC.get(name, name))
     return float(_core.momentum(generator, q[None, :], p[None, :])[0][0])
@@ -58,7 +58,7 @@ def test_every_scene_builds_with_its_defaults(name):
 def test_the_scene_functions_are_the_catalogue_with_its_defaults(name):
     function = getattr(scenes, name)
     assert function().description == scenes.CATALOGUE[name].description
-    defaults = {p.name.lower(): p.default for p in inspect.signature(function).parameters.values()}
+    defaults = {p.name: p.default for p in inspect.signature(function).parameters.values()}
     assert defaults == scenes.CATALOGUE[name].parameters
 
 
@@ -113,3 +113,23 @@ def test_nbody_refuses_bad_data_naming_the_argument(change, argument):
     data = {"masses": [1.0, 1.0], "positions": [[0, 0, 0], [1, 0, 0]], "velocities": [[0, 0, 0], [0, 1, 0]]}
     with pytest.raises(ValueError, match=f"^{argument}"):
         scenes.nbody(**{**data, **change})
+
+
+@pytest.mark.parametrize(
+    "build, argument",
+    [
+        (lambda: scenes.rolling_sphere(vy0=math.nan), "vy0"),
+        (lambda: scenes.rolling_sphere(spin=math.inf), "spin"),
+        (lambda: scenes.ball_on_turntable(x0=math.nan), "x0"),
+        (lambda: scenes.ball_on_turntable(vx0=math.inf), "vx0"),
+        (lambda: scenes.elliptic_billiard(A=0.5), "A"),
+        (lambda: scenes.elliptic_billiard(B=-1.0), "B"),
+        (lambda: scenes.elliptic_billiard(y0=math.nan), "y0"),
+        (lambda: scenes.elliptic_billiard(py0=math.inf), "py0"),
+        (lambda: scenes.charged_particle(B=math.nan), "B"),
+        (lambda: scenes.damped_driven_pendulum(drive=math.nan), "drive"),
+    ],
+)
+def test_scene_parameters_are_named_as_the_constructor_names_them(build, argument):
+    with pytest.raises(ValueError, match=rf"^{argument}: "):
+        build()

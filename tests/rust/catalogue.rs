@@ -91,10 +91,10 @@ fn invariants_follow_the_parameters() {
     for (scene, parameter, value) in [
         ("kepler", "e", 0.3),
         ("kepler_polar", "e", 0.1),
-        ("charged_particle", "b", 2.5),
+        ("charged_particle", "B", 2.5),
         ("harmonic_oscillator", "omega", 3.0),
         ("bouncing_ball", "h0", 2.5),
-        ("elliptic_billiard", "a", 3.0),
+        ("elliptic_billiard", "A", 3.0),
         ("elliptic_billiard", "px0", -0.2),
     ] {
         let mut setup = lookup(scene).unwrap().setup();

@@ -326,12 +326,12 @@ pub static CATALOGUE: [CatalogueEntry; 23] = [
     },
     CatalogueEntry {
         name: "charged_particle",
-        parameters: &[real("b", 1.0)],
-        description: |s| format!("charged particle in the uniform field B = {:?}", s.value("b")),
+        parameters: &[real("B", 1.0)],
+        description: |s| format!("charged particle in the uniform field B = {:?}", s.value("B")),
         dt: |_| 0.05,
-        invariants: |s| vec![("E", 0.5 * s.value("b").powi(2)), ("L", -0.5 * s.value("b"))],
+        invariants: |s| vec![("E", 0.5 * s.value("B").powi(2)), ("L", -0.5 * s.value("B"))],
         build: |s| {
-            Ok(ChargedParticle::uniform_field(s.value("b"))?
+            Ok(ChargedParticle::uniform_field(s.value("B"))?
                 .map(|s| general_lagrangian(LagrangianScene::ChargedParticle(s))))
         },
     },
@@ -437,8 +437,8 @@ pub static CATALOGUE: [CatalogueEntry; 23] = [
     CatalogueEntry {
         name: "elliptic_billiard",
         parameters: &[
-            real("a", 2.0),
-            real("b", 1.0),
+            real("A", 2.0),
+            real("B", 1.0),
             real("x0", 0.3),
             real("y0", 0.1),
             real("px0", 0.6),
@@ -447,25 +447,25 @@ pub static CATALOGUE: [CatalogueEntry; 23] = [
         description: |s| {
             format!(
                 "a free particle in the elliptic billiard x²/A² + y²/B² ≤ 1, A = {}, B = {}",
-                general(s.value("a")),
-                general(s.value("b"))
+                general(s.value("A")),
+                general(s.value("B"))
             )
         },
         // At most a twentieth of the time to cross the short axis.
         dt: |s| {
             let speed = s.value("px0").hypot(s.value("py0"));
-            let most = 0.1 * s.value("b") / if speed > 0.0 { speed } else { 1.0 };
+            let most = 0.1 * s.value("B") / if speed > 0.0 { speed } else { 1.0 };
             EllipticBilliard::HORIZON / steps_to(EllipticBilliard::HORIZON, most) as f64
         },
         invariants: |s| {
             let (q, p) = ([s.value("x0"), s.value("y0")], [s.value("px0"), s.value("py0")]);
-            let table = EllipticBilliard::new(s.value("a"), s.value("b"));
+            let table = EllipticBilliard::new(s.value("A"), s.value("B"));
             let focal = table.map_or(f64::NAN, |t| t.focal_product(&q, &p));
             vec![("E", 0.5 * (p[0] * p[0] + p[1] * p[1])), ("L1L2", focal)]
         },
         build: |s| {
             let (q0, p0) = ([s.value("x0"), s.value("y0")], [s.value("px0"), s.value("py0")]);
-            let p = EllipticBilliard::problem(s.value("a"), s.value("b"), q0, p0)?;
+            let p = EllipticBilliard::problem(s.value("A"), s.value("B"), q0, p0)?;
             Ok(p.map(|s| mechanical(Scene::EllipticBilliard(s))))
         },
     },

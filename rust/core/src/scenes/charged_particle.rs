@@ -25,11 +25,7 @@ impl ChargedParticle {
         if !(m.is_finite() && m > 0.0) {
             return Err(Error::invalid("m", format!("must be finite and positive, got {m}")));
         }
-        for (name, x) in [("charge", charge), ("B", b), ("kappa", kappa)] {
-            if !x.is_finite() {
-                return Err(Error::invalid(name, format!("must be finite, got {x}")));
-            }
-        }
+        super::finite(&[("charge", charge), ("B", b), ("kappa", kappa)])?;
         Ok(ChargedParticle { m, charge, b, kappa })
     }
 

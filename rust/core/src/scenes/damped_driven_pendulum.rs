@@ -34,11 +34,7 @@ impl DampedDrivenPendulum {
                 format!("must be finite and non-negative, got {gamma}"),
             ));
         }
-        for (name, x) in [("g", g), ("amplitude", amplitude), ("drive", drive)] {
-            if !x.is_finite() {
-                return Err(Error::invalid(name, format!("must be finite, got {x}")));
-            }
-        }
+        super::finite(&[("g", g), ("amplitude", amplitude), ("drive", drive)])?;
         Ok(DampedDrivenPendulum {
             m,
             l,

@@ -19,12 +19,12 @@ impl EllipticBilliard {
     /// The table with semi-axes A ≥ B > 0 (the foci on the x axis).
     pub fn new(a: f64, b: f64) -> Result<Self, Error> {
         if !(b.is_finite() && b > 0.0) {
-            return Err(Error::invalid("b", format!("must be finite and positive, got {b}")));
+            return Err(Error::invalid("B", format!("must be finite and positive, got {b}")));
         }
         if !(a.is_finite() && a >= b) {
             return Err(Error::invalid(
-                "a",
-                format!("must be finite and at least b = {b} (the foci on the x axis), got {a}"),
+                "A",
+                format!("must be finite and at least B = {b} (the foci on the x axis), got {a}"),
             ));
         }
         Ok(EllipticBilliard {
@@ -58,15 +58,12 @@ impl EllipticBilliard {
     /// unit speed on the default table A = 2, B = 1). No reference: the invariants are the test.
     pub fn problem(a: f64, b: f64, q0: [f64; 2], p0: [f64; 2]) -> Result<Problem<Self>, Error> {
         let system = Self::new(a, b)?;
-        let phi = system.inside(&q0);
-        if phi.is_nan() || phi <= 0.0 {
+        super::finite(&[("x0", q0[0]), ("y0", q0[1]), ("px0", p0[0]), ("py0", p0[1])])?;
+        if system.inside(&q0) <= 0.0 {
             return Err(Error::invalid(
                 "x0",
                 format!("(x0, y0) = ({}, {}) must lie strictly inside the table", q0[0], q0[1]),
             ));
-        }
-        if !p0.iter().all(|p| p.is_finite()) {
-            return Err(Error::invalid("px0", format!("the momenta must be finite, got {p0:?}")));
         }
         Ok(Problem {
             system,

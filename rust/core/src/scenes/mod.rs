@@ -241,3 +241,11 @@ impl NonholonomicScene {
         }
     }
 }
+
+/// Refuses the first of a scene's named values that is not finite, naming it.
+pub(crate) fn finite(values: &[(&'static str, f64)]) -> Result<(), crate::Error> {
+    match values.iter().find(|(_, x)| !x.is_finite()) {
+        Some((name, x)) => Err(crate::Error::invalid(name, format!("must be finite, got {x}"))),
+        None => Ok(()),
+    }
+}

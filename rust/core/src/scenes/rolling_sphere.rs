@@ -114,9 +114,7 @@ impl RollingSphere {
         if !(alpha.is_finite() && (0.0..0.5 * PI).contains(&alpha)) {
             return Err(Error::invalid("alpha", format!("must be in [0, π/2), got {alpha}")));
         }
-        if !g.is_finite() {
-            return Err(Error::invalid("g", format!("must be finite, got {g}")));
-        }
+        super::finite(&[("g", g), ("vx0", velocity[0]), ("vy0", velocity[1]), ("spin", spin)])?;
         let (sphere, contact) = Self::ball(radius, g * alpha.sin(), 0.0)?;
         let [vx, vy] = velocity;
         let omega = [-vy / radius, vx / radius, spin];
@@ -159,6 +157,13 @@ impl RollingSphere {
                 format!("must be finite and positive, got {rate}"),
             ));
         }
+        super::finite(&[
+            ("x0", centre[0]),
+            ("y0", centre[1]),
+            ("vx0", velocity[0]),
+            ("vy0", velocity[1]),
+            ("spin", spin),
+        ])?;
         let (sphere, contact) = Self::ball(radius, 0.0, rate)?;
         let ([x, y], [vx, vy]) = (centre, velocity);
         let omega = [(rate * x - vy) / radius, (vx + rate * y) / radius, spin];
@@ -228,12 +233,6 @@ impl RollingSphere {
         omega: [f64; 3],
         nu: f64,
     ) -> Result<(Vec<f64>, Vec<f64>), Error> {
-        if !centre.iter().chain(&velocity).chain(&omega).all(|x| x.is_finite()) {
-            return Err(Error::invalid(
-                "velocity",
-                "the initial centre, velocity and spin must be finite",
-            ));
-        }
         let axis = [omega[0], omega[1], omega[2] - nu];
         let norm = axis.iter().map(|x| x * x).sum::<f64>().sqrt();
         let (phi, theta) = if norm > 0.0 {
@@ -249,7 +248,7 @@ impl RollingSphere {
         let mut p0 = vec![0.0; 5];
         let v0 = [velocity[0], velocity[1], phi_dot, theta_dot, psi_dot];
         self.dl_dv(&q0, &v0, 0.0, &mut p0)
-            .map_err(|e| Error::invalid("velocity", e.to_string()))?;
+            .map_err(|e| Error::invalid("vx0", e.to_string()))?;
         Ok((q0, p0))
     }
 }
