@@ -35,6 +35,8 @@ pytest.importorskip("sympy")
         "varmech.reduction",
         "varmech.methods",
         "varmech.analysis.work_precision",
+        "varmech.analysis.energy_growth",
+        "varmech.analysis.sections",
     ],
 )
 def test_examples_run(name):
