@@ -37,6 +37,7 @@ pytest.importorskip("sympy")
         "varmech.analysis.work_precision",
         "varmech.analysis.energy_growth",
         "varmech.analysis.sections",
+        "varmech.analysis.phase_portrait",
     ],
 )
 def test_examples_run(name):
