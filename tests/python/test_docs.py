@@ -38,6 +38,7 @@ pytest.importorskip("sympy")
         "varmech.analysis.energy_growth",
         "varmech.analysis.sections",
         "varmech.analysis.phase_portrait",
+        "varmech.analysis.stability",
     ],
 )
 def test_examples_run(name):
