@@ -39,8 +39,15 @@ pytest.importorskip("sympy")
         "varmech.analysis.sections",
         "varmech.analysis.phase_portrait",
         "varmech.analysis.stability",
+        "varmech.charts.energy",
+        "varmech.charts.nonholonomic",
+        "varmech.charts.sections",
+        "varmech.charts.stability",
+        "varmech.charts.work_precision",
     ],
 )
 def test_examples_run(name):
+    if name.startswith("varmech.charts"):
+        pytest.importorskip("matplotlib")
     result = doctest.testmod(importlib.import_module(name), optionflags=doctest.ELLIPSIS)
     assert result.attempted > 0 and result.failed == 0, result

@@ -17,7 +17,50 @@ def energy_error(trajectories: Mapping[str, Trajectory], path: str | Path, title
     scale (the run's mean kinetic energy; see :class:`~varmech.InvariantStatistics`), one line
     per labelled trajectory with its verdict in the legend, and write the figure to ``path``
     (PNG or SVG by its suffix). A forced run's line is its balance E − W. The t axis is in
-    ``time_unit`` (a scene's :attr:`~varmech.scenes.Scene.time_unit`)."""
+    ``time_unit`` (a scene's :attr:`~varmech.scenes.Scene.time_unit`).
+
+    Parameters
+    ----------
+    trajectories : mapping of str to Trajectory
+        The runs to draw, by legend label.
+    path : str or pathlib.Path
+        The file to write, ending in ``.png`` or ``.svg``; its folder is created.
+    title : str, optional
+        The figure's title (default none).
+    time_unit : str, default "time units"
+        The unit of the t axis.
+
+    Returns
+    -------
+    pathlib.Path
+        ``path``, written (the figure is closed).
+
+    Raises
+    ------
+    ImportError
+        matplotlib is missing (``pip install 'varmech[charts]'``).
+    ValueError
+        ``path`` does not end in ``.png`` or ``.svg``.
+
+    See Also
+    --------
+    varmech.check_conservation : The verdict in the legend.
+    varmech.charts.work_precision.energy_growth_chart : The same over a long run, from a table.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> import matplotlib.pyplot as plt
+    >>> import varmech
+    >>> from varmech.charts import energy_error
+    >>> scene = varmech.scenes.harmonic_oscillator()
+    >>> runs = {m: varmech.integrate(scene, dt=0.1, steps=200, method=m) for m in ("verlet", "rk4")}
+    >>> with tempfile.TemporaryDirectory() as folder:
+    ...     path = energy_error(runs, Path(folder) / "energy.png", title="harmonic oscillator")
+    ...     print(path.name, plt.imread(path).shape)   # 7 × 4.2 inches at 120 dpi, RGBA
+    energy.png (504, 840, 4)
+    """
     plt = pyplot()
     fig, ax = plt.subplots(figsize=(7, 4.2), layout="constrained")
     for label, traj in trajectories.items():

@@ -24,7 +24,47 @@ def nonholonomic_energy_chart(table: Table, path: str | Path, title: str = "") -
     :func:`~varmech.analysis.nonholonomic.nonholonomic_energy` table against t on log–log axes,
     one line per method with its verdict in the legend, and a dotted ∝ t line through the end of
     the naive method's, against which its linear drift reads; write the figure to ``path`` (PNG
-    or SVG). Errors of exactly 0 (the start) are left out."""
+    or SVG). Errors of exactly 0 (the start) are left out.
+
+    Parameters
+    ----------
+    table : Table
+        A table returned by :func:`~varmech.analysis.nonholonomic.nonholonomic_energy`.
+    path : str or pathlib.Path
+        The file to write, ending in ``.png`` or ``.svg``; its folder is created.
+    title : str, optional
+        The figure's title (default the table's title).
+
+    Returns
+    -------
+    pathlib.Path
+        ``path``, written (the figure is closed).
+
+    Raises
+    ------
+    ImportError
+        matplotlib is missing (``pip install 'varmech[charts]'``).
+    ValueError
+        ``path`` does not end in ``.png`` or ``.svg``.
+
+    See Also
+    --------
+    varmech.analysis.nonholonomic.nonholonomic_energy : The measurements.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> import matplotlib.pyplot as plt
+    >>> import varmech
+    >>> from varmech.analysis.nonholonomic import nonholonomic_energy
+    >>> from varmech.charts import nonholonomic_energy_chart
+    >>> table = nonholonomic_energy(steps=200, samples=10)
+    >>> with tempfile.TemporaryDirectory() as folder:
+    ...     path = nonholonomic_energy_chart(table, Path(folder) / "rolling_disk.png")
+    ...     print(path.name, plt.imread(path).shape)
+    rolling_disk.png (552, 960, 4)
+    """
     plt = pyplot()
     verdicts = table.meta.get("verdicts", {})
     fig, ax = plt.subplots(figsize=(8, 4.6), layout="constrained")
