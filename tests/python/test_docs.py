@@ -44,6 +44,7 @@ pytest.importorskip("sympy")
         "varmech.charts.sections",
         "varmech.charts.stability",
         "varmech.charts.work_precision",
+        "varmech.pointers",
     ],
 )
 def test_examples_run(name):
