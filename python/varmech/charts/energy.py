@@ -9,9 +9,10 @@ import numpy as np
 
 from ..conservation import check_conservation
 from ..integrate import Trajectory
-from ._figure import pyplot, save, time_label
+from ._figure import documented, pyplot, save, time_label
 
 
+@documented
 def energy_error(trajectories: Mapping[str, Trajectory], path: str | Path, title: str = "", time_unit: str = "time units") -> Path:
     """Plot the energy error |H(t) − H₀| against t on log–log axes, relative to the energy's
     scale (the run's mean kinetic energy; see :class:`~varmech.InvariantStatistics`), one line
@@ -23,24 +24,15 @@ def energy_error(trajectories: Mapping[str, Trajectory], path: str | Path, title
     ----------
     trajectories : mapping of str to Trajectory
         The runs to draw, by legend label.
-    path : str or pathlib.Path
-        The file to write, ending in ``.png`` or ``.svg``; its folder is created.
+    {path}
     title : str, optional
         The figure's title (default none).
     time_unit : str, default "time units"
         The unit of the t axis.
 
-    Returns
-    -------
-    pathlib.Path
-        ``path``, written (the figure is closed).
+    {returns}
 
-    Raises
-    ------
-    ImportError
-        matplotlib is missing (``pip install 'varmech[charts]'``).
-    ValueError
-        ``path`` does not end in ``.png`` or ``.svg``.
+    {raises}.
 
     See Also
     --------

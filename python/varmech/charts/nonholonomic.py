@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 
 from ..table import Table
-from ._figure import pyplot, save
+from ._figure import documented, pyplot, save
 
 #: What each line is, in the legend.
 LABELS = {
@@ -19,6 +19,7 @@ LABELS = {
 }
 
 
+@documented
 def nonholonomic_energy_chart(table: Table, path: str | Path, title: str = "") -> Path:
     """Plot the relative energy error |E − E₀|/E₀ of a
     :func:`~varmech.analysis.nonholonomic.nonholonomic_energy` table against t on log–log axes,
@@ -30,22 +31,13 @@ def nonholonomic_energy_chart(table: Table, path: str | Path, title: str = "") -
     ----------
     table : Table
         A table returned by :func:`~varmech.analysis.nonholonomic.nonholonomic_energy`.
-    path : str or pathlib.Path
-        The file to write, ending in ``.png`` or ``.svg``; its folder is created.
+    {path}
     title : str, optional
         The figure's title (default the table's title).
 
-    Returns
-    -------
-    pathlib.Path
-        ``path``, written (the figure is closed).
+    {returns}
 
-    Raises
-    ------
-    ImportError
-        matplotlib is missing (``pip install 'varmech[charts]'``).
-    ValueError
-        ``path`` does not end in ``.png`` or ``.svg``.
+    {raises}.
 
     See Also
     --------

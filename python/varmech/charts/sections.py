@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 
 from ..table import Table
-from ._figure import pyplot, save
+from ._figure import documented, pyplot, save
 
 
 def _henon_heiles_boundary(energy: float) -> tuple[np.ndarray, np.ndarray] | None:
@@ -22,6 +22,7 @@ def _henon_heiles_boundary(energy: float) -> tuple[np.ndarray, np.ndarray] | Non
     return np.concatenate([y, y[::-1]]), np.concatenate([py, -py[::-1]])
 
 
+@documented
 def poincare_chart(table: Table | Sequence[Table], path: str | Path, title: str = "") -> Path:
     """Scatter the section points of :func:`varmech.analysis.sections.poincare_section` in the table's
     plane (``meta["plane"]``, e.g. (y, p_y)), small dots, one colour per orbit, one panel per
@@ -33,22 +34,13 @@ def poincare_chart(table: Table | Sequence[Table], path: str | Path, title: str 
     ----------
     table : Table or sequence of Table
         Tables returned by :func:`~varmech.analysis.sections.poincare_section`, one panel each.
-    path : str or pathlib.Path
-        The file to write, ending in ``.png`` or ``.svg``; its folder is created.
+    {path}
     title : str, optional
         The figure's title (default none; each panel is titled with its energy).
 
-    Returns
-    -------
-    pathlib.Path
-        ``path``, written (the figure is closed).
+    {returns}
 
-    Raises
-    ------
-    ImportError
-        matplotlib is missing (``pip install 'varmech[charts]'``).
-    ValueError
-        ``path`` does not end in ``.png`` or ``.svg``, or no table is given.
+    {raises}, or no table is given.
 
     See Also
     --------
@@ -101,6 +93,7 @@ def poincare_chart(table: Table | Sequence[Table], path: str | Path, title: str 
     return save(fig, path)
 
 
+@documented
 def phase_portrait_chart(table: Table, path: str | Path, title: str = "") -> Path:
     """Draw the orbits of :func:`varmech.analysis.phase_portrait.phase_portrait` in the (q, p) plane:
     librations in blues, rotations in oranges (darker for higher energy), undetermined orbits
@@ -111,22 +104,13 @@ def phase_portrait_chart(table: Table, path: str | Path, title: str = "") -> Pat
     ----------
     table : Table
         A table returned by :func:`~varmech.analysis.phase_portrait.phase_portrait`.
-    path : str or pathlib.Path
-        The file to write, ending in ``.png`` or ``.svg``; its folder is created.
+    {path}
     title : str, optional
         The figure's title (default none).
 
-    Returns
-    -------
-    pathlib.Path
-        ``path``, written (the figure is closed).
+    {returns}
 
-    Raises
-    ------
-    ImportError
-        matplotlib is missing (``pip install 'varmech[charts]'``).
-    ValueError
-        ``path`` does not end in ``.png`` or ``.svg``.
+    {raises}.
 
     See Also
     --------

@@ -11,7 +11,7 @@ import numpy as np
 
 from ..analysis.stability import OUTCOMES, REFERENCE_LIMITS
 from ..table import Table
-from ._figure import pyplot, save, time_label
+from ._figure import documented, pyplot, save, time_label
 
 # Outcome colours of the implicit-regions map, in the order of OUTCOMES.
 _OUTCOME_COLOURS = {
@@ -29,6 +29,7 @@ _MARKERS = "osD^vPX*<>"
 _LINESTYLES = ("-", "--", "-.", (0, (3, 1, 1, 1, 1, 1)), ":")
 
 
+@documented
 def stability_chart(
     table: Table, path: str | Path, title: str = "", limits: Mapping[str, float] | None = None
 ) -> Path:
@@ -48,24 +49,15 @@ def stability_chart(
     ----------
     table : Table
         A table returned by :func:`~varmech.analysis.stability.growth_table`.
-    path : str or pathlib.Path
-        The file to write, ending in ``.png`` or ``.svg``; its folder is created.
+    {path}
     title : str, optional
         The figure's title (default: what is plotted).
     limits : mapping of str to float, optional
         The stability limit hω_max of each method to mark.
 
-    Returns
-    -------
-    pathlib.Path
-        ``path``, written (the figure is closed).
+    {returns}
 
-    Raises
-    ------
-    ImportError
-        matplotlib is missing (``pip install 'varmech[charts]'``).
-    ValueError
-        ``path`` does not end in ``.png`` or ``.svg``.
+    {raises}.
 
     See Also
     --------
@@ -136,6 +128,7 @@ def stability_chart(
     return save(fig, path)
 
 
+@documented
 def implicit_regions_chart(table: Table, path: str | Path, title: str = "") -> Path:
     """A categorical map of the outcome over step size h (columns) and initial angle q₀ (rows),
     one panel per method, from :func:`~varmech.analysis.stability.implicit_regions`. Writes ``path``
@@ -145,22 +138,13 @@ def implicit_regions_chart(table: Table, path: str | Path, title: str = "") -> P
     ----------
     table : Table
         A table returned by :func:`~varmech.analysis.stability.implicit_regions`.
-    path : str or pathlib.Path
-        The file to write, ending in ``.png`` or ``.svg``; its folder is created.
+    {path}
     title : str, optional
         The figure's title (default: the scene and the number of steps).
 
-    Returns
-    -------
-    pathlib.Path
-        ``path``, written (the figure is closed).
+    {returns}
 
-    Raises
-    ------
-    ImportError
-        matplotlib is missing (``pip install 'varmech[charts]'``).
-    ValueError
-        ``path`` does not end in ``.png`` or ``.svg``.
+    {raises}.
 
     See Also
     --------

@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 
 from ..table import Table
-from ._figure import pyplot, save, skipped_note, time_label
+from ._figure import documented, pyplot, save, skipped_note, time_label
 
 _AXIS_LABELS = {
     "seconds": "wall time (s)",
@@ -22,6 +22,7 @@ _AXIS_LABELS = {
 _STYLE = {"varmech": dict(ls="-", marker="o"), "scipy": dict(ls="--", marker="s"), "rebound": dict(ls=":", marker="^")}
 
 
+@documented
 def work_precision_chart(table: Table, path: str | Path, *, x: str = "seconds", y: str = "final_error", title: str = "") -> Path:
     """Plot ``y`` (``"final_error"`` or ``"max_energy_error"``) against ``x`` (``"seconds"`` or
     ``"evaluations"``) on log–log axes, one line per (tool, method) of a
@@ -35,8 +36,7 @@ def work_precision_chart(table: Table, path: str | Path, *, x: str = "seconds", 
     ----------
     table : Table
         A table returned by :func:`~varmech.work_precision`.
-    path : str or pathlib.Path
-        The file to write, ending in ``.png`` or ``.svg``; its folder is created.
+    {path}
     x : str, default "seconds"
         The column of the horizontal axis (work).
     y : str, default "final_error"
@@ -44,17 +44,9 @@ def work_precision_chart(table: Table, path: str | Path, *, x: str = "seconds", 
     title : str, optional
         The figure's title (default: the scene and the horizon).
 
-    Returns
-    -------
-    pathlib.Path
-        ``path``, written (the figure is closed).
+    {returns}
 
-    Raises
-    ------
-    ImportError
-        matplotlib is missing (``pip install 'varmech[charts]'``).
-    ValueError
-        ``path`` does not end in ``.png`` or ``.svg``, or ``x`` or ``y`` is not a column of ``table``.
+    {raises}, or ``x`` or ``y`` is not a column of ``table``.
 
     See Also
     --------
@@ -102,6 +94,7 @@ def work_precision_chart(table: Table, path: str | Path, *, x: str = "seconds", 
     return save(fig, path)
 
 
+@documented
 def energy_growth_chart(table: Table, path: str | Path, title: str = "", *, samples: bool = True) -> Path:
     """Plot the energy error of an :func:`~varmech.energy_growth` table against t on log–log
     axes, one line per method with its verdict in the legend, and write the figure to ``path``
@@ -119,24 +112,15 @@ def energy_growth_chart(table: Table, path: str | Path, title: str = "", *, samp
     ----------
     table : Table
         A table returned by :func:`~varmech.energy_growth`.
-    path : str or pathlib.Path
-        The file to write, ending in ``.png`` or ``.svg``; its folder is created.
+    {path}
     title : str, optional
         The figure's title (default: the scene and the step).
     samples : bool, default True
         Also draw the sampled errors, faintly.
 
-    Returns
-    -------
-    pathlib.Path
-        ``path``, written (the figure is closed).
+    {returns}
 
-    Raises
-    ------
-    ImportError
-        matplotlib is missing (``pip install 'varmech[charts]'``).
-    ValueError
-        ``path`` does not end in ``.png`` or ``.svg``.
+    {raises}.
 
     See Also
     --------
