@@ -367,16 +367,8 @@ def unstable_intervals(
 
     Parameters
     ----------
-    method : str
-        A varmech method for unconstrained systems (:func:`varmech.methods`).
-    h_omega_max : float, default 10.0
-        The end of the scanned range of hω.
-    resolution : float, default 1e-3
-        The grid step of hω; not above ``h_omega_max``.
-    tol : float, default 1e-9
-        Unstable means ρ > 1 + ``tol``.
-    progress : bool, optional
-        Show a progress bar: None on a terminal only (for 50 grid points or more).
+    method, h_omega_max, resolution, tol, progress
+        As for :func:`stability_scan` (unstable means ρ > 1 + ``tol``).
 
     Returns
     -------
@@ -386,9 +378,7 @@ def unstable_intervals(
     Raises
     ------
     ValueError
-        An unknown ``method``, or one for constrained systems or the N-body problem only;
-        ``h_omega_max``, ``resolution`` or ``tol`` not positive and finite, or ``resolution``
-        above ``h_omega_max``.
+        As for :func:`stability_scan`.
 
     See Also
     --------
