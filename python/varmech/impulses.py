@@ -232,7 +232,35 @@ def _kinetic(model: Model, q: np.ndarray, p: np.ndarray, t: float) -> float:
 
 def inverse_mass(model: Model, q: ArrayLike, t: float = 0.0) -> np.ndarray:
     """M(q)⁻¹, the metric of the inverse Legendre transform q̇ = M⁻¹(p − a(q)): columns
-    q̇(q, eᵢ) − q̇(q, 0), shape (n, n)."""
+    q̇(q, eᵢ) − q̇(q, 0), exact for a Lagrangian quadratic in q̇.
+
+    Parameters
+    ----------
+    model : Model
+        A varmech model.
+    q : array_like
+        The configuration, shape (n,).
+    t : float, default 0.0
+        The time.
+
+    Returns
+    -------
+    numpy.ndarray
+        M(q)⁻¹, shape (n, n).
+
+    Raises
+    ------
+    ValueError
+        ``q`` not n finite numbers.
+
+    Examples
+    --------
+    >>> import numpy as np, varmech
+    >>> from varmech.impulses import inverse_mass
+    >>> rod = varmech.MechanicalSystem(3, lambda q: 0.0, lambda q: np.zeros(3), mass=[1.0, 1.0, 1.0 / 3.0])
+    >>> np.diag(inverse_mass(rod, np.zeros(3))).round(12)
+    array([1., 1., 3.])
+    """
     n = model.dim
     qq = vector("q", q, n)
     zero = _velocity(model, qq, np.zeros(n), t)

@@ -166,7 +166,40 @@ def _rho(psi: np.ndarray) -> float:
 
 def step_matrix(method: str, h_omega: float) -> np.ndarray:
     """The 2×2 matrix Ψ of one step of ``method`` on q̈ = −q with h = ``h_omega``: its columns are
-    (q₁, p₁) after one step from (q, p) = (1, 0) and from (0, 1)."""
+    (q₁, p₁) after one step from (q, p) = (1, 0) and from (0, 1).
+
+    Parameters
+    ----------
+    method : str
+        A varmech method for unconstrained systems (:func:`varmech.methods`).
+    h_omega : float
+        The dimensionless step hω, positive.
+
+    Returns
+    -------
+    numpy.ndarray
+        Ψ, shape (2, 2).
+
+    Raises
+    ------
+    ValueError
+        An unknown ``method``, or one for constrained systems or the N-body problem only; or
+        ``h_omega`` not positive and finite.
+
+    Examples
+    --------
+    Verlet's step matrix [[1 − y²/2, y], [−y(1 − y²/4), 1 − y²/2]] has determinant 1
+    (symplectic):
+
+    >>> import numpy as np
+    >>> from varmech.analysis.stability import step_matrix
+    >>> psi = step_matrix("verlet", 1.0)
+    >>> psi
+    array([[ 0.5 ,  1.  ],
+           [-0.75,  0.5 ]])
+    >>> float(np.linalg.det(psi))
+    1.0
+    """
     _method(method)
     return _step_matrix(method, positive("h_omega", h_omega))
 
@@ -595,7 +628,26 @@ def stability_table(
 
 def relative_difference(measured: float, reference: float) -> float:
     """(measured − reference)/reference; measured − reference when the reference is 0; 0 when both
-    are inf; inf when only one is; NaN when the reference is NaN."""
+    are inf; inf when only one is; NaN when either is NaN.
+
+    Parameters
+    ----------
+    measured, reference : float
+        The two limits hω_max.
+
+    Returns
+    -------
+    float
+        The relative difference, as above.
+
+    Examples
+    --------
+    >>> from varmech.analysis.stability import relative_difference
+    >>> relative_difference(3.0, 2.0), relative_difference(0.1, 0.0)
+    (0.5, 0.1)
+    >>> relative_difference(float("inf"), float("inf"))
+    0.0
+    """
     if math.isnan(reference) or math.isnan(measured):
         return math.nan
     if math.isinf(reference) or math.isinf(measured):
