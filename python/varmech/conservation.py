@@ -171,8 +171,30 @@ class InvariantStatistics:
         return abs(self.initial) >= 1e-2 * self.scale
 
     def describe(self, symbol: str, error: str | None = None) -> list[str]:
-        """The lines of a report on this quantity: ``symbol`` names its value (H, J, …) and
-        ``error`` its error (default Δ``symbol``)."""
+        """The lines of a report on this quantity: verdict, initial value, errors and drift.
+
+        Parameters
+        ----------
+        symbol : str
+            The quantity's symbol in the text (H, J, …).
+        error : str, optional
+            The symbol of its error (default Δ``symbol``).
+
+        Returns
+        -------
+        list of str
+            Three lines (four for an energy whose initial value is not representative of
+            its size): the verdict and advice; the initial value and the largest error,
+            absolute and against the scale; the round-off level and the drift rate.
+
+        Examples
+        --------
+        >>> import varmech
+        >>> traj = varmech.integrate(varmech.scenes.harmonic_oscillator(), dt=0.1, steps=1000)
+        >>> lines = varmech.check_conservation(traj).energy.describe("H")
+        >>> len(lines), lines[0]
+        (3, 'energy      verdict: bounded')
+        """
         error = error or f"Δ{symbol}"
         head = f"{self.name:<12}verdict: {self.verdict}"
         if self.advice:
@@ -368,7 +390,8 @@ def check_conservation(traj: Trajectory, generators: Sequence[Generator] | None 
 
     See Also
     --------
-    ConservationReport, InvariantStatistics
+    ConservationReport : The report this returns, its fields and verdict.
+    InvariantStatistics : The statistics of one invariant, with its verdict.
 
     Examples
     --------

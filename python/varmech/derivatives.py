@@ -15,8 +15,35 @@ from .model import Lagrangian, MechanicalSystem, Model
 class DerivativeCheck:
     """The worst mismatch between each supplied derivative and central differences.
 
-    ``mismatch`` maps a derivative's name to max |supplied − differences| / max(1, |differences|);
-    ``ok`` says whether every mismatch is below ``rtol``.
+    The record :func:`check_derivatives` returns; printing it gives a table, a row a derivative.
+
+    Attributes
+    ----------
+    mismatch : dict of str to float
+        Each supplied derivative's name (``"gradient"``, ``"mass_derivative"``, ``"dl_dq"``,
+        ``"dl_dv"``, ``"L_qq"``, ``"L_qv"``, ``"L_vv"``) mapped to
+        max |supplied − differences| / max(1, max |differences|); inf for a wrong shape.
+    rtol : float
+        The largest mismatch called a match.
+    ok : bool
+        Every mismatch is at most ``rtol``.
+    worst : (str, float)
+        The name and mismatch of the worst derivative.
+
+    See Also
+    --------
+    check_derivatives : Makes the record.
+
+    Examples
+    --------
+    >>> import varmech
+    >>> right = varmech.MechanicalSystem(1, lambda q: 0.5 * q[0] ** 2, lambda q: q.copy())
+    >>> check = varmech.check_derivatives(right, [0.3])
+    >>> check.ok, check.worst[0], check.worst[1] < 1e-9
+    (True, 'gradient', True)
+    >>> print(check)  # doctest: +ELLIPSIS
+    Derivative check (rtol 1e-06):
+      gradient  ...e-...  ok
     """
 
     mismatch: dict[str, float]

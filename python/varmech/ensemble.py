@@ -37,10 +37,33 @@ if TYPE_CHECKING:
 class EnsembleConservation:
     """The conservation reports of an ensemble's members and their summary.
 
-    ``reports[i]`` is :func:`varmech.check_conservation` of member i (None for a member that
-    saved fewer than two states); ``worst_energy_error`` is the largest max |ΔE| / scale over the
-    members (of the balance E − W for forced models); ``not_bounded`` lists the members whose
-    energy verdict is worse than ``"bounded"`` (a secular drift or a failure).
+    The record :meth:`Ensemble.check_conservation` returns; printing it gives a one-line summary.
+
+    Attributes
+    ----------
+    reports : list of ConservationReport or None
+        ``reports[i]`` is :func:`varmech.check_conservation` of member i (None for a member that
+        saved fewer than two states).
+    worst_energy_error : float
+        The largest max |ΔE| / scale over the members (of the balance E − W for forced models),
+        the scale being each run's mean kinetic energy.
+    not_bounded : list of int
+        The members whose energy verdict is worse than ``"bounded"`` (a secular drift or a
+        failure).
+
+    See Also
+    --------
+    varmech.InvariantStatistics : The verdicts and the scale.
+
+    Examples
+    --------
+    >>> import numpy as np, varmech
+    >>> q0 = np.array([[0.5, 0.0], [0.6, 0.0]])
+    >>> p0 = np.array([[0.0, 1.5], [0.0, 1.4]])
+    >>> runs = varmech.ensemble(varmech.scenes.kepler(), q0, p0, dt=0.01, steps=200, save_every=50,
+    ...                         method="verlet", progress=False)
+    >>> print(runs.check_conservation())  # doctest: +ELLIPSIS
+    Ensemble conservation: 2 of 2 members judged, worst energy error ...e-05 × scale, not bounded: none
     """
 
     reports: list[ConservationReport | None]
@@ -137,8 +160,23 @@ class Ensemble:
         return iter(self.trajectories)
 
     def energy(self) -> np.ndarray:
-        """The energy function E at every saved state, shape (members, saved); NaN after a
-        member's last state."""
+        """The energy function E(q, p, t) = p·q̇ − L at every saved state.
+
+        Returns
+        -------
+        numpy.ndarray
+            Shape (members, saved); NaN after a member's last state.
+
+        Examples
+        --------
+        >>> import numpy as np, varmech
+        >>> q0 = np.array([[0.5, 0.0], [0.6, 0.0]])
+        >>> p0 = np.array([[0.0, 1.5], [0.0, 1.4]])
+        >>> runs = varmech.ensemble(varmech.scenes.kepler(), q0, p0, dt=0.01, steps=200,
+        ...                         save_every=50, method="verlet", progress=False)
+        >>> runs.energy()[:, 0].round(4)          # H = |p|²/2 − 1/|q|
+        array([-0.875 , -0.6867])
+        """
         out = np.full(self.q.shape[:2], np.nan)
         for i, tr in enumerate(self.trajectories):
             if len(tr):
@@ -146,8 +184,12 @@ class Ensemble:
         return out
 
     def check_conservation(self) -> EnsembleConservation:
-        """:func:`varmech.check_conservation` of every member, and the summary
-        (:class:`EnsembleConservation`).
+        """:func:`varmech.check_conservation` of every member, and the summary.
+
+        Returns
+        -------
+        EnsembleConservation
+            The members' reports, the worst energy error and the members not bounded.
 
         Examples
         --------
@@ -172,9 +214,30 @@ class Ensemble:
         return EnsembleConservation(reports, worst, not_bounded)
 
     def to_xarray(self) -> xarray.Dataset:
-        """A labelled :class:`xarray.Dataset`: ``q`` and ``p`` with dims (member, time,
-        coordinate), ``status`` by member, the parameters as coordinates of ``member``
-        (needs xarray, the extra ``xarray``)."""
+        """The ensemble as a labelled :class:`xarray.Dataset` (needs xarray, the extra ``xarray``).
+
+        Returns
+        -------
+        xarray.Dataset
+            ``q`` and ``p`` with dims (member, time, coordinate), ``status`` by member, the
+            parameters as coordinates of ``member``.
+
+        Raises
+        ------
+        ImportError
+            xarray is missing.
+
+        Examples
+        --------
+        >>> import numpy as np, varmech
+        >>> q0 = np.array([[0.5, 0.0], [0.6, 0.0]])
+        >>> p0 = np.array([[0.0, 1.5], [0.0, 1.4]])
+        >>> runs = varmech.ensemble(varmech.scenes.kepler(), q0, p0, dt=0.01, steps=200,
+        ...                         save_every=50, method="verlet", progress=False)
+        >>> data = runs.to_xarray()
+        >>> dict(data.sizes), list(data.data_vars)
+        ({'member': 2, 'time': 5, 'coordinate': 2}, ['q', 'p', 'status'])
+        """
         try:
             import xarray
         except ImportError as err:

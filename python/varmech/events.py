@@ -59,20 +59,32 @@ EventFunction = Callable[[float, np.ndarray, np.ndarray], float]
 class Event:
     """An event: the function g and how its crossings are watched.
 
-    Parameters
+    A crossing is a sign change of g(t, q, p) over a step; :func:`varmech.integrate` locates it
+    by a partial step of the method (see the module's documentation) and records it in the
+    trajectory's ``events``.
+
+    Attributes
     ----------
-    function
+    function : callable or None
         g(t, q, p) → float, or g(t, q, v) with ``variables="v"`` (v = q̇, the velocities).
         None for the built-in events, which carry a ``native`` spec instead.
-    direction
+    direction : int, default 0
         +1: count only crossings where g increases (− to +); −1: where it decreases; 0: both.
-    terminal
+    terminal : bool or int, default False
         True: the run stops after the step of the first crossing; an integer k ≥ 1: of the k-th;
-        False (default): never.
-    variables
-        ``"p"`` (default): g takes the momenta; ``"v"``: the velocities.
-    name
-        Shown in messages (default: the function's ``__name__``).
+        False: never.
+    variables : {"p", "v"}, default "p"
+        ``"p"``: g takes the momenta; ``"v"``: the velocities.
+    name : str, default ""
+        Shown in messages (empty: the function's ``__name__``).
+    native : (str, object) or None, default None
+        A built-in event's spec for the core, (kind, payload), as :func:`crossing` and the other
+        built-in events set it; None for a Python function.
+
+    See Also
+    --------
+    crossing : The built-in event q_k = value, evaluated natively.
+    Occurrences : The located crossings of an event.
 
     Examples
     --------
@@ -101,8 +113,35 @@ class Event:
 
 @dataclass(frozen=True)
 class Occurrences:
-    """The located crossings of one event: times ``t`` (k,), positions ``q`` and momenta ``p``
-    (k, n), in order of time, each a state of the integrator (a partial step of the method)."""
+    """The located crossings of one event, in order of time.
+
+    Each crossing is a state of the integrator (a partial step of the method); ``len()`` is
+    their number. ``trajectory.events[i]`` holds those of the i-th event.
+
+    Attributes
+    ----------
+    name : str
+        The event's name.
+    t : numpy.ndarray
+        The crossing times, shape (k,).
+    q : numpy.ndarray
+        The positions at the crossings, shape (k, n).
+    p : numpy.ndarray
+        The momenta at the crossings, shape (k, n).
+
+    Examples
+    --------
+    The harmonic oscillator q = sin t crosses q = 0 downward at t = π and 3π:
+
+    >>> import numpy as np
+    >>> import varmech
+    >>> from varmech.events import crossing
+    >>> traj = varmech.integrate(varmech.scenes.harmonic_oscillator(), dt=0.01, t_end=10.0,
+    ...                          method="kahan_li6", events=[crossing(0, direction=-1)])
+    >>> found = traj.events[0]
+    >>> len(found), (found.t / np.pi).round(6)
+    (2, array([1., 3.]))
+    """
 
     name: str
     t: np.ndarray

@@ -44,10 +44,32 @@ __all__ = ["Engagement", "Impulse", "ImpulseResponse", "engage", "impulse_respon
 
 @dataclass(frozen=True)
 class Impulse:
-    """A blow: its components P on the generalized coordinates (``generalized``, an array (n,)
-    or a function of q), or an impulse vector ``impulse`` applied at the point ``point(q)``, with
-    P = (∂x/∂q)ᵀ I (``jacobian(q)`` the (d, n) matrix ∂x/∂q, or central differences, with a
-    warning). ``t`` is when it acts (for the runs that take impulses).
+    """A blow: the components of impulse P_r = I · ∂x/∂qᵣ it gives each generalized coordinate.
+
+    Give either the components P themselves (``generalized``), or an impulse vector
+    ``impulse`` applied at the point ``point(q)``, with P = (∂x/∂q)ᵀ I.
+
+    Attributes
+    ----------
+    generalized : array_like or callable, optional
+        P as an array (n,), or a function of q returning one.
+    point : callable, optional
+        x(q), the point struck, an array (d,).
+    impulse : array_like, optional
+        The impulse vector I (d,) applied at ``point``.
+    jacobian : callable, optional
+        ∂x/∂q(q), the (d, n) matrix; default central differences, with a warning.
+    t : float, default 0.0
+        When it acts (for the runs that take impulses, ``integrate(..., impulses=[...])``).
+
+    See Also
+    --------
+    impulse_response : The state just after the blow.
+
+    References
+    ----------
+    .. [1] W. E. Byerly, *An Introduction to the Use of Generalized Coordinates in Mechanics
+       and Physics*, Ginn (1916), chapter III.
 
     Examples
     --------
@@ -66,7 +88,25 @@ class Impulse:
     t: float = 0.0
 
     def components(self, q: np.ndarray) -> np.ndarray:
-        """P_r at the configuration q, shape (n,)."""
+        """The components of impulse P_r = I · ∂x/∂qᵣ at the configuration q.
+
+        Parameters
+        ----------
+        q : numpy.ndarray
+            The configuration, shape (n,).
+
+        Returns
+        -------
+        numpy.ndarray
+            P, shape (n,).
+
+        Raises
+        ------
+        ValueError
+            Not exactly one of ``generalized`` and ``point``; a ``point`` without ``impulse``;
+            ``generalized`` not n finite numbers; the point and the impulse of different
+            lengths; or ``jacobian`` not of shape (d, n).
+        """
         n = len(q)
         if (self.generalized is None) == (self.point is None):
             raise ValueError("impulse: give exactly one of generalized= and point= (with impulse=)")
@@ -103,8 +143,33 @@ def _differences(f: Callable[[np.ndarray], np.ndarray], q: np.ndarray) -> np.nda
 
 @dataclass(frozen=True)
 class ImpulseResponse:
-    """The state just after a blow: momenta ``p`` and velocities ``v`` (n,), and the change of
-    kinetic energy ``kinetic_change`` = T⁺ − T⁻; ``p_before``, ``v_before`` the state before."""
+    """The state just after a blow, and the change of kinetic energy.
+
+    The record :func:`impulse_response` returns.
+
+    Attributes
+    ----------
+    p : numpy.ndarray
+        The momenta just after, p⁺ = p⁻ + P, shape (n,).
+    v : numpy.ndarray
+        The velocities just after, q̇(q, p⁺), shape (n,).
+    kinetic_change : float
+        T⁺ − T⁻ (the energy the blow gives; negative if it takes some).
+    p_before : numpy.ndarray
+        The momenta just before, shape (n,).
+    v_before : numpy.ndarray
+        The velocities just before, shape (n,).
+
+    Examples
+    --------
+    A free particle of unit mass at rest, struck by a unit impulse along x:
+
+    >>> import numpy as np, varmech
+    >>> free = varmech.MechanicalSystem(2, lambda q: 0.0, lambda q: np.zeros(2))
+    >>> after = varmech.impulse_response(free, [0.0, 0.0], [0.0, 0.0], varmech.Impulse(generalized=[1.0, 0.0]))
+    >>> after.v.tolist(), after.v_before.tolist(), after.kinetic_change
+    ([1.0, 0.0], [0.0, 0.0], 0.5)
+    """
 
     p: np.ndarray
     v: np.ndarray
@@ -115,9 +180,31 @@ class ImpulseResponse:
 
 @dataclass(frozen=True)
 class Engagement:
-    """The state just after constraints engage: momenta ``p`` and velocities ``v``, the
-    multipliers λ of the impulse Aᵀλ, the kinetic energy lost, and Carnot's ½Δq̇ᵀMΔq̇, which it
-    equals for a perfectly inelastic engagement."""
+    """The state just after constraints engage, and the kinetic energy lost.
+
+    The record :func:`engage` returns.
+
+    Attributes
+    ----------
+    p : numpy.ndarray
+        The momenta just after, p⁺ = p⁻ + Aᵀλ, shape (n,).
+    v : numpy.ndarray
+        The velocities just after, with A q̇⁺ = 0, shape (n,).
+    multipliers : numpy.ndarray
+        λ, the multipliers of the impulse Aᵀλ, shape (m,).
+    energy_lost : float
+        T⁻ − T⁺.
+    carnot : float
+        Carnot's ½Δq̇ᵀMΔq̇, which ``energy_lost`` equals for a perfectly inelastic engagement.
+
+    Examples
+    --------
+    >>> import numpy as np, varmech
+    >>> free = varmech.MechanicalSystem(2, lambda q: 0.0, lambda q: np.zeros(2))
+    >>> after = varmech.engage(free, [0.0, 0.0], [1.0, 1.0], velocity_constraints=lambda q: [[0.0, 1.0]])
+    >>> after.p.tolist(), after.multipliers.tolist(), after.energy_lost
+    ([1.0, 0.0], [-1.0], 0.5)
+    """
 
     p: np.ndarray
     v: np.ndarray
@@ -148,7 +235,35 @@ def _kinetic(model: Model, q: np.ndarray, p: np.ndarray, t: float) -> float:
 
 def inverse_mass(model: Model, q: ArrayLike, t: float = 0.0) -> np.ndarray:
     """M(q)⁻¹, the metric of the inverse Legendre transform q̇ = M⁻¹(p − a(q)): columns
-    q̇(q, eᵢ) − q̇(q, 0), shape (n, n)."""
+    q̇(q, eᵢ) − q̇(q, 0), exact for a Lagrangian quadratic in q̇.
+
+    Parameters
+    ----------
+    model : Model
+        A varmech model.
+    q : array_like
+        The configuration, shape (n,).
+    t : float, default 0.0
+        The time.
+
+    Returns
+    -------
+    numpy.ndarray
+        M(q)⁻¹, shape (n, n).
+
+    Raises
+    ------
+    ValueError
+        ``q`` not n finite numbers.
+
+    Examples
+    --------
+    >>> import numpy as np, varmech
+    >>> from varmech.impulses import inverse_mass
+    >>> rod = varmech.MechanicalSystem(3, lambda q: 0.0, lambda q: np.zeros(3), mass=[1.0, 1.0, 1.0 / 3.0])
+    >>> np.diag(inverse_mass(rod, np.zeros(3))).round(12)
+    array([1., 1., 3.])
+    """
     n = model.dim
     qq = vector("q", q, n)
     zero = _velocity(model, qq, np.zeros(n), t)
@@ -166,6 +281,46 @@ def impulse_response(
 ) -> ImpulseResponse:
     """The state just after ``impulse`` strikes ``model`` at (q, p) (or the velocities v):
     p⁺ = p + P(q), q̇⁺ = q̇(q, p⁺), and the change of kinetic energy.
+
+    The positions do not change during a blow; the momenta jump by the components of impulse,
+    Δ(∂L/∂q̇ᵣ) = P_r (Byerly, Arts. 26–28 [1]_).
+
+    Parameters
+    ----------
+    model : Model
+        A varmech model.
+    q : array_like
+        The configuration, shape (n,).
+    p : array_like, optional
+        The momenta just before (give ``p`` or ``v``).
+    impulse : Impulse
+        The blow.
+    v : array_like, optional
+        The velocities just before, instead of ``p``.
+    t : float, default 0.0
+        The time (for a time-dependent Lagrangian).
+
+    Returns
+    -------
+    ImpulseResponse
+        The momenta and velocities after and before, and the change of kinetic energy.
+
+    Raises
+    ------
+    TypeError
+        ``impulse`` is not an :class:`Impulse`.
+    ValueError
+        Not exactly one of ``p`` and ``v``; ``q``, ``p`` or ``v`` not n finite numbers; or the
+        impulse malformed (see :meth:`Impulse.components`).
+
+    See Also
+    --------
+    engage : Constraints that engage suddenly.
+
+    References
+    ----------
+    .. [1] W. E. Byerly, *An Introduction to the Use of Generalized Coordinates in Mechanics
+       and Physics*, Ginn (1916), chapter III.
 
     Examples
     --------
@@ -210,6 +365,48 @@ def engage(
     A(q)q̇ = 0 (``velocity_constraints`` giving A, for rolling), by Lagrange's impulsive equations
     Δp = Aᵀλ, A q̇⁺ = 0: λ = −(A M⁻¹ Aᵀ)⁻¹ A q̇⁻. Reports the kinetic energy lost and Carnot's
     ½Δq̇ᵀMΔq̇.
+
+    Parameters
+    ----------
+    model : Model
+        A varmech model whose Lagrangian is quadratic in q̇ (M⁻¹ from its inverse Legendre
+        transform).
+    q : array_like
+        The configuration, shape (n,).
+    p : array_like, optional
+        The momenta just before (give ``p`` or ``v``).
+    v : array_like, optional
+        The velocities just before, instead of ``p``.
+    constraints : callable, optional
+        g(q) → (m,), holonomic constraints g(q) = 0 (give this or ``velocity_constraints``).
+    jacobian : callable, optional
+        ∂g/∂q(q) → (m, n); default central differences of ``constraints``, with a warning.
+    velocity_constraints : callable, optional
+        A(q) → (m, n), velocity constraints A(q)q̇ = 0.
+    t : float, default 0.0
+        The time (for a time-dependent Lagrangian).
+
+    Returns
+    -------
+    Engagement
+        The momenta and velocities after, λ, the kinetic energy lost and Carnot's term.
+
+    Raises
+    ------
+    ValueError
+        Not exactly one of ``p`` and ``v``, or of ``constraints`` and ``velocity_constraints``;
+        ``q``, ``p`` or ``v`` not n finite numbers; A not a matrix with n columns; or dependent
+        constraints (A M⁻¹ Aᵀ singular).
+
+    See Also
+    --------
+    varmech.project : The same M-orthogonal projection of the momenta.
+    impulse_response : A blow.
+
+    References
+    ----------
+    .. [1] W. E. Byerly, *An Introduction to the Use of Generalized Coordinates in Mechanics
+       and Physics*, Ginn (1916), chapter III.
 
     Examples
     --------

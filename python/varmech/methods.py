@@ -31,7 +31,30 @@ def methods() -> list[MethodInfo]:
 
 
 def method_info(name: str) -> MethodInfo:
-    """The facts of the method called ``name``; ValueError naming ``method`` for another name."""
+    """The facts of the method called ``name``.
+
+    Parameters
+    ----------
+    name : str
+        A method's name, as in :func:`methods`.
+
+    Returns
+    -------
+    MethodInfo
+        Its record.
+
+    Raises
+    ------
+    ValueError
+        No method has that name (the message names the argument ``method``).
+
+    Examples
+    --------
+    >>> from varmech.methods import method_info
+    >>> info = method_info("kahan_li8")
+    >>> info.order, info.symplectic, info.implicit
+    (8, True, False)
+    """
     for m in _core.methods():
         if m.name == name:
             return m
@@ -39,7 +62,23 @@ def method_info(name: str) -> MethodInfo:
 
 
 def format_table() -> str:
-    """The methods as a Markdown table."""
+    """The methods as a Markdown table.
+
+    Returns
+    -------
+    str
+        A header row, a separator, then one row a method: order, force evaluations a step
+        ("Newton" for implicit methods), symplectic, symmetric and hω_max.
+
+    Examples
+    --------
+    >>> from varmech.methods import format_table
+    >>> for line in format_table().splitlines()[:3]:
+    ...     print(line)
+    | method | order | force evaluations / step | symplectic | symmetric | hω_max |
+    |---|---|---|---|---|---|
+    | `explicit_euler` | 1 | 1 | no | no | 0 |
+    """
     rows = [
         "| method | order | force evaluations / step | symplectic | symmetric | hω_max |",
         "|---|---|---|---|---|---|",

@@ -93,7 +93,31 @@ def _pointer_kind(obj: Any) -> str | None:
 def is_pointer(obj: Any) -> bool:
     """Whether ``obj`` is meant as a function pointer (a numba cfunc, a ctypes or cffi function
     pointer, a ``scipy.LowLevelCallable``, or a raw int address, which is refused) rather than a
-    Python closure."""
+    Python closure.
+
+    Only the kind of object is looked at, not its signature (:func:`address` checks that).
+
+    Parameters
+    ----------
+    obj : object
+        A model function as given.
+
+    Returns
+    -------
+    bool
+        True for the kinds of function pointer above (and :class:`Function`).
+
+    Examples
+    --------
+    >>> import ctypes
+    >>> from varmech import pointers
+    >>> @pointers.CFUNCTYPE
+    ... def gradient(q, v, t, n, out):
+    ...     out[0] = q[0]
+    ...     return 0
+    >>> pointers.is_pointer(gradient), pointers.is_pointer(lambda q: q)
+    (True, False)
+    """
     return _pointer_kind(obj) is not None
 
 
@@ -132,9 +156,43 @@ def _cffi_signature(obj: Any) -> str | None:
 
 
 def address(obj: Any, name: str) -> int:
-    """The address of the function pointer ``obj`` given as argument ``name``, after checking
-    its signature against :data:`C_SIGNATURE`; a TypeError naming ``name`` and showing the
-    expected signature otherwise."""
+    """The address of the function pointer ``obj``, after checking its signature.
+
+    Parameters
+    ----------
+    obj : object
+        A numba cfunc, a ctypes or cffi function pointer, a ``scipy.LowLevelCallable`` or a
+        :class:`Function`, of signature :data:`C_SIGNATURE`.
+    name : str
+        The argument it was given as, for the message.
+
+    Returns
+    -------
+    int
+        The address of its code.
+
+    Raises
+    ------
+    TypeError
+        ``obj`` is not such a pointer, or its signature is not :data:`C_SIGNATURE` (a raw int
+        address, whose signature cannot be checked, included); the message names ``name``
+        and shows the expected signature.
+
+    Examples
+    --------
+    >>> import ctypes
+    >>> from varmech import pointers
+    >>> @pointers.CFUNCTYPE
+    ... def gradient(q, v, t, n, out):
+    ...     out[0] = q[0]
+    ...     return 0
+    >>> pointers.address(gradient, "gradient") == ctypes.cast(gradient, ctypes.c_void_p).value
+    True
+    >>> pointers.address(12345, "gradient")
+    Traceback (most recent call last):
+        ...
+    TypeError: gradient: expected a function pointer of signature ... got a raw address 12345, whose signature cannot be checked
+    """
     kind = _pointer_kind(obj)
     if kind == "varmech":
         return int(obj.address)
@@ -161,8 +219,43 @@ def address(obj: Any, name: str) -> int:
 def functions(entries: dict[str, Any], dim: int) -> dict[str, Function] | None:
     """The model functions ``entries`` (name → function or None) of a model with ``dim``
     coordinates as :class:`Function` objects when every given one is a pointer, or None when none
-    is; a TypeError naming them when pointers and Python closures are mixed or a pointer's
-    signature is wrong."""
+    is.
+
+    Parameters
+    ----------
+    entries : dict of str to object
+        The model's functions by name (``"potential"``, ``"gradient"``, ``"lagrangian"``,
+        ``"dl_dq"``, ``"dl_dv"``, ``"hessians"``, ``"force"``), None for one not given.
+    dim : int
+        The number of coordinates n.
+
+    Returns
+    -------
+    dict of str to Function, or None
+        Every given function wrapped, or None when they are all Python closures.
+
+    Raises
+    ------
+    TypeError
+        Pointers and Python closures are mixed (naming both), or a pointer's signature is wrong
+        (naming it).
+
+    Examples
+    --------
+    >>> import ctypes
+    >>> from varmech import pointers
+    >>> @pointers.CFUNCTYPE
+    ... def gradient(q, v, t, n, out):
+    ...     out[0] = q[0]
+    ...     return 0
+    >>> wrapped = pointers.functions({"potential": None, "gradient": gradient}, 1)
+    >>> wrapped
+    {'gradient': Function('gradient', <CFunctionType object at ...>)}
+    >>> wrapped["gradient"]([2.0]).tolist()
+    [2.0]
+    >>> pointers.functions({"gradient": lambda q: q}, 1) is None
+    True
+    """
     given = {k: f for k, f in entries.items() if f is not None}
     pointers = [k for k, f in given.items() if is_pointer(f)]
     if not pointers:
@@ -196,7 +289,33 @@ class Function:
     (:func:`varmech.check_derivatives`, the time-dependence probe) calls it; the core calls
     the pointer itself. A nonzero status is a :class:`varmech.VarmechError` naming the function.
 
-    ``pointer`` is the object the user gave (kept alive with the model), ``address`` its code.
+    Parameters
+    ----------
+    name : str
+        The model function it stands for (``"potential"``, ``"gradient"``, ``"lagrangian"``,
+        ``"dl_dq"``, ``"dl_dv"``, ``"hessians"`` or ``"force"``), which fixes its result's shape.
+    pointer : object
+        The object the user gave (kept alive with the model).
+    address : int
+        Its code's address (:func:`address`).
+    dim : int
+        The number of coordinates n.
+
+    See Also
+    --------
+    functions : Wraps a model's functions.
+
+    Examples
+    --------
+    >>> import ctypes
+    >>> from varmech import pointers
+    >>> @pointers.CFUNCTYPE
+    ... def potential(q, v, t, n, out):
+    ...     out[0] = 0.5 * q[0] * q[0]
+    ...     return 0
+    >>> f = pointers.Function("potential", potential, pointers.address(potential, "potential"), 1)
+    >>> f([3.0])
+    4.5
     """
 
     def __init__(self, name: str, pointer: Any, address: int, dim: int):

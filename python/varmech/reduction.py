@@ -30,6 +30,44 @@ def cyclic_coordinates(
     Sampling can miss a dependence that vanishes on the samples, so the result is a list of
     candidates (Routh reduction needs ∂L/∂qᵢ = 0 everywhere); derivatives from differences
     (closures without ``dl_dq``) are accurate to about 1e-10, within the default ``rtol``.
+
+    Parameters
+    ----------
+    model : Model
+        A varmech model.
+    q : array_like
+        The configuration to sample around, shape (n,).
+    spread : float, default 1.0
+        The half-width of the sampled positions and the largest sampled |q̇ᵢ|.
+    samples : int, default 64
+        The number of random states.
+    seed : int, default 0
+        The seed of ``numpy.random.default_rng``.
+    rtol : float, default 1e-9
+        The largest relative |∂L/∂qᵢ| called zero.
+
+    Returns
+    -------
+    list of int
+        The indices of the candidate cyclic coordinates, increasing.
+
+    Raises
+    ------
+    ValueError
+        ``q`` not n finite numbers, ``spread`` not positive and finite, or ``samples`` not a
+        positive integer.
+
+    See Also
+    --------
+    routh : Ignores the cyclic coordinates.
+
+    Examples
+    --------
+    >>> import varmech
+    >>> from varmech.reduction import cyclic_coordinates
+    >>> top = varmech.scenes.heavy_top()        # q = (θ, φ, ψ): nutation, precession, spin
+    >>> cyclic_coordinates(top.model, top.q0)
+    [1, 2]
     """
     relative = _relative_dl_dq(model, q, spread=spread, samples=samples, seed=seed)
     ignorable = np.all(relative <= rtol, axis=0)
@@ -101,6 +139,47 @@ class ReducedModel(Model):
     The reduced model is an ordinary model: integrate it with ``midpoint``, ``trapezoid``,
     ``galerkin4`` or ``galerkin6``, then put the ignored coordinates back with
     :meth:`reconstruct`.
+
+    Parameters
+    ----------
+    full : Model
+        The full model, unforced and unconstrained (not itself reduced).
+    cyclic : sequence of int
+        The indices c of the ignored coordinates, distinct, leaving at least one.
+    momenta : array_like
+        Their conserved momenta μ = ∂L/∂ċ, one each.
+    reference : array_like, optional
+        The values of the ignored coordinates at which L is evaluated (default zeros).
+
+    Attributes
+    ----------
+    full : Model
+        The full model.
+    cyclic : tuple of int
+        The ignored coordinates' indices.
+    momenta : numpy.ndarray
+        μ.
+    shape : tuple of int
+        The indices of the remaining (shape) coordinates x in the full model.
+
+    See Also
+    --------
+    routh : Builds the reduced model, checking that the coordinates are cyclic.
+    cyclic_coordinates : Finds candidates.
+
+    References
+    ----------
+    .. [1] J. E. Marsden, T. S. Ratiu and J. Scheurle, "Reduction theory and the
+       Lagrange–Routh equations", *J. Math. Phys.* 41, 3379–3429 (2000).
+
+    Examples
+    --------
+    >>> import varmech
+    >>> from varmech.reduction import ReducedModel
+    >>> top = varmech.scenes.heavy_top()
+    >>> reduced = ReducedModel(top.model, [1, 2], top.p0[[1, 2]])
+    >>> reduced.dim, reduced.shape, reduced.cyclic
+    (1, (0,), (1, 2))
     """
 
     _core: _core.RouthModel
@@ -125,8 +204,36 @@ class ReducedModel(Model):
         self.name = f"{full.name}, Routh-reduced (ignoring {', '.join(f'q[{i}]' for i in indices)})"
 
     def reduce(self, q: ArrayLike, p: ArrayLike, *, rtol: float = 1e-12) -> tuple[np.ndarray, np.ndarray]:
-        """The reduced state (x, p_x) of a full state (q, p) whose cyclic momenta are μ (to
-        ``rtol``); ValueError naming ``p`` otherwise."""
+        """The reduced state (x, p_x) of a full state (q, p) whose cyclic momenta are μ.
+
+        Parameters
+        ----------
+        q : array_like
+            The full configuration, shape (n,).
+        p : array_like
+            The full momenta, shape (n,); those of the cyclic coordinates must be μ.
+        rtol : float, default 1e-12
+            How close to μ, relative to max(1, |μ|).
+
+        Returns
+        -------
+        x, p_x : numpy.ndarray
+            The shape coordinates and their momenta, shape (r,) each.
+
+        Raises
+        ------
+        ValueError
+            ``q`` or ``p`` not n finite numbers, or the cyclic momenta of ``p`` not μ (naming
+            ``p``).
+
+        Examples
+        --------
+        >>> import varmech
+        >>> top = varmech.scenes.heavy_top()       # q = (θ, φ, ψ); φ and ψ are cyclic
+        >>> reduced = varmech.routh(top, [1, 2])
+        >>> reduced.reduce(top.q0, top.p0)
+        (array([0.3]), array([0.]))
+        """
         n = self.full.dim
         q, p = vector("q", q, n), vector("p", p, n)
         pc = p[list(self.cyclic)]
@@ -135,9 +242,36 @@ class ReducedModel(Model):
         return q[list(self.shape)], p[list(self.shape)]
 
     def amended_potential(self, x: ArrayLike, t: ArrayLike = 0.0) -> np.ndarray:
-        """V_μ(x, t) = −R(x, 0, t) (V + ½μᵀM_cc⁻¹μ for a mechanical system), for one state
-        (r,) or rows (N, r). Relative equilibria (x at rest, c turning uniformly) are its
-        critical points."""
+        """The amended potential V_μ(x, t) = −R(x, 0, t).
+
+        For a mechanical system V_μ = V + ½μᵀM_cc⁻¹μ. Relative equilibria (x at rest, c turning
+        uniformly) are its critical points.
+
+        Parameters
+        ----------
+        x : array_like
+            One state (r,) or rows (N, r) of shape coordinates.
+        t : float or array_like, default 0.0
+            The time, or one per row.
+
+        Returns
+        -------
+        numpy.ndarray
+            V_μ, shape () for one state or (N,) for rows.
+
+        Raises
+        ------
+        ValueError
+            ``x`` not r numbers (or rows of them), or ``t`` not one time per row.
+
+        Examples
+        --------
+        >>> import varmech
+        >>> top = varmech.scenes.heavy_top()       # q = (θ, φ, ψ); φ and ψ are cyclic
+        >>> reduced = varmech.routh(top, [1, 2])
+        >>> reduced.amended_potential([[0.3], [0.4]]).round(6)
+        array([7.205336, 7.19527 ])
+        """
         x = np.asarray(x, dtype=float)
         rows = np.ascontiguousarray(np.atleast_2d(x))
         t1 = np.ascontiguousarray(np.broadcast_to(np.asarray(t, dtype=float), rows.shape[:1]))
@@ -145,7 +279,35 @@ class ReducedModel(Model):
         return values.reshape(x.shape[:-1])
 
     def cyclic_velocity(self, x: ArrayLike, xdot: ArrayLike, t: ArrayLike = 0.0) -> np.ndarray:
-        """ċ with ∂L/∂ċ(x, ẋ, ċ, t) = μ, for one state or rows."""
+        """The velocities ċ of the ignored coordinates, solving ∂L/∂ċ(x, ẋ, ċ, t) = μ.
+
+        Parameters
+        ----------
+        x : array_like
+            Shape coordinates, (r,) or rows (N, r) (broadcast against ``xdot``).
+        xdot : array_like
+            Their velocities ẋ, (r,) or rows (N, r).
+        t : float or array_like, default 0.0
+            The time, or one per row.
+
+        Returns
+        -------
+        numpy.ndarray
+            ċ, shape (m,) for one state or (N, m) for rows.
+
+        Raises
+        ------
+        ValueError
+            ``x`` or ``xdot`` not r numbers (or rows of them), or ``t`` not one time per row.
+
+        Examples
+        --------
+        >>> import varmech
+        >>> top = varmech.scenes.heavy_top()       # q = (θ, φ, ψ); φ and ψ are cyclic
+        >>> reduced = varmech.routh(top, [1, 2])
+        >>> reduced.cyclic_velocity([0.3], [0.0]).round(12)    # at θ = 0.3 at rest: no precession
+        array([0., 5.])
+        """
         xdot = np.asarray(xdot, dtype=float)
         rows = np.ascontiguousarray(np.atleast_2d(xdot))
         x2 = np.ascontiguousarray(np.broadcast_to(np.asarray(x, dtype=float), rows.shape))
@@ -163,6 +325,37 @@ class ReducedModel(Model):
         rule this is exactly what the unreduced DEL integration computes). Otherwise Δc = ∫ċ dt
         by 3-point Gauss quadrature along the cubic Hermite interpolant of the saved states,
         accurate to O(H⁴) in the spacing H of the saved states.
+
+        Parameters
+        ----------
+        traj : Trajectory
+            A run of this reduced model.
+        c0 : array_like, optional
+            The ignored coordinates at the start (default zeros).
+
+        Returns
+        -------
+        Trajectory
+            The run of the full model: q with x and c, p with p_x and μ.
+
+        Raises
+        ------
+        ValueError
+            ``traj`` is not a trajectory of this reduced model, or ``c0`` not m finite numbers.
+
+        Examples
+        --------
+        The midpoint rule reduced and reconstructed is the midpoint rule on the full model:
+
+        >>> import numpy as np, varmech
+        >>> top = varmech.scenes.heavy_top()
+        >>> reduced = varmech.routh(top, [1, 2])
+        >>> x0, px0 = reduced.reduce(top.q0, top.p0)
+        >>> run = varmech.integrate(reduced, x0, px0, dt=0.01, steps=100, method="midpoint")
+        >>> full = reduced.reconstruct(run, top.q0[[1, 2]])
+        >>> direct = varmech.integrate(top, dt=0.01, steps=100, method="midpoint")
+        >>> bool(np.abs(full.q - direct.q).max() < 1e-13), bool((full.p[:, 1:] == top.p0[1:]).all())
+        (True, True)
         """
         if not isinstance(traj, Trajectory) or traj.model is not self:
             raise ValueError("traj: must be a trajectory of this reduced model")

@@ -38,8 +38,20 @@ pytest.importorskip("sympy")
         "varmech.analysis.work_precision",
         "varmech._errors",
         "varmech.table",
+        "varmech.analysis.energy_growth",
+        "varmech.analysis.sections",
+        "varmech.analysis.phase_portrait",
+        "varmech.analysis.stability",
+        "varmech.charts.energy",
+        "varmech.charts.nonholonomic",
+        "varmech.charts.sections",
+        "varmech.charts.stability",
+        "varmech.charts.work_precision",
+        "varmech.pointers",
     ],
 )
 def test_examples_run(name):
+    if name.startswith("varmech.charts"):
+        pytest.importorskip("matplotlib")
     result = doctest.testmod(importlib.import_module(name), optionflags=doctest.ELLIPSIS)
     assert result.attempted > 0 and result.failed == 0, result

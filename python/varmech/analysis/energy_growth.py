@@ -131,7 +131,56 @@ def energy_growth(
     progress
         Show a progress bar: None on a terminal only, True or False to force it.
 
-    Ctrl-C raises KeyboardInterrupt with the rows measured so far as ``err.partial``.
+    Returns
+    -------
+    Table
+        A :class:`~varmech.Table` with columns ``tool`` ("varmech", "scipy" or "rebound"),
+        ``method``, ``t`` (in the scene's time unit), ``energy_error`` (the largest |ΔH/H₀| in
+        that bin) and ``max_energy_error`` (its running maximum), one row a non-empty bin and
+        method. ``meta`` holds ``"verdicts"`` (above), ``"notes"`` (skipped baselines and why),
+        ``"scene"``, ``"time_unit"``, ``"dt"``, ``"t_end"``, ``"baseline_t_end"``, ``"rtol"``
+        and ``"sampling"``.
+
+    Raises
+    ------
+    ValueError
+        The scene's energy is not conserved (L depends on t, or forces act); an unknown
+        baseline; ``dt`` not positive and finite; ``samples`` below 10; or an unknown method,
+        or one that does not fit the scene's model (from :func:`~varmech.integrate`).
+    KeyboardInterrupt
+        On Ctrl-C, with the rows measured so far as ``err.partial``.
+
+    See Also
+    --------
+    verdicts : The verdicts of the table as a small Table.
+    varmech.charts.work_precision.energy_growth_chart : Plots the table.
+    varmech.check_conservation : The verdict of one trajectory.
+
+    Notes
+    -----
+    Each varmech method costs about 1.11 runs over the horizon: one saving ``samples`` (at least
+    1009, a prime) evenly spaced states, then its first tenth, hundredth, ... again with denser
+    saving, which resolves the early, log-spaced times on the same trajectory. A symplectic
+    method's error stays bounded (it conserves a modified energy H̃ = H + O(hᵖ) over
+    exponentially long times); a non-symplectic one drifts secularly, linearly in t.
+
+    References
+    ----------
+    .. [1] E. Hairer, C. Lubich and G. Wanner, *Geometric Numerical Integration*, 2nd ed.,
+       Springer (2006), chapter IX (backward error analysis, long-time energy conservation).
+
+    Examples
+    --------
+    >>> import varmech
+    >>> from varmech.analysis.energy_growth import energy_growth, verdicts
+    >>> table = energy_growth(varmech.scenes.harmonic_oscillator(), ["verlet", "rk4"],
+    ...                       t_end=100.0, samples=10, baselines=())
+    >>> table.columns
+    ('tool', 'method', 't', 'energy_error', 'max_energy_error')
+    >>> {m: v["verdict"] for m, v in table.meta["verdicts"].items()}
+    {'verlet': 'bounded', 'rk4': 'secular drift'}
+    >>> verdicts(table).column("verdict").tolist()
+    ['bounded', 'secular drift']
     """
     if not conserves_energy(scene.model):
         raise ValueError(f"scene: the energy of {scene.name!r} is not conserved (L depends on t, or forces act)")
@@ -256,8 +305,29 @@ def energy_growth(
 
 
 def verdicts(table: Table) -> Table:
-    """The verdicts of an :func:`energy_growth` table as a small Table (tool, method, verdict,
-    drift_rate, drift_rate_stderr, max_error, t_end)."""
+    """The verdicts of an :func:`energy_growth` table as a small Table.
+
+    Parameters
+    ----------
+    table : Table
+        A table returned by :func:`energy_growth`.
+
+    Returns
+    -------
+    Table
+        One row a method: ``tool``, ``method``, ``verdict`` ("bounded" or "secular drift"),
+        ``drift_rate`` (of the energy, per unit time) and ``drift_rate_stderr``, ``max_error``
+        (against the mean kinetic energy) and ``t_end``.
+
+    Examples
+    --------
+    >>> import varmech
+    >>> from varmech.analysis.energy_growth import energy_growth, verdicts
+    >>> table = energy_growth(varmech.scenes.harmonic_oscillator(), ["verlet"], t_end=100.0,
+    ...                       samples=10, baselines=())
+    >>> verdicts(table).column("verdict").tolist()
+    ['bounded']
+    """
     out = Table(
         ("tool", "method", "verdict", "drift_rate", "drift_rate_stderr", "max_error", "t_end"),
         title=f"Energy verdicts: {table.meta.get('scene', '')}",

@@ -59,11 +59,70 @@ def phase_portrait(
     :func:`varmech.integrate` call; ``kahan_li6`` for separable models by default, ``galerkin6``
     otherwise), and their mirrors another, saving every ``save_every`` steps.
 
-    One row per saved state: ``orbit``, ``energy`` (H at the start), ``motion`` (from the
-    trajectory: ``"libration"`` if p reverses and q stays within 2π, ``"rotation"`` if p never
-    reverses and q advances by 2π or more, else ``"undetermined"``), ``t``, ``q``, ``p`` and
-    ``energy_error`` = H − H₀ (absolute: a portrait's energies pass through 0).
-    ``meta["max_energy_error"]`` is its largest magnitude.
+    Parameters
+    ----------
+    model_or_scene : Model or Scene
+        An unconstrained, conservative model of one degree of freedom, e.g.
+        :func:`varmech.scenes.pendulum` (H = p²/2 − cos q).
+    energies : iterable of float, optional
+        The orbits' energies H₀ (default :data:`PENDULUM_ENERGIES` for the pendulum; required
+        otherwise, unless ``initial_states`` is given).
+    initial_states : array_like, shape (m, 2), optional
+        Rows (q, p) to start from instead of ``energies``.
+    q_start : float, default 0.0
+        Where the orbits of ``energies`` start, with p > 0 solved from H(q_start, p) = H₀.
+    mirror : bool, default True
+        Add a twin with −p to each rotation.
+    dt : float, default 0.01
+        The step, in the scene's time units.
+    t_end : float, default 40.0
+        Each orbit's horizon.
+    method : str, optional
+        A varmech method (default ``kahan_li6`` for separable models, ``galerkin6`` otherwise).
+    save_every : int, default 5
+        Steps between saved states.
+    progress : bool, optional
+        Show a progress bar: None on a terminal only, True or False to force it.
+
+    Returns
+    -------
+    Table
+        One row per saved state: ``orbit``, ``energy`` (H at the start), ``motion`` (from the
+        trajectory: ``"libration"`` if p reverses and q stays within 2π, ``"rotation"`` if p
+        never reverses and q advances by 2π or more, else ``"undetermined"``), ``t``, ``q``,
+        ``p`` and ``energy_error`` = H − H₀ (absolute: a portrait's energies pass through 0).
+        ``meta["max_energy_error"]`` is its largest magnitude; ``meta["separatrix_energy"]``
+        is 1 for the pendulum; ``meta["notes"]`` names orbits that diverged.
+
+    Raises
+    ------
+    TypeError
+        ``model_or_scene`` is neither a model nor a scene.
+    ValueError
+        A constrained or non-conservative model, or one with more than one degree of freedom;
+        ``dt`` or ``t_end`` not positive and finite; both or (except for the pendulum) neither
+        of ``energies`` and ``initial_states``; ``initial_states`` not rows of two finite
+        numbers; an energy below the potential at ``q_start``; or an unknown ``method``.
+    KeyboardInterrupt
+        On Ctrl-C, with the rows measured so far as ``err.partial``.
+
+    See Also
+    --------
+    varmech.charts.sections.phase_portrait_chart : Plots the portrait.
+    varmech.analysis.sections.poincare_section : The analogue for two degrees of freedom.
+
+    Examples
+    --------
+    >>> import varmech
+    >>> from varmech.analysis.phase_portrait import phase_portrait
+    >>> table = phase_portrait(varmech.scenes.pendulum(), [-0.5, 2.0], dt=0.05, t_end=20.0,
+    ...                        progress=False)
+    >>> table.columns
+    ('orbit', 'energy', 'motion', 't', 'q', 'p', 'energy_error')
+    >>> table.unique("motion"), table.unique("orbit")   # the rotation got a mirror, orbit 2
+    (['libration', 'rotation'], [0, 1, 2])
+    >>> table.meta["max_energy_error"] < 1e-9
+    True
     """
     model = model_of(model_or_scene)
     if model.dim != 1:

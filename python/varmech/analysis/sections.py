@@ -294,9 +294,58 @@ def poincare_section(
     progress
         Show a progress bar: None on a terminal only, True or False to force it.
 
-    An orbit that diverges (above Hénon–Heiles' escape energy 1/6) keeps its crossings up to the
-    divergence, with a note in ``meta["notes"]``. Ctrl-C raises KeyboardInterrupt with the rows
-    so far as ``err.partial``.
+    Returns
+    -------
+    Table
+        Columns ``orbit``, ``t``, the coordinates, their momenta ``p_<name>`` and
+        ``energy_error``, one row a crossing, orbit by orbit in time order. ``meta`` holds
+        ``"plane"``, ``"seeds"``, ``"max_section_residual"``, ``"max_energy_error"``,
+        ``"max_hermite_gap"`` (``locate="step"``), the set-up (``"model"``, ``"energy"``,
+        ``"section"``, ``"method"``, ``"dt"``, ``"t_end"``, ``"locate"``) and ``"notes"``: an
+        orbit that diverges (above Hénon–Heiles' escape energy 1/6) keeps its crossings up to
+        the divergence, with a note.
+
+    Raises
+    ------
+    TypeError
+        ``model_or_scene`` is neither a model nor a scene.
+    ValueError
+        A constrained or non-conservative model; ``energy`` not finite; ``names``, ``section``,
+        ``locate``, ``seeds``, ``orbits``, ``dt`` or ``t_end`` malformed; no ``box`` where one is
+        needed (any model but Hénon–Heiles on x = 0), or too few energy-allowed seeds in it; an
+        explicit seed outside the energy-allowed region; or an unknown ``method``.
+    KeyboardInterrupt
+        On Ctrl-C, with the rows measured so far as ``err.partial``.
+
+    See Also
+    --------
+    orbit_divergence : The same orbits' divergence from a neighbour, a chaos indicator.
+    covered_cells : Box counting on the section: curve or area.
+    varmech.charts.sections.poincare_chart : Plots the section.
+
+    Notes
+    -----
+    A Poincaré section reduces a flow on the three-dimensional energy shell of a system of two
+    degrees of freedom to a map of a plane: regular orbits lie on invariant tori and pierce
+    the plane on closed curves, chaotic ones scatter over an area [1]_.
+
+    References
+    ----------
+    .. [1] M. Hénon and C. Heiles, "The applicability of the third integral of motion: some
+       numerical experiments", *Astron. J.* 69, 73–79 (1964).
+
+    Examples
+    --------
+    >>> import varmech
+    >>> from varmech.analysis.sections import poincare_section
+    >>> table = poincare_section(varmech.scenes.henon_heiles(), 1 / 12, orbits=3, dt=0.1,
+    ...                          t_end=60.0, progress=False)
+    >>> table.columns
+    ('orbit', 't', 'x', 'y', 'p_x', 'p_y', 'energy_error')
+    >>> table.meta["plane"], table.meta["method"]
+    (('y', 'p_y'), 'kahan_li6')
+    >>> table.meta["max_section_residual"] < 1e-12, table.meta["max_energy_error"] < 1e-8
+    (True, True)
     """
     model = model_of(model_or_scene)
     energy = float(energy)
@@ -399,9 +448,51 @@ def orbit_divergence(
     A sticky chaotic orbit that stays near an island for the whole run counts as regular: the
     fraction is a lower bound that grows with ``t_end``.
 
-    One row per orbit: ``orbit``, the seed's plane coordinates (``y0``, ``p_y0`` for
-    Hénon–Heiles), ``divergence``, ``chaotic``. ``meta["chaotic_fraction"]`` is the fraction of
-    chaotic orbits.
+    Parameters
+    ----------
+    model_or_scene, energy, orbits, seeds, box, dt, t_end, method, section, seed, progress
+        As for :func:`poincare_section`.
+    separation : float, default 1e-9
+        The twin's initial offset in the plane momentum.
+    threshold : float, default 5.0
+        Decades of growth from which an orbit counts as chaotic (:data:`CHAOS_THRESHOLD`).
+
+    Returns
+    -------
+    Table
+        One row per orbit: ``orbit``, the seed's plane coordinates (``y0``, ``p_y0`` for
+        Hénon–Heiles), ``divergence``, ``chaotic``. ``meta["chaotic_fraction"]`` is the fraction
+        of chaotic orbits; ``meta["notes"]`` names orbits without a twin or that diverged.
+
+    Raises
+    ------
+    TypeError
+        ``model_or_scene`` is neither a model nor a scene.
+    ValueError
+        As for :func:`poincare_section`, and ``separation`` not positive and finite.
+    KeyboardInterrupt
+        On Ctrl-C, with the rows measured so far as ``err.partial``.
+
+    See Also
+    --------
+    poincare_section : The section of the same orbits.
+
+    Notes
+    -----
+    This is a finite-time, two-point variant of the largest Lyapunov exponent: it measures the
+    growth of one separation rather than of a tangent vector, and saturates instead of growing
+    without bound.
+
+    Examples
+    --------
+    >>> import varmech
+    >>> from varmech.analysis.sections import orbit_divergence
+    >>> table = orbit_divergence(varmech.scenes.henon_heiles(), 1 / 8, orbits=3, dt=0.1,
+    ...                          t_end=100.0, progress=False)
+    >>> table.columns
+    ('orbit', 'y0', 'p_y0', 'divergence', 'chaotic')
+    >>> len(table), 0.0 <= table.meta["chaotic_fraction"] <= 1.0
+    (3, True)
     """
     model = model_of(model_or_scene)
     energy = float(energy)
@@ -467,7 +558,32 @@ def covered_cells(table: Table, *, bins: int = 40, extent: Any = None, points: i
     points (all by default). A regular orbit's points lie on a curve and fill O(bins) cells,
     a chaotic orbit's fill an area, O(bins²) cells given enough points.
 
-    One row per orbit: ``orbit``, ``points``, ``cells``, ``fraction`` (cells / bins²)."""
+    Parameters
+    ----------
+    table : Table
+        A table returned by :func:`poincare_section`.
+    bins : int, default 40
+        Cells along each axis.
+    extent : ((float, float), (float, float)), optional
+        The plane's ranges; default: the bounding box of all the table's points.
+    points : int, optional
+        Use each orbit's first ``points`` points; default all.
+
+    Returns
+    -------
+    Table
+        One row per orbit: ``orbit``, ``points``, ``cells``, ``fraction`` (cells / bins²).
+
+    Examples
+    --------
+    >>> import varmech
+    >>> from varmech.analysis.sections import covered_cells, poincare_section
+    >>> section = poincare_section(varmech.scenes.henon_heiles(), 1 / 12, orbits=2, dt=0.1,
+    ...                            t_end=60.0, progress=False)
+    >>> cells = covered_cells(section, bins=10)
+    >>> cells.columns, len(cells)
+    (('orbit', 'points', 'cells', 'fraction'), 2)
+    """
     a_name, b_name = table.meta.get("plane", ("y", "p_y"))
     a, b, orbit = table.column(a_name), table.column(b_name), table.column("orbit")
     if extent is None:

@@ -166,7 +166,40 @@ def _rho(psi: np.ndarray) -> float:
 
 def step_matrix(method: str, h_omega: float) -> np.ndarray:
     """The 2×2 matrix Ψ of one step of ``method`` on q̈ = −q with h = ``h_omega``: its columns are
-    (q₁, p₁) after one step from (q, p) = (1, 0) and from (0, 1)."""
+    (q₁, p₁) after one step from (q, p) = (1, 0) and from (0, 1).
+
+    Parameters
+    ----------
+    method : str
+        A varmech method for unconstrained systems (:func:`varmech.methods`).
+    h_omega : float
+        The dimensionless step hω, positive.
+
+    Returns
+    -------
+    numpy.ndarray
+        Ψ, shape (2, 2).
+
+    Raises
+    ------
+    ValueError
+        An unknown ``method``, or one for constrained systems or the N-body problem only; or
+        ``h_omega`` not positive and finite.
+
+    Examples
+    --------
+    Verlet's step matrix [[1 − y²/2, y], [−y(1 − y²/4), 1 − y²/2]] has determinant 1
+    (symplectic):
+
+    >>> import numpy as np
+    >>> from varmech.analysis.stability import step_matrix
+    >>> psi = step_matrix("verlet", 1.0)
+    >>> psi
+    array([[ 0.5 ,  1.  ],
+           [-0.75,  0.5 ]])
+    >>> float(np.linalg.det(psi))
+    1.0
+    """
     _method(method)
     return _step_matrix(method, positive("h_omega", h_omega))
 
@@ -178,8 +211,46 @@ def growth_factor(method: str, h_omega: float | ArrayLike, *, progress: bool | N
     τ = tr Ψ, δ = det Ψ. A symplectic method has δ = 1, hence ρ = 1 to round-off at every hω
     inside its stability interval and ρ > 1 beyond it; see the module's documentation.
 
-    ``h_omega`` is a positive number (the result is a float) or an array of them (an array of the
-    same shape). ``progress`` shows a bar for long arrays (None: on a terminal only).
+    Parameters
+    ----------
+    method : str
+        A varmech method for unconstrained systems (:func:`varmech.methods`).
+    h_omega : float or array_like
+        The dimensionless step hω, positive.
+    progress : bool or None, default False
+        Show a progress bar for arrays of 50 values or more: None on a terminal only.
+
+    Returns
+    -------
+    float or numpy.ndarray
+        ρ(Ψ): a float for a number, an array of the shape of ``h_omega`` for an array.
+
+    Raises
+    ------
+    ValueError
+        An unknown ``method``, or one for constrained systems or the N-body problem only;
+        or a value of ``h_omega`` not positive and finite.
+
+    See Also
+    --------
+    step_matrix : The matrix Ψ itself.
+    stability_scan : The largest hω with ρ ≤ 1 + tol.
+    growth_table : ρ over a grid of hω for several methods, as a Table.
+
+    References
+    ----------
+    .. [1] E. Hairer, C. Lubich and G. Wanner, *Geometric Numerical Integration*, 2nd ed.,
+       Springer (2006), section I.5 and chapter XIII (linear stability of splitting methods).
+
+    Examples
+    --------
+    >>> from varmech.analysis.stability import growth_factor
+    >>> growth_factor("verlet", 1.5), growth_factor("verlet", 2.5)   # inside, beyond hω = 2
+    (1.0, 4.0)
+    >>> growth_factor("rk4", [0.5, 1.0]).round(5)                     # damped: ρ < 1
+    array([0.99989, 0.99391])
+    >>> round(growth_factor("explicit_euler", 1.0), 6)                 # √(1 + y²)
+    1.414214
     """
     _method(method)
     if np.ndim(h_omega) == 0:
@@ -245,6 +316,19 @@ def stability_scan(
     instability would be missed (none exists for varmech's methods: a NumPy scan of the
     compositions at 1e-5 finds none).
 
+    Parameters
+    ----------
+    method : str
+        A varmech method for unconstrained systems (:func:`varmech.methods`).
+    h_omega_max : float, default 10.0
+        The end of the scanned range of hω.
+    resolution : float, default 1e-3
+        The grid step of hω; not above ``h_omega_max``.
+    tol : float, default 1e-9
+        Stable means ρ ≤ 1 + ``tol``.
+    progress : bool, optional
+        Show a progress bar: None on a terminal only (for 50 grid points or more).
+
     Returns
     -------
     float
@@ -254,9 +338,33 @@ def stability_scan(
         (explicit Euler: ρ = √(1 + y²) > 1 at every y > 0; its tolerance-limited interval
         (0, √(2·tol)] lies far below any sensible resolution).
 
+    Raises
+    ------
+    ValueError
+        An unknown ``method``, or one for constrained systems or the N-body problem only;
+        ``h_omega_max``, ``resolution`` or ``tol`` not positive and finite, or ``resolution``
+        above ``h_omega_max``.
+
+    See Also
+    --------
+    unstable_intervals : Every unstable window in the scanned range.
+    stability_table : The scans of several methods against the reference limits.
+
+    Notes
+    -----
     The tolerance absorbs round-off: inside the stability interval of a symplectic method ρ is 1
     to about 1e-13, while just past the limit ρ − 1 ≈ √(τ²/4 − 1) rises like the square root of
-    the distance, so the result does not depend on ``tol`` to many digits.
+    the distance, so the result does not depend on ``tol`` to many digits. The cost is one
+    :func:`~varmech.integrate` call of two single steps per grid point up to the limit, plus
+    about 45 for the bisection.
+
+    Examples
+    --------
+    >>> from varmech.analysis.stability import stability_scan
+    >>> round(stability_scan("verlet", h_omega_max=3.0, resolution=0.01), 10)
+    2.0
+    >>> stability_scan("midpoint", h_omega_max=3.0, resolution=0.01)   # A-stable
+    inf
     """
     _method(method)
     h_omega_max, resolution, tol = _check_scan(h_omega_max, resolution, tol)
@@ -289,6 +397,33 @@ def unstable_intervals(
     of Verlet become stable again past their first instability, then unstable again, where the
     product of the stage rotations has its trace cross ±2 once more. Windows narrower than
     ``resolution`` can be missed.
+
+    Parameters
+    ----------
+    method, h_omega_max, resolution, tol, progress
+        As for :func:`stability_scan` (unstable means ρ > 1 + ``tol``).
+
+    Returns
+    -------
+    list of (float, float)
+        The unstable intervals (start, end), in increasing order.
+
+    Raises
+    ------
+    ValueError
+        As for :func:`stability_scan`.
+
+    See Also
+    --------
+    stability_scan : The first instability only.
+
+    Examples
+    --------
+    >>> from varmech.analysis.stability import unstable_intervals
+    >>> [(round(a, 4), b) for a, b in unstable_intervals("yoshida4", 3.0, resolution=0.01)]
+    [(1.5734, 3.0)]
+    >>> unstable_intervals("midpoint", 3.0, resolution=0.01)
+    []
     """
     _method(method)
     h_omega_max, resolution, tol = _check_scan(h_omega_max, resolution, tol)
@@ -343,8 +478,49 @@ def growth_table(
     0.005. With ``limits`` (default), ``table.meta["limits"]`` holds each method's stability limit
     from :func:`stability_scan` over the same range (inf: stable on all of it), which
     :func:`varmech.charts.stability.stability_chart` marks; ``meta["reference"]`` the
-    reference limits known for these methods. Ctrl-C stops the sweep: the KeyboardInterrupt
-    propagates with the rows measured so far as ``err.partial``.
+    reference limits known for these methods.
+
+    Parameters
+    ----------
+    methods : str or iterable of str, optional
+        varmech methods for unconstrained systems; default all of them.
+    h_omega : array_like, optional
+        The values of hω, positive; default 0.005, 0.010, … 4.
+    limits : bool, default True
+        Also scan each method's stability limit up to the largest hω (grid step 1e-3).
+    tol : float, default 1e-9
+        The scans' tolerance (:func:`stability_scan`).
+    progress : bool, optional
+        Show a progress bar: None on a terminal only (for 50 rows or more).
+
+    Returns
+    -------
+    Table
+        Columns ``method``, ``h_omega`` and ``growth`` (ρ), one row per method and hω;
+        ``meta`` holds ``"limits"`` (with ``limits``), ``"reference"``, ``"reference_source"``,
+        ``"definition"`` and ``"tol"``.
+
+    Raises
+    ------
+    ValueError
+        An unknown method, or one for constrained systems or the N-body problem only; a value of
+        ``h_omega`` not positive and finite; or (with ``limits``) ``tol`` not positive.
+    KeyboardInterrupt
+        On Ctrl-C, with the rows measured so far as ``err.partial``.
+
+    See Also
+    --------
+    growth_factor : ρ of one method.
+    varmech.charts.stability.stability_chart : Plots the table.
+
+    Examples
+    --------
+    >>> from varmech.analysis.stability import growth_table
+    >>> table = growth_table("verlet", [0.5, 1.0, 2.5])
+    >>> table.column("growth").tolist()
+    [1.0, 1.0, 4.0]
+    >>> round(table.meta["limits"]["verlet"], 10), table.meta["reference"]
+    (2.0, {'verlet': 2.0})
     """
     names = _methods_arg(methods)
     ys = np.arange(1, 801) * 0.005 if h_omega is None else np.atleast_1d(np.asarray(h_omega, dtype=float)).ravel()
@@ -389,8 +565,46 @@ def stability_table(
     reference/compositions.json; NaN where the file has no value), ``relative_difference``
     ((measured − reference)/reference; the absolute difference when the reference is 0, 0 when
     both are inf, NaN without a reference) and ``documented`` (``MethodInfo.h_omega_max``, the
-    methods table). ``methods`` defaults to every unconstrained method. Ctrl-C stops the sweep:
-    the KeyboardInterrupt propagates with the rows measured so far as ``err.partial``."""
+    methods table).
+
+    Parameters
+    ----------
+    methods : str or iterable of str, optional
+        varmech methods for unconstrained systems; default all of them.
+    h_omega_max, resolution, tol
+        As for :func:`stability_scan` (defaults 10, 1e-3 and 1e-9).
+    progress : bool, optional
+        Show a progress bar: None on a terminal only, True or False to force it.
+
+    Returns
+    -------
+    Table
+        One row per method, with the columns above; ``meta`` describes the scan (``"scan"``,
+        ``"inf"``, ``"reference_source"``).
+
+    Raises
+    ------
+    ValueError
+        An unknown method, or one for constrained systems or the N-body problem only;
+        ``h_omega_max``, ``resolution`` or ``tol`` not positive and finite, or ``resolution``
+        above ``h_omega_max``.
+    KeyboardInterrupt
+        On Ctrl-C, with the rows measured so far as ``err.partial``.
+
+    See Also
+    --------
+    stability_scan : The scan of one method.
+    relative_difference : The comparison with the reference.
+
+    Examples
+    --------
+    >>> from varmech.analysis.stability import stability_table
+    >>> table = stability_table(["verlet", "yoshida4"], h_omega_max=3.0, resolution=0.01)
+    >>> table.columns
+    ('method', 'h_omega_max', 'reference', 'relative_difference', 'documented')
+    >>> [bool(abs(d) < 1e-5) for d in table.column("relative_difference")]
+    [True, True]
+    """
     names = _methods_arg(methods)
     info = {m.name: m for m in _methods()}
     table = Table(
@@ -414,7 +628,26 @@ def stability_table(
 
 def relative_difference(measured: float, reference: float) -> float:
     """(measured − reference)/reference; measured − reference when the reference is 0; 0 when both
-    are inf; inf when only one is; NaN when the reference is NaN."""
+    are inf; inf when only one is; NaN when either is NaN.
+
+    Parameters
+    ----------
+    measured, reference : float
+        The two limits hω_max.
+
+    Returns
+    -------
+    float
+        The relative difference, as above.
+
+    Examples
+    --------
+    >>> from varmech.analysis.stability import relative_difference
+    >>> relative_difference(3.0, 2.0), relative_difference(0.1, 0.0)
+    (0.5, 0.1)
+    >>> relative_difference(float("inf"), float("inf"))
+    0.0
+    """
     if math.isnan(reference) or math.isnan(measured):
         return math.nan
     if math.isinf(reference) or math.isinf(measured):
@@ -462,9 +695,57 @@ def implicit_regions(
     Columns: ``method``, ``h``, ``q0``, ``outcome``, ``steps_done`` (steps completed before the
     failure), ``energy_error`` (the largest relative energy error over the steps completed) and
     ``newton_per_step`` (mean Newton iterations per step completed; NaN before the first).
-    The default q₀ values avoid π/2, where H₀ = 0. Each run is 20 steps by default, so the whole
-    map takes well under a second. Ctrl-C stops the sweep: the KeyboardInterrupt propagates with
-    the rows so far as ``err.partial``.
+    The default q₀ values avoid π/2, where H₀ = 0.
+
+    Parameters
+    ----------
+    method : str or sequence of str, optional
+        Implicit varmech methods; default :data:`IMPLICIT_METHODS`.
+    scene : str or Scene, default "pendulum"
+        A :mod:`varmech.scenes` name or a Scene.
+    steps : int, default 20
+        Steps per run.
+    h_values : sequence of float, default (0.1, 0.25, … 6.0)
+        The step sizes h, positive.
+    q0_values : sequence of float, default (0.25, 0.5, … 3.1)
+        The initial values of the first coordinate, finite.
+    energy_threshold : float, default 0.05
+        The relative energy error that counts as a failure.
+    progress : bool, optional
+        Show a progress bar: None on a terminal only (for 50 runs or more).
+
+    Returns
+    -------
+    Table
+        One row per method, h and q₀, with the columns above; ``meta`` holds ``"scene"``,
+        ``"time_unit"``, ``"steps"``, ``"energy_threshold"`` and ``"p0"``.
+
+    Raises
+    ------
+    TypeError
+        ``scene`` is neither a scene name nor a Scene.
+    ValueError
+        An unknown method, or one for constrained systems or the N-body problem only; an
+        unknown scene name; ``steps`` not a positive integer; ``h_values`` or
+        ``energy_threshold`` not positive and finite; ``h_values`` or ``q0_values`` empty or
+        not finite.
+    KeyboardInterrupt
+        On Ctrl-C, with the rows measured so far as ``err.partial``.
+
+    See Also
+    --------
+    varmech.charts.stability.implicit_regions_chart : Plots the map.
+
+    Notes
+    -----
+    Each run is 20 steps by default, so the whole default map takes well under a second.
+
+    Examples
+    --------
+    >>> from varmech.analysis.stability import implicit_regions
+    >>> table = implicit_regions("midpoint", h_values=(0.5, 3.0), q0_values=(1.0, 3.0))
+    >>> table.column("outcome").tolist()
+    ['ok', 'ok', 'energy', 'spurious branch']
     """
     from ..scenes import Scene, get
 

@@ -3,8 +3,38 @@
 from __future__ import annotations
 
 import textwrap
+from collections.abc import Callable
 from pathlib import Path
-from typing import Any
+from typing import Any, TypeVar
+
+_F = TypeVar("_F", bound=Callable[..., Any])
+
+# The docstring sections every chart shares (it writes ``path`` and returns it), put in for the
+# placeholders ``{path}``, ``{returns}`` and ``{raises}`` by :func:`documented`, as matplotlib's
+# and SciPy's docstring templates do. ``{raises}`` ends mid-sentence, for a chart's own cases.
+_SECTIONS = {
+    "{path}": """path : str or pathlib.Path
+        The file to write, ending in ``.png`` or ``.svg``; its folder is created.""",
+    "{returns}": """Returns
+    -------
+    pathlib.Path
+        ``path``, written (the figure is closed).""",
+    "{raises}": """Raises
+    ------
+    ImportError
+        matplotlib is missing (``pip install 'varmech[charts]'``).
+    ValueError
+        ``path`` does not end in ``.png`` or ``.svg``""",
+}
+
+
+def documented(chart: _F) -> _F:
+    """``chart`` with the shared sections put into its docstring for their placeholders."""
+    doc = chart.__doc__ or ""
+    for placeholder, section in _SECTIONS.items():
+        doc = doc.replace(placeholder, section)
+    chart.__doc__ = doc
+    return chart
 
 
 def pyplot() -> Any:

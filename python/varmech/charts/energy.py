@@ -9,15 +9,50 @@ import numpy as np
 
 from ..conservation import check_conservation
 from ..integrate import Trajectory
-from ._figure import pyplot, save, time_label
+from ._figure import documented, pyplot, save, time_label
 
 
+@documented
 def energy_error(trajectories: Mapping[str, Trajectory], path: str | Path, title: str = "", time_unit: str = "time units") -> Path:
     """Plot the energy error |H(t) − H₀| against t on log–log axes, relative to the energy's
     scale (the run's mean kinetic energy; see :class:`~varmech.InvariantStatistics`), one line
     per labelled trajectory with its verdict in the legend, and write the figure to ``path``
     (PNG or SVG by its suffix). A forced run's line is its balance E − W. The t axis is in
-    ``time_unit`` (a scene's :attr:`~varmech.scenes.Scene.time_unit`)."""
+    ``time_unit`` (a scene's :attr:`~varmech.scenes.Scene.time_unit`).
+
+    Parameters
+    ----------
+    trajectories : mapping of str to Trajectory
+        The runs to draw, by legend label.
+    {path}
+    title : str, optional
+        The figure's title (default none).
+    time_unit : str, default "time units"
+        The unit of the t axis.
+
+    {returns}
+
+    {raises}.
+
+    See Also
+    --------
+    varmech.check_conservation : The verdict in the legend.
+    varmech.charts.work_precision.energy_growth_chart : The same over a long run, from a table.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> import matplotlib.pyplot as plt
+    >>> import varmech
+    >>> from varmech.charts import energy_error
+    >>> scene = varmech.scenes.harmonic_oscillator()
+    >>> runs = {m: varmech.integrate(scene, dt=0.1, steps=200, method=m) for m in ("verlet", "rk4")}
+    >>> with tempfile.TemporaryDirectory() as folder:
+    ...     path = energy_error(runs, Path(folder) / "energy.png", title="harmonic oscillator")
+    ...     print(path.name, plt.imread(path).shape)   # 7 × 4.2 inches at 120 dpi, RGBA
+    energy.png (504, 840, 4)
+    """
     plt = pyplot()
     fig, ax = plt.subplots(figsize=(7, 4.2), layout="constrained")
     for label, traj in trajectories.items():

@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 
 from ..table import Table
-from ._figure import pyplot, save
+from ._figure import documented, pyplot, save
 
 #: What each line is, in the legend.
 LABELS = {
@@ -19,12 +19,44 @@ LABELS = {
 }
 
 
+@documented
 def nonholonomic_energy_chart(table: Table, path: str | Path, title: str = "") -> Path:
     """Plot the relative energy error |E − E₀|/E₀ of a
     :func:`~varmech.analysis.nonholonomic.nonholonomic_energy` table against t on log–log axes,
     one line per method with its verdict in the legend, and a dotted ∝ t line through the end of
     the naive method's, against which its linear drift reads; write the figure to ``path`` (PNG
-    or SVG). Errors of exactly 0 (the start) are left out."""
+    or SVG). Errors of exactly 0 (the start) are left out.
+
+    Parameters
+    ----------
+    table : Table
+        A table returned by :func:`~varmech.analysis.nonholonomic.nonholonomic_energy`.
+    {path}
+    title : str, optional
+        The figure's title (default the table's title).
+
+    {returns}
+
+    {raises}.
+
+    See Also
+    --------
+    varmech.analysis.nonholonomic.nonholonomic_energy : The measurements.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> import matplotlib.pyplot as plt
+    >>> import varmech
+    >>> from varmech.analysis.nonholonomic import nonholonomic_energy
+    >>> from varmech.charts import nonholonomic_energy_chart
+    >>> table = nonholonomic_energy(steps=200, samples=10)
+    >>> with tempfile.TemporaryDirectory() as folder:
+    ...     path = nonholonomic_energy_chart(table, Path(folder) / "rolling_disk.png")
+    ...     print(path.name, plt.imread(path).shape)
+    rolling_disk.png (552, 960, 4)
+    """
     plt = pyplot()
     verdicts = table.meta.get("verdicts", {})
     fig, ax = plt.subplots(figsize=(8, 4.6), layout="constrained")

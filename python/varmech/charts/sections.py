@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 
 from ..table import Table
-from ._figure import pyplot, save
+from ._figure import documented, pyplot, save
 
 
 def _henon_heiles_boundary(energy: float) -> tuple[np.ndarray, np.ndarray] | None:
@@ -22,12 +22,45 @@ def _henon_heiles_boundary(energy: float) -> tuple[np.ndarray, np.ndarray] | Non
     return np.concatenate([y, y[::-1]]), np.concatenate([py, -py[::-1]])
 
 
+@documented
 def poincare_chart(table: Table | Sequence[Table], path: str | Path, title: str = "") -> Path:
     """Scatter the section points of :func:`varmech.analysis.sections.poincare_section` in the table's
     plane (``meta["plane"]``, e.g. (y, p_y)), small dots, one colour per orbit, one panel per
     table (pass several tables, e.g. H = 1/12 and 1/8, for panels side by side). The boundary of
     the energy-allowed region is drawn for Hénon–Heiles' x = 0 section. Writes ``path`` (PNG or
-    SVG by its suffix)."""
+    SVG by its suffix).
+
+    Parameters
+    ----------
+    table : Table or sequence of Table
+        Tables returned by :func:`~varmech.analysis.sections.poincare_section`, one panel each.
+    {path}
+    title : str, optional
+        The figure's title (default none; each panel is titled with its energy).
+
+    {returns}
+
+    {raises}, or no table is given.
+
+    See Also
+    --------
+    varmech.analysis.sections.poincare_section : The measurements.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> import matplotlib.pyplot as plt
+    >>> import varmech
+    >>> from varmech.analysis.sections import poincare_section
+    >>> from varmech.charts import poincare_chart
+    >>> tables = [poincare_section(varmech.scenes.henon_heiles(), energy, orbits=2, dt=0.1,
+    ...                            t_end=60.0, progress=False) for energy in (1 / 12, 1 / 8)]
+    >>> with tempfile.TemporaryDirectory() as folder:
+    ...     path = poincare_chart(tables, Path(folder) / "henon_heiles.png")
+    ...     print(path.name, plt.imread(path).shape)   # two panels side by side
+    henon_heiles.png (600, 1248, 4)
+    """
     tables = [table] if isinstance(table, Table) else list(table)
     if not tables:
         raise ValueError("table: give at least one table")
@@ -60,11 +93,44 @@ def poincare_chart(table: Table | Sequence[Table], path: str | Path, title: str 
     return save(fig, path)
 
 
+@documented
 def phase_portrait_chart(table: Table, path: str | Path, title: str = "") -> Path:
     """Draw the orbits of :func:`varmech.analysis.phase_portrait.phase_portrait` in the (q, p) plane:
     librations in blues, rotations in oranges (darker for higher energy), undetermined orbits
     in grey. When rotations are present q is taken modulo 2π into (−π, π]; for the pendulum the
-    separatrix p = ±2cos(q/2) (energy 1) is drawn dashed. Writes ``path`` (PNG or SVG)."""
+    separatrix p = ±2cos(q/2) (energy 1) is drawn dashed. Writes ``path`` (PNG or SVG).
+
+    Parameters
+    ----------
+    table : Table
+        A table returned by :func:`~varmech.analysis.phase_portrait.phase_portrait`.
+    {path}
+    title : str, optional
+        The figure's title (default none).
+
+    {returns}
+
+    {raises}.
+
+    See Also
+    --------
+    varmech.analysis.phase_portrait.phase_portrait : The measurements.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> import matplotlib.pyplot as plt
+    >>> import varmech
+    >>> from varmech.analysis.phase_portrait import phase_portrait
+    >>> from varmech.charts import phase_portrait_chart
+    >>> table = phase_portrait(varmech.scenes.pendulum(), [-0.5, 2.0], dt=0.05, t_end=20.0,
+    ...                        progress=False)
+    >>> with tempfile.TemporaryDirectory() as folder:
+    ...     path = phase_portrait_chart(table, Path(folder) / "pendulum.png")
+    ...     print(path.name, plt.imread(path).shape)
+    pendulum.png (552, 900, 4)
+    """
     plt = pyplot()
     fig, ax = plt.subplots(figsize=(7.5, 4.6), layout="constrained")
     orbit, q, p, e = table.column("orbit"), table.column("q"), table.column("p"), table.column("energy")

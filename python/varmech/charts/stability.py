@@ -11,7 +11,7 @@ import numpy as np
 
 from ..analysis.stability import OUTCOMES, REFERENCE_LIMITS
 from ..table import Table
-from ._figure import pyplot, save, time_label
+from ._figure import documented, pyplot, save, time_label
 
 # Outcome colours of the implicit-regions map, in the order of OUTCOMES.
 _OUTCOME_COLOURS = {
@@ -29,6 +29,7 @@ _MARKERS = "osD^vPX*<>"
 _LINESTYLES = ("-", "--", "-.", (0, (3, 1, 1, 1, 1, 1)), ":")
 
 
+@documented
 def stability_chart(
     table: Table, path: str | Path, title: str = "", limits: Mapping[str, float] | None = None
 ) -> Path:
@@ -42,7 +43,39 @@ def stability_chart(
     vertical line in its method's colour, labelled with the methods and hω on a top axis: ``limits``
     if given, else the table's measured ``meta["limits"]``, else the reference limits
     (:data:`~varmech.analysis.stability.REFERENCE_LIMITS`); an infinite limit is said in the
-    legend ("stable for every hω"). Writes ``path`` (PNG or SVG)."""
+    legend ("stable for every hω"). Writes ``path`` (PNG or SVG).
+
+    Parameters
+    ----------
+    table : Table
+        A table returned by :func:`~varmech.analysis.stability.growth_table`.
+    {path}
+    title : str, optional
+        The figure's title (default: what is plotted).
+    limits : mapping of str to float, optional
+        The stability limit hω_max of each method to mark.
+
+    {returns}
+
+    {raises}.
+
+    See Also
+    --------
+    varmech.analysis.stability.growth_table : The measurements.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> import matplotlib.pyplot as plt
+    >>> from varmech.analysis.stability import growth_table
+    >>> from varmech.charts import stability_chart
+    >>> table = growth_table(["verlet", "rk4"], [0.5, 1.0, 2.5, 3.0], limits=False)
+    >>> with tempfile.TemporaryDirectory() as folder:   # the reference limits are marked
+    ...     path = stability_chart(table, Path(folder) / "stability.png")
+    ...     print(path.name, plt.imread(path).shape)
+    stability.png (624, 1140, 4)
+    """
     plt = pyplot()
     if limits is None:
         limits = table.meta.get("limits") or REFERENCE_LIMITS
@@ -95,10 +128,41 @@ def stability_chart(
     return save(fig, path)
 
 
+@documented
 def implicit_regions_chart(table: Table, path: str | Path, title: str = "") -> Path:
     """A categorical map of the outcome over step size h (columns) and initial angle q₀ (rows),
     one panel per method, from :func:`~varmech.analysis.stability.implicit_regions`. Writes ``path``
-    (PNG or SVG)."""
+    (PNG or SVG).
+
+    Parameters
+    ----------
+    table : Table
+        A table returned by :func:`~varmech.analysis.stability.implicit_regions`.
+    {path}
+    title : str, optional
+        The figure's title (default: the scene and the number of steps).
+
+    {returns}
+
+    {raises}.
+
+    See Also
+    --------
+    varmech.analysis.stability.implicit_regions : The measurements.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> import matplotlib.pyplot as plt
+    >>> from varmech.analysis.stability import implicit_regions
+    >>> from varmech.charts import implicit_regions_chart
+    >>> table = implicit_regions("midpoint", h_values=(0.5, 3.0), q0_values=(1.0, 3.0))
+    >>> with tempfile.TemporaryDirectory() as folder:
+    ...     path = implicit_regions_chart(table, Path(folder) / "implicit.png")
+    ...     print(path.name, plt.imread(path).shape)
+    implicit.png (432, 624, 4)
+    """
     plt = pyplot()
     from matplotlib.colors import BoundaryNorm, ListedColormap
     from matplotlib.patches import Patch

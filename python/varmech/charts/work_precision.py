@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 
 from ..table import Table
-from ._figure import pyplot, save, skipped_note, time_label
+from ._figure import documented, pyplot, save, skipped_note, time_label
 
 _AXIS_LABELS = {
     "seconds": "wall time (s)",
@@ -22,13 +22,50 @@ _AXIS_LABELS = {
 _STYLE = {"varmech": dict(ls="-", marker="o"), "scipy": dict(ls="--", marker="s"), "rebound": dict(ls=":", marker="^")}
 
 
+@documented
 def work_precision_chart(table: Table, path: str | Path, *, x: str = "seconds", y: str = "final_error", title: str = "") -> Path:
     """Plot ``y`` (``"final_error"`` or ``"max_energy_error"``) against ``x`` (``"seconds"`` or
     ``"evaluations"``) on log–log axes, one line per (tool, method) of a
     :func:`~varmech.work_precision` table, and write the figure to ``path`` (PNG or SVG).
 
     Lower left is better: less work for a smaller error. Each line follows its sweep (steps, or
-    tolerances); points with a non-finite or zero value are left out.
+    tolerances); points with a non-finite or zero value are left out. Skipped baselines
+    (``meta["notes"]``) are noted beside the legend.
+
+    Parameters
+    ----------
+    table : Table
+        A table returned by :func:`~varmech.work_precision`.
+    {path}
+    x : str, default "seconds"
+        The column of the horizontal axis (work).
+    y : str, default "final_error"
+        The column of the vertical axis (error).
+    title : str, optional
+        The figure's title (default: the scene and the horizon).
+
+    {returns}
+
+    {raises}, or ``x`` or ``y`` is not a column of ``table``.
+
+    See Also
+    --------
+    varmech.work_precision : The measurements.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> import matplotlib.pyplot as plt
+    >>> import varmech
+    >>> from varmech.charts import work_precision_chart
+    >>> table = varmech.work_precision(varmech.scenes.harmonic_oscillator(), ["verlet"],
+    ...                                steps=[64, 128], baselines=(), rebound=(), repeat=1)
+    >>> with tempfile.TemporaryDirectory() as folder:
+    ...     path = work_precision_chart(table, Path(folder) / "work_precision.png",
+    ...                                 x="evaluations")
+    ...     print(path.name, plt.imread(path).shape)
+    work_precision.png (576, 1020, 4)
     """
     for name in (x, y):
         if name not in table.columns:
@@ -57,6 +94,7 @@ def work_precision_chart(table: Table, path: str | Path, *, x: str = "seconds", 
     return save(fig, path)
 
 
+@documented
 def energy_growth_chart(table: Table, path: str | Path, title: str = "", *, samples: bool = True) -> Path:
     """Plot the energy error of an :func:`~varmech.energy_growth` table against t on log–log
     axes, one line per method with its verdict in the legend, and write the figure to ``path``
@@ -68,7 +106,44 @@ def energy_growth_chart(table: Table, path: str | Path, title: str = "", *, samp
     log-spaced bin) are drawn faintly behind, showing the oscillation. A dashed √t line (Brouwer's
     law, the growth of random round-off) and a dotted ∝ t line go through the first drifting curve
     (the first with the verdict "secular drift"), two decades before its end, so that its slope
-    reads against them.
+    reads against them. Skipped baselines (``meta["notes"]``) are noted beside the legend.
+
+    Parameters
+    ----------
+    table : Table
+        A table returned by :func:`~varmech.energy_growth`.
+    {path}
+    title : str, optional
+        The figure's title (default: the scene and the step).
+    samples : bool, default True
+        Also draw the sampled errors, faintly.
+
+    {returns}
+
+    {raises}.
+
+    See Also
+    --------
+    varmech.energy_growth : The measurements.
+
+    References
+    ----------
+    .. [1] D. Brouwer, "On the accumulation of errors in numerical integration",
+       *Astron. J.* 46, 149–153 (1937).
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> import matplotlib.pyplot as plt
+    >>> import varmech
+    >>> from varmech.charts import energy_growth_chart
+    >>> table = varmech.energy_growth(varmech.scenes.harmonic_oscillator(), ["verlet", "rk4"],
+    ...                               t_end=100.0, samples=10, baselines=())
+    >>> with tempfile.TemporaryDirectory() as folder:
+    ...     path = energy_growth_chart(table, Path(folder) / "energy_growth.png")
+    ...     print(path.name, plt.imread(path).shape)
+    energy_growth.png (576, 1140, 4)
     """
     plt = pyplot()
     verdicts = table.meta.get("verdicts", {})
