@@ -111,6 +111,8 @@ impl Lagrangian for DoublePendulum {
 
     /// Both first derivatives from one sin_cos(θ₁ − θ₂), which they share.
     fn gradients(&self, q: &[f64], v: &[f64], _t: f64, dq: &mut [f64], dv: &mut [f64]) -> Result<(), ModelError> {
+        // Every length checked first, so that no branch parts sin and cos (one libm sincos).
+        let (q, v, dq, dv) = (&q[..2], &v[..2], &mut dq[..2], &mut dv[..2]);
         let (s, c) = (q[0] - q[1]).sin_cos();
         self.dl_dq_at(q, v, s, dq);
         self.dl_dv_at(v, c, dv);
