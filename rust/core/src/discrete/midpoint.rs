@@ -13,6 +13,7 @@ pub struct Midpoint;
 
 impl Midpoint {
     /// ∂L/∂q into ws.a and ∂L/∂q̇ into ws.b, at the midpoint.
+    #[inline(always)]
     fn derivatives<S: Lagrangian + ?Sized>(sys: &S, at: &Segment<'_>, ws: &mut Workspace) -> Result<(), ModelError> {
         ws.set(at, 0.5);
         sys.gradients(&ws.x, &ws.v, at.t + 0.5 * at.h, &mut ws.a, &mut ws.b)
@@ -30,6 +31,7 @@ impl DiscreteLagrangian for Midpoint {
         Ok(at.h * sys.lagrangian(&ws.x, &ws.v, at.t + 0.5 * at.h)?)
     }
 
+    #[inline(always)]
     fn d1<S: Lagrangian + ?Sized>(
         &self,
         sys: &S,

@@ -49,6 +49,7 @@ impl Workspace {
     }
 
     /// v = δq/h and x = q₀ + s·δq.
+    #[inline(always)]
     fn set(&mut self, at: &Segment<'_>, s: f64) {
         for (((v, x), a), d) in self.v.iter_mut().zip(self.x.iter_mut()).zip(at.q0).zip(at.dq) {
             *v = d / at.h;
@@ -159,6 +160,7 @@ pub fn increment(q0: &[f64], q1: &[f64]) -> Vec<f64> {
 }
 
 /// out = α·a + β·b.
+#[inline(always)]
 fn combine(out: &mut [f64], alpha: f64, a: &[f64], beta: f64, b: &[f64]) {
     for ((o, x), y) in out.iter_mut().zip(a).zip(b) {
         *o = alpha * x + beta * y;

@@ -32,11 +32,30 @@ impl DoublePendulum {
 
     /// The mass matrix M(θ): L = ½θ̇ᵀM(θ)θ̇ − V(θ).
     fn mass(&self, q: &[f64]) -> [[f64; 2]; 2] {
-        let c = self.m2 * self.l1 * self.l2 * (q[0] - q[1]).cos();
+        self.mass_at((q[0] - q[1]).cos())
+    }
+
+    /// M(θ) from cos(θ₁ − θ₂).
+    fn mass_at(&self, cos_delta: f64) -> [[f64; 2]; 2] {
+        let c = self.m2 * self.l1 * self.l2 * cos_delta;
         [
             [(self.m1 + self.m2) * self.l1 * self.l1, c],
             [c, self.m2 * self.l2 * self.l2],
         ]
+    }
+
+    /// ∂L/∂θ = ∓m₂l₁l₂θ̇₁θ̇₂ sin(θ₁ − θ₂) − ∂V/∂θ, from sin(θ₁ − θ₂).
+    fn dl_dq_at(&self, q: &[f64], v: &[f64], sin_delta: f64, out: &mut [f64]) {
+        let k = self.m2 * self.l1 * self.l2 * v[0] * v[1] * sin_delta;
+        out[0] = -k - (self.m1 + self.m2) * self.g * self.l1 * q[0].sin();
+        out[1] = k - self.m2 * self.g * self.l2 * q[1].sin();
+    }
+
+    /// ∂L/∂θ̇ = M(θ)θ̇, from cos(θ₁ − θ₂).
+    fn dl_dv_at(&self, v: &[f64], cos_delta: f64, out: &mut [f64]) {
+        let [[a, b], [_, d]] = self.mass_at(cos_delta);
+        out[0] = a * v[0] + b * v[1];
+        out[1] = b * v[0] + d * v[1];
     }
 
     /// GeometricProblems.jl's defaults (l = (2, 3), m = (1, 2), g = 9.80665), from
@@ -81,16 +100,22 @@ impl Lagrangian for DoublePendulum {
     }
 
     fn dl_dq(&self, q: &[f64], v: &[f64], _t: f64, out: &mut [f64]) -> Result<(), ModelError> {
-        let k = self.m2 * self.l1 * self.l2 * v[0] * v[1] * (q[0] - q[1]).sin();
-        out[0] = -k - (self.m1 + self.m2) * self.g * self.l1 * q[0].sin();
-        out[1] = k - self.m2 * self.g * self.l2 * q[1].sin();
+        self.dl_dq_at(q, v, (q[0] - q[1]).sin(), out);
         Ok(())
     }
 
     fn dl_dv(&self, q: &[f64], v: &[f64], _t: f64, out: &mut [f64]) -> Result<(), ModelError> {
-        let [[a, b], [_, d]] = self.mass(q);
-        out[0] = a * v[0] + b * v[1];
-        out[1] = b * v[0] + d * v[1];
+        self.dl_dv_at(v, (q[0] - q[1]).cos(), out);
+        Ok(())
+    }
+
+    /// Both first derivatives from one sin_cos(θ₁ − θ₂), which they share.
+    fn gradients(&self, q: &[f64], v: &[f64], _t: f64, dq: &mut [f64], dv: &mut [f64]) -> Result<(), ModelError> {
+        // Every length checked first, so that no branch parts sin and cos (one libm sincos).
+        let (q, v, dq, dv) = (&q[..2], &v[..2], &mut dq[..2], &mut dv[..2]);
+        let (s, c) = (q[0] - q[1]).sin_cos();
+        self.dl_dq_at(q, v, s, dq);
+        self.dl_dv_at(v, c, dv);
         Ok(())
     }
 

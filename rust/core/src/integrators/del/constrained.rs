@@ -14,6 +14,8 @@ use crate::ModelError;
 /// F(x) for x = (λ, s): the scheme's equations in s with (h/2)G(q₀)ᵀλ taken from the last
 /// block (the one holding p₀), then the discrete constraint on δq, the last n of s: g(q₀ + δq)
 /// for holonomic constraints, A(q̃)δq for velocity ones ([`nonholonomic::discrete_constraint`]).
+// Inlined into Newton's iteration, whose chain of dependent evaluations a call would lengthen.
+#[inline(always)]
 pub(super) fn constrained_equations<Sc: StepEquations, S: Lagrangian + ?Sized>(
     scheme: &mut Sc,
     sys: &S,

@@ -61,6 +61,8 @@ impl<R: DiscreteLagrangian> StepEquations for TwoPoint<R> {
         n
     }
 
+    // Inlined into Newton's iteration, whose chain of dependent evaluations a call would lengthen.
+    #[inline(always)]
     fn equations<S: Lagrangian + ?Sized>(
         &mut self,
         sys: &S,
