@@ -68,7 +68,7 @@ def test_the_chart_says_what_it_plots(table, tmp_path, monkeypatch):
     chart_module.nonholonomic_energy_chart(table, tmp_path / "again.png")
     (ax,) = figures[0].axes
     assert ax.get_title() == "rolling disk: relative energy error over 5000 steps of dt = 0.1"
-    assert (ax.get_xlabel(), ax.get_ylabel()) == ("t", "relative energy error |E − E₀| / E₀")
+    assert (ax.get_xlabel(), ax.get_ylabel()) == ("t (time units)", "relative energy error |E − E₀| / E₀")
     assert ax.get_xscale() == ax.get_yscale() == "log"
     labels = [text.get_text() for text in ax.get_legend().get_texts()]
     assert labels == [

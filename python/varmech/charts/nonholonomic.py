@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 
 from ..table import Table
-from ._figure import documented, pyplot, save
+from ._figure import documented, pyplot, save, time_label
 
 #: What each line is, in the legend.
 LABELS = {
@@ -70,7 +70,7 @@ def nonholonomic_energy_chart(table: Table, path: str | Path, title: str = "") -
             t1, e1 = t[keep][-1], e[keep][-1]
             guide = np.array([t1 / 100, t1])
             ax.loglog(guide, e1 * guide / t1, "k:", lw=0.8, label="∝ t")
-    ax.set_xlabel("t")
+    ax.set_xlabel(time_label(table.meta))
     ax.set_ylabel("relative energy error |E − E₀| / E₀")
     ax.set_title(title or table.title)
     ax.grid(True, which="major", alpha=0.3)
