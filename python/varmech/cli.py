@@ -14,6 +14,8 @@ from .methods import format_table
 from .reduction import routh
 from .table import Table
 
+__all__: list[str] = []  # internal: importable, not part of the public API
+
 #: Showcase runs of the tour, scene → (methods, horizon) with None for the scene's t_end: each
 #: over a horizon long enough to tell bounded from drifting. A scene without one runs with its
 #: kind's default and accurate methods over its t_end (see :func:`tour_runs`).

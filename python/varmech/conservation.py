@@ -18,6 +18,16 @@ from . import _core
 from .integrate import Trajectory
 from .model import Cyclic, Generator, Model, Rotation, Translation
 
+__all__ = [
+    "FAILURE",
+    "ROUND_OFF",
+    "VERDICTS",
+    "ConservationReport",
+    "InvariantStatistics",
+    "check_conservation",
+    "momentum",
+]
+
 #: The verdicts, best first: "conserved to round-off", "bounded", "secular drift", "failed".
 VERDICTS: tuple[str, ...] = tuple(_core.VERDICTS)
 #: An error this large against the scale is a failure; also ``integrate``'s default

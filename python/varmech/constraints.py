@@ -11,6 +11,13 @@ from . import _core
 from ._util import vector
 from .model import Model
 
+__all__ = [
+    "INTEGRABLE_CURVATURE",
+    "IntegrableConstraintsWarning",
+    "integrable_near",
+    "project",
+]
+
 
 def project(model: Model, q0: ArrayLike, p0: ArrayLike | None = None, *, v0: ArrayLike | None = None) -> tuple[np.ndarray, np.ndarray]:
     """The nearest consistent state (q, p) of a constrained model: q on g(q) = 0 by Newton's

@@ -1,6 +1,6 @@
 """Dense output: the state between saved states, by cubic Hermite interpolation
-(:func:`hermite`, ``traj.sol``); and the states at requested times, by the method's own partial
-step (:func:`at_times`, ``integrate(t_eval=)``).
+(``hermite``, ``traj.sol``); and the states at requested times, by the method's own partial
+step (``at_times``, ``integrate(t_eval=)``).
 
 On each interval [tₖ, tₖ₊₁] of a trajectory's saved states, q(t) is the cubic that matches qₖ,
 q̇ₖ and qₖ₊₁, q̇ₖ₊₁, with q̇ from the inverse Legendre transform of (qₖ, pₖ); p(t) the cubic
@@ -24,6 +24,8 @@ from . import _core
 if TYPE_CHECKING:
     from .integrate import Trajectory
     from .model import Model
+
+__all__: list[str] = []  # internal: importable, not part of the public API
 
 
 def hermite(traj: Trajectory, t: ArrayLike) -> tuple[np.ndarray, np.ndarray]:

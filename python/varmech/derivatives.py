@@ -10,6 +10,11 @@ from numpy.typing import ArrayLike
 from ._util import vector
 from .model import Lagrangian, MechanicalSystem, Model
 
+__all__ = [
+    "DerivativeCheck",
+    "check_derivatives",
+]
+
 
 @dataclass(frozen=True)
 class DerivativeCheck:

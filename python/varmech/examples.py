@@ -14,17 +14,104 @@ import numpy as np
 from .model import Cyclic, Lagrangian, MechanicalSystem, Rotation, Translation
 from .scenes import CATALOGUE, Scene
 
+__all__ = [
+    "ball_on_turntable",
+    "bouncing_ball",
+    "cartesian_pendulum",
+    "chaplygin_sleigh",
+    "charged_particle",
+    "charged_particle_nonuniform",
+    "closure_of",
+    "damped_driven_pendulum",
+    "double_pendulum",
+    "elliptic_billiard",
+    "fermi_pasta_ulam",
+    "harmonic_oscillator",
+    "heavy_top",
+    "henon_heiles",
+    "kepler",
+    "kepler_polar",
+    "nbody",
+    "pendulum",
+    "rigid_body",
+    "rolling_disk",
+    "rolling_sphere",
+    "spherical_pendulum",
+]
+
 
 def harmonic_oscillator(omega: float = 1.0) -> MechanicalSystem:
+    """The harmonic oscillator H = p²/2 + ω²q²/2 as a separable closure model.
+
+    Parameters
+    ----------
+    omega : float, default 1.0
+        The angular frequency ω.
+
+    Returns
+    -------
+    MechanicalSystem
+        n = 1, with V and ∇V as NumPy closures.
+
+    See Also
+    --------
+    varmech.scenes.harmonic_oscillator : the native scene it twins.
+
+    Examples
+    --------
+    >>> from varmech import examples, integrate
+    >>> traj = integrate(examples.harmonic_oscillator(2.0), [1.0], [0.0], dt=0.01, steps=100)
+    >>> round(float(traj.energy()[-1]), 3)
+    2.0
+    """
     w2 = omega * omega
     return MechanicalSystem(1, lambda q: 0.5 * w2 * q[0] * q[0], lambda q: w2 * q, name="harmonic_oscillator (closure)")
 
 
 def pendulum() -> MechanicalSystem:
+    """The pendulum H = p²/2 − cos q as a separable closure model.
+
+    Returns
+    -------
+    MechanicalSystem
+        n = 1, with V = −cos q and ∇V = sin q.
+
+    See Also
+    --------
+    varmech.scenes.pendulum : the native scene it twins.
+
+    Examples
+    --------
+    >>> from varmech import examples, integrate, scenes
+    >>> s = scenes.pendulum()
+    >>> twin = integrate(examples.pendulum(), s.q0, s.p0, dt=s.dt, steps=10)
+    >>> bool((twin.q == integrate(s, dt=s.dt, steps=10).q).all())
+    True
+    """
     return MechanicalSystem(1, lambda q: -math.cos(q[0]), np.sin, name="pendulum (closure)")
 
 
 def kepler() -> MechanicalSystem:
+    """Kepler's problem H = |p|²/2 − 1/|q| in the plane as a closure model, rotation invariant.
+
+    Returns
+    -------
+    MechanicalSystem
+        n = 2, with the symmetry ``Rotation(spatial_dim=2)`` (angular momentum).
+
+    See Also
+    --------
+    varmech.scenes.kepler : the native scene it twins.
+    varmech.examples.kepler_polar : the same problem in polar coordinates.
+
+    Examples
+    --------
+    >>> from varmech import examples, integrate, scenes
+    >>> s = scenes.kepler()
+    >>> traj = integrate(examples.kepler(), s.q0, s.p0, dt=s.dt, steps=100)
+    >>> round(float(traj.q[-1, 0] * traj.p[-1, 1] - traj.q[-1, 1] * traj.p[-1, 0]), 12), s.invariants["L"]
+    (0.8, 0.8)
+    """
     def potential(q: np.ndarray) -> float:
         return -1.0 / math.hypot(q[0], q[1])
 
@@ -36,6 +123,25 @@ def kepler() -> MechanicalSystem:
 
 
 def henon_heiles() -> MechanicalSystem:
+    """The Hénon–Heiles potential V = (x² + y²)/2 + x²y − y³/3 as a closure model.
+
+    Returns
+    -------
+    MechanicalSystem
+        n = 2, separable.
+
+    See Also
+    --------
+    varmech.scenes.henon_heiles : the native scene it twins.
+
+    Examples
+    --------
+    >>> from varmech import examples, integrate, scenes
+    >>> s = scenes.henon_heiles()
+    >>> traj = integrate(examples.henon_heiles(), s.q0, s.p0, dt=0.01, steps=1000)
+    >>> round(float(traj.energy()[-1]), 4), s.invariants["H"]
+    (0.13, 0.13)
+    """
     def potential(q: np.ndarray) -> float:
         x, y = q
         return 0.5 * (x * x + y * y) + x * x * y - y * y * y / 3.0
@@ -48,6 +154,39 @@ def henon_heiles() -> MechanicalSystem:
 
 
 def fermi_pasta_ulam(m: int = 3, omega: float = 50.0) -> MechanicalSystem:
+    """The Fermi–Pasta–Ulam chain: m stiff linear springs of frequency ω alternating with soft
+    quartic ones, fixed ends, as a closure model with the springs vectorised.
+
+    Parameters
+    ----------
+    m : int, default 3
+        The number of stiff springs; the chain has 2m masses.
+    omega : float, default 50.0
+        The stiff springs' frequency ω.
+
+    Returns
+    -------
+    MechanicalSystem
+        n = 2m.
+
+    Raises
+    ------
+    ValueError
+        Naming ``m`` when below 1.
+
+    See Also
+    --------
+    varmech.scenes.fermi_pasta_ulam : the native scene it twins.
+
+    Examples
+    --------
+    >>> from varmech import examples
+    >>> examples.fermi_pasta_ulam(m=2).dim
+    4
+    """
+    if m < 1:
+        raise ValueError(f"m: must be at least 1, got {m}")
+
     def springs(q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         stiff = q[1::2] - q[0::2]
         ends = np.concatenate(([0.0], q, [0.0]))
@@ -73,7 +212,38 @@ def fermi_pasta_ulam(m: int = 3, omega: float = 50.0) -> MechanicalSystem:
 
 
 def nbody(G: float, masses: np.ndarray) -> MechanicalSystem:
-    """Gravitational N-body in 3 dimensions, vectorised over pairs."""
+    """The gravitational N-body problem in 3 dimensions, V = −Σ G mᵢmⱼ/|qᵢ − qⱼ|, vectorised
+    over the pairs.
+
+    Parameters
+    ----------
+    G : float
+        The gravitational constant.
+    masses : array_like, shape (N,)
+        The bodies' masses.
+
+    Returns
+    -------
+    MechanicalSystem
+        n = 3N, mass diag(m₁, m₁, m₁, m₂, …), with the three translations and the three
+        rotations as symmetries.
+
+    Raises
+    ------
+    ValueError
+        Naming ``mass`` for a mass that is not finite and positive.
+
+    See Also
+    --------
+    varmech.scenes.nbody : the native N-body scene it twins.
+
+    Examples
+    --------
+    >>> from varmech import examples
+    >>> model = examples.nbody(1.0, [1.0, 1e-3])
+    >>> model.dim, model.separable
+    (6, True)
+    """
     m = np.asarray(masses, dtype=float)
     n = len(m)
     i, j = np.triu_indices(n, 1)
@@ -99,8 +269,36 @@ def nbody(G: float, masses: np.ndarray) -> MechanicalSystem:
 
 
 def double_pendulum(m1: float = 1.0, m2: float = 2.0, l1: float = 2.0, l2: float = 3.0, g: float = 9.80665) -> Lagrangian:
-    """The planar double pendulum as a general Lagrangian with exact first and second
-    derivatives."""
+    """The planar double pendulum in its two angles as a general Lagrangian with exact first and
+    second derivatives.
+
+    Parameters
+    ----------
+    m1, m2 : float, default 1.0, 2.0
+        The bobs' masses.
+    l1, l2 : float, default 2.0, 3.0
+        The rods' lengths.
+    g : float, default 9.80665
+        The gravitational acceleration.
+
+    Returns
+    -------
+    Lagrangian
+        n = 2, with ∂L/∂q, ∂L/∂v and the three Hessians as closures.
+
+    See Also
+    --------
+    varmech.scenes.double_pendulum : the native scene it twins.
+    varmech.symbolic.examples.double_pendulum : its symbolic twin.
+
+    Examples
+    --------
+    >>> from varmech import examples, integrate, scenes
+    >>> s = scenes.double_pendulum()
+    >>> traj = integrate(examples.double_pendulum(), s.q0, s.p0, dt=0.001, steps=100)
+    >>> round(float(traj.energy()[-1]), 3), round(s.invariants["E"], 3)
+    (-40.218, -40.218)
+    """
 
     def mass(q: np.ndarray) -> np.ndarray:
         c = m2 * l1 * l2 * math.cos(q[0] - q[1])
@@ -129,7 +327,34 @@ def double_pendulum(m1: float = 1.0, m2: float = 2.0, l1: float = 2.0, l2: float
 
 
 def spherical_pendulum(m: float = 1.0, l: float = 1.0, g: float = 1.0) -> Lagrangian:
-    """The spherical pendulum in (θ, φ) as a general Lagrangian; φ is cyclic."""
+    """The spherical pendulum in (θ, φ) as a general Lagrangian; φ is cyclic.
+
+    Parameters
+    ----------
+    m : float, default 1.0
+        The bob's mass.
+    l : float, default 1.0
+        The rod's length.
+    g : float, default 1.0
+        The gravitational acceleration.
+
+    Returns
+    -------
+    Lagrangian
+        n = 2, with the symmetry ``Cyclic(1)`` (the momentum p_φ).
+
+    See Also
+    --------
+    varmech.scenes.spherical_pendulum : the native scene it twins.
+
+    Examples
+    --------
+    >>> from varmech import examples, integrate, scenes
+    >>> s = scenes.spherical_pendulum()
+    >>> traj = integrate(examples.spherical_pendulum(), s.q0, s.p0, dt=s.dt, steps=100)
+    >>> bool(abs(traj.p[-1, 1] - s.invariants["p_phi"]) < 1e-12)
+    True
+    """
     ml2 = m * l * l
 
     def lagrangian(q: np.ndarray, v: np.ndarray, t: float) -> float:
@@ -157,7 +382,34 @@ def spherical_pendulum(m: float = 1.0, l: float = 1.0, g: float = 1.0) -> Lagran
 
 def heavy_top(i1: float = 1.0, i3: float = 0.5, mgl: float = 1.0) -> Lagrangian:
     """The heavy symmetric top in Euler angles (θ, φ, ψ), θ from the upward vertical, as a
-    general Lagrangian with exact first and second derivatives; φ and ψ are cyclic."""
+    general Lagrangian with exact first and second derivatives; φ and ψ are cyclic.
+
+    Parameters
+    ----------
+    i1 : float, default 1.0
+        The moment of inertia about a transverse axis through the pivot.
+    i3 : float, default 0.5
+        The moment of inertia about the symmetry axis.
+    mgl : float, default 1.0
+        Mass × gravity × the pivot's distance to the centre of mass.
+
+    Returns
+    -------
+    Lagrangian
+        n = 3, with the symmetries ``Cyclic(1)`` and ``Cyclic(2)``.
+
+    See Also
+    --------
+    varmech.scenes.heavy_top : the native scene it twins.
+
+    Examples
+    --------
+    >>> from varmech import examples, integrate, scenes
+    >>> s = scenes.heavy_top()
+    >>> twin = integrate(examples.heavy_top(), s.q0, s.p0, dt=s.dt, steps=10)
+    >>> bool(abs(twin.q - integrate(s, dt=s.dt, steps=10).q).max() < 1e-12)
+    True
+    """
 
     def lagrangian(q: np.ndarray, v: np.ndarray, t: float) -> float:
         s, c = math.sin(q[0]), math.cos(q[0])
@@ -193,7 +445,32 @@ def heavy_top(i1: float = 1.0, i3: float = 0.5, mgl: float = 1.0) -> Lagrangian:
 
 def kepler_polar(m: float = 1.0, k: float = 1.0) -> Lagrangian:
     """Kepler's problem in polar coordinates (r, θ), L = ½m(ṙ² + r²θ̇²) + k/r, as a general
-    Lagrangian with exact first and second derivatives; θ is cyclic."""
+    Lagrangian with exact first and second derivatives; θ is cyclic.
+
+    Parameters
+    ----------
+    m : float, default 1.0
+        The mass.
+    k : float, default 1.0
+        The strength of the attraction k/r.
+
+    Returns
+    -------
+    Lagrangian
+        n = 2, with the symmetry ``Cyclic(1)`` (the angular momentum p_θ).
+
+    See Also
+    --------
+    varmech.scenes.kepler_polar : the native scene it twins.
+
+    Examples
+    --------
+    >>> from varmech import examples, integrate, scenes
+    >>> s = scenes.kepler_polar()
+    >>> traj = integrate(examples.kepler_polar(), s.q0, s.p0, dt=s.dt, steps=100)
+    >>> round(float(traj.p[-1, 1]), 12), s.invariants["p_theta"]
+    (0.8, 0.8)
+    """
 
     def lagrangian(q: np.ndarray, v: np.ndarray, t: float) -> float:
         return 0.5 * m * (v[0] ** 2 + q[0] ** 2 * v[1] ** 2) + k / q[0]
@@ -215,7 +492,33 @@ def kepler_polar(m: float = 1.0, k: float = 1.0) -> Lagrangian:
 
 def charged_particle(B: float = 1.0, kappa: float = 0.0) -> Lagrangian:
     """A unit charge of unit mass in the plane, in the field B(q) = B(1 + κ|q|²) ẑ, in the
-    symmetric gauge: L = ½|v|² + a(|q|²)(x v_y − y v_x) with a(r²) = ½B(1 + κr²/2)."""
+    symmetric gauge: L = ½|v|² + a(|q|²)(x v_y − y v_x) with a(r²) = ½B(1 + κr²/2).
+
+    Parameters
+    ----------
+    B : float, default 1.0
+        The field at the origin.
+    kappa : float, default 0.0
+        Its growth κ with |q|²; 0 is the uniform field.
+
+    Returns
+    -------
+    Lagrangian
+        n = 2, rotation invariant.
+
+    See Also
+    --------
+    varmech.scenes.charged_particle : the native scene it twins.
+    charged_particle_nonuniform : κ = 1/4.
+
+    Examples
+    --------
+    >>> from varmech import examples, integrate, scenes
+    >>> s = scenes.charged_particle()
+    >>> traj = integrate(examples.charged_particle(), s.q0, s.p0, dt=s.dt, steps=100)
+    >>> round(float(traj.energy()[-1]), 12), s.invariants["E"]
+    (0.5, 0.5)
+    """
 
     def gauge(q: np.ndarray) -> tuple[float, float]:
         c = 0.5 * B
@@ -238,14 +541,57 @@ def charged_particle(B: float = 1.0, kappa: float = 0.0) -> Lagrangian:
 
 
 def charged_particle_nonuniform() -> Lagrangian:
-    """The charged particle in the non-uniform field B(q) = (1 + |q|²/4) ẑ (the native scene's
-    field): :func:`charged_particle` with B = 1, κ = 1/4."""
+    """The charged particle in the native scene's non-uniform field B(q) = (1 + |q|²/4) ẑ:
+    :func:`charged_particle` with B = 1, κ = 1/4.
+
+    Returns
+    -------
+    Lagrangian
+        n = 2, rotation invariant.
+
+    See Also
+    --------
+    varmech.scenes.charged_particle_nonuniform : the native scene it twins.
+
+    Examples
+    --------
+    >>> from varmech import examples, integrate, scenes
+    >>> s = scenes.charged_particle_nonuniform()
+    >>> twin = integrate(examples.charged_particle_nonuniform(), s.q0, s.p0, dt=s.dt, steps=10)
+    >>> bool(abs(twin.p - integrate(s, dt=s.dt, steps=10).p).max() < 1e-12)
+    True
+    """
     return charged_particle(kappa=0.25)
 
 
 def damped_driven_pendulum(gamma: float = 0.5, amplitude: float = 1.5, drive: float = 2.0 / 3.0) -> Lagrangian:
-    """θ̈ + γθ̇ + sin θ = A cos Ωt: L = ½θ̇² + cos θ, the Rayleigh dissipation ½γθ̇² and the
-    driving torque as a force."""
+    """The damped, driven pendulum θ̈ + γθ̇ + sin θ = A cos Ωt: L = ½θ̇² + cos θ, the Rayleigh
+    dissipation ½γθ̇² and the driving torque as a force.
+
+    Parameters
+    ----------
+    gamma : float, default 0.5
+        The damping γ.
+    amplitude : float, default 1.5
+        The driving torque's amplitude A.
+    drive : float, default 2/3
+        The driving frequency Ω.
+
+    Returns
+    -------
+    Lagrangian
+        n = 1, forced: its energy is not conserved but balanced against the work done.
+
+    See Also
+    --------
+    varmech.scenes.damped_driven_pendulum : the native scene it twins.
+
+    Examples
+    --------
+    >>> from varmech import examples
+    >>> examples.damped_driven_pendulum().forced
+    True
+    """
     return Lagrangian(
         1,
         lambda q, v, t: 0.5 * v[0] ** 2 + math.cos(q[0]),
@@ -258,7 +604,41 @@ def damped_driven_pendulum(gamma: float = 0.5, amplitude: float = 1.5, drive: fl
 
 
 def cartesian_pendulum(m: float = 1.0, l: float = 1.0, g: float = 1.0) -> MechanicalSystem:
-    """The planar pendulum in Cartesian coordinates (x, y): V = mgy on g(q) = ½(x² + y² − l²)."""
+    """The planar pendulum in Cartesian coordinates (x, y): V = mgy on the constraint
+    g(q) = ½(x² + y² − l²) = 0.
+
+    Parameters
+    ----------
+    m : float, default 1.0
+        The bob's mass.
+    l : float, default 1.0
+        The rod's length.
+    g : float, default 1.0
+        The gravitational acceleration.
+
+    Returns
+    -------
+    MechanicalSystem
+        n = 2 with one holonomic constraint.
+
+    Raises
+    ------
+    ValueError
+        Naming ``mass`` when ``m`` is not finite and positive.
+
+    See Also
+    --------
+    varmech.scenes.cartesian_pendulum : the native scene it twins.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from varmech import examples, integrate, scenes
+    >>> s = scenes.cartesian_pendulum()
+    >>> traj = integrate(examples.cartesian_pendulum(), s.q0, s.p0, dt=s.dt, steps=100)
+    >>> round(float(np.hypot(*traj.q[-1])), 12)
+    1.0
+    """
     return MechanicalSystem(
         2,
         lambda q: m * g * q[1],
@@ -279,9 +659,33 @@ def _e(q: np.ndarray) -> np.ndarray:
 
 
 def rigid_body(inertia: tuple[float, float, float] = (0.5, 0.9, 1.0)) -> MechanicalSystem:
-    """The rigid body in unit quaternions as a natural system on |q| = 1:
+    """The free rigid body in unit quaternions as a natural system on |q| = 1:
     M(q) = 4EᵀIE + αqqᵀ (α = 4 tr I/3 fills the direction q, which the constraint freezes),
-    U = q₁² − q₂² − q₃² + q₄²."""
+    U = q₁² − q₂² − q₃² + q₄².
+
+    Parameters
+    ----------
+    inertia : tuple of 3 float, default (0.5, 0.9, 1.0)
+        The principal moments of inertia I.
+
+    Returns
+    -------
+    MechanicalSystem
+        n = 4 with a configuration-dependent mass and the constraint |q|² = 1.
+
+    See Also
+    --------
+    varmech.scenes.rigid_body : the native scene it twins.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from varmech import examples, integrate, scenes
+    >>> s = scenes.rigid_body()
+    >>> traj = integrate(examples.rigid_body(), s.q0, s.p0, dt=s.dt, steps=20)
+    >>> round(float(np.linalg.norm(traj.q[-1])), 12)
+    1.0
+    """
     i = np.diag(inertia)
     alpha = 4.0 * sum(inertia) / 3.0
     sign = np.array([1.0, -1.0, -1.0, 1.0])
@@ -312,19 +716,89 @@ def rigid_body(inertia: tuple[float, float, float] = (0.5, 0.9, 1.0)) -> Mechani
 
 
 def bouncing_ball(g: float = 9.81) -> MechanicalSystem:
-    """The ball above its floor, H = p²/2 + gq (the floor is a contact: in the closure twin,
-    ``Contact(lambda q: q[0], lambda q: [1.0])``)."""
+    """The ball above its floor, H = p²/2 + gq; the floor q = 0 is a contact, which in the closure
+    twin is ``Contact(lambda q: q[0], lambda q: [1.0])``.
+
+    Parameters
+    ----------
+    g : float, default 9.81
+        The gravitational acceleration.
+
+    Returns
+    -------
+    MechanicalSystem
+        n = 1, without the floor.
+
+    See Also
+    --------
+    varmech.scenes.bouncing_ball : the native scene it twins, floor included.
+
+    Examples
+    --------
+    >>> from varmech import Contact, examples, integrate, scenes
+    >>> s = scenes.bouncing_ball()
+    >>> floor = Contact(lambda q: q[0], lambda q: [1.0])
+    >>> traj = integrate(examples.bouncing_ball(), s.q0, s.p0, dt=0.01, t_end=2.0, contacts=[floor])
+    >>> bool(traj.q.min() >= 0.0), round(float(traj.energy()[-1]), 2), s.invariants["H"]
+    (True, 9.81, 9.81)
+    """
     return MechanicalSystem(1, lambda q: g * q[0], lambda q: np.array([g]), name="bouncing_ball (closure)")
 
 
 def elliptic_billiard() -> MechanicalSystem:
-    """The billiard's free particle, H = |p|²/2 (the table x²/A² + y²/B² ≤ 1 is a contact)."""
+    """The elliptic billiard's free particle, H = |p|²/2; the table x²/A² + y²/B² ≤ 1 is a
+    contact (:class:`varmech.surfaces.Ellipsoid`).
+
+    Returns
+    -------
+    MechanicalSystem
+        n = 2, without the table's wall.
+
+    See Also
+    --------
+    varmech.scenes.elliptic_billiard : the native scene it twins, wall included.
+
+    Examples
+    --------
+    >>> from varmech import examples
+    >>> model = examples.elliptic_billiard()
+    >>> model.dim, model.separable
+    (2, True)
+    """
     return MechanicalSystem(2, lambda q: 0.0, lambda q: np.zeros(2), name="elliptic_billiard (closure)")
 
 
 def rolling_disk(radius: float = 1.0) -> MechanicalSystem:
     """The vertical disk of radius R rolling on a plane, q = (x, y, θ, φ), mass
-    diag(1, 1, R²/4, R²/2), with ẋ = Rφ̇cosθ, ẏ = Rφ̇sinθ as velocity constraints."""
+    diag(1, 1, R²/4, R²/2), with ẋ = Rφ̇cosθ, ẏ = Rφ̇sinθ as velocity constraints.
+
+    Parameters
+    ----------
+    radius : float, default 1.0
+        The disk's radius R.
+
+    Returns
+    -------
+    MechanicalSystem
+        n = 4 with two velocity (nonholonomic) constraints.
+
+    Raises
+    ------
+    ValueError
+        Naming ``mass`` when ``radius`` is 0.
+
+    See Also
+    --------
+    varmech.scenes.rolling_disk : the native scene it twins.
+
+    Examples
+    --------
+    >>> from varmech import examples, integrate, scenes
+    >>> s = scenes.rolling_disk()
+    >>> traj = integrate(examples.rolling_disk(), s.q0, s.p0, dt=s.dt, steps=100)
+    >>> round(float(traj.energy()[-1]), 12), s.invariants["E"]
+    (3.06125, 3.06125)
+    """
     r2 = radius * radius
 
     def rolling(q: np.ndarray) -> np.ndarray:
@@ -340,7 +814,36 @@ def rolling_disk(radius: float = 1.0) -> MechanicalSystem:
 
 def chaplygin_sleigh(inertia: float = 1.0, blade: float = 1.0) -> MechanicalSystem:
     """The Chaplygin sleigh, q = (x, y, θ), mass diag(1, 1, I), its blade b behind the centre:
-    −ẋsinθ + ẏcosθ − bθ̇ = 0."""
+    −ẋ sin θ + ẏ cos θ − bθ̇ = 0.
+
+    Parameters
+    ----------
+    inertia : float, default 1.0
+        The moment of inertia I about the centre.
+    blade : float, default 1.0
+        The blade's distance b behind the centre.
+
+    Returns
+    -------
+    MechanicalSystem
+        n = 3 with one velocity constraint.
+
+    Raises
+    ------
+    ValueError
+        Naming ``mass`` when ``inertia`` is not finite and positive.
+
+    See Also
+    --------
+    varmech.scenes.chaplygin_sleigh : the native scene it twins.
+
+    Examples
+    --------
+    >>> from varmech import examples
+    >>> model = examples.chaplygin_sleigh()
+    >>> model.dim, model.velocity_constraints
+    (3, 1)
+    """
 
     def no_slip(q: np.ndarray) -> np.ndarray:
         return np.array([[-math.sin(q[2]), math.cos(q[2]), -blade]])
@@ -352,10 +855,42 @@ def chaplygin_sleigh(inertia: float = 1.0, blade: float = 1.0) -> MechanicalSyst
 
 
 def rolling_sphere(alpha: float = 0.5, g: float = 9.81, radius: float = 1.0, omega: float = 0.0, name: str = "rolling_sphere") -> Lagrangian:
-    """The ball (unit mass, I = 2a²/5) on a rough plane inclined at α, or on a level table
-    turning at Ω, q = (x, y, φ, θ, ψ) in ZXZ Euler angles: L = ½(ẋ² + ẏ²) +
-    ½I(φ̇² + θ̇² + ψ̇² + 2φ̇ψ̇cosθ) + g sinα x, with ẋ − aω_y + Ωy = 0, ẏ + aω_x − Ωx = 0
-    (affine for Ω ≠ 0)."""
+    """The ball (unit mass, I = 2a²/5) rolling on a rough plane inclined at α, or on a level table
+    turning at Ω, q = (x, y, φ, θ, ψ) in ZXZ Euler angles:
+    L = ½(ẋ² + ẏ²) + ½I(φ̇² + θ̇² + ψ̇² + 2φ̇ψ̇cosθ) + g sinα x, with
+    ẋ − aω_y + Ωy = 0, ẏ + aω_x − Ωx = 0 (affine for Ω ≠ 0).
+
+    Parameters
+    ----------
+    alpha : float, default 0.5
+        The plane's inclination α.
+    g : float, default 9.81
+        The gravitational acceleration.
+    radius : float, default 1.0
+        The ball's radius a.
+    omega : float, default 0.0
+        The table's rate of turn Ω.
+    name : str, default "rolling_sphere"
+        The model's name, less " (closure)".
+
+    Returns
+    -------
+    Lagrangian
+        n = 5 with two velocity constraints and the symmetry ``Cyclic(2)``.
+
+    See Also
+    --------
+    varmech.scenes.rolling_sphere : the native scene it twins.
+    ball_on_turntable : the level turning table.
+
+    Examples
+    --------
+    >>> from varmech import examples, integrate, scenes
+    >>> s = scenes.rolling_sphere()
+    >>> traj = integrate(examples.rolling_sphere(), s.q0, s.p0, dt=s.dt, steps=100)
+    >>> round(float(traj.energy()[-1]), 3), round(s.invariants["E"], 3)
+    (0.963, 0.963)
+    """
     inertia, slope = 0.4 * radius * radius, g * math.sin(alpha)
 
     def lagrangian(q: np.ndarray, v: np.ndarray, t: float) -> float:
@@ -383,14 +918,67 @@ def rolling_sphere(alpha: float = 0.5, g: float = 9.81, radius: float = 1.0, ome
 
 
 def ball_on_turntable(omega: float = 1.0, radius: float = 1.0) -> Lagrangian:
-    """The ball of :func:`rolling_sphere` on a level table turning at Ω: affine constraints."""
+    """The ball of :func:`rolling_sphere` on a level table turning at Ω: its velocity
+    constraints are affine, so the table does work and the energy is not conserved.
+
+    Parameters
+    ----------
+    omega : float, default 1.0
+        The table's rate of turn Ω.
+    radius : float, default 1.0
+        The ball's radius a.
+
+    Returns
+    -------
+    Lagrangian
+        n = 5 with two affine velocity constraints.
+
+    See Also
+    --------
+    varmech.scenes.ball_on_turntable : the native scene it twins.
+
+    Examples
+    --------
+    >>> from varmech import examples, scenes
+    >>> examples.ball_on_turntable().affine, scenes.ball_on_turntable().model.affine
+    (True, True)
+    """
     return rolling_sphere(alpha=0.0, radius=radius, omega=omega, name="ball_on_turntable")
 
 
 def closure_of(scene: Scene) -> MechanicalSystem | Lagrangian:
     """The closure twin of a built-in scene: the function of this module with the scene's name,
     at its default parameters (an N-body scene's twin has the scene's G and masses).
-    ValueError for a scene without a twin."""
+
+    Parameters
+    ----------
+    scene : Scene
+        A scene of :mod:`varmech.scenes`.
+
+    Returns
+    -------
+    MechanicalSystem or Lagrangian
+        The closure model that computes the scene's formulas.
+
+    Raises
+    ------
+    ValueError
+        Naming ``scene`` for a scene without a twin here.
+
+    See Also
+    --------
+    varmech.symbolic.examples.symbolic_of : the symbolic twin.
+
+    Examples
+    --------
+    >>> from varmech import examples, scenes
+    >>> examples.closure_of(scenes.outer_solar_system()).dim
+    18
+    >>> examples.closure_of(scenes.planar_chain())
+    Traceback (most recent call last):
+    ...
+    ValueError: scene: 'planar_chain' has no closure twin in varmech.examples
+    """
     gravity = getattr(scene.model._core, "gravity", None)
     if gravity is not None:
         return nbody(*gravity)

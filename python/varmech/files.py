@@ -44,6 +44,12 @@ if TYPE_CHECKING:
     from .integrate import Trajectory
     from .model import Model
 
+__all__ = [
+    "LAZY_BYTES",
+    "Rows",
+    "load",
+]
+
 FORMAT = "varmech-trajectory"
 FORMAT_VERSION = 2
 #: Rows per chunk: about 64 kB of a (N, 2)-shaped q for the small systems.
@@ -294,7 +300,40 @@ def columns_of(model: Model, method: str) -> tuple[str, ...]:
 
 class Rows:
     """A column of a trajectory file, read when used: indexing reads the rows asked for, and
-    NumPy (``np.asarray``, arithmetic) reads the whole column once and keeps it."""
+    NumPy (``np.asarray``, arithmetic) reads the whole column once and keeps it.
+
+    :func:`load` with ``lazy=True`` gives each column of the trajectory as one; it is not made
+    by hand.
+
+    Parameters
+    ----------
+    path : pathlib.Path
+        The HDF5 file.
+    name : str
+        The column's dataset in the file (``"t"``, ``"q"``, ``"p"``, ...).
+    shape : tuple of int
+        The committed rows and each row's shape.
+    dtype : numpy.dtype or str
+        The column's element type.
+
+    Attributes
+    ----------
+    shape : tuple of int
+        As given.
+    dtype : numpy.dtype
+        As given.
+    ndim : int
+        ``len(shape)``.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib, numpy as np, varmech
+    >>> s = varmech.scenes.kepler()
+    >>> traj = varmech.integrate(s, dt=s.dt, steps=100, save_every=10)
+    >>> back = varmech.load(traj.save(pathlib.Path(tempfile.mkdtemp()) / "k.h5"), lazy=True)
+    >>> back.q.shape, bool(np.array_equal(back.q[-1], traj.q[-1]))
+    ((11, 2), True)
+    """
 
     __array_priority__ = 1.0
 

@@ -25,6 +25,12 @@ from .model import Lagrangian, Model
 if TYPE_CHECKING:
     from .scenes import Scene
 
+__all__ = [
+    "Trajectory",
+    "integrate",
+    "symplecticity_defect",
+]
+
 
 @dataclass
 class Trajectory:
@@ -164,7 +170,7 @@ class Trajectory:
     def sol(self, t: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
         """(q(t), p(t)) between the saved states, by cubic Hermite interpolation from q, q̇ and
         p, ṗ at the states on either side: error O(Δ⁴) in their spacing Δ. See
-        :func:`varmech.dense.hermite`.
+        ``dense.hermite``.
 
         Parameters
         ----------
@@ -660,7 +666,7 @@ def _evaluated(
     output: str | os.PathLike[str] | None,
     watched: Sequence[_events.Event],
 ) -> Trajectory:
-    """``integrate(t_eval=)``: the run's states at ``times`` (:func:`varmech.dense.at_times`)."""
+    """``integrate(t_eval=)``: the run's states at ``times`` (``dense.at_times``)."""
     for name, given in (("save_every", save_every != 1), ("output", output is not None), ("events", bool(watched))):
         if given:
             raise ValueError(f"{name}: not with t_eval, which gives the states kept")

@@ -4,6 +4,12 @@ from __future__ import annotations
 
 from . import _core
 
+__all__ = [
+    "MethodInfo",
+    "method_info",
+    "methods",
+]
+
 #: Facts about one fixed-step method (name, order, stages, force_evaluations, implicit,
 #: constrained, symplectic, symmetric, h_omega_max, reference): see ``_core.MethodInfo``.
 MethodInfo = _core.MethodInfo

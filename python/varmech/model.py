@@ -13,6 +13,16 @@ from numpy.typing import ArrayLike
 from . import _core, pointers
 from ._core import ModelKind
 
+__all__ = [
+    "Cyclic",
+    "Lagrangian",
+    "MechanicalSystem",
+    "Model",
+    "NativeSystem",
+    "Rotation",
+    "Translation",
+]
+
 _AXES = "xyz"
 
 

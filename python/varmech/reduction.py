@@ -18,6 +18,12 @@ from .model import Model
 if TYPE_CHECKING:
     from .scenes import Scene
 
+__all__ = [
+    "ReducedModel",
+    "cyclic_coordinates",
+    "routh",
+]
+
 
 def cyclic_coordinates(
     model: Model, q: ArrayLike, *, spread: float = 1.0, samples: int = 64, seed: int = 0, rtol: float = 1e-9

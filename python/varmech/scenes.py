@@ -19,6 +19,39 @@ from ._util import positive
 from .impacts import Contact
 from .model import Model, NativeSystem
 
+__all__ = [
+    "CATALOGUE",
+    "SYMBOLIC",
+    "TIME_UNITS",
+    "Reference",
+    "Scene",
+    "ball_on_turntable",
+    "bouncing_ball",
+    "cartesian_pendulum",
+    "cartesian_spherical_pendulum",
+    "chaplygin_sleigh",
+    "charged_particle",
+    "charged_particle_nonuniform",
+    "damped_driven_pendulum",
+    "double_pendulum",
+    "elliptic_billiard",
+    "fermi_pasta_ulam",
+    "get",
+    "harmonic_oscillator",
+    "heavy_top",
+    "henon_heiles",
+    "kepler",
+    "kepler_polar",
+    "nbody",
+    "outer_solar_system",
+    "pendulum",
+    "planar_chain",
+    "rigid_body",
+    "rolling_disk",
+    "rolling_sphere",
+    "spherical_pendulum",
+]
+
 
 @dataclass(frozen=True)
 class Reference:

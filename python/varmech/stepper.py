@@ -15,6 +15,10 @@ from .model import Model
 if TYPE_CHECKING:
     from .scenes import Scene
 
+__all__ = [
+    "Stepper",
+]
+
 
 class Stepper:
     """One model, one method and the state (t, q, p), advanced one step or n steps at a time.

@@ -4,7 +4,7 @@ from one (:func:`resume`).
 A long run is cut into segments of whole saving periods; each goes on from the last one's
 checkpoint (``_core.resume``), so the states are those of one uninterrupted run, bit for bit.
 After a segment its rows and checkpoint are appended to the file and committed
-(:class:`varmech.files.Writer`) and dropped from memory, so memory stays flat whatever the
+(``files.Writer``) and dropped from memory, so memory stays flat whatever the
 length of the run. A segment lasts at most ``checkpoint_every`` (steps, or a
 :class:`datetime.timedelta` of run time) and by default about :data:`SEGMENT_SECONDS`.
 """
@@ -31,6 +31,11 @@ from .model import Model
 
 if TYPE_CHECKING:
     from tqdm import tqdm
+
+__all__ = [
+    "SEGMENT_SECONDS",
+    "resume",
+]
 
 #: The default length of a segment in run time: what a crash can lose.
 SEGMENT_SECONDS = 2.0
@@ -241,7 +246,7 @@ def resume(
     -------
     Trajectory
         The whole run, read back from the file (lazily when it is large; see
-        :func:`varmech.files.larger_than_memory`).
+        ``files.larger_than_memory``).
 
     Raises
     ------

@@ -11,6 +11,10 @@ from typing import Any
 
 import numpy as np
 
+__all__ = [
+    "Table",
+]
+
 
 @dataclass
 class Table:

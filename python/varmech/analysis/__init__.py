@@ -12,3 +12,5 @@
 Every sweep honours Ctrl-C: the KeyboardInterrupt propagates with the rows measured so far as
 ``err.partial`` (:func:`._interrupt.interruptible`).
 """
+
+__all__: list[str] = []  # internal: importable, not part of the public API

@@ -20,6 +20,8 @@ from .. import _core
 from ..model import Model
 from ..scenes import Scene
 
+__all__: list[str] = []  # internal: importable, not part of the public API
+
 #: solve_ivp's methods.
 SCIPY_METHODS = ("RK23", "RK45", "DOP853", "Radau", "BDF", "LSODA")
 

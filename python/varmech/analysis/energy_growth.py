@@ -25,6 +25,12 @@ from . import baselines as _baselines
 from ._energy import conserves_energy, energy_of, relative_error
 from ._interrupt import interruptible
 
+__all__ = [
+    "ENERGY_GROWTH_COLUMNS",
+    "energy_growth",
+    "verdicts",
+]
+
 ENERGY_GROWTH_COLUMNS = ("tool", "method", "t", "energy_error", "max_energy_error")
 
 
@@ -121,7 +127,7 @@ def energy_growth(
     baselines, rtol, atol
         ``solve_ivp`` methods (default DOP853) at tolerance ``rtol`` (atol as in
         :func:`~varmech.work_precision`), sampled by their dense output; and REBOUND's
-        integrators (:data:`~varmech.analysis.baselines.REBOUND_METHODS`) on N-body scenes, the
+        integrators (``analysis.baselines.REBOUND_METHODS``) on N-body scenes, the
         fixed-step ones at step ``dt`` and ``"IAS15"`` at its default precision, with
         ``"leapfrog order=8"`` also on the Kepler scene. Skipped with a note in
         ``meta["notes"]`` when SciPy or REBOUND is missing, or the scene is not theirs.

@@ -5,7 +5,7 @@ The vertical disk rolling without slipping (q = (x, y, θ, φ), ẋ = Rφ̇ cos 
 conserves its energy, its spin θ̇ and its rolling rate φ̇. :func:`nonholonomic_energy` follows
 the relative energy error |E(t) − E₀|/E₀ of the reversible discrete Lagrange–d'Alembert
 integrator (``midpoint``, McLachlan & Perlmutter 2006), of its order-4 composition (``dla4``),
-of Cortés & Martínez's non-reversible step (``cortes_martinez``) and of :func:`rk4_projection`,
+of Cortés & Martínez's non-reversible step (``cortes_martinez``) and of ``rk4_projection``,
 classical RK4 on the Lagrange–d'Alembert equations followed by a projection of the velocity
 onto A(q)q̇ = 0 (a comparator here, not a varmech method).
 :func:`varmech.charts.nonholonomic.nonholonomic_energy_chart` plots the table.
@@ -24,6 +24,13 @@ from ..model import MechanicalSystem
 from ..table import Table
 from ._interrupt import interruptible
 
+__all__ = [
+    "NONHOLONOMIC_ENERGY_COLUMNS",
+    "RK4_PROJECTION",
+    "nonholonomic_energy",
+]
+
+#: The columns of a :func:`nonholonomic_energy` table.
 NONHOLONOMIC_ENERGY_COLUMNS = ("method", "t", "energy_error")
 
 #: The naive comparator's name in the table.
@@ -116,12 +123,44 @@ def nonholonomic_energy(
 ) -> Table:
     """The rolling disk's relative energy error |E(t) − E₀|/E₀ over ``steps`` steps of ``dt``,
     at ``samples`` evenly spaced times, for each of ``methods`` (varmech methods for velocity
-    constraints, and ``"rk4_projection"``, :func:`rk4_projection`).
+    constraints, and ``"rk4_projection"``: classical RK4 followed by the projection of the
+    velocity onto the constraints A(q)v = 0 in the mass metric). This is the measurement behind
+    ``python -m varmech chart nonholonomic``.
 
-    ``table.meta["verdicts"]`` holds each method's energy verdict and
-    ``table.meta["drift_rates"]`` its fitted drift rate d(E − E₀)/dt
-    (:func:`varmech.energy_statistics`). Ctrl-C stops the sweep: the KeyboardInterrupt
-    propagates with the methods measured so far as ``err.partial``.
+    Ctrl-C stops the sweep: the KeyboardInterrupt propagates with the methods measured so far as
+    ``err.partial``.
+
+    Parameters
+    ----------
+    methods : iterable of str, default ("midpoint", "cortes_martinez", "rk4_projection")
+        varmech methods that take velocity constraints, and :data:`RK4_PROJECTION`.
+    dt : float, default 0.1
+        The step.
+    steps : int, default 100000
+        Steps of each run.
+    samples : int, default 2000
+        Evenly spaced times at which the energy error is recorded.
+    progress : bool, optional
+        Show a progress bar; default: when standard error is a terminal.
+
+    Returns
+    -------
+    Table
+        Columns :data:`NONHOLONOMIC_ENERGY_COLUMNS` (``method``, ``t``, ``energy_error``), one
+        row a sample; ``table.meta["verdicts"]`` holds each method's energy verdict
+        ("bounded" or "secular drift") and ``table.meta["drift_rates"]`` its fitted drift rate
+        d(E − E₀)/dt.
+
+    Raises
+    ------
+    ValueError
+        Naming ``steps`` or ``samples`` when below 1, or ``method`` for a method that does not
+        take velocity constraints.
+
+    See Also
+    --------
+    varmech.charts.nonholonomic_energy_chart : draws this table.
+    varmech.analysis.energy_growth.energy_growth : the same measurement for other scenes.
 
     Examples
     --------

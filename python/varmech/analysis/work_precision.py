@@ -30,6 +30,13 @@ from . import baselines as _baselines
 from ._energy import conserves_energy, energy_of, relative_error
 from ._interrupt import interruptible
 
+__all__ = [
+    "DEFAULT_EPSILONS",
+    "DEFAULT_RTOLS",
+    "WORK_PRECISION_COLUMNS",
+    "work_precision",
+]
+
 #: The default tolerance sweep: 1e-3 … 1e-12, a decade a setting.
 DEFAULT_RTOLS = tuple(10.0**-k for k in range(3, 13))
 #: IAS15's default precision sweep (its own default is 1e-9).
@@ -159,7 +166,7 @@ def work_precision(
         columns included. Skipped, with a note in ``meta["notes"]``, without SciPy, and for
         forced or constrained scenes.
     rebound, epsilons
-        REBOUND's integrators (:data:`~varmech.analysis.baselines.REBOUND_METHODS`; default
+        REBOUND's integrators (``analysis.baselines.REBOUND_METHODS``; default
         ``"WHFast"`` and ``"IAS15"``): the fixed-step ones (``"WHFast"``, ``"WHFast
         corrector=11"``, ``"leapfrog order=8"``) over the step sweep of ``verlet`` (or
         ``steps[name]``), ``"IAS15"`` over the precisions ``epsilons``. They run on N-body

@@ -11,6 +11,10 @@ from ..conservation import check_conservation
 from ..integrate import Trajectory
 from ._figure import documented, pyplot, save, time_label
 
+__all__ = [
+    "energy_error",
+]
+
 
 @documented
 def energy_error(trajectories: Mapping[str, Trajectory], path: str | Path, title: str = "", time_unit: str = "time units") -> Path:

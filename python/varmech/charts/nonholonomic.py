@@ -10,6 +10,10 @@ import numpy as np
 from ..table import Table
 from ._figure import documented, pyplot, save, time_label
 
+__all__ = [
+    "nonholonomic_energy_chart",
+]
+
 #: What each line is, in the legend.
 LABELS = {
     "midpoint": "midpoint (reversible DLA)",

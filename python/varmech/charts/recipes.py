@@ -21,6 +21,11 @@ from .sections import phase_portrait_chart, poincare_chart
 from .stability import implicit_regions_chart, stability_chart
 from .work_precision import energy_growth_chart, work_precision_chart
 
+__all__ = [
+    "chart",
+    "scenes_for",
+]
+
 
 @dataclass(frozen=True)
 class ChartKind:
@@ -218,18 +223,65 @@ def chart(
     box: tuple[tuple[float, float], tuple[float, float]] | None = None,
     say: Callable[[str], object] | None = None,
 ) -> list[Path]:
-    """Measure chart ``kind`` on ``scene`` (its default when None) and write, for each figure,
-    ``<out>/<name>_<scene>.<fmt>`` and the data as ``.csv``; returns the paths written.
+    """Measure chart ``kind`` on ``scene`` and write its figures and data: the Python form of
+    ``python -m varmech chart KIND [SCENE]``.
 
-    ``methods`` default to the kind's own that integrate the scene, or else the scene's kind's
-    accurate and default methods (:func:`fitting_methods`). ``energies`` are the Poincaré
-    sections' energy shells (default: Hénon–Heiles' 1/12 and 1/8, another scene's own energy)
-    or the phase portrait's orbits (default: the pendulum's own, another scene's energy times
-    1/4 … 4); ``box`` the sections' seeding box (Hénon–Heiles: its allowed region; another
-    scene: a box twice its initial state's size). A scene the kind does not apply to
-    (:func:`scenes_for`) is a ValueError naming ``scene``.
-    ``say`` is called with each note of the measurements (skipped baselines, stopped sweeps),
-    which the charts draw too."""
+    For each figure, ``<out>/<name>_<scene>.<fmt>`` is written, and the measured table as
+    ``.csv``. ``methods`` default to the kind's own that integrate the scene, or else the
+    scene's kind's accurate and default methods.
+
+    Parameters
+    ----------
+    kind : str
+        One of ``work-precision``, ``energy``, ``stability``, ``implicit-regions``,
+        ``poincare``, ``phase``, ``nonholonomic``.
+    scene : str, optional
+        A scene of :data:`varmech.scenes.CATALOGUE` or a symbolic one; default: the kind's own
+        (:func:`scenes_for` lists those the kind applies to).
+    methods : tuple of str, optional
+        The methods to measure; default as above.
+    out : pathlib.Path, default Path("out/charts")
+        The folder written to.
+    fmt : {"png", "svg"}, default "png"
+        The figures' format.
+    quick : bool, default False
+        A short measurement (fewer steps, orbits and tolerances), for a first look and tests.
+    progress : bool, optional
+        Show progress bars; default: when standard error is a terminal.
+    energies : tuple of float, optional
+        The Poincaré sections' energy shells (default: Hénon–Heiles' 1/12 and 1/8, another
+        scene's own energy) or the phase portrait's orbits (default: the pendulum's own, another
+        scene's energy times 1/4 … 4).
+    box : ((float, float), (float, float)), optional
+        The sections' seeding box (Hénon–Heiles: its allowed region; another scene: a box twice
+        its initial state's size).
+    say : callable, optional
+        Called with each note of the measurements (skipped baselines, stopped sweeps), which
+        the charts draw too.
+
+    Returns
+    -------
+    list of pathlib.Path
+        The files written, each table's CSV before its figures.
+
+    Raises
+    ------
+    ValueError
+        Naming ``kind`` for an unknown chart, ``format`` for a format other than png or svg,
+        ``scene`` for an unknown scene or one the kind does not apply to.
+
+    See Also
+    --------
+    scenes_for : the scenes a chart kind applies to.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> from varmech.charts.recipes import chart
+    >>> paths = chart("implicit-regions", out=pathlib.Path(tempfile.mkdtemp()), quick=True, progress=False)
+    >>> [path.name for path in paths]
+    ['implicit_regions_pendulum.csv', 'implicit_regions_pendulum.png']
+    """
     if kind not in KINDS:
         raise ValueError(f"kind: expected one of {', '.join(KINDS)}, got {kind!r}")
     if fmt not in ("png", "svg"):
@@ -258,7 +310,35 @@ def chart(
 
 
 def scenes_for(kind: str) -> list[str]:
-    """The scenes chart ``kind`` applies to (every scene of the catalogue and the symbolic ones,
-    less those it refuses, such as a phase portrait of two degrees of freedom)."""
+    """The scenes chart ``kind`` applies to: every scene of the catalogue and the symbolic ones,
+    less those it refuses, such as a phase portrait of two degrees of freedom.
+
+    Parameters
+    ----------
+    kind : str
+        A chart kind, as :func:`chart` takes it.
+
+    Returns
+    -------
+    list of str
+        The scenes' names, in the catalogue's order.
+
+    Raises
+    ------
+    ValueError
+        Naming ``kind`` for an unknown chart.
+
+    See Also
+    --------
+    chart : measures and draws a chart kind on one of these scenes.
+
+    Examples
+    --------
+    >>> from varmech.charts.recipes import scenes_for
+    >>> scenes_for("phase")
+    ['harmonic_oscillator', 'pendulum']
+    """
+    if kind not in KINDS:
+        raise ValueError(f"kind: expected one of {', '.join(KINDS)}, got {kind!r}")
     refuses = KINDS[kind].refuses
     return [name for name in (*scenes.CATALOGUE, *scenes.SYMBOLIC) if refuses(scenes.get(name)) is None]

@@ -11,6 +11,11 @@ import numpy as np
 from ..table import Table
 from ._figure import documented, pyplot, save, skipped_note, time_label
 
+__all__ = [
+    "energy_growth_chart",
+    "work_precision_chart",
+]
+
 _AXIS_LABELS = {
     "seconds": "wall time (s)",
     "evaluations": "force evaluations",

@@ -64,6 +64,33 @@ def double_pendulum(
 
     with the native scene's l = (2, 3), m = (1, 2), g = 9.80665 by default. A general
     Lagrangian (its mass matrix depends on θ₁ − θ₂).
+
+    Parameters
+    ----------
+    m1, m2 : float, default 1.0, 2.0
+        The bobs' masses.
+    l1, l2 : float, default 2.0, 3.0
+        The rods' lengths.
+    g : float, default 9.80665
+        The gravitational acceleration.
+    jit : bool, default True
+        Compile the model's tapes (Cranelift), or interpret them.
+
+    Returns
+    -------
+    SymbolicModel
+        A general Lagrangian, n = 2.
+
+    See Also
+    --------
+    varmech.scenes.double_pendulum : the native scene it twins.
+    varmech.examples.double_pendulum : its closure twin.
+
+    Examples
+    --------
+    >>> from varmech.symbolic import examples
+    >>> examples.double_pendulum(m2=1.0).parameters
+    {'m1': 1.0, 'm2': 1.0, 'l1': 2.0, 'l2': 3.0, 'g': 9.80665}
     """
     q1, q2, v1, v2 = sp.symbols("q1 q2 v1 v2")
     m1_, m2_, l1_, l2_, g_ = sp.symbols("m1 m2 l1 l2 g", positive=True)
@@ -85,6 +112,35 @@ def spherical_pendulum(m: float = 1.0, l: float = 1.0, g: float = 1.0, *, jit: b
         L = ½ml²(θ̇² + sin²θ φ̇²) + mgl cos θ
 
     (m = l = g = 1 by default). φ is cyclic: p_φ = ml² sin²θ φ̇ is conserved.
+
+    Parameters
+    ----------
+    m : float, default 1.0
+        The mass.
+    l : float, default 1.0
+        The rod's length.
+    g : float, default 1.0
+        The gravitational acceleration.
+    jit : bool, default True
+        Compile the model's tapes (Cranelift), or interpret them.
+
+    Returns
+    -------
+    SymbolicModel
+        A general Lagrangian, n = 2, φ cyclic.
+
+    See Also
+    --------
+    varmech.scenes.spherical_pendulum : the native scene it twins.
+
+    Examples
+    --------
+    >>> import varmech
+    >>> from varmech.symbolic import examples
+    >>> s = varmech.scenes.spherical_pendulum()
+    >>> traj = varmech.integrate(examples.spherical_pendulum(), s.q0, s.p0, dt=s.dt, steps=100)
+    >>> bool(abs(traj.p[-1, 1] - s.invariants["p_phi"]) < 1e-12)
+    True
     """
     th, ph, vth, vph = sp.symbols("theta phi v_theta v_phi")
     m_, l_, g_ = sp.symbols("m l g", positive=True)
@@ -101,6 +157,33 @@ def heavy_top(I1: float = 1.0, I3: float = 0.5, Mgl: float = 1.0, *, jit: bool =
 
     (I₁ = 1, I₃ = ½, Mgl = 1 by default). φ and ψ are cyclic: p_φ and p_ψ are conserved, and
     :func:`varmech.symbolic.routh` ignores them in closed form.
+
+    Parameters
+    ----------
+    I1 : float, default 1.0
+        The transverse moment of inertia about the pivot.
+    I3 : float, default 0.5
+        The moment of inertia about the symmetry axis.
+    Mgl : float, default 1.0
+        Mass × gravity × the pivot's distance to the centre of mass.
+    jit : bool, default True
+        Compile the model's tapes (Cranelift), or interpret them.
+
+    Returns
+    -------
+    SymbolicModel
+        A general Lagrangian, n = 3, φ and ψ cyclic.
+
+    See Also
+    --------
+    varmech.scenes.heavy_top : the native scene it twins.
+    varmech.symbolic.routh : reduces it by its cyclic angles.
+
+    Examples
+    --------
+    >>> from varmech.symbolic import examples
+    >>> examples.heavy_top().L
+    I1*(v_phi**2*sin(theta)**2 + v_theta**2)/2 + I3*(v_phi*cos(theta) + v_psi)**2/2 - Mgl*cos(theta)
     """
     th, ph, ps, vth, vph, vps = sp.symbols("theta phi psi v_theta v_phi v_psi")
     i1, i3 = sp.symbols("I1 I3", positive=True)
@@ -123,6 +206,30 @@ def kepler(*, jit: bool = True) -> SymbolicModel:
         L = ½|q̇|² + 1/|q|,   H = |p|²/2 − 1/|q|
 
     rotation invariant: the angular momentum x p_y − y p_x is conserved.
+
+    Parameters
+    ----------
+    jit : bool, default True
+        Compile the model's tapes (Cranelift), or interpret them.
+
+    Returns
+    -------
+    SymbolicModel
+        A separable mechanical system, n = 2, rotation invariant.
+
+    See Also
+    --------
+    varmech.scenes.kepler : the native scene it twins.
+    kepler_polar : the same problem in polar coordinates.
+
+    Examples
+    --------
+    >>> import varmech
+    >>> from varmech.symbolic import examples
+    >>> s = varmech.scenes.kepler()
+    >>> twin = varmech.integrate(examples.kepler(), s.q0, s.p0, dt=s.dt, steps=10)
+    >>> bool((twin.q == varmech.integrate(s, dt=s.dt, steps=10).q).all())
+    True
     """
     x, y, vx, vy = sp.symbols("x y v_x v_y")
     return mechanical(
@@ -142,6 +249,33 @@ def kepler_polar(m: float = 1.0, k: float = 1.0, *, jit: bool = True) -> Symboli
         L = ½m(ṙ² + r²θ̇²) + k/r
 
     (m = k = 1 by default). θ is cyclic: p_θ = mr²θ̇ is conserved.
+
+    Parameters
+    ----------
+    m : float, default 1.0
+        The mass.
+    k : float, default 1.0
+        The strength of the attraction k/r.
+    jit : bool, default True
+        Compile the model's tapes (Cranelift), or interpret them.
+
+    Returns
+    -------
+    SymbolicModel
+        A general Lagrangian, n = 2, θ cyclic.
+
+    See Also
+    --------
+    varmech.scenes.kepler_polar : the native scene it twins.
+
+    Examples
+    --------
+    >>> import varmech
+    >>> from varmech.symbolic import examples
+    >>> s = varmech.scenes.kepler_polar()
+    >>> traj = varmech.integrate(examples.kepler_polar(), s.q0, s.p0, dt=s.dt, steps=100)
+    >>> round(float(traj.p[-1, 1]), 12), s.invariants["p_theta"]
+    (0.8, 0.8)
     """
     r, th, vr, vth = sp.symbols("r theta v_r v_theta")
     m_, k_ = sp.symbols("m k", positive=True)
@@ -160,6 +294,38 @@ def charged_particle(
     (∇×A = B(q) for A = a(|q|²)(−y, x)). κ = 0 is the uniform field, in which the particle
     gyrates at Ω = eB/m. Rotation invariant: the canonical angular momentum x p_y − y p_x is
     conserved. The defaults are the native scene's (m = e = B = 1, κ = 0).
+
+    Parameters
+    ----------
+    B : float, default 1.0
+        The field at the origin.
+    kappa : float, default 0.0
+        Its growth κ with |q|².
+    m : float, default 1.0
+        The mass.
+    e : float, default 1.0
+        The charge.
+    jit : bool, default True
+        Compile the model's tapes (Cranelift), or interpret them.
+
+    Returns
+    -------
+    SymbolicModel
+        A general Lagrangian (linear in the velocities), n = 2, rotation invariant.
+
+    See Also
+    --------
+    varmech.scenes.charged_particle : the native scene it twins.
+    charged_particle_nonuniform : κ = 1/4.
+
+    Examples
+    --------
+    >>> import varmech
+    >>> from varmech.symbolic import examples
+    >>> s = varmech.scenes.charged_particle()
+    >>> traj = varmech.integrate(examples.charged_particle(), s.q0, s.p0, dt=s.dt, steps=100)
+    >>> round(float(traj.energy()[-1]), 12), s.invariants["E"]
+    (0.5, 0.5)
     """
     x, y, vx, vy = sp.symbols("x y v_x v_y")
     B_, kappa_, e_ = sp.symbols("B kappa e")
@@ -179,7 +345,28 @@ def charged_particle(
 
 def charged_particle_nonuniform(*, jit: bool = True) -> SymbolicModel:
     """The charged particle in the native scene's non-uniform field B(q) = (1 + |q|²/4) ẑ:
-    :func:`charged_particle` with B = 1, κ = ¼."""
+    :func:`charged_particle` with B = 1, κ = ¼.
+
+    Parameters
+    ----------
+    jit : bool, default True
+        Compile the model's tapes (Cranelift), or interpret them.
+
+    Returns
+    -------
+    SymbolicModel
+        As :func:`charged_particle` returns it.
+
+    See Also
+    --------
+    varmech.scenes.charged_particle_nonuniform : the native scene it twins.
+
+    Examples
+    --------
+    >>> from varmech.symbolic import examples
+    >>> examples.charged_particle_nonuniform().parameters["kappa"]
+    0.25
+    """
     return charged_particle(kappa=0.25, jit=jit)
 
 
@@ -200,6 +387,38 @@ def damped_driven_pendulum(
     with the Rayleigh dissipation R and the driving torque Q as a force (``amplitude`` is A,
     ``drive`` is Ω). The defaults are the native scene's, Baker & Gollub's chaotic regime
     (γ = ½, A = 3/2, Ω = 2/3, m = l = g = 1).
+
+    Parameters
+    ----------
+    gamma : float, default 0.5
+        The damping γ.
+    amplitude : float, default 1.5
+        The torque's amplitude A.
+    drive : float, default 2/3
+        The driving frequency Ω.
+    m : float, default 1.0
+        The mass.
+    l : float, default 1.0
+        The rod's length.
+    g : float, default 1.0
+        The gravitational acceleration.
+    jit : bool, default True
+        Compile the model's tapes (Cranelift), or interpret them.
+
+    Returns
+    -------
+    SymbolicModel
+        A forced general Lagrangian, n = 1.
+
+    See Also
+    --------
+    varmech.scenes.damped_driven_pendulum : the native scene it twins.
+
+    Examples
+    --------
+    >>> from varmech.symbolic import examples
+    >>> examples.damped_driven_pendulum(gamma=0.0).parameters["gamma"]
+    0.0
     """
     th, om, t = sp.symbols("theta omega t")
     gamma_, amplitude_, drive_ = sp.symbols("gamma amplitude drive")
@@ -223,6 +442,37 @@ def cartesian_pendulum(m: float = 1.0, l: float = 1.0, g: float = 1.0, *, jit: b
         L = ½m(ẋ² + ẏ²) − mgy,   g(q) = ½(x² + y² − l²) = 0
 
     (m = l = g = 1 by default), integrated by ``rattle``.
+
+    Parameters
+    ----------
+    m : float, default 1.0
+        The mass.
+    l : float, default 1.0
+        The rod's length.
+    g : float, default 1.0
+        The gravitational acceleration.
+    jit : bool, default True
+        Compile the model's tapes (Cranelift), or interpret them.
+
+    Returns
+    -------
+    SymbolicModel
+        A separable mechanical system, n = 2, with one holonomic constraint.
+
+    Raises
+    ------
+    ValueError
+        Naming ``mass`` when ``m`` is not finite and positive.
+
+    See Also
+    --------
+    varmech.scenes.cartesian_pendulum : the native scene it twins.
+
+    Examples
+    --------
+    >>> from varmech.symbolic import examples
+    >>> examples.cartesian_pendulum(l=2.0).constraints
+    1
     """
     x, y, vx, vy = sp.symbols("x y v_x v_y")
     m_, l_, g_ = sp.symbols("m l g", positive=True)
@@ -251,6 +501,29 @@ def elastic_pendulum(
     energy is conserved, and the motion is chaotic at large amplitude. It hangs at rest at
     r = l_eq = l₀ + mg/k, about which the small oscillations are the radial one at √(k/m) and
     the swing at √(g/l_eq). Defaults: m = 1, k = 10, l₀ = 1, g = 9.80665.
+
+    Parameters
+    ----------
+    m : float, default 1.0
+        The mass.
+    k : float, default 10.0
+        The spring's stiffness.
+    l0 : float, default 1.0
+        The spring's rest length l₀.
+    g : float, default 9.80665
+        The gravitational acceleration.
+    jit : bool, default True
+        Compile the model's tapes (Cranelift), or interpret them.
+
+    Returns
+    -------
+    SymbolicModel
+        A general Lagrangian, n = 2.
+
+    See Also
+    --------
+    elastic_pendulum_cartesian : the same pendulum, separable.
+    scene : its scene, ``scene("elastic_pendulum")``.
 
     Examples
     --------
@@ -285,6 +558,33 @@ def elastic_pendulum_cartesian(
     The same two degrees of freedom as in polar coordinates, but with a constant mass matrix:
     the model is separable, so every explicit composition applies (up to Kahan–Li's order 8),
     where the polar form takes only the implicit methods. Defaults as :func:`elastic_pendulum`.
+
+    Parameters
+    ----------
+    m : float, default 1.0
+        The mass.
+    k : float, default 10.0
+        The spring's stiffness.
+    l0 : float, default 1.0
+        The spring's rest length l₀.
+    g : float, default 9.80665
+        The gravitational acceleration.
+    jit : bool, default True
+        Compile the model's tapes (Cranelift), or interpret them.
+
+    Returns
+    -------
+    SymbolicModel
+        A separable mechanical system, n = 2.
+
+    Raises
+    ------
+    ValueError
+        Naming ``mass`` when ``m`` is not finite and positive.
+
+    See Also
+    --------
+    elastic_pendulum : the same pendulum in polar coordinates.
 
     Examples
     --------
@@ -324,6 +624,28 @@ def rotating_hoop(
     T + V = h + mR²Ω² sin²θ is not: the motor works on the bead at the rate
     d(T + V)/dt = mR²Ω² sin 2θ θ̇. For Ω² > g/R the bottom is unstable and the bead rests
     (relative to the hoop) at cos θ* = g/(RΩ²). Defaults: m = R = 1, Ω = 5, g = 9.80665.
+
+    Parameters
+    ----------
+    m : float, default 1.0
+        The mass.
+    R : float, default 1.0
+        The hoop's radius.
+    Omega : float, default 5.0
+        The hoop's rate of turn Ω.
+    g : float, default 9.80665
+        The gravitational acceleration.
+    jit : bool, default True
+        Compile the model's tapes (Cranelift), or interpret them.
+
+    Returns
+    -------
+    SymbolicModel
+        A Lagrangian in t's presence, separable once simplified, n = 1.
+
+    See Also
+    --------
+    varmech.symbolic.lagrangian : builds it from L(θ, θ̇, t).
 
     Examples
     --------
@@ -371,7 +693,37 @@ def symbolic_of(scene: Scene, *, jit: bool = True) -> SymbolicModel:
     keyword of that name, compared without case — the charged particle's ``b`` is ``B``; the
     others, such as Kepler's eccentricity ``e``, set the initial state, not the model).
 
-    ValueError for a scene without a symbolic twin.
+    Parameters
+    ----------
+    scene : Scene
+        A scene of :mod:`varmech.scenes`.
+    jit : bool, default True
+        Compile the model's tapes (Cranelift), or interpret them.
+
+    Returns
+    -------
+    SymbolicModel
+        The symbolic model of the scene's Lagrangian at its parameters.
+
+    Raises
+    ------
+    ValueError
+        Naming ``scene`` for a scene without a symbolic twin.
+
+    See Also
+    --------
+    varmech.examples.closure_of : the closure twin.
+
+    Examples
+    --------
+    >>> import varmech
+    >>> from varmech.symbolic import examples
+    >>> examples.symbolic_of(varmech.scenes.kepler_polar()).parameters
+    {'m': 1.0, 'k': 1.0}
+    >>> examples.symbolic_of(varmech.scenes.pendulum())
+    Traceback (most recent call last):
+    ...
+    ValueError: scene: 'pendulum' has no symbolic twin in varmech.symbolic.examples
     """
     twin = _TWINS.get(scene.name) if scene.name in CATALOGUE else None
     if twin is None:
@@ -407,7 +759,33 @@ def scene(name: str) -> Scene:
     """The symbolic scene called ``name`` (one of :data:`varmech.scenes.SYMBOLIC`): a compiled
     model with its initial state and horizon, which :func:`varmech.scenes.get`, the
     measurement tools and ``python -m varmech chart`` take as they take a built-in scene.
-    ValueError for another name."""
+
+    Parameters
+    ----------
+    name : str
+        One of :data:`varmech.scenes.SYMBOLIC`.
+
+    Returns
+    -------
+    Scene
+        The compiled model with its initial state, horizon and step.
+
+    Raises
+    ------
+    ValueError
+        Naming ``name`` for another name.
+
+    See Also
+    --------
+    varmech.scenes.get : the built-in scenes, and these by name.
+
+    Examples
+    --------
+    >>> from varmech.symbolic import examples
+    >>> s = examples.scene("elastic_pendulum")
+    >>> s.dt, s.t_end, s.model.kind_name
+    (0.05, 1000.0, 'separable')
+    """
     if name not in _SCENES:
-        raise ValueError(f"scene: unknown symbolic scene {name!r}; choose from {', '.join(_SCENES)}")
+        raise ValueError(f"name: unknown symbolic scene {name!r}; choose from {', '.join(_SCENES)}")
     return _SCENES[name]()
