@@ -157,7 +157,7 @@ class Trajectory:
 
     def constraint_residuals(self) -> tuple[np.ndarray, np.ndarray]:
         """|g(q)|∞ and |G(q)M⁻¹p|∞ at each saved state of a constrained model, shapes (N,); 0
-        and |A(q)q̇|∞ with velocity constraints."""
+        and |A(q)q̇|∞ with velocity constraints; |g(q)|∞ and |G(q)q̇, A(q)q̇ + b(q)|∞ with both."""
         return _core.constraint_residuals(self.model._core, *self._arrays()[1:])[0]
 
     def _arrays(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
