@@ -57,7 +57,7 @@ fn the_skate_holds_both_constraints_to_round_off_and_its_energy_without_drift() 
         let r = model.residuals(traj.q_at(k), traj.p_at(k)).unwrap();
         position = position.max(r.position);
         velocity = velocity.max(r.velocity / r.velocity_size);
-        energy.push(model.system.energy(traj.q_at(k), traj.p_at(k), 0.0).unwrap());
+        energy.push(Lagrangian::energy(&model.system, traj.q_at(k), traj.p_at(k), 0.0).unwrap());
     }
     let tenth = energy.len() / 10;
     let spread = |e: &[f64]| e.iter().fold(0.0_f64, |a, x| a.max((x - energy[0]).abs()));
@@ -107,17 +107,11 @@ fn a_height_held_at_zero_changes_nothing_in_the_plane() {
     // Lagrange–d'Alembert steps, so the same states to round-off.
     let (h, steps) = (0.05, 2_000);
     let plane = Nonholonomic {
-        system: Pushed {
-            mass: vec![1.0, 1.0, INERTIA],
-            force: vec![SLOPE, 0.0, 0.0],
-        },
+        system: Pushed::new(vec![1.0, 1.0, INERTIA], vec![SLOPE, 0.0, 0.0]),
         constraints: KnifeEdge(Heading::Angle(2)),
     };
     let lifted = Mixed {
-        system: Pushed {
-            mass: vec![1.0, 1.0, INERTIA, 2.0],
-            force: vec![SLOPE, 0.0, 0.0, -9.81 * 2.0],
-        },
+        system: Pushed::new(vec![1.0, 1.0, INERTIA, 2.0], vec![SLOPE, 0.0, 0.0, -9.81 * 2.0]),
         holonomic: Holding::Plane(3),
         velocity: KnifeEdge(Heading::Angle(2)),
     };

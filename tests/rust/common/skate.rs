@@ -3,37 +3,39 @@
 //! (tests/rust/mixed_constraints.rs; the allocation test steps it too).
 
 use nalgebra::DMatrix;
-use varmech::model::{HolonomicConstraints, Lagrangian, Mixed, VelocityConstraints};
+use varmech::model::{HolonomicConstraints, Mass, MechanicalSystem, Mixed, VelocityConstraints};
 use varmech::ModelError;
 
-/// L = ½Σ mᵢq̇ᵢ² + f·q: free masses under a constant force.
+/// L = ½q̇ᵀ diag(m) q̇ + f·q: free masses under a constant force, V = −f·q.
 pub struct Pushed {
-    pub mass: Vec<f64>,
+    pub mass: Mass,
     pub force: Vec<f64>,
 }
 
-impl Lagrangian for Pushed {
+impl Pushed {
+    pub fn new(mass: Vec<f64>, force: Vec<f64>) -> Self {
+        Pushed {
+            mass: Mass::diagonal(mass).expect("positive masses"),
+            force,
+        }
+    }
+}
+
+impl MechanicalSystem for Pushed {
     fn dim(&self) -> usize {
-        self.mass.len()
+        self.force.len()
     }
 
-    fn lagrangian(&self, q: &[f64], v: &[f64], _t: f64) -> Result<f64, ModelError> {
-        let kinetic: f64 = v.iter().zip(&self.mass).map(|(v, m)| 0.5 * m * v * v).sum();
-        Ok(kinetic + q.iter().zip(&self.force).map(|(q, f)| q * f).sum::<f64>())
+    fn mass(&self) -> &Mass {
+        &self.mass
     }
 
-    fn dl_dq(&self, _q: &[f64], _v: &[f64], _t: f64, out: &mut [f64]) -> Result<(), ModelError> {
-        out.copy_from_slice(&self.force);
-        Ok(())
+    fn potential(&self, q: &[f64]) -> Result<f64, ModelError> {
+        Ok(-q.iter().zip(&self.force).map(|(q, f)| q * f).sum::<f64>())
     }
 
-    fn dl_dv(&self, _q: &[f64], v: &[f64], _t: f64, out: &mut [f64]) -> Result<(), ModelError> {
-        out.iter_mut().zip(v).zip(&self.mass).for_each(|((o, v), m)| *o = m * v);
-        Ok(())
-    }
-
-    fn velocity(&self, _q: &[f64], p: &[f64], _t: f64, v: &mut [f64]) -> Result<(), ModelError> {
-        v.iter_mut().zip(p).zip(&self.mass).for_each(|((v, p), m)| *v = p / m);
+    fn gradient(&self, _q: &[f64], grad: &mut [f64]) -> Result<(), ModelError> {
+        grad.iter_mut().zip(&self.force).for_each(|(g, f)| *g = -f);
         Ok(())
     }
 }
@@ -108,10 +110,7 @@ pub const OMEGA: f64 = 1.3;
 /// turning at ω, at rest otherwise).
 pub fn skate() -> (Mixed<Pushed, Holding, KnifeEdge>, Vec<f64>, Vec<f64>) {
     let model = Mixed {
-        system: Pushed {
-            mass: vec![1.0, 1.0, INERTIA, INERTIA],
-            force: vec![SLOPE, 0.0, 0.0, 0.0],
-        },
+        system: Pushed::new(vec![1.0, 1.0, INERTIA, INERTIA], vec![SLOPE, 0.0, 0.0, 0.0]),
         holonomic: Holding::Circle(2),
         velocity: KnifeEdge(Heading::Vector(2)),
     };
