@@ -331,6 +331,8 @@ class ConservationReport:
         for m in self.momenta:
             lines += ["  " + line for line in m.describe("J")]
         residuals = ("g(q)", "G M⁻¹ p") if len(self.constraints or ()) == 2 else ("A q̇ + b" if self.affine else "A q̇",)
+        if self.constraints and len(self.constraints) == 2 and self.constraints[1].name != "|G q̇|":
+            residuals = ("g(q)", "G q̇, A q̇ + b")  # holonomic and velocity constraints together
         for c, error in zip(self.constraints or (), residuals):
             lines += ["  " + line for line in c.describe("r", error)]
         return "\n".join(lines)

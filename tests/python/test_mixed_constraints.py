@@ -89,6 +89,22 @@ def test_symbolic_and_closure_skates_take_the_same_steps():
     assert np.max(np.abs(steeper.q[-1] - exact(4.0) * [2, 2, 1, 1])) < 2e-2
 
 
+def test_a_mass_closure_skate_takes_the_closure_skates_steps():
+    # The natural-system path (a mass closure M(q), here constant): the same states to round-off.
+    natural = varmech.MechanicalSystem(
+        4, lambda q: -SLOPE * q[0], lambda q: np.array([-SLOPE, 0.0, 0.0, 0.0]),
+        mass=lambda q: np.diag([1.0, 1.0, INERTIA, INERTIA]), mass_derivative=lambda q: np.zeros((4, 4, 4)),
+        constraints=circle, constraint_jacobian=circle_jacobian, constraint_count=1,
+        velocity_constraints=blade, velocity_constraint_count=1,
+    )
+    assert (natural.kind.name, natural.constraints, natural.velocity_constraints) == ("nonholonomic", 1, 1)
+    run = dict(dt=0.05, steps=2_000, save_every=100)
+    a, b = varmech.integrate(natural, Q0, v0=V0, **run), varmech.integrate(skate(), Q0, v0=V0, **run)
+    assert np.max(np.abs(a.q - b.q)) < 1e-12 and np.max(np.abs(a.p - b.p)) < 1e-12  # measured 8.8e-14
+    assert np.max(a.constraint_residuals()[0]) < 1e-15 and np.max(a.constraint_residuals()[1]) < 1e-14
+    assert "|G q̇, A q̇ + b| = " in str(varmech.check_conservation(a))
+
+
 def test_a_height_held_at_zero_changes_nothing_in_the_plane():
     # The skate with its heading an angle, q = (x, y, φ), and the same skate lifted by a height
     # z that gravity pulls down and g(q) = z holds at 0: the same steps, to round-off.
