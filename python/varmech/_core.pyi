@@ -308,15 +308,18 @@ class ClosureConstrained(_ModelProperties):
 
 @final
 class ClosureNonholonomic(_ModelProperties):
-    """A closure model with velocity constraints A(q)q̇ = 0 from a Python closure."""
+    """A closure model with velocity constraints A(q)q̇ = 0 from a Python closure, alone or
+    beside holonomic ones (a ClosureConstrained system)."""
 
     def __new__(
         cls,
-        system: ClosureModel | ClosureNatural | ClosureLagrangian,
+        system: ClosureModel | ClosureNatural | ClosureLagrangian | ClosureConstrained,
         count: int,
         matrix: Callable[[_FloatArray], Any],
         offset: Callable[[_FloatArray], Any] | None = None,
     ) -> ClosureNonholonomic: ...
+    @property
+    def constraints(self) -> int: ...
     @property
     def velocity_constraints(self) -> int: ...
 

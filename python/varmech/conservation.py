@@ -286,7 +286,7 @@ class ConservationReport:
         Lagrange–d'Alembert energy balance), judged as the energy is.
     constraints : tuple of InvariantStatistics or None
         For constrained models: |g(q)|∞ and |G(q)M⁻¹p|∞ over the run; with velocity
-        constraints |A(q)q̇ + b(q)|∞ alone.
+        constraints |A(q)q̇ + b(q)|∞ alone; with both, |g(q)|∞ and |G(q)q̇, A(q)q̇ + b(q)|∞.
     affine : bool
         Whether the velocity constraints are affine (b ≠ 0, a moving surface): their forces do
         work, and the energy is not judged.
@@ -321,7 +321,7 @@ class ConservationReport:
     #: Lagrange–d'Alembert energy balance), judged as the energy is.
     energy_balance: InvariantStatistics | None = None
     #: For constrained models: |g(q)|∞ and |G(q)M⁻¹p|∞ over the run; with velocity constraints
-    #: |A(q)q̇ + b(q)|∞ alone.
+    #: |A(q)q̇ + b(q)|∞ alone; with both, |g(q)|∞ and |G(q)q̇, A(q)q̇ + b(q)|∞.
     constraints: tuple[InvariantStatistics, ...] | None = None
     #: Whether the velocity constraints are affine (b ≠ 0): then the energy is not judged.
     affine: bool = False
@@ -362,6 +362,8 @@ class ConservationReport:
         for m in self.momenta:
             lines += ["  " + line for line in m.describe("J")]
         residuals = ("g(q)", "G M⁻¹ p") if len(self.constraints or ()) == 2 else ("A q̇ + b" if self.affine else "A q̇",)
+        if self.constraints and len(self.constraints) == 2 and self.constraints[1].name != "|G q̇|":
+            residuals = ("g(q)", "G q̇, A q̇ + b")  # holonomic and velocity constraints together
         for c, error in zip(self.constraints or (), residuals):
             lines += ["  " + line for line in c.describe("r", error)]
         return "\n".join(lines)
@@ -432,9 +434,11 @@ def check_conservation(traj: Trajectory, generators: Sequence[Generator] | None 
     constraints: tuple[InvariantStatistics, ...] | None = None
     if model.constraints:
         (g, v), (g_size, v_size) = _core.constraint_residuals(model._core, *traj._arrays()[1:])
+        # With velocity constraints beside them, the velocities' residual holds both sets.
+        name, scale = ("|G q̇, A q̇ + b|", "mean ‖[G; A]‖‖q̇‖ + |b|") if model.velocity_constraints else ("|G q̇|", "mean ‖G‖‖q̇‖")
         constraints = (
             _statistics(_core.statistics(t, g, g_size, g_size, steps), "|g(q)|", g[0], "mean ‖G‖‖q‖", t),
-            _statistics(_core.statistics(t, v, v_size, v_size, steps), "|G q̇|", v[0], "mean ‖G‖‖q̇‖", t),
+            _statistics(_core.statistics(t, v, v_size, v_size, steps), name, v[0], scale, t),
         )
     elif model.velocity_constraints:
         (_, v), (_, v_size) = _core.constraint_residuals(model._core, *traj._arrays()[1:])

@@ -232,7 +232,8 @@ class Trajectory:
         -------
         position, velocity : ndarray, shape (N,)
             |g(q)|∞ and |G(q)M⁻¹p|∞ (the hidden constraint) for holonomic constraints;
-            0 and |A(q)q̇|∞ for velocity constraints.
+            0 and |A(q)q̇|∞ for velocity constraints; |g(q)|∞ and |G(q)q̇, A(q)q̇ + b(q)|∞
+            with both.
 
         Raises
         ------

@@ -505,7 +505,10 @@ class MechanicalSystem(Model):
         with ``velocity_constraint_count`` = m. Integrated by the reversible discrete
         Lagrange–d'Alembert integrator, ``midpoint`` (the default), its order-4 composition
         ``dla4``, or the non-reversible ``cortes_martinez`` (see the user guide, "Rolling and other
-        nonholonomic constraints"); not together with holonomic ``constraints``.
+        nonholonomic constraints"). With holonomic ``constraints`` too (m plus their count below
+        n), each step also holds g(q) = 0 and puts the velocity on both: the model's kind stays
+        ``nonholonomic``, and :func:`varmech.check_conservation` reports |g(q)| and
+        |G q̇, A q̇ + b| together.
     velocity_constraint_offset
         With ``velocity_constraints``: ``velocity_constraint_offset(q) -> array (m,)``, the
         affine term b(q) of affine constraints A(q)q̇ + b(q) = 0 (a moving surface: on a table
@@ -528,7 +531,8 @@ class MechanicalSystem(Model):
     ValueError
         A malformed argument, named: ``dim`` not positive, a ``mass`` that is not positive
         (definite) or of the wrong shape, a count without its constraints or constraints
-        without their count, velocity and holonomic constraints together.
+        without their count, velocity and holonomic constraints more than n − 1 together
+        (naming ``velocity_constraint_count``).
     TypeError
         A function pointer with another signature than :data:`varmech.pointers.SIGNATURE`, or
         pointers and closures mixed in one model, naming the argument.
@@ -606,8 +610,6 @@ class MechanicalSystem(Model):
         if (constraints is None) != (constraint_count is None) or (constraint_jacobian is not None and constraints is None):
             raise ValueError("constraints: give constraints(q) with constraint_count (and optionally constraint_jacobian)")
         _check_velocity_constraints(velocity_constraints, velocity_constraint_count, velocity_constraint_offset)
-        if constraints is not None and velocity_constraints is not None:
-            raise ValueError("velocity_constraints: not together with holonomic constraints (yet); give one kind")
         native = pointers.functions({"potential": potential, "gradient": gradient}, int(dim))
         others = {"mass": mass if callable(mass) else None, "mass_derivative": mass_derivative}
         others |= {"constraints": constraints, "constraint_jacobian": constraint_jacobian}
@@ -690,8 +692,9 @@ def _check_velocity_constraints(
 def _roll(
     core: Any, matrix: Callable[[np.ndarray], ArrayLike] | None, count: int | None, offset: Callable[[np.ndarray], ArrayLike] | None
 ) -> Any:
-    """The unconstrained closure model ``core`` with the velocity constraints A(q)q̇ + b(q) = 0
-    of ``matrix`` (m = ``count`` rows) and ``offset`` (b; 0 without it), if any."""
+    """The closure model ``core`` (unconstrained, or on holonomic constraints) with the
+    velocity constraints A(q)q̇ + b(q) = 0 of ``matrix`` (m = ``count`` rows) and ``offset`` (b;
+    0 without it), if any."""
     if matrix is None or count is None:
         return core
     return _core.ClosureNonholonomic(core, int(count), matrix, offset)

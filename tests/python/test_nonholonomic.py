@@ -263,5 +263,6 @@ def test_symbolic_velocity_constraints_that_are_not_a_q_qdot_are_named(rows, mes
     T = sum(s**2 for s in v) / 2
     with pytest.raises(ValueError, match=rf"^velocity_constraints\[0\]: .*{message}"):
         varmech.symbolic.lagrangian(T, q, v, t=t, velocity_constraints=rows(v, q, t))
-    with pytest.raises(ValueError, match="^velocity_constraints: not together with holonomic constraints"):
-        varmech.symbolic.lagrangian(T, q, v, constraints=[q[0]], velocity_constraints=[v[1] - q[0] * v[2]])
+    # Beside holonomic constraints they are taken too (issue 18: tests/python/test_mixed_constraints.py).
+    both = varmech.symbolic.lagrangian(T, q, v, constraints=[q[0]], velocity_constraints=[v[1] - q[0] * v[2]])
+    assert (both.constraints, both.velocity_constraints, both.kind.name) == (1, 1, "nonholonomic")

@@ -1,6 +1,7 @@
 //! The native step loop allocates nothing (with or without events): a long run makes exactly as many allocations as a
 //! run of 100 steps (the set-up's), whatever the method, and so does RATTLE's on a chain and the
-//! discrete Lagrange–d'Alembert step's on the rolling scenes; a
+//! discrete Lagrange–d'Alembert step's on the rolling scenes and, with a holonomic constraint
+//! too, on the skate; a
 //! stepper's steps make none at all, nor does taking it apart, resuming and resetting it.
 
 use std::alloc::{GlobalAlloc, Layout, System};
@@ -11,6 +12,9 @@ use varmech::integrators::{integrate, Dynamics, General, Method, ModelKind, Opti
 use varmech::model::Routhian;
 use varmech::scenes::{self, NBody, NonholonomicScene, SceneModel};
 
+#[path = "common/skate.rs"]
+#[allow(dead_code)] // the skate's other forms serve the mixed-constraints tests
+mod skate;
 #[path = "common/tapes.rs"]
 mod tapes;
 
@@ -340,5 +344,27 @@ fn the_nonholonomic_step_loop_allocates_nothing() {
                 "{name}, {method:?}: {short} allocations for 100 steps, {long} for 5000"
             );
         }
+    }
+}
+
+#[test]
+fn the_mixed_constraints_step_loop_allocates_nothing() {
+    // The skate: g(q) = 0 and A(q)q̇ = 0 together, the Jacobian by differences of the equations.
+    let (model, q0, p0) = skate::skate();
+    let methods = Method::ALL.into_iter().filter(|&m| ModelKind::Nonholonomic.admits(m));
+    for method in methods {
+        let run = |steps| {
+            let options = Options {
+                save_every: 10,
+                ..Options::new(0.01, steps)
+            };
+            counted(&model, method, &q0, &p0, &options)
+        };
+        run(10);
+        let (short, long) = (run(100), run(5_000));
+        assert_eq!(
+            short, long,
+            "{method:?}: {short} allocations for 100 steps, {long} for 5000"
+        );
     }
 }

@@ -23,6 +23,7 @@ mod hessians;
 mod jit;
 mod kepler;
 mod kepler_polar;
+mod mixed_constraints;
 mod nbody_kernel;
 mod nonholonomic;
 mod nonholonomic_scenes;

@@ -86,8 +86,8 @@ def lagrangian(
         Nonholonomic constraints A(q)q̇ = 0 (rolling without slipping, a skate's blade): a list
         of m < n expressions linear in the velocities; A = ∂c/∂q̇ and its derivatives ∂A/∂q are
         derived, and the model takes the discrete Lagrange–d'Alembert integrator. A coordinate
-        they move (its column of A not ≡ 0) is not cyclic: the constraint force acts on it. Not
-        together with ``constraints`` (yet).
+        they move (its column of A not ≡ 0) is not cyclic: the constraint force acts on it. With
+        ``constraints`` too (fewer than n of both), each step also holds g(q) = 0.
     force
         A generalized force Q(q, q̇, t), one expression per coordinate (friction, driving).
     rayleigh
@@ -115,8 +115,8 @@ def lagrangian(
         An expression that cannot be compiled (an unsupported function such as an undefined
         ``sympy.Function('f')``, or a symbol that is neither a coordinate, a velocity, t nor a
         parameter), naming it and why; constraints of the wrong number or depending on q̇ or t;
-        velocity constraints not linear in q̇, with a part free of q̇, depending on t or given
-        with ``constraints``, naming them; a force with the wrong number of components.
+        velocity constraints not linear in q̇, with a part free of q̇, depending on t, or with
+        ``constraints`` n or more together, naming them; a force with the wrong number of components.
 
     Examples
     --------
@@ -302,8 +302,6 @@ def _build(
     :func:`mechanical`."""
     forces = expressions(force, "force", variables) if force is not None else None
     dissipation = variables.plain(rayleigh, "rayleigh") if rayleigh is not None else None
-    if constraints is not None and velocity_constraints is not None:
-        raise ValueError("velocity_constraints: not together with holonomic constraints (yet); give one kind")
     holonomic = expressions(constraints, "constraints", variables) if constraints is not None else None
     nonholonomic = None
     if velocity_constraints is not None:

@@ -11,7 +11,7 @@ use varmech::model::compiled::{
     CompiledConstraints, CompiledLagrangian, CompiledModel as Compiled, CompiledSeparable, CompiledVelocityConstraints,
     Function, Tape,
 };
-use varmech::model::{Constrained, HolonomicConstraints, Nonholonomic, VelocityConstraints};
+use varmech::model::{Constrained, HolonomicConstraints, Mixed, Nonholonomic, VelocityConstraints};
 
 use crate::convert::slice;
 use crate::errors::to_pyerr;
@@ -46,6 +46,8 @@ impl CompiledModel {
             }),
             Compiled::NonholonomicSeparable(c) => body(c),
             Compiled::NonholonomicLagrangian(c) => body(c),
+            Compiled::MixedSeparable(c) => body(c),
+            Compiled::MixedLagrangian(c) => body(c),
         }
     }
 }
@@ -163,10 +165,12 @@ impl CompiledModel {
                 .map_err(err)?,
             ),
         };
-        if constraints > 0 && velocity_constraints > 0 {
-            return Err(PyValueError::new_err(
-                "velocity_constraints: not together with holonomic constraints (yet); give one kind",
-            ));
+        if constraints > 0 && velocity_constraints > 0 && constraints + velocity_constraints >= dim {
+            return Err(PyValueError::new_err(format!(
+                "velocity_constraints: with the {constraints} holonomic constraints, at most dim − 1 − \
+                 {constraints} = {} velocity constraints fit on {dim} coordinates, got {velocity_constraints}",
+                dim.saturating_sub(1 + constraints)
+            )));
         }
         let rolling = match velocity_constraints {
             0 => None,
@@ -197,7 +201,12 @@ impl CompiledModel {
                 )
                 .map_err(err)?;
                 match (constraint_functions, rolling) {
-                    (Some(c), _) => Compiled::ConstrainedSeparable(Constrained {
+                    (Some(holonomic), Some(velocity)) => Compiled::MixedSeparable(Mixed {
+                        system: s,
+                        holonomic,
+                        velocity,
+                    }),
+                    (Some(c), None) => Compiled::ConstrainedSeparable(Constrained {
                         system: s,
                         constraints: c,
                     }),
@@ -220,7 +229,12 @@ impl CompiledModel {
                 )
                 .map_err(err)?;
                 match (constraint_functions, rolling) {
-                    (Some(c), _) => Compiled::ConstrainedLagrangian(Constrained {
+                    (Some(holonomic), Some(velocity)) => Compiled::MixedLagrangian(Mixed {
+                        system: l,
+                        holonomic,
+                        velocity,
+                    }),
+                    (Some(c), None) => Compiled::ConstrainedLagrangian(Constrained {
                         system: l,
                         constraints: c,
                     }),
@@ -254,6 +268,8 @@ impl CompiledModel {
         match &self.model {
             Compiled::ConstrainedSeparable(c) => c.constraints.count(),
             Compiled::ConstrainedLagrangian(c) => c.constraints.count(),
+            Compiled::MixedSeparable(c) => c.holonomic.count(),
+            Compiled::MixedLagrangian(c) => c.holonomic.count(),
             _ => 0,
         }
     }
@@ -264,6 +280,8 @@ impl CompiledModel {
         match &self.model {
             Compiled::NonholonomicSeparable(c) => c.constraints.count(),
             Compiled::NonholonomicLagrangian(c) => c.constraints.count(),
+            Compiled::MixedSeparable(c) => c.velocity.count(),
+            Compiled::MixedLagrangian(c) => c.velocity.count(),
             _ => 0,
         }
     }

@@ -6,6 +6,7 @@ use varmech::model::{Lagrangian, MechanicalSystem};
 use varmech::scenes::{Problem, State};
 use varmech::Error;
 
+pub mod skate;
 pub mod tapes;
 
 /// splitmix64: reproducible points without a dependency.

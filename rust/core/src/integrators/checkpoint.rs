@@ -25,7 +25,7 @@ pub struct Checkpoint {
 
 const MAGIC: &[u8; 8] = b"varmech\x01";
 /// The layout of [`StepperState`] and its parts; raise it whenever they change.
-pub const FORMAT: u32 = 1;
+pub const FORMAT: u32 = 2;
 const HEADER: usize = MAGIC.len() + 4;
 
 impl Checkpoint {

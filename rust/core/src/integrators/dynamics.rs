@@ -2,8 +2,8 @@
 
 use super::{Increment, Integrator, ModelKind, StepError, StepStart, StepperState};
 use crate::model::{
-    self, Constrained, EnergyTerms, HolonomicConstraints, Lagrangian, MechanicalSystem, Nonholonomic, PhaseState,
-    VelocityConstraints,
+    self, Constrained, EnergyTerms, HolonomicConstraints, Lagrangian, MechanicalSystem, Mixed, Nonholonomic,
+    PhaseState, VelocityConstraints,
 };
 use crate::{Error, ModelError};
 
@@ -311,5 +311,82 @@ impl<L: Lagrangian, C: VelocityConstraints> Dynamics for Nonholonomic<L, C> {
 
     fn project(&self, q: &[f64], p: &[f64]) -> Option<Result<PhaseState, Error>> {
         Some(Nonholonomic::project(self, q, p))
+    }
+}
+
+/// A Lagrangian on holonomic and velocity constraints together, for the discrete
+/// Lagrange–d'Alembert integrator with g(q₁) = 0 among its discrete constraints (see
+/// [`super::Del`]); its kind is the nonholonomic one, whose methods all take both.
+impl<L: Lagrangian, H: HolonomicConstraints, C: VelocityConstraints> Dynamics for Mixed<L, H, C> {
+    fn dim(&self) -> usize {
+        self.system.dim()
+    }
+
+    fn kind(&self) -> ModelKind {
+        ModelKind::Nonholonomic
+    }
+
+    /// |g(q₀)|∞ (else `q0` is off the constraints) and |[G; A](q₀)q̇₀ + [0; b]|∞ (else `p0`)
+    /// within 1e-10 of the state's size. A model error is the model's own, at step 0.
+    fn check_initial(&self, q0: &[f64], p0: &[f64]) -> Result<(), Error> {
+        let residuals = self.residuals(q0, p0).map_err(|source| Error::Model {
+            step: 0,
+            time: 0.0,
+            source,
+        })?;
+        let scale = q0.iter().chain(p0).fold(1.0_f64, |m, x| m.max(x.abs()));
+        let off = |x: f64| x.is_nan() || x > 1e-10 * scale;
+        if off(residuals.position) {
+            return Err(Error::invalid(
+                "q0",
+                format!(
+                    "is off the holonomic constraints: |g(q0)| = {:.3e}; project the initial state first",
+                    residuals.position
+                ),
+            ));
+        }
+        if off(residuals.velocity) {
+            return Err(Error::invalid(
+                "p0",
+                format!(
+                    "is off the constraints' velocities: |G(q0)q̇0, A(q0)q̇0 + b| = {:.3e}; project the initial \
+                     state first",
+                    residuals.velocity
+                ),
+            ));
+        }
+        Ok(())
+    }
+
+    fn increment(
+        &self,
+        integrator: &mut Integrator,
+        start: &StepStart,
+        increment: &mut Increment,
+    ) -> Result<(), StepError> {
+        integrator.increment_mixed(&self.system, (&self.holonomic, &self.velocity), start, increment)
+    }
+
+    /// E = p·q̇ − L, unless L depends on t or the velocity constraints are affine (the
+    /// holonomic ones, fixed, do no work).
+    fn energy(&self, q: &[f64], p: &[f64], t: f64) -> Option<Result<EnergyTerms, ModelError>> {
+        let conserved = !self.system.is_time_dependent() && !self.velocity.is_affine();
+        conserved.then(|| self.system.energy_terms(q, p, t))
+    }
+
+    fn as_lagrangian(&self) -> &dyn Lagrangian {
+        &self.system
+    }
+
+    fn constraint_residuals(&self, q: &[f64], p: &[f64]) -> Option<Result<model::Residuals, ModelError>> {
+        Some(self.residuals(q, p))
+    }
+
+    fn velocity_constraints(&self) -> Option<&dyn VelocityConstraints> {
+        Some(&self.velocity)
+    }
+
+    fn project(&self, q: &[f64], p: &[f64]) -> Option<Result<PhaseState, Error>> {
+        Some(Mixed::project(self, q, p))
     }
 }

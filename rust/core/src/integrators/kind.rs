@@ -18,9 +18,11 @@ pub enum ModelKind {
     /// A general Lagrangian on holonomic constraints: the constrained DEL equations of the
     /// two-point rules.
     ConstrainedLagrangian,
-    /// A Lagrangian (separable, natural or general) with velocity constraints A(q)q̇ = 0: the
-    /// discrete Lagrange–d'Alembert integrators on the midpoint rule (see [`super::Del`]), the
-    /// reversible one, its order-4 composition, and Cortés–Martínez's non-reversible one.
+    /// A Lagrangian (separable, natural or general) with velocity constraints A(q)q̇ = 0, alone
+    /// or beside holonomic ones g(q) = 0 ([`crate::model::Mixed`]): the discrete
+    /// Lagrange–d'Alembert integrators on the midpoint rule (see [`super::Del`]), the
+    /// reversible one, its order-4 composition, and Cortés–Martínez's non-reversible one, each
+    /// with g(q₁) = 0 among its discrete constraints when there are holonomic ones.
     Nonholonomic,
     /// The gravitational N-body problem ([`crate::model::NBody`]), a separable system with a
     /// dominant central body: every method of a separable system and the Wisdom–Holman methods.

@@ -301,15 +301,43 @@ impl Integrator {
         S: Lagrangian + ?Sized,
         C: VelocityConstraints,
     {
-        let at = match self.method {
-            Method::CortesMartinez => DiscreteConstraint::Start,
-            _ => DiscreteConstraint::Midpoint,
-        };
-        let c = Constraints::Velocity(constraints, at);
+        let c = Constraints::Velocity(constraints, self.discrete_constraint());
         match &mut self.scheme {
             Scheme::Midpoint(s) => s.increment(sys, c, *start, increment.reborrow()),
             Scheme::ComposedMidpoint(s) => s.increment(sys, c, *start, increment.reborrow()),
             _ => Err(self.method.refusal(ModelKind::Nonholonomic).into()),
+        }
+    }
+
+    /// As [`Integrator::increment_nonholonomic`] with holonomic constraints g(q) = 0 beside the
+    /// velocity constraints: the discrete Lagrange–d'Alembert equations with g(q₁) = 0 among
+    /// the discrete constraints and the momenta put on both hidden constraints (see [`Del`]).
+    pub fn increment_mixed<S, H, C>(
+        &mut self,
+        sys: &S,
+        (holonomic, velocity): (&H, &C),
+        start: &StepStart,
+        increment: &mut Increment,
+    ) -> Result<(), StepError>
+    where
+        S: Lagrangian + ?Sized,
+        H: HolonomicConstraints,
+        C: VelocityConstraints,
+    {
+        let c = Constraints::Mixed(holonomic, velocity, self.discrete_constraint());
+        match &mut self.scheme {
+            Scheme::Midpoint(s) => s.increment(sys, c, *start, increment.reborrow()),
+            Scheme::ComposedMidpoint(s) => s.increment(sys, c, *start, increment.reborrow()),
+            _ => Err(self.method.refusal(ModelKind::Nonholonomic).into()),
+        }
+    }
+
+    /// Where the method takes the velocity constraints' discrete constraint: at the step's
+    /// start for `cortes_martinez`, at its midpoint (reversible) otherwise.
+    fn discrete_constraint(&self) -> DiscreteConstraint {
+        match self.method {
+            Method::CortesMartinez => DiscreteConstraint::Start,
+            _ => DiscreteConstraint::Midpoint,
         }
     }
 

@@ -10,6 +10,7 @@
 //!   [`Constrained`], a mechanical system on them;
 //! - [`VelocityConstraints`]: nonholonomic constraints A(q)q̇ = 0, and [`Nonholonomic`], a
 //!   Lagrangian system on them; [`curvature`], Frobenius' test of whether they integrate;
+//! - [`Mixed`]: a Lagrangian system on holonomic and velocity constraints together;
 //! - [`NBody`]: point masses under Newtonian gravity, the model of the N-body scenes and of
 //!   the Wisdom–Holman methods;
 //! - [`Routhian`]: Routh reduction, R = L − μ·ċ on the non-cyclic coordinates;
@@ -26,6 +27,7 @@ mod frobenius;
 mod lagrangian;
 mod mass;
 mod mechanical;
+mod mixed;
 mod natural;
 mod nbody;
 mod nonholonomic;
@@ -42,6 +44,7 @@ pub use frobenius::curvature;
 pub use lagrangian::{Hessians, Lagrangian};
 pub use mass::Mass;
 pub use mechanical::MechanicalSystem;
+pub use mixed::Mixed;
 pub use natural::{differenced_kinetic_gradient, kinetic_gradient_from_mass_derivative, Natural, NaturalSystem};
 pub use nbody::{NBody, PairKernel};
 pub use nonholonomic::{differenced_derivative, Nonholonomic, VelocityConstraints};

@@ -78,6 +78,11 @@ impl ClosureConstrained {
 }
 
 impl ClosureConstrained {
+    /// Number of constraints m.
+    pub fn count(&self) -> usize {
+        self.count
+    }
+
     pub fn system(&self) -> &ConstrainedSystem {
         &self.system
     }

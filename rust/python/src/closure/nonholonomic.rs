@@ -1,5 +1,5 @@
 //! A closure model with velocity constraints A(q)q̇ + b(q) = 0 given by Python closures (b
-//! optional: linear constraints without it).
+//! optional: linear constraints without it), alone or beside holonomic ones.
 
 use std::cell::RefCell;
 
@@ -8,9 +8,10 @@ use numpy::PyArray1;
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use varmech::integrators::Dynamics;
-use varmech::model::{Natural, Nonholonomic, VelocityConstraints};
+use varmech::model::{Mixed, Natural, Nonholonomic, VelocityConstraints};
 use varmech::ModelError;
 
+use super::constraints::{ClosureConstrained, ClosureConstraints, ConstrainedSystem};
 use super::lagrangian::{ClosureLagrangian, ClosureLagrangianSystem};
 use super::mechanical::{ClosureModel, ClosureSystem};
 use super::natural::{ClosureNatural, ClosureNaturalSystem};
@@ -18,7 +19,8 @@ use super::readers::{call_array, check_closures, check_count};
 use crate::errors::boxed;
 
 /// A closure model (separable [`ClosureModel`], natural [`ClosureNatural`] or general
-/// [`ClosureLagrangian`]) with m velocity constraints A(q)q̇ + b(q) = 0, `matrix(q) -> array
+/// [`ClosureLagrangian`], or either of the first two on holonomic constraints,
+/// [`ClosureConstrained`]) with m velocity constraints A(q)q̇ + b(q) = 0, `matrix(q) -> array
 /// (m, n)` and optionally the affine term `offset(q) -> array (m,)`: the discrete
 /// Lagrange–d'Alembert integrator's model.
 #[pyclass(frozen, module = "varmech._core")]
@@ -29,11 +31,13 @@ pub struct ClosureNonholonomic {
     offset: Option<Py<PyAny>>,
 }
 
-/// The model under a [`ClosureNonholonomic`].
+/// The model under a [`ClosureNonholonomic`]'s velocity constraints.
 enum Unconstrained {
     Separable(Py<ClosureModel>),
     Natural(Py<ClosureNatural>),
     Lagrangian(Py<ClosureLagrangian>),
+    /// On holonomic constraints: the core's [`Mixed`] model.
+    Holonomic(Py<ClosureConstrained>),
 }
 
 #[pymethods]
@@ -52,9 +56,11 @@ impl ClosureNonholonomic {
             (Unconstrained::Natural(s.clone().unbind()), s.get().dim())
         } else if let Ok(s) = system.cast::<ClosureLagrangian>() {
             (Unconstrained::Lagrangian(s.clone().unbind()), s.get().dim())
+        } else if let Ok(s) = system.cast::<ClosureConstrained>() {
+            (Unconstrained::Holonomic(s.clone().unbind()), s.get().dim())
         } else {
             return Err(PyTypeError::new_err(
-                "system: expected a ClosureModel, a ClosureNatural or a ClosureLagrangian",
+                "system: expected a ClosureModel, a ClosureNatural, a ClosureLagrangian or a ClosureConstrained",
             ));
         };
         check_closures(
@@ -65,6 +71,16 @@ impl ClosureNonholonomic {
             ],
         )?;
         check_count("velocity_constraint_count", count, dim)?;
+        if let Unconstrained::Holonomic(s) = &system {
+            let holonomic = s.get().count();
+            if holonomic + count >= dim {
+                return Err(PyValueError::new_err(format!(
+                    "velocity_constraint_count: with the {holonomic} holonomic constraints, at most \
+                     dim − 1 − {holonomic} = {} velocity constraints fit on {dim} coordinates, got {count}",
+                    dim.saturating_sub(1 + holonomic)
+                )));
+            }
+        }
         Ok(ClosureNonholonomic {
             system,
             count,
@@ -79,6 +95,7 @@ impl ClosureNonholonomic {
             Unconstrained::Separable(s) => s.get().dim(),
             Unconstrained::Natural(s) => s.get().dim(),
             Unconstrained::Lagrangian(s) => s.get().dim(),
+            Unconstrained::Holonomic(s) => s.get().dim(),
         }
     }
 
@@ -87,17 +104,28 @@ impl ClosureNonholonomic {
         self.count
     }
 
+    /// Number of holonomic constraints g(q) = 0 beside the velocity constraints (0 without).
+    #[getter]
+    fn constraints(&self) -> usize {
+        match &self.system {
+            Unconstrained::Holonomic(s) => s.get().count(),
+            _ => 0,
+        }
+    }
+
     fn __repr__(&self) -> String {
         format!(
-            "ClosureNonholonomic(dim={}, velocity_constraints={})",
+            "ClosureNonholonomic(dim={}, constraints={}, velocity_constraints={})",
             self.dim(),
+            self.constraints(),
             self.count
         )
     }
 }
 
 impl ClosureNonholonomic {
-    /// Runs `body` with the model bound to the GIL as the core's [`Nonholonomic`] system.
+    /// Runs `body` with the model bound to the GIL as the core's [`Nonholonomic`] system, or
+    /// its [`Mixed`] one on holonomic constraints.
     pub fn with_integrable<R>(&self, py: Python<'_>, body: impl FnOnce(&dyn Dynamics) -> R) -> R {
         let constraints = ClosureVelocityConstraints {
             py,
@@ -119,6 +147,21 @@ impl ClosureNonholonomic {
                 system: ClosureLagrangianSystem::new(py, s.get()),
                 constraints,
             }),
+            Unconstrained::Holonomic(s) => {
+                let (s, holonomic) = (s.get(), ClosureConstraints::new(py, s.get()));
+                match s.system() {
+                    ConstrainedSystem::Separable(system) => body(&Mixed {
+                        system: ClosureSystem::new(py, system.get()),
+                        holonomic,
+                        velocity: constraints,
+                    }),
+                    ConstrainedSystem::Natural(system) => body(&Mixed {
+                        system: Natural::new(ClosureNaturalSystem::new(py, system.get())),
+                        holonomic,
+                        velocity: constraints,
+                    }),
+                }
+            }
         }
     }
 }

@@ -6,14 +6,15 @@ use serde::{Deserialize, Serialize};
 
 use super::{nonholonomic, Constraints, StepEquations};
 use crate::integrators::{Increment, StepError, StepStart};
-use crate::model::Lagrangian;
+use crate::model::{HolonomicConstraints, Lagrangian};
 use crate::solve::difference::{central_jacobian, Evaluations};
 use crate::solve::newton::{Correction, Newton, NewtonOptions, NewtonProblem, Reasons, Rules};
 use crate::ModelError;
 
 /// F(x) for x = (λ, s): the scheme's equations in s with (h/2)G(q₀)ᵀλ taken from the last
 /// block (the one holding p₀), then the discrete constraint on δq, the last n of s: g(q₀ + δq)
-/// for holonomic constraints, A(q̃)δq for velocity ones ([`nonholonomic::discrete_constraint`]).
+/// for holonomic constraints, A(q̃)δq + h b(q̃) for velocity ones
+/// ([`nonholonomic::discrete_constraint`]), both for mixed ones (G stacked over A in G(q₀)).
 // Inlined into Newton's iteration, whose chain of dependent evaluations a call would lengthen.
 #[inline(always)]
 pub(super) fn constrained_equations<Sc: StepEquations, S: Lagrangian + ?Sized>(
@@ -36,29 +37,52 @@ pub(super) fn constrained_equations<Sc: StepEquations, S: Lagrangian + ?Sized>(
         *o -= 0.5 * start.h * (0..m).map(|k| mp.g0[(k, j)] * lambda[k]).sum::<f64>();
     }
     let dq = &s[u - n..];
+    let (holonomic, velocity) = out[u..].split_at_mut(constraints.holonomic_count());
     match constraints {
         Constraints::Velocity(c, at) => {
-            nonholonomic::discrete_constraint((c, at), mp, (start.q, start.h), dq, &mut out[u..])
+            nonholonomic::discrete_constraint((c, at), mp, (start.q, start.h), dq, velocity)
         }
-        Constraints::Holonomic(c) => {
-            for ((q1, q), d) in mp.q1.iter_mut().zip(start.q).zip(dq) {
-                *q1 = q + d;
-            }
-            c.residual(&mp.q1, &mut out[u..])
+        Constraints::Holonomic(g) => position_constraint(g, mp, start.q, dq, holonomic),
+        Constraints::Mixed(g, c, at) => {
+            position_constraint(g, mp, start.q, dq, holonomic)?;
+            nonholonomic::discrete_constraint((c, at), mp, (start.q, start.h), dq, velocity)
         }
         Constraints::None => Ok(()),
     }
 }
 
-/// The buffers of the constrained step: G(q₀) and G(q₁) (or A), q₁ and p₁, and μ's Newton
-/// iteration; for velocity constraints also q̄, A(q̄), ∂A/∂qᵢ and the affine term's b(q̄),
-/// ∂b/∂qᵢ and b(q₁).
+/// g(q₀ + δq) into `out`, q₁ = q₀ + δq into `mp.q1`.
+fn position_constraint(
+    g: &dyn HolonomicConstraints,
+    mp: &mut Multipliers,
+    q0: &[f64],
+    dq: &[f64],
+    out: &mut [f64],
+) -> Result<(), ModelError> {
+    for ((q1, q), d) in mp.q1.iter_mut().zip(q0).zip(dq) {
+        *q1 = q + d;
+    }
+    g.residual(&mp.q1, out)
+}
+
+/// The two blocks of a stacked constraint matrix [G; A] of mixed constraints, where each set
+/// writes its own ([`Constraints::matrix`]).
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub(super) struct Parts {
+    pub holonomic: DMatrix<f64>,
+    pub velocity: DMatrix<f64>,
+}
+
+/// The buffers of the constrained step: G(q₀) and G(q₁) (or A, or [G; A] for mixed
+/// constraints, with its blocks), q₁ and p₁, and μ's Newton iteration; for velocity
+/// constraints also q̄, A(q̄), ∂A/∂qᵢ and the affine term's b(q̄), ∂b/∂qᵢ and b(q₁).
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub(super) struct Multipliers {
     /// G at the step's start; the last step's G(q₁) once a step is taken (first same as last).
     pub g0: DMatrix<f64>,
     pub cached: bool,
     g1: DMatrix<f64>,
+    pub parts: Parts,
     pub q1: Vec<f64>,
     pub midpoint: Vec<f64>,
     pub a_mid: DMatrix<f64>,
@@ -75,17 +99,23 @@ pub(super) struct Multipliers {
 }
 
 impl Multipliers {
-    pub fn new(n: usize, m: usize) -> Self {
+    /// The buffers for m constraints on n coordinates, the first `holonomic` of them holonomic.
+    pub fn new(n: usize, m: usize, holonomic: usize) -> Self {
+        let velocity = m - holonomic;
         Multipliers {
             g0: DMatrix::zeros(m, n),
             cached: false,
             g1: DMatrix::zeros(m, n),
+            parts: Parts {
+                holonomic: DMatrix::zeros(holonomic, n),
+                velocity: DMatrix::zeros(velocity, n),
+            },
             q1: vec![0.0; n],
             midpoint: vec![0.0; n],
-            a_mid: DMatrix::zeros(m, n),
-            da: DMatrix::zeros(m, n),
-            b_mid: vec![0.0; m],
-            db: vec![0.0; m],
+            a_mid: DMatrix::zeros(velocity, n),
+            da: DMatrix::zeros(velocity, n),
+            b_mid: vec![0.0; velocity],
+            db: vec![0.0; velocity],
             b1: vec![0.0; m],
             p1: vec![0.0; n],
             v: vec![0.0; n],
@@ -94,6 +124,11 @@ impl Multipliers {
             mu: vec![0.0; m],
             newton: Newton::new(m),
         }
+    }
+
+    /// Number of holonomic constraints the buffers are sized for.
+    pub fn holonomic(&self) -> usize {
+        self.parts.holonomic.nrows()
     }
 
     /// p₁ = p₀ + δp − (h/2)G(q₁)ᵀμ with G(q₁)q̇(q₁, p₁) + b(q₁) = 0 (G the constraints' Jacobian,
@@ -113,7 +148,7 @@ impl Multipliers {
         for ((x, q), d) in self.q1.iter_mut().zip(q).zip(step.dq.iter()) {
             *x = q + d;
         }
-        c.matrix(&self.q1, &mut self.g1)?;
+        c.matrix(&self.q1, &mut self.g1, &mut self.parts)?;
         c.offset(&self.q1, &mut self.b1)?;
         self.mu.fill(0.0);
         let mut problem = OntoHiddenConstraint {

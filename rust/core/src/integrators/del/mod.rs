@@ -25,7 +25,7 @@ use crate::solve::lu::lu_in_place;
 use crate::solve::newton::{Correction, Newton, NewtonProblem, Reasons, Rules};
 use crate::solve::NewtonOptions;
 use crate::ModelError;
-use constrained::{constrained_equations, Multipliers};
+use constrained::{constrained_equations, Multipliers, Parts};
 
 /// The implicit equations of one step of a variational integrator. The unknowns x are the
 /// increments from q₀ of every point the step solves for, n at a time; the last n are
@@ -81,24 +81,46 @@ pub(in crate::integrators) enum Constraints<'a> {
     /// A(q)q̇ = 0: the discrete Lagrange–d'Alembert equations, with the discrete constraint
     /// where it says (at the midpoint, reversible, unless a method asks otherwise).
     Velocity(&'a dyn VelocityConstraints, DiscreteConstraint),
+    /// g(q) = 0 and A(q)q̇ + b(q) = 0 together: the discrete Lagrange–d'Alembert equations
+    /// with both sets of multipliers, the holonomic rows first (g(q₁) = 0, then the velocity
+    /// constraints' discrete constraint), the constraint matrix stacked [G; A].
+    Mixed(
+        &'a dyn HolonomicConstraints,
+        &'a dyn VelocityConstraints,
+        DiscreteConstraint,
+    ),
 }
 
 impl Constraints<'_> {
-    /// Writes the constraint matrix at q into `out`: G(q) = ∂g/∂q, or A(q); nothing without
-    /// constraints.
-    fn matrix(&self, q: &[f64], out: &mut DMatrix<f64>) -> Result<(), ModelError> {
+    /// Writes the constraint matrix at q into `out`: G(q) = ∂g/∂q, A(q), or [G(q); A(q)]
+    /// (assembled in `parts`); nothing without constraints.
+    fn matrix(&self, q: &[f64], out: &mut DMatrix<f64>, parts: &mut Parts) -> Result<(), ModelError> {
         match self {
             Constraints::None => Ok(()),
             Constraints::Holonomic(c) => c.jacobian(q, out),
             Constraints::Velocity(c, _) => c.matrix(q, out),
+            Constraints::Mixed(g, a, _) => {
+                let k = g.count();
+                g.jacobian(q, &mut parts.holonomic)?;
+                a.matrix(q, &mut parts.velocity)?;
+                out.rows_mut(0, k).copy_from(&parts.holonomic);
+                out.rows_mut(k, a.count()).copy_from(&parts.velocity);
+                Ok(())
+            }
         }
     }
 
     /// Writes the affine term b(q) of velocity constraints A(q)q̇ + b(q) = 0 into `out`: 0 for
-    /// holonomic (their hidden constraint is G(q)q̇ = 0) and linear velocity constraints.
+    /// holonomic (their hidden constraint is G(q)q̇ = 0) and linear velocity constraints, and
+    /// for the holonomic rows of mixed ones.
     fn offset(&self, q: &[f64], out: &mut [f64]) -> Result<(), ModelError> {
         match self {
             Constraints::Velocity(c, _) => c.offset(q, out),
+            Constraints::Mixed(g, c, _) => {
+                let (holonomic, velocity) = out.split_at_mut(g.count());
+                holonomic.fill(0.0);
+                c.offset(q, velocity)
+            }
             Constraints::None | Constraints::Holonomic(_) => {
                 out.fill(0.0);
                 Ok(())
@@ -106,12 +128,21 @@ impl Constraints<'_> {
         }
     }
 
-    /// Number of constraints m.
+    /// Number of constraints m (of both kinds).
     fn count(&self) -> usize {
         match self {
             Constraints::None => 0,
             Constraints::Holonomic(c) => c.count(),
             Constraints::Velocity(c, _) => c.count(),
+            Constraints::Mixed(g, c, _) => g.count() + c.count(),
+        }
+    }
+
+    /// Number of holonomic constraints among them.
+    fn holonomic_count(&self) -> usize {
+        match self {
+            Constraints::Holonomic(c) | Constraints::Mixed(c, _, _) => c.count(),
+            Constraints::None | Constraints::Velocity(..) => 0,
         }
     }
 }
@@ -166,6 +197,19 @@ impl Constraints<'_> {
 /// round-off constraint residuals, and its reversibility is checked by the bounded energy of
 /// the sleigh and the disk in the tests.)
 ///
+/// With holonomic constraints g(q) = 0 beside the velocity constraints (a rolling body whose
+/// contact is held on a surface; [`crate::model::Mixed`]) the step takes both sets of
+/// multipliers, the forces (h/2)[G; A]ᵀλ at q₀ and (h/2)[G; A]ᵀμ at q₁ of the stacked
+/// constraint matrix:
+///
+/// p₀ + D₁L_d(q₀, q₁) − (h/2)[G; A](q₀)ᵀλ = 0,   g(q₁) = 0,   A(q̄)(q₁ − q₀) + h b(q̄) = 0,
+/// p₁ = D₂L_d(q₀, q₁) − (h/2)[G; A](q₁)ᵀμ,   [G; A](q₁)q̇(q₁, p₁) + [0; b(q₁)] = 0,
+///
+/// the constrained DEL equations (RATTLE's discrete constraint g(q₁) = 0) and the reversible
+/// DLA step at once: as symmetric as each, so that [`super::Method::Dla4`] composes it to
+/// order 4 (measured in tests/rust/mixed_constraints.rs, with the closed form of a skate on an
+/// incline).
+///
 /// With the discrete constraint at the step's start instead, A(q₀)(q₁ − q₀) = 0
 /// ([`super::Method::CortesMartinez`]), the step is Cortés & Martínez's (2001) discrete
 /// Lagrange–d'Alembert integrator: its DEL equations in (qₖ₋₁, qₖ, qₖ₊₁) are
@@ -207,7 +251,7 @@ impl<Sc: StepEquations> Del<Sc> {
             scheme,
             options,
             m: 0,
-            multipliers: Multipliers::new(n, 0),
+            multipliers: Multipliers::new(n, 0, 0),
             x: vec![0.0; m],
             plus: vec![0.0; m],
             minus: vec![0.0; m],
@@ -248,14 +292,15 @@ impl<Sc: StepEquations> Del<Sc> {
         self.multipliers.cached = false;
     }
 
-    /// Sizes the buffers for m constraints (allocating only when m changes).
-    fn size_for(&mut self, n: usize, m: usize) {
-        if m == self.m {
+    /// Sizes the buffers for m constraints, `holonomic` of them holonomic (allocating only
+    /// when they change).
+    fn size_for(&mut self, n: usize, m: usize, holonomic: usize) {
+        if m == self.m && holonomic == self.multipliers.holonomic() {
             return;
         }
         let total = self.scheme.unknowns(n) + m;
         self.m = m;
-        self.multipliers = Multipliers::new(n, m);
+        self.multipliers = Multipliers::new(n, m, holonomic);
         self.block = DMatrix::zeros(total - m, total - m);
         self.x = vec![0.0; total];
         self.plus = vec![0.0; total];
@@ -289,10 +334,11 @@ impl<Sc: StepEquations> Del<Sc> {
         out: Increment<'_>,
     ) -> Result<(), StepError> {
         let n = start.q.len();
-        self.size_for(n, constraints.count());
+        self.size_for(n, constraints.count(), constraints.holonomic_count());
         let m = self.m;
         if !self.multipliers.cached {
-            constraints.matrix(start.q, &mut self.multipliers.g0)?;
+            let Multipliers { g0, parts, .. } = &mut self.multipliers;
+            constraints.matrix(start.q, g0, parts)?;
         }
         if self.continuum_sign == 0.0 {
             let hessian_sign = self.hessian_sign(sys, start)?;
@@ -409,7 +455,7 @@ impl<Sc: StepEquations, S: Lagrangian + ?Sized> NewtonProblem for Equations<'_, 
 
     /// ∂F/∂x from the model's second derivatives where it supplies them and no force acts (the
     /// forces' derivatives are not supplied), with ∂A/∂q for velocity constraints; by central
-    /// differences otherwise (and with holonomic constraints), each unknown's step relative to
+    /// differences otherwise (and with holonomic constraints, alone or mixed), each unknown's step relative to
     /// the position it moves (λ: to itself).
     fn jacobian(&mut self, jac: &mut DMatrix<f64>) -> Result<(), StepError> {
         let Equations {
@@ -434,7 +480,7 @@ impl<Sc: StepEquations, S: Lagrangian + ?Sized> NewtonProblem for Equations<'_, 
                         && nonholonomic::jacobian((c, at), multipliers, block, (start.q, start.h), x, jac)
                             .map(|_| true)?
                 }
-                Constraints::Holonomic(_) => false,
+                Constraints::Holonomic(_) | Constraints::Mixed(..) => false,
             };
         if !exact {
             let n = start.q.len();

@@ -29,7 +29,7 @@ pub use separable::CompiledSeparable;
 pub use tape::{sign, Binary, Op, Tape, Unary};
 pub use velocity_constraints::CompiledVelocityConstraints;
 
-use crate::model::{Constrained, Nonholonomic};
+use crate::model::{Constrained, Mixed, Nonholonomic};
 use crate::Error;
 
 /// A compiled model of each kind the integrators know (see
@@ -42,6 +42,8 @@ pub enum CompiledModel {
     ConstrainedLagrangian(Constrained<CompiledLagrangian, CompiledConstraints>),
     NonholonomicSeparable(Nonholonomic<CompiledSeparable, CompiledVelocityConstraints>),
     NonholonomicLagrangian(Nonholonomic<CompiledLagrangian, CompiledVelocityConstraints>),
+    MixedSeparable(Mixed<CompiledSeparable, CompiledConstraints, CompiledVelocityConstraints>),
+    MixedLagrangian(Mixed<CompiledLagrangian, CompiledConstraints, CompiledVelocityConstraints>),
 }
 
 impl CompiledModel {
@@ -68,6 +70,16 @@ impl CompiledModel {
                 system: c.system.with_parameters(params)?,
                 constraints: c.constraints.with_parameters(params)?,
             }),
+            CompiledModel::MixedSeparable(c) => CompiledModel::MixedSeparable(Mixed {
+                system: c.system.with_parameters(params)?,
+                holonomic: constrained(&c.holonomic)?,
+                velocity: c.velocity.with_parameters(params)?,
+            }),
+            CompiledModel::MixedLagrangian(c) => CompiledModel::MixedLagrangian(Mixed {
+                system: c.system.with_parameters(params)?,
+                holonomic: constrained(&c.holonomic)?,
+                velocity: c.velocity.with_parameters(params)?,
+            }),
         })
     }
 
@@ -80,6 +92,8 @@ impl CompiledModel {
             CompiledModel::ConstrainedLagrangian(c) => c.system.parameters(),
             CompiledModel::NonholonomicSeparable(c) => c.system.parameters(),
             CompiledModel::NonholonomicLagrangian(c) => c.system.parameters(),
+            CompiledModel::MixedSeparable(c) => c.system.parameters(),
+            CompiledModel::MixedLagrangian(c) => c.system.parameters(),
         }
     }
 }
