@@ -35,8 +35,9 @@ pub(crate) fn check_interrupt() -> Result<(), ModelError> {
     CHECK.with(Cell::get).map_or(Ok(()), |check| check())
 }
 
-/// Polls for interrupts at a stride that adapts to keep polls about 10–40 ms apart, so that a
-/// step of 50 ns and a step of 50 ms are both interruptible promptly and cheaply.
+/// Polls for interrupts at a stride that adapts to keep polls about 10–40 ms apart (the first
+/// at least 2 ms into the run), so that a step of 50 ns and a step of 50 ms are both
+/// interruptible promptly and cheaply.
 #[derive(Clone, Debug)]
 pub(crate) struct InterruptPoll {
     stride: usize,
@@ -53,6 +54,11 @@ impl Default for InterruptPoll {
 impl InterruptPoll {
     const FAST: Duration = Duration::from_millis(10);
     const SLOW: Duration = Duration::from_millis(40);
+    /// The least time between two polls. While the stride ramps up from one step, a due poll
+    /// that comes sooner is skipped: a poll takes the GIL, and a run's first milliseconds are
+    /// when another thread holds it (a long run's commit of its last segment to its file), so
+    /// that each early poll would wait for that thread.
+    const LEAST: Duration = Duration::from_millis(2);
 
     pub(crate) fn new() -> Self {
         InterruptPoll {
@@ -71,6 +77,11 @@ impl InterruptPoll {
         }
         let now = Instant::now();
         let elapsed = now - self.last;
+        if elapsed < Self::LEAST {
+            self.stride = (self.stride * 2).min(1 << 24);
+            self.countdown = self.stride;
+            return false;
+        }
         if elapsed < Self::FAST {
             self.stride = (self.stride * 2).min(1 << 24);
         } else if elapsed > Self::SLOW {
