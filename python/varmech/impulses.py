@@ -106,6 +106,14 @@ class Impulse:
             Not exactly one of ``generalized`` and ``point``; a ``point`` without ``impulse``;
             ``generalized`` not n finite numbers; the point and the impulse of different
             lengths; or ``jacobian`` not of shape (d, n).
+
+        Examples
+        --------
+        Components given as a function of q, evaluated where the blow strikes:
+
+        >>> import numpy as np
+        >>> Impulse(generalized=lambda q: [np.cos(q[1]), 0.0]).components(np.array([0.0, np.pi])).tolist()
+        [-1.0, 0.0]
         """
         n = len(q)
         if (self.generalized is None) == (self.point is None):
