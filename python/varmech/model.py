@@ -75,6 +75,12 @@ class Translation:
         varmech._core.Generator
             The generator's kind and data, checked against the model's dimension when a model
             is built with it.
+
+        Examples
+        --------
+        >>> g = Translation(1).spec()
+        >>> type(g).__name__, g.axis, g.spatial_dim, g.name
+        ('Translation', 1, 3, 'P_y')
         """
         return _core.Generator.Translation(self.axis, self.spatial_dim)
 
@@ -127,6 +133,14 @@ class Rotation:
         varmech._core.Generator
             The generator's kind and data, checked against the model's dimension when a model
             is built with it.
+
+        Examples
+        --------
+        In the plane the axis is ignored, and the momentum is named L:
+
+        >>> g = Rotation(spatial_dim=2).spec()
+        >>> type(g).__name__, g.spatial_dim, g.name
+        ('Rotation', 2, 'L')
         """
         return _core.Generator.Rotation(self.axis, self.spatial_dim)
 
@@ -176,6 +190,13 @@ class Cyclic:
         varmech._core.Generator
             The generator's kind and data, checked against the model's dimension when a model
             is built with it.
+
+        Examples
+        --------
+        >>> from varmech import _core
+        >>> g = Cyclic(2).spec()
+        >>> isinstance(g, _core.Generator.Cyclic), g.index, g.name
+        (True, 2, 'p[2]')
         """
         return _core.Generator.Cyclic(self.index)
 
@@ -320,6 +341,16 @@ class Model:
         ValueError
             Naming the argument whose shape does not fit (``q``, ``p`` or ``t``), or a
             general Lagrangian whose Newton solve of ∂L/∂q̇ = p fails.
+
+        Examples
+        --------
+        The inverse of :meth:`momentum`, here for the double pendulum's M(θ):
+
+        >>> import varmech
+        >>> model = varmech.scenes.double_pendulum().model
+        >>> p = model.momentum([0.1, 0.2], [1.0, -2.0])
+        >>> model.velocity([0.1, 0.2], p).round(12).tolist()
+        [1.0, -2.0]
         """
         return self._derivative("velocity", q, p, t)
 
@@ -345,6 +376,15 @@ class Model:
         ------
         ValueError
             Naming the argument whose shape does not fit (``q``, ``v`` or ``t``).
+
+        Examples
+        --------
+        A rod on a table (x, y, θ; mass 1, k² = 1/3): p = Mq̇, one row per state.
+
+        >>> import numpy as np, varmech
+        >>> rod = varmech.MechanicalSystem(3, lambda q: 0.0, lambda q: np.zeros(3), mass=[1.0, 1.0, 1.0 / 3.0])
+        >>> rod.momentum(np.zeros(3), [[1.0, 2.0, 3.0], [0.0, 0.0, 6.0]]).tolist()
+        [[1.0, 2.0, 1.0], [0.0, 0.0, 2.0]]
         """
         return self._derivative("momentum", q, v, t)
 
@@ -376,6 +416,17 @@ class Model:
         ------
         TypeError
             Naming ``parameters``, for every model but a symbolic one.
+
+        Examples
+        --------
+        A model from closures has no parameters (its closures hold their values):
+
+        >>> import varmech
+        >>> oscillator = varmech.MechanicalSystem(1, lambda q: 0.5 * q @ q, lambda q: q, name="oscillator")
+        >>> oscillator.with_parameters(omega=2.0)
+        Traceback (most recent call last):
+            ...
+        TypeError: parameters: oscillator has no parameters to set (omega given); only symbolic models (varmech.symbolic) take them
         """
         raise TypeError(
             f"parameters: {self.name} has no parameters to set ({', '.join(values)} given); "
