@@ -119,6 +119,17 @@ class Stepper:
             at tₙ.
         Exception
             A closure's own exception, unchanged.
+
+        Examples
+        --------
+        One Störmer–Verlet step of the pendulum from (q, p) = (0, 1): q₁ = q₀ + hp₀ − ½h² sin q₀
+        and p₁ = p₀ − ½h(sin q₀ + sin q₁).
+
+        >>> import varmech
+        >>> stepper = varmech.Stepper(varmech.scenes.pendulum(), dt=0.1)
+        >>> stepper.step()
+        >>> stepper.t, stepper.steps, stepper.q.tolist(), stepper.p.round(8).tolist()
+        (0.1, 1, [0.1], [0.99500833])
         """
         self._stepper.step()
 
@@ -145,6 +156,18 @@ class Stepper:
             good step.
         KeyboardInterrupt
             Ctrl-C, at the last step completed.
+
+        Examples
+        --------
+        >>> import varmech
+        >>> stepper = varmech.Stepper(varmech.scenes.pendulum(), dt=0.01)
+        >>> stepper.advance(t_end=0.25)
+        >>> stepper.steps, round(stepper.t, 12)
+        (25, 0.25)
+        >>> stepper.advance(t_end=0.255)
+        Traceback (most recent call last):
+            ...
+        ValueError: t_end: 0.255 is not a whole number of steps dt = 0.01 from t0 = 0.25 (0.5 steps); adjust dt or pass steps
         """
         self._stepper.advance(_steps(self.dt, self.t, steps, t_end))
 
@@ -170,6 +193,17 @@ class Stepper:
             Naming the argument: a state of the wrong shape or not finite, both or neither of
             ``p0`` and ``v0``, ``t0`` not finite, or velocities off a model's velocity
             constraints (a state off holonomic constraints names ``q0`` or ``p0``).
+
+        Examples
+        --------
+        From the velocities, at the current time, with the step count back at 0:
+
+        >>> import varmech
+        >>> stepper = varmech.Stepper(varmech.scenes.pendulum(), dt=0.01)
+        >>> stepper.advance(10)
+        >>> stepper.reset([0.0], v0=[2.0])
+        >>> stepper.steps, round(stepper.t, 12), stepper.p.tolist()
+        (0, 0.1, [2.0])
         """
         t0 = self.t if t0 is None else finite("t0", t0)
         q, p = _initial_state(self._model, q0, p0, v0, t0)
@@ -239,6 +273,19 @@ class Stepper:
         -------
         bytes
             The checkpoint (it records the model's kind and the method, not the model itself).
+
+        Examples
+        --------
+        Taken at t = 0.1, it still holds that state after the stepper has gone on:
+
+        >>> import varmech
+        >>> kepler = varmech.scenes.kepler()
+        >>> stepper = varmech.Stepper(kepler, dt=0.01)
+        >>> stepper.advance(10)
+        >>> saved = stepper.checkpoint()
+        >>> stepper.advance(10)
+        >>> type(saved).__name__, varmech.Stepper.from_checkpoint(kepler, saved)
+        ('bytes', Stepper('kepler', method='verlet', dt=0.01, t=0.1, steps=10))
         """
         return bytes(self._stepper.checkpoint())
 
@@ -265,6 +312,18 @@ class Stepper:
             model it does not fit.
         TypeError
             Naming ``model``: not a varmech model or scene.
+
+        Examples
+        --------
+        A run's checkpoint, stepped on, lands bit for bit where the whole run does:
+
+        >>> import varmech
+        >>> kepler = varmech.scenes.kepler()
+        >>> stepper = varmech.Stepper.from_checkpoint(kepler, varmech.integrate(kepler, dt=0.01, steps=50).checkpoint)
+        >>> stepper.advance(50)
+        >>> whole = varmech.integrate(kepler, dt=0.01, steps=100)
+        >>> stepper.steps, bool((stepper.q == whole.q[-1]).all() and (stepper.p == whole.p[-1]).all())
+        (100, True)
         """
         model, _, _ = _model_of(model, None, None, None)
         stepper = cls.__new__(cls)
