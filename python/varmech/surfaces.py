@@ -77,6 +77,14 @@ class Wall:
         -------
         ndarray, shape (n,)
             The unit vector along coordinate k.
+
+        Examples
+        --------
+        The same unit vector wherever q is, in as many coordinates as q has:
+
+        >>> import numpy as np
+        >>> Wall(2, -1.0).gradient(np.array([5.0, 6.0, 7.0])).tolist()
+        [0.0, 0.0, 1.0]
         """
         return np.eye(len(q))[self.k]
 
@@ -168,6 +176,16 @@ class Ellipsoid:
         -------
         ndarray, shape (n,)
             ∇φ(q).
+
+        Examples
+        --------
+        An elliptic table x²/4 + y² ≤ 1 in the first two of three coordinates: at its rim
+        (2, 0), ∇φ points inwards, and the third coordinate plays no part.
+
+        >>> import numpy as np
+        >>> table = Ellipsoid((0, 1), (0.0, 0.0), (2.0, 1.0))
+        >>> table.gradient(np.array([2.0, 0.0, 5.0])).tolist()
+        [-1.0, 0.0, 0.0]
         """
         out = np.zeros(len(q))
         sign = -2.0 if self.inside else 2.0
