@@ -196,6 +196,21 @@ class SymbolicModel(Model):
         ------
         ValueError
             Naming ``parameters``: an unknown parameter, or a value that is not finite.
+
+        Examples
+        --------
+        The pendulum taken to the Moon: ``g`` changes, ``l`` is kept, and nothing is derived again.
+
+        >>> import sympy as sp, varmech.symbolic
+        >>> th, om, g, l = sp.symbols("theta omega g l")
+        >>> L = l**2 * om**2 / 2 + g * l * sp.cos(th)
+        >>> earth = varmech.symbolic.lagrangian(L, [th], [om], parameters={g: 9.81, l: 2.0})
+        >>> earth.with_parameters(g=1.62).parameters, earth.parameters
+        ({'g': 1.62, 'l': 2.0}, {'g': 9.81, 'l': 2.0})
+        >>> earth.with_parameters(m=1.0)
+        Traceback (most recent call last):
+            ...
+        ValueError: parameters: m not a parameter of symbolic lagrangian (it has g, l)
         """
         started = time.perf_counter()
         names = self._spec.parameter_names
@@ -229,6 +244,20 @@ class SymbolicModel(Model):
         -------
         SymbolicModel
             A new model built from the same tapes; this one is unchanged.
+
+        Examples
+        --------
+        Interpreted and compiled tapes give the same run bit for bit (``with_jit(True)`` falls
+        back to the interpreter where Cranelift cannot compile, and ``jit`` then says False):
+
+        >>> import sympy as sp, varmech, varmech.symbolic
+        >>> th, om = sp.symbols("theta omega")
+        >>> model = varmech.symbolic.lagrangian(om**2 / 2 + sp.cos(th), [th], [om])
+        >>> interpreted = model.with_jit(False)
+        >>> a = varmech.integrate(interpreted, [0.5], [0.0], dt=0.01, steps=100)
+        >>> b = varmech.integrate(model.with_jit(True), [0.5], [0.0], dt=0.01, steps=100)
+        >>> interpreted.jit, bool((a.q == b.q).all() and (a.p == b.p).all())
+        (False, True)
         """
         return SymbolicModel(replace(self._spec, jit=bool(jit)), self._symbolic)
 
@@ -242,6 +271,16 @@ class SymbolicModel(Model):
         FirstOrder or None
             f(t, y) for y = (q, p), as :func:`scipy.integrate.solve_ivp` takes it; None where
             ∂L/∂q̇ is not linear in q̇, or for a forced or constrained model.
+
+        Examples
+        --------
+        For the pendulum, θ̇ = p and ṗ = −g sin θ, the parameters substituted:
+
+        >>> import numpy as np, sympy as sp, varmech.symbolic
+        >>> th, om, g = sp.symbols("theta omega g")
+        >>> model = varmech.symbolic.lagrangian(om**2 / 2 + g * sp.cos(th), [th], [om], parameters={g: 9.81})
+        >>> model.first_order()(0.0, np.array([np.pi / 2, 0.5])).tolist()
+        [0.5, -9.81]
         """
         return FirstOrder.build(self)
 
