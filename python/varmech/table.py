@@ -86,6 +86,17 @@ class Table:
         ------
         ValueError
             Naming ``row``: not one value per column.
+
+        Examples
+        --------
+        >>> table = Table(("method", "h"))
+        >>> table.append("verlet", 0.1)
+        >>> table.rows
+        [('verlet', 0.1)]
+        >>> table.append("verlet")
+        Traceback (most recent call last):
+            ...
+        ValueError: row: has 1 values for 2 columns ('method', 'h')
         """
         self._check(values)
         self.rows.append(tuple(values))
@@ -114,6 +125,14 @@ class Table:
         ------
         KeyError
             Naming ``name``: no such column.
+
+        Examples
+        --------
+        A column of numbers is a float array, any other an object array:
+
+        >>> table = Table(("method", "h"), [("verlet", 0.1), ("midpoint", 0.05)])
+        >>> table.column("h"), table.column("method")
+        (array([0.1 , 0.05]), array(['verlet', 'midpoint'], dtype=object))
         """
         i = self._index(name, "name")
         values = [row[i] for row in self.rows]
@@ -139,6 +158,12 @@ class Table:
         ------
         KeyError
             Naming the keyword that is not a column.
+
+        Examples
+        --------
+        >>> table = Table(("method", "h"), [("verlet", 0.1), ("verlet", 0.05), ("midpoint", 0.1)])
+        >>> table.where(method="verlet", h=0.05).rows, len(table.where(h=0.1))
+        ([('verlet', 0.05)], 2)
         """
         idx = {self._index(k, k): v for k, v in equal.items()}
         rows = [r for r in self.rows if all(r[i] == v for i, v in idx.items())]
@@ -161,6 +186,11 @@ class Table:
         ------
         KeyError
             Naming ``name``: no such column.
+
+        Examples
+        --------
+        >>> Table(("method", "h"), [("verlet", 0.1), ("midpoint", 0.1), ("verlet", 0.05)]).unique("method")
+        ['verlet', 'midpoint']
         """
         i = self._index(name, "name")
         return list(dict.fromkeys(r[i] for r in self.rows))
@@ -183,6 +213,17 @@ class Table:
         ------
         OSError
             The file cannot be written.
+
+        Examples
+        --------
+        >>> import pathlib, tempfile
+        >>> table = Table(("method", "h"), [("verlet", 0.1)], title="Step sizes", meta={"scene": "kepler"})
+        >>> path = table.to_csv(pathlib.Path(tempfile.mkdtemp()) / "steps.csv")
+        >>> print(path.read_text(), end="")
+        # Step sizes
+        # scene: kepler
+        method,h
+        verlet,0.1
         """
         path = Path(path)
         path.parent.mkdir(parents=True, exist_ok=True)
@@ -215,6 +256,14 @@ class Table:
         str
             One line for the title, one for the column names, one per row (" | " between
             values), and a last line counting the rows left out.
+
+        Examples
+        --------
+        >>> table = Table(("h", "error"), [(0.1, 1 / 3), (0.05, float("nan"))])
+        >>> print(table.format(max_rows=None))
+        h | error
+        0.1 | 0.3333
+        0.05 | nan
         """
 
         def fmt(x: Any) -> str:
