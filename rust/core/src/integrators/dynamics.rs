@@ -26,22 +26,15 @@ pub trait Dynamics {
         let Some(residuals) = self.constraint_residuals(q0, p0) else {
             return Ok(());
         };
-        let model::Residuals { position, velocity, .. } =
+        let residuals =
             residuals.map_err(|e| Error::invalid("q0", format!("the constraints failed to evaluate: {e}")))?;
-        let scale = q0.iter().chain(p0).fold(1.0_f64, |m, x| m.max(x.abs()));
-        if position > 1e-10 * scale {
-            return Err(Error::invalid(
-                "q0",
-                format!("is off the constraints: |g(q0)| = {position:.3e}; project the initial state first"),
-            ));
-        }
-        if velocity > 1e-10 * scale {
-            return Err(Error::invalid(
-                "p0",
-                format!("is off the hidden constraint: |G(q0)M⁻¹p0| = {velocity:.3e}; project the initial state first"),
-            ));
-        }
-        Ok(())
+        on_constraints(
+            &residuals,
+            q0,
+            p0,
+            ("constraints", "|g(q0)|"),
+            ("hidden constraint", "|G(q0)M⁻¹p0|"),
+        )
     }
 
     /// One step's increments (δq, δp) from `start`.
@@ -262,22 +255,19 @@ impl<L: Lagrangian, C: VelocityConstraints> Dynamics for Nonholonomic<L, C> {
     /// |A(q₀)q̇₀|∞ within 1e-10 of the state's size; otherwise `p0` is off the constraints. A
     /// model error is the model's own, at step 0 (the stepper sets its time).
     fn check_initial(&self, q0: &[f64], p0: &[f64]) -> Result<(), Error> {
-        let velocity = self
-            .residuals(q0, p0)
-            .map_err(|source| Error::Model {
-                step: 0,
-                time: 0.0,
-                source,
-            })?
-            .velocity;
-        let scale = q0.iter().chain(p0).fold(1.0_f64, |m, x| m.max(x.abs()));
-        if velocity.is_nan() || velocity > 1e-10 * scale {
-            return Err(Error::invalid(
-                "p0",
-                format!("is off the velocity constraints: |A(q0)q̇0| = {velocity:.3e}; project the initial state first"),
-            ));
-        }
-        Ok(())
+        let residuals = self.residuals(q0, p0).map_err(|source| Error::Model {
+            step: 0,
+            time: 0.0,
+            source,
+        })?;
+        // No position residual: it is 0.
+        on_constraints(
+            &residuals,
+            q0,
+            p0,
+            ("constraints", "|g(q0)|"),
+            ("velocity constraints", "|A(q0)q̇0|"),
+        )
     }
 
     fn increment(
@@ -334,28 +324,13 @@ impl<L: Lagrangian, H: HolonomicConstraints, C: VelocityConstraints> Dynamics fo
             time: 0.0,
             source,
         })?;
-        let scale = q0.iter().chain(p0).fold(1.0_f64, |m, x| m.max(x.abs()));
-        let off = |x: f64| x.is_nan() || x > 1e-10 * scale;
-        if off(residuals.position) {
-            return Err(Error::invalid(
-                "q0",
-                format!(
-                    "is off the holonomic constraints: |g(q0)| = {:.3e}; project the initial state first",
-                    residuals.position
-                ),
-            ));
-        }
-        if off(residuals.velocity) {
-            return Err(Error::invalid(
-                "p0",
-                format!(
-                    "is off the constraints' velocities: |G(q0)q̇0, A(q0)q̇0 + b| = {:.3e}; project the initial \
-                     state first",
-                    residuals.velocity
-                ),
-            ));
-        }
-        Ok(())
+        on_constraints(
+            &residuals,
+            q0,
+            p0,
+            ("holonomic constraints", "|g(q0)|"),
+            ("constraints' velocities", "|G(q0)q̇0, A(q0)q̇0 + b|"),
+        )
     }
 
     fn increment(
@@ -389,4 +364,29 @@ impl<L: Lagrangian, H: HolonomicConstraints, C: VelocityConstraints> Dynamics fo
     fn project(&self, q: &[f64], p: &[f64]) -> Option<Result<PhaseState, Error>> {
         Some(Mixed::project(self, q, p))
     }
+}
+
+/// Refuses initial data off the constraints: the position residual (else `q0`) and the velocity
+/// residual (else `p0`) within 1e-10 of the state's size, NaN being off. `position` and
+/// `velocity` are (what the residual measures, its formula), for the messages.
+fn on_constraints(
+    residuals: &model::Residuals,
+    q0: &[f64],
+    p0: &[f64],
+    position: (&str, &str),
+    velocity: (&str, &str),
+) -> Result<(), Error> {
+    let scale = q0.iter().chain(p0).fold(1.0_f64, |m, x| m.max(x.abs()));
+    for (argument, residual, (what, formula)) in [
+        ("q0", residuals.position, position),
+        ("p0", residuals.velocity, velocity),
+    ] {
+        if residual.is_nan() || residual > 1e-10 * scale {
+            return Err(Error::invalid(
+                argument,
+                format!("is off the {what}: {formula} = {residual:.3e}; project the initial state first"),
+            ));
+        }
+    }
+    Ok(())
 }
