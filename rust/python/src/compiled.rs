@@ -13,6 +13,7 @@ use varmech::model::compiled::{
 };
 use varmech::model::{Constrained, HolonomicConstraints, Mixed, Nonholonomic, VelocityConstraints};
 
+use crate::closure::readers::check_total;
 use crate::convert::slice;
 use crate::errors::to_pyerr;
 use crate::generator::{self, Generator as Spec};
@@ -165,12 +166,8 @@ impl CompiledModel {
                 .map_err(err)?,
             ),
         };
-        if constraints > 0 && velocity_constraints > 0 && constraints + velocity_constraints >= dim {
-            return Err(PyValueError::new_err(format!(
-                "velocity_constraints: with the {constraints} holonomic constraints, at most dim − 1 − \
-                 {constraints} = {} velocity constraints fit on {dim} coordinates, got {velocity_constraints}",
-                dim.saturating_sub(1 + constraints)
-            )));
+        if constraints > 0 && velocity_constraints > 0 {
+            check_total("velocity_constraints", constraints, velocity_constraints, dim)?;
         }
         let rolling = match velocity_constraints {
             0 => None,

@@ -15,7 +15,7 @@ use super::constraints::{ClosureConstrained, ClosureConstraints, ConstrainedSyst
 use super::lagrangian::{ClosureLagrangian, ClosureLagrangianSystem};
 use super::mechanical::{ClosureModel, ClosureSystem};
 use super::natural::{ClosureNatural, ClosureNaturalSystem};
-use super::readers::{call_array, check_closures, check_count};
+use super::readers::{call_array, check_closures, check_count, check_total};
 use crate::errors::boxed;
 
 /// A closure model (separable [`ClosureModel`], natural [`ClosureNatural`] or general
@@ -72,14 +72,7 @@ impl ClosureNonholonomic {
         )?;
         check_count("velocity_constraint_count", count, dim)?;
         if let Unconstrained::Holonomic(s) = &system {
-            let holonomic = s.get().count();
-            if holonomic + count >= dim {
-                return Err(PyValueError::new_err(format!(
-                    "velocity_constraint_count: with the {holonomic} holonomic constraints, at most \
-                     dim − 1 − {holonomic} = {} velocity constraints fit on {dim} coordinates, got {count}",
-                    dim.saturating_sub(1 + holonomic)
-                )));
-            }
+            check_total("velocity_constraint_count", s.get().count(), count, dim)?;
         }
         Ok(ClosureNonholonomic {
             system,

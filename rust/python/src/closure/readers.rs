@@ -44,6 +44,19 @@ pub fn check_count(argument: &'static str, count: usize, dim: usize) -> PyResult
     check_dense(argument, count, dim).map_err(|e| PyValueError::new_err(e.to_string()))
 }
 
+/// `velocity` velocity constraints beside `holonomic` holonomic ones on `dim` coordinates: at
+/// most dim − 1 rows together; errors name `argument`.
+pub fn check_total(argument: &'static str, holonomic: usize, velocity: usize, dim: usize) -> PyResult<()> {
+    if holonomic + velocity >= dim {
+        return Err(PyValueError::new_err(format!(
+            "{argument}: with the {holonomic} holonomic constraints, at most dim − 1 − {holonomic} = {} velocity \
+             constraints fit on {dim} coordinates, got {velocity}",
+            dim.saturating_sub(1 + holonomic)
+        )));
+    }
+    Ok(())
+}
+
 /// The name of a Python object's type, for messages.
 pub fn type_name(x: &Bound<'_, PyAny>) -> String {
     x.get_type().name().map(|n| n.to_string()).unwrap_or_default()
