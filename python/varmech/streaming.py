@@ -105,12 +105,9 @@ def stream(
     def committed() -> None:
         """Waits for the last segment's commit (Ctrl-C held back meanwhile), raising its error."""
         nonlocal pending
-        if pending is not None and pending.done():
-            # Nothing to wait for: read the result without masking Ctrl-C (two system calls a segment).
-            done, pending = pending, None
-            done.result()
-        elif pending is not None:
-            with _uninterrupted():
+        if pending is not None:
+            # A finished commit has nothing to wait for: no masking (two system calls a segment).
+            with contextlib.nullcontext() if pending.done() else _uninterrupted():
                 done, pending = pending, None
                 done.result()
 
