@@ -3,7 +3,7 @@
 //! `reset` and `set_dt` make it a fresh stepper; malformed arguments are typed errors.
 
 use varmech::integrators::{integrate, Dynamics, General, Method, Options, Stepper, StepperState};
-use varmech::scenes::{planar_chain, DoublePendulum, Kepler};
+use varmech::scenes::{planar_chain, DoublePendulum, FermiPastaUlam, HarmonicOscillator, HeavyTop, Kepler};
 use varmech::Error;
 
 /// Bits of a state, so that -0.0 ≠ 0.0 and equality means the same floating-point numbers.
@@ -87,6 +87,43 @@ fn the_midpoint_rule_on_the_double_pendulum_takes_integrates_steps() {
         0.01,
         300,
     );
+}
+
+/// The two-point DEL methods run up to 4 coordinates in a loop of fixed-size arrays
+/// (`Stepper::advance`, `integrate`) and step one at a time by the general step
+/// (`Stepper::step`): the same bits and counts at every size, with exact second derivatives
+/// (the pendulums, the top) and by differences (the oscillator, FPU through L = T − V), and
+/// beyond 4 (FPU's 6) where both take the general step.
+#[test]
+fn the_two_point_del_methods_take_integrates_steps_at_every_size() {
+    let oscillator = HarmonicOscillator::problem(1.3).unwrap();
+    let pendulum = DoublePendulum::problem();
+    let top = HeavyTop::problem();
+    let fpu4 = FermiPastaUlam::new(2, 20.0).unwrap();
+    let fpu6 = FermiPastaUlam::problem();
+    let cases: [(&dyn Dynamics, &[f64], &[f64], f64); 5] = [
+        (
+            &General(&oscillator.system),
+            &oscillator.initial.q,
+            &oscillator.initial.p,
+            0.1,
+        ),
+        (
+            &General(&pendulum.system),
+            &pendulum.initial.q,
+            &pendulum.initial.p,
+            0.01,
+        ),
+        (&General(&top.system), &top.initial.q, &top.initial.p, 0.01),
+        (&General(&fpu4), &[0.3, 0.0, -0.2, 0.1], &[0.0, 1.0, 0.5, -0.4], 0.01),
+        (&General(&fpu6.system), &fpu6.initial.q, &fpu6.initial.p, 0.01),
+    ];
+    for (sys, q0, p0, dt) in cases {
+        assert_eq!(sys.dim(), q0.len());
+        for method in [Method::Midpoint, Method::Trapezoid] {
+            agrees_with_integrate(sys, method, q0, p0, dt, 300);
+        }
+    }
 }
 
 #[test]

@@ -75,6 +75,7 @@ impl Quadrature {
     }
 
     /// The slot of the r-th block of equations: Q₁, …, Q_{s−1}, then Q₀.
+    #[inline(always)]
     fn slot(&self, r: usize) -> usize {
         if r + 1 < self.s {
             r + 1
@@ -84,6 +85,7 @@ impl Quadrature {
     }
 
     /// `pos` = q(cᵢh) and `vel` = q̇(cᵢh) for the control increments `at.dq`.
+    #[inline(always)]
     fn node_state(&mut self, i: usize, at: &Segment<'_>) {
         let n = at.q0.len();
         for a in 0..n {
@@ -114,6 +116,20 @@ impl Quadrature {
         at: Segment<'_>,
         jac: &mut DMatrix<f64>,
     ) -> Result<bool, ModelError> {
+        let stride = jac.nrows();
+        self.jacobian_into(sys, at, jac.as_mut_slice(), stride)
+    }
+
+    /// [`Quadrature::jacobian`] into the column-major `jac` of column stride `stride`: a
+    /// matrix's storage or an array's, whose size the inlined loops then know.
+    #[inline(always)]
+    pub(crate) fn jacobian_into<S: Lagrangian + ?Sized>(
+        &mut self,
+        sys: &S,
+        at: Segment<'_>,
+        jac: &mut [f64],
+        stride: usize,
+    ) -> Result<bool, ModelError> {
         let (n, t, h) = (at.q0.len(), at.t, at.h);
         jac.fill(0.0);
         for i in 0..self.nodes.len() {
@@ -128,8 +144,7 @@ impl Quadrature {
                 for c in 0..self.s {
                     let (lk, dk) = (self.basis[i][c + 1], self.slopes[i][c + 1]);
                     let weights = [b * h * lj * lk, b * lj * dk, b * dj * lk, b * dj * dk / h];
-                    let stride = jac.nrows();
-                    let jac = &mut jac.as_mut_slice()[c * n * stride + r * n..];
+                    let jac = &mut jac[c * n * stride + r * n..];
                     sized!(add_block(jac, stride, weights, hs; n));
                 }
             }

@@ -1,4 +1,4 @@
-use super::{combine, DiscreteLagrangian, Segment, Workspace};
+use super::{combine, DiscreteLagrangian, Segment, Vector, Workspace};
 use crate::model::Lagrangian;
 use crate::ModelError;
 use serde::{Deserialize, Serialize};
@@ -14,9 +14,19 @@ pub struct Midpoint;
 impl Midpoint {
     /// ∂L/∂q into ws.a and ∂L/∂q̇ into ws.b, at the midpoint.
     #[inline(always)]
-    fn derivatives<S: Lagrangian + ?Sized>(sys: &S, at: &Segment<'_>, ws: &mut Workspace) -> Result<(), ModelError> {
+    fn derivatives<S: Lagrangian + ?Sized, V: Vector>(
+        sys: &S,
+        at: &Segment<'_>,
+        ws: &mut Workspace<V>,
+    ) -> Result<(), ModelError> {
         ws.set(at, 0.5);
-        sys.gradients(&ws.x, &ws.v, at.t + 0.5 * at.h, &mut ws.a, &mut ws.b)
+        sys.gradients(
+            ws.x.as_ref(),
+            ws.v.as_ref(),
+            at.t + 0.5 * at.h,
+            ws.a.as_mut(),
+            ws.b.as_mut(),
+        )
     }
 }
 
@@ -28,57 +38,57 @@ impl DiscreteLagrangian for Midpoint {
     fn value<S: Lagrangian + ?Sized>(&self, sys: &S, at: Segment<'_>) -> Result<f64, ModelError> {
         let mut ws = Workspace::new(at.q0.len());
         ws.set(&at, 0.5);
-        Ok(at.h * sys.lagrangian(&ws.x, &ws.v, at.t + 0.5 * at.h)?)
+        Ok(at.h * sys.lagrangian(ws.x.as_ref(), ws.v.as_ref(), at.t + 0.5 * at.h)?)
     }
 
     #[inline(always)]
-    fn d1<S: Lagrangian + ?Sized>(
+    fn d1<S: Lagrangian + ?Sized, V: Vector>(
         &self,
         sys: &S,
         at: Segment<'_>,
         out: &mut [f64],
-        ws: &mut Workspace,
+        ws: &mut Workspace<V>,
     ) -> Result<(), ModelError> {
         Self::derivatives(sys, &at, ws)?;
-        combine(out, 0.5 * at.h, &ws.a, -1.0, &ws.b);
+        combine(out, 0.5 * at.h, ws.a.as_ref(), -1.0, ws.b.as_ref());
         Ok(())
     }
 
-    fn d2<S: Lagrangian + ?Sized>(
+    fn d2<S: Lagrangian + ?Sized, V: Vector>(
         &self,
         sys: &S,
         at: Segment<'_>,
         out: &mut [f64],
-        ws: &mut Workspace,
+        ws: &mut Workspace<V>,
     ) -> Result<(), ModelError> {
         Self::derivatives(sys, &at, ws)?;
-        combine(out, 0.5 * at.h, &ws.a, 1.0, &ws.b);
+        combine(out, 0.5 * at.h, ws.a.as_ref(), 1.0, ws.b.as_ref());
         Ok(())
     }
 
     /// h·∂L/∂q at the midpoint.
-    fn momentum_change<S: Lagrangian + ?Sized>(
+    fn momentum_change<S: Lagrangian + ?Sized, V: Vector>(
         &self,
         sys: &S,
         at: Segment<'_>,
         out: &mut [f64],
-        ws: &mut Workspace,
+        ws: &mut Workspace<V>,
     ) -> Result<(), ModelError> {
         ws.set(&at, 0.5);
-        sys.dl_dq(&ws.x, &ws.v, at.t + 0.5 * at.h, out)?;
+        sys.dl_dq(ws.x.as_ref(), ws.v.as_ref(), at.t + 0.5 * at.h, out)?;
         out.iter_mut().for_each(|x| *x *= at.h);
         Ok(())
     }
 
     /// h·∂L/∂q from D₁L_d's evaluation (ws.a).
-    fn momentum_change_after_d1<S: Lagrangian + ?Sized>(
+    fn momentum_change_after_d1<S: Lagrangian + ?Sized, V: Vector>(
         &self,
         _sys: &S,
         at: Segment<'_>,
         out: &mut [f64],
-        ws: &mut Workspace,
+        ws: &mut Workspace<V>,
     ) -> Result<(), ModelError> {
-        out.iter_mut().zip(&ws.a).for_each(|(o, a)| *o = a * at.h);
+        out.iter_mut().zip(ws.a.as_ref()).for_each(|(o, a)| *o = a * at.h);
         Ok(())
     }
 }

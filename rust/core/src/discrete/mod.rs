@@ -26,15 +26,21 @@ pub use trapezoidal::Trapezoidal;
 use crate::model::Lagrangian;
 use crate::ModelError;
 
+/// A vector of the scratch space: a `Vec` for any n, or an array `[f64; N]` for a loop whose
+/// size is known when it is compiled (the fixed-size DEL step), so that its loops unroll.
+pub trait Vector: AsRef<[f64]> + AsMut<[f64]> {}
+
+impl<T: AsRef<[f64]> + AsMut<[f64]>> Vector for T {}
+
 /// Scratch space for the slot derivatives of a discrete Lagrangian, so that Newton iterations
 /// allocate nothing.
 #[derive(Clone, Debug, Serialize, Deserialize)]
-pub struct Workspace {
-    v: Vec<f64>,
-    x: Vec<f64>,
-    a: Vec<f64>,
-    b: Vec<f64>,
-    c: Vec<f64>,
+pub struct Workspace<V = Vec<f64>> {
+    v: V,
+    x: V,
+    a: V,
+    b: V,
+    c: V,
 }
 
 impl Workspace {
@@ -47,11 +53,26 @@ impl Workspace {
             c: vec![0.0; n],
         }
     }
+}
 
+impl<const N: usize> Default for Workspace<[f64; N]> {
+    fn default() -> Self {
+        Workspace {
+            v: [0.0; N],
+            x: [0.0; N],
+            a: [0.0; N],
+            b: [0.0; N],
+            c: [0.0; N],
+        }
+    }
+}
+
+impl<V: Vector> Workspace<V> {
     /// v = δq/h and x = q₀ + s·δq.
     #[inline(always)]
     fn set(&mut self, at: &Segment<'_>, s: f64) {
-        for (((v, x), a), d) in self.v.iter_mut().zip(self.x.iter_mut()).zip(at.q0).zip(at.dq) {
+        let (v, x) = (self.v.as_mut(), self.x.as_mut());
+        for (((v, x), a), d) in v.iter_mut().zip(x.iter_mut()).zip(at.q0).zip(at.dq) {
             *v = d / at.h;
             *x = a + s * d;
         }
@@ -80,42 +101,42 @@ pub trait DiscreteLagrangian {
     fn value<S: Lagrangian + ?Sized>(&self, sys: &S, at: Segment<'_>) -> Result<f64, ModelError>;
 
     /// Writes D₁L_d(q₀, q₀ + δq, h) into `out`.
-    fn d1<S: Lagrangian + ?Sized>(
+    fn d1<S: Lagrangian + ?Sized, V: Vector>(
         &self,
         sys: &S,
         at: Segment<'_>,
         out: &mut [f64],
-        ws: &mut Workspace,
+        ws: &mut Workspace<V>,
     ) -> Result<(), ModelError>;
 
     /// Writes D₂L_d(q₀, q₀ + δq, h) into `out`.
-    fn d2<S: Lagrangian + ?Sized>(
+    fn d2<S: Lagrangian + ?Sized, V: Vector>(
         &self,
         sys: &S,
         at: Segment<'_>,
         out: &mut [f64],
-        ws: &mut Workspace,
+        ws: &mut Workspace<V>,
     ) -> Result<(), ModelError>;
 
     /// Writes D₁L_d + D₂L_d, the change of momentum p₁ − p₀ over the step when p₀ = −D₁L_d,
     /// in a form free of the cancellation between the two (the ∂L/∂q̇ terms drop out).
-    fn momentum_change<S: Lagrangian + ?Sized>(
+    fn momentum_change<S: Lagrangian + ?Sized, V: Vector>(
         &self,
         sys: &S,
         at: Segment<'_>,
         out: &mut [f64],
-        ws: &mut Workspace,
+        ws: &mut Workspace<V>,
     ) -> Result<(), ModelError>;
 
     /// [`Self::momentum_change`] right after [`Self::d1`] at the same segment, with what `d1`
     /// left in `ws`: a step solver's last evaluation is D₁L_d at the solution, whose ∂L/∂q the
     /// rules reuse instead of evaluating it again (the same numbers). Default: evaluate anew.
-    fn momentum_change_after_d1<S: Lagrangian + ?Sized>(
+    fn momentum_change_after_d1<S: Lagrangian + ?Sized, V: Vector>(
         &self,
         sys: &S,
         at: Segment<'_>,
         out: &mut [f64],
-        ws: &mut Workspace,
+        ws: &mut Workspace<V>,
     ) -> Result<(), ModelError> {
         self.momentum_change(sys, at, out, ws)
     }

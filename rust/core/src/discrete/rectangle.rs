@@ -1,4 +1,4 @@
-use super::{combine, DiscreteLagrangian, Segment, Workspace};
+use super::{combine, DiscreteLagrangian, Segment, Vector, Workspace};
 use crate::model::Lagrangian;
 use crate::ModelError;
 
@@ -18,46 +18,46 @@ impl DiscreteLagrangian for Rectangle {
         let Segment { q0, t, h, .. } = at;
         let mut ws = Workspace::new(q0.len());
         ws.set(&at, 0.0);
-        Ok(h * sys.lagrangian(q0, &ws.v, t)?)
+        Ok(h * sys.lagrangian(q0, ws.v.as_ref(), t)?)
     }
 
-    fn d1<S: Lagrangian + ?Sized>(
+    fn d1<S: Lagrangian + ?Sized, V: Vector>(
         &self,
         sys: &S,
         at: Segment<'_>,
         out: &mut [f64],
-        ws: &mut Workspace,
+        ws: &mut Workspace<V>,
     ) -> Result<(), ModelError> {
         let Segment { q0, t, h, .. } = at;
         ws.set(&at, 0.0);
-        sys.gradients(q0, &ws.v, t, &mut ws.a, &mut ws.b)?;
-        combine(out, h, &ws.a, -1.0, &ws.b);
+        sys.gradients(q0, ws.v.as_ref(), t, ws.a.as_mut(), ws.b.as_mut())?;
+        combine(out, h, ws.a.as_ref(), -1.0, ws.b.as_ref());
         Ok(())
     }
 
-    fn d2<S: Lagrangian + ?Sized>(
+    fn d2<S: Lagrangian + ?Sized, V: Vector>(
         &self,
         sys: &S,
         at: Segment<'_>,
         out: &mut [f64],
-        ws: &mut Workspace,
+        ws: &mut Workspace<V>,
     ) -> Result<(), ModelError> {
         let Segment { q0, t, .. } = at;
         ws.set(&at, 0.0);
-        sys.dl_dv(q0, &ws.v, t, out)
+        sys.dl_dv(q0, ws.v.as_ref(), t, out)
     }
 
     /// h·∂L/∂q(q₀).
-    fn momentum_change<S: Lagrangian + ?Sized>(
+    fn momentum_change<S: Lagrangian + ?Sized, V: Vector>(
         &self,
         sys: &S,
         at: Segment<'_>,
         out: &mut [f64],
-        ws: &mut Workspace,
+        ws: &mut Workspace<V>,
     ) -> Result<(), ModelError> {
         let Segment { q0, t, h, .. } = at;
         ws.set(&at, 0.0);
-        sys.dl_dq(q0, &ws.v, t, out)?;
+        sys.dl_dq(q0, ws.v.as_ref(), t, out)?;
         out.iter_mut().for_each(|x| *x *= h);
         Ok(())
     }

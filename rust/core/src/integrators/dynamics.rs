@@ -138,6 +138,10 @@ impl<L: Lagrangian> Dynamics for General<'_, L> {
         integrator.increment_lagrangian(self.0, start, increment)
     }
 
+    fn advance(&self, state: &mut StepperState, steps: usize) -> Result<(), Error> {
+        state.advance_lagrangian(self.0, steps)
+    }
+
     /// E = p·q̇ − L, unless L depends on t.
     fn energy(&self, q: &[f64], p: &[f64], t: f64) -> Option<Result<EnergyTerms, ModelError>> {
         (!self.0.is_time_dependent()).then(|| self.0.energy_terms(q, p, t))

@@ -1,5 +1,5 @@
-use super::stepper::{diverged, Phase};
-use super::{compensated, Increment, Splitting, StepError, StepStart};
+use super::stepper::Phase;
+use super::{Increment, Splitting, StepStart};
 use crate::model::MechanicalSystem;
 use crate::{Error, ModelError};
 use serde::{Deserialize, Serialize};
@@ -93,24 +93,12 @@ impl KickDrift {
         steps: usize,
     ) -> Result<(), Error> {
         let array = |x: &[f64]| -> [f64; N] { std::array::from_fn(|i| x[i]) };
-        let Phase {
-            q: state_q,
-            p: state_p,
-            eq: state_eq,
-            ep: state_ep,
-            compensated,
-            steps: done,
-            clock,
-        } = state;
-        self.scale(clock.h);
-        let (mut q, mut p, mut eq, mut ep) = (array(state_q), array(state_p), array(state_eq), array(state_ep));
+        self.scale(state.clock.h);
         let (mut stage_q, mut stage_p, mut force) = (array(&self.q), array(&self.p), array(&self.force));
-        let (mut dq, mut dp) = ([0.0; N], [0.0; N]);
-        let (mut q_next, mut p_next, mut eq_next, mut ep_next) = ([0.0; N], [0.0; N], [0.0; N], [0.0; N]);
         // Counts in locals, written back once: through the pointers they would cost stores.
-        let (mut cached, mut evaluations, mut n) = (self.force_cached, self.evaluations, *done);
-        let mut result = Ok(());
-        for _ in 0..steps {
+        let (mut cached, mut evaluations) = (self.force_cached, self.evaluations);
+        let scaled = &self.scaled;
+        let result = state.run::<N, _>(steps, |_, q, p, dq, dp| {
             let stage = Stage {
                 q: &mut stage_q,
                 p: &mut stage_p,
@@ -120,31 +108,9 @@ impl KickDrift {
                 cached: &mut cached,
                 evaluations: &mut evaluations,
             };
-            if let Err(e) = sequence(sys, &self.scaled, &q, &p, &mut dq, &mut dp, stage, counts) {
-                result = Err(StepError::from(e).at(n + 1, clock.at(n)));
-                break;
-            }
-            let finite = if compensated {
-                compensated::add(&q, &eq, &dq, &mut q_next, &mut eq_next)
-                    & compensated::add(&p, &ep, &dp, &mut p_next, &mut ep_next)
-            } else {
-                compensated::add_plain(&q, &dq, &mut q_next) & compensated::add_plain(&p, &dp, &mut p_next)
-            };
-            if !finite {
-                result = Err(diverged(n + 1, clock.at(n)));
-                break;
-            }
-            (q, p) = (q_next, p_next);
-            if compensated {
-                (eq, ep) = (eq_next, ep_next);
-            }
-            n += 1;
-        }
-        (self.force_cached, self.evaluations, *done) = (cached, evaluations, n);
-        state_q.copy_from_slice(&q);
-        state_p.copy_from_slice(&p);
-        state_eq.copy_from_slice(&eq);
-        state_ep.copy_from_slice(&ep);
+            Ok(sequence(sys, scaled, q, p, dq, dp, stage, counts)?)
+        });
+        (self.force_cached, self.evaluations) = (cached, evaluations);
         self.q.copy_from_slice(&stage_q);
         self.p.copy_from_slice(&stage_p);
         self.force.copy_from_slice(&force);

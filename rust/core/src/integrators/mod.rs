@@ -63,6 +63,7 @@ pub use rattle::Rattle;
 pub use run::{integrate, integrate_with_events, resume, resume_with_events, Options};
 pub use splitting::{Leading, Splitting};
 pub use step::{Increment, StepStart};
+use stepper::Phase;
 pub use stepper::{Stepper, StepperState};
 pub use trajectory::{Failure, Trajectory};
 pub use wisdom_holman::{Kernel, WisdomHolman};
@@ -224,6 +225,22 @@ impl Integrator {
     pub(super) fn kick_drift(&mut self) -> Option<&mut KickDrift> {
         match &mut self.scheme {
             Scheme::KickDrift(s) => Some(s),
+            _ => None,
+        }
+    }
+
+    /// The next `steps` steps of a general Lagrangian `sys` of N coordinates in the fixed-size
+    /// loop of the two-point DEL methods ([`Del::run`]); None where it does not apply (another
+    /// method, constraints, forces, or the run's first step, which the general step makes).
+    fn run_two_point<S: Lagrangian + ?Sized, const N: usize>(
+        &mut self,
+        sys: &S,
+        phase: Phase<'_>,
+        steps: usize,
+    ) -> Option<Result<(), crate::Error>> {
+        match &mut self.scheme {
+            Scheme::Midpoint(s) if s.runs_fixed(sys) => Some(s.run::<S, N>(sys, phase, steps)),
+            Scheme::Trapezoid(s) if s.runs_fixed(sys) => Some(s.run::<S, N>(sys, phase, steps)),
             _ => None,
         }
     }

@@ -6,9 +6,9 @@ mod own_variables;
 use std::borrow::{Borrow, BorrowMut};
 use std::ops::Deref;
 
-use super::{compensated, Dynamics, Increment, Integrator, Method, Options, Poll, StepStart};
+use super::{compensated, Dynamics, General, Increment, Integrator, Method, Options, Poll, StepError, StepStart};
 use crate::error::check_vector;
-use crate::model::MechanicalSystem;
+use crate::model::{Lagrangian, MechanicalSystem};
 use crate::solve::interrupt::InterruptPoll;
 use crate::Error;
 
@@ -321,6 +321,49 @@ impl StepperState {
         Ok(())
     }
 
+    /// `steps` steps of a general Lagrangian: the two-point DEL methods on up to 4
+    /// coordinates in their loop of fixed-size arrays ([`super::Del::run`]; the driver's
+    /// costs, not the physics, dominate such small steps), every other case step by step.
+    pub(super) fn advance_lagrangian<L: Lagrangian>(&mut self, sys: &L, steps: usize) -> Result<(), Error> {
+        let mut left = steps;
+        while left > 0 {
+            let StepperState {
+                integrator,
+                clock,
+                steps: done,
+                compensated,
+                q,
+                p,
+                eq,
+                ep,
+                ..
+            } = self;
+            let n = q.len();
+            let phase = Phase {
+                q,
+                p,
+                eq,
+                ep,
+                compensated: *compensated,
+                steps: done,
+                clock: *clock,
+            };
+            let fixed = match n {
+                1 => integrator.run_two_point::<L, 1>(sys, phase, left),
+                2 => integrator.run_two_point::<L, 2>(sys, phase, left),
+                3 => integrator.run_two_point::<L, 3>(sys, phase, left),
+                4 => integrator.run_two_point::<L, 4>(sys, phase, left),
+                _ => None,
+            };
+            if let Some(result) = fixed {
+                return result;
+            }
+            self.step(&General(sys))?;
+            left -= 1;
+        }
+        Ok(())
+    }
+
     /// The time tₙ = t₀ + n·h (counted from the last change of h, see [`Stepper::set_dt`]).
     pub fn t(&self) -> f64 {
         self.clock.at(self.steps)
@@ -407,6 +450,63 @@ pub(super) struct Phase<'a> {
     pub(super) compensated: bool,
     pub(super) steps: &'a mut usize,
     pub(super) clock: Clock,
+}
+
+impl Phase<'_> {
+    /// `steps` steps of N coordinates with the state in fixed-size arrays: `increment(t, q, p,
+    /// δq, δp)` writes each step's increments, which are added as [`StepperState::step`] adds
+    /// them (the same bits), in one loop with no dispatch. Stops at the first failure, dated
+    /// as the stepper dates it, with the last good state kept. The loop of the methods' own
+    /// fixed-size paths ([`super::KickDrift::run`], the DEL step's).
+    #[inline(always)]
+    pub(super) fn run<const N: usize, F>(self, steps: usize, mut increment: F) -> Result<(), Error>
+    where
+        F: FnMut(f64, &[f64; N], &[f64; N], &mut [f64; N], &mut [f64; N]) -> Result<(), StepError>,
+    {
+        let array = |x: &[f64]| -> [f64; N] { std::array::from_fn(|i| x[i]) };
+        let Phase {
+            q: state_q,
+            p: state_p,
+            eq: state_eq,
+            ep: state_ep,
+            compensated,
+            steps: done,
+            clock,
+        } = self;
+        let (mut q, mut p, mut eq, mut ep) = (array(state_q), array(state_p), array(state_eq), array(state_ep));
+        let (mut dq, mut dp) = ([0.0; N], [0.0; N]);
+        let (mut q_next, mut p_next, mut eq_next, mut ep_next) = ([0.0; N], [0.0; N], [0.0; N], [0.0; N]);
+        // The count in a local, written back once: through the pointer it would cost stores.
+        let mut n = *done;
+        let mut result = Ok(());
+        for _ in 0..steps {
+            if let Err(e) = increment(clock.at(n), &q, &p, &mut dq, &mut dp) {
+                result = Err(e.at(n + 1, clock.at(n)));
+                break;
+            }
+            let finite = if compensated {
+                compensated::add(&q, &eq, &dq, &mut q_next, &mut eq_next)
+                    & compensated::add(&p, &ep, &dp, &mut p_next, &mut ep_next)
+            } else {
+                compensated::add_plain(&q, &dq, &mut q_next) & compensated::add_plain(&p, &dp, &mut p_next)
+            };
+            if !finite {
+                result = Err(diverged(n + 1, clock.at(n)));
+                break;
+            }
+            (q, p) = (q_next, p_next);
+            if compensated {
+                (eq, ep) = (eq_next, ep_next);
+            }
+            n += 1;
+        }
+        *done = n;
+        state_q.copy_from_slice(&q);
+        state_p.copy_from_slice(&p);
+        state_eq.copy_from_slice(&eq);
+        state_ep.copy_from_slice(&ep);
+        result
+    }
 }
 
 /// [`Dynamics::check_initial`], a model's error dated at t0.

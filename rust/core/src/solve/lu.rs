@@ -15,7 +15,7 @@ pub(crate) fn lu_in_place(a: &mut DMatrix<f64>, pivots: &mut [usize]) -> Option<
 }
 
 #[inline(always)]
-fn factorise(a: &mut [f64], pivots: &mut [usize], n: usize) -> Option<f64> {
+pub(crate) fn factorise(a: &mut [f64], pivots: &mut [usize], n: usize) -> Option<f64> {
     let (a, pivots) = (&mut a[..n * n], &mut pivots[..n]);
     let mut sign = 1.0;
     for k in 0..n {
@@ -61,7 +61,7 @@ pub(crate) fn lu_solve(lu: &DMatrix<f64>, pivots: &[usize], b: &mut [f64]) {
 }
 
 #[inline(always)]
-fn substitute(a: &[f64], pivots: &[usize], b: &mut [f64], n: usize) {
+pub(crate) fn substitute(a: &[f64], pivots: &[usize], b: &mut [f64], n: usize) {
     let (a, b) = (&a[..n * n], &mut b[..n]);
     for (k, &piv) in pivots[..n].iter().enumerate() {
         b.swap(k, piv);

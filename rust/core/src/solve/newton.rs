@@ -139,6 +139,51 @@ pub(crate) trait NewtonProblem {
     }
 }
 
+/// An iteration's progress, by the sizes of its corrections: whether the next step factorises
+/// a fresh Jacobian, and when to stop ([`Rules`]). Shared by [`Newton::solve`] and the
+/// fixed-size DEL step, which must decide alike.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Progress {
+    keep_jacobian: bool,
+    last: f64,
+    smallest: f64,
+}
+
+impl Progress {
+    pub fn new() -> Self {
+        Progress {
+            keep_jacobian: false,
+            last: f64::INFINITY,
+            smallest: f64::INFINITY,
+        }
+    }
+
+    /// Whether the next Newton step factorises a fresh Jacobian.
+    #[inline(always)]
+    pub fn fresh(&self) -> bool {
+        !self.keep_jacobian
+    }
+
+    /// Whether the iteration has converged after `correction`, made with a fresh Jacobian or
+    /// a kept one: on the increment, or at the noise floor of the equations (round-off, or
+    /// derivatives by differences), where even a fresh Newton step no longer halves the
+    /// smallest correction so far. If not, the Jacobian is kept while the corrections halve.
+    #[inline(always)]
+    pub fn converged(&mut self, fresh: bool, correction: Correction, tolerance: f64, rules: Rules) -> bool {
+        let at_floor = rules.noise_floor
+            && fresh
+            && correction.size > 0.5 * self.smallest
+            && correction.size <= NOISE_FLOOR * correction.scale;
+        self.smallest = self.smallest.min(correction.size);
+        if correction.size <= tolerance * correction.scale || at_floor {
+            return true;
+        }
+        self.keep_jacobian = rules.simplified && correction.size <= 0.5 * self.last;
+        self.last = correction.size;
+        false
+    }
+}
+
 /// What a converged iteration reports.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct Solution {
@@ -166,7 +211,8 @@ pub(crate) struct Newton {
 }
 
 /// ‖r‖∞.
-fn norm(r: &DVector<f64>) -> f64 {
+#[inline(always)]
+pub(crate) fn norm(r: &[f64]) -> f64 {
     r.iter().fold(0.0_f64, |m, x| m.max(x.abs()))
 }
 
@@ -205,6 +251,39 @@ impl Newton {
         self.sign
     }
 
+    /// The buffer of the Jacobian, for an iteration run outside [`Newton::solve`] (the
+    /// fixed-size DEL step), which also keeps its results here with [`Newton::keep`].
+    pub fn jacobian_mut(&mut self) -> &mut DMatrix<f64> {
+        &mut self.jacobian
+    }
+
+    /// The last factorised Jacobian (column-major) and its pivots, for N equations, so that an
+    /// iteration run outside [`Newton::solve`] starts from what it left.
+    pub fn factors<const N: usize>(&self) -> ([[f64; N]; N], [usize; N]) {
+        let lu = std::array::from_fn(|c| std::array::from_fn(|r| self.jacobian[(r, c)]));
+        (lu, std::array::from_fn(|i| self.pivots[i]))
+    }
+
+    /// Records what an iteration run outside [`Newton::solve`] left: F at its last iterate,
+    /// the last factorised Jacobian (column-major) with its pivots and determinant sign, and
+    /// its Newton steps.
+    pub fn keep(&mut self, residual: &[f64], lu: &[f64], pivots: &[usize], sign: f64, iterations: u64) {
+        self.residual.copy_from_slice(residual);
+        self.jacobian.copy_from_slice(lu);
+        self.pivots.copy_from_slice(pivots);
+        self.sign = sign;
+        self.iterations += iterations;
+    }
+
+    /// Checks for Ctrl-C when due.
+    #[inline(always)]
+    pub fn poll_interrupt(&mut self) -> Result<(), StepError> {
+        if self.interrupt.due() {
+            check_interrupt().map_err(StepError::Interrupted)?;
+        }
+        Ok(())
+    }
+
     /// Solves F(x) = 0 from the problem's current x.
     pub fn solve<P: NewtonProblem>(
         &mut self,
@@ -214,7 +293,7 @@ impl Newton {
     ) -> Result<Solution, StepError> {
         let reasons = P::REASONS;
         problem.residual(self.residual.as_mut_slice())?;
-        let mut residual = norm(&self.residual);
+        let mut residual = norm(self.residual.as_slice());
         if !residual.is_finite() {
             return Err(StepError::NonFinite {
                 reason: reasons.non_finite_start,
@@ -226,14 +305,10 @@ impl Newton {
                 residual,
             });
         }
-        let mut keep_jacobian = false;
-        let mut last = f64::INFINITY;
-        let mut smallest = f64::INFINITY;
+        let mut progress = Progress::new();
         for iteration in 1..=options.max_iterations {
-            if self.interrupt.due() {
-                check_interrupt().map_err(StepError::Interrupted)?;
-            }
-            let fresh = !keep_jacobian;
+            self.poll_interrupt()?;
+            let fresh = progress.fresh();
             if fresh {
                 problem.jacobian(&mut self.jacobian)?;
                 self.sign = match lu_in_place(&mut self.jacobian, &mut self.pivots) {
@@ -251,27 +326,18 @@ impl Newton {
             lu_solve(&self.jacobian, &self.pivots, self.residual.as_mut_slice());
             let correction = problem.correct(self.residual.as_slice());
             problem.residual(self.residual.as_mut_slice())?;
-            residual = norm(&self.residual);
+            residual = norm(self.residual.as_slice());
             if !(correction.size.is_finite() && residual.is_finite()) {
                 return Err(StepError::NonFinite {
                     reason: reasons.non_finite,
                 });
             }
-            // At the noise floor of the equations (round-off, or derivatives by differences),
-            // even a fresh Newton step no longer halves the smallest correction so far.
-            let at_floor = rules.noise_floor
-                && fresh
-                && correction.size > 0.5 * smallest
-                && correction.size <= NOISE_FLOOR * correction.scale;
-            smallest = smallest.min(correction.size);
-            if correction.size <= options.tolerance * correction.scale || at_floor || problem.solved(residual) {
+            if progress.converged(fresh, correction, options.tolerance, rules) || problem.solved(residual) {
                 return Ok(Solution {
                     iterations: iteration,
                     residual,
                 });
             }
-            keep_jacobian = rules.simplified && correction.size <= 0.5 * last;
-            last = correction.size;
         }
         Err(StepError::Convergence {
             residual,

@@ -5,6 +5,7 @@
 use serde::{Deserialize, Serialize};
 mod composed;
 mod constrained;
+mod fixed;
 mod galerkin;
 mod nonholonomic;
 mod two_point;
@@ -373,14 +374,24 @@ impl<Sc: StepEquations> Del<Sc> {
         };
         self.newton.solve(&mut equations, &self.options, rules)?;
         // The fold test knows the unconstrained equations' continuum limit only.
-        if m == 0 && self.newton.jacobian_sign() != self.continuum_sign {
+        if m == 0 {
+            self.same_branch(self.newton.jacobian_sign())?;
+        }
+        self.finish(sys, constraints, start, out)
+    }
+
+    /// Refuses a solution whose Jacobian's determinant has the sign `sign`, opposite to the
+    /// continuum limit's: beyond a fold of the DEL map.
+    #[inline(always)]
+    fn same_branch(&self, sign: f64) -> Result<(), StepError> {
+        if sign != self.continuum_sign {
             return Err(StepError::SpuriousBranch {
                 reason: "the step's solution lies beyond a fold of the discrete Euler–Lagrange map \
                          (the Jacobian's determinant changed sign from its continuum limit), where \
                          the equations have several solutions and Newton's may be spurious",
             });
         }
-        self.finish(sys, constraints, start, out)
+        Ok(())
     }
 
     /// The increments once the step is solved.
@@ -431,13 +442,16 @@ struct Equations<'a, Sc, S: ?Sized> {
     evaluations: &'a mut u64,
 }
 
+/// Why a step's Newton iteration failed.
+const REASONS: Reasons = Reasons {
+    singular: "the Jacobian of the step's equations is singular",
+    non_finite_start: "the implicit equations are non-finite at the predictor",
+    non_finite: "the implicit equations became non-finite (Newton's method or the solution diverged)",
+    not_converged: "Newton's method did not converge",
+};
+
 impl<Sc: StepEquations, S: Lagrangian + ?Sized> NewtonProblem for Equations<'_, Sc, S> {
-    const REASONS: Reasons = Reasons {
-        singular: "the Jacobian of the step's equations is singular",
-        non_finite_start: "the implicit equations are non-finite at the predictor",
-        non_finite: "the implicit equations became non-finite (Newton's method or the solution diverged)",
-        not_converged: "Newton's method did not converge",
-    };
+    const REASONS: Reasons = REASONS;
 
     fn residual(&mut self, r: &mut [f64]) -> Result<(), StepError> {
         *self.evaluations += 1;
@@ -495,23 +509,34 @@ impl<Sc: StepEquations, S: Lagrangian + ?Sized> NewtonProblem for Equations<'_, 
             let at = Evaluations { plus, minus };
             central_jacobian(equations, x, size, at, jac)?;
         }
-        if !jac.iter().all(|x| x.is_finite()) {
-            let reason = "the Jacobian of the step's equations is non-finite: the solution is blowing up";
-            return Err(StepError::NonFinite { reason });
-        }
-        Ok(())
+        finite_jacobian(jac.as_slice())
     }
 
     fn correct(&mut self, delta: &[f64]) -> Correction {
-        let h = self.start.h;
-        let (mut size, mut scale) = (0.0_f64, 0.0_f64);
-        for (j, (x, d)) in self.x.iter_mut().zip(delta).enumerate() {
-            *x -= d;
-            // A multiplier moves q₁ by about (h²/2)M⁻¹Gᵀλ: its correction counts at that size.
-            let weight = if j < self.m { 0.5 * h * h } else { 1.0 };
-            size = size.max(weight * d.abs());
-            scale = scale.max(weight * x.abs());
-        }
-        Correction { size, scale }
+        correct(self.x, delta, self.m, self.start.h)
     }
+}
+
+/// Refuses a non-finite Jacobian.
+#[inline(always)]
+fn finite_jacobian(jac: &[f64]) -> Result<(), StepError> {
+    if !jac.iter().all(|x| x.is_finite()) {
+        let reason = "the Jacobian of the step's equations is non-finite: the solution is blowing up";
+        return Err(StepError::NonFinite { reason });
+    }
+    Ok(())
+}
+
+/// x ← x − δ for the unknowns x = (λ, the scheme's) of m multipliers, measured in the max norm.
+#[inline(always)]
+fn correct(x: &mut [f64], delta: &[f64], m: usize, h: f64) -> Correction {
+    let (mut size, mut scale) = (0.0_f64, 0.0_f64);
+    for (j, (x, d)) in x.iter_mut().zip(delta).enumerate() {
+        *x -= d;
+        // A multiplier moves q₁ by about (h²/2)M⁻¹Gᵀλ: its correction counts at that size.
+        let weight = if j < m { 0.5 * h * h } else { 1.0 };
+        size = size.max(weight * d.abs());
+        scale = scale.max(weight * x.abs());
+    }
+    Correction { size, scale }
 }

@@ -1,5 +1,5 @@
 use super::{segment, StepEquations};
-use crate::discrete::{DiscreteLagrangian, Quadrature, Segment, Workspace};
+use crate::discrete::{DiscreteLagrangian, Quadrature, Segment, Vector, Workspace};
 use crate::integrators::StepStart;
 use crate::model::Lagrangian;
 use crate::ModelError;
@@ -56,6 +56,88 @@ impl<R: DiscreteLagrangian> TwoPoint<R> {
     }
 }
 
+impl<R: DiscreteLagrangian> TwoPoint<R> {
+    /// [`StepEquations::equations`] with the scratch space `ws`: arrays, for the fixed-size step.
+    #[inline(always)]
+    pub(super) fn equations_in<S: Lagrangian + ?Sized, V: Vector>(
+        &mut self,
+        ws: &mut Workspace<V>,
+        sys: &S,
+        start: StepStart<'_>,
+        x: &[f64],
+        out: &mut [f64],
+    ) -> Result<(), ModelError> {
+        equations(&self.rule, &mut self.forcing, ws, sys, start, x, out)
+    }
+
+    /// [`StepEquations::momentum_change`] with the scratch space `ws` of the last
+    /// [`TwoPoint::equations_in`].
+    #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn momentum_change_in<S: Lagrangian + ?Sized, V: Vector>(
+        &mut self,
+        ws: &mut Workspace<V>,
+        sys: &S,
+        start: StepStart<'_>,
+        x: &[f64],
+        residual: &[f64],
+        dp: &mut [f64],
+    ) -> Result<f64, ModelError> {
+        momentum_change(&self.rule, &mut self.forcing, ws, sys, start, x, residual, dp)
+    }
+}
+
+/// F(δq) = p₀ + D₁L_d(q₀, q₀ + δq) + f_d⁻ into `out`.
+#[inline(always)]
+fn equations<R: DiscreteLagrangian, S: Lagrangian + ?Sized, V: Vector>(
+    rule: &R,
+    forcing: &mut Forcing,
+    ws: &mut Workspace<V>,
+    sys: &S,
+    start: StepStart<'_>,
+    x: &[f64],
+    out: &mut [f64],
+) -> Result<(), ModelError> {
+    let at = segment(&start, x);
+    rule.d1(sys, at, out, ws)?;
+    out.iter_mut().zip(start.p).for_each(|(o, p)| *o += p);
+    if sys.is_forced() {
+        let f = forcing.evaluate(sys, at)?;
+        out.iter_mut().zip(f).for_each(|(o, f)| *o += 0.5 * start.h * f);
+    }
+    Ok(())
+}
+
+/// p₁ − p₀ = D₁L_d + D₂L_d + h·f(q̄, v) − F into `dp`, since F = p₀ + D₁L_d + f_d⁻; returns the
+/// forces' work. Called after [`equations`] at the same x, as Newton's method leaves it: the
+/// rule reuses that D₁L_d's evaluation in `ws`.
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn momentum_change<R: DiscreteLagrangian, S: Lagrangian + ?Sized, V: Vector>(
+    rule: &R,
+    forcing: &mut Forcing,
+    ws: &mut Workspace<V>,
+    sys: &S,
+    start: StepStart<'_>,
+    x: &[f64],
+    residual: &[f64],
+    dp: &mut [f64],
+) -> Result<f64, ModelError> {
+    let at = segment(&start, x);
+    rule.momentum_change_after_d1(sys, at, dp, ws)?;
+    dp.iter_mut().zip(residual).for_each(|(d, r)| *d -= r);
+    if !sys.is_forced() {
+        return Ok(0.0);
+    }
+    let f = forcing.evaluate(sys, at)?;
+    let mut work = 0.0;
+    for ((d, f), x) in dp.iter_mut().zip(f).zip(x) {
+        *d += start.h * f;
+        work += f * x;
+    }
+    Ok(work)
+}
+
 impl<R: DiscreteLagrangian> StepEquations for TwoPoint<R> {
     fn unknowns(&self, n: usize) -> usize {
         n
@@ -70,19 +152,10 @@ impl<R: DiscreteLagrangian> StepEquations for TwoPoint<R> {
         x: &[f64],
         out: &mut [f64],
     ) -> Result<(), ModelError> {
-        let at = segment(&start, x);
-        self.rule.d1(sys, at, out, &mut self.ws)?;
-        out.iter_mut().zip(start.p).for_each(|(o, p)| *o += p);
-        if sys.is_forced() {
-            let f = self.forcing.evaluate(sys, at)?;
-            out.iter_mut().zip(f).for_each(|(o, f)| *o += 0.5 * start.h * f);
-        }
-        Ok(())
+        let TwoPoint { rule, ws, forcing, .. } = self;
+        equations(rule, forcing, ws, sys, start, x, out)
     }
 
-    /// p₁ − p₀ = D₁L_d + D₂L_d + h·f(q̄, v) − F, since F = p₀ + D₁L_d + f_d⁻. Called after
-    /// [`Self::equations`] at the same x, as Newton's method leaves it: the rule reuses that D₁L_d's
-    /// evaluation.
     fn momentum_change<S: Lagrangian + ?Sized>(
         &mut self,
         sys: &S,
@@ -91,19 +164,8 @@ impl<R: DiscreteLagrangian> StepEquations for TwoPoint<R> {
         residual: &[f64],
         dp: &mut [f64],
     ) -> Result<f64, ModelError> {
-        let at = segment(&start, x);
-        self.rule.momentum_change_after_d1(sys, at, dp, &mut self.ws)?;
-        dp.iter_mut().zip(residual).for_each(|(d, r)| *d -= r);
-        if !sys.is_forced() {
-            return Ok(0.0);
-        }
-        let f = self.forcing.evaluate(sys, at)?;
-        let mut work = 0.0;
-        for ((d, f), x) in dp.iter_mut().zip(f).zip(x) {
-            *d += start.h * f;
-            work += f * x;
-        }
-        Ok(work)
+        let TwoPoint { rule, ws, forcing, .. } = self;
+        momentum_change(rule, forcing, ws, sys, start, x, residual, dp)
     }
 
     fn predict(&self, dq: &[f64], x: &mut [f64]) {

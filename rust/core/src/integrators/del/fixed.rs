@@ -1,0 +1,151 @@
+//! The DEL step of a two-point rule on N ≤ 4 coordinates, without constraints or forces, in a
+//! loop of fixed-size arrays: [`Del::increment`]'s arithmetic in its order (the same bits,
+//! tests/rust/bits.rs), with the state, the unknowns, F and the LU factors on the stack and
+//! every length known to the compiler. On a double pendulum the general step's runtime lengths,
+//! calls and buffers cost more than the model's own arithmetic (issue 15).
+
+use super::{correct, finite_jacobian, segment, Constraints, Del, Equations, TwoPoint, REASONS};
+use crate::discrete::{DiscreteLagrangian, Workspace};
+use crate::integrators::del::StepEquations;
+use crate::integrators::stepper::Phase;
+use crate::integrators::{StepError, StepStart};
+use crate::model::Lagrangian;
+use crate::solve::lu::{factorise, substitute};
+use crate::solve::newton::{norm, NewtonProblem, Progress, Rules};
+use crate::Error;
+
+impl<R: DiscreteLagrangian> Del<TwoPoint<R>> {
+    /// Whether [`Del::run`] takes the next steps of `sys`: no constraints and no forces, and
+    /// the run's first step made (which judges the continuum limit's determinant sign).
+    pub(in crate::integrators) fn runs_fixed<S: Lagrangian + ?Sized>(&self, sys: &S) -> bool {
+        self.m == 0 && self.continuum_sign != 0.0 && !sys.is_forced()
+    }
+
+    /// `steps` steps of N coordinates, as [`Del::increment`] makes them when
+    /// [`Del::runs_fixed`] holds. The Jacobian is [`Equations`]' own (exact, or by differences
+    /// for a model without second derivatives), factorised on the stack.
+    pub(in crate::integrators) fn run<S: Lagrangian + ?Sized, const N: usize>(
+        &mut self,
+        sys: &S,
+        phase: Phase<'_>,
+        steps: usize,
+    ) -> Result<(), Error> {
+        let array = |x: &[f64]| -> [f64; N] { std::array::from_fn(|i| x[i]) };
+        let h = phase.clock.h;
+        let (mut last, mut before_last, mut history) =
+            (array(&self.last_dq), array(&self.before_last_dq), self.history);
+        // The last step's unknowns, F and factorised Jacobian, kept for the Newton workspace.
+        let (lu, pivots) = self.newton.factors::<N>();
+        let mut kept = (
+            array(&self.x),
+            array(self.newton.residual_mut()),
+            lu,
+            pivots,
+            self.newton.jacobian_sign(),
+        );
+        // Counts in locals, written back once.
+        let (mut evaluations, mut iterations) = (self.evaluations, 0);
+        let (options, rules) = (
+            self.options,
+            Rules {
+                simplified: true,
+                noise_floor: true,
+            },
+        );
+        let result = phase.run::<N, _>(steps, |t, q, p, dq, dp| {
+            let start = StepStart { t, h, q, p };
+            // The Newton iteration's values are the closure's own, so that they may stay in
+            // registers: through memory, scalar stores feeding vector loads stall.
+            let mut x: [f64; N] = std::array::from_fn(|i| match history {
+                0 => 0.0,
+                1 => last[i],
+                _ => 2.0 * last[i] - before_last[i],
+            });
+            let (mut r, mut lu, mut pivots, mut sign) = ([0.0; N], [[0.0; N]; N], [0; N], 0.0);
+            let mut ws = Workspace::<[f64; N]>::default();
+            evaluations += 1;
+            self.scheme.equations_in(&mut ws, sys, start, &x, &mut r)?;
+            let mut residual = norm(&r);
+            if !residual.is_finite() {
+                return Err(StepError::NonFinite {
+                    reason: REASONS.non_finite_start,
+                });
+            }
+            let mut progress = Progress::new();
+            let mut iteration = 0;
+            loop {
+                if iteration == options.max_iterations {
+                    return Err(StepError::Convergence {
+                        residual,
+                        iterations: iteration,
+                        reason: REASONS.not_converged,
+                    });
+                }
+                iteration += 1;
+                self.newton.poll_interrupt()?;
+                let fresh = progress.fresh();
+                if fresh {
+                    let exact =
+                        self.scheme
+                            .quadrature()
+                            .jacobian_into(sys, segment(&start, &x), lu.as_flattened_mut(), N)?;
+                    if exact {
+                        finite_jacobian(lu.as_flattened())?;
+                    } else {
+                        let mut equations = Equations {
+                            scheme: &mut self.scheme,
+                            sys,
+                            constraints: Constraints::None,
+                            start,
+                            m: 0,
+                            multipliers: &mut self.multipliers,
+                            block: &mut self.block,
+                            x: &mut x,
+                            plus: &mut self.plus,
+                            minus: &mut self.minus,
+                            evaluations: &mut evaluations,
+                        };
+                        let jacobian = self.newton.jacobian_mut();
+                        equations.jacobian(jacobian)?;
+                        lu.as_flattened_mut().copy_from_slice(jacobian.as_slice());
+                    }
+                    sign = factorise(lu.as_flattened_mut(), &mut pivots, N).ok_or_else(|| StepError::Convergence {
+                        residual,
+                        iterations: iteration - 1,
+                        reason: REASONS.singular,
+                    })?;
+                }
+                iterations += 1;
+                substitute(lu.as_flattened(), &pivots, &mut r, N);
+                let correction = correct(&mut x, &r, 0, h);
+                evaluations += 1;
+                self.scheme.equations_in(&mut ws, sys, start, &x, &mut r)?;
+                residual = norm(&r);
+                if !(correction.size.is_finite() && residual.is_finite()) {
+                    return Err(StepError::NonFinite {
+                        reason: REASONS.non_finite,
+                    });
+                }
+                if progress.converged(fresh, correction, options.tolerance, rules) {
+                    break;
+                }
+            }
+            self.same_branch(sign)?;
+            evaluations += 1;
+            self.scheme.momentum_change_in(&mut ws, sys, start, &x, &r, dp)?;
+            *dq = x;
+            (before_last, last) = (last, x);
+            history = (history + 1).min(2);
+            kept = (x, r, lu, pivots, sign);
+            Ok(())
+        });
+        self.last_dq.copy_from_slice(&last);
+        self.before_last_dq.copy_from_slice(&before_last);
+        self.history = history;
+        self.evaluations = evaluations;
+        let (x, r, lu, pivots, sign) = kept;
+        self.x.copy_from_slice(&x);
+        self.newton.keep(&r, lu.as_flattened(), &pivots, sign, iterations);
+        result
+    }
+}
