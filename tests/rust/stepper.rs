@@ -101,7 +101,9 @@ fn the_two_point_del_methods_take_integrates_steps_at_every_size() {
     let top = HeavyTop::problem();
     let fpu4 = FermiPastaUlam::new(2, 20.0).unwrap();
     let fpu6 = FermiPastaUlam::problem();
-    let cases: [(&dyn Dynamics, &[f64], &[f64], f64); 5] = [
+    /// A model, its (q0, p0) and the step.
+    type Case<'a> = (&'a dyn Dynamics, &'a [f64], &'a [f64], f64);
+    let cases: [Case; 5] = [
         (
             &General(&oscillator.system),
             &oscillator.initial.q,
