@@ -277,6 +277,31 @@ impl StepperState {
         Ok(())
     }
 
+    /// The integrator, and the state as a method's own loop advances it.
+    fn phase(&mut self) -> (&mut Integrator, Phase<'_>) {
+        let StepperState {
+            integrator,
+            clock,
+            steps,
+            compensated,
+            q,
+            p,
+            eq,
+            ep,
+            ..
+        } = self;
+        let phase = Phase {
+            q,
+            p,
+            eq,
+            ep,
+            compensated: *compensated,
+            steps,
+            clock: *clock,
+        };
+        (integrator, phase)
+    }
+
     /// `steps` steps of a separable system: the methods with their own variables on them
     /// (`own_variables.rs`), the kick–drift methods on up to 4 coordinates in a loop of
     /// fixed-size arrays ([`super::KickDrift::run`]; the driver's costs, not the physics,
@@ -285,29 +310,9 @@ impl StepperState {
         if let Some(result) = sys.as_nbody().and_then(|nbody| self.advance_own(nbody, steps)) {
             return result;
         }
-        let StepperState {
-            integrator,
-            clock,
-            steps: done,
-            compensated,
-            q,
-            p,
-            eq,
-            ep,
-            ..
-        } = self;
+        let (integrator, phase) = self.phase();
         if let Some(kick_drift) = integrator.kick_drift() {
-            let n = q.len();
-            let phase = Phase {
-                q,
-                p,
-                eq,
-                ep,
-                compensated: *compensated,
-                steps: done,
-                clock: *clock,
-            };
-            match n {
+            match phase.q.len() {
                 1 => return kick_drift.run::<S, 1>(sys, phase, steps),
                 2 => return kick_drift.run::<S, 2>(sys, phase, steps),
                 3 => return kick_drift.run::<S, 3>(sys, phase, steps),
@@ -327,27 +332,8 @@ impl StepperState {
     pub(super) fn advance_lagrangian<L: Lagrangian>(&mut self, sys: &L, steps: usize) -> Result<(), Error> {
         let mut left = steps;
         while left > 0 {
-            let StepperState {
-                integrator,
-                clock,
-                steps: done,
-                compensated,
-                q,
-                p,
-                eq,
-                ep,
-                ..
-            } = self;
-            let n = q.len();
-            let phase = Phase {
-                q,
-                p,
-                eq,
-                ep,
-                compensated: *compensated,
-                steps: done,
-                clock: *clock,
-            };
+            let (integrator, phase) = self.phase();
+            let n = phase.q.len();
             let fixed = match n {
                 1 => integrator.run_two_point::<L, 1>(sys, phase, left),
                 2 => integrator.run_two_point::<L, 2>(sys, phase, left),
