@@ -157,6 +157,9 @@ impl Constraints<'_> {
 /// [`NewtonOptions`]) or at the noise floor of the equations. The predictor extrapolates the
 /// last two increments. p₁ − p₀ is formed by the scheme free of cancellation, so that Noether
 /// momenta stay conserved to round-off.
+/// On up to 4 coordinates, without constraints or forces, the stepper runs the two-point rules'
+/// steps in a loop of fixed-size arrays (`Del::run`, in `fixed.rs`): the same arithmetic and bits.
+///
 ///
 /// A step whose Jacobian at the solution has the opposite determinant sign to the continuum
 /// limit ([`Quadrature`]) has crossed a fold of the DEL map: beyond it the
