@@ -259,11 +259,7 @@ impl<L: Lagrangian, C: VelocityConstraints> Dynamics for Nonholonomic<L, C> {
     /// |A(q₀)q̇₀|∞ within 1e-10 of the state's size; otherwise `p0` is off the constraints. A
     /// model error is the model's own, at step 0 (the stepper sets its time).
     fn check_initial(&self, q0: &[f64], p0: &[f64]) -> Result<(), Error> {
-        let residuals = self.residuals(q0, p0).map_err(|source| Error::Model {
-            step: 0,
-            time: 0.0,
-            source,
-        })?;
+        let residuals = self.residuals(q0, p0).map_err(at_start)?;
         // No position residual: it is 0.
         on_constraints(
             &residuals,
@@ -323,11 +319,7 @@ impl<L: Lagrangian, H: HolonomicConstraints, C: VelocityConstraints> Dynamics fo
     /// |g(q₀)|∞ (else `q0` is off the constraints) and |[G; A](q₀)q̇₀ + [0; b]|∞ (else `p0`)
     /// within 1e-10 of the state's size. A model error is the model's own, at step 0.
     fn check_initial(&self, q0: &[f64], p0: &[f64]) -> Result<(), Error> {
-        let residuals = self.residuals(q0, p0).map_err(|source| Error::Model {
-            step: 0,
-            time: 0.0,
-            source,
-        })?;
+        let residuals = self.residuals(q0, p0).map_err(at_start)?;
         on_constraints(
             &residuals,
             q0,
@@ -367,6 +359,15 @@ impl<L: Lagrangian, H: HolonomicConstraints, C: VelocityConstraints> Dynamics fo
 
     fn project(&self, q: &[f64], p: &[f64]) -> Option<Result<PhaseState, Error>> {
         Some(Mixed::project(self, q, p))
+    }
+}
+
+/// A model's error evaluating the initial data: its own, at step 0 (the stepper sets its time).
+fn at_start(source: ModelError) -> Error {
+    Error::Model {
+        step: 0,
+        time: 0.0,
+        source,
     }
 }
 
