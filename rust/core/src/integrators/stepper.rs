@@ -329,37 +329,33 @@ impl StepperState {
     /// `steps` steps of a general Lagrangian: the two-point DEL methods on up to 4
     /// coordinates in their loop of fixed-size arrays ([`super::Del::run`]; the driver's
     /// costs, not the physics, dominate such small steps), every other case step by step.
-    /// The loop cannot take a run's first step, which judges the continuum limit's sign, so
-    /// it is asked again after one general step, and not after every step of a case it never
-    /// takes.
     pub(super) fn advance_lagrangian<L: Lagrangian>(&mut self, sys: &L, steps: usize) -> Result<(), Error> {
-        if steps == 0 {
-            return Ok(());
-        }
-        if let Some(result) = self.run_fixed(sys, steps) {
-            return result;
-        }
-        self.step(&General(sys))?;
-        if let Some(result) = self.run_fixed(sys, steps - 1) {
-            return result;
-        }
-        for _ in 1..steps {
+        let mut left = steps;
+        while left > 0 {
+            let (integrator, phase) = self.phase();
+            let n = phase.q.len();
+            let fixed = match n {
+                1 => integrator.run_two_point::<L, 1>(sys, phase, left),
+                2 => integrator.run_two_point::<L, 2>(sys, phase, left),
+                3 => integrator.run_two_point::<L, 3>(sys, phase, left),
+                4 => integrator.run_two_point::<L, 4>(sys, phase, left),
+                _ => None,
+            };
+            if let Some(result) = fixed {
+                return result;
+            }
             self.step(&General(sys))?;
+            left -= 1;
+            // Only a run's first step makes the loop apply (it judges the continuum limit's
+            // sign): once past it, a case the loop does not take steps on without asking.
+            if left < steps - 1 {
+                for _ in 0..left {
+                    self.step(&General(sys))?;
+                }
+                return Ok(());
+            }
         }
         Ok(())
-    }
-
-    /// `steps` steps in the two-point DEL methods' fixed-size loop, for the state's size;
-    /// None where it does not apply.
-    fn run_fixed<L: Lagrangian>(&mut self, sys: &L, steps: usize) -> Option<Result<(), Error>> {
-        let (integrator, phase) = self.phase();
-        match phase.q.len() {
-            1 => integrator.run_two_point::<L, 1>(sys, phase, steps),
-            2 => integrator.run_two_point::<L, 2>(sys, phase, steps),
-            3 => integrator.run_two_point::<L, 3>(sys, phase, steps),
-            4 => integrator.run_two_point::<L, 4>(sys, phase, steps),
-            _ => None,
-        }
     }
 
     /// The time tₙ = t₀ + n·h (counted from the last change of h, see [`Stepper::set_dt`]).
