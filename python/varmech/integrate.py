@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import datetime
 import math
 import os
@@ -832,7 +833,9 @@ def _run(
                     found=found,
                 )
             except BaseException as err:
-                err.partial = files.load(target, model=model, lazy=True)  # type: ignore[attr-defined]
+                # A file that cannot be read back (a disk that failed) leaves the error as it is.
+                with contextlib.suppress(ValueError):
+                    err.partial = files.load(target, model=model, lazy=True)  # type: ignore[attr-defined]
                 raise
             return files.load(target, model=model, lazy=files.larger_than_memory(target))
         if checkpoint_every is not None:
