@@ -114,11 +114,16 @@ def stream(
                 done.result()
 
     try:
-        if checkpoint is None:
-            # The initial state and its checkpoint are committed at once, so that a run killed
-            # in its first segment resumes too; every segment then goes on from a checkpoint.
-            assert first is not None
-            record = first(0, None)
+        if writer.rows == 0:
+            # A new file commits the run's first state and its checkpoint at once, so that a run
+            # killed in its first segment resumes too (and a continued run's file starts, as
+            # its trajectory in memory does, with the state it goes on from); every segment
+            # then goes on from a checkpoint.
+            if checkpoint is None:
+                assert first is not None
+                record = first(0, None)
+            else:
+                record = _core.resume(model._core, checkpoint, steps=0, save_every=save_every)
             with _uninterrupted():
                 writer.append(record)
             if watched and initial_energy is None:

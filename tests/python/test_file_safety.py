@@ -316,3 +316,15 @@ def test_a_run_killed_in_its_first_segment_resumes_bit_for_bit(tmp_path):
     s = scenes.kepler()
     whole = varmech.integrate(s, dt=1e-3, steps=1000, save_every=100)
     assert _same(resumed.q, whole.q) and _same(resumed.p, whole.p) and resumed.steps == 1000
+
+
+def test_a_continued_run_streamed_to_a_file_starts_with_its_state_committed(tmp_path):
+    s = scenes.kepler()
+    traj = varmech.integrate(s, dt=s.dt, steps=100, save_every=10)
+    in_memory = varmech.integrate(traj, steps=50, save_every=10)
+    # Before, the file lacked the state the run went on from, and nothing was resumable
+    # until the first segment was committed.
+    streamed = varmech.integrate(traj, steps=50, save_every=10, output=tmp_path / "c.h5")
+    for name in ("t", "q", "p"):
+        assert _same(getattr(streamed, name), getattr(in_memory, name)), name
+    assert (streamed.steps, streamed.nfev) == (in_memory.steps, in_memory.nfev)
