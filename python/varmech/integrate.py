@@ -143,6 +143,12 @@ class Trajectory:
         """Writes the trajectory to the HDF5 file ``path`` (h5py, the extra ``io``); read it back
         with :func:`varmech.load`. See :mod:`varmech.files` for the layout.
 
+        The model is stored as what builds it, as data: a scene's name and parameters, G and the
+        masses, a symbolic model's expressions and tapes, a Routh model's full model and
+        momenta; loading rebuilds it without running code from the file. A model of Python
+        closures is stored as its pickle, which :func:`varmech.load` unpickles only with
+        ``allow_pickle=True`` (or pass ``model=``). Every dataset carries a checksum.
+
         Parameters
         ----------
         path : str or os.PathLike
@@ -158,7 +164,8 @@ class Trajectory:
         Raises
         ------
         ValueError
-            Naming ``path``: the file exists and ``overwrite`` is False, or it cannot be written.
+            Naming ``path``: the file exists and ``overwrite`` is False, or it cannot be written
+            (its directory, or a full disk).
         ImportError
             h5py is not installed.
 
@@ -173,6 +180,10 @@ class Trajectory:
         >>> path = traj.save(pathlib.Path(tempfile.mkdtemp()) / "pendulum.h5")
         >>> path.name, len(varmech.load(path))
         ('pendulum.h5', 11)
+        >>> import h5py, json
+        >>> with h5py.File(path) as f:
+        ...     json.loads(f["model"][()])
+        {'kind': 'scene', 'name': 'pendulum', 'parameters': {}}
         """
         return files.save(self, path, overwrite=overwrite)
 

@@ -338,8 +338,9 @@ def _check_checkpoint(path: str | os.PathLike[str], stored: Trajectory) -> None:
     last = (float(stored.t[-1]), stored.q[-1], stored.p[-1])
     if at.steps != stored.steps or not all(_same(a, b) for a, b in zip((at.t, at.q, at.p), last)):
         raise ValueError(
-            f"path: {str(path)!r} is damaged: its checkpoint (step {at.steps}, t = {at.t}) is not the state of its "
-            f"last committed row (step {stored.steps}, t = {last[0]})"
+            f"path: {str(path)!r} cannot be resumed: its checkpoint (step {at.steps}, t = {at.t}) is not the state of "
+            f"its last committed row (step {stored.steps}, t = {last[0]}); the file is damaged, or its rows are "
+            "not the run's saved states (a trajectory of t_eval times)"
         )
 
 

@@ -216,9 +216,14 @@ def test_resume_refuses_a_checkpoint_that_is_not_the_last_rows_state(tmp_path):
         committed[2] = f[f"checkpoint{committed[1]}"].shape[0]
         f["committed"][...] = committed
     before = path.read_bytes()
-    with pytest.raises(ValueError, match=r"^path: .*damaged: its checkpoint \(step 900, .*\) is not the state of its last committed row \(step 1000"):
+    with pytest.raises(ValueError, match=r"^path: .*its checkpoint \(step 900, .*\) is not the state of its last committed row \(step 1000"):
         varmech.resume(path, steps=10)
     assert path.read_bytes() == before  # nothing appended
+    # Rows at t_eval times are not the states a checkpoint goes on from: resume went on from t = 1
+    # while appending after t = 0.5.
+    traj = varmech.integrate(s, dt=0.01, steps=100, t_eval=[0.105, 0.5])
+    with pytest.raises(ValueError, match=r"^path: .*its checkpoint \(step 100, t = 1.0\) .*\(step 100, t = 0.5\).*t_eval"):
+        varmech.resume(traj.save(tmp_path / "t_eval.h5"), steps=10)
 
 
 @pytest.mark.parametrize("column", ["t", "q", "p"])
