@@ -40,6 +40,8 @@ import json
 import os
 import pickle
 import shutil
+import subprocess
+import sys
 from collections.abc import Iterator, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -419,12 +421,51 @@ def check_intact(path: Path) -> bool:
     return bool(flags & 0b101)
 
 
-def open_read(path: Path) -> Any:
+def open_read(path: Path, *, probe: bool = False) -> Any:
     """The h5py file ``path`` opened for reading, after :func:`check_intact`: in SWMR mode only
-    when a writer has it open, since libhdf5 retries a failed checksum in SWMR mode for minutes
-    (a damaged file would hang), where a plain read fails at once."""
+    when a writer has it open, since libhdf5 retries a failed metadata checksum in SWMR mode
+    without end (a damaged file hangs it, deaf to Ctrl-C), where a plain read fails at once.
+    With ``probe``, such a file is first read by another process, which can be stopped
+    (:func:`_probe`)."""
     _fresh(path)
-    return _h5py().File(path, "r", swmr=check_intact(path))
+    swmr = check_intact(path)
+    if swmr and probe and sys.executable:
+        _probe(path)
+    return _h5py().File(path, "r", swmr=swmr)
+
+
+#: How long another process may take to read the metadata of a file a writer holds open before
+#: the file is called damaged (s): a healthy file takes a fraction of a second.
+PROBE_SECONDS = 30.0
+#: What that process reads: every object's header, the committed counts, the checkpoints and
+#: each column's last committed row (the metadata a load or a resume then reads).
+_PROBE = """
+import sys, h5py
+with h5py.File(sys.argv[1], "r", swmr=True) as f:
+    f.visititems(lambda name, obj: None)
+    rows, slot, length = (int(x) for x in f["committed"][:3])
+    f["checkpoint0"][:], f["checkpoint1"][:]
+    for name in ("t", "q", "p", "newton", "work"):
+        if name in f and rows:
+            f[name][rows - 1]
+"""
+
+
+def _probe(path: Path) -> None:
+    """Reads the metadata of ``path`` in SWMR mode in another process (:data:`_PROBE`);
+    ValueError naming ``path`` when that fails or takes longer than :data:`PROBE_SECONDS`."""
+    try:
+        done = subprocess.run(
+            [sys.executable, "-c", _PROBE, str(path)], capture_output=True, text=True, timeout=PROBE_SECONDS
+        )
+    except subprocess.TimeoutExpired:
+        raise ValueError(
+            f"path: {str(path)!r} is corrupt: reading its metadata took over {PROBE_SECONDS:g} s "
+            "(libhdf5 retries a damaged file that a writer had open without end)"
+        ) from None
+    if done.returncode:
+        last = (done.stderr.strip().splitlines() or ["no message"])[-1]
+        raise ValueError(f"path: {str(path)!r} is corrupt or truncated: {last}")
 
 
 #: The files (device, inode) whose write failed in this process.
@@ -636,7 +677,7 @@ def load(
     if not source.is_file():
         raise ValueError(f"path: no file {str(source)!r}")
     try:
-        with open_read(source) as f:
+        with open_read(source, probe=True) as f:
             if not f.swmr_mode:
                 # Every object's header is read (and its checksum checked) now, not first by a
                 # writer appending to the file.

@@ -135,6 +135,7 @@ def stream(
                 segment = max(save_every, int(rate * seconds) // save_every * save_every)
             take = min(left, segment, SEGMENT_ROWS * save_every, cap or left)
             started = time.perf_counter()
+            assert checkpoint is not None  # committed before the first segment
             try:
                 specs = None
                 if watched:
