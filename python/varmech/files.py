@@ -3,7 +3,7 @@
 
 The layout, self-describing so that any HDF5 reader can use it (``docs/file_format.md``)::
 
-    /            attrs: format = "varmech-trajectory", format_version = 2, varmech_version,
+    /            attrs: format = "varmech-trajectory", format_version = 3, varmech_version,
                         method, dt, dim, save_every (0: unknown), model (its repr), complete,
                         steps, nfev, status, message
     /t           (N,)   float64   the saved times
@@ -14,24 +14,34 @@ The layout, self-describing so that any HDF5 reader can use it (``docs/file_form
     /checkpoint0, /checkpoint1    uint8  the last committed state's checkpoint, in the slot
                                   /committed names (the other holds the one before)
     /events/<k>  attr name; t (k,), q, p (k, n): the crossings of the run's k-th event
-    /model       opaque bytes     the model's pickle (what builds it: a scene's name and
-                                  parameters, expressions, or closures by reference)
+    /model       string           what builds the model, as JSON data (Model._recipe): a
+                                  scene's name and parameters, G and the masses, a symbolic
+                                  model's expressions and tapes; or {"kind": "pickle"}
+    /model_pickle opaque bytes    the pickle of a model only pickle carries (closures)
 
-The arrays are chunked by rows and grow as a run appends to them. A writer appends the rows
+The arrays are chunked by rows, carry HDF5's Fletcher-32 checksum and grow as a run appends to
+them. A writer appends the rows
 and the checkpoint of a chunk, flushes them, and only then updates ``/committed`` (HDF5's
 single-writer/multiple-reader mode keeps the file readable at every moment): a run killed at
 any point leaves a file whose committed rows and checkpoint are intact. The root's ``complete``
 is set when the writer closes; a file without it is a run that stopped without closing
 (``status`` -1 on loading, and :func:`varmech.resume` continues it).
 
-Loading unpickles the model, as :mod:`pickle` does: open only files you trust, or pass
-``model=`` to :func:`load` to skip the stored one.
+Loading runs no code from the file: the model is built from its data, and a pickle
+(``/model_pickle``, or the ``/model`` of a format-2 file) is unpickled only when the caller
+passes ``allow_pickle=True``. Before libhdf5 opens a file its superblock is checked against the
+file's size (libhdf5 can hang on a truncated file).
 """
 
 from __future__ import annotations
 
+import errno
+import json
 import os
 import pickle
+import shutil
+import subprocess
+import sys
 from collections.abc import Iterator, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -39,10 +49,10 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from .events import Occurrences
+from .model import Model, from_recipe
 
 if TYPE_CHECKING:
     from .integrate import Trajectory
-    from .model import Model
 
 __all__ = [
     "LAZY_BYTES",
@@ -51,13 +61,17 @@ __all__ = [
 ]
 
 FORMAT = "varmech-trajectory"
-FORMAT_VERSION = 2
+FORMAT_VERSION = 3
+#: The versions this varmech reads: 2 differs only in its ``/model``, a pickle.
+READS = (2, 3)
 #: Rows per chunk: about 64 kB of a (N, 2)-shaped q for the small systems.
 CHUNK_ROWS = 4096
 _COLUMNS = ("t", "q", "p", "newton", "work")
 #: A streamed run's file larger than this is read back lazily (its columns when used).
 LAZY_BYTES = 256 * 2**20
 _DTYPES = {"newton": np.uint64}
+#: Room kept free on the disk beyond what a commit writes: the file's metadata and its closing.
+SPARE_BYTES = 2**16
 
 
 def _h5py() -> Any:
@@ -136,16 +150,20 @@ class Writer:
                     maxshape=(None, *shape[1:]),
                     chunks=(CHUNK_ROWS, *shape[1:]),
                     dtype=_DTYPES.get(name, np.float64),
+                    fletcher32=True,
                 )
             for slot in (0, 1):
-                f.create_dataset(f"checkpoint{slot}", shape=(0,), maxshape=(None,), chunks=(4096,), dtype=np.uint8)
-            f.create_dataset("committed", data=np.zeros(5, dtype=np.int64))
-            f.create_dataset("model", data=np.void(pickle.dumps(model)))
+                f.create_dataset(
+                    f"checkpoint{slot}", shape=(0,), maxshape=(None,), chunks=(4096,), dtype=np.uint8, fletcher32=True
+                )
+            f.create_dataset("committed", data=np.zeros(5, dtype=np.int64), chunks=(5,), fletcher32=True)
+            _store_model(f, model)
             _create_events(f, events, n)
             f.swmr_mode = True
         except OSError as e:
             raise ValueError(f"{argument}: cannot write {str(path)!r}: {e}") from e
         self._columns = ("t", "q", "p", *columns)
+        self._row_bytes = 8 * (1 + 2 * n + len(columns))
         self.rows = 0
         self._slot = 1
         self.is_open = True
@@ -159,6 +177,8 @@ class Writer:
         h5py = _h5py()
         writer = cls.__new__(cls)
         writer.path, writer._argument = path, "path"
+        _fresh(path)
+        check_intact(path)
         try:
             try:
                 f = h5py.File(path, "r+", libver="latest")
@@ -181,6 +201,7 @@ class Writer:
             raise ValueError(f"path: cannot append to {str(path)!r}: {e}") from e
         writer._file = f
         writer._columns = tuple(name for name in _COLUMNS if name in f)
+        writer._row_bytes = 8 * (1 + 2 * int(f.attrs["dim"]) + len(writer._columns) - 3)
         writer.rows, writer._slot, writer.is_open = rows, slot, True
         writer._datasets = None
         return writer
@@ -193,6 +214,30 @@ class Writer:
 
         Through h5py's low-level API (extent, hyperslab, write): about 0.2 ms a commit, where
         the high-level indexing took 1.5 ms."""
+        # A full disk is refused before the write: a write that fails leaves libhdf5 holding
+        # the file in a state no later open in this process can use (see _fresh).
+        need = (2 * len(record.t) + CHUNK_ROWS) * self._row_bytes + 2 * len(record.checkpoint or b"") + SPARE_BYTES
+        free = shutil.disk_usage(self.path.parent).free
+        if free < need:
+            raise self._failed(f"[Errno {errno.ENOSPC}] {os.strerror(errno.ENOSPC)}: {free} bytes free, a commit needs {need}")
+        try:
+            self._append(record, skip_first, events)
+        except (OSError, RuntimeError) as e:
+            stat = self.path.stat()
+            _FAILED.add((stat.st_dev, stat.st_ino))
+            raise self._failed(str(e)) from e
+
+    def _failed(self, why: str) -> ValueError:
+        """The error of a write that failed (a full disk, say): the rows committed before stay
+        the run's, as the file says."""
+        if not self.rows:
+            return ValueError(f"{self._argument}: cannot write to {str(self.path)!r} ({why}); nothing was committed")
+        return ValueError(
+            f"{self._argument}: cannot write to {str(self.path)!r} ({why}); its {self.rows} rows committed before are "
+            "kept: free some space, then varmech.resume(path) goes on from them"
+        )
+
+    def _append(self, record: Any, skip_first: bool, events: Sequence[Occurrences]) -> None:
         h5py = _h5py()
         f, start = self._file, int(skip_first)
         if self._datasets is None:
@@ -237,14 +282,72 @@ class Writer:
         """Records the end of the run (``status``, ``message`` and the committed counts) and
         closes the file."""
         self.abandon()
-        with _h5py().File(self.path, "r+") as f:
-            rows, _, _, steps, nfev = (int(x) for x in f["committed"][()])
-            f.attrs.update({"complete": True, "status": status, "message": message, "steps": steps, "nfev": nfev})
+        try:
+            _fresh(self.path)
+            with _h5py().File(self.path, "r+") as f:
+                rows, _, _, steps, nfev = (int(x) for x in f["committed"][()])
+                f.attrs.update({"complete": True, "status": status, "message": message, "steps": steps, "nfev": nfev})
+        except (OSError, RuntimeError) as e:
+            raise ValueError(
+                f"{self._argument}: cannot close {str(self.path)!r} ({e}); its committed rows are kept, and "
+                "varmech.resume(path) goes on from them"
+            ) from e
 
     def abandon(self) -> None:
-        """Closes the file as it is (a run stopped by an exception that could not be recorded)."""
-        self._file.close()
+        """Closes the file as it is (a run stopped by an exception that could not be recorded);
+        a close that fails (a full disk) leaves the file as its last commit left it."""
         self.is_open = False
+        try:
+            self._file.close()
+        except (OSError, RuntimeError):
+            pass
+
+
+def _store_model(f: Any, model: Model) -> None:
+    """``/model``: the model's recipe as JSON, or ``{"kind": "pickle"}`` and its pickle in
+    ``/model_pickle`` (a model no pickle carries, such as one of lambdas, stores nothing and
+    loads only with ``model=``)."""
+    recipe = model._recipe()
+    if recipe is None:
+        try:
+            f.create_dataset("model_pickle", data=np.void(pickle.dumps(model)))
+            recipe = {"kind": "pickle"}
+        except (pickle.PicklingError, TypeError, AttributeError):
+            recipe = {"kind": "none"}
+    f.create_dataset("model", data=json.dumps(recipe, allow_nan=True))
+
+
+def _stored_model(f: Any, source: Path, version: int, allow_pickle: bool) -> Model:
+    """The model the file stores, built from its data; a pickle only with ``allow_pickle``."""
+    if version >= 3:
+        text = f["model"][()]
+        try:
+            recipe = json.loads(text.decode() if isinstance(text, bytes) else text)
+        except (ValueError, RecursionError) as e:
+            raise ValueError(f"path: {str(source)!r} is corrupt: its /model is not JSON ({e})") from None
+        kind = recipe.get("kind") if isinstance(recipe, dict) else None
+        blob = f["model_pickle"][()].tobytes() if kind == "pickle" else None
+    else:
+        kind, blob = "pickle", f["model"][()].tobytes()
+    if kind == "none":
+        raise ValueError(f"path: {str(source)!r} stores no model (its closures did not pickle); pass model=")
+    if blob is None:
+        try:
+            return from_recipe(recipe)
+        except ValueError as e:
+            raise ValueError(f"path: cannot rebuild the model of {str(source)!r}: {e}; pass model=") from e
+    if not allow_pickle:
+        raise ValueError(
+            f"path: the model of {str(source)!r} is a pickle (a model of Python closures), and unpickling a "
+            "file can run any code: pass model= (the model, built by you), or allow_pickle=True if you trust the file"
+        )
+    try:
+        model = pickle.loads(blob)  # noqa: S301 - the caller trusts the file (allow_pickle=True)
+    except Exception as e:
+        raise ValueError(f"path: cannot unpickle the model of {str(source)!r}: {e}; pass model=") from e
+    if not isinstance(model, Model):
+        raise ValueError(f"path: the pickle in {str(source)!r} is a {type(model).__name__}, not a varmech model")
+    return model
 
 
 def _create_events(f: Any, names: Sequence[str], n: int) -> None:
@@ -256,7 +359,9 @@ def _create_events(f: Any, names: Sequence[str], n: int) -> None:
         g = group.create_group(str(k))
         g.attrs["name"] = name
         for column, shape in (("t", (0,)), ("q", (0, n)), ("p", (0, n))):
-            g.create_dataset(column, shape=shape, maxshape=(None, *shape[1:]), chunks=(256, *shape[1:]), dtype=np.float64)
+            g.create_dataset(
+                column, shape=shape, maxshape=(None, *shape[1:]), chunks=(256, *shape[1:]), dtype=np.float64, fletcher32=True
+            )
 
 
 def _recover(path: Path) -> None:
@@ -273,6 +378,117 @@ def _recover(path: Path) -> None:
                 dst[name].resize(rows, axis=0)
         dst[f"checkpoint{slot}"].resize((length,))
     os.replace(part, path)
+
+
+#: HDF5's file signature, found at byte 0 or a power of two from 512 on (after a user block).
+_SIGNATURE = b"\x89HDF\r\n\x1a\n"
+
+
+def check_intact(path: Path) -> bool:
+    """Whether a writer has the file open (a live run, or a killed one), by its superblock;
+    ValueError naming ``path`` when the file is shorter than its superblock's end-of-file
+    address (or has none): libhdf5 can hang, deaf to Ctrl-C, reading past a truncated file's
+    end, so the file is checked before libhdf5 opens it."""
+    size = path.stat().st_size
+    with open(path, "rb") as f:
+        base = 0
+        while base + 8 <= size:
+            f.seek(base)
+            if f.read(8) == _SIGNATURE:
+                break
+            base = 512 if base == 0 else 2 * base
+        else:
+            raise ValueError(f"path: {str(path)!r} is corrupt or truncated: no HDF5 superblock")
+        head = f.read(64)
+    # The superblock's version decides where the end-of-file address lies (HDF5 file format
+    # specification, section II.A): after the base address and one (versions 2, 3) or two
+    # (versions 0, 1) other addresses.
+    version = head[0] if head else -1
+    if version in (2, 3) and len(head) >= 4:
+        width, at, flags = head[1], 4 + 2 * head[1], head[3]
+    elif version in (0, 1) and len(head) >= 16:
+        width, flags = head[5], int.from_bytes(head[12:16], "little")
+        at = (16 if version == 0 else 20) + 2 * width
+    else:
+        raise ValueError(f"path: {str(path)!r} is corrupt or truncated: a superblock of unknown version {version}")
+    if width not in (2, 4, 8) or len(head) < at + width:
+        raise ValueError(f"path: {str(path)!r} is corrupt or truncated: a damaged superblock")
+    end = int.from_bytes(head[at : at + width], "little") + int.from_bytes(head[at - 2 * width: at - width], "little")
+    if end > size:
+        raise ValueError(f"path: {str(path)!r} is corrupt or truncated: {size} bytes of the {end} its superblock records")
+    # The file consistency flags: opened for writing (bit 0), for single-writer/multiple-reader
+    # writing (bit 2).
+    return bool(flags & 0b101)
+
+
+def open_read(path: Path, *, probe: bool = False) -> Any:
+    """The h5py file ``path`` opened for reading, after :func:`check_intact`: in SWMR mode only
+    when a writer has it open, since libhdf5 retries a failed metadata checksum in SWMR mode
+    without end (a damaged file hangs it, deaf to Ctrl-C), where a plain read fails at once.
+    With ``probe``, such a file is first read by another process, which can be stopped
+    (:func:`_probe`)."""
+    _fresh(path)
+    swmr = check_intact(path)
+    if swmr and probe and sys.executable:
+        _probe(path)
+    return _h5py().File(path, "r", swmr=swmr)
+
+
+#: How long another process may take to read the metadata of a file a writer holds open before
+#: the file is called damaged (s): a healthy file takes a fraction of a second.
+PROBE_SECONDS = 30.0
+#: What that process reads: every object's header, the committed counts, the checkpoints and
+#: each column's last committed row (the metadata a load or a resume then reads).
+_PROBE = """
+import sys, h5py
+with h5py.File(sys.argv[1], "r", swmr=True) as f:
+    f.visititems(lambda name, obj: None)
+    rows, slot, length = (int(x) for x in f["committed"][:3])
+    f["checkpoint0"][:], f["checkpoint1"][:]
+    for name in ("t", "q", "p", "newton", "work"):
+        if name in f and rows:
+            f[name][rows - 1]
+"""
+
+
+def _probe(path: Path) -> None:
+    """Reads the metadata of ``path`` in SWMR mode in another process (:data:`_PROBE`);
+    ValueError naming ``path`` when that fails or takes longer than :data:`PROBE_SECONDS`."""
+    try:
+        done = subprocess.run(
+            [sys.executable, "-c", _PROBE, str(path)], capture_output=True, text=True, timeout=PROBE_SECONDS
+        )
+    except subprocess.TimeoutExpired:
+        raise ValueError(
+            f"path: {str(path)!r} is corrupt: reading its metadata took over {PROBE_SECONDS:g} s "
+            "(libhdf5 retries a damaged file that a writer had open without end)"
+        ) from None
+    if done.returncode:
+        last = (done.stderr.strip().splitlines() or ["no message"])[-1]
+        raise ValueError(f"path: {str(path)!r} is corrupt or truncated: {last}")
+
+
+#: The files (device, inode) whose write failed in this process.
+_FAILED: set[tuple[int, int]] = set()
+
+
+def _fresh(path: Path) -> None:
+    """Replaces a file whose write failed in this process by a copy of its bytes: libhdf5 keeps
+    the failed file open with metadata it could not write, and would share that state with any
+    later open of the same file (the same inode), where the copy opens afresh."""
+    try:
+        stat = path.stat()
+    except OSError:
+        return
+    if (stat.st_dev, stat.st_ino) in _FAILED:
+        part = path.with_name(path.name + ".recovering")
+        try:
+            shutil.copyfile(path, part)
+            os.replace(part, path)
+        except OSError as e:
+            part.unlink(missing_ok=True)
+            raise ValueError(f"path: cannot copy {str(path)!r}, whose write failed, to reopen it: {e}; free some space") from e
+        _FAILED.discard((stat.st_dev, stat.st_ino))
 
 
 def save(traj: Trajectory, path: str | os.PathLike[str], *, overwrite: bool = False) -> Path:
@@ -355,16 +571,26 @@ class Rows:
             row = int(first) + (self.shape[0] if first < 0 else 0)
             if not 0 <= row < self.shape[0]:
                 raise IndexError(f"row {first} out of range for {self.shape[0]} rows")
-            with _h5py().File(self._path, "r", swmr=True) as f:
-                data = f[self._name][row]
+            data = self._checked(lambda ds: ds[row])
             return data[key[1:]] if isinstance(key, tuple) else data
         return np.asarray(self)[key]
 
     def __array__(self, dtype: Any = None, copy: Any = None) -> np.ndarray:
         if self._data is None:
-            with _h5py().File(self._path, "r", swmr=True) as f:
-                self._data = f[self._name][: self.shape[0]]
+            self._data = self._checked(lambda ds: ds[: self.shape[0]])
         return self._data if dtype is None else self._data.astype(dtype)
+
+    def _checked(self, read: Any) -> np.ndarray:
+        """``read(dataset)``, refused (ValueError naming ``path``) when its checksum fails or a
+        value is not finite."""
+        try:
+            with open_read(self._path) as f:
+                data = read(f[self._name])
+        except OSError as e:
+            raise ValueError(f"path: {str(self._path)!r} is corrupt: {e}") from e
+        if data.dtype.kind == "f" and not np.isfinite(data).all():
+            raise ValueError(f"path: {str(self._path)!r} holds non-finite {self._name} rows: damaged")
+        return data
 
     def __array_ufunc__(self, ufunc: Any, method: str, *inputs: Any, **kwargs: Any) -> Any:
         inputs = tuple(np.asarray(x) if isinstance(x, Rows) else x for x in inputs)
@@ -380,11 +606,21 @@ class Rows:
         return f"Rows({str(self._path)!r}, {self._name!r}, shape={self.shape})"
 
 
-def load(path: str | os.PathLike[str], *, model: Model | None = None, lazy: bool = False) -> Trajectory:
+def load(
+    path: str | os.PathLike[str], *, model: Model | None = None, lazy: bool = False, allow_pickle: bool = False
+) -> Trajectory:
     """The trajectory saved in ``path`` by :meth:`Trajectory.save` or streamed there by a run
-    (``integrate(output=)``), with its model unpickled, or ``model`` instead (which must have the
-    file's dimension). Only the committed rows are read; a run that stopped without closing its
-    file loads with ``status`` -1, and its checkpoint lets :func:`varmech.resume` go on.
+    (``integrate(output=)``), with its model built from the file's data, or ``model`` instead
+    (which must have the file's dimension). Only the committed rows are read; a run that
+    stopped without closing its file loads with ``status`` -1, and its checkpoint lets
+    :func:`varmech.resume` go on.
+
+    Loading runs no code from the file. Scenes, N-body models, symbolic and Routh-reduced
+    models are stored as data (names, numbers, expressions, tapes) and built again by their
+    constructors. A model of Python closures can travel only as a pickle, and unpickling runs
+    whatever the file says: such a file loads with ``model=`` (yours) or, if you trust it, with
+    ``allow_pickle=True``. A file whose superblock promises more bytes than it has (truncated),
+    whose checksums fail, or whose rows are not finite is refused before anything is used.
 
     ``lazy=True`` reads no column until it is used (each a :class:`Rows`; indexing reads only
     the rows asked for), for files larger than memory.
@@ -394,10 +630,13 @@ def load(path: str | os.PathLike[str], *, model: Model | None = None, lazy: bool
     path : str or os.PathLike
         The HDF5 file.
     model : Model, optional
-        The model to attach instead of the file's pickled one (needed for a closure model whose
-        closures do not unpickle).
+        The model to attach instead of the file's stored one (needed for a closure model
+        unless ``allow_pickle``).
     lazy : bool, default False
         Read each column only when used.
+    allow_pickle : bool, default False
+        Unpickle a stored closure model (which runs code from the file: only for files you
+        trust).
 
     Returns
     -------
@@ -407,8 +646,9 @@ def load(path: str | os.PathLike[str], *, model: Model | None = None, lazy: bool
     Raises
     ------
     ValueError
-        Naming ``path`` for a missing, corrupt or truncated file, or one that is not a varmech
-        trajectory; naming ``model`` for a model of another dimension.
+        Naming ``path`` for a missing, corrupt or truncated file, one that is not a varmech
+        trajectory, or whose rows are not finite, and for a pickled model without ``model=`` or
+        ``allow_pickle=True``; naming ``model`` for a model of another dimension.
 
     Examples
     --------
@@ -419,42 +659,59 @@ def load(path: str | os.PathLike[str], *, model: Model | None = None, lazy: bool
     >>> back = varmech.load(path)
     >>> bool(np.array_equal(back.q, traj.q)) and back.method == traj.method
     True
+
+    A model of closures (here V = q, by NumPy's functions) is not unpickled unless asked:
+
+    >>> ramp = varmech.MechanicalSystem(1, np.sum, np.ones_like)
+    >>> path = varmech.integrate(ramp, [0.0], [0.0], dt=0.1, steps=10).save(path.with_name("ramp.h5"))
+    >>> varmech.load(path)
+    Traceback (most recent call last):
+    ...
+    ValueError: path: the model of ... is a pickle (a model of Python closures), ...
+    >>> varmech.load(path, model=ramp).steps, varmech.load(path, allow_pickle=True).steps
+    (10, 10)
     """
     from .integrate import Trajectory
 
-    h5py = _h5py()
     source = Path(path)
     if not source.is_file():
         raise ValueError(f"path: no file {str(source)!r}")
     try:
-        with h5py.File(source, "r", swmr=True) as f:
+        with open_read(source, probe=True) as f:
+            if not f.swmr_mode:
+                # Every object's header is read (and its checksum checked) now, not first by a
+                # writer appending to the file.
+                f.visititems(lambda name, obj: None)
             if f.attrs.get("format") != FORMAT:
                 raise ValueError(f"path: {str(source)!r} is not a varmech trajectory file")
             version = int(f.attrs["format_version"])
-            if version != FORMAT_VERSION:
-                raise ValueError(f"path: format version {version}; this varmech reads version {FORMAT_VERSION}")
+            if version not in READS:
+                raise ValueError(f"path: format version {version}; this varmech reads versions {READS}")
             a = dict(f.attrs)
             rows, slot, length, steps, nfev = (int(x) for x in f["committed"][()])
             present = [name for name in _COLUMNS if name in f]
             shapes = {name: (rows, *f[name].shape[1:]) for name in present}
-            if any(f[name].shape[0] < rows for name in present):
+            if any(f[name].shape[0] < rows for name in present) or slot not in (0, 1) or min(rows, length, steps) < 0:
                 raise ValueError(f"path: {str(source)!r} is truncated: fewer rows than committed")
             columns: dict[str, Any] = {
                 name: Rows(source, name, shapes[name], f[name].dtype) if lazy else f[name][:rows] for name in present
             }
+            # A lazy file's rows are checked as they are read; its last (which a resume goes on
+            # from) here.
+            last = {name: f[name][rows - 1 : rows] for name in ("t", "q", "p")} if lazy and rows else columns
+            for name in ("t", "q", "p", "work"):
+                if name in last and not np.isfinite(last[name]).all():
+                    raise ValueError(f"path: {str(source)!r} holds non-finite {name} rows: damaged")
             checkpoint = f[f"checkpoint{slot}"][:length].tobytes()
             # Crossings after the last committed state are a killed run's uncommitted segment's.
             t_last = float(f["t"][rows - 1]) if rows else -np.inf
             events = tuple(_occurrences(f["events"][str(k)], t_last) for k in range(len(f["events"]))) if "events" in f else ()
-            blob: bytes = f["model"][()].tobytes() if model is None else b""
+            if model is None:
+                model = _stored_model(f, source, version, allow_pickle)
     except (OSError, KeyError, RuntimeError) as e:
-        # h5py raises RuntimeError for some damaged structures (a bad heap signature).
+        # h5py raises RuntimeError for some damaged structures (a bad heap signature), and
+        # OSError for a failed checksum.
         raise ValueError(f"path: {str(source)!r} is corrupt or truncated: {e}") from e
-    if model is None:
-        try:
-            model = pickle.loads(blob)  # noqa: S301 - documented: a file's model is its pickle
-        except Exception as e:
-            raise ValueError(f"path: cannot rebuild the model {a['model']!r}: {e}; pass model=") from e
     if model.dim != int(a["dim"]):
         raise ValueError(f"model: has dimension {model.dim}, the file's states {int(a['dim'])}")
     complete = bool(a["complete"])
@@ -479,7 +736,7 @@ def load(path: str | os.PathLike[str], *, model: Model | None = None, lazy: bool
 def save_every_of(path: str | os.PathLike[str]) -> int:
     """The saving period of the run in ``path``: its ``save_every`` attribute, or (for a saved
     trajectory, which has none) the steps between its first two states."""
-    with _h5py().File(path, "r", swmr=True) as f:
+    with open_read(Path(path)) as f:
         every = int(f.attrs.get("save_every", 0))
         if every > 0:
             return every

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import datetime
 import math
 import os
@@ -142,6 +143,12 @@ class Trajectory:
         """Writes the trajectory to the HDF5 file ``path`` (h5py, the extra ``io``); read it back
         with :func:`varmech.load`. See :mod:`varmech.files` for the layout.
 
+        The model is stored as what builds it, as data: a scene's name and parameters, G and the
+        masses, a symbolic model's expressions and tapes, a Routh model's full model and
+        momenta; loading rebuilds it without running code from the file. A model of Python
+        closures is stored as its pickle, which :func:`varmech.load` unpickles only with
+        ``allow_pickle=True`` (or pass ``model=``). Every dataset carries a checksum.
+
         Parameters
         ----------
         path : str or os.PathLike
@@ -157,7 +164,8 @@ class Trajectory:
         Raises
         ------
         ValueError
-            Naming ``path``: the file exists and ``overwrite`` is False, or it cannot be written.
+            Naming ``path``: the file exists and ``overwrite`` is False, or it cannot be written
+            (its directory, or a full disk).
         ImportError
             h5py is not installed.
 
@@ -172,6 +180,10 @@ class Trajectory:
         >>> path = traj.save(pathlib.Path(tempfile.mkdtemp()) / "pendulum.h5")
         >>> path.name, len(varmech.load(path))
         ('pendulum.h5', 11)
+        >>> import h5py, json
+        >>> with h5py.File(path) as f:
+        ...     json.loads(f["model"][()])
+        {'kind': 'scene', 'name': 'pendulum', 'parameters': {}}
         """
         return files.save(self, path, overwrite=overwrite)
 
@@ -832,7 +844,9 @@ def _run(
                     found=found,
                 )
             except BaseException as err:
-                err.partial = files.load(target, model=model, lazy=True)  # type: ignore[attr-defined]
+                # A file that cannot be read back (a disk that failed) leaves the error as it is.
+                with contextlib.suppress(ValueError):
+                    err.partial = files.load(target, model=model, lazy=True)  # type: ignore[attr-defined]
                 raise
             return files.load(target, model=model, lazy=files.larger_than_memory(target))
         if checkpoint_every is not None:

@@ -2,9 +2,11 @@
 
 from __future__ import annotations
 
+import importlib
+import math
 import warnings
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import astuple, dataclass
 from typing import Any
 
 import numpy as np
@@ -445,6 +447,96 @@ class Model:
             raise TypeError(f"cannot pickle {type(self).__name__} {self.name!r}: it records no constructor arguments")
         return (_rebuild, (type(self), arguments))
 
+    def _recipe(self) -> dict[str, Any] | None:
+        """What builds the model as plain data (names, numbers and lists: JSON, with its
+        ``"kind"``), which a file stores so that loading it runs no code (:func:`from_recipe`
+        builds it again); None for a model only pickle can carry (one of Python closures)."""
+        return None
+
+
+#: The builders of models from their recipes (:meth:`Model._recipe`) by kind: the module of each
+#: model class adds its own.
+RECIPES: dict[str, Callable[[dict[str, Any]], Model]] = {}
+
+
+def from_recipe(recipe: Any) -> Model:
+    """The model :meth:`Model._recipe` described, built by its class's public constructor from
+    checked data (no code is run from the recipe); ValueError saying what is wrong otherwise.
+
+    Parameters
+    ----------
+    recipe : dict
+        A recipe, as :meth:`Model._recipe` gives it (or a file stores it).
+
+    Returns
+    -------
+    Model
+        The model, the same to the bit as the one the recipe came from.
+
+    Raises
+    ------
+    ValueError
+        When ``recipe`` is not one (an unknown kind, a field missing or of the wrong type), or
+        its model cannot be built.
+
+    Examples
+    --------
+    >>> import varmech
+    >>> from varmech.model import from_recipe
+    >>> from_recipe(varmech.scenes.kepler(e=0.3).model._recipe()).parameters
+    {'e': 0.3}
+    """
+    kind = recipe.get("kind") if isinstance(recipe, dict) else None
+    if kind == "symbolic" and kind not in RECIPES:
+        # The symbolic models (SymPy, an optional extra) register their builder when imported.
+        importlib.import_module("varmech.symbolic")
+    builder = RECIPES.get(kind) if isinstance(kind, str) else None
+    if builder is None:
+        raise ValueError(f"not a model recipe of a known kind ({kind!r})")
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            return builder(recipe)
+    except (KeyError, TypeError, IndexError, RecursionError) as e:
+        raise ValueError(f"a malformed {kind} recipe: {type(e).__name__}: {e}") from None
+
+
+def field(recipe: dict[str, Any], name: str, kind: type | tuple[type, ...]) -> Any:
+    """``recipe[name]``, checked to be of ``kind`` (a bool is no number)."""
+    value = recipe[name]
+    if not isinstance(value, kind) or (isinstance(value, bool) and kind is not bool):
+        raise TypeError(f"{name} is a {type(value).__name__}")
+    return value
+
+
+def numbers(values: Any, name: str) -> list[int | float]:
+    """``values`` checked to be a list of numbers (JSON's ints and floats; no bools)."""
+    if not isinstance(values, list) or not all(isinstance(x, (int, float)) and not isinstance(x, bool) for x in values):
+        raise TypeError(f"{name} is not a list of numbers")
+    return values
+
+
+def integers(values: Any, name: str) -> list[int]:
+    """``values`` checked to be a list of integers (no bools)."""
+    if not isinstance(values, list) or not all(type(x) is int for x in values):
+        raise TypeError(f"{name} is not a list of integers")
+    return values
+
+
+def symmetry_data(s: Symmetry) -> list[Any]:
+    """A built-in symmetry as data: its class's name and fields."""
+    return [type(s).__name__, *astuple(s)]
+
+
+def symmetry_of(data: Any) -> Symmetry:
+    """The built-in symmetry of :func:`symmetry_data`."""
+    classes: dict[str, type[Symmetry]] = {"Translation": Translation, "Rotation": Rotation, "Cyclic": Cyclic}
+    if not isinstance(data, list) or not data or data[0] not in classes:
+        raise TypeError(f"{data!r} is not a symmetry")
+    if not all(isinstance(x, int) and not isinstance(x, bool) for x in data[1:]):
+        raise TypeError(f"{data!r}: a symmetry's fields are integers")
+    return classes[data[0]](*data[1:])
+
 
 def _broadcast(name: str, value: ArrayLike, shape: tuple[int, ...]) -> np.ndarray:
     """``value`` as a contiguous float array of ``shape``; ValueError naming it when it does not
@@ -509,6 +601,14 @@ class NativeSystem(Model):
             "build it with varmech.scenes.get(name, **parameters)"
         )
 
+    def _recipe(self) -> dict[str, Any] | None:
+        if self.parameters is not None:
+            return {"kind": "scene", "name": self.name, "parameters": dict(self.parameters)}
+        gravity = self._core.gravity
+        if gravity is not None:
+            return {"kind": "nbody", "G": gravity[0], "masses": list(gravity[1])}
+        return None
+
 
 def _scene_model(name: str, parameters: dict[str, float]) -> NativeSystem:
     """The native model of catalogue scene ``name`` with ``parameters`` (a pickle's)."""
@@ -518,6 +618,25 @@ def _scene_model(name: str, parameters: dict[str, float]) -> NativeSystem:
 def _nbody_model(gravitational_constant: float, masses: list[float]) -> NativeSystem:
     """The native N-body model of G and ``masses`` (a pickle's)."""
     return NativeSystem(_core.nbody(gravitational_constant, masses))
+
+
+def _scene_of_recipe(recipe: dict[str, Any]) -> NativeSystem:
+    parameters = field(recipe, "parameters", dict)
+    values = numbers(list(parameters.values()), "parameters")
+    if not all(isinstance(k, str) for k in parameters):
+        raise TypeError("parameters are not named")
+    return _scene_model(field(recipe, "name", str), dict(zip(parameters, values)))
+
+
+def _nbody_of_recipe(recipe: dict[str, Any]) -> NativeSystem:
+    gravity = field(recipe, "G", (int, float))
+    masses = numbers(recipe["masses"], "masses")
+    if not math.isfinite(gravity):
+        raise TypeError("G is not finite")
+    return _nbody_model(float(gravity), [float(m) for m in masses])
+
+
+RECIPES.update(scene=_scene_of_recipe, nbody=_nbody_of_recipe)
 
 
 class MechanicalSystem(Model):

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import operator
 from collections.abc import Sequence
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -13,7 +13,7 @@ from numpy.typing import ArrayLike
 from . import _core
 from ._util import vector
 from .integrate import Trajectory
-from .model import Model
+from .model import RECIPES, Model, field, from_recipe, integers, numbers
 
 if TYPE_CHECKING:
     from .scenes import Scene
@@ -208,6 +208,19 @@ class ReducedModel(Model):
         self.shape = tuple(i for i in range(n) if i not in indices)
         self.symmetries = ()
         self.name = f"{full.name}, Routh-reduced (ignoring {', '.join(f'q[{i}]' for i in indices)})"
+        self._reference = ref
+
+    def _recipe(self) -> dict[str, Any] | None:
+        full = self.full._recipe()
+        if full is None:
+            return None
+        return {
+            "kind": "reduced",
+            "full": full,
+            "cyclic": list(self.cyclic),
+            "momenta": self.momenta.tolist(),
+            "reference": self._reference.tolist(),
+        }
 
     def reduce(self, q: ArrayLike, p: ArrayLike, *, rtol: float = 1e-12) -> tuple[np.ndarray, np.ndarray]:
         """The reduced state (x, p_x) of a full state (q, p) whose cyclic momenta are μ.
@@ -459,3 +472,12 @@ def routh(
     reduced = ReducedModel(model, cyclic, momenta, reference=reference)
     _check_cyclic(model, _indices(cyclic, model.dim), around)
     return reduced
+
+
+def _reduced_of_recipe(recipe: dict[str, Any]) -> ReducedModel:
+    full = from_recipe(field(recipe, "full", dict))
+    reference = numbers(recipe["reference"], "reference")
+    return ReducedModel(full, integers(recipe["cyclic"], "cyclic"), numbers(recipe["momenta"], "momenta"), reference=reference)
+
+
+RECIPES["reduced"] = _reduced_of_recipe

@@ -23,6 +23,8 @@ from collections.abc import Callable, Iterator, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+import numpy as np
+
 from . import _core, files
 from . import events as _events
 from ._progress import progress_bar
@@ -112,31 +114,41 @@ def stream(
                 done.result()
 
     try:
+        if writer.rows == 0:
+            # A new file commits the run's first state and its checkpoint at once, so that a run
+            # killed in its first segment resumes too (and a continued run's file starts, as
+            # its trajectory in memory does, with the state it goes on from); every segment
+            # then goes on from a checkpoint.
+            if checkpoint is None:
+                assert first is not None
+                record = first(0, None)
+            else:
+                record = _core.resume(model._core, checkpoint, steps=0, save_every=save_every)
+            with _uninterrupted():
+                writer.append(record)
+            if watched and initial_energy is None:
+                initial_energy = _events.first_energy(model, record)
+            checkpoint = record.checkpoint
         while True:
             left = steps - done
             if rate is not None and math.isfinite(seconds):
                 segment = max(save_every, int(rate * seconds) // save_every * save_every)
             take = min(left, segment, SEGMENT_ROWS * save_every, cap or left)
             started = time.perf_counter()
-            # Every segment after a new run's first starts with the state the last one ended on.
-            repeats = checkpoint is not None or writer.rows > 0
+            assert checkpoint is not None  # committed before the first segment
             try:
-                if checkpoint is None:
-                    assert first is not None
-                    record = first(take, None if bar.disable else report)
-                else:
-                    specs = None
-                    if watched:
-                        assert event_specs is not None and initial_energy is not None
-                        specs = _events.going_on(event_specs, found, initial_energy)
-                    record = _core.resume(
-                        model._core,
-                        checkpoint,
-                        steps=take,
-                        save_every=save_every,
-                        progress=None if bar.disable else report,
-                        events=specs,
-                    )
+                specs = None
+                if watched:
+                    assert event_specs is not None and initial_energy is not None
+                    specs = _events.going_on(event_specs, found, initial_energy)
+                record = _core.resume(
+                    model._core,
+                    checkpoint,
+                    steps=take,
+                    save_every=save_every,
+                    progress=None if bar.disable else report,
+                    events=specs,
+                )
             except BaseException as err:
                 # The segment's states and crossings up to the stop are committed; the file is
                 # closed below.
@@ -144,12 +156,12 @@ def stream(
                 committed()
                 if partial is not None:
                     with _uninterrupted():
-                        writer.append(partial, skip_first=repeats, events=_events.occurrences(partial, watched))
+                        writer.append(partial, skip_first=True, events=_events.occurrences(partial, watched))
                 raise
             elapsed = time.perf_counter() - started
             crossings = _events.occurrences(record, watched)
             committed()
-            pending = committer.submit(writer.append, record, skip_first=repeats, events=crossings)
+            pending = committer.submit(writer.append, record, skip_first=True, events=crossings)
             if watched and initial_energy is None:
                 initial_energy = _events.first_energy(model, record)
             found = [k + len(o) for k, o in zip(found, crossings)]
@@ -173,7 +185,8 @@ def stream(
         with _uninterrupted():
             committer.shutdown(wait=True)
         if writer.is_open:
-            with _uninterrupted():
+            with _uninterrupted(), contextlib.suppress(ValueError):
+                # A file that cannot be closed (a full disk) keeps its last commit.
                 writer.close(-1, str(err) or type(err).__name__)
         raise
     finally:
@@ -213,16 +226,26 @@ def resume(
     checkpoint_every: int | datetime.timedelta | None = None,
     progress: bool | None = None,
     events: Sequence[_events.Event | _events.EventFunction] | None = None,
+    model: Model | None = None,
+    allow_pickle: bool = False,
 ) -> Trajectory:
     """Goes on with the run in the file ``path`` (from ``integrate(output=)``, or
     :meth:`Trajectory.save`) for ``steps`` more steps or to ``t_end``, appending to the file.
 
     The run goes on from the file's last committed checkpoint, so the states are those of one
     run of the whole length, bit for bit, whether the run ended, failed, was stopped by Ctrl-C,
-    or was killed. ``save_every`` is the file's by default (its saving period). ``events`` (as
-    :func:`varmech.integrate`'s; the same as the file's, if it has any) are watched from the
-    checkpoint on, with terminal counts over the whole run and an energy error measured from the
-    file's first state.
+    or was killed (a streamed run commits its initial state at once, so even one killed in its
+    first second resumes). ``save_every`` is the file's by default (its saving period).
+    ``events`` (as :func:`varmech.integrate`'s; the same as the file's, if it has any) are
+    watched from the checkpoint on, with terminal counts over the whole run and an energy error
+    measured from the file's first state.
+
+    The file is loaded as :func:`varmech.load` loads it (no code run from it: a model of
+    closures needs ``model=`` or ``allow_pickle=True``), and its checkpoint must be the state
+    of its last committed row: the same step count as ``/committed`` records, and the same
+    time, positions and momenta, to the bit. A file that disagrees (a damaged ``/committed``
+    pointing at an older checkpoint, say) is refused rather than continued from the wrong
+    state.
 
     Parameters
     ----------
@@ -238,6 +261,11 @@ def resume(
         A progress bar, as in :func:`varmech.integrate`.
     events : sequence of Event or callable, optional
         Event functions, as in :func:`varmech.integrate`.
+    model : Model, optional
+        The model to go on with instead of the file's (as :func:`varmech.load` takes it).
+    allow_pickle : bool, default False
+        Unpickle a stored closure model, as :func:`varmech.load` does (only for files you
+        trust).
 
     Returns
     -------
@@ -248,8 +276,11 @@ def resume(
     Raises
     ------
     ValueError
-        Naming ``path`` for a file without a checkpoint, or a missing or damaged one; the
-        arguments of :func:`varmech.integrate` as it names them.
+        Naming ``path`` for a file without a checkpoint, a missing, truncated or damaged one
+        (failed checksums, non-finite rows, a checkpoint that is not the last row's state),
+        one that cannot be written (a full disk: the rows committed before are kept), and a
+        pickled model without ``model=`` or ``allow_pickle=True``; the arguments of
+        :func:`varmech.integrate` as it names them.
 
     Examples
     --------
@@ -262,9 +293,10 @@ def resume(
     >>> traj.steps, bool(np.array_equal(traj.q, once.q))
     (150, True)
     """
-    stored = files.load(path, lazy=True)
-    if stored.checkpoint is None:
+    stored = files.load(path, lazy=True, model=model, allow_pickle=allow_pickle)
+    if stored.checkpoint is None or not len(stored.t):
         raise ValueError(f"path: {str(path)!r} has no checkpoint to resume from")
+    _check_checkpoint(path, stored)
     t_now = float(stored.t[-1])
     more = _steps(stored.dt, t_now, steps, t_end)
     if save_every is None:
@@ -294,3 +326,26 @@ def resume(
     finally:
         bar.close()
     return files.load(path, model=stored.model, lazy=files.larger_than_memory(path))
+
+
+def _check_checkpoint(path: str | os.PathLike[str], stored: Trajectory) -> None:
+    """ValueError naming ``path`` unless the file's checkpoint is the state of its last
+    committed row, at the step count ``/committed`` records."""
+    assert stored.checkpoint is not None
+    try:
+        at = _core.Stepper.from_checkpoint(stored.model._core, stored.checkpoint)
+    except ValueError as e:
+        raise ValueError(f"path: {str(path)!r} has a damaged checkpoint: {e}") from e
+    last = (float(stored.t[-1]), stored.q[-1], stored.p[-1])
+    if at.steps != stored.steps or not all(_same(a, b) for a, b in zip((at.t, at.q, at.p), last)):
+        raise ValueError(
+            f"path: {str(path)!r} cannot be resumed: its checkpoint (step {at.steps}, t = {at.t}) is not the state of "
+            f"its last committed row (step {stored.steps}, t = {last[0]}); the file is damaged, or its rows are "
+            "not the run's saved states (a trajectory of t_eval times)"
+        )
+
+
+def _same(a: Any, b: Any) -> bool:
+    """Equal to the bit."""
+    a, b = np.asarray(a, dtype=np.float64), np.asarray(b, dtype=np.float64)
+    return a.shape == b.shape and bool(np.array_equal(a.view(np.uint64), b.view(np.uint64)))

@@ -12,7 +12,8 @@ import sympy as sp
 
 from .. import _core
 from .._util import finite
-from ..model import Model, Symmetry, _specs
+from ..model import RECIPES, Model, Symmetry, _specs, field, integers, numbers, symmetry_data, symmetry_of
+from . import _tree
 from ._lower import Tape
 from ._rhs import FirstOrder
 
@@ -287,3 +288,77 @@ class SymbolicModel(Model):
     def __reduce__(self) -> tuple[Any, ...]:
         # The tapes and expressions, never the compiled code: unpickling compiles them again.
         return (SymbolicModel, (self._spec, self._symbolic))
+
+    def _recipe(self) -> dict[str, Any] | None:
+        # The tapes (the core checks every index of a tape it is given) and the expressions as
+        # data; None for an expression of a class the data does not know.
+        spec, symbolic = self._spec, self._symbolic
+        try:
+            expressions = {
+                "q": [_tree.encode(x) for x in symbolic.q],
+                "v": [_tree.encode(x) for x in symbolic.v],
+                "t": _tree.encode(symbolic.t),
+                "L": _tree.encode(symbolic.L),
+                "expressions": {k: [_tree.encode(e) for e in v] for k, v in symbolic.expressions.items()},
+            }
+        except TypeError:
+            return None
+        return {
+            "kind": "symbolic",
+            "name": symbolic.name,
+            "cyclic": list(symbolic.cyclic),
+            **expressions,
+            "model": spec.kind,
+            "dim": spec.dim,
+            "functions": {k: [ops.tolist(), c.tolist(), out.tolist()] for k, (ops, c, out) in spec.functions.items()},
+            "parameter_names": list(spec.parameter_names),
+            "parameters": spec.parameters.tolist(),
+            "constraints": spec.constraints,
+            "velocity_constraints": spec.velocity_constraints,
+            "time_dependent": spec.time_dependent,
+            "forced": spec.forced,
+            "symmetries": [symmetry_data(x) for x in spec.symmetries],
+            "jit": spec.jit,
+        }
+
+
+def _of_recipe(recipe: dict[str, Any]) -> SymbolicModel:
+    """The symbolic model of :meth:`SymbolicModel._recipe`, its tapes checked by the core."""
+    functions: dict[str, Any] = {}
+    for name, tape in field(recipe, "functions", dict).items():
+        ops, constants, outputs = tape
+        functions[name] = (
+            np.array(ops, dtype=np.int64).reshape(-1, 3),
+            np.array(numbers(constants, "constants"), dtype=np.float64),
+            np.array(outputs, dtype=np.int64),
+        )
+    names = field(recipe, "parameter_names", list)
+    if not all(isinstance(x, str) for x in names):
+        raise TypeError("parameter_names are not names")
+    spec = Spec(
+        kind=field(recipe, "model", str),
+        dim=field(recipe, "dim", int),
+        functions=functions,
+        parameter_names=tuple(names),
+        parameters=np.array(numbers(recipe["parameters"], "parameters"), dtype=np.float64),
+        constraints=field(recipe, "constraints", int),
+        time_dependent=field(recipe, "time_dependent", bool),
+        forced=field(recipe, "forced", bool),
+        symmetries=tuple(symmetry_of(x) for x in field(recipe, "symmetries", list)),
+        jit=field(recipe, "jit", bool),
+        velocity_constraints=field(recipe, "velocity_constraints", int),
+    )
+    expressions = field(recipe, "expressions", dict)
+    symbolic = Symbolic(
+        q=tuple(_tree.decode(x) for x in field(recipe, "q", list)),
+        v=tuple(_tree.decode(x) for x in field(recipe, "v", list)),
+        t=_tree.decode(recipe["t"]),
+        L=_tree.decode(recipe["L"]),
+        expressions={k: tuple(_tree.decode(e) for e in field(expressions, k, list)) for k in expressions},
+        cyclic=tuple(integers(recipe["cyclic"], "cyclic")),
+        name=field(recipe, "name", str),
+    )
+    return SymbolicModel(spec, symbolic)
+
+
+RECIPES["symbolic"] = _of_recipe
