@@ -386,13 +386,16 @@ def _energy_threshold(model: Model, max_energy_error: float | None | Literal["au
     return threshold
 
 
-def _check_time_independent(model: Model, q: np.ndarray, p: np.ndarray, times: tuple[float, ...]) -> None:
+def _check_time_independent(
+    model: Model, q: np.ndarray, p: np.ndarray, times: tuple[float, ...], names: str = "q0, p0"
+) -> None:
     """Refuses a Lagrangian declared time-independent whose L(q0, q̇0, t) changes with t: its
-    energy would be judged as conserved while it is not."""
+    energy would be judged as conserved while it is not. ``names`` are the arguments (q, p)
+    came from, for an error in finding q̇0."""
     if not isinstance(model, Lagrangian) or model.time_dependent:
         return
     t = np.array(times[:1])
-    v = _core.derivative(model._core, "velocity", t, q[None, :], p[None, :])[0]
+    v = _core.derivative(model._core, "velocity", t, q[None, :], p[None, :], names=names)[0]
     values = [returned_scalar("lagrangian(q, v, t)", model.lagrangian(q.copy(), v.copy(), s)) for s in times]
     spread = max(values) - min(values)
     size = max(abs(x) for x in values) + float(np.abs(p * v).sum())
@@ -640,7 +643,8 @@ def integrate(
     # A horizon past the largest float is the core's to refuse (naming dt); probe finite times.
     t_end = t0 + nsteps * dt
     probes = (t0, t0 + dt, t0 + 0.5, t0 + 1.0, t0 + 0.37 * (t_end - t0), t_end)
-    _check_time_independent(model, q, p, tuple(s for s in probes if math.isfinite(s)))
+    starts = "q0, v0" if v0 is not None else "q0, p0"
+    _check_time_independent(model, q, p, tuple(s for s in probes if math.isfinite(s)), starts)
 
     def start(
         q: np.ndarray, p: np.ndarray, t0: float, steps: int, report: Callable[[int], None] | None, events: Any = None

@@ -366,8 +366,9 @@ class Model:
         Raises
         ------
         ValueError
-            Naming the argument whose shape or values do not fit (``q``, ``p`` or ``t``), or a
-            general Lagrangian whose Newton solve of ∂L/∂q̇ = p fails.
+            Naming the argument whose shape or values do not fit (``q``, ``p`` or ``t``), or,
+            starting with ``q, p``, a general Lagrangian whose Newton solve of ∂L/∂q̇ = p
+            fails there.
 
         Examples
         --------
@@ -423,7 +424,7 @@ class Model:
         if rows.ndim != 2 or rows.shape[1] != self.dim:
             raise ValueError(f"{name}: expected shape ({self.dim},) or (N, {self.dim}), got {x.shape}")
         q2, t1 = _broadcast("q", q, rows.shape), _broadcast("t", t, rows.shape[:1])
-        return _core.derivative(self._core, what, t1, q2, rows).reshape(x.shape)
+        return _core.derivative(self._core, what, t1, q2, rows, names=f"q, {name}").reshape(x.shape)
 
     def with_parameters(self, **values: float) -> Model:
         """The model with its parameters set by name; only symbolic models
