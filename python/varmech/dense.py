@@ -41,7 +41,7 @@ def hermite(traj: Trajectory, t: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
     >>> bool(abs(q[0] - np.sin(np.pi / 4)) < 1e-7)
     True
     """
-    times = np.asarray(t, dtype=float)
+    times = floats("t", t)
     if traj.model.constraints:
         raise ValueError("t: dense output needs ṗ, which on a constrained model holds the constraint forces")
     if len(traj.t) < 2:

@@ -109,6 +109,11 @@ CASES = [
                                                  progress=False), ValueError, "q0: must be finite, got non-finite values for members \\[1\\]"),
     ("ensemble p0 inf", lambda: varmech.ensemble(scenes.kepler(), [[1.0, 0.0]], [[np.inf, 1.0]], dt=0.1, steps=2, progress=False),
      ValueError, "p0: must be finite"),
+    ("nbody masses strings", lambda: scenes.nbody(["1", "1"], np.eye(2, 3), np.zeros((2, 3))), ValueError, "masses: must be numbers"),
+    ("at_times t strings", lambda: varmech.integrate(scenes.harmonic_oscillator(), dt=0.1, steps=10).sol(["0.5"]),
+     ValueError, "t: must be numbers"),
+    ("routh cyclic_velocity x strings", lambda: varmech.routh(scenes.heavy_top(), [1, 2]).cyclic_velocity(["0.3"], [0.0]),
+     ValueError, "x: must be numbers"),
     # The inverse Legendre transform at the initial state names the state's arguments.
     ("singular Hessian at q0, p0", lambda: varmech.integrate(
         _lagrangian(1, dl_dv=lambda q, v, t: np.ones(1)), [2.0], [2.0], dt=1.0, steps=0, method="midpoint"),
