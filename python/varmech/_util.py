@@ -18,7 +18,7 @@ def _shown(x: Any) -> str:
     return text if len(text) <= 80 else f"{text[:60]}... ({type(x).__name__})"
 
 
-def floats(name: str, x: ArrayLike) -> np.ndarray:
+def floats(name: str, x: Any) -> np.ndarray:
     """``x`` as a float64 array of its own shape, or ValueError naming ``name``: numbers only
     (bools and ints included), never strings or bytes read as numbers, none beyond a float's
     range."""
