@@ -531,9 +531,12 @@ def energy_terms(model: _Model, t: _FloatArray, q: _FloatArray, p: _FloatArray) 
     """(E, T, V) at each state: the energy function p·q̇ − L, its kinetic term E − V and its
     potential V = −L(q, 0, t)."""
 
-def derivative(model: _Model, what: str, t: _FloatArray, q: _FloatArray, x: _FloatArray) -> _FloatArray:
+def derivative(
+    model: _Model, what: str, t: _FloatArray, q: _FloatArray, x: _FloatArray, *, names: str | None = None
+) -> _FloatArray:
     """At each state: ``"momentum"`` p = ∂L/∂q̇(q, x, t), ``"velocity"`` the q̇ with
-    ∂L/∂q̇ = x, ``"dl_dq"`` ∂L/∂q(q, x, t), or ``"dp_dt"`` ṗ = ∂L/∂q + f(q, x, t) with x = q̇."""
+    ∂L/∂q̇ = x, ``"dl_dq"`` ∂L/∂q(q, x, t), or ``"dp_dt"`` ṗ = ∂L/∂q + f(q, x, t) with x = q̇.
+    With ``names`` (the user's arguments the states come from), the core's own errors name them."""
 
 def momentum(generator: Generator, q: _FloatArray, p: _FloatArray) -> tuple[_FloatArray, _FloatArray]:
     """(J, Σ|pᵢξᵢ|) at each state."""

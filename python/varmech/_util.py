@@ -3,17 +3,47 @@
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike
 
+#: The largest count (steps, dimensions, indices) the core's unsigned integers take.
+MAX_COUNT = 2**63 - 1
+
+
+def _shown(x: Any) -> str:
+    """``x`` for a message, cut short (an int of 10**400 has 401 digits)."""
+    text = repr(x)
+    return text if len(text) <= 80 else f"{text[:60]}... ({type(x).__name__})"
+
+
+def floats(name: str, x: Any) -> np.ndarray:
+    """``x`` as a float64 array of its own shape, or ValueError naming ``name``: numbers only
+    (bools and ints included), never strings or bytes read as numbers, none beyond a float's
+    range."""
+    if type(x) is np.ndarray and x.dtype == np.float64:
+        return x
+    try:
+        a = np.asarray(x)
+    except (TypeError, ValueError) as e:
+        raise ValueError(f"{name}: must be an array of numbers ({e})") from None
+    if a.dtype.kind in "biuf":
+        return a.astype(float, copy=False)
+    # An object array holds ints too large for int64, Fractions, or a mix that includes strings.
+    if a.dtype.kind != "O" or any(isinstance(e, (str, bytes)) or e is None for e in a.flat):
+        raise ValueError(f"{name}: must be numbers, got {_shown(x)}")
+    try:
+        return a.astype(float)
+    except OverflowError:
+        raise ValueError(f"{name}: must be finite, got a number beyond the float range in {_shown(x)}") from None
+    except (TypeError, ValueError) as e:
+        raise ValueError(f"{name}: must be numbers, got {_shown(x)} ({e})") from None
+
 
 def vector(name: str, x: ArrayLike, n: int) -> np.ndarray:
     """``x`` as a contiguous float64 array (n,), or ValueError naming ``name``."""
-    try:
-        a = np.array(x, dtype=float)
-    except (TypeError, ValueError) as e:
-        raise ValueError(f"{name}: must be an array of {n} numbers ({e})") from None
+    a = floats(name, x)
     if a.shape != (n,):
         raise ValueError(f"{name}: must have shape ({n},), got {a.shape}")
     if not np.all(np.isfinite(a)):
@@ -21,30 +51,75 @@ def vector(name: str, x: ArrayLike, n: int) -> np.ndarray:
     return np.ascontiguousarray(a)
 
 
+def number(name: str, x: float) -> float:
+    """``x`` as a float, or ValueError naming ``name``: a string is not read as a number, and an
+    int beyond the float range is refused."""
+    if isinstance(x, (str, bytes)):
+        raise ValueError(f"{name}: must be a number, got {_shown(x)}")
+    try:
+        return float(x)
+    except OverflowError:
+        raise ValueError(f"{name}: must be finite, got {_shown(x)}") from None
+    except (TypeError, ValueError):
+        raise ValueError(f"{name}: must be a number, got {_shown(x)}") from None
+
+
 def positive(name: str, x: float) -> float:
     """``x`` as a finite positive float, or ValueError naming ``name``."""
-    try:
-        v = float(x)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name}: must be a number, got {x!r}") from None
+    v = number(name, x)
     if not (math.isfinite(v) and v > 0):
-        raise ValueError(f"{name}: must be finite and positive, got {x!r}")
+        raise ValueError(f"{name}: must be finite and positive, got {_shown(x)}")
     return v
 
 
 def finite(name: str, x: float) -> float:
     """``x`` as a finite float, or ValueError naming ``name``."""
-    try:
-        v = float(x)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name}: must be a number, got {x!r}") from None
+    v = number(name, x)
     if not math.isfinite(v):
         raise ValueError(f"{name}: must be finite, got {v}")
     return v
 
 
-def positive_int(name: str, x: int) -> int:
-    """``x`` as a positive int, or ValueError naming ``name``."""
-    if isinstance(x, bool) or not isinstance(x, (int, np.integer)) or x < 1:
-        raise ValueError(f"{name}: must be a positive integer, got {x!r}")
+def integer(name: str, x: int, least: int = 0) -> int:
+    """``x`` as an int from ``least`` to :data:`MAX_COUNT`, or ValueError naming ``name`` (a
+    float, even a whole one, or a bool is not taken for an integer)."""
+    what = "a positive integer" if least == 1 else f"an integer ≥ {least}"
+    if isinstance(x, bool) or not isinstance(x, (int, np.integer)) or x < least:
+        raise ValueError(f"{name}: must be {what}, got {_shown(x)}")
+    if x > MAX_COUNT:
+        raise ValueError(f"{name}: must be at most 2**63 - 1, got {_shown(x)}")
     return int(x)
+
+
+def positive_int(name: str, x: int) -> int:
+    """``x`` as a positive int (at most :data:`MAX_COUNT`), or ValueError naming ``name``."""
+    return integer(name, x, 1)
+
+
+def returned(call: str, x: Any) -> np.ndarray:
+    """A closure's result as a float64 array of its own shape, read as the core reads one
+    (a float, an int, or an array of ints or floats): anything else is a TypeError naming
+    ``call`` (``"gradient(q)"``), as the core's own readers raise."""
+    if type(x) is np.ndarray and x.dtype == np.float64:
+        return x
+    if isinstance(x, (float, int)) and not isinstance(x, bool):
+        try:
+            return np.asarray(float(x))
+        except OverflowError:
+            raise ValueError(f"{call} returned {_shown(x)}, beyond the float range") from None
+    try:
+        a = None if isinstance(x, np.ma.MaskedArray) else np.asarray(x)
+    except (TypeError, ValueError):
+        a = None
+    if a is None or a.dtype.kind not in "iuf" or (a.dtype.kind == "f" and a.dtype.itemsize > 8):
+        what = f"a {a.dtype} array" if isinstance(x, np.ndarray) and a is not None else type(x).__name__
+        raise TypeError(f"{call} must return numbers (a float or an array of floats), got {what}")
+    return a.astype(float, copy=False)
+
+
+def returned_scalar(call: str, x: Any) -> float:
+    """A closure's result that must be one float, read as :func:`returned` reads one."""
+    a = returned(call, x)
+    if a.shape != ():
+        raise TypeError(f"{call} must return a float, got an array of shape {a.shape}")
+    return float(a)

@@ -15,6 +15,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from . import _core
+from ._util import returned
 from .integrate import Trajectory
 from .model import Cyclic, Generator, Model, Rotation, Translation
 
@@ -80,7 +81,7 @@ def _momentum_terms(traj: Trajectory, generator: Generator) -> tuple[np.ndarray,
     n = traj.q.shape[1]
     xi = np.empty_like(traj.q)
     for k, q in enumerate(traj.q):
-        row = np.asarray(generator(q.copy()), dtype=float)
+        row = returned("generator: xi(q)", generator(q.copy()))
         if row.shape != (n,):
             raise ValueError(f"generator: xi(q) must return shape ({n},), got {row.shape}")
         xi[k] = row

@@ -20,6 +20,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from . import _core
+from ._util import floats
 
 if TYPE_CHECKING:
     from .integrate import Trajectory
@@ -40,7 +41,7 @@ def hermite(traj: Trajectory, t: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
     >>> bool(abs(q[0] - np.sin(np.pi / 4)) < 1e-7)
     True
     """
-    times = np.asarray(t, dtype=float)
+    times = floats("t", t)
     if traj.model.constraints:
         raise ValueError("t: dense output needs ṗ, which on a constrained model holds the constraint forces")
     if len(traj.t) < 2:
@@ -80,7 +81,7 @@ def grid_step(t: float, t0: float, dt: float, steps: int, at_least: int = 0) -> 
 
 def eval_times(t_eval: ArrayLike, t0: float, t_end: float) -> np.ndarray:
     """``t_eval`` checked: finite, increasing, within [t0, t_end] (ValueError naming it)."""
-    times = np.asarray(t_eval, dtype=float).reshape(-1)
+    times = floats("t_eval", t_eval).reshape(-1)
     if times.size == 0 or not np.all(np.isfinite(times)):
         raise ValueError("t_eval: must be a non-empty array of finite times")
     if np.any(np.diff(times) < 0):

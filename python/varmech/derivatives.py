@@ -7,7 +7,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ._util import vector
+from ._util import finite, returned, vector
 from .model import Lagrangian, MechanicalSystem, Model
 
 __all__ = [
@@ -68,20 +68,20 @@ class DerivativeCheck:
         return "\n".join([f"Derivative check (rtol {self.rtol:g}):", *rows])
 
 
-def _central(f, x: np.ndarray) -> np.ndarray:
+def _central(call: str, f, x: np.ndarray) -> np.ndarray:
     """∂f/∂xᵢ stacked on the first axis, by central differences with steps ε^{1/3}·max(|xᵢ|, 1)
-    (f scalar or array valued)."""
+    (f scalar or array valued, named ``call`` when it returns something else)."""
     rows = []
     for i in range(len(x)):
         h = np.finfo(float).eps ** (1 / 3) * max(abs(x[i]), 1.0)
         e = np.zeros_like(x)
         e[i] = h
-        rows.append((np.asarray(f(x + e), dtype=float) - np.asarray(f(x - e), dtype=float)) / (2 * h))
+        rows.append((returned(call, f(x + e)) - returned(call, f(x - e))) / (2 * h))
     return np.array(rows)
 
 
-def _mismatch(supplied: ArrayLike, differences: np.ndarray) -> float:
-    s = np.asarray(supplied, dtype=float)
+def _mismatch(call: str, supplied: ArrayLike, differences: np.ndarray) -> float:
+    s = returned(call, supplied)
     if s.shape != differences.shape:
         return float("inf")
     return float(np.max(np.abs(s - differences)) / max(1.0, float(np.max(np.abs(differences)))))
@@ -119,9 +119,11 @@ def check_derivatives(model: Model, q: ArrayLike, v: ArrayLike | None = None, t:
     Raises
     ------
     TypeError
-        ``model`` is not a closure model.
+        ``model`` is not a closure model, or one of its closures returns something other than
+        numbers (the message names it).
     ValueError
-        ``model`` supplies no derivatives, or ``q``, ``v`` of the wrong shape.
+        ``model`` supplies no derivatives, or ``q``, ``v``, ``t`` that are not finite numbers of
+        the right shape.
 
     Examples
     --------
@@ -135,26 +137,30 @@ def check_derivatives(model: Model, q: ArrayLike, v: ArrayLike | None = None, t:
     """
     n = model.dim
     q = vector("q", q, n)
+    t = finite("t", t)
     mismatch: dict[str, float] = {}
     if isinstance(model, MechanicalSystem):
         if model.gradient is not None:
-            mismatch["gradient"] = _mismatch(model.gradient(q.copy()), _central(model.potential, q))
+            mismatch["gradient"] = _mismatch("gradient(q)", model.gradient(q.copy()), _central("potential(q)", model.potential, q))
         if model.mass_derivative is not None:
-            mismatch["mass_derivative"] = _mismatch(model.mass_derivative(q.copy()), _central(model.mass, q))
+            mismatch["mass_derivative"] = _mismatch(
+                "mass_derivative(q)", model.mass_derivative(q.copy()), _central("mass(q)", model.mass, q)
+            )
     elif isinstance(model, Lagrangian):
         v = vector("v", v if v is not None else np.zeros(n), n)
+        L, H = "lagrangian(q, v, t)", "hessians(q, v, t)"
         if model.dl_dq is not None:
-            mismatch["dl_dq"] = _mismatch(model.dl_dq(q.copy(), v.copy(), t), _central(lambda x: model.lagrangian(x, v, t), q))
+            mismatch["dl_dq"] = _mismatch("dl_dq(q, v, t)", model.dl_dq(q.copy(), v.copy(), t), _central(L, lambda x: model.lagrangian(x, v, t), q))
         if model.dl_dv is not None:
-            mismatch["dl_dv"] = _mismatch(model.dl_dv(q.copy(), v.copy(), t), _central(lambda x: model.lagrangian(q, x, t), v))
+            mismatch["dl_dv"] = _mismatch("dl_dv(q, v, t)", model.dl_dv(q.copy(), v.copy(), t), _central(L, lambda x: model.lagrangian(q, x, t), v))
         if model.hessians is not None:
             lqq, lqv, lvv = model.hessians(q.copy(), v.copy(), t)
             # _central stacks ∂/∂xⱼ on the first axis: the transpose of (i, j) = ∂²L/∂·ᵢ∂xⱼ.
             if model.dl_dq is not None:
-                mismatch["L_qq"] = _mismatch(lqq, _central(lambda x: model.dl_dq(x, v, t), q).T)
-                mismatch["L_qv"] = _mismatch(lqv, _central(lambda x: model.dl_dq(q, x, t), v).T)
+                mismatch["L_qq"] = _mismatch(H, lqq, _central("dl_dq(q, v, t)", lambda x: model.dl_dq(x, v, t), q).T)
+                mismatch["L_qv"] = _mismatch(H, lqv, _central("dl_dq(q, v, t)", lambda x: model.dl_dq(q, x, t), v).T)
             if model.dl_dv is not None:
-                mismatch["L_vv"] = _mismatch(lvv, _central(lambda x: model.dl_dv(q, x, t), v).T)
+                mismatch["L_vv"] = _mismatch(H, lvv, _central("dl_dv(q, v, t)", lambda x: model.dl_dv(q, x, t), v).T)
     else:
         raise TypeError(f"model: expected a MechanicalSystem or Lagrangian of closures, got {type(model).__name__}")
     if not mismatch:

@@ -22,7 +22,7 @@ from numpy.typing import ArrayLike
 from . import _core
 from . import events as _events
 from ._progress import progress_bar
-from ._util import finite, positive, positive_int
+from ._util import finite, floats, positive, positive_int
 from .conservation import VERDICTS, ConservationReport, check_conservation
 from .integrate import Trajectory, _energy_threshold, _model_of, _newton, _steps, _trajectory, integrate
 from .model import Model, NativeSystem, _scene_model
@@ -344,7 +344,7 @@ def ensemble(
     Raises
     ------
     ValueError
-        Naming ``q0`` (not (members, n)), ``p0`` or ``v0`` (another shape), ``parameters`` (a name
+        Naming ``q0`` (not (members, n), or not finite numbers), ``p0`` or ``v0`` (likewise), ``parameters`` (a name
         the model does not have, or not one value a member), ``workers`` or ``chunk_size``
         (not a positive integer), ``save_every`` (the output would not fit in memory), or an
         argument of :func:`varmech.integrate`.
@@ -371,9 +371,10 @@ def ensemble(
         raise ValueError(f"model: the scene {model.name}'s contacts do not run in ensembles yet; pass scene.model without them")
     model, _, _ = _model_of(model, None, None, None)
     n = model.dim
-    q = np.array(q0, dtype=float)
+    q = np.array(floats("q0", q0))
     if q.ndim != 2 or q.shape[1] != n or q.shape[0] == 0:
         raise ValueError(f"q0: must have shape (members, {n}) with at least one member, got shape {q.shape}")
+    _finite_rows("q0", q)
     members = q.shape[0]
     values = _parameter_values(model, parameters, members)
     models = _member_models(model, values, members)
@@ -620,7 +621,8 @@ def _parameter_values(model: Model, parameters: Mapping[str, ArrayLike] | None, 
         if name not in known:
             has = ", ".join(known) if known else "none"
             raise ValueError(f"parameters: {name} is not a parameter of {model.name} (it has {has})")
-        x = np.broadcast_to(np.asarray(given, dtype=float), (members,)) if np.ndim(given) == 0 else np.asarray(given, dtype=float)
+        x = floats("parameters", given)
+        x = np.broadcast_to(x, (members,)) if x.ndim == 0 else x
         if x.shape != (members,) or not np.all(np.isfinite(x)):
             raise ValueError(f"parameters: {name} needs one finite value a member ({members}), got shape {x.shape}")
         values[name] = np.array(x)
@@ -639,16 +641,24 @@ def _member_models(model: Model, values: dict[str, np.ndarray], members: int) ->
     return [model.with_parameters(**{k: float(v[i]) for k, v in values.items()}) for i in range(members)]
 
 
+def _finite_rows(name: str, x: np.ndarray) -> None:
+    """Refuses members whose initial data are not finite, as integrate refuses them."""
+    bad = np.flatnonzero(~np.all(np.isfinite(x), axis=1))
+    if bad.size:
+        raise ValueError(f"{name}: must be finite, got non-finite values for members {bad[:10].tolist()}")
+
+
 def _momenta(models: Sequence[Model], q: np.ndarray, p0: ArrayLike | None, v0: ArrayLike | None, t0: float) -> np.ndarray:
     """p0 checked against q0, or p0 = ∂L/∂q̇(q0, v0, t0) of each member's model."""
     if (p0 is None) == (v0 is None):
         raise ValueError("p0, v0: give exactly one of the initial momenta p0 and velocities v0")
     name, given = ("p0", p0) if p0 is not None else ("v0", v0)
-    x = np.array(given, dtype=float)
+    x = np.array(floats(name, given))
     if x.ndim != 2 or x.shape[1] != q.shape[1]:
         raise ValueError(f"{name}: must have shape (members, {q.shape[1]}), got shape {x.shape}")
     if x.shape[0] != q.shape[0]:
         raise ValueError(f"{name}: {x.shape[0]} members, but q0 has {q.shape[0]}")
+    _finite_rows(name, x)
     if name == "p0":
         return x
     if all(m is models[0] for m in models):

@@ -50,6 +50,7 @@ from typing import Any, Literal
 import numpy as np
 
 from . import _core
+from ._util import finite, integer, number, positive, positive_int
 
 #: An event function g(t, q, p) (or g(t, q, v), see :class:`Event`).
 EventFunction = Callable[[float, np.ndarray, np.ndarray], float]
@@ -194,10 +195,8 @@ def crossing(k: int, value: float = 0.0, *, direction: int = 0, terminal: bool |
     >>> len(traj.events[0])   # sin t rises through 1/2 at π/6 and 2π + π/6
     2
     """
-    k = _index("crossing", k)
-    value = float(value)
-    if not math.isfinite(value):
-        raise ValueError(f"value: must be finite, got {value}")
+    k = integer("k", k)
+    value = finite("value", value)
     return Event(None, direction, terminal, name=f"q[{k}] = {value:g}", native=("crossing", (k, value)))
 
 
@@ -236,9 +235,7 @@ def energy_error(bound: float, *, terminal: bool | int = True) -> Event:
     >>> traj.status, round(float(traj.t[-1]), 2)
     (1, 1.99)
     """
-    bound = float(bound)
-    if not (math.isfinite(bound) and bound > 0):
-        raise ValueError(f"bound: must be finite and positive, got {bound}")
+    bound = positive("bound", bound)
     return Event(None, +1, terminal, name=f"|E - E0| > {bound:g}", native=("energy_error", bound))
 
 
@@ -329,25 +326,15 @@ def encounter(radius: float, *, groups: Sequence[Sequence[int]] | None = None, d
 
 
 def _distance(kind: str, radius: float, groups: Sequence[Sequence[int]] | None, dim: int, direction: int, terminal: bool | int) -> Event:
-    radius = float(radius)
-    if not (math.isfinite(radius) and radius > 0):
-        raise ValueError(f"radius: must be finite and positive, got {radius}")
+    radius = positive("radius", radius)
     if groups is not None:
         try:
-            spec: Any = [[_index("groups", k) for k in g] for g in groups]
+            spec: Any = [[integer("groups", k) for k in g] for g in groups]
         except TypeError:
             raise TypeError(f"groups: expected sequences of coordinate indices, got {groups!r}") from None
     else:
-        spec = _index("dim", dim)
-        if spec < 1:
-            raise ValueError(f"dim: must be a positive integer, got {dim!r}")
+        spec = positive_int("dim", dim)
     return Event(None, direction, terminal, name=f"{kind}({radius:g})", native=(kind, (radius, spec)))
-
-
-def _index(name: str, k: Any) -> int:
-    if isinstance(k, bool) or not isinstance(k, (int, np.integer)) or k < 0:
-        raise ValueError(f"{name}: must be a non-negative integer, got {k!r}")
-    return int(k)
 
 
 def _event(i: int, e: Event | EventFunction) -> Event:
@@ -374,8 +361,8 @@ def _terminal(label: str, terminal: Any) -> int:
 
 def _direction(label: str, direction: Any) -> int:
     try:
-        d = float(direction)
-    except (TypeError, ValueError):
+        d = number("direction", direction)
+    except ValueError:
         raise ValueError(f"{label}: direction must be a number (its sign counts), got {direction!r}") from None
     if math.isnan(d):
         raise ValueError(f"{label}: direction must be a number (its sign counts), got {direction!r}")

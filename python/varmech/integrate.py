@@ -19,7 +19,7 @@ from . import events as _events
 from . import impacts as _impacts
 from . import impulses as _impulses
 from ._progress import progress_bar
-from ._util import finite, positive, positive_int, vector
+from ._util import MAX_COUNT, finite, number, positive, positive_int, returned_scalar, vector
 from .constraints import warn_if_integrable
 from .model import Lagrangian, Model
 
@@ -320,9 +320,14 @@ def _steps(dt: float, t0: float, steps: int | None, t_end: float | None) -> int:
         if isinstance(steps, bool) or not isinstance(steps, (int, np.integer)) or not 0 <= steps < 2**63:
             raise ValueError(f"steps: must be an integer from 0 to 2**63 - 1, got {steps!r}")
         return int(steps)
-    t_end = float(t_end)  # type: ignore[arg-type]
+    t_end = number("t_end", t_end)  # type: ignore[arg-type]
     if not math.isfinite(t_end) or t_end < t0:
         raise ValueError(f"t_end: must be finite and not before t0 = {t0}, got {t_end}")
+    if not (t_end - t0) / dt <= MAX_COUNT:
+        raise ValueError(
+            f"t_end: {t_end} is more than 2**63 - 1 steps of dt = {dt} from t0 = {t0} "
+            f"((t_end - t0)/dt = {(t_end - t0) / dt:.3g}); take a larger dt or a nearer t_end"
+        )
     n = round((t_end - t0) / dt)
     if abs(n * dt - (t_end - t0)) > 1e-9 * max(abs(t_end - t0), dt):
         raise ValueError(
@@ -393,14 +398,17 @@ def _energy_threshold(model: Model, max_energy_error: float | None | Literal["au
     return threshold
 
 
-def _check_time_independent(model: Model, q: np.ndarray, p: np.ndarray, times: tuple[float, ...]) -> None:
+def _check_time_independent(
+    model: Model, q: np.ndarray, p: np.ndarray, times: tuple[float, ...], names: str = "q0, p0"
+) -> None:
     """Refuses a Lagrangian declared time-independent whose L(q0, q̇0, t) changes with t: its
-    energy would be judged as conserved while it is not."""
+    energy would be judged as conserved while it is not. ``names`` are the arguments (q, p)
+    came from, for an error in finding q̇0."""
     if not isinstance(model, Lagrangian) or model.time_dependent:
         return
     t = np.array(times[:1])
-    v = _core.derivative(model._core, "velocity", t, q[None, :], p[None, :])[0]
-    values = [float(model.lagrangian(q.copy(), v.copy(), s)) for s in times]
+    v = _core.derivative(model._core, "velocity", t, q[None, :], p[None, :], names=names)[0]
+    values = [returned_scalar("lagrangian(q, v, t)", model.lagrangian(q.copy(), v.copy(), s)) for s in times]
     spread = max(values) - min(values)
     size = max(abs(x) for x in values) + float(np.abs(p * v).sum())
     if not spread <= 1e-12 * size:
@@ -647,7 +655,8 @@ def integrate(
     # A horizon past the largest float is the core's to refuse (naming dt); probe finite times.
     t_end = t0 + nsteps * dt
     probes = (t0, t0 + dt, t0 + 0.5, t0 + 1.0, t0 + 0.37 * (t_end - t0), t_end)
-    _check_time_independent(model, q, p, tuple(s for s in probes if math.isfinite(s)))
+    starts = "q0, v0" if v0 is not None else "q0, p0"
+    _check_time_independent(model, q, p, tuple(s for s in probes if math.isfinite(s)), starts)
 
     def start(
         q: np.ndarray, p: np.ndarray, t0: float, steps: int, report: Callable[[int], None] | None, events: Any = None

@@ -14,6 +14,7 @@ from numpy.typing import ArrayLike
 
 from . import _core, pointers
 from ._core import ModelKind
+from ._util import floats, integer, positive_int, returned
 
 __all__ = [
     "Cyclic",
@@ -45,6 +46,11 @@ class Translation:
     name : str
         ``"P_x"``, ``"P_y"``, ``"P_z"`` (``"P_k"`` beyond 3 dimensions), as reports name J.
 
+    Raises
+    ------
+    ValueError
+        ``axis`` not an integer ≥ 0 or ``spatial_dim`` not a positive integer, naming it.
+
     See Also
     --------
     varmech.momentum : J along a trajectory.
@@ -63,6 +69,10 @@ class Translation:
 
     axis: int
     spatial_dim: int = 3
+
+    def __post_init__(self) -> None:
+        integer("axis", self.axis)
+        integer("spatial_dim", self.spatial_dim, 1)
 
     @property
     def name(self) -> str:
@@ -104,6 +114,11 @@ class Rotation:
     name : str
         ``"L"`` in the plane, else ``"L_x"``, ``"L_y"``, ``"L_z"``.
 
+    Raises
+    ------
+    ValueError
+        ``axis`` not an integer ≥ 0 or ``spatial_dim`` not a positive integer, naming it.
+
     See Also
     --------
     varmech.momentum : J along a trajectory.
@@ -121,6 +136,10 @@ class Rotation:
 
     axis: int = 2
     spatial_dim: int = 3
+
+    def __post_init__(self) -> None:
+        integer("axis", self.axis)
+        integer("spatial_dim", self.spatial_dim, 1)
 
     @property
     def name(self) -> str:
@@ -161,6 +180,11 @@ class Cyclic:
     name : str
         ``"p[index]"``, as reports name J.
 
+    Raises
+    ------
+    ValueError
+        ``index`` not an integer ≥ 0 (``Cyclic(-1)``, ``Cyclic(1.5)``).
+
     See Also
     --------
     varmech.momentum : J along a trajectory.
@@ -178,6 +202,9 @@ class Cyclic:
     """
 
     index: int
+
+    def __post_init__(self) -> None:
+        integer("index", self.index)
 
     @property
     def name(self) -> str:
@@ -341,8 +368,9 @@ class Model:
         Raises
         ------
         ValueError
-            Naming the argument whose shape does not fit (``q``, ``p`` or ``t``), or a
-            general Lagrangian whose Newton solve of ∂L/∂q̇ = p fails.
+            Naming the argument whose shape or values do not fit (``q``, ``p`` or ``t``), or,
+            starting with ``q, p``, a general Lagrangian whose Newton solve of ∂L/∂q̇ = p
+            fails there.
 
         Examples
         --------
@@ -393,12 +421,12 @@ class Model:
     def _derivative(self, what: str, q: ArrayLike, x: ArrayLike, t: ArrayLike) -> np.ndarray:
         # x is the momenta p for the velocity, else the velocities v.
         name = "p" if what == "velocity" else "v"
-        x = np.ascontiguousarray(x, dtype=float)
+        x = np.ascontiguousarray(floats(name, x))
         rows = np.atleast_2d(x)
         if rows.ndim != 2 or rows.shape[1] != self.dim:
             raise ValueError(f"{name}: expected shape ({self.dim},) or (N, {self.dim}), got {x.shape}")
         q2, t1 = _broadcast("q", q, rows.shape), _broadcast("t", t, rows.shape[:1])
-        return _core.derivative(self._core, what, t1, q2, rows).reshape(x.shape)
+        return _core.derivative(self._core, what, t1, q2, rows, names=f"q, {name}").reshape(x.shape)
 
     def with_parameters(self, **values: float) -> Model:
         """The model with its parameters set by name; only symbolic models
@@ -541,7 +569,7 @@ def symmetry_of(data: Any) -> Symmetry:
 def _broadcast(name: str, value: ArrayLike, shape: tuple[int, ...]) -> np.ndarray:
     """``value`` as a contiguous float array of ``shape``; ValueError naming it when it does not
     broadcast to the states' shape."""
-    array = np.asarray(value, dtype=float)
+    array = floats(name, value)
     try:
         return np.ascontiguousarray(np.broadcast_to(array, shape))
     except ValueError:
@@ -775,8 +803,7 @@ class MechanicalSystem(Model):
             "symmetries": symmetries,
             "name": name,
         }
-        if isinstance(dim, bool) or not isinstance(dim, (int, np.integer)) or dim < 1:
-            raise ValueError(f"dim: must be a positive integer, got {dim!r}")
+        dim = positive_int("dim", dim)
         if (constraints is None) != (constraint_count is None) or (constraint_jacobian is not None and constraints is None):
             raise ValueError("constraints: give constraints(q) with constraint_count (and optionally constraint_jacobian)")
         _check_velocity_constraints(velocity_constraints, velocity_constraint_count, velocity_constraint_offset)
@@ -820,7 +847,7 @@ class MechanicalSystem(Model):
             self._constrain(constraints, constraint_jacobian, constraint_count)
             self._core = _roll(self._core, velocity_constraints, velocity_constraint_count, velocity_constraint_offset)
             return
-        m = np.array(mass, dtype=float)
+        m = np.array(floats("mass", mass))
         if m.ndim > 2 or (m.ndim >= 1 and any(s != dim for s in m.shape)):
             raise ValueError(f"mass: must be a scalar, a vector ({dim},) or a matrix ({dim}, {dim}), got shape {m.shape}")
         if not np.all(np.isfinite(m)):
@@ -839,8 +866,7 @@ class MechanicalSystem(Model):
         """Puts the model on the constraints, if any."""
         if constraints is None:
             return
-        if isinstance(count, bool) or not isinstance(count, (int, np.integer)):
-            raise ValueError(f"constraint_count: must be a positive integer, got {count!r}")
+        count = positive_int("constraint_count", count)
         # The constraints wrap the unconstrained closure model this class built just before.
         assert isinstance(self._core, (_core.ClosureModel, _core.ClosureNatural))
         self._core = _core.ClosureConstrained(self._core, int(count), constraints, jacobian)
@@ -855,8 +881,17 @@ def _check_velocity_constraints(
         raise ValueError("velocity_constraints: give velocity_constraints(q) with velocity_constraint_count")
     if offset is not None and matrix is None:
         raise ValueError("velocity_constraint_offset: only with velocity_constraints(q) and velocity_constraint_count")
-    if count is not None and (isinstance(count, bool) or not isinstance(count, (int, np.integer))):
-        raise ValueError(f"velocity_constraint_count: must be a positive integer, got {count!r}")
+    if count is not None:
+        positive_int("velocity_constraint_count", count)
+
+
+def _forced(value: Any, n: int) -> np.ndarray:
+    """A force closure's result, read as the core reads one, before a Rayleigh term is added
+    to it (numpy would broadcast a wrong shape, or read a string)."""
+    f = returned("force(q, v, t)", value)
+    if f.shape != (n,):
+        raise ValueError(f"force(q, v, t) returned an array of shape {f.shape}, expected ({n},) (one per coordinate)")
+    return f
 
 
 def _roll(
@@ -981,8 +1016,7 @@ class Lagrangian(Model):
             "symmetries": symmetries,
             "name": name,
         }
-        if isinstance(dim, bool) or not isinstance(dim, (int, np.integer)) or dim < 1:
-            raise ValueError(f"dim: must be a positive integer, got {dim!r}")
+        dim = positive_int("dim", dim)
         _check_velocity_constraints(velocity_constraints, velocity_constraint_count, velocity_constraint_offset)
         functions = {"lagrangian": lagrangian, "dl_dq": dl_dq, "dl_dv": dl_dv, "hessians": hessians, "force": force}
         native = pointers.functions(functions, int(dim))
@@ -1000,11 +1034,11 @@ class Lagrangian(Model):
             )
         total_force = force
         if rayleigh is not None:
-            c = np.array(rayleigh, dtype=float)
+            c = floats("rayleigh", rayleigh)
             if c.ndim > 2 or (c.ndim >= 1 and any(s != dim for s in c.shape)) or not np.all(np.isfinite(c)):
                 raise ValueError(f"rayleigh: must be a finite scalar, a vector ({dim},) or a matrix ({dim}, {dim})")
             damping = (lambda v: c @ v) if c.ndim == 2 else (lambda v: c * v)
-            total_force = (lambda q, v, t: -damping(v)) if force is None else (lambda q, v, t: np.asarray(force(q, v, t), dtype=float) - damping(v))
+            total_force = (lambda q, v, t: -damping(v)) if force is None else (lambda q, v, t: _forced(force(q, v, t), dim) - damping(v))
         if native is not None:
             handed = {k: _handed(f) for k, f in native.items()}
             self._core = _core.PointerLagrangian(

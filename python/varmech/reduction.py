@@ -11,7 +11,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from . import _core
-from ._util import vector
+from ._util import floats, vector
 from .integrate import Trajectory
 from .model import RECIPES, Model, field, from_recipe, integers, numbers
 
@@ -291,9 +291,9 @@ class ReducedModel(Model):
         >>> reduced.amended_potential([[0.3], [0.4]]).round(6)
         array([7.205336, 7.19527 ])
         """
-        x = np.asarray(x, dtype=float)
+        x = floats("x", x)
         rows = np.ascontiguousarray(np.atleast_2d(x))
-        t1 = np.ascontiguousarray(np.broadcast_to(np.asarray(t, dtype=float), rows.shape[:1]))
+        t1 = np.ascontiguousarray(np.broadcast_to(floats("t", t), rows.shape[:1]))
         values = _core.amended_potential(self._core, t1, rows)
         return values.reshape(x.shape[:-1])
 
@@ -327,10 +327,10 @@ class ReducedModel(Model):
         >>> reduced.cyclic_velocity([0.3], [0.0]).round(12)    # at θ = 0.3 at rest: no precession
         array([0., 5.])
         """
-        xdot = np.asarray(xdot, dtype=float)
+        xdot = floats("xdot", xdot)
         rows = np.ascontiguousarray(np.atleast_2d(xdot))
-        x2 = np.ascontiguousarray(np.broadcast_to(np.asarray(x, dtype=float), rows.shape))
-        t1 = np.ascontiguousarray(np.broadcast_to(np.asarray(t, dtype=float), rows.shape[:1]))
+        x2 = np.ascontiguousarray(np.broadcast_to(floats("x", x), rows.shape))
+        t1 = np.ascontiguousarray(np.broadcast_to(floats("t", t), rows.shape[:1]))
         out = _core.cyclic_velocity(self._core, t1, x2, rows)
         return out.reshape(xdot.shape[:-1] + (len(self.cyclic),))
 

@@ -15,7 +15,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from . import _core
-from ._util import positive
+from ._util import floats, positive
 from .impacts import Contact
 from .model import Model, NativeSystem
 
@@ -720,9 +720,7 @@ def nbody(masses: ArrayLike, positions: ArrayLike, velocities: ArrayLike, G: flo
     >>> round(float(E[-1]), 6), traj.method
     (-0.0005, 'verlet')
     """
-    m = np.asarray(masses, dtype=float)
-    x = np.asarray(positions, dtype=float)
-    v = np.asarray(velocities, dtype=float)
+    m, x, v = floats("masses", masses), floats("positions", positions), floats("velocities", velocities)
     if m.ndim != 1 or x.shape != (len(m), 3) or v.shape != (len(m), 3):
         raise ValueError(f"positions, velocities: must have shape ({len(m)}, 3) to match masses")
     bad = np.flatnonzero(~(np.isfinite(m) & (m > 0)))

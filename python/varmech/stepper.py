@@ -311,7 +311,7 @@ class Stepper:
             Naming ``checkpoint`` for bytes that are not one, or ``model``/``method`` for a
             model it does not fit.
         TypeError
-            Naming ``model``: not a varmech model or scene.
+            Naming ``model``: not a varmech model or scene; or ``checkpoint``: not bytes.
 
         Examples
         --------
@@ -325,6 +325,9 @@ class Stepper:
         >>> stepper.steps, bool((stepper.q == whole.q[-1]).all() and (stepper.p == whole.p[-1]).all())
         (100, True)
         """
+        if not isinstance(checkpoint, (bytes, bytearray, memoryview)):
+            # bytes() would read a str as an error and an int n as n zero bytes.
+            raise TypeError(f"checkpoint: expected the bytes of Stepper.checkpoint(), got {type(checkpoint).__name__}")
         model, _, _ = _model_of(model, None, None, None)
         stepper = cls.__new__(cls)
         stepper._model = model

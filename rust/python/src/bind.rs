@@ -13,7 +13,8 @@ use crate::closure::{
     ClosureNonholonomic, ClosureSystem,
 };
 use crate::compiled::CompiledModel;
-use crate::errors::{boxed, to_pyerr};
+use crate::convert;
+use crate::errors::boxed;
 use crate::native::NativeModel;
 use crate::pointers::{PointerLagrangian, PointerSystem};
 use crate::routh::RouthModel;
@@ -131,9 +132,8 @@ impl PyModelKind {
     }
 
     /// Whether `method` integrates a model of this kind.
-    fn admits(&self, py: Python<'_>, method: &str) -> PyResult<bool> {
-        let method = Method::from_name(method).map_err(|e| to_pyerr(py, e))?;
-        Ok(self.0.admits(method))
+    fn admits(&self, #[pyo3(from_py_with = convert::method)] method: Method) -> bool {
+        self.0.admits(method)
     }
 
     fn __repr__(&self) -> String {

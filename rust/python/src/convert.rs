@@ -4,6 +4,7 @@ use numpy::{PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray1, PyReadonlyArra
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyInt;
+use varmech::integrators::Method;
 use varmech::model::Mass;
 
 use crate::closure::readers::type_name;
@@ -29,6 +30,19 @@ pub fn count(name: &str, x: &Bound<'_, PyAny>) -> PyResult<usize> {
             PyTypeError::new_err(format!("{name}: must be an integer, got {}", type_name(x)))
         }
     })
+}
+
+/// The `method` argument, a method's name, as the core's [`Method`]: anything but a str is a
+/// TypeError and an unknown name a ValueError, both naming `method` (pyo3's own extraction
+/// says only that the object is not a str).
+pub fn method(x: &Bound<'_, PyAny>) -> PyResult<Method> {
+    let name = x.extract::<String>().map_err(|_| {
+        PyTypeError::new_err(format!(
+            "method: must be a method's name, a str (see varmech.methods()), got {}",
+            type_name(x)
+        ))
+    })?;
+    Method::from_name(&name).map_err(|e| to_pyerr(x.py(), e))
 }
 
 /// Rows of a float64 (N, n) array, as one contiguous row-major slice.

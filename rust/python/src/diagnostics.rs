@@ -11,7 +11,7 @@ use varmech::ModelError;
 
 use crate::bind::{bind_model, dim_of};
 use crate::convert::{self, rows, slice, states, ArrayPair};
-use crate::errors::{model_error, to_pyerr};
+use crate::errors::{model_error, model_error_at, to_pyerr};
 use crate::generator::Generator;
 
 /// Three arrays: the energy and its two terms.
@@ -48,8 +48,10 @@ fn energy_terms<'py>(
 /// A first derivative of L at each state (t, q, x): `"momentum"`, p = ∂L/∂q̇(q, x, t) from
 /// velocities x (Mq̇ for mechanical systems); `"velocity"`, the inverse Legendre transform,
 /// q̇ with ∂L/∂q̇ = x from momenta x (M⁻¹p); `"dl_dq"`, ∂L/∂q(q, x, t) from velocities x;
-/// `"dp_dt"`, ṗ = ∂L/∂q + f(q, x, t) from velocities x.
+/// `"dp_dt"`, ṗ = ∂L/∂q + f(q, x, t) from velocities x. With `names` (the user's arguments the
+/// states come from), the core's own errors name them.
 #[pyfunction]
+#[pyo3(signature = (model, what, t, q, x, *, names=None))]
 fn derivative<'py>(
     py: Python<'py>,
     model: &Bound<'py, PyAny>,
@@ -57,6 +59,7 @@ fn derivative<'py>(
     t: PyReadonlyArray1<'py, f64>,
     q: PyReadonlyArray2<'py, f64>,
     x: PyReadonlyArray2<'py, f64>,
+    names: Option<&str>,
 ) -> PyResult<Bound<'py, PyAny>> {
     if !matches!(what, "momentum" | "velocity" | "dl_dq" | "dp_dt") {
         return Err(PyValueError::new_err(format!(
@@ -87,7 +90,11 @@ fn derivative<'py>(
         })
         .map(|()| y)
     })?;
-    Ok(convert::matrix(py, result.map_err(model_error)?, n)?.into_any())
+    let result = result.map_err(|e| match names {
+        Some(names) => model_error_at(e, names),
+        None => model_error(e),
+    });
+    Ok(convert::matrix(py, result?, n)?.into_any())
 }
 
 /// J = p·ξ(q) of a generator for each row of (q, p), and the size Σ|pᵢξᵢ| of its terms.

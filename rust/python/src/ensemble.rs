@@ -5,15 +5,15 @@
 use numpy::PyReadonlyArray2;
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
-use varmech::integrators::{self, Dynamics, MemberEvents, Members, Parallel};
+use varmech::integrators::{self, Dynamics, MemberEvents, Members, Method, Parallel};
 
 use crate::bind::check_signals;
 use crate::compiled::CompiledModel;
-use crate::convert::rows;
+use crate::convert::{self, rows};
 use crate::errors::{model_error, to_pyerr};
 use crate::events::{EventTuple, Events};
 use crate::native::NativeModel;
-use crate::run::{method_and_options, newton_max_iterations_count, reporting, save_every_count, steps_count};
+use crate::run::{newton_max_iterations_count, reporting, run_options, save_every_count, steps_count};
 use crate::trajectory::TrajectoryRecord;
 
 /// A model the core evaluates without the GIL.
@@ -70,7 +70,7 @@ fn ensemble<'py>(
     p0: PyReadonlyArray2<'py, f64>,
     dt: f64,
     #[pyo3(from_py_with = steps_count)] steps: usize,
-    method: &str,
+    #[pyo3(from_py_with = convert::method)] method: Method,
     #[pyo3(from_py_with = save_every_count)] save_every: usize,
     compensated: bool,
     max_energy_error: Option<f64>,
@@ -82,9 +82,7 @@ fn ensemble<'py>(
     progress: Option<Py<PyAny>>,
     events: Option<Vec<EventTuple<'py>>>,
 ) -> PyResult<(Vec<MemberResult>, Option<Py<PyAny>>)> {
-    let (method, options) = method_and_options(
-        py,
-        method,
+    let options = run_options(
         dt,
         steps,
         save_every,
@@ -93,7 +91,7 @@ fn ensemble<'py>(
         t0,
         newton_tolerance,
         newton_max_iterations,
-    )?;
+    );
     let ((q0, _), (p0, _)) = (rows("q0", &q0)?, rows("p0", &p0)?);
     let models = Models(
         models

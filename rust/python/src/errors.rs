@@ -52,6 +52,18 @@ pub fn model_error(e: ModelError) -> PyErr {
     }
 }
 
+/// [`model_error`] at states the caller names for its user (`"q0, p0"`): the core's own error
+/// starts with those names and says what checks them; a closure's exception stays unchanged.
+pub fn model_error_at(e: ModelError, names: &str) -> PyErr {
+    match e.downcast::<PyErr>() {
+        Ok(err) => *err,
+        Err(e) => PyValueError::new_err(format!(
+            "{names}: {e} (at these {names}; varmech.check_derivatives compares the model's derivatives with \
+             differences there)"
+        )),
+    }
+}
+
 /// The Python exception for a core error, with the core's message: ValueError (which names the
 /// argument), DivergenceError, ConvergenceError (with `residual` and `iterations`),
 /// SpuriousBranchError, or the model's own exception (a closure's, or KeyboardInterrupt)

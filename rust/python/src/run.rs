@@ -10,7 +10,7 @@ use varmech::integrators::{
 use varmech::ModelError;
 
 use crate::bind::{bind_model, dim_of, Poll};
-use crate::convert::{count, slice};
+use crate::convert::{self, count, slice};
 use crate::errors::{boxed, failure_to_pyerr, to_pyerr};
 use crate::events::{EventTuple, Events};
 use crate::trajectory::TrajectoryRecord;
@@ -28,7 +28,7 @@ fn integrate<'py>(
     p0: PyReadonlyArray1<'py, f64>,
     dt: f64,
     #[pyo3(from_py_with = steps_count)] steps: usize,
-    method: &str,
+    #[pyo3(from_py_with = convert::method)] method: Method,
     #[pyo3(from_py_with = save_every_count)] save_every: usize,
     compensated: bool,
     max_energy_error: Option<f64>,
@@ -38,9 +38,7 @@ fn integrate<'py>(
     progress: Option<Py<PyAny>>,
     events: Option<Vec<EventTuple<'py>>>,
 ) -> PyResult<TrajectoryRecord> {
-    let (method, options) = method_and_options(
-        py,
-        method,
+    let options = run_options(
         dt,
         steps,
         save_every,
@@ -49,7 +47,7 @@ fn integrate<'py>(
         t0,
         newton_tolerance,
         newton_max_iterations,
-    )?;
+    );
     let (q0, p0) = (slice("q0", &q0)?, slice("p0", &p0)?);
     let events = detector_parts(py, model, events)?;
     let result = bind_model(py, model, |sys, poll| {
@@ -65,11 +63,9 @@ fn integrate<'py>(
     record(py, result)
 }
 
-/// A run's method and [`Options`] from the binding's arguments (`integrate`'s and `ensemble`'s).
+/// A run's [`Options`] from the binding's arguments (`integrate`'s and `ensemble`'s).
 #[allow(clippy::too_many_arguments)]
-pub(crate) fn method_and_options(
-    py: Python<'_>,
-    method: &str,
+pub(crate) fn run_options(
     dt: f64,
     steps: usize,
     save_every: usize,
@@ -78,13 +74,12 @@ pub(crate) fn method_and_options(
     t0: f64,
     newton_tolerance: f64,
     newton_max_iterations: usize,
-) -> PyResult<(Method, Options)> {
-    let method = Method::from_name(method).map_err(|e| to_pyerr(py, e))?;
+) -> Options {
     let newton = NewtonOptions {
         tolerance: newton_tolerance,
         max_iterations: newton_max_iterations,
     };
-    let options = Options {
+    Options {
         dt,
         steps,
         save_every,
@@ -92,8 +87,7 @@ pub(crate) fn method_and_options(
         max_energy_error,
         t0,
         newton,
-    };
-    Ok((method, options))
+    }
 }
 
 /// The event functions and specs of `events`, checked against the model.
@@ -183,12 +177,11 @@ pub(crate) fn newton_max_iterations_count(x: &Bound<'_, PyAny>) -> PyResult<usiz
 fn symplecticity_defect<'py>(
     py: Python<'py>,
     model: &Bound<'py, PyAny>,
-    method: &str,
+    #[pyo3(from_py_with = convert::method)] method: Method,
     q: PyReadonlyArray1<'py, f64>,
     p: PyReadonlyArray1<'py, f64>,
     dt: f64,
 ) -> PyResult<f64> {
-    let method = Method::from_name(method).map_err(|e| to_pyerr(py, e))?;
     let (q, p) = (slice("q", &q)?, slice("p", &p)?);
     let defect = bind_model(py, model, |sys, _poll| {
         diagnostics::symplecticity_defect(sys, method, q, p, dt)

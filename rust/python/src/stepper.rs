@@ -8,7 +8,7 @@ use varmech::integrators::{self, Checkpoint, Dynamics, Method, NewtonOptions, Op
 use varmech::Error;
 
 use crate::bind::{bind_model, Poll};
-use crate::convert::slice;
+use crate::convert::{self, slice};
 use crate::errors::to_pyerr;
 
 /// One model, one method and the state, advanced step by step
@@ -53,13 +53,12 @@ impl Stepper {
         q0: PyReadonlyArray1<'py, f64>,
         p0: PyReadonlyArray1<'py, f64>,
         dt: f64,
-        method: &str,
+        #[pyo3(from_py_with = convert::method)] method: Method,
         t0: f64,
         compensated: bool,
         newton_tolerance: f64,
         newton_max_iterations: usize,
     ) -> PyResult<Self> {
-        let method = Method::from_name(method).map_err(|e| to_pyerr(py, e))?;
         let options = Options {
             compensated,
             t0,
