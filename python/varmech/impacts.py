@@ -735,8 +735,8 @@ def run(
         try:
             q, p, impacts, grazed = through(flows, contacts, i, t_hit, q_hit, p_hit, dt - before, first)
         except ContactError as err:
-            # The run up to the step of the impact, ending with that step's start.
-            err.step, err.time = done, t_hit
+            # The run up to the step of the impact, ending with that step's start tₙ, the error's time.
+            err.step, err.time = done, t_grid - dt
             stepper = _core.Stepper.from_checkpoint(model._core, record.checkpoint)
             stepper.reset(np.asarray(q_start[k]), np.asarray(p_start[k]), t_grid - dt)
             err._varmech_joined = (pieces.joined(done - 1, stepper.checkpoint()), occurrences())  # type: ignore[attr-defined]
