@@ -571,7 +571,7 @@ def through(
     grazing = 0
     while True:
         contact = contacts[i]
-        normal = np.asarray(contact.gradient(q.copy()), dtype=float).reshape(-1)
+        normal = _normal(flows.model, contact, q, p)
         lam = exact_jump(flows.model, t, normal, q, p, contact.restitution)
 
         def piece(lam: float, q: np.ndarray = q, p: np.ndarray = p, normal: np.ndarray = normal, i: int = i, tau: float = tau) -> Piece:
@@ -593,6 +593,17 @@ def through(
             )
         i, t, q, p, tau = j, t + s, q1, p1, tau - s
         first = partial(float, energy)
+
+
+def _normal(model: Model, contact: Contact, q: np.ndarray, p: np.ndarray) -> np.ndarray:
+    """The direction of an impact's jump: ∇φ(q), or on a constrained model the part of it the
+    constraints let act. The surface's impulse comes with the constraints' own workless impulse
+    Gᵀμ that keeps the momenta on them (GM⁻¹p⁺ = 0), which adds up to λ∇φ projected
+    M-orthogonally (:func:`varmech.project`'s projection, whose affine part cancels here)."""
+    normal = np.asarray(contact.gradient(q.copy()), dtype=float).reshape(-1)
+    if model.constraints or model.velocity_constraints:
+        normal = _core.project(model._core, q, p + normal)[1] - _core.project(model._core, q, p)[1]
+    return np.asarray(normal)
 
 
 def _piece(flows: Flow, contacts: list[Contact], i: int, q: np.ndarray, p: np.ndarray, tau: float) -> Piece:

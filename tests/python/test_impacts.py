@@ -426,3 +426,24 @@ def test_a_contact_errors_time_is_the_start_of_its_step_as_documented():
     err = info.value
     assert err.time == err.partial.t[-1]
     assert err.time == pytest.approx((err.step - 1) * dt, abs=1e-12)
+
+
+def test_rattle_goes_through_an_impact_reflected_on_its_constraint_as_the_angle_twin_does():
+    # Issue 32: RATTLE with law="reflect" failed at its first impact, blaming p0: ∇φ's jump took
+    # the momenta off the hidden constraint. With the constraint's own workless impulse the
+    # jump reflects the velocity along the circle, as the pendulum in its angle θ reflects θ̇ at
+    # the wall θ = −π/6 (x = −1/2): the same impact times, H and the constraints kept.
+    scene = varmech.scenes.cartesian_pendulum()   # released from rest at θ = 2, g = l = 1
+    wall = varmech.Contact.wall(0, -0.5, law="reflect", name="wall")
+    dt, steps = 1e-3, 20000
+    traj = varmech.integrate(scene, dt=dt, steps=steps, contacts=[wall])
+    angle = varmech.MechanicalSystem(1, lambda q: -math.cos(q[0]), lambda q: np.array([math.sin(q[0])]), name="pendulum")
+    stop = varmech.Contact(lambda q: q[0] + math.pi / 6, lambda q: [1.0], law="reflect")
+    twin = varmech.integrate(angle, [2.0], [0.0], dt=dt, steps=steps, contacts=[stop])
+    hits, twin_hits = traj.events[0].t, twin.events[0].t
+    assert len(hits) == len(twin_hits) >= 3
+    np.testing.assert_allclose(hits, twin_hits, rtol=0, atol=1e-5)
+    position, velocity = traj.constraint_residuals()
+    assert position.max() < 1e-12 and velocity.max() < 1e-12
+    E = traj.energy()
+    assert abs(E - E[0]).max() < 1e-5 and traj.q[:, 0].min() > -0.5 - 1e-12
