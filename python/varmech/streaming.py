@@ -248,7 +248,8 @@ def resume(
     Raises
     ------
     ValueError
-        Naming ``path`` for a file without a checkpoint, or a missing or damaged one; the
+        Naming ``path`` for a file without a checkpoint, or a missing or damaged one, or a run
+        with contacts (not continued yet: its checkpoint does not hold them); the
         arguments of :func:`varmech.integrate` as it names them.
 
     Examples
@@ -263,6 +264,12 @@ def resume(
     (150, True)
     """
     stored = files.load(path, lazy=True)
+    if stored.contacts:
+        raise ValueError(
+            f"path: {str(path)!r} holds a run with contacts ({', '.join(map(repr, stored.contacts))}), which resume"
+            " cannot continue yet (its checkpoint does not hold them); start a new run from its last state with"
+            " integrate(model, traj.q[-1], traj.p[-1], t0=traj.t[-1], contacts=...)"
+        )
     if stored.checkpoint is None:
         raise ValueError(f"path: {str(path)!r} has no checkpoint to resume from")
     t_now = float(stored.t[-1])
