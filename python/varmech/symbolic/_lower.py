@@ -243,7 +243,8 @@ def lower(expressions: Sequence[sp.Expr], slots: Mapping[sp.Symbol, int], parame
     outputs the int64 registers of ``expressions`` in order.
 
     ``slots`` maps a symbol to its input slot (qᵢ → i, q̇ᵢ → n + i, t → 2n), ``parameters``
-    to its index in the parameter vector. ValueError names an expression that cannot be
+    to its index in the parameter vector. ``DiracDelta`` (the derivative of sign, and its
+    derivatives) is 0: it vanishes almost everywhere. ValueError names an expression that cannot be
     compiled and the reason (an unsupported function, or a symbol that is neither an input nor
     a parameter).
 
@@ -257,7 +258,10 @@ def lower(expressions: Sequence[sp.Expr], slots: Mapping[sp.Symbol, int], parame
     >>> outputs.tolist()
     [4]
     """
-    replacements, reduced = sp.cse(list(expressions), symbols=sp.numbered_symbols("_cse", cls=sp.Dummy), order="none")
+    # DiracDelta (sign' and |x|'', and its derivatives) vanishes wherever it is defined: 0, before
+    # the common subexpressions, so that the terms it multiplies go too.
+    expressions = [sp.sympify(e).replace(sp.DiracDelta, lambda *args: sp.S.Zero) for e in expressions]
+    replacements, reduced = sp.cse(expressions, symbols=sp.numbered_symbols("_cse", cls=sp.Dummy), order="none")
     builder = _Builder(slots, parameters)
     for symbol, expr in replacements:
         builder.values[symbol] = builder.lower(expr)
