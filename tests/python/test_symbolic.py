@@ -230,3 +230,52 @@ def test_sign_and_abs_compile_in_a_general_lagrangian_and_run_the_v_shaped_well(
     # kink falls on the grid (t = 1), so to round-off.
     exact = np.array([1 - 0.25, 0.0, -(1 - 0.25), -1.0])
     np.testing.assert_allclose(traj.q[1:, 0], exact, rtol=0, atol=1e-13)
+
+
+def test_a_chain_is_derived_in_work_linear_in_its_length_with_progress_and_a_stated_limit(monkeypatch):
+    # Issue 32: a 1 500-coordinate chain had not compiled after 240 s, with no sign of progress.
+    # SymPy differentiated the whole L, and every gradient entry, by every coordinate (n² for n
+    # terms); now each term is differentiated by the symbols it holds: twice the chain, twice the
+    # derivatives. A bar counts the 3n + 2 rows derived and the functions lowered.
+    from varmech.symbolic import _derive
+
+    calls = []
+    differentiate = _derive.sp.diff
+    monkeypatch.setattr(_derive.sp, "diff", lambda *args: calls.append(1) or differentiate(*args))
+    shown = []
+
+    class Bar:
+        def __init__(self, total, **options):
+            shown.append(["total", total])
+
+        def update(self, k=1):
+            shown[-1].append(k)
+
+        def reset(self, total):
+            shown.append(["total", total])
+
+        def set_description(self, *args, **options):
+            pass
+
+        def close(self):
+            pass
+
+    monkeypatch.setattr(symbolic, "progress_bar", Bar)
+
+    def chain(n):
+        q = sp.symbols(f"q0:{n}")
+        V = sum((q[i + 1] - q[i]) ** 2 / 2 + (q[i + 1] - q[i]) ** 4 / 4 for i in range(n - 1))
+        calls.clear()
+        shown.clear()
+        model = symbolic.mechanical(V, list(q), 1, progress=True)
+        return model, len(calls)
+
+    (small, short), (large, long) = chain(20), chain(40)
+    assert large.kind_name == "separable" and len(large.expressions["gradient"]) == 40
+    assert long < 2.2 * short            # was 4×: 3n² Hessian entries, each sp.diff
+    derived, lowered = shown
+    assert derived[:2] == ["total", 3 * 40 + 2] and sum(derived[2:]) == 3 * 40 + 2
+    assert lowered == ["total", 3, 1, 1, 1]   # V, ∇V, M
+    q = sp.symbols(f"q0:{symbolic.MAX_COORDINATES + 1}")
+    with pytest.raises(ValueError, match=rf"^q: {symbolic.MAX_COORDINATES + 1} coordinates; symbolic models are compiled up to"):
+        symbolic.mechanical(sp.Add(*(x**2 for x in q)), list(q), 1)
