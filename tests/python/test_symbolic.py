@@ -270,7 +270,7 @@ def test_a_chain_is_derived_in_work_linear_in_its_length_with_progress_and_a_sta
         model = symbolic.mechanical(V, list(q), 1, progress=True)
         return model, len(calls)
 
-    (small, short), (large, long) = chain(20), chain(40)
+    (_, short), (large, long) = chain(20), chain(40)
     assert large.kind_name == "separable" and len(large.expressions["gradient"]) == 40
     assert long < 2.2 * short            # was 4×: 3n² Hessian entries, each sp.diff
     derived, lowered = shown
