@@ -264,8 +264,9 @@ def exact_jump(model: Model, t: float, normal: np.ndarray, q: np.ndarray, p: np.
 
 def reflect(model: Model, contact: Contact, q: np.ndarray, p: np.ndarray, t: float) -> np.ndarray:
     """The momenta just after an impact on ``contact`` at (q, p): the normal velocity reversed and
-    scaled by e, in the metric of the kinetic energy (:func:`exact_jump`)."""
-    normal = np.asarray(contact.gradient(q.copy()), dtype=float).reshape(-1)
+    scaled by e, in the metric of the kinetic energy (:func:`exact_jump`), along the constraints of
+    a constrained model (:func:`_normal`)."""
+    normal = _normal(model, contact, q, p)
     return np.asarray(p + exact_jump(model, t, normal, q, p, contact.restitution) * normal)
 
 
