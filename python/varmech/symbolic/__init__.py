@@ -45,8 +45,8 @@ from ._routh import routhian
 
 __all__ = ["MAX_COORDINATES", "TAPE_OPS", "SymbolicModel", "examples", "lagrangian", "mechanical", "routh"]
 
-#: The most coordinates a symbolic model is compiled with: the build takes about 0.1 s per
-#: coordinate of a chain (SymPy's derivatives, term by term), 3–4 minutes at this size.
+#: The most coordinates a symbolic model is compiled with: a chain's build grows linearly, about
+#: 0.1 s a coordinate under load (SymPy's derivatives, term by term), minutes at this size.
 MAX_COORDINATES = 2000
 
 
