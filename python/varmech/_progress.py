@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import sys
+import threading
 from collections.abc import Iterable, Iterator
 from typing import TextIO, TypeVar
 
@@ -34,3 +35,10 @@ def progress_bar(
     """A progress bar on ``file`` (stderr) that appears once its run has taken ``delay`` seconds
     (a short run shows none). ``enabled=None`` shows it only on a terminal."""
     return tqdm(total=total, unit=unit, desc=desc, disable=not _shown(enabled), delay=delay, leave=False, file=file)
+
+
+def thread_lock() -> None:
+    """Gives tqdm a thread lock instead of its default process lock, a named semaphore: for a
+    worker process, which draws no bar, and whose semaphore would leak when its pool terminates
+    it (the resource tracker's "leaked semaphore objects" at exit)."""
+    tqdm.set_lock(threading.RLock())

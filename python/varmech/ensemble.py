@@ -21,7 +21,7 @@ from numpy.typing import ArrayLike
 
 from . import _core
 from . import events as _events
-from ._progress import progress_bar
+from ._progress import progress_bar, thread_lock
 from ._util import finite, floats, positive, positive_int
 from .conservation import VERDICTS, ConservationReport, check_conservation
 from .integrate import Trajectory, _energy_threshold, _model_of, _newton, _steps, _trajectory, integrate
@@ -525,21 +525,30 @@ def _in_processes(
     tasks = [(shipped, q[a : a + chunk_size], p[a : a + chunk_size]) for a in range(0, members, chunk_size)]
     chunks: list[Any] = [None] * len(tasks)
     start = "forkserver" if "forkserver" in multiprocessing.get_all_start_methods() else "spawn"
-    pool = multiprocessing.get_context(start).Pool(workers, initializer=signal.signal, initargs=(signal.SIGINT, signal.SIG_IGN))
+    pool = multiprocessing.get_context(start).Pool(workers, initializer=_worker_start)
     bar = progress_bar(total=members, unit="member", desc=f"{settings['method']} ({workers} processes)", enabled=progress)
     try:
         for k, result in enumerate(pool.imap(_closure_chunk, tasks)):
             chunks[k] = cloudpickle.loads(result)
             bar.update(len(chunks[k][0]))
+        # Done: the workers exit on their own, running their finalizers.
+        pool.close()
     except BaseException as err:
         if isinstance(err, KeyboardInterrupt):
             err.partial = _gathered(chunks, values, _unfinished(model, settings, members, chunk_size, err))  # type: ignore[attr-defined]
+        pool.terminate()
         raise
     finally:
-        pool.terminate()
         pool.join()
         bar.close()
     return _gathered(chunks, values)
+
+
+def _worker_start() -> None:
+    """A worker process's start: Ctrl-C is the parent's to handle, and its progress bars (all
+    off) lock with a thread lock, not a named semaphore that would leak when it is terminated."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    thread_lock()
 
 
 def _closure_chunk(task: tuple[bytes, np.ndarray, np.ndarray]) -> bytes:

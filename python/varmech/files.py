@@ -115,6 +115,7 @@ class Writer:
         save_every: int = 0,
         events: Sequence[str] = (),
         argument: str = "path",
+        contacts: Sequence[str] = (),
     ):
         from . import __version__
 
@@ -142,6 +143,9 @@ class Writer:
                     "message": "The run stopped before closing its file.",
                 }
             )
+            if contacts:
+                # A run's contacts are not in its checkpoint: load marks it, and resume refuses it.
+                f.attrs["contacts"] = list(contacts)
             for name in ("t", "q", "p", *columns):
                 shape = (0, n) if name in ("q", "p") else (0,)
                 f.create_dataset(
@@ -499,7 +503,9 @@ def save(traj: Trajectory, path: str | os.PathLike[str], *, overwrite: bool = Fa
     """
     target = writable(path, overwrite, "path")
     columns, names = columns_of(traj.model, traj.method), [o.name for o in traj.events]
-    writer = Writer(target, model=traj.model, method=traj.method, dt=traj.dt, columns=columns, events=names)
+    writer = Writer(
+        target, model=traj.model, method=traj.method, dt=traj.dt, columns=columns, events=names, contacts=traj.contacts
+    )
     writer.append(traj, events=traj.events)
     writer.close(traj.status, traj.message)
     return target
@@ -730,6 +736,7 @@ def load(
         message=str(a["message"]) if complete else f"The run stopped at step {steps} without closing its file.",
         checkpoint=checkpoint or None,
         events=events,
+        contacts=tuple(str(name) for name in a.get("contacts", ())),
     )
 
 

@@ -264,8 +264,9 @@ def exact_jump(model: Model, t: float, normal: np.ndarray, q: np.ndarray, p: np.
 
 def reflect(model: Model, contact: Contact, q: np.ndarray, p: np.ndarray, t: float) -> np.ndarray:
     """The momenta just after an impact on ``contact`` at (q, p): the normal velocity reversed and
-    scaled by e, in the metric of the kinetic energy (:func:`exact_jump`)."""
-    normal = np.asarray(contact.gradient(q.copy()), dtype=float).reshape(-1)
+    scaled by e, in the metric of the kinetic energy (:func:`exact_jump`), along the constraints of
+    a constrained model (:func:`_normal`)."""
+    normal = _normal(model, contact, q, p)
     return np.asarray(p + exact_jump(model, t, normal, q, p, contact.restitution) * normal)
 
 
@@ -571,7 +572,7 @@ def through(
     grazing = 0
     while True:
         contact = contacts[i]
-        normal = np.asarray(contact.gradient(q.copy()), dtype=float).reshape(-1)
+        normal = _normal(flows.model, contact, q, p)
         lam = exact_jump(flows.model, t, normal, q, p, contact.restitution)
 
         def piece(lam: float, q: np.ndarray = q, p: np.ndarray = p, normal: np.ndarray = normal, i: int = i, tau: float = tau) -> Piece:
@@ -593,6 +594,17 @@ def through(
             )
         i, t, q, p, tau = j, t + s, q1, p1, tau - s
         first = partial(float, energy)
+
+
+def _normal(model: Model, contact: Contact, q: np.ndarray, p: np.ndarray) -> np.ndarray:
+    """The direction of an impact's jump: ∇φ(q), or on a constrained model the part of it the
+    constraints let act. The surface's impulse comes with the constraints' own workless impulse
+    Gᵀμ that keeps the momenta on them (GM⁻¹p⁺ = 0), which adds up to λ∇φ projected
+    M-orthogonally (:func:`varmech.project`'s projection, whose affine part cancels here)."""
+    normal = np.asarray(contact.gradient(q.copy()), dtype=float).reshape(-1)
+    if model.constraints or model.velocity_constraints:
+        normal = _core.project(model._core, q, p + normal)[1] - _core.project(model._core, q, p)[1]
+    return np.asarray(normal)
 
 
 def _piece(flows: Flow, contacts: list[Contact], i: int, q: np.ndarray, p: np.ndarray, tau: float) -> Piece:
@@ -735,8 +747,8 @@ def run(
         try:
             q, p, impacts, grazed = through(flows, contacts, i, t_hit, q_hit, p_hit, dt - before, first)
         except ContactError as err:
-            # The run up to the step of the impact, ending with that step's start.
-            err.step, err.time = done, t_hit
+            # The run up to the step of the impact, ending with that step's start tₙ, the error's time.
+            err.step, err.time = done, t_grid - dt
             stepper = _core.Stepper.from_checkpoint(model._core, record.checkpoint)
             stepper.reset(np.asarray(q_start[k]), np.asarray(p_start[k]), t_grid - dt)
             err._varmech_joined = (pieces.joined(done - 1, stepper.checkpoint()), occurrences())  # type: ignore[attr-defined]

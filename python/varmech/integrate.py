@@ -85,6 +85,10 @@ class Trajectory:
         The last state's checkpoint: ``integrate(traj, steps=)`` goes on from it, bit for bit.
     events : tuple of Occurrences
         Each event's located crossings, in the order the events were given.
+    contacts : tuple of str
+        The names of the contacts of a run with ``contacts`` (empty otherwise). The core's
+        checkpoint does not hold them, so such a run is not continued (``integrate(traj,
+        steps=)``, :func:`varmech.resume`): that is refused, naming ``contacts``.
 
     Examples
     --------
@@ -114,6 +118,8 @@ class Trajectory:
     checkpoint: bytes | None = field(default=None, repr=False)
     #: Each event's located crossings (times and states), in the order the events were given.
     events: tuple[_events.Occurrences, ...] = field(default=(), repr=False)
+    #: The names of a run's contacts: a run with contacts cannot be continued yet.
+    contacts: tuple[str, ...] = field(default=(), repr=False)
     _v: np.ndarray | None = field(default=None, repr=False)
 
     @property
@@ -535,7 +541,9 @@ def integrate(
         impacts, each step that crosses a surface split at the contact configuration (see
         :mod:`varmech.impacts`); the impacts are each contact's occurrences in ``traj.events``.
         Default: a scene's ``contacts`` (an impact scene's floor or wall); ``contacts=[]``
-        runs without them. Not yet with ``t_eval``, ``output``, ``events`` or ``impulses``.
+        runs without them. Not yet with ``t_eval``, ``output``, ``events`` or ``impulses``;
+        such a run is not continued yet (``integrate(traj, steps=)`` and :func:`varmech.resume`
+        refuse it, naming ``contacts``).
     checkpoint_every
         With ``output``: commit states and a checkpoint at least every this many steps (rounded
         down to whole ``save_every`` periods), or every :class:`datetime.timedelta` of run time.
@@ -690,6 +698,7 @@ def integrate(
         ):
             if clash:
                 raise ValueError(f"contacts: not yet with {name}")
+        names = tuple(str(getattr(c, "name", c)) for c in contacts)
         try:
             j, hits = _impacts.run(start, model, method, q, p, t0, dt, nsteps, list(contacts))
         except BaseException as err:
@@ -701,11 +710,14 @@ def integrate(
                 work = j.work if model.forced else None
                 err.partial = Trajectory(  # type: ignore[attr-defined]
                     j.t, j.q, j.p, model, method, dt, j.steps, j.force_evaluations, j.newton, work,
-                    status=-1, message=str(err), checkpoint=j.checkpoint, events=hits,
+                    status=-1, message=str(err), checkpoint=j.checkpoint, events=hits, contacts=names,
                 )
             raise
         work = j.work if model.forced else None
-        return Trajectory(j.t, j.q, j.p, model, method, dt, j.steps, j.force_evaluations, j.newton, work, checkpoint=j.checkpoint, events=hits)
+        return Trajectory(
+            j.t, j.q, j.p, model, method, dt, j.steps, j.force_evaluations, j.newton, work, checkpoint=j.checkpoint, events=hits,
+            contacts=names,
+        )
     if impulses is not None:
         for name, clash in (("t_eval", t_eval is not None), ("output", output is not None), ("events", bool(watched))):
             if clash:
@@ -767,6 +779,12 @@ def _go_on(
     """``integrate(traj, steps=)``: the run of ``traj`` continued from its checkpoint, watching
     ``events`` from there (terminal counts after ``traj``'s crossings of the same events, an
     energy error from ``traj``'s first energy)."""
+    if traj.contacts:
+        raise ValueError(
+            f"contacts: a run with contacts ({', '.join(map(repr, traj.contacts))}) cannot be continued yet, its"
+            " checkpoint does not hold them; run the whole span with integrate(model, ..., contacts=...), or start a"
+            " new run from its last state: integrate(model, traj.q[-1], traj.p[-1], t0=traj.t[-1], contacts=...)"
+        )
     if traj.checkpoint is None:
         raise ValueError("model: this trajectory has no checkpoint to go on from (it failed before its first state)")
     nsteps = _steps(traj.dt, float(traj.t[-1]), steps, t_end)

@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
-
 import numpy as np
 from numpy.typing import ArrayLike
 
@@ -11,9 +9,7 @@ from . import _core
 from ._util import finite, positive
 from .integrate import _initial_state, _model_of, _newton, _steps
 from .model import Model
-
-if TYPE_CHECKING:
-    from .scenes import Scene
+from .scenes import Scene
 
 __all__ = [
     "Stepper",
@@ -44,7 +40,9 @@ class Stepper:
     ------
     ValueError
         Malformed arguments (the message starts with the argument's name), a method that does
-        not integrate the model, or initial data off a constrained model's constraints.
+        not integrate the model, or initial data off a constrained model's constraints; naming
+        ``contacts`` for a scene with contacts (a stepper does not go through impacts yet:
+        :func:`varmech.integrate` does).
 
     Notes
     -----
@@ -86,6 +84,7 @@ class Stepper:
         newton_tolerance: float = 1e-14,
         newton_max_iterations: int = 50,
     ) -> None:
+        _no_contacts(model)
         model, q0, p0 = _model_of(model, q0, p0, v0)
         if method is None:
             method = model.kind.default_method
@@ -308,8 +307,8 @@ class Stepper:
         Raises
         ------
         ValueError
-            Naming ``checkpoint`` for bytes that are not one, or ``model``/``method`` for a
-            model it does not fit.
+            Naming ``checkpoint`` for bytes that are not one, ``model``/``method`` for a
+            model it does not fit, or ``contacts`` for a scene with contacts (as the constructor).
         TypeError
             Naming ``model``: not a varmech model or scene; or ``checkpoint``: not bytes.
 
@@ -328,6 +327,7 @@ class Stepper:
         if not isinstance(checkpoint, (bytes, bytearray, memoryview)):
             # bytes() would read a str as an error and an int n as n zero bytes.
             raise TypeError(f"checkpoint: expected the bytes of Stepper.checkpoint(), got {type(checkpoint).__name__}")
+        _no_contacts(model)
         model, _, _ = _model_of(model, None, None, None)
         stepper = cls.__new__(cls)
         stepper._model = model
@@ -340,3 +340,14 @@ class Stepper:
 
     def __repr__(self) -> str:
         return f"Stepper({self._model.name!r}, method={self.method!r}, dt={self.dt:g}, t={self.t:g}, steps={self.steps})"
+
+
+def _no_contacts(model: object) -> None:
+    """ValueError naming ``contacts`` for a scene with contacts: a stepper does not go through
+    impacts yet, and stepping the scene's model alone would fall through its surfaces."""
+    if isinstance(model, Scene) and model.contacts:
+        names = ", ".join(repr(c.name) for c in model.contacts)
+        raise ValueError(
+            f"contacts: the scene {model.name!r} has contacts ({names}), which a Stepper cannot go through yet;"
+            " integrate(scene, ...) runs them, or step scene.model to run it without them"
+        )

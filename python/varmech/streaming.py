@@ -278,8 +278,9 @@ def resume(
     ValueError
         Naming ``path`` for a file without a checkpoint, a missing, truncated or damaged one
         (failed checksums, non-finite rows, a checkpoint that is not the last row's state),
-        one that cannot be written (a full disk: the rows committed before are kept), and a
-        pickled model without ``model=`` or ``allow_pickle=True``; the arguments of
+        one that cannot be written (a full disk: the rows committed before are kept), a
+        pickled model without ``model=`` or ``allow_pickle=True``, or a run with contacts (not
+        continued yet: its checkpoint does not hold them); the arguments of
         :func:`varmech.integrate` as it names them.
 
     Examples
@@ -294,6 +295,12 @@ def resume(
     (150, True)
     """
     stored = files.load(path, lazy=True, model=model, allow_pickle=allow_pickle)
+    if stored.contacts:
+        raise ValueError(
+            f"path: {str(path)!r} holds a run with contacts ({', '.join(map(repr, stored.contacts))}), which resume"
+            " cannot continue yet (its checkpoint does not hold them); start a new run from its last state with"
+            " integrate(model, traj.q[-1], traj.p[-1], t0=traj.t[-1], contacts=...)"
+        )
     if stored.checkpoint is None or not len(stored.t):
         raise ValueError(f"path: {str(path)!r} has no checkpoint to resume from")
     _check_checkpoint(path, stored)

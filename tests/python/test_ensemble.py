@@ -3,6 +3,7 @@ parameter sweeps, Ctrl-C, and bad input named."""
 
 import os
 import signal
+import subprocess
 import sys
 import threading
 import time
@@ -347,3 +348,35 @@ def test_a_killed_dask_worker_is_retried_and_the_ensemble_is_complete_and_equal(
     assert runs.failed == [] and len(runs) == 8
     for i in range(8):
         assert _same(runs[i], local[i]), f"member {i}"
+
+
+LEAK = """
+import numpy as np, varmech
+
+class LeftTheChart(Exception):
+    pass
+
+def gradient(q):
+    if abs(q[0]) > 2.0:
+        raise LeftTheChart(f"left the chart at q = {q[0]}")
+    return q.copy()
+
+if __name__ == "__main__":
+    oscillator = varmech.MechanicalSystem(1, potential=lambda q: 0.5 * q[0] ** 2, gradient=gradient)
+    q0, p0 = [[0.5], [1.0], [1.0], [1.5]], [[0.0], [0.0], [2.0], [0.0]]
+    runs = varmech.ensemble(oscillator, q0, p0, dt=0.1, steps=100, workers=2, chunk_size=1, progress=False)
+    print(runs.failed)
+"""
+
+
+def test_a_closure_ensemble_in_processes_leaks_no_semaphore_at_exit(tmp_path):
+    # Issue 32: with a raising member the interpreter warned at exit "resource_tracker: There
+    # appear to be 1 leaked semaphore objects": each worker's tqdm made a process lock (a named
+    # semaphore) that the pool's terminate left behind. Twice, since the leak was a race.
+    script = tmp_path / "leak.py"
+    script.write_text(LEAK)
+    for _ in range(2):
+        done = subprocess.run([sys.executable, str(script)], capture_output=True, text=True, timeout=120, env=os.environ.copy())
+        assert done.returncode == 0, done.stderr
+        assert done.stdout.strip() == "[2]"
+        assert "leaked" not in done.stderr and "resource_tracker" not in done.stderr, done.stderr

@@ -178,3 +178,23 @@ def test_ctrl_c_stops_advance_at_a_good_state(interrupt_after):
     assert 0 < stepper.steps < 10**10
     assert np.all(np.isfinite(stepper.q)) and stepper.t == pytest.approx(stepper.steps * 1e-3)
     stepper.step()
+
+
+def test_every_path_that_goes_on_keeps_the_runs_forces_and_parameters(tmp_path):
+    # Issue 32's audit: besides contacts (tests/python/test_impacts.py), the forces and the
+    # parameters of a run change its motion; continuing in memory, resuming its file and a
+    # stepper from its checkpoint each land bit for bit on the one run of the whole length.
+    sp = pytest.importorskip("sympy")
+    import varmech.symbolic as symbolic
+
+    x, v, k, c = sp.symbols("x v k c")
+    model = symbolic.lagrangian(v**2 / 2 - k * x**2 / 2, [x], [v], parameters={k: 1.0, c: 0.0}, force=[-c * v])
+    run = dict(dt=0.01, method="midpoint", parameters={"k": 4.0, "c": 0.3})
+    half = varmech.integrate(model, [1.0], [0.0], steps=100, **run)
+    whole = varmech.integrate(model, [1.0], [0.0], steps=200, **run)
+    assert not np.array_equal(whole.q[-1], varmech.integrate(model, [1.0], [0.0], dt=0.01, steps=200, method="midpoint").q[-1])
+    assert np.array_equal(varmech.integrate(half, steps=100).q[-1], whole.q[-1])
+    assert np.array_equal(varmech.resume(half.save(tmp_path / "half.h5"), steps=100).q[-1], whole.q[-1])
+    stepper = varmech.Stepper.from_checkpoint(half.model, half.checkpoint)
+    stepper.advance(100)
+    assert np.array_equal(stepper.q, whole.q[-1]) and stepper.work == pytest.approx(whole.work[-1], rel=1e-12)

@@ -210,3 +210,72 @@ def test_the_binding_refuses_malformed_models_naming_what_is_wrong():
         build(functions={**functions, "lagrangian": (ops, constants, outputs[:2])})
     with pytest.raises(ValueError, match="parameters"):
         double_pendulum()._core.with_parameters(np.array([1.0, np.nan, 2.0, 3.0, 9.8]))
+
+
+@pytest.mark.parametrize("kink", ["abs", "sign"])
+def test_sign_and_abs_compile_in_a_general_lagrangian_and_run_the_v_shaped_well(kink):
+    # Issue 32: a general L with |x| (∂²L/∂x² = −2kδ(x)), or x·sign x (whose every derivative
+    # holds δ), failed with "DiracDelta cannot be compiled". δ vanishes wherever it is defined,
+    # so it compiles as 0. The term a·x·ẋ (a total derivative, which moves nothing) makes L
+    # general: its momentum ẋ + ax is not ½Mẋ's. From x = 1 at rest in V = 2|x| the motion is
+    # x = 1 − t² to x = 0 at t = 1, and x = −1 at rest at t = 2.
+    x, v, k, a = sp.symbols("x v k a")
+    well = k * (sp.Abs(x) if kink == "abs" else x * sp.sign(x))
+    model = symbolic.lagrangian(v**2 / 2 + a * x * v - well, [x], [v], parameters={k: 2.0, a: 0.3})
+    assert model.kind_name == "lagrangian"
+    assert any(e.has(sp.DiracDelta) for e in model.expressions["hessians"])
+    traj = varmech.integrate(model, [1.0], v0=[0.0], dt=0.01, steps=200, method="midpoint", save_every=50)
+    assert traj.status == 0
+    # The exact states at t = 0.5, 1, 1.5, 2: the midpoint rule is exact on parabolas, and the
+    # kink falls on the grid (t = 1), so to round-off.
+    exact = np.array([1 - 0.25, 0.0, -(1 - 0.25), -1.0])
+    np.testing.assert_allclose(traj.q[1:, 0], exact, rtol=0, atol=1e-13)
+
+
+def test_a_chain_is_derived_in_work_linear_in_its_length_with_progress_and_a_stated_limit(monkeypatch):
+    # Issue 32: a 1 500-coordinate chain had not compiled after 240 s, with no sign of progress.
+    # SymPy differentiated the whole L, and every gradient entry, by every coordinate (n² for n
+    # terms); now each term is differentiated by the symbols it holds: twice the chain, twice the
+    # derivatives. A bar counts the 3n + 2 rows derived and the functions lowered.
+    from varmech.symbolic import _derive
+
+    calls = []
+    differentiate = _derive.sp.diff
+    monkeypatch.setattr(_derive.sp, "diff", lambda *args: calls.append(1) or differentiate(*args))
+    shown = []
+
+    class Bar:
+        def __init__(self, total, **options):
+            shown.append(["total", total])
+
+        def update(self, k=1):
+            shown[-1].append(k)
+
+        def reset(self, total):
+            shown.append(["total", total])
+
+        def set_description(self, *args, **options):
+            pass
+
+        def close(self):
+            pass
+
+    monkeypatch.setattr(symbolic, "progress_bar", Bar)
+
+    def chain(n):
+        q = sp.symbols(f"q0:{n}")
+        V = sum((q[i + 1] - q[i]) ** 2 / 2 + (q[i + 1] - q[i]) ** 4 / 4 for i in range(n - 1))
+        calls.clear()
+        shown.clear()
+        model = symbolic.mechanical(V, list(q), 1, progress=True)
+        return model, len(calls)
+
+    (_, short), (large, long) = chain(20), chain(40)
+    assert large.kind_name == "separable" and len(large.expressions["gradient"]) == 40
+    assert long < 2.2 * short            # was 4×: 3n² Hessian entries, each sp.diff
+    derived, lowered = shown
+    assert derived[:2] == ["total", 3 * 40 + 2] and sum(derived[2:]) == 3 * 40 + 2
+    assert lowered == ["total", 3, 1, 1, 1]   # V, ∇V, M
+    q = sp.symbols(f"q0:{symbolic.MAX_COORDINATES + 1}")
+    with pytest.raises(ValueError, match=rf"^q: {symbolic.MAX_COORDINATES + 1} coordinates; symbolic models are compiled up to"):
+        symbolic.mechanical(sp.Add(*(x**2 for x in q)), list(q), 1)

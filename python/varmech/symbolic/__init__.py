@@ -35,6 +35,7 @@ import time
 from collections.abc import Mapping, Sequence
 from typing import Any
 
+from .._progress import progress_bar
 from ..model import Cyclic, Symmetry
 from ._derive import derive, vanishes
 from ._inputs import Variables, check_symbols, expressions, parameters, variables
@@ -42,7 +43,11 @@ from ._lower import TAPE_OPS, check_compilable, lower
 from ._model import Spec, Symbolic, SymbolicModel
 from ._routh import routhian
 
-__all__ = ["TAPE_OPS", "SymbolicModel", "examples", "lagrangian", "mechanical", "routh"]
+__all__ = ["MAX_COORDINATES", "TAPE_OPS", "SymbolicModel", "examples", "lagrangian", "mechanical", "routh"]
+
+#: The most coordinates a symbolic model is compiled with: a chain's build grows linearly, about
+#: 0.1 s a coordinate under load (SymPy's derivatives, term by term), minutes at this size.
+MAX_COORDINATES = 2000
 
 
 def lagrangian(
@@ -59,6 +64,7 @@ def lagrangian(
     symmetries: Sequence[Symmetry] = (),
     jit: bool = True,
     name: str = "symbolic lagrangian",
+    progress: bool | None = None,
 ) -> SymbolicModel:
     """A compiled model of the Lagrangian ``L``.
 
@@ -100,6 +106,11 @@ def lagrangian(
         Compile the tapes to machine code (the interpreter runs them otherwise).
     name
         A label for reports.
+    progress
+        A progress bar (tqdm, on stderr) once the build has taken a second: the rows of
+        derivatives (3n + 2), then the functions lowered. ``None`` (default): only when stderr
+        is a terminal. The build grows with the terms of L and of its derivatives (see the
+        user guide's "Compile time"); Ctrl-C stops it.
 
     Returns
     -------
@@ -114,7 +125,8 @@ def lagrangian(
     ValueError
         An expression that cannot be compiled (an unsupported function such as an undefined
         ``sympy.Function('f')``, or a symbol that is neither a coordinate, a velocity, t nor a
-        parameter), naming it and why; constraints of the wrong number or depending on q̇ or t;
+        parameter), naming it and why; more than :data:`MAX_COORDINATES` coordinates, naming
+        ``q``; constraints of the wrong number or depending on q̇ or t;
         velocity constraints not linear in q̇, with a part free of q̇, depending on t, or with
         ``constraints`` n or more together, naming them; a force with the wrong number of components.
 
@@ -129,10 +141,10 @@ def lagrangian(
     ('separable', {'g': 9.81})
     """
     started = time.perf_counter()
-    variables_ = variables(q, v, t)
+    variables_ = _sized(variables(q, v, t))
     return _build(
         variables_, variables_.plain(L, "L"), parameters, constraints, force, rayleigh, symmetries, jit, name, started,
-        velocity_constraints=velocity_constraints,
+        velocity_constraints=velocity_constraints, progress=progress,
     )
 
 
@@ -151,6 +163,7 @@ def mechanical(
     symmetries: Sequence[Symmetry] = (),
     jit: bool = True,
     name: str = "symbolic mechanical system",
+    progress: bool | None = None,
 ) -> SymbolicModel:
     """A compiled model of the mechanical system L = ½q̇ᵀM(q)q̇ − V(q, t).
 
@@ -169,7 +182,7 @@ def mechanical(
     v
         The velocity symbols; may be omitted (V and M hold no velocities: fresh symbols
         ``<q>_dot`` stand for them, as in ``expressions``).
-    t, parameters, constraints, velocity_constraints, force, rayleigh, symmetries, jit, name
+    t, parameters, constraints, velocity_constraints, force, rayleigh, symmetries, jit, name, progress
         As for :func:`lagrangian`.
 
     Returns
@@ -196,14 +209,15 @@ def mechanical(
     ('separable', (1,))
     """
     started = time.perf_counter()
-    variables_ = variables(q, v, t, fresh_velocities=True)
+    variables_ = _sized(variables(q, v, t, fresh_velocities=True))
     m = _mass_matrix(mass, variables_)
     potential = variables_.plain(V, "V")
     check_compilable(potential, "V")
     velocity = sp.Matrix(variables_.v)
     L = (velocity.T * m * velocity)[0, 0] / 2 - potential
     return _build(
-        variables_, L, parameters, constraints, force, rayleigh, symmetries, jit, name, started, velocity_constraints=velocity_constraints
+        variables_, L, parameters, constraints, force, rayleigh, symmetries, jit, name, started,
+        velocity_constraints=velocity_constraints, progress=progress,
     )
 
 
@@ -265,6 +279,19 @@ def routh(model: SymbolicModel, cyclic: Sequence[int], momenta: Any) -> Symbolic
     return _build(variables_, reduced.R, reduced.parameters, None, None, None, (), model._spec.jit, name, started)
 
 
+def _sized(variables: Variables) -> Variables:
+    """``variables``, if there are at most :data:`MAX_COORDINATES` coordinates: ValueError naming
+    ``q`` otherwise, before anything is derived."""
+    n = len(variables.q)
+    if n > MAX_COORDINATES:
+        raise ValueError(
+            f"q: {n} coordinates; symbolic models are compiled up to {MAX_COORDINATES} (SymPy derives each term of L"
+            " and of its derivatives, about 0.1 s per coordinate of a chain and more for a denser L, and a general"
+            " L compiles three dense n×n Hessians); give a native or closure model (varmech.MechanicalSystem)"
+        )
+    return variables
+
+
 def _mass_matrix(mass: Any, variables: Variables) -> sp.Matrix:
     """M as an n×n SymPy Matrix in the plain symbols; ValueError naming ``mass`` unless it is
     a scalar or a symmetric n×n matrix."""
@@ -297,6 +324,7 @@ def _build(
     started: float,
     *,
     velocity_constraints: Any = None,
+    progress: bool | None = None,
 ) -> SymbolicModel:
     """Checks, derives, lowers and compiles: the common path of :func:`lagrangian` and
     :func:`mechanical`."""
@@ -314,29 +342,40 @@ def _build(
     for what, x in parts:
         check_compilable(x, what)
         check_symbols(x, what, variables, params.index)
-    derivation = derive(
-        L, variables.q, variables.v, variables.t, force=forces, rayleigh=dissipation, constraints=holonomic,
-        velocity_constraints=nonholonomic,
-    )
-    slots = variables.slots
-    tapes = {fn: lower(exprs, slots, params.index) for fn, exprs in derivation.functions.items()}
-    declared = tuple(symmetries)
-    found = tuple(Cyclic(i) for i in derivation.cyclic if Cyclic(i) not in declared)
-    spec = Spec(
-        kind=derivation.kind,
-        dim=len(variables.q),
-        functions=tapes,
-        parameter_names=params.names,
-        parameters=params.values,
-        constraints=len(derivation.functions.get("constraints", ())),
-        velocity_constraints=len(nonholonomic or ()),
-        time_dependent=derivation.time_dependent,
-        forced="force" in derivation.functions,
-        symmetries=declared + found,
-        jit=bool(jit),
-    )
-    symbolic = Symbolic(variables.q, variables.v, variables.t, L, derivation.functions, derivation.cyclic, name)
-    return SymbolicModel(spec, symbolic, started=started)
+    n = len(variables.q)
+    # Derivation, then lowering, row by row and function by function: a bar after a second.
+    bar = progress_bar(total=3 * n + 2, unit="row", desc=f"{name}: deriving", enabled=progress)
+    try:
+        derivation = derive(
+            L, variables.q, variables.v, variables.t, force=forces, rayleigh=dissipation, constraints=holonomic,
+            velocity_constraints=nonholonomic, tick=bar.update,
+        )
+        bar.set_description(f"{name}: lowering", refresh=False)
+        bar.reset(total=len(derivation.functions))
+        tapes = {}
+        for fn, exprs in derivation.functions.items():
+            tapes[fn] = lower(exprs, variables.slots, params.index)
+            bar.update()
+        bar.set_description(f"{name}: compiling")
+        declared = tuple(symmetries)
+        found = tuple(Cyclic(i) for i in derivation.cyclic if Cyclic(i) not in declared)
+        spec = Spec(
+            kind=derivation.kind,
+            dim=n,
+            functions=tapes,
+            parameter_names=params.names,
+            parameters=params.values,
+            constraints=len(derivation.functions.get("constraints", ())),
+            velocity_constraints=len(nonholonomic or ()),
+            time_dependent=derivation.time_dependent,
+            forced="force" in derivation.functions,
+            symmetries=declared + found,
+            jit=bool(jit),
+        )
+        symbolic = Symbolic(variables.q, variables.v, variables.t, L, derivation.functions, derivation.cyclic, name)
+        return SymbolicModel(spec, symbolic, started=started)
+    finally:
+        bar.close()
 
 
 # The examples build their models with lagrangian and mechanical, so they come after them.

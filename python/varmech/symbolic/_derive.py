@@ -10,7 +10,7 @@ constraints g(q) with their Jacobian G = ∂g/∂q come with either kind. Cyclic
 from __future__ import annotations
 
 import random
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
 
 import sympy as sp
@@ -46,9 +46,22 @@ def vanishes(expr: sp.Expr) -> bool:
     return sp.simplify(expr) == 0
 
 
-def _free_of(expr: sp.Expr, symbols: Sequence[sp.Symbol]) -> bool:
+def _free_of(expr: sp.Expr, symbols: Sequence[sp.Symbol] | set[sp.Symbol]) -> bool:
     """Whether ``expr`` does not depend on any of ``symbols`` (∂expr/∂s ≡ 0 for each)."""
-    return all(vanishes(sp.diff(expr, s)) for s in symbols if s in expr.free_symbols)
+    # Over the symbols expr holds (none, for the zeros of a large Hessian), not over ``symbols``.
+    return all(vanishes(sp.diff(expr, s)) for s in expr.free_symbols if s in symbols)
+
+
+def gradient(expr: sp.Expr, symbols: Sequence[sp.Symbol]) -> list[sp.Expr]:
+    """[∂expr/∂s for s in symbols], each term of a sum differentiated only by the symbols it
+    holds: the same expressions as ``sp.diff`` one symbol at a time, which walks every term of
+    the sum for each symbol (n² work for a chain of n coordinates, where this is n)."""
+    holding: dict[sp.Symbol, list[sp.Expr]] = {s: [] for s in symbols}
+    for term in sp.Add.make_args(expr):
+        for s in term.free_symbols:
+            if s in holding:
+                holding[s].append(term)
+    return [sp.Add(*(sp.diff(term, s) for term in holding[s])) if holding[s] else sp.S.Zero for s in symbols]
 
 
 def derive(
@@ -61,10 +74,12 @@ def derive(
     rayleigh: sp.Expr | None = None,
     constraints: Sequence[sp.Expr] | None = None,
     velocity_constraints: Sequence[sp.Expr] | None = None,
+    tick: Callable[[int], object] | None = None,
 ) -> Derivation:
     """The functions of L(q, q̇, t) for the core, with the generalized force
     Q = ``force`` − ∂R/∂q̇ (R the Rayleigh function ``rayleigh``), the constraints g(q) = 0
     and the velocity constraints A(q)q̇ = 0 (see :func:`velocity_constraint_functions`).
+    ``tick(k)`` is called as each k rows of derivatives are done, 3n + 2 in all (a progress bar).
 
     ``L`` is a scalar expression, ``force`` has n components, and ``constraints`` m < n
     components free of q̇ and t (see :func:`constraint_functions`).
@@ -93,9 +108,13 @@ def derive(
         rayleigh=None if rayleigh is None else rayleigh.xreplace(real),
         constraints=None if constraints is None else [e.xreplace(real) for e in constraints],
         velocity_constraints=None if velocity_constraints is None else [e.xreplace(real) for e in velocity_constraints],
+        tick=tick or (lambda k: None),
     )
     back = {r: s for s, r in real.items()}
-    functions = {name: tuple(e.xreplace(back) for e in exprs) for name, exprs in derivation.functions.items()}
+    # An atom is its own twin's or itself: xreplace would rebuild each of a Hessian's n² zeros.
+    functions = {
+        name: tuple(back.get(e, e) if e.is_Atom else e.xreplace(back) for e in exprs) for name, exprs in derivation.functions.items()
+    }
     return replace(derivation, functions=functions)
 
 
@@ -116,13 +135,18 @@ def _derive(
     rayleigh: sp.Expr | None,
     constraints: Sequence[sp.Expr] | None,
     velocity_constraints: Sequence[sp.Expr] | None,
+    tick: Callable[[int], object],
 ) -> Derivation:
     """:func:`derive` over real symbols."""
     n = len(q)
-    dl_dq = [sp.diff(L, s) for s in q]
-    dl_dv = [sp.diff(L, s) for s in v]
-    hessians = [[sp.diff(d, s) for s in q] for d in dl_dq] + [[sp.diff(d, s) for s in v] for d in dl_dq]
-    hessians += [[sp.diff(d, s) for s in v] for d in dl_dv]
+    dl_dq = gradient(L, q)
+    dl_dv = gradient(L, v)
+    tick(2)
+    hessians = []
+    for rows, symbols in ((dl_dq, q), (dl_dq, v), (dl_dv, v)):
+        for d in rows:
+            hessians.append(gradient(d, symbols))
+            tick(1)
     time_dependent = not _free_of(L, [t])
     generalized = _generalized_force(force, rayleigh, v, n)
     functions: dict[str, tuple[sp.Expr, ...]] = {}
@@ -136,7 +160,7 @@ def _derive(
     else:
         potential = -L.xreplace(dict.fromkeys(v, sp.Integer(0)))
         functions["potential"] = (potential,)
-        functions["gradient"] = tuple(sp.diff(potential, s) for s in q)
+        functions["gradient"] = tuple(gradient(potential, q))
         functions["mass"] = mass
     if constraints is not None:
         functions.update(constraint_functions(constraints, q, v, t))
@@ -176,7 +200,7 @@ def _constant_mass(
     ∂²L/∂q∂q̇ ≡ 0, and ∂L/∂q̇ vanishes at q̇ = 0 (no term linear in q̇)."""
     n = len(q)
     mixed, vv = mixed_and_vv[:n], mixed_and_vv[n:]
-    state = [*q, *v, t]
+    state = {*q, *v, t}
     if not all(_free_of(entry, state) for row in vv for entry in row):
         return None
     if not all(vanishes(entry) for row in mixed for entry in row):
@@ -185,7 +209,7 @@ def _constant_mass(
     if not all(vanishes(d.xreplace(at_rest)) for d in dl_dv):
         return None
     # Free of the state, but perhaps only after simplification (sin²q + cos²q).
-    m = [[entry if not entry.free_symbols & set(state) else sp.simplify(entry) for entry in row] for row in vv]
+    m = [[entry if not entry.free_symbols & state else sp.simplify(entry) for entry in row] for row in vv]
     if not all(vanishes(m[i][j]) for i in range(n) for j in range(n) if i != j):
         return tuple(entry for row in m for entry in row)
     diagonal = tuple(m[i][i] for i in range(n))

@@ -237,13 +237,22 @@ def check_compilable(expr: sp.Expr, what: str) -> None:
             raise ValueError(f"{what}: {node} cannot be compiled: {unsupported(node)}")
 
 
+def _without_delta(expr: sp.Expr) -> sp.Expr:
+    """``expr`` with every DiracDelta (and derivative of one) 0 (replace walks the whole tree
+    and rebuilds it: only where one is found)."""
+    if expr.is_Atom or not expr.has(sp.DiracDelta):
+        return expr
+    return expr.replace(sp.DiracDelta, lambda *args: sp.S.Zero)
+
+
 def lower(expressions: Sequence[sp.Expr], slots: Mapping[sp.Symbol, int], parameters: Mapping[sp.Symbol, int]) -> Tape:
     """The tape of one function: ``(ops, constants, outputs)``, with ops an int64 array (k, 3)
     of rows ``[code, a, b]`` (codes from :data:`TAPE_OPS`), constants a float64 array and
     outputs the int64 registers of ``expressions`` in order.
 
     ``slots`` maps a symbol to its input slot (qᵢ → i, q̇ᵢ → n + i, t → 2n), ``parameters``
-    to its index in the parameter vector. ValueError names an expression that cannot be
+    to its index in the parameter vector. ``DiracDelta`` (the derivative of sign, and its
+    derivatives) is 0: it vanishes almost everywhere. ValueError names an expression that cannot be
     compiled and the reason (an unsupported function, or a symbol that is neither an input nor
     a parameter).
 
@@ -257,8 +266,15 @@ def lower(expressions: Sequence[sp.Expr], slots: Mapping[sp.Symbol, int], parame
     >>> outputs.tolist()
     [4]
     """
-    replacements, reduced = sp.cse(list(expressions), symbols=sp.numbered_symbols("_cse", cls=sp.Dummy), order="none")
+    # DiracDelta (sign' and |x|'', and its derivatives) vanishes wherever it is defined: 0, before
+    # the common subexpressions, so that the terms it multiplies go too.
+    expressions = [_without_delta(sp.sympify(e)) for e in expressions]
+    # Only compound expressions go through cse: the zeros of a large Hessian (3n² outputs, nearly
+    # all 0 for a chain) cost it time and share nothing.
+    compound = [e for e in expressions if not e.is_Atom]
+    replacements, reduced = sp.cse(compound, symbols=sp.numbered_symbols("_cse", cls=sp.Dummy), order="none")
     builder = _Builder(slots, parameters)
     for symbol, expr in replacements:
         builder.values[symbol] = builder.lower(expr)
-    return builder.tape([builder.lower(expr) for expr in reduced])
+    shared = iter(reduced)
+    return builder.tape([builder.lower(expr if expr.is_Atom else next(shared)) for expr in expressions])
