@@ -200,7 +200,7 @@ def test_stable_symplectic_runs_never_drift_or_fail(method, fraction, periods):
     steps = max(100, round(periods * 2 * math.pi / dt))
     traj = varmech.integrate(scenes.harmonic_oscillator(), dt=dt, steps=steps, method=method)
     energy = varmech.check_conservation(traj).energy
-    # Half the limit is a coarse step: Verlet at hω = 1 keeps the energy to 25% (0.67 of the
+    # Half the limit is a coarse step: Verlet at hω = 1 keeps the energy to 25% (0.75 of the
     # scale less the mean error), "too coarse" since issue 32; never a drift or a failure.
     if energy.max_abs_error >= TOO_COARSE * energy.judged_scale:
         assert energy.verdict == "too coarse"

@@ -211,7 +211,8 @@ fn oscillations(size: &[f64], noise: f64) -> f64 {
     let (lo, hi) = size.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &x| {
         (lo.min(x), hi.max(x))
     });
-    if !(hi - lo > noise) {
+    let range = hi - lo;
+    if range.is_nan() || range <= noise {
         return f64::INFINITY;
     }
     let mean = size.iter().sum::<f64>() / size.len() as f64;
@@ -286,7 +287,7 @@ impl Batches {
     /// means moved by less than a quarter of what the slope predicts. Over such a run a
     /// transient cannot be told from a drift.
     fn levels_off(&self) -> bool {
-        !(self.late >= 0.25)
+        self.late.is_nan() || self.late < 0.25
     }
 
     /// A drift: the trend is significant, carries the error past its own oscillation and past
