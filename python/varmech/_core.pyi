@@ -11,6 +11,7 @@ __all__ = [
     "FAILURE",
     "ROUND_OFF",
     "TAPE_OPS",
+    "TOO_COARSE",
     "VERDICTS",
     "CatalogueEntry",
     "ClosureConstrained",
@@ -544,8 +545,9 @@ def momentum(generator: Generator, q: _FloatArray, p: _FloatArray) -> tuple[_Flo
 def momentum_along(xi: _FloatArray, p: _FloatArray) -> tuple[_FloatArray, _FloatArray]:
     """(J = p·ξ, its size) at each state, from ξ(q) evaluated there."""
 
-VERDICTS: tuple[str, str, str, str]
+VERDICTS: tuple[str, str, str, str, str, str]
 FAILURE: float
+TOO_COARSE: float
 ROUND_OFF: float
 
 @final
@@ -554,6 +556,8 @@ class Statistics:
 
     @property
     def scale(self) -> float: ...
+    @property
+    def judged_scale(self) -> float: ...
     @property
     def round_off(self) -> float: ...
     @property
@@ -566,6 +570,8 @@ class Statistics:
     def drift_rate(self) -> float: ...
     @property
     def drift_rate_stderr(self) -> float: ...
+    @property
+    def oscillations(self) -> float: ...
     @property
     def first_non_finite(self) -> int | None: ...
     @property

@@ -3,7 +3,9 @@
 Every quantity is judged against its own scale (see :class:`InvariantStatistics`): the energy
 against the mean kinetic energy of the run, a Noether momentum J = p·ξ(q) against its mean size
 max(Σ|pᵢξᵢ|, ‖p‖∞‖ξ‖∞), the constraint residuals |g(q)| and |G(q)q̇| against ‖G‖‖q‖ and ‖G‖‖q̇‖
-(|A(q)q̇| against ‖A‖‖q̇‖ for velocity constraints).
+(|A(q)q̇| against ‖A‖‖q̇‖ for velocity constraints). The scale is measured on the run's own
+states, which an error shifts: the level of the error is judged against the scale less its mean
+error (see :class:`InvariantStatistics`).
 """
 
 from __future__ import annotations
@@ -16,12 +18,13 @@ import numpy as np
 
 from . import _core
 from ._util import returned
-from .integrate import Trajectory
+from .integrate import Trajectory, integrate
 from .model import Cyclic, Generator, Model, Rotation, Translation
 
 __all__ = [
     "FAILURE",
     "ROUND_OFF",
+    "TOO_COARSE",
     "VERDICTS",
     "ConservationReport",
     "InvariantStatistics",
@@ -29,11 +32,15 @@ __all__ = [
     "momentum",
 ]
 
-#: The verdicts, best first: "conserved to round-off", "bounded", "secular drift", "failed".
+#: The verdicts, best first: "conserved to round-off", "bounded", "too short to judge",
+#: "secular drift", "too coarse", "failed".
 VERDICTS: tuple[str, ...] = tuple(_core.VERDICTS)
-#: An error this large against the scale is a failure; also ``integrate``'s default
-#: ``max_energy_error``.
+#: An error this large against the scale (less the mean error) is a failure; also
+#: ``integrate``'s default ``max_energy_error`` (against the running scale).
 FAILURE: float = _core.FAILURE
+#: An error this large against the scale (less the mean error) is of the order of the scale:
+#: "too coarse", whatever its trend.
+TOO_COARSE: float = _core.TOO_COARSE
 #: Round-off is an error within ROUND_OFF · ε · (size of the terms) · √(1 + steps).
 ROUND_OFF: float = _core.ROUND_OFF
 
@@ -57,7 +64,8 @@ def momentum(traj: Trajectory, generator: Generator) -> np.ndarray:
     Raises
     ------
     TypeError
-        ``generator`` is none of these, naming it.
+        ``generator`` is none of these, or ``xi(q)`` returned something that is not numbers,
+        naming it.
     ValueError
         ``xi(q)`` returned another shape than (n,).
 
@@ -94,23 +102,37 @@ class InvariantStatistics:
 
     A field of :class:`ConservationReport` (``report.energy``, ``report.momenta[k]``, …).
 
+    The scale is measured on the run's own states, which the error shifts (an orbit that lost
+    energy is deeper and faster: by Kepler's virial theorem its mean kinetic energy is −E), so
+    the level of the error is judged against ``judged_scale``, the scale less the mean |error|.
     The verdict is the first that applies of:
 
     - ``"failed"``: a value is not finite (``first_non_finite`` is the first saved state where
-      it is not), or max |error| reaches :data:`FAILURE` × ``scale``: the quantity is wrong by
-      its own size;
+      it is not), or max |error| reaches :data:`FAILURE` × ``judged_scale``: the quantity is
+      wrong by its own size;
+    - ``"too short to judge"``: the run took no step (there is nothing to judge);
     - ``"conserved to round-off"``: max |error| ≤ ``round_off`` = :data:`ROUND_OFF` · ε ·
       (largest size of the quantity's terms) · √(1 + steps), the rounding error of its terms
       grown as a random walk (Brouwer's law);
+    - ``"too coarse"``: max |error| reaches :data:`TOO_COARSE` × ``judged_scale``, an error of
+      the order of the scale, whatever its trend: the step does not resolve the motion;
     - ``"secular drift"``: the error grows. Over eight batches in time, the slope of the batch
       means differs from zero by more than four standard errors, the drift over the run exceeds
       round-off, the 4 ε of the terms a step that biased rounding (an implicit method's solve)
       can add, and the error's own oscillation (the median band within a batch: a bounded
       error that wanders with the state, as on a chaotic orbit, shifts by less than it
       oscillates), and the last batch's largest |error| is more than twice the first's. The
-      run must span several oscillations of the error: over a fraction of one, a bounded
-      error's rise cannot be told from a drift;
-    - ``"bounded"``: otherwise, a band that does not grow and stays below the failure level.
+      run must span two oscillations of the motion or more (``oscillations``: half the
+      crossings of the quantity's size through its mean), and the error must keep growing (over
+      the run's second half its batch means move by a quarter of what the slope predicts or
+      more); otherwise a bounded error's rise, or a transient's rise and plateau, cannot be told
+      from a drift and the verdict is ``"too short to judge"``;
+    - ``"bounded"``: otherwise, a band that does not grow and stays below the too-coarse level.
+
+    A forced run's balance E − W is not conserved by any method: its error is the
+    discretisation error of the work. When it would be "secular drift", :func:`check_conservation`
+    runs the same motion again at h/2 and, if the error falls at the method's order, calls it
+    "bounded" with the measured order in the advice.
 
     ``max_rel_error`` and ``band`` are relative to ``scale``; ``drift_rate`` and
     ``drift_rate_stderr`` are absolute, per unit time.
@@ -142,10 +164,16 @@ class InvariantStatistics:
     first_non_finite : int or None
         The first saved state where the quantity is not finite (None: it is finite throughout).
     verdict : str
-        ``"conserved to round-off"``, ``"bounded"``, ``"secular drift"`` or ``"failed"``.
+        One of :data:`VERDICTS`.
     advice : str
-        For a failure, where it happened and what to do; for a coarse band, to reduce dt;
+        For a failure or a too coarse run, where and how large and what to do; for a run too
+        short, why; for a coarse band, to reduce dt; for a forced balance, its measured order;
         otherwise empty.
+    judged_scale : float
+        The scale less the mean |error| over the run: what the error's level is judged against.
+    oscillations : float
+        How many times the motion oscillates over the run (half the crossings of the
+        quantity's size through its mean; infinite when the size is constant).
     representative : bool
         Whether |initial| is of the order of the scale, so that an error relative to it means
         something.
@@ -174,12 +202,17 @@ class InvariantStatistics:
     verdict: str
     #: For a failure: where it happened, and what to do.
     advice: str = ""
+    #: The scale less the mean |error|: what the error's level is judged against.
+    judged_scale: float = math.nan
+    #: How many times the motion oscillates over the run.
+    oscillations: float = math.inf
 
     @property
     def representative(self) -> bool:
         """Whether |J₀| is of the order of the scale, so that an error relative to J₀ means
-        something (it does not for an energy whose zero is at the initial state)."""
-        return abs(self.initial) >= 1e-2 * self.scale
+        something (it does not for an energy whose zero is at the initial state, nor for a
+        J₀ of 0)."""
+        return abs(self.initial) > 0 and abs(self.initial) >= 1e-2 * self.scale
 
     def describe(self, symbol: str, error: str | None = None) -> list[str]:
         """The lines of a report on this quantity: verdict, initial value, errors and drift.
@@ -232,10 +265,28 @@ def _statistics(record: _core.Statistics, name: str, initial: float, scale_name:
     """The report of the core's statistics, with a failure located in time."""
     k = record.first_non_finite
     advice = ""
+    judged = record.judged_scale
+    level = (
+        f"{record.max_abs_error / judged:.3g} × the scale less the mean error ({judged:.3g})"
+        if judged > 0
+        else f"{record.max_rel_error:.3g} × the scale {record.scale:.3g}, with a mean error beyond the scale"
+    )
     if k is not None:
         advice = f"not finite from saved state {k} (t = {t[k]:.6g}) on"
     elif record.verdict == "failed":
-        advice = f"the error reaches {record.max_rel_error:.3g} × the scale"
+        advice = f"the error reaches {level}"
+    elif record.verdict == "too coarse":
+        advice = f"the error reaches {level}: the step does not resolve the motion; reduce dt"
+    elif record.verdict == "too short to judge":
+        if len(t) < 2:
+            advice = "nothing to judge: the run took no step"
+        elif record.oscillations < 2:
+            advice = (
+                f"the error rises over {record.oscillations:.3g} oscillation(s) of the motion, too few to tell "
+                f"a band from a drift: run longer"
+            )
+        else:
+            advice = "the error rose, then levelled off over the run's second half: run longer to tell a transient from a drift"
     elif record.verdict == "bounded" and record.max_rel_error > COARSE:
         advice = f"coarse: the band reaches {record.max_rel_error:.2g} of the scale; reduce dt for accuracy"
     return InvariantStatistics(
@@ -252,6 +303,8 @@ def _statistics(record: _core.Statistics, name: str, initial: float, scale_name:
         k,
         record.verdict,
         advice,
+        judged,
+        record.oscillations,
     )
 
 
@@ -370,17 +423,18 @@ class ConservationReport:
         return "\n".join(lines)
 
 
-def check_conservation(traj: Trajectory, generators: Sequence[Generator] | None = None) -> ConservationReport:
+def check_conservation(traj: Trajectory, generators: Sequence[Generator] | None = None, *, refine: bool = True) -> ConservationReport:
     """Check the energy, the Noether momenta and the constraints of ``traj``.
 
     The energy function E = p·q̇ − L is judged when L does not depend on t and no constraint
     does work (affine velocity constraints A(q)q̇ + b(q) = 0 do); with forces acting the report
-    judges the balance E − W, W the work of the forces, instead. With velocity constraints the
-    report judges the residuals |A(q)q̇ + b(q)| and only the momenta of the symmetries the
-    model declares: a nonholonomic system need not conserve the momenta of the symmetries of
-    its L (the native scenes declare those they conserve). Each quantity's error is measured
-    against a scale (the mean kinetic energy for the energy), and judged "conserved to
-    round-off", "bounded", "secular drift" or "failed" (:class:`InvariantStatistics` says how).
+    judges the balance E − W, W the work of the forces, instead. An energy that is not finite
+    at a saved state fails the report in every case, L depending on t included. With velocity
+    constraints the report judges the residuals |A(q)q̇ + b(q)| and only the momenta of the
+    symmetries the model declares: a nonholonomic system need not conserve the momenta of the
+    symmetries of its L (the native scenes declare those they conserve). Each quantity's error
+    is measured against a scale (the mean kinetic energy for the energy), and judged by one of
+    :data:`VERDICTS` (:class:`InvariantStatistics` says how).
 
     Parameters
     ----------
@@ -389,6 +443,11 @@ def check_conservation(traj: Trajectory, generators: Sequence[Generator] | None 
     generators : sequence of Translation, Rotation, Cyclic or callable, optional
         The symmetries whose momenta J = p·ξ(q) are judged. Default: those the model declares;
         a closure generator ``xi(q)`` is named ``xi[k]``.
+    refine : bool, default True
+        For a forced run whose balance would be "secular drift": run the same motion again at
+        h/2 and call the balance "bounded" when its error falls at the method's order (the
+        discretisation error of the work, not a drift), with the measured order in the advice.
+        This costs twice the run; ``False`` skips it.
 
     Returns
     -------
@@ -425,7 +484,14 @@ def check_conservation(traj: Trajectory, generators: Sequence[Generator] | None 
         stats = energy_statistics(model, t, *traj._arrays()[1:], steps=steps, work=np.asarray(traj.work) if model.forced else None)
         if stats.verdict == "failed":
             stats = replace(stats, advice=f"{stats.advice}; {_failure_advice(traj)}")
+        elif model.forced and stats.verdict == "secular drift" and refine:
+            stats = _refined(traj, stats)
         energy, balance = (None, stats) if model.forced else (stats, None)
+    else:
+        # Not conserved, so not judged; but a non-finite energy fails the run all the same.
+        stats = energy_statistics(model, t, *traj._arrays()[1:], steps=steps)
+        if stats.first_non_finite is not None:
+            energy = replace(stats, advice=f"{stats.advice}: the model's energy p·q̇ − L does not evaluate there")
     momenta = []
     for k, xi in enumerate(generators):
         name = xi.name if isinstance(xi, (Translation, Rotation, Cyclic)) else f"xi[{k}]"
@@ -459,6 +525,43 @@ def energy_statistics(
     w = np.zeros(len(t)) if work is None else np.ascontiguousarray(work, dtype=float)
     record = _core.energy_statistics(t, e, kinetic, potential, w, int(steps))
     return _statistics(record, "energy" if work is None else "balance", e[0] - w[0], "mean kinetic energy", t)
+
+
+def _refined(traj: Trajectory, stats: InvariantStatistics) -> InvariantStatistics:
+    """A forced run's drifting balance, judged by the same motion at h/2: "bounded" when its
+    error falls at the method's order (discretisation error of the work), with the measured
+    order; otherwise the drift stands, with the order measured. Unchanged for a run that did
+    not reach its end (events or an error stopped it) or saved states off its steps
+    (``t_eval``), which the same motion at h/2 cannot be compared at."""
+    steps = (traj.t - traj.t[0]) / traj.dt
+    gaps = np.diff(np.rint(steps)).astype(np.int64)
+    if traj.status != 0 or len(gaps) == 0 or np.any(gaps <= 0) or not np.allclose(steps, np.rint(steps), rtol=0, atol=1e-6):
+        return stats
+    every = int(np.gcd.reduce(gaps))
+    fine = integrate(
+        traj.model,
+        traj.q[0],
+        traj.p[0],
+        dt=traj.dt / 2,
+        steps=2 * int(traj.steps),
+        method=traj.method,
+        t0=float(traj.t[0]),
+        save_every=2 * every,
+        max_energy_error=None,
+        progress=False,
+    )
+    keep = np.rint((traj.t - traj.t[0]) / traj.dt).astype(np.int64) // every
+    t, q, p, work = fine.t[keep], fine.q[keep], fine.p[keep], np.asarray(fine.work)[keep]
+    halved = energy_statistics(traj.model, t, q, p, steps=int(fine.steps), work=work)
+    order = {m.name: m for m in _core.methods()}[traj.method].order
+    measured = math.log2(stats.max_abs_error / halved.max_abs_error) if halved.max_abs_error > 0 else math.inf
+    if measured >= order - 0.5 or halved.verdict == "conserved to round-off":
+        advice = (
+            f"discretisation error of the work, not a drift: it falls as h^{measured:.2f} at h/2 "
+            f"({traj.method} is of order {order})"
+        )
+        return replace(stats, verdict="bounded", advice=advice)
+    return replace(stats, advice=f"it falls only as h^{measured:.2f} at h/2, not at {traj.method}'s order {order}")
 
 
 def _failure_advice(traj: Trajectory) -> str:

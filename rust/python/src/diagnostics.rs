@@ -137,12 +137,14 @@ fn momentum_along<'py>(
 #[pyclass(frozen, get_all, module = "varmech._core")]
 pub struct Statistics {
     scale: f64,
+    judged_scale: f64,
     round_off: f64,
     max_abs_error: f64,
     max_rel_error: f64,
     band: f64,
     drift_rate: f64,
     drift_rate_stderr: f64,
+    oscillations: f64,
     first_non_finite: Option<usize>,
     verdict: &'static str,
 }
@@ -151,12 +153,14 @@ impl From<diagnostics::Statistics> for Statistics {
     fn from(s: diagnostics::Statistics) -> Self {
         Statistics {
             scale: s.scale,
+            judged_scale: s.judged_scale,
             round_off: s.round_off,
             max_abs_error: s.max_abs_error,
             max_rel_error: s.max_rel_error,
             band: s.band,
             drift_rate: s.drift_rate,
             drift_rate_stderr: s.drift_rate_stderr,
+            oscillations: s.oscillations,
             first_non_finite: s.first_non_finite,
             verdict: s.verdict.name(),
         }
@@ -260,6 +264,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Statistics>()?;
     m.add("VERDICTS", PyTuple::new(m.py(), Verdict::ALL.map(Verdict::name))?)?;
     m.add("FAILURE", Scale::FAILURE)?;
+    m.add("TOO_COARSE", diagnostics::Statistics::TOO_COARSE)?;
     m.add("ROUND_OFF", Scale::ROUND_OFF)?;
     Ok(())
 }

@@ -3,8 +3,8 @@
 //! - [`energies`]: H(q, p) = ½pᵀM⁻¹p + V(q) along a run of a mechanical system, and
 //!   [`energy_terms`]: E = p·q̇ − L with its kinetic and potential terms along any run;
 //! - [`Statistics`]: the error of a conserved quantity against its scale, its band and drift
-//!   rate, and a [`Verdict`] ("conserved to round-off", "bounded", "secular drift",
-//!   "failed"); [`energy_statistics`] builds them for the energy or a forced run's balance;
+//!   rate, and a [`Verdict`] ("conserved to round-off", "bounded", "too short to judge",
+//!   "secular drift", "too coarse", "failed"); [`energy_statistics`] builds them for the energy or a forced run's balance;
 //! - [`symplecticity_defect`]: ‖ΨᵀJΨ − J‖ of a one-step map.
 
 mod conservation;

@@ -64,6 +64,11 @@ impl Scale {
     /// Whether `error` fails after `steps` steps: not finite, or beyond both round-off and
     /// `tolerance` × the scale (`tolerance` is [`Scale::FAILURE`] for the verdicts).
     pub fn fails(&self, error: f64, steps: u64, tolerance: f64) -> bool {
-        !error.is_finite() || (error.abs() >= tolerance * self.scale() && error.abs() > self.round_off(steps))
+        self.fails_against(error, self.scale(), steps, tolerance)
+    }
+
+    /// [`Scale::fails`] against another `scale` (the verdicts' scale less the mean error).
+    pub fn fails_against(&self, error: f64, scale: f64, steps: u64, tolerance: f64) -> bool {
+        !error.is_finite() || (error.abs() >= tolerance * scale && error.abs() > self.round_off(steps))
     }
 }
