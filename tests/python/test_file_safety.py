@@ -11,7 +11,6 @@ import shutil
 import signal
 import subprocess
 import sys
-import textwrap
 import time
 from pathlib import Path
 
@@ -141,38 +140,41 @@ def test_a_crafted_recipe_is_data_never_code(tmp_path):
         assert not marker.exists()
 
 
-def _outcome(code, timeout=60):
-    """What ``code`` (run in its own process) printed, or a failure when it hangs."""
+def _load_and_resume(path, setup="", model="None", timeout=60):
+    """What ``varmech.load`` and ``varmech.resume`` of ``path`` did, run after ``setup`` in a
+    process of their own: a line each ("load passed", "resume ValueError …"), or a failure when
+    either hangs."""
+    code = f"""
+import varmech
+{setup}
+path, model = {str(path)!r}, {model}
+for what, action in (("load", lambda: varmech.load(path, model=model)),
+                     ("resume", lambda: varmech.resume(path, steps=10, model=model))):
     try:
-        done = subprocess.run([sys.executable, "-c", textwrap.dedent(code)], capture_output=True, text=True, timeout=timeout)
+        action()
+        print(what, "passed")
+    except ValueError as e:
+        print(what, "ValueError", e)
+"""
+    try:
+        done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=timeout)
     except subprocess.TimeoutExpired:
         pytest.fail("hung")
-    return done.stdout + done.stderr
+    out = done.stdout + done.stderr
+    lines = [line for line in out.splitlines() if line.startswith(("load", "resume"))]
+    assert len(lines) == 2, out
+    return lines
 
 
 @pytest.mark.parametrize("name", ["hang-truncated.h5", "hang-bitflip.h5"])
 def test_a_damaged_file_is_refused_by_name_and_never_hangs(tmp_path, name):
     path = tmp_path / name
     shutil.copyfile(DATA / name, path)
-    code = f"""
-        import varmech
-        path = {str(path)!r}
-        model = varmech.scenes.kepler().model
-        for what, action in (("load", lambda: varmech.load(path, model=model)),
-                             ("resume", lambda: varmech.resume(path, steps=10, model=model))):
-            try:
-                action()
-                print(what, "passed")
-            except ValueError as e:
-                print(what, "ValueError", e)
-        """
-    out = _outcome(code)
-    lines = [line for line in out.splitlines() if line.startswith(("load", "resume"))]
-    assert len(lines) == 2, out
+    lines = _load_and_resume(path, model="varmech.scenes.kepler().model")
     # resume refuses whatever load says: both name the path.
-    assert lines[1].startswith("resume ValueError path: "), out
+    assert lines[1].startswith("resume ValueError path: "), lines
     if name == "hang-truncated.h5":
-        assert lines[0].startswith("load ValueError path: ") and "corrupt or truncated: 5914 bytes" in lines[0], out
+        assert lines[0].startswith("load ValueError path: ") and "corrupt or truncated: 5914 bytes" in lines[0], lines
 
 
 def _killed_early(path):
@@ -212,21 +214,8 @@ def test_a_damaged_file_left_open_by_a_killed_writer_is_refused_in_bounded_time(
     checksum_at = size_at + width + int.from_bytes(data[size_at : size_at + width], "little")
     data[checksum_at - 2] ^= 1
     path.write_bytes(bytes(data))
-    code = f"""
-        import varmech
-        from varmech import files
-        files.PROBE_SECONDS = 5
-        for what, action in (("load", lambda: varmech.load({str(path)!r})),
-                             ("resume", lambda: varmech.resume({str(path)!r}, steps=10))):
-            try:
-                action()
-                print(what, "passed")
-            except ValueError as e:
-                print(what, "ValueError", e)
-        """
-    out = _outcome(code)
-    lines = [line for line in out.splitlines() if line.startswith(("load", "resume"))]
-    assert len(lines) == 2 and all(" ValueError path: " in line and "corrupt" in line for line in lines), out
+    lines = _load_and_resume(path, setup="varmech.files.PROBE_SECONDS = 5")
+    assert all(" ValueError path: " in line and "corrupt" in line for line in lines), lines
 
 
 def _streamed(tmp_path, steps=1000, every=10, checkpoint_every=100):
