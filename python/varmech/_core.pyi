@@ -146,10 +146,11 @@ class Stepper:
         newton_max_iterations: int = 50,
     ) -> Stepper: ...
     def checkpoint(self) -> bytes:
-        """The stepper's whole state as bytes (see [`Checkpoint`])."""
+        """The stepper's whole state as bytes, with its model's fingerprint (see [`Checkpoint`])."""
     @staticmethod
-    def from_checkpoint(model: _Model, checkpoint: bytes) -> Stepper:
-        """The stepper of `model` at the state of `checkpoint` (from `checkpoint()`, or a run's)."""
+    def from_checkpoint(model: _Model, checkpoint: bytes, *, method: str | None = None, dt: float | None = None) -> Stepper:
+        """The stepper of `model` at the state of `checkpoint` (from `checkpoint()`, or a run's),
+        checked against the model (and `method` and `dt` where given)."""
     def step(self) -> None:
         """Advances one step."""
     def advance(self, n: int) -> None:
@@ -524,9 +525,12 @@ def resume(
     save_every: int = 1,
     progress: Callable[[int], object] | None = None,
     events: list[tuple[str, int, int, str, Any]] | None = None,
+    method: str | None = None,
+    dt: float | None = None,
 ) -> TrajectoryRecord:
     """Goes on from a run's checkpoint for `steps` more steps (see [`integrators::resume`]),
-    watching `events` (as `integrate`'s) if given."""
+    watching `events` (as `integrate`'s) if given; a checkpoint of another `method` or `dt`
+    than given is refused ([`Checkpoint::expect`])."""
 
 def energy_terms(model: _Model, t: _FloatArray, q: _FloatArray, p: _FloatArray) -> tuple[_FloatArray, _FloatArray, _FloatArray]:
     """(E, T, V) at each state: the energy function p·q̇ − L, its kinetic term E − V and its

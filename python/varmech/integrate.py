@@ -890,7 +890,9 @@ def _run(
             else:
                 assert not watched or initial_energy is not None
                 specs = _events.going_on(event_specs, found, initial_energy) if watched and initial_energy is not None else None
-                record = _core.resume(model._core, checkpoint, steps=nsteps, save_every=save_every, progress=shown, events=specs)
+                record = _core.resume(
+                    model._core, checkpoint, steps=nsteps, save_every=save_every, progress=shown, events=specs, method=method, dt=dt
+                )
             bar.update(record.steps - base - bar.n)
         except BaseException as err:
             partial = take_partial(err)

@@ -289,8 +289,15 @@ class Stepper:
         return bytes(self._stepper.checkpoint())
 
     @classmethod
-    def from_checkpoint(cls, model: Model | Scene, checkpoint: bytes) -> Stepper:
+    def from_checkpoint(cls, model: Model | Scene, checkpoint: bytes, *, method: str | None = None, dt: float | None = None) -> Stepper:
         """The stepper of ``model`` at the state of ``checkpoint``.
+
+        A checkpoint records a fingerprint of what it was taken of: the model's kind, size and
+        constraints, what the model computes at the checkpoint's state (its Lagrangian, forces
+        and constraints there, which tells apart another model of the same size or the same
+        model with another parameter), the method, the step, the summation and the Newton
+        options. Every length and index of its state is checked against the model and method
+        before a step is taken.
 
         Parameters
         ----------
@@ -298,6 +305,9 @@ class Stepper:
             The model the checkpoint was taken of (or its scene).
         checkpoint : bytes
             From :meth:`checkpoint`, or a trajectory's :attr:`~Trajectory.checkpoint`.
+        method, dt : optional
+            The method and step the caller goes on with (a file's or a trajectory's): a
+            checkpoint of another is refused.
 
         Returns
         -------
@@ -307,8 +317,11 @@ class Stepper:
         Raises
         ------
         ValueError
-            Naming ``checkpoint`` for bytes that are not one, ``model``/``method`` for a
-            model it does not fit, or ``contacts`` for a scene with contacts (as the constructor).
+            Naming ``checkpoint`` for bytes that are not one (damaged, truncated, of another
+            checkpoint format, or crafted so that its state does not fit the model and method),
+            or the checkpoint of another model, method, step or options, saying which; naming
+            ``model`` or ``method`` for a model of another size or kind, or ``contacts`` for a
+            scene with contacts (as the constructor).
         TypeError
             Naming ``model``: not a varmech model or scene; or ``checkpoint``: not bytes.
 
@@ -331,7 +344,7 @@ class Stepper:
         model, _, _ = _model_of(model, None, None, None)
         stepper = cls.__new__(cls)
         stepper._model = model
-        stepper._stepper = _core.Stepper.from_checkpoint(model._core, bytes(checkpoint))
+        stepper._stepper = _core.Stepper.from_checkpoint(model._core, bytes(checkpoint), method=method, dt=dt)
         return stepper
 
     def __reduce__(self) -> tuple[object, ...]:

@@ -2,6 +2,9 @@
 are named; failures leave the last good state."""
 
 import math
+import subprocess
+import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -198,3 +201,59 @@ def test_every_path_that_goes_on_keeps_the_runs_forces_and_parameters(tmp_path):
     stepper = varmech.Stepper.from_checkpoint(half.model, half.checkpoint)
     stepper.advance(100)
     assert np.array_equal(stepper.q, whole.q[-1]) and stepper.work == pytest.approx(whole.work[-1], rel=1e-12)
+
+
+def _crc32c(data):
+    """CRC-32C (Castagnoli), the checkpoints' CRC."""
+    crc = 0xFFFFFFFF
+    for byte in data:
+        crc ^= byte
+        for _ in range(8):
+            crc = (crc >> 1) ^ (0x82F63B78 if crc & 1 else 0)
+    return crc ^ 0xFFFFFFFF
+
+
+def test_a_crafted_checkpoint_is_refused_naming_it_never_a_panic():
+    kepler = scenes.kepler()
+    # The reproducer (issue 32): format 2, two payload bytes changed and its CRC recomputed.
+    reproducer = (Path(__file__).parents[1] / "rust" / "crafted_checkpoint.hex").read_text().strip()
+    with pytest.raises(ValueError, match="^checkpoint: written in checkpoint format 2, this varmech reads format 3"):
+        varmech.Stepper.from_checkpoint(kepler, bytes.fromhex(reproducer))
+    stepper = varmech.Stepper(kepler, dt=0.05, method="kahan_li8")
+    stepper.advance(5)
+    good = stepper.checkpoint()
+    # q's length and values in the payload: one coordinate dropped, or one added, CRC recomputed.
+    q = np.asarray(stepper.q).tobytes()
+    at = good.index(b"\x02" + q)
+    payload_end = len(good) - 4
+    for crafted_q in (b"\x01" + q[:8], b"\x03" + q + q[:8]):
+        payload = good[12:at] + crafted_q + good[at + 17 : payload_end]
+        crafted = good[:12] + payload + _crc32c(payload).to_bytes(4, "little")
+        with pytest.raises(ValueError, match="^checkpoint: "):
+            varmech.Stepper.from_checkpoint(kepler, crafted).advance(20)
+
+
+def test_a_checkpoint_of_another_model_method_or_step_is_refused_naming_the_difference(tmp_path):
+    oscillator = scenes.harmonic_oscillator(1.0)
+    traj = varmech.integrate(oscillator, dt=0.01, steps=10)
+    with pytest.raises(ValueError, match="^checkpoint: it is of another model"):
+        varmech.Stepper.from_checkpoint(scenes.harmonic_oscillator(1.5), traj.checkpoint)
+    kepler = varmech.integrate(scenes.kepler(), dt=0.01, steps=10)
+    with pytest.raises(ValueError, match="^checkpoint: it is of another model"):
+        varmech.Stepper.from_checkpoint(scenes.henon_heiles(), kepler.checkpoint)
+    with pytest.raises(ValueError, match="^checkpoint: it is of a run of method verlet, not kahan_li8"):
+        varmech.Stepper.from_checkpoint(oscillator, traj.checkpoint, method="kahan_li8")
+    with pytest.raises(ValueError, match=r"^checkpoint: it is of a run of dt = 0.01, not 0.02"):
+        varmech.Stepper.from_checkpoint(oscillator, traj.checkpoint, dt=0.02)
+    # The same model built again, in another process, takes it and goes on bit for bit.
+    path = tmp_path / "ck.bin"
+    path.write_bytes(traj.checkpoint)
+    script = (
+        "import sys, numpy as np, varmech\n"
+        "s = varmech.Stepper.from_checkpoint(varmech.scenes.harmonic_oscillator(1.0), open(sys.argv[1], 'rb').read(), method='verlet', dt=0.01)\n"
+        "s.advance(10)\n"
+        "sys.stdout.write(np.concatenate([s.q, s.p]).tobytes().hex())\n"
+    )
+    out = subprocess.run([sys.executable, "-c", script, str(path)], capture_output=True, text=True, check=True).stdout
+    whole = varmech.integrate(oscillator, dt=0.01, steps=20)
+    assert out == np.concatenate([whole.q[-1], whole.p[-1]]).tobytes().hex()

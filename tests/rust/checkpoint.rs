@@ -67,7 +67,7 @@ fn resumes_from<S: Dynamics + ?Sized>(case: &str, sys: &S, method: Method, q0: &
     }
     assert_eq!(second.force_evaluations, whole.force_evaluations, "{case}: evaluations");
     // The stepper's whole state; the energy check's running scale saw one state more.
-    let state = |t: &Trajectory| Checkpoint::of(Checkpoint::from_bytes(&t.checkpoint).unwrap().state()).to_bytes();
+    let state = |t: &Trajectory| Checkpoint::of(sys, Checkpoint::from_bytes(&t.checkpoint).unwrap().state()).to_bytes();
     assert!(
         state(&second) == state(&whole),
         "{case}: the final stepper states differ"

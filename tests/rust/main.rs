@@ -11,6 +11,7 @@ mod checkpoint;
 mod compiled;
 mod constraints;
 mod convergence;
+mod crafted_checkpoints;
 mod damped_driven_pendulum;
 mod ensemble;
 mod events;

@@ -110,9 +110,11 @@ fn detector<'f>(functions: Events, specs: Vec<EventSpec>) -> Result<Detector<'f>
 }
 
 /// Goes on from a run's checkpoint for `steps` more steps (see [`integrators::resume`]),
-/// watching `events` (as `integrate`'s) if given.
+/// watching `events` (as `integrate`'s) if given; a checkpoint of another `method` or `dt`
+/// than given is refused ([`Checkpoint::expect`]).
 #[pyfunction]
-#[pyo3(signature = (model, checkpoint, *, steps, save_every=1, progress=None, events=None))]
+#[pyo3(signature = (model, checkpoint, *, steps, save_every=1, progress=None, events=None, method=None, dt=None))]
+#[allow(clippy::too_many_arguments)]
 fn resume<'py>(
     py: Python<'py>,
     model: &Bound<'py, PyAny>,
@@ -121,8 +123,10 @@ fn resume<'py>(
     #[pyo3(from_py_with = save_every_count)] save_every: usize,
     progress: Option<Py<PyAny>>,
     events: Option<Vec<EventTuple<'py>>>,
+    method: Option<&str>,
+    dt: Option<f64>,
 ) -> PyResult<TrajectoryRecord> {
-    let checkpoint = Checkpoint::from_bytes(checkpoint).map_err(|e| to_pyerr(py, e))?;
+    let checkpoint = decode(py, checkpoint, method, dt)?;
     let events = detector_parts(py, model, events)?;
     let result = bind_model(py, model, |sys, poll| {
         let report = reporting(poll, &progress);
@@ -135,6 +139,14 @@ fn resume<'py>(
         }
     })?;
     record(py, result)
+}
+
+/// The checkpoint in `bytes`, refused unless of `method` and `dt` where given.
+pub(crate) fn decode(py: Python<'_>, bytes: &[u8], method: Option<&str>, dt: Option<f64>) -> PyResult<Checkpoint> {
+    let method = method.map(Method::from_name).transpose().map_err(|e| to_pyerr(py, e))?;
+    let checkpoint = Checkpoint::from_bytes(bytes).map_err(|e| to_pyerr(py, e))?;
+    checkpoint.expect(method, dt).map_err(|e| to_pyerr(py, e))?;
+    Ok(checkpoint)
 }
 
 /// The poll of a run: the Ctrl-C check, then `progress(steps)` if given.

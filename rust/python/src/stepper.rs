@@ -10,6 +10,7 @@ use varmech::Error;
 use crate::bind::{bind_model, Poll};
 use crate::convert::{self, slice};
 use crate::errors::to_pyerr;
+use crate::run::decode;
 
 /// One model, one method and the state, advanced step by step
 /// ([`varmech::integrators::Stepper`]): native models with the GIL released, Ctrl-C honoured
@@ -79,18 +80,26 @@ impl Stepper {
         })
     }
 
-    /// The stepper's whole state as bytes (see [`Checkpoint`]).
-    fn checkpoint<'py>(&self, py: Python<'py>) -> Bound<'py, PyBytes> {
-        PyBytes::new(py, &Checkpoint::of(&self.state).to_bytes())
+    /// The stepper's whole state as bytes, with its model's fingerprint (see [`Checkpoint`]).
+    fn checkpoint<'py>(&mut self, py: Python<'py>) -> PyResult<Bound<'py, PyBytes>> {
+        let bytes = self.with(py, |stepper, _| Ok(Checkpoint::of(stepper.model(), stepper).to_bytes()))?;
+        Ok(PyBytes::new(py, &bytes))
     }
 
-    /// The stepper of `model` at the state of `checkpoint` (from `checkpoint()`, or a run's).
+    /// The stepper of `model` at the state of `checkpoint` (from `checkpoint()`, or a run's),
+    /// checked against the model (and `method` and `dt` where given).
     #[staticmethod]
-    fn from_checkpoint<'py>(py: Python<'py>, model: &Bound<'py, PyAny>, checkpoint: &[u8]) -> PyResult<Self> {
-        let state = Checkpoint::from_bytes(checkpoint)
-            .map_err(|e| to_pyerr(py, e))?
-            .into_state();
+    #[pyo3(signature = (model, checkpoint, *, method=None, dt=None))]
+    fn from_checkpoint<'py>(
+        py: Python<'py>,
+        model: &Bound<'py, PyAny>,
+        checkpoint: &[u8],
+        method: Option<&str>,
+        dt: Option<f64>,
+    ) -> PyResult<Self> {
+        let checkpoint = decode(py, checkpoint, method, dt)?;
         let state = bind_model(py, model, |sys, _| {
+            let state = checkpoint.into_state(sys)?;
             integrators::Stepper::resume(sys, state).map(integrators::Stepper::into_state)
         })?
         .map_err(|e| to_pyerr(py, e))?;

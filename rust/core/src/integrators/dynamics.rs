@@ -37,6 +37,12 @@ pub trait Dynamics {
         )
     }
 
+    /// The number of constraints m and how many of them are holonomic, which size a
+    /// constrained method's buffers. Default: none.
+    fn constraint_counts(&self) -> (usize, usize) {
+        (0, 0)
+    }
+
     /// One step's increments (δq, δp) from `start`.
     fn increment(
         &self,
@@ -162,6 +168,10 @@ impl<S: MechanicalSystem, C: HolonomicConstraints> Dynamics for Constrained<S, C
         ModelKind::ConstrainedSeparable
     }
 
+    fn constraint_counts(&self) -> (usize, usize) {
+        (self.constraints.count(), self.constraints.count())
+    }
+
     fn increment(
         &self,
         integrator: &mut Integrator,
@@ -197,6 +207,10 @@ impl<L: Lagrangian, C: HolonomicConstraints> Dynamics for Constrained<General<'_
 
     fn kind(&self) -> ModelKind {
         ModelKind::ConstrainedLagrangian
+    }
+
+    fn constraint_counts(&self) -> (usize, usize) {
+        (self.constraints.count(), self.constraints.count())
     }
 
     fn increment(
@@ -270,6 +284,10 @@ impl<L: Lagrangian, C: VelocityConstraints> Dynamics for Nonholonomic<L, C> {
         )
     }
 
+    fn constraint_counts(&self) -> (usize, usize) {
+        (self.constraints.count(), 0)
+    }
+
     fn increment(
         &self,
         integrator: &mut Integrator,
@@ -327,6 +345,11 @@ impl<L: Lagrangian, H: HolonomicConstraints, C: VelocityConstraints> Dynamics fo
             ("holonomic constraints", "|g(q0)|"),
             ("constraints' velocities", "|G(q0)q̇0, A(q0)q̇0 + b|"),
         )
+    }
+
+    fn constraint_counts(&self) -> (usize, usize) {
+        let holonomic = self.holonomic.count();
+        (holonomic + self.velocity.count(), holonomic)
     }
 
     fn increment(

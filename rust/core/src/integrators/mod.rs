@@ -47,7 +47,7 @@ pub mod wisdom_holman;
 pub use crate::discrete::{Galerkin, Quadrature};
 pub use crate::error::StepError;
 pub use crate::solve::NewtonOptions;
-pub use checkpoint::Checkpoint;
+pub use checkpoint::{Checkpoint, Fingerprint, FORMAT as CHECKPOINT_FORMAT};
 pub use composition::Composition;
 pub use del::{Composed, Del, StepEquations, TwoPoint};
 use del::{Constraints, DiscreteConstraint};
@@ -165,6 +165,32 @@ impl Integrator {
             Scheme::Rattle(s) => s.reset(),
             Scheme::WisdomHolman(s) => s.reset(),
             Scheme::ExplicitRk(_) => {}
+        }
+    }
+
+    /// Sizes the buffers as the first step on a model of n coordinates with m constraints
+    /// (`holonomic` of them holonomic) does: a template of a running state's shape.
+    pub(super) fn prepare(&mut self, n: usize, m: usize, holonomic: usize) {
+        match &mut self.scheme {
+            Scheme::Midpoint(s) => s.size_for(n, m, holonomic),
+            Scheme::Trapezoid(s) => s.size_for(n, m, holonomic),
+            Scheme::Galerkin(s) => s.size_for(n, m, holonomic),
+            Scheme::ComposedMidpoint(s) => s.size_for(n, m, holonomic),
+            Scheme::Rattle(s) => s.size_for(m),
+            Scheme::WisdomHolman(s) => s.prepare(n),
+            Scheme::KickDrift(_) | Scheme::ExplicitRk(_) => {}
+        }
+    }
+
+    /// The options of the implicit methods' Newton iteration; None for the explicit methods.
+    pub fn newton_options(&self) -> Option<NewtonOptions> {
+        match &self.scheme {
+            Scheme::Midpoint(s) => Some(s.options()),
+            Scheme::Trapezoid(s) => Some(s.options()),
+            Scheme::Galerkin(s) => Some(s.options()),
+            Scheme::ComposedMidpoint(s) => Some(s.options()),
+            Scheme::Rattle(s) => Some(s.options()),
+            _ => None,
         }
     }
 

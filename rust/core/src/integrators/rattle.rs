@@ -107,6 +107,11 @@ impl Rattle {
         self.newton.iterations() + self.sweeps
     }
 
+    /// The options of the Newton iteration.
+    pub(super) fn options(&self) -> NewtonOptions {
+        self.options
+    }
+
     pub(super) fn reset(&mut self) {
         self.cached = false;
     }

@@ -169,7 +169,8 @@ fn start<'s, S: Dynamics + ?Sized>(
 /// those of one run of the whole length, bit for bit, and the first is the checkpoint's.
 ///
 /// Refuses a model with another number of coordinates or of a kind the checkpoint's method
-/// does not integrate (see [`Stepper::resume`]), and `save_every` = 0.
+/// does not integrate, a checkpoint whose state does not fit the model or whose fingerprint is
+/// another model's ([`Checkpoint::resume_on`]), and `save_every` = 0.
 pub fn resume<S, P>(
     sys: &S,
     checkpoint: Checkpoint,
@@ -219,7 +220,7 @@ fn resumed<S: Dynamics + ?Sized>(
     if save_every == 0 {
         return Err(fail(Error::invalid("save_every", "must be at least 1"), empty(sys)));
     }
-    let Checkpoint { state, watch } = checkpoint;
+    let (state, watch) = checkpoint.resume_on(sys).map_err(|e| fail(e, empty(sys)))?;
     let stepper = Stepper::resume(sys, state).map_err(|e| fail(e, empty(sys)))?;
     let end = (stepper.steps().checked_add(steps)).filter(|_| (stepper.t() + steps as f64 * stepper.dt()).is_finite());
     let Some(end) = end else {
@@ -328,11 +329,7 @@ where
     traj.count(&stepper);
     // Events: the partial steps' force evaluations are the run's too.
     traj.force_evaluations += search.map_or(0, |s| s.force_evaluations());
-    traj.checkpoint = Checkpoint {
-        state: stepper.into_state(),
-        watch,
-    }
-    .to_bytes();
+    traj.checkpoint = Checkpoint::new(sys, stepper.into_state(), watch).to_bytes();
     match outcome {
         Ok(()) => Ok(traj),
         Err(error) => Err(fail(error, traj)),

@@ -6,6 +6,7 @@ mod own_variables;
 use std::borrow::{Borrow, BorrowMut};
 use std::ops::Deref;
 
+use super::checkpoint::shape::shape;
 use super::{compensated, Dynamics, General, Increment, Integrator, Method, Options, Poll, StepError, StepStart};
 use crate::error::check_vector;
 use crate::model::{Lagrangian, MechanicalSystem};
@@ -75,28 +76,7 @@ where
         options.check()?;
         method.check(model.kind())?;
         check_initial(&*model, q0, p0, options.t0)?;
-        let zeros = || vec![0.0; n];
-        let state = StepperState {
-            integrator: Integrator::with_newton(method, n, options.newton),
-            clock: Clock {
-                t0: options.t0,
-                n0: 0,
-                h: options.dt,
-            },
-            steps: 0,
-            compensated: options.compensated,
-            q: q0.to_vec(),
-            p: p0.to_vec(),
-            eq: zeros(),
-            ep: zeros(),
-            dq: zeros(),
-            dp: zeros(),
-            q_next: zeros(),
-            p_next: zeros(),
-            eq_next: zeros(),
-            ep_next: zeros(),
-            interrupt: InterruptPoll::new(),
-        };
+        let state = StepperState::fresh(method, q0, p0, options);
         Ok(Stepper { model, state })
     }
 }
@@ -213,6 +193,90 @@ impl<M, St: Borrow<StepperState>> Deref for Stepper<M, St> {
 }
 
 impl StepperState {
+    /// The state of a new stepper from (q0, p0), checked by the caller.
+    fn fresh(method: Method, q0: &[f64], p0: &[f64], options: &Options) -> Self {
+        let n = q0.len();
+        let zeros = || vec![0.0; n];
+        StepperState {
+            integrator: Integrator::with_newton(method, n, options.newton),
+            clock: Clock {
+                t0: options.t0,
+                n0: 0,
+                h: options.dt,
+            },
+            steps: 0,
+            compensated: options.compensated,
+            q: q0.to_vec(),
+            p: p0.to_vec(),
+            eq: zeros(),
+            ep: zeros(),
+            dq: zeros(),
+            dp: zeros(),
+            q_next: zeros(),
+            p_next: zeros(),
+            eq_next: zeros(),
+            ep_next: zeros(),
+            interrupt: InterruptPoll::new(),
+        }
+    }
+
+    /// Why a decoded state (a checkpoint's, which its CRC does not protect against a crafted
+    /// file) cannot be stepped on `model`, if it cannot: every length, matrix size, variant
+    /// and count in it is compared with the state its method has on `model`, fresh or after a
+    /// step (the constrained methods size their buffers at the first step), every pivot must
+    /// index its vector, and the state, clock and options must be finite and in range. The
+    /// caller has checked the dimension and that the method integrates the model's kind.
+    pub(super) fn misfit<S: Dynamics + ?Sized>(&self, model: &S) -> Option<String> {
+        let vectors = [("q", &self.q), ("p", &self.p), ("eq", &self.eq), ("ep", &self.ep)];
+        if let Some((name, _)) = vectors.iter().find(|(_, x)| !x.iter().all(|v| v.is_finite())) {
+            return Some(format!("its state's {name} is not finite"));
+        }
+        let Clock { t0, n0, h } = self.clock;
+        if !(t0.is_finite() && h.is_finite() && h > 0.0 && n0 <= self.steps && self.t().is_finite()) {
+            return Some(format!(
+                "its clock (t0 = {t0}, dt = {h}, set at step {n0} of {}) is not a valid one",
+                self.steps
+            ));
+        }
+        let newton = self.integrator.newton_options().unwrap_or_default();
+        if let Err(e) = newton.check() {
+            return Some(format!("its Newton options are not valid ({e})"));
+        }
+        let options = Options {
+            t0,
+            compensated: self.compensated,
+            newton,
+            ..Options::new(h, 0)
+        };
+        // Of the model's size: the state's own vectors are what is checked.
+        let zeros = vec![0.0; model.dim()];
+        let fresh = StepperState::fresh(self.method(), &zeros, &zeros, &options);
+        let mut stepped = fresh.clone();
+        let (m, holonomic) = model.constraint_counts();
+        stepped.integrator.prepare(model.dim(), m, holonomic);
+        let (found, fresh, stepped) = (shape(self), shape(&fresh), shape(&stepped));
+        if found == fresh || found == stepped {
+            return None;
+        }
+        let (at, expected) = found
+            .iter()
+            .zip(&stepped)
+            .find(|(a, b)| a != b)
+            .map_or_else(|| (None, None), |(a, b)| (Some(a), Some(b)));
+        Some(match (at, expected) {
+            (Some(a), Some(b)) => format!(
+                "its state does not fit this model and its method {}: {a} where they have {b}",
+                self.method().info().name
+            ),
+            _ => format!(
+                "its state does not fit this model and its method {}: {} parts where they have {}",
+                self.method().info().name,
+                found.len(),
+                stepped.len()
+            ),
+        })
+    }
+
     /// One step of `model`, which has as many coordinates as the state (checked when the
     /// stepper was made or resumed).
     pub(super) fn step<S: Dynamics + ?Sized>(&mut self, model: &S) -> Result<(), Error> {
@@ -386,6 +450,16 @@ impl StepperState {
     /// The method applied.
     pub fn method(&self) -> Method {
         self.integrator.method()
+    }
+
+    /// Whether the increments are added with compensated summation.
+    pub fn compensated(&self) -> bool {
+        self.compensated
+    }
+
+    /// The options of the implicit methods' Newton iteration; None for the explicit methods.
+    pub fn newton_options(&self) -> Option<super::NewtonOptions> {
+        self.integrator.newton_options()
     }
 
     /// Force evaluations made so far (see [`Integrator::force_evaluations`]).

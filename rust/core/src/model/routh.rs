@@ -35,7 +35,8 @@ const NEWTON: NewtonOptions = NewtonOptions {
 ///
 /// a kinetic term, a gyroscopic term linear in ẋ, and the amended potential V_μ. Newton's
 /// method with the exact ∂²L/∂ċ² (from [`Lagrangian::hessians`]) finds that ċ in one step;
-/// for a general L it iterates, from the last solution.
+/// for a general L it iterates, from ċ = 0 (never from the last solution, so that what R
+/// evaluates depends on its arguments alone).
 ///
 /// The scratch sits in a `RefCell`, so a `Routhian` serves one thread.
 pub struct Routhian<'a, L: ?Sized> {
@@ -59,7 +60,7 @@ struct Scratch {
     /// The full state (x, c; ẋ, ċ); c holds its reference value, which L does not see.
     q: Vec<f64>,
     v: Vec<f64>,
-    /// The last cyclic velocity solved for, the next solve's start.
+    /// The last cyclic velocity solved for (each solve starts from 0).
     cdot: Vec<f64>,
     /// The point (x, ẋ, t) of the last one-node solve, while `cdot` holds its solution: the
     /// integrators ask for ∂R/∂x and ∂R/∂ẋ at the same point in turn.
@@ -266,7 +267,7 @@ impl<'a, L: Lagrangian + ?Sized> Routhian<'a, L> {
         Ok(out)
     }
 
-    /// Solves Σᵢ wᵢ ∂L/∂ċ(xᵢ, ẋᵢ, ċ, tᵢ) = μ for ċ by Newton's method from the last solution,
+    /// Solves Σᵢ wᵢ ∂L/∂ċ(xᵢ, ẋᵢ, ċ, tᵢ) = μ for ċ by Newton's method from ċ = 0,
     /// leaving the full state of the last node in the scratch; a one-node solve at the point
     /// of the last one is remembered.
     fn solve(&self, s: &mut Scratch, nodes: &[Node]) -> Result<(), ModelError> {
@@ -277,6 +278,9 @@ impl<'a, L: Lagrangian + ?Sized> Routhian<'a, L> {
             }
         }
         s.solved = None;
+        // From ċ = 0, never from the last solution: the result is then a function of the
+        // point alone, so an evaluation elsewhere (an energy check, a save) cannot move it.
+        s.cdot.fill(0.0);
         self.newton(s, nodes)?;
         if let [node] = nodes {
             s.solved = Some(node.t);
@@ -393,7 +397,7 @@ impl Ends<'_> {
     }
 }
 
-/// Σᵢ wᵢ ∂L/∂ċ(xᵢ, ẋᵢ, ċ, tᵢ) − μ = 0 for ċ (the scratch's `cdot`), from the last solution.
+/// Σᵢ wᵢ ∂L/∂ċ(xᵢ, ẋᵢ, ċ, tᵢ) − μ = 0 for ċ (the scratch's `cdot`), from ċ = 0.
 struct CyclicVelocities<'p, 'a, L: ?Sized> {
     routh: &'p Routhian<'a, L>,
     s: &'p mut Scratch,
@@ -556,8 +560,9 @@ impl<L: Lagrangian + ?Sized> Lagrangian for Routhian<'_, L> {
         }
         for (k, &i) in self.cyclic.iter().enumerate() {
             s.p[i] = self.momenta[k];
-            s.v[i] = s.cdot[k];
         }
+        // From q̇ = 0, as the solve of ċ: ẋ depends on (x, p) alone.
+        s.v.fill(0.0);
         let Scratch { q, v, p, .. } = &mut *s;
         self.full.velocity(q, p, t, v)?;
         self.shape.iter().zip(xdot.iter_mut()).for_each(|(&i, o)| *o = s.v[i]);

@@ -49,6 +49,16 @@ impl<Sc: StepEquations + Clone> Composed<Sc> {
         self.stages.iter().map(Del::work).sum()
     }
 
+    /// Sizes every stage's buffers for m constraints, `holonomic` of them holonomic.
+    pub(in crate::integrators) fn size_for(&mut self, n: usize, m: usize, holonomic: usize) {
+        self.stages.iter_mut().for_each(|s| s.size_for(n, m, holonomic));
+    }
+
+    /// The options of the stages' Newton iteration.
+    pub(in crate::integrators) fn options(&self) -> NewtonOptions {
+        self.stages[0].options()
+    }
+
     pub(in crate::integrators) fn reset(&mut self) {
         self.stages.iter_mut().for_each(Del::reset);
     }

@@ -289,6 +289,11 @@ impl<Sc: StepEquations> Del<Sc> {
         self.work
     }
 
+    /// The options of the Newton iteration.
+    pub(in crate::integrators) fn options(&self) -> NewtonOptions {
+        self.options
+    }
+
     pub(in crate::integrators) fn reset(&mut self) {
         self.history = 0;
         self.continuum_sign = 0.0;
@@ -298,7 +303,7 @@ impl<Sc: StepEquations> Del<Sc> {
 
     /// Sizes the buffers for m constraints, `holonomic` of them holonomic (allocating only
     /// when they change).
-    fn size_for(&mut self, n: usize, m: usize, holonomic: usize) {
+    pub(in crate::integrators) fn size_for(&mut self, n: usize, m: usize, holonomic: usize) {
         if m == self.m && holonomic == self.multipliers.holonomic() {
             return;
         }

@@ -28,15 +28,19 @@ pub struct Jacobi {
 impl Jacobi {
     /// The Jacobi coordinates of `model`'s bodies, body 0 the central one.
     pub fn new(model: &NBody) -> Self {
-        let n = model.masses().len();
-        let mut jacobi = Jacobi {
-            g: 0.0,
-            masses: vec![0.0; n],
-            mu: vec![0.0; n],
-            ratio: vec![0.0; n],
-        };
+        let mut jacobi = Self::sized(model.masses().len());
         jacobi.set_model(model);
         jacobi
+    }
+
+    /// Zeros for `bodies` bodies, before a model's values are set.
+    pub(in crate::integrators) fn sized(bodies: usize) -> Self {
+        Jacobi {
+            g: 0.0,
+            masses: vec![0.0; bodies],
+            mu: vec![0.0; bodies],
+            ratio: vec![0.0; bodies],
+        }
     }
 
     /// Whether these are the coordinates of `model` (the same G and masses).

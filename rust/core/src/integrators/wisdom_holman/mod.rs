@@ -86,6 +86,12 @@ impl WisdomHolman {
         })
     }
 
+    /// Holds the Jacobi coordinates' place, as after a first step (a template of the state's
+    /// shape: their values are set by the next step's model).
+    pub(in crate::integrators) fn prepare(&mut self, n: usize) {
+        self.jacobi = Some(Jacobi::sized(n / 3));
+    }
+
     /// Forgets the inner variables: the next step starts from the (q, p) it is given.
     pub fn reset(&mut self) {
         self.loaded = false;
