@@ -336,11 +336,11 @@ def resume(
 
 
 def _check_checkpoint(path: str | os.PathLike[str], stored: Trajectory) -> None:
-    """ValueError naming ``path`` unless the file's checkpoint is the state of its last
-    committed row, at the step count ``/committed`` records."""
+    """ValueError naming ``path`` unless the file's checkpoint is of its model, method and step
+    and is the state of its last committed row, at the step count ``/committed`` records."""
     assert stored.checkpoint is not None
     try:
-        at = _core.Stepper.from_checkpoint(stored.model._core, stored.checkpoint)
+        at = _core.Stepper.from_checkpoint(stored.model._core, stored.checkpoint, method=stored.method, dt=stored.dt)
     except ValueError as e:
         raise ValueError(f"path: {str(path)!r} has a damaged checkpoint: {e}") from e
     last = (float(stored.t[-1]), stored.q[-1], stored.p[-1])

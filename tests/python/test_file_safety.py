@@ -269,6 +269,25 @@ def test_resume_refuses_a_checkpoint_that_is_not_the_last_rows_state(tmp_path):
         varmech.resume(traj.save(tmp_path / "t_eval.h5"), steps=10)
 
 
+def test_resume_refuses_a_file_whose_model_or_method_was_swapped(tmp_path):
+    # Issue 32: a file whose /model was swapped for another model of the same dimension resumed
+    # 0.44 away from the real run. The checkpoint's fingerprint tells them apart, and the file's
+    # method and dt attributes are checked against the checkpoint's too.
+    s, path = _streamed(tmp_path)
+    good = path.read_bytes()
+    with h5py.File(path, "r+") as f:
+        del f["model"]
+        f.create_dataset("model", data=json.dumps(scenes.henon_heiles().model._recipe()))
+    with pytest.raises(ValueError, match="^path: .*checkpoint: it is of another model"):
+        varmech.resume(path, steps=10)
+    for attribute, value, named in (("method", "yoshida4", "method "), ("dt", 0.02, "dt = ")):
+        path.write_bytes(good)
+        with h5py.File(path, "r+") as f:
+            f.attrs[attribute] = value
+        with pytest.raises(ValueError, match=f"^path: .*checkpoint: it is of a run of {named}"):
+            varmech.resume(path, steps=10)
+
+
 @pytest.mark.parametrize("column", ["t", "q", "p"])
 def test_non_finite_rows_are_refused(tmp_path, column):
     s, path = _streamed(tmp_path)
