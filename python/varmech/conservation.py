@@ -534,8 +534,9 @@ def _refined(traj: Trajectory, stats: InvariantStatistics) -> InvariantStatistic
     not reach its end (events or an error stopped it) or saved states off its steps
     (``t_eval``), which the same motion at h/2 cannot be compared at."""
     steps = (traj.t - traj.t[0]) / traj.dt
-    gaps = np.diff(np.rint(steps)).astype(np.int64)
-    if traj.status != 0 or len(gaps) == 0 or np.any(gaps <= 0) or not np.allclose(steps, np.rint(steps), rtol=0, atol=1e-6):
+    at = np.rint(steps).astype(np.int64)
+    gaps = np.diff(at)
+    if traj.status != 0 or len(gaps) == 0 or np.any(gaps <= 0) or not np.allclose(steps, at, rtol=0, atol=1e-6):
         return stats
     every = int(np.gcd.reduce(gaps))
     fine = integrate(
@@ -550,7 +551,7 @@ def _refined(traj: Trajectory, stats: InvariantStatistics) -> InvariantStatistic
         max_energy_error=None,
         progress=False,
     )
-    keep = np.rint((traj.t - traj.t[0]) / traj.dt).astype(np.int64) // every
+    keep = at // every
     t, q, p, work = fine.t[keep], fine.q[keep], fine.p[keep], np.asarray(fine.work)[keep]
     halved = energy_statistics(traj.model, t, q, p, steps=int(fine.steps), work=work)
     order = {m.name: m for m in _core.methods()}[traj.method].order
