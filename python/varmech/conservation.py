@@ -531,12 +531,13 @@ def _refined(traj: Trajectory, stats: InvariantStatistics) -> InvariantStatistic
     """A forced run's drifting balance, judged by the same motion at h/2: "bounded" when its
     error falls at the method's order (discretisation error of the work), with the measured
     order; otherwise the drift stands, with the order measured. Unchanged for a run that did
-    not reach its end (events or an error stopped it) or saved states off its steps
-    (``t_eval``), which the same motion at h/2 cannot be compared at."""
+    not reach its end (events or an error stopped it), saved states off its steps
+    (``t_eval``), which the same motion at h/2 cannot be compared at, or a run with contacts,
+    which the model alone would run without its impacts."""
     steps = (traj.t - traj.t[0]) / traj.dt
     at = np.rint(steps).astype(np.int64)
     gaps = np.diff(at)
-    if traj.status != 0 or len(gaps) == 0 or np.any(gaps <= 0) or not np.allclose(steps, at, rtol=0, atol=1e-6):
+    if traj.status != 0 or traj.contacts or len(gaps) == 0 or np.any(gaps <= 0) or not np.allclose(steps, at, rtol=0, atol=1e-6):
         return stats
     every = int(np.gcd.reduce(gaps))
     fine = integrate(
