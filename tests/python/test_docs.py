@@ -30,6 +30,7 @@ pytest.importorskip("sympy")
         "varmech.conservation",
         "varmech.ensemble",
         "varmech.integrate",
+        "varmech.trajectory",
         "varmech.model",
         "varmech.constraints",
         "varmech.derivatives",
