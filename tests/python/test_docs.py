@@ -13,7 +13,7 @@ pytest.importorskip("sympy")
 @pytest.mark.parametrize(
     "name",
     [
-        "varmech.symbolic",
+        "varmech.symbolic._constructors",
         "varmech.symbolic.examples",
         "varmech.symbolic._lower",
         "varmech.symbolic._derive",
