@@ -25,6 +25,7 @@ from types import ModuleType
 
 from . import _errors, analysis, events, pointers, scenes
 from ._core import ConvergenceError, DivergenceError, SpuriousBranchError, VarmechError
+from ._version import __version__ as __version__
 from .analysis import sections, stability
 from .analysis.energy_growth import energy_growth
 from .analysis.phase_portrait import phase_portrait
@@ -42,18 +43,16 @@ from .conservation import ConservationReport, InvariantStatistics, check_conserv
 from .constraints import IntegrableConstraintsWarning, project
 from .derivatives import DerivativeCheck, check_derivatives
 from .ensemble import Ensemble, EnsembleConservation, ensemble
-from .files import load
 from .impacts import Contact, ContactError
 from .impulses import Engagement, Impulse, ImpulseResponse, engage, impulse_response
-from .integrate import Trajectory, integrate, symplecticity_defect
+from .integrate import integrate, symplecticity_defect
 from .methods import MethodInfo, methods
 from .model import Cyclic, Lagrangian, MechanicalSystem, Model, NativeSystem, Rotation, Translation
 from .reduction import ReducedModel, cyclic_coordinates, routh
 from .stepper import Stepper
 from .streaming import resume
 from .table import Table
-
-__version__ = "0.1.0"
+from .trajectory import Trajectory, load
 
 __all__ = [
     "ConservationReport",

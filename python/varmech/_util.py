@@ -123,3 +123,29 @@ def returned_scalar(call: str, x: Any) -> float:
     if a.shape != ():
         raise TypeError(f"{call} must return a float, got an array of shape {a.shape}")
     return float(a)
+
+
+def step_count(dt: float, t0: float, steps: int | None, t_end: float | None) -> int:
+    """The steps of a run from ``t0``: ``steps``, or those of ``dt`` to ``t_end`` (exactly one given,
+    a whole number of steps)."""
+    if (steps is None) == (t_end is None):
+        raise ValueError("steps, t_end: give exactly one of them")
+    if steps is not None:
+        if isinstance(steps, bool) or not isinstance(steps, (int, np.integer)) or not 0 <= steps < 2**63:
+            raise ValueError(f"steps: must be an integer from 0 to 2**63 - 1, got {steps!r}")
+        return int(steps)
+    t_end = number("t_end", t_end)  # type: ignore[arg-type]
+    if not math.isfinite(t_end) or t_end < t0:
+        raise ValueError(f"t_end: must be finite and not before t0 = {t0}, got {t_end}")
+    if not (t_end - t0) / dt <= MAX_COUNT:
+        raise ValueError(
+            f"t_end: {t_end} is more than 2**63 - 1 steps of dt = {dt} from t0 = {t0} "
+            f"((t_end - t0)/dt = {(t_end - t0) / dt:.3g}); take a larger dt or a nearer t_end"
+        )
+    n = round((t_end - t0) / dt)
+    if abs(n * dt - (t_end - t0)) > 1e-9 * max(abs(t_end - t0), dt):
+        raise ValueError(
+            f"t_end: {t_end} is not a whole number of steps dt = {dt} from t0 = {t0} "
+            f"({(t_end - t0) / dt:.6g} steps); adjust dt or pass steps"
+        )
+    return n

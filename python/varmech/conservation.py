@@ -18,8 +18,9 @@ import numpy as np
 
 from . import _core
 from ._util import returned
-from .integrate import Trajectory, integrate
+from .integrate import integrate
 from .model import Cyclic, Generator, Model, Rotation, Translation
+from .trajectory import Trajectory
 
 __all__ = [
     "FAILURE",

@@ -23,8 +23,8 @@ from . import _core
 from ._util import floats
 
 if TYPE_CHECKING:
-    from .integrate import Trajectory
     from .model import Model
+    from .trajectory import Trajectory
 
 __all__: list[str] = []  # internal: importable, not part of the public API
 

@@ -22,10 +22,11 @@ from numpy.typing import ArrayLike
 from . import _core
 from . import events as _events
 from ._progress import progress_bar, thread_lock
-from ._util import finite, floats, positive, positive_int
+from ._util import finite, floats, positive, positive_int, step_count
 from .conservation import VERDICTS, ConservationReport, check_conservation
-from .integrate import Trajectory, _energy_threshold, _model_of, _newton, _steps, _trajectory, integrate
+from .integrate import _energy_threshold, _model_of, _newton, integrate
 from .model import Model, NativeSystem, _scene_model
+from .trajectory import Trajectory, _trajectory
 
 if TYPE_CHECKING:
     import xarray
@@ -383,7 +384,7 @@ def ensemble(
     if method is None:
         method = model.kind.default_method
     dt = positive("dt", dt)
-    nsteps = _steps(dt, t0, steps, t_end)
+    nsteps = step_count(dt, t0, steps, t_end)
     save_every = positive_int("save_every", save_every)
     workers = None if workers is None else positive_int("workers", workers)
     chunk_size = None if chunk_size is None else positive_int("chunk_size", chunk_size)

@@ -1,5 +1,6 @@
 """Trajectories in HDF5 files (h5py, the optional extra ``io``): :meth:`Trajectory.save`,
-:func:`load`, and the files that runs stream to (``integrate(output=)``, :func:`varmech.resume`).
+:func:`varmech.load` (in :mod:`varmech.trajectory`, which builds the Trajectory), and the files
+that runs stream to (``integrate(output=)``, :func:`varmech.resume`).
 
 The layout, self-describing so that any HDF5 reader can use it (``docs/file_format.md``)::
 
@@ -48,16 +49,17 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from ._version import __version__
 from .events import Occurrences
+from .methods import method_info
 from .model import Model, from_recipe
 
 if TYPE_CHECKING:
-    from .integrate import Trajectory
+    from .trajectory import Trajectory
 
 __all__ = [
     "LAZY_BYTES",
     "Rows",
-    "load",
 ]
 
 FORMAT = "varmech-trajectory"
@@ -66,7 +68,7 @@ FORMAT_VERSION = 3
 READS = (2, 3)
 #: Rows per chunk: about 64 kB of a (N, 2)-shaped q for the small systems.
 CHUNK_ROWS = 4096
-_COLUMNS = ("t", "q", "p", "newton", "work")
+COLUMNS = ("t", "q", "p", "newton", "work")
 #: A streamed run's file larger than this is read back lazily (its columns when used).
 LAZY_BYTES = 256 * 2**20
 _DTYPES = {"newton": np.uint64}
@@ -117,8 +119,6 @@ class Writer:
         argument: str = "path",
         contacts: Sequence[str] = (),
     ):
-        from . import __version__
-
         h5py = _h5py()
         self.path = path
         self._argument = argument
@@ -204,7 +204,7 @@ class Writer:
         except OSError as e:
             raise ValueError(f"path: cannot append to {str(path)!r}: {e}") from e
         writer._file = f
-        writer._columns = tuple(name for name in _COLUMNS if name in f)
+        writer._columns = tuple(name for name in COLUMNS if name in f)
         writer._row_bytes = 8 * (1 + 2 * int(f.attrs["dim"]) + len(writer._columns) - 3)
         writer.rows, writer._slot, writer.is_open = rows, slot, True
         writer._datasets = None
@@ -321,7 +321,7 @@ def _store_model(f: Any, model: Model) -> None:
     f.create_dataset("model", data=json.dumps(recipe, allow_nan=True))
 
 
-def _stored_model(f: Any, source: Path, version: int, allow_pickle: bool) -> Model:
+def stored_model(f: Any, source: Path, version: int, allow_pickle: bool) -> Model:
     """The model the file stores, built from its data; a pickle only with ``allow_pickle``."""
     if version >= 3:
         text = f["model"][()]
@@ -378,7 +378,7 @@ def _recover(path: Path) -> None:
         rows, slot, length = (int(x) for x in src["committed"][:3])
         for name in src:
             src.copy(src[name], dst, name=name)
-            if name in _COLUMNS:
+            if name in COLUMNS:
                 dst[name].resize(rows, axis=0)
         dst[f"checkpoint{slot}"].resize((length,))
     os.replace(part, path)
@@ -514,8 +514,6 @@ def save(traj: Trajectory, path: str | os.PathLike[str], *, overwrite: bool = Fa
 def columns_of(model: Model, method: str) -> tuple[str, ...]:
     """The optional columns of a run of ``method`` on ``model``: Newton counts for the methods
     that solve equations, work for forced models."""
-    from .methods import method_info
-
     info = method_info(method)
     return (*(("newton",) if info.implicit or info.constrained else ()), *(("work",) if model.forced else ()))
 
@@ -524,7 +522,7 @@ class Rows:
     """A column of a trajectory file, read when used: indexing reads the rows asked for, and
     NumPy (``np.asarray``, arithmetic) reads the whole column once and keeps it.
 
-    :func:`load` with ``lazy=True`` gives each column of the trajectory as one; it is not made
+    :func:`varmech.load` with ``lazy=True`` gives each column of the trajectory as one; it is not made
     by hand.
 
     Parameters
@@ -612,134 +610,6 @@ class Rows:
         return f"Rows({str(self._path)!r}, {self._name!r}, shape={self.shape})"
 
 
-def load(
-    path: str | os.PathLike[str], *, model: Model | None = None, lazy: bool = False, allow_pickle: bool = False
-) -> Trajectory:
-    """The trajectory saved in ``path`` by :meth:`Trajectory.save` or streamed there by a run
-    (``integrate(output=)``), with its model built from the file's data, or ``model`` instead
-    (which must have the file's dimension). Only the committed rows are read; a run that
-    stopped without closing its file loads with ``status`` -1, and its checkpoint lets
-    :func:`varmech.resume` go on.
-
-    Loading runs no code from the file. Scenes, N-body models, symbolic and Routh-reduced
-    models are stored as data (names, numbers, expressions, tapes) and built again by their
-    constructors. A model of Python closures can travel only as a pickle, and unpickling runs
-    whatever the file says: such a file loads with ``model=`` (yours) or, if you trust it, with
-    ``allow_pickle=True``. A file whose superblock promises more bytes than it has (truncated),
-    whose checksums fail, or whose rows are not finite is refused before anything is used.
-
-    ``lazy=True`` reads no column until it is used (each a :class:`Rows`; indexing reads only
-    the rows asked for), for files larger than memory.
-
-    Parameters
-    ----------
-    path : str or os.PathLike
-        The HDF5 file.
-    model : Model, optional
-        The model to attach instead of the file's stored one (needed for a closure model
-        unless ``allow_pickle``).
-    lazy : bool, default False
-        Read each column only when used.
-    allow_pickle : bool, default False
-        Unpickle a stored closure model (which runs code from the file: only for files you
-        trust).
-
-    Returns
-    -------
-    Trajectory
-        The run in the file, with its checkpoint.
-
-    Raises
-    ------
-    ValueError
-        Naming ``path`` for a missing, corrupt or truncated file, one that is not a varmech
-        trajectory, or whose rows are not finite, and for a pickled model without ``model=`` or
-        ``allow_pickle=True``; naming ``model`` for a model of another dimension.
-
-    Examples
-    --------
-    >>> import tempfile, pathlib, numpy as np, varmech
-    >>> s = varmech.scenes.kepler()
-    >>> traj = varmech.integrate(s, dt=s.dt, steps=100, save_every=10)
-    >>> path = traj.save(pathlib.Path(tempfile.mkdtemp()) / "kepler.h5")
-    >>> back = varmech.load(path)
-    >>> bool(np.array_equal(back.q, traj.q)) and back.method == traj.method
-    True
-
-    A model of closures (here V = q, by NumPy's functions) is not unpickled unless asked:
-
-    >>> ramp = varmech.MechanicalSystem(1, np.sum, np.ones_like)
-    >>> path = varmech.integrate(ramp, [0.0], [0.0], dt=0.1, steps=10).save(path.with_name("ramp.h5"))
-    >>> varmech.load(path)
-    Traceback (most recent call last):
-    ...
-    ValueError: path: the model of ... is a pickle (a model of Python closures), ...
-    >>> varmech.load(path, model=ramp).steps, varmech.load(path, allow_pickle=True).steps
-    (10, 10)
-    """
-    from .integrate import Trajectory
-
-    source = Path(path)
-    if not source.is_file():
-        raise ValueError(f"path: no file {str(source)!r}")
-    try:
-        with open_read(source, probe=True) as f:
-            if not f.swmr_mode:
-                # Every object's header is read (and its checksum checked) now, not first by a
-                # writer appending to the file.
-                f.visititems(lambda name, obj: None)
-            if f.attrs.get("format") != FORMAT:
-                raise ValueError(f"path: {str(source)!r} is not a varmech trajectory file")
-            version = int(f.attrs["format_version"])
-            if version not in READS:
-                raise ValueError(f"path: format version {version}; this varmech reads versions {READS}")
-            a = dict(f.attrs)
-            rows, slot, length, steps, nfev = (int(x) for x in f["committed"][()])
-            present = [name for name in _COLUMNS if name in f]
-            shapes = {name: (rows, *f[name].shape[1:]) for name in present}
-            if any(f[name].shape[0] < rows for name in present) or slot not in (0, 1) or min(rows, length, steps) < 0:
-                raise ValueError(f"path: {str(source)!r} is truncated: fewer rows than committed")
-            columns: dict[str, Any] = {
-                name: Rows(source, name, shapes[name], f[name].dtype) if lazy else f[name][:rows] for name in present
-            }
-            # A lazy file's rows are checked as they are read; its last (which a resume goes on
-            # from) here.
-            last = {name: f[name][rows - 1 : rows] for name in ("t", "q", "p")} if lazy and rows else columns
-            for name in ("t", "q", "p", "work"):
-                if name in last and not np.isfinite(last[name]).all():
-                    raise ValueError(f"path: {str(source)!r} holds non-finite {name} rows: damaged")
-            checkpoint = f[f"checkpoint{slot}"][:length].tobytes()
-            # Crossings after the last committed state are a killed run's uncommitted segment's.
-            t_last = float(f["t"][rows - 1]) if rows else -np.inf
-            events = tuple(_occurrences(f["events"][str(k)], t_last) for k in range(len(f["events"]))) if "events" in f else ()
-            if model is None:
-                model = _stored_model(f, source, version, allow_pickle)
-    except (OSError, KeyError, RuntimeError) as e:
-        # h5py raises RuntimeError for some damaged structures (a bad heap signature), and
-        # OSError for a failed checksum.
-        raise ValueError(f"path: {str(source)!r} is corrupt or truncated: {e}") from e
-    if model.dim != int(a["dim"]):
-        raise ValueError(f"model: has dimension {model.dim}, the file's states {int(a['dim'])}")
-    complete = bool(a["complete"])
-    return Trajectory(
-        columns["t"],
-        columns["q"],
-        columns["p"],
-        model,
-        str(a["method"]),
-        float(a["dt"]),
-        steps,
-        nfev,
-        columns.get("newton"),
-        columns.get("work"),
-        status=int(a["status"]) if complete else -1,
-        message=str(a["message"]) if complete else f"The run stopped at step {steps} without closing its file.",
-        checkpoint=checkpoint or None,
-        events=events,
-        contacts=tuple(str(name) for name in a.get("contacts", ())),
-    )
-
-
 def save_every_of(path: str | os.PathLike[str]) -> int:
     """The saving period of the run in ``path``: its ``save_every`` attribute, or (for a saved
     trajectory, which has none) the steps between its first two states."""
@@ -749,13 +619,6 @@ def save_every_of(path: str | os.PathLike[str]) -> int:
             return every
         t, dt = f["t"][:2], float(f.attrs["dt"])
     return max(1, round(float(t[1] - t[0]) / dt)) if len(t) > 1 else 1
-
-
-def _occurrences(group: Any, t_last: float) -> Occurrences:
-    """An event's crossings in the file, up to the committed time ``t_last``."""
-    t = group["t"][()]
-    keep = int(np.searchsorted(t, t_last, side="right"))
-    return Occurrences(str(group.attrs["name"]), t[:keep], group["q"][:keep], group["p"][:keep])
 
 
 def larger_than_memory(path: str | os.PathLike[str]) -> bool:

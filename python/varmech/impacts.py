@@ -62,6 +62,7 @@ from . import surfaces as _surfaces
 from .impulses import Joined, Pieces, _velocity
 from .methods import method_info
 from .model import Model
+from .trajectory import take_partial
 
 #: The public API; the rest serves :func:`varmech.integrate`.
 __all__ = ["Contact", "ContactError"]
@@ -711,8 +712,6 @@ def run(
             record = start(q, p, t, steps - done, None, specs)
         except BaseException as err:
             # The run so far is the error's partial trajectory, with the piece's own.
-            from .integrate import take_partial
-
             piece = take_partial(err)
             if piece is not None:
                 pieces.add(piece)

@@ -35,6 +35,7 @@ from numpy.typing import ArrayLike
 
 from . import _core
 from ._util import vector
+from .constraints import project
 from .dense import grid_step
 from .model import Model
 
@@ -518,8 +519,6 @@ def run(start: Start, model: Model, q0: np.ndarray, p0: np.ndarray, t0: float, d
     them. One between tₙ and tₙ₊₁ splits the step: Φ_τ, the jump p += P(q), Φ_{h−τ}, all steps of
     the run's method, so the run keeps its order; on a constrained model the jump is followed by
     the workless constraint impulse (the momenta projected, :func:`varmech.project`)."""
-    from .constraints import project
-
     for i, imp in enumerate(impulses):
         if not isinstance(imp, Impulse):
             raise TypeError(f"impulses[{i}]: expected a varmech.Impulse, got {type(imp).__name__}")

@@ -1,4 +1,5 @@
-"""Fixed-step integration and its result."""
+"""Fixed-step integration: :func:`integrate` (its result, :class:`~varmech.trajectory.Trajectory`,
+in :mod:`varmech.trajectory`)."""
 
 from __future__ import annotations
 
@@ -7,348 +8,35 @@ import datetime
 import math
 import os
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass, field
-from pathlib import Path
-from typing import TYPE_CHECKING, Any, Literal
+from typing import Any, Literal
 
 import numpy as np
 from numpy.typing import ArrayLike
 
-from . import _core, dense, files
+from . import _core, dense, files, streaming
 from . import events as _events
 from . import impacts as _impacts
 from . import impulses as _impulses
 from ._progress import progress_bar
-from ._util import MAX_COUNT, finite, number, positive, positive_int, returned_scalar, vector
+from ._util import finite, positive, positive_int, returned_scalar, step_count, vector
 from .constraints import warn_if_integrable
 from .model import Lagrangian, Model
+from .scenes import Scene
 
-if TYPE_CHECKING:
-    from .scenes import Scene
+# Trajectory lives in varmech.trajectory; imported here, it is still found under its old name
+# (varmech.integrate.Trajectory), which pickles made before the move refer to.
+from .trajectory import Trajectory, _trajectory, load, take_partial
 
 __all__ = [
-    "Trajectory",
     "integrate",
     "symplecticity_defect",
 ]
-
-
-@dataclass
-class Trajectory:
-    """The saved states of a run (scipy-style result), as :func:`integrate` returns it.
-
-    ``t`` has shape (N,), ``q`` and ``p`` shape (N, n); ``v`` = M⁻¹p is computed on demand.
-    ``nfev`` counts force evaluations (for the implicit methods, evaluations of the discrete
-    Lagrangian's slot derivatives); ``newton_iterations`` and ``newton_iterations_per_step``
-    count the implicit methods' iterations.
-    ``status`` is 0 when the run reached its end, 1 when a terminal event stopped it (see
-    :mod:`varmech.events`), -1 for the partial trajectory attached to an error
-    (``err.partial``); ``message`` says which. ``events`` holds each event's located crossings
-    (:class:`varmech.events.Occurrences`, one per function given, in that order; empty without
-    events).
-
-    Attributes
-    ----------
-    t : ndarray, shape (N,)
-        The saved times.
-    q, p : ndarray, shape (N, n)
-        The positions and the momenta p = ∂L/∂q̇ at the saved times.
-    v : ndarray, shape (N, n)
-        The velocities q̇ (M⁻¹p for mechanical systems), computed on first use.
-    model : Model
-        The model integrated.
-    method : str
-        The method's name (see :func:`varmech.methods`).
-    dt : float
-        The step h.
-    steps : int
-        Steps taken from the initial state.
-    nfev : int
-        Force evaluations made (the implicit methods: evaluations of the discrete Lagrangian's
-        slot derivatives).
-    newton : ndarray, shape (N,) or None
-        Cumulative Newton iterations at each saved state (None for explicit methods).
-    newton_iterations : int
-        Newton iterations over the run (0 for explicit methods).
-    newton_iterations_per_step : ndarray, shape (N − 1,)
-        Mean Newton iterations a step between consecutive saved states.
-    work : ndarray, shape (N,) or None
-        Work done by the non-conservative forces up to each saved state.
-    status : int
-        0: the run reached its end; 1: a terminal event stopped it; -1: the partial trajectory
-        of a failed run (``err.partial``).
-    success : bool
-        ``status == 0``.
-    message : str
-        Why the run stopped.
-    checkpoint : bytes or None
-        The last state's checkpoint: ``integrate(traj, steps=)`` goes on from it, bit for bit.
-    events : tuple of Occurrences
-        Each event's located crossings, in the order the events were given.
-    contacts : tuple of str
-        The names of the contacts of a run with ``contacts`` (empty otherwise). The core's
-        checkpoint does not hold them, so such a run is not continued (``integrate(traj,
-        steps=)``, :func:`varmech.resume`): that is refused, naming ``contacts``.
-
-    Examples
-    --------
-    >>> import varmech
-    >>> traj = varmech.integrate(varmech.scenes.pendulum(), dt=0.01, steps=1000, save_every=100)
-    >>> traj.t.shape, traj.q.shape, traj.method, traj.status
-    ((11,), (11, 1), 'verlet', 0)
-    >>> more = varmech.integrate(traj, steps=1000)    # goes on, bit for bit
-    >>> float(more.t[-1])
-    20.0
-    """
-
-    t: np.ndarray
-    q: np.ndarray
-    p: np.ndarray
-    model: Model
-    method: str
-    dt: float
-    steps: int
-    nfev: int
-    newton: np.ndarray | None = field(default=None, repr=False)
-    #: Work done by the non-conservative forces up to each saved state (zeros without forces).
-    work: np.ndarray | None = field(default=None, repr=False)
-    status: int = 0
-    message: str = "The integration reached its final time."
-    #: The last state's checkpoint (bytes): ``integrate(traj, steps=)`` goes on from it, bit for bit.
-    checkpoint: bytes | None = field(default=None, repr=False)
-    #: Each event's located crossings (times and states), in the order the events were given.
-    events: tuple[_events.Occurrences, ...] = field(default=(), repr=False)
-    #: The names of a run's contacts: a run with contacts cannot be continued yet.
-    contacts: tuple[str, ...] = field(default=(), repr=False)
-    _v: np.ndarray | None = field(default=None, repr=False)
-
-    @property
-    def success(self) -> bool:
-        return self.status == 0
-
-    @property
-    def newton_iterations(self) -> int:
-        """Newton iterations of the implicit methods over the run (0 for explicit methods)."""
-        return int(self.newton[-1]) if self.newton is not None and len(self.newton) else 0
-
-    @property
-    def newton_iterations_per_step(self) -> np.ndarray:
-        """Mean Newton iterations per step between consecutive saved states, shape (N − 1,)."""
-        steps = np.diff(np.rint((self.t - self.t[0]) / self.dt))
-        newton = self.newton if self.newton is not None else np.zeros(len(self.t))
-        return np.diff(newton) / np.maximum(steps, 1)
-
-    @property
-    def v(self) -> np.ndarray:
-        """Velocities q̇ (with ∂L/∂q̇ = p; M⁻¹p for mechanical systems), shape (N, n)."""
-        if self._v is None:
-            self._v = _core.derivative(self.model._core, "velocity", *self._arrays())
-        return self._v
-
-    def save(self, path: str | os.PathLike[str], *, overwrite: bool = False) -> Path:
-        """Writes the trajectory to the HDF5 file ``path`` (h5py, the extra ``io``); read it back
-        with :func:`varmech.load`. See :mod:`varmech.files` for the layout.
-
-        The model is stored as what builds it, as data: a scene's name and parameters, G and the
-        masses, a symbolic model's expressions and tapes, a Routh model's full model and
-        momenta; loading rebuilds it without running code from the file. A model of Python
-        closures is stored as its pickle, which :func:`varmech.load` unpickles only with
-        ``allow_pickle=True`` (or pass ``model=``). Every dataset carries a checksum.
-
-        Parameters
-        ----------
-        path : str or os.PathLike
-            The file to write.
-        overwrite : bool, default False
-            Replace an existing file.
-
-        Returns
-        -------
-        pathlib.Path
-            The path written.
-
-        Raises
-        ------
-        ValueError
-            Naming ``path``: the file exists and ``overwrite`` is False, or it cannot be written
-            (its directory, or a full disk).
-        ImportError
-            h5py is not installed.
-
-        See Also
-        --------
-        varmech.load : read it back (lazily, for runs larger than memory).
-
-        Examples
-        --------
-        >>> import pathlib, tempfile, varmech
-        >>> traj = varmech.integrate(varmech.scenes.pendulum(), dt=0.01, steps=100, save_every=10)
-        >>> path = traj.save(pathlib.Path(tempfile.mkdtemp()) / "pendulum.h5")
-        >>> path.name, len(varmech.load(path))
-        ('pendulum.h5', 11)
-        >>> import h5py, json
-        >>> with h5py.File(path) as f:
-        ...     json.loads(f["model"][()])
-        {'kind': 'scene', 'name': 'pendulum', 'parameters': {}}
-        """
-        return files.save(self, path, overwrite=overwrite)
-
-    def sol(self, t: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
-        """(q(t), p(t)) between the saved states, by cubic Hermite interpolation from q, q̇ and
-        p, ṗ at the states on either side: error O(Δ⁴) in their spacing Δ. See
-        ``dense.hermite``.
-
-        Parameters
-        ----------
-        t : float or array_like
-            Times within the saved span [t[0], t[-1]].
-
-        Returns
-        -------
-        q, p : ndarray, shape t.shape + (n,)
-            The interpolated positions and momenta.
-
-        Raises
-        ------
-        ValueError
-            Naming ``t``: times not finite or outside the saved span, fewer than two saved
-            states, or a constrained model (whose ṗ holds the constraint forces).
-
-        Examples
-        --------
-        Halfway between states saved 0.1 apart, against the state the run saved at every step:
-
-        >>> import varmech
-        >>> traj = varmech.integrate(varmech.scenes.pendulum(), dt=0.01, steps=100, save_every=10)
-        >>> q, p = traj.sol(0.05)
-        >>> fine = varmech.integrate(varmech.scenes.pendulum(), dt=0.01, steps=5)
-        >>> q.shape, float(abs(q - fine.q[-1]).max()) < 1e-7
-        ((1,), True)
-        """
-        return dense.hermite(self, t)
-
-    def energy(self) -> np.ndarray:
-        """The energy function E = p·q̇ − L (= ½pᵀM⁻¹p + V(q) for mechanical systems) at each
-        saved state.
-
-        Returns
-        -------
-        ndarray, shape (N,)
-            E at each saved state (computed for any model; conserved only when L does not
-            depend on t and no forces act).
-
-        Raises
-        ------
-        Exception
-            What a closure of the model raises, unchanged.
-
-        Examples
-        --------
-        The pendulum's energy, from E = −1/2, stays within 10⁻⁵ over a second of Störmer–Verlet:
-
-        >>> import varmech
-        >>> E = varmech.integrate(varmech.scenes.pendulum(), dt=0.01, steps=100, save_every=10).energy()
-        >>> E.shape, float(E[0]), float(abs(E - E[0]).max()) < 1e-5
-        ((11,), -0.5, True)
-        """
-        return self.energy_terms()[0]
-
-    def energy_terms(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """(E, T, V) at each saved state: the energy function, its kinetic term T = E − V and its
-        potential V = −L(q, 0, t), the energy of the configuration at rest (½pᵀM⁻¹p and V(q)
-        for mechanical systems). The conservation verdicts measure energy errors against the
-        mean of T.
-
-        Returns
-        -------
-        E, T, V : ndarray, shape (N,)
-            The energy and its kinetic and potential terms at each saved state.
-
-        Raises
-        ------
-        Exception
-            What a closure of the model raises, unchanged.
-
-        Examples
-        --------
-        >>> import numpy as np, varmech
-        >>> E, T, V = varmech.integrate(varmech.scenes.pendulum(), dt=0.01, steps=100, save_every=10).energy_terms()
-        >>> float(T[0]), float(V[0]), bool(np.allclose(E, T + V))   # at rest at the bottom, struck: p = 1
-        (0.5, -1.0, True)
-        """
-        return _core.energy_terms(self.model._core, *self._arrays())
-
-    def constraint_residuals(self) -> tuple[np.ndarray, np.ndarray]:
-        """How far each saved state is off the constraints.
-
-        Returns
-        -------
-        position, velocity : ndarray, shape (N,)
-            |g(q)|∞ and |G(q)M⁻¹p|∞ (the hidden constraint) for holonomic constraints;
-            0 and |A(q)q̇|∞ for velocity constraints; |g(q)|∞ and |G(q)q̇, A(q)q̇ + b(q)|∞
-            with both.
-
-        Raises
-        ------
-        ValueError
-            Naming ``model``: it has no constraints.
-
-        Examples
-        --------
-        RATTLE keeps the Cartesian pendulum on its circle, and its velocity tangent to it:
-
-        >>> import varmech
-        >>> s = varmech.scenes.cartesian_pendulum()
-        >>> position, velocity = varmech.integrate(s, dt=s.dt, steps=100, save_every=50).constraint_residuals()
-        >>> position.shape, bool(position.max() < 1e-12), bool(velocity.max() < 1e-12)
-        ((3,), True, True)
-        """
-        return _core.constraint_residuals(self.model._core, *self._arrays()[1:])[0]
-
-    def _arrays(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """(t, q, p) as arrays (read now from a file loaded lazily)."""
-        return np.asarray(self.t), np.asarray(self.q), np.asarray(self.p)
-
-    def __len__(self) -> int:
-        return len(self.t)
-
-    def __repr__(self) -> str:
-        return (
-            f"Trajectory({self.model.name!r}, method={self.method!r}, dt={self.dt:g}, steps={self.steps}, "
-            f"saved={len(self.t)}, nfev={self.nfev}, status={self.status})"
-        )
-
-
-def _steps(dt: float, t0: float, steps: int | None, t_end: float | None) -> int:
-    if (steps is None) == (t_end is None):
-        raise ValueError("steps, t_end: give exactly one of them")
-    if steps is not None:
-        if isinstance(steps, bool) or not isinstance(steps, (int, np.integer)) or not 0 <= steps < 2**63:
-            raise ValueError(f"steps: must be an integer from 0 to 2**63 - 1, got {steps!r}")
-        return int(steps)
-    t_end = number("t_end", t_end)  # type: ignore[arg-type]
-    if not math.isfinite(t_end) or t_end < t0:
-        raise ValueError(f"t_end: must be finite and not before t0 = {t0}, got {t_end}")
-    if not (t_end - t0) / dt <= MAX_COUNT:
-        raise ValueError(
-            f"t_end: {t_end} is more than 2**63 - 1 steps of dt = {dt} from t0 = {t0} "
-            f"((t_end - t0)/dt = {(t_end - t0) / dt:.3g}); take a larger dt or a nearer t_end"
-        )
-    n = round((t_end - t0) / dt)
-    if abs(n * dt - (t_end - t0)) > 1e-9 * max(abs(t_end - t0), dt):
-        raise ValueError(
-            f"t_end: {t_end} is not a whole number of steps dt = {dt} from t0 = {t0} "
-            f"({(t_end - t0) / dt:.6g} steps); adjust dt or pass steps"
-        )
-    return n
 
 
 def _model_of(
     model: Model | Scene, q0: ArrayLike | None, p0: ArrayLike | None, v0: ArrayLike | None
 ) -> tuple[Model, ArrayLike | None, ArrayLike | None]:
     """The model of a model or scene, and (q0, p0), a scene's initial state by default."""
-    from .scenes import Scene
-
     if isinstance(model, Scene):
         if q0 is None:
             q0 = model.q0
@@ -636,8 +324,6 @@ def integrate(
         if named:
             raise ValueError(f"{named[0]}: a continued run keeps its trajectory's {', '.join(named)}")
         return _go_on(model, steps, t_end, save_every, progress, output, overwrite, checkpoint_every, events)
-    from .scenes import Scene
-
     # A scene's contacts by default; none given (``[]``) is a run without contacts.
     contacts = (model.contacts if contacts is None and isinstance(model, Scene) else contacts) or None
     model, q0, p0 = _model_of(model, q0, p0, v0)
@@ -652,7 +338,7 @@ def integrate(
         raise ValueError("dt: the step is required")
     dt = positive("dt", dt)
     t0 = 0.0 if t0 is None else finite("t0", t0)
-    nsteps = _steps(dt, t0, steps, t_end)
+    nsteps = step_count(dt, t0, steps, t_end)
     save_every = positive_int("save_every", save_every)
     threshold = _energy_threshold(model, max_energy_error)
     newton_tolerance, newton_max_iterations = _newton(newton_tolerance, newton_max_iterations)
@@ -787,7 +473,7 @@ def _go_on(
         )
     if traj.checkpoint is None:
         raise ValueError("model: this trajectory has no checkpoint to go on from (it failed before its first state)")
-    nsteps = _steps(traj.dt, float(traj.t[-1]), steps, t_end)
+    nsteps = step_count(traj.dt, float(traj.t[-1]), steps, t_end)
     save_every = positive_int("save_every", save_every)
     watched, specs = _events.specs(events, traj.model.dim) if events is not None else ([], [])
     found = _events.found_before(traj.events, watched)
@@ -835,8 +521,6 @@ def _run(
     ``watched`` are the run's events (``event_specs`` the binding's), whose crossings the result
     reports; a continued run's are watched after ``found`` crossings of each, an energy error
     measured from ``initial_energy``."""
-    from . import streaming
-
     bar = progress_bar(total=nsteps, unit="step", desc=method, enabled=progress)
     try:
         if output is not None:
@@ -873,9 +557,9 @@ def _run(
             except BaseException as err:
                 # A file that cannot be read back (a disk that failed) leaves the error as it is.
                 with contextlib.suppress(ValueError):
-                    err.partial = files.load(target, model=model, lazy=True)  # type: ignore[attr-defined]
+                    err.partial = load(target, model=model, lazy=True)  # type: ignore[attr-defined]
                 raise
-            return files.load(target, model=model, lazy=files.larger_than_memory(target))
+            return load(target, model=model, lazy=files.larger_than_memory(target))
         if checkpoint_every is not None:
             raise ValueError("checkpoint_every: checkpoints are written to a file; pass output=")
 
@@ -902,40 +586,6 @@ def _run(
     finally:
         bar.close()
     return _trajectory(record, model, method, dt, watched)
-
-
-def take_partial(err: BaseException) -> _core.TrajectoryRecord | None:
-    """The binding's record of a failed run's states, taken off the exception it rides on
-    (``_varmech_partial``), to be given as ``err.partial`` in the user's terms."""
-    partial = getattr(err, "_varmech_partial", None)
-    if partial is not None:
-        delattr(err, "_varmech_partial")
-    return partial
-
-
-def _trajectory(
-    record: _core.TrajectoryRecord, model: Model, method: str, dt: float, events: Sequence[_events.Event] = (), **status: Any
-) -> Trajectory:
-    """The Trajectory of the binding's record of a run, with its events' crossings (and the
-    status of a terminal event's stop, unless `status` is given)."""
-    r = record
-    found = _events.occurrences(r, events)
-    status = status or _events.termination(r, events, found)
-    return Trajectory(
-        r.t,
-        r.q,
-        r.p,
-        model,
-        method,
-        dt,
-        r.steps,
-        r.force_evaluations,
-        r.newton,
-        r.work,
-        checkpoint=r.checkpoint,
-        events=found,
-        **status,
-    )
 
 
 def symplecticity_defect(model: Model, method: str, q: ArrayLike, p: ArrayLike, dt: float) -> float:

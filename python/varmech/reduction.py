@@ -5,18 +5,16 @@ from __future__ import annotations
 
 import operator
 from collections.abc import Sequence
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike
 
 from . import _core
 from ._util import floats, vector
-from .integrate import Trajectory
 from .model import RECIPES, Model, field, from_recipe, integers, numbers
-
-if TYPE_CHECKING:
-    from .scenes import Scene
+from .scenes import Scene
+from .trajectory import Trajectory
 
 __all__ = [
     "ReducedModel",
@@ -452,8 +450,6 @@ def routh(
     >>> round(float(traj.q.min()), 6), round(float(traj.q.max()), 6)
     (0.3, 0.479475)
     """
-    from .scenes import Scene
-
     if cyclic is None:
         if not isinstance(model, Scene):
             raise ValueError("cyclic: give the indices to ignore (cyclic_coordinates(model, q) finds candidates)")

@@ -197,6 +197,7 @@ def get(name: str, **parameters: float) -> Scene:
     if name in SYMBOLIC and name not in CATALOGUE:
         if parameters:
             raise ValueError(f"parameters: the symbolic scene {name} takes none here; build its model with them")
+        # Imported here, on first use: the symbolic scenes need SymPy, an optional extra.
         from .symbolic import examples
 
         return examples.scene(name)

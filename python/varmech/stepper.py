@@ -6,8 +6,8 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from . import _core
-from ._util import finite, positive
-from .integrate import _initial_state, _model_of, _newton, _steps
+from ._util import finite, positive, step_count
+from .integrate import _initial_state, _model_of, _newton
 from .model import Model
 from .scenes import Scene
 
@@ -168,7 +168,7 @@ class Stepper:
             ...
         ValueError: t_end: 0.255 is not a whole number of steps dt = 0.01 from t0 = 0.25 (0.5 steps); adjust dt or pass steps
         """
-        self._stepper.advance(_steps(self.dt, self.t, steps, t_end))
+        self._stepper.advance(step_count(self.dt, self.t, steps, t_end))
 
     def reset(self, q0: ArrayLike, p0: ArrayLike | None = None, *, v0: ArrayLike | None = None, t0: float | None = None) -> None:
         """Start afresh from (q0, p0) (or q0 and the velocities v0) at ``t0`` (default: the

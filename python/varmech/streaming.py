@@ -28,8 +28,9 @@ import numpy as np
 from . import _core, files
 from . import events as _events
 from ._progress import progress_bar
-from .integrate import Trajectory, _steps, take_partial
+from ._util import step_count
 from .model import Model
+from .trajectory import Trajectory, load, take_partial
 
 if TYPE_CHECKING:
     from tqdm import tqdm
@@ -294,7 +295,7 @@ def resume(
     >>> traj.steps, bool(np.array_equal(traj.q, once.q))
     (150, True)
     """
-    stored = files.load(path, lazy=True, model=model, allow_pickle=allow_pickle)
+    stored = load(path, lazy=True, model=model, allow_pickle=allow_pickle)
     if stored.contacts:
         raise ValueError(
             f"path: {str(path)!r} holds a run with contacts ({', '.join(map(repr, stored.contacts))}), which resume"
@@ -305,7 +306,7 @@ def resume(
         raise ValueError(f"path: {str(path)!r} has no checkpoint to resume from")
     _check_checkpoint(path, stored)
     t_now = float(stored.t[-1])
-    more = _steps(stored.dt, t_now, steps, t_end)
+    more = step_count(stored.dt, t_now, steps, t_end)
     if save_every is None:
         save_every = files.save_every_of(path)
     watched, specs = _events.specs(events, stored.model.dim) if events is not None else ([], [])
@@ -332,7 +333,7 @@ def resume(
         )
     finally:
         bar.close()
-    return files.load(path, model=stored.model, lazy=files.larger_than_memory(path))
+    return load(path, model=stored.model, lazy=files.larger_than_memory(path))
 
 
 def _check_checkpoint(path: str | os.PathLike[str], stored: Trajectory) -> None:

@@ -13,7 +13,7 @@ pytest.importorskip("sympy")
 @pytest.mark.parametrize(
     "name",
     [
-        "varmech.symbolic",
+        "varmech.symbolic._constructors",
         "varmech.symbolic.examples",
         "varmech.symbolic._lower",
         "varmech.symbolic._derive",
@@ -30,6 +30,7 @@ pytest.importorskip("sympy")
         "varmech.conservation",
         "varmech.ensemble",
         "varmech.integrate",
+        "varmech.trajectory",
         "varmech.model",
         "varmech.constraints",
         "varmech.derivatives",

@@ -117,10 +117,11 @@ def test_the_walk_finds_the_api():
         "varmech.integrate.integrate",
         "varmech.scenes.kepler",
         "varmech.scenes.rolling_disk",
-        "varmech.integrate.Trajectory",
-        "varmech.integrate.Trajectory.save",
+        "varmech.trajectory.Trajectory",
+        "varmech.trajectory.Trajectory.save",
+        "varmech.trajectory.load",
         "varmech.charts.work_precision.work_precision_chart",
-        "varmech.symbolic.lagrangian",
+        "varmech.symbolic._constructors.lagrangian",
     ]:
         assert name in OBJECTS, name
     assert len(FUNCTIONS) > 100 and len(RECORDS) > 10

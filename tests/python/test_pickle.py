@@ -87,6 +87,20 @@ def test_a_native_scene_pickles_with_its_parameters(scene):
     _check_model(scene.model, scene.q0, scene.p0, scene.dt)
 
 
+def test_a_trajectory_pickled_under_its_old_module_loads():
+    """Trajectory moved from varmech.integrate to varmech.trajectory; a pickle made before names
+    the old module, which still holds it, and loads to the same trajectory."""
+    scene = scenes.pendulum()
+    traj = _run(scene.model, scene.q0, scene.p0, scene.dt)
+    assert type(traj).__module__ == "varmech.trajectory"
+    new = pickle.dumps(traj, protocol=0)  # protocol 0 names a class as text: "c<module>\n<name>\n"
+    old = new.replace(b"cvarmech.trajectory\nTrajectory\n", b"cvarmech.integrate\nTrajectory\n")
+    assert old.count(b"cvarmech.integrate\nTrajectory\n") == 1
+    copy = pickle.loads(old)
+    assert type(copy) is varmech.Trajectory
+    _assert_same_trajectory(copy, traj)
+
+
 def test_a_native_nbody_model_pickles_by_its_masses():
     rng = np.random.default_rng(3)
     scene = scenes.nbody([1.0, 1e-3, 2e-3], rng.normal(size=(3, 3)), rng.normal(size=(3, 3)) * 0.1, G=0.5)

@@ -14,6 +14,7 @@ if not hasattr(_core, "CompiledModel"):
 
 import varmech  # noqa: E402
 import varmech.symbolic as symbolic  # noqa: E402
+import varmech.symbolic._constructors as constructors  # noqa: E402
 from varmech import scenes  # noqa: E402
 from varmech.symbolic.examples import cartesian_pendulum, double_pendulum, heavy_top, symbolic_of  # noqa: E402
 
@@ -260,7 +261,7 @@ def test_a_chain_is_derived_in_work_linear_in_its_length_with_progress_and_a_sta
         def close(self):
             pass
 
-    monkeypatch.setattr(symbolic, "progress_bar", Bar)
+    monkeypatch.setattr(constructors, "progress_bar", Bar)
 
     def chain(n):
         q = sp.symbols(f"q0:{n}")

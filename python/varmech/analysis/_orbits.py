@@ -9,9 +9,9 @@ import numpy as np
 from .. import _core
 from ..ensemble import Ensemble, ensemble
 from ..events import Event
-from ..integrate import Trajectory
 from ..model import Model
 from ..scenes import Scene
+from ..trajectory import Trajectory
 from ._energy import conserves_energy, energy_of
 
 ModelLike = Model | Scene

@@ -10,9 +10,9 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .._util import positive
-from ..integrate import Trajectory
 from ..model import Model
 from ..table import Table
+from ..trajectory import Trajectory
 from ._interrupt import interruptible
 from ._orbits import ModelLike, default_method, model_of, run_orbits, solve_momentum
 

@@ -47,9 +47,9 @@ from numpy.typing import ArrayLike
 
 from .._util import positive
 from ..events import crossing
-from ..integrate import Trajectory
 from ..model import Model
 from ..table import Table
+from ..trajectory import Trajectory
 from ._interrupt import interruptible
 from ._orbits import ModelLike, default_method, energy_at, model_of, relative, run_orbits, solve_momentum
 

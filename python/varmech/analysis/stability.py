@@ -49,6 +49,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
+from .. import scenes
 from .._core import ConvergenceError, DivergenceError, SpuriousBranchError
 from .._progress import progress as _progress
 from .._util import positive
@@ -122,9 +123,7 @@ def _oscillator() -> Any:
     """The native model of q̈ = −q (built once)."""
     global _OSCILLATOR
     if _OSCILLATOR is None:
-        from ..scenes import harmonic_oscillator
-
-        _OSCILLATOR = harmonic_oscillator(1.0).model
+        _OSCILLATOR = scenes.harmonic_oscillator(1.0).model
     return _OSCILLATOR
 
 
@@ -747,13 +746,11 @@ def implicit_regions(
     >>> table.column("outcome").tolist()
     ['ok', 'ok', 'energy', 'spurious branch']
     """
-    from ..scenes import Scene, get
-
     names = list(IMPLICIT_METHODS) if method is None else ([method] if isinstance(method, str) else list(method))
     for name in names:
         _method(name)
-    sc = get(scene) if isinstance(scene, str) else scene
-    if not isinstance(sc, Scene):
+    sc = scenes.get(scene) if isinstance(scene, str) else scene
+    if not isinstance(sc, scenes.Scene):
         raise TypeError(f"scene: expected a scene name or a varmech Scene, got {type(scene).__name__}")
     if isinstance(steps, bool) or not isinstance(steps, (int, np.integer)) or steps < 1:
         raise ValueError(f"steps: must be a positive integer, got {steps!r}")

@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 
 from ..conservation import check_conservation
-from ..integrate import Trajectory
+from ..trajectory import Trajectory
 from ._figure import documented, pyplot, save, time_label
 
 __all__ = [

@@ -32,7 +32,8 @@ import sympy as sp
 
 from ..model import Rotation
 from ..scenes import CATALOGUE, Scene
-from . import SymbolicModel, lagrangian, mechanical
+from ._constructors import lagrangian, mechanical
+from ._model import SymbolicModel
 
 __all__ = [
     "cartesian_pendulum",

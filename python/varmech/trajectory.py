@@ -1,0 +1,476 @@
+"""A run's saved states: :class:`Trajectory`, the result of :func:`varmech.integrate`, made
+from the binding's record of a run or read back from a file (:func:`load`)."""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from . import _core, dense, files
+from . import events as _events
+from .events import Occurrences
+from .model import Model
+
+__all__ = [
+    "Trajectory",
+    "load",
+]
+
+
+@dataclass
+class Trajectory:
+    """The saved states of a run (scipy-style result), as :func:`integrate` returns it.
+
+    ``t`` has shape (N,), ``q`` and ``p`` shape (N, n); ``v`` = M⁻¹p is computed on demand.
+    ``nfev`` counts force evaluations (for the implicit methods, evaluations of the discrete
+    Lagrangian's slot derivatives); ``newton_iterations`` and ``newton_iterations_per_step``
+    count the implicit methods' iterations.
+    ``status`` is 0 when the run reached its end, 1 when a terminal event stopped it (see
+    :mod:`varmech.events`), -1 for the partial trajectory attached to an error
+    (``err.partial``); ``message`` says which. ``events`` holds each event's located crossings
+    (:class:`varmech.events.Occurrences`, one per function given, in that order; empty without
+    events).
+
+    Attributes
+    ----------
+    t : ndarray, shape (N,)
+        The saved times.
+    q, p : ndarray, shape (N, n)
+        The positions and the momenta p = ∂L/∂q̇ at the saved times.
+    v : ndarray, shape (N, n)
+        The velocities q̇ (M⁻¹p for mechanical systems), computed on first use.
+    model : Model
+        The model integrated.
+    method : str
+        The method's name (see :func:`varmech.methods`).
+    dt : float
+        The step h.
+    steps : int
+        Steps taken from the initial state.
+    nfev : int
+        Force evaluations made (the implicit methods: evaluations of the discrete Lagrangian's
+        slot derivatives).
+    newton : ndarray, shape (N,) or None
+        Cumulative Newton iterations at each saved state (None for explicit methods).
+    newton_iterations : int
+        Newton iterations over the run (0 for explicit methods).
+    newton_iterations_per_step : ndarray, shape (N − 1,)
+        Mean Newton iterations a step between consecutive saved states.
+    work : ndarray, shape (N,) or None
+        Work done by the non-conservative forces up to each saved state.
+    status : int
+        0: the run reached its end; 1: a terminal event stopped it; -1: the partial trajectory
+        of a failed run (``err.partial``).
+    success : bool
+        ``status == 0``.
+    message : str
+        Why the run stopped.
+    checkpoint : bytes or None
+        The last state's checkpoint: ``integrate(traj, steps=)`` goes on from it, bit for bit.
+    events : tuple of Occurrences
+        Each event's located crossings, in the order the events were given.
+    contacts : tuple of str
+        The names of the contacts of a run with ``contacts`` (empty otherwise). The core's
+        checkpoint does not hold them, so such a run is not continued (``integrate(traj,
+        steps=)``, :func:`varmech.resume`): that is refused, naming ``contacts``.
+
+    Examples
+    --------
+    >>> import varmech
+    >>> traj = varmech.integrate(varmech.scenes.pendulum(), dt=0.01, steps=1000, save_every=100)
+    >>> traj.t.shape, traj.q.shape, traj.method, traj.status
+    ((11,), (11, 1), 'verlet', 0)
+    >>> more = varmech.integrate(traj, steps=1000)    # goes on, bit for bit
+    >>> float(more.t[-1])
+    20.0
+    """
+
+    t: np.ndarray
+    q: np.ndarray
+    p: np.ndarray
+    model: Model
+    method: str
+    dt: float
+    steps: int
+    nfev: int
+    newton: np.ndarray | None = field(default=None, repr=False)
+    #: Work done by the non-conservative forces up to each saved state (zeros without forces).
+    work: np.ndarray | None = field(default=None, repr=False)
+    status: int = 0
+    message: str = "The integration reached its final time."
+    #: The last state's checkpoint (bytes): ``integrate(traj, steps=)`` goes on from it, bit for bit.
+    checkpoint: bytes | None = field(default=None, repr=False)
+    #: Each event's located crossings (times and states), in the order the events were given.
+    events: tuple[_events.Occurrences, ...] = field(default=(), repr=False)
+    #: The names of a run's contacts: a run with contacts cannot be continued yet.
+    contacts: tuple[str, ...] = field(default=(), repr=False)
+    _v: np.ndarray | None = field(default=None, repr=False)
+
+    @property
+    def success(self) -> bool:
+        return self.status == 0
+
+    @property
+    def newton_iterations(self) -> int:
+        """Newton iterations of the implicit methods over the run (0 for explicit methods)."""
+        return int(self.newton[-1]) if self.newton is not None and len(self.newton) else 0
+
+    @property
+    def newton_iterations_per_step(self) -> np.ndarray:
+        """Mean Newton iterations per step between consecutive saved states, shape (N − 1,)."""
+        steps = np.diff(np.rint((self.t - self.t[0]) / self.dt))
+        newton = self.newton if self.newton is not None else np.zeros(len(self.t))
+        return np.diff(newton) / np.maximum(steps, 1)
+
+    @property
+    def v(self) -> np.ndarray:
+        """Velocities q̇ (with ∂L/∂q̇ = p; M⁻¹p for mechanical systems), shape (N, n)."""
+        if self._v is None:
+            self._v = _core.derivative(self.model._core, "velocity", *self._arrays())
+        return self._v
+
+    def save(self, path: str | os.PathLike[str], *, overwrite: bool = False) -> Path:
+        """Writes the trajectory to the HDF5 file ``path`` (h5py, the extra ``io``); read it back
+        with :func:`varmech.load`. See :mod:`varmech.files` for the layout.
+
+        The model is stored as what builds it, as data: a scene's name and parameters, G and the
+        masses, a symbolic model's expressions and tapes, a Routh model's full model and
+        momenta; loading rebuilds it without running code from the file. A model of Python
+        closures is stored as its pickle, which :func:`varmech.load` unpickles only with
+        ``allow_pickle=True`` (or pass ``model=``). Every dataset carries a checksum.
+
+        Parameters
+        ----------
+        path : str or os.PathLike
+            The file to write.
+        overwrite : bool, default False
+            Replace an existing file.
+
+        Returns
+        -------
+        pathlib.Path
+            The path written.
+
+        Raises
+        ------
+        ValueError
+            Naming ``path``: the file exists and ``overwrite`` is False, or it cannot be written
+            (its directory, or a full disk).
+        ImportError
+            h5py is not installed.
+
+        See Also
+        --------
+        varmech.load : read it back (lazily, for runs larger than memory).
+
+        Examples
+        --------
+        >>> import pathlib, tempfile, varmech
+        >>> traj = varmech.integrate(varmech.scenes.pendulum(), dt=0.01, steps=100, save_every=10)
+        >>> path = traj.save(pathlib.Path(tempfile.mkdtemp()) / "pendulum.h5")
+        >>> path.name, len(varmech.load(path))
+        ('pendulum.h5', 11)
+        >>> import h5py, json
+        >>> with h5py.File(path) as f:
+        ...     json.loads(f["model"][()])
+        {'kind': 'scene', 'name': 'pendulum', 'parameters': {}}
+        """
+        return files.save(self, path, overwrite=overwrite)
+
+    def sol(self, t: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
+        """(q(t), p(t)) between the saved states, by cubic Hermite interpolation from q, q̇ and
+        p, ṗ at the states on either side: error O(Δ⁴) in their spacing Δ. See
+        ``dense.hermite``.
+
+        Parameters
+        ----------
+        t : float or array_like
+            Times within the saved span [t[0], t[-1]].
+
+        Returns
+        -------
+        q, p : ndarray, shape t.shape + (n,)
+            The interpolated positions and momenta.
+
+        Raises
+        ------
+        ValueError
+            Naming ``t``: times not finite or outside the saved span, fewer than two saved
+            states, or a constrained model (whose ṗ holds the constraint forces).
+
+        Examples
+        --------
+        Halfway between states saved 0.1 apart, against the state the run saved at every step:
+
+        >>> import varmech
+        >>> traj = varmech.integrate(varmech.scenes.pendulum(), dt=0.01, steps=100, save_every=10)
+        >>> q, p = traj.sol(0.05)
+        >>> fine = varmech.integrate(varmech.scenes.pendulum(), dt=0.01, steps=5)
+        >>> q.shape, float(abs(q - fine.q[-1]).max()) < 1e-7
+        ((1,), True)
+        """
+        return dense.hermite(self, t)
+
+    def energy(self) -> np.ndarray:
+        """The energy function E = p·q̇ − L (= ½pᵀM⁻¹p + V(q) for mechanical systems) at each
+        saved state.
+
+        Returns
+        -------
+        ndarray, shape (N,)
+            E at each saved state (computed for any model; conserved only when L does not
+            depend on t and no forces act).
+
+        Raises
+        ------
+        Exception
+            What a closure of the model raises, unchanged.
+
+        Examples
+        --------
+        The pendulum's energy, from E = −1/2, stays within 10⁻⁵ over a second of Störmer–Verlet:
+
+        >>> import varmech
+        >>> E = varmech.integrate(varmech.scenes.pendulum(), dt=0.01, steps=100, save_every=10).energy()
+        >>> E.shape, float(E[0]), float(abs(E - E[0]).max()) < 1e-5
+        ((11,), -0.5, True)
+        """
+        return self.energy_terms()[0]
+
+    def energy_terms(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(E, T, V) at each saved state: the energy function, its kinetic term T = E − V and its
+        potential V = −L(q, 0, t), the energy of the configuration at rest (½pᵀM⁻¹p and V(q)
+        for mechanical systems). The conservation verdicts measure energy errors against the
+        mean of T.
+
+        Returns
+        -------
+        E, T, V : ndarray, shape (N,)
+            The energy and its kinetic and potential terms at each saved state.
+
+        Raises
+        ------
+        Exception
+            What a closure of the model raises, unchanged.
+
+        Examples
+        --------
+        >>> import numpy as np, varmech
+        >>> E, T, V = varmech.integrate(varmech.scenes.pendulum(), dt=0.01, steps=100, save_every=10).energy_terms()
+        >>> float(T[0]), float(V[0]), bool(np.allclose(E, T + V))   # at rest at the bottom, struck: p = 1
+        (0.5, -1.0, True)
+        """
+        return _core.energy_terms(self.model._core, *self._arrays())
+
+    def constraint_residuals(self) -> tuple[np.ndarray, np.ndarray]:
+        """How far each saved state is off the constraints.
+
+        Returns
+        -------
+        position, velocity : ndarray, shape (N,)
+            |g(q)|∞ and |G(q)M⁻¹p|∞ (the hidden constraint) for holonomic constraints;
+            0 and |A(q)q̇|∞ for velocity constraints; |g(q)|∞ and |G(q)q̇, A(q)q̇ + b(q)|∞
+            with both.
+
+        Raises
+        ------
+        ValueError
+            Naming ``model``: it has no constraints.
+
+        Examples
+        --------
+        RATTLE keeps the Cartesian pendulum on its circle, and its velocity tangent to it:
+
+        >>> import varmech
+        >>> s = varmech.scenes.cartesian_pendulum()
+        >>> position, velocity = varmech.integrate(s, dt=s.dt, steps=100, save_every=50).constraint_residuals()
+        >>> position.shape, bool(position.max() < 1e-12), bool(velocity.max() < 1e-12)
+        ((3,), True, True)
+        """
+        return _core.constraint_residuals(self.model._core, *self._arrays()[1:])[0]
+
+    def _arrays(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(t, q, p) as arrays (read now from a file loaded lazily)."""
+        return np.asarray(self.t), np.asarray(self.q), np.asarray(self.p)
+
+    def __len__(self) -> int:
+        return len(self.t)
+
+    def __repr__(self) -> str:
+        return (
+            f"Trajectory({self.model.name!r}, method={self.method!r}, dt={self.dt:g}, steps={self.steps}, "
+            f"saved={len(self.t)}, nfev={self.nfev}, status={self.status})"
+        )
+
+
+def take_partial(err: BaseException) -> _core.TrajectoryRecord | None:
+    """The binding's record of a failed run's states, taken off the exception it rides on
+    (``_varmech_partial``), to be given as ``err.partial`` in the user's terms."""
+    partial = getattr(err, "_varmech_partial", None)
+    if partial is not None:
+        delattr(err, "_varmech_partial")
+    return partial
+
+
+def _trajectory(
+    record: _core.TrajectoryRecord, model: Model, method: str, dt: float, events: Sequence[_events.Event] = (), **status: Any
+) -> Trajectory:
+    """The Trajectory of the binding's record of a run, with its events' crossings (and the
+    status of a terminal event's stop, unless `status` is given)."""
+    r = record
+    found = _events.occurrences(r, events)
+    status = status or _events.termination(r, events, found)
+    return Trajectory(
+        r.t,
+        r.q,
+        r.p,
+        model,
+        method,
+        dt,
+        r.steps,
+        r.force_evaluations,
+        r.newton,
+        r.work,
+        checkpoint=r.checkpoint,
+        events=found,
+        **status,
+    )
+
+
+def load(
+    path: str | os.PathLike[str], *, model: Model | None = None, lazy: bool = False, allow_pickle: bool = False
+) -> Trajectory:
+    """The trajectory saved in ``path`` by :meth:`Trajectory.save` or streamed there by a run
+    (``integrate(output=)``), with its model built from the file's data, or ``model`` instead
+    (which must have the file's dimension). Only the committed rows are read; a run that
+    stopped without closing its file loads with ``status`` -1, and its checkpoint lets
+    :func:`varmech.resume` go on.
+
+    Loading runs no code from the file. Scenes, N-body models, symbolic and Routh-reduced
+    models are stored as data (names, numbers, expressions, tapes) and built again by their
+    constructors. A model of Python closures can travel only as a pickle, and unpickling runs
+    whatever the file says: such a file loads with ``model=`` (yours) or, if you trust it, with
+    ``allow_pickle=True``. A file whose superblock promises more bytes than it has (truncated),
+    whose checksums fail, or whose rows are not finite is refused before anything is used.
+
+    ``lazy=True`` reads no column until it is used (each a :class:`Rows`; indexing reads only
+    the rows asked for), for files larger than memory.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The HDF5 file.
+    model : Model, optional
+        The model to attach instead of the file's stored one (needed for a closure model
+        unless ``allow_pickle``).
+    lazy : bool, default False
+        Read each column only when used.
+    allow_pickle : bool, default False
+        Unpickle a stored closure model (which runs code from the file: only for files you
+        trust).
+
+    Returns
+    -------
+    Trajectory
+        The run in the file, with its checkpoint.
+
+    Raises
+    ------
+    ValueError
+        Naming ``path`` for a missing, corrupt or truncated file, one that is not a varmech
+        trajectory, or whose rows are not finite, and for a pickled model without ``model=`` or
+        ``allow_pickle=True``; naming ``model`` for a model of another dimension.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib, numpy as np, varmech
+    >>> s = varmech.scenes.kepler()
+    >>> traj = varmech.integrate(s, dt=s.dt, steps=100, save_every=10)
+    >>> path = traj.save(pathlib.Path(tempfile.mkdtemp()) / "kepler.h5")
+    >>> back = varmech.load(path)
+    >>> bool(np.array_equal(back.q, traj.q)) and back.method == traj.method
+    True
+
+    A model of closures (here V = q, by NumPy's functions) is not unpickled unless asked:
+
+    >>> ramp = varmech.MechanicalSystem(1, np.sum, np.ones_like)
+    >>> path = varmech.integrate(ramp, [0.0], [0.0], dt=0.1, steps=10).save(path.with_name("ramp.h5"))
+    >>> varmech.load(path)
+    Traceback (most recent call last):
+    ...
+    ValueError: path: the model of ... is a pickle (a model of Python closures), ...
+    >>> varmech.load(path, model=ramp).steps, varmech.load(path, allow_pickle=True).steps
+    (10, 10)
+    """
+    source = Path(path)
+    if not source.is_file():
+        raise ValueError(f"path: no file {str(source)!r}")
+    try:
+        with files.open_read(source, probe=True) as f:
+            if not f.swmr_mode:
+                # Every object's header is read (and its checksum checked) now, not first by a
+                # writer appending to the file.
+                f.visititems(lambda name, obj: None)
+            if f.attrs.get("format") != files.FORMAT:
+                raise ValueError(f"path: {str(source)!r} is not a varmech trajectory file")
+            version = int(f.attrs["format_version"])
+            if version not in files.READS:
+                raise ValueError(f"path: format version {version}; this varmech reads versions {files.READS}")
+            a = dict(f.attrs)
+            rows, slot, length, steps, nfev = (int(x) for x in f["committed"][()])
+            present = [name for name in files.COLUMNS if name in f]
+            shapes = {name: (rows, *f[name].shape[1:]) for name in present}
+            if any(f[name].shape[0] < rows for name in present) or slot not in (0, 1) or min(rows, length, steps) < 0:
+                raise ValueError(f"path: {str(source)!r} is truncated: fewer rows than committed")
+            columns: dict[str, Any] = {
+                name: files.Rows(source, name, shapes[name], f[name].dtype) if lazy else f[name][:rows] for name in present
+            }
+            # A lazy file's rows are checked as they are read; its last (which a resume goes on
+            # from) here.
+            last = {name: f[name][rows - 1 : rows] for name in ("t", "q", "p")} if lazy and rows else columns
+            for name in ("t", "q", "p", "work"):
+                if name in last and not np.isfinite(last[name]).all():
+                    raise ValueError(f"path: {str(source)!r} holds non-finite {name} rows: damaged")
+            checkpoint = f[f"checkpoint{slot}"][:length].tobytes()
+            # Crossings after the last committed state are a killed run's uncommitted segment's.
+            t_last = float(f["t"][rows - 1]) if rows else -np.inf
+            events = tuple(_occurrences(f["events"][str(k)], t_last) for k in range(len(f["events"]))) if "events" in f else ()
+            if model is None:
+                model = files.stored_model(f, source, version, allow_pickle)
+    except (OSError, KeyError, RuntimeError) as e:
+        # h5py raises RuntimeError for some damaged structures (a bad heap signature), and
+        # OSError for a failed checksum.
+        raise ValueError(f"path: {str(source)!r} is corrupt or truncated: {e}") from e
+    if model.dim != int(a["dim"]):
+        raise ValueError(f"model: has dimension {model.dim}, the file's states {int(a['dim'])}")
+    complete = bool(a["complete"])
+    return Trajectory(
+        columns["t"],
+        columns["q"],
+        columns["p"],
+        model,
+        str(a["method"]),
+        float(a["dt"]),
+        steps,
+        nfev,
+        columns.get("newton"),
+        columns.get("work"),
+        status=int(a["status"]) if complete else -1,
+        message=str(a["message"]) if complete else f"The run stopped at step {steps} without closing its file.",
+        checkpoint=checkpoint or None,
+        events=events,
+        contacts=tuple(str(name) for name in a.get("contacts", ())),
+    )
+
+
+def _occurrences(group: Any, t_last: float) -> Occurrences:
+    """An event's crossings in the file, up to the committed time ``t_last``."""
+    t = group["t"][()]
+    keep = int(np.searchsorted(t, t_last, side="right"))
+    return Occurrences(str(group.attrs["name"]), t[:keep], group["q"][:keep], group["p"][:keep])
