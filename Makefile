@@ -25,8 +25,10 @@ SPHINX = $(PYTHON) -m sphinx -b html -W --keep-going docs docs/_build/html
 docs: install
 	$(SPHINX)
 
+# --workspace: the features of the binding's build too, so that the core's release build from the
+# editable install is reused (rust/python/Cargo.toml's `either`); the binding itself has no tests.
 test: lint
-	cargo test --release
+	cargo test --release --workspace
 	$(PYTHON) -m pytest -q
 	$(SPHINX) -E -a
 
