@@ -2,7 +2,7 @@
 # `make test` (build, run every test). PYTHON may name another interpreter.
 PYTHON ?= python3
 
-.PHONY: install tour lint test docs test-aarch64 bench compare gallery
+.PHONY: install tour lint test docs wheel-check test-aarch64 bench compare gallery
 
 install:
 	$(PYTHON) -m pip install -e ".[test,charts]"
@@ -25,10 +25,20 @@ SPHINX = $(PYTHON) -m sphinx -b html -W --keep-going docs docs/_build/html
 docs: install
 	$(SPHINX)
 
+# Every test but the packaging check (the tests marked `wheel`, run by `make wheel-check`).
+# --workspace: the features of the binding's build too, so that the core's release build from the
+# editable install is reused (rust/python/Cargo.toml's `either`); the binding itself has no tests.
 test: lint
-	cargo test --release
-	$(PYTHON) -m pytest -q
+	cargo test --release --workspace
+	$(PYTHON) -m pytest -q -m "not wheel"
 	$(SPHINX) -E -a
+
+# The packaging check (tests/python/test_wheel.py): a manylinux2014 wheel built with zig, checked by
+# auditwheel, installed into a fresh venv and running the quickstart. A release build of its own
+# (zig's target dir, so nothing of the editable install is reused): minutes, hence not part of
+# `make test`; run it before a release (release.yml builds the release wheels).
+wheel-check: install
+	$(PYTHON) -m pytest -q -m wheel tests/python/test_wheel.py
 
 # The core's tests on aarch64 (the N-body kernel's scalar path there), cross-built and run under
 # qemu: needs `rustup target add aarch64-unknown-linux-gnu` and Debian's gcc-aarch64-linux-gnu and

@@ -57,15 +57,21 @@ def test_the_tour_runs_every_scene_with_its_showcase_or_its_kinds_methods():
     assert runs["damped_driven_pendulum"] == ((kind.default_method, kind.accurate_method), 100.0)
 
 
-@pytest.mark.parametrize("kind", ["stability", "phase"])
-def test_chart_writes_the_files_it_names(tmp_path, kind, run_cli):
-    pytest.importorskip("matplotlib")
-    out = run_cli("chart", kind, "--quick", "--format", "svg", "--out", tmp_path).stdout
-    named = [line.split(" ", 1)[1] for line in out.splitlines() if line.startswith("wrote ")]
+def chart_from_the_command_line(run_cli, kind, out):
+    """Runs ``chart <kind> --quick --format svg`` and checks that it wrote the files it names,
+    figures and their data, with the CSV header of the kind."""
+    printed = run_cli("chart", kind, "--quick", "--format", "svg", "--out", out).stdout
+    named = [line.split(" ", 1)[1] for line in printed.splitlines() if line.startswith("wrote ")]
     assert {p.rsplit(".", 1)[1] for p in named} == {"csv", "svg"}
-    assert sorted(named) == sorted(str(p) for p in tmp_path.iterdir())
+    assert sorted(named) == sorted(str(p) for p in out.iterdir())
     header = next(line for line in open(next(p for p in named if p.endswith(".csv"))) if not line.startswith("#"))
     assert header.startswith("method," if kind == "stability" else "orbit,")
+
+
+def test_chart_writes_the_files_it_names(tmp_path, run_cli):
+    """The phase portrait; the stability chart's are checked with its labels, below."""
+    pytest.importorskip("matplotlib")
+    chart_from_the_command_line(run_cli, "phase", tmp_path)
 
 
 def test_chart_refuses_an_unknown_scene(run_cli):
@@ -81,15 +87,15 @@ def svg_texts(path):
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("kind", sorted(KINDS))
+@pytest.mark.parametrize("kind", sorted(kind for kind in KINDS if scenes_for(kind)))
 def test_every_chart_runs_with_its_defaults_on_every_scene_it_lists(tmp_path, kind):
     """Every scene the kind applies to, with the default methods (from the scene's kind):
-    none is refused for its method. The sweeps are the quick ones, shortened further."""
+    none is refused for its method. The sweeps are the quick ones. The charts of no scene
+    (stability, nonholonomic) are drawn with their defaults by their own tests, which check more."""
     pytest.importorskip("matplotlib")
-    for name in scenes_for(kind) or [None]:  # [None]: a chart of no scene (stability)
-        if name is not None:
-            scene = scenes.get(name)
-            assert all(scene.model.kind.admits(m) for m in fitting_methods(KINDS[kind].methods, scene)), name
+    for name in scenes_for(kind):
+        scene = scenes.get(name)
+        assert all(scene.model.kind.admits(m) for m in fitting_methods(KINDS[kind].methods, scene)), name
         if kind in ("work-precision", "energy") and name not in ("kepler", "double_pendulum", "outer_solar_system"):
             continue  # the rest by their methods alone: their sweeps take minutes
         written = chart(kind, name, out=tmp_path, quick=True, fmt="svg", progress=False)
@@ -135,9 +141,10 @@ def test_skipped_baselines_are_said_on_screen_and_drawn_on_the_chart(tmp_path, r
     assert f"note: {note}" in " ".join(" ".join(t.split()) for t in texts) and "t (time units)" in texts, texts
 
 
-def test_the_stability_chart_labels_its_limits_and_its_coincident_curves(tmp_path):
+def test_the_stability_chart_labels_its_limits_and_its_coincident_curves(tmp_path, run_cli):
     pytest.importorskip("matplotlib")
-    chart("stability", out=tmp_path, quick=True, fmt="svg", progress=False)
+    # Drawn once (its sweeps take a while): from the command line, which writes the files it names.
+    chart_from_the_command_line(run_cli, "stability", tmp_path)
     texts = svg_texts(tmp_path / "stability.svg")
     assert "verlet (the same ρ as symplectic_euler)" in texts and "midpoint: stable for every hω" in texts
     assert "symplectic_euler, verlet 2" in texts and "yoshida4 1.5734" in texts

@@ -1,7 +1,8 @@
 """A release wheel, as a user gets it: built here for manylinux2014 (maturin with zig, no
 Docker), accepted by auditwheel with that tag, installed into a fresh venv with its extra
 ``symbolic`` from the index, and running the README's quickstart there, with the ``varmech``
-command. Slow (a release build, then pip): ``pytest -m "not slow"`` leaves it out."""
+command. The packaging check, marked ``wheel``: a release build of its own, then pip, minutes;
+``make wheel-check`` runs it, ``make test`` (``pytest -m "not wheel"``) leaves it out."""
 
 import os
 import platform
@@ -18,7 +19,7 @@ from test_readme import quickstart
 ROOT = Path(__file__).resolve().parents[2]
 
 pytestmark = [
-    pytest.mark.slow,
+    pytest.mark.wheel,
     pytest.mark.skipif(
         sys.platform != "linux" or platform.machine() != "x86_64", reason="the manylinux wheel of this test is x86_64 Linux's"
     ),
