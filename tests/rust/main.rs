@@ -20,6 +20,7 @@ mod forcing;
 mod general_lagrangian;
 mod heavy_top;
 mod hessians;
+mod impacts;
 #[cfg(feature = "jit")]
 mod jit;
 mod kepler;

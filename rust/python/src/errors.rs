@@ -88,6 +88,7 @@ pub fn to_pyerr(py: Python<'_>, error: Error) -> PyErr {
             (err, step, time)
         }
         Error::SpuriousBranch { step, time, .. } => (SpuriousBranchError::new_err(error.to_string()), step, time),
+        Error::Contact { step, time, .. } => (VarmechError::new_err(error.to_string()), step, time),
         Error::Model { step, time, source } => {
             (raised(source, |source| Error::Model { step, time, source }), step, time)
         }

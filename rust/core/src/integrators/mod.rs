@@ -32,6 +32,7 @@ mod dynamics;
 mod ensemble;
 pub mod events;
 mod explicit_rk;
+pub mod jumps;
 mod kick_drift;
 mod kind;
 mod method;
@@ -52,15 +53,21 @@ pub use composition::Composition;
 pub use del::{Composed, Del, StepEquations, TwoPoint};
 use del::{Constraints, DiscreteConstraint};
 pub use dynamics::{Dynamics, General};
-pub use ensemble::{integrate_ensemble, Ensemble, MemberEvents, Members, Outcome, Parallel, Shared, Stopped};
+pub use ensemble::{
+    integrate_ensemble, integrate_ensemble_watching, Ensemble, MemberEvents, Members, Outcome, Parallel, Shared,
+    Stopped,
+};
 pub use events::{Detector, EventFunctions, EventSpec, NativeEvent, Occurrence};
 pub use explicit_rk::ExplicitRk;
+pub use jumps::{Contact, Contacts, Impacts, Law, NativeContact, NativeSurface, Surface, MAX_IMPACTS};
 pub use kick_drift::KickDrift;
 pub use kind::ModelKind;
 pub use method::{Method, MethodInfo};
 pub use poll::{Counting, Poll};
 pub use rattle::Rattle;
-pub use run::{integrate, integrate_with_events, resume, resume_with_events, Options};
+pub use run::{
+    integrate, integrate_watching, integrate_with_events, resume, resume_watching, resume_with_events, Options, Watch,
+};
 pub use splitting::{Leading, Splitting};
 pub use step::{Increment, StepStart};
 use stepper::Phase;

@@ -3,6 +3,7 @@
 use serde::{Deserialize, Serialize};
 
 use super::events::Search;
+use super::jumps::{Contacts, Resolver};
 use super::{Checkpoint, Counting, Detector, Dynamics, Failure, Method, NewtonOptions, Poll, Stepper, Trajectory};
 use crate::model::{EnergyTerms, Scale};
 use crate::{memory, Error};
@@ -103,10 +104,30 @@ where
     P: Poll,
 {
     let (stepper, watch) = start(sys, method, q0, p0, options)?;
-    run(sys, stepper, watch, options.steps, options.save_every, poll, None)
+    run(
+        sys,
+        stepper,
+        watch,
+        options.steps,
+        options.save_every,
+        poll,
+        (None, None),
+    )
 }
 
 // Events: the run with a [`Detector`] (begin).
+/// What a run watches besides its states: events ([`Detector`]) and contacts ([`Contacts`]),
+/// either, both or neither. Both are checked after every step (the steps are then taken one
+/// at a time); a step that crosses a contact is redone in pieces at each impact, and the events
+/// are evaluated and located on the pieces.
+#[derive(Default)]
+pub struct Watch<'w, 'e, 'c> {
+    /// The events, located by partial steps of the method ([`integrate_with_events`]).
+    pub events: Option<&'w mut Detector<'e>>,
+    /// The unilateral contacts φ(q) ≥ 0, whose impacts the run resolves.
+    pub contacts: Option<&'w Contacts<'c>>,
+}
+
 /// As [`integrate`], watching the `events`' functions after every step (the steps are then
 /// taken one at a time): each crossing is located by a partial step of the method
 /// ([`Detector`]) and pushed to [`Trajectory::events`]. When an event reaches its terminal
@@ -125,23 +146,86 @@ where
     S: Dynamics + ?Sized,
     P: Poll,
 {
-    let (stepper, watch) = start(sys, method, q0, p0, options)?;
-    // The run's search, its scratch stepper on the same model.
-    let search = match events.begin(sys, &stepper) {
+    let watch = Watch {
+        events: Some(events),
+        contacts: None,
+    };
+    integrate_watching(sys, method, q0, p0, options, poll, watch)
+}
+// Events (end).
+
+/// As [`integrate`], watching `watch`'s events (as [`integrate_with_events`] does) and
+/// resolving the impacts on its contacts.
+///
+/// The step that crosses a contact's φ = 0 is split at the contact: the method's partial step
+/// of size αh from (qₙ, pₙ) to the contact configuration q̃ (α located to round-off), the jump
+/// p⁺ = p⁻ + λ∇φ(q̃) of the contact's [`Law`](super::Law) (∇φ projected on the constraints of a
+/// constrained model), then the method's partial step of (1 − α)h to tₙ₊₁; the rest of the step
+/// is checked against every contact again (a corner, a second bounce), up to
+/// [`MAX_IMPACTS`](super::MAX_IMPACTS) impacts in one step. A step without an impact is bit for
+/// bit the step without contacts. The impacts go to [`Trajectory::impacts`], and the saved
+/// states include the state just before and just after each (one time, two rows). The energy
+/// check ([`Options::max_energy_error`]) discounts the change of energy at the jumps (e < 1).
+///
+/// Refuses, naming `contacts`, a surface that does not fit the model's coordinates and the
+/// variational law on a method or model it does not fit; naming `q0`, an initial state outside
+/// φ ≥ 0. Fails with [`Error::Contact`] (the run ending at the start of the step, its last good
+/// state) when an impact cannot be resolved: a non-finite state after a jump, a resting or
+/// grazing contact, or more than `MAX_IMPACTS` impacts in a step.
+pub fn integrate_watching<S, P>(
+    sys: &S,
+    method: Method,
+    q0: &[f64],
+    p0: &[f64],
+    options: &Options,
+    poll: P,
+    watch: Watch<'_, '_, '_>,
+) -> Result<Trajectory, Box<Failure>>
+where
+    S: Dynamics + ?Sized,
+    P: Poll,
+{
+    let (stepper, energy) = start(sys, method, q0, p0, options)?;
+    watched(
+        sys,
+        stepper,
+        energy,
+        (options.steps, options.save_every),
+        poll,
+        watch,
+        "q0",
+    )
+}
+
+/// The run of `stepper` to step `end` watching `watch`: the events' search and the contacts'
+/// resolver begun on the stepper's state (named `argument` if it is outside a contact).
+fn watched<S, P>(
+    sys: &S,
+    stepper: Stepper<&S>,
+    energy: Option<EnergyWatch>,
+    (end, save_every): (usize, usize),
+    poll: P,
+    watch: Watch<'_, '_, '_>,
+    argument: &'static str,
+) -> Result<Trajectory, Box<Failure>>
+where
+    S: Dynamics + ?Sized,
+    P: Poll,
+{
+    let search = match watch.events.map(|events| events.begin(sys, &stepper)).transpose() {
         Ok(search) => search,
         Err(error) => return Err(fail(error, first_state(sys, &stepper))),
     };
-    run(
-        sys,
-        stepper,
-        watch,
-        options.steps,
-        options.save_every,
-        poll,
-        Some(search),
-    )
+    let resolver = watch
+        .contacts
+        .map(|contacts| Resolver::begin(sys, &stepper, contacts, argument, energy.is_some()))
+        .transpose();
+    let resolver = match resolver {
+        Ok(resolver) => resolver,
+        Err(error) => return Err(fail(error, first_state(sys, &stepper))),
+    };
+    run(sys, stepper, energy, end, save_every, poll, (search, resolver))
 }
-// Events (end).
 
 /// The stepper of a new run and its energy check.
 #[allow(clippy::type_complexity)]
@@ -183,7 +267,7 @@ where
     P: Poll,
 {
     let (stepper, watch, end) = resumed(sys, checkpoint, steps, save_every)?;
-    run(sys, stepper, watch, end, save_every, poll, None)
+    run(sys, stepper, watch, end, save_every, poll, (None, None))
 }
 
 /// As [`resume`], watching the `events` as [`integrate_with_events`] does, from the
@@ -201,12 +285,31 @@ where
     S: Dynamics + ?Sized,
     P: Poll,
 {
-    let (stepper, watch, end) = resumed(sys, checkpoint, steps, save_every)?;
-    let search = match events.begin(sys, &stepper) {
-        Ok(search) => search,
-        Err(error) => return Err(fail(error, first_state(sys, &stepper))),
+    let watch = Watch {
+        events: Some(events),
+        contacts: None,
     };
-    run(sys, stepper, watch, end, save_every, poll, Some(search))
+    resume_watching(sys, checkpoint, steps, save_every, poll, watch)
+}
+
+/// As [`resume`], watching `watch`'s events and contacts as [`integrate_watching`] does, from
+/// the checkpoint's state on (give the first run's contacts again: a run with contacts and its
+/// resumption are one run, bit for bit). A checkpoint whose state is outside a contact is
+/// refused, naming `checkpoint`.
+pub fn resume_watching<S, P>(
+    sys: &S,
+    checkpoint: Checkpoint,
+    steps: usize,
+    save_every: usize,
+    poll: P,
+    watch: Watch<'_, '_, '_>,
+) -> Result<Trajectory, Box<Failure>>
+where
+    S: Dynamics + ?Sized,
+    P: Poll,
+{
+    let (stepper, energy, end) = resumed(sys, checkpoint, steps, save_every)?;
+    watched(sys, stepper, energy, (end, save_every), poll, watch, "checkpoint")
 }
 
 /// The stepper of a checkpoint, its energy check and the step to reach.
@@ -260,7 +363,7 @@ fn run<'s, S, P>(
     end: usize,
     save_every: usize,
     mut poll: P,
-    mut search: Option<Search<'_, '_, &'s S>>,
+    (mut search, mut resolver): (Option<Search<'_, '_, &'s S>>, Option<Resolver<'_, '_, &'s S>>),
 ) -> Result<Trajectory, Box<Failure>>
 where
     S: Dynamics + ?Sized,
@@ -268,6 +371,7 @@ where
 {
     let n = sys.dim();
     let mut traj = empty(sys);
+    traj.impacts.dim = n;
     let start = stepper.steps();
     let saved = ((end - start) / save_every).saturating_add(2);
     // Reserving succeeds beyond the memory there is (Linux overcommits) and the run would then
@@ -300,12 +404,20 @@ where
         // Every `save_every`-th state is saved, and the last.
         let save = (stepper.steps() / save_every + 1).saturating_mul(save_every).min(end);
         let n = save - stepper.steps();
-        let advanced = match search.as_mut() {
-            None => stepper.advance(n, Counting(|steps| poll.poll(steps))),
+        let advanced = match (search.as_mut(), resolver.as_mut()) {
+            (None, None) => stepper.advance(n, Counting(|steps| poll.poll(steps))),
             // Events: step by step, stopping after a terminal event's step.
-            Some(search) => search
+            (Some(search), None) => search
                 .advance(&mut stepper, n, &mut traj.events, &mut poll)
                 .map(|stop| traj.terminated_by = stop),
+            // Contacts: step by step, each step that crosses one redone in pieces.
+            (search, Some(resolver)) => {
+                let advanced = resolver.advance(&mut stepper, n, search, &mut traj, &mut poll);
+                if let Some(watch) = watch.as_mut() {
+                    watch.shift(resolver.take_energy_jump());
+                }
+                advanced.map(|stop| traj.terminated_by = stop)
+            }
         };
         if let Err(error) = advanced {
             // Stops with the last good state kept, and the work counted.
@@ -329,6 +441,7 @@ where
     traj.count(&stepper);
     // Events: the partial steps' force evaluations are the run's too.
     traj.force_evaluations += search.map_or(0, |s| s.force_evaluations());
+    traj.force_evaluations += resolver.map_or(0, |r| r.force_evaluations());
     traj.checkpoint = Checkpoint::new(sys, stepper.into_state(), watch).to_bytes();
     match outcome {
         Ok(()) => Ok(traj),
@@ -368,6 +481,12 @@ impl EnergyWatch {
         };
         watch.push(&terms, stepper.work());
         Some(Ok(watch))
+    }
+
+    /// Discounts a change `delta` of the energy at jumps (impacts with e < 1): the check
+    /// judges E − W − E₀ of the smooth motion.
+    fn shift(&mut self, delta: f64) {
+        self.initial += delta;
     }
 
     fn push(&mut self, terms: &EnergyTerms, work: f64) {
