@@ -45,6 +45,7 @@ body spends beyond a curved surface's chord.
 
 from __future__ import annotations
 
+import json
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any, Literal
@@ -52,7 +53,6 @@ from typing import Any, Literal
 import numpy as np
 from numpy.typing import ArrayLike
 
-from . import _core
 from . import surfaces as _surfaces
 from ._core import ContactError
 from .events import Occurrences
@@ -257,7 +257,7 @@ Spec = tuple[str, float, str, str, Any]
 def specs(contacts: Sequence[Contact]) -> list[Spec]:
     """The binding's tuples of ``contacts``, each a :class:`Contact` (TypeError naming
     ``contacts[i]``); the core checks each against the model and the initial state."""
-    out = []
+    out: list[Spec] = []
     for i, c in enumerate(contacts):
         if not isinstance(c, Contact):
             raise TypeError(f"contacts[{i}]: expected a varmech.Contact, got {type(c).__name__}")
@@ -266,8 +266,67 @@ def specs(contacts: Sequence[Contact]) -> list[Spec]:
     return out
 
 
-def occurrences(record: Any, contacts: Sequence[Contact]) -> tuple[Occurrences, ...]:
+def occurrences(record: Any, contacts: Sequence[Contact | str]) -> tuple[Occurrences, ...]:
     """Each contact's impacts in the binding's record of a run: time, contact configuration and
     the momenta just before."""
+    if not contacts:
+        return ()
     index, t, q, before = record.impacts[:4]
-    return tuple(Occurrences(c.name, t[index == i], q[index == i], before[index == i]) for i, c in enumerate(contacts))
+    return tuple(Occurrences(name(c), t[index == i], q[index == i], before[index == i]) for i, c in enumerate(contacts))
+
+
+def name(contact: Contact | str) -> str:
+    """A contact's name (a loaded file's contact given by Python functions is its name)."""
+    return contact if isinstance(contact, str) else contact.name
+
+
+def stored(contacts: Sequence[Contact | str]) -> str:
+    """The contacts as a file stores them, JSON: each native one's name, restitution, law and
+    surface (``Surface.native``), and null for one given by Python functions (no code is stored)."""
+    rows = [
+        [c.name, c.restitution, c.law, *c.phi.native] if isinstance(c, Contact) and isinstance(c.phi, _surfaces.Surface) else None
+        for c in contacts
+    ]
+    return json.dumps(rows)
+
+
+def restored(text: str, names: Sequence[str]) -> tuple[Contact | str, ...]:
+    """The contacts a file stored (:func:`stored`), those given by Python functions as their
+    ``names``; ValueError naming ``path`` for a record that is not one."""
+    try:
+        rows = json.loads(text)
+        out: list[Contact | str] = []
+        for row, label in zip(rows, names, strict=True):
+            if row is None:
+                out.append(str(label))
+                continue
+            name, restitution, law, kind, payload = row
+            surface: _surfaces.Surface
+            if kind == "crossing":
+                k, value = payload
+                surface = _surfaces.Wall(int(k), float(value))
+            else:
+                ks, centre, axes, inside = payload
+                surface = _surfaces.Ellipsoid(tuple(ks), tuple(centre), tuple(axes), bool(inside))
+            out.append(Contact(surface, _surfaces.Gradient(surface), restitution, name, law))
+        return tuple(out)
+    except (ValueError, TypeError) as e:
+        raise ValueError(f"path: its contacts are not a stored contact list ({e})") from None
+
+
+def going_on(stored: Sequence[Contact | str], given: Sequence[Contact] | None = None) -> tuple[Contact, ...]:
+    """The contacts a continued run goes on with: its own, or ``given`` in their place (the same
+    names, in the same order); a ValueError naming ``contacts`` for one of Python functions
+    loaded from a file as its name and not given again."""
+    if given is None:
+        unknown = [c for c in stored if isinstance(c, str)]
+        if unknown:
+            raise ValueError(
+                f"contacts: the run's contacts {', '.join(map(repr, unknown))} were given by Python functions, which its"
+                " file does not store; pass them again: varmech.resume(path, contacts=[...])"
+            )
+        return tuple(c for c in stored if isinstance(c, Contact))
+    specs(given)
+    if [name(c) for c in given] != [name(c) for c in stored]:
+        raise ValueError(f"contacts: the run has the contacts {[name(c) for c in stored]}, not {[name(c) for c in given]}")
+    return tuple(given)
