@@ -55,6 +55,7 @@ from numpy.typing import ArrayLike
 
 from . import surfaces as _surfaces
 from ._core import ContactError
+from ._util import floats, integer, number
 from .events import Occurrences
 
 #: The public API; the rest serves :func:`varmech.integrate`.
@@ -165,7 +166,8 @@ class Contact:
         Raises
         ------
         ValueError
-            ``restitution`` not in [0, 1], or an unknown ``law``.
+            ``k`` not an integer ≥ 0, ``value`` not a number, ``restitution`` not in [0, 1],
+            or an unknown ``law``.
 
         Examples
         --------
@@ -176,7 +178,7 @@ class Contact:
         3
         """
 
-        surface = _surfaces.Wall(int(k), float(value))
+        surface = _surfaces.Wall(integer("k", k), number("value", value))
         label = name if name is not None else f"q[{k}] ≥ {value:g}"
         return cls(surface, _surfaces.Gradient(surface), restitution, label, law)
 
@@ -227,7 +229,8 @@ class Contact:
         ------
         ValueError
             ``semi_axes``, ``coordinates`` and ``centre`` of different lengths, semi-axes not
-            finite and positive, a centre not finite, a negative coordinate, ``restitution``
+            numbers, finite and positive, a centre not finite numbers, a coordinate not an integer
+            ≥ 0, ``restitution``
             not in [0, 1], or an unknown ``law``.
 
         Examples
@@ -241,9 +244,9 @@ class Contact:
         >>> len(traj.events[0]) > 20, min(table.phi(q) for q in traj.q) > -1e-12
         (True, True)
         """
-        axes = tuple(float(a) for a in np.atleast_1d(np.asarray(semi_axes, dtype=float)))
-        ks = tuple(range(len(axes))) if coordinates is None else tuple(int(k) for k in np.atleast_1d(coordinates))
-        c = (0.0,) * len(ks) if centre is None else tuple(float(x) for x in np.atleast_1d(np.asarray(centre, dtype=float)))
+        axes = tuple(float(a) for a in np.atleast_1d(floats("semi_axes", semi_axes)))
+        ks = tuple(range(len(axes))) if coordinates is None else tuple(integer("coordinates", k) for k in np.atleast_1d(coordinates).tolist())
+        c = (0.0,) * len(ks) if centre is None else tuple(float(x) for x in np.atleast_1d(floats("centre", centre)))
         surface = _surfaces.Ellipsoid(ks, c, axes, bool(inside))
         label = name if name is not None else ("ellipsoid" if inside else "outside an ellipsoid")
         return cls(surface, _surfaces.Gradient(surface), restitution, label, law)
@@ -304,7 +307,7 @@ def restored(text: str, names: Sequence[str]) -> tuple[Contact | str, ...]:
             surface: _surfaces.Surface
             if kind == "crossing":
                 k, value = payload
-                surface = _surfaces.Wall(int(k), float(value))
+                surface = _surfaces.Wall(integer("k", k), number("value", value))
             else:
                 ks, centre, axes, inside = payload
                 surface = _surfaces.Ellipsoid(tuple(ks), tuple(centre), tuple(axes), bool(inside))
