@@ -84,7 +84,7 @@ class Contact:
     name : str, default "contact"
         The contact's name (its events' name in ``traj.events``).
     law : {"variational", "reflect"}, default "variational"
-        The impact law: the variational collision integrator (:func:`variational_jump`; for
+        The impact law: the variational collision integrator (the discrete energy kept; for
         kick–drift methods and the two-point rules ``midpoint`` and ``trapezoid``, elastic
         contacts only), or the exact reflection of the momenta between the method's partial
         steps (any method; symplectic across an impact only to the method's order).
@@ -119,7 +119,7 @@ class Contact:
     gradient: Callable[[np.ndarray], ArrayLike]
     restitution: float = 1.0
     name: str = "contact"
-    #: The impact law: ``"variational"``, the variational collision integrator (:func:`variational_jump`;
+    #: The impact law: ``"variational"``, the variational collision integrator (the discrete energy kept;
     #: kick–drift methods and the two-point rules ``midpoint`` and ``trapezoid``), or
     #: ``"reflect"``, the exact reflection of the momenta between the method's partial steps (any
     #: method; symplectic across an impact only to the method's order).
