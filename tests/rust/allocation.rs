@@ -2,13 +2,16 @@
 //! run of 100 steps (the set-up's), whatever the method, and so does RATTLE's on a chain and the
 //! discrete Lagrange–d'Alembert step's on the rolling scenes and, with a holonomic constraint
 //! too, on the skate; a
-//! stepper's steps make none at all, nor does taking it apart, resuming and resetting it.
+//! stepper's steps make none at all, nor does taking it apart, resuming and resetting it, nor
+//! does a discrete energy E_d once made.
 
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
 use std::ops::Deref;
 
-use varmech::integrators::{integrate, Dynamics, General, Method, ModelKind, Options, Stepper, StepperState};
+use varmech::integrators::{
+    integrate, DiscreteEnergy, Dynamics, General, Method, ModelKind, Options, Stepper, StepperState,
+};
 use varmech::model::Routhian;
 use varmech::scenes::{self, NBody, NonholonomicScene, SceneModel};
 
@@ -366,5 +369,39 @@ fn the_mixed_constraints_step_loop_allocates_nothing() {
             short, long,
             "{method:?}: {short} allocations for 100 steps, {long} for 5000"
         );
+    }
+}
+
+/// Allocations made by 1 000 evaluations of `method`'s discrete energy on `sys`, after a first
+/// one (which may grow a thread's scratch, as the inverse Legendre transform's).
+fn discrete_energy_allocations<S: Dynamics>(sys: &S, method: Method, start: (&[f64], &[f64])) -> usize {
+    let mut energy = DiscreteEnergy::new(method, start.0.len()).unwrap();
+    let end: (Vec<f64>, Vec<f64>) = (start.0.iter().map(|x| x + 0.01).collect(), start.1.to_vec());
+    let mut evaluate = || energy.energy(sys, 0.0, 0.01, start, (&end.0, &end.1)).unwrap();
+    evaluate();
+    let before = allocated();
+    for _ in 0..1000 {
+        std::hint::black_box(evaluate());
+    }
+    allocated() - before
+}
+
+#[test]
+fn the_discrete_energy_allocates_nothing() {
+    let kepler = scenes::Kepler::problem(0.6).unwrap();
+    let start = (&kepler.initial.q[..], &kepler.initial.p[..]);
+    let double = scenes::DoublePendulum::new(1.0, 2.0, 2.0, 3.0, 9.80665).unwrap();
+    let pendulum = tapes::pendulum_lagrangian();
+    for method in Method::ALL.into_iter().filter(|m| DiscreteEnergy::new(*m, 2).is_some()) {
+        assert_eq!(
+            discrete_energy_allocations(&kepler.system, method, start),
+            0,
+            "{method:?}"
+        );
+    }
+    for method in [Method::Midpoint, Method::Trapezoid] {
+        let natural = discrete_energy_allocations(&General(&double), method, (&[0.7, -0.4], &[1.3, 0.8]));
+        let compiled = discrete_energy_allocations(&General(&pendulum), method, (&[0.3], &[0.7]));
+        assert_eq!((natural, compiled), (0, 0), "{method:?}: natural, compiled");
     }
 }
