@@ -3,14 +3,17 @@
 //! discrete Lagrange–d'Alembert step's on the rolling scenes and, with a holonomic constraint
 //! too, on the skate; a
 //! stepper's steps make none at all, nor does taking it apart, resuming and resetting it, nor
-//! does a discrete energy E_d once made.
+//! does a discrete energy E_d once made. A run with contacts allocates nothing in its steps
+//! either, impacts included, but for the growth of its output (the impacts and the states at
+//! them).
 
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
 use std::ops::Deref;
 
 use varmech::integrators::{
-    integrate, DiscreteEnergy, Dynamics, General, Method, ModelKind, Options, Stepper, StepperState,
+    integrate, integrate_watching, Contact, Contacts, DiscreteEnergy, Dynamics, General, Law, Method, ModelKind,
+    NativeSurface, Options, Stepper, StepperState, Watch,
 };
 use varmech::model::Routhian;
 use varmech::scenes::{self, NBody, NonholonomicScene, SceneModel};
@@ -404,4 +407,62 @@ fn the_discrete_energy_allocates_nothing() {
         let compiled = discrete_energy_allocations(&General(&pendulum), method, (&[0.3], &[0.7]));
         assert_eq!((natural, compiled), (0, 0), "{method:?}: natural, compiled");
     }
+}
+
+/// Allocations of a run of `steps` steps of 0.01 of the free particle from (q0, p0) in the
+/// table |q| ≤ `radius` (reflect law), and its impacts.
+fn billiard(steps: usize, radius: f64) -> (usize, usize) {
+    let free = scenes::EllipticBilliard::new(1.0, 1.0).unwrap();
+    let table = Contact {
+        surface: Box::new(NativeSurface::Ellipsoid {
+            coordinates: vec![0, 1],
+            centre: vec![0.0, 0.0],
+            semi_axes: vec![radius, radius],
+            inside: true,
+        }),
+        restitution: 1.0,
+        law: Law::Reflect,
+        name: "table".into(),
+    };
+    let contacts = Contacts::new(vec![table]).unwrap();
+    let options = Options {
+        save_every: 100,
+        ..Options::new(0.01, steps)
+    };
+    let watch = Watch {
+        events: None,
+        contacts: Some(&contacts),
+    };
+    let before = allocated();
+    let traj = integrate_watching(
+        &free,
+        Method::Verlet,
+        &[0.3, -0.2],
+        &[0.6, 0.8],
+        &options,
+        || Ok(()),
+        watch,
+    )
+    .unwrap();
+    (allocated() - before, traj.impacts.len())
+}
+
+#[test]
+fn contacts_allocate_nothing_in_the_step_loop() {
+    // A table never reached: a long run allocates as much as a short one.
+    let (short, none) = billiard(100, 1e6);
+    let (long, _) = billiard(100_000, 1e6);
+    assert_eq!(none, 0);
+    assert_eq!(long, short, "{long} allocations in 100 000 steps, {short} in 100");
+    // Thousands of impacts: only the output grows, each of its 9 columns (the impacts' 6, the
+    // saved states' 3) doubling its storage now and then.
+    let (short, few) = billiard(1000, 1.0);
+    let (long, many) = billiard(100_000, 1.0);
+    assert!(few >= 5 && many >= 500, "{few}, {many} impacts");
+    let doublings = 9 * ((many as f64).log2().ceil() as usize + 1);
+    assert!(
+        long - short <= doublings,
+        "{} allocations for {many} impacts",
+        long - short
+    );
 }

@@ -63,14 +63,14 @@ pub use ensemble::{
 };
 pub use events::{Detector, EventFunctions, EventSpec, NativeEvent, Occurrence};
 pub use explicit_rk::ExplicitRk;
-pub use jumps::{Contact, Contacts, Impacts, Law, NativeContact, NativeSurface, Surface, MAX_IMPACTS};
+pub use jumps::{Contact, Contacts, Impacts, Law, NativeContact, NativeSurface, Surface, Watch, Watcher, MAX_IMPACTS};
 pub use kick_drift::KickDrift;
 pub use kind::ModelKind;
 pub use method::{Method, MethodInfo};
 pub use poll::{Counting, Poll};
 pub use rattle::Rattle;
 pub use run::{
-    integrate, integrate_watching, integrate_with_events, resume, resume_watching, resume_with_events, Options, Watch,
+    integrate, integrate_watching, integrate_with_events, resume, resume_watching, resume_with_events, Options,
 };
 pub use splitting::{Leading, Splitting};
 pub use step::{Increment, StepStart};
