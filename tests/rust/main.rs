@@ -13,6 +13,7 @@ mod constraints;
 mod convergence;
 mod crafted_checkpoints;
 mod damped_driven_pendulum;
+mod discrete_energy;
 mod ensemble;
 mod events;
 mod failures;

@@ -2,9 +2,8 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::events::Search;
-use super::jumps::{Contacts, Resolver};
-use super::{Checkpoint, Counting, Detector, Dynamics, Failure, Method, NewtonOptions, Poll, Stepper, Trajectory};
+use super::jumps::{Watch, Watcher};
+use super::{Checkpoint, Detector, Dynamics, Failure, Method, NewtonOptions, Poll, Stepper, Trajectory};
 use crate::model::{EnergyTerms, Scale};
 use crate::{memory, Error};
 
@@ -111,23 +110,11 @@ where
         options.steps,
         options.save_every,
         poll,
-        (None, None),
+        Watcher::idle(),
     )
 }
 
 // Events: the run with a [`Detector`] (begin).
-/// What a run watches besides its states: events ([`Detector`]) and contacts ([`Contacts`]),
-/// either, both or neither. Both are checked after every step (the steps are then taken one
-/// at a time); a step that crosses a contact is redone in pieces at each impact, and the events
-/// are evaluated and located on the pieces.
-#[derive(Default)]
-pub struct Watch<'w, 'e, 'c> {
-    /// The events, located by partial steps of the method ([`integrate_with_events`]).
-    pub events: Option<&'w mut Detector<'e>>,
-    /// The unilateral contacts φ(q) ≥ 0, whose impacts the run resolves.
-    pub contacts: Option<&'w Contacts<'c>>,
-}
-
 /// As [`integrate`], watching the `events`' functions after every step (the steps are then
 /// taken one at a time): each crossing is located by a partial step of the method
 /// ([`Detector`]) and pushed to [`Trajectory::events`]. When an event reaches its terminal
@@ -197,8 +184,8 @@ where
     )
 }
 
-/// The run of `stepper` to step `end` watching `watch`: the events' search and the contacts'
-/// resolver begun on the stepper's state (named `argument` if it is outside a contact).
+/// The run of `stepper` to step `end` watching `watch` (its [`Watcher`] begun on the
+/// stepper's state, named `argument` if it is outside a contact).
 fn watched<S, P>(
     sys: &S,
     stepper: Stepper<&S>,
@@ -212,19 +199,10 @@ where
     S: Dynamics + ?Sized,
     P: Poll,
 {
-    let search = match watch.events.map(|events| events.begin(sys, &stepper)).transpose() {
-        Ok(search) => search,
-        Err(error) => return Err(fail(error, first_state(sys, &stepper))),
-    };
-    let resolver = watch
-        .contacts
-        .map(|contacts| Resolver::begin(sys, &stepper, contacts, argument, energy.is_some()))
-        .transpose();
-    let resolver = match resolver {
-        Ok(resolver) => resolver,
-        Err(error) => return Err(fail(error, first_state(sys, &stepper))),
-    };
-    run(sys, stepper, energy, end, save_every, poll, (search, resolver))
+    match Watcher::begin(sys, &stepper, watch, argument, energy.is_some()) {
+        Ok(watcher) => run(sys, stepper, energy, end, save_every, poll, watcher),
+        Err(error) => Err(fail(error, first_state(sys, &stepper))),
+    }
 }
 
 /// The stepper of a new run and its energy check.
@@ -267,7 +245,7 @@ where
     P: Poll,
 {
     let (stepper, watch, end) = resumed(sys, checkpoint, steps, save_every)?;
-    run(sys, stepper, watch, end, save_every, poll, (None, None))
+    run(sys, stepper, watch, end, save_every, poll, Watcher::idle())
 }
 
 /// As [`resume`], watching the `events` as [`integrate_with_events`] does, from the
@@ -363,7 +341,7 @@ fn run<'s, S, P>(
     end: usize,
     save_every: usize,
     mut poll: P,
-    (mut search, mut resolver): (Option<Search<'_, '_, &'s S>>, Option<Resolver<'_, '_, &'s S>>),
+    mut watcher: Watcher<'_, '_, '_, &'s S>,
 ) -> Result<Trajectory, Box<Failure>>
 where
     S: Dynamics + ?Sized,
@@ -404,21 +382,12 @@ where
         // Every `save_every`-th state is saved, and the last.
         let save = (stepper.steps() / save_every + 1).saturating_mul(save_every).min(end);
         let n = save - stepper.steps();
-        let advanced = match (search.as_mut(), resolver.as_mut()) {
-            (None, None) => stepper.advance(n, Counting(|steps| poll.poll(steps))),
-            // Events: step by step, stopping after a terminal event's step.
-            (Some(search), None) => search
-                .advance(&mut stepper, n, &mut traj.events, &mut poll)
-                .map(|stop| traj.terminated_by = stop),
-            // Contacts: step by step, each step that crosses one redone in pieces.
-            (search, Some(resolver)) => {
-                let advanced = resolver.advance(&mut stepper, n, search, &mut traj, &mut poll);
-                if let Some(watch) = watch.as_mut() {
-                    watch.shift(resolver.take_energy_jump());
-                }
-                advanced.map(|stop| traj.terminated_by = stop)
-            }
-        };
+        // Events and contacts: step by step, stopping after a terminal event's step.
+        let advanced = watcher.advance(&mut stepper, n, &mut traj, &mut poll);
+        if let Some(watch) = watch.as_mut() {
+            watch.shift(watcher.take_energy_jump());
+        }
+        let advanced = advanced.map(|stop| traj.terminated_by = stop);
         if let Err(error) = advanced {
             // Stops with the last good state kept, and the work counted.
             let time = stepper.t();
@@ -440,8 +409,7 @@ where
     }
     traj.count(&stepper);
     // Events: the partial steps' force evaluations are the run's too.
-    traj.force_evaluations += search.map_or(0, |s| s.force_evaluations());
-    traj.force_evaluations += resolver.map_or(0, |r| r.force_evaluations());
+    traj.force_evaluations += watcher.force_evaluations();
     traj.checkpoint = Checkpoint::new(sys, stepper.into_state(), watch).to_bytes();
     match outcome {
         Ok(()) => Ok(traj),

@@ -516,7 +516,7 @@ impl StepperState {
     }
 }
 
-impl<M: Deref<Target: Dynamics>> Stepper<M> {
+impl<M: Deref<Target: Dynamics>, St: Borrow<StepperState>> Stepper<M, St> {
     /// The work done by the non-conservative forces so far; None for a model without them.
     pub fn forced_work(&self) -> Option<f64> {
         self.model.as_lagrangian().is_forced().then(|| self.work())

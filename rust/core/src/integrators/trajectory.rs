@@ -91,9 +91,10 @@ impl Trajectory {
 
     /// Saves (q, p) as the state at time `t`, with the stepper's Newton count and work: a
     /// state inside a step (just before or after an impact).
-    pub(super) fn push_state<M>(&mut self, t: f64, q: &[f64], p: &[f64], stepper: &Stepper<M>)
+    pub(super) fn push_state<M, St>(&mut self, t: f64, q: &[f64], p: &[f64], stepper: &Stepper<M, St>)
     where
         M: Deref<Target: Dynamics>,
+        St: std::borrow::Borrow<super::StepperState>,
     {
         self.t.push(t);
         self.newton.extend(stepper.newton());

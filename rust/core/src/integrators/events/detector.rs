@@ -1,6 +1,7 @@
 //! The detector: the sign-change test after each step, and each crossing located by the
 //! method's own partial step.
 
+use std::borrow::{Borrow, BorrowMut};
 use std::ops::Deref;
 
 use super::{EventFunctions, EventSpec, Occurrence};
@@ -46,13 +47,14 @@ impl<'f> Detector<'f> {
     /// `model`: the functions started and evaluated there, the scratch stepper of the partial
     /// steps made (a copy of the stepper: its method, summation and Newton options), and the
     /// buffers of the state before a step, once per run.
-    pub(in crate::integrators) fn begin<'d, M>(
+    pub(in crate::integrators) fn begin<'d, M, St>(
         &'d mut self,
         model: M,
-        stepper: &Stepper<M>,
+        stepper: &Stepper<M, St>,
     ) -> Result<Search<'d, 'f, M>, Error>
     where
         M: Deref<Target: Dynamics>,
+        St: Borrow<StepperState>,
     {
         let (t, q, p) = (stepper.t(), stepper.q(), stepper.p());
         let m = self.specs.len();
@@ -105,9 +107,9 @@ impl<M: Deref<Target: Dynamics>> Search<'_, '_, M> {
     /// Advances `stepper` by up to `n` steps, one at a time, pushing every located crossing to
     /// `occurrences` (in order of time within a step). Returns the event whose terminal count
     /// was reached, the run stopping at the end of that step; None after the n steps.
-    pub(in crate::integrators) fn advance<P: Poll>(
+    pub(in crate::integrators) fn advance<St: BorrowMut<StepperState>, P: Poll>(
         &mut self,
-        stepper: &mut Stepper<M>,
+        stepper: &mut Stepper<M, St>,
         n: usize,
         occurrences: &mut Vec<Occurrence>,
         poll: &mut P,
@@ -127,7 +129,7 @@ impl<M: Deref<Target: Dynamics>> Search<'_, '_, M> {
 
     /// Keeps the stepper's state (tₙ, qₙ, pₙ), the start of its next step; gᵢ(zₙ) are those
     /// of the last step's end.
-    pub(in crate::integrators) fn start_step(&mut self, stepper: &Stepper<M>) {
+    pub(in crate::integrators) fn start_step<St: Borrow<StepperState>>(&mut self, stepper: &Stepper<M, St>) {
         self.t = stepper.t();
         self.q.copy_from_slice(stepper.q());
         self.p.copy_from_slice(stepper.p());

@@ -7,15 +7,20 @@
 //!   [`Contacts`]: the set a run watches, checked once;
 //! - `resolve.rs`: a step that crosses a surface, redone in pieces at each contact;
 //!   `reflect.rs` and `variational.rs`: the laws that give the jump's multiplier λ;
-//! - [`Impacts`]: what a run reports of them ([`super::Trajectory::impacts`]).
+//! - [`Impacts`]: what a run reports of them ([`super::Trajectory::impacts`]);
+//! - [`Watch`]: the events and contacts a run or a stepper watches, and [`Watcher`], the one
+//!   loop of steps that checks them, begun on a stepper's state.
 
 mod reflect;
 mod resolve;
 mod surfaces;
+mod variational;
+mod watch;
 
 pub(in crate::integrators) use resolve::Resolver;
 pub use surfaces::NativeSurface;
 pub(crate) use surfaces::{check_ellipsoid, ellipsoid, wall};
+pub use watch::{Watch, Watcher};
 
 use super::{Dynamics, Method};
 use crate::{Error, ModelError};
@@ -174,7 +179,7 @@ impl<'s> Contacts<'s> {
                 time: t,
                 source,
             })?;
-            if !(value >= 0.0) {
+            if value.is_nan() || value < 0.0 {
                 let reason = format!("outside the contact {}: φ = {value} < 0", c.name);
                 return Err(Error::invalid(argument, reason));
             }

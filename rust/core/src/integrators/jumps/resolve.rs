@@ -3,21 +3,37 @@
 //! crossed (located to round-off), the jump applied there, and the rest of the step re-checked
 //! against every contact, up to [`MAX_IMPACTS`] impacts in the step.
 
+use std::borrow::{Borrow, BorrowMut};
 use std::ops::Deref;
 
-use super::{reflect, Contacts, Impacts, Law, MAX_IMPACTS};
+use super::{reflect, variational, Contacts, Impacts, Law, MAX_IMPACTS};
 use crate::integrators::events::Search;
+use crate::integrators::DiscreteEnergy;
 use crate::integrators::{Counting, Dynamics, Method, Occurrence, Poll, Stepper, StepperState, Trajectory};
 use crate::solve::bracket::illinois;
 use crate::Error;
 
-/// Why the variational law does not fit `method` on `model`, if it does not.
-pub(super) fn variational_misfit<S: Dynamics + ?Sized>(_model: &S, method: Method) -> Option<String> {
-    Some(format!(
-        "needs the discrete energy E_d of the method, which this build does not have for {}; give the contact \
-         law reflect",
-        method.info().name
-    ))
+/// Why the variational law does not fit `method` on `model`, if it does not: it needs the
+/// method's discrete energy ([`DiscreteEnergy`]) and a conservative, autonomous, unconstrained
+/// model (the energy balance is E_d's alone).
+pub(super) fn variational_misfit<S: Dynamics + ?Sized>(model: &S, method: Method) -> Option<String> {
+    if DiscreteEnergy::new(method, 0).is_none() {
+        return Some(format!(
+            "needs a kick–drift method or a two-point rule (midpoint, trapezoid), not {}; give the contact law \
+             reflect or use such a method",
+            method.info().name
+        ));
+    }
+    let lagrangian = model.as_lagrangian();
+    let constrained = model.constraint_counts() != (0, 0) || model.velocity_constraints().is_some();
+    if lagrangian.is_forced() || lagrangian.is_time_dependent() || constrained {
+        return Some(
+            "keeps the discrete energy, which needs a conservative, autonomous, unconstrained model; give the \
+             contact law reflect"
+                .into(),
+        );
+    }
+    None
 }
 
 /// A run's resolver: the contacts, the scratch stepper of the partial steps (a copy of the
@@ -52,15 +68,17 @@ pub(in crate::integrators) struct Resolver<'c, 's, M> {
     /// `energy_jump`, for the run's check to discount).
     energy: bool,
     energy_jump: f64,
+    /// The method's discrete energy, for the variational law.
+    discrete: Option<DiscreteEnergy>,
 }
 
 impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
     /// The resolver of `contacts` for a run of `stepper` on `model` from its state (named
     /// `argument` in the refusal of a state outside φ ≥ 0), `energy` when the run checks its
     /// energy.
-    pub(in crate::integrators) fn begin(
+    pub(in crate::integrators) fn begin<St: Borrow<StepperState>>(
         model: M,
-        stepper: &Stepper<M>,
+        stepper: &Stepper<M, St>,
         contacts: &'c Contacts<'s>,
         argument: &'static str,
         energy: bool,
@@ -90,6 +108,9 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
             pending: Impacts::with_capacity(n, MAX_IMPACTS),
             energy,
             energy_jump: 0.0,
+            discrete: (contacts.contacts().iter().any(|c| c.law == Law::Variational))
+                .then(|| DiscreteEnergy::new(stepper.method(), n))
+                .flatten(),
         };
         let (step, time) = (stepper.steps(), stepper.t());
         evaluate(contacts, stepper.q(), &mut resolver.phi, step, time)?;
@@ -101,9 +122,9 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
     /// `search`'s events on the pieces. Returns the event whose terminal count was reached, the
     /// run stopping at the end of that step; None after the n steps. On failure the stepper is
     /// at the last good step.
-    pub(in crate::integrators) fn advance<P: Poll>(
+    pub(in crate::integrators) fn advance<St: BorrowMut<StepperState>, P: Poll>(
         &mut self,
-        stepper: &mut Stepper<M>,
+        stepper: &mut Stepper<M, St>,
         n: usize,
         mut search: Option<&mut Search<'_, '_, M>>,
         traj: &mut Trajectory,
@@ -165,9 +186,9 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
     /// changed) when its first piece on the scratch stepper crosses no contact after all
     /// (round-off at a grazing end); true with the stepper set to the step's end state and the
     /// impacts in `pending`.
-    fn resolve(
+    fn resolve<St: BorrowMut<StepperState>>(
         &mut self,
-        stepper: &mut Stepper<M>,
+        stepper: &mut Stepper<M, St>,
         mut search: Option<&mut Search<'_, '_, M>>,
         occurrences: &mut Vec<Occurrence>,
     ) -> Result<bool, Error> {
@@ -225,7 +246,7 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
                 search.piece(step, (t_contact, &self.contact_q, &self.contact_p), s, occurrences)?;
             }
             let contact = &contacts.contacts()[j];
-            self.jump(j, step, t_contact)?;
+            self.jump(j, step, (ta, s, tau - s))?;
             if !self.piece_p.iter().all(|x| x.is_finite()) {
                 return Err(contact_error(format!(
                     "a non-finite state after the impact on {} at t = {t_contact}",
@@ -250,15 +271,14 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
         Ok(true)
     }
 
-    /// The jump on contact j at (t, q̃, p⁻) (the contact buffers): p⁺ into `piece_p`.
-    fn jump(&mut self, j: usize, step: usize, t: f64) -> Result<(), Error> {
-        let contact = &self.contacts.contacts()[j];
+    /// The jump on contact j at (q̃, p⁻) (the contact buffers), at the end of the piece of size s
+    /// from ta with `rest` of the step after it: p⁺ into `piece_p`.
+    fn jump(&mut self, j: usize, step: usize, (ta, s, rest): (f64, f64, f64)) -> Result<(), Error> {
+        let contacts = self.contacts;
+        let contact = &contacts.contacts()[j];
+        let (t, time) = (ta + s, self.t);
+        let model_error = |source| Error::Model { step, time, source };
         let model = self.scratch.model();
-        let model_error = |source| Error::Model {
-            step,
-            time: self.t,
-            source,
-        };
         let (q, p) = (&self.contact_q[..], &self.contact_p[..]);
         contact.surface.gradient(q, &mut self.normal).map_err(model_error)?;
         // On a constrained model, the part of ∇φ the constraints let act: the surface's impulse
@@ -274,27 +294,86 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
                 *x = a - b;
             }
         }
-        let lagrangian = model.as_lagrangian();
-        let lambda = match contact.law {
-            Law::Reflect | Law::Variational => reflect::multiplier(
-                lagrangian,
-                (t, q, p),
-                &self.normal,
-                contact.restitution,
-                (&mut self.v, &mut self.w, &self.zeros),
-            )
-            .map_err(model_error)?,
+        let vectors = (&mut self.v[..], &mut self.w[..], &self.zeros[..]);
+        let reflection = reflect::multiplier(
+            model.as_lagrangian(),
+            (t, q, p),
+            &self.normal,
+            contact.restitution,
+            vectors,
+        )
+        .map_err(model_error)?;
+        // For e < 1 both laws take Newton's law, the reflection.
+        let lambda = if contact.law == Law::Variational && contact.restitution == 1.0 && rest > 0.0 {
+            let (lambda, found) = self.variational(step, (ta, s, rest), reflection)?;
+            self.pending.grazing += usize::from(!found);
+            lambda
+        } else {
+            reflection
         };
+        let (q, p) = (&self.contact_q[..], &self.contact_p[..]);
         for (x, (a, b)) in self.piece_p.iter_mut().zip(p.iter().zip(&self.normal)) {
             *x = a + lambda * b;
         }
         if self.energy {
+            let model = self.scratch.model();
             let energy = |p: &[f64]| model.energy(q, p, t).transpose().map_err(model_error);
             if let (Some(before), Some(after)) = (energy(p)?, energy(&self.piece_p)?) {
                 self.energy_jump += after.energy - before.energy;
             }
         }
         Ok(())
+    }
+
+    /// λ of the variational law ([`variational::multiplier`]) for the jump at the end of the
+    /// piece of size s from ta, from the reflection's λ: E_d of the piece after the jump, to
+    /// the step's end `rest` later, equal to E_d of the piece before. Leaves `piece_q` at q̃.
+    fn variational(
+        &mut self,
+        step: usize,
+        (ta, s, rest): (f64, f64, f64),
+        reflection: f64,
+    ) -> Result<(f64, bool), Error> {
+        let time = self.t;
+        let model_error = |source| Error::Model { step, time, source };
+        let Resolver {
+            scratch,
+            discrete,
+            piece_q,
+            piece_p,
+            contact_q,
+            contact_p,
+            normal,
+            v,
+            ..
+        } = self;
+        let Some(discrete) = discrete.as_mut() else {
+            return Ok((reflection, false));
+        };
+        let t = ta + s;
+        let before = (&piece_q[..], &piece_p[..]);
+        let target = discrete
+            .energy(scratch.model(), ta, s, before, (contact_q, contact_p))
+            .map_err(model_error)?;
+        scratch
+            .model()
+            .as_lagrangian()
+            .velocity(contact_q, contact_p, t, v)
+            .map_err(model_error)?;
+        let scale = contact_p.iter().zip(v.iter()).map(|(a, b)| a * b).sum::<f64>();
+        piece_q.copy_from_slice(contact_q);
+        let after = |lambda: f64| {
+            for (x, (a, b)) in piece_p.iter_mut().zip(contact_p.iter().zip(normal.iter())) {
+                *x = a + lambda * b;
+            }
+            scratch.restart(t, piece_q, piece_p, rest);
+            scratch.step().map_err(|e| redate(e, step, time))?;
+            let end = (scratch.q(), scratch.p());
+            discrete
+                .energy(scratch.model(), t, rest, (piece_q, piece_p), end)
+                .map_err(model_error)
+        };
+        variational::multiplier(after, reflection, target, scale)
     }
 
     /// The earliest s ∈ (0, τ] where φⱼ along the piece from (ta, piece_q, piece_p) falls
