@@ -73,7 +73,8 @@ impl DiscreteEnergy {
 
     /// E_d of the method's step of size τ from `start` = (q₀, p₀) to `end` = (q₁, p₁) at time
     /// t (L autonomous): a kick–drift method replays its stages from `start` (`end` unused); a
-    /// two-point rule takes both ends. For τ = 0 it is H(q₀, p₀).
+    /// two-point rule takes both ends. For τ = 0 (and a two-point rule's end = start) it is
+    /// H(q₀, p₀).
     ///
     /// # Errors
     /// The model's own error, or the trapezoid's velocity iteration failing to converge (a
@@ -88,53 +89,16 @@ impl DiscreteEnergy {
     ) -> Result<f64, ModelError> {
         let lagrangian = sys.as_lagrangian();
         match &self.rule {
-            Rule::KickDrift(_) => self.kick_drift(lagrangian, t, tau, start),
+            Rule::KickDrift(splitting) => {
+                let buffers = (&mut self.q[..], &mut self.p[..], &mut self.v[..], &mut self.force[..]);
+                kick_drift(splitting, buffers, &self.zeros, lagrangian, t, tau, start)
+            }
             Rule::Midpoint => {
                 self.mean(start, end);
                 Ok(lagrangian.energy_terms(&self.q, &self.p, t)?.energy)
             }
             Rule::Trapezoid => self.trapezoid(lagrangian, t, tau, start, end),
         }
-    }
-
-    /// Σᵢ bᵢ T(pᵢ) + Σⱼ aⱼ V(q⁽ʲ⁾) along the stages from (q₀, p₀), with T = ½p·q̇(q, p) and
-    /// V = −L(q, 0): the last kick's force is not needed.
-    fn kick_drift(
-        &mut self,
-        sys: &dyn Lagrangian,
-        t: f64,
-        tau: f64,
-        (q0, p0): (&[f64], &[f64]),
-    ) -> Result<f64, ModelError> {
-        let Rule::KickDrift(splitting) = &self.rule else {
-            unreachable!("a kick–drift rule")
-        };
-        let (kicks, drifts) = (splitting.kicks(), splitting.drifts());
-        let (q, p, v, force, zeros) = (&mut self.q, &mut self.p, &mut self.v, &mut self.force, &self.zeros);
-        q.copy_from_slice(q0);
-        p.copy_from_slice(p0);
-        let mut energy = 0.0;
-        for (j, &a) in kicks.iter().enumerate() {
-            if j > 0 {
-                let b = drifts[j - 1];
-                sys.velocity(q, p, t, v)?;
-                energy += b * 0.5 * dot(p, v);
-                for (x, y) in q.iter_mut().zip(v.iter()) {
-                    *x += b * tau * y;
-                }
-            }
-            if a == 0.0 {
-                continue;
-            }
-            energy -= a * sys.lagrangian(q, zeros, t)?;
-            if j + 1 < kicks.len() {
-                sys.dl_dq(q, zeros, t, force)?;
-                for (x, f) in p.iter_mut().zip(force.iter()) {
-                    *x += a * tau * f;
-                }
-            }
-        }
-        Ok(energy)
     }
 
     /// q̄ = (q₀ + q₁)/2 into `q`, p̄ = (p₀ + p₁)/2 into `p`.
@@ -197,7 +161,7 @@ impl DiscreteEnergy {
             }
         }
         let scale = v.iter().fold(1.0_f64, |m, x| m.max(x.abs()));
-        if !(step <= 1e-6 * scale) {
+        if step.is_nan() || step > 1e-6 * scale {
             return Err(format!(
                 "the trapezoid's discrete energy: its velocity iteration stalled at a change of \
                  {step:.3e} (a step τ = {tau} too large for it)"
@@ -210,6 +174,45 @@ impl DiscreteEnergy {
         let e1 = dot(momentum_end, v) - sys.lagrangian(q1, v, t)?;
         Ok(0.5 * (e0 + e1))
     }
+}
+
+/// Σᵢ bᵢ T(pᵢ) + Σⱼ aⱼ V(q⁽ʲ⁾) along the stages from (q₀, p₀), with T = ½p·q̇(q, p) and
+/// V = −L(q, 0): the last kick's force is not needed.
+#[allow(clippy::too_many_arguments)]
+fn kick_drift(
+    splitting: &Splitting,
+    (q, p, v, force): (&mut [f64], &mut [f64], &mut [f64], &mut [f64]),
+    zeros: &[f64],
+    sys: &dyn Lagrangian,
+    t: f64,
+    tau: f64,
+    (q0, p0): (&[f64], &[f64]),
+) -> Result<f64, ModelError> {
+    let (kicks, drifts) = (splitting.kicks(), splitting.drifts());
+    q.copy_from_slice(q0);
+    p.copy_from_slice(p0);
+    let mut energy = 0.0;
+    for (j, &a) in kicks.iter().enumerate() {
+        if j > 0 {
+            let b = drifts[j - 1];
+            sys.velocity(q, p, t, v)?;
+            energy += b * 0.5 * dot(p, v);
+            for (x, y) in q.iter_mut().zip(v.iter()) {
+                *x += b * tau * y;
+            }
+        }
+        if a == 0.0 {
+            continue;
+        }
+        energy -= a * sys.lagrangian(q, zeros, t)?;
+        if j + 1 < kicks.len() {
+            sys.dl_dq(q, zeros, t, force)?;
+            for (x, f) in p.iter_mut().zip(force.iter()) {
+                *x += a * tau * f;
+            }
+        }
+    }
+    Ok(energy)
 }
 
 fn dot(a: &[f64], b: &[f64]) -> f64 {
