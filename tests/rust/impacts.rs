@@ -478,7 +478,7 @@ fn contacts_that_do_not_fit_are_refused_by_name() {
     let (argument, reason) = refusal(&floor(1.0, Law::Variational), Method::Rk4, 1.0);
     assert_eq!(argument, "contacts");
     assert!(
-        reason.starts_with("floor: the variational collision integrator needs"),
+        reason.starts_with("\"floor\" (contacts[0]): the variational collision integrator needs"),
         "{reason}"
     );
     assert_eq!(refusal(&floor(1.0, Law::Reflect), Method::Verlet, -0.1).0, "q0");
@@ -494,7 +494,7 @@ fn contacts_that_do_not_fit_are_refused_by_name() {
     let (argument, reason) = refusal(&Contacts::new(vec![wrong]).unwrap(), Method::Verlet, 1.0);
     assert_eq!(
         (argument, reason.as_str()),
-        ("contacts", "wall: coordinate 3 is not in 0 … 0")
+        ("contacts", "\"wall\" (contacts[0]): coordinate 3 is not in 0 … 0")
     );
     let elastic = Contact {
         surface: Box::new(NativeSurface::Wall {

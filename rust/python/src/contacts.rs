@@ -74,7 +74,11 @@ impl ContactSpecs {
                     let (phi, gradient) = payload.extract()?;
                     Kind::Functions(Functions { phi, gradient })
                 }
-                _ => return Err(PyValueError::new_err(format!("contacts: {name}: unknown kind {kind:?}"))),
+                _ => {
+                    return Err(PyValueError::new_err(format!(
+                        "contacts: {name}: unknown kind {kind:?}"
+                    )))
+                }
             };
             contacts.push((kind, restitution, law, name));
         }

@@ -5,14 +5,15 @@ use numpy::PyReadonlyArray1;
 use pyo3::prelude::*;
 use varmech::diagnostics;
 use varmech::integrators::{
-    self, Checkpoint, Counting, Detector, EventSpec, Failure, Method, NewtonOptions, Options, Splitting, Trajectory, Watch,
+    self, Checkpoint, Counting, Detector, EventSpec, Failure, Method, NewtonOptions, Options, Splitting, Trajectory,
+    Watch,
 };
 use varmech::ModelError;
 
 use crate::bind::{bind_model, dim_of, Poll};
+use crate::contacts::{ContactSpecs, ContactTuple};
 use crate::convert::{self, count, slice};
 use crate::errors::{boxed, failure_to_pyerr, to_pyerr};
-use crate::contacts::{ContactSpecs, ContactTuple};
 use crate::events::{EventTuple, Events};
 use crate::trajectory::TrajectoryRecord;
 
@@ -78,7 +79,10 @@ fn watching<'c>(
         None => None,
         Some((functions, specs)) => Some(Detector::new(Box::new(functions), specs).map_err(never_started)?),
     };
-    let contacts = contacts.map(ContactSpecs::contacts).transpose().map_err(never_started)?;
+    let contacts = contacts
+        .map(ContactSpecs::contacts)
+        .transpose()
+        .map_err(never_started)?;
     run(Watch {
         events: detector.as_mut(),
         contacts: contacts.as_ref(),

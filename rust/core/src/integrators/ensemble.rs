@@ -193,10 +193,7 @@ where
     for (event, spec) in events.functions.iter().zip(&events.specs) {
         event.check(&spec.name, n)?;
     }
-    let checked = Contacts::native(contacts)?;
-    if let Some((c, reason)) = checked.contacts().iter().find_map(|c| Some((c, c.surface.misfit(n)?))) {
-        return Err(Error::invalid("contacts", format!("{}: {reason}", c.name)));
-    }
+    Contacts::native(contacts)?.fit(n)?;
 
     let workers = parallel
         .workers

@@ -82,6 +82,13 @@ pub struct Contact<'s> {
     pub name: String,
 }
 
+impl Contact<'_> {
+    /// The refusal of this contact, the `i`-th, naming `contacts` and it.
+    fn refused(&self, i: usize, reason: String) -> Error {
+        Error::invalid("contacts", format!("{:?} (contacts[{i}]): {reason}", self.name))
+    }
+}
+
 impl std::fmt::Debug for Contact<'_> {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("Contact")
@@ -124,10 +131,9 @@ impl<'s> Contacts<'s> {
     /// The set of `contacts`. Refuses (naming `contacts` and the contact) a restitution outside
     /// [0, 1].
     pub fn new(contacts: Vec<Contact<'s>>) -> Result<Self, Error> {
-        for c in &contacts {
+        for (i, c) in contacts.iter().enumerate() {
             if !(0.0..=1.0).contains(&c.restitution) {
-                let reason = format!("{}: restitution must lie in [0, 1], got {}", c.name, c.restitution);
-                return Err(Error::invalid("contacts", reason));
+                return Err(c.refused(i, format!("restitution must lie in [0, 1], got {}", c.restitution)));
             }
         }
         Ok(Contacts { contacts })
@@ -153,6 +159,16 @@ impl<'s> Contacts<'s> {
         &self.contacts
     }
 
+    /// Whether every surface acts on n coordinates (a native surface's coordinates in range).
+    pub fn fit(&self, n: usize) -> Result<(), Error> {
+        for (i, c) in self.contacts.iter().enumerate() {
+            if let Some(reason) = c.surface.misfit(n) {
+                return Err(c.refused(i, reason));
+            }
+        }
+        Ok(())
+    }
+
     /// Whether a run of `method` on `model` from q (named `argument`: `q0`, or the checkpoint
     /// resumed) at time t can watch these contacts: each surface fits the model's coordinates, the
     /// variational law fits the method and the model, and q lies in φ ≥ 0 for every contact.
@@ -163,15 +179,11 @@ impl<'s> Contacts<'s> {
         (t, q): (f64, &[f64]),
         argument: &'static str,
     ) -> Result<(), Error> {
-        let n = model.dim();
-        for c in &self.contacts {
-            if let Some(reason) = c.surface.misfit(n) {
-                return Err(Error::invalid("contacts", format!("{}: {reason}", c.name)));
-            }
+        self.fit(model.dim())?;
+        for (i, c) in self.contacts.iter().enumerate() {
             if c.law == Law::Variational {
                 if let Some(reason) = resolve::variational_misfit(model, method) {
-                    let reason = format!("{}: the variational collision integrator {reason}", c.name);
-                    return Err(Error::invalid("contacts", reason));
+                    return Err(c.refused(i, format!("the variational collision integrator {reason}")));
                 }
             }
             let value = c.surface.phi(q).map_err(|source| Error::Model {
@@ -180,7 +192,7 @@ impl<'s> Contacts<'s> {
                 source,
             })?;
             if value.is_nan() || value < 0.0 {
-                let reason = format!("outside the contact {}: φ = {value} < 0", c.name);
+                let reason = format!("outside the contact {:?}: φ = {value} < 0", c.name);
                 return Err(Error::invalid(argument, reason));
             }
         }
