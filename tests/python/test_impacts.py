@@ -410,7 +410,8 @@ def test_the_variational_law_still_refuses_the_other_methods_and_non_conservativ
 
     # rk4 integrates the separable ball, galerkin4 the Lagrangian: neither has a discrete energy.
     model = _ball() if method == "rk4" else falling()
-    with pytest.raises(ValueError, match=rf"^contacts: .* \(contacts\[0\]\): the variational collision integrator needs a kick–drift method or a two-point rule .*, not {method}"):
+    refused = rf"^contacts: .* \(contacts\[0\]\): the variational collision integrator needs a kick–drift method or a two-point rule .*, not {method}"
+    with pytest.raises(ValueError, match=refused):
         varmech.integrate(model, [1.0], [0.0], dt=1e-3, steps=10, method=method, contacts=[floor])
     damped = falling(rayleigh=0.1)
     with pytest.raises(ValueError, match=r"^contacts: .* \(contacts\[0\]\): the variational collision integrator keeps the discrete energy"):
