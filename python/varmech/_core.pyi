@@ -20,6 +20,7 @@ __all__ = [
     "ClosureNatural",
     "ClosureNonholonomic",
     "CompiledModel",
+    "ContactError",
     "ConvergenceError",
     "DivergenceError",
     "Generator",
@@ -127,6 +128,14 @@ class TrajectoryRecord:
     @property
     def terminated_by(self) -> int | None:
         """The index of the event whose terminal count stopped the run, if one did."""
+    @property
+    def impacts(self) -> tuple[NDArray[np.uint64], _FloatArray, _FloatArray, _FloatArray, _FloatArray]:
+        """The impacts on the run's contacts in order of time: the contact's index (k,), t (k,),
+        the contact configuration q and the momenta just before and just after (k, n)."""
+    @property
+    def grazing(self) -> int:
+        """Impacts under the variational law that took Newton's law for want of a discrete-energy
+        root near the reflection (grazing)."""
 
 @final
 class Stepper:
@@ -242,6 +251,13 @@ class ConvergenceError(VarmechError):
     time: float
     residual: float
     iterations: int
+    partial: Any
+
+class ContactError(VarmechError):
+    """An impact could not be resolved: a resting or grazing contact, or an accumulation of impacts."""
+
+    step: int
+    time: float
     partial: Any
 
 class SpuriousBranchError(ConvergenceError):
@@ -485,12 +501,13 @@ def ensemble(
     chunk_size: int | None = None,
     progress: Callable[[int], object] | None = None,
     events: list[tuple[str, int, int, str, Any]] | None = None,
+    contacts: list[tuple[str, float, str, str, Any]] | None = None,
 ) -> tuple[list[tuple[TrajectoryRecord, BaseException | None]], BaseException | None]:
     """Members (rows of q0 and p0, (members, n)) integrated in parallel with the GIL released,
     with one shared model or one a member, each watching the built-in ``events``: each member's
     record (the partial one of a failure) and exception, and the exception (KeyboardInterrupt)
     that stopped the ensemble, if any. ``progress(steps)`` gets the steps of all members every
-    10 ms."""
+    10 ms. ``contacts``: native contacts (as ``integrate``'s), each member resolving its impacts."""
 
 def integrate(
     model: _Model,
@@ -508,6 +525,7 @@ def integrate(
     newton_max_iterations: int = 50,
     progress: Callable[[int], object] | None = None,
     events: list[tuple[str, int, int, str, Any]] | None = None,
+    contacts: list[tuple[str, float, str, str, Any]] | None = None,
 ) -> TrajectoryRecord:
     """The saved states; on failure the exception carries ``_varmech_partial``, the
     TrajectoryRecord up to the failure. ``progress(steps)`` is called with the steps completed at
@@ -515,7 +533,10 @@ def integrate(
     (name, direction, terminal count or 0, kind, payload), kind ``"p"``/``"v"`` (payload g(t, q,
     p) or g(t, q, v)), ``"crossing"`` ((k, value)), ``"ellipsoid"`` ((coordinates, centre,
     semi_axes, inside)), ``"energy_error"`` (bound), ``"escape"``, ``"encounter"`` ((radius,
-    groups)); see varmech.events and varmech.surfaces."""
+    groups)); see varmech.events and varmech.surfaces. ``contacts``: tuples (name, restitution,
+    law, kind, payload), kind ``"crossing"`` or ``"ellipsoid"`` (the events' payloads) or
+    ``"functions"`` ((phi, gradient)), law ``"reflect"`` or ``"variational"``; the impacts on
+    them are resolved in the step loop (see varmech.impacts)."""
 
 def resume(
     model: _Model,
@@ -527,10 +548,11 @@ def resume(
     events: list[tuple[str, int, int, str, Any]] | None = None,
     method: str | None = None,
     dt: float | None = None,
+    contacts: list[tuple[str, float, str, str, Any]] | None = None,
 ) -> TrajectoryRecord:
-    """Goes on from a run's checkpoint for `steps` more steps (see [`integrators::resume`]),
-    watching `events` (as `integrate`'s) if given; a checkpoint of another `method` or `dt`
-    than given is refused ([`Checkpoint::expect`])."""
+    """Goes on from a run's checkpoint for `steps` more steps, watching `events` and resolving
+    the impacts on `contacts` (as `integrate`'s) if given; a checkpoint of another `method` or
+    `dt` than given is refused."""
 
 def energy_terms(model: _Model, t: _FloatArray, q: _FloatArray, p: _FloatArray) -> tuple[_FloatArray, _FloatArray, _FloatArray]:
     """(E, T, V) at each state: the energy function p·q̇ − L, its kinetic term E − V and its

@@ -16,12 +16,12 @@ from __future__ import annotations
 import dataclasses
 from typing import Any
 
-from ._core import ConvergenceError, DivergenceError, SpuriousBranchError, VarmechError
+from ._core import ContactError, ConvergenceError, DivergenceError, SpuriousBranchError, VarmechError
 
 _VARMECH_ERROR = """Base class of varmech's errors: catch it to catch any of them.
 
     A run that fails raises a subclass (:class:`DivergenceError`, :class:`ConvergenceError`,
-    :class:`SpuriousBranchError`, :class:`~varmech.ContactError`); a VarmechError itself means
+    :class:`SpuriousBranchError`, :class:`ContactError`); a VarmechError itself means
     a model's evaluation failed in the core without a Python exception of its own, or an event
     function returned a value that is not finite. Bad arguments are ValueError or TypeError,
     never a VarmechError. It is a :class:`RuntimeError`.
@@ -154,12 +154,47 @@ _SPURIOUS_BRANCH_ERROR = """A step's implicit equations were solved beyond a fol
     1 0.0 1
     """
 
+_CONTACT_ERROR = """An impact could not be resolved: a non-finite state through it, a body that crosses the
+    surface again at once after leaving it (a resting or grazing contact), or more than 64
+    impacts in one step (an accumulation of impacts, as of a ball coming to rest).
+
+    Impacts model collisions, not resting contact: a ball with e < 1 bounces ever lower and
+    faster, and its impacts accumulate at a finite time; stop the run before it (a terminal
+    event) or model the resting phase as a constraint.
+
+    Attributes
+    ----------
+    step : int
+        The step in which the impact failed (1 for the first).
+    time : float
+        The time tₙ at the start of that step.
+    partial : Trajectory
+        The run up to the last good step (``status`` -1), with the impacts resolved so far in
+        its ``events``.
+
+    See Also
+    --------
+    varmech.Contact : the surfaces and their coefficients of restitution.
+
+    Examples
+    --------
+    A ball with e = 0.5 comes to rest on the floor at t = (1 + 2e/(1 − e))√(2h₀/g) ≈ 1.35:
+
+    >>> import varmech
+    >>> try:
+    ...     varmech.integrate(varmech.scenes.bouncing_ball(restitution=0.5), dt=0.01, t_end=2.0)
+    ... except varmech.ContactError as err:
+    ...     print(err.step, round(err.time, 2), len(err.partial.events[0]), err.partial.status)
+    136 1.35 8 -1
+    """
+
 #: The numpydoc docstrings of the binding's exceptions, which :func:`install` sets.
 DOCSTRINGS: dict[type[BaseException], str] = {
     VarmechError: _VARMECH_ERROR,
     DivergenceError: _DIVERGENCE_ERROR,
     ConvergenceError: _CONVERGENCE_ERROR,
     SpuriousBranchError: _SPURIOUS_BRANCH_ERROR,
+    ContactError: _CONTACT_ERROR,
 }
 
 #: The docstrings' examples, for doctest (the classes belong to module ``varmech``).

@@ -21,17 +21,18 @@ from numpy.typing import ArrayLike
 
 from . import _core
 from . import events as _events
+from . import impacts as _impacts
 from ._progress import progress_bar, thread_lock
 from ._util import finite, floats, positive, positive_int, step_count
 from .conservation import VERDICTS, ConservationReport, check_conservation
+from .impacts import Contact
 from .integrate import _energy_threshold, _model_of, _newton, integrate
 from .model import Model, NativeSystem, _scene_model
+from .scenes import Scene
 from .trajectory import Trajectory, _trajectory
 
 if TYPE_CHECKING:
     import xarray
-
-    from .scenes import Scene
 
 
 @dataclass
@@ -276,6 +277,7 @@ def ensemble(
     newton_tolerance: float = 1e-14,
     newton_max_iterations: int = 50,
     events: Sequence[_events.Event | _events.EventFunction] | None = None,
+    contacts: Sequence[Contact] | None = None,
     workers: int | None = None,
     client: Any = None,
     chunk_size: int | None = None,
@@ -315,6 +317,10 @@ def ensemble(
         built-in ones (:func:`varmech.events.crossing`, ``energy_error``, ``escape``,
         ``encounter``) run in the core's parallel loop, a copy for each member; a Python
         function holds the GIL, so with one the members run as a closure model's do.
+    contacts
+        Unilateral contacts, as in :func:`varmech.integrate` (default a scene's): each member
+        goes through its impacts. Native surfaces (``Contact.wall``, ``Contact.ellipsoid``) run
+        on the threads; a contact of Python functions runs the members as a closure model's.
     workers
         The most threads to use; default: one a core (with ``client``: on each Dask worker, its
         own thread count). For a closure model, the number of processes; default: none, the
@@ -368,8 +374,9 @@ def ensemble(
     >>> bool(np.array_equal(runs[1].q, single.q))
     True
     """
-    if getattr(model, "contacts", ()):
-        raise ValueError(f"model: the scene {model.name}'s contacts do not run in ensembles yet; pass scene.model without them")
+    # A scene's contacts by default, as in integrate.
+    contacts = list(model.contacts if contacts is None and isinstance(model, Scene) else contacts or ())
+    contact_specs = _impacts.specs(contacts)
     model, _, _ = _model_of(model, None, None, None)
     n = model.dim
     q = np.array(floats("q0", q0))
@@ -392,12 +399,13 @@ def ensemble(
     newton_tolerance, newton_max_iterations = _newton(newton_tolerance, newton_max_iterations)
     newton: dict[str, Any] = dict(newton_tolerance=newton_tolerance, newton_max_iterations=newton_max_iterations)
     watched, event_specs = _events.specs(events, n) if events is not None else ([], [])
-    settings = run | newton | dict(max_energy_error=max_energy_error, events=events)
+    settings = run | newton | dict(max_energy_error=max_energy_error, events=events, contacts=contacts)
     if client is not None:
         return _on_cluster(client, model, q, p, values, settings | dict(workers=workers), chunk_size, progress)
     cores = [m._core for m in (models if values else models[:1])]
     released = [c for c in cores if isinstance(c, (_core.NativeModel, _core.CompiledModel))]
-    if len(released) == len(cores) and all(e.native is not None for e in watched):
+    native = all(e.native is not None for e in watched) and all(kind != "functions" for _, _, _, kind, _ in contact_specs)
+    if len(released) == len(cores) and native:
         threshold = _energy_threshold(model, max_energy_error)
         bar = progress_bar(total=nsteps * members, unit="step", desc=f"{method} ×{members}", enabled=progress)
         try:
@@ -405,13 +413,14 @@ def ensemble(
             results, interrupted = _core.ensemble(
                 released, q, p, **run, **newton, max_energy_error=threshold, workers=workers, chunk_size=chunk_size, progress=report,
                 events=event_specs or None,
+                contacts=contact_specs or None,
             )
         finally:
             bar.close()
         trajs, errors = [], []
         for i, (record, error) in enumerate(results):
             status: dict[str, Any] = {} if error is None else {"status": -1, "message": str(error)}
-            trajs.append(_trajectory(record, models[i], method, dt, watched, **status))
+            trajs.append(_trajectory(record, models[i], method, dt, watched, contacts, **status))
             errors.append(error)
         result = Ensemble(trajs, errors, values)
         if interrupted is not None:

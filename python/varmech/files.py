@@ -49,8 +49,10 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from . import impacts as _impacts
 from ._version import __version__
 from .events import Occurrences
+from .impacts import Contact
 from .methods import method_info
 from .model import Model, from_recipe
 
@@ -117,7 +119,7 @@ class Writer:
         save_every: int = 0,
         events: Sequence[str] = (),
         argument: str = "path",
-        contacts: Sequence[str] = (),
+        contacts: Sequence[Contact | str] = (),
     ):
         h5py = _h5py()
         self.path = path
@@ -144,8 +146,9 @@ class Writer:
                 }
             )
             if contacts:
-                # A run's contacts are not in its checkpoint: load marks it, and resume refuses it.
-                f.attrs["contacts"] = list(contacts)
+                # The native ones as data; one of Python functions by its name (resume takes it again).
+                f.attrs["contacts"] = [_impacts.name(c) for c in contacts]
+                f.attrs["contact_surfaces"] = _impacts.stored(contacts)
             for name in ("t", "q", "p", *columns):
                 shape = (0, n) if name in ("q", "p") else (0,)
                 f.create_dataset(

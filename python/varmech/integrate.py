@@ -352,6 +352,8 @@ def integrate(
     starts = "q0, v0" if v0 is not None else "q0, p0"
     _check_time_independent(model, q, p, tuple(s for s in probes if math.isfinite(s)), starts)
 
+    contact_specs = _impacts.specs(contacts or ())
+
     def start(
         q: np.ndarray, p: np.ndarray, t0: float, steps: int, report: Callable[[int], None] | None, events: Any = None
     ) -> _core.TrajectoryRecord:
@@ -370,40 +372,19 @@ def integrate(
             newton_max_iterations=newton_max_iterations,
             progress=report,
             events=events if events is not None else (event_specs or None),
+            contacts=contact_specs or None,
         )
 
     def first(steps: int, report: Callable[[int], None] | None) -> _core.TrajectoryRecord:
         return start(q, p, t0, steps, report)
 
     if contacts is not None:
-        for name, clash in (
-            ("t_eval", t_eval is not None),
-            ("output", output is not None),
-            ("events", bool(watched)),
-            ("impulses", impulses is not None),
-        ):
+        for name, clash in (("t_eval", t_eval is not None), ("impulses", impulses is not None)):
             if clash:
-                raise ValueError(f"contacts: not yet with {name}")
-        names = tuple(str(getattr(c, "name", c)) for c in contacts)
-        try:
-            j, hits = _impacts.run(start, model, method, q, p, t0, dt, nsteps, list(contacts))
-        except BaseException as err:
-            # The whole run up to the failure, not only its last piece.
-            so_far = getattr(err, "_varmech_joined", None)
-            if so_far is not None:
-                del err._varmech_joined  # type: ignore[attr-defined]
-                j, hits = so_far
-                work = j.work if model.forced else None
-                err.partial = Trajectory(  # type: ignore[attr-defined]
-                    j.t, j.q, j.p, model, method, dt, j.steps, j.force_evaluations, j.newton, work,
-                    status=-1, message=str(err), checkpoint=j.checkpoint, events=hits, contacts=names,
+                raise ValueError(
+                    f"contacts: not with {name}, whose states the core does not yet take through impacts (they are"
+                    " Python steps between core runs, which would skip an impact inside their step)"
                 )
-            raise
-        work = j.work if model.forced else None
-        return Trajectory(
-            j.t, j.q, j.p, model, method, dt, j.steps, j.force_evaluations, j.newton, work, checkpoint=j.checkpoint, events=hits,
-            contacts=names,
-        )
     if impulses is not None:
         for name, clash in (("t_eval", t_eval is not None), ("output", output is not None), ("events", bool(watched))):
             if clash:
@@ -414,7 +395,21 @@ def integrate(
     if t_eval is not None:
         return _evaluated(first, model, method, dt, t0, nsteps, dense.eval_times(t_eval, t0, t_end), save_every, progress, output, watched)
     return _run(
-        first, None, 0, model, method, dt, nsteps, save_every, progress, output, overwrite, checkpoint_every, watched, event_specs
+        first,
+        None,
+        0,
+        model,
+        method,
+        dt,
+        nsteps,
+        save_every,
+        progress,
+        output,
+        overwrite,
+        checkpoint_every,
+        watched,
+        event_specs,
+        contacts=tuple(contacts or ()),
     )
 
 
@@ -465,12 +460,7 @@ def _go_on(
     """``integrate(traj, steps=)``: the run of ``traj`` continued from its checkpoint, watching
     ``events`` from there (terminal counts after ``traj``'s crossings of the same events, an
     energy error from ``traj``'s first energy)."""
-    if traj.contacts:
-        raise ValueError(
-            f"contacts: a run with contacts ({', '.join(map(repr, traj.contacts))}) cannot be continued yet, its"
-            " checkpoint does not hold them; run the whole span with integrate(model, ..., contacts=...), or start a"
-            " new run from its last state: integrate(model, traj.q[-1], traj.p[-1], t0=traj.t[-1], contacts=...)"
-        )
+    contacts = _impacts.going_on(traj.contacts)
     if traj.checkpoint is None:
         raise ValueError("model: this trajectory has no checkpoint to go on from (it failed before its first state)")
     nsteps = step_count(traj.dt, float(traj.t[-1]), steps, t_end)
@@ -495,6 +485,7 @@ def _go_on(
         specs,
         initial,
         found,
+        contacts=contacts,
     )
 
 
@@ -515,19 +506,22 @@ def _run(
     event_specs: list[Any],
     initial_energy: float | None = None,
     found: Sequence[int] = (),
+    *,
+    contacts: Sequence[_impacts.Contact] = (),
 ) -> Trajectory:
     """Runs ``nsteps`` steps by ``first`` (a new run) or from ``checkpoint`` (after ``base``
     steps): in memory, or streamed to ``output`` in segments (:mod:`varmech.streaming`).
     ``watched`` are the run's events (``event_specs`` the binding's), whose crossings the result
     reports; a continued run's are watched after ``found`` crossings of each, an energy error
-    measured from ``initial_energy``."""
+    measured from ``initial_energy``. The run resolves the impacts on ``contacts``, which the
+    result reports after the events' crossings."""
     bar = progress_bar(total=nsteps, unit="step", desc=method, enabled=progress)
     try:
         if output is not None:
             target = files.writable(output, bool(overwrite), "output")
             streaming.checkpoint_period(checkpoint_every, save_every)
             columns = files.columns_of(model, method)
-            names = [o.name for o in _events.occurrences_of(watched)]
+            names = [o.name for o in _events.occurrences_of(watched)] + [c.name for c in contacts]
             writer = files.Writer(
                 target,
                 model=model,
@@ -537,6 +531,7 @@ def _run(
                 save_every=save_every,
                 events=names,
                 argument="output",
+                contacts=contacts,
             )
             try:
                 streaming.stream(
@@ -553,6 +548,7 @@ def _run(
                     event_specs=event_specs,
                     initial_energy=initial_energy,
                     found=found,
+                    contacts=contacts,
                 )
             except BaseException as err:
                 # A file that cannot be read back (a disk that failed) leaves the error as it is.
@@ -575,17 +571,27 @@ def _run(
                 assert not watched or initial_energy is not None
                 specs = _events.going_on(event_specs, found, initial_energy) if watched and initial_energy is not None else None
                 record = _core.resume(
-                    model._core, checkpoint, steps=nsteps, save_every=save_every, progress=shown, events=specs, method=method, dt=dt
+                    model._core,
+                    checkpoint,
+                    steps=nsteps,
+                    save_every=save_every,
+                    progress=shown,
+                    events=specs,
+                    method=method,
+                    dt=dt,
+                    contacts=_impacts.specs(contacts) or None,
                 )
             bar.update(record.steps - base - bar.n)
         except BaseException as err:
             partial = take_partial(err)
             if partial is not None:
-                err.partial = _trajectory(partial, model, method, dt, watched, status=-1, message=str(err))  # type: ignore[attr-defined]
+                err.partial = _trajectory(  # type: ignore[attr-defined]
+                    partial, model, method, dt, watched, contacts, status=-1, message=str(err)
+                )
             raise
     finally:
         bar.close()
-    return _trajectory(record, model, method, dt, watched)
+    return _trajectory(record, model, method, dt, watched, contacts)
 
 
 def symplecticity_defect(model: Model, method: str, q: ArrayLike, p: ArrayLike, dt: float) -> float:

@@ -27,10 +27,12 @@ import numpy as np
 
 from . import _core, files
 from . import events as _events
+from . import impacts as _impacts
 from ._progress import progress_bar
 from ._util import step_count
+from .impacts import Contact
 from .model import Model
-from .trajectory import Trajectory, load, take_partial
+from .trajectory import Trajectory, crossings, load, take_partial
 
 if TYPE_CHECKING:
     from tqdm import tqdm
@@ -82,6 +84,7 @@ def stream(
     event_specs: list[Any] | None = None,
     initial_energy: float | None = None,
     found: Sequence[int] = (),
+    contacts: Sequence[Contact] = (),
 ) -> None:
     """Runs ``steps`` steps in segments appended to ``writer``: the first by ``first`` (a new
     run) or from ``checkpoint`` (after ``base`` steps), every other from the last checkpoint.
@@ -90,8 +93,10 @@ def stream(
     the whole run, and an energy error is measured from ``initial_energy`` (the run's first
     energy; by default taken at its first state) after the ``found`` crossings of each so far. Closes the file with the
     run's status; an exception stops the run with every state up to it committed, and closes
-    the file saying why."""
+    the file saying why. Each segment resolves the impacts on ``contacts``, committed as the
+    events after ``watched``'s."""
     cap, seconds = checkpoint_period(checkpoint_every, save_every)
+    contact_specs = _impacts.specs(contacts) or None
     found = list(found) or [0] * len(watched)
     done, rate = 0, None
     segment = files.CHUNK_ROWS * save_every
@@ -149,6 +154,7 @@ def stream(
                     save_every=save_every,
                     progress=None if bar.disable else report,
                     events=specs,
+                    contacts=contact_specs,
                 )
             except BaseException as err:
                 # The segment's states and crossings up to the stop are committed; the file is
@@ -157,19 +163,19 @@ def stream(
                 committed()
                 if partial is not None:
                     with _uninterrupted():
-                        writer.append(partial, skip_first=True, events=_events.occurrences(partial, watched))
+                        writer.append(partial, skip_first=True, events=crossings(partial, watched, contacts))
                 raise
             elapsed = time.perf_counter() - started
-            crossings = _events.occurrences(record, watched)
+            found_now = crossings(record, watched, contacts)
             committed()
-            pending = committer.submit(writer.append, record, skip_first=True, events=crossings)
+            pending = committer.submit(writer.append, record, skip_first=True, events=found_now)
             if watched and initial_energy is None:
                 initial_energy = _events.first_energy(model, record)
-            found = [k + len(o) for k, o in zip(found, crossings)]
+            found = [k + len(o) for k, o in zip(found, found_now)]
             checkpoint = record.checkpoint
             if record.terminated_by is not None:
                 i = record.terminated_by
-                last = crossings[i]
+                last = found_now[i]
                 committed()
                 with _uninterrupted():
                     writer.close(1, _events.termination_message(last, found[i]))
@@ -229,6 +235,7 @@ def resume(
     events: Sequence[_events.Event | _events.EventFunction] | None = None,
     model: Model | None = None,
     allow_pickle: bool = False,
+    contacts: Sequence[Contact] | None = None,
 ) -> Trajectory:
     """Goes on with the run in the file ``path`` (from ``integrate(output=)``, or
     :meth:`Trajectory.save`) for ``steps`` more steps or to ``t_end``, appending to the file.
@@ -239,7 +246,9 @@ def resume(
     first second resumes). ``save_every`` is the file's by default (its saving period).
     ``events`` (as :func:`varmech.integrate`'s; the same as the file's, if it has any) are
     watched from the checkpoint on, with terminal counts over the whole run and an energy error
-    measured from the file's first state.
+    measured from the file's first state. The run's contacts go on: the file stores the native
+    ones (``Contact.wall``, ``Contact.ellipsoid``); those given by Python functions are given
+    again as ``contacts``.
 
     The file is loaded as :func:`varmech.load` loads it (no code run from it: a model of
     closures needs ``model=`` or ``allow_pickle=True``), and its checkpoint must be the state
@@ -267,6 +276,9 @@ def resume(
     allow_pickle : bool, default False
         Unpickle a stored closure model, as :func:`varmech.load` does (only for files you
         trust).
+    contacts : sequence of Contact, optional
+        The run's contacts, for a file whose contacts were given by Python functions (the file
+        stores their names, not their code): the same names, in the same order.
 
     Returns
     -------
@@ -280,8 +292,8 @@ def resume(
         Naming ``path`` for a file without a checkpoint, a missing, truncated or damaged one
         (failed checksums, non-finite rows, a checkpoint that is not the last row's state),
         one that cannot be written (a full disk: the rows committed before are kept), a
-        pickled model without ``model=`` or ``allow_pickle=True``, or a run with contacts (not
-        continued yet: its checkpoint does not hold them); the arguments of
+        pickled model without ``model=`` or ``allow_pickle=True``; naming ``contacts`` for
+        contacts of Python functions not given again, or given with other names; the arguments of
         :func:`varmech.integrate` as it names them.
 
     Examples
@@ -296,12 +308,7 @@ def resume(
     (150, True)
     """
     stored = load(path, lazy=True, model=model, allow_pickle=allow_pickle)
-    if stored.contacts:
-        raise ValueError(
-            f"path: {str(path)!r} holds a run with contacts ({', '.join(map(repr, stored.contacts))}), which resume"
-            " cannot continue yet (its checkpoint does not hold them); start a new run from its last state with"
-            " integrate(model, traj.q[-1], traj.p[-1], t0=traj.t[-1], contacts=...)"
-        )
+    going_on = _impacts.going_on(stored.contacts, contacts)
     if stored.checkpoint is None or not len(stored.t):
         raise ValueError(f"path: {str(path)!r} has no checkpoint to resume from")
     _check_checkpoint(path, stored)
@@ -310,7 +317,7 @@ def resume(
     if save_every is None:
         save_every = files.save_every_of(path)
     watched, specs = _events.specs(events, stored.model.dim) if events is not None else ([], [])
-    names = [o.name for o in _events.occurrences_of(watched)]
+    names = [o.name for o in _events.occurrences_of(watched)] + [c.name for c in going_on]
     writer = files.Writer.reopen(Path(path), stored, names)
     initial = _events.first_energy(stored.model, stored)
     counts = _events.found_before(stored.events, watched)
@@ -330,6 +337,7 @@ def resume(
             event_specs=specs,
             initial_energy=initial,
             found=counts,
+            contacts=going_on,
         )
     finally:
         bar.close()

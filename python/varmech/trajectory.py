@@ -4,6 +4,7 @@ from the binding's record of a run or read back from a file (:func:`load`)."""
 from __future__ import annotations
 
 import os
+import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -14,7 +15,9 @@ from numpy.typing import ArrayLike
 
 from . import _core, dense, files
 from . import events as _events
+from . import impacts as _impacts
 from .events import Occurrences
+from .impacts import Contact
 from .model import Model
 
 __all__ = [
@@ -74,11 +77,13 @@ class Trajectory:
     checkpoint : bytes or None
         The last state's checkpoint: ``integrate(traj, steps=)`` goes on from it, bit for bit.
     events : tuple of Occurrences
-        Each event's located crossings, in the order the events were given.
-    contacts : tuple of str
-        The names of the contacts of a run with ``contacts`` (empty otherwise). The core's
-        checkpoint does not hold them, so such a run is not continued (``integrate(traj,
-        steps=)``, :func:`varmech.resume`): that is refused, naming ``contacts``.
+        Each event's located crossings, in the order the events were given, then each
+        contact's impacts (time, contact configuration, momenta just before).
+    contacts : tuple of Contact
+        The run's contacts (empty without them), which a continued run (``integrate(traj,
+        steps=)``, :func:`varmech.resume`) goes on with. A file stores the native ones
+        (``Contact.wall``, ``Contact.ellipsoid``); one given by Python functions is loaded as
+        its name (a str), and a run goes on with it only when it is given again.
 
     Examples
     --------
@@ -108,8 +113,9 @@ class Trajectory:
     checkpoint: bytes | None = field(default=None, repr=False)
     #: Each event's located crossings (times and states), in the order the events were given.
     events: tuple[_events.Occurrences, ...] = field(default=(), repr=False)
-    #: The names of a run's contacts: a run with contacts cannot be continued yet.
-    contacts: tuple[str, ...] = field(default=(), repr=False)
+    #: The run's contacts, which a continued run goes on with (a loaded file's contacts given by
+    #: Python functions are their names: pass them again to :func:`varmech.resume`).
+    contacts: tuple[Contact | str, ...] = field(default=(), repr=False)
     _v: np.ndarray | None = field(default=None, repr=False)
 
     @property
@@ -319,13 +325,26 @@ def take_partial(err: BaseException) -> _core.TrajectoryRecord | None:
 
 
 def _trajectory(
-    record: _core.TrajectoryRecord, model: Model, method: str, dt: float, events: Sequence[_events.Event] = (), **status: Any
+    record: _core.TrajectoryRecord,
+    model: Model,
+    method: str,
+    dt: float,
+    events: Sequence[_events.Event] = (),
+    contacts: Sequence[Contact | str] = (),
+    **status: Any,
 ) -> Trajectory:
-    """The Trajectory of the binding's record of a run, with its events' crossings (and the
-    status of a terminal event's stop, unless `status` is given)."""
+    """The Trajectory of the binding's record of a run, with its events' crossings and its
+    contacts' impacts after them (and the status of a terminal event's stop, unless `status` is
+    given)."""
     r = record
-    found = _events.occurrences(r, events)
+    found = crossings(r, events, contacts)
     status = status or _events.termination(r, events, found)
+    if r.grazing:
+        warnings.warn(
+            f"{r.grazing} grazing impact(s) had no discrete-energy solution near the reflection and took Newton's law",
+            RuntimeWarning,
+            stacklevel=4,
+        )
     return Trajectory(
         r.t,
         r.q,
@@ -339,8 +358,15 @@ def _trajectory(
         r.work,
         checkpoint=r.checkpoint,
         events=found,
+        contacts=tuple(contacts),
         **status,
     )
+
+
+def crossings(record: Any, events: Sequence[_events.Event], contacts: Sequence[Contact | str]) -> tuple[Occurrences, ...]:
+    """Each event's located crossings in the binding's record of a run, then each contact's
+    impacts."""
+    return _events.occurrences(record, events) + _impacts.occurrences(record, contacts)
 
 
 def load(
@@ -465,8 +491,17 @@ def load(
         message=str(a["message"]) if complete else f"The run stopped at step {steps} without closing its file.",
         checkpoint=checkpoint or None,
         events=events,
-        contacts=tuple(str(name) for name in a.get("contacts", ())),
+        contacts=_stored_contacts(a),
     )
+
+
+def _stored_contacts(attrs: Any) -> tuple[Contact | str, ...]:
+    """A file's contacts: the native ones rebuilt, the others (and all of a file written before
+    contacts were stored) their names."""
+    names = [str(name) for name in attrs.get("contacts", ())]
+    if "contact_surfaces" not in attrs:
+        return tuple(names)
+    return _impacts.restored(str(attrs["contact_surfaces"]), names)
 
 
 def _occurrences(group: Any, t_last: float) -> Occurrences:

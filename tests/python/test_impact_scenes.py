@@ -158,7 +158,7 @@ def test_bad_impact_scenes_and_shapes_are_named():
     with pytest.raises(ValueError, match="^semi_axes: coordinates, centre and semi_axes"):
         varmech.Contact.ellipsoid([1.0, 1.0], coordinates=[0])
     free = examples.elliptic_billiard()
-    with pytest.raises(ValueError, match=r"^contacts\[0\]: coordinates \(0, 2\)"):
+    with pytest.raises(ValueError, match=r"^contacts: .* \(contacts\[0\]\): coordinate 2 is not in 0 … 1"):
         varmech.integrate(free, [0.0, 0.0], [1.0, 0.0], dt=0.1, steps=10, contacts=[varmech.Contact.ellipsoid([1.0, 1.0], coordinates=[0, 2])])
     with pytest.raises(ValueError, match="^q0: outside the contact"):
         varmech.integrate(free, [2.0, 0.0], [1.0, 0.0], dt=0.1, steps=10, contacts=[varmech.Contact.ellipsoid([1.0, 1.0])])

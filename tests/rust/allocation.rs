@@ -2,13 +2,19 @@
 //! run of 100 steps (the set-up's), whatever the method, and so does RATTLE's on a chain and the
 //! discrete Lagrange–d'Alembert step's on the rolling scenes and, with a holonomic constraint
 //! too, on the skate; a
-//! stepper's steps make none at all, nor does taking it apart, resuming and resetting it.
+//! stepper's steps make none at all, nor does taking it apart, resuming and resetting it, nor
+//! does a discrete energy E_d once made. A run with contacts allocates nothing in its steps
+//! either, impacts included, but for the growth of its output (the impacts and the states at
+//! them).
 
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
 use std::ops::Deref;
 
-use varmech::integrators::{integrate, Dynamics, General, Method, ModelKind, Options, Stepper, StepperState};
+use varmech::integrators::{
+    integrate, integrate_watching, Contact, Contacts, DiscreteEnergy, Dynamics, General, Law, Method, ModelKind,
+    NativeSurface, Options, Stepper, StepperState, Watch,
+};
 use varmech::model::Routhian;
 use varmech::scenes::{self, NBody, NonholonomicScene, SceneModel};
 
@@ -367,4 +373,96 @@ fn the_mixed_constraints_step_loop_allocates_nothing() {
             "{method:?}: {short} allocations for 100 steps, {long} for 5000"
         );
     }
+}
+
+/// Allocations made by 1 000 evaluations of `method`'s discrete energy on `sys`, after a first
+/// one (which may grow a thread's scratch, as the inverse Legendre transform's).
+fn discrete_energy_allocations<S: Dynamics>(sys: &S, method: Method, start: (&[f64], &[f64])) -> usize {
+    let mut energy = DiscreteEnergy::new(method, start.0.len()).unwrap();
+    let end: (Vec<f64>, Vec<f64>) = (start.0.iter().map(|x| x + 0.01).collect(), start.1.to_vec());
+    let mut evaluate = || energy.energy(sys, 0.0, 0.01, start, (&end.0, &end.1)).unwrap();
+    evaluate();
+    let before = allocated();
+    for _ in 0..1000 {
+        std::hint::black_box(evaluate());
+    }
+    allocated() - before
+}
+
+#[test]
+fn the_discrete_energy_allocates_nothing() {
+    let kepler = scenes::Kepler::problem(0.6).unwrap();
+    let start = (&kepler.initial.q[..], &kepler.initial.p[..]);
+    let double = scenes::DoublePendulum::new(1.0, 2.0, 2.0, 3.0, 9.80665).unwrap();
+    let pendulum = tapes::pendulum_lagrangian();
+    for method in Method::ALL.into_iter().filter(|m| DiscreteEnergy::new(*m, 2).is_some()) {
+        assert_eq!(
+            discrete_energy_allocations(&kepler.system, method, start),
+            0,
+            "{method:?}"
+        );
+    }
+    for method in [Method::Midpoint, Method::Trapezoid] {
+        let natural = discrete_energy_allocations(&General(&double), method, (&[0.7, -0.4], &[1.3, 0.8]));
+        let compiled = discrete_energy_allocations(&General(&pendulum), method, (&[0.3], &[0.7]));
+        assert_eq!((natural, compiled), (0, 0), "{method:?}: natural, compiled");
+    }
+}
+
+/// Allocations of a run of `steps` steps of 0.01 of the free particle from (q0, p0) in the
+/// table |q| ≤ `radius` (reflect law), and its impacts.
+fn billiard(steps: usize, radius: f64) -> (usize, usize) {
+    let free = scenes::EllipticBilliard::new(1.0, 1.0).unwrap();
+    let table = Contact {
+        surface: Box::new(NativeSurface::Ellipsoid {
+            coordinates: vec![0, 1],
+            centre: vec![0.0, 0.0],
+            semi_axes: vec![radius, radius],
+            inside: true,
+        }),
+        restitution: 1.0,
+        law: Law::Reflect,
+        name: "table".into(),
+    };
+    let contacts = Contacts::new(vec![table]).unwrap();
+    let options = Options {
+        save_every: 100,
+        ..Options::new(0.01, steps)
+    };
+    let watch = Watch {
+        events: None,
+        contacts: Some(&contacts),
+    };
+    let before = allocated();
+    let traj = integrate_watching(
+        &free,
+        Method::Verlet,
+        &[0.3, -0.2],
+        &[0.6, 0.8],
+        &options,
+        || Ok(()),
+        watch,
+    )
+    .unwrap();
+    (allocated() - before, traj.impacts.len())
+}
+
+#[test]
+fn contacts_allocate_nothing_in_the_step_loop() {
+    // A table never reached: a long run allocates as much as a short one.
+    let (short, none) = billiard(100, 1e6);
+    let (long, _) = billiard(100_000, 1e6);
+    assert_eq!(none, 0);
+    assert_eq!(long, short, "{long} allocations in 100 000 steps, {short} in 100");
+    // Thousands of impacts: only the output grows, each of its 9 columns (the impacts' 6, the
+    // saved states' 3) doubling its storage now and then.
+    let (short, few) = billiard(1000, 1.0);
+    let (long, many) = billiard(100_000, 1.0);
+    assert!(few >= 5 && many >= 500, "{few}, {many} impacts");
+    let doublings = 9 * ((many as f64).log2().ceil() as usize + 1);
+    assert!(
+        long - short <= doublings,
+        "{} allocations for {many} impacts",
+        long - short
+    );
 }

@@ -13,6 +13,7 @@ mod constraints;
 mod convergence;
 mod crafted_checkpoints;
 mod damped_driven_pendulum;
+mod discrete_energy;
 mod ensemble;
 mod events;
 mod failures;
@@ -20,6 +21,7 @@ mod forcing;
 mod general_lagrangian;
 mod heavy_top;
 mod hessians;
+mod impacts;
 #[cfg(feature = "jit")]
 mod jit;
 mod kepler;

@@ -33,6 +33,11 @@ pub enum Error {
     Model { step: usize, time: f64, source: ModelError },
     /// The interrupt poll (Ctrl-C) asked the run to stop before `step`.
     Interrupted { step: usize, time: f64, source: ModelError },
+    /// An impact in `step` (which starts at `time`) could not be resolved: a non-finite state
+    /// after a jump, a body that crosses a surface again at once after leaving it (a resting or
+    /// grazing contact), or more than [`crate::integrators::MAX_IMPACTS`] impacts in the step
+    /// (an accumulation, as of a ball coming to rest). The run ends at the step's start.
+    Contact { step: usize, time: f64, reason: String },
 }
 
 impl Error {
@@ -74,6 +79,9 @@ impl fmt::Display for Error {
             }
             Error::Interrupted { step, time, .. } => {
                 write!(f, "integration interrupted at step {step} (t = {time})")
+            }
+            Error::Contact { step, time, reason } => {
+                write!(f, "impact not resolved in step {step} (from t = {time}): {reason}")
             }
         }
     }

@@ -9,6 +9,7 @@ use varmech::integrators::{self, Dynamics, MemberEvents, Members, Method, Parall
 
 use crate::bind::check_signals;
 use crate::compiled::CompiledModel;
+use crate::contacts::{ContactSpecs, ContactTuple};
 use crate::convert::{self, rows};
 use crate::errors::{model_error, to_pyerr};
 use crate::events::{EventTuple, Events};
@@ -56,12 +57,13 @@ type MemberResult = (TrajectoryRecord, Option<Py<PyAny>>);
 
 /// Integrates the members (rows of `q0` and `p0`, (members, n)) with `models` (one shared, or
 /// one a member) on at most `workers` threads in tasks of `chunk_size` members, the GIL
-/// released, each watching `events` (spec tuples of built-in events, see [`Events::new`]);
+/// released, each watching `events` (spec tuples of built-in events, see [`Events::new`]) and
+/// resolving the impacts on `contacts` (native surfaces, see [`ContactSpecs::new`]);
 /// `progress(steps)` gets the steps of all members so far. Returns each member's
 /// record and exception (None when it completed), and the exception (KeyboardInterrupt) that
 /// stopped the ensemble, if one did: the members then stopped where they were.
 #[pyfunction]
-#[pyo3(signature = (models, q0, p0, *, dt, steps, method, save_every=1, compensated=true, max_energy_error=None, t0=0.0, newton_tolerance=1e-14, newton_max_iterations=50, workers=None, chunk_size=None, progress=None, events=None))]
+#[pyo3(signature = (models, q0, p0, *, dt, steps, method, save_every=1, compensated=true, max_energy_error=None, t0=0.0, newton_tolerance=1e-14, newton_max_iterations=50, workers=None, chunk_size=None, progress=None, events=None, contacts=None))]
 #[allow(clippy::too_many_arguments)]
 fn ensemble<'py>(
     py: Python<'py>,
@@ -81,6 +83,7 @@ fn ensemble<'py>(
     chunk_size: Option<usize>,
     progress: Option<Py<PyAny>>,
     events: Option<Vec<EventTuple<'py>>>,
+    contacts: Option<Vec<ContactTuple<'py>>>,
 ) -> PyResult<(Vec<MemberResult>, Option<Py<PyAny>>)> {
     let options = run_options(
         dt,
@@ -112,10 +115,15 @@ fn ensemble<'py>(
         }
         None => MemberEvents::default(),
     };
+    let contacts = match contacts {
+        Some(tuples) => ContactSpecs::new(tuples)?.into_native()?,
+        None => Vec::new(),
+    };
     let parallel = Parallel { workers, chunk_size };
     let run = py.detach(|| {
         let report = reporting(&check_signals, &progress);
-        integrators::integrate_ensemble(&models, method, q0, p0, &options, parallel, &events, report)
+        let watched = (&events, contacts.as_slice());
+        integrators::integrate_ensemble_watching(&models, method, q0, p0, &options, parallel, watched, report)
     });
     let run = run.map_err(|e| to_pyerr(py, e))?;
     let members = run

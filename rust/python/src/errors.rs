@@ -24,6 +24,12 @@ pyo3::create_exception!(
 );
 pyo3::create_exception!(
     varmech,
+    ContactError,
+    VarmechError,
+    "An impact could not be resolved: a resting or grazing contact, or an accumulation of impacts."
+);
+pyo3::create_exception!(
+    varmech,
     DivergenceError,
     VarmechError,
     "The solution blew up: a non-finite state, or an energy error beyond max_energy_error."
@@ -36,6 +42,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("DivergenceError", py.get_type::<DivergenceError>())?;
     m.add("ConvergenceError", py.get_type::<ConvergenceError>())?;
     m.add("SpuriousBranchError", py.get_type::<SpuriousBranchError>())?;
+    m.add("ContactError", py.get_type::<ContactError>())?;
     Ok(())
 }
 
@@ -66,7 +73,7 @@ pub fn model_error_at(e: ModelError, names: &str) -> PyErr {
 
 /// The Python exception for a core error, with the core's message: ValueError (which names the
 /// argument), DivergenceError, ConvergenceError (with `residual` and `iterations`),
-/// SpuriousBranchError, or the model's own exception (a closure's, or KeyboardInterrupt)
+/// SpuriousBranchError, ContactError, or the model's own exception (a closure's, or KeyboardInterrupt)
 /// unchanged; all but the ValueError carry the `step` and `time` where they happened.
 pub fn to_pyerr(py: Python<'_>, error: Error) -> PyErr {
     let (exception, step, time) = match error {
@@ -88,6 +95,7 @@ pub fn to_pyerr(py: Python<'_>, error: Error) -> PyErr {
             (err, step, time)
         }
         Error::SpuriousBranch { step, time, .. } => (SpuriousBranchError::new_err(error.to_string()), step, time),
+        Error::Contact { step, time, .. } => (ContactError::new_err(error.to_string()), step, time),
         Error::Model { step, time, source } => {
             (raised(source, |source| Error::Model { step, time, source }), step, time)
         }

@@ -14,6 +14,7 @@ mod bind;
 mod closure;
 mod compiled;
 mod constraints;
+mod contacts;
 mod convert;
 mod diagnostics;
 mod ensemble;

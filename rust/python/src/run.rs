@@ -6,20 +6,23 @@ use pyo3::prelude::*;
 use varmech::diagnostics;
 use varmech::integrators::{
     self, Checkpoint, Counting, Detector, EventSpec, Failure, Method, NewtonOptions, Options, Splitting, Trajectory,
+    Watch,
 };
 use varmech::ModelError;
 
 use crate::bind::{bind_model, dim_of, Poll};
+use crate::contacts::{ContactSpecs, ContactTuple};
 use crate::convert::{self, count, slice};
 use crate::errors::{boxed, failure_to_pyerr, to_pyerr};
 use crate::events::{EventTuple, Events};
 use crate::trajectory::TrajectoryRecord;
 
 /// Integrates; returns the saved states as a [`TrajectoryRecord`] or raises with
-/// `_varmech_partial`, the states up to the failure. With `events` (spec tuples, see
-/// [`Events::new`]) the run watches them ([`integrators::integrate_with_events`]).
+/// `_varmech_partial`, the states up to the failure. The run watches `events` (spec tuples, see
+/// [`Events::new`]) and resolves the impacts on `contacts` (see [`ContactSpecs::new`]), if given
+/// ([`integrators::integrate_watching`]).
 #[pyfunction]
-#[pyo3(signature = (model, q0, p0, *, dt, steps, method, save_every=1, compensated=true, max_energy_error=None, t0=0.0, newton_tolerance=1e-14, newton_max_iterations=50, progress=None, events=None))]
+#[pyo3(signature = (model, q0, p0, *, dt, steps, method, save_every=1, compensated=true, max_energy_error=None, t0=0.0, newton_tolerance=1e-14, newton_max_iterations=50, progress=None, events=None, contacts=None))]
 #[allow(clippy::too_many_arguments)]
 fn integrate<'py>(
     py: Python<'py>,
@@ -37,6 +40,7 @@ fn integrate<'py>(
     #[pyo3(from_py_with = newton_max_iterations_count)] newton_max_iterations: usize,
     progress: Option<Py<PyAny>>,
     events: Option<Vec<EventTuple<'py>>>,
+    contacts: Option<Vec<ContactTuple<'py>>>,
 ) -> PyResult<TrajectoryRecord> {
     let options = run_options(
         dt,
@@ -50,17 +54,39 @@ fn integrate<'py>(
     );
     let (q0, p0) = (slice("q0", &q0)?, slice("p0", &p0)?);
     let events = detector_parts(py, model, events)?;
+    let contacts = contacts.map(ContactSpecs::new).transpose()?;
     let result = bind_model(py, model, |sys, poll| {
         let report = reporting(poll, &progress);
-        match events {
-            None => integrators::integrate(sys, method, q0, p0, &options, report),
-            Some((functions, specs)) => {
-                let mut detector = detector(functions, specs)?;
-                integrators::integrate_with_events(sys, method, q0, p0, &options, report, &mut detector)
-            }
-        }
+        watching(events, contacts.as_ref(), |watch| {
+            integrators::integrate_watching(sys, method, q0, p0, &options, report, watch)
+        })
     })?;
     record(py, result)
+}
+
+/// Runs `run` with the [`Watch`] of `events` and `contacts`, or the failure of a run that never
+/// started (events or contacts malformed).
+fn watching<'c>(
+    events: Option<(Events, Vec<EventSpec>)>,
+    contacts: Option<&'c ContactSpecs>,
+    run: impl FnOnce(Watch<'_, '_, 'c>) -> Result<Trajectory, Box<Failure>>,
+) -> Result<Trajectory, Box<Failure>> {
+    let never_started = |error| {
+        let partial = Trajectory::default();
+        Box::new(Failure { error, partial })
+    };
+    let mut detector = match events {
+        None => None,
+        Some((functions, specs)) => Some(Detector::new(Box::new(functions), specs).map_err(never_started)?),
+    };
+    let contacts = contacts
+        .map(ContactSpecs::contacts)
+        .transpose()
+        .map_err(never_started)?;
+    run(Watch {
+        events: detector.as_mut(),
+        contacts: contacts.as_ref(),
+    })
 }
 
 /// A run's [`Options`] from the binding's arguments (`integrate`'s and `ensemble`'s).
@@ -101,19 +127,11 @@ fn detector_parts<'py>(
         .transpose()
 }
 
-/// The run's detector, or the failure of a run that never started.
-fn detector<'f>(functions: Events, specs: Vec<EventSpec>) -> Result<Detector<'f>, Box<Failure>> {
-    Detector::new(Box::new(functions), specs).map_err(|error| {
-        let partial = Trajectory::default();
-        Box::new(Failure { error, partial })
-    })
-}
-
 /// Goes on from a run's checkpoint for `steps` more steps (see [`integrators::resume`]),
-/// watching `events` (as `integrate`'s) if given; a checkpoint of another `method` or `dt`
-/// than given is refused ([`Checkpoint::expect`]).
+/// watching `events` and resolving the impacts on `contacts` (as `integrate`'s) if given; a
+/// checkpoint of another `method` or `dt` than given is refused ([`Checkpoint::expect`]).
 #[pyfunction]
-#[pyo3(signature = (model, checkpoint, *, steps, save_every=1, progress=None, events=None, method=None, dt=None))]
+#[pyo3(signature = (model, checkpoint, *, steps, save_every=1, progress=None, events=None, method=None, dt=None, contacts=None))]
 #[allow(clippy::too_many_arguments)]
 fn resume<'py>(
     py: Python<'py>,
@@ -125,18 +143,16 @@ fn resume<'py>(
     events: Option<Vec<EventTuple<'py>>>,
     method: Option<&str>,
     dt: Option<f64>,
+    contacts: Option<Vec<ContactTuple<'py>>>,
 ) -> PyResult<TrajectoryRecord> {
     let checkpoint = decode(py, checkpoint, method, dt)?;
     let events = detector_parts(py, model, events)?;
+    let contacts = contacts.map(ContactSpecs::new).transpose()?;
     let result = bind_model(py, model, |sys, poll| {
         let report = reporting(poll, &progress);
-        match events {
-            None => integrators::resume(sys, checkpoint, steps, save_every, report),
-            Some((functions, specs)) => {
-                let mut detector = detector(functions, specs)?;
-                integrators::resume_with_events(sys, checkpoint, steps, save_every, report, &mut detector)
-            }
-        }
+        watching(events, contacts.as_ref(), |watch| {
+            integrators::resume_watching(sys, checkpoint, steps, save_every, report, watch)
+        })
     })?;
     record(py, result)
 }

@@ -37,7 +37,24 @@ pub struct TrajectoryRecord {
     /// The index of the event whose terminal count stopped the run, if one did.
     #[pyo3(get)]
     terminated_by: Option<usize>,
+    /// The impacts on the run's contacts in order of time: the contact's index (k,), t (k,),
+    /// the contact configuration q and the momenta just before and just after (k, n).
+    #[pyo3(get)]
+    impacts: ImpactArrays,
+    /// Impacts under the variational law that took Newton's law for want of a discrete-energy
+    /// root near the reflection (grazing).
+    #[pyo3(get)]
+    grazing: usize,
 }
+
+/// Impacts as arrays: the contact's index (k,), t (k,), q, p before and p after (k, n).
+type ImpactArrays = (
+    Py<PyArray1<usize>>,
+    Py<PyArray1<f64>>,
+    Py<PyArray2<f64>>,
+    Py<PyArray2<f64>>,
+    Py<PyArray2<f64>>,
+);
 
 /// Event crossings as arrays: the event's index (k,), t (k,), q and p (k, n), and the start of
 /// each one's step, q and p (k, n).
@@ -76,6 +93,14 @@ impl TrajectoryRecord {
             matrix(py, q_start, n)?.unbind(),
             matrix(py, p_start, n)?.unbind(),
         );
+        let i = traj.impacts;
+        let impacts = (
+            PyArray1::from_vec(py, i.contact).unbind(),
+            PyArray1::from_vec(py, i.t).unbind(),
+            matrix(py, i.q, n)?.unbind(),
+            matrix(py, i.p_before, n)?.unbind(),
+            matrix(py, i.p_after, n)?.unbind(),
+        );
         Ok(TrajectoryRecord {
             t: PyArray1::from_vec(py, traj.t).unbind(),
             q: matrix(py, traj.q, n)?.unbind(),
@@ -87,6 +112,8 @@ impl TrajectoryRecord {
             checkpoint: PyBytes::new(py, &traj.checkpoint).unbind(),
             events,
             terminated_by: traj.terminated_by,
+            impacts,
+            grazing: i.grazing,
         })
     }
 

@@ -12,8 +12,8 @@ use std::sync::mpsc::{self, RecvTimeoutError};
 use std::time::{Duration, Instant};
 
 use super::{
-    integrate, integrate_with_events, Counting, Detector, Dynamics, EventSpec, Failure, Method, NativeEvent, Options,
-    Poll, Trajectory,
+    integrate_watching, Contacts, Counting, Detector, Dynamics, EventSpec, Failure, Method, NativeContact, NativeEvent,
+    Options, Poll, Trajectory, Watch,
 };
 use crate::{memory, Error, ModelError};
 
@@ -137,6 +137,28 @@ pub fn integrate_ensemble<M, P>(
     options: &Options,
     parallel: Parallel,
     events: &MemberEvents,
+    poll: P,
+) -> Result<Ensemble, Error>
+where
+    M: Members + ?Sized,
+    P: Poll,
+{
+    integrate_ensemble_watching(models, method, q0, p0, options, parallel, (events, &[]), poll)
+}
+
+/// As [`integrate_ensemble`], every member also resolving the impacts on `contacts` (each its
+/// own copy: [`Contacts::native`]), as [`integrate_watching`] does; each member is bit for bit
+/// its single run. Refuses, before any member starts, contacts that a member's run would refuse
+/// (naming `contacts`).
+#[allow(clippy::too_many_arguments)]
+pub fn integrate_ensemble_watching<M, P>(
+    models: &M,
+    method: Method,
+    q0: &[f64],
+    p0: &[f64],
+    options: &Options,
+    parallel: Parallel,
+    (events, contacts): (&MemberEvents, &[NativeContact]),
     mut poll: P,
 ) -> Result<Ensemble, Error>
 where
@@ -171,6 +193,7 @@ where
     for (event, spec) in events.functions.iter().zip(&events.specs) {
         event.check(&spec.name, n)?;
     }
+    Contacts::native(contacts)?.fit(n)?;
 
     let workers = parallel
         .workers
@@ -195,8 +218,9 @@ where
                     let i = c * chunk + k;
                     let rows = i * n..(i + 1) * n;
                     let (q0, p0) = (&q0[rows.clone()], &p0[rows]);
-                    *slot =
-                        Some(models.with_model(i, |sys| member(sys, method, (q0, p0), options, events, stop, steps)));
+                    *slot = Some(models.with_model(i, |sys| {
+                        member(sys, method, (q0, p0), options, (events, contacts), stop, steps)
+                    }));
                     // The receiver waits until every member is done.
                     let _ = sender.send(());
                 }
@@ -227,7 +251,7 @@ where
     Ok(Ensemble { members, interrupted })
 }
 
-/// One member: [`integrate`] (or [`integrate_with_events`] watching `events`), its poll
+/// One member: [`integrate_watching`] of its `events` and `contacts` (with neither, [`super::integrate`]), its poll
 /// counting its steps into `steps` and stopping when `stop` is set; a member not started
 /// before the stop is interrupted at its initial state.
 fn member(
@@ -235,7 +259,7 @@ fn member(
     method: Method,
     (q0, p0): (&[f64], &[f64]),
     options: &Options,
-    events: &MemberEvents,
+    (events, contacts): (&MemberEvents, &[NativeContact]),
     stop: &AtomicBool,
     steps: &AtomicUsize,
 ) -> Outcome {
@@ -262,14 +286,19 @@ fn member(
             false => Ok(()),
         }
     });
-    let outcome = if events.functions.is_empty() {
-        integrate(sys, method, q0, p0, options, poll)
-    } else {
-        match events.detector() {
-            Ok(mut detector) => integrate_with_events(sys, method, q0, p0, options, poll, &mut detector),
-            Err(error) => return unstarted(error),
-        }
+    let mut detector = match (!events.functions.is_empty()).then(|| events.detector()).transpose() {
+        Ok(detector) => detector,
+        Err(error) => return unstarted(error),
     };
+    let own = match Contacts::native(contacts) {
+        Ok(own) => own,
+        Err(error) => return unstarted(error),
+    };
+    let watch = Watch {
+        events: detector.as_mut(),
+        contacts: (!own.is_empty()).then_some(&own),
+    };
+    let outcome = integrate_watching(sys, method, q0, p0, options, poll, watch);
     steps.fetch_add(options.steps.saturating_sub(counted), Relaxed);
     outcome
 }

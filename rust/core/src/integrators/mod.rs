@@ -12,6 +12,8 @@
 //! - [`Splitting`]: the coefficients of the kick–drift methods (symplectic Euler, Störmer–Verlet,
 //!   its symmetric compositions, the Runge–Kutta–Nyström splittings);
 //! - [`KickDrift`]: a [`Splitting`] applied to a separable system;
+//! - [`DiscreteEnergy`]: E_d = −∂L_d/∂τ of a kick–drift method's or a two-point rule's step,
+//!   which the variational collision integrator conserves across an impact;
 //! - [`ExplicitRk`]: explicit Euler and classical RK4, the non-structure-preserving baselines;
 //! - [`wisdom_holman`]: the Wisdom–Holman methods of the N-body problem, Kepler drifts and
 //!   interaction kicks in Jacobi coordinates, with symplectic correctors ([`WisdomHolman`]);
@@ -28,10 +30,12 @@ mod checkpoint;
 pub mod compensated;
 mod composition;
 mod del;
+mod discrete_energy;
 mod dynamics;
 mod ensemble;
 pub mod events;
 mod explicit_rk;
+pub mod jumps;
 mod kick_drift;
 mod kind;
 mod method;
@@ -51,16 +55,23 @@ pub use checkpoint::{Checkpoint, Fingerprint, FORMAT as CHECKPOINT_FORMAT};
 pub use composition::Composition;
 pub use del::{Composed, Del, StepEquations, TwoPoint};
 use del::{Constraints, DiscreteConstraint};
+pub use discrete_energy::DiscreteEnergy;
 pub use dynamics::{Dynamics, General};
-pub use ensemble::{integrate_ensemble, Ensemble, MemberEvents, Members, Outcome, Parallel, Shared, Stopped};
+pub use ensemble::{
+    integrate_ensemble, integrate_ensemble_watching, Ensemble, MemberEvents, Members, Outcome, Parallel, Shared,
+    Stopped,
+};
 pub use events::{Detector, EventFunctions, EventSpec, NativeEvent, Occurrence};
 pub use explicit_rk::ExplicitRk;
+pub use jumps::{Contact, Contacts, Impacts, Law, NativeContact, NativeSurface, Surface, Watch, Watcher, MAX_IMPACTS};
 pub use kick_drift::KickDrift;
 pub use kind::ModelKind;
 pub use method::{Method, MethodInfo};
 pub use poll::{Counting, Poll};
 pub use rattle::Rattle;
-pub use run::{integrate, integrate_with_events, resume, resume_with_events, Options};
+pub use run::{
+    integrate, integrate_watching, integrate_with_events, resume, resume_watching, resume_with_events, Options,
+};
 pub use splitting::{Leading, Splitting};
 pub use step::{Increment, StepStart};
 use stepper::Phase;

@@ -2,8 +2,8 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::events::Search;
-use super::{Checkpoint, Counting, Detector, Dynamics, Failure, Method, NewtonOptions, Poll, Stepper, Trajectory};
+use super::jumps::{Watch, Watcher};
+use super::{Checkpoint, Detector, Dynamics, Failure, Method, NewtonOptions, Poll, Stepper, Trajectory};
 use crate::model::{EnergyTerms, Scale};
 use crate::{memory, Error};
 
@@ -103,7 +103,15 @@ where
     P: Poll,
 {
     let (stepper, watch) = start(sys, method, q0, p0, options)?;
-    run(sys, stepper, watch, options.steps, options.save_every, poll, None)
+    run(
+        sys,
+        stepper,
+        watch,
+        options.steps,
+        options.save_every,
+        poll,
+        Watcher::idle(),
+    )
 }
 
 // Events: the run with a [`Detector`] (begin).
@@ -125,23 +133,77 @@ where
     S: Dynamics + ?Sized,
     P: Poll,
 {
-    let (stepper, watch) = start(sys, method, q0, p0, options)?;
-    // The run's search, its scratch stepper on the same model.
-    let search = match events.begin(sys, &stepper) {
-        Ok(search) => search,
-        Err(error) => return Err(fail(error, first_state(sys, &stepper))),
+    let watch = Watch {
+        events: Some(events),
+        contacts: None,
     };
-    run(
-        sys,
-        stepper,
-        watch,
-        options.steps,
-        options.save_every,
-        poll,
-        Some(search),
-    )
+    integrate_watching(sys, method, q0, p0, options, poll, watch)
 }
 // Events (end).
+
+/// As [`integrate`], watching `watch`'s events (as [`integrate_with_events`] does) and
+/// resolving the impacts on its contacts.
+///
+/// The step that crosses a contact's φ = 0 is split at the contact: the method's partial step
+/// of size αh from (qₙ, pₙ) to the contact configuration q̃ (α located to round-off), the jump
+/// p⁺ = p⁻ + λ∇φ(q̃) of the contact's [`Law`](super::Law) (∇φ projected on the constraints of a
+/// constrained model), then the method's partial step of (1 − α)h to tₙ₊₁; the rest of the step
+/// is checked against every contact again (a corner, a second bounce), up to
+/// [`MAX_IMPACTS`](super::MAX_IMPACTS) impacts in one step. A step without an impact is bit for
+/// bit the step without contacts. The impacts go to [`Trajectory::impacts`], and the saved
+/// states include the state just before and just after each (one time, two rows). The energy
+/// check ([`Options::max_energy_error`]) discounts the change of energy at the jumps (e < 1).
+///
+/// Refuses, naming `contacts`, a surface that does not fit the model's coordinates and the
+/// variational law on a method or model it does not fit; naming `q0`, an initial state outside
+/// φ ≥ 0. Fails with [`Error::Contact`] (the run ending at the start of the step, its last good
+/// state) when an impact cannot be resolved: a non-finite state after a jump, a resting or
+/// grazing contact, or more than `MAX_IMPACTS` impacts in a step.
+pub fn integrate_watching<S, P>(
+    sys: &S,
+    method: Method,
+    q0: &[f64],
+    p0: &[f64],
+    options: &Options,
+    poll: P,
+    watch: Watch<'_, '_, '_>,
+) -> Result<Trajectory, Box<Failure>>
+where
+    S: Dynamics + ?Sized,
+    P: Poll,
+{
+    let (stepper, energy) = start(sys, method, q0, p0, options)?;
+    watched(
+        sys,
+        stepper,
+        energy,
+        (options.steps, options.save_every),
+        poll,
+        watch,
+        "q0",
+    )
+}
+
+/// The run of `stepper` to step `end` watching `watch` (its [`Watcher`] begun on the
+/// stepper's state, named `argument` if it is outside a contact).
+fn watched<S, P>(
+    sys: &S,
+    stepper: Stepper<&S>,
+    energy: Option<EnergyWatch>,
+    (end, save_every): (usize, usize),
+    poll: P,
+    watch: Watch<'_, '_, '_>,
+    argument: &'static str,
+) -> Result<Trajectory, Box<Failure>>
+where
+    S: Dynamics + ?Sized,
+    P: Poll,
+{
+    match Watcher::begin(sys, &stepper, watch, argument, energy.is_some()) {
+        Ok(watcher) => run(sys, stepper, energy, end, save_every, poll, watcher),
+        Err(error) => Err(fail(error, first_state(sys, &stepper))),
+    }
+}
 
 /// The stepper of a new run and its energy check.
 #[allow(clippy::type_complexity)]
@@ -183,7 +245,7 @@ where
     P: Poll,
 {
     let (stepper, watch, end) = resumed(sys, checkpoint, steps, save_every)?;
-    run(sys, stepper, watch, end, save_every, poll, None)
+    run(sys, stepper, watch, end, save_every, poll, Watcher::idle())
 }
 
 /// As [`resume`], watching the `events` as [`integrate_with_events`] does, from the
@@ -201,12 +263,31 @@ where
     S: Dynamics + ?Sized,
     P: Poll,
 {
-    let (stepper, watch, end) = resumed(sys, checkpoint, steps, save_every)?;
-    let search = match events.begin(sys, &stepper) {
-        Ok(search) => search,
-        Err(error) => return Err(fail(error, first_state(sys, &stepper))),
+    let watch = Watch {
+        events: Some(events),
+        contacts: None,
     };
-    run(sys, stepper, watch, end, save_every, poll, Some(search))
+    resume_watching(sys, checkpoint, steps, save_every, poll, watch)
+}
+
+/// As [`resume`], watching `watch`'s events and contacts as [`integrate_watching`] does, from
+/// the checkpoint's state on (give the first run's contacts again: a run with contacts and its
+/// resumption are one run, bit for bit). A checkpoint whose state is outside a contact is
+/// refused, naming `checkpoint`.
+pub fn resume_watching<S, P>(
+    sys: &S,
+    checkpoint: Checkpoint,
+    steps: usize,
+    save_every: usize,
+    poll: P,
+    watch: Watch<'_, '_, '_>,
+) -> Result<Trajectory, Box<Failure>>
+where
+    S: Dynamics + ?Sized,
+    P: Poll,
+{
+    let (stepper, energy, end) = resumed(sys, checkpoint, steps, save_every)?;
+    watched(sys, stepper, energy, (end, save_every), poll, watch, "checkpoint")
 }
 
 /// The stepper of a checkpoint, its energy check and the step to reach.
@@ -260,7 +341,7 @@ fn run<'s, S, P>(
     end: usize,
     save_every: usize,
     mut poll: P,
-    mut search: Option<Search<'_, '_, &'s S>>,
+    mut watcher: Watcher<'_, '_, '_, &'s S>,
 ) -> Result<Trajectory, Box<Failure>>
 where
     S: Dynamics + ?Sized,
@@ -268,6 +349,7 @@ where
 {
     let n = sys.dim();
     let mut traj = empty(sys);
+    traj.impacts.dim = n;
     let start = stepper.steps();
     let saved = ((end - start) / save_every).saturating_add(2);
     // Reserving succeeds beyond the memory there is (Linux overcommits) and the run would then
@@ -300,13 +382,12 @@ where
         // Every `save_every`-th state is saved, and the last.
         let save = (stepper.steps() / save_every + 1).saturating_mul(save_every).min(end);
         let n = save - stepper.steps();
-        let advanced = match search.as_mut() {
-            None => stepper.advance(n, Counting(|steps| poll.poll(steps))),
-            // Events: step by step, stopping after a terminal event's step.
-            Some(search) => search
-                .advance(&mut stepper, n, &mut traj.events, &mut poll)
-                .map(|stop| traj.terminated_by = stop),
-        };
+        // Events and contacts: step by step, stopping after a terminal event's step.
+        let advanced = watcher.advance(&mut stepper, n, &mut traj, &mut poll);
+        if let Some(watch) = watch.as_mut() {
+            watch.shift(watcher.take_energy_jump());
+        }
+        let advanced = advanced.map(|stop| traj.terminated_by = stop);
         if let Err(error) = advanced {
             // Stops with the last good state kept, and the work counted.
             let time = stepper.t();
@@ -328,7 +409,7 @@ where
     }
     traj.count(&stepper);
     // Events: the partial steps' force evaluations are the run's too.
-    traj.force_evaluations += search.map_or(0, |s| s.force_evaluations());
+    traj.force_evaluations += watcher.force_evaluations();
     traj.checkpoint = Checkpoint::new(sys, stepper.into_state(), watch).to_bytes();
     match outcome {
         Ok(()) => Ok(traj),
@@ -368,6 +449,12 @@ impl EnergyWatch {
         };
         watch.push(&terms, stepper.work());
         Some(Ok(watch))
+    }
+
+    /// Discounts a change `delta` of the energy at jumps (impacts with e < 1): the check
+    /// judges E − W − E₀ of the smooth motion.
+    fn shift(&mut self, delta: f64) {
+        self.initial += delta;
     }
 
     fn push(&mut self, terms: &EnergyTerms, work: f64) {

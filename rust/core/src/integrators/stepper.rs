@@ -154,17 +154,39 @@ where
             return Err(Error::invalid("t0", "must be finite"));
         }
         check_initial(&*self.model, q0, p0, t0)?;
-        state.q.copy_from_slice(q0);
-        state.p.copy_from_slice(p0);
-        state.eq.fill(0.0);
-        state.ep.fill(0.0);
-        state.clock = Clock {
-            t0,
-            n0: 0,
-            h: state.clock.h,
-        };
-        state.steps = 0;
-        state.integrator.reset();
+        let h = state.clock.h;
+        state.restart(t0, q0, p0, h);
+        Ok(())
+    }
+
+    /// As [`Stepper::reset`] followed by [`Stepper::set_dt`] to h, unchecked: the partial steps
+    /// of a located event or impact, from states the run has checked.
+    pub(in crate::integrators) fn restart(&mut self, t0: f64, q0: &[f64], p0: &[f64], h: f64) {
+        self.state.borrow_mut().restart(t0, q0, p0, h);
+    }
+
+    /// Sets the state (qₙ, pₙ) to (q, p) after a jump, keeping the clock and the steps: the
+    /// state at the end of a step that an impact split ([`super::Contacts`]). The
+    /// compensated-summation carries and the integrator's caches and predictor are cleared, as
+    /// a restart from (q, p) would: the next step does not start where the last one ended.
+    /// Refuses q or p of the wrong length or not finite; the state is then unchanged.
+    pub fn jump_to(&mut self, q: &[f64], p: &[f64]) -> Result<(), Error> {
+        let state = self.state.borrow_mut();
+        let n = state.q.len();
+        check_vector("q", q, n)?;
+        check_vector("p", p, n)?;
+        let (t0, n0, h, steps) = (state.clock.t0, state.clock.n0, state.clock.h, state.steps);
+        state.restart(t0, q, p, h);
+        (state.clock.n0, state.steps) = (n0, steps);
+        Ok(())
+    }
+
+    /// Back to (q, p) one step before the last, after a step whose impacts could not be
+    /// resolved: the run's last good state, restarted (carries and caches cleared).
+    pub(in crate::integrators) fn rewind(&mut self, q: &[f64], p: &[f64]) -> Result<(), Error> {
+        self.jump_to(q, p)?;
+        let state = self.state.borrow_mut();
+        state.steps = state.steps.saturating_sub(1).max(state.clock.n0);
         Ok(())
     }
 
@@ -218,6 +240,17 @@ impl StepperState {
             ep_next: zeros(),
             interrupt: InterruptPoll::new(),
         }
+    }
+
+    /// The state (q0, p0) at t0 after 0 steps of size h, restarted: carries and caches cleared.
+    fn restart(&mut self, t0: f64, q0: &[f64], p0: &[f64], h: f64) {
+        self.q.copy_from_slice(q0);
+        self.p.copy_from_slice(p0);
+        self.eq.fill(0.0);
+        self.ep.fill(0.0);
+        self.clock = Clock { t0, n0: 0, h };
+        self.steps = 0;
+        self.integrator.reset();
     }
 
     /// Why a decoded state (a checkpoint's, which its CRC does not protect against a crafted
@@ -483,7 +516,7 @@ impl StepperState {
     }
 }
 
-impl<M: Deref<Target: Dynamics>> Stepper<M> {
+impl<M: Deref<Target: Dynamics>, St: Borrow<StepperState>> Stepper<M, St> {
     /// The work done by the non-conservative forces so far; None for a model without them.
     pub fn forced_work(&self) -> Option<f64> {
         self.model.as_lagrangian().is_forced().then(|| self.work())

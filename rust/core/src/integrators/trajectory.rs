@@ -3,7 +3,7 @@
 use std::borrow::Cow;
 use std::ops::Deref;
 
-use super::{Dynamics, Occurrence, Stepper};
+use super::{Dynamics, Impacts, Occurrence, Stepper};
 use crate::Error;
 
 /// The saved states of a run: row k is (`t[k]`, `q[k]`, `p[k]`); q and p are stored row-major.
@@ -34,6 +34,9 @@ pub struct Trajectory {
     pub events: Vec<Occurrence>,
     /// The event whose terminal count stopped the run, if one did.
     pub terminated_by: Option<usize>,
+    /// The impacts on the run's contacts ([`super::integrate_watching`]), in order of time; the
+    /// saved states hold the state just before and just after each (one time, two rows).
+    pub impacts: Impacts,
 }
 
 impl Trajectory {
@@ -84,6 +87,20 @@ impl Trajectory {
         self.work.extend(stepper.forced_work());
         self.q.extend_from_slice(stepper.q());
         self.p.extend_from_slice(stepper.p());
+    }
+
+    /// Saves (q, p) as the state at time `t`, with the stepper's Newton count and work: a
+    /// state inside a step (just before or after an impact).
+    pub(super) fn push_state<M, St>(&mut self, t: f64, q: &[f64], p: &[f64], stepper: &Stepper<M, St>)
+    where
+        M: Deref<Target: Dynamics>,
+        St: std::borrow::Borrow<super::StepperState>,
+    {
+        self.t.push(t);
+        self.newton.extend(stepper.newton());
+        self.work.extend(stepper.forced_work());
+        self.q.extend_from_slice(q);
+        self.p.extend_from_slice(p);
     }
 
     /// Records the stepper's counts: the steps completed and the work they took.

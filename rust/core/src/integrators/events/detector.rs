@@ -1,6 +1,7 @@
 //! The detector: the sign-change test after each step, and each crossing located by the
 //! method's own partial step.
 
+use std::borrow::{Borrow, BorrowMut};
 use std::ops::Deref;
 
 use super::{EventFunctions, EventSpec, Occurrence};
@@ -46,13 +47,14 @@ impl<'f> Detector<'f> {
     /// `model`: the functions started and evaluated there, the scratch stepper of the partial
     /// steps made (a copy of the stepper: its method, summation and Newton options), and the
     /// buffers of the state before a step, once per run.
-    pub(in crate::integrators) fn begin<'d, M>(
+    pub(in crate::integrators) fn begin<'d, M, St>(
         &'d mut self,
         model: M,
-        stepper: &Stepper<M>,
+        stepper: &Stepper<M, St>,
     ) -> Result<Search<'d, 'f, M>, Error>
     where
         M: Deref<Target: Dynamics>,
+        St: Borrow<StepperState>,
     {
         let (t, q, p) = (stepper.t(), stepper.q(), stepper.p());
         let m = self.specs.len();
@@ -105,51 +107,92 @@ impl<M: Deref<Target: Dynamics>> Search<'_, '_, M> {
     /// Advances `stepper` by up to `n` steps, one at a time, pushing every located crossing to
     /// `occurrences` (in order of time within a step). Returns the event whose terminal count
     /// was reached, the run stopping at the end of that step; None after the n steps.
-    pub(in crate::integrators) fn advance<P: Poll>(
+    pub(in crate::integrators) fn advance<St: BorrowMut<StepperState>, P: Poll>(
         &mut self,
-        stepper: &mut Stepper<M>,
+        stepper: &mut Stepper<M, St>,
         n: usize,
         occurrences: &mut Vec<Occurrence>,
         poll: &mut P,
     ) -> Result<Option<usize>, Error> {
         for _ in 0..n {
-            self.t = stepper.t();
-            self.q.copy_from_slice(stepper.q());
-            self.p.copy_from_slice(stepper.p());
+            self.start_step(stepper);
             stepper.advance(1, Counting(|steps| poll.poll(steps)))?;
-            let (step, t) = (stepper.steps(), stepper.t());
-            let lagrangian = stepper.model().as_lagrangian();
-            let functions = &mut self.detector.functions;
-            if let Err(source) = functions.evaluate(lagrangian, t, stepper.q(), stepper.p(), &mut self.g_next) {
-                return Err(Error::Model {
-                    step,
-                    time: self.t,
-                    source,
-                });
-            }
-            check_finite(&self.detector.specs, &self.g_next, step, t)?;
             let first = occurrences.len();
-            for i in 0..self.g.len() {
-                if crosses(self.detector.specs[i].direction, self.g[i], self.g_next[i]) {
-                    let occurrence = self.locate(i, step, stepper.dt())?;
-                    occurrences.push(occurrence);
-                }
-            }
-            occurrences[first..].sort_unstable_by(|a, b| a.t.total_cmp(&b.t));
-            std::mem::swap(&mut self.g, &mut self.g_next);
-            let mut stop = None;
-            for occurrence in &occurrences[first..] {
-                let i = occurrence.event;
-                self.counts[i] += 1;
-                if self.counts[i] == self.detector.specs[i].terminal && stop.is_none() {
-                    stop = Some(i);
-                }
-            }
-            if stop.is_some() {
-                return Ok(stop);
+            let (step, t, h) = (stepper.steps(), stepper.t(), stepper.dt());
+            self.piece(step, (t, stepper.q(), stepper.p()), h, occurrences)?;
+            if let Some(stop) = self.count(occurrences, first) {
+                return Ok(Some(stop));
             }
         }
         Ok(None)
+    }
+
+    /// Keeps the stepper's state (tₙ, qₙ, pₙ), the start of its next step; gᵢ(zₙ) are those
+    /// of the last step's end.
+    pub(in crate::integrators) fn start_step<St: Borrow<StepperState>>(&mut self, stepper: &Stepper<M, St>) {
+        self.t = stepper.t();
+        self.q.copy_from_slice(stepper.q());
+        self.p.copy_from_slice(stepper.p());
+    }
+
+    /// The piece of step `step` of size τ from the kept start to `end` = (t, q, p): the
+    /// functions evaluated at its end, and each crossing located on it, pushed to `occurrences`.
+    /// The end's values are then the next piece's start's. A step without impacts is one piece.
+    pub(in crate::integrators) fn piece(
+        &mut self,
+        step: usize,
+        (t, q, p): (f64, &[f64], &[f64]),
+        tau: f64,
+        occurrences: &mut Vec<Occurrence>,
+    ) -> Result<(), Error> {
+        let lagrangian = self.scratch.model().as_lagrangian();
+        let functions = &mut self.detector.functions;
+        if let Err(source) = functions.evaluate(lagrangian, t, q, p, &mut self.g_next) {
+            return Err(Error::Model {
+                step,
+                time: self.t,
+                source,
+            });
+        }
+        check_finite(&self.detector.specs, &self.g_next, step, t)?;
+        for i in 0..self.g.len() {
+            if crosses(self.detector.specs[i].direction, self.g[i], self.g_next[i]) {
+                let occurrence = self.locate(i, step, tau)?;
+                occurrences.push(occurrence);
+            }
+        }
+        std::mem::swap(&mut self.g, &mut self.g_next);
+        Ok(())
+    }
+
+    /// A new piece from (t, q, p), the state just after a jump: the functions evaluated there.
+    pub(in crate::integrators) fn restart_piece(
+        &mut self,
+        step: usize,
+        (t, q, p): (f64, &[f64], &[f64]),
+    ) -> Result<(), Error> {
+        self.t = t;
+        self.q.copy_from_slice(q);
+        self.p.copy_from_slice(p);
+        let lagrangian = self.scratch.model().as_lagrangian();
+        let evaluated = self.detector.functions.evaluate(lagrangian, t, q, p, &mut self.g);
+        evaluated.map_err(|source| Error::Model { step, time: t, source })?;
+        check_finite(&self.detector.specs, &self.g, step, t)
+    }
+
+    /// Sorts the step's occurrences (from `first` on) by time and counts them: the event whose
+    /// terminal count they reach first, if any.
+    pub(in crate::integrators) fn count(&mut self, occurrences: &mut [Occurrence], first: usize) -> Option<usize> {
+        occurrences[first..].sort_unstable_by(|a, b| a.t.total_cmp(&b.t));
+        let mut stop = None;
+        for occurrence in &occurrences[first..] {
+            let i = occurrence.event;
+            self.counts[i] += 1;
+            if self.counts[i] == self.detector.specs[i].terminal && stop.is_none() {
+                stop = Some(i);
+            }
+        }
+        stop
     }
 
     /// The crossing of event i in step `step` of size h: τ* with f(τ*) = 0, f(τ) = ±gᵢ(Φ_τ(zₙ))

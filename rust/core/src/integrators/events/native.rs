@@ -1,10 +1,12 @@
 //! The built-in event functions, evaluated in Rust (no call out of the core per step).
 
 use super::EventFunctions;
+use crate::integrators::jumps::{check_ellipsoid, ellipsoid, wall, NativeSurface, Surface};
 use crate::model::Lagrangian;
 use crate::{Error, ModelError};
 
-/// A built-in event function g(t, q, p).
+/// A built-in event function g(t, q, p). `Crossing` and `Ellipsoid` are the native surfaces'
+/// φ ([`NativeSurface`]), computed by the same functions.
 #[derive(Clone, Debug, PartialEq)]
 pub enum NativeEvent {
     /// g = q_k − value: the coordinate k crossing a value.
@@ -44,36 +46,18 @@ impl NativeEvent {
         };
         match self {
             NativeEvent::Crossing { coordinate, value } => {
-                if *coordinate >= n {
-                    return fail(format!("coordinate {coordinate} is not in 0 … {}", n - 1));
-                }
-                if !value.is_finite() {
-                    return fail(format!("value must be finite, got {value}"));
-                }
-                Ok(())
+                let wall = NativeSurface::Wall {
+                    coordinate: *coordinate,
+                    value: *value,
+                };
+                wall.misfit(n).map_or(Ok(()), fail)
             }
             NativeEvent::Ellipsoid {
                 coordinates,
                 centre,
                 semi_axes,
                 ..
-            } => {
-                let m = coordinates.len();
-                if m == 0 || centre.len() != m || semi_axes.len() != m {
-                    return fail(format!(
-                        "coordinates, centre and semi_axes must be non-empty and of equal length, got {m}, {} and {}",
-                        centre.len(),
-                        semi_axes.len()
-                    ));
-                }
-                if let Some(k) = coordinates.iter().find(|&&k| k >= n) {
-                    return fail(format!("coordinate {k} is not in 0 … {}", n - 1));
-                }
-                if let Some(c) = centre.iter().find(|c| !c.is_finite()) {
-                    return fail(format!("centre must be finite, got {c}"));
-                }
-                semi_axes.iter().try_for_each(|&a| positive("semi-axis", a))
-            }
+            } => check_ellipsoid(coordinates, centre, semi_axes, n).map_or(Ok(()), fail),
             NativeEvent::EnergyError { bound, .. } => positive("bound", *bound),
             NativeEvent::Escape { radius, groups } | NativeEvent::Encounter { radius, groups } => {
                 positive("radius", *radius)?;
@@ -105,27 +89,13 @@ impl NativeEvent {
         let squared = |x: &[usize]| x.iter().map(|&k| q[k] * q[k]).sum::<f64>();
         let apart = |x: &[usize], y: &[usize]| x.iter().zip(y).map(|(&i, &j)| (q[i] - q[j]).powi(2)).sum::<f64>();
         Ok(match self {
-            NativeEvent::Crossing { coordinate, value } => q[*coordinate] - value,
+            NativeEvent::Crossing { coordinate, value } => wall(q, *coordinate, *value),
             NativeEvent::Ellipsoid {
                 coordinates,
                 centre,
                 semi_axes,
                 inside,
-            } => {
-                let sum = coordinates
-                    .iter()
-                    .zip(centre)
-                    .zip(semi_axes)
-                    .fold(0.0, |s, ((&k, c), a)| {
-                        let u = (q[k] - c) / a;
-                        s + u * u
-                    });
-                if *inside {
-                    1.0 - sum
-                } else {
-                    sum - 1.0
-                }
-            }
+            } => ellipsoid(q, coordinates, centre, semi_axes, *inside),
             NativeEvent::EnergyError { bound, initial } => {
                 (model.energy_terms(q, p, t)?.energy - initial).abs() - bound
             }

@@ -1,0 +1,524 @@
+//! The impact resolution: a step that ends with some φ < 0 redone in pieces on a scratch
+//! stepper, each piece a partial step of the method from its start, split at the first contact
+//! crossed (located to round-off), the jump applied there, and the rest of the step re-checked
+//! against every contact, up to [`MAX_IMPACTS`] impacts in the step.
+
+use std::borrow::{Borrow, BorrowMut};
+use std::ops::Deref;
+
+use super::{reflect, variational, Contacts, Impacts, Law, MAX_IMPACTS};
+use crate::integrators::events::Search;
+use crate::integrators::DiscreteEnergy;
+use crate::integrators::{Counting, Dynamics, Method, Occurrence, Poll, Stepper, StepperState, Trajectory};
+use crate::solve::bracket::illinois;
+use crate::Error;
+
+/// Why the variational law does not fit `method` on `model`, if it does not: it needs the
+/// method's discrete energy ([`DiscreteEnergy`]) and a conservative, autonomous, unconstrained
+/// model (the energy balance is E_d's alone).
+pub(super) fn variational_misfit<S: Dynamics + ?Sized>(model: &S, method: Method) -> Option<String> {
+    if DiscreteEnergy::new(method, 0).is_none() {
+        return Some(format!(
+            "needs a kick–drift method or a two-point rule (midpoint, trapezoid), not {}; give the contact law \
+             reflect or use such a method",
+            method.info().name
+        ));
+    }
+    let lagrangian = model.as_lagrangian();
+    let constrained = model.constraint_counts() != (0, 0) || model.velocity_constraints().is_some();
+    if lagrangian.is_forced() || lagrangian.is_time_dependent() || constrained {
+        return Some(
+            "keeps the discrete energy, which needs a conservative, autonomous, unconstrained model; give the \
+             contact law reflect"
+                .into(),
+        );
+    }
+    None
+}
+
+/// A run's resolver: the contacts, the scratch stepper of the partial steps (a copy of the
+/// run's stepper) and every buffer of the resolution, made once per run.
+pub(in crate::integrators) struct Resolver<'c, 's, M> {
+    contacts: &'c Contacts<'s>,
+    scratch: Stepper<M>,
+    /// The scratch's force evaluations when it was made (the run's so far).
+    counted: u64,
+    /// φ of every contact at the run's state (the next step's start), at a piece's start, at
+    /// its end.
+    phi: Vec<f64>,
+    phi_start: Vec<f64>,
+    phi_end: Vec<f64>,
+    /// The step's start (tₙ, qₙ, pₙ).
+    t: f64,
+    q: Vec<f64>,
+    p: Vec<f64>,
+    /// The piece's start.
+    piece_q: Vec<f64>,
+    piece_p: Vec<f64>,
+    /// The contact state (q̃, p⁻), the normal and the laws' work buffers.
+    contact_q: Vec<f64>,
+    contact_p: Vec<f64>,
+    normal: Vec<f64>,
+    v: Vec<f64>,
+    w: Vec<f64>,
+    zeros: Vec<f64>,
+    /// The step's impacts, kept when the step is resolved.
+    pending: Impacts,
+    /// Whether the run checks its energy (then each jump's change of E is summed in
+    /// `energy_jump`, for the run's check to discount).
+    energy: bool,
+    energy_jump: f64,
+    /// The method's discrete energy, for the variational law.
+    discrete: Option<DiscreteEnergy>,
+}
+
+impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
+    /// The resolver of `contacts` for a run of `stepper` on `model` from its state (named
+    /// `argument` in the refusal of a state outside φ ≥ 0), `energy` when the run checks its
+    /// energy.
+    pub(in crate::integrators) fn begin<St: Borrow<StepperState>>(
+        model: M,
+        stepper: &Stepper<M, St>,
+        contacts: &'c Contacts<'s>,
+        argument: &'static str,
+        energy: bool,
+    ) -> Result<Self, Error> {
+        let n = stepper.q().len();
+        contacts.check(&*model, stepper.method(), (stepper.t(), stepper.q()), argument)?;
+        let scratch = Stepper::resume(model, StepperState::clone(stepper))?;
+        let m = contacts.len();
+        let mut resolver = Resolver {
+            contacts,
+            counted: scratch.force_evaluations(),
+            scratch,
+            phi: vec![0.0; m],
+            phi_start: vec![0.0; m],
+            phi_end: vec![0.0; m],
+            t: stepper.t(),
+            q: stepper.q().to_vec(),
+            p: stepper.p().to_vec(),
+            piece_q: vec![0.0; n],
+            piece_p: vec![0.0; n],
+            contact_q: vec![0.0; n],
+            contact_p: vec![0.0; n],
+            normal: vec![0.0; n],
+            v: vec![0.0; n],
+            w: vec![0.0; n],
+            zeros: vec![0.0; n],
+            pending: Impacts::with_capacity(n, MAX_IMPACTS),
+            energy,
+            energy_jump: 0.0,
+            discrete: (contacts.contacts().iter().any(|c| c.law == Law::Variational))
+                .then(|| DiscreteEnergy::new(stepper.method(), n))
+                .flatten(),
+        };
+        let (step, time) = (stepper.steps(), stepper.t());
+        evaluate(contacts, stepper.q(), &mut resolver.phi, step, time)?;
+        Ok(resolver)
+    }
+
+    /// Advances `stepper` by up to `n` steps, one at a time, resolving the impacts of each
+    /// (saved in `traj`: the impacts, and the states just before and after each) and watching
+    /// `search`'s events on the pieces. Returns the event whose terminal count was reached, the
+    /// run stopping at the end of that step; None after the n steps. On failure the stepper is
+    /// at the last good step.
+    pub(in crate::integrators) fn advance<St: BorrowMut<StepperState>, P: Poll>(
+        &mut self,
+        stepper: &mut Stepper<M, St>,
+        n: usize,
+        mut search: Option<&mut Search<'_, '_, M>>,
+        traj: &mut Trajectory,
+        poll: &mut P,
+    ) -> Result<Option<usize>, Error> {
+        for _ in 0..n {
+            self.t = stepper.t();
+            self.q.copy_from_slice(stepper.q());
+            self.p.copy_from_slice(stepper.p());
+            if let Some(search) = search.as_deref_mut() {
+                search.start_step(stepper);
+            }
+            stepper.advance(1, Counting(|steps| poll.poll(steps)))?;
+            let (step, h) = (stepper.steps(), stepper.dt());
+            let first = traj.events.len();
+            evaluate(self.contacts, stepper.q(), &mut self.phi_end, step, self.t)?;
+            let crossed = (0..self.phi.len()).any(|j| {
+                let leaving = self.phi[j] <= 0.0;
+                below(self.phi_end[j] - floor(self.phi[j], leaving), leaving)
+            });
+            let resolved = if crossed {
+                match self.resolve(stepper, search.as_deref_mut(), &mut traj.events) {
+                    Ok(resolved) => resolved,
+                    Err(error) => {
+                        // The run ends at the step's start, with none of the step's events.
+                        traj.events.truncate(first);
+                        stepper.rewind(&self.q, &self.p)?;
+                        return Err(error);
+                    }
+                }
+            } else {
+                false
+            };
+            if resolved {
+                for k in 0..self.pending.len() {
+                    let (t, q) = (self.pending.t[k], self.pending.q_at(k));
+                    traj.push_state(t, q, self.pending.p_before_at(k), stepper);
+                    traj.push_state(t, q, self.pending.p_after_at(k), stepper);
+                }
+                traj.impacts.append(&mut self.pending);
+            } else {
+                if crossed {
+                    // The scratch's first piece crossed nothing after all: φ at the step's end.
+                    evaluate(self.contacts, stepper.q(), &mut self.phi_end, step, self.t)?;
+                }
+                std::mem::swap(&mut self.phi, &mut self.phi_end);
+                if let Some(search) = search.as_deref_mut() {
+                    search.piece(step, (stepper.t(), stepper.q(), stepper.p()), h, &mut traj.events)?;
+                }
+            }
+            if let Some(stop) = search.as_deref_mut().and_then(|s| s.count(&mut traj.events, first)) {
+                return Ok(Some(stop));
+            }
+        }
+        Ok(None)
+    }
+
+    /// The step just taken by `stepper` from the kept start, redone in pieces: false (nothing
+    /// changed) when its first piece on the scratch stepper crosses no contact after all
+    /// (round-off at a grazing end); true with the stepper set to the step's end state and the
+    /// impacts in `pending`.
+    fn resolve<St: BorrowMut<StepperState>>(
+        &mut self,
+        stepper: &mut Stepper<M, St>,
+        mut search: Option<&mut Search<'_, '_, M>>,
+        occurrences: &mut Vec<Occurrence>,
+    ) -> Result<bool, Error> {
+        let (step, h) = (stepper.steps(), stepper.dt());
+        let (contacts, time) = (self.contacts, self.t);
+        let contact_error = |reason: String| Error::Contact { step, time, reason };
+        self.piece_q.copy_from_slice(&self.q);
+        self.piece_p.copy_from_slice(&self.p);
+        self.phi_start.copy_from_slice(&self.phi);
+        self.pending.clear();
+        let (mut ta, mut tau, mut last) = (self.t, h, None);
+        loop {
+            // The piece to the step's end, and the first contact it crosses.
+            self.partial(step, ta, tau)?;
+            evaluate(contacts, self.scratch.q(), &mut self.phi_end, step, self.t)?;
+            let mut first: Option<(f64, usize)> = None;
+            for j in 0..contacts.len() {
+                let leaving = last == Some(j) || self.phi_start[j] <= 0.0;
+                if !below(self.phi_end[j] - floor(self.phi_start[j], leaving), leaving) {
+                    continue;
+                }
+                let s = self.locate(j, step, (ta, tau), leaving).map_err(|e| match e {
+                    Located::Error(e) => e,
+                    Located::Resting => contact_error(format!(
+                        "a body leaving the contact {} crosses it again at once (a resting or grazing contact, \
+                         such as e = 0 under a force pressing on it), which impacts cannot resolve",
+                        contacts.contacts()[j].name
+                    )),
+                })?;
+                if let Some(s) = s {
+                    if first.is_none_or(|(s0, _)| s < s0) {
+                        first = Some((s, j));
+                    }
+                }
+            }
+            let Some((s, j)) = first else {
+                if self.pending.is_empty() {
+                    return Ok(false);
+                }
+                // The last piece ends the step: the scratch holds its end.
+                break;
+            };
+            if self.pending.len() == MAX_IMPACTS {
+                return Err(contact_error(format!(
+                    "more than {MAX_IMPACTS} impacts in one step (an accumulation of impacts, as of a body \
+                     coming to rest on a surface); shorten the step or stop the run before"
+                )));
+            }
+            // The contact state (q̃, p⁻), the end of this piece.
+            self.partial(step, ta, s)?;
+            self.contact_q.copy_from_slice(self.scratch.q());
+            self.contact_p.copy_from_slice(self.scratch.p());
+            let t_contact = ta + s;
+            if let Some(search) = search.as_deref_mut() {
+                search.piece(step, (t_contact, &self.contact_q, &self.contact_p), s, occurrences)?;
+            }
+            let contact = &contacts.contacts()[j];
+            self.jump(j, step, (ta, s, tau - s))?;
+            if !self.piece_p.iter().all(|x| x.is_finite()) {
+                return Err(contact_error(format!(
+                    "a non-finite state after the impact on {} at t = {t_contact}",
+                    contact.name
+                )));
+            }
+            self.pending
+                .push(j, step, t_contact, &self.contact_q, &self.contact_p, &self.piece_p);
+            if let Some(search) = search.as_deref_mut() {
+                search.restart_piece(step, (t_contact, &self.contact_q, &self.piece_p))?;
+            }
+            self.piece_q.copy_from_slice(&self.contact_q);
+            evaluate(contacts, &self.piece_q, &mut self.phi_start, step, self.t)?;
+            (ta, tau, last) = (t_contact, tau - s, Some(j));
+        }
+        // The step's end: the last piece's, at tₙ₊₁.
+        stepper.jump_to(self.scratch.q(), self.scratch.p())?;
+        std::mem::swap(&mut self.phi, &mut self.phi_end);
+        if let Some(search) = search {
+            search.piece(step, (stepper.t(), stepper.q(), stepper.p()), tau, occurrences)?;
+        }
+        Ok(true)
+    }
+
+    /// The jump on contact j at (q̃, p⁻) (the contact buffers), at the end of the piece of size s
+    /// from ta with `rest` of the step after it: p⁺ into `piece_p`.
+    fn jump(&mut self, j: usize, step: usize, (ta, s, rest): (f64, f64, f64)) -> Result<(), Error> {
+        let contacts = self.contacts;
+        let contact = &contacts.contacts()[j];
+        let (t, time) = (ta + s, self.t);
+        let model_error = |source| Error::Model { step, time, source };
+        let model = self.scratch.model();
+        let (q, p) = (&self.contact_q[..], &self.contact_p[..]);
+        contact.surface.gradient(q, &mut self.normal).map_err(model_error)?;
+        // On a constrained model, the part of ∇φ the constraints let act: the surface's impulse
+        // comes with the constraints' workless one that keeps the momenta on them, which adds up
+        // to ∇φ projected M-orthogonally (the projection's affine part cancels).
+        for (x, (a, b)) in self.v.iter_mut().zip(p.iter().zip(&self.normal)) {
+            *x = a + b;
+        }
+        if let Some(projected) = model.project(q, &self.v) {
+            let (_, with) = projected?;
+            let (_, without) = model.project(q, p).expect("a constrained model projects")?;
+            for (x, (a, b)) in self.normal.iter_mut().zip(with.iter().zip(&without)) {
+                *x = a - b;
+            }
+        }
+        let vectors = (&mut self.v[..], &mut self.w[..], &self.zeros[..]);
+        let reflection = reflect::multiplier(
+            model.as_lagrangian(),
+            (t, q, p),
+            &self.normal,
+            contact.restitution,
+            vectors,
+        )
+        .map_err(model_error)?;
+        // For e < 1 both laws take Newton's law, the reflection.
+        let lambda = if contact.law == Law::Variational && contact.restitution == 1.0 && rest > 0.0 {
+            let (lambda, found) = self.variational(step, (ta, s, rest), reflection)?;
+            self.pending.grazing += usize::from(!found);
+            lambda
+        } else {
+            reflection
+        };
+        let (q, p) = (&self.contact_q[..], &self.contact_p[..]);
+        for (x, (a, b)) in self.piece_p.iter_mut().zip(p.iter().zip(&self.normal)) {
+            *x = a + lambda * b;
+        }
+        if self.energy {
+            let model = self.scratch.model();
+            let energy = |p: &[f64]| model.energy(q, p, t).transpose().map_err(model_error);
+            if let (Some(before), Some(after)) = (energy(p)?, energy(&self.piece_p)?) {
+                self.energy_jump += after.energy - before.energy;
+            }
+        }
+        Ok(())
+    }
+
+    /// λ of the variational law ([`variational::multiplier`]) for the jump at the end of the
+    /// piece of size s from ta, from the reflection's λ: E_d of the piece after the jump, to
+    /// the step's end `rest` later, equal to E_d of the piece before. Leaves `piece_q` at q̃.
+    fn variational(
+        &mut self,
+        step: usize,
+        (ta, s, rest): (f64, f64, f64),
+        reflection: f64,
+    ) -> Result<(f64, bool), Error> {
+        let time = self.t;
+        let model_error = |source| Error::Model { step, time, source };
+        let Resolver {
+            scratch,
+            discrete,
+            piece_q,
+            piece_p,
+            contact_q,
+            contact_p,
+            normal,
+            v,
+            ..
+        } = self;
+        let Some(discrete) = discrete.as_mut() else {
+            return Ok((reflection, false));
+        };
+        let t = ta + s;
+        let before = (&piece_q[..], &piece_p[..]);
+        let target = discrete
+            .energy(scratch.model(), ta, s, before, (contact_q, contact_p))
+            .map_err(model_error)?;
+        scratch
+            .model()
+            .as_lagrangian()
+            .velocity(contact_q, contact_p, t, v)
+            .map_err(model_error)?;
+        let scale = contact_p.iter().zip(v.iter()).map(|(a, b)| a * b).sum::<f64>();
+        piece_q.copy_from_slice(contact_q);
+        let after = |lambda: f64| {
+            for (x, (a, b)) in piece_p.iter_mut().zip(contact_p.iter().zip(normal.iter())) {
+                *x = a + lambda * b;
+            }
+            scratch.restart(t, piece_q, piece_p, rest);
+            scratch.step().map_err(|e| redate(e, step, time))?;
+            let end = (scratch.q(), scratch.p());
+            discrete
+                .energy(scratch.model(), t, rest, (piece_q, piece_p), end)
+                .map_err(model_error)
+        };
+        variational::multiplier(after, reflection, target, scale)
+    }
+
+    /// The earliest s ∈ (0, τ] where φⱼ along the piece from (ta, piece_q, piece_p) falls
+    /// through 0 (`leaving`: the piece starts on that surface and only φⱼ < 0 counts):
+    /// bracketed by eight samples (refined towards 0, up to four times, for a piece leaving the
+    /// surface: a body that is below at every one crosses again at once, [`Located::Resting`]),
+    /// then the Illinois method ([`illinois`]) to round-off. None when no sample is below
+    /// (round-off at the piece's end).
+    fn locate(&mut self, j: usize, step: usize, (ta, tau): (f64, f64), leaving: bool) -> Result<Option<f64>, Located> {
+        let floor = floor(self.phi_start[j], leaving);
+        let (mut lo, mut g_lo) = (0.0, self.phi_start[j] - floor);
+        let mut hi = tau;
+        let mut bracket = None;
+        for _ in 0..4 {
+            let mut previous = (lo, g_lo);
+            let mut found = None;
+            for k in 1..=8 {
+                let x = lo + (hi - lo) * k as f64 / 8.0;
+                let v = self.phi_along(j, step, ta, x)? - floor;
+                if below(v, leaving) {
+                    found = Some((k, x, v));
+                    break;
+                }
+                previous = (x, v);
+            }
+            let Some((k, x, v)) = found else {
+                return Ok(None);
+            };
+            if k > 1 {
+                (lo, g_lo) = previous;
+            }
+            if k > 1 || !leaving {
+                bracket = Some(((lo, g_lo), (x, v)));
+                break;
+            }
+            hi = x;
+        }
+        let Some((a, b)) = bracket else {
+            return Err(Located::Resting);
+        };
+        let tolerance = 4.0 * f64::EPSILON * tau;
+        let (s, _) = illinois(
+            |s| Ok::<_, Error>(self.phi_along(j, step, ta, s)? - floor),
+            a,
+            b,
+            tolerance,
+        )?;
+        Ok(Some(s))
+    }
+
+    /// φⱼ at the end of the partial step of size s from the piece's start.
+    fn phi_along(&mut self, j: usize, step: usize, ta: f64, s: f64) -> Result<f64, Error> {
+        self.partial(step, ta, s)?;
+        let surface = &self.contacts.contacts()[j].surface;
+        surface.phi(self.scratch.q()).map_err(|source| Error::Model {
+            step,
+            time: self.t,
+            source,
+        })
+    }
+
+    /// The scratch stepper at the end of the method's step of size s (0: none) from the
+    /// piece's start at ta; an error names the run's step and its start.
+    fn partial(&mut self, step: usize, ta: f64, s: f64) -> Result<(), Error> {
+        self.scratch
+            .restart(ta, &self.piece_q, &self.piece_p, if s > 0.0 { s } else { 1.0 });
+        if s > 0.0 {
+            self.scratch.step().map_err(|e| redate(e, step, self.t))?;
+        }
+        Ok(())
+    }
+
+    /// The change of energy at the jumps since the last call.
+    pub(in crate::integrators) fn take_energy_jump(&mut self) -> f64 {
+        std::mem::take(&mut self.energy_jump)
+    }
+
+    /// Force evaluations of the partial steps.
+    pub(in crate::integrators) fn force_evaluations(&self) -> u64 {
+        self.scratch.force_evaluations() - self.counted
+    }
+}
+
+/// Why a crossing was not located.
+enum Located {
+    Error(Error),
+    /// Below the surface at every sample of a piece leaving it.
+    Resting,
+}
+
+impl From<Error> for Located {
+    fn from(e: Error) -> Self {
+        Located::Error(e)
+    }
+}
+
+/// The level a piece's φ must fall below to cross again: 0, or φ at its start for a piece that
+/// starts a little past the surface (a contact state located to round-off on its far side),
+/// so that a piece leaving it, however short, is not taken for a crossing.
+fn floor(phi_start: f64, leaving: bool) -> f64 {
+    if leaving {
+        phi_start.min(0.0)
+    } else {
+        0.0
+    }
+}
+
+/// Whether φ at a piece's end is past the surface: φ < 0, or φ = 0 on a piece that did not
+/// start on it (a crossing ends at 0 or below, as events count it).
+fn below(phi: f64, leaving: bool) -> bool {
+    phi < 0.0 || (phi <= 0.0 && !leaving)
+}
+
+/// φ of every contact at q into `phi`; a surface's error names the run's step and time.
+fn evaluate(contacts: &Contacts<'_>, q: &[f64], phi: &mut [f64], step: usize, time: f64) -> Result<(), Error> {
+    for (c, phi) in contacts.contacts().iter().zip(phi) {
+        *phi = c.surface.phi(q).map_err(|source| Error::Model { step, time, source })?;
+        if !phi.is_finite() {
+            let source = format!("contact {} returned a non-finite φ = {phi}", c.name).into();
+            return Err(Error::Model { step, time, source });
+        }
+    }
+    Ok(())
+}
+
+/// A partial step's error, named by the run's step and its start.
+fn redate(error: Error, step: usize, time: f64) -> Error {
+    match error {
+        Error::Divergence { reason, .. } => Error::Divergence { step, time, reason },
+        Error::Convergence {
+            residual,
+            iterations,
+            reason,
+            ..
+        } => Error::Convergence {
+            step,
+            time,
+            residual,
+            iterations,
+            reason,
+        },
+        Error::SpuriousBranch { reason, .. } => Error::SpuriousBranch { step, time, reason },
+        Error::Model { source, .. } => Error::Model { step, time, source },
+        Error::Interrupted { source, .. } => Error::Interrupted { step, time, source },
+        Error::Contact { reason, .. } => Error::Contact { step, time, reason },
+        e @ Error::InvalidArgument { .. } => e,
+    }
+}

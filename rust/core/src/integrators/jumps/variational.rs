@@ -1,0 +1,44 @@
+//! The variational law: the variational collision integrator of Fetecau, Marsden, Ortiz & West
+//! (2003), "Nonsmooth Lagrangian mechanics and variational collision integrators", SIAM J. Appl.
+//! Dyn. Syst. 2, 381–416.
+
+use crate::Error;
+
+/// λ with the discrete energy of the piece after the jump, `after(λ)`, equal to `target`, that of
+/// the piece before: the contact point and the fraction of the step then make the action of the
+/// two pieces stationary, D₂L_d(q_k, q̃, τ₁) + D₁L_d(q̃, q_{k+1}, τ₂) = λ∇φ(q̃) and
+/// E_d(q_k, q̃, τ₁) = E_d(q̃, q_{k+1}, τ₂), so the step across the impact is symplectic. Solved by
+/// secants from the reflection's λ `exact`, O(τ²) away; `(exact, false)` where there is no root
+/// near it (a grazing impact, |∇φ·q̇| of order τ). `scale` sizes the energies' round-off.
+pub(super) fn multiplier(
+    mut after: impl FnMut(f64) -> Result<f64, Error>,
+    exact: f64,
+    target: f64,
+    scale: f64,
+) -> Result<(f64, bool), Error> {
+    // An implicit rule's E_d(λ), from a Newton solve, can stall a few ulps from the root, where
+    // the secant sees no slope.
+    let noise = 16.0 * f64::EPSILON * (target.abs() + scale.abs());
+    let (mut lam0, mut lam1) = (exact, exact * (1.0 + 1e-6));
+    let mut f0 = after(lam0)? - target;
+    for _ in 0..40 {
+        let f1 = after(lam1)? - target;
+        if f1 == 0.0 || (lam1 - lam0).abs() <= 4.0 * f64::EPSILON * lam1.abs() || (f1 == f0 && f1.abs() <= noise) {
+            let (lo, hi) = if exact > 0.0 {
+                (0.5 * exact, 1.5 * exact)
+            } else {
+                (1.5 * exact, 0.5 * exact)
+            };
+            return Ok(if (lo..=hi).contains(&lam1) {
+                (lam1, true)
+            } else {
+                (exact, false)
+            });
+        }
+        if f1 == f0 || !f1.is_finite() {
+            break;
+        }
+        (lam0, lam1, f0) = (lam1, lam1 - f1 * (lam1 - lam0) / (f1 - f0), f1);
+    }
+    Ok((exact, false))
+}

@@ -1,0 +1,95 @@
+//! What a run or a stepper watches besides its states: events and contacts, begun once on a
+//! stepper's state and checked after every step.
+
+use std::borrow::{Borrow, BorrowMut};
+use std::ops::Deref;
+
+use super::Resolver;
+use crate::integrators::events::Search;
+use crate::integrators::{Contacts, Detector, Dynamics, Poll, Stepper, StepperState, Trajectory};
+use crate::Error;
+
+/// What a run watches besides its states: events ([`Detector`]) and contacts ([`Contacts`]),
+/// either, both or neither. Both are checked after every step (the steps are then taken one
+/// at a time); a step that crosses a contact is redone in pieces at each impact, and the events
+/// are evaluated and located on the pieces.
+#[derive(Default)]
+pub struct Watch<'w, 'e, 'c> {
+    /// The events, located by partial steps of the method ([`crate::integrators::integrate_with_events`]).
+    pub events: Option<&'w mut Detector<'e>>,
+    /// The unilateral contacts φ(q) ≥ 0, whose impacts the run resolves.
+    pub contacts: Option<&'w Contacts<'c>>,
+}
+
+/// A [`Watch`] begun on a stepper's state: the events' search and the contacts' resolver, with
+/// their scratch steppers and buffers, made once. [`Watcher::advance`] takes a stepper's steps
+/// as a run does ([`crate::integrators::integrate_watching`]: one loop for both), so that a
+/// stepper stepped through a watcher is bit for bit the run. Outside a run it serves the
+/// binding's `Stepper` with contacts and events.
+pub struct Watcher<'w, 'e, 'c, M> {
+    search: Option<Search<'w, 'e, M>>,
+    resolver: Option<Resolver<'w, 'c, M>>,
+}
+
+impl<'w, 'e, 'c, M> Watcher<'w, 'e, 'c, M>
+where
+    M: Deref<Target: Dynamics> + Copy,
+{
+    /// The watcher of `watch` for `stepper` on `model` from its state: the events started
+    /// there, the contacts checked against the model and its method and the state (named
+    /// `argument`, `q0` or `checkpoint`, if outside a contact). `energy`: the caller checks the
+    /// energy, and takes the change at the jumps from [`Watcher::take_energy_jump`].
+    pub fn begin<St: Borrow<StepperState>>(
+        model: M,
+        stepper: &Stepper<M, St>,
+        watch: Watch<'w, 'e, 'c>,
+        argument: &'static str,
+        energy: bool,
+    ) -> Result<Self, Error> {
+        let search = watch.events.map(|events| events.begin(model, stepper)).transpose()?;
+        let resolver = (watch.contacts)
+            .map(|contacts| Resolver::begin(model, stepper, contacts, argument, energy))
+            .transpose()?;
+        Ok(Watcher { search, resolver })
+    }
+
+    /// The watcher of nothing: the steps many at a time, as a plain run takes them.
+    pub(in crate::integrators) fn idle() -> Self {
+        Watcher {
+            search: None,
+            resolver: None,
+        }
+    }
+
+    /// Advances `stepper` by up to `n` steps, pushing the located events to `record.events`,
+    /// the impacts to `record.impacts` and the states just before and after each impact to its
+    /// saved states. Returns the event whose terminal count was reached (the stepper stopping at
+    /// the end of that step); None after the n steps. On failure the stepper is at the last good
+    /// step ([`Error::Contact`]: the start of the step of the impact).
+    pub fn advance<St: BorrowMut<StepperState>, P: Poll>(
+        &mut self,
+        stepper: &mut Stepper<M, St>,
+        n: usize,
+        record: &mut Trajectory,
+        poll: &mut P,
+    ) -> Result<Option<usize>, Error> {
+        match (self.search.as_mut(), self.resolver.as_mut()) {
+            (None, None) => stepper
+                .advance(n, crate::integrators::Counting(|steps| poll.poll(steps)))
+                .map(|()| None),
+            (Some(search), None) => search.advance(stepper, n, &mut record.events, poll),
+            (search, Some(resolver)) => resolver.advance(stepper, n, search, record, poll),
+        }
+    }
+
+    /// The change of energy at the jumps since the last call (impacts with e < 1).
+    pub fn take_energy_jump(&mut self) -> f64 {
+        self.resolver.as_mut().map_or(0.0, |r| r.take_energy_jump())
+    }
+
+    /// Force evaluations of the partial steps (located events and impacts).
+    pub fn force_evaluations(&self) -> u64 {
+        self.search.as_ref().map_or(0, |s| s.force_evaluations())
+            + self.resolver.as_ref().map_or(0, |r| r.force_evaluations())
+    }
+}
