@@ -244,7 +244,6 @@ def test_ctrl_c_stops_every_member_and_keeps_what_was_computed(interrupt_after):
         (dict(workers=0), "workers"),
         (dict(workers=-2), "workers"),
         (dict(chunk_size=0), "chunk_size"),
-        (dict(model=scenes.bouncing_ball(), q0=np.ones((4, 1)), p0=np.zeros((4, 1))), "model"),
         (dict(steps=10**12, dt=1e-12, q0=np.zeros((10**4, 2)), p0=np.zeros((10**4, 2))), "save_every"),
     ],
 )
