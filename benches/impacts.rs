@@ -44,6 +44,7 @@ fn run(free: &EllipticBilliard, contacts: Option<&Contacts<'_>>, method: Method)
             let watch = Watch {
                 events: None,
                 contacts: Some(contacts),
+                ..Watch::default()
             };
             integrate_watching(free, method, &Q0, &P0, &options, || Ok(()), watch)
         }
@@ -62,6 +63,7 @@ fn billiard(c: &mut Criterion) {
         let watch = Watch {
             events: None,
             contacts: Some(&contacts),
+            ..Watch::default()
         };
         if integrate_watching(&free, Method::Verlet, &Q0, &P0, &options, || Ok(()), watch).is_err() {
             continue;

@@ -432,6 +432,7 @@ fn billiard(steps: usize, radius: f64) -> (usize, usize) {
     let watch = Watch {
         events: None,
         contacts: Some(&contacts),
+        ..Watch::default()
     };
     let before = allocated();
     let traj = integrate_watching(

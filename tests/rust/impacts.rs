@@ -31,6 +31,7 @@ fn with_contacts<'w>(contacts: &'w Contacts<'static>) -> Watch<'w, 'static, 'sta
     Watch {
         events: None,
         contacts: Some(contacts),
+        ..Watch::default()
     }
 }
 
@@ -223,6 +224,7 @@ fn a_step_without_an_impact_is_bit_for_bit_the_step_without_contacts() {
         let watch = Watch {
             events: Some(&mut events),
             contacts: Some(&contacts),
+            ..Watch::default()
         };
         let both = integrate_watching(&ball, method, &[1.0], &[2.0], &options, || Ok(()), watch).unwrap();
         assert_eq!(both.events.len(), 1, "{method:?}");
@@ -258,6 +260,7 @@ fn events_are_located_on_the_pieces_of_a_step_with_an_impact() {
     let watch = Watch {
         events: Some(&mut events),
         contacts: Some(&contacts),
+        ..Watch::default()
     };
     let traj = integrate_watching(&ball, Method::Verlet, &[1.0], &[0.0], &options, || Ok(()), watch).unwrap();
     assert_eq!(traj.events.len(), 2 * traj.impacts.len());

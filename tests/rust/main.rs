@@ -22,6 +22,7 @@ mod general_lagrangian;
 mod heavy_top;
 mod hessians;
 mod impacts;
+mod impulses;
 #[cfg(feature = "jit")]
 mod jit;
 mod kepler;

@@ -297,6 +297,7 @@ fn member(
     let watch = Watch {
         events: detector.as_mut(),
         contacts: (!own.is_empty()).then_some(&own),
+        ..Watch::default()
     };
     let outcome = integrate_watching(sys, method, q0, p0, options, poll, watch);
     steps.fetch_add(options.steps.saturating_sub(counted), Relaxed);

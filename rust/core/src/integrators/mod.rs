@@ -63,7 +63,10 @@ pub use ensemble::{
 };
 pub use events::{Detector, EventFunctions, EventSpec, NativeEvent, Occurrence};
 pub use explicit_rk::ExplicitRk;
-pub use jumps::{Contact, Contacts, Impacts, Law, NativeContact, NativeSurface, Surface, Watch, Watcher, MAX_IMPACTS};
+pub use jumps::{
+    Blow, Contact, Contacts, Generalized, Impacts, Impulse, Law, NativeContact, NativeSurface, PointFunction, Schedule,
+    Struck, Surface, Watch, Watcher, MAX_IMPACTS,
+};
 pub use kick_drift::KickDrift;
 pub use kind::ModelKind;
 pub use method::{Method, MethodInfo};

@@ -110,7 +110,7 @@ where
         options.steps,
         options.save_every,
         poll,
-        Watcher::idle(),
+        (Watcher::idle(), true),
     )
 }
 
@@ -135,7 +135,7 @@ where
 {
     let watch = Watch {
         events: Some(events),
-        contacts: None,
+        ..Watch::default()
     };
     integrate_watching(sys, method, q0, p0, options, poll, watch)
 }
@@ -185,7 +185,8 @@ where
 }
 
 /// The run of `stepper` to step `end` watching `watch` (its [`Watcher`] begun on the
-/// stepper's state, named `argument` if it is outside a contact).
+/// stepper's state, named `argument` if it is outside a contact): a new run when `argument` is
+/// `q0` (its schedule's times at t0 taken), else a resumed one.
 fn watched<S, P>(
     sys: &S,
     stepper: Stepper<&S>,
@@ -200,7 +201,7 @@ where
     P: Poll,
 {
     match Watcher::begin(sys, &stepper, watch, argument, energy.is_some()) {
-        Ok(watcher) => run(sys, stepper, energy, end, save_every, poll, watcher),
+        Ok(watcher) => run(sys, stepper, energy, end, save_every, poll, (watcher, argument == "q0")),
         Err(error) => Err(fail(error, first_state(sys, &stepper))),
     }
 }
@@ -245,7 +246,7 @@ where
     P: Poll,
 {
     let (stepper, watch, end) = resumed(sys, checkpoint, steps, save_every)?;
-    run(sys, stepper, watch, end, save_every, poll, Watcher::idle())
+    run(sys, stepper, watch, end, save_every, poll, (Watcher::idle(), false))
 }
 
 /// As [`resume`], watching the `events` as [`integrate_with_events`] does, from the
@@ -265,7 +266,7 @@ where
 {
     let watch = Watch {
         events: Some(events),
-        contacts: None,
+        ..Watch::default()
     };
     resume_watching(sys, checkpoint, steps, save_every, poll, watch)
 }
@@ -333,7 +334,8 @@ fn first_state<S: Dynamics + ?Sized>(sys: &S, stepper: &Stepper<&S>) -> Trajecto
 }
 
 /// Advances `stepper` to step `end`, saving every `save_every`-th state, the first and the
-/// last, with the energy checked at each saved state (and the events searched, if any).
+/// last, with the energy checked at each saved state (and the events searched, if any). A
+/// `fresh` run starts its watcher ([`Watcher::start`]).
 fn run<'s, S, P>(
     sys: &'s S,
     mut stepper: Stepper<&'s S>,
@@ -341,7 +343,7 @@ fn run<'s, S, P>(
     end: usize,
     save_every: usize,
     mut poll: P,
-    mut watcher: Watcher<'_, '_, '_, &'s S>,
+    (mut watcher, fresh): (Watcher<'_, '_, '_, &'s S>, bool),
 ) -> Result<Trajectory, Box<Failure>>
 where
     S: Dynamics + ?Sized,
@@ -376,9 +378,21 @@ where
         return Err(fail(Error::invalid("save_every", reason), traj));
     }
 
-    traj.push(stepper.t(), &stepper);
-    let mut outcome = Ok(());
-    while stepper.steps() < end {
+    let mut outcome = if fresh {
+        watcher.start(&mut stepper, &mut traj)
+    } else {
+        Ok(())
+    };
+    // With samples their states alone are saved; a state already saved at its time (just after
+    // a jump there) is not saved again.
+    let sampling = watcher.sampling();
+    let keep = |traj: &mut Trajectory, stepper: &Stepper<&'s S>| {
+        if !sampling && traj.t.last() != Some(&stepper.t()) {
+            traj.push(stepper.t(), stepper);
+        }
+    };
+    keep(&mut traj, &stepper);
+    while stepper.steps() < end && outcome.is_ok() {
         // Every `save_every`-th state is saved, and the last.
         let save = (stepper.steps() / save_every + 1).saturating_mul(save_every).min(end);
         let n = save - stepper.steps();
@@ -388,16 +402,12 @@ where
             watch.shift(watcher.take_energy_jump());
         }
         let advanced = advanced.map(|stop| traj.terminated_by = stop);
+        // A failure stops with the last good state kept, and the work counted.
+        keep(&mut traj, &stepper);
         if let Err(error) = advanced {
-            // Stops with the last good state kept, and the work counted.
-            let time = stepper.t();
-            if traj.t.last() != Some(&time) {
-                traj.push(time, &stepper);
-            }
             outcome = Err(error);
             break;
         }
-        traj.push(stepper.t(), &stepper);
         if let Some(error) = watch.as_mut().and_then(|w| w.check(sys, &stepper)) {
             // The state of this step is kept: it is finite, only its energy is off.
             outcome = Err(error);

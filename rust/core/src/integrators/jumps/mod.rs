@@ -1,6 +1,7 @@
-//! Jumps of the state inside a step: impacts on unilateral contacts φ(q) ≥ 0, resolved by the
-//! one step loop that runs, resumes, events, steppers and ensembles share (the resolve law a
-//! replaceable function, as in REBOUND; the reset in the solver loop, as in diffsol).
+//! Jumps of the state inside a step: impacts on unilateral contacts φ(q) ≥ 0 and impulses at
+//! given times, resolved by the one step loop that runs, resumes, events, steppers and
+//! ensembles share (the resolve law a replaceable function, as in REBOUND; the reset in the
+//! solver loop, as in diffsol).
 //!
 //! - [`Surface`]: φ(q) and ∇φ(q), native ([`NativeSurface`]) or the binding's closures;
 //! - [`Contact`]: a surface with its restitution e ∈ [0, 1], its [`Law`] and its name;
@@ -8,16 +9,20 @@
 //! - `resolve.rs`: a step that crosses a surface, redone in pieces at each contact;
 //!   `reflect.rs` and `variational.rs`: the laws that give the jump's multiplier λ;
 //! - [`Impacts`]: what a run reports of them ([`super::Trajectory::impacts`]);
-//! - [`Watch`]: the events and contacts a run or a stepper watches, and [`Watcher`], the one
-//!   loop of steps that checks them, begun on a stepper's state.
+//! - [`Schedule`]: impulses ([`Impulse`], a [`Blow`] at a time) and samples (`t_eval`) at given
+//!   times, each splitting the step that holds it (`schedule.rs`);
+//! - [`Watch`]: the events, contacts and schedule a run or a stepper watches, and [`Watcher`],
+//!   the one loop of steps that checks them, begun on a stepper's state.
 
 mod reflect;
 mod resolve;
+mod schedule;
 mod surfaces;
 mod variational;
 mod watch;
 
 pub(in crate::integrators) use resolve::Resolver;
+pub use schedule::{Blow, Generalized, Impulse, PointFunction, Schedule, Struck};
 pub use surfaces::NativeSurface;
 pub(crate) use surfaces::{check_ellipsoid, ellipsoid, wall};
 pub use watch::{Watch, Watcher};

@@ -1,12 +1,13 @@
-//! The impact resolution: a step that ends with some φ < 0 redone in pieces on a scratch
-//! stepper, each piece a partial step of the method from its start, split at the first contact
-//! crossed (located to round-off), the jump applied there, and the rest of the step re-checked
-//! against every contact, up to [`MAX_IMPACTS`] impacts in the step.
+//! The jumps' resolution: a step that ends with some φ < 0, or that holds an impulse's time, redone
+//! in pieces on a scratch stepper, each piece a partial step of the method from its start, split
+//! at the first contact crossed (located to round-off) or at the impulse, the jump applied there,
+//! and the rest of the step re-checked against every contact, up to [`MAX_IMPACTS`] impacts in
+//! the step. The samples of a step are partial steps from the last jump before them.
 
 use std::borrow::{Borrow, BorrowMut};
 use std::ops::Deref;
 
-use super::{reflect, variational, Contacts, Impacts, Law, MAX_IMPACTS};
+use super::{reflect, variational, Contact, Contacts, Impacts, Law, Schedule, MAX_IMPACTS};
 use crate::integrators::events::Search;
 use crate::integrators::DiscreteEnergy;
 use crate::integrators::{Counting, Dynamics, Method, Occurrence, Poll, Stepper, StepperState, Trajectory};
@@ -36,10 +37,14 @@ pub(super) fn variational_misfit<S: Dynamics + ?Sized>(model: &S, method: Method
     None
 }
 
-/// A run's resolver: the contacts, the scratch stepper of the partial steps (a copy of the
-/// run's stepper) and every buffer of the resolution, made once per run.
+/// A run's resolver: the contacts and the schedule, the scratch stepper of the partial steps
+/// (a copy of the run's stepper) and every buffer of the resolution, made once per run.
 pub(in crate::integrators) struct Resolver<'c, 's, M> {
-    contacts: &'c Contacts<'s>,
+    contacts: &'c [Contact<'s>],
+    schedule: Option<&'c Schedule<'s>>,
+    /// The next impulse and sample of the schedule (those before are done).
+    next_impulse: usize,
+    next_sample: usize,
     scratch: Stepper<M>,
     /// The scratch's force evaluations when it was made (the run's so far).
     counted: u64,
@@ -55,15 +60,17 @@ pub(in crate::integrators) struct Resolver<'c, 's, M> {
     /// The piece's start.
     piece_q: Vec<f64>,
     piece_p: Vec<f64>,
-    /// The contact state (q̃, p⁻), the normal and the laws' work buffers.
+    /// The jump's state (q̃, p⁻), the normal and the laws' work buffers.
     contact_q: Vec<f64>,
     contact_p: Vec<f64>,
     normal: Vec<f64>,
     v: Vec<f64>,
     w: Vec<f64>,
     zeros: Vec<f64>,
-    /// The step's impacts, kept when the step is resolved.
+    /// The step's impacts, kept when the step is resolved, and its impulses (by their index in
+    /// the schedule).
     pending: Impacts,
+    blown: Impacts,
     /// Whether the run checks its energy (then each jump's change of E is summed in
     /// `energy_jump`, for the run's check to discount).
     energy: bool,
@@ -73,28 +80,39 @@ pub(in crate::integrators) struct Resolver<'c, 's, M> {
 }
 
 impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
-    /// The resolver of `contacts` for a run of `stepper` on `model` from its state (named
-    /// `argument` in the refusal of a state outside φ ≥ 0), `energy` when the run checks its
-    /// energy.
+    /// The resolver of `contacts` and `schedule` for a run of `stepper` on `model` from its
+    /// state (named `argument` in the refusal of a state outside φ ≥ 0), `energy` when the run
+    /// checks its energy. The schedule's times after the state's are to come (and those at it,
+    /// for [`Resolver::start`]).
     pub(in crate::integrators) fn begin<St: Borrow<StepperState>>(
         model: M,
         stepper: &Stepper<M, St>,
-        contacts: &'c Contacts<'s>,
+        (contacts, schedule): (Option<&'c Contacts<'s>>, Option<&'c Schedule<'s>>),
         argument: &'static str,
         energy: bool,
     ) -> Result<Self, Error> {
         let n = stepper.q().len();
-        contacts.check(&*model, stepper.method(), (stepper.t(), stepper.q()), argument)?;
+        if let Some(contacts) = contacts {
+            contacts.check(&*model, stepper.method(), (stepper.t(), stepper.q()), argument)?;
+        }
+        if let Some(schedule) = schedule {
+            schedule.fit(n)?;
+        }
+        let contacts = contacts.map_or(&[][..], |c| c.contacts());
         let scratch = Stepper::resume(model, StepperState::clone(stepper))?;
         let m = contacts.len();
+        let t0 = stepper.t();
         let mut resolver = Resolver {
             contacts,
+            schedule,
+            next_impulse: schedule.map_or(0, |s| s.impulses().partition_point(|b| b.t <= t0)),
+            next_sample: schedule.map_or(0, |s| s.samples().partition_point(|&t| t <= t0)),
             counted: scratch.force_evaluations(),
             scratch,
             phi: vec![0.0; m],
             phi_start: vec![0.0; m],
             phi_end: vec![0.0; m],
-            t: stepper.t(),
+            t: t0,
             q: stepper.q().to_vec(),
             p: stepper.p().to_vec(),
             piece_q: vec![0.0; n],
@@ -106,15 +124,39 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
             w: vec![0.0; n],
             zeros: vec![0.0; n],
             pending: Impacts::with_capacity(n, MAX_IMPACTS),
+            blown: Impacts::with_capacity(n, schedule.map_or(0, |s| s.impulses().len())),
             energy,
             energy_jump: 0.0,
-            discrete: (contacts.contacts().iter().any(|c| c.law == Law::Variational))
+            discrete: (contacts.iter().any(|c| c.law == Law::Variational))
                 .then(|| DiscreteEnergy::new(stepper.method(), n))
                 .flatten(),
         };
         let (step, time) = (stepper.steps(), stepper.t());
         evaluate(contacts, stepper.q(), &mut resolver.phi, step, time)?;
         Ok(resolver)
+    }
+
+    /// Whether the run saves the samples' states, and those alone.
+    pub(in crate::integrators) fn sampling(&self) -> bool {
+        self.schedule.is_some_and(Schedule::sampling)
+    }
+
+    /// A new run's start (a resumed run's times at its start are the first run's): the samples
+    /// at its t0 taken, then the impulses there applied (the states just before and after each
+    /// saved).
+    pub(in crate::integrators) fn start<St: BorrowMut<StepperState>>(
+        &mut self,
+        stepper: &mut Stepper<M, St>,
+        search: Option<&mut Search<'_, '_, M>>,
+        traj: &mut Trajectory,
+    ) -> Result<(), Error> {
+        if let Some(schedule) = self.schedule {
+            let t0 = stepper.t();
+            self.next_impulse = schedule.impulses().partition_point(|b| b.t < t0);
+            self.next_sample = schedule.samples().partition_point(|&t| t < t0);
+        }
+        self.take_samples(stepper, traj)?;
+        self.blow_at_grid(stepper, search, traj)
     }
 
     /// Advances `stepper` by up to `n` steps, one at a time, resolving the impacts of each
@@ -145,7 +187,8 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
                 let leaving = self.phi[j] <= 0.0;
                 below(self.phi_end[j] - floor(self.phi[j], leaving), leaving)
             });
-            let resolved = if crossed {
+            let inside = self.impulse_inside(self.next_impulse, stepper.t()).is_some();
+            let resolved = if crossed || inside {
                 match self.resolve(stepper, search.as_deref_mut(), &mut traj.events) {
                     Ok(resolved) => resolved,
                     Err(error) => {
@@ -159,12 +202,8 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
                 false
             };
             if resolved {
-                for k in 0..self.pending.len() {
-                    let (t, q) = (self.pending.t[k], self.pending.q_at(k));
-                    traj.push_state(t, q, self.pending.p_before_at(k), stepper);
-                    traj.push_state(t, q, self.pending.p_after_at(k), stepper);
-                }
-                traj.impacts.append(&mut self.pending);
+                self.take_samples(stepper, traj)?;
+                self.push_jumps(stepper, traj);
             } else {
                 if crossed {
                     // The scratch's first piece crossed nothing after all: φ at the step's end.
@@ -174,7 +213,9 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
                 if let Some(search) = search.as_deref_mut() {
                     search.piece(step, (stepper.t(), stepper.q(), stepper.p()), h, &mut traj.events)?;
                 }
+                self.take_samples(stepper, traj)?;
             }
+            self.blow_at_grid(stepper, search.as_deref_mut(), traj)?;
             if let Some(stop) = search.as_deref_mut().and_then(|s| s.count(&mut traj.events, first)) {
                 return Ok(Some(stop));
             }
@@ -182,27 +223,161 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
         Ok(None)
     }
 
+    /// The time of impulse `k` if it falls inside the step that ends at `t_end`.
+    fn impulse_inside(&self, k: usize, t_end: f64) -> Option<f64> {
+        let impulses = self.schedule?.impulses();
+        impulses.get(k).map(|b| b.t).filter(|&t| t < t_end)
+    }
+
+    /// The step's jumps saved, in order of time (the states just before and after each, unless
+    /// the run saves its samples alone), and its impacts reported.
+    fn push_jumps<St: Borrow<StepperState>>(&mut self, stepper: &Stepper<M, St>, traj: &mut Trajectory) {
+        if !self.sampling() {
+            let (a, b) = (&self.pending, &self.blown);
+            let (mut i, mut k) = (0, 0);
+            while i < a.len() || k < b.len() {
+                let (jumps, row) = if k == b.len() || (i < a.len() && a.t[i] <= b.t[k]) {
+                    i += 1;
+                    (a, i - 1)
+                } else {
+                    k += 1;
+                    (b, k - 1)
+                };
+                let (t, q) = (jumps.t[row], jumps.q_at(row));
+                traj.push_state(t, q, jumps.p_before_at(row), stepper);
+                traj.push_state(t, q, jumps.p_after_at(row), stepper);
+            }
+        }
+        self.blown.clear();
+        traj.impacts.append(&mut self.pending);
+    }
+
+    /// The impulses at the stepper's time, a point of the grid (the end of the step just taken,
+    /// or a new run's t0): the jumps applied to its state, which is saved just before and after
+    /// each (unless the run saves its samples alone); the events restarted there.
+    fn blow_at_grid<St: BorrowMut<StepperState>>(
+        &mut self,
+        stepper: &mut Stepper<M, St>,
+        search: Option<&mut Search<'_, '_, M>>,
+        traj: &mut Trajectory,
+    ) -> Result<(), Error> {
+        let Some(schedule) = self.schedule else {
+            return Ok(());
+        };
+        let (t, step) = (stepper.t(), stepper.steps());
+        let first = self.next_impulse;
+        while schedule.impulses().get(self.next_impulse).is_some_and(|b| b.t == t) {
+            self.contact_q.copy_from_slice(stepper.q());
+            self.contact_p.copy_from_slice(stepper.p());
+            self.blow(self.next_impulse, step, t)?;
+            if !self.sampling() {
+                traj.push_state(t, &self.contact_q, &self.contact_p, stepper);
+                traj.push_state(t, &self.contact_q, &self.piece_p, stepper);
+            }
+            stepper.jump_to(&self.contact_q, &self.piece_p)?;
+            self.next_impulse += 1;
+        }
+        if self.next_impulse > first {
+            if let Some(search) = search {
+                search.restart_piece(step, (t, stepper.q(), stepper.p()))?;
+            }
+        }
+        Ok(())
+    }
+
+    /// The jump of impulse k at (q, p⁻) (the contact buffers) at time t: p⁺ = p⁻ + P(q) into
+    /// `piece_p`, projected on the constraints of a constrained model (their workless impulse).
+    fn blow(&mut self, k: usize, step: usize, t: f64) -> Result<(), Error> {
+        let model_error = |source| Error::Model { step, time: t, source };
+        let impulse = &self.schedule.expect("a schedule blows").impulses()[k];
+        impulse
+            .blow
+            .components(&self.contact_q, &mut self.v)
+            .map_err(model_error)?;
+        for (x, (a, b)) in self.piece_p.iter_mut().zip(self.contact_p.iter().zip(&self.v)) {
+            *x = a + b;
+        }
+        let model = self.scratch.model();
+        if let Some(projected) = model.project(&self.contact_q, &self.piece_p) {
+            let (_, p) = projected?;
+            self.piece_p.copy_from_slice(&p);
+        }
+        if !self.piece_p.iter().all(|x| x.is_finite()) {
+            let source = format!("impulses[{k}] at t = {t} gives non-finite momenta").into();
+            return Err(model_error(source));
+        }
+        self.energy_change(step, t)
+    }
+
+    /// The samples of the step just taken (those after its start, up to its end): each the
+    /// partial step of the method to it from the last jump before it, or from the step's start;
+    /// one at the step's end is its state. A sample at a jump's time is the state just before it.
+    fn take_samples<St: Borrow<StepperState>>(
+        &mut self,
+        stepper: &Stepper<M, St>,
+        traj: &mut Trajectory,
+    ) -> Result<(), Error> {
+        let Some(schedule) = self.schedule else {
+            return Ok(());
+        };
+        let (t_end, step) = (stepper.t(), stepper.steps());
+        while let Some(&ts) = schedule.samples().get(self.next_sample).filter(|&&ts| ts <= t_end) {
+            self.next_sample += 1;
+            if ts == t_end {
+                traj.push_state(ts, stepper.q(), stepper.p(), stepper);
+                continue;
+            }
+            // The last jump before ts, of the impacts and of the impulses.
+            let last = |jumps: &Impacts| jumps.t.iter().rposition(|&t| t < ts).map(|k| (jumps.t[k], k));
+            let from = match (last(&self.pending), last(&self.blown)) {
+                (Some((ta, i)), Some((tb, _))) if ta >= tb => Some((&self.pending, i)),
+                (_, Some((_, k))) => Some((&self.blown, k)),
+                (Some((_, i)), None) => Some((&self.pending, i)),
+                (None, None) => None,
+            };
+            let ta = match from {
+                Some((jumps, k)) => {
+                    self.piece_q.copy_from_slice(jumps.q_at(k));
+                    self.piece_p.copy_from_slice(jumps.p_after_at(k));
+                    jumps.t[k]
+                }
+                None => {
+                    self.piece_q.copy_from_slice(&self.q);
+                    self.piece_p.copy_from_slice(&self.p);
+                    self.t
+                }
+            };
+            self.partial(step, ta, ts - ta)?;
+            traj.push_state(ts, self.scratch.q(), self.scratch.p(), stepper);
+        }
+        Ok(())
+    }
+
     /// The step just taken by `stepper` from the kept start, redone in pieces: false (nothing
     /// changed) when its first piece on the scratch stepper crosses no contact after all
-    /// (round-off at a grazing end); true with the stepper set to the step's end state and the
-    /// impacts in `pending`.
+    /// (round-off at a grazing end) and holds no impulse; true with the stepper set to the
+    /// step's end state and its impacts in `pending`, its impulses in `blown`.
     fn resolve<St: BorrowMut<StepperState>>(
         &mut self,
         stepper: &mut Stepper<M, St>,
         mut search: Option<&mut Search<'_, '_, M>>,
         occurrences: &mut Vec<Occurrence>,
     ) -> Result<bool, Error> {
-        let (step, h) = (stepper.steps(), stepper.dt());
+        let (step, h, t_end) = (stepper.steps(), stepper.dt(), stepper.t());
         let (contacts, time) = (self.contacts, self.t);
         let contact_error = |reason: String| Error::Contact { step, time, reason };
         self.piece_q.copy_from_slice(&self.q);
         self.piece_p.copy_from_slice(&self.p);
         self.phi_start.copy_from_slice(&self.phi);
         self.pending.clear();
+        self.blown.clear();
         let (mut ta, mut tau, mut last) = (self.t, h, None);
         loop {
-            // The piece to the step's end, and the first contact it crosses.
-            self.partial(step, ta, tau)?;
+            // The piece to the next impulse inside the step, or to the step's end, and the
+            // first contact it crosses.
+            let inside = self.impulse_inside(self.next_impulse, t_end);
+            let piece = inside.map_or(tau, |t| t - ta);
+            self.partial(step, ta, piece)?;
             evaluate(contacts, self.scratch.q(), &mut self.phi_end, step, self.t)?;
             let mut first: Option<(f64, usize)> = None;
             for j in 0..contacts.len() {
@@ -210,12 +385,12 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
                 if !below(self.phi_end[j] - floor(self.phi_start[j], leaving), leaving) {
                     continue;
                 }
-                let s = self.locate(j, step, (ta, tau), leaving).map_err(|e| match e {
+                let s = self.locate(j, step, (ta, piece), leaving).map_err(|e| match e {
                     Located::Error(e) => e,
                     Located::Resting => contact_error(format!(
                         "a body leaving the contact {} crosses it again at once (a resting or grazing contact, \
                          such as e = 0 under a force pressing on it), which impacts cannot resolve",
-                        contacts.contacts()[j].name
+                        contacts[j].name
                     )),
                 })?;
                 if let Some(s) = s {
@@ -224,12 +399,27 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
                     }
                 }
             }
-            let Some((s, j)) = first else {
-                if self.pending.is_empty() {
-                    return Ok(false);
+            let (s, j) = match (first, inside) {
+                (Some(first), _) => first,
+                (None, Some(t_blow)) => {
+                    // The piece reaches the impulse: the scratch holds (q, p⁻) there.
+                    self.contact_q.copy_from_slice(self.scratch.q());
+                    self.contact_p.copy_from_slice(self.scratch.p());
+                    if let Some(search) = search.as_deref_mut() {
+                        search.piece(step, (t_blow, &self.contact_q, &self.contact_p), piece, occurrences)?;
+                    }
+                    let k = self.next_impulse;
+                    self.blow(k, step, t_blow)?;
+                    self.blown
+                        .push(k, step, t_blow, &self.contact_q, &self.contact_p, &self.piece_p);
+                    self.next_impulse += 1;
+                    self.restart_piece(step, search.as_deref_mut(), t_blow)?;
+                    (ta, tau, last) = (t_blow, tau - piece, None);
+                    continue;
                 }
+                (None, None) if self.pending.is_empty() && self.blown.is_empty() => return Ok(false),
                 // The last piece ends the step: the scratch holds its end.
-                break;
+                (None, None) => break,
             };
             if self.pending.len() == MAX_IMPACTS {
                 return Err(contact_error(format!(
@@ -245,7 +435,7 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
             if let Some(search) = search.as_deref_mut() {
                 search.piece(step, (t_contact, &self.contact_q, &self.contact_p), s, occurrences)?;
             }
-            let contact = &contacts.contacts()[j];
+            let contact = &contacts[j];
             self.jump(j, step, (ta, s, tau - s))?;
             if !self.piece_p.iter().all(|x| x.is_finite()) {
                 return Err(contact_error(format!(
@@ -255,11 +445,7 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
             }
             self.pending
                 .push(j, step, t_contact, &self.contact_q, &self.contact_p, &self.piece_p);
-            if let Some(search) = search.as_deref_mut() {
-                search.restart_piece(step, (t_contact, &self.contact_q, &self.piece_p))?;
-            }
-            self.piece_q.copy_from_slice(&self.contact_q);
-            evaluate(contacts, &self.piece_q, &mut self.phi_start, step, self.t)?;
+            self.restart_piece(step, search.as_deref_mut(), t_contact)?;
             (ta, tau, last) = (t_contact, tau - s, Some(j));
         }
         // The step's end: the last piece's, at tₙ₊₁.
@@ -271,11 +457,21 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
         Ok(true)
     }
 
+    /// The next piece from the jump at t, (q̃, p⁺) in the contact and piece buffers: its start
+    /// kept, φ and the events evaluated there.
+    fn restart_piece(&mut self, step: usize, search: Option<&mut Search<'_, '_, M>>, t: f64) -> Result<(), Error> {
+        if let Some(search) = search {
+            search.restart_piece(step, (t, &self.contact_q, &self.piece_p))?;
+        }
+        self.piece_q.copy_from_slice(&self.contact_q);
+        evaluate(self.contacts, &self.piece_q, &mut self.phi_start, step, self.t)
+    }
+
     /// The jump on contact j at (q̃, p⁻) (the contact buffers), at the end of the piece of size s
     /// from ta with `rest` of the step after it: p⁺ into `piece_p`.
     fn jump(&mut self, j: usize, step: usize, (ta, s, rest): (f64, f64, f64)) -> Result<(), Error> {
         let contacts = self.contacts;
-        let contact = &contacts.contacts()[j];
+        let contact = &contacts[j];
         let (t, time) = (ta + s, self.t);
         let model_error = |source| Error::Model { step, time, source };
         let model = self.scratch.model();
@@ -311,14 +507,21 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
         } else {
             reflection
         };
-        let (q, p) = (&self.contact_q[..], &self.contact_p[..]);
-        for (x, (a, b)) in self.piece_p.iter_mut().zip(p.iter().zip(&self.normal)) {
+        for (x, (a, b)) in self.piece_p.iter_mut().zip(self.contact_p.iter().zip(&self.normal)) {
             *x = a + lambda * b;
         }
+        self.energy_change(step, t)
+    }
+
+    /// The change of energy at the jump at time t from (q̃, p⁻) (the contact buffers) to p⁺
+    /// (`piece_p`), summed when the run checks its energy.
+    fn energy_change(&mut self, step: usize, t: f64) -> Result<(), Error> {
         if self.energy {
-            let model = self.scratch.model();
-            let energy = |p: &[f64]| model.energy(q, p, t).transpose().map_err(model_error);
-            if let (Some(before), Some(after)) = (energy(p)?, energy(&self.piece_p)?) {
+            let (q, model) = (&self.contact_q[..], self.scratch.model());
+            let energy = |p: &[f64]| {
+                (model.energy(q, p, t).transpose()).map_err(|source| Error::Model { step, time: t, source })
+            };
+            if let (Some(before), Some(after)) = (energy(&self.contact_p)?, energy(&self.piece_p)?) {
                 self.energy_jump += after.energy - before.energy;
             }
         }
@@ -427,7 +630,7 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
     /// φⱼ at the end of the partial step of size s from the piece's start.
     fn phi_along(&mut self, j: usize, step: usize, ta: f64, s: f64) -> Result<f64, Error> {
         self.partial(step, ta, s)?;
-        let surface = &self.contacts.contacts()[j].surface;
+        let surface = &self.contacts[j].surface;
         surface.phi(self.scratch.q()).map_err(|source| Error::Model {
             step,
             time: self.t,
@@ -488,8 +691,8 @@ fn below(phi: f64, leaving: bool) -> bool {
 }
 
 /// φ of every contact at q into `phi`; a surface's error names the run's step and time.
-fn evaluate(contacts: &Contacts<'_>, q: &[f64], phi: &mut [f64], step: usize, time: f64) -> Result<(), Error> {
-    for (c, phi) in contacts.contacts().iter().zip(phi) {
+fn evaluate(contacts: &[Contact<'_>], q: &[f64], phi: &mut [f64], step: usize, time: f64) -> Result<(), Error> {
+    for (c, phi) in contacts.iter().zip(phi) {
         *phi = c.surface.phi(q).map_err(|source| Error::Model { step, time, source })?;
         if !phi.is_finite() {
             let source = format!("contact {} returned a non-finite φ = {phi}", c.name).into();

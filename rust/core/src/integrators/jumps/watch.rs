@@ -1,24 +1,27 @@
-//! What a run or a stepper watches besides its states: events and contacts, begun once on a
-//! stepper's state and checked after every step.
+//! What a run or a stepper watches besides its states: events, contacts and a schedule of
+//! impulses and samples, begun once on a stepper's state and checked after every step.
 
 use std::borrow::{Borrow, BorrowMut};
 use std::ops::Deref;
 
-use super::Resolver;
+use super::{Resolver, Schedule};
 use crate::integrators::events::Search;
 use crate::integrators::{Contacts, Detector, Dynamics, Poll, Stepper, StepperState, Trajectory};
 use crate::Error;
 
-/// What a run watches besides its states: events ([`Detector`]) and contacts ([`Contacts`]),
-/// either, both or neither. Both are checked after every step (the steps are then taken one
-/// at a time); a step that crosses a contact is redone in pieces at each impact, and the events
-/// are evaluated and located on the pieces.
+/// What a run watches besides its states: events ([`Detector`]), contacts ([`Contacts`]) and
+/// a [`Schedule`] of impulses and samples, any of them or none. They are checked after every
+/// step (the steps are then taken one at a time); a step that crosses a contact or holds an
+/// impulse is redone in pieces at each jump, and the events are evaluated and located on the
+/// pieces.
 #[derive(Default)]
 pub struct Watch<'w, 'e, 'c> {
     /// The events, located by partial steps of the method ([`crate::integrators::integrate_with_events`]).
     pub events: Option<&'w mut Detector<'e>>,
     /// The unilateral contacts φ(q) ≥ 0, whose impacts the run resolves.
     pub contacts: Option<&'w Contacts<'c>>,
+    /// The impulses the run applies and the samples it takes (then saving those alone).
+    pub schedule: Option<&'w Schedule<'c>>,
 }
 
 /// A [`Watch`] begun on a stepper's state: the events' search and the contacts' resolver, with
@@ -47,10 +50,29 @@ where
         energy: bool,
     ) -> Result<Self, Error> {
         let search = watch.events.map(|events| events.begin(model, stepper)).transpose()?;
-        let resolver = (watch.contacts)
-            .map(|contacts| Resolver::begin(model, stepper, contacts, argument, energy))
+        let resolver = (watch.contacts.is_some() || watch.schedule.is_some())
+            .then(|| Resolver::begin(model, stepper, (watch.contacts, watch.schedule), argument, energy))
             .transpose()?;
         Ok(Watcher { search, resolver })
+    }
+
+    /// A new run's start at the stepper's t0: the samples there, then the impulses there
+    /// applied, their states just before and after saved to `record` (see [`Watcher::advance`]).
+    /// A resumed run skips this: its times at the start are the first run's.
+    pub fn start<St: BorrowMut<StepperState>>(
+        &mut self,
+        stepper: &mut Stepper<M, St>,
+        record: &mut Trajectory,
+    ) -> Result<(), Error> {
+        match self.resolver.as_mut() {
+            Some(resolver) => resolver.start(stepper, self.search.as_mut(), record),
+            None => Ok(()),
+        }
+    }
+
+    /// Whether the run saves the samples' states, and those alone.
+    pub fn sampling(&self) -> bool {
+        self.resolver.as_ref().is_some_and(|r| r.sampling())
     }
 
     /// The watcher of nothing: the steps many at a time, as a plain run takes them.
@@ -62,8 +84,8 @@ where
     }
 
     /// Advances `stepper` by up to `n` steps, pushing the located events to `record.events`,
-    /// the impacts to `record.impacts` and the states just before and after each impact to its
-    /// saved states. Returns the event whose terminal count was reached (the stepper stopping at
+    /// the impacts to `record.impacts` and the states just before and after each impact and
+    /// impulse to its saved states (or, with samples, the samples' states alone). Returns the event whose terminal count was reached (the stepper stopping at
     /// the end of that step); None after the n steps. On failure the stepper is at the last good
     /// step ([`Error::Contact`]: the start of the step of the impact).
     pub fn advance<St: BorrowMut<StepperState>, P: Poll>(

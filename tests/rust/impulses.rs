@@ -1,0 +1,332 @@
+//! The schedule of a run ([`Schedule`]): impulses at given times, each splitting the step that
+//! holds it (the method's order kept across the blow), and samples (`t_eval`), the method's
+//! partial steps to the requested times, taken through impacts; both composed with contacts and
+//! carried by a resumed run bit for bit.
+
+use varmech::integrators::{
+    integrate, integrate_watching, resume_watching, Blow, Checkpoint, Contact, Contacts, Generalized, Impulse, Law,
+    Method, NativeSurface, Options, Schedule, Struck, Trajectory, Watch,
+};
+use varmech::scenes::{BouncingBall, HarmonicOscillator};
+use varmech::Error;
+
+fn blow(t: f64, p: &[f64]) -> Impulse<'static> {
+    Impulse {
+        t,
+        blow: Box::new(Generalized(p.to_vec())),
+    }
+}
+
+fn scheduled<'w>(schedule: &'w Schedule<'static>) -> Watch<'w, 'static, 'static> {
+    Watch {
+        schedule: Some(schedule),
+        ..Watch::default()
+    }
+}
+
+/// The oscillator q̈ = −q from (0, 1), struck by Δp = `kick` at t*: its state at t.
+fn oscillator_after_blow(t: f64, t_star: f64, kick: f64) -> (f64, f64) {
+    let (q, p) = (t_star.sin(), t_star.cos() + kick);
+    let s = t - t_star;
+    (q * s.cos() + p * s.sin(), -q * s.sin() + p * s.cos())
+}
+
+#[test]
+fn an_impulse_between_grid_points_keeps_the_methods_order() {
+    let oscillator = HarmonicOscillator::new(1.0).unwrap();
+    let (t_star, kick, t_end) = (1.2345, 0.7, 6.0);
+    let exact = oscillator_after_blow(t_end, t_star, kick);
+    for (method, order, h) in [(Method::Verlet, 2.0, 0.02), (Method::KahanLi6, 6.0, 0.2)] {
+        let errors: Vec<f64> = [h, h / 2.0, h / 4.0]
+            .iter()
+            .map(|&dt| {
+                let schedule = Schedule::new(vec![blow(t_star, &[kick])], vec![]).unwrap();
+                let options = Options::new(dt, (t_end / dt).round() as usize);
+                let traj = integrate_watching(
+                    &oscillator,
+                    method,
+                    &[0.0],
+                    &[1.0],
+                    &options,
+                    || Ok(()),
+                    scheduled(&schedule),
+                )
+                .unwrap();
+                // The jump is saved: two rows at t*, their momenta differing by the blow.
+                let rows: Vec<usize> = (0..traj.len()).filter(|&k| traj.t[k] == t_star).collect();
+                assert_eq!(rows.len(), 2);
+                assert!((traj.p_at(rows[1])[0] - traj.p_at(rows[0])[0] - kick).abs() <= 1e-14);
+                assert_eq!(traj.q_at(rows[0]), traj.q_at(rows[1]));
+                let last = traj.len() - 1;
+                (traj.q_at(last)[0] - exact.0)
+                    .abs()
+                    .max((traj.p_at(last)[0] - exact.1).abs())
+            })
+            .collect();
+        for w in errors.windows(2) {
+            let measured = (w[0] / w[1]).log2();
+            assert!((measured - order).abs() < 0.3, "{method:?}: {errors:?}");
+        }
+    }
+}
+
+#[test]
+fn an_impulse_on_the_grid_and_at_t0_jumps_there_and_the_run_goes_on_as_a_new_one() {
+    let oscillator = HarmonicOscillator::new(1.0).unwrap();
+    let dt = 0.05;
+    let schedule = Schedule::new(vec![blow(40.0 * dt, &[0.4]), blow(0.0, &[0.5])], vec![]).unwrap();
+    let options = Options::new(dt, 200);
+    let traj = integrate_watching(
+        &oscillator,
+        Method::Verlet,
+        &[0.0],
+        &[1.0],
+        &options,
+        || Ok(()),
+        scheduled(&schedule),
+    )
+    .unwrap();
+    // Rows: t0 before and after the first blow, 39 steps, t₄₀ before and after, 160 steps.
+    assert_eq!(traj.len(), 2 + 39 + 2 + 160);
+    assert_eq!((traj.p_at(0)[0], traj.p_at(1)[0]), (1.0, 1.5));
+    let before = integrate(
+        &oscillator,
+        Method::Verlet,
+        &[0.0],
+        &[1.5],
+        &Options::new(dt, 40),
+        || Ok(()),
+    )
+    .unwrap();
+    assert_eq!(&traj.q[1..42], &before.q[..]);
+    let end = before.len() - 1;
+    let after = Options {
+        t0: before.t[end],
+        ..Options::new(dt, 160)
+    };
+    let p = [before.p_at(end)[0] + 0.4];
+    let rest = integrate(&oscillator, Method::Verlet, before.q_at(end), &p, &after, || Ok(())).unwrap();
+    assert_eq!(traj.p_at(42), &p[..]);
+    assert_eq!(traj.q[42..], rest.q[..]);
+    assert_eq!(traj.p[42..], rest.p[..]);
+}
+
+#[test]
+fn a_blow_at_a_point_gives_the_components_of_its_jacobian_or_of_central_differences() {
+    // A rod of length 2 on a table, (x, y, θ), struck across an end: P = Jᵀ I = (0, 1, cos θ).
+    let point = |q: &[f64], x: &mut [f64]| {
+        (x[0], x[1]) = (q[0] + q[2].cos(), q[1] + q[2].sin());
+        Ok(())
+    };
+    let jacobian = |q: &[f64], j: &mut [f64]| {
+        j.copy_from_slice(&[1.0, 0.0, -q[2].sin(), 0.0, 1.0, q[2].cos()]);
+        Ok(())
+    };
+    let q = [0.3, -0.2, 0.4];
+    let exact = [0.0, 1.0, 0.4f64.cos()];
+    let given = Struck {
+        point: Box::new(point),
+        jacobian: Some(Box::new(jacobian)),
+        impulse: vec![0.0, 1.0],
+    };
+    let differenced = Struck {
+        point: Box::new(point),
+        jacobian: None,
+        impulse: vec![0.0, 1.0],
+    };
+    let (mut a, mut b) = ([0.0; 3], [0.0; 3]);
+    given.components(&q, &mut a).unwrap();
+    differenced.components(&q, &mut b).unwrap();
+    assert_eq!(a, exact);
+    // Central differences: error O(ε^(2/3)) ≈ 4e-11.
+    assert!(a.iter().zip(&b).all(|(x, y)| (x - y).abs() < 1e-9), "{b:?}");
+}
+
+fn floor() -> Contacts<'static> {
+    let contact = Contact {
+        surface: Box::new(NativeSurface::Wall {
+            coordinate: 0,
+            value: 0.0,
+        }),
+        restitution: 1.0,
+        law: Law::Reflect,
+        name: "floor".into(),
+    };
+    Contacts::new(vec![contact]).unwrap()
+}
+
+/// The ball dropped from h₀ = 1 at rest, bouncing elastically: its exact height and momentum.
+fn ball_at(t: f64, g: f64) -> (f64, f64) {
+    let fall = (2.0 / g).sqrt();
+    let s = ((t + fall) % (2.0 * fall)) - fall;
+    (1.0 - 0.5 * g * s * s, -g * s)
+}
+
+#[test]
+fn samples_are_taken_through_impacts_to_round_off_on_the_bouncing_ball() {
+    // Verlet is exact on the parabola and the impacts are located to round-off, so the samples,
+    // partial steps from the last impact before them, are the exact motion to round-off.
+    let g = 9.81;
+    let ball = BouncingBall::new(g).unwrap();
+    let contacts = floor();
+    let times: Vec<f64> = (0..200).map(|k| 0.0137 + 0.0499 * k as f64).collect();
+    let schedule = Schedule::new(vec![], times.clone()).unwrap();
+    let options = Options::new(0.01, 1000);
+    let watch = Watch {
+        contacts: Some(&contacts),
+        schedule: Some(&schedule),
+        ..Watch::default()
+    };
+    let traj = integrate_watching(&ball, Method::Verlet, &[1.0], &[0.0], &options, || Ok(()), watch).unwrap();
+    assert_eq!(traj.t, times, "the samples alone are saved");
+    assert!(traj.impacts.len() >= 4);
+    for (k, &t) in times.iter().enumerate() {
+        let (q, p) = ball_at(t, g);
+        assert!(
+            (traj.q_at(k)[0] - q).abs() < 1e-11 && (traj.p_at(k)[0] - p).abs() < 1e-10,
+            "t = {t}"
+        );
+    }
+    // The run goes on to its end, whatever it samples.
+    let plain = integrate_watching(
+        &ball,
+        Method::Verlet,
+        &[1.0],
+        &[0.0],
+        &options,
+        || Ok(()),
+        Watch {
+            contacts: Some(&contacts),
+            ..Watch::default()
+        },
+    )
+    .unwrap();
+    assert_eq!(traj.checkpoint, plain.checkpoint);
+    assert_eq!(traj.impacts, plain.impacts);
+}
+
+#[test]
+fn samples_on_the_grid_are_the_runs_own_states_to_the_bit() {
+    let oscillator = HarmonicOscillator::new(1.0).unwrap();
+    let options = Options::new(0.01, 300);
+    let run = integrate(&oscillator, Method::KahanLi8, &[0.0], &[1.0], &options, || Ok(())).unwrap();
+    let picked = [0, 7, 8, 150, 300];
+    let schedule = Schedule::new(vec![], picked.iter().map(|&k| run.t[k]).collect()).unwrap();
+    let at = integrate_watching(
+        &oscillator,
+        Method::KahanLi8,
+        &[0.0],
+        &[1.0],
+        &options,
+        || Ok(()),
+        scheduled(&schedule),
+    )
+    .unwrap();
+    for (row, &k) in picked.iter().enumerate() {
+        assert_eq!((at.q_at(row), at.p_at(row)), (run.q_at(k), run.p_at(k)));
+    }
+}
+
+#[test]
+fn a_ball_struck_up_in_flight_bounces_higher_and_the_energy_check_discounts_the_blow() {
+    // Struck at t = 0.2 by Δp = 3 (unit mass), the ball's energy rises by ½((p + 3)² − p²);
+    // the run's energy check (on by default) judges the smooth motion alone.
+    let g = 9.81;
+    let ball = BouncingBall::new(g).unwrap();
+    let contacts = floor();
+    let schedule = Schedule::new(vec![blow(0.2, &[3.0])], vec![]).unwrap();
+    let watch = Watch {
+        contacts: Some(&contacts),
+        schedule: Some(&schedule),
+        ..Watch::default()
+    };
+    let traj = integrate_watching(
+        &ball,
+        Method::Verlet,
+        &[1.0],
+        &[0.0],
+        &Options::new(0.01, 500),
+        || Ok(()),
+        watch,
+    )
+    .unwrap();
+    let p = -g * 0.2 + 3.0;
+    let energy = g * (1.0 - 0.5 * g * 0.04) + 0.5 * p * p;
+    let last = traj.len() - 1;
+    let e = 0.5 * traj.p_at(last)[0].powi(2) + g * traj.q_at(last)[0];
+    assert!((e - energy).abs() < 1e-10, "{e} against {energy}");
+    assert!(!traj.impacts.is_empty());
+}
+
+#[test]
+fn a_resumed_run_takes_the_impulses_and_samples_after_its_start_bit_for_bit() {
+    let g = 9.81;
+    let ball = BouncingBall::new(g).unwrap();
+    let contacts = floor();
+    // Impulses inside a step, at the checkpoint's time (the first run's) and after it.
+    let impulses = || vec![blow(0.1234, &[1.0]), blow(2.0, &[-0.5]), blow(3.0001, &[0.25])];
+    let samples: Vec<f64> = (1..40).map(|k| 0.1 * k as f64 + 0.003).collect();
+    let run = |schedule: &Schedule<'static>, steps: usize, from: Option<Vec<u8>>| -> Trajectory {
+        let watch = Watch {
+            contacts: Some(&contacts),
+            schedule: Some(schedule),
+            ..Watch::default()
+        };
+        match from {
+            None => integrate_watching(
+                &ball,
+                Method::Verlet,
+                &[1.0],
+                &[0.0],
+                &Options::new(0.01, steps),
+                || Ok(()),
+                watch,
+            ),
+            Some(bytes) => {
+                let checkpoint = Checkpoint::from_bytes(&bytes).unwrap();
+                resume_watching(&ball, checkpoint, steps, 1, || Ok(()), watch)
+            }
+        }
+        .unwrap()
+    };
+    for with_samples in [false, true] {
+        let schedule = Schedule::new(impulses(), if with_samples { samples.clone() } else { vec![] }).unwrap();
+        let whole = run(&schedule, 400, None);
+        let first = run(&schedule, 200, None);
+        let rest = run(&schedule, 200, Some(first.checkpoint.clone()));
+        assert_eq!(rest.checkpoint, whole.checkpoint);
+        let n = first.len() - usize::from(!with_samples);
+        assert_eq!(&whole.t[..n], &first.t[..n]);
+        assert_eq!(&whole.t[n..], &rest.t[..]);
+        assert_eq!(&whole.q[n..], &rest.q[..]);
+    }
+}
+
+#[test]
+fn bad_schedules_are_refused_by_name() {
+    let message = |e: Error| e.to_string();
+    let nan = Schedule::new(vec![blow(f64::NAN, &[1.0])], vec![])
+        .err()
+        .map(message)
+        .unwrap();
+    assert!(nan.contains("impulses") && nan.contains("finite"), "{nan}");
+    let unsorted = Schedule::new(vec![], vec![0.5, 0.2]).err().map(message).unwrap();
+    assert!(unsorted.contains("t_eval") && unsorted.contains("sorted"), "{unsorted}");
+    let oscillator = HarmonicOscillator::new(1.0).unwrap();
+    let schedule = Schedule::new(vec![blow(0.5, &[1.0, 2.0])], vec![]).unwrap();
+    let failure = integrate_watching(
+        &oscillator,
+        Method::Verlet,
+        &[0.0],
+        &[1.0],
+        &Options::new(0.1, 10),
+        || Ok(()),
+        scheduled(&schedule),
+    )
+    .unwrap_err();
+    let refused = failure.error.to_string();
+    assert!(
+        refused.contains("impulses[0]") && refused.contains("2 components of impulse for 1"),
+        "{refused}"
+    );
+}
