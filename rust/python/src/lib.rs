@@ -26,6 +26,7 @@ mod pointers;
 mod routh;
 mod run;
 mod scenes;
+mod schedule;
 mod stepper;
 mod trajectory;
 

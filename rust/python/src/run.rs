@@ -15,14 +15,16 @@ use crate::contacts::{ContactSpecs, ContactTuple};
 use crate::convert::{self, count, slice};
 use crate::errors::{boxed, failure_to_pyerr, to_pyerr};
 use crate::events::{EventTuple, Events};
+use crate::schedule::{ImpulseTuple, ScheduleSpecs};
 use crate::trajectory::TrajectoryRecord;
 
 /// Integrates; returns the saved states as a [`TrajectoryRecord`] or raises with
 /// `_varmech_partial`, the states up to the failure. The run watches `events` (spec tuples, see
-/// [`Events::new`]) and resolves the impacts on `contacts` (see [`ContactSpecs::new`]), if given
+/// [`Events::new`]), resolves the impacts on `contacts` (see [`ContactSpecs::new`]), applies
+/// `impulses` (see [`ScheduleSpecs::new`]) and saves the states at `t_eval` alone, if given
 /// ([`integrators::integrate_watching`]).
 #[pyfunction]
-#[pyo3(signature = (model, q0, p0, *, dt, steps, method, save_every=1, compensated=true, max_energy_error=None, t0=0.0, newton_tolerance=1e-14, newton_max_iterations=50, progress=None, events=None, contacts=None))]
+#[pyo3(signature = (model, q0, p0, *, dt, steps, method, save_every=1, compensated=true, max_energy_error=None, t0=0.0, newton_tolerance=1e-14, newton_max_iterations=50, progress=None, events=None, contacts=None, impulses=None, t_eval=None))]
 #[allow(clippy::too_many_arguments)]
 fn integrate<'py>(
     py: Python<'py>,
@@ -41,6 +43,8 @@ fn integrate<'py>(
     progress: Option<Py<PyAny>>,
     events: Option<Vec<EventTuple<'py>>>,
     contacts: Option<Vec<ContactTuple<'py>>>,
+    impulses: Option<Vec<ImpulseTuple<'py>>>,
+    t_eval: Option<Vec<f64>>,
 ) -> PyResult<TrajectoryRecord> {
     let options = run_options(
         dt,
@@ -55,20 +59,22 @@ fn integrate<'py>(
     let (q0, p0) = (slice("q0", &q0)?, slice("p0", &p0)?);
     let events = detector_parts(py, model, events)?;
     let contacts = contacts.map(ContactSpecs::new).transpose()?;
+    let schedule = ScheduleSpecs::new(impulses.unwrap_or_default(), t_eval.unwrap_or_default())?;
     let result = bind_model(py, model, |sys, poll| {
         let report = reporting(poll, &progress);
-        watching(events, contacts.as_ref(), |watch| {
+        watching(events, contacts.as_ref(), &schedule, |watch| {
             integrators::integrate_watching(sys, method, q0, p0, &options, report, watch)
         })
     })?;
     record(py, result)
 }
 
-/// Runs `run` with the [`Watch`] of `events` and `contacts`, or the failure of a run that never
-/// started (events or contacts malformed).
+/// Runs `run` with the [`Watch`] of `events`, `contacts` and `schedule`, or the failure of a
+/// run that never started (events, contacts or schedule malformed).
 fn watching<'c>(
     events: Option<(Events, Vec<EventSpec>)>,
     contacts: Option<&'c ContactSpecs>,
+    schedule: &'c ScheduleSpecs,
     run: impl FnOnce(Watch<'_, '_, 'c>) -> Result<Trajectory, Box<Failure>>,
 ) -> Result<Trajectory, Box<Failure>> {
     let never_started = |error| {
@@ -83,9 +89,14 @@ fn watching<'c>(
         .map(ContactSpecs::contacts)
         .transpose()
         .map_err(never_started)?;
+    let schedule = (!schedule.is_empty())
+        .then(|| schedule.schedule())
+        .transpose()
+        .map_err(never_started)?;
     run(Watch {
         events: detector.as_mut(),
         contacts: contacts.as_ref(),
+        schedule: schedule.as_ref(),
     })
 }
 
@@ -128,10 +139,11 @@ fn detector_parts<'py>(
 }
 
 /// Goes on from a run's checkpoint for `steps` more steps (see [`integrators::resume`]),
-/// watching `events` and resolving the impacts on `contacts` (as `integrate`'s) if given; a
+/// watching `events`, resolving the impacts on `contacts` and applying `impulses` and taking the
+/// samples `t_eval` after the checkpoint's time (as `integrate`'s) if given; a
 /// checkpoint of another `method` or `dt` than given is refused ([`Checkpoint::expect`]).
 #[pyfunction]
-#[pyo3(signature = (model, checkpoint, *, steps, save_every=1, progress=None, events=None, method=None, dt=None, contacts=None))]
+#[pyo3(signature = (model, checkpoint, *, steps, save_every=1, progress=None, events=None, method=None, dt=None, contacts=None, impulses=None, t_eval=None))]
 #[allow(clippy::too_many_arguments)]
 fn resume<'py>(
     py: Python<'py>,
@@ -144,13 +156,16 @@ fn resume<'py>(
     method: Option<&str>,
     dt: Option<f64>,
     contacts: Option<Vec<ContactTuple<'py>>>,
+    impulses: Option<Vec<ImpulseTuple<'py>>>,
+    t_eval: Option<Vec<f64>>,
 ) -> PyResult<TrajectoryRecord> {
     let checkpoint = decode(py, checkpoint, method, dt)?;
     let events = detector_parts(py, model, events)?;
     let contacts = contacts.map(ContactSpecs::new).transpose()?;
+    let schedule = ScheduleSpecs::new(impulses.unwrap_or_default(), t_eval.unwrap_or_default())?;
     let result = bind_model(py, model, |sys, poll| {
         let report = reporting(poll, &progress);
-        watching(events, contacts.as_ref(), |watch| {
+        watching(events, contacts.as_ref(), &schedule, |watch| {
             integrators::resume_watching(sys, checkpoint, steps, save_every, report, watch)
         })
     })?;
