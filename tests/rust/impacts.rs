@@ -5,7 +5,7 @@
 
 use varmech::integrators::{
     integrate, integrate_ensemble_watching, integrate_watching, integrate_with_events, resume_watching, Checkpoint,
-    Contact, Contacts, Detector, DiscreteEnergy, EventSpec, Impacts, Law, MemberEvents, Method, NativeContact,
+    Contact, Contacts, Detector, DiscreteEnergy, EventSpec, Impacts, Law, MemberWatch, Method, NativeContact,
     NativeEvent, NativeSurface, Options, Parallel, Shared, Stepper, Trajectory, Watch, Watcher,
 };
 use varmech::model::Lagrangian;
@@ -342,7 +342,10 @@ fn an_ensemble_member_is_its_single_run_bit_for_bit() {
         workers: Some(2),
         chunk_size: None,
     };
-    let events = MemberEvents::default();
+    let watched = MemberWatch {
+        contacts: vec![table.clone()],
+        ..MemberWatch::default()
+    };
     let ensemble = integrate_ensemble_watching(
         &Shared(&free),
         Method::Verlet,
@@ -350,7 +353,7 @@ fn an_ensemble_member_is_its_single_run_bit_for_bit() {
         &p0,
         &options,
         parallel,
-        (&events, std::slice::from_ref(&table)),
+        &watched,
         || Ok(()),
     )
     .unwrap();

@@ -4,8 +4,9 @@
 //! carried by a resumed run bit for bit.
 
 use varmech::integrators::{
-    integrate, integrate_watching, resume_watching, Blow, Checkpoint, Contact, Contacts, Generalized, Impulse, Law,
-    Method, NativeSurface, Options, Schedule, Struck, Trajectory, Watch,
+    integrate, integrate_ensemble_watching, integrate_watching, resume_watching, Blow, Checkpoint, Contact, Contacts,
+    Generalized, Impulse, Law, MemberWatch, Method, NativeContact, NativeSurface, Options, Parallel, Schedule, Shared,
+    Struck, Trajectory, Watch,
 };
 use varmech::scenes::{BouncingBall, HarmonicOscillator};
 use varmech::Error;
@@ -329,4 +330,63 @@ fn bad_schedules_are_refused_by_name() {
         refused.contains("impulses[0]") && refused.contains("2 components of impulse for 1"),
         "{refused}"
     );
+}
+
+#[test]
+fn an_ensemble_member_with_impulses_samples_and_contacts_is_its_single_run_bit_for_bit() {
+    let g = 9.81;
+    let ball = BouncingBall::new(g).unwrap();
+    let contacts = floor();
+    let samples: Vec<f64> = (1..60).map(|k| 0.05 * k as f64 + 0.001).collect();
+    let watched = MemberWatch {
+        contacts: vec![NativeContact {
+            surface: NativeSurface::Wall {
+                coordinate: 0,
+                value: 0.0,
+            },
+            restitution: 1.0,
+            law: Law::Reflect,
+            name: "floor".into(),
+        }],
+        impulses: vec![(0.2345, Generalized(vec![2.0])), (1.5, Generalized(vec![-1.0]))],
+        samples: samples.clone(),
+        ..MemberWatch::default()
+    };
+    let (q0, p0) = ([1.0, 0.5, 2.0], [0.0, 1.0, -1.0]);
+    let options = Options::new(0.01, 300);
+    let parallel = Parallel {
+        workers: Some(2),
+        chunk_size: None,
+    };
+    let ensemble = integrate_ensemble_watching(
+        &Shared(&ball),
+        Method::Verlet,
+        &q0,
+        &p0,
+        &options,
+        parallel,
+        &watched,
+        || Ok(()),
+    )
+    .unwrap();
+    for (i, outcome) in ensemble.members.iter().enumerate() {
+        let schedule = Schedule::new(vec![blow(0.2345, &[2.0]), blow(1.5, &[-1.0])], samples.clone()).unwrap();
+        let watch = Watch {
+            contacts: Some(&contacts),
+            schedule: Some(&schedule),
+            ..Watch::default()
+        };
+        let single = integrate_watching(
+            &ball,
+            Method::Verlet,
+            &q0[i..=i],
+            &p0[i..=i],
+            &options,
+            || Ok(()),
+            watch,
+        )
+        .unwrap();
+        assert_eq!(single.t, samples);
+        assert_eq!(outcome.as_ref().unwrap(), &single, "member {i}");
+    }
 }

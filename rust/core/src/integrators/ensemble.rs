@@ -4,16 +4,16 @@
 //! one run on one thread, its state touched by no other, so its trajectory is bit for bit that
 //! of the single run whatever the number of threads or the chunking. A member that fails keeps
 //! its [`Failure`] (error and partial trajectory) and the others go on. Members may watch
-//! native events ([`MemberEvents`]), each with its own copy of the functions, as
-//! [`integrate_with_events`] does.
+//! native events, contacts and a schedule of impulses and samples ([`MemberWatch`]), each with
+//! its own copy, as [`integrate_watching`] does.
 
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering::Relaxed};
 use std::sync::mpsc::{self, RecvTimeoutError};
 use std::time::{Duration, Instant};
 
 use super::{
-    integrate_watching, Contacts, Counting, Detector, Dynamics, EventSpec, Failure, Method, NativeContact, NativeEvent,
-    Options, Poll, Trajectory, Watch,
+    integrate_watching, Contacts, Counting, Detector, Dynamics, EventSpec, Failure, Generalized, Impulse, Method,
+    NativeContact, NativeEvent, Options, Poll, Schedule, Trajectory, Watch,
 };
 use crate::{memory, Error, ModelError};
 
@@ -86,6 +86,38 @@ impl MemberEvents {
     }
 }
 
+/// What every member watches, native and owned, each member making its own copy: events,
+/// contacts, and a schedule of impulses (their components as numbers) and samples (`t_eval`).
+#[derive(Clone, Debug, Default)]
+pub struct MemberWatch {
+    pub events: MemberEvents,
+    pub contacts: Vec<NativeContact>,
+    pub impulses: Vec<(f64, Generalized)>,
+    pub samples: Vec<f64>,
+}
+
+impl MemberWatch {
+    /// A member's schedule, None without impulses and samples.
+    fn schedule(&self) -> Option<Result<Schedule<'static>, Error>> {
+        let impulses = self.impulses.iter().map(|(t, blow)| Impulse {
+            t: *t,
+            blow: Box::new(blow.clone()),
+        });
+        (!self.impulses.is_empty() || !self.samples.is_empty())
+            .then(|| Schedule::new(impulses.collect(), self.samples.clone()))
+    }
+
+    /// Refuses what a member's run would refuse of these on n coordinates, before any starts.
+    fn check(&self, n: usize) -> Result<(), Error> {
+        self.events.detector()?;
+        for (event, spec) in self.events.functions.iter().zip(&self.events.specs) {
+            event.check(&spec.name, n)?;
+        }
+        Contacts::native(&self.contacts)?.fit(n)?;
+        self.schedule().transpose()?.map_or(Ok(()), |s| s.fit(n))
+    }
+}
+
 /// A member's run: its trajectory, or its failure with the states up to it.
 pub type Outcome = Result<Trajectory, Box<Failure>>;
 
@@ -143,13 +175,17 @@ where
     M: Members + ?Sized,
     P: Poll,
 {
-    integrate_ensemble_watching(models, method, q0, p0, options, parallel, (events, &[]), poll)
+    let watched = MemberWatch {
+        events: events.clone(),
+        ..MemberWatch::default()
+    };
+    integrate_ensemble_watching(models, method, q0, p0, options, parallel, &watched, poll)
 }
 
-/// As [`integrate_ensemble`], every member also resolving the impacts on `contacts` (each its
-/// own copy: [`Contacts::native`]), as [`integrate_watching`] does; each member is bit for bit
-/// its single run. Refuses, before any member starts, contacts that a member's run would refuse
-/// (naming `contacts`).
+/// As [`integrate_ensemble`], every member watching `watched` (each its own copy) as
+/// [`integrate_watching`] does: events, the impacts on contacts, impulses and samples; each
+/// member is bit for bit its single run. Refuses, before any member starts, what a member's run
+/// would refuse (naming `events`, `contacts`, `impulses` or `t_eval`).
 #[allow(clippy::too_many_arguments)]
 pub fn integrate_ensemble_watching<M, P>(
     models: &M,
@@ -158,7 +194,7 @@ pub fn integrate_ensemble_watching<M, P>(
     p0: &[f64],
     options: &Options,
     parallel: Parallel,
-    (events, contacts): (&MemberEvents, &[NativeContact]),
+    watched: &MemberWatch,
     mut poll: P,
 ) -> Result<Ensemble, Error>
 where
@@ -189,11 +225,7 @@ where
         return Err(Error::invalid("models", reason));
     }
     check_memory(members, n, options)?;
-    events.detector()?;
-    for (event, spec) in events.functions.iter().zip(&events.specs) {
-        event.check(&spec.name, n)?;
-    }
-    Contacts::native(contacts)?.fit(n)?;
+    watched.check(n)?;
 
     let workers = parallel
         .workers
@@ -218,9 +250,8 @@ where
                     let i = c * chunk + k;
                     let rows = i * n..(i + 1) * n;
                     let (q0, p0) = (&q0[rows.clone()], &p0[rows]);
-                    *slot = Some(models.with_model(i, |sys| {
-                        member(sys, method, (q0, p0), options, (events, contacts), stop, steps)
-                    }));
+                    *slot =
+                        Some(models.with_model(i, |sys| member(sys, method, (q0, p0), options, watched, stop, steps)));
                     // The receiver waits until every member is done.
                     let _ = sender.send(());
                 }
@@ -251,15 +282,15 @@ where
     Ok(Ensemble { members, interrupted })
 }
 
-/// One member: [`integrate_watching`] of its `events` and `contacts` (with neither, [`super::integrate`]), its poll
-/// counting its steps into `steps` and stopping when `stop` is set; a member not started
-/// before the stop is interrupted at its initial state.
+/// One member: [`integrate_watching`] of its copy of `watched`, its poll counting its steps
+/// into `steps` and stopping when `stop` is set; a member not started before the stop is
+/// interrupted at its initial state.
 fn member(
     sys: &dyn Dynamics,
     method: Method,
     (q0, p0): (&[f64], &[f64]),
     options: &Options,
-    (events, contacts): (&MemberEvents, &[NativeContact]),
+    watched: &MemberWatch,
     stop: &AtomicBool,
     steps: &AtomicUsize,
 ) -> Outcome {
@@ -286,18 +317,19 @@ fn member(
             false => Ok(()),
         }
     });
+    let events = &watched.events;
     let mut detector = match (!events.functions.is_empty()).then(|| events.detector()).transpose() {
         Ok(detector) => detector,
         Err(error) => return unstarted(error),
     };
-    let own = match Contacts::native(contacts) {
-        Ok(own) => own,
-        Err(error) => return unstarted(error),
+    let (contacts, schedule) = match (Contacts::native(&watched.contacts), watched.schedule().transpose()) {
+        (Ok(contacts), Ok(schedule)) => (contacts, schedule),
+        (Err(error), _) | (_, Err(error)) => return unstarted(error),
     };
     let watch = Watch {
         events: detector.as_mut(),
-        contacts: (!own.is_empty()).then_some(&own),
-        ..Watch::default()
+        contacts: (!contacts.is_empty()).then_some(&contacts),
+        schedule: schedule.as_ref(),
     };
     let outcome = integrate_watching(sys, method, q0, p0, options, poll, watch);
     steps.fetch_add(options.steps.saturating_sub(counted), Relaxed);

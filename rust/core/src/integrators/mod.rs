@@ -58,8 +58,8 @@ use del::{Constraints, DiscreteConstraint};
 pub use discrete_energy::DiscreteEnergy;
 pub use dynamics::{Dynamics, General};
 pub use ensemble::{
-    integrate_ensemble, integrate_ensemble_watching, Ensemble, MemberEvents, Members, Outcome, Parallel, Shared,
-    Stopped,
+    integrate_ensemble, integrate_ensemble_watching, Ensemble, MemberEvents, MemberWatch, Members, Outcome, Parallel,
+    Shared, Stopped,
 };
 pub use events::{Detector, EventFunctions, EventSpec, NativeEvent, Occurrence};
 pub use explicit_rk::ExplicitRk;
