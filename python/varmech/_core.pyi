@@ -526,6 +526,8 @@ def integrate(
     progress: Callable[[int], object] | None = None,
     events: list[tuple[str, int, int, str, Any]] | None = None,
     contacts: list[tuple[str, float, str, str, Any]] | None = None,
+    impulses: list[tuple[float, str, Any]] | None = None,
+    t_eval: _FloatArray | list[float] | None = None,
 ) -> TrajectoryRecord:
     """The saved states; on failure the exception carries ``_varmech_partial``, the
     TrajectoryRecord up to the failure. ``progress(steps)`` is called with the steps completed at
@@ -536,7 +538,10 @@ def integrate(
     groups)); see varmech.events and varmech.surfaces. ``contacts``: tuples (name, restitution,
     law, kind, payload), kind ``"crossing"`` or ``"ellipsoid"`` (the events' payloads) or
     ``"functions"`` ((phi, gradient)), law ``"reflect"`` or ``"variational"``; the impacts on
-    them are resolved in the step loop (see varmech.impacts)."""
+    them are resolved in the step loop (see varmech.impacts). ``impulses``: tuples (t, kind,
+    payload), kind ``"generalized"`` (the components), ``"function"`` (P(q)) or ``"point"``
+    ((x(q), its Jacobian or None, the impulse vector)), each splitting its step. ``t_eval``: the
+    sample times, whose states alone are then saved."""
 
 def resume(
     model: _Model,
@@ -549,10 +554,13 @@ def resume(
     method: str | None = None,
     dt: float | None = None,
     contacts: list[tuple[str, float, str, str, Any]] | None = None,
+    impulses: list[tuple[float, str, Any]] | None = None,
+    t_eval: _FloatArray | list[float] | None = None,
 ) -> TrajectoryRecord:
-    """Goes on from a run's checkpoint for `steps` more steps, watching `events` and resolving
-    the impacts on `contacts` (as `integrate`'s) if given; a checkpoint of another `method` or
-    `dt` than given is refused."""
+    """Goes on from a run's checkpoint for `steps` more steps, watching `events`, resolving the
+    impacts on `contacts`, applying the `impulses` and taking the samples `t_eval` after the
+    checkpoint's time (as `integrate`'s) if given; a checkpoint of another `method` or `dt`
+    than given is refused."""
 
 def energy_terms(model: _Model, t: _FloatArray, q: _FloatArray, p: _FloatArray) -> tuple[_FloatArray, _FloatArray, _FloatArray]:
     """(E, T, V) at each state: the energy function p·q̇ − L, its kinetic term E − V and its

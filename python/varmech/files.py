@@ -50,9 +50,11 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from . import impacts as _impacts
+from . import impulses as _impulses
 from ._version import __version__
 from .events import Occurrences
 from .impacts import Contact
+from .impulses import Impulse
 from .methods import method_info
 from .model import Model, from_recipe
 
@@ -120,6 +122,7 @@ class Writer:
         events: Sequence[str] = (),
         argument: str = "path",
         contacts: Sequence[Contact | str] = (),
+        impulses: Sequence[Impulse | float] = (),
     ):
         h5py = _h5py()
         self.path = path
@@ -149,6 +152,9 @@ class Writer:
                 # The native ones as data; one of Python functions by its name (resume takes it again).
                 f.attrs["contacts"] = [_impacts.name(c) for c in contacts]
                 f.attrs["contact_surfaces"] = _impacts.stored(contacts)
+            if impulses:
+                # Likewise: the components given as numbers; one of Python functions by its time.
+                f.attrs["impulses"] = _impulses.stored(impulses)
             for name in ("t", "q", "p", *columns):
                 shape = (0, n) if name in ("q", "p") else (0,)
                 f.create_dataset(
@@ -507,7 +513,8 @@ def save(traj: Trajectory, path: str | os.PathLike[str], *, overwrite: bool = Fa
     target = writable(path, overwrite, "path")
     columns, names = columns_of(traj.model, traj.method), [o.name for o in traj.events]
     writer = Writer(
-        target, model=traj.model, method=traj.method, dt=traj.dt, columns=columns, events=names, contacts=traj.contacts
+        target, model=traj.model, method=traj.method, dt=traj.dt, columns=columns, events=names, contacts=traj.contacts,
+        impulses=traj.impulses,
     )
     writer.append(traj, events=traj.events)
     writer.close(traj.status, traj.message)

@@ -25,8 +25,9 @@ q̇(q, eᵢ) − q̇(q, 0), exact for such Lagrangians.
 
 from __future__ import annotations
 
+import json
 import warnings
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -35,8 +36,6 @@ from numpy.typing import ArrayLike
 
 from . import _core
 from ._util import vector
-from .constraints import project
-from .dense import grid_step
 from .model import Model
 
 #: The public API; the rest serves :func:`varmech.integrate`.
@@ -136,6 +135,23 @@ class Impulse:
             warnings.warn("impulse: no jacobian of the point given; central differences are used", stacklevel=3)
             jac = _differences(lambda y: np.asarray(self.point(y), dtype=float).reshape(-1), q)  # type: ignore[misc]
         return np.asarray(jac.T @ blow)
+
+
+    def spec(self) -> tuple[str, Any]:
+        """The binding's kind and payload of this blow (a ValueError as :meth:`components`
+        raises for a malformed one; the core checks the number of components)."""
+        if (self.generalized is None) == (self.point is None):
+            raise ValueError("impulse: give exactly one of generalized= and point= (with impulse=)")
+        if self.generalized is not None:
+            if callable(self.generalized):
+                return "function", self.generalized
+            return "generalized", np.asarray(self.generalized, dtype=float).reshape(-1).tolist()
+        if self.impulse is None:
+            raise ValueError("impulse: a point struck needs the impulse vector, impulse=")
+        if self.jacobian is None:
+            warnings.warn("impulse: no jacobian of the point given; central differences are used", stacklevel=4)
+        blow = np.asarray(self.impulse, dtype=float).reshape(-1).tolist()
+        return "point", (self.point, self.jacobian, blow)
 
 
 def _differences(f: Callable[[np.ndarray], np.ndarray], q: np.ndarray) -> np.ndarray:
@@ -460,106 +476,57 @@ def engage(
     return Engagement(after, v_after, multipliers, lost, carnot)
 
 
-@dataclass
-class Joined:
-    """A run in pieces, joined: the columns and counts ``integrate`` makes a Trajectory of."""
-
-    t: np.ndarray
-    q: np.ndarray
-    p: np.ndarray
-    newton: np.ndarray
-    work: np.ndarray
-    steps: int
-    force_evaluations: int
-    checkpoint: bytes
+Spec = tuple[float, str, Any]
 
 
-class Pieces:
-    """A run assembled from pieces (core runs between impulses or impacts) and single states (at
-    a jump): the saved rows, the Newton counts and work made cumulative over the pieces, and the
-    force evaluations."""
-
-    def __init__(self) -> None:
-        self.rows: dict[str, list[np.ndarray]] = {name: [] for name in ("t", "q", "p", "newton", "work")}
-        self.nfev = 0
-        self._newton, self._work = 0, 0.0
-
-    def add(self, record: Any, *, drop_last: bool = False) -> None:
-        """A piece's rows (its first left out after the first piece: it repeats the last row;
-        its last too with ``drop_last``) and its counts."""
-        first, last = int(bool(self.rows["t"])), len(record.t) - int(drop_last)
-        for name in ("t", "q", "p"):
-            self.rows[name].append(np.asarray(getattr(record, name))[first:last])
-        newton, work = np.asarray(record.newton), np.asarray(record.work)
-        self.rows["newton"].append(newton[first:last] + self._newton)
-        self.rows["work"].append(work[first:last] + self._work)
-        self._newton += int(newton[-1])
-        self._work += float(work[-1])
-        self.nfev += record.force_evaluations
-
-    def row(self, t: float, q: np.ndarray, p: np.ndarray) -> None:
-        """A single state, with the counts so far."""
-        for name, value in (("t", np.array([t])), ("q", q[None, :]), ("p", p[None, :])):
-            self.rows[name].append(value)
-        self.rows["newton"].append(np.array([self._newton]))
-        self.rows["work"].append(np.array([self._work]))
-
-    def joined(self, steps: int, checkpoint: bytes) -> Joined:
-        """The whole run, of ``steps`` steps, ending with ``checkpoint``."""
-        t, q, p, newton, work = (np.concatenate(self.rows[name]) for name in ("t", "q", "p", "newton", "work"))
-        return Joined(t, q, p, newton, work, steps, self.nfev, checkpoint)
-
-
-Start = Callable[[np.ndarray, np.ndarray, float, int, Callable[[int], None] | None], Any]
-
-
-def run(start: Start, model: Model, q0: np.ndarray, p0: np.ndarray, t0: float, dt: float, steps: int, impulses: list[Impulse]) -> Joined:
-    """A run of ``steps`` steps of ``dt`` from (t0, q0, p0) with ``impulses`` (``start(q, p, t0,
-    steps, progress)`` runs a piece): pieces from grid state to grid state, each impulse between
-    them. One between tₙ and tₙ₊₁ splits the step: Φ_τ, the jump p += P(q), Φ_{h−τ}, all steps of
-    the run's method, so the run keeps its order; on a constrained model the jump is followed by
-    the workless constraint impulse (the momenta projected, :func:`varmech.project`)."""
+def specs(impulses: Sequence[Impulse], t0: float, t_end: float) -> list[Spec]:
+    """The binding's tuples of ``impulses``, each an :class:`Impulse` (TypeError naming
+    ``impulses[i]``) at a time in the run's span [t0, t_end] (ValueError naming ``impulses``); the
+    core checks each against the model."""
+    out: list[Spec] = []
     for i, imp in enumerate(impulses):
         if not isinstance(imp, Impulse):
             raise TypeError(f"impulses[{i}]: expected a varmech.Impulse, got {type(imp).__name__}")
-    t_end = t0 + steps * dt
-    ordered = sorted(impulses, key=lambda imp: imp.t)
-    for imp in ordered:
-        if not (np.isfinite(imp.t) and t0 <= imp.t <= t_end):
+        if not (np.isfinite(imp.t) and min(t0, t_end) <= imp.t <= max(t0, t_end)):
             raise ValueError(f"impulses: a time {imp.t} outside the run's span [{t0}, {t_end}]")
-    pieces = Pieces()
+        out.append((float(imp.t), *imp.spec()))
+    return out
 
-    def piece(q: np.ndarray, p: np.ndarray, t: float, n: int) -> Any:
-        record = start(q, p, t, n, None)
-        pieces.add(record)
-        return record
 
-    q, p, t, done = q0, p0, t0, 0
-    for imp in ordered:
-        n = grid_step(imp.t, t0, dt, steps, done)
-        record = piece(q, p, t, n - done)
-        tau = imp.t - float(record.t[-1])
-        stepper = None
-        if tau > 0:
-            stepper = _core.Stepper.from_checkpoint(model._core, record.checkpoint)
-            stepper.dt = tau
-            stepper.step()
-            q_at, p_at = np.asarray(stepper.q), np.asarray(stepper.p)
-            pieces.row(imp.t, q_at, p_at)
-        else:
-            q_at, p_at = np.asarray(record.q[-1]), np.asarray(record.p[-1])
-        p_jump = p_at + imp.components(q_at)
-        if model.constraints:
-            q_at, p_jump = project(model, q_at, p_jump)
-        pieces.row(imp.t, q_at, p_jump)
-        if stepper is not None:
-            stepper.reset(q_at, p_jump, imp.t)
-            stepper.dt = dt - tau
-            stepper.step()
-            pieces.nfev += stepper.force_evaluations
-            q, p, t, done = np.asarray(stepper.q), np.asarray(stepper.p), t0 + (n + 1) * dt, n + 1
-            pieces.row(t, q, p)
-        else:
-            q, p, t, done = q_at, p_jump, imp.t, n
-    record = piece(q, p, t, steps - done)
-    return pieces.joined(steps, record.checkpoint)
+def stored(impulses: Sequence[Impulse | float]) -> str:
+    """The impulses as a file stores them, JSON: each one's time and its components given as
+    numbers, or null for one given by Python functions (no code is stored)."""
+    rows = []
+    for imp in impulses:
+        native = isinstance(imp, Impulse) and imp.generalized is not None and not callable(imp.generalized)
+        components = np.asarray(imp.generalized, dtype=float).reshape(-1).tolist() if native else None  # type: ignore[union-attr]
+        rows.append([float(imp if isinstance(imp, float) else imp.t), components])
+    return json.dumps(rows)
+
+
+def restored(text: str) -> tuple[Impulse | float, ...]:
+    """The impulses a file stored (:func:`stored`), those given by Python functions as their
+    times; ValueError naming ``path`` for a record that is not one."""
+    try:
+        return tuple(float(t) if p is None else Impulse(generalized=[float(x) for x in p], t=float(t)) for t, p in json.loads(text))
+    except (ValueError, TypeError) as e:
+        raise ValueError(f"path: its impulses are not a stored impulse list ({e})") from None
+
+
+def going_on(stored: Sequence[Impulse | float], given: Sequence[Impulse] | None, t: float) -> tuple[Impulse, ...]:
+    """The impulses a run continued from time ``t`` goes on with: its own, or ``given`` in their
+    place (the same times); a ValueError naming ``impulses`` for one still to come that was given
+    by Python functions, loaded from a file as its time, and not given again."""
+    if given is None:
+        unknown = [imp for imp in stored if isinstance(imp, float) and imp > t]
+        if unknown:
+            raise ValueError(
+                f"impulses: the run's impulses at t = {', '.join(map(str, unknown))} were given by Python functions, which"
+                " its file does not store; pass them again: varmech.resume(path, impulses=[...])"
+            )
+        return tuple(imp for imp in stored if isinstance(imp, Impulse))
+    specs(given, -np.inf, np.inf)
+    times = sorted(imp if isinstance(imp, float) else imp.t for imp in stored)
+    if sorted(imp.t for imp in given) != times:
+        raise ValueError(f"impulses: the run has impulses at t = {times}, not at {sorted(imp.t for imp in given)}")
+    return tuple(given)

@@ -212,26 +212,27 @@ def integrate(
         is refused unless ``overwrite``.
     t_eval
         Keep the states at these times (increasing, within the run's span) instead of every
-        ``save_every``-th: each is reached from the grid state before it by one step of the same
-        method of size τ < h, so it has the method's own error (order measured in
-        ``tests/python/test_dense.py``), as ``solve_ivp(t_eval=)`` does with its dense output.
-        The run itself is unchanged (it ends on its grid, with its checkpoint); not with
-        ``save_every``, ``output`` or ``events``.
+        ``save_every``-th: each is reached by one step of the same method of size τ < h from the
+        grid state before it (or from the last jump, an impact or an impulse, between them), so
+        it has the method's own error (order measured in ``tests/python/test_dense.py``), as
+        ``solve_ivp(t_eval=)`` does with its dense output. At a jump's time it is the state just
+        before. The run itself is unchanged (it ends on its grid, with its checkpoint); not with
+        ``save_every`` or ``output``, whose rows are the run's own states.
     impulses
         Blows (:class:`varmech.Impulse`) at their times ``impulse.t`` within the run: the momenta
-        jump by P(q) there. An impulse between grid points splits its step: a step of the same
+        jump by P(q) there (on a constrained model, projected back on the constraints by their
+        workless impulse). An impulse between grid points splits its step: a step of the same
         method to tₙ + τ, the jump, a step of h − τ back onto the grid, so the method keeps its
         order (``tests/python/test_impulses.py``). The saved states include those just before and
-        just after each jump (one time, two rows), and saving restarts from the grid state after
-        it. Not yet with ``t_eval``, ``output`` or ``events``.
+        just after each jump (one time, two rows). A continued run (``integrate(traj, steps=)``)
+        goes on with the impulses still to come.
     contacts
         Unilateral constraints φ(q) ≥ 0 (:class:`varmech.Contact`): the run goes through their
         impacts, each step that crosses a surface split at the contact configuration (see
         :mod:`varmech.impacts`); the impacts are each contact's occurrences in ``traj.events``.
         Default: a scene's ``contacts`` (an impact scene's floor or wall); ``contacts=[]``
-        runs without them. Not yet with ``t_eval``, ``output``, ``events`` or ``impulses``;
-        such a run is not continued yet (``integrate(traj, steps=)`` and :func:`varmech.resume`
-        refuse it, naming ``contacts``).
+        runs without them. They compose with events, impulses, ``t_eval``, ``output`` and
+        continued runs, which go on with them.
     checkpoint_every
         With ``output``: commit states and a checkpoint at least every this many steps (rounded
         down to whole ``save_every`` periods), or every :class:`datetime.timedelta` of run time.
@@ -319,7 +320,7 @@ def integrate(
             "contacts": contacts,
         }
         named = [name for name, value in given.items() if value is not None]
-        if named and named[0] in ("t_eval", "impulses", "contacts"):
+        if named and named[0] == "t_eval":
             raise ValueError(f"{named[0]}: not with a continued run (start a new run from its last state)")
         if named:
             raise ValueError(f"{named[0]}: a continued run keeps its trajectory's {', '.join(named)}")
@@ -353,10 +354,15 @@ def integrate(
     _check_time_independent(model, q, p, tuple(s for s in probes if math.isfinite(s)), starts)
 
     contact_specs = _impacts.specs(contacts or ())
+    impulse_specs = _impulses.specs(impulses, t0, t_end) if impulses is not None else []
+    times = None
+    if t_eval is not None:
+        for name, clash in (("save_every", save_every != 1), ("output", output is not None)):
+            if clash:
+                raise ValueError(f"{name}: not with t_eval, which keeps the states at its times, not the run's own")
+        times = dense.eval_times(t_eval, t0, t_end)
 
-    def start(
-        q: np.ndarray, p: np.ndarray, t0: float, steps: int, report: Callable[[int], None] | None, events: Any = None
-    ) -> _core.TrajectoryRecord:
+    def first(steps: int, report: Callable[[int], None] | None) -> _core.TrajectoryRecord:
         return _core.integrate(
             model._core,
             q,
@@ -371,29 +377,12 @@ def integrate(
             newton_tolerance=newton_tolerance,
             newton_max_iterations=newton_max_iterations,
             progress=report,
-            events=events if events is not None else (event_specs or None),
+            events=event_specs or None,
             contacts=contact_specs or None,
+            impulses=impulse_specs or None,
+            t_eval=times,
         )
 
-    def first(steps: int, report: Callable[[int], None] | None) -> _core.TrajectoryRecord:
-        return start(q, p, t0, steps, report)
-
-    if contacts is not None:
-        for name, clash in (("t_eval", t_eval is not None), ("impulses", impulses is not None)):
-            if clash:
-                raise ValueError(
-                    f"contacts: not with {name}, whose states the core does not yet take through impacts (they are"
-                    " Python steps between core runs, which would skip an impact inside their step)"
-                )
-    if impulses is not None:
-        for name, clash in (("t_eval", t_eval is not None), ("output", output is not None), ("events", bool(watched))):
-            if clash:
-                raise ValueError(f"impulses: not yet with {name}")
-        j = _impulses.run(start, model, q, p, t0, dt, nsteps, list(impulses))
-        work = j.work if model.forced else None
-        return Trajectory(j.t, j.q, j.p, model, method, dt, j.steps, j.force_evaluations, j.newton, work, checkpoint=j.checkpoint)
-    if t_eval is not None:
-        return _evaluated(first, model, method, dt, t0, nsteps, dense.eval_times(t_eval, t0, t_end), save_every, progress, output, watched)
     return _run(
         first,
         None,
@@ -410,40 +399,8 @@ def integrate(
         watched,
         event_specs,
         contacts=tuple(contacts or ()),
+        impulses=tuple(impulses or ()),
     )
-
-
-def _evaluated(
-    first: Callable[[int, Callable[[int], None] | None], _core.TrajectoryRecord],
-    model: Model,
-    method: str,
-    dt: float,
-    t0: float,
-    nsteps: int,
-    times: np.ndarray,
-    save_every: int,
-    progress: bool | None,
-    output: str | os.PathLike[str] | None,
-    watched: Sequence[_events.Event],
-) -> Trajectory:
-    """``integrate(t_eval=)``: the run's states at ``times`` (``dense.at_times``)."""
-    for name, given in (("save_every", save_every != 1), ("output", output is not None), ("events", bool(watched))):
-        if given:
-            raise ValueError(f"{name}: not with t_eval, which gives the states kept")
-    bar = progress_bar(total=nsteps, unit="step", desc=method, enabled=progress)
-    try:
-        columns, record = dense.at_times(lambda steps: first(steps, None), model, times, t0, dt, nsteps, lambda s: bar.update(s - bar.n))
-    except BaseException as err:
-        partial = take_partial(err)
-        if partial is not None:
-            err.partial = _trajectory(partial, model, method, dt, status=-1, message=str(err))  # type: ignore[attr-defined]
-        raise
-    finally:
-        bar.close()
-    c = columns
-    newton = c["newton"].astype(np.uint64) if files.columns_of(model, method)[:1] == ("newton",) else None
-    work = c["work"] if model.forced else None
-    return Trajectory(c["t"], c["q"], c["p"], model, method, dt, record.steps, record.force_evaluations, newton, work, checkpoint=record.checkpoint)
 
 
 def _go_on(
@@ -486,6 +443,7 @@ def _go_on(
         initial,
         found,
         contacts=contacts,
+        impulses=_impulses.going_on(traj.impulses, None, float(traj.t[-1])),
     )
 
 
@@ -508,13 +466,17 @@ def _run(
     found: Sequence[int] = (),
     *,
     contacts: Sequence[_impacts.Contact] = (),
+    impulses: Sequence[_impulses.Impulse] = (),
 ) -> Trajectory:
     """Runs ``nsteps`` steps by ``first`` (a new run) or from ``checkpoint`` (after ``base``
     steps): in memory, or streamed to ``output`` in segments (:mod:`varmech.streaming`).
     ``watched`` are the run's events (``event_specs`` the binding's), whose crossings the result
     reports; a continued run's are watched after ``found`` crossings of each, an energy error
     measured from ``initial_energy``. The run resolves the impacts on ``contacts``, which the
-    result reports after the events' crossings."""
+    result reports after the events' crossings, and applies the ``impulses`` after its start (a
+    continued run's, those still to come)."""
+    # Their times were checked against the run's span when it began.
+    impulse_specs = _impulses.specs(impulses, -math.inf, math.inf)
     bar = progress_bar(total=nsteps, unit="step", desc=method, enabled=progress)
     try:
         if output is not None:
@@ -532,6 +494,7 @@ def _run(
                 events=names,
                 argument="output",
                 contacts=contacts,
+                impulses=impulses,
             )
             try:
                 streaming.stream(
@@ -549,6 +512,7 @@ def _run(
                     initial_energy=initial_energy,
                     found=found,
                     contacts=contacts,
+                    impulses=impulse_specs,
                 )
             except BaseException as err:
                 # A file that cannot be read back (a disk that failed) leaves the error as it is.
@@ -580,18 +544,19 @@ def _run(
                     method=method,
                     dt=dt,
                     contacts=_impacts.specs(contacts) or None,
+                    impulses=impulse_specs or None,
                 )
             bar.update(record.steps - base - bar.n)
         except BaseException as err:
             partial = take_partial(err)
             if partial is not None:
                 err.partial = _trajectory(  # type: ignore[attr-defined]
-                    partial, model, method, dt, watched, contacts, status=-1, message=str(err)
+                    partial, model, method, dt, watched, contacts, impulses, status=-1, message=str(err)
                 )
             raise
     finally:
         bar.close()
-    return _trajectory(record, model, method, dt, watched, contacts)
+    return _trajectory(record, model, method, dt, watched, contacts, impulses)
 
 
 def symplecticity_defect(model: Model, method: str, q: ArrayLike, p: ArrayLike, dt: float) -> float:

@@ -28,9 +28,11 @@ import numpy as np
 from . import _core, files
 from . import events as _events
 from . import impacts as _impacts
+from . import impulses as _impulses
 from ._progress import progress_bar
 from ._util import step_count
 from .impacts import Contact
+from .impulses import Impulse
 from .model import Model
 from .trajectory import Trajectory, crossings, load, take_partial
 
@@ -85,6 +87,7 @@ def stream(
     initial_energy: float | None = None,
     found: Sequence[int] = (),
     contacts: Sequence[Contact] = (),
+    impulses: list[Any] | None = None,
 ) -> None:
     """Runs ``steps`` steps in segments appended to ``writer``: the first by ``first`` (a new
     run) or from ``checkpoint`` (after ``base`` steps), every other from the last checkpoint.
@@ -94,7 +97,8 @@ def stream(
     energy; by default taken at its first state) after the ``found`` crossings of each so far. Closes the file with the
     run's status; an exception stops the run with every state up to it committed, and closes
     the file saying why. Each segment resolves the impacts on ``contacts``, committed as the
-    events after ``watched``'s."""
+    events after ``watched``'s, and applies the ``impulses`` (the binding's tuples) after its
+    start."""
     cap, seconds = checkpoint_period(checkpoint_every, save_every)
     contact_specs = _impacts.specs(contacts) or None
     found = list(found) or [0] * len(watched)
@@ -155,6 +159,7 @@ def stream(
                     progress=None if bar.disable else report,
                     events=specs,
                     contacts=contact_specs,
+                    impulses=impulses or None,
                 )
             except BaseException as err:
                 # The segment's states and crossings up to the stop are committed; the file is
@@ -236,6 +241,7 @@ def resume(
     model: Model | None = None,
     allow_pickle: bool = False,
     contacts: Sequence[Contact] | None = None,
+    impulses: Sequence[Impulse] | None = None,
 ) -> Trajectory:
     """Goes on with the run in the file ``path`` (from ``integrate(output=)``, or
     :meth:`Trajectory.save`) for ``steps`` more steps or to ``t_end``, appending to the file.
@@ -246,9 +252,10 @@ def resume(
     first second resumes). ``save_every`` is the file's by default (its saving period).
     ``events`` (as :func:`varmech.integrate`'s; the same as the file's, if it has any) are
     watched from the checkpoint on, with terminal counts over the whole run and an energy error
-    measured from the file's first state. The run's contacts go on: the file stores the native
-    ones (``Contact.wall``, ``Contact.ellipsoid``); those given by Python functions are given
-    again as ``contacts``.
+    measured from the file's first state. The run's contacts and impulses still to come go on:
+    the file stores the native contacts (``Contact.wall``, ``Contact.ellipsoid``) and the
+    impulses given as numbers; those given by Python functions are given again as ``contacts``
+    and ``impulses``.
 
     The file is loaded as :func:`varmech.load` loads it (no code run from it: a model of
     closures needs ``model=`` or ``allow_pickle=True``), and its checkpoint must be the state
@@ -279,6 +286,9 @@ def resume(
     contacts : sequence of Contact, optional
         The run's contacts, for a file whose contacts were given by Python functions (the file
         stores their names, not their code): the same names, in the same order.
+    impulses : sequence of Impulse, optional
+        The run's impulses, for a file whose impulses were given by Python functions (the file
+        stores their times): the same times.
 
     Returns
     -------
@@ -293,7 +303,8 @@ def resume(
         (failed checksums, non-finite rows, a checkpoint that is not the last row's state),
         one that cannot be written (a full disk: the rows committed before are kept), a
         pickled model without ``model=`` or ``allow_pickle=True``; naming ``contacts`` for
-        contacts of Python functions not given again, or given with other names; the arguments of
+        contacts of Python functions not given again, or given with other names, and
+        ``impulses`` likewise (other times); the arguments of
         :func:`varmech.integrate` as it names them.
 
     Examples
@@ -313,6 +324,7 @@ def resume(
         raise ValueError(f"path: {str(path)!r} has no checkpoint to resume from")
     _check_checkpoint(path, stored)
     t_now = float(stored.t[-1])
+    blows = _impulses.going_on(stored.impulses, impulses, t_now)
     more = step_count(stored.dt, t_now, steps, t_end)
     if save_every is None:
         save_every = files.save_every_of(path)
@@ -338,6 +350,7 @@ def resume(
             initial_energy=initial,
             found=counts,
             contacts=going_on,
+            impulses=_impulses.specs(blows, -math.inf, math.inf),
         )
     finally:
         bar.close()

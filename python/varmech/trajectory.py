@@ -16,8 +16,10 @@ from numpy.typing import ArrayLike
 from . import _core, dense, files
 from . import events as _events
 from . import impacts as _impacts
+from . import impulses as _impulses
 from .events import Occurrences
 from .impacts import Contact
+from .impulses import Impulse
 from .model import Model
 
 __all__ = [
@@ -84,6 +86,11 @@ class Trajectory:
         steps=)``, :func:`varmech.resume`) goes on with. A file stores the native ones
         (``Contact.wall``, ``Contact.ellipsoid``); one given by Python functions is loaded as
         its name (a str), and a run goes on with it only when it is given again.
+    impulses : tuple of Impulse
+        The run's impulses (empty without them); a continued run (``integrate(traj, steps=)``,
+        :func:`varmech.resume`) applies those still to come. A file stores those given as
+        numbers; one given by Python functions is loaded as its time (a float), and a run goes
+        on with it only when it is given again.
 
     Examples
     --------
@@ -116,6 +123,9 @@ class Trajectory:
     #: The run's contacts, which a continued run goes on with (a loaded file's contacts given by
     #: Python functions are their names: pass them again to :func:`varmech.resume`).
     contacts: tuple[Contact | str, ...] = field(default=(), repr=False)
+    #: The run's impulses, whose ones still to come a continued run applies (a loaded file's
+    #: given by Python functions are their times: pass them again to :func:`varmech.resume`).
+    impulses: tuple[Impulse | float, ...] = field(default=(), repr=False)
     _v: np.ndarray | None = field(default=None, repr=False)
 
     @property
@@ -331,6 +341,7 @@ def _trajectory(
     dt: float,
     events: Sequence[_events.Event] = (),
     contacts: Sequence[Contact | str] = (),
+    impulses: Sequence[Impulse] = (),
     **status: Any,
 ) -> Trajectory:
     """The Trajectory of the binding's record of a run, with its events' crossings and its
@@ -359,6 +370,7 @@ def _trajectory(
         checkpoint=r.checkpoint,
         events=found,
         contacts=tuple(contacts),
+        impulses=tuple(impulses),
         **status,
     )
 
@@ -492,6 +504,7 @@ def load(
         checkpoint=checkpoint or None,
         events=events,
         contacts=_stored_contacts(a),
+        impulses=_impulses.restored(str(a["impulses"])) if "impulses" in a else (),
     )
 
 

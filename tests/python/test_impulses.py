@@ -184,5 +184,82 @@ def test_bad_impulse_times_are_named():
         varmech.integrate(s, dt=0.1, steps=100, impulses=[varmech.Impulse(generalized=[1.0], t=50.0)])
     with pytest.raises(TypeError, match=r"^impulses\[0\]: expected a varmech.Impulse"):
         varmech.integrate(s, dt=0.1, steps=100, impulses=[[1.0]])
-    with pytest.raises(ValueError, match="^impulses: not yet with t_eval"):
-        varmech.integrate(s, dt=0.1, steps=100, impulses=[varmech.Impulse(generalized=[1.0], t=1.0)], t_eval=[1.0])
+    with pytest.raises(ValueError, match=r"^impulses: impulses\[0\]: 2 components of impulse for 1 coordinates"):
+        varmech.integrate(s, dt=0.1, steps=100, impulses=[varmech.Impulse(generalized=[1.0, 2.0], t=1.0)])
+    with pytest.raises(ValueError, match="^impulse: give exactly one"):
+        varmech.integrate(s, dt=0.1, steps=100, impulses=[varmech.Impulse(t=1.0)])
+
+
+def test_a_users_exception_in_a_blow_propagates_unchanged_with_the_partial_run():
+    s = varmech.scenes.harmonic_oscillator()
+
+    def broken(q):
+        raise KeyError("mine")
+
+    with pytest.raises(KeyError, match="mine") as caught:
+        varmech.integrate(s, dt=0.1, steps=100, impulses=[varmech.Impulse(generalized=broken, t=2.05)])
+    assert caught.value.partial.t[-1] == pytest.approx(2.0)
+
+
+@pytest.mark.parametrize("method", ["verlet", "kahan_li6"])
+def test_samples_after_a_blow_follow_the_struck_motion_at_the_methods_order(method):
+    # t_eval and impulses compose: each sample is a partial step from the last jump before it.
+    s = varmech.scenes.harmonic_oscillator()
+    t_star, blow = 1.2345, 0.7
+    times = np.linspace(0.0137, 5.9, 40)
+    exact = np.array([_oscillator_after_blow(t, t_star, blow) if t > t_star else (math.sin(t), math.cos(t)) for t in times])
+    errors = []
+    for dt in (0.1, 0.05):
+        traj = varmech.integrate(
+            s, [0.0], [1.0], dt=dt, steps=round(6.0 / dt), method=method, impulses=[varmech.Impulse(generalized=[blow], t=t_star)], t_eval=times
+        )
+        np.testing.assert_array_equal(traj.t, times)
+        errors.append(np.max(np.abs(np.column_stack([traj.q[:, 0], traj.p[:, 0]]) - exact)))
+    order = {"verlet": 2, "kahan_li6": 6}[method]
+    assert abs(math.log2(errors[0] / errors[1]) - order) < 0.4, errors
+
+
+def test_an_event_after_a_blow_is_located_on_the_struck_motion():
+    # The oscillator at rest at q = 1 (p = 0), struck at t* = 0.3 by Δp = 1: the event q = 0 comes
+    # at the exact crossing of the struck motion.
+    s = varmech.scenes.harmonic_oscillator()
+    t_star = 0.3
+    q_star, p_star = math.cos(t_star), -math.sin(t_star) - 1.0
+    # q(t) = q* cos s + p* sin s = 0 at s = atan2(q*, −p*).
+    exact = t_star + math.atan2(q_star, -p_star)
+
+    def height(t, q, p):
+        return q[0]
+
+    height.terminal = True  # type: ignore[attr-defined]
+    traj = varmech.integrate(
+        s, [1.0], [0.0], dt=1e-3, steps=2000, method="kahan_li8", impulses=[varmech.Impulse(generalized=[-1.0], t=t_star)], events=[height]
+    )
+    assert traj.events[0].t[0] == pytest.approx(exact, abs=1e-10)
+    assert traj.status == 1
+
+
+def test_a_run_with_impulses_goes_on_with_those_still_to_come_in_memory_and_from_its_file(tmp_path):
+    # A terminal event stops the run before its second blow; the continued run applies it, bit
+    # for bit the run that was never stopped (watching never changes what a run computes).
+    s = varmech.scenes.harmonic_oscillator()
+    blows = [varmech.Impulse(generalized=[0.5], t=0.1234), varmech.Impulse(generalized=lambda q: [q[0]], t=3.0005)]
+
+    def falling(t, q, p):
+        return q[0] - 0.5
+
+    falling.terminal, falling.direction = True, -1  # type: ignore[attr-defined]
+    whole = varmech.integrate(s, [0.0], [1.0], dt=0.01, steps=400, impulses=blows)
+    half = varmech.integrate(s, [0.0], [1.0], dt=0.01, steps=400, impulses=blows, events=[falling])
+    assert half.status == 1 and half.t[-1] < 3.0005
+    assert [imp.t for imp in half.impulses] == [0.1234, 3.0005]
+    more = varmech.integrate(half, t_end=4.0)
+    np.testing.assert_array_equal(more.q[-1], whole.q[-1])
+    np.testing.assert_array_equal(more.p[-1], whole.p[-1])
+    path = tmp_path / "struck.h5"
+    varmech.integrate(s, [0.0], [1.0], dt=0.01, steps=400, impulses=blows, events=[falling], output=path)
+    with pytest.raises(ValueError, match=r"^impulses: the run's impulses at t = 3.0005 were given by Python functions"):
+        varmech.resume(path, t_end=4.0)
+    resumed = varmech.resume(path, t_end=4.0, impulses=blows)
+    np.testing.assert_array_equal(resumed.q[-1], whole.q[-1])
+    np.testing.assert_array_equal(resumed.p[-1], whole.p[-1])

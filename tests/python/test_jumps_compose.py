@@ -95,6 +95,55 @@ def test_a_run_with_contacts_goes_on_as_one_run(model, surface, tmp_path):
     _same(resumed, whole)
 
 
+def _struck_ball(t: np.ndarray, t_star: float, kick: float, e: float = 0.9) -> tuple[np.ndarray, np.ndarray]:
+    """The ball dropped from 1 at rest, struck up by Δp = ``kick`` at t* (before its first impact),
+    bouncing with restitution e: its exact height and momentum at the times t."""
+    q, p, t0 = 1.0 - G * t_star**2 / 2, -G * t_star + kick, t_star
+    flights = []  # (start, height, momentum) of each free flight after the blow
+    for _ in range(40):
+        flights.append((t0, q, p))
+        s = (p + np.sqrt(p * p + 2 * G * q)) / G  # q + p s − g s²/2 = 0
+        t0, q, p = t0 + s, 0.0, -e * (p - G * s)
+    out = []
+    for ti in t:
+        if ti <= t_star:
+            out.append((1.0 - G * ti**2 / 2, -G * ti))
+            continue
+        start, q0, p0 = max(f for f in flights if f[0] < ti)
+        s = ti - start
+        out.append((q0 + p0 * s - G * s * s / 2, p0 - G * s))
+    exact = np.array(out)
+    return exact[:, 0], exact[:, 1]
+
+
+@pytest.mark.parametrize(("model", "surface"), CASES)
+def test_a_ball_struck_in_flight_and_sampled_follows_its_exact_motion_through_the_bounces(model, surface):
+    # Impulses, t_eval and contacts together: the blow splits its step, each sample is the
+    # method's partial step from the last jump before it, and Verlet is exact on the parabolas.
+    m, floor = MODELS[model](), _floor(surface)
+    times = np.linspace(0.013, 5.9, 97)
+    blow = varmech.Impulse(generalized=[2.0], t=0.3047)
+    traj = _run(m, floor, impulses=[blow], t_eval=times)
+    np.testing.assert_array_equal(traj.t, times)
+    q, p = _struck_ball(times, blow.t, 2.0)
+    assert np.max(np.abs(traj.q[:, 0] - q)) < 1e-10 and np.max(np.abs(traj.p[:, 0] - p)) < 1e-9
+    # The run itself is the run without samples, to the bit.
+    plain = _run(m, floor, impulses=[blow])
+    assert traj.checkpoint == plain.checkpoint
+    np.testing.assert_array_equal(traj.events[0].t, plain.events[0].t)
+
+
+@pytest.mark.parametrize(("model", "surface"), CASES)
+def test_a_struck_run_with_contacts_streamed_and_resumed_is_one_run(model, surface, tmp_path):
+    m, floor = MODELS[model](), _floor(surface)
+    blows = [varmech.Impulse(generalized=[2.0], t=0.3047), varmech.Impulse(generalized=[-1.0], t=1.5)]
+    whole = _run(m, floor, impulses=blows)
+    path = tmp_path / "struck.h5"
+    _same(_run(m, floor, steps=STEPS // 3, impulses=blows, output=path, checkpoint_every=37), _run(m, floor, steps=STEPS // 3, impulses=blows))
+    given = None if surface == "wall" else [floor]
+    _same(varmech.resume(path, steps=STEPS - STEPS // 3, model=m, contacts=given), whole)
+
+
 def _tail(whole: varmech.Trajectory, short: varmech.Trajectory) -> varmech.Trajectory:
     """The part of ``whole`` from ``short``'s last state on, as a continued run reports it."""
     k = len(short.t) - 1
