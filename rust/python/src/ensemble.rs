@@ -5,7 +5,7 @@
 use numpy::PyReadonlyArray2;
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
-use varmech::integrators::{self, Dynamics, MemberEvents, Members, Method, Parallel};
+use varmech::integrators::{self, Dynamics, MemberEvents, MemberWatch, Members, Method, Parallel};
 
 use crate::bind::check_signals;
 use crate::compiled::CompiledModel;
@@ -15,6 +15,7 @@ use crate::errors::{model_error, to_pyerr};
 use crate::events::{EventTuple, Events};
 use crate::native::NativeModel;
 use crate::run::{newton_max_iterations_count, reporting, run_options, save_every_count, steps_count};
+use crate::schedule::{ImpulseTuple, ScheduleSpecs};
 use crate::trajectory::TrajectoryRecord;
 
 /// A model the core evaluates without the GIL.
@@ -58,12 +59,14 @@ type MemberResult = (TrajectoryRecord, Option<Py<PyAny>>);
 /// Integrates the members (rows of `q0` and `p0`, (members, n)) with `models` (one shared, or
 /// one a member) on at most `workers` threads in tasks of `chunk_size` members, the GIL
 /// released, each watching `events` (spec tuples of built-in events, see [`Events::new`]) and
-/// resolving the impacts on `contacts` (native surfaces, see [`ContactSpecs::new`]);
+/// resolving the impacts on `contacts` (native surfaces, see [`ContactSpecs::new`]), applying
+/// `impulses` (their components as numbers, see [`ScheduleSpecs::new`]) and taking the samples
+/// `t_eval`;
 /// `progress(steps)` gets the steps of all members so far. Returns each member's
 /// record and exception (None when it completed), and the exception (KeyboardInterrupt) that
 /// stopped the ensemble, if one did: the members then stopped where they were.
 #[pyfunction]
-#[pyo3(signature = (models, q0, p0, *, dt, steps, method, save_every=1, compensated=true, max_energy_error=None, t0=0.0, newton_tolerance=1e-14, newton_max_iterations=50, workers=None, chunk_size=None, progress=None, events=None, contacts=None))]
+#[pyo3(signature = (models, q0, p0, *, dt, steps, method, save_every=1, compensated=true, max_energy_error=None, t0=0.0, newton_tolerance=1e-14, newton_max_iterations=50, workers=None, chunk_size=None, progress=None, events=None, contacts=None, impulses=None, t_eval=None))]
 #[allow(clippy::too_many_arguments)]
 fn ensemble<'py>(
     py: Python<'py>,
@@ -84,6 +87,8 @@ fn ensemble<'py>(
     progress: Option<Py<PyAny>>,
     events: Option<Vec<EventTuple<'py>>>,
     contacts: Option<Vec<ContactTuple<'py>>>,
+    impulses: Option<Vec<ImpulseTuple<'py>>>,
+    t_eval: Option<Vec<f64>>,
 ) -> PyResult<(Vec<MemberResult>, Option<Py<PyAny>>)> {
     let options = run_options(
         dt,
@@ -119,11 +124,17 @@ fn ensemble<'py>(
         Some(tuples) => ContactSpecs::new(tuples)?.into_native()?,
         None => Vec::new(),
     };
+    let impulses = ScheduleSpecs::new(impulses.unwrap_or_default(), Vec::new())?.into_native()?;
+    let watched = MemberWatch {
+        events,
+        contacts,
+        impulses,
+        samples: t_eval.unwrap_or_default(),
+    };
     let parallel = Parallel { workers, chunk_size };
     let run = py.detach(|| {
         let report = reporting(&check_signals, &progress);
-        let watched = (&events, contacts.as_slice());
-        integrators::integrate_ensemble_watching(&models, method, q0, p0, &options, parallel, watched, report)
+        integrators::integrate_ensemble_watching(&models, method, q0, p0, &options, parallel, &watched, report)
     });
     let run = run.map_err(|e| to_pyerr(py, e))?;
     let members = run

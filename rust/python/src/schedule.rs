@@ -87,6 +87,20 @@ impl ScheduleSpecs {
         Ok(ScheduleSpecs { impulses, samples })
     }
 
+    /// The impulses as native ones, for runs without the GIL (ensembles); one given by Python
+    /// functions is a ValueError naming `impulses`.
+    pub fn into_native(self) -> PyResult<Vec<(f64, Generalized)>> {
+        (self.impulses.into_iter().enumerate())
+            .map(|(i, (t, kind))| match kind {
+                Kind::Generalized(blow) => Ok((t, blow)),
+                _ => Err(PyValueError::new_err(format!(
+                    "impulses: impulses[{i}] is given by Python functions; the parallel ensemble applies only \
+                     impulses whose components are numbers (Impulse(generalized=[...]))"
+                ))),
+            })
+            .collect()
+    }
+
     /// Whether there is nothing to schedule.
     pub fn is_empty(&self) -> bool {
         self.impulses.is_empty() && self.samples.is_empty()
