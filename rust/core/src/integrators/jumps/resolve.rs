@@ -73,18 +73,15 @@ pub(in crate::integrators) struct Resolver<'c, 's, M> {
 }
 
 impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
-    /// The resolver of `contacts` for a run of `stepper` on `model` from its state (named
-    /// `argument` in the refusal of a state outside φ ≥ 0), `energy` when the run checks its
-    /// energy.
+    /// The resolver of `contacts` (checked by the caller, [`Contacts::check`]) for a run of
+    /// `stepper` on `model` from its state, `energy` when the run checks its energy.
     pub(in crate::integrators) fn begin<St: Borrow<StepperState>>(
         model: M,
         stepper: &Stepper<M, St>,
         contacts: &'c Contacts<'s>,
-        argument: &'static str,
         energy: bool,
     ) -> Result<Self, Error> {
         let n = stepper.q().len();
-        contacts.check(&*model, stepper.method(), (stepper.t(), stepper.q()), argument)?;
         let scratch = Stepper::resume(model, StepperState::clone(stepper))?;
         let m = contacts.len();
         let mut resolver = Resolver {
