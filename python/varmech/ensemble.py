@@ -26,7 +26,7 @@ from ._progress import progress_bar, thread_lock
 from ._util import finite, floats, positive, positive_int, step_count
 from .conservation import VERDICTS, ConservationReport, check_conservation
 from .impacts import Contact
-from .integrate import _energy_threshold, _model_of, _newton, integrate
+from .integrate import _contacts_of, _energy_threshold, _model_of, _newton, integrate
 from .model import Model, NativeSystem, _scene_model
 from .scenes import Scene
 from .trajectory import Trajectory, _trajectory
@@ -374,8 +374,7 @@ def ensemble(
     >>> bool(np.array_equal(runs[1].q, single.q))
     True
     """
-    # A scene's contacts by default, as in integrate.
-    contacts = list(model.contacts if contacts is None and isinstance(model, Scene) else contacts or ())
+    contacts = list(_contacts_of(model, contacts))
     contact_specs = _impacts.specs(contacts)
     model, _, _ = _model_of(model, None, None, None)
     n = model.dim

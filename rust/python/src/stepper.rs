@@ -1,20 +1,26 @@
 //! A stepper of a Python model: the core's [`StepperState`] kept between calls and resumed on
-//! the model, through the one dispatch [`bind_model`], for each call.
+//! the model, through the one dispatch [`bind_model`], for each call; with contacts, each call's
+//! steps go through a [`Watcher`] resumed on that state.
 
 use numpy::{PyArray1, PyReadonlyArray1};
 use pyo3::prelude::*;
 use pyo3::types::PyBytes;
-use varmech::integrators::{self, Checkpoint, Dynamics, Method, NewtonOptions, Options, StepperState};
+use varmech::integrators::{
+    self, Checkpoint, Dynamics, Impacts, Method, NewtonOptions, Options, StepperState, Trajectory, Watch, Watcher,
+};
 use varmech::Error;
 
 use crate::bind::{bind_model, Poll};
+use crate::contacts::{ContactSpecs, ContactTuple};
 use crate::convert::{self, slice};
 use crate::errors::to_pyerr;
 use crate::run::decode;
+use crate::trajectory::{impact_arrays, ImpactArrays};
 
 /// One model, one method and the state, advanced step by step
 /// ([`varmech::integrators::Stepper`]): native models with the GIL released, Ctrl-C honoured
-/// by `advance`, and a failed step leaves the last good state.
+/// by `advance`, and a failed step leaves the last good state. With `contacts`, the steps go
+/// through their impacts as a run's do ([`Watcher`]), bit for bit.
 ///
 /// A call holds the stepper mutably (pyo3's borrow flag, not a lock): another call while one
 /// runs (a thread while the GIL is released, a closure model re-entering) raises RuntimeError
@@ -24,20 +30,100 @@ use crate::run::decode;
 pub struct Stepper {
     model: Py<PyAny>,
     state: StepperState,
+    /// The contacts whose impacts the steps resolve, if any.
+    contacts: Option<ContactSpecs>,
+    /// The impacts gone through since the start or the last reset.
+    impacts: Impacts,
+    /// Force evaluations of the impacts' partial steps.
+    partial_evaluations: u64,
 }
 
 type Core<'s, 'a> = integrators::Stepper<&'s dyn Dynamics, &'a mut StepperState>;
 
 impl Stepper {
+    /// The stepper of `state` on `model`, watching `contacts` (checked at the state, named
+    /// `argument` if outside one).
+    fn watching(
+        py: Python<'_>,
+        model: &Bound<'_, PyAny>,
+        state: StepperState,
+        contacts: Option<Vec<ContactTuple<'_>>>,
+        argument: &'static str,
+    ) -> PyResult<Self> {
+        let contacts = contacts.map(ContactSpecs::new).transpose()?;
+        let n = state.q().len();
+        let mut stepper = Stepper {
+            model: model.clone().unbind(),
+            state,
+            contacts,
+            impacts: Impacts::default(),
+            partial_evaluations: 0,
+        };
+        stepper.impacts.dim = n;
+        stepper.check(py, argument)?;
+        Ok(stepper)
+    }
+
+    /// Whether the contacts fit the model and method and the state lies in φ ≥ 0 (named
+    /// `argument` if not).
+    fn check(&mut self, py: Python<'_>, argument: &'static str) -> PyResult<()> {
+        let Some(specs) = &self.contacts else {
+            return Ok(());
+        };
+        let state = &mut self.state;
+        bind_model(py, self.model.bind(py), |sys, _| {
+            let stepper = integrators::Stepper::resume(sys, state)?;
+            let contacts = specs.contacts()?;
+            let watch = Watch {
+                events: None,
+                contacts: Some(&contacts),
+            };
+            Watcher::begin(sys, &stepper, watch, argument, false).map(drop)
+        })?
+        .map_err(|e| to_pyerr(py, e))
+    }
+
     /// Runs `body` on the state resumed on the model; the state stays put whatever happens.
     fn with<R, F>(&mut self, py: Python<'_>, body: F) -> PyResult<R>
     where
         R: Send,
         F: for<'s, 'a> FnOnce(&mut Core<'s, 'a>, Poll<'s>) -> Result<R, Error> + Send,
     {
-        let Stepper { model, state } = self;
+        let Stepper { model, state, .. } = self;
         bind_model(py, model.bind(py), |sys, poll| {
             body(&mut integrators::Stepper::resume(sys, state)?, poll)
+        })?
+        .map_err(|e| to_pyerr(py, e))
+    }
+
+    /// Advances `n` steps (one by [`integrators::Stepper::step`] where `single`), through the
+    /// contacts' impacts if any: a [`Watcher`] resumed on the state, its impacts kept.
+    fn go(&mut self, py: Python<'_>, n: usize, single: bool) -> PyResult<()> {
+        let Some(specs) = &self.contacts else {
+            return self.with(py, |stepper, poll| {
+                if single {
+                    stepper.step()
+                } else {
+                    stepper.advance(n, poll)
+                }
+            });
+        };
+        let (impacts, evaluations) = (&mut self.impacts, &mut self.partial_evaluations);
+        let state = &mut self.state;
+        bind_model(py, self.model.bind(py), |sys, mut poll| {
+            let mut stepper = integrators::Stepper::resume(sys, state)?;
+            let contacts = specs.contacts()?;
+            let watch = Watch {
+                events: None,
+                contacts: Some(&contacts),
+            };
+            let mut watcher = Watcher::resume(sys, &stepper, watch, false)?;
+            let mut record = Trajectory::default();
+            let advanced = watcher.advance(&mut stepper, n, &mut record, &mut poll);
+            // The impacts of the steps completed, a failed step's excepted.
+            impacts.append(&mut record.impacts);
+            *evaluations += watcher.force_evaluations();
+            advanced.map(drop)
         })?
         .map_err(|e| to_pyerr(py, e))
     }
@@ -46,7 +132,7 @@ impl Stepper {
 #[pymethods]
 impl Stepper {
     #[new]
-    #[pyo3(signature = (model, q0, p0, *, dt, method, t0=0.0, compensated=true, newton_tolerance=1e-14, newton_max_iterations=50))]
+    #[pyo3(signature = (model, q0, p0, *, dt, method, t0=0.0, compensated=true, newton_tolerance=1e-14, newton_max_iterations=50, contacts=None))]
     #[allow(clippy::too_many_arguments)]
     fn new<'py>(
         py: Python<'py>,
@@ -59,6 +145,7 @@ impl Stepper {
         compensated: bool,
         newton_tolerance: f64,
         newton_max_iterations: usize,
+        contacts: Option<Vec<ContactTuple<'py>>>,
     ) -> PyResult<Self> {
         let options = Options {
             compensated,
@@ -74,10 +161,7 @@ impl Stepper {
             integrators::Stepper::new(sys, method, q0, p0, &options).map(integrators::Stepper::into_state)
         })?
         .map_err(|e| to_pyerr(py, e))?;
-        Ok(Stepper {
-            model: model.clone().unbind(),
-            state,
-        })
+        Stepper::watching(py, model, state, contacts, "q0")
     }
 
     /// The stepper's whole state as bytes, with its model's fingerprint (see [`Checkpoint`]).
@@ -89,13 +173,14 @@ impl Stepper {
     /// The stepper of `model` at the state of `checkpoint` (from `checkpoint()`, or a run's),
     /// checked against the model (and `method` and `dt` where given).
     #[staticmethod]
-    #[pyo3(signature = (model, checkpoint, *, method=None, dt=None))]
+    #[pyo3(signature = (model, checkpoint, *, method=None, dt=None, contacts=None))]
     fn from_checkpoint<'py>(
         py: Python<'py>,
         model: &Bound<'py, PyAny>,
         checkpoint: &[u8],
         method: Option<&str>,
         dt: Option<f64>,
+        contacts: Option<Vec<ContactTuple<'py>>>,
     ) -> PyResult<Self> {
         let checkpoint = decode(py, checkpoint, method, dt)?;
         let state = bind_model(py, model, |sys, _| {
@@ -103,23 +188,21 @@ impl Stepper {
             integrators::Stepper::resume(sys, state).map(integrators::Stepper::into_state)
         })?
         .map_err(|e| to_pyerr(py, e))?;
-        Ok(Stepper {
-            model: model.clone().unbind(),
-            state,
-        })
+        Stepper::watching(py, model, state, contacts, "checkpoint")
     }
 
     /// Advances one step.
     fn step(&mut self, py: Python<'_>) -> PyResult<()> {
-        self.with(py, |stepper, _| stepper.step())
+        self.go(py, 1, true)
     }
 
     /// Advances `n` steps, checking for Ctrl-C on the way.
     fn advance(&mut self, py: Python<'_>, n: usize) -> PyResult<()> {
-        self.with(py, |stepper, poll| stepper.advance(n, poll))
+        self.go(py, n, false)
     }
 
-    /// Starts afresh from (q0, p0) at t0, with the step count at 0.
+    /// Starts afresh from (q0, p0) at t0, with the step count at 0 and no impacts; a state
+    /// outside a contact is refused (naming `q0`), the stepper unchanged.
     fn reset<'py>(
         &mut self,
         py: Python<'py>,
@@ -128,7 +211,17 @@ impl Stepper {
         t0: f64,
     ) -> PyResult<()> {
         let (q0, p0) = (slice("q0", &q0)?, slice("p0", &p0)?);
-        self.with(py, |stepper, _| stepper.reset(t0, q0, p0))
+        let before = self.state.clone();
+        self.with(py, |stepper, _| stepper.reset(t0, q0, p0))?;
+        if let Err(e) = self.check(py, "q0") {
+            self.state = before;
+            return Err(e);
+        }
+        self.impacts = Impacts {
+            dim: self.impacts.dim,
+            ..Impacts::default()
+        };
+        Ok(())
     }
 
     #[getter]
@@ -168,7 +261,20 @@ impl Stepper {
 
     #[getter]
     fn force_evaluations(&self) -> u64 {
-        self.state.force_evaluations()
+        self.state.force_evaluations() + self.partial_evaluations
+    }
+
+    /// The impacts gone through since the start or the last reset, as a run's record has them:
+    /// the contact's index (k,), t (k,), q, p before and p after (k, n).
+    #[getter]
+    fn impacts(&self, py: Python<'_>) -> PyResult<ImpactArrays> {
+        impact_arrays(py, self.impacts.clone(), self.impacts.dim)
+    }
+
+    /// Impacts under the variational law that took Newton's law (grazing), as a run's.
+    #[getter]
+    fn grazing(&self) -> usize {
+        self.impacts.grazing
     }
 
     #[getter]
