@@ -140,6 +140,12 @@ def test_an_unresolvable_impact_raises_contact_error_with_the_stepper_at_its_las
         assert np.array_equal(stepper.q, partial.q[-1]) and stepper.steps == err.step - 1
 
 
+def _bent(contact: varmech.Contact) -> varmech.Contact:
+    """The contact with restitution 1.5, set past its own check (as a crafted object would)."""
+    object.__setattr__(contact, "restitution", 1.5)
+    return contact
+
+
 def _message(call, *args, **kw) -> str:
     with pytest.raises((ValueError, TypeError)) as info:
         call(*args, **kw)
@@ -155,6 +161,11 @@ def test_bad_contacts_and_states_outside_them_are_refused_as_integrate_refuses_t
         ({"contacts": [varmech.Contact.wall(3, name="far")]}, r"^ValueError: contacts: \"far\" \(contacts\[0\]\): coordinate 3"),
         # the variational law on a method without a discrete energy
         ({"method": "rk4"}, r"^ValueError: contacts: \"floor\" \(contacts\[0\]\): the variational collision integrator needs"),
+        # a restitution outside [0, 1] past the Contact's own check: the core's refusal
+        (
+            {"contacts": [_bent(varmech.Contact.wall(0, name="floor"))]},
+            r'^ValueError: contacts: "floor" \(contacts\[0\]\): restitution must lie in \[0, 1\], got 1.5$',
+        ),
         # not a Contact
         ({"contacts": ["floor"]}, r"^TypeError: contacts\[0\]: expected a varmech.Contact, got str$"),
     ]
