@@ -139,7 +139,8 @@ class TrajectoryRecord:
 
 @final
 class Stepper:
-    """One model, one method and the state, advanced step by step."""
+    """One model, one method and the state, advanced step by step; with `contacts` and
+    `impulses`, the steps go through their impacts and blows as a run's do, bit for bit."""
 
     def __new__(
         cls,
@@ -153,19 +154,32 @@ class Stepper:
         compensated: bool = True,
         newton_tolerance: float = 1e-14,
         newton_max_iterations: int = 50,
+        contacts: list[tuple[str, float, str, str, Any]] | None = None,
+        impulses: list[tuple[float, str, Any]] | None = None,
     ) -> Stepper: ...
     def checkpoint(self) -> bytes:
         """The stepper's whole state as bytes, with its model's fingerprint (see [`Checkpoint`])."""
     @staticmethod
-    def from_checkpoint(model: _Model, checkpoint: bytes, *, method: str | None = None, dt: float | None = None) -> Stepper:
+    def from_checkpoint(
+        model: _Model,
+        checkpoint: bytes,
+        *,
+        method: str | None = None,
+        dt: float | None = None,
+        contacts: list[tuple[str, float, str, str, Any]] | None = None,
+        impulses: list[tuple[float, str, Any]] | None = None,
+    ) -> Stepper:
         """The stepper of `model` at the state of `checkpoint` (from `checkpoint()`, or a run's),
-        checked against the model (and `method` and `dt` where given)."""
+        checked against the model (and `method` and `dt` where given), watching `contacts`
+        (checked at its state, naming `checkpoint`) and applying the `impulses` after its time."""
     def step(self) -> None:
         """Advances one step."""
     def advance(self, n: int) -> None:
         """Advances `n` steps, checking for Ctrl-C on the way."""
     def reset(self, q0: _FloatArray, p0: _FloatArray, t0: float) -> None:
-        """Starts afresh from (q0, p0) at t0, with the step count at 0."""
+        """Starts afresh from (q0, p0) at t0, with the step count at 0 and no impacts, the
+        impulses at t0 applied as a new stepper's; a state outside a contact is refused (naming
+        `q0`), the stepper unchanged."""
     @property
     def t(self) -> float: ...
     @property
@@ -186,6 +200,13 @@ class Stepper:
     def newton_iterations(self) -> int: ...
     @property
     def work(self) -> float: ...
+    @property
+    def impacts(self) -> tuple[NDArray[np.uint64], _FloatArray, _FloatArray, _FloatArray, _FloatArray]:
+        """The impacts gone through since the start or the last reset, as a run's record has them:
+        the contact's index (k,), t (k,), q, p before and p after (k, n)."""
+    @property
+    def grazing(self) -> int:
+        """Impacts under the variational law that took Newton's law (grazing), as a run's."""
 
 @final
 class MethodInfo:
@@ -502,12 +523,15 @@ def ensemble(
     progress: Callable[[int], object] | None = None,
     events: list[tuple[str, int, int, str, Any]] | None = None,
     contacts: list[tuple[str, float, str, str, Any]] | None = None,
+    impulses: list[tuple[float, str, Any]] | None = None,
+    t_eval: _FloatArray | list[float] | None = None,
 ) -> tuple[list[tuple[TrajectoryRecord, BaseException | None]], BaseException | None]:
     """Members (rows of q0 and p0, (members, n)) integrated in parallel with the GIL released,
     with one shared model or one a member, each watching the built-in ``events``: each member's
     record (the partial one of a failure) and exception, and the exception (KeyboardInterrupt)
     that stopped the ensemble, if any. ``progress(steps)`` gets the steps of all members every
-    10 ms. ``contacts``: native contacts (as ``integrate``'s), each member resolving its impacts."""
+    10 ms. ``contacts``: native contacts (as ``integrate``'s), each member resolving its impacts;
+    ``impulses`` (their components as numbers) and ``t_eval`` as ``integrate``'s."""
 
 def integrate(
     model: _Model,

@@ -19,14 +19,16 @@ from typing import TYPE_CHECKING, Any, Literal
 import numpy as np
 from numpy.typing import ArrayLike
 
-from . import _core
+from . import _core, dense
 from . import events as _events
 from . import impacts as _impacts
+from . import impulses as _impulses
 from ._progress import progress_bar, thread_lock
 from ._util import finite, floats, positive, positive_int, step_count
 from .conservation import VERDICTS, ConservationReport, check_conservation
 from .impacts import Contact
-from .integrate import _energy_threshold, _model_of, _newton, integrate
+from .impulses import Impulse
+from .integrate import _contacts_of, _energy_threshold, _model_of, _newton, integrate
 from .model import Model, NativeSystem, _scene_model
 from .scenes import Scene
 from .trajectory import Trajectory, _trajectory
@@ -278,6 +280,8 @@ def ensemble(
     newton_max_iterations: int = 50,
     events: Sequence[_events.Event | _events.EventFunction] | None = None,
     contacts: Sequence[Contact] | None = None,
+    impulses: Sequence[Impulse] | None = None,
+    t_eval: ArrayLike | None = None,
     workers: int | None = None,
     client: Any = None,
     chunk_size: int | None = None,
@@ -321,6 +325,10 @@ def ensemble(
         Unilateral contacts, as in :func:`varmech.integrate` (default a scene's): each member
         goes through its impacts. Native surfaces (``Contact.wall``, ``Contact.ellipsoid``) run
         on the threads; a contact of Python functions runs the members as a closure model's.
+    impulses, t_eval
+        Blows at given times and the times whose states each member keeps, as in
+        :func:`varmech.integrate`. Impulses given as numbers (``Impulse(generalized=[...])``)
+        run on the threads; one of Python functions runs the members as a closure model's.
     workers
         The most threads to use; default: one a core (with ``client``: on each Dask worker, its
         own thread count). For a closure model, the number of processes; default: none, the
@@ -374,8 +382,7 @@ def ensemble(
     >>> bool(np.array_equal(runs[1].q, single.q))
     True
     """
-    # A scene's contacts by default, as in integrate.
-    contacts = list(model.contacts if contacts is None and isinstance(model, Scene) else contacts or ())
+    contacts = list(_contacts_of(model, contacts))
     contact_specs = _impacts.specs(contacts)
     model, _, _ = _model_of(model, None, None, None)
     n = model.dim
@@ -399,12 +406,22 @@ def ensemble(
     newton_tolerance, newton_max_iterations = _newton(newton_tolerance, newton_max_iterations)
     newton: dict[str, Any] = dict(newton_tolerance=newton_tolerance, newton_max_iterations=newton_max_iterations)
     watched, event_specs = _events.specs(events, n) if events is not None else ([], [])
-    settings = run | newton | dict(max_energy_error=max_energy_error, events=events, contacts=contacts)
+    impulse_specs = _impulses.specs(impulses or (), t0, t0 + nsteps * dt)
+    times = None
+    if t_eval is not None:
+        if save_every != 1:
+            raise ValueError("save_every: not with t_eval, which keeps the states at its times, not the run's own")
+        times = dense.eval_times(t_eval, t0, t0 + nsteps * dt)
+    settings = run | newton | dict(max_energy_error=max_energy_error, events=events, contacts=contacts, impulses=impulses, t_eval=t_eval)
     if client is not None:
         return _on_cluster(client, model, q, p, values, settings | dict(workers=workers), chunk_size, progress)
     cores = [m._core for m in (models if values else models[:1])]
     released = [c for c in cores if isinstance(c, (_core.NativeModel, _core.CompiledModel))]
-    native = all(e.native is not None for e in watched) and all(kind != "functions" for _, _, _, kind, _ in contact_specs)
+    native = (
+        all(e.native is not None for e in watched)
+        and all(kind != "functions" for _, _, _, kind, _ in contact_specs)
+        and all(kind == "generalized" for _, kind, _ in impulse_specs)
+    )
     if len(released) == len(cores) and native:
         threshold = _energy_threshold(model, max_energy_error)
         bar = progress_bar(total=nsteps * members, unit="step", desc=f"{method} ×{members}", enabled=progress)
@@ -414,13 +431,15 @@ def ensemble(
                 released, q, p, **run, **newton, max_energy_error=threshold, workers=workers, chunk_size=chunk_size, progress=report,
                 events=event_specs or None,
                 contacts=contact_specs or None,
+                impulses=impulse_specs or None,
+                t_eval=times,
             )
         finally:
             bar.close()
         trajs, errors = [], []
         for i, (record, error) in enumerate(results):
             status: dict[str, Any] = {} if error is None else {"status": -1, "message": str(error)}
-            trajs.append(_trajectory(record, models[i], method, dt, watched, contacts, **status))
+            trajs.append(_trajectory(record, models[i], method, dt, watched, contacts, tuple(impulses or ()), **status))
             errors.append(error)
         result = Ensemble(trajs, errors, values)
         if interrupted is not None:

@@ -46,6 +46,7 @@ body spends beyond a curved surface's chord.
 from __future__ import annotations
 
 import json
+import warnings
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any, Literal
@@ -269,13 +270,25 @@ def specs(contacts: Sequence[Contact]) -> list[Spec]:
     return out
 
 
-def occurrences(record: Any, contacts: Sequence[Contact | str]) -> tuple[Occurrences, ...]:
-    """Each contact's impacts in the binding's record of a run: time, contact configuration and
-    the momenta just before."""
+def occurrences(record: Any, contacts: Sequence[Contact | str], *, after: bool = False) -> tuple[Occurrences, ...]:
+    """Each contact's impacts in the binding's record of a run (or its stepper's): time, contact
+    configuration and the momenta just before (just after, ``after``)."""
     if not contacts:
         return ()
-    index, t, q, before = record.impacts[:4]
-    return tuple(Occurrences(name(c), t[index == i], q[index == i], before[index == i]) for i, c in enumerate(contacts))
+    index, t, q, before, p_after = record.impacts
+    p = p_after if after else before
+    return tuple(Occurrences(name(c), t[index == i], q[index == i], p[index == i]) for i, c in enumerate(contacts))
+
+
+def warn_grazing(count: int, stacklevel: int) -> None:
+    """The RuntimeWarning of ``count`` grazing impacts (none: no warning), at the caller
+    ``stacklevel`` frames up from here."""
+    if count:
+        warnings.warn(
+            f"{count} grazing impact(s) had no discrete-energy solution near the reflection and took Newton's law",
+            RuntimeWarning,
+            stacklevel=stacklevel + 1,
+        )
 
 
 def name(contact: Contact | str) -> str:

@@ -137,7 +137,7 @@ class Impulse:
         return np.asarray(jac.T @ blow)
 
 
-    def spec(self) -> tuple[str, Any]:
+    def _spec(self) -> tuple[str, Any]:
         """The binding's kind and payload of this blow (a ValueError as :meth:`components`
         raises for a malformed one; the core checks the number of components)."""
         if (self.generalized is None) == (self.point is None):
@@ -489,7 +489,7 @@ def specs(impulses: Sequence[Impulse], t0: float, t_end: float) -> list[Spec]:
             raise TypeError(f"impulses[{i}]: expected a varmech.Impulse, got {type(imp).__name__}")
         if not (np.isfinite(imp.t) and min(t0, t_end) <= imp.t <= max(t0, t_end)):
             raise ValueError(f"impulses: a time {imp.t} outside the run's span [{t0}, {t_end}]")
-        out.append((float(imp.t), *imp.spec()))
+        out.append((float(imp.t), *imp._spec()))
     return out
 
 

@@ -48,6 +48,12 @@ def _model_of(
     return model, q0, p0
 
 
+def _contacts_of(model: Model | Scene, contacts: Sequence[_impacts.Contact] | None) -> tuple[_impacts.Contact, ...]:
+    """The contacts a run or a stepper of ``model`` watches: ``contacts``, a scene's by default
+    (``[]``: none)."""
+    return tuple(model.contacts if contacts is None and isinstance(model, Scene) else contacts or ())
+
+
 def _initial_state(
     model: Model, q0: ArrayLike | None, p0: ArrayLike | None, v0: ArrayLike | None, t0: float
 ) -> tuple[np.ndarray, np.ndarray]:
@@ -325,8 +331,7 @@ def integrate(
         if named:
             raise ValueError(f"{named[0]}: a continued run keeps its trajectory's {', '.join(named)}")
         return _go_on(model, steps, t_end, save_every, progress, output, overwrite, checkpoint_every, events)
-    # A scene's contacts by default; none given (``[]``) is a run without contacts.
-    contacts = (model.contacts if contacts is None and isinstance(model, Scene) else contacts) or None
+    contacts = _contacts_of(model, contacts) or None
     model, q0, p0 = _model_of(model, q0, p0, v0)
     if parameters is not None:
         if not isinstance(parameters, Mapping):

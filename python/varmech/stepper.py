@@ -2,12 +2,20 @@
 
 from __future__ import annotations
 
+import math
+from collections.abc import Callable, Sequence
+
 import numpy as np
 from numpy.typing import ArrayLike
 
 from . import _core
+from . import impacts as _impacts
+from . import impulses as _impulses
 from ._util import finite, positive, step_count
-from .integrate import _initial_state, _model_of, _newton
+from .events import Occurrences
+from .impacts import Contact
+from .impulses import Impulse
+from .integrate import _contacts_of, _initial_state, _model_of, _newton
 from .model import Model
 from .scenes import Scene
 
@@ -23,7 +31,9 @@ class Stepper:
     keeps only the current state, so that a caller can look at it between steps: locate an
     event, change the step size, start again from another state. Its steps are exactly
     ``integrate``'s: n calls of :meth:`step` land bit for bit on the final state of
-    ``integrate(..., steps=n)`` with the same arguments.
+    ``integrate(..., steps=n)`` with the same arguments, contacts included: a step that crosses
+    a contact is split at the impact as a run's is (see :mod:`varmech.impacts`), and the
+    impacts gone through are :attr:`impacts`; so is a step that holds an impulse's time.
 
     Parameters
     ----------
@@ -35,19 +45,32 @@ class Stepper:
         The step h > 0; settable between steps (:attr:`dt`).
     compensated, newton_tolerance, newton_max_iterations
         As for :func:`varmech.integrate`.
+    contacts : sequence of Contact, optional
+        The unilateral contacts φ(q) ≥ 0 whose impacts the steps go through, as for
+        :func:`varmech.integrate`. Default: a scene's ``contacts``; ``contacts=[]`` steps
+        without them.
+    impulses : sequence of Impulse, optional
+        Blows at their times ``impulse.t`` ≥ t0, as for :func:`varmech.integrate`: the step that
+        holds one is split there (one at t0 acts at once).
 
     Raises
     ------
     ValueError
         Malformed arguments (the message starts with the argument's name), a method that does
         not integrate the model, or initial data off a constrained model's constraints; naming
-        ``contacts`` for a scene with contacts (a stepper does not go through impacts yet:
-        :func:`varmech.integrate` does).
+        ``contacts`` for a contact that does not fit the model or method (a restitution outside
+        [0, 1], a coordinate out of range, the variational law on a method without a discrete
+        energy) and ``q0`` for an initial state outside a contact (φ < 0), as ``integrate``.
+        Naming ``impulses`` for an impulse before t0 or of another number of components.
+    TypeError
+        Naming ``contacts[i]`` or ``impulses[i]`` for an entry that is not a
+        :class:`~varmech.Contact` or :class:`~varmech.Impulse`.
 
     Notes
     -----
     :meth:`step` and :meth:`advance` raise what :func:`varmech.integrate` raises
-    (:class:`~varmech.DivergenceError`, :class:`~varmech.ConvergenceError`, a closure's own
+    (:class:`~varmech.DivergenceError`, :class:`~varmech.ConvergenceError`,
+    :class:`~varmech.ContactError` for an impact that cannot be resolved, a closure's own
     exception, KeyboardInterrupt on Ctrl-C during :meth:`advance`), with ``err.step`` and
     ``err.time`` where the exception allows; the stepper then stays at the last good step.
     Native models step with the GIL released.
@@ -68,6 +91,20 @@ class Stepper:
     >>> stepper.advance(t_end=0.5)
     >>> stepper.steps
     100
+
+    A bouncing ball goes through its floor's impacts (the scene's contact), step by step, as
+    ``integrate`` does; the first impact is at √(2h₀/g), to round-off:
+
+    >>> ball = varmech.scenes.bouncing_ball()
+    >>> stepper = varmech.Stepper(ball, dt=0.01)
+    >>> for _ in range(300):
+    ...     stepper.step()
+    >>> floor = stepper.impacts[0]
+    >>> floor.name, len(floor), round(float(floor.t[0]), 12), round((2 / 9.81) ** 0.5, 12)
+    ('floor', 3, 0.451523640986, 0.451523640986)
+    >>> traj = varmech.integrate(ball, dt=0.01, steps=300)
+    >>> bool((stepper.q == traj.q[-1]).all() and (stepper.p == traj.p[-1]).all())
+    True
     """
 
     def __init__(
@@ -83,8 +120,12 @@ class Stepper:
         compensated: bool = True,
         newton_tolerance: float = 1e-14,
         newton_max_iterations: int = 50,
+        contacts: Sequence[Contact] | None = None,
+        impulses: Sequence[Impulse] | None = None,
     ) -> None:
-        _no_contacts(model)
+        contacts = _contacts_of(model, contacts)
+        specs = _impacts.specs(contacts)
+        blows = _impulses.specs(impulses or (), finite("t0", t0), math.inf)
         model, q0, p0 = _model_of(model, q0, p0, v0)
         if method is None:
             method = model.kind.default_method
@@ -93,6 +134,8 @@ class Stepper:
         newton_tolerance, newton_max_iterations = _newton(newton_tolerance, newton_max_iterations)
         q, p = _initial_state(model, q0, p0, v0, t0)
         self._model = model
+        self._contacts = contacts
+        self._impulses = tuple(impulses or ())
         self._stepper = _core.Stepper(
             model._core,
             q,
@@ -103,6 +146,8 @@ class Stepper:
             compensated=bool(compensated),
             newton_tolerance=newton_tolerance,
             newton_max_iterations=newton_max_iterations,
+            contacts=specs or None,
+            impulses=blows or None,
         )
 
     def step(self) -> None:
@@ -116,6 +161,9 @@ class Stepper:
             An implicit method's Newton iteration failed (or, as
             :class:`~varmech.SpuriousBranchError`, converged beyond a fold); the stepper stays
             at tₙ.
+        ContactError
+            An impact in the step that cannot be resolved (a resting contact, an accumulation
+            of impacts); the stepper stays at tₙ.
         Exception
             A closure's own exception, unchanged.
 
@@ -130,7 +178,7 @@ class Stepper:
         >>> stepper.t, stepper.steps, stepper.q.tolist(), stepper.p.round(8).tolist()
         (0.1, 1, [0.1], [0.99500833])
         """
-        self._stepper.step()
+        self._stepping(self._stepper.step)
 
     def advance(self, steps: int | None = None, *, t_end: float | None = None) -> None:
         """Advance ``steps`` steps, or to ``t_end``, a whole number of steps from :attr:`t`.
@@ -150,7 +198,7 @@ class Stepper:
             Naming ``steps, t_end`` when not exactly one is given, ``steps`` when it is not a
             non-negative integer, or ``t_end`` when it is before :attr:`t` or not a whole number
             of steps away.
-        DivergenceError, ConvergenceError
+        DivergenceError, ConvergenceError, ContactError
             As :meth:`step`, with ``err.step`` and ``err.time``; the stepper stays at the last
             good step.
         KeyboardInterrupt
@@ -168,12 +216,19 @@ class Stepper:
             ...
         ValueError: t_end: 0.255 is not a whole number of steps dt = 0.01 from t0 = 0.25 (0.5 steps); adjust dt or pass steps
         """
-        self._stepper.advance(step_count(self.dt, self.t, steps, t_end))
+        n = step_count(self.dt, self.t, steps, t_end)
+        self._stepping(lambda: self._stepper.advance(n))
+
+    def _stepping(self, steps: Callable[[], None]) -> None:
+        """Takes the ``steps``, warning of their grazing impacts (as a run does)."""
+        grazing = self._stepper.grazing
+        steps()
+        _impacts.warn_grazing(self._stepper.grazing - grazing, stacklevel=3)
 
     def reset(self, q0: ArrayLike, p0: ArrayLike | None = None, *, v0: ArrayLike | None = None, t0: float | None = None) -> None:
         """Start afresh from (q0, p0) (or q0 and the velocities v0) at ``t0`` (default: the
-        current time), with :attr:`steps` at 0: the next steps are those of a new stepper from
-        there. The work counts go on.
+        current time), with :attr:`steps` at 0 and no :attr:`impacts`: the next steps are those
+        of a new stepper from there. The work counts go on.
 
         Parameters
         ----------
@@ -191,7 +246,8 @@ class Stepper:
         ValueError
             Naming the argument: a state of the wrong shape or not finite, both or neither of
             ``p0`` and ``v0``, ``t0`` not finite, or velocities off a model's velocity
-            constraints (a state off holonomic constraints names ``q0`` or ``p0``).
+            constraints (a state off holonomic constraints names ``q0`` or ``p0``, one outside a
+            contact ``q0``); the stepper is then unchanged.
 
         Examples
         --------
@@ -212,6 +268,24 @@ class Stepper:
     def model(self) -> Model:
         """The model stepped."""
         return self._model
+
+    @property
+    def contacts(self) -> tuple[Contact, ...]:
+        """The contacts whose impacts the steps go through (empty without them)."""
+        return self._contacts
+
+    @property
+    def impacts(self) -> tuple[Occurrences, ...]:
+        """Each contact's impacts since the start or the last :meth:`reset`, in the order of
+        :attr:`contacts`: the times, the contact configurations q̃ and the momenta p⁻ just before
+        the jump, as a run's ``traj.events`` holds them (:attr:`impacts_after` has p⁺)."""
+        return _impacts.occurrences(self._stepper, self._contacts)
+
+    @property
+    def impacts_after(self) -> tuple[Occurrences, ...]:
+        """As :attr:`impacts`, with the momenta p⁺ just after each jump (a run's saved state
+        just after the impact)."""
+        return _impacts.occurrences(self._stepper, self._contacts, after=True)
 
     @property
     def method(self) -> str:
@@ -250,7 +324,7 @@ class Stepper:
     @property
     def force_evaluations(self) -> int:
         """Force evaluations so far (for the implicit methods, of the discrete Lagrangian's slot
-        derivatives)."""
+        derivatives), those of the impacts' partial steps included."""
         return self._stepper.force_evaluations
 
     @property
@@ -271,7 +345,9 @@ class Stepper:
         Returns
         -------
         bytes
-            The checkpoint (it records the model's kind and the method, not the model itself).
+            The checkpoint (it records the model's kind and the method, not the model itself
+            nor the contacts and impulses: give them to :meth:`from_checkpoint` again, a scene's
+            contacts by default).
 
         Examples
         --------
@@ -289,8 +365,19 @@ class Stepper:
         return bytes(self._stepper.checkpoint())
 
     @classmethod
-    def from_checkpoint(cls, model: Model | Scene, checkpoint: bytes, *, method: str | None = None, dt: float | None = None) -> Stepper:
-        """The stepper of ``model`` at the state of ``checkpoint``.
+    def from_checkpoint(
+        cls,
+        model: Model | Scene,
+        checkpoint: bytes,
+        *,
+        method: str | None = None,
+        dt: float | None = None,
+        contacts: Sequence[Contact] | None = None,
+        impulses: Sequence[Impulse] | None = None,
+    ) -> Stepper:
+        """The stepper of ``model`` at the state of ``checkpoint``, going through the impacts on
+        ``contacts`` (a scene's by default) and applying the ``impulses`` after the checkpoint's
+        time as the constructor's does.
 
         A checkpoint records a fingerprint of what it was taken of: the model's kind, size and
         constraints, what the model computes at the checkpoint's state (its Lagrangian, forces
@@ -308,6 +395,12 @@ class Stepper:
         method, dt : optional
             The method and step the caller goes on with (a file's or a trajectory's): a
             checkpoint of another is refused.
+        contacts : sequence of Contact, optional
+            The contacts the stepper goes on with (the checkpointed stepper's or run's, for bit
+            for bit): default a scene's ``contacts``; ``[]`` for none.
+        impulses : sequence of Impulse, optional
+            The impulses the stepper goes on with; those at or before the checkpoint's time
+            were its run's.
 
         Returns
         -------
@@ -320,10 +413,13 @@ class Stepper:
             Naming ``checkpoint`` for bytes that are not one (damaged, truncated, of another
             checkpoint format, or crafted so that its state does not fit the model and method),
             or the checkpoint of another model, method, step or options, saying which; naming
-            ``model`` or ``method`` for a model of another size or kind, or ``contacts`` for a
-            scene with contacts (as the constructor).
+            ``model`` or ``method`` for a model of another size or kind; naming ``contacts``
+            for contacts that do not fit (as the constructor), and ``checkpoint`` for a state
+            outside a contact.
         TypeError
-            Naming ``model``: not a varmech model or scene; or ``checkpoint``: not bytes.
+            Naming ``model``: not a varmech model or scene; ``checkpoint``: not bytes; or
+            ``contacts[i]`` or ``impulses[i]``: not a :class:`~varmech.Contact` or
+            :class:`~varmech.Impulse`.
 
         Examples
         --------
@@ -340,27 +436,28 @@ class Stepper:
         if not isinstance(checkpoint, (bytes, bytearray, memoryview)):
             # bytes() would read a str as an error and an int n as n zero bytes.
             raise TypeError(f"checkpoint: expected the bytes of Stepper.checkpoint(), got {type(checkpoint).__name__}")
-        _no_contacts(model)
+        contacts = _contacts_of(model, contacts)
+        specs = _impacts.specs(contacts)
+        blows = _impulses.specs(impulses or (), -math.inf, math.inf)
         model, _, _ = _model_of(model, None, None, None)
         stepper = cls.__new__(cls)
         stepper._model = model
-        stepper._stepper = _core.Stepper.from_checkpoint(model._core, bytes(checkpoint), method=method, dt=dt)
+        stepper._contacts = contacts
+        stepper._impulses = tuple(impulses or ())
+        stepper._stepper = _core.Stepper.from_checkpoint(
+            model._core, bytes(checkpoint), method=method, dt=dt, contacts=specs or None, impulses=blows or None
+        )
         return stepper
 
     def __reduce__(self) -> tuple[object, ...]:
-        # By its model and checkpoint: the unpickled stepper goes on bit for bit.
-        return (Stepper.from_checkpoint, (self._model, self.checkpoint()))
+        # By its model, checkpoint, contacts and impulses: the unpickled stepper goes on bit for
+        # bit (its impacts counted from there).
+        return (_unpickled, (self._model, self.checkpoint(), self._contacts, self._impulses))
 
     def __repr__(self) -> str:
         return f"Stepper({self._model.name!r}, method={self.method!r}, dt={self.dt:g}, t={self.t:g}, steps={self.steps})"
 
 
-def _no_contacts(model: object) -> None:
-    """ValueError naming ``contacts`` for a scene with contacts: a stepper does not go through
-    impacts yet, and stepping the scene's model alone would fall through its surfaces."""
-    if isinstance(model, Scene) and model.contacts:
-        names = ", ".join(repr(c.name) for c in model.contacts)
-        raise ValueError(
-            f"contacts: the scene {model.name!r} has contacts ({names}), which a Stepper cannot go through yet;"
-            " integrate(scene, ...) runs them, or step scene.model to run it without them"
-        )
+def _unpickled(model: Model, checkpoint: bytes, contacts: tuple[Contact, ...], impulses: tuple[Impulse, ...] = ()) -> Stepper:
+    """A pickled stepper, from its model, checkpoint, contacts and impulses."""
+    return Stepper.from_checkpoint(model, checkpoint, contacts=contacts, impulses=impulses)

@@ -4,7 +4,6 @@ from the binding's record of a run or read back from a file (:func:`load`)."""
 from __future__ import annotations
 
 import os
-import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -350,12 +349,7 @@ def _trajectory(
     r = record
     found = crossings(r, events, contacts)
     status = status or _events.termination(r, events, found)
-    if r.grazing:
-        warnings.warn(
-            f"{r.grazing} grazing impact(s) had no discrete-energy solution near the reflection and took Newton's law",
-            RuntimeWarning,
-            stacklevel=4,
-        )
+    _impacts.warn_grazing(r.grazing, stacklevel=4)
     return Trajectory(
         r.t,
         r.q,

@@ -418,17 +418,9 @@ def test_the_variational_law_still_refuses_the_other_methods_and_non_conservativ
         varmech.integrate(damped, [1.0], [0.0], dt=1e-3, steps=10, method="midpoint", contacts=[floor])
 
 
-def test_a_stepper_refuses_a_scene_with_contacts_and_a_failed_run_goes_on_with_them():
-    # A Stepper takes the method's steps alone; it refuses a scene whose surfaces it would fall
-    # through, naming them. A run that failed at a resting contact goes on with its floor, and
-    # fails there again.
-    scene = varmech.scenes.bouncing_ball()
-    traj = varmech.integrate(scene, dt=1e-2, steps=100)
-    stepper = r"^contacts: the scene 'bouncing_ball' has contacts \('floor'\)"
-    with pytest.raises(ValueError, match=stepper):
-        varmech.Stepper(scene, dt=1e-2)
-    with pytest.raises(ValueError, match=stepper):
-        varmech.Stepper.from_checkpoint(scene, traj.checkpoint)
+def test_a_failed_run_goes_on_with_its_contacts():
+    # A run that failed at a resting contact goes on with its floor, and fails there again (a
+    # Stepper with contacts: tests/python/test_stepper_contacts.py).
     with pytest.raises(varmech.ContactError) as info:
         varmech.integrate(varmech.scenes.bouncing_ball(restitution=0.5), dt=0.01, t_end=2.0)
     assert info.value.partial.contacts == varmech.scenes.bouncing_ball(restitution=0.5).contacts
@@ -437,8 +429,8 @@ def test_a_stepper_refuses_a_scene_with_contacts_and_a_failed_run_goes_on_with_t
 
 
 def test_a_run_without_contacts_still_goes_on_and_its_model_steps_alone():
-    # The refusal is of the contacts only: the same scene run with contacts=[] is continued bit
-    # for bit, and its bare model (the user's choice) steps.
+    # The same scene run with contacts=[] is continued bit for bit, and its bare model (the
+    # user's choice) steps.
     scene = varmech.scenes.bouncing_ball()
     traj = varmech.integrate(scene, dt=1e-2, steps=50, contacts=[])
     assert traj.contacts == ()

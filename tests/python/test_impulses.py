@@ -3,6 +3,7 @@ ch. III; reference/impulses_and_rolling.md): a rod struck at one end, a lamina's
 percussion, a spinning sphere set down on a rough wedge, and Carnot's theorem."""
 
 import math
+import pickle
 
 import numpy as np
 import pytest
@@ -263,3 +264,39 @@ def test_a_run_with_impulses_goes_on_with_those_still_to_come_in_memory_and_from
     resumed = varmech.resume(path, t_end=4.0, impulses=blows)
     np.testing.assert_array_equal(resumed.q[-1], whole.q[-1])
     np.testing.assert_array_equal(resumed.p[-1], whole.p[-1])
+
+
+def test_a_stepper_applies_its_impulses_as_a_run_does_bit_for_bit():
+    s = varmech.scenes.bouncing_ball()
+    blows = [varmech.Impulse(generalized=[1.0], t=0.0), varmech.Impulse(generalized=[2.0], t=0.3047), varmech.Impulse(generalized=[-1.0], t=1.5)]
+    run = varmech.integrate(s, dt=0.01, steps=300, impulses=blows)
+    stepper = varmech.Stepper(s, dt=0.01, impulses=blows)
+    assert stepper.p[0] == run.p[1]  # the blow at t0 acts at once
+    for _ in range(100):
+        stepper.step()
+    stepper.advance(50)
+    # Pickled and checkpointed steppers go on with the impulses still to come.
+    again = pickle.loads(pickle.dumps(stepper))
+    resumed = varmech.Stepper.from_checkpoint(s, stepper.checkpoint(), impulses=blows)
+    for each in (stepper, again, resumed):
+        each.advance(150)
+        np.testing.assert_array_equal(each.q, run.q[-1])
+        np.testing.assert_array_equal(each.p, run.p[-1])
+    with pytest.raises(ValueError, match=r"^impulses: a time -1.0 outside the run's span \[0.0, inf\]"):
+        varmech.Stepper(s, dt=0.01, impulses=[varmech.Impulse(generalized=[1.0], t=-1.0)])
+
+
+@pytest.mark.parametrize("model", ["native", "closure"])
+def test_an_ensemble_with_impulses_and_t_eval_is_each_members_single_run(model):
+    # Native models run on threads (their impulses given as numbers), closures member by member.
+    s = varmech.scenes.harmonic_oscillator()
+    m = s.model if model == "native" else varmech.MechanicalSystem(1, lambda q: 0.5 * q[0] ** 2, lambda q: q.copy())
+    q0 = np.array([[0.0], [0.5], [1.0]])
+    blows = [varmech.Impulse(generalized=[0.7], t=1.2345)]
+    times = np.linspace(0.01, 2.9, 13)
+    ens = varmech.ensemble(m, q0, np.ones((3, 1)), dt=0.01, steps=300, impulses=blows, t_eval=times, progress=False)
+    for i, traj in enumerate(ens.trajectories):
+        single = varmech.integrate(m, q0[i], [1.0], dt=0.01, steps=300, impulses=blows, t_eval=times, progress=False)
+        np.testing.assert_array_equal(traj.t, times)
+        np.testing.assert_array_equal(traj.q, single.q)
+        np.testing.assert_array_equal(traj.p, single.p)

@@ -547,3 +547,103 @@ fn a_stepper_stepped_through_a_watcher_is_the_run_bit_for_bit() {
     let last = run.len() - 1;
     assert_eq!((stepper.q(), stepper.p()), (run.q_at(last), run.p_at(last)));
 }
+
+/// The stepper of `sys` from (q0, p0) stepped `steps` times, each step through a watcher of
+/// `contacts` resumed for it (as the binding's `Stepper.step()` does), and the impacts.
+fn stepped_one_call_at_a_time<S: varmech::integrators::Dynamics>(
+    sys: &S,
+    (q0, p0): (&[f64], &[f64]),
+    options: &Options,
+    contacts: &Contacts<'static>,
+) -> (Vec<f64>, Vec<f64>, Impacts) {
+    let mut stepper = Stepper::new(sys, Method::Verlet, q0, p0, options).unwrap();
+    drop(Watcher::begin(sys, &stepper, with_contacts(contacts), "q0", false).unwrap());
+    let mut impacts = Impacts {
+        dim: q0.len(),
+        ..Impacts::default()
+    };
+    let mut poll = || -> Result<(), ModelError> { Ok(()) };
+    for _ in 0..options.steps {
+        let mut watcher = Watcher::resume(sys, &stepper, with_contacts(contacts), false).unwrap();
+        let mut record = Trajectory::default();
+        record.impacts.dim = q0.len();
+        assert_eq!(watcher.advance(&mut stepper, 1, &mut record, &mut poll).unwrap(), None);
+        impacts.append(&mut record.impacts);
+    }
+    (stepper.q().to_vec(), stepper.p().to_vec(), impacts)
+}
+
+#[test]
+fn a_stepper_stepped_through_a_watcher_resumed_for_each_step_is_the_run_bit_for_bit() {
+    // The binding's Stepper with contacts begins a watcher for each call: φ recomputed at the
+    // state is the run's carried φ, bit for bit, and the scratch restarts at every piece.
+    let ball = BouncingBall::new(G).unwrap();
+    let on_floor = floor(1.0, Law::Variational);
+    let options = Options::new(1e-2, 600);
+    let (q0, p0) = ([1.0], [0.0]);
+    let run = integrate_watching(
+        &ball,
+        Method::Verlet,
+        &q0,
+        &p0,
+        &options,
+        || Ok(()),
+        with_contacts(&on_floor),
+    );
+    let ball_run = (
+        run.unwrap(),
+        stepped_one_call_at_a_time(&ball, (&q0, &p0), &options, &on_floor),
+    );
+    let billiard = EllipticBilliard::new(1.0, 1.0).unwrap();
+    let on_table = circle(1.0, Law::Reflect);
+    let options = Options::new(1e-2, 1000);
+    let (q0, p0) = ([0.3, -0.2], [0.6, 0.8]);
+    let run = integrate_watching(
+        &billiard,
+        Method::Verlet,
+        &q0,
+        &p0,
+        &options,
+        || Ok(()),
+        with_contacts(&on_table),
+    );
+    let billiard_run = (
+        run.unwrap(),
+        stepped_one_call_at_a_time(&billiard, (&q0, &p0), &options, &on_table),
+    );
+    for (run, (q, p, impacts)) in [ball_run, billiard_run] {
+        assert!(run.impacts.len() >= 5, "{}", run.impacts.len());
+        assert_eq!(impacts, run.impacts);
+        let last = run.len() - 1;
+        assert_eq!((&q[..], &p[..]), (run.q_at(last), run.p_at(last)));
+    }
+}
+
+#[test]
+fn a_state_a_round_off_past_a_surface_is_refused_at_the_start_and_taken_as_leaving_on_resume() {
+    // φ = −1e-17, moving away: the state an impact located on the floor's far side leaves. A
+    // run's start refuses it (naming the argument); a resumed watcher takes the step leaving
+    // the floor, with no impact, bit for bit the step without contacts.
+    let ball = BouncingBall::new(G).unwrap();
+    let contacts = floor(1.0, Law::Variational);
+    let options = Options::new(1e-3, 1);
+    let (q0, p0) = ([-1e-17], [1.0]);
+    let mut stepper = Stepper::new(&ball, Method::Verlet, &q0, &p0, &options).unwrap();
+    match Watcher::begin(&ball, &stepper, with_contacts(&contacts), "q0", false) {
+        Err(Error::InvalidArgument { argument, reason }) => {
+            assert_eq!(argument, "q0");
+            assert!(reason.contains("floor"), "{reason}");
+        }
+        other => panic!("expected q0 refused, got {:?}", other.err()),
+    }
+    let mut watcher = Watcher::resume(&ball, &stepper, with_contacts(&contacts), false).unwrap();
+    let mut record = Trajectory::default();
+    record.impacts.dim = 1;
+    let mut poll = || -> Result<(), ModelError> { Ok(()) };
+    watcher.advance(&mut stepper, 1, &mut record, &mut poll).unwrap();
+    let mut free = Stepper::new(&ball, Method::Verlet, &q0, &p0, &options).unwrap();
+    free.step().unwrap();
+    assert!(record.impacts.is_empty());
+    assert!(stepper.q()[0] > 0.0);
+    assert_eq!((stepper.q(), stepper.p()), (free.q(), free.p()));
+}

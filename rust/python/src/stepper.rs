@@ -1,20 +1,27 @@
 //! A stepper of a Python model: the core's [`StepperState`] kept between calls and resumed on
-//! the model, through the one dispatch [`bind_model`], for each call.
+//! the model, through the one dispatch [`bind_model`], for each call; with contacts, each call's
+//! steps go through a [`Watcher`] resumed on that state.
 
 use numpy::{PyArray1, PyReadonlyArray1};
 use pyo3::prelude::*;
 use pyo3::types::PyBytes;
-use varmech::integrators::{self, Checkpoint, Dynamics, Method, NewtonOptions, Options, StepperState};
+use varmech::integrators::{
+    self, Checkpoint, Dynamics, Impacts, Method, NewtonOptions, Options, StepperState, Trajectory, Watch, Watcher,
+};
 use varmech::Error;
 
 use crate::bind::{bind_model, Poll};
+use crate::contacts::{ContactSpecs, ContactTuple};
 use crate::convert::{self, slice};
 use crate::errors::to_pyerr;
 use crate::run::decode;
+use crate::schedule::{ImpulseTuple, ScheduleSpecs};
+use crate::trajectory::{impact_arrays, ImpactArrays};
 
 /// One model, one method and the state, advanced step by step
 /// ([`varmech::integrators::Stepper`]): native models with the GIL released, Ctrl-C honoured
-/// by `advance`, and a failed step leaves the last good state.
+/// by `advance`, and a failed step leaves the last good state. With `contacts` and `impulses`,
+/// the steps go through their impacts and blows as a run's do ([`Watcher`]), bit for bit.
 ///
 /// A call holds the stepper mutably (pyo3's borrow flag, not a lock): another call while one
 /// runs (a thread while the GIL is released, a closure model re-entering) raises RuntimeError
@@ -24,20 +31,114 @@ use crate::run::decode;
 pub struct Stepper {
     model: Py<PyAny>,
     state: StepperState,
+    /// The contacts whose impacts the steps resolve, if any.
+    contacts: Option<ContactSpecs>,
+    /// The impulses the steps apply (those after the state's time).
+    impulses: ScheduleSpecs,
+    /// The impacts gone through since the start or the last reset.
+    impacts: Impacts,
+    /// Force evaluations of the impacts' partial steps.
+    partial_evaluations: u64,
 }
 
 type Core<'s, 'a> = integrators::Stepper<&'s dyn Dynamics, &'a mut StepperState>;
 
 impl Stepper {
+    /// The stepper of `state` on `model`, watching `contacts` (checked at the state, named
+    /// `argument` if outside one) and applying `impulses`: those at the state's time too where
+    /// `fresh` (a new stepper; a checkpoint's were its run's).
+    fn watching(
+        py: Python<'_>,
+        model: &Bound<'_, PyAny>,
+        state: StepperState,
+        (contacts, impulses): (Option<Vec<ContactTuple<'_>>>, Option<Vec<ImpulseTuple<'_>>>),
+        (argument, fresh): (&'static str, bool),
+    ) -> PyResult<Self> {
+        let contacts = contacts.map(ContactSpecs::new).transpose()?;
+        let impulses = ScheduleSpecs::new(impulses.unwrap_or_default(), Vec::new())?;
+        let n = state.q().len();
+        let mut stepper = Stepper {
+            model: model.clone().unbind(),
+            state,
+            contacts,
+            impulses,
+            impacts: Impacts::default(),
+            partial_evaluations: 0,
+        };
+        stepper.impacts.dim = n;
+        stepper.check(py, argument, fresh)?;
+        Ok(stepper)
+    }
+
+    /// Whether the contacts and impulses fit the model and method and the state lies in φ ≥ 0
+    /// (named `argument` if not); where `fresh`, the impulses at the state's time applied.
+    fn check(&mut self, py: Python<'_>, argument: &'static str, fresh: bool) -> PyResult<()> {
+        if self.contacts.is_none() && self.impulses.is_empty() {
+            return Ok(());
+        }
+        let (specs, impulses, state) = (&self.contacts, &self.impulses, &mut self.state);
+        bind_model(py, self.model.bind(py), |sys, _| {
+            let mut stepper = integrators::Stepper::resume(sys, state)?;
+            let contacts = specs.as_ref().map(ContactSpecs::contacts).transpose()?;
+            let schedule = (!impulses.is_empty()).then(|| impulses.schedule()).transpose()?;
+            let watch = Watch {
+                contacts: contacts.as_ref(),
+                schedule: schedule.as_ref(),
+                ..Watch::default()
+            };
+            let mut watcher = Watcher::begin(sys, &stepper, watch, argument, false)?;
+            if fresh {
+                watcher.start(&mut stepper, &mut Trajectory::default())?;
+            }
+            Ok(())
+        })?
+        .map_err(|e| to_pyerr(py, e))
+    }
+
     /// Runs `body` on the state resumed on the model; the state stays put whatever happens.
     fn with<R, F>(&mut self, py: Python<'_>, body: F) -> PyResult<R>
     where
         R: Send,
         F: for<'s, 'a> FnOnce(&mut Core<'s, 'a>, Poll<'s>) -> Result<R, Error> + Send,
     {
-        let Stepper { model, state } = self;
+        let Stepper { model, state, .. } = self;
         bind_model(py, model.bind(py), |sys, poll| {
             body(&mut integrators::Stepper::resume(sys, state)?, poll)
+        })?
+        .map_err(|e| to_pyerr(py, e))
+    }
+
+    /// Advances `n` steps (one by [`integrators::Stepper::step`] where `single`), through the
+    /// contacts' impacts if any: a [`Watcher`] resumed on the state, its impacts kept.
+    fn go(&mut self, py: Python<'_>, n: usize, single: bool) -> PyResult<()> {
+        if self.contacts.is_none() && self.impulses.is_empty() {
+            return self.with(py, |stepper, poll| {
+                if single {
+                    stepper.step()
+                } else {
+                    stepper.advance(n, poll)
+                }
+            });
+        }
+        let (specs, impulses) = (&self.contacts, &self.impulses);
+        let (impacts, evaluations) = (&mut self.impacts, &mut self.partial_evaluations);
+        let state = &mut self.state;
+        bind_model(py, self.model.bind(py), |sys, mut poll| {
+            let mut stepper = integrators::Stepper::resume(sys, state)?;
+            let contacts = specs.as_ref().map(ContactSpecs::contacts).transpose()?;
+            let schedule = (!impulses.is_empty()).then(|| impulses.schedule()).transpose()?;
+            let watch = Watch {
+                contacts: contacts.as_ref(),
+                schedule: schedule.as_ref(),
+                ..Watch::default()
+            };
+            let mut watcher = Watcher::resume(sys, &stepper, watch, false)?;
+            let mut record = Trajectory::default();
+            let advanced = watcher.advance(&mut stepper, n, &mut record, &mut poll);
+            // The impacts of the steps completed, a failed step's excepted.
+            impacts.append(&mut record.impacts);
+            *evaluations += watcher.force_evaluations();
+            advanced.map(drop)
         })?
         .map_err(|e| to_pyerr(py, e))
     }
@@ -46,7 +147,7 @@ impl Stepper {
 #[pymethods]
 impl Stepper {
     #[new]
-    #[pyo3(signature = (model, q0, p0, *, dt, method, t0=0.0, compensated=true, newton_tolerance=1e-14, newton_max_iterations=50))]
+    #[pyo3(signature = (model, q0, p0, *, dt, method, t0=0.0, compensated=true, newton_tolerance=1e-14, newton_max_iterations=50, contacts=None, impulses=None))]
     #[allow(clippy::too_many_arguments)]
     fn new<'py>(
         py: Python<'py>,
@@ -59,6 +160,8 @@ impl Stepper {
         compensated: bool,
         newton_tolerance: f64,
         newton_max_iterations: usize,
+        contacts: Option<Vec<ContactTuple<'py>>>,
+        impulses: Option<Vec<ImpulseTuple<'py>>>,
     ) -> PyResult<Self> {
         let options = Options {
             compensated,
@@ -74,10 +177,7 @@ impl Stepper {
             integrators::Stepper::new(sys, method, q0, p0, &options).map(integrators::Stepper::into_state)
         })?
         .map_err(|e| to_pyerr(py, e))?;
-        Ok(Stepper {
-            model: model.clone().unbind(),
-            state,
-        })
+        Stepper::watching(py, model, state, (contacts, impulses), ("q0", true))
     }
 
     /// The stepper's whole state as bytes, with its model's fingerprint (see [`Checkpoint`]).
@@ -89,13 +189,15 @@ impl Stepper {
     /// The stepper of `model` at the state of `checkpoint` (from `checkpoint()`, or a run's),
     /// checked against the model (and `method` and `dt` where given).
     #[staticmethod]
-    #[pyo3(signature = (model, checkpoint, *, method=None, dt=None))]
+    #[pyo3(signature = (model, checkpoint, *, method=None, dt=None, contacts=None, impulses=None))]
     fn from_checkpoint<'py>(
         py: Python<'py>,
         model: &Bound<'py, PyAny>,
         checkpoint: &[u8],
         method: Option<&str>,
         dt: Option<f64>,
+        contacts: Option<Vec<ContactTuple<'py>>>,
+        impulses: Option<Vec<ImpulseTuple<'py>>>,
     ) -> PyResult<Self> {
         let checkpoint = decode(py, checkpoint, method, dt)?;
         let state = bind_model(py, model, |sys, _| {
@@ -103,23 +205,22 @@ impl Stepper {
             integrators::Stepper::resume(sys, state).map(integrators::Stepper::into_state)
         })?
         .map_err(|e| to_pyerr(py, e))?;
-        Ok(Stepper {
-            model: model.clone().unbind(),
-            state,
-        })
+        Stepper::watching(py, model, state, (contacts, impulses), ("checkpoint", false))
     }
 
     /// Advances one step.
     fn step(&mut self, py: Python<'_>) -> PyResult<()> {
-        self.with(py, |stepper, _| stepper.step())
+        self.go(py, 1, true)
     }
 
     /// Advances `n` steps, checking for Ctrl-C on the way.
     fn advance(&mut self, py: Python<'_>, n: usize) -> PyResult<()> {
-        self.with(py, |stepper, poll| stepper.advance(n, poll))
+        self.go(py, n, false)
     }
 
-    /// Starts afresh from (q0, p0) at t0, with the step count at 0.
+    /// Starts afresh from (q0, p0) at t0, with the step count at 0 and no impacts, the
+    /// impulses at t0 applied as a new stepper's; a state outside a contact is refused (naming
+    /// `q0`), the stepper unchanged.
     fn reset<'py>(
         &mut self,
         py: Python<'py>,
@@ -128,7 +229,17 @@ impl Stepper {
         t0: f64,
     ) -> PyResult<()> {
         let (q0, p0) = (slice("q0", &q0)?, slice("p0", &p0)?);
-        self.with(py, |stepper, _| stepper.reset(t0, q0, p0))
+        let before = self.state.clone();
+        self.with(py, |stepper, _| stepper.reset(t0, q0, p0))?;
+        if let Err(e) = self.check(py, "q0", true) {
+            self.state = before;
+            return Err(e);
+        }
+        self.impacts = Impacts {
+            dim: self.impacts.dim,
+            ..Impacts::default()
+        };
+        Ok(())
     }
 
     #[getter]
@@ -168,7 +279,20 @@ impl Stepper {
 
     #[getter]
     fn force_evaluations(&self) -> u64 {
-        self.state.force_evaluations()
+        self.state.force_evaluations() + self.partial_evaluations
+    }
+
+    /// The impacts gone through since the start or the last reset, as a run's record has them:
+    /// the contact's index (k,), t (k,), q, p before and p after (k, n).
+    #[getter]
+    fn impacts(&self, py: Python<'_>) -> PyResult<ImpactArrays> {
+        impact_arrays(py, self.impacts.clone(), self.impacts.dim)
+    }
+
+    /// Impacts under the variational law that took Newton's law (grazing), as a run's.
+    #[getter]
+    fn grazing(&self) -> usize {
+        self.impacts.grazing
     }
 
     #[getter]

@@ -4,7 +4,7 @@ use numpy::{PyArray1, PyArray2, PyUntypedArrayMethods};
 
 use pyo3::prelude::*;
 use pyo3::types::PyBytes;
-use varmech::integrators::Trajectory;
+use varmech::integrators::{Impacts, Trajectory};
 
 use crate::convert::matrix;
 
@@ -48,7 +48,7 @@ pub struct TrajectoryRecord {
 }
 
 /// Impacts as arrays: the contact's index (k,), t (k,), q, p before and p after (k, n).
-type ImpactArrays = (
+pub(crate) type ImpactArrays = (
     Py<PyArray1<usize>>,
     Py<PyArray1<f64>>,
     Py<PyArray2<f64>>,
@@ -66,6 +66,17 @@ type EventArrays = (
     Py<PyArray2<f64>>,
     Py<PyArray2<f64>>,
 );
+
+/// The arrays of `impacts` (a run's, or a stepper's so far) of n coordinates.
+pub(crate) fn impact_arrays(py: Python<'_>, impacts: Impacts, n: usize) -> PyResult<ImpactArrays> {
+    Ok((
+        PyArray1::from_vec(py, impacts.contact).unbind(),
+        PyArray1::from_vec(py, impacts.t).unbind(),
+        matrix(py, impacts.q, n)?.unbind(),
+        matrix(py, impacts.p_before, n)?.unbind(),
+        matrix(py, impacts.p_after, n)?.unbind(),
+    ))
+}
 
 /// The recorded column, or None when the run recorded none (an empty vector).
 fn recorded<'py, T: numpy::Element>(py: Python<'py>, column: Vec<T>) -> Option<Py<PyArray1<T>>> {
@@ -93,14 +104,8 @@ impl TrajectoryRecord {
             matrix(py, q_start, n)?.unbind(),
             matrix(py, p_start, n)?.unbind(),
         );
-        let i = traj.impacts;
-        let impacts = (
-            PyArray1::from_vec(py, i.contact).unbind(),
-            PyArray1::from_vec(py, i.t).unbind(),
-            matrix(py, i.q, n)?.unbind(),
-            matrix(py, i.p_before, n)?.unbind(),
-            matrix(py, i.p_after, n)?.unbind(),
-        );
+        let grazing = traj.impacts.grazing;
+        let impacts = impact_arrays(py, traj.impacts, n)?;
         Ok(TrajectoryRecord {
             t: PyArray1::from_vec(py, traj.t).unbind(),
             q: matrix(py, traj.q, n)?.unbind(),
@@ -113,7 +118,7 @@ impl TrajectoryRecord {
             events,
             terminated_by: traj.terminated_by,
             impacts,
-            grazing: i.grazing,
+            grazing,
         })
     }
 

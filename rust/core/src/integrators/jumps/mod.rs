@@ -256,7 +256,7 @@ impl Impacts {
     }
 
     /// Moves `other`'s impacts to the end of these, leaving it empty (its storage kept).
-    pub(in crate::integrators) fn append(&mut self, other: &mut Impacts) {
+    pub fn append(&mut self, other: &mut Impacts) {
         self.contact.append(&mut other.contact);
         self.step.append(&mut other.step);
         self.t.append(&mut other.t);

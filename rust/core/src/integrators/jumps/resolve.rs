@@ -80,21 +80,17 @@ pub(in crate::integrators) struct Resolver<'c, 's, M> {
 }
 
 impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
-    /// The resolver of `contacts` and `schedule` for a run of `stepper` on `model` from its
-    /// state (named `argument` in the refusal of a state outside φ ≥ 0), `energy` when the run
-    /// checks its energy. The schedule's times after the state's are to come (and those at it,
-    /// for [`Resolver::start`]).
+    /// The resolver of `contacts` (checked by the caller, [`Contacts::check`]) and `schedule`
+    /// for a run of `stepper` on `model` from its state, `energy` when the run checks its
+    /// energy. The schedule's times after the state's are to come (and those at it, for
+    /// [`Resolver::start`]).
     pub(in crate::integrators) fn begin<St: Borrow<StepperState>>(
         model: M,
         stepper: &Stepper<M, St>,
         (contacts, schedule): (Option<&'c Contacts<'s>>, Option<&'c Schedule<'s>>),
-        argument: &'static str,
         energy: bool,
     ) -> Result<Self, Error> {
         let n = stepper.q().len();
-        if let Some(contacts) = contacts {
-            contacts.check(&*model, stepper.method(), (stepper.t(), stepper.q()), argument)?;
-        }
         if let Some(schedule) = schedule {
             schedule.fit(n)?;
         }

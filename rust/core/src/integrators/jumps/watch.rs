@@ -49,9 +49,40 @@ where
         argument: &'static str,
         energy: bool,
     ) -> Result<Self, Error> {
+        Self::make(model, stepper, watch, Some(argument), energy)
+    }
+
+    /// As [`Watcher::begin`], for a stepper whose state a watcher of the same `watch` has
+    /// checked (begun there) or reached (stepped there): the contacts are not checked again.
+    /// A state that an impact located on a surface's far side leaves a round-off past it
+    /// (φ ≈ −1e-17) is then taken, as within one run, for one leaving the surface, so that a
+    /// stepper advanced through a watcher resumed for each call is bit for bit one run (the
+    /// binding's `Stepper`).
+    pub fn resume<St: Borrow<StepperState>>(
+        model: M,
+        stepper: &Stepper<M, St>,
+        watch: Watch<'w, 'e, 'c>,
+        energy: bool,
+    ) -> Result<Self, Error> {
+        Self::make(model, stepper, watch, None, energy)
+    }
+
+    /// The watcher, its contacts checked at the state named `argument` if given.
+    fn make<St: Borrow<StepperState>>(
+        model: M,
+        stepper: &Stepper<M, St>,
+        watch: Watch<'w, 'e, 'c>,
+        argument: Option<&'static str>,
+        energy: bool,
+    ) -> Result<Self, Error> {
         let search = watch.events.map(|events| events.begin(model, stepper)).transpose()?;
         let resolver = (watch.contacts.is_some() || watch.schedule.is_some())
-            .then(|| Resolver::begin(model, stepper, (watch.contacts, watch.schedule), argument, energy))
+            .then(|| {
+                if let (Some(argument), Some(contacts)) = (argument, watch.contacts) {
+                    contacts.check(&*model, stepper.method(), (stepper.t(), stepper.q()), argument)?;
+                }
+                Resolver::begin(model, stepper, (watch.contacts, watch.schedule), energy)
+            })
             .transpose()?;
         Ok(Watcher { search, resolver })
     }
