@@ -4,17 +4,19 @@
 //! without an impact, a resumed run and an ensemble member are those of the plain run.
 
 use varmech::integrators::{
-    integrate, integrate_ensemble_watching, integrate_watching, integrate_with_events, resume_watching, Checkpoint,
-    Contact, Contacts, Detector, DiscreteEnergy, EventSpec, Impacts, Law, MemberWatch, Method, NativeContact,
-    NativeEvent, NativeSurface, Options, Parallel, Shared, Stepper, Trajectory, Watch, Watcher,
+    integrate, integrate_watching, integrate_with_events, resume_watching, Checkpoint, Contact, Contacts, Detector,
+    DiscreteEnergy, EventSpec, Failure, Impacts, Law, MemberWatch, Method, NativeContact, NativeEvent, NativeSurface,
+    Options, Stepper, Trajectory, Watch, Watcher,
 };
 use varmech::model::Lagrangian;
 use varmech::scenes::{BouncingBall, EllipticBilliard};
 use varmech::{Error, ModelError};
 
+use crate::common::verlet_ensemble;
+
 const G: f64 = 9.81;
 
-fn floor(restitution: f64, law: Law) -> Contacts<'static> {
+pub(crate) fn floor(restitution: f64, law: Law) -> Contacts<'static> {
     let contact = Contact {
         surface: Box::new(NativeSurface::Wall {
             coordinate: 0,
@@ -27,7 +29,13 @@ fn floor(restitution: f64, law: Law) -> Contacts<'static> {
     Contacts::new(vec![contact]).unwrap()
 }
 
-fn with_contacts<'w>(contacts: &'w Contacts<'static>) -> Watch<'w, 'static, 'static> {
+/// The ball (g = 9.81) dropped from rest at height 1 with verlet, watching `watch`.
+pub(crate) fn drop_ball(options: &Options, watch: Watch<'_, '_, '_>) -> Result<Trajectory, Box<Failure>> {
+    let ball = BouncingBall::new(G).unwrap();
+    integrate_watching(&ball, Method::Verlet, &[1.0], &[0.0], options, || Ok(()), watch)
+}
+
+pub(crate) fn with_contacts<'w>(contacts: &'w Contacts<'static>) -> Watch<'w, 'static, 'static> {
     Watch {
         events: None,
         contacts: Some(contacts),
@@ -88,19 +96,9 @@ fn the_ball_first_hits_the_floor_at_the_exact_time_and_keeps_its_energy() {
 #[test]
 fn an_accumulation_of_impacts_ends_the_run_with_a_contact_error_at_the_steps_start() {
     // e = 0.5: the ball comes to rest at t = (1 + 2e/(1 − e))√(2h₀/g) ≈ 1.35.
-    let ball = BouncingBall::new(G).unwrap();
     let contacts = floor(0.5, Law::Reflect);
     let options = Options::new(0.01, 200);
-    let failure = integrate_watching(
-        &ball,
-        Method::Verlet,
-        &[1.0],
-        &[0.0],
-        &options,
-        || Ok(()),
-        with_contacts(&contacts),
-    )
-    .unwrap_err();
+    let failure = drop_ball(&options, with_contacts(&contacts)).unwrap_err();
     let Error::Contact { step, time, .. } = failure.error else {
         panic!("{}", failure.error)
     };
@@ -338,25 +336,11 @@ fn an_ensemble_member_is_its_single_run_bit_for_bit() {
     let q0: Vec<f64> = (0..members).flat_map(|i| [0.1 * i as f64, -0.2]).collect();
     let p0: Vec<f64> = (0..members).flat_map(|i| [0.6, 0.8 - 0.1 * i as f64]).collect();
     let options = Options::new(0.01, 2000);
-    let parallel = Parallel {
-        workers: Some(2),
-        chunk_size: None,
-    };
     let watched = MemberWatch {
         contacts: vec![table.clone()],
         ..MemberWatch::default()
     };
-    let ensemble = integrate_ensemble_watching(
-        &Shared(&free),
-        Method::Verlet,
-        &q0,
-        &p0,
-        &options,
-        parallel,
-        &watched,
-        || Ok(()),
-    )
-    .unwrap();
+    let ensemble = verlet_ensemble(&free, (&q0, &p0), &options, &watched);
     let contacts = Contacts::native(std::slice::from_ref(&table)).unwrap();
     for (i, outcome) in ensemble.members.iter().enumerate() {
         let member = outcome.as_ref().unwrap();
@@ -381,16 +365,7 @@ fn the_variational_law_keeps_the_discrete_energy_across_each_impact() {
     let ball = BouncingBall::new(G).unwrap();
     let contacts = floor(1.0, Law::Variational);
     let options = Options::new(0.01, 300);
-    let traj = integrate_watching(
-        &ball,
-        Method::Verlet,
-        &[1.0],
-        &[0.0],
-        &options,
-        || Ok(()),
-        with_contacts(&contacts),
-    )
-    .unwrap();
+    let traj = drop_ball(&options, with_contacts(&contacts)).unwrap();
     assert_eq!((traj.impacts.len(), traj.impacts.grazing), (3, 0));
     let mut energy = DiscreteEnergy::new(Method::Verlet, 1).unwrap();
     for k in 0..traj.impacts.len() {
@@ -428,23 +403,13 @@ fn the_variational_law_moves_h_by_g2h2_times_1_minus_2alpha_over_8_at_the_method
     // makes E_d(τ₁ = αh) = E_d(τ₂ = (1 − α)h) at the impact, so H jumps by g²h²(1 − 2α)/8 there
     // (the apex falls by that over g). With the first impact at the fraction α = 1/4 of a step,
     // the jump and the second impact's time error fall at exactly order 2.
-    let ball = BouncingBall::new(G).unwrap();
     let contacts = floor(1.0, Law::Variational);
     let (t1, alpha) = ((2.0 / G).sqrt(), 0.25);
     let mut errors = Vec::new();
     for m in [100, 200, 400] {
         let dt = t1 / (m as f64 + alpha);
         let options = Options::new(dt, 3 * m + 10);
-        let traj = integrate_watching(
-            &ball,
-            Method::Verlet,
-            &[1.0],
-            &[0.0],
-            &options,
-            || Ok(()),
-            with_contacts(&contacts),
-        )
-        .unwrap();
+        let traj = drop_ball(&options, with_contacts(&contacts)).unwrap();
         let impacts = &traj.impacts;
         assert_eq!(impacts.len(), 2);
         assert!((impacts.t[0] - t1).abs() < 1e-14);

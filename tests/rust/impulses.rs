@@ -4,12 +4,14 @@
 //! carried by a resumed run bit for bit.
 
 use varmech::integrators::{
-    integrate, integrate_ensemble_watching, integrate_watching, resume_watching, Blow, Checkpoint, Contact, Contacts,
-    Generalized, Impulse, Law, MemberWatch, Method, NativeContact, NativeSurface, Options, Parallel, Schedule, Shared,
-    Struck, Trajectory, Watch,
+    integrate, integrate_watching, resume_watching, Blow, Checkpoint, Contacts, Failure, Generalized, Impulse, Law,
+    MemberWatch, Method, NativeContact, NativeSurface, Options, Schedule, Struck, Trajectory, Watch,
 };
 use varmech::scenes::{BouncingBall, HarmonicOscillator};
 use varmech::Error;
+
+use crate::common::verlet_ensemble;
+use crate::impacts::{drop_ball, floor, with_contacts};
 
 fn blow(t: f64, p: &[f64]) -> Impulse<'static> {
     Impulse {
@@ -25,6 +27,28 @@ fn scheduled<'w>(schedule: &'w Schedule<'static>) -> Watch<'w, 'static, 'static>
     }
 }
 
+/// The watch of `contacts` and `schedule`.
+fn both<'w>(contacts: &'w Contacts<'static>, schedule: &'w Schedule<'static>) -> Watch<'w, 'static, 'static> {
+    Watch {
+        contacts: Some(contacts),
+        ..scheduled(schedule)
+    }
+}
+
+/// The run of the oscillator q̈ = −q from (0, 1) with `schedule`.
+fn run_oscillator(method: Method, options: &Options, schedule: &Schedule<'static>) -> Result<Trajectory, Box<Failure>> {
+    let oscillator = HarmonicOscillator::new(1.0).unwrap();
+    integrate_watching(
+        &oscillator,
+        method,
+        &[0.0],
+        &[1.0],
+        options,
+        || Ok(()),
+        scheduled(schedule),
+    )
+}
+
 /// The oscillator q̈ = −q from (0, 1), struck by Δp = `kick` at t*: its state at t.
 fn oscillator_after_blow(t: f64, t_star: f64, kick: f64) -> (f64, f64) {
     let (q, p) = (t_star.sin(), t_star.cos() + kick);
@@ -34,7 +58,6 @@ fn oscillator_after_blow(t: f64, t_star: f64, kick: f64) -> (f64, f64) {
 
 #[test]
 fn an_impulse_between_grid_points_keeps_the_methods_order() {
-    let oscillator = HarmonicOscillator::new(1.0).unwrap();
     let (t_star, kick, t_end) = (1.2345, 0.7, 6.0);
     let exact = oscillator_after_blow(t_end, t_star, kick);
     for (method, order, h) in [(Method::Verlet, 2.0, 0.02), (Method::KahanLi6, 6.0, 0.2)] {
@@ -43,16 +66,7 @@ fn an_impulse_between_grid_points_keeps_the_methods_order() {
             .map(|&dt| {
                 let schedule = Schedule::new(vec![blow(t_star, &[kick])], vec![]).unwrap();
                 let options = Options::new(dt, (t_end / dt).round() as usize);
-                let traj = integrate_watching(
-                    &oscillator,
-                    method,
-                    &[0.0],
-                    &[1.0],
-                    &options,
-                    || Ok(()),
-                    scheduled(&schedule),
-                )
-                .unwrap();
+                let traj = run_oscillator(method, &options, &schedule).unwrap();
                 // The jump is saved: two rows at t*, their momenta differing by the blow.
                 let rows: Vec<usize> = (0..traj.len()).filter(|&k| traj.t[k] == t_star).collect();
                 assert_eq!(rows.len(), 2);
@@ -77,16 +91,7 @@ fn an_impulse_on_the_grid_and_at_t0_jumps_there_and_the_run_goes_on_as_a_new_one
     let dt = 0.05;
     let schedule = Schedule::new(vec![blow(40.0 * dt, &[0.4]), blow(0.0, &[0.5])], vec![]).unwrap();
     let options = Options::new(dt, 200);
-    let traj = integrate_watching(
-        &oscillator,
-        Method::Verlet,
-        &[0.0],
-        &[1.0],
-        &options,
-        || Ok(()),
-        scheduled(&schedule),
-    )
-    .unwrap();
+    let traj = run_oscillator(Method::Verlet, &options, &schedule).unwrap();
     // Rows: t0 before and after the first blow, 39 steps, t₄₀ before and after, 160 steps.
     assert_eq!(traj.len(), 2 + 39 + 2 + 160);
     assert_eq!((traj.p_at(0)[0], traj.p_at(1)[0]), (1.0, 1.5));
@@ -143,19 +148,6 @@ fn a_blow_at_a_point_gives_the_components_of_its_jacobian_or_of_central_differen
     assert!(a.iter().zip(&b).all(|(x, y)| (x - y).abs() < 1e-9), "{b:?}");
 }
 
-fn floor() -> Contacts<'static> {
-    let contact = Contact {
-        surface: Box::new(NativeSurface::Wall {
-            coordinate: 0,
-            value: 0.0,
-        }),
-        restitution: 1.0,
-        law: Law::Reflect,
-        name: "floor".into(),
-    };
-    Contacts::new(vec![contact]).unwrap()
-}
-
 /// The ball dropped from h₀ = 1 at rest, bouncing elastically: its exact height and momentum.
 fn ball_at(t: f64, g: f64) -> (f64, f64) {
     let fall = (2.0 / g).sqrt();
@@ -168,17 +160,12 @@ fn samples_are_taken_through_impacts_to_round_off_on_the_bouncing_ball() {
     // Verlet is exact on the parabola and the impacts are located to round-off, so the samples,
     // partial steps from the last impact before them, are the exact motion to round-off.
     let g = 9.81;
-    let ball = BouncingBall::new(g).unwrap();
-    let contacts = floor();
+    let contacts = floor(1.0, Law::Reflect);
     let times: Vec<f64> = (0..200).map(|k| 0.0137 + 0.0499 * k as f64).collect();
     let schedule = Schedule::new(vec![], times.clone()).unwrap();
     let options = Options::new(0.01, 1000);
-    let watch = Watch {
-        contacts: Some(&contacts),
-        schedule: Some(&schedule),
-        ..Watch::default()
-    };
-    let traj = integrate_watching(&ball, Method::Verlet, &[1.0], &[0.0], &options, || Ok(()), watch).unwrap();
+    let watch = both(&contacts, &schedule);
+    let traj = drop_ball(&options, watch).unwrap();
     assert_eq!(traj.t, times, "the samples alone are saved");
     assert!(traj.impacts.len() >= 4);
     for (k, &t) in times.iter().enumerate() {
@@ -189,19 +176,7 @@ fn samples_are_taken_through_impacts_to_round_off_on_the_bouncing_ball() {
         );
     }
     // The run goes on to its end, whatever it samples.
-    let plain = integrate_watching(
-        &ball,
-        Method::Verlet,
-        &[1.0],
-        &[0.0],
-        &options,
-        || Ok(()),
-        Watch {
-            contacts: Some(&contacts),
-            ..Watch::default()
-        },
-    )
-    .unwrap();
+    let plain = drop_ball(&options, with_contacts(&contacts)).unwrap();
     assert_eq!(traj.checkpoint, plain.checkpoint);
     assert_eq!(traj.impacts, plain.impacts);
 }
@@ -213,16 +188,7 @@ fn samples_on_the_grid_are_the_runs_own_states_to_the_bit() {
     let run = integrate(&oscillator, Method::KahanLi8, &[0.0], &[1.0], &options, || Ok(())).unwrap();
     let picked = [0, 7, 8, 150, 300];
     let schedule = Schedule::new(vec![], picked.iter().map(|&k| run.t[k]).collect()).unwrap();
-    let at = integrate_watching(
-        &oscillator,
-        Method::KahanLi8,
-        &[0.0],
-        &[1.0],
-        &options,
-        || Ok(()),
-        scheduled(&schedule),
-    )
-    .unwrap();
+    let at = run_oscillator(Method::KahanLi8, &options, &schedule).unwrap();
     for (row, &k) in picked.iter().enumerate() {
         assert_eq!((at.q_at(row), at.p_at(row)), (run.q_at(k), run.p_at(k)));
     }
@@ -233,24 +199,10 @@ fn a_ball_struck_up_in_flight_bounces_higher_and_the_energy_check_discounts_the_
     // Struck at t = 0.2 by Δp = 3 (unit mass), the ball's energy rises by ½((p + 3)² − p²);
     // the run's energy check (on by default) judges the smooth motion alone.
     let g = 9.81;
-    let ball = BouncingBall::new(g).unwrap();
-    let contacts = floor();
+    let contacts = floor(1.0, Law::Reflect);
     let schedule = Schedule::new(vec![blow(0.2, &[3.0])], vec![]).unwrap();
-    let watch = Watch {
-        contacts: Some(&contacts),
-        schedule: Some(&schedule),
-        ..Watch::default()
-    };
-    let traj = integrate_watching(
-        &ball,
-        Method::Verlet,
-        &[1.0],
-        &[0.0],
-        &Options::new(0.01, 500),
-        || Ok(()),
-        watch,
-    )
-    .unwrap();
+    let watch = both(&contacts, &schedule);
+    let traj = drop_ball(&Options::new(0.01, 500), watch).unwrap();
     let p = -g * 0.2 + 3.0;
     let energy = g * (1.0 - 0.5 * g * 0.04) + 0.5 * p * p;
     let last = traj.len() - 1;
@@ -263,26 +215,14 @@ fn a_ball_struck_up_in_flight_bounces_higher_and_the_energy_check_discounts_the_
 fn a_resumed_run_takes_the_impulses_and_samples_after_its_start_bit_for_bit() {
     let g = 9.81;
     let ball = BouncingBall::new(g).unwrap();
-    let contacts = floor();
+    let contacts = floor(1.0, Law::Reflect);
     // Impulses inside a step, at the checkpoint's time (the first run's) and after it.
     let impulses = || vec![blow(0.1234, &[1.0]), blow(2.0, &[-0.5]), blow(3.0001, &[0.25])];
     let samples: Vec<f64> = (1..40).map(|k| 0.1 * k as f64 + 0.003).collect();
     let run = |schedule: &Schedule<'static>, steps: usize, from: Option<Vec<u8>>| -> Trajectory {
-        let watch = Watch {
-            contacts: Some(&contacts),
-            schedule: Some(schedule),
-            ..Watch::default()
-        };
+        let watch = both(&contacts, schedule);
         match from {
-            None => integrate_watching(
-                &ball,
-                Method::Verlet,
-                &[1.0],
-                &[0.0],
-                &Options::new(0.01, steps),
-                || Ok(()),
-                watch,
-            ),
+            None => drop_ball(&Options::new(0.01, steps), watch),
             Some(bytes) => {
                 let checkpoint = Checkpoint::from_bytes(&bytes).unwrap();
                 resume_watching(&ball, checkpoint, steps, 1, || Ok(()), watch)
@@ -313,18 +253,8 @@ fn bad_schedules_are_refused_by_name() {
     assert!(nan.contains("impulses") && nan.contains("finite"), "{nan}");
     let unsorted = Schedule::new(vec![], vec![0.5, 0.2]).err().map(message).unwrap();
     assert!(unsorted.contains("t_eval") && unsorted.contains("sorted"), "{unsorted}");
-    let oscillator = HarmonicOscillator::new(1.0).unwrap();
     let schedule = Schedule::new(vec![blow(0.5, &[1.0, 2.0])], vec![]).unwrap();
-    let failure = integrate_watching(
-        &oscillator,
-        Method::Verlet,
-        &[0.0],
-        &[1.0],
-        &Options::new(0.1, 10),
-        || Ok(()),
-        scheduled(&schedule),
-    )
-    .unwrap_err();
+    let failure = run_oscillator(Method::Verlet, &Options::new(0.1, 10), &schedule).unwrap_err();
     let refused = failure.error.to_string();
     assert!(
         refused.contains("impulses[0]") && refused.contains("2 components of impulse for 1"),
@@ -336,7 +266,7 @@ fn bad_schedules_are_refused_by_name() {
 fn an_ensemble_member_with_impulses_samples_and_contacts_is_its_single_run_bit_for_bit() {
     let g = 9.81;
     let ball = BouncingBall::new(g).unwrap();
-    let contacts = floor();
+    let contacts = floor(1.0, Law::Reflect);
     let samples: Vec<f64> = (1..60).map(|k| 0.05 * k as f64 + 0.001).collect();
     let watched = MemberWatch {
         contacts: vec![NativeContact {
@@ -354,28 +284,10 @@ fn an_ensemble_member_with_impulses_samples_and_contacts_is_its_single_run_bit_f
     };
     let (q0, p0) = ([1.0, 0.5, 2.0], [0.0, 1.0, -1.0]);
     let options = Options::new(0.01, 300);
-    let parallel = Parallel {
-        workers: Some(2),
-        chunk_size: None,
-    };
-    let ensemble = integrate_ensemble_watching(
-        &Shared(&ball),
-        Method::Verlet,
-        &q0,
-        &p0,
-        &options,
-        parallel,
-        &watched,
-        || Ok(()),
-    )
-    .unwrap();
+    let ensemble = verlet_ensemble(&ball, (&q0, &p0), &options, &watched);
     for (i, outcome) in ensemble.members.iter().enumerate() {
         let schedule = Schedule::new(vec![blow(0.2345, &[2.0]), blow(1.5, &[-1.0])], samples.clone()).unwrap();
-        let watch = Watch {
-            contacts: Some(&contacts),
-            schedule: Some(&schedule),
-            ..Watch::default()
-        };
+        let watch = both(&contacts, &schedule);
         let single = integrate_watching(
             &ball,
             Method::Verlet,

@@ -6,7 +6,8 @@ use numpy::{PyArray1, PyReadonlyArray1};
 use pyo3::prelude::*;
 use pyo3::types::PyBytes;
 use varmech::integrators::{
-    self, Checkpoint, Dynamics, Impacts, Method, NewtonOptions, Options, StepperState, Trajectory, Watch, Watcher,
+    self, Checkpoint, Contacts, Dynamics, Impacts, Method, NewtonOptions, Options, Schedule, StepperState, Trajectory,
+    Watch, Watcher,
 };
 use varmech::Error;
 
@@ -79,14 +80,8 @@ impl Stepper {
         let (specs, impulses, state) = (&self.contacts, &self.impulses, &mut self.state);
         bind_model(py, self.model.bind(py), |sys, _| {
             let mut stepper = integrators::Stepper::resume(sys, state)?;
-            let contacts = specs.as_ref().map(ContactSpecs::contacts).transpose()?;
-            let schedule = (!impulses.is_empty()).then(|| impulses.schedule()).transpose()?;
-            let watch = Watch {
-                contacts: contacts.as_ref(),
-                schedule: schedule.as_ref(),
-                ..Watch::default()
-            };
-            let mut watcher = Watcher::begin(sys, &stepper, watch, argument, false)?;
+            let watched = Watched::new(specs, impulses)?;
+            let mut watcher = Watcher::begin(sys, &stepper, watched.watch(), argument, false)?;
             if fresh {
                 watcher.start(&mut stepper, &mut Trajectory::default())?;
             }
@@ -125,14 +120,8 @@ impl Stepper {
         let state = &mut self.state;
         bind_model(py, self.model.bind(py), |sys, mut poll| {
             let mut stepper = integrators::Stepper::resume(sys, state)?;
-            let contacts = specs.as_ref().map(ContactSpecs::contacts).transpose()?;
-            let schedule = (!impulses.is_empty()).then(|| impulses.schedule()).transpose()?;
-            let watch = Watch {
-                contacts: contacts.as_ref(),
-                schedule: schedule.as_ref(),
-                ..Watch::default()
-            };
-            let mut watcher = Watcher::resume(sys, &stepper, watch, false)?;
+            let watched = Watched::new(specs, impulses)?;
+            let mut watcher = Watcher::resume(sys, &stepper, watched.watch(), false)?;
             let mut record = Trajectory::default();
             let advanced = watcher.advance(&mut stepper, n, &mut record, &mut poll);
             // The impacts of the steps completed, a failed step's excepted.
@@ -141,6 +130,29 @@ impl Stepper {
             advanced.map(drop)
         })?
         .map_err(|e| to_pyerr(py, e))
+    }
+}
+
+/// The core's contacts and schedule of a stepper's specs, made for a call.
+struct Watched<'a> {
+    contacts: Option<Contacts<'a>>,
+    schedule: Option<Schedule<'a>>,
+}
+
+impl<'a> Watched<'a> {
+    fn new(contacts: &'a Option<ContactSpecs>, impulses: &'a ScheduleSpecs) -> Result<Self, Error> {
+        Ok(Watched {
+            contacts: contacts.as_ref().map(ContactSpecs::contacts).transpose()?,
+            schedule: (!impulses.is_empty()).then(|| impulses.schedule()).transpose()?,
+        })
+    }
+
+    fn watch(&self) -> Watch<'_, 'static, 'a> {
+        Watch {
+            contacts: self.contacts.as_ref(),
+            schedule: self.schedule.as_ref(),
+            ..Watch::default()
+        }
     }
 }
 

@@ -1,7 +1,10 @@
 //! Helpers shared by the integration tests.
 
 use varmech::diagnostics::{self, Statistics, Verdict};
-use varmech::integrators::{integrate, General, Method, Options, Trajectory};
+use varmech::integrators::{
+    integrate, integrate_ensemble_watching, Dynamics, Ensemble, General, MemberWatch, Method, Options, Parallel,
+    Shared, Trajectory,
+};
 use varmech::model::{Lagrangian, MechanicalSystem};
 use varmech::scenes::{Problem, State};
 use varmech::Error;
@@ -150,4 +153,22 @@ impl InvariantStatistics {
             max_rel_error: max_abs_error / scale,
         }
     }
+}
+
+/// The verlet ensemble of `sys` on two workers from the rows (q0, p0), every member watching
+/// `watched`.
+pub fn verlet_ensemble<S: Dynamics + Sync>(
+    sys: &S,
+    (q0, p0): (&[f64], &[f64]),
+    options: &Options,
+    watched: &MemberWatch,
+) -> Ensemble {
+    let parallel = Parallel {
+        workers: Some(2),
+        chunk_size: None,
+    };
+    integrate_ensemble_watching(&Shared(sys), Method::Verlet, q0, p0, options, parallel, watched, || {
+        Ok(())
+    })
+    .unwrap()
 }
