@@ -376,7 +376,7 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
             self.partial(step, ta, piece)?;
             evaluate(contacts, self.scratch.q(), &mut self.phi_end, step, self.t)?;
             let mut first: Option<(f64, usize)> = None;
-            for j in 0..contacts.len() {
+            for (j, contact) in contacts.iter().enumerate() {
                 let leaving = last == Some(j) || self.phi_start[j] <= 0.0;
                 if !below(self.phi_end[j] - floor(self.phi_start[j], leaving), leaving) {
                     continue;
@@ -386,7 +386,7 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
                     Located::Resting => contact_error(format!(
                         "a body leaving the contact {} crosses it again at once (a resting or grazing contact, \
                          such as e = 0 under a force pressing on it), which impacts cannot resolve",
-                        contacts[j].name
+                        contact.name
                     )),
                 })?;
                 if let Some(s) = s {
