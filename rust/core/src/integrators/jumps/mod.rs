@@ -18,6 +18,7 @@ mod variational;
 mod watch;
 
 pub(in crate::integrators) use resolve::Resolver;
+pub use resolve::Gaps;
 pub use surfaces::NativeSurface;
 pub(crate) use surfaces::{check_ellipsoid, ellipsoid, wall};
 pub use watch::{Watch, Watcher};
@@ -43,6 +44,12 @@ pub trait Surface {
     /// Why the surface cannot act on n coordinates, if it cannot (a native surface's
     /// coordinates out of range). By default it can.
     fn misfit(&self, _n: usize) -> Option<String> {
+        None
+    }
+
+    /// The surface as a native one, which a run evaluates after every step without dispatch
+    /// ([`Gaps`]); None (the default) for the others.
+    fn native(&self) -> Option<&NativeSurface> {
         None
     }
 }

@@ -6,12 +6,12 @@
 use std::borrow::{Borrow, BorrowMut};
 use std::ops::Deref;
 
-use super::{reflect, variational, Contacts, Impacts, Law, MAX_IMPACTS};
+use super::{reflect, variational, Contact, Contacts, Impacts, Law, NativeSurface, Surface, MAX_IMPACTS};
 use crate::integrators::events::Search;
 use crate::integrators::DiscreteEnergy;
 use crate::integrators::{Counting, Dynamics, Method, Occurrence, Poll, Stepper, StepperState, Trajectory};
 use crate::solve::bracket::illinois;
-use crate::Error;
+use crate::{Error, ModelError};
 
 /// Why the variational law does not fit `method` on `model`, if it does not: it needs the
 /// method's discrete energy ([`DiscreteEnergy`]) and a conservative, autonomous, unconstrained
@@ -40,6 +40,8 @@ pub(super) fn variational_misfit<S: Dynamics + ?Sized>(model: &S, method: Method
 /// run's stepper) and every buffer of the resolution, made once per run.
 pub(in crate::integrators) struct Resolver<'c, 's, M> {
     contacts: &'c Contacts<'s>,
+    /// Each contact's surface, if native ([`Gaps`]).
+    native: Vec<Option<&'c NativeSurface>>,
     scratch: Stepper<M>,
     /// The scratch's force evaluations when it was made (the run's so far).
     counted: u64,
@@ -89,6 +91,7 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
         let m = contacts.len();
         let mut resolver = Resolver {
             contacts,
+            native: contacts.contacts().iter().map(|c| c.surface.native()).collect(),
             counted: scratch.force_evaluations(),
             scratch,
             phi: vec![0.0; m],
@@ -117,11 +120,15 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
         Ok(resolver)
     }
 
-    /// Advances `stepper` by up to `n` steps, one at a time, resolving the impacts of each
-    /// (saved in `traj`: the impacts, and the states just before and after each) and watching
-    /// `search`'s events on the pieces. Returns the event whose terminal count was reached, the
-    /// run stopping at the end of that step; None after the n steps. On failure the stepper is
-    /// at the last good step.
+    /// Advances `stepper` by up to `n` steps, resolving the impacts of each (saved in `traj`:
+    /// the impacts, and the states just before and after each) and watching `search`'s events
+    /// on the pieces. Returns the event whose terminal count was reached, the run stopping at
+    /// the end of that step; None after the n steps. On failure the stepper is at the last good
+    /// step.
+    ///
+    /// Without events the steps are the method's own loop, checked against the contacts after
+    /// each ([`Gaps`]) and stopped by the first that crosses one; with events, one at a time
+    /// (the events need each step's start).
     pub(in crate::integrators) fn advance<St: BorrowMut<StepperState>, P: Poll>(
         &mut self,
         stepper: &mut Stepper<M, St>,
@@ -130,6 +137,10 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
         traj: &mut Trajectory,
         poll: &mut P,
     ) -> Result<Option<usize>, Error> {
+        if search.is_none() {
+            self.advance_clear(stepper, n, traj, poll)?;
+            return Ok(None);
+        }
         for _ in 0..n {
             self.t = stepper.t();
             self.q.copy_from_slice(stepper.q());
@@ -138,48 +149,94 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
                 search.start_step(stepper);
             }
             stepper.advance(1, Counting(|steps| poll.poll(steps)))?;
-            let (step, h) = (stepper.steps(), stepper.dt());
             let first = traj.events.len();
-            evaluate(self.contacts, stepper.q(), &mut self.phi_end, step, self.t)?;
-            let crossed = (0..self.phi.len()).any(|j| {
-                let leaving = self.phi[j] <= 0.0;
-                below(self.phi_end[j] - floor(self.phi[j], leaving), leaving)
-            });
-            let resolved = if crossed {
-                match self.resolve(stepper, search.as_deref_mut(), &mut traj.events) {
-                    Ok(resolved) => resolved,
-                    Err(error) => {
-                        // The run ends at the step's start, with none of the step's events.
-                        traj.events.truncate(first);
-                        stepper.rewind(&self.q, &self.p)?;
-                        return Err(error);
-                    }
-                }
-            } else {
-                false
-            };
-            if resolved {
-                for k in 0..self.pending.len() {
-                    let (t, q) = (self.pending.t[k], self.pending.q_at(k));
-                    traj.push_state(t, q, self.pending.p_before_at(k), stepper);
-                    traj.push_state(t, q, self.pending.p_after_at(k), stepper);
-                }
-                traj.impacts.append(&mut self.pending);
-            } else {
-                if crossed {
-                    // The scratch's first piece crossed nothing after all: φ at the step's end.
-                    evaluate(self.contacts, stepper.q(), &mut self.phi_end, step, self.t)?;
-                }
-                std::mem::swap(&mut self.phi, &mut self.phi_end);
-                if let Some(search) = search.as_deref_mut() {
-                    search.piece(step, (stepper.t(), stepper.q(), stepper.p()), h, &mut traj.events)?;
-                }
-            }
+            evaluate(self.contacts, stepper.q(), &mut self.phi_end, stepper.steps(), self.t)?;
+            let crossed = crosses(&self.phi, &self.phi_end);
+            self.settle(stepper, crossed, search.as_deref_mut(), traj, first)?;
             if let Some(stop) = search.as_deref_mut().and_then(|s| s.count(&mut traj.events, first)) {
                 return Ok(Some(stop));
             }
         }
         Ok(None)
+    }
+
+    /// [`Resolver::advance`] without events: the steps that cross no contact in the method's
+    /// own loop, each that crosses one settled as the one-at-a-time loop settles it.
+    fn advance_clear<St: BorrowMut<StepperState>, P: Poll>(
+        &mut self,
+        stepper: &mut Stepper<M, St>,
+        n: usize,
+        traj: &mut Trajectory,
+        poll: &mut P,
+    ) -> Result<(), Error> {
+        let mut left = n;
+        while left > 0 {
+            let before = stepper.steps();
+            let mut gaps = Gaps {
+                contacts: self.contacts,
+                native: &self.native,
+                phi: &mut self.phi,
+                phi_end: &mut self.phi_end,
+                error: None,
+            };
+            let start = (&mut self.t, &mut self.q[..], &mut self.p[..]);
+            let stopped = stepper.advance_while(left, Counting(|steps| poll.poll(steps)), &mut gaps, start)?;
+            if let Some(source) = gaps.error.take() {
+                let (step, time) = (stepper.steps(), self.t);
+                return Err(Error::Model { step, time, source });
+            }
+            left -= stepper.steps() - before;
+            if stopped {
+                self.settle(stepper, true, None, traj, traj.events.len())?;
+            }
+        }
+        Ok(())
+    }
+
+    /// The step just taken by `stepper` from the kept start (t, q, p), with φ at its end in
+    /// `phi_end`: redone in pieces if it `crossed` a contact (its impacts, and the states just
+    /// before and after each, saved in `traj`), `search`'s events located on it or its pieces
+    /// (those from `first` on are the step's). On failure the stepper is at the step's start.
+    fn settle<St: BorrowMut<StepperState>>(
+        &mut self,
+        stepper: &mut Stepper<M, St>,
+        crossed: bool,
+        mut search: Option<&mut Search<'_, '_, M>>,
+        traj: &mut Trajectory,
+        first: usize,
+    ) -> Result<(), Error> {
+        let (step, h) = (stepper.steps(), stepper.dt());
+        let resolved = if crossed {
+            match self.resolve(stepper, search.as_deref_mut(), &mut traj.events) {
+                Ok(resolved) => resolved,
+                Err(error) => {
+                    // The run ends at the step's start, with none of the step's events.
+                    traj.events.truncate(first);
+                    stepper.rewind(&self.q, &self.p)?;
+                    return Err(error);
+                }
+            }
+        } else {
+            false
+        };
+        if resolved {
+            for k in 0..self.pending.len() {
+                let (t, q) = (self.pending.t[k], self.pending.q_at(k));
+                traj.push_state(t, q, self.pending.p_before_at(k), stepper);
+                traj.push_state(t, q, self.pending.p_after_at(k), stepper);
+            }
+            traj.impacts.append(&mut self.pending);
+        } else {
+            if crossed {
+                // The scratch's first piece crossed nothing after all: φ at the step's end.
+                evaluate(self.contacts, stepper.q(), &mut self.phi_end, step, self.t)?;
+            }
+            std::mem::swap(&mut self.phi, &mut self.phi_end);
+            if let Some(search) = search {
+                search.piece(step, (stepper.t(), stepper.q(), stepper.p()), h, &mut traj.events)?;
+            }
+        }
+        Ok(())
     }
 
     /// The step just taken by `stepper` from the kept start, redone in pieces: false (nothing
@@ -487,16 +544,71 @@ fn below(phi: f64, leaving: bool) -> bool {
     phi < 0.0 || (phi <= 0.0 && !leaving)
 }
 
+/// Whether a step from φ at its start to φ at its end crosses a contact (one it starts on or
+/// past, it leaves: only φ < 0 past the start's counts).
+fn crosses(phi_start: &[f64], phi_end: &[f64]) -> bool {
+    phi_start.iter().zip(phi_end).any(|(&start, &end)| {
+        let leaving = start <= 0.0;
+        below(end - floor(start, leaving), leaving)
+    })
+}
+
 /// φ of every contact at q into `phi`; a surface's error names the run's step and time.
 fn evaluate(contacts: &Contacts<'_>, q: &[f64], phi: &mut [f64], step: usize, time: f64) -> Result<(), Error> {
     for (c, phi) in contacts.contacts().iter().zip(phi) {
-        *phi = c.surface.phi(q).map_err(|source| Error::Model { step, time, source })?;
-        if !phi.is_finite() {
-            let source = format!("contact {} returned a non-finite φ = {phi}", c.name).into();
-            return Err(Error::Model { step, time, source });
-        }
+        *phi = gap(c, None, q).map_err(|source| Error::Model { step, time, source })?;
     }
     Ok(())
+}
+
+/// φ of contact `c` at q (through `native`, its surface if native, without dispatch); a
+/// non-finite φ is an error.
+#[inline]
+fn gap(c: &Contact<'_>, native: Option<&NativeSurface>, q: &[f64]) -> Result<f64, ModelError> {
+    let phi = match native {
+        Some(surface) => surface.phi(q)?,
+        None => c.surface.phi(q)?,
+    };
+    if !phi.is_finite() {
+        return Err(format!("contact {} returned a non-finite φ = {phi}", c.name).into());
+    }
+    Ok(phi)
+}
+
+/// φ of a run's contacts, checked at the end of each step the method's own loop takes
+/// ([`crate::integrators::Dynamics::advance_while`]): a step is clear when it crosses no
+/// contact, by the test the one-at-a-time loop judges a step by; φ at its end is then the next
+/// step's start. A failing φ stops the steps as a crossing does, its error kept for the run.
+pub struct Gaps<'g, 's> {
+    contacts: &'g Contacts<'s>,
+    /// Each contact's surface, if native.
+    native: &'g [Option<&'g NativeSurface>],
+    /// φ at the state (the next step's start), and at a step's end.
+    phi: &'g mut [f64],
+    phi_end: &'g mut [f64],
+    error: Option<ModelError>,
+}
+
+impl Gaps<'_, '_> {
+    /// Whether a step ending at q crosses no contact, each φ evaluated (finite); φ at q is
+    /// then the next step's start.
+    #[inline]
+    pub fn clear(&mut self, q: &[f64]) -> bool {
+        for (j, c) in self.contacts.contacts().iter().enumerate() {
+            match gap(c, self.native[j], q) {
+                Ok(phi) => self.phi_end[j] = phi,
+                Err(error) => {
+                    self.error = Some(error);
+                    return false;
+                }
+            }
+        }
+        if crosses(self.phi, self.phi_end) {
+            return false;
+        }
+        self.phi.copy_from_slice(self.phi_end);
+        true
+    }
 }
 
 /// A partial step's error, named by the run's step and its start.

@@ -10,9 +10,9 @@ use crate::integrators::{Contacts, Detector, Dynamics, Poll, Stepper, StepperSta
 use crate::Error;
 
 /// What a run watches besides its states: events ([`Detector`]) and contacts ([`Contacts`]),
-/// either, both or neither. Both are checked after every step (the steps are then taken one
-/// at a time); a step that crosses a contact is redone in pieces at each impact, and the events
-/// are evaluated and located on the pieces.
+/// either, both or neither. Both are checked after every step (contacts alone inside the
+/// method's own loop, events with the steps taken one at a time); a step that crosses a contact
+/// is redone in pieces at each impact, and the events are evaluated and located on the pieces.
 #[derive(Default)]
 pub struct Watch<'w, 'e, 'c> {
     /// The events, located by partial steps of the method ([`crate::integrators::integrate_with_events`]).
