@@ -515,9 +515,23 @@ fn a_stepper_watching_a_contact_never_hit_allocates_nothing() {
     }
     let double = scenes::DoublePendulum::new(1.0, 2.0, 2.0, 3.0, 9.80665).unwrap();
     let general = General(&double);
-    let stepper = Stepper::new(&general, Method::Midpoint, &[0.7, -0.4], &[1.3, 0.8], &Options::new(0.01, 0)).unwrap();
+    let stepper = Stepper::new(
+        &general,
+        Method::Midpoint,
+        &[0.7, -0.4],
+        &[1.3, 0.8],
+        &Options::new(0.01, 0),
+    )
+    .unwrap();
     assert_eq!(watched_allocations(&general, stepper, 0, 2000), 0);
     let chain = scenes::planar_chain(8).unwrap();
-    let stepper = Stepper::new(&chain.system, Method::Rattle, &chain.initial.q, &chain.initial.p, &Options::new(0.01, 0)).unwrap();
+    let stepper = Stepper::new(
+        &chain.system,
+        Method::Rattle,
+        &chain.initial.q,
+        &chain.initial.p,
+        &Options::new(0.01, 0),
+    )
+    .unwrap();
     assert_eq!(watched_allocations(&chain.system, stepper, 1, 2000), 0);
 }

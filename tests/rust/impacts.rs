@@ -4,9 +4,9 @@
 //! without an impact, a resumed run and an ensemble member are those of the plain run.
 
 use varmech::integrators::{
-    integrate, integrate_ensemble_watching, Dynamics, General, integrate_watching, integrate_with_events, resume_watching, Checkpoint,
-    Contact, Contacts, Detector, DiscreteEnergy, EventSpec, Impacts, Law, MemberEvents, Method, NativeContact,
-    NativeEvent, NativeSurface, Options, Parallel, Shared, Stepper, Trajectory, Watch, Watcher,
+    integrate, integrate_ensemble_watching, integrate_watching, integrate_with_events, resume_watching, Checkpoint,
+    Contact, Contacts, Detector, DiscreteEnergy, Dynamics, EventSpec, General, Impacts, Law, MemberEvents, Method,
+    NativeContact, NativeEvent, NativeSurface, Options, Parallel, Shared, Stepper, Trajectory, Watch, Watcher,
 };
 use varmech::model::Lagrangian;
 use varmech::scenes::{planar_chain, BouncingBall, EllipticBilliard, NBody};
@@ -557,7 +557,14 @@ fn wall(coordinate: usize, value: f64, law: Law) -> Contacts<'static> {
 /// steps in the method's own loop, against the same run plain (`contacts` never hit) or
 /// watching an event that never occurs, which takes them one at a time: the same states, bit
 /// for bit, and the same impacts.
-fn same_bits<S: Dynamics>(model: &S, method: Method, (q0, p0): (&[f64], &[f64]), options: &Options, contacts: &Contacts<'static>, plain: bool) -> usize {
+fn same_bits<S: Dynamics>(
+    model: &S,
+    method: Method,
+    (q0, p0): (&[f64], &[f64]),
+    options: &Options,
+    contacts: &Contacts<'static>,
+    plain: bool,
+) -> usize {
     let fast = integrate_watching(model, method, q0, p0, options, || Ok(()), with_contacts(contacts)).unwrap();
     let other = if plain {
         integrate(model, method, q0, p0, options, || Ok(())).unwrap()
@@ -571,7 +578,11 @@ fn same_bits<S: Dynamics>(model: &S, method: Method, (q0, p0): (&[f64], &[f64]),
     };
     assert!(other.events.is_empty());
     assert_eq!(fast.len(), other.len(), "{method:?}");
-    assert_eq!((&fast.t, &fast.q, &fast.p), (&other.t, &other.q, &other.p), "{method:?}");
+    assert_eq!(
+        (&fast.t, &fast.q, &fast.p),
+        (&other.t, &other.q, &other.p),
+        "{method:?}"
+    );
     assert_eq!(fast.impacts, other.impacts, "{method:?}");
     // The checkpoint counts the work done: the events' partial steps, and the Wisdom–Holman
     // methods' synchronisation after each step, which a watched run needs.
@@ -609,7 +620,14 @@ fn a_contact_never_hit_leaves_every_step_loop_bit_for_bit_the_plain_one() {
         ..Options::new(10.0, 500)
     };
     for method in [Method::Verlet, Method::WisdomHolmanCorrected] {
-        same_bits(&solar.system, method, initial, &options, &wall(4, -1e9, Law::Reflect), true);
+        same_bits(
+            &solar.system,
+            method,
+            initial,
+            &options,
+            &wall(4, -1e9, Law::Reflect),
+            true,
+        );
     }
     let chain = planar_chain(8).unwrap();
     let options = Options {
@@ -617,7 +635,14 @@ fn a_contact_never_hit_leaves_every_step_loop_bit_for_bit_the_plain_one() {
         ..Options::new(0.01, 500)
     };
     let initial = (&chain.initial.q[..], &chain.initial.p[..]);
-    same_bits(&chain.system, Method::Rattle, initial, &options, &wall(1, -1e3, Law::Reflect), true);
+    same_bits(
+        &chain.system,
+        Method::Rattle,
+        initial,
+        &options,
+        &wall(1, -1e3, Law::Reflect),
+        true,
+    );
 }
 
 #[test]
@@ -646,7 +671,14 @@ fn steps_with_impacts_in_the_methods_loop_are_bit_for_bit_those_taken_one_at_a_t
     assert!(impacts >= 30);
     let free = EllipticBilliard::new(1.0, 1.0).unwrap();
     for method in [Method::Verlet, Method::Midpoint] {
-        let impacts = same_bits(&free, method, (&[0.3, -0.2], &[0.6, 0.8]), &options, &circle(1.0, Law::Reflect), false);
+        let impacts = same_bits(
+            &free,
+            method,
+            (&[0.3, -0.2], &[0.6, 0.8]),
+            &options,
+            &circle(1.0, Law::Reflect),
+            false,
+        );
         assert!(impacts >= 10, "{method:?}: {impacts} impacts");
     }
 }

@@ -7,9 +7,7 @@ use std::borrow::{Borrow, BorrowMut};
 use std::ops::Deref;
 
 use super::checkpoint::shape::shape;
-use super::{
-    compensated, Dynamics, Gaps, General, Increment, Integrator, Method, Options, Poll, StepError, StepStart,
-};
+use super::{compensated, Dynamics, Gaps, General, Increment, Integrator, Method, Options, Poll, StepError, StepStart};
 use crate::error::check_vector;
 use crate::model::{Lagrangian, MechanicalSystem};
 use crate::solve::interrupt::InterruptPoll;
@@ -500,7 +498,8 @@ impl StepperState {
         if let Some(result) = sys.as_nbody().and_then(|nbody| self.advance_own(nbody, steps)) {
             return result;
         }
-        self.advance_separable_while(sys, steps, &mut |_: &[f64]| true).map(drop)
+        self.advance_separable_while(sys, steps, &mut |_: &[f64]| true)
+            .map(drop)
     }
 
     /// `steps` steps of a separable system, stopping after the first whose end q is not

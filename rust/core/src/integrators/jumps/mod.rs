@@ -17,8 +17,8 @@ mod surfaces;
 mod variational;
 mod watch;
 
-pub(in crate::integrators) use resolve::Resolver;
 pub use resolve::Gaps;
+pub(in crate::integrators) use resolve::Resolver;
 pub use surfaces::NativeSurface;
 pub(crate) use surfaces::{check_ellipsoid, ellipsoid, wall};
 pub use watch::{Watch, Watcher};
