@@ -177,11 +177,17 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
                 native: &self.native,
                 phi: &mut self.phi,
                 phi_end: &mut self.phi_end,
+                swapped: false,
                 error: None,
             };
             let start = (&mut self.t, &mut self.q[..], &mut self.p[..]);
-            let stopped = stepper.advance_while(left, Counting(|steps| poll.poll(steps)), &mut gaps, start)?;
-            if let Some(source) = gaps.error.take() {
+            let stopped = stepper.advance_while(left, Counting(|steps| poll.poll(steps)), &mut gaps, start);
+            let (swapped, error) = (gaps.swapped, gaps.error.take());
+            if swapped {
+                std::mem::swap(&mut self.phi, &mut self.phi_end);
+            }
+            let stopped = stopped?;
+            if let Some(source) = error {
                 let (step, time) = (stepper.steps(), self.t);
                 return Err(Error::Model { step, time, source });
             }
@@ -544,13 +550,17 @@ fn below(phi: f64, leaving: bool) -> bool {
     phi < 0.0 || (phi <= 0.0 && !leaving)
 }
 
-/// Whether a step from φ at its start to φ at its end crosses a contact (one it starts on or
-/// past, it leaves: only φ < 0 past the start's counts).
+/// Whether a step from φ at its start to φ at its end crosses a contact.
 fn crosses(phi_start: &[f64], phi_end: &[f64]) -> bool {
-    phi_start.iter().zip(phi_end).any(|(&start, &end)| {
-        let leaving = start <= 0.0;
-        below(end - floor(start, leaving), leaving)
-    })
+    phi_start.iter().zip(phi_end).any(|(&start, &end)| crossing(start, end))
+}
+
+/// Whether a step from φ = `start` to φ = `end` crosses the contact (one it starts on or past,
+/// it leaves: only φ < 0 past the start's counts).
+#[inline(always)]
+fn crossing(start: f64, end: f64) -> bool {
+    let leaving = start <= 0.0;
+    below(end - floor(start, leaving), leaving)
 }
 
 /// φ of every contact at q into `phi`; a surface's error names the run's step and time.
@@ -563,7 +573,7 @@ fn evaluate(contacts: &Contacts<'_>, q: &[f64], phi: &mut [f64], step: usize, ti
 
 /// φ of contact `c` at q (through `native`, its surface if native, without dispatch); a
 /// non-finite φ is an error.
-#[inline]
+#[inline(always)]
 fn gap(c: &Contact<'_>, native: Option<&NativeSurface>, q: &[f64]) -> Result<f64, ModelError> {
     let phi = match native {
         Some(surface) => surface.phi(q)?,
@@ -583,30 +593,36 @@ pub struct Gaps<'g, 's> {
     contacts: &'g Contacts<'s>,
     /// Each contact's surface, if native.
     native: &'g [Option<&'g NativeSurface>],
-    /// φ at the state (the next step's start), and at a step's end.
+    /// φ at the state (the next step's start), and at a step's end: the resolver's, swapped
+    /// (`swapped`) rather than copied after a clear step.
     phi: &'g mut [f64],
     phi_end: &'g mut [f64],
+    swapped: bool,
     error: Option<ModelError>,
 }
 
 impl Gaps<'_, '_> {
     /// Whether a step ending at q crosses no contact, each φ evaluated (finite); φ at q is
     /// then the next step's start.
-    #[inline]
+    #[inline(always)]
     pub fn clear(&mut self, q: &[f64]) -> bool {
-        for (j, c) in self.contacts.contacts().iter().enumerate() {
-            match gap(c, self.native[j], q) {
-                Ok(phi) => self.phi_end[j] = phi,
+        let mut crossed = false;
+        let contacts = self.contacts.contacts().iter().zip(self.native);
+        for ((c, native), (start, end)) in contacts.zip(self.phi.iter().zip(self.phi_end.iter_mut())) {
+            *end = match gap(c, *native, q) {
+                Ok(phi) => phi,
                 Err(error) => {
                     self.error = Some(error);
                     return false;
                 }
-            }
+            };
+            crossed |= crossing(*start, *end);
         }
-        if crosses(self.phi, self.phi_end) {
+        if crossed {
             return false;
         }
-        self.phi.copy_from_slice(self.phi_end);
+        std::mem::swap(&mut self.phi, &mut self.phi_end);
+        self.swapped = !self.swapped;
         true
     }
 }

@@ -69,7 +69,7 @@ pub(crate) fn check_ellipsoid(coordinates: &[usize], centre: &[f64], semi_axes: 
 }
 
 impl Surface for NativeSurface {
-    #[inline]
+    #[inline(always)]
     fn phi(&self, q: &[f64]) -> Result<f64, ModelError> {
         Ok(match self {
             NativeSurface::Wall { coordinate, value } => wall(q, *coordinate, *value),
