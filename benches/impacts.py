@@ -23,7 +23,7 @@ well is the other common version; on a curved wall it needs the nearest point.)
   impacts``): the trajectory with its impacts, and the invariant's error over 10⁴ impacts.
 
     PYTHONPATH=$PWD/python python benches/impacts.py [--repeat 5] [--quick] [--old /tmp/old88600cf]
-        [--markdown benches/impacts_results.md]
+        [--markdown benches/impacts_results.md | --only "never hit"]
 
 ``--quick`` shrinks every size (10² bounces and impacts, 10⁴ for the million, 32 ensemble
 members) to check that the bench runs; its numbers are not the results.
@@ -142,13 +142,12 @@ LAWS = ("variational", "reflect")
 CIRCLE_Q0, CIRCLE_P0 = [0.3, 0.1], [0.6, 0.8]
 
 
-def timed_run(vm, scene: str, law: str | None, steps: int, dt: float, far: bool = False):
+def timed_run(vm, scene: str, law: str | None, steps: int, dt: float, far: bool = False, method: str = "verlet"):
     """One run of the cost tables, built with the varmech module ``vm`` (this one, or the old
     one in its subprocess, which gets this function's source): the native ``scene`` ("ball" on
     ``Contact.wall(0)``, "billiard" the elliptic table A = 2, B = 1, "circle" the unit circle)
     with its contact under ``law`` (none if None; with ``far`` one never hit, the wall moved to
-    10³⁰); returns the
-    seconds of the ``integrate`` call and its impacts."""
+    10³⁰), stepped by ``method``; returns the seconds of the ``integrate`` call and its impacts."""
     if scene == "ball":
         model, q0, p0 = vm.scenes.bouncing_ball().model, [1.0], [0.0]
         contact = lambda: vm.Contact.wall(0, -1e30 if far else 0.0, law=law)  # noqa: E731
@@ -158,7 +157,7 @@ def timed_run(vm, scene: str, law: str | None, steps: int, dt: float, far: bool 
         contact = lambda: vm.Contact.ellipsoid([1e30 * a for a in axes] if far else axes, law=law)  # noqa: E731
     contacts = {} if law is None else {"contacts": [contact()]}
     start = time.perf_counter()
-    traj = vm.integrate(model, q0, p0, dt=dt, steps=steps, save_every=10**9, method="verlet", **contacts)
+    traj = vm.integrate(model, q0, p0, dt=dt, steps=steps, save_every=10**9, method=method, **contacts)
     return time.perf_counter() - start, (len(traj.events[0]) if contacts else 0)
 
 
@@ -294,41 +293,45 @@ def million(repeat: int, quick: bool, skipped: dict[str, str]) -> list[str]:
 
 def idle_contact(repeat: int, quick: bool, old: OldCore | None, skipped: dict[str, str]) -> list[str]:
     """A run with a contact never hit (the ball's floor at −10³⁰) against the same run without,
-    old and new, and the new one against the same wall as a native event (no contact)."""
+    old and new, for verlet and yoshida4, and the new one against the same wall as a native event
+    (no contact)."""
     dt, steps, least = 1e-3, 10**6, (0.05 if quick else 0.3)
     seconds, _ = timed_run(varmech, "ball", None, steps, dt)
     steps = max(steps, math.ceil(steps * 1.3 * least / seconds))  # long enough to time
     sides = {"new": lambda *a: timed_run(varmech, *a), **({"old": old} if old is not None else {})}
+    methods = ("verlet", "yoshida4")
     runs = {}
     for side, run in sides.items():
-        runs[(side, None)] = lambda run=run: run("ball", None, steps, dt)
-        for law in LAWS:
-            if not (side == "new" and law in skipped):
-                runs[(side, law)] = lambda run=run, law=law: run("ball", law, steps, dt, True)
+        for method in methods:
+            runs[(side, method, None)] = lambda run=run, m=method: run("ball", None, steps, dt, False, m)
+            for law in LAWS:
+                if not (side == "new" and law in skipped):
+                    runs[(side, method, law)] = lambda run=run, law=law, m=method: run("ball", law, steps, dt, True, m)
     model = varmech.scenes.bouncing_ball().model
-    runs[("new", "event")] = lambda: (
+    runs[("new", "verlet", "event")] = lambda: (
         _seconds(varmech.integrate, model, [1.0], [0.0], dt=dt, steps=steps, save_every=10**9, events=[varmech.events.crossing(0, -1e30)]),
         0,
     )
     best = best_interleaved(runs, repeat)
     lines = [
-        f"The native ball, verlet, h = {dt:g}, {steps} steps, `save_every` = 10⁹, with `Contact.wall(0, -1e30)` (never hit) "
-        f"and without contacts; and (new only) the same wall as a native event `events.crossing(0, -1e30)`, no contact. "
-        f"Best of {repeat}, interleaved.",
+        f"The native ball, h = {dt:g}, {steps} steps, `save_every` = 10⁹, with `Contact.wall(0, -1e30)` (never hit) "
+        f"and without contacts; and (new only, verlet) the same wall as a native event `events.crossing(0, -1e30)`, no "
+        f"contact. Best of {repeat}, interleaved.",
         "",
-        "| run | old s | old ÷ no contacts | new s | new ÷ no contacts |",
-        "|---|---:|---:|---:|---:|",
+        "| method | run | old s | old ÷ no contacts | new s | new ÷ no contacts |",
+        "|---|---|---:|---:|---:|---:|",
     ]
-    for what in (None, *LAWS, "event"):
-        cells = []
-        for side in ("old", "new"):
-            if (side, what) in best:
-                seconds = best[(side, what)][0]
-                cells += [f"{seconds:.3f}", f"{seconds / best[(side, None)][0]:.3f}"]
-            else:
-                cells += ["skipped" if side == "new" else "–", "–"]
-        name = {None: "no contacts", "event": "crossing event, no contact"}.get(what, f"contact, law {what}")
-        lines.append(f"| {name} | {' | '.join(cells)} |")
+    for method in methods:
+        for what in (None, *LAWS, *(("event",) if method == "verlet" else ())):
+            cells = []
+            for side in ("old", "new"):
+                if (side, method, what) in best:
+                    seconds = best[(side, method, what)][0]
+                    cells += [f"{seconds:.3f}", f"{seconds / best[(side, method, None)][0]:.3f}"]
+                else:
+                    cells += ["skipped" if side == "new" else "–", "–"]
+            name = {None: "no contacts", "event": "crossing event, no contact"}.get(what, f"contact, law {what}")
+            lines.append(f"| {method} | {name} | {' | '.join(cells)} |")
     lines += ["", "Target (issue 33): ≤ 1.05× (a contact, native scene, verlet)."]
     return lines
 
@@ -518,7 +521,10 @@ def main() -> None:
     parser.add_argument("--quick", action="store_true", help="small sizes, to check that the bench runs")
     parser.add_argument("--old", type=Path, default=OLD, help="a checkout of the old implementation (commit 88600cf), built")
     parser.add_argument("--markdown", type=Path)
+    parser.add_argument("--only", help="run only the sections whose title contains this (printed; not with --markdown)")
     args = parser.parse_args()
+    if args.only is not None and args.markdown is not None:
+        parser.error("--only prints some sections; --markdown writes the whole file: give one of them")
     start = time.perf_counter()
     commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True, cwd=Path(__file__).parent).stdout.strip()
     dirty = subprocess.run(["git", "status", "--porcelain"], capture_output=True, text=True, cwd=Path(__file__).parent).stdout.strip()
@@ -526,16 +532,20 @@ def main() -> None:
     skipped = {law: why for law in LAWS if (why := law_available(law)) is not None}
     old = OldCore(args.old) if (args.old / "python" / "varmech").is_dir() else None
     try:
-        sections = {
-            "Cost per impact: old (Python loop around the core) and new (in the core's step loop)": per_impact(
+        every = {
+            "Cost per impact: old (Python loop around the core) and new (in the core's step loop)": lambda: per_impact(
                 args.repeat, args.quick, old, skipped
             ),
-            "A circular billiard to 10⁶ impacts": million(args.repeat, args.quick, skipped),
-            "A contact never hit": idle_contact(args.repeat, args.quick, old, skipped),
-            "An ensemble of billiards on 1 and 2 workers": ensemble_speedup(args.repeat, args.quick, skipped),
-            "Accuracy at matched cost: the billiard's focal invariant": matched_cost(args.repeat, args.quick, skipped),
-            "The ball: energy and bounce times": ball_accuracy(args.quick, skipped),
+            "A circular billiard to 10⁶ impacts": lambda: million(args.repeat, args.quick, skipped),
+            "A contact never hit": lambda: idle_contact(args.repeat, args.quick, old, skipped),
+            "An ensemble of billiards on 1 and 2 workers": lambda: ensemble_speedup(args.repeat, args.quick, skipped),
+            "Accuracy at matched cost: the billiard's focal invariant": lambda: matched_cost(args.repeat, args.quick, skipped),
+            "The ball: energy and bounce times": lambda: ball_accuracy(args.quick, skipped),
         }
+        wanted = {title: section for title, section in every.items() if (args.only or "").lower() in title.lower()}
+        if not wanted:
+            parser.error(f"--only {args.only!r} names no section; they are: {', '.join(every)}")
+        sections = {title: section() for title, section in wanted.items()}
     finally:
         if old is not None:
             old.close()

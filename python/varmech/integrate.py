@@ -222,8 +222,9 @@ def integrate(
         grid state before it (or from the last jump, an impact or an impulse, between them), so
         it has the method's own error (order measured in ``tests/python/test_dense.py``), as
         ``solve_ivp(t_eval=)`` does with its dense output. At a jump's time it is the state just
-        before. The run itself is unchanged (it ends on its grid, with its checkpoint); not with
-        ``save_every`` or ``output``, whose rows are the run's own states.
+        before. The run itself is unchanged (it ends on its grid, with its checkpoint, from which
+        ``integrate(traj, steps=, t_eval=)`` goes on); not with ``save_every`` or ``output``,
+        whose rows are the run's own states.
     impulses
         Blows (:class:`varmech.Impulse`) at their times ``impulse.t`` within the run: the momenta
         jump by P(q) there (on a constrained model, projected back on the constraints by their
@@ -325,12 +326,10 @@ def integrate(
             "impulses": impulses,
             "contacts": contacts,
         }
-        named = [name for name, value in given.items() if value is not None]
-        if named and named[0] == "t_eval":
-            raise ValueError(f"{named[0]}: not with a continued run (start a new run from its last state)")
+        named = [name for name, value in given.items() if value is not None and name != "t_eval"]
         if named:
             raise ValueError(f"{named[0]}: a continued run keeps its trajectory's {', '.join(named)}")
-        return _go_on(model, steps, t_end, save_every, progress, output, overwrite, checkpoint_every, events)
+        return _go_on(model, steps, t_end, save_every, progress, output, overwrite, checkpoint_every, events, t_eval)
     contacts = _contacts_of(model, contacts) or None
     model, q0, p0 = _model_of(model, q0, p0, v0)
     if parameters is not None:
@@ -360,12 +359,7 @@ def integrate(
 
     contact_specs = _impacts.specs(contacts or ())
     impulse_specs = _impulses.specs(impulses, t0, t_end) if impulses is not None else []
-    times = None
-    if t_eval is not None:
-        for name, clash in (("save_every", save_every != 1), ("output", output is not None)):
-            if clash:
-                raise ValueError(f"{name}: not with t_eval, which keeps the states at its times, not the run's own")
-        times = dense.eval_times(t_eval, t0, t_end)
+    times = _sample_times(t_eval, t0, t_end, save_every, output)
 
     def first(steps: int, report: Callable[[int], None] | None) -> _core.TrajectoryRecord:
         return _core.integrate(
@@ -408,6 +402,19 @@ def integrate(
     )
 
 
+def _sample_times(
+    t_eval: ArrayLike | None, t0: float, t_end: float, save_every: int, output: str | os.PathLike[str] | None
+) -> np.ndarray | None:
+    """``t_eval`` checked for a run over [t0, t_end] (``dense.eval_times``), refusing
+    ``save_every`` and ``output`` with it."""
+    if t_eval is None:
+        return None
+    for name, clash in (("save_every", save_every != 1), ("output", output is not None)):
+        if clash:
+            raise ValueError(f"{name}: not with t_eval, which keeps the states at its times, not the run's own")
+    return dense.eval_times(t_eval, t0, t_end)
+
+
 def _go_on(
     traj: Trajectory,
     steps: int | None,
@@ -418,15 +425,19 @@ def _go_on(
     overwrite: bool,
     checkpoint_every: int | datetime.timedelta | None,
     events: Sequence[_events.Event | _events.EventFunction] | None,
+    t_eval: ArrayLike | None = None,
 ) -> Trajectory:
     """``integrate(traj, steps=)``: the run of ``traj`` continued from its checkpoint, watching
     ``events`` from there (terminal counts after ``traj``'s crossings of the same events, an
-    energy error from ``traj``'s first energy)."""
+    energy error from ``traj``'s first energy), keeping the states at ``t_eval`` if given."""
     contacts = _impacts.going_on(traj.contacts)
     if traj.checkpoint is None:
         raise ValueError("model: this trajectory has no checkpoint to go on from (it failed before its first state)")
-    nsteps = step_count(traj.dt, float(traj.t[-1]), steps, t_end)
+    # The checkpoint's time: a trajectory of t_eval times ends at its last sample, not there.
+    t_now = _core.Stepper.from_checkpoint(traj.model._core, traj.checkpoint).t
+    nsteps = step_count(traj.dt, t_now, steps, t_end)
     save_every = positive_int("save_every", save_every)
+    times = _sample_times(t_eval, t_now, t_now + nsteps * traj.dt, save_every, output)
     watched, specs = _events.specs(events, traj.model.dim) if events is not None else ([], [])
     found = _events.found_before(traj.events, watched)
     initial = _events.first_energy(traj.model, traj) if watched else None
@@ -448,7 +459,8 @@ def _go_on(
         initial,
         found,
         contacts=contacts,
-        impulses=_impulses.going_on(traj.impulses, None, float(traj.t[-1])),
+        impulses=_impulses.going_on(traj.impulses, None, t_now),
+        times=times,
     )
 
 
@@ -472,14 +484,16 @@ def _run(
     *,
     contacts: Sequence[_impacts.Contact] = (),
     impulses: Sequence[_impulses.Impulse] = (),
+    times: np.ndarray | None = None,
 ) -> Trajectory:
     """Runs ``nsteps`` steps by ``first`` (a new run) or from ``checkpoint`` (after ``base``
     steps): in memory, or streamed to ``output`` in segments (:mod:`varmech.streaming`).
     ``watched`` are the run's events (``event_specs`` the binding's), whose crossings the result
     reports; a continued run's are watched after ``found`` crossings of each, an energy error
     measured from ``initial_energy``. The run resolves the impacts on ``contacts``, which the
-    result reports after the events' crossings, and applies the ``impulses`` after its start (a
-    continued run's, those still to come)."""
+    result reports after the events' crossings, applies the ``impulses`` after its start (a
+    continued run's, those still to come) and keeps the states at ``times`` alone if given (a
+    continued run's; a new run's ``first`` takes its own)."""
     # Their times were checked against the run's span when it began.
     impulse_specs = _impulses.specs(impulses, -math.inf, math.inf)
     bar = progress_bar(total=nsteps, unit="step", desc=method, enabled=progress)
@@ -550,6 +564,7 @@ def _run(
                     dt=dt,
                     contacts=_impacts.specs(contacts) or None,
                     impulses=impulse_specs or None,
+                    t_eval=times,
                 )
             bar.update(record.steps - base - bar.n)
         except BaseException as err:

@@ -121,3 +121,18 @@ def test_bad_t_eval_is_named():
             varmech.integrate(s, dt=0.1, steps=100, t_eval=bad)
     with pytest.raises(ValueError, match="^save_every: not with t_eval"):
         varmech.integrate(s, dt=0.1, steps=100, save_every=10, t_eval=[0.5])
+
+
+def test_a_run_of_t_eval_times_goes_on_from_its_checkpoint_with_more_of_them():
+    # The trajectory ends at its last sample; the run at its last step, where it goes on from.
+    s = varmech.scenes.pendulum()
+    first, second = np.linspace(0.013, 2.9, 17), np.linspace(5.013, 9.9, 23)
+    whole = varmech.integrate(s, dt=0.01, steps=1000, t_eval=np.concatenate([first, second]))
+    half = varmech.integrate(s, dt=0.01, steps=500, t_eval=first)
+    more = varmech.integrate(half, t_end=10.0, t_eval=second)
+    np.testing.assert_array_equal(more.t, second)
+    np.testing.assert_array_equal(more.q, whole.q[len(first) :])
+    np.testing.assert_array_equal(more.p, whole.p[len(first) :])
+    assert more.steps == 1000
+    with pytest.raises(ValueError, match=r"^t_eval: must lie within the run's span \[5.0"):
+        varmech.integrate(half, t_end=10.0, t_eval=[4.0])

@@ -13,7 +13,7 @@ use std::ops::Deref;
 
 use varmech::integrators::{
     integrate, integrate_watching, Contact, Contacts, DiscreteEnergy, Dynamics, General, Law, Method, ModelKind,
-    NativeSurface, Options, Stepper, StepperState, Watch,
+    NativeSurface, Options, Stepper, StepperState, Trajectory, Watch, Watcher,
 };
 use varmech::model::Routhian;
 use varmech::scenes::{self, NBody, NonholonomicScene, SceneModel};
@@ -466,4 +466,73 @@ fn contacts_allocate_nothing_in_the_step_loop() {
         "{} allocations for {many} impacts",
         long - short
     );
+}
+
+/// Allocations of `steps` steps of `stepper` through a watcher of a wall q_k ≥ −10⁹ that it
+/// never reaches, after a first call (which sizes the watcher's buffers).
+fn watched_allocations<M>(model: M, mut stepper: Stepper<M>, coordinate: usize, steps: usize) -> usize
+where
+    M: Deref<Target: Dynamics> + Copy,
+{
+    let far = Contact {
+        surface: Box::new(NativeSurface::Wall {
+            coordinate,
+            value: -1e9,
+        }),
+        restitution: 1.0,
+        law: Law::Reflect,
+        name: "far".into(),
+    };
+    let contacts = Contacts::new(vec![far]).unwrap();
+    let watch = Watch {
+        contacts: Some(&contacts),
+        ..Watch::default()
+    };
+    let mut watcher = Watcher::begin(model, &stepper, watch, "q0", false).unwrap();
+    let mut record = Trajectory::default();
+    let mut poll = || Ok(());
+    watcher.advance(&mut stepper, 1, &mut record, &mut poll).unwrap();
+    let before = allocated();
+    watcher.advance(&mut stepper, steps, &mut record, &mut poll).unwrap();
+    let count = allocated() - before;
+    assert_eq!((stepper.steps(), record.impacts.len()), (steps + 1, 0));
+    count
+}
+
+#[test]
+fn a_stepper_watching_a_contact_never_hit_allocates_nothing() {
+    // Each loop the steps may take: fixed-size kick–drift (the billiard), step by step (18
+    // coordinates), the method's own variables (Wisdom–Holman), the fixed-size DEL loop (the
+    // double pendulum) and a constrained model's (RATTLE on the chain).
+    let free = scenes::EllipticBilliard::new(1.0, 1.0).unwrap();
+    let stepper = Stepper::new(&free, Method::Verlet, &[0.3, -0.2], &[0.6, 0.8], &Options::new(0.01, 0)).unwrap();
+    assert_eq!(watched_allocations(&free, stepper, 0, 10_000), 0);
+    let problem = NBody::outer_solar_system();
+    let (q0, p0) = (&problem.initial.q, &problem.initial.p);
+    for method in [Method::Verlet, Method::WisdomHolmanCorrected] {
+        let stepper = Stepper::new(&problem.system, method, q0, p0, &Options::new(10.0, 0)).unwrap();
+        let count = watched_allocations(&problem.system, stepper, 4, 2000);
+        assert_eq!(count, 0, "{method:?}: {count} allocations");
+    }
+    let double = scenes::DoublePendulum::new(1.0, 2.0, 2.0, 3.0, 9.80665).unwrap();
+    let general = General(&double);
+    let stepper = Stepper::new(
+        &general,
+        Method::Midpoint,
+        &[0.7, -0.4],
+        &[1.3, 0.8],
+        &Options::new(0.01, 0),
+    )
+    .unwrap();
+    assert_eq!(watched_allocations(&general, stepper, 0, 2000), 0);
+    let chain = scenes::planar_chain(8).unwrap();
+    let stepper = Stepper::new(
+        &chain.system,
+        Method::Rattle,
+        &chain.initial.q,
+        &chain.initial.p,
+        &Options::new(0.01, 0),
+    )
+    .unwrap();
+    assert_eq!(watched_allocations(&chain.system, stepper, 1, 2000), 0);
 }

@@ -5,11 +5,11 @@
 
 use varmech::integrators::{
     integrate, integrate_watching, integrate_with_events, resume_watching, Checkpoint, Contact, Contacts, Detector,
-    DiscreteEnergy, EventSpec, Failure, Impacts, Law, MemberWatch, Method, NativeContact, NativeEvent, NativeSurface,
-    Options, Stepper, Trajectory, Watch, Watcher,
+    DiscreteEnergy, Dynamics, EventSpec, Failure, General, Impacts, Law, MemberWatch, Method, NativeContact,
+    NativeEvent, NativeSurface, Options, Stepper, Trajectory, Watch, Watcher,
 };
 use varmech::model::Lagrangian;
-use varmech::scenes::{BouncingBall, EllipticBilliard};
+use varmech::scenes::{planar_chain, BouncingBall, EllipticBilliard, NBody};
 use varmech::{Error, ModelError};
 
 use crate::common::verlet_ensemble;
@@ -611,4 +611,146 @@ fn a_state_a_round_off_past_a_surface_is_refused_at_the_start_and_taken_as_leavi
     assert!(record.impacts.is_empty());
     assert!(stepper.q()[0] > 0.0);
     assert_eq!((stepper.q(), stepper.p()), (free.q(), free.p()));
+}
+
+/// A wall q_k ≥ `value` (reflect law), named "wall".
+fn wall(coordinate: usize, value: f64, law: Law) -> Contacts<'static> {
+    let contact = Contact {
+        surface: Box::new(NativeSurface::Wall { coordinate, value }),
+        restitution: 1.0,
+        law,
+        name: "wall".into(),
+    };
+    Contacts::new(vec![contact]).unwrap()
+}
+
+/// The run of `method` on `model` from (q0, p0) with `contacts` and no events, which takes its
+/// steps in the method's own loop, against the same run plain (`contacts` never hit) or
+/// watching an event that never occurs, which takes them one at a time: the same states, bit
+/// for bit, and the same impacts.
+fn same_bits<S: Dynamics>(
+    model: &S,
+    method: Method,
+    (q0, p0): (&[f64], &[f64]),
+    options: &Options,
+    contacts: &Contacts<'static>,
+    plain: bool,
+) -> usize {
+    let fast = integrate_watching(model, method, q0, p0, options, || Ok(()), with_contacts(contacts)).unwrap();
+    let other = if plain {
+        integrate(model, method, q0, p0, options, || Ok(())).unwrap()
+    } else {
+        let mut never = height(1e12, 0);
+        let watch = Watch {
+            events: Some(&mut never),
+            contacts: Some(contacts),
+            ..Watch::default()
+        };
+        integrate_watching(model, method, q0, p0, options, || Ok(()), watch).unwrap()
+    };
+    assert!(other.events.is_empty());
+    assert_eq!(fast.len(), other.len(), "{method:?}");
+    assert_eq!(
+        (&fast.t, &fast.q, &fast.p),
+        (&other.t, &other.q, &other.p),
+        "{method:?}"
+    );
+    assert_eq!(fast.impacts, other.impacts, "{method:?}");
+    // The checkpoint counts the work done: the events' partial steps, and the Wisdom–Holman
+    // methods' synchronisation after each step, which a watched run needs.
+    if plain && !Method::WISDOM_HOLMAN.contains(&method) {
+        assert_eq!(fast.checkpoint, other.checkpoint, "{method:?}");
+    }
+    fast.impacts.len()
+}
+
+#[test]
+fn a_contact_never_hit_leaves_every_step_loop_bit_for_bit_the_plain_one() {
+    // Each loop the steps may take: the fixed-size kick–drift loop (the ball, with and without
+    // compensated summation), the step-by-step one (18 coordinates; midpoint on a separable
+    // model), the method's own variables (Wisdom–Holman), the fixed-size DEL loop (midpoint
+    // and trapezoid on the ball as a general Lagrangian) and a constrained model's (RATTLE).
+    let ball = BouncingBall::new(G).unwrap();
+    let far = wall(0, -1e3, Law::Reflect);
+    for compensated in [true, false] {
+        let options = Options {
+            save_every: 7,
+            compensated,
+            ..Options::new(1e-3, 5000)
+        };
+        for method in [Method::Verlet, Method::Yoshida4, Method::Midpoint] {
+            same_bits(&ball, method, (&[1.0], &[2.0]), &options, &far, true);
+        }
+        for method in [Method::Midpoint, Method::Trapezoid] {
+            same_bits(&General(&ball), method, (&[1.0], &[2.0]), &options, &far, true);
+        }
+    }
+    let solar = NBody::outer_solar_system();
+    let initial = (&solar.initial.q[..], &solar.initial.p[..]);
+    let options = Options {
+        save_every: 3,
+        ..Options::new(10.0, 500)
+    };
+    for method in [Method::Verlet, Method::WisdomHolmanCorrected] {
+        same_bits(
+            &solar.system,
+            method,
+            initial,
+            &options,
+            &wall(4, -1e9, Law::Reflect),
+            true,
+        );
+    }
+    let chain = planar_chain(8).unwrap();
+    let options = Options {
+        save_every: 3,
+        ..Options::new(0.01, 500)
+    };
+    let initial = (&chain.initial.q[..], &chain.initial.p[..]);
+    same_bits(
+        &chain.system,
+        Method::Rattle,
+        initial,
+        &options,
+        &wall(1, -1e3, Law::Reflect),
+        true,
+    );
+}
+
+#[test]
+fn steps_with_impacts_in_the_methods_loop_are_bit_for_bit_those_taken_one_at_a_time() {
+    // A run with contacts alone takes its steps in the method's own loop and stops it at each
+    // step that crosses a contact; watching an event too, it takes them one at a time.
+    let ball = BouncingBall::new(G).unwrap();
+    let options = Options {
+        save_every: 5,
+        ..Options::new(1e-2, 3000)
+    };
+    for law in [Law::Reflect, Law::Variational] {
+        for method in [Method::Verlet, Method::Yoshida4, Method::Midpoint] {
+            let impacts = same_bits(&ball, method, (&[1.0], &[0.0]), &options, &floor(1.0, law), false);
+            assert!(impacts >= 30, "{method:?}, {law:?}: {impacts} impacts");
+        }
+    }
+    let impacts = same_bits(
+        &General(&ball),
+        Method::Midpoint,
+        (&[1.0], &[0.0]),
+        &options,
+        &floor(1.0, Law::Reflect),
+        false,
+    );
+    assert!(impacts >= 30);
+    let free = EllipticBilliard::new(1.0, 1.0).unwrap();
+    for method in [Method::Verlet, Method::Midpoint] {
+        let impacts = same_bits(
+            &free,
+            method,
+            (&[0.3, -0.2], &[0.6, 0.8]),
+            &options,
+            &circle(1.0, Law::Reflect),
+            false,
+        );
+        assert!(impacts >= 10, "{method:?}: {impacts} impacts");
+    }
 }

@@ -1,6 +1,6 @@
 //! What a method integrates: the dynamics of a model, seen through one step's increments.
 
-use super::{Increment, Integrator, ModelKind, StepError, StepStart, StepperState};
+use super::{Gaps, Increment, Integrator, ModelKind, StepError, StepStart, StepperState};
 use crate::model::{
     self, Constrained, EnergyTerms, HolonomicConstraints, Lagrangian, MechanicalSystem, Mixed, Nonholonomic,
     PhaseState, VelocityConstraints,
@@ -62,6 +62,13 @@ pub trait Dynamics {
         Ok(())
     }
 
+    /// As [`Dynamics::advance`], with the contacts' `gaps` checked at the end of every step:
+    /// stops after the first step that is not clear ([`Gaps::clear`]), which is kept; true
+    /// then. By default, one step after the other.
+    fn advance_while(&self, state: &mut StepperState, steps: usize, gaps: &mut Gaps<'_, '_>) -> Result<bool, Error> {
+        state.step_while(self, steps, &mut |q: &[f64]| gaps.clear(q))
+    }
+
     /// The energy function and its terms at (q, p, t), where L does not depend on t and no
     /// constraint does work (forced or not: a forced run balances it against the work done).
     fn energy(&self, q: &[f64], p: &[f64], t: f64) -> Option<Result<EnergyTerms, ModelError>>;
@@ -114,6 +121,10 @@ impl<S: MechanicalSystem> Dynamics for S {
         state.advance_separable(self, steps)
     }
 
+    fn advance_while(&self, state: &mut StepperState, steps: usize, gaps: &mut Gaps<'_, '_>) -> Result<bool, Error> {
+        state.advance_separable_while(self, steps, &mut |q: &[f64]| gaps.clear(q))
+    }
+
     fn energy(&self, q: &[f64], p: &[f64], t: f64) -> Option<Result<EnergyTerms, ModelError>> {
         Some(self.energy_terms(q, p, t))
     }
@@ -146,6 +157,10 @@ impl<L: Lagrangian> Dynamics for General<'_, L> {
 
     fn advance(&self, state: &mut StepperState, steps: usize) -> Result<(), Error> {
         state.advance_lagrangian(self.0, steps)
+    }
+
+    fn advance_while(&self, state: &mut StepperState, steps: usize, gaps: &mut Gaps<'_, '_>) -> Result<bool, Error> {
+        state.advance_lagrangian_while(self.0, steps, &mut |q: &[f64]| gaps.clear(q))
     }
 
     /// E = p·q̇ − L, unless L depends on t.

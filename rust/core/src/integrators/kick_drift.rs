@@ -1,5 +1,5 @@
 use super::stepper::Phase;
-use super::{Increment, Splitting, StepStart};
+use super::{Increment, Splitting, StepError, StepStart};
 use crate::model::MechanicalSystem;
 use crate::{Error, ModelError};
 use serde::{Deserialize, Serialize};
@@ -85,20 +85,22 @@ impl KickDrift {
     /// `steps` steps of N coordinates with the state in fixed-size arrays, one loop with no
     /// dispatch, the step's arithmetic that of [`KickDrift::increment`] and of the stepper,
     /// so that the results agree bit for bit. Called by the stepper for small separable
-    /// systems ([`StepperState`](super::StepperState)).
-    pub(super) fn run<S: MechanicalSystem + ?Sized, const N: usize>(
+    /// systems ([`StepperState`](super::StepperState)), stopping after a step whose end is
+    /// not `clear` ([`Phase::run`]).
+    pub(super) fn run<S: MechanicalSystem + ?Sized, const N: usize, C: FnMut(&[f64]) -> bool + ?Sized>(
         &mut self,
         sys: &S,
         state: Phase<'_>,
         steps: usize,
-    ) -> Result<(), Error> {
+        clear: &mut C,
+    ) -> Result<bool, Error> {
         let array = |x: &[f64]| -> [f64; N] { std::array::from_fn(|i| x[i]) };
         self.scale(state.clock.h);
         let (mut stage_q, mut stage_p, mut force) = (array(&self.q), array(&self.p), array(&self.force));
         // Counts in locals, written back once: through the pointers they would cost stores.
         let (mut cached, mut evaluations) = (self.force_cached, self.evaluations);
         let scaled = &self.scaled;
-        let result = state.run::<N, _>(steps, |_, q, p, dq, dp| {
+        let increment = |_: f64, q: &[f64; N], p: &[f64; N], dq: &mut [f64; N], dp: &mut [f64; N]| {
             let stage = Stage {
                 q: &mut stage_q,
                 p: &mut stage_p,
@@ -108,8 +110,9 @@ impl KickDrift {
                 cached: &mut cached,
                 evaluations: &mut evaluations,
             };
-            Ok(sequence(sys, scaled, q, p, dq, dp, stage, counts)?)
-        });
+            Ok::<_, StepError>(sequence(sys, scaled, q, p, dq, dp, stage, counts)?)
+        };
+        let result = state.run::<N, _, C>(steps, increment, clear);
         (self.force_cached, self.evaluations) = (cached, evaluations);
         self.q.copy_from_slice(&stage_q);
         self.p.copy_from_slice(&stage_p);

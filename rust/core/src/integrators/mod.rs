@@ -64,8 +64,8 @@ pub use ensemble::{
 pub use events::{Detector, EventFunctions, EventSpec, NativeEvent, Occurrence};
 pub use explicit_rk::ExplicitRk;
 pub use jumps::{
-    Blow, Contact, Contacts, Generalized, Impacts, Impulse, Law, NativeContact, NativeSurface, PointFunction, Schedule,
-    Struck, Surface, Watch, Watcher, MAX_IMPACTS,
+    Blow, Contact, Contacts, Gaps, Generalized, Impacts, Impulse, Law, NativeContact, NativeSurface, PointFunction,
+    Schedule, Struck, Surface, Watch, Watcher, MAX_IMPACTS,
 };
 pub use kick_drift::KickDrift;
 pub use kind::ModelKind;
@@ -271,16 +271,18 @@ impl Integrator {
 
     /// The next `steps` steps of a general Lagrangian `sys` of N coordinates in the fixed-size
     /// loop of the two-point DEL methods ([`Del::run`]); None where it does not apply (another
-    /// method, constraints, forces, or the run's first step, which the general step makes).
-    fn run_two_point<S: Lagrangian + ?Sized, const N: usize>(
+    /// method, constraints, forces, or the run's first step, which the general step makes),
+    /// stopping after a step whose end is not `clear` (true then, [`Phase::run`]).
+    fn run_two_point<S: Lagrangian + ?Sized, const N: usize, C: FnMut(&[f64]) -> bool + ?Sized>(
         &mut self,
         sys: &S,
         phase: Phase<'_>,
         steps: usize,
-    ) -> Option<Result<(), crate::Error>> {
+        clear: &mut C,
+    ) -> Option<Result<bool, crate::Error>> {
         match &mut self.scheme {
-            Scheme::Midpoint(s) if s.runs_fixed(sys) => Some(s.run::<S, N>(sys, phase, steps)),
-            Scheme::Trapezoid(s) if s.runs_fixed(sys) => Some(s.run::<S, N>(sys, phase, steps)),
+            Scheme::Midpoint(s) if s.runs_fixed(sys) => Some(s.run::<S, N, C>(sys, phase, steps, clear)),
+            Scheme::Trapezoid(s) if s.runs_fixed(sys) => Some(s.run::<S, N, C>(sys, phase, steps, clear)),
             _ => None,
         }
     }

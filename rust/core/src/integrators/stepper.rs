@@ -7,7 +7,7 @@ use std::borrow::{Borrow, BorrowMut};
 use std::ops::Deref;
 
 use super::checkpoint::shape::shape;
-use super::{compensated, Dynamics, General, Increment, Integrator, Method, Options, Poll, StepError, StepStart};
+use super::{compensated, Dynamics, Gaps, General, Increment, Integrator, Method, Options, Poll, StepError, StepStart};
 use crate::error::check_vector;
 use crate::model::{Lagrangian, MechanicalSystem};
 use crate::solve::interrupt::InterruptPoll;
@@ -136,6 +136,40 @@ where
         let result = state.advance_polled(&*self.model, n, poll);
         state.synchronise();
         result
+    }
+
+    /// As [`Stepper::advance`], with the contacts' `gaps` checked at the end of every step
+    /// ([`Gaps::clear`]): up to `n` steps, in the method's own loop, stopping after the first
+    /// that is not clear (it crosses a contact, or a φ failed). Then true, with that step kept
+    /// and its start (tₙ, qₙ, pₙ) written into `start`, for the step to be redone in pieces. A
+    /// method with its own variables takes its steps one at a time, (q, p) synchronised after
+    /// each.
+    pub(in crate::integrators) fn advance_while<P: Poll>(
+        &mut self,
+        n: usize,
+        poll: P,
+        gaps: &mut Gaps<'_, '_>,
+        start: (&mut f64, &mut [f64], &mut [f64]),
+    ) -> Result<bool, Error> {
+        let state = self.state.borrow_mut();
+        let model = &*self.model;
+        let own = state.integrator.own_variables().is_some();
+        let result = state.polled(n, poll, |state, steps| {
+            if own {
+                state.advance_own_while(model, steps, gaps)
+            } else {
+                model.advance_while(state, steps, gaps)
+            }
+        });
+        state.synchronise();
+        if result? {
+            let (t, q, p) = start;
+            *t = state.clock.at(state.steps - 1);
+            q.copy_from_slice(&state.q_next);
+            p.copy_from_slice(&state.p_next);
+            return Ok(true);
+        }
+        Ok(false)
     }
 
     /// Starts afresh from (q0, p0) at time t0, with the step count at 0: the next steps are
@@ -349,11 +383,26 @@ impl StepperState {
     }
 
     /// `n` steps of `model`, `poll` called before a step when due.
-    fn advance_polled<S, P>(&mut self, model: &S, n: usize, mut poll: P) -> Result<(), Error>
+    fn advance_polled<S, P>(&mut self, model: &S, n: usize, poll: P) -> Result<(), Error>
     where
         S: Dynamics + ?Sized,
         P: Poll,
     {
+        // This step and those after it that need no poll, in one call: the model's own loop
+        // ([`Dynamics::advance`]) runs them.
+        self.polled(n, poll, |state, steps| model.advance(state, steps).map(|()| false))
+            .map(drop)
+    }
+
+    /// `n` steps in runs of those that need no poll before them, `poll` called before a run
+    /// when due; `run(state, k)` takes k steps, true when it stopped after fewer (then so does
+    /// this, true).
+    fn polled<P: Poll>(
+        &mut self,
+        n: usize,
+        mut poll: P,
+        mut run: impl FnMut(&mut Self, usize) -> Result<bool, Error>,
+    ) -> Result<bool, Error> {
         let mut left = n;
         while left > 0 {
             if self.interrupt.due() {
@@ -365,13 +414,53 @@ impl StepperState {
                     });
                 }
             }
-            // This step and those after it that need no poll, in one call: the model's own
-            // loop ([`Dynamics::advance`]) runs them.
             let steps = 1 + self.interrupt.quiet(left - 1);
-            model.advance(self, steps)?;
+            let before = self.steps;
+            if run(self, steps)? {
+                // The steps not taken go back to the countdown, keeping the polls' pace.
+                self.interrupt.unquiet(steps - (self.steps - before));
+                return Ok(true);
+            }
             left -= steps;
         }
-        Ok(())
+        Ok(false)
+    }
+
+    /// Steps of `model` one at a time, stopping after the first whose end q is not `clear`:
+    /// true then, with its start in (q_next, p_next), where the step's swap leaves it.
+    pub(super) fn step_while<S, C>(&mut self, model: &S, steps: usize, clear: &mut C) -> Result<bool, Error>
+    where
+        S: Dynamics + ?Sized,
+        C: FnMut(&[f64]) -> bool + ?Sized,
+    {
+        for _ in 0..steps {
+            self.step(model)?;
+            if !clear(&self.q) {
+                return Ok(true);
+            }
+        }
+        Ok(false)
+    }
+
+    /// As [`StepperState::step_while`] for a method with its own variables: each step as
+    /// [`Stepper::step`] takes it, (q, p) synchronised for `gaps`, its start kept first.
+    fn advance_own_while<S: Dynamics + ?Sized>(
+        &mut self,
+        model: &S,
+        steps: usize,
+        gaps: &mut Gaps<'_, '_>,
+    ) -> Result<bool, Error> {
+        for _ in 0..steps {
+            self.q_next.copy_from_slice(&self.q);
+            self.p_next.copy_from_slice(&self.p);
+            let result = model.advance(self, 1);
+            self.synchronise();
+            result?;
+            if !gaps.clear(&self.q) {
+                return Ok(true);
+            }
+        }
+        Ok(false)
     }
 
     /// The integrator, and the state as a method's own loop advances it.
@@ -385,6 +474,8 @@ impl StepperState {
             p,
             eq,
             ep,
+            q_next,
+            p_next,
             ..
         } = self;
         let phase = Phase {
@@ -392,6 +483,8 @@ impl StepperState {
             p,
             eq,
             ep,
+            start_q: q_next,
+            start_p: p_next,
             compensated: *compensated,
             steps,
             clock: *clock,
@@ -400,42 +493,62 @@ impl StepperState {
     }
 
     /// `steps` steps of a separable system: the methods with their own variables on them
-    /// (`own_variables.rs`), the kick–drift methods on up to 4 coordinates in a loop of
-    /// fixed-size arrays ([`super::KickDrift::run`]; the driver's costs, not the physics,
-    /// dominate such small steps), every other case step by step.
+    /// (`own_variables.rs`), every other as [`StepperState::advance_separable_while`].
     pub(super) fn advance_separable<S: MechanicalSystem>(&mut self, sys: &S, steps: usize) -> Result<(), Error> {
         if let Some(result) = sys.as_nbody().and_then(|nbody| self.advance_own(nbody, steps)) {
             return result;
         }
+        self.advance_separable_while(sys, steps, &mut |_: &[f64]| true)
+            .map(drop)
+    }
+
+    /// `steps` steps of a separable system, stopping after the first whose end q is not
+    /// `clear` (true then, as [`StepperState::step_while`]): the kick–drift methods on up to 4
+    /// coordinates in a loop of fixed-size arrays ([`super::KickDrift::run`]; the driver's
+    /// costs, not the physics, dominate such small steps), every other case step by step. Not
+    /// for the methods with their own variables.
+    pub(super) fn advance_separable_while<S, C>(&mut self, sys: &S, steps: usize, clear: &mut C) -> Result<bool, Error>
+    where
+        S: MechanicalSystem,
+        C: FnMut(&[f64]) -> bool + ?Sized,
+    {
         let (integrator, phase) = self.phase();
         if let Some(kick_drift) = integrator.kick_drift() {
             match phase.q.len() {
-                1 => return kick_drift.run::<S, 1>(sys, phase, steps),
-                2 => return kick_drift.run::<S, 2>(sys, phase, steps),
-                3 => return kick_drift.run::<S, 3>(sys, phase, steps),
-                4 => return kick_drift.run::<S, 4>(sys, phase, steps),
+                1 => return kick_drift.run::<S, 1, C>(sys, phase, steps, clear),
+                2 => return kick_drift.run::<S, 2, C>(sys, phase, steps, clear),
+                3 => return kick_drift.run::<S, 3, C>(sys, phase, steps, clear),
+                4 => return kick_drift.run::<S, 4, C>(sys, phase, steps, clear),
                 _ => {}
             }
         }
-        for _ in 0..steps {
-            self.step(sys)?;
-        }
-        Ok(())
+        self.step_while(sys, steps, clear)
     }
 
-    /// `steps` steps of a general Lagrangian: the two-point DEL methods on up to 4
-    /// coordinates in their loop of fixed-size arrays ([`super::Del::run`]; the driver's
-    /// costs, not the physics, dominate such small steps), every other case step by step.
+    /// `steps` steps of a general Lagrangian, as [`StepperState::advance_lagrangian_while`].
     pub(super) fn advance_lagrangian<L: Lagrangian>(&mut self, sys: &L, steps: usize) -> Result<(), Error> {
+        self.advance_lagrangian_while(sys, steps, &mut |_: &[f64]| true)
+            .map(drop)
+    }
+
+    /// `steps` steps of a general Lagrangian, stopping after the first whose end q is not
+    /// `clear` (true then, as [`StepperState::step_while`]): the two-point DEL methods on up
+    /// to 4 coordinates in their loop of fixed-size arrays ([`super::Del::run`]; the driver's
+    /// costs, not the physics, dominate such small steps), every other case step by step.
+    pub(super) fn advance_lagrangian_while<L, C>(&mut self, sys: &L, steps: usize, clear: &mut C) -> Result<bool, Error>
+    where
+        L: Lagrangian,
+        C: FnMut(&[f64]) -> bool + ?Sized,
+    {
         let mut left = steps;
         while left > 0 {
             let (integrator, phase) = self.phase();
             let n = phase.q.len();
             let fixed = match n {
-                1 => integrator.run_two_point::<L, 1>(sys, phase, left),
-                2 => integrator.run_two_point::<L, 2>(sys, phase, left),
-                3 => integrator.run_two_point::<L, 3>(sys, phase, left),
-                4 => integrator.run_two_point::<L, 4>(sys, phase, left),
+                1 => integrator.run_two_point::<L, 1, C>(sys, phase, left, clear),
+                2 => integrator.run_two_point::<L, 2, C>(sys, phase, left, clear),
+                3 => integrator.run_two_point::<L, 3, C>(sys, phase, left, clear),
+                4 => integrator.run_two_point::<L, 4, C>(sys, phase, left, clear),
                 _ => None,
             };
             if let Some(result) = fixed {
@@ -443,21 +556,26 @@ impl StepperState {
             }
             self.step(&General(sys))?;
             left -= 1;
+            if !clear(&self.q) {
+                return Ok(true);
+            }
             // Only a run's first step makes the loop apply (it judges the continuum limit's
             // sign): once past it, a case the loop does not take steps on without asking.
             if left < steps - 1 {
-                for _ in 0..left {
-                    self.step(&General(sys))?;
-                }
-                return Ok(());
+                return self.step_while(&General(sys), left, clear);
             }
         }
-        Ok(())
+        Ok(false)
     }
 
     /// The time tₙ = t₀ + n·h (counted from the last change of h, see [`Stepper::set_dt`]).
     pub fn t(&self) -> f64 {
         self.clock.at(self.steps)
+    }
+
+    /// The time after `steps` steps on the present clock (the run's ahead).
+    pub(in crate::integrators) fn time_at(&self, steps: usize) -> f64 {
+        self.clock.at(steps)
     }
 
     /// The steps n completed.
@@ -542,12 +660,15 @@ impl Clock {
 }
 
 /// A stepper's state as a method's own loop advances it: (qₙ, pₙ), the carries (e_q, e_p) of
-/// compensated summation, and the steps done, counted up as the loop goes.
+/// compensated summation, and the steps done, counted up as the loop goes; `start_q`,
+/// `start_p` receive the start of a step found not clear (see [`Phase::run`]).
 pub(super) struct Phase<'a> {
     pub(super) q: &'a mut [f64],
     pub(super) p: &'a mut [f64],
     pub(super) eq: &'a mut [f64],
     pub(super) ep: &'a mut [f64],
+    pub(super) start_q: &'a mut [f64],
+    pub(super) start_p: &'a mut [f64],
     pub(super) compensated: bool,
     pub(super) steps: &'a mut usize,
     pub(super) clock: Clock,
@@ -557,12 +678,14 @@ impl Phase<'_> {
     /// `steps` steps of N coordinates with the state in fixed-size arrays: `increment(t, q, p,
     /// δq, δp)` writes each step's increments, which are added as [`StepperState::step`] adds
     /// them (the same bits), in one loop with no dispatch. Stops at the first failure, dated
-    /// as the stepper dates it, with the last good state kept. The loop of the methods' own
-    /// fixed-size paths ([`super::KickDrift::run`], the DEL step's).
+    /// as the stepper dates it, with the last good state kept; and after the first step whose
+    /// end q is not `clear`, kept, its start written to (`start_q`, `start_p`): true then. The
+    /// loop of the methods' own fixed-size paths ([`super::KickDrift::run`], the DEL step's).
     #[inline(always)]
-    pub(super) fn run<const N: usize, F>(self, steps: usize, mut increment: F) -> Result<(), Error>
+    pub(super) fn run<const N: usize, F, C>(self, steps: usize, mut increment: F, clear: &mut C) -> Result<bool, Error>
     where
         F: FnMut(f64, &[f64; N], &[f64; N], &mut [f64; N], &mut [f64; N]) -> Result<(), StepError>,
+        C: FnMut(&[f64]) -> bool + ?Sized,
     {
         let array = |x: &[f64]| -> [f64; N] { std::array::from_fn(|i| x[i]) };
         let Phase {
@@ -570,6 +693,8 @@ impl Phase<'_> {
             p: state_p,
             eq: state_eq,
             ep: state_ep,
+            start_q,
+            start_p,
             compensated,
             steps: done,
             clock,
@@ -579,7 +704,7 @@ impl Phase<'_> {
         let (mut q_next, mut p_next, mut eq_next, mut ep_next) = ([0.0; N], [0.0; N], [0.0; N], [0.0; N]);
         // The count in a local, written back once: through the pointer it would cost stores.
         let mut n = *done;
-        let mut result = Ok(());
+        let mut result = Ok(false);
         for _ in 0..steps {
             if let Err(e) = increment(clock.at(n), &q, &p, &mut dq, &mut dp) {
                 result = Err(e.at(n + 1, clock.at(n)));
@@ -595,11 +720,20 @@ impl Phase<'_> {
                 result = Err(diverged(n + 1, clock.at(n)));
                 break;
             }
+            let stop = !clear(&q_next);
+            if stop {
+                start_q.copy_from_slice(&q);
+                start_p.copy_from_slice(&p);
+            }
             (q, p) = (q_next, p_next);
             if compensated {
                 (eq, ep) = (eq_next, ep_next);
             }
             n += 1;
+            if stop {
+                result = Ok(true);
+                break;
+            }
         }
         *done = n;
         state_q.copy_from_slice(&q);

@@ -100,4 +100,11 @@ impl InterruptPoll {
         self.countdown -= k;
         k
     }
+
+    /// Gives back to the countdown `k` steps that [`InterruptPoll::quiet`] took off and a loop
+    /// did not run (it stopped early).
+    #[inline]
+    pub(crate) fn unquiet(&mut self, k: usize) {
+        self.countdown += k;
+    }
 }

@@ -24,12 +24,13 @@ impl<R: DiscreteLagrangian> Del<TwoPoint<R>> {
     /// `steps` steps of N coordinates, as [`Del::increment`] makes them when
     /// [`Del::runs_fixed`] holds. The Jacobian is [`Equations`]' own (exact, or by differences
     /// for a model without second derivatives), factorised on the stack.
-    pub(in crate::integrators) fn run<S: Lagrangian + ?Sized, const N: usize>(
+    pub(in crate::integrators) fn run<S: Lagrangian + ?Sized, const N: usize, C: FnMut(&[f64]) -> bool + ?Sized>(
         &mut self,
         sys: &S,
         phase: Phase<'_>,
         steps: usize,
-    ) -> Result<(), Error> {
+        clear: &mut C,
+    ) -> Result<bool, Error> {
         let array = |x: &[f64]| -> [f64; N] { std::array::from_fn(|i| x[i]) };
         let h = phase.clock.h;
         let (mut last, mut before_last, mut history) =
@@ -52,7 +53,7 @@ impl<R: DiscreteLagrangian> Del<TwoPoint<R>> {
                 noise_floor: true,
             },
         );
-        let result = phase.run::<N, _>(steps, |t, q, p, dq, dp| {
+        let increment = |t: f64, q: &[f64; N], p: &[f64; N], dq: &mut [f64; N], dp: &mut [f64; N]| {
             let start = StepStart { t, h, q, p };
             // The Newton iteration's values are the closure's own, so that they may stay in
             // registers: through memory, scalar stores feeding vector loads stall.
@@ -138,7 +139,8 @@ impl<R: DiscreteLagrangian> Del<TwoPoint<R>> {
             history = (history + 1).min(2);
             kept = (x, r, lu, pivots, sign);
             Ok(())
-        });
+        };
+        let result = phase.run::<N, _, C>(steps, increment, clear);
         self.last_dq.copy_from_slice(&last);
         self.before_last_dq.copy_from_slice(&before_last);
         self.history = history;

@@ -21,6 +21,7 @@ mod surfaces;
 mod variational;
 mod watch;
 
+pub use resolve::Gaps;
 pub(in crate::integrators) use resolve::Resolver;
 pub use schedule::{Blow, Generalized, Impulse, PointFunction, Schedule, Struck};
 pub use surfaces::NativeSurface;
@@ -48,6 +49,12 @@ pub trait Surface {
     /// Why the surface cannot act on n coordinates, if it cannot (a native surface's
     /// coordinates out of range). By default it can.
     fn misfit(&self, _n: usize) -> Option<String> {
+        None
+    }
+
+    /// The surface as a native one, which a run evaluates after every step without dispatch
+    /// ([`Gaps`]); None (the default) for the others.
+    fn native(&self) -> Option<&NativeSurface> {
         None
     }
 }

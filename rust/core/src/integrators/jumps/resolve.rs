@@ -7,12 +7,12 @@
 use std::borrow::{Borrow, BorrowMut};
 use std::ops::Deref;
 
-use super::{reflect, variational, Contact, Contacts, Impacts, Law, Schedule, MAX_IMPACTS};
+use super::{reflect, variational, Contact, Contacts, Impacts, Law, NativeSurface, Schedule, Surface, MAX_IMPACTS};
 use crate::integrators::events::Search;
 use crate::integrators::DiscreteEnergy;
 use crate::integrators::{Counting, Dynamics, Method, Occurrence, Poll, Stepper, StepperState, Trajectory};
 use crate::solve::bracket::illinois;
-use crate::Error;
+use crate::{Error, ModelError};
 
 /// Why the variational law does not fit `method` on `model`, if it does not: it needs the
 /// method's discrete energy ([`DiscreteEnergy`]) and a conservative, autonomous, unconstrained
@@ -41,6 +41,8 @@ pub(super) fn variational_misfit<S: Dynamics + ?Sized>(model: &S, method: Method
 /// (a copy of the run's stepper) and every buffer of the resolution, made once per run.
 pub(in crate::integrators) struct Resolver<'c, 's, M> {
     contacts: &'c [Contact<'s>],
+    /// Each contact's surface, if native ([`Gaps`]).
+    native: Vec<Option<&'c NativeSurface>>,
     schedule: Option<&'c Schedule<'s>>,
     /// The next impulse and sample of the schedule (those before are done).
     next_impulse: usize,
@@ -100,6 +102,7 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
         let t0 = stepper.t();
         let mut resolver = Resolver {
             contacts,
+            native: contacts.iter().map(|c| c.surface.native()).collect(),
             schedule,
             next_impulse: schedule.map_or(0, |s| s.impulses().partition_point(|b| b.t <= t0)),
             next_sample: schedule.map_or(0, |s| s.samples().partition_point(|&t| t <= t0)),
@@ -155,11 +158,15 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
         self.blow_at_grid(stepper, search, traj)
     }
 
-    /// Advances `stepper` by up to `n` steps, one at a time, resolving the impacts of each
-    /// (saved in `traj`: the impacts, and the states just before and after each) and watching
-    /// `search`'s events on the pieces. Returns the event whose terminal count was reached, the
-    /// run stopping at the end of that step; None after the n steps. On failure the stepper is
-    /// at the last good step.
+    /// Advances `stepper` by up to `n` steps, resolving the impacts of each (saved in `traj`:
+    /// the impacts, and the states just before and after each), applying the schedule's
+    /// impulses and taking its samples, and watching `search`'s events on the pieces. Returns
+    /// the event whose terminal count was reached, the run stopping at the end of that step;
+    /// None after the n steps. On failure the stepper is at the last good step.
+    ///
+    /// Without events the steps up to the next scheduled time are the method's own loop,
+    /// checked against the contacts after each ([`Gaps`]) and stopped by the first that crosses
+    /// one; with events, one at a time (the events need each step's start).
     pub(in crate::integrators) fn advance<St: BorrowMut<StepperState>, P: Poll>(
         &mut self,
         stepper: &mut Stepper<M, St>,
@@ -168,7 +175,17 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
         traj: &mut Trajectory,
         poll: &mut P,
     ) -> Result<Option<usize>, Error> {
-        for _ in 0..n {
+        let mut left = n;
+        while left > 0 {
+            let free = if search.is_none() {
+                self.free_steps(stepper, left)
+            } else {
+                0
+            };
+            if free > 0 {
+                left -= self.advance_clear(stepper, free, traj, poll)?;
+                continue;
+            }
             self.t = stepper.t();
             self.q.copy_from_slice(stepper.q());
             self.p.copy_from_slice(stepper.p());
@@ -176,47 +193,122 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
                 search.start_step(stepper);
             }
             stepper.advance(1, Counting(|steps| poll.poll(steps)))?;
-            let (step, h) = (stepper.steps(), stepper.dt());
+            left -= 1;
             let first = traj.events.len();
-            evaluate(self.contacts, stepper.q(), &mut self.phi_end, step, self.t)?;
-            let crossed = (0..self.phi.len()).any(|j| {
-                let leaving = self.phi[j] <= 0.0;
-                below(self.phi_end[j] - floor(self.phi[j], leaving), leaving)
-            });
-            let inside = self.impulse_inside(self.next_impulse, stepper.t()).is_some();
-            let resolved = if crossed || inside {
-                match self.resolve(stepper, search.as_deref_mut(), &mut traj.events) {
-                    Ok(resolved) => resolved,
-                    Err(error) => {
-                        // The run ends at the step's start, with none of the step's events.
-                        traj.events.truncate(first);
-                        stepper.rewind(&self.q, &self.p)?;
-                        return Err(error);
-                    }
-                }
-            } else {
-                false
-            };
-            if resolved {
-                self.take_samples(stepper, traj)?;
-                self.push_jumps(stepper, traj);
-            } else {
-                if crossed {
-                    // The scratch's first piece crossed nothing after all: φ at the step's end.
-                    evaluate(self.contacts, stepper.q(), &mut self.phi_end, step, self.t)?;
-                }
-                std::mem::swap(&mut self.phi, &mut self.phi_end);
-                if let Some(search) = search.as_deref_mut() {
-                    search.piece(step, (stepper.t(), stepper.q(), stepper.p()), h, &mut traj.events)?;
-                }
-                self.take_samples(stepper, traj)?;
-            }
-            self.blow_at_grid(stepper, search.as_deref_mut(), traj)?;
+            evaluate(self.contacts, stepper.q(), &mut self.phi_end, stepper.steps(), self.t)?;
+            let crossed = crosses(&self.phi, &self.phi_end);
+            self.settle(stepper, crossed, search.as_deref_mut(), traj, first)?;
             if let Some(stop) = search.as_deref_mut().and_then(|s| s.count(&mut traj.events, first)) {
                 return Ok(Some(stop));
             }
         }
         Ok(None)
+    }
+
+    /// How many of the next `n` steps end before the schedule's next time (impulse or sample):
+    /// those the method's own loop may take.
+    fn free_steps<St: Borrow<StepperState>>(&self, stepper: &Stepper<M, St>, n: usize) -> usize {
+        let Some(schedule) = self.schedule else {
+            return n;
+        };
+        let next = [
+            schedule.impulses().get(self.next_impulse).map(|b| b.t),
+            schedule.samples().get(self.next_sample).copied(),
+        ];
+        let Some(t_next) = next.into_iter().flatten().reduce(f64::min) else {
+            return n;
+        };
+        let (start, t) = (stepper.steps(), stepper.t());
+        // The estimate, then the clock's own times (tₙ₊ₖ < t_next for the k steps taken).
+        let estimate = ((t_next - t) / stepper.dt()).floor();
+        let mut k = if estimate > 0.0 { (estimate as usize).min(n) } else { 0 };
+        while k > 0 && stepper.time_at(start + k) >= t_next {
+            k -= 1;
+        }
+        while k < n && stepper.time_at(start + k + 1) < t_next {
+            k += 1;
+        }
+        k
+    }
+
+    /// Up to `n` steps without events in the method's own loop, the first that crosses a
+    /// contact settled as the one-at-a-time loop settles it: the steps taken.
+    fn advance_clear<St: BorrowMut<StepperState>, P: Poll>(
+        &mut self,
+        stepper: &mut Stepper<M, St>,
+        n: usize,
+        traj: &mut Trajectory,
+        poll: &mut P,
+    ) -> Result<usize, Error> {
+        let before = stepper.steps();
+        let mut gaps = Gaps {
+            contacts: self.contacts,
+            native: &self.native,
+            phi: &mut self.phi,
+            phi_end: &mut self.phi_end,
+            swapped: false,
+            error: None,
+        };
+        let start = (&mut self.t, &mut self.q[..], &mut self.p[..]);
+        let stopped = stepper.advance_while(n, Counting(|steps| poll.poll(steps)), &mut gaps, start);
+        let (swapped, error) = (gaps.swapped, gaps.error.take());
+        if swapped {
+            std::mem::swap(&mut self.phi, &mut self.phi_end);
+        }
+        let stopped = stopped?;
+        if let Some(source) = error {
+            let (step, time) = (stepper.steps(), self.t);
+            return Err(Error::Model { step, time, source });
+        }
+        if stopped {
+            self.settle(stepper, true, None, traj, traj.events.len())?;
+        }
+        Ok(stepper.steps() - before)
+    }
+
+    /// The step just taken by `stepper` from the kept start (t, q, p), with φ at its end in
+    /// `phi_end`: redone in pieces if it `crossed` a contact or holds an impulse (its jumps,
+    /// and the states just before and after each, saved in `traj`), `search`'s events located
+    /// on it or its pieces (those from `first` on are the step's), its samples taken and the
+    /// impulses at its end applied. On failure the stepper is at the step's start.
+    fn settle<St: BorrowMut<StepperState>>(
+        &mut self,
+        stepper: &mut Stepper<M, St>,
+        crossed: bool,
+        mut search: Option<&mut Search<'_, '_, M>>,
+        traj: &mut Trajectory,
+        first: usize,
+    ) -> Result<(), Error> {
+        let (step, h) = (stepper.steps(), stepper.dt());
+        let inside = self.impulse_inside(self.next_impulse, stepper.t()).is_some();
+        let resolved = if crossed || inside {
+            match self.resolve(stepper, search.as_deref_mut(), &mut traj.events) {
+                Ok(resolved) => resolved,
+                Err(error) => {
+                    // The run ends at the step's start, with none of the step's events.
+                    traj.events.truncate(first);
+                    stepper.rewind(&self.q, &self.p)?;
+                    return Err(error);
+                }
+            }
+        } else {
+            false
+        };
+        if resolved {
+            self.take_samples(stepper, traj)?;
+            self.push_jumps(stepper, traj);
+        } else {
+            if crossed {
+                // The scratch's first piece crossed nothing after all: φ at the step's end.
+                evaluate(self.contacts, stepper.q(), &mut self.phi_end, step, self.t)?;
+            }
+            std::mem::swap(&mut self.phi, &mut self.phi_end);
+            if let Some(search) = search.as_deref_mut() {
+                search.piece(step, (stepper.t(), stepper.q(), stepper.p()), h, &mut traj.events)?;
+            }
+            self.take_samples(stepper, traj)?;
+        }
+        self.blow_at_grid(stepper, search, traj)
     }
 
     /// The time of impulse `k` if it falls inside the step that ends at `t_end`.
@@ -686,16 +778,81 @@ fn below(phi: f64, leaving: bool) -> bool {
     phi < 0.0 || (phi <= 0.0 && !leaving)
 }
 
+/// Whether a step from φ at its start to φ at its end crosses a contact.
+fn crosses(phi_start: &[f64], phi_end: &[f64]) -> bool {
+    phi_start.iter().zip(phi_end).any(|(&start, &end)| crossing(start, end))
+}
+
+/// Whether a step from φ = `start` to φ = `end` crosses the contact (one it starts on or past,
+/// it leaves: only φ < 0 past the start's counts).
+#[inline(always)]
+fn crossing(start: f64, end: f64) -> bool {
+    let leaving = start <= 0.0;
+    below(end - floor(start, leaving), leaving)
+}
+
 /// φ of every contact at q into `phi`; a surface's error names the run's step and time.
 fn evaluate(contacts: &[Contact<'_>], q: &[f64], phi: &mut [f64], step: usize, time: f64) -> Result<(), Error> {
     for (c, phi) in contacts.iter().zip(phi) {
-        *phi = c.surface.phi(q).map_err(|source| Error::Model { step, time, source })?;
-        if !phi.is_finite() {
-            let source = format!("contact {} returned a non-finite φ = {phi}", c.name).into();
-            return Err(Error::Model { step, time, source });
-        }
+        *phi = gap(c, None, q).map_err(|source| Error::Model { step, time, source })?;
     }
     Ok(())
+}
+
+/// φ of contact `c` at q (through `native`, its surface if native, without dispatch); a
+/// non-finite φ is an error.
+#[inline(always)]
+fn gap(c: &Contact<'_>, native: Option<&NativeSurface>, q: &[f64]) -> Result<f64, ModelError> {
+    let phi = match native {
+        Some(surface) => surface.phi(q)?,
+        None => c.surface.phi(q)?,
+    };
+    if !phi.is_finite() {
+        return Err(format!("contact {} returned a non-finite φ = {phi}", c.name).into());
+    }
+    Ok(phi)
+}
+
+/// φ of a run's contacts, checked at the end of each step the method's own loop takes
+/// ([`crate::integrators::Dynamics::advance_while`]): a step is clear when it crosses no
+/// contact, by the test the one-at-a-time loop judges a step by; φ at its end is then the next
+/// step's start. A failing φ stops the steps as a crossing does, its error kept for the run.
+pub struct Gaps<'g, 's> {
+    contacts: &'g [Contact<'s>],
+    /// Each contact's surface, if native.
+    native: &'g [Option<&'g NativeSurface>],
+    /// φ at the state (the next step's start), and at a step's end: the resolver's, swapped
+    /// (`swapped`) rather than copied after a clear step.
+    phi: &'g mut [f64],
+    phi_end: &'g mut [f64],
+    swapped: bool,
+    error: Option<ModelError>,
+}
+
+impl Gaps<'_, '_> {
+    /// Whether a step ending at q crosses no contact, each φ evaluated (finite); φ at q is
+    /// then the next step's start.
+    #[inline(always)]
+    pub fn clear(&mut self, q: &[f64]) -> bool {
+        let mut crossed = false;
+        let contacts = self.contacts.iter().zip(self.native);
+        for ((c, native), (start, end)) in contacts.zip(self.phi.iter().zip(self.phi_end.iter_mut())) {
+            *end = match gap(c, *native, q) {
+                Ok(phi) => phi,
+                Err(error) => {
+                    self.error = Some(error);
+                    return false;
+                }
+            };
+            crossed |= crossing(*start, *end);
+        }
+        if crossed {
+            return false;
+        }
+        std::mem::swap(&mut self.phi, &mut self.phi_end);
+        self.swapped = !self.swapped;
+        true
+    }
 }
 
 /// A partial step's error, named by the run's step and its start.

@@ -69,6 +69,7 @@ pub(crate) fn check_ellipsoid(coordinates: &[usize], centre: &[f64], semi_axes: 
 }
 
 impl Surface for NativeSurface {
+    #[inline(always)]
     fn phi(&self, q: &[f64]) -> Result<f64, ModelError> {
         Ok(match self {
             NativeSurface::Wall { coordinate, value } => wall(q, *coordinate, *value),
@@ -119,5 +120,9 @@ impl Surface for NativeSurface {
                 ..
             } => check_ellipsoid(coordinates, centre, semi_axes, n),
         }
+    }
+
+    fn native(&self) -> Option<&NativeSurface> {
+        Some(self)
     }
 }

@@ -11,9 +11,9 @@ use crate::Error;
 
 /// What a run watches besides its states: events ([`Detector`]), contacts ([`Contacts`]) and
 /// a [`Schedule`] of impulses and samples, any of them or none. They are checked after every
-/// step (the steps are then taken one at a time); a step that crosses a contact or holds an
-/// impulse is redone in pieces at each jump, and the events are evaluated and located on the
-/// pieces.
+/// step (contacts alone inside the method's own loop up to the next scheduled time, events with
+/// the steps taken one at a time); a step that crosses a contact or holds an impulse is redone
+/// in pieces at each jump, and the events are evaluated and located on the pieces.
 #[derive(Default)]
 pub struct Watch<'w, 'e, 'c> {
     /// The events, located by partial steps of the method ([`crate::integrators::integrate_with_events`]).
