@@ -148,6 +148,17 @@ fn a_blow_at_a_point_gives_the_components_of_its_jacobian_or_of_central_differen
     assert!(a.iter().zip(&b).all(|(x, y)| (x - y).abs() < 1e-9), "{b:?}");
 }
 
+/// The step count and state of a ball's run's checkpoint (its energy check aside: a run of
+/// samples checks it at other steps).
+fn end_state(traj: &Trajectory) -> (usize, Vec<f64>, Vec<f64>) {
+    let ball = BouncingBall::new(9.81).unwrap();
+    let state = Checkpoint::from_bytes(&traj.checkpoint)
+        .unwrap()
+        .into_state(&ball)
+        .unwrap();
+    (state.steps(), state.q().to_vec(), state.p().to_vec())
+}
+
 /// The ball dropped from h₀ = 1 at rest, bouncing elastically: its exact height and momentum.
 fn ball_at(t: f64, g: f64) -> (f64, f64) {
     let fall = (2.0 / g).sqrt();
@@ -177,7 +188,7 @@ fn samples_are_taken_through_impacts_to_round_off_on_the_bouncing_ball() {
     }
     // The run goes on to its end, whatever it samples.
     let plain = drop_ball(&options, with_contacts(&contacts)).unwrap();
-    assert_eq!(traj.checkpoint, plain.checkpoint);
+    assert_eq!(end_state(&traj), end_state(&plain));
     assert_eq!(traj.impacts, plain.impacts);
 }
 
@@ -235,7 +246,7 @@ fn a_resumed_run_takes_the_impulses_and_samples_after_its_start_bit_for_bit() {
         let whole = run(&schedule, 400, None);
         let first = run(&schedule, 200, None);
         let rest = run(&schedule, 200, Some(first.checkpoint.clone()));
-        assert_eq!(rest.checkpoint, whole.checkpoint);
+        assert_eq!(end_state(&rest), end_state(&whole));
         let n = first.len() - usize::from(!with_samples);
         assert_eq!(&whole.t[..n], &first.t[..n]);
         assert_eq!(&whole.t[n..], &rest.t[..]);

@@ -334,8 +334,9 @@ fn first_state<S: Dynamics + ?Sized>(sys: &S, stepper: &Stepper<&S>) -> Trajecto
 }
 
 /// Advances `stepper` to step `end`, saving every `save_every`-th state, the first and the
-/// last, with the energy checked at each saved state (and the events searched, if any). A
-/// `fresh` run starts its watcher ([`Watcher::start`]).
+/// last, with the energy checked at each saved state (and the events searched, if any); with
+/// samples, saving those alone, the energy checked every [`SAMPLING_PERIOD`] steps. A `fresh`
+/// run starts its watcher ([`Watcher::start`]).
 fn run<'s, S, P>(
     sys: &'s S,
     mut stepper: Stepper<&'s S>,
@@ -392,9 +393,15 @@ where
         }
     };
     keep(&mut traj, &stepper);
+    // With samples no state is saved at a period's end, where the energy alone is checked.
+    let period = if sampling {
+        save_every.max(SAMPLING_PERIOD)
+    } else {
+        save_every
+    };
     while stepper.steps() < end && outcome.is_ok() {
         // Every `save_every`-th state is saved, and the last.
-        let save = (stepper.steps() / save_every + 1).saturating_mul(save_every).min(end);
+        let save = (stepper.steps() / period + 1).saturating_mul(period).min(end);
         let n = save - stepper.steps();
         // Events and contacts: step by step, stopping after a terminal event's step.
         let advanced = watcher.advance(&mut stepper, n, &mut traj, &mut poll);
@@ -426,6 +433,9 @@ where
         Err(error) => Err(fail(error, traj)),
     }
 }
+
+/// The steps between two checks of the energy of a run that saves its samples alone.
+const SAMPLING_PERIOD: usize = 1024;
 
 /// The run's energy check: E − W against its value at the start, judged by a running [`Scale`].
 #[derive(Clone, Debug, Serialize, Deserialize)]
