@@ -19,7 +19,7 @@ from typing import TYPE_CHECKING, Any, Literal
 import numpy as np
 from numpy.typing import ArrayLike
 
-from . import _core, dense
+from . import _core
 from . import events as _events
 from . import impacts as _impacts
 from . import impulses as _impulses
@@ -28,7 +28,7 @@ from ._util import finite, floats, positive, positive_int, step_count
 from .conservation import VERDICTS, ConservationReport, check_conservation
 from .impacts import Contact
 from .impulses import Impulse
-from .integrate import _contacts_of, _energy_threshold, _model_of, _newton, integrate
+from .integrate import _contacts_of, _energy_threshold, _model_of, _newton, _sample_times, integrate
 from .model import Model, NativeSystem, _scene_model
 from .scenes import Scene
 from .trajectory import Trajectory, _trajectory
@@ -407,11 +407,7 @@ def ensemble(
     newton: dict[str, Any] = dict(newton_tolerance=newton_tolerance, newton_max_iterations=newton_max_iterations)
     watched, event_specs = _events.specs(events, n) if events is not None else ([], [])
     impulse_specs = _impulses.specs(impulses or (), t0, t0 + nsteps * dt)
-    times = None
-    if t_eval is not None:
-        if save_every != 1:
-            raise ValueError("save_every: not with t_eval, which keeps the states at its times, not the run's own")
-        times = dense.eval_times(t_eval, t0, t0 + nsteps * dt)
+    times = _sample_times(t_eval, t0, t0 + nsteps * dt, save_every, None)
     settings = run | newton | dict(max_energy_error=max_energy_error, events=events, contacts=contacts, impulses=impulses, t_eval=t_eval)
     if client is not None:
         return _on_cluster(client, model, q, p, values, settings | dict(workers=workers), chunk_size, progress)

@@ -29,13 +29,13 @@ import json
 import warnings
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 from numpy.typing import ArrayLike
 
 from . import _core
-from ._util import vector
+from ._util import floats, vector
 from .model import Model
 
 #: The public API; the rest serves :func:`varmech.integrate`.
@@ -116,36 +116,35 @@ class Impulse:
         [-1.0, 0.0]
         """
         n = len(q)
-        if (self.generalized is None) == (self.point is None):
-            raise ValueError("impulse: give exactly one of generalized= and point= (with impulse=)")
-        if self.generalized is not None:
-            given = self.generalized(q.copy()) if callable(self.generalized) else self.generalized
-            return vector("generalized", given, n)
-        if self.impulse is None:
-            raise ValueError("impulse: a point struck needs the impulse vector, impulse=")
-        blow = np.asarray(self.impulse, dtype=float).reshape(-1)
-        x = np.asarray(self.point(q.copy()), dtype=float).reshape(-1)  # type: ignore[misc]
-        if x.shape != blow.shape:
-            raise ValueError(f"impulse: the point has {x.size} coordinates and the impulse {blow.size}")
-        if self.jacobian is not None:
-            jac = np.asarray(self.jacobian(q.copy()), dtype=float)
+        kind, payload = self._spec()
+        if kind == "function":
+            return vector("generalized", payload(q.copy()), n)
+        if kind == "generalized":
+            # The components as given, not the binding's flattened list: their shape is checked.
+            return vector("generalized", cast(ArrayLike, self.generalized), n)
+        point, jacobian, blow = payload
+        x = np.asarray(point(q.copy()), dtype=float).reshape(-1)
+        if x.size != len(blow):
+            raise ValueError(f"impulse: the point has {x.size} coordinates and the impulse {len(blow)}")
+        if jacobian is not None:
+            jac = np.asarray(jacobian(q.copy()), dtype=float)
             if jac.shape != (x.size, n):
                 raise ValueError(f"jacobian: expected shape {(x.size, n)}, got {jac.shape}")
         else:
-            warnings.warn("impulse: no jacobian of the point given; central differences are used", stacklevel=3)
-            jac = _differences(lambda y: np.asarray(self.point(y), dtype=float).reshape(-1), q)  # type: ignore[misc]
-        return np.asarray(jac.T @ blow)
+            jac = _differences(lambda y: np.asarray(point(y), dtype=float).reshape(-1), q)
+        return np.asarray(jac.T @ np.asarray(blow))
 
 
     def _spec(self) -> tuple[str, Any]:
-        """The binding's kind and payload of this blow (a ValueError as :meth:`components`
-        raises for a malformed one; the core checks the number of components)."""
+        """The binding's kind and payload of this blow, checked (a ValueError for a malformed
+        one; the core checks the number of components); a point without its Jacobian warns
+        that central differences are used."""
         if (self.generalized is None) == (self.point is None):
             raise ValueError("impulse: give exactly one of generalized= and point= (with impulse=)")
         if self.generalized is not None:
             if callable(self.generalized):
                 return "function", self.generalized
-            return "generalized", np.asarray(self.generalized, dtype=float).reshape(-1).tolist()
+            return "generalized", floats("generalized", self.generalized).reshape(-1).tolist()
         if self.impulse is None:
             raise ValueError("impulse: a point struck needs the impulse vector, impulse=")
         if self.jacobian is None:
@@ -513,10 +512,13 @@ def restored(text: str) -> tuple[Impulse | float, ...]:
         raise ValueError(f"path: its impulses are not a stored impulse list ({e})") from None
 
 
-def going_on(stored: Sequence[Impulse | float], given: Sequence[Impulse] | None, t: float) -> tuple[Impulse, ...]:
-    """The impulses a run continued from time ``t`` goes on with: its own, or ``given`` in their
-    place (the same times); a ValueError naming ``impulses`` for one still to come that was given
-    by Python functions, loaded from a file as its time, and not given again."""
+def going_on(
+    stored: Sequence[Impulse | float], given: Sequence[Impulse] | None, t: float
+) -> tuple[tuple[Impulse, ...], list[Spec]]:
+    """The impulses a run continued from time ``t`` goes on with, and their binding's tuples:
+    its own, or ``given`` in their place (the same times); a ValueError naming ``impulses`` for
+    one still to come that was given by Python functions, loaded from a file as its time, and
+    not given again."""
     if given is None:
         unknown = [imp for imp in stored if isinstance(imp, float) and imp > t]
         if unknown:
@@ -524,9 +526,10 @@ def going_on(stored: Sequence[Impulse | float], given: Sequence[Impulse] | None,
                 f"impulses: the run's impulses at t = {', '.join(map(str, unknown))} were given by Python functions, which"
                 " its file does not store; pass them again: varmech.resume(path, impulses=[...])"
             )
-        return tuple(imp for imp in stored if isinstance(imp, Impulse))
-    specs(given, -np.inf, np.inf)
+        own = tuple(imp for imp in stored if isinstance(imp, Impulse))
+        return own, specs(own, -np.inf, np.inf)
+    tuples = specs(given, -np.inf, np.inf)
     times = sorted(imp if isinstance(imp, float) else imp.t for imp in stored)
     if sorted(imp.t for imp in given) != times:
         raise ValueError(f"impulses: the run has impulses at t = {times}, not at {sorted(imp.t for imp in given)}")
-    return tuple(given)
+    return tuple(given), tuples

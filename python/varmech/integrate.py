@@ -398,7 +398,7 @@ def integrate(
         watched,
         event_specs,
         contacts=tuple(contacts or ()),
-        impulses=tuple(impulses or ()),
+        blows=(tuple(impulses or ()), impulse_specs),
     )
 
 
@@ -459,7 +459,7 @@ def _go_on(
         initial,
         found,
         contacts=contacts,
-        impulses=_impulses.going_on(traj.impulses, None, t_now),
+        blows=_impulses.going_on(traj.impulses, None, t_now),
         times=times,
     )
 
@@ -483,7 +483,7 @@ def _run(
     found: Sequence[int] = (),
     *,
     contacts: Sequence[_impacts.Contact] = (),
-    impulses: Sequence[_impulses.Impulse] = (),
+    blows: tuple[Sequence[_impulses.Impulse], list[_impulses.Spec]] = ((), []),
     times: np.ndarray | None = None,
 ) -> Trajectory:
     """Runs ``nsteps`` steps by ``first`` (a new run) or from ``checkpoint`` (after ``base``
@@ -491,11 +491,10 @@ def _run(
     ``watched`` are the run's events (``event_specs`` the binding's), whose crossings the result
     reports; a continued run's are watched after ``found`` crossings of each, an energy error
     measured from ``initial_energy``. The run resolves the impacts on ``contacts``, which the
-    result reports after the events' crossings, applies the ``impulses`` after its start (a
-    continued run's, those still to come) and keeps the states at ``times`` alone if given (a
-    continued run's; a new run's ``first`` takes its own)."""
-    # Their times were checked against the run's span when it began.
-    impulse_specs = _impulses.specs(impulses, -math.inf, math.inf)
+    result reports after the events' crossings, applies the impulses of ``blows`` (with their
+    binding's tuples) after its start (a continued run's, those still to come) and keeps the
+    states at ``times`` alone if given (a continued run's; a new run's ``first`` takes its own)."""
+    impulses, impulse_specs = blows
     bar = progress_bar(total=nsteps, unit="step", desc=method, enabled=progress)
     try:
         if output is not None:

@@ -324,7 +324,7 @@ def resume(
         raise ValueError(f"path: {str(path)!r} has no checkpoint to resume from")
     _check_checkpoint(path, stored)
     t_now = float(stored.t[-1])
-    blows = _impulses.going_on(stored.impulses, impulses, t_now)
+    _, blows = _impulses.going_on(stored.impulses, impulses, t_now)
     more = step_count(stored.dt, t_now, steps, t_end)
     if save_every is None:
         save_every = files.save_every_of(path)
@@ -350,7 +350,7 @@ def resume(
             initial_energy=initial,
             found=counts,
             contacts=going_on,
-            impulses=_impulses.specs(blows, -math.inf, math.inf),
+            impulses=blows,
         )
     finally:
         bar.close()
