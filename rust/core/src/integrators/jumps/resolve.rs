@@ -280,7 +280,7 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
         first: usize,
     ) -> Result<(), Error> {
         let (step, h) = (stepper.steps(), stepper.dt());
-        let inside = self.impulse_inside(self.next_impulse, stepper.t()).is_some();
+        let inside = self.impulse_inside(stepper.t()).is_some();
         let resolved = if crossed || inside {
             match self.resolve(stepper, search.as_deref_mut(), &mut traj.events) {
                 Ok(resolved) => resolved,
@@ -294,10 +294,7 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
         } else {
             false
         };
-        if resolved {
-            self.take_samples(stepper, traj)?;
-            self.push_jumps(stepper, traj);
-        } else {
+        if !resolved {
             if crossed {
                 // The scratch's first piece crossed nothing after all: φ at the step's end.
                 evaluate(self.contacts, stepper.q(), &mut self.phi_end, step, self.t)?;
@@ -306,15 +303,19 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
             if let Some(search) = search.as_deref_mut() {
                 search.piece(step, (stepper.t(), stepper.q(), stepper.p()), h, &mut traj.events)?;
             }
-            self.take_samples(stepper, traj)?;
+        }
+        // The samples from the step's jumps, before they are reported.
+        self.take_samples(stepper, traj)?;
+        if resolved {
+            self.push_jumps(stepper, traj);
         }
         self.blow_at_grid(stepper, search, traj)
     }
 
-    /// The time of impulse `k` if it falls inside the step that ends at `t_end`.
-    fn impulse_inside(&self, k: usize, t_end: f64) -> Option<f64> {
+    /// The time of the next impulse if it falls inside the step that ends at `t_end`.
+    fn impulse_inside(&self, t_end: f64) -> Option<f64> {
         let impulses = self.schedule?.impulses();
-        impulses.get(k).map(|b| b.t).filter(|&t| t < t_end)
+        impulses.get(self.next_impulse).map(|b| b.t).filter(|&t| t < t_end)
     }
 
     /// The step's jumps saved, in order of time (the states just before and after each, unless
@@ -463,7 +464,7 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
         loop {
             // The piece to the next impulse inside the step, or to the step's end, and the
             // first contact it crosses.
-            let inside = self.impulse_inside(self.next_impulse, t_end);
+            let inside = self.impulse_inside(t_end);
             let piece = inside.map_or(tau, |t| t - ta);
             self.partial(step, ta, piece)?;
             evaluate(contacts, self.scratch.q(), &mut self.phi_end, step, self.t)?;
