@@ -668,22 +668,23 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
         variational::multiplier(after, reflection, target, scale)
     }
 
-    /// The earliest s ∈ (0, τ] where φⱼ along the piece from (ta, piece_q, piece_p) falls
-    /// through 0 (`leaving`: the piece starts on that surface and only φⱼ < 0 counts):
-    /// bracketed by eight samples (refined towards 0, up to four times, for a piece leaving the
-    /// surface: a body that is below at every one crosses again at once, [`Located::Resting`]),
-    /// then the Illinois method ([`illinois`]) to round-off. None when no sample is below
+    /// The s ∈ (0, τ] where φⱼ along the piece from (ta, piece_q, piece_p) falls through 0,
+    /// by the Illinois method ([`illinois`]) to round-off. A piece that starts above the surface
+    /// brackets it by its ends (φⱼ falls through 0 once in a step short against the path's
+    /// curvature). A piece leaving it (`leaving`: it starts on that surface and only φⱼ < 0
+    /// counts) is bracketed by eight samples, refined towards 0 up to four times: a body below
+    /// at every one crosses again at once ([`Located::Resting`]); None when no sample is below
     /// (round-off at the piece's end).
     fn locate(&mut self, j: usize, step: usize, (ta, tau): (f64, f64), leaving: bool) -> Result<Option<f64>, Located> {
         let floor = floor(self.phi_start[j], leaving);
-        let (mut lo, mut g_lo) = (0.0, self.phi_start[j] - floor);
+        let start = (0.0, self.phi_start[j] - floor);
         let mut hi = tau;
-        let mut bracket = None;
-        for _ in 0..4 {
-            let mut previous = (lo, g_lo);
+        let mut bracket = (!leaving).then_some((start, (tau, self.phi_end[j])));
+        for _ in 0..if leaving { 4 } else { 0 } {
+            let mut previous = start;
             let mut found = None;
             for k in 1..=8 {
-                let x = lo + (hi - lo) * k as f64 / 8.0;
+                let x = hi * k as f64 / 8.0;
                 let v = self.phi_along(j, step, ta, x)? - floor;
                 if below(v, leaving) {
                     found = Some((k, x, v));
@@ -695,10 +696,7 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
                 return Ok(None);
             };
             if k > 1 {
-                (lo, g_lo) = previous;
-            }
-            if k > 1 || !leaving {
-                bracket = Some(((lo, g_lo), (x, v)));
+                bracket = Some((previous, (x, v)));
                 break;
             }
             hi = x;
