@@ -8,14 +8,15 @@ The step that crosses a surface is split at the contact: the method's own partia
 p⁺ = p⁻ + λ∇φ(q̃), and the method's partial step of size (1 − α)h to the grid time tₙ₊₁. The
 contact's ``law`` fixes λ:
 
-- ``"variational"`` (the default; kick–drift methods, ``MethodInfo.splitting``, and the implicit
-  two-point rules ``midpoint`` and ``trapezoid``): the variational collision integrator of
-  Fetecau, Marsden, Ortiz & West (2003). λ keeps the discrete energy E_d = −∂L_d/∂τ of the piece
-  after the jump equal to that of the piece before, which makes the action of the two partial
-  steps stationary in the contact point and the fraction, so **the step across an impact is
-  symplectic** (measured defect ≤ 1e-9, round-off of the differences, for every kick–drift
-  method, and for midpoint and trapezoid on separable and on natural systems M(q)). H itself
-  moves by O(h²) at an impact and stays bounded over many. It needs a conservative, autonomous,
+- ``"variational"`` (the default; kick–drift methods, ``MethodInfo.splitting``, the implicit
+  two-point rules ``midpoint`` and ``trapezoid`` and the Galerkin rules ``galerkin4`` and
+  ``galerkin6``): the variational collision integrator of Fetecau, Marsden, Ortiz & West (2003).
+  λ keeps the discrete energy E_d = −∂L_d/∂τ of the piece after the jump equal to that of the
+  piece before, which makes the action of the two partial steps stationary in the contact point
+  and the fraction, so **the step across an impact is symplectic** (measured defect ≤ 1e-9,
+  round-off of the differences, for every kick–drift method, for midpoint and trapezoid on
+  separable and on natural systems M(q), and for the Galerkin rules on a general Lagrangian).
+  H itself moves by O(h²) at an impact and stays bounded over many. It needs a conservative, autonomous,
   unconstrained model (the energy balance is E_d's alone). Where E_d has no root near the
   reflection (a grazing impact, |∇φ·q̇| of order h) the impact takes Newton's law, with a
   RuntimeWarning counting such impacts.
@@ -86,8 +87,8 @@ class Contact:
         The contact's name (its events' name in ``traj.events``).
     law : {"variational", "reflect"}, default "variational"
         The impact law: the variational collision integrator (the discrete energy kept; for
-        kick–drift methods and the two-point rules ``midpoint`` and ``trapezoid``, elastic
-        contacts only), or the exact reflection of the momenta between the method's partial
+        kick–drift methods, the two-point rules ``midpoint`` and ``trapezoid`` and the Galerkin
+        rules ``galerkin4`` and ``galerkin6``, elastic contacts only), or the exact reflection of the momenta between the method's partial
         steps (any method; symplectic across an impact only to the method's order).
 
     Raises
@@ -121,7 +122,7 @@ class Contact:
     restitution: float = 1.0
     name: str = "contact"
     #: The impact law: ``"variational"``, the variational collision integrator (the discrete energy kept;
-    #: kick–drift methods and the two-point rules ``midpoint`` and ``trapezoid``), or
+    #: kick–drift methods, the two-point rules ``midpoint`` and ``trapezoid``, the Galerkin rules), or
     #: ``"reflect"``, the exact reflection of the momenta between the method's partial steps (any
     #: method; symplectic across an impact only to the method's order).
     law: Literal["variational", "reflect"] = "variational"

@@ -245,6 +245,22 @@ impl Galerkin {
         }
     }
 
+    /// The discrete energy E_d = −∂L_d/∂h of the step through the control increments `at.dq`
+    /// that make L_d stationary in the interior points, which may then be held as h varies:
+    /// E_d = Σᵢ bᵢ E(q(cᵢh), q̇(cᵢh)), E = q̇·∂L/∂q̇ − L, for an autonomous L.
+    pub(crate) fn energy<S: Lagrangian + ?Sized>(&mut self, sys: &S, at: Segment<'_>) -> Result<f64, ModelError> {
+        let quad = &mut self.quadrature;
+        let mut energy = 0.0;
+        for i in 0..quad.s {
+            quad.node_state(i, &at);
+            let ti = at.t + quad.nodes[i] * at.h;
+            sys.dl_dv(&quad.pos, &quad.vel, ti, &mut self.lv[i])?;
+            let momentum: f64 = self.lv[i].iter().zip(&quad.vel).map(|(p, v)| p * v).sum();
+            energy += quad.weights[i] * (momentum - sys.lagrangian(&quad.pos, &quad.vel, ti)?);
+        }
+        Ok(energy)
+    }
+
     /// out = Σⱼ ∂L_d/∂Qⱼ = hΣᵢ bᵢ ∂L/∂q(cᵢ) from the last [`Galerkin::derivatives`].
     pub(crate) fn slot_sum(&self, h: f64, out: &mut [f64]) {
         out.fill(0.0);

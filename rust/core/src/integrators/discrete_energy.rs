@@ -2,9 +2,9 @@
 //! variational collision integrator conserves across an impact (Fetecau, Marsden, Ortiz &
 //! West 2003), for an autonomous L.
 
-use super::{Dynamics, Method, Splitting};
+use super::{Dynamics, Increment, Integrator, Method, Splitting, StepStart};
 use crate::model::Lagrangian;
-use crate::ModelError;
+use crate::{ModelError, StepError};
 
 /// The methods with a discrete energy here, and their data.
 #[derive(Clone, Debug)]
@@ -19,6 +19,9 @@ enum Rule {
     /// L_d = (τ/2)[L(q₀, v) + L(q₁, v)]: E_d = ½[E(q₀, v) + E(q₁, v)], with v solved from the
     /// half-sum of the momenta (see [`DiscreteEnergy::trapezoid`]).
     Trapezoid,
+    /// A Galerkin rule: its step solved again from (q₀, p₀), E_d from the control points that
+    /// make L_d stationary ([`crate::discrete::Galerkin::energy`]).
+    Galerkin(Box<Integrator>),
 }
 
 /// The discrete energy E_d = −∂L_d/∂τ of one method's step, with the buffers it needs, made
@@ -49,11 +52,13 @@ const PASSES: usize = 50;
 
 impl DiscreteEnergy {
     /// The discrete energy of `method`'s step on n coordinates; None where the method has none
-    /// here (only the kick–drift methods and the midpoint and trapezoidal rules have one).
+    /// here (the kick–drift methods, the midpoint and trapezoidal rules and the Galerkin rules
+    /// have one).
     pub fn new(method: Method, n: usize) -> Option<DiscreteEnergy> {
         let rule = match method {
             Method::Midpoint => Rule::Midpoint,
             Method::Trapezoid => Rule::Trapezoid,
+            Method::Galerkin4 | Method::Galerkin6 => Rule::Galerkin(Box::new(Integrator::new(method, n))),
             _ => Rule::KickDrift(Splitting::of(method)?),
         };
         let buffer = || vec![0.0; n];
@@ -72,13 +77,13 @@ impl DiscreteEnergy {
     }
 
     /// E_d of the method's step of size τ from `start` = (q₀, p₀) to `end` = (q₁, p₁) at time
-    /// t (L autonomous): a kick–drift method replays its stages from `start` (`end` unused); a
-    /// two-point rule takes both ends. For τ = 0 (and a two-point rule's end = start) it is
-    /// H(q₀, p₀).
+    /// t (L autonomous): a kick–drift method replays its stages and a Galerkin rule solves its
+    /// step again from `start` (`end` unused); a two-point rule takes both ends. For τ = 0 (and
+    /// a two-point rule's end = start) it is H(q₀, p₀).
     ///
     /// # Errors
-    /// The model's own error, or the trapezoid's velocity iteration failing to converge (a
-    /// step too large for it).
+    /// The model's own error, the trapezoid's velocity iteration failing to converge (a step
+    /// too large for it), or the Galerkin step's own failure.
     pub fn energy<S: Dynamics + ?Sized>(
         &mut self,
         sys: &S,
@@ -86,19 +91,37 @@ impl DiscreteEnergy {
         tau: f64,
         start: (&[f64], &[f64]),
         end: (&[f64], &[f64]),
-    ) -> Result<f64, ModelError> {
+    ) -> Result<f64, StepError> {
         let lagrangian = sys.as_lagrangian();
-        match &self.rule {
+        Ok(match &mut self.rule {
             Rule::KickDrift(splitting) => {
                 let buffers = (&mut self.q[..], &mut self.p[..], &mut self.v[..], &mut self.force[..]);
-                kick_drift(splitting, buffers, &self.zeros, lagrangian, t, tau, start)
+                kick_drift(splitting, buffers, &self.zeros, lagrangian, t, tau, start)?
             }
             Rule::Midpoint => {
                 self.mean(start, end);
-                Ok(lagrangian.energy_terms(&self.q, &self.p, t)?.energy)
+                lagrangian.energy_terms(&self.q, &self.p, t)?.energy
             }
-            Rule::Trapezoid => self.trapezoid(lagrangian, t, tau, start, end),
-        }
+            Rule::Trapezoid => self.trapezoid(lagrangian, t, tau, start, end)?,
+            Rule::Galerkin(_) if tau == 0.0 => lagrangian.energy(start.0, start.1, t)?,
+            Rule::Galerkin(integrator) => {
+                let step = StepStart {
+                    t,
+                    h: tau,
+                    q: start.0,
+                    p: start.1,
+                };
+                let mut increment = Increment {
+                    dq: &mut self.q,
+                    dp: &mut self.p,
+                };
+                integrator.reset();
+                sys.increment(integrator, &step, &mut increment)?;
+                integrator
+                    .galerkin_energy(lagrangian, step)
+                    .expect("a Galerkin method")?
+            }
+        })
     }
 
     /// q̄ = (q₀ + q₁)/2 into `q`, p̄ = (p₀ + p₁)/2 into `p`.

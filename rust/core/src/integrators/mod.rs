@@ -12,7 +12,7 @@
 //! - [`Splitting`]: the coefficients of the kick–drift methods (symplectic Euler, Störmer–Verlet,
 //!   its symmetric compositions, the Runge–Kutta–Nyström splittings);
 //! - [`KickDrift`]: a [`Splitting`] applied to a separable system;
-//! - [`DiscreteEnergy`]: E_d = −∂L_d/∂τ of a kick–drift method's or a two-point rule's step,
+//! - [`DiscreteEnergy`]: E_d = −∂L_d/∂τ of a kick–drift method's, a two-point or Galerkin rule's step,
 //!   which the variational collision integrator conserves across an impact;
 //! - [`ExplicitRk`]: explicit Euler and classical RK4, the non-structure-preserving baselines;
 //! - [`wisdom_holman`]: the Wisdom–Holman methods of the N-body problem, Kepler drifts and
@@ -214,6 +214,19 @@ impl Integrator {
     pub(super) fn own_variables(&mut self) -> Option<&mut WisdomHolman> {
         match &mut self.scheme {
             Scheme::WisdomHolman(s) => Some(s),
+            _ => None,
+        }
+    }
+
+    /// The discrete energy of a Galerkin method's last step, from `start`; None for the other
+    /// methods.
+    pub(super) fn galerkin_energy(
+        &mut self,
+        sys: &dyn Lagrangian,
+        start: StepStart<'_>,
+    ) -> Option<Result<f64, crate::ModelError>> {
+        match &mut self.scheme {
+            Scheme::Galerkin(s) => Some(s.energy(sys, start)),
             _ => None,
         }
     }

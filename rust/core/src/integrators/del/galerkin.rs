@@ -63,3 +63,16 @@ impl StepEquations for Galerkin {
         &mut self.quadrature
     }
 }
+
+impl super::Del<Galerkin> {
+    /// The discrete energy of the last step, from `start` ([`Galerkin::energy`] at its solved
+    /// control points).
+    pub(in crate::integrators) fn energy<S: Lagrangian + ?Sized>(
+        &mut self,
+        sys: &S,
+        start: StepStart<'_>,
+    ) -> Result<f64, ModelError> {
+        let controls = &self.x[self.m..];
+        self.scheme.energy(sys, segment(&start, controls))
+    }
+}

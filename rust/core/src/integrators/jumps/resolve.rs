@@ -20,8 +20,8 @@ use crate::{Error, ModelError};
 pub(super) fn variational_misfit<S: Dynamics + ?Sized>(model: &S, method: Method) -> Option<String> {
     if DiscreteEnergy::new(method, 0).is_none() {
         return Some(format!(
-            "needs a kick–drift method or a two-point rule (midpoint, trapezoid), not {}; give the contact law \
-             reflect or use such a method",
+            "needs a kick–drift method, a two-point rule (midpoint, trapezoid) or a Galerkin rule, not {}; give \
+             the contact law reflect or use such a method",
             method.info().name
         ));
     }
@@ -646,7 +646,7 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
         let before = (&piece_q[..], &piece_p[..]);
         let target = discrete
             .energy(scratch.model(), ta, s, before, (contact_q, contact_p))
-            .map_err(model_error)?;
+            .map_err(|e| e.at(step, time))?;
         scratch
             .model()
             .as_lagrangian()
@@ -663,7 +663,7 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
             let end = (scratch.q(), scratch.p());
             discrete
                 .energy(scratch.model(), t, rest, (piece_q, piece_p), end)
-                .map_err(model_error)
+                .map_err(|e| e.at(step, time))
         };
         variational::multiplier(after, reflection, target, scale)
     }
