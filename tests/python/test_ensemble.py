@@ -286,6 +286,24 @@ def test_a_dask_cluster_gives_every_member_bit_for_bit(cluster_client, chunk_siz
     assert swept.failed == [1] and isinstance(swept.errors[1], varmech.DivergenceError) and swept.errors[1].step >= 1
 
 
+def test_a_dask_cluster_runs_struck_and_sampled_bouncing_balls_bit_for_bit(cluster_client):
+    # Contacts, impulses and t_eval go to the workers with the settings: every member (the
+    # native ball on its floor, struck downwards at t = 0.25 and sampled at 40 times) is its
+    # single run, with the same impacts.
+    ball = scenes.bouncing_ball()
+    q0, p0 = np.linspace(0.5, 1.5, 6)[:, None], np.zeros((6, 1))
+    run = dict(
+        dt=1e-3, t_end=2.0, method="verlet", impulses=[varmech.Impulse(generalized=[-1.0], t=0.2505)],
+        t_eval=np.linspace(0.0, 2.0, 40),
+    )
+    runs = varmech.ensemble(ball, q0, p0, client=cluster_client, chunk_size=2, progress=False, **run)
+    for i in range(6):
+        single = varmech.integrate(ball.model, q0[i], p0[i], contacts=ball.contacts, **run)
+        assert len(single.events[0]) >= 2
+        assert _same(runs[i], single), f"member {i}"
+        assert np.array_equal(runs[i].events[0].t, single.events[0].t)
+
+
 def test_ctrl_c_on_a_cluster_keeps_the_chunks_it_finished(cluster_client, monkeypatch):
     # Ctrl-C arriving as the first chunk is gathered (raised from the progress bar's update): the
     # KeyboardInterrupt carries the ensemble so far, the finished chunk's members bit for bit,
