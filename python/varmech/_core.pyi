@@ -39,6 +39,7 @@ __all__ = [
     "VarmechError",
     "amended_potential",
     "catalogue",
+    "central_differences",
     "constraint_curvature",
     "constraint_residuals",
     "cyclic_increments",
@@ -46,8 +47,12 @@ __all__ = [
     "derivative",
     "energy_statistics",
     "energy_terms",
+    "engage",
     "ensemble",
+    "impulse_components",
+    "impulse_response",
     "integrate",
+    "inverse_mass",
     "is_affine",
     "is_forced",
     "is_time_dependent",
@@ -315,6 +320,29 @@ def constraint_curvature(model: _Model, q: _FloatArray) -> list[float] | None:
     """Frobenius' test of the velocity constraints at each row of q: the curvature of ker A(q)
     relative to ∂A/∂q (round-off where they integrate); None without velocity constraints."""
 def project(model: _Model, q0: _FloatArray, p0: _FloatArray) -> tuple[_FloatArray, _FloatArray]: ...
+
+# Lagrange's impulsive equations at one state (rust/python/src/impulsive.rs). A blow is
+# (kind, payload) as in a run's impulses: "generalized" (numbers), "function" (P(q)), "point"
+# ((x(q), its Jacobian or None, the impulse vector)).
+def impulse_components(kind: str, payload: object, q: _FloatArray) -> _FloatArray:
+    """P(q), the blow's components of impulse."""
+
+def impulse_response(
+    model: _Model, t: float, q: _FloatArray, p: _FloatArray, kind: str, payload: object
+) -> tuple[_FloatArray, _FloatArray, _FloatArray, float]:
+    """(p⁺, q̇⁺, q̇⁻, T⁺ − T⁻) just after the blow at (q, p)."""
+
+def engage(
+    model: _Model, t: float, q: _FloatArray, p: _FloatArray, a: _FloatArray, argument: str
+) -> tuple[_FloatArray, _FloatArray, _FloatArray, float, float]:
+    """(p⁺, q̇⁺, λ, T⁻ − T⁺, Carnot's ½Δq̇ᵀMΔq̇) just after A(q)q̇ = 0 engages; dependent
+    constraints are a ValueError naming ``argument``."""
+
+def inverse_mass(model: _Model, q: _FloatArray, t: float) -> _FloatArray:
+    """M(q)⁻¹, shape (n, n)."""
+
+def central_differences(g: Callable[[_FloatArray], object], q: _FloatArray, call: str) -> _FloatArray:
+    """∂g/∂q, shape (m, n), by central differences; ``call`` names g in errors."""
 
 @final
 class ClosureModel(_ModelProperties):

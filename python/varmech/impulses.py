@@ -21,6 +21,9 @@ perfectly inelastic engagement.
 The metric M⁻¹ is the model's inverse Legendre transform: q̇(q, p) = M⁻¹(p − a(q)) for a
 Lagrangian quadratic in q̇ (kinetic energy, gyroscopic terms); its columns are differences
 q̇(q, eᵢ) − q̇(q, 0), exact for such Lagrangians.
+
+This module declares; the core computes (``varmech::integrators::impulsive``, and the blows of
+a run's impulses, ``jumps/schedule.rs``), with the same components of impulse in both.
 """
 
 from __future__ import annotations
@@ -29,7 +32,7 @@ import json
 import warnings
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from typing import Any, cast
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -104,8 +107,8 @@ class Impulse:
         ------
         ValueError
             Not exactly one of ``generalized`` and ``point``; a ``point`` without ``impulse``;
-            ``generalized`` not n finite numbers; the point and the impulse of different
-            lengths; or ``jacobian`` not of shape (d, n).
+            ``generalized`` not n finite numbers; ``point`` not returning d numbers for an
+            impulse of d; or ``jacobian`` not returning shape (d, n).
 
         Examples
         --------
@@ -115,25 +118,8 @@ class Impulse:
         >>> Impulse(generalized=lambda q: [np.cos(q[1]), 0.0]).components(np.array([0.0, np.pi])).tolist()
         [-1.0, 0.0]
         """
-        n = len(q)
         kind, payload = self._spec()
-        if kind == "function":
-            return vector("generalized", payload(q.copy()), n)
-        if kind == "generalized":
-            # The components as given, not the binding's flattened list: their shape is checked.
-            return vector("generalized", cast(ArrayLike, self.generalized), n)
-        point, jacobian, blow = payload
-        x = np.asarray(point(q.copy()), dtype=float).reshape(-1)
-        if x.size != len(blow):
-            raise ValueError(f"impulse: the point has {x.size} coordinates and the impulse {len(blow)}")
-        if jacobian is not None:
-            jac = np.asarray(jacobian(q.copy()), dtype=float)
-            if jac.shape != (x.size, n):
-                raise ValueError(f"jacobian: expected shape {(x.size, n)}, got {jac.shape}")
-        else:
-            jac = _differences(lambda y: np.asarray(point(y), dtype=float).reshape(-1), q)
-        return np.asarray(jac.T @ np.asarray(blow))
-
+        return _core.impulse_components(kind, payload, np.ascontiguousarray(q, dtype=float))
 
     def _spec(self) -> tuple[str, Any]:
         """The binding's kind and payload of this blow, checked (a ValueError for a malformed
@@ -151,18 +137,6 @@ class Impulse:
             warnings.warn("impulse: no jacobian of the point given; central differences are used", stacklevel=4)
         blow = np.asarray(self.impulse, dtype=float).reshape(-1).tolist()
         return "point", (self.point, self.jacobian, blow)
-
-
-def _differences(f: Callable[[np.ndarray], np.ndarray], q: np.ndarray) -> np.ndarray:
-    """∂f/∂q by central differences, shape (len f, len q)."""
-    columns = []
-    for i in range(len(q)):
-        h = np.finfo(float).eps ** (1 / 3) * max(abs(q[i]), 1.0)
-        up, down = q.copy(), q.copy()
-        up[i] += h
-        down[i] -= h
-        columns.append((f(up) - f(down)) / (2 * h))
-    return np.stack(columns, axis=1)
 
 
 @dataclass(frozen=True)
@@ -248,15 +222,6 @@ def _state(model: Model, q: ArrayLike, p: ArrayLike | None, v: ArrayLike | None,
     return qq, model.momentum(qq, vector("v", v, n), t)
 
 
-def _velocity(model: Model, q: np.ndarray, p: np.ndarray, t: float) -> np.ndarray:
-    return np.asarray(_core.derivative(model._core, "velocity", np.array([t]), q[None, :], p[None, :])[0])
-
-
-def _kinetic(model: Model, q: np.ndarray, p: np.ndarray, t: float) -> float:
-    """T = E − V at (q, p)."""
-    return float(_core.energy_terms(model._core, np.array([t]), q[None, :], p[None, :])[1][0])
-
-
 def inverse_mass(model: Model, q: ArrayLike, t: float = 0.0) -> np.ndarray:
     """M(q)⁻¹, the metric of the inverse Legendre transform q̇ = M⁻¹(p − a(q)): columns
     q̇(q, eᵢ) − q̇(q, 0), exact for a Lagrangian quadratic in q̇.
@@ -288,10 +253,7 @@ def inverse_mass(model: Model, q: ArrayLike, t: float = 0.0) -> np.ndarray:
     >>> np.diag(inverse_mass(rod, np.zeros(3))).round(12)
     array([1., 1., 3.])
     """
-    n = model.dim
-    qq = vector("q", q, n)
-    zero = _velocity(model, qq, np.zeros(n), t)
-    return np.stack([_velocity(model, qq, np.eye(n)[i], t) - zero for i in range(n)], axis=1)
+    return _core.inverse_mass(model._core, vector("q", q, model.dim), float(t))
 
 
 def impulse_response(
@@ -363,14 +325,8 @@ def impulse_response(
     if not isinstance(impulse, Impulse):
         raise TypeError(f"impulse: expected a varmech.Impulse, got {type(impulse).__name__}")
     qq, before = _state(model, q, p, v, t)
-    after = before + impulse.components(qq)
-    return ImpulseResponse(
-        after,
-        _velocity(model, qq, after, t),
-        _kinetic(model, qq, after, t) - _kinetic(model, qq, before, t),
-        before,
-        _velocity(model, qq, before, t),
-    )
+    after, v_after, v_before, change = _core.impulse_response(model._core, float(t), qq, before, *impulse._spec())
+    return ImpulseResponse(after, v_after, change, before, v_before)
 
 
 def engage(
@@ -456,22 +412,11 @@ def engage(
             a = np.atleast_2d(np.asarray(jacobian(qq.copy()), dtype=float))
         else:
             warnings.warn("engage: no jacobian of the constraints given; central differences are used", stacklevel=2)
-            a = _differences(lambda y: np.asarray(constraints(y), dtype=float).reshape(-1), qq)
+            a = _core.central_differences(constraints, qq, "constraints")
         name = "jacobian"
     if a.ndim != 2 or a.shape[1] != n:
         raise ValueError(f"{name}: expected a matrix with {n} columns, got shape {a.shape}")
-    minv = inverse_mass(model, qq, t)
-    v_before = _velocity(model, qq, before, t)
-    gram = a @ minv @ a.T
-    try:
-        multipliers = -np.linalg.solve(gram, a @ v_before)
-    except np.linalg.LinAlgError as e:
-        raise ValueError(f"{name}: the constraints are dependent here (A M⁻¹ Aᵀ is singular)") from e
-    after = before + a.T @ multipliers
-    v_after = _velocity(model, qq, after, t)
-    jump = v_after - v_before
-    carnot = 0.5 * float(jump @ np.linalg.solve(minv, jump))
-    lost = _kinetic(model, qq, before, t) - _kinetic(model, qq, after, t)
+    after, v_after, multipliers, lost, carnot = _core.engage(model._core, float(t), qq, before, np.ascontiguousarray(a), name)
     return Engagement(after, v_after, multipliers, lost, carnot)
 
 

@@ -3,11 +3,13 @@
 //! partial steps to the requested times, taken through impacts; both composed with contacts and
 //! carried by a resumed run bit for bit.
 
+use nalgebra::DMatrix;
 use varmech::integrators::{
-    integrate, integrate_watching, resume_watching, Blow, Checkpoint, Contacts, Failure, Generalized, Impulse, Law,
-    MemberWatch, Method, NativeContact, NativeSurface, Options, Schedule, Struck, Trajectory, Watch,
+    impulsive, integrate, integrate_watching, resume_watching, Blow, Checkpoint, Contacts, Failure, Generalized,
+    Impulse, Law, MemberWatch, Method, NativeContact, NativeSurface, Options, Schedule, Struck, Trajectory, Watch,
 };
-use varmech::scenes::{BouncingBall, HarmonicOscillator};
+use varmech::model::Lagrangian;
+use varmech::scenes::{BouncingBall, DoublePendulum, HarmonicOscillator};
 use varmech::Error;
 
 use crate::common::verlet_ensemble;
@@ -146,6 +148,42 @@ fn a_blow_at_a_point_gives_the_components_of_its_jacobian_or_of_central_differen
     assert_eq!(a, exact);
     // Central differences: error O(ε^(2/3)) ≈ 4e-11.
     assert!(a.iter().zip(&b).all(|(x, y)| (x - y).abs() < 1e-9), "{b:?}");
+}
+
+#[test]
+fn lagranges_impulsive_equations_give_m_dv_equal_to_p_and_carnots_loss_on_engaging() {
+    // The double pendulum's M(q) depends on q: a blow P gives M Δq̇ = P and T⁺ − T⁻ =
+    // ½(p⁺·q̇⁺ − p⁻·q̇⁻); the first joint gripped suddenly (A = [1, 0]) stops it, losing
+    // Carnot's ½Δq̇ᵀMΔq̇ (Byerly, Arts. 26–31).
+    let double = DoublePendulum::new(1.0, 2.0, 2.0, 3.0, 9.80665).unwrap();
+    let model: &dyn Lagrangian = &double;
+    let (q, p, blow) = ([0.7, -0.4], [0.2, 0.1], [0.5, -0.3]);
+    let after = impulsive::respond(model, 0.0, (&q, &p), &Generalized(blow.to_vec())).unwrap();
+    let minv = impulsive::inverse_mass(model, &q, 0.0).unwrap();
+    let dv = nalgebra::DVector::from_iterator(2, after.v.iter().zip(&after.v_before).map(|(a, b)| a - b));
+    let recovered = minv.lu().solve(&dv).unwrap();
+    assert!(
+        (recovered[0] - blow[0]).abs() < 1e-13 && (recovered[1] - blow[1]).abs() < 1e-13,
+        "{recovered}"
+    );
+    let dot = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(x, y)| x * y).sum::<f64>();
+    let change = 0.5 * (dot(&after.p, &after.v) - dot(&p, &after.v_before));
+    // T = E − V: round-off of |V| ≈ 30 (measured 1.8e-14).
+    assert!(
+        (after.kinetic_change - change).abs() < 1e-12,
+        "{} {change}",
+        after.kinetic_change
+    );
+
+    let grip = DMatrix::from_row_slice(1, 2, &[1.0, 0.0]);
+    let engaged = impulsive::engage(model, 0.0, (&q, &p), &grip).unwrap().unwrap();
+    assert!(engaged.v[0].abs() < 1e-15, "{:?}", engaged.v);
+    assert!(engaged.energy_lost > 0.0);
+    assert!((engaged.energy_lost - engaged.carnot).abs() < 1e-12, "{engaged:?}");
+    // Δp = Aᵀλ: the second momentum does not change.
+    assert_eq!(engaged.p[1], p[1]);
+    let dependent = DMatrix::from_row_slice(2, 2, &[1.0, 0.0, 2.0, 0.0]);
+    assert_eq!(impulsive::engage(model, 0.0, (&q, &p), &dependent).unwrap(), None);
 }
 
 /// The step count and state of a ball's run's checkpoint (its energy check aside: a run of

@@ -21,6 +21,7 @@ mod ensemble;
 mod errors;
 mod events;
 mod generator;
+mod impulsive;
 mod native;
 mod pointers;
 mod routh;
@@ -47,5 +48,6 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<stepper::Stepper>()?;
     diagnostics::register(m)?;
     constraints::register(m)?;
+    impulsive::register(m)?;
     Ok(())
 }

@@ -14,7 +14,7 @@ use crate::closure::readers::{call_array, call_vector};
 pub type ImpulseTuple<'py> = (f64, String, Bound<'py, PyAny>);
 
 /// A blow as Python gave it.
-enum Kind {
+pub enum Kind {
     Generalized(Generalized),
     Function(Py<PyAny>),
     Point {
@@ -22,6 +22,55 @@ enum Kind {
         jacobian: Option<Py<PyAny>>,
         impulse: Vec<f64>,
     },
+}
+
+impl Kind {
+    /// The blow of `kind` with its payload; an unknown kind is None.
+    pub fn new(kind: &str, payload: &Bound<'_, PyAny>) -> PyResult<Option<Self>> {
+        Ok(Some(match kind {
+            "generalized" => Kind::Generalized(Generalized(payload.extract()?)),
+            "function" => Kind::Function(payload.extract()?),
+            "point" => {
+                let (point, jacobian, impulse) = payload.extract()?;
+                Kind::Point {
+                    point,
+                    jacobian,
+                    impulse,
+                }
+            }
+            _ => return Ok(None),
+        }))
+    }
+
+    /// The core's blow, borrowing Python's functions.
+    pub fn blow(&self) -> Box<dyn Blow + '_> {
+        match self {
+            Kind::Generalized(native) => Box::new(native.clone()),
+            Kind::Function(f) => Box::new(Function(f)),
+            Kind::Point {
+                point,
+                jacobian,
+                impulse,
+            } => {
+                let d = impulse.len();
+                Box::new(Struck {
+                    point: point_function(point, "point", move |_| vec![d]),
+                    jacobian: jacobian
+                        .as_ref()
+                        .map(|j| point_function(j, "jacobian", move |n| vec![d, n])),
+                    impulse: impulse.clone(),
+                })
+            }
+        }
+    }
+
+    /// The argument a misfit of the blow names: its components, or its impulse vector.
+    pub fn argument(&self) -> &'static str {
+        match self {
+            Kind::Point { .. } => "impulse",
+            _ => "generalized",
+        }
+    }
 }
 
 /// Components of impulse given as Python's function P(q) -> array (n,).
@@ -66,21 +115,9 @@ impl ScheduleSpecs {
     pub fn new(tuples: Vec<ImpulseTuple<'_>>, samples: Vec<f64>) -> PyResult<Self> {
         let mut impulses = Vec::with_capacity(tuples.len());
         for (i, (t, kind, payload)) in tuples.into_iter().enumerate() {
-            let kind = match kind.as_str() {
-                "generalized" => Kind::Generalized(Generalized(payload.extract()?)),
-                "function" => Kind::Function(payload.extract()?),
-                "point" => {
-                    let (point, jacobian, impulse) = payload.extract()?;
-                    Kind::Point {
-                        point,
-                        jacobian,
-                        impulse,
-                    }
-                }
-                _ => {
-                    let message = format!("impulses[{i}]: unknown kind {kind:?}");
-                    return Err(PyValueError::new_err(message));
-                }
+            let Some(kind) = Kind::new(&kind, &payload)? else {
+                let message = format!("impulses[{i}]: unknown kind {kind:?}");
+                return Err(PyValueError::new_err(message));
             };
             impulses.push((t, kind));
         }
@@ -108,26 +145,9 @@ impl ScheduleSpecs {
 
     /// The core's schedule, its blows borrowed from these.
     pub fn schedule(&self) -> Result<Schedule<'_>, varmech::Error> {
-        let impulses = self.impulses.iter().map(|(t, kind)| Impulse {
+        let impulses = (self.impulses.iter()).map(|(t, kind)| Impulse {
             t: *t,
-            blow: match kind {
-                Kind::Generalized(native) => Box::new(native.clone()) as Box<dyn Blow>,
-                Kind::Function(f) => Box::new(Function(f)),
-                Kind::Point {
-                    point,
-                    jacobian,
-                    impulse,
-                } => {
-                    let d = impulse.len();
-                    Box::new(Struck {
-                        point: point_function(point, "point", move |_| vec![d]),
-                        jacobian: jacobian
-                            .as_ref()
-                            .map(|j| point_function(j, "jacobian", move |n| vec![d, n])),
-                        impulse: impulse.clone(),
-                    })
-                }
-            },
+            blow: kind.blow(),
         });
         Schedule::new(impulses.collect(), self.samples.clone())
     }

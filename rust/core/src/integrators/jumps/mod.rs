@@ -12,8 +12,12 @@
 //! - [`Schedule`]: impulses ([`Impulse`], a [`Blow`] at a time) and samples (`t_eval`) at given
 //!   times, each splitting the step that holds it (`schedule.rs`);
 //! - [`Watch`]: the events, contacts and schedule a run or a stepper watches, and [`Watcher`],
-//!   the one loop of steps that checks them, begun on a stepper's state.
+//!   the one loop of steps that checks them, begun on a stepper's state;
+//! - `impulsive.rs`: Lagrange's impulsive equations at one state, outside a run: a blow's
+//!   response ([`impulsive::respond`]) and constraints that engage suddenly
+//!   ([`impulsive::engage`]).
 
+pub mod impulsive;
 mod reflect;
 mod resolve;
 mod schedule;
