@@ -48,6 +48,31 @@ impl Error {
             reason: reason.into(),
         }
     }
+
+    /// The same error, named by the run's `step` and its start `time`: a partial step's, which
+    /// a run reports as its own step's.
+    pub(crate) fn at(self, step: usize, time: f64) -> Error {
+        match self {
+            Error::Divergence { reason, .. } => Error::Divergence { step, time, reason },
+            Error::Convergence {
+                residual,
+                iterations,
+                reason,
+                ..
+            } => Error::Convergence {
+                step,
+                time,
+                residual,
+                iterations,
+                reason,
+            },
+            Error::SpuriousBranch { reason, .. } => Error::SpuriousBranch { step, time, reason },
+            Error::Model { source, .. } => Error::Model { step, time, source },
+            Error::Interrupted { source, .. } => Error::Interrupted { step, time, source },
+            Error::Contact { reason, .. } => Error::Contact { step, time, reason },
+            e @ Error::InvalidArgument { .. } => e,
+        }
+    }
 }
 
 impl fmt::Display for Error {

@@ -659,7 +659,7 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
                 *x = a + lambda * b;
             }
             scratch.restart(t, piece_q, piece_p, rest);
-            scratch.step().map_err(|e| redate(e, step, time))?;
+            scratch.step().map_err(|e| e.at(step, time))?;
             let end = (scratch.q(), scratch.p());
             discrete
                 .energy(scratch.model(), t, rest, (piece_q, piece_p), end)
@@ -731,7 +731,7 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
         self.scratch
             .restart(ta, &self.piece_q, &self.piece_p, if s > 0.0 { s } else { 1.0 });
         if s > 0.0 {
-            self.scratch.step().map_err(|e| redate(e, step, self.t))?;
+            self.scratch.step().map_err(|e| e.at(step, self.t))?;
         }
         Ok(())
     }
@@ -851,29 +851,5 @@ impl Gaps<'_, '_> {
         std::mem::swap(&mut self.phi, &mut self.phi_end);
         self.swapped = !self.swapped;
         true
-    }
-}
-
-/// A partial step's error, named by the run's step and its start.
-fn redate(error: Error, step: usize, time: f64) -> Error {
-    match error {
-        Error::Divergence { reason, .. } => Error::Divergence { step, time, reason },
-        Error::Convergence {
-            residual,
-            iterations,
-            reason,
-            ..
-        } => Error::Convergence {
-            step,
-            time,
-            residual,
-            iterations,
-            reason,
-        },
-        Error::SpuriousBranch { reason, .. } => Error::SpuriousBranch { step, time, reason },
-        Error::Model { source, .. } => Error::Model { step, time, source },
-        Error::Interrupted { source, .. } => Error::Interrupted { step, time, source },
-        Error::Contact { reason, .. } => Error::Contact { step, time, reason },
-        e @ Error::InvalidArgument { .. } => e,
     }
 }
