@@ -71,10 +71,15 @@ impl Stepper {
         Ok(stepper)
     }
 
+    /// Whether the steps are the method's alone, with no contacts and no impulses to watch.
+    fn unwatched(&self) -> bool {
+        self.contacts.is_none() && self.impulses.is_empty()
+    }
+
     /// Whether the contacts and impulses fit the model and method and the state lies in φ ≥ 0
     /// (named `argument` if not); where `fresh`, the impulses at the state's time applied.
     fn check(&mut self, py: Python<'_>, argument: &'static str, fresh: bool) -> PyResult<()> {
-        if self.contacts.is_none() && self.impulses.is_empty() {
+        if self.unwatched() {
             return Ok(());
         }
         let (specs, impulses, state) = (&self.contacts, &self.impulses, &mut self.state);
@@ -106,7 +111,7 @@ impl Stepper {
     /// Advances `n` steps (one by [`integrators::Stepper::step`] where `single`), through the
     /// contacts' impacts if any: a [`Watcher`] resumed on the state, its impacts kept.
     fn go(&mut self, py: Python<'_>, n: usize, single: bool) -> PyResult<()> {
-        if self.contacts.is_none() && self.impulses.is_empty() {
+        if self.unwatched() {
             return self.with(py, |stepper, poll| {
                 if single {
                     stepper.step()

@@ -180,13 +180,13 @@ where
         (options.steps, options.save_every),
         poll,
         watch,
-        "q0",
+        true,
     )
 }
 
 /// The run of `stepper` to step `end` watching `watch` (its [`Watcher`] begun on the
-/// stepper's state, named `argument` if it is outside a contact): a new run when `argument` is
-/// `q0` (its schedule's times at t0 taken), else a resumed one.
+/// stepper's state): a `fresh` run (its schedule's times at t0 taken, a state outside a contact
+/// named `q0`) or a resumed one (named `checkpoint`).
 fn watched<S, P>(
     sys: &S,
     stepper: Stepper<&S>,
@@ -194,14 +194,15 @@ fn watched<S, P>(
     (end, save_every): (usize, usize),
     poll: P,
     watch: Watch<'_, '_, '_>,
-    argument: &'static str,
+    fresh: bool,
 ) -> Result<Trajectory, Box<Failure>>
 where
     S: Dynamics + ?Sized,
     P: Poll,
 {
+    let argument = if fresh { "q0" } else { "checkpoint" };
     match Watcher::begin(sys, &stepper, watch, argument, energy.is_some()) {
-        Ok(watcher) => run(sys, stepper, energy, end, save_every, poll, (watcher, argument == "q0")),
+        Ok(watcher) => run(sys, stepper, energy, end, save_every, poll, (watcher, fresh)),
         Err(error) => Err(fail(error, first_state(sys, &stepper))),
     }
 }
@@ -288,7 +289,7 @@ where
     P: Poll,
 {
     let (stepper, energy, end) = resumed(sys, checkpoint, steps, save_every)?;
-    watched(sys, stepper, energy, (end, save_every), poll, watch, "checkpoint")
+    watched(sys, stepper, energy, (end, save_every), poll, watch, false)
 }
 
 /// The stepper of a checkpoint, its energy check and the step to reach.

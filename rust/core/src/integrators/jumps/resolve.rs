@@ -671,38 +671,19 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
     /// The s ∈ (0, τ] where φⱼ along the piece from (ta, piece_q, piece_p) falls through 0,
     /// by the Illinois method ([`illinois`]) to round-off. A piece that starts above the surface
     /// brackets it by its ends (φⱼ falls through 0 once in a step short against the path's
-    /// curvature). A piece leaving it (`leaving`: it starts on that surface and only φⱼ < 0
-    /// counts) is bracketed by eight samples, refined towards 0 up to four times: a body below
-    /// at every one crosses again at once ([`Located::Resting`]); None when no sample is below
+    /// curvature); one leaving it (`leaving`: it starts on that surface and only φⱼ < 0 counts)
+    /// is bracketed by samples ([`Resolver::leaving_bracket`]). None when no sample is below
     /// (round-off at the piece's end).
     fn locate(&mut self, j: usize, step: usize, (ta, tau): (f64, f64), leaving: bool) -> Result<Option<f64>, Located> {
         let floor = floor(self.phi_start[j], leaving);
         let start = (0.0, self.phi_start[j] - floor);
-        let mut hi = tau;
-        let mut bracket = (!leaving).then_some((start, (tau, self.phi_end[j])));
-        for _ in 0..if leaving { 4 } else { 0 } {
-            let mut previous = start;
-            let mut found = None;
-            for k in 1..=8 {
-                let x = hi * k as f64 / 8.0;
-                let v = self.phi_along(j, step, ta, x)? - floor;
-                if below(v, leaving) {
-                    found = Some((k, x, v));
-                    break;
-                }
-                previous = (x, v);
+        let (a, b) = if leaving {
+            match self.leaving_bracket(j, step, (ta, tau), start, floor)? {
+                Some(bracket) => bracket,
+                None => return Ok(None),
             }
-            let Some((k, x, v)) = found else {
-                return Ok(None);
-            };
-            if k > 1 {
-                bracket = Some((previous, (x, v)));
-                break;
-            }
-            hi = x;
-        }
-        let Some((a, b)) = bracket else {
-            return Err(Located::Resting);
+        } else {
+            (start, (tau, self.phi_end[j]))
         };
         let tolerance = 4.0 * f64::EPSILON * tau;
         let (s, _) = illinois(
@@ -712,6 +693,42 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
             tolerance,
         )?;
         Ok(Some(s))
+    }
+
+    /// The bracket of a crossing of φⱼ − `floor` (`start` its value at s = 0) on a piece
+    /// leaving the surface: eight samples over (0, τ], refined towards 0 up to four times while
+    /// the first is already below; a body below at every one crosses again at once
+    /// ([`Located::Resting`]). None when no sample is below.
+    fn leaving_bracket(
+        &mut self,
+        j: usize,
+        step: usize,
+        (ta, tau): (f64, f64),
+        start: (f64, f64),
+        floor: f64,
+    ) -> Result<Option<Bracket>, Located> {
+        let mut hi = tau;
+        for _ in 0..4 {
+            let mut previous = start;
+            let mut found = None;
+            for k in 1..=8 {
+                let x = hi * k as f64 / 8.0;
+                let v = self.phi_along(j, step, ta, x)? - floor;
+                if below(v, true) {
+                    found = Some((k, x, v));
+                    break;
+                }
+                previous = (x, v);
+            }
+            let Some((k, x, v)) = found else {
+                return Ok(None);
+            };
+            if k > 1 {
+                return Ok(Some((previous, (x, v))));
+            }
+            hi = x;
+        }
+        Err(Located::Resting)
     }
 
     /// φⱼ at the end of the partial step of size s from the piece's start.
@@ -746,6 +763,9 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
         self.scratch.force_evaluations() - self.counted
     }
 }
+
+/// Two points (s, φ − floor) on either side of a crossing.
+type Bracket = ((f64, f64), (f64, f64));
 
 /// Why a crossing was not located.
 enum Located {
