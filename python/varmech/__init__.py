@@ -52,7 +52,7 @@ from .reduction import ReducedModel, cyclic_coordinates, routh
 from .stepper import Stepper
 from .streaming import resume
 from .table import Table
-from .trajectory import Trajectory, load
+from .trajectory import Reactions, Trajectory, load
 
 __all__ = [
     "ConservationReport",
@@ -74,6 +74,7 @@ __all__ = [
     "MethodInfo",
     "Model",
     "NativeSystem",
+    "Reactions",
     "ReducedModel",
     "Rotation",
     "SpuriousBranchError",

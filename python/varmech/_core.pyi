@@ -62,6 +62,7 @@ __all__ = [
     "momentum_along",
     "nbody",
     "project",
+    "reactions",
     "resume",
     "routh",
     "scene",
@@ -320,6 +321,10 @@ def constraint_curvature(model: _Model, q: _FloatArray) -> list[float] | None:
     """Frobenius' test of the velocity constraints at each row of q: the curvature of ker A(q)
     relative to ∂A/∂q (round-off where they integrate); None without velocity constraints."""
 def project(model: _Model, q0: _FloatArray, p0: _FloatArray) -> tuple[_FloatArray, _FloatArray]: ...
+def reactions(
+    model: _Model, t: _FloatArray, q: _FloatArray, p: _FloatArray
+) -> tuple[_FloatArray, _FloatArray, tuple[_FloatArray, _FloatArray]]:
+    """(λ (N, m), Cᵀλ (N, n), (Cᵀλ·q̇, Σ|(Cᵀλ)ᵢq̇ᵢ|)) at each state: the forces of constraint."""
 
 # Lagrange's impulsive equations at one state (rust/python/src/impulsive.rs). A blow is
 # (kind, payload) as in a run's impulses: "generalized" (numbers), "function" (P(q)), "point"

@@ -345,6 +345,11 @@ class ConservationReport:
     affine : bool
         Whether the velocity constraints are affine (b ≠ 0, a moving surface): their forces do
         work, and the energy is not judged.
+    constraint_power : InvariantStatistics or None
+        For fixed constraints: the power Cᵀλ·q̇ of the constraint forces
+        (:meth:`Trajectory.reactions`), which vanishes on the exact motion: a work-free check of
+        the multipliers and of the velocities' constraint together, against Σ|(Cᵀλ)ᵢq̇ᵢ|.
+        None without constraints, or with affine ones (their forces do work).
     verdict : str
         The energy's verdict, or why the energy is not conserved (L depends on t, forces act:
         then see ``energy_balance``, or affine constraints do work).
@@ -380,6 +385,8 @@ class ConservationReport:
     constraints: tuple[InvariantStatistics, ...] | None = None
     #: Whether the velocity constraints are affine (b ≠ 0): then the energy is not judged.
     affine: bool = False
+    #: For fixed constraints: the power Cᵀλ·q̇ of the constraint forces, 0 on the exact motion.
+    constraint_power: InvariantStatistics | None = None
 
     @property
     def verdict(self) -> str:
@@ -403,9 +410,10 @@ class ConservationReport:
 
     @property
     def quantities(self) -> tuple[InvariantStatistics, ...]:
-        """Every quantity judged: energy or balance, momenta, constraints."""
+        """Every quantity judged: energy or balance, momenta, constraints and their power."""
         energy = tuple(e for e in (self.energy, self.energy_balance) if e is not None)
-        return energy + self.momenta + (self.constraints or ())
+        power = (self.constraint_power,) if self.constraint_power is not None else ()
+        return energy + self.momenta + (self.constraints or ()) + power
 
     def __str__(self) -> str:
         lines = [f"Conservation report: {self.model}, {self.method}, dt = {self.dt:g}, t = 0 … {self.t_end:g}"]
@@ -421,11 +429,13 @@ class ConservationReport:
             residuals = ("g(q)", "G q̇, A q̇ + b")  # holonomic and velocity constraints together
         for c, error in zip(self.constraints or (), residuals):
             lines += ["  " + line for line in c.describe("r", error)]
+        if self.constraint_power is not None:
+            lines += ["  " + line for line in self.constraint_power.describe("P", "Cᵀλ·q̇")]
         return "\n".join(lines)
 
 
 def check_conservation(traj: Trajectory, generators: Sequence[Generator] | None = None, *, refine: bool = True) -> ConservationReport:
-    """Check the energy, the Noether momenta and the constraints of ``traj``.
+    """Check the energy, the Noether momenta and the constraints of ``traj``, and the power of the constraint forces.
 
     The energy function E = p·q̇ − L is judged when L does not depend on t and no constraint
     does work (affine velocity constraints A(q)q̇ + b(q) = 0 do); with forces acting the report
@@ -512,7 +522,11 @@ def check_conservation(traj: Trajectory, generators: Sequence[Generator] | None 
         (_, v), (_, v_size) = _core.constraint_residuals(model._core, *traj._arrays()[1:])
         name, scale = ("|A q̇ + b|", "mean ‖A‖‖q̇‖ + |b|") if affine else ("|A q̇|", "mean ‖A‖‖q̇‖")
         constraints = (_statistics(_core.statistics(t, v, v_size, v_size, steps), name, v[0], scale, t),)
-    return ConservationReport(model.name, traj.method, traj.dt, float(t[-1]), energy, tuple(momenta), balance, constraints, affine)
+    power = None
+    if constraints is not None and not affine:
+        _, _, (p, p_size) = _core.reactions(model._core, *traj._arrays())
+        power = _statistics(_core.statistics(t, p, p_size, p_size, steps), "power", p[0], "mean Σ|(Cᵀλ)ᵢq̇ᵢ|", t)
+    return ConservationReport(model.name, traj.method, traj.dt, float(t[-1]), energy, tuple(momenta), balance, constraints, affine, power)
 
 
 def energy_statistics(

@@ -32,6 +32,7 @@ mod nbody_kernel;
 mod nonholonomic;
 mod nonholonomic_scenes;
 mod nonholonomic_variants;
+mod reactions;
 mod routh;
 mod solar_system;
 mod splitting;

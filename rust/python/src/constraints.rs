@@ -1,14 +1,14 @@
 //! Holonomic and velocity constraints seen from Python: residuals of saved states, and
 //! projection of an initial state onto the constraints.
 
-use numpy::{PyArray1, PyReadonlyArray1, PyReadonlyArray2};
+use numpy::{PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
-use varmech::model::Residuals;
+use varmech::model::{Reaction, Residuals};
 use varmech::ModelError;
 
 use crate::bind::{bind_model, dim_of};
-use crate::convert::{rows, slice, ArrayPair};
+use crate::convert::{matrix, rows, slice, states, ArrayPair};
 use crate::errors::{model_error, to_pyerr};
 
 fn unconstrained() -> PyErr {
@@ -45,6 +45,37 @@ fn constraint_residuals<'py>(
     ))
 }
 
+/// The multipliers λ (N, m), the generalized constraint forces Cᵀλ (N, n), their power and its
+/// size (N,) at each state (t, q, p) of a constrained model ([`varmech::model::reaction`]).
+type Reactions<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<f64>>, ArrayPair<'py>);
+
+#[pyfunction]
+fn reactions<'py>(
+    py: Python<'py>,
+    model: &Bound<'py, PyAny>,
+    t: PyReadonlyArray1<'py, f64>,
+    q: PyReadonlyArray2<'py, f64>,
+    p: PyReadonlyArray2<'py, f64>,
+) -> PyResult<Reactions<'py>> {
+    let n = dim_of(py, model)?;
+    let (t, q, p) = states(n, &t, &q, &p)?;
+    let result: Option<Result<Vec<Reaction>, ModelError>> = bind_model(py, model, |sys, _poll| {
+        t.iter()
+            .zip(q.chunks_exact(n).zip(p.chunks_exact(n)))
+            .map(|(t, (q, p))| sys.reaction(q, p, *t))
+            .collect()
+    })?;
+    let reactions = result.ok_or_else(unconstrained)?.map_err(model_error)?;
+    let m = reactions.first().map_or(0, |r| r.multipliers.len());
+    let flat = |f: fn(&Reaction) -> &[f64]| reactions.iter().flat_map(f).copied().collect::<Vec<f64>>();
+    let column = |f: fn(&Reaction) -> f64| PyArray1::from_vec(py, reactions.iter().map(f).collect());
+    Ok((
+        matrix(py, flat(|r| &r.multipliers), m)?,
+        matrix(py, flat(|r| &r.force), n)?,
+        (column(|r| r.power), column(|r| r.power_size)),
+    ))
+}
+
 /// The nearest consistent state (q on the constraints, p on the hidden constraint; with velocity
 /// constraints q as it is, p on A(q)q̇ = 0).
 #[pyfunction]
@@ -63,5 +94,6 @@ fn project<'py>(
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(constraint_residuals, m)?)?;
     m.add_function(wrap_pyfunction!(project, m)?)?;
+    m.add_function(wrap_pyfunction!(reactions, m)?)?;
     Ok(())
 }

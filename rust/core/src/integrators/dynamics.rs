@@ -90,6 +90,11 @@ pub trait Dynamics {
     fn velocity_constraints(&self) -> Option<&dyn VelocityConstraints> {
         None
     }
+
+    /// The forces of constraint at (q, p, t) ([`model::reaction`]); None without constraints.
+    fn reaction(&self, _q: &[f64], _p: &[f64], _t: f64) -> Option<Result<model::Reaction, ModelError>> {
+        None
+    }
 }
 
 impl<S: MechanicalSystem> Dynamics for S {
@@ -211,6 +216,11 @@ impl<S: MechanicalSystem, C: HolonomicConstraints> Dynamics for Constrained<S, C
     fn project(&self, q: &[f64], p: &[f64]) -> Option<Result<PhaseState, Error>> {
         Some(Constrained::project(self, q, p))
     }
+
+    fn reaction(&self, q: &[f64], p: &[f64], t: f64) -> Option<Result<model::Reaction, ModelError>> {
+        let rows = model::holonomic_rows(&self.constraints);
+        Some(model::reaction(&self.system, &rows, self.constraints.count(), q, p, t))
+    }
 }
 
 /// A general Lagrangian on holonomic constraints, for the implicit variational methods with
@@ -251,6 +261,11 @@ impl<L: Lagrangian, C: HolonomicConstraints> Dynamics for Constrained<General<'_
 
     fn project(&self, q: &[f64], p: &[f64]) -> Option<Result<PhaseState, Error>> {
         Some(self.project_general(q, p))
+    }
+
+    fn reaction(&self, q: &[f64], p: &[f64], t: f64) -> Option<Result<model::Reaction, ModelError>> {
+        let rows = model::holonomic_rows(&self.constraints);
+        Some(model::reaction(self.system.0, &rows, self.constraints.count(), q, p, t))
     }
 }
 
@@ -335,6 +350,11 @@ impl<L: Lagrangian, C: VelocityConstraints> Dynamics for Nonholonomic<L, C> {
     fn project(&self, q: &[f64], p: &[f64]) -> Option<Result<PhaseState, Error>> {
         Some(Nonholonomic::project(self, q, p))
     }
+
+    fn reaction(&self, q: &[f64], p: &[f64], t: f64) -> Option<Result<model::Reaction, ModelError>> {
+        let rows = model::velocity_rows(&self.constraints);
+        Some(model::reaction(&self.system, &rows, self.constraints.count(), q, p, t))
+    }
 }
 
 /// A Lagrangian on holonomic and velocity constraints together, for the discrete
@@ -397,6 +417,12 @@ impl<L: Lagrangian, H: HolonomicConstraints, C: VelocityConstraints> Dynamics fo
 
     fn project(&self, q: &[f64], p: &[f64]) -> Option<Result<PhaseState, Error>> {
         Some(Mixed::project(self, q, p))
+    }
+
+    fn reaction(&self, q: &[f64], p: &[f64], t: f64) -> Option<Result<model::Reaction, ModelError>> {
+        let rows = model::mixed_rows(&self.holonomic, &self.velocity);
+        let m = self.holonomic.count() + self.velocity.count();
+        Some(model::reaction(&self.system, &rows, m, q, p, t))
     }
 }
 
