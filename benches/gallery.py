@@ -6,7 +6,8 @@ docs/gallery/ (PNG) with its data (CSV).
 ``--only`` redraws the named charts alone (``--only work-precision:kepler``; a kind without a
 scene selects every chart of that kind). Needs the ``bench`` extra (matplotlib, scipy, rebound).
 Takes a few minutes; each chart's sweep shows a progress bar and Ctrl-C stops it. The impact
-chart (``--only impacts``) races a rival that is no library code, so benches/impacts.py draws it.
+chart (``--only impacts``) races a rival that is no library code, so benches/impacts.py draws it;
+benches/reactions.py draws the tension of a pendulum (``--only reactions``).
 """
 
 from __future__ import annotations
@@ -16,6 +17,7 @@ import time
 from pathlib import Path
 
 from impacts import billiard_chart
+from reactions import tension_chart
 
 from varmech.charts.recipes import KINDS, chart
 
@@ -38,7 +40,7 @@ GALLERY = [
 ]
 #: (kind, scene, draw(out, quick) → paths): charts drawn by a bench script, for their rival is
 #: no library code (the naive "reflect at the end of the step" scheme).
-BENCHED = [("impacts", "billiard", billiard_chart)]
+BENCHED = [("impacts", "billiard", billiard_chart), ("reactions", "pendulum", tension_chart)]
 
 
 def selected(kind: str, scene: str | None, only: list[str]) -> bool:

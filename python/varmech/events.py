@@ -239,6 +239,55 @@ def energy_error(bound: float, *, terminal: bool | int = True) -> Event:
     return Event(None, +1, terminal, name=f"|E - E0| > {bound:g}", native=("energy_error", bound))
 
 
+def multiplier(k: int = 0, *, direction: int = 0, terminal: bool | int = False) -> Event:
+    """The multiplier λ_k of the model's constraints crossing 0: g = λ_k (evaluated natively, in
+    the core). λ is :meth:`Trajectory.reactions`'s, with Lagrange's sign (the constraints'
+    force is Cᵀλ), so this is where a held contact's force or a string's tension vanishes: the
+    instant a body on a surface would leave it (lift-off), or a string go slack. Located by a
+    partial step of the method, like every event, so to the method's order.
+
+    Parameters
+    ----------
+    k
+        The row of λ (holonomic constraints first, then velocity constraints).
+    direction
+        +1: only crossings upward; −1: only downward; 0: both.
+    terminal
+        Stop the run at the end of the step of the first crossing (True), of the k-th (an
+        integer k), or never (False).
+
+    Returns
+    -------
+    Event
+        The event, for ``integrate(..., events=[...])``; the model must have a row k.
+
+    Raises
+    ------
+    ValueError
+        ``k`` not an integer ≥ 0; at ``integrate``, ``direction`` not −1, 0 or 1 or a model
+        without row k (naming ``events``).
+
+    Examples
+    --------
+    A particle sliding from rest at the top of a smooth sphere of radius 1 (x, z), held on it
+    by ½(x² + z² − 1) = 0: the sphere pushes, λ > 0, until z = 2/3 (cos θ = 2/3), where it
+    would leave it:
+
+    >>> import numpy as np, varmech
+    >>> sphere = varmech.MechanicalSystem(2, lambda q: q[1], lambda q: np.array([0.0, 1.0]),
+    ...     constraints=lambda q: np.array([0.5 * (q @ q - 1)]), constraint_jacobian=lambda q: q[None, :].copy(),
+    ...     constraint_count=1)
+    >>> q0 = [np.sin(1e-3), np.cos(1e-3)]
+    >>> traj = varmech.integrate(sphere, q0, v0=[0.0, 0.0], dt=1e-3, t_end=20.0, method="rattle4",
+    ...                          events=[varmech.events.multiplier(0, direction=-1, terminal=True)])
+    >>> z = traj.events[0].q[0, 1]
+    >>> round(float(z), 6), round(2 / 3 * float(np.cos(1e-3)), 6)
+    (0.666666, 0.666666)
+    """
+    k = integer("k", k)
+    return Event(None, direction, terminal, name=f"lambda[{k}] = 0", native=("multiplier", k))
+
+
 def escape(radius: float, *, groups: Sequence[Sequence[int]] | None = None, dim: int = 3, terminal: bool | int = True) -> Event:
     """A group of coordinates (a body's position) leaving the ball of ``radius`` about the
     origin: g = maxⱼ |x_j|² − radius², crossing upward (evaluated natively). Terminal by default.
@@ -382,9 +431,10 @@ def _check_signature(label: str, e: Event) -> None:
         raise TypeError(f"{label}: an event function takes (t, q, {x}), got {signature}") from None
 
 
-def specs(events: Sequence[Event | EventFunction], n: int) -> tuple[list[Event], list[tuple[str, int, int, str, Any]]]:
+def specs(events: Sequence[Event | EventFunction], n: int, rows: int = 0) -> tuple[list[Event], list[tuple[str, int, int, str, Any]]]:
     """The events as Events, and the spec tuples the binding takes (name, direction, terminal,
-    kind, payload) for a model of n coordinates. Malformed ones are refused naming them."""
+    kind, payload) for a model of n coordinates and ``rows`` constraint rows (holonomic and
+    velocity). Malformed ones are refused naming them."""
     if isinstance(events, (Event,)) or callable(events) or isinstance(events, (str, bytes)):
         raise TypeError("events: expected a list of event functions or varmech.events.Event")
     items = [_event(i, e) for i, e in enumerate(events)]
@@ -400,6 +450,9 @@ def specs(events: Sequence[Event | EventFunction], n: int) -> tuple[list[Event],
                 if n % dim:
                     raise ValueError(f"{label}: {n} coordinates are not blocks of dim = {dim}; pass dim or groups")
                 payload = (radius, [list(range(j, j + dim)) for j in range(0, n, dim)])
+            if kind == "multiplier" and payload >= rows:
+                has = f"{rows} constraint rows (holonomic, then velocity)" if rows else "no constraints"
+                raise ValueError(f"{label}: the model has {has}; λ_{payload} is not one of them")
         else:
             if e.variables not in ("p", "v"):
                 raise ValueError(f"{label}: variables must be 'p' or 'v', got {e.variables!r}")
@@ -468,4 +521,4 @@ def first_energy(model: Any, run: Any) -> float:
     return float(_core.energy_terms(model._core, t, q, p)[0][0])
 
 
-__all__ = ["Event", "Occurrences", "crossing", "encounter", "energy_error", "escape"]
+__all__ = ["Event", "Occurrences", "crossing", "encounter", "energy_error", "escape", "multiplier"]

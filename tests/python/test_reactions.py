@@ -1,6 +1,6 @@
 """Forces of constraint (Trajectory.reactions): the multipliers λ of ṗ = ∂L/∂q + Cᵀλ against
-closed forms — the pendulum's tension, a particle on a cone (circular orbit, and a general orbit
-against SciPy on the reduced equations), a disk rolling on a circle, a skate on a slope with its
+closed forms — the pendulum's tension, a particle on a cone and on a paraboloid (circular orbits,
+and general orbits against SciPy on the reduced equations), a disk rolling on a circle, a skate on a slope with its
 heading held to a circle — for every model source, with the power Cᵀλ·q̇ at round-off."""
 
 import numpy as np
@@ -78,41 +78,73 @@ def test_the_power_of_the_constraint_force_is_round_off_for_rattle_and_not_for_s
     assert varmech.check_conservation(shake).constraint_power.verdict != "conserved to round-off"
 
 
-A, M = 1.0, 1.0  # the cone x² + y² = a²z² (half-angle 45°), unit mass
+A, M = 1.0, 1.0
+# Surfaces of revolution z(r) about the vertical, g = 1 … 9.81, each as (constraint g(q), its
+# Jacobian, z(r), z'(r), z''(r)): the cone x² + y² = a²z² (the lecture's §4.1, half-angle 45°)
+# and the paraboloid x² + y² = az (the issue's formula).
+SURFACES = {
+    "cone": (
+        lambda q: np.array([0.5 * (q[0] ** 2 + q[1] ** 2 - A**2 * q[2] ** 2)]),
+        lambda q: np.array([[q[0], q[1], -(A**2) * q[2]]]),
+        lambda r: r / A, lambda r: 1 / A + 0 * r, lambda r: 0 * r,
+    ),
+    "paraboloid": (
+        lambda q: np.array([0.5 * (q[0] ** 2 + q[1] ** 2 - A * q[2])]),
+        lambda q: np.array([[q[0], q[1], -A / 2]]),
+        lambda r: r**2 / A, lambda r: 2 * r / A, lambda r: 2 / A + 0 * r,
+    ),
+}
 
 
-def cone():
+def surface(name):
+    g, jacobian, *_ = SURFACES[name]
     return varmech.MechanicalSystem(
         3, lambda q: M * G * q[2], lambda q: np.array([0.0, 0.0, M * G]), mass=M,
-        constraints=lambda q: np.array([0.5 * (q[0] ** 2 + q[1] ** 2 - A**2 * q[2] ** 2)]),
-        constraint_jacobian=lambda q: np.array([[q[0], q[1], -(A**2) * q[2]]]), constraint_count=1,
+        constraints=g, constraint_jacobian=jacobian, constraint_count=1,
     )
 
 
-def test_a_circular_orbit_on_a_cone_is_held_by_its_closed_form_multiplier():
-    # Horizontal: λr = −mrω²; vertical: −λa²z = mg; so ω² = g/(ar), λ = −mg/(ar), constant.
+def reduced(name, ell):
+    """(r, ṙ)' of a particle on z(r) with angular momentum ℓ: from L = ½m(ṙ²(1 + z'²) + r²φ̇²) − mgz,
+    m r̈ (1 + z'²) = mrφ̇² − mgz' − m z'z''ṙ²."""
+    _, _, _, dz, ddz = SURFACES[name]
+
+    def f(t, s):
+        r, rdot = s
+        return [rdot, (ell**2 / (M**2 * r**3) - G * dz(r) - dz(r) * ddz(r) * rdot**2) / (1 + dz(r) ** 2)]
+
+    return f
+
+
+@pytest.mark.parametrize("name", SURFACES)
+def test_a_circular_orbit_on_a_surface_of_revolution_is_held_by_its_closed_form_multiplier(name):
+    # Horizontal λr·(∂g/∂x scale 1) = −mrω², vertical λ·∂g/∂z = mg: on the cone ω² = g/(ar),
+    # λ = −mg/(ar); on the paraboloid ω² = 2g/a, λ = −2mg/a, whatever r.
     r = 1.5
-    omega = np.sqrt(G / (A * r))
-    traj = varmech.integrate(cone(), [r, 0.0, r / A], v0=[0.0, r * omega, 0.0], dt=1e-3, steps=5000, save_every=100, method="rattle4")
-    radius = np.hypot(traj.q[:, 0], traj.q[:, 1])
-    assert np.max(np.abs(radius - r)) < 1e-10
-    np.testing.assert_allclose(traj.reactions().multipliers[:, 0], -M * G / (A * r), rtol=1e-10)
+    _, jacobian, z, _, _ = SURFACES[name]
+    lam = M * G / jacobian([r, 0.0, z(r)])[0, 2]
+    omega = np.sqrt(-lam / M)
+    traj = varmech.integrate(surface(name), [r, 0.0, z(r)], v0=[0.0, r * omega, 0.0], dt=1e-3, steps=5000, save_every=100, method="rattle4")
+    # rattle4's error at hω ≈ 0.005 (the paraboloid's ω = 4.4): about 1e-10.
+    assert np.max(np.abs(np.hypot(traj.q[:, 0], traj.q[:, 1]) - r)) < 1e-9
+    np.testing.assert_allclose(traj.reactions().multipliers[:, 0], lam, rtol=1e-9)
+    np.testing.assert_allclose(lam, {"cone": -M * G / (A * r), "paraboloid": -2 * M * G / A}[name], rtol=1e-15)
 
 
-def test_a_general_orbit_on_a_cone_follows_the_reduced_equations():
+@pytest.mark.parametrize("name", SURFACES)
+def test_a_general_orbit_on_a_surface_of_revolution_follows_the_reduced_equations(name):
     integrate = pytest.importorskip("scipy.integrate")
+    _, _, z, dz, _ = SURFACES[name]
     r0, rdot0, phidot0 = 1.0, 0.8, 0.7 * np.sqrt(G / A)
     ell = M * r0**2 * phidot0
-
-    def reduced(t, s):  # (r, ṙ): m(1 + 1/a²)r̈ = ℓ²/(mr³) − mg/a
-        return [s[1], (ell**2 / (M**2 * s[0] ** 3) - G / A) / (1 + 1 / A**2)]
-
+    f = reduced(name, ell)
     t = np.linspace(0.0, 4.0, 41)
-    ref = integrate.solve_ivp(reduced, (0, 4.0), [r0, rdot0], t_eval=t, rtol=1e-12, atol=1e-12, method="DOP853")
+    ref = integrate.solve_ivp(f, (0, 4.0), [r0, rdot0], t_eval=t, rtol=1e-12, atol=1e-12, method="DOP853")
     r = ref.y[0]
-    rddot = np.array([reduced(0, s)[1] for s in ref.y.T])
+    rddot = np.array([f(0, s)[1] for s in ref.y.T])
     expected = M * (rddot - r * (ell / (M * r**2)) ** 2) / r  # the horizontal balance λr = m(r̈ − rφ̇²)
-    traj = varmech.integrate(cone(), [r0, 0.0, r0 / A], v0=[rdot0, r0 * phidot0, rdot0 / A], dt=1e-3, steps=4000, save_every=100, method="rattle4")
+    v0 = [rdot0, r0 * phidot0, dz(r0) * rdot0]
+    traj = varmech.integrate(surface(name), [r0, 0.0, z(r0)], v0=v0, dt=1e-3, steps=4000, save_every=100, method="rattle4")
     np.testing.assert_allclose(traj.t, t, atol=1e-12)
     np.testing.assert_allclose(np.hypot(traj.q[:, 0], traj.q[:, 1]), r, atol=1e-9)
     np.testing.assert_allclose(traj.reactions().multipliers[:, 0], expected, rtol=1e-8)
@@ -183,3 +215,51 @@ def test_reactions_name_the_model_without_constraints_and_pass_a_closures_error_
     calls["n"] = 10_000
     with pytest.raises(Boom, match="the user's own"):
         traj.reactions()
+
+
+def on_sphere():
+    """A particle on the outside of a smooth unit sphere (x, z), g = 1: held by ½(x² + z² − 1) = 0,
+    whose force λ(x, z) pushes outwards while λ > 0."""
+    return varmech.MechanicalSystem(
+        2, lambda q: q[1], lambda q: np.array([0.0, 1.0]),
+        constraints=lambda q: np.array([0.5 * (q @ q - 1.0)]), constraint_jacobian=lambda q: q[None, :].copy(), constraint_count=1,
+    )
+
+
+@pytest.mark.parametrize("method, steps, order", [("rattle", (0.01, 0.005, 0.0025), 2.0), ("rattle4", (0.04, 0.02, 0.01), 4.0)])
+def test_a_particle_leaves_the_sphere_where_cos_theta_is_two_thirds_of_its_start_to_the_methods_order(method, steps, order):
+    # From rest at θ₀: v² = 2g(cos θ₀ − cos θ), and N = mg cos θ − mv² = mg(3 cos θ − 2 cos θ₀) = 0.
+    theta0 = 0.1
+    leave = varmech.events.multiplier(0, direction=-1, terminal=True)
+    errors = []
+    for h in steps:
+        traj = varmech.integrate(on_sphere(), [np.sin(theta0), np.cos(theta0)], v0=[0.0, 0.0], dt=h, t_end=20.0, method=method, events=[leave])
+        assert traj.status == 1 and len(traj.events[0].t) == 1
+        errors.append(abs(traj.events[0].q[0, 1] - 2 / 3 * np.cos(theta0)))
+    measured = np.log2(np.array(errors[:-1]) / errors[1:])
+    assert np.all(np.abs(measured - order) < 0.2), (errors, measured)
+
+
+def test_a_string_whirled_too_slowly_goes_slack_where_its_tension_reaches_zero():
+    # The unit pendulum from the bottom at v₀² = 3.5: T = 3 cos θ + v₀² − 2 = 0 at cos θ = −1/2.
+    # λ = −T crosses 0 upwards there.
+    slack = varmech.events.multiplier(0, direction=+1, terminal=True)
+    errors = []
+    for h in (0.02, 0.01, 0.005):
+        traj = varmech.integrate(varmech.scenes.cartesian_pendulum(), [0.0, -1.0], v0=[np.sqrt(3.5), 0.0], dt=h, t_end=10.0, method="rattle4", events=[slack])
+        q = traj.events[0].q[0]
+        assert traj.status == 1 and q[0] > 0, q
+        errors.append(abs(-q[1] - (-0.5)))
+        # Before it, the string pulled (λ < 0) at every saved state.
+        assert np.all(traj.reactions().multipliers[:-1, 0] < 0)
+    measured = np.log2(np.array(errors[:-1]) / errors[1:])
+    assert errors[-1] < 1e-8 and np.all(np.abs(measured - 4.0) < 0.2), (errors, measured)
+
+
+def test_multiplier_events_name_what_the_model_lacks():
+    with pytest.raises(ValueError, match=r"events\[0\] \(lambda\[1\] = 0\): the model has 1 constraint rows"):
+        varmech.integrate(varmech.scenes.cartesian_pendulum(), dt=0.01, steps=10, events=[varmech.events.multiplier(1)])
+    with pytest.raises(ValueError, match="the model has no constraints"):
+        varmech.integrate(varmech.scenes.pendulum(), dt=0.01, steps=10, events=[varmech.events.multiplier(0)])
+    with pytest.raises(ValueError, match="k: must be an integer ≥ 0"):
+        varmech.events.multiplier(-1)

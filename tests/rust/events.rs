@@ -202,6 +202,6 @@ fn the_ellipsoid_event_refuses_bad_shapes_by_name() {
     }
     // Outside an obstacle the sign is reversed: g = Σu² − 1.
     let sys = EllipticBilliard::new(2.0, 1.0).unwrap();
-    let obstacle = shape(vec![0, 1], vec![0.0, 0.0], vec![2.0, 1.0]);
+    let mut obstacle = shape(vec![0, 1], vec![0.0, 0.0], vec![2.0, 1.0]);
     assert_eq!(obstacle.value(&sys, 0.0, &[2.0, 1.0], &[0.0, 0.0]).unwrap(), 1.0);
 }

@@ -29,16 +29,16 @@ fn the_multiplier_of_each_saved_state_is_the_pendulums_tension_and_does_no_work(
     let p = scenes::cartesian_pendulum();
     let traj = run(&p, Method::Rattle, 0.01, 10.0);
     let mut worst: (f64, f64) = (0.0, 0.0);
+    let r = p.system.reactions(&traj.t, &traj.q, &traj.p).unwrap().unwrap();
+    assert_eq!(r.multipliers.len(), traj.len());
     for k in 0..traj.len() {
-        let (q, pk) = (traj.q_at(k), traj.p_at(k));
-        let r = p.system.reaction(q, pk, traj.t[k]).unwrap().unwrap();
-        let t = tension(q, pk);
-        assert_eq!(r.multipliers.len(), 1);
-        worst.0 = worst.0.max((r.multipliers[0] + t).abs() / t.abs().max(1.0));
+        let (q, lambda) = (traj.q_at(k), r.multipliers[k]);
+        let t = tension(q, traj.p_at(k));
+        worst.0 = worst.0.max((lambda + t).abs() / t.abs().max(1.0));
         for i in 0..2 {
-            assert!((r.force[i] - r.multipliers[0] * q[i]).abs() <= 1e-14 * t.abs().max(1.0));
+            assert!((r.force[2 * k + i] - lambda * q[i]).abs() <= 1e-14 * t.abs().max(1.0));
         }
-        worst.1 = worst.1.max(r.power.abs() / r.power_size.max(f64::MIN_POSITIVE));
+        worst.1 = worst.1.max(r.power[k].abs() / r.power_size[k].max(f64::MIN_POSITIVE));
     }
     // The fourth-order difference along the motion: about 1e-12; the power: RATTLE keeps
     // G(q)M⁻¹p = 0 to round-off.
@@ -50,12 +50,8 @@ fn the_multiplier_of_each_saved_state_is_the_pendulums_tension_and_does_no_work(
 fn the_multipliers_converge_at_the_methods_order() {
     let p = scenes::cartesian_pendulum();
     let end = |traj: &Trajectory| {
-        let k = traj.len() - 1;
-        p.system
-            .reaction(traj.q_at(k), traj.p_at(k), traj.t[k])
-            .unwrap()
-            .unwrap()
-            .multipliers[0]
+        let r = p.system.reactions(&traj.t, &traj.q, &traj.p).unwrap().unwrap();
+        r.multipliers[traj.len() - 1]
     };
     let reference = end(&run(&p, Method::Rattle4, 1e-4, 1.0));
     for (method, order, steps) in [

@@ -4,7 +4,7 @@
 use numpy::{PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
-use varmech::model::{Reaction, Residuals};
+use varmech::model::{Reactions, Residuals};
 use varmech::ModelError;
 
 use crate::bind::{bind_model, dim_of};
@@ -47,7 +47,7 @@ fn constraint_residuals<'py>(
 
 /// The multipliers λ (N, m), the generalized constraint forces Cᵀλ (N, n), their power and its
 /// size (N,) at each state (t, q, p) of a constrained model ([`varmech::model::reaction`]).
-type Reactions<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<f64>>, ArrayPair<'py>);
+type ReactionArrays<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<f64>>, ArrayPair<'py>);
 
 #[pyfunction]
 fn reactions<'py>(
@@ -56,23 +56,16 @@ fn reactions<'py>(
     t: PyReadonlyArray1<'py, f64>,
     q: PyReadonlyArray2<'py, f64>,
     p: PyReadonlyArray2<'py, f64>,
-) -> PyResult<Reactions<'py>> {
+) -> PyResult<ReactionArrays<'py>> {
     let n = dim_of(py, model)?;
     let (t, q, p) = states(n, &t, &q, &p)?;
-    let result: Option<Result<Vec<Reaction>, ModelError>> = bind_model(py, model, |sys, _poll| {
-        t.iter()
-            .zip(q.chunks_exact(n).zip(p.chunks_exact(n)))
-            .map(|(t, (q, p))| sys.reaction(q, p, *t))
-            .collect()
-    })?;
-    let reactions = result.ok_or_else(unconstrained)?.map_err(model_error)?;
-    let m = reactions.first().map_or(0, |r| r.multipliers.len());
-    let flat = |f: fn(&Reaction) -> &[f64]| reactions.iter().flat_map(f).copied().collect::<Vec<f64>>();
-    let column = |f: fn(&Reaction) -> f64| PyArray1::from_vec(py, reactions.iter().map(f).collect());
+    let result: Option<Result<Reactions, ModelError>> = bind_model(py, model, |sys, _poll| sys.reactions(t, q, p))?;
+    let r = result.ok_or_else(unconstrained)?.map_err(model_error)?;
+    let m = r.multipliers.len().checked_div(t.len()).unwrap_or(0);
     Ok((
-        matrix(py, flat(|r| &r.multipliers), m)?,
-        matrix(py, flat(|r| &r.force), n)?,
-        (column(|r| r.power), column(|r| r.power_size)),
+        matrix(py, r.multipliers, m)?,
+        matrix(py, r.force, n)?,
+        (PyArray1::from_vec(py, r.power), PyArray1::from_vec(py, r.power_size)),
     ))
 }
 

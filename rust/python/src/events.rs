@@ -5,8 +5,7 @@
 use numpy::PyArray1;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
-use varmech::integrators::{EventFunctions, EventSpec, NativeEvent};
-use varmech::model::Lagrangian;
+use varmech::integrators::{Dynamics, EventFunctions, EventSpec, NativeEvent};
 use varmech::ModelError;
 
 use crate::errors::{boxed, to_pyerr};
@@ -29,7 +28,7 @@ pub type EventTuple<'py> = (String, i8, usize, String, Bound<'py, PyAny>);
 impl Events {
     /// The functions and specs of the spec tuples, for a model of n coordinates. Kinds: `"p"`,
     /// `"v"` (payload the function), `"crossing"` ((k, value)), `"ellipsoid"` ((coordinates,
-    /// centre, semi_axes, inside)), `"energy_error"` (bound),
+    /// centre, semi_axes, inside)), `"energy_error"` (bound), `"multiplier"` (row),
     /// `"escape"`, `"encounter"` ((radius, groups)). A malformed one is a ValueError naming
     /// `events`.
     pub fn new(py: Python<'_>, tuples: Vec<EventTuple<'_>>, n: usize) -> PyResult<(Self, Vec<EventSpec>)> {
@@ -61,6 +60,10 @@ impl Events {
                         .or_else(|_| payload.extract::<f64>().map(|bound| (bound, f64::NAN)))?;
                     Function::Native(NativeEvent::EnergyError { bound, initial })
                 }
+                "multiplier" => Function::Native(NativeEvent::Multiplier {
+                    row: payload.extract()?,
+                    reaction: None,
+                }),
                 "escape" | "encounter" => {
                     let (radius, groups) = payload.extract()?;
                     Function::Native(if kind == "escape" {
@@ -118,7 +121,7 @@ impl EventFunctions for Events {
         self.functions.len()
     }
 
-    fn start(&mut self, model: &dyn Lagrangian, t: f64, q: &[f64], p: &[f64]) -> Result<(), ModelError> {
+    fn start(&mut self, model: &dyn Dynamics, t: f64, q: &[f64], p: &[f64]) -> Result<(), ModelError> {
         self.functions.iter_mut().try_for_each(|f| match f {
             Function::Native(native) => native.start(model, t, q, p),
             Function::Python { .. } => Ok(()),
@@ -127,19 +130,20 @@ impl EventFunctions for Events {
 
     fn evaluate(
         &mut self,
-        model: &dyn Lagrangian,
+        model: &dyn Dynamics,
         t: f64,
         q: &[f64],
         p: &[f64],
         g: &mut [f64],
     ) -> Result<(), ModelError> {
-        for (f, g) in self.functions.iter().zip(g) {
+        let v = &mut self.v;
+        for (f, g) in self.functions.iter_mut().zip(g) {
             *g = match f {
                 Function::Native(native) => native.value(model, t, q, p)?,
                 Function::Python { function, velocities } => {
                     let x = if *velocities {
-                        model.velocity(q, p, t, &mut self.v)?;
-                        &self.v
+                        model.as_lagrangian().velocity(q, p, t, v)?;
+                        &*v
                     } else {
                         p
                     };

@@ -128,7 +128,7 @@ pub(crate) fn run_options(
 }
 
 /// The event functions and specs of `events`, checked against the model.
-fn detector_parts<'py>(
+pub(crate) fn detector_parts<'py>(
     py: Python<'py>,
     model: &Bound<'py, PyAny>,
     events: Option<Vec<EventTuple<'py>>>,

@@ -1,13 +1,13 @@
 //! A stepper of a Python model: the core's [`StepperState`] kept between calls and resumed on
-//! the model, through the one dispatch [`bind_model`], for each call; with contacts, each call's
-//! steps go through a [`Watcher`] resumed on that state.
+//! the model, through the one dispatch [`bind_model`], for each call; with contacts, impulses or
+//! events, each call's steps go through a [`Watcher`] resumed on that state.
 
 use numpy::{PyArray1, PyReadonlyArray1};
 use pyo3::prelude::*;
 use pyo3::types::PyBytes;
 use varmech::integrators::{
-    self, Checkpoint, Contacts, Dynamics, Impacts, Method, NewtonOptions, Options, Schedule, StepperState, Trajectory,
-    Watch, Watcher,
+    self, Checkpoint, Contacts, Detector, Dynamics, EventSpec, Impacts, Method, NewtonOptions, Occurrence, Options,
+    Schedule, StepperState, Trajectory, Watch, Watcher,
 };
 use varmech::Error;
 
@@ -15,14 +15,16 @@ use crate::bind::{bind_model, Poll};
 use crate::contacts::{ContactSpecs, ContactTuple};
 use crate::convert::{self, slice};
 use crate::errors::to_pyerr;
-use crate::run::decode;
+use crate::events::{EventTuple, Events};
+use crate::run::{decode, detector_parts};
 use crate::schedule::{ImpulseTuple, ScheduleSpecs};
-use crate::trajectory::{impact_arrays, ImpactArrays};
+use crate::trajectory::{event_arrays, impact_arrays, EventArrays, ImpactArrays};
 
 /// One model, one method and the state, advanced step by step
 /// ([`varmech::integrators::Stepper`]): native models with the GIL released, Ctrl-C honoured
 /// by `advance`, and a failed step leaves the last good state. With `contacts` and `impulses`,
-/// the steps go through their impacts and blows as a run's do ([`Watcher`]), bit for bit.
+/// the steps go through their impacts and blows as a run's do ([`Watcher`]), bit for bit; with
+/// `events`, their crossings are located as a run's are, a terminal one stopping the call.
 ///
 /// A call holds the stepper mutably (pyo3's borrow flag, not a lock): another call while one
 /// runs (a thread while the GIL is released, a closure model re-entering) raises RuntimeError
@@ -38,25 +40,34 @@ pub struct Stepper {
     impulses: ScheduleSpecs,
     /// The impacts gone through since the start or the last reset.
     impacts: Impacts,
-    /// Force evaluations of the impacts' partial steps.
+    /// Force evaluations of the impacts' and the events' partial steps.
     partial_evaluations: u64,
+    /// The event functions the steps watch, with their specs (terminal counts carried from call
+    /// to call, as a run gone on from counts them).
+    events: Option<(Events, Vec<EventSpec>)>,
+    /// The events' crossings since the start or the last reset.
+    occurrences: Vec<Occurrence>,
+    /// The event whose terminal count stopped the last call, if one did.
+    terminated_by: Option<usize>,
 }
 
 type Core<'s, 'a> = integrators::Stepper<&'s dyn Dynamics, &'a mut StepperState>;
 
 impl Stepper {
     /// The stepper of `state` on `model`, watching `contacts` (checked at the state, named
-    /// `argument` if outside one) and applying `impulses`: those at the state's time too where
-    /// `fresh` (a new stepper; a checkpoint's were its run's).
-    fn watching(
-        py: Python<'_>,
-        model: &Bound<'_, PyAny>,
+    /// `argument` if outside one) and `events` (started at the state) and applying `impulses`:
+    /// those at the state's time too where `fresh` (a new stepper; a checkpoint's were its
+    /// run's).
+    fn watching<'py>(
+        py: Python<'py>,
+        model: &Bound<'py, PyAny>,
         state: StepperState,
-        (contacts, impulses): (Option<Vec<ContactTuple<'_>>>, Option<Vec<ImpulseTuple<'_>>>),
+        (contacts, impulses, events): Specs<'py>,
         (argument, fresh): (&'static str, bool),
     ) -> PyResult<Self> {
         let contacts = contacts.map(ContactSpecs::new).transpose()?;
         let impulses = ScheduleSpecs::new(impulses.unwrap_or_default(), Vec::new())?;
+        let events = detector_parts(py, model, events)?;
         let n = state.q().len();
         let mut stepper = Stepper {
             model: model.clone().unbind(),
@@ -65,28 +76,34 @@ impl Stepper {
             impulses,
             impacts: Impacts::default(),
             partial_evaluations: 0,
+            events,
+            occurrences: Vec::new(),
+            terminated_by: None,
         };
         stepper.impacts.dim = n;
         stepper.check(py, argument, fresh)?;
         Ok(stepper)
     }
 
-    /// Whether the steps are the method's alone, with no contacts and no impulses to watch.
+    /// Whether the steps are the method's alone, with no contacts, impulses or events to watch.
     fn unwatched(&self) -> bool {
-        self.contacts.is_none() && self.impulses.is_empty()
+        self.contacts.is_none() && self.impulses.is_empty() && self.events.is_none()
     }
 
     /// Whether the contacts and impulses fit the model and method and the state lies in φ ≥ 0
-    /// (named `argument` if not); where `fresh`, the impulses at the state's time applied.
+    /// (named `argument` if not), the events started at the state; where `fresh`, the impulses
+    /// at the state's time applied.
     fn check(&mut self, py: Python<'_>, argument: &'static str, fresh: bool) -> PyResult<()> {
         if self.unwatched() {
             return Ok(());
         }
         let (specs, impulses, state) = (&self.contacts, &self.impulses, &mut self.state);
+        let events = &mut self.events;
         bind_model(py, self.model.bind(py), |sys, _| {
             let mut stepper = integrators::Stepper::resume(sys, state)?;
             let watched = Watched::new(specs, impulses)?;
-            let mut watcher = Watcher::begin(sys, &stepper, watched.watch(), argument, false)?;
+            let mut detector = lend(events)?;
+            let mut watcher = Watcher::begin(sys, &stepper, watched.watch(detector.as_mut()), argument, false)?;
             if fresh {
                 watcher.start(&mut stepper, &mut Trajectory::default())?;
             }
@@ -122,20 +139,45 @@ impl Stepper {
         }
         let (specs, impulses) = (&self.contacts, &self.impulses);
         let (impacts, evaluations) = (&mut self.impacts, &mut self.partial_evaluations);
+        let (events, occurrences, terminated_by) = (&mut self.events, &mut self.occurrences, &mut self.terminated_by);
         let state = &mut self.state;
+        *terminated_by = None;
         bind_model(py, self.model.bind(py), |sys, mut poll| {
             let mut stepper = integrators::Stepper::resume(sys, state)?;
             let watched = Watched::new(specs, impulses)?;
-            let mut watcher = Watcher::resume(sys, &stepper, watched.watch(), false)?;
+            let mut detector = lend(events)?;
+            let mut watcher = Watcher::resume(sys, &stepper, watched.watch(detector.as_mut()), false)?;
             let mut record = Trajectory::default();
             let advanced = watcher.advance(&mut stepper, n, &mut record, &mut poll);
-            // The impacts of the steps completed, a failed step's excepted.
+            // The impacts and crossings of the steps completed, a failed step's excepted.
             impacts.append(&mut record.impacts);
             *evaluations += watcher.force_evaluations();
-            advanced.map(drop)
+            drop(watcher);
+            drop(detector);
+            if let Some((_, specs)) = events {
+                EventSpec::carry(specs, &record.events);
+            }
+            occurrences.append(&mut record.events);
+            *terminated_by = advanced?;
+            Ok(())
         })?
         .map_err(|e| to_pyerr(py, e))
     }
+}
+
+/// A stepper's contacts, impulses and events, as the constructor takes them.
+type Specs<'py> = (
+    Option<Vec<ContactTuple<'py>>>,
+    Option<Vec<ImpulseTuple<'py>>>,
+    Option<Vec<EventTuple<'py>>>,
+);
+
+/// A call's [`Detector`] of the stepper's event functions, lent to it with a copy of their specs.
+fn lend(events: &mut Option<(Events, Vec<EventSpec>)>) -> Result<Option<Detector<'_>>, varmech::Error> {
+    events
+        .as_mut()
+        .map(|(functions, specs)| Detector::new(Box::new(functions), specs.clone()))
+        .transpose()
 }
 
 /// The core's contacts and schedule of a stepper's specs, made for a call.
@@ -152,11 +194,12 @@ impl<'a> Watched<'a> {
         })
     }
 
-    fn watch(&self) -> Watch<'_, 'static, 'a> {
+    /// The watch of these, with the call's `events`.
+    fn watch<'w, 'e>(&'w self, events: Option<&'w mut Detector<'e>>) -> Watch<'w, 'e, 'a> {
         Watch {
+            events,
             contacts: self.contacts.as_ref(),
             schedule: self.schedule.as_ref(),
-            ..Watch::default()
         }
     }
 }
@@ -164,7 +207,7 @@ impl<'a> Watched<'a> {
 #[pymethods]
 impl Stepper {
     #[new]
-    #[pyo3(signature = (model, q0, p0, *, dt, method, t0=0.0, compensated=true, newton_tolerance=1e-14, newton_max_iterations=50, contacts=None, impulses=None))]
+    #[pyo3(signature = (model, q0, p0, *, dt, method, t0=0.0, compensated=true, newton_tolerance=1e-14, newton_max_iterations=50, contacts=None, impulses=None, events=None))]
     #[allow(clippy::too_many_arguments)]
     fn new<'py>(
         py: Python<'py>,
@@ -179,6 +222,7 @@ impl Stepper {
         newton_max_iterations: usize,
         contacts: Option<Vec<ContactTuple<'py>>>,
         impulses: Option<Vec<ImpulseTuple<'py>>>,
+        events: Option<Vec<EventTuple<'py>>>,
     ) -> PyResult<Self> {
         let options = Options {
             compensated,
@@ -194,7 +238,7 @@ impl Stepper {
             integrators::Stepper::new(sys, method, q0, p0, &options).map(integrators::Stepper::into_state)
         })?
         .map_err(|e| to_pyerr(py, e))?;
-        Stepper::watching(py, model, state, (contacts, impulses), ("q0", true))
+        Stepper::watching(py, model, state, (contacts, impulses, events), ("q0", true))
     }
 
     /// The stepper's whole state as bytes, with its model's fingerprint (see [`Checkpoint`]).
@@ -206,7 +250,8 @@ impl Stepper {
     /// The stepper of `model` at the state of `checkpoint` (from `checkpoint()`, or a run's),
     /// checked against the model (and `method` and `dt` where given).
     #[staticmethod]
-    #[pyo3(signature = (model, checkpoint, *, method=None, dt=None, contacts=None, impulses=None))]
+    #[pyo3(signature = (model, checkpoint, *, method=None, dt=None, contacts=None, impulses=None, events=None))]
+    #[allow(clippy::too_many_arguments)]
     fn from_checkpoint<'py>(
         py: Python<'py>,
         model: &Bound<'py, PyAny>,
@@ -215,6 +260,7 @@ impl Stepper {
         dt: Option<f64>,
         contacts: Option<Vec<ContactTuple<'py>>>,
         impulses: Option<Vec<ImpulseTuple<'py>>>,
+        events: Option<Vec<EventTuple<'py>>>,
     ) -> PyResult<Self> {
         let checkpoint = decode(py, checkpoint, method, dt)?;
         let state = bind_model(py, model, |sys, _| {
@@ -222,7 +268,7 @@ impl Stepper {
             integrators::Stepper::resume(sys, state).map(integrators::Stepper::into_state)
         })?
         .map_err(|e| to_pyerr(py, e))?;
-        Stepper::watching(py, model, state, (contacts, impulses), ("checkpoint", false))
+        Stepper::watching(py, model, state, (contacts, impulses, events), ("checkpoint", false))
     }
 
     /// Advances one step.
@@ -235,28 +281,45 @@ impl Stepper {
         self.go(py, n, false)
     }
 
-    /// Starts afresh from (q0, p0) at t0, with the step count at 0 and no impacts, the
-    /// impulses at t0 applied as a new stepper's; a state outside a contact is refused (naming
-    /// `q0`), the stepper unchanged.
+    /// Starts afresh from (q0, p0) at t0, with the step count at 0, no impacts and no event
+    /// crossings, the impulses at t0 applied and the `events` (the constructor's again) started
+    /// as a new stepper's; a state outside a contact is refused (naming `q0`), the stepper
+    /// unchanged.
+    #[pyo3(signature = (q0, p0, t0, *, events=None))]
     fn reset<'py>(
         &mut self,
         py: Python<'py>,
         q0: PyReadonlyArray1<'py, f64>,
         p0: PyReadonlyArray1<'py, f64>,
         t0: f64,
+        events: Option<Vec<EventTuple<'py>>>,
     ) -> PyResult<()> {
         let (q0, p0) = (slice("q0", &q0)?, slice("p0", &p0)?);
-        let before = self.state.clone();
+        let fresh = detector_parts(py, self.model.bind(py), events)?;
+        let (state, events) = (self.state.clone(), std::mem::replace(&mut self.events, fresh));
         self.with(py, |stepper, _| stepper.reset(t0, q0, p0))?;
         if let Err(e) = self.check(py, "q0", true) {
-            self.state = before;
+            (self.state, self.events) = (state, events);
             return Err(e);
         }
         self.impacts = Impacts {
             dim: self.impacts.dim,
             ..Impacts::default()
         };
+        (self.occurrences, self.terminated_by) = (Vec::new(), None);
         Ok(())
+    }
+
+    /// The events' crossings since the start or the last reset, as a run's record holds them.
+    #[getter]
+    fn events(&self, py: Python<'_>) -> PyResult<EventArrays> {
+        event_arrays(py, &self.occurrences, self.impacts.dim)
+    }
+
+    /// The index of the event whose terminal count stopped the last call, if one did.
+    #[getter]
+    fn terminated_by(&self) -> Option<usize> {
+        self.terminated_by
     }
 
     #[getter]

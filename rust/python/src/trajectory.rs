@@ -4,7 +4,7 @@ use numpy::{PyArray1, PyArray2, PyUntypedArrayMethods};
 
 use pyo3::prelude::*;
 use pyo3::types::PyBytes;
-use varmech::integrators::{Impacts, Trajectory};
+use varmech::integrators::{Impacts, Occurrence, Trajectory};
 
 use crate::convert::matrix;
 
@@ -58,7 +58,7 @@ pub(crate) type ImpactArrays = (
 
 /// Event crossings as arrays: the event's index (k,), t (k,), q and p (k, n), and the start of
 /// each one's step, q and p (k, n).
-type EventArrays = (
+pub(crate) type EventArrays = (
     Py<PyArray1<usize>>,
     Py<PyArray1<f64>>,
     Py<PyArray2<f64>>,
@@ -78,6 +78,28 @@ pub(crate) fn impact_arrays(py: Python<'_>, impacts: Impacts, n: usize) -> PyRes
     ))
 }
 
+/// The arrays of event crossings (a run's, or a stepper's so far) of n coordinates.
+pub(crate) fn event_arrays(py: Python<'_>, events: &[Occurrence], n: usize) -> PyResult<EventArrays> {
+    let (mut index, mut t, mut q, mut p) = (vec![], vec![], vec![], vec![]);
+    let (mut q_start, mut p_start) = (vec![], vec![]);
+    for e in events {
+        index.push(e.event);
+        t.push(e.t);
+        q.extend_from_slice(&e.q);
+        p.extend_from_slice(&e.p);
+        q_start.extend_from_slice(&e.q_start);
+        p_start.extend_from_slice(&e.p_start);
+    }
+    Ok((
+        PyArray1::from_vec(py, index).unbind(),
+        PyArray1::from_vec(py, t).unbind(),
+        matrix(py, q, n)?.unbind(),
+        matrix(py, p, n)?.unbind(),
+        matrix(py, q_start, n)?.unbind(),
+        matrix(py, p_start, n)?.unbind(),
+    ))
+}
+
 /// The recorded column, or None when the run recorded none (an empty vector).
 fn recorded<'py, T: numpy::Element>(py: Python<'py>, column: Vec<T>) -> Option<Py<PyArray1<T>>> {
     (!column.is_empty()).then(|| PyArray1::from_vec(py, column).unbind())
@@ -86,24 +108,7 @@ fn recorded<'py, T: numpy::Element>(py: Python<'py>, column: Vec<T>) -> Option<P
 impl TrajectoryRecord {
     pub fn new(py: Python<'_>, traj: Trajectory) -> PyResult<Self> {
         let n = traj.dim;
-        let (mut index, mut t, mut q, mut p) = (vec![], vec![], vec![], vec![]);
-        let (mut q_start, mut p_start) = (vec![], vec![]);
-        for e in traj.events {
-            index.push(e.event);
-            t.push(e.t);
-            q.extend(e.q);
-            p.extend(e.p);
-            q_start.extend(e.q_start);
-            p_start.extend(e.p_start);
-        }
-        let events = (
-            PyArray1::from_vec(py, index).unbind(),
-            PyArray1::from_vec(py, t).unbind(),
-            matrix(py, q, n)?.unbind(),
-            matrix(py, p, n)?.unbind(),
-            matrix(py, q_start, n)?.unbind(),
-            matrix(py, p_start, n)?.unbind(),
-        );
+        let events = event_arrays(py, &traj.events, n)?;
         let grazing = traj.impacts.grazing;
         let impacts = impact_arrays(py, traj.impacts, n)?;
         Ok(TrajectoryRecord {

@@ -76,6 +76,9 @@ pub trait Dynamics {
     /// The system as a Lagrangian, for the diagnostics (energy function, Legendre transforms).
     fn as_lagrangian(&self) -> &dyn Lagrangian;
 
+    /// The system as a trait object, for what a generic run hands on (event functions).
+    fn as_dynamics(&self) -> &dyn Dynamics;
+
     /// |g(q)|∞ and |G(q)M⁻¹p|∞, with their sizes, for a constrained system; None for the others.
     fn constraint_residuals(&self, _q: &[f64], _p: &[f64]) -> Option<Result<model::Residuals, ModelError>> {
         None
@@ -91,9 +94,25 @@ pub trait Dynamics {
         None
     }
 
-    /// The forces of constraint at (q, p, t) ([`model::reaction`]); None without constraints.
-    fn reaction(&self, _q: &[f64], _p: &[f64], _t: f64) -> Option<Result<model::Reaction, ModelError>> {
+    /// The forces of constraint at (q, p, t) into `out` ([`model::Reaction::solve`], made for
+    /// this model's n and m); None without constraints.
+    fn reaction(&self, _out: &mut model::Reaction, _q: &[f64], _p: &[f64], _t: f64) -> Option<Result<(), ModelError>> {
         None
+    }
+
+    /// The [`Self::reaction`]s at the states (`t[k]`, q row k, p row k); None without
+    /// constraints.
+    fn reactions(&self, t: &[f64], q: &[f64], p: &[f64]) -> Option<Result<model::Reactions, ModelError>> {
+        let n = self.dim();
+        let mut one = model::Reaction::new(n, self.constraint_counts().0);
+        let mut all = model::Reactions::default();
+        for (k, t) in t.iter().enumerate() {
+            if let Err(e) = self.reaction(&mut one, &q[k * n..(k + 1) * n], &p[k * n..(k + 1) * n], *t)? {
+                return Some(Err(e));
+            }
+            all.push(&one);
+        }
+        Some(Ok(all))
     }
 }
 
@@ -137,6 +156,10 @@ impl<S: MechanicalSystem> Dynamics for S {
     fn as_lagrangian(&self) -> &dyn Lagrangian {
         self
     }
+
+    fn as_dynamics(&self) -> &dyn Dynamics {
+        self
+    }
 }
 
 /// A general Lagrangian L(q, q̇, t), for the implicit variational methods.
@@ -176,6 +199,10 @@ impl<L: Lagrangian> Dynamics for General<'_, L> {
     fn as_lagrangian(&self) -> &dyn Lagrangian {
         self.0
     }
+
+    fn as_dynamics(&self) -> &dyn Dynamics {
+        self
+    }
 }
 
 /// A separable mechanical system on holonomic constraints, for RATTLE and SHAKE.
@@ -209,6 +236,10 @@ impl<S: MechanicalSystem, C: HolonomicConstraints> Dynamics for Constrained<S, C
         &self.system
     }
 
+    fn as_dynamics(&self) -> &dyn Dynamics {
+        self
+    }
+
     fn constraint_residuals(&self, q: &[f64], p: &[f64]) -> Option<Result<model::Residuals, ModelError>> {
         Some(self.residuals(q, p))
     }
@@ -217,9 +248,9 @@ impl<S: MechanicalSystem, C: HolonomicConstraints> Dynamics for Constrained<S, C
         Some(Constrained::project(self, q, p))
     }
 
-    fn reaction(&self, q: &[f64], p: &[f64], t: f64) -> Option<Result<model::Reaction, ModelError>> {
+    fn reaction(&self, out: &mut model::Reaction, q: &[f64], p: &[f64], t: f64) -> Option<Result<(), ModelError>> {
         let rows = model::holonomic_rows(&self.constraints);
-        Some(model::reaction(&self.system, &rows, self.constraints.count(), q, p, t))
+        Some(out.solve(&self.system, &rows, (q, p, t)))
     }
 }
 
@@ -255,6 +286,10 @@ impl<L: Lagrangian, C: HolonomicConstraints> Dynamics for Constrained<General<'_
         self.system.0
     }
 
+    fn as_dynamics(&self) -> &dyn Dynamics {
+        self
+    }
+
     fn constraint_residuals(&self, q: &[f64], p: &[f64]) -> Option<Result<model::Residuals, ModelError>> {
         Some(self.residuals_general(q, p))
     }
@@ -263,9 +298,9 @@ impl<L: Lagrangian, C: HolonomicConstraints> Dynamics for Constrained<General<'_
         Some(self.project_general(q, p))
     }
 
-    fn reaction(&self, q: &[f64], p: &[f64], t: f64) -> Option<Result<model::Reaction, ModelError>> {
+    fn reaction(&self, out: &mut model::Reaction, q: &[f64], p: &[f64], t: f64) -> Option<Result<(), ModelError>> {
         let rows = model::holonomic_rows(&self.constraints);
-        Some(model::reaction(self.system.0, &rows, self.constraints.count(), q, p, t))
+        Some(out.solve(self.system.0, &rows, (q, p, t)))
     }
 }
 
@@ -339,6 +374,10 @@ impl<L: Lagrangian, C: VelocityConstraints> Dynamics for Nonholonomic<L, C> {
         &self.system
     }
 
+    fn as_dynamics(&self) -> &dyn Dynamics {
+        self
+    }
+
     fn constraint_residuals(&self, q: &[f64], p: &[f64]) -> Option<Result<model::Residuals, ModelError>> {
         Some(self.residuals(q, p))
     }
@@ -351,9 +390,9 @@ impl<L: Lagrangian, C: VelocityConstraints> Dynamics for Nonholonomic<L, C> {
         Some(Nonholonomic::project(self, q, p))
     }
 
-    fn reaction(&self, q: &[f64], p: &[f64], t: f64) -> Option<Result<model::Reaction, ModelError>> {
+    fn reaction(&self, out: &mut model::Reaction, q: &[f64], p: &[f64], t: f64) -> Option<Result<(), ModelError>> {
         let rows = model::velocity_rows(&self.constraints);
-        Some(model::reaction(&self.system, &rows, self.constraints.count(), q, p, t))
+        Some(out.solve(&self.system, &rows, (q, p, t)))
     }
 }
 
@@ -407,6 +446,10 @@ impl<L: Lagrangian, H: HolonomicConstraints, C: VelocityConstraints> Dynamics fo
         &self.system
     }
 
+    fn as_dynamics(&self) -> &dyn Dynamics {
+        self
+    }
+
     fn constraint_residuals(&self, q: &[f64], p: &[f64]) -> Option<Result<model::Residuals, ModelError>> {
         Some(self.residuals(q, p))
     }
@@ -419,10 +462,9 @@ impl<L: Lagrangian, H: HolonomicConstraints, C: VelocityConstraints> Dynamics fo
         Some(Mixed::project(self, q, p))
     }
 
-    fn reaction(&self, q: &[f64], p: &[f64], t: f64) -> Option<Result<model::Reaction, ModelError>> {
+    fn reaction(&self, out: &mut model::Reaction, q: &[f64], p: &[f64], t: f64) -> Option<Result<(), ModelError>> {
         let rows = model::mixed_rows(&self.holonomic, &self.velocity);
-        let m = self.holonomic.count() + self.velocity.count();
-        Some(model::reaction(&self.system, &rows, m, q, p, t))
+        Some(out.solve(&self.system, &rows, (q, p, t)))
     }
 }
 

@@ -65,10 +65,10 @@ impl<'f> Detector<'f> {
         };
         let mut g = vec![0.0; m];
         self.functions
-            .start(model.as_lagrangian(), t, q, p)
+            .start(model.as_dynamics(), t, q, p)
             .map_err(model_error)?;
         self.functions
-            .evaluate(model.as_lagrangian(), t, q, p, &mut g)
+            .evaluate(model.as_dynamics(), t, q, p, &mut g)
             .map_err(model_error)?;
         check_finite(&self.specs, &g, 0, t)?;
         let scratch = Stepper::resume(model, StepperState::clone(stepper))?;
@@ -145,9 +145,9 @@ impl<M: Deref<Target: Dynamics>> Search<'_, '_, M> {
         tau: f64,
         occurrences: &mut Vec<Occurrence>,
     ) -> Result<(), Error> {
-        let lagrangian = self.scratch.model().as_lagrangian();
+        let model = self.scratch.model().as_dynamics();
         let functions = &mut self.detector.functions;
-        if let Err(source) = functions.evaluate(lagrangian, t, q, p, &mut self.g_next) {
+        if let Err(source) = functions.evaluate(model, t, q, p, &mut self.g_next) {
             return Err(Error::Model {
                 step,
                 time: self.t,
@@ -174,8 +174,8 @@ impl<M: Deref<Target: Dynamics>> Search<'_, '_, M> {
         self.t = t;
         self.q.copy_from_slice(q);
         self.p.copy_from_slice(p);
-        let lagrangian = self.scratch.model().as_lagrangian();
-        let evaluated = self.detector.functions.evaluate(lagrangian, t, q, p, &mut self.g);
+        let model = self.scratch.model().as_dynamics();
+        let evaluated = self.detector.functions.evaluate(model, t, q, p, &mut self.g);
         evaluated.map_err(|source| Error::Model { step, time: t, source })?;
         check_finite(&self.detector.specs, &self.g, step, t)
     }
@@ -220,11 +220,11 @@ impl<M: Deref<Target: Dynamics>> Search<'_, '_, M> {
         self.scratch.set_dt(tau)?;
         self.scratch.step()?;
         let s = &self.scratch;
-        let (t, lagrangian) = (self.t + tau, s.model().as_lagrangian());
+        let (t, model) = (self.t + tau, s.model().as_dynamics());
         let evaluated = self
             .detector
             .functions
-            .evaluate(lagrangian, t, s.q(), s.p(), &mut self.g_trial);
+            .evaluate(model, t, s.q(), s.p(), &mut self.g_trial);
         evaluated.map_err(|source: ModelError| Error::Model {
             step,
             time: self.t,

@@ -15,7 +15,7 @@ pub use detector::Detector;
 pub(in crate::integrators) use detector::Search;
 pub use native::NativeEvent;
 
-use crate::model::Lagrangian;
+use super::Dynamics;
 use crate::ModelError;
 
 /// Event functions g₁ … g_m of the state: a run records where each changes sign.
@@ -30,20 +30,37 @@ pub trait EventFunctions {
 
     /// Called once at the initial state (t₀, q₀, p₀) of a run, before any evaluation (e.g. to
     /// take the initial energy). By default nothing.
-    fn start(&mut self, _model: &dyn Lagrangian, _t: f64, _q: &[f64], _p: &[f64]) -> Result<(), ModelError> {
+    fn start(&mut self, _model: &dyn Dynamics, _t: f64, _q: &[f64], _p: &[f64]) -> Result<(), ModelError> {
         Ok(())
     }
 
-    /// Writes gᵢ(t, q, p) into `g[i]`, i < m. `model` gives the velocities q̇(q, p, t) and the
-    /// energy where a function needs them.
+    /// Writes gᵢ(t, q, p) into `g[i]`, i < m. `model` gives the velocities q̇(q, p, t), the
+    /// energy and the forces of constraint where a function needs them.
+    fn evaluate(&mut self, model: &dyn Dynamics, t: f64, q: &[f64], p: &[f64], g: &mut [f64])
+        -> Result<(), ModelError>;
+}
+
+/// A borrowed set of functions is one: a stepper keeps its functions between calls, lending
+/// them to each call's [`Detector`].
+impl<E: EventFunctions + ?Sized> EventFunctions for &mut E {
+    fn len(&self) -> usize {
+        (**self).len()
+    }
+
+    fn start(&mut self, model: &dyn Dynamics, t: f64, q: &[f64], p: &[f64]) -> Result<(), ModelError> {
+        (**self).start(model, t, q, p)
+    }
+
     fn evaluate(
         &mut self,
-        model: &dyn Lagrangian,
+        model: &dyn Dynamics,
         t: f64,
         q: &[f64],
         p: &[f64],
         g: &mut [f64],
-    ) -> Result<(), ModelError>;
+    ) -> Result<(), ModelError> {
+        (**self).evaluate(model, t, q, p, g)
+    }
 }
 
 /// How an event is watched: a crossing is a step from gₙ ≠ 0 to gₙ₊₁ of the other sign or 0.
@@ -56,6 +73,18 @@ pub struct EventSpec {
     /// Stop the run after this many occurrences (at the end of the step of the last one); 0:
     /// never.
     pub terminal: usize,
+}
+
+impl EventSpec {
+    /// Counts `found` (one call's crossings, of these specs in order) toward the terminal
+    /// counts, for the next call of a stepper going on: a count reached becomes 0, never
+    /// again, as for a run gone on from.
+    pub fn carry(specs: &mut [EventSpec], found: &[Occurrence]) {
+        for o in found {
+            let terminal = &mut specs[o.event].terminal;
+            *terminal = terminal.saturating_sub(1);
+        }
+    }
 }
 
 /// A located crossing of event `event`, during step `step` (counted from 1): the state

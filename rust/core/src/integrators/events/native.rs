@@ -2,7 +2,8 @@
 
 use super::EventFunctions;
 use crate::integrators::jumps::{check_ellipsoid, ellipsoid, wall, NativeSurface, Surface};
-use crate::model::Lagrangian;
+use crate::integrators::Dynamics;
+use crate::model::Reaction;
 use crate::{Error, ModelError};
 
 /// A built-in event function g(t, q, p). `Crossing` and `Ellipsoid` are the native surfaces'
@@ -30,6 +31,13 @@ pub enum NativeEvent {
     /// g = min_{i<j} |x_i − x_j|² − r² over the groups (e.g. bodies), or |x₀|² − r² for a single
     /// group: two groups closer than r (a close encounter), or one closer to the origin.
     Encounter { radius: f64, groups: Vec<Vec<usize>> },
+    /// g = λ_row, a multiplier of the model's constraints ([`Dynamics::reaction`]): a contact's
+    /// force or a string's tension reaching 0 (lift-off, slack). `reaction` holds the buffers,
+    /// made at the run's start for the model's sizes.
+    Multiplier {
+        row: usize,
+        reaction: Option<Box<Reaction>>,
+    },
 }
 
 impl NativeEvent {
@@ -59,6 +67,8 @@ impl NativeEvent {
                 ..
             } => check_ellipsoid(coordinates, centre, semi_axes, n).map_or(Ok(()), fail),
             NativeEvent::EnergyError { bound, .. } => positive("bound", *bound),
+            // The row is checked against the model's constraints at the run's start.
+            NativeEvent::Multiplier { .. } => Ok(()),
             NativeEvent::Escape { radius, groups } | NativeEvent::Encounter { radius, groups } => {
                 positive("radius", *radius)?;
                 let width = groups.first().map_or(0, Vec::len);
@@ -73,19 +83,28 @@ impl NativeEvent {
         }
     }
 
-    /// Takes E₀ for the energy error; nothing for the others.
-    pub fn start(&mut self, model: &dyn Lagrangian, t: f64, q: &[f64], p: &[f64]) -> Result<(), ModelError> {
-        // E₀ given (a resumed run's, the whole run's first energy) is kept; NaN is computed here.
-        if let NativeEvent::EnergyError { initial, .. } = self {
-            if initial.is_nan() {
-                *initial = model.energy_terms(q, p, t)?.energy;
+    /// Takes E₀ for the energy error, and makes a multiplier's buffers for the model (refusing
+    /// a row it does not have); nothing for the others.
+    pub fn start(&mut self, model: &dyn Dynamics, t: f64, q: &[f64], p: &[f64]) -> Result<(), ModelError> {
+        match self {
+            // E₀ given (a resumed run's, the whole run's first energy) is kept; NaN is computed here.
+            NativeEvent::EnergyError { initial, .. } if initial.is_nan() => {
+                *initial = model.as_lagrangian().energy_terms(q, p, t)?.energy;
             }
+            NativeEvent::Multiplier { row, reaction } => {
+                let m = model.constraint_counts().0;
+                if *row >= m {
+                    return Err(format!("multiplier({row}): the model has {m} constraint rows").into());
+                }
+                *reaction = Some(Box::new(Reaction::new(q.len(), m)));
+            }
+            _ => {}
         }
         Ok(())
     }
 
     /// g(t, q, p).
-    pub fn value(&self, model: &dyn Lagrangian, t: f64, q: &[f64], p: &[f64]) -> Result<f64, ModelError> {
+    pub fn value(&mut self, model: &dyn Dynamics, t: f64, q: &[f64], p: &[f64]) -> Result<f64, ModelError> {
         let squared = |x: &[usize]| x.iter().map(|&k| q[k] * q[k]).sum::<f64>();
         let apart = |x: &[usize], y: &[usize]| x.iter().zip(y).map(|(&i, &j)| (q[i] - q[j]).powi(2)).sum::<f64>();
         Ok(match self {
@@ -97,10 +116,19 @@ impl NativeEvent {
                 inside,
             } => ellipsoid(q, coordinates, centre, semi_axes, *inside),
             NativeEvent::EnergyError { bound, initial } => {
-                (model.energy_terms(q, p, t)?.energy - initial).abs() - bound
+                (model.as_lagrangian().energy_terms(q, p, t)?.energy - *initial).abs() - *bound
+            }
+            NativeEvent::Multiplier { row, reaction } => {
+                let reaction = reaction
+                    .as_deref_mut()
+                    .ok_or("multiplier: evaluated before the run's start")?;
+                model
+                    .reaction(reaction, q, p, t)
+                    .ok_or("multiplier: the model has no constraints")??;
+                reaction.multipliers[*row]
             }
             NativeEvent::Escape { radius, groups } => {
-                groups.iter().map(|g| squared(g)).fold(f64::NEG_INFINITY, f64::max) - radius * radius
+                groups.iter().map(|g| squared(g)).fold(f64::NEG_INFINITY, f64::max) - *radius * *radius
             }
             NativeEvent::Encounter { radius, groups } => {
                 let closest = match groups.as_slice() {
@@ -112,7 +140,7 @@ impl NativeEvent {
                         .map(|(x, y)| apart(x, y))
                         .fold(f64::INFINITY, f64::min),
                 };
-                closest - radius * radius
+                closest - *radius * *radius
             }
         })
     }
@@ -123,19 +151,19 @@ impl EventFunctions for Vec<NativeEvent> {
         Vec::len(self)
     }
 
-    fn start(&mut self, model: &dyn Lagrangian, t: f64, q: &[f64], p: &[f64]) -> Result<(), ModelError> {
+    fn start(&mut self, model: &dyn Dynamics, t: f64, q: &[f64], p: &[f64]) -> Result<(), ModelError> {
         self.iter_mut().try_for_each(|e| e.start(model, t, q, p))
     }
 
     fn evaluate(
         &mut self,
-        model: &dyn Lagrangian,
+        model: &dyn Dynamics,
         t: f64,
         q: &[f64],
         p: &[f64],
         g: &mut [f64],
     ) -> Result<(), ModelError> {
-        for (e, g) in self.iter().zip(g) {
+        for (e, g) in self.iter_mut().zip(g) {
             *g = e.value(model, t, q, p)?;
         }
         Ok(())
