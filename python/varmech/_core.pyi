@@ -145,8 +145,9 @@ class TrajectoryRecord:
 
 @final
 class Stepper:
-    """One model, one method and the state, advanced step by step; with `contacts` and
-    `impulses`, the steps go through their impacts and blows as a run's do, bit for bit."""
+    """One model, one method and the state, advanced step by step; with `contacts`,
+    `impulses` and `events`, the steps go through their impacts and blows and locate the
+    crossings as a run's do, bit for bit."""
 
     def __new__(
         cls,
@@ -162,6 +163,7 @@ class Stepper:
         newton_max_iterations: int = 50,
         contacts: list[tuple[str, float, str, str, Any]] | None = None,
         impulses: list[tuple[float, str, Any]] | None = None,
+        events: list[tuple[str, int, int, str, Any]] | None = None,
     ) -> Stepper: ...
     def checkpoint(self) -> bytes:
         """The stepper's whole state as bytes, with its model's fingerprint (see [`Checkpoint`])."""
@@ -174,18 +176,22 @@ class Stepper:
         dt: float | None = None,
         contacts: list[tuple[str, float, str, str, Any]] | None = None,
         impulses: list[tuple[float, str, Any]] | None = None,
+        events: list[tuple[str, int, int, str, Any]] | None = None,
     ) -> Stepper:
         """The stepper of `model` at the state of `checkpoint` (from `checkpoint()`, or a run's),
         checked against the model (and `method` and `dt` where given), watching `contacts`
-        (checked at its state, naming `checkpoint`) and applying the `impulses` after its time."""
+        (checked at its state, naming `checkpoint`) and `events` and applying the `impulses`
+        after its time."""
     def step(self) -> None:
         """Advances one step."""
     def advance(self, n: int) -> None:
         """Advances `n` steps, checking for Ctrl-C on the way."""
-    def reset(self, q0: _FloatArray, p0: _FloatArray, t0: float) -> None:
-        """Starts afresh from (q0, p0) at t0, with the step count at 0 and no impacts, the
-        impulses at t0 applied as a new stepper's; a state outside a contact is refused (naming
-        `q0`), the stepper unchanged."""
+    def reset(
+        self, q0: _FloatArray, p0: _FloatArray, t0: float, *, events: list[tuple[str, int, int, str, Any]] | None = None
+    ) -> None:
+        """Starts afresh from (q0, p0) at t0, with the step count at 0, no impacts and no event
+        crossings, the impulses at t0 applied and the `events` started as a new stepper's; a
+        state outside a contact is refused (naming `q0`), the stepper unchanged."""
     @property
     def t(self) -> float: ...
     @property
@@ -213,6 +219,14 @@ class Stepper:
     @property
     def grazing(self) -> int:
         """Impacts under the variational law that took Newton's law (grazing), as a run's."""
+    @property
+    def events(
+        self,
+    ) -> tuple[NDArray[np.uint64], _FloatArray, _FloatArray, _FloatArray, _FloatArray, _FloatArray]:
+        """The events' crossings since the start or the last reset, as a run's record has them."""
+    @property
+    def terminated_by(self) -> int | None:
+        """The index of the event whose terminal count stopped the last call, if one did."""
 
 @final
 class MethodInfo:

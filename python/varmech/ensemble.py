@@ -405,7 +405,7 @@ def ensemble(
     run: dict[str, Any] = dict(dt=dt, steps=nsteps, method=method, save_every=save_every, compensated=bool(compensated), t0=t0)
     newton_tolerance, newton_max_iterations = _newton(newton_tolerance, newton_max_iterations)
     newton: dict[str, Any] = dict(newton_tolerance=newton_tolerance, newton_max_iterations=newton_max_iterations)
-    watched, event_specs = _events.specs(events, n, model.constraints + model.velocity_constraints) if events is not None else ([], [])
+    watched, event_specs = _events.specs(events, model) if events is not None else ([], [])
     impulse_specs = _impulses.specs(impulses or (), t0, t0 + nsteps * dt)
     times = _sample_times(t_eval, t0, t0 + nsteps * dt, save_every, None)
     settings = run | newton | dict(max_energy_error=max_energy_error, events=events, contacts=contacts, impulses=impulses, t_eval=t_eval)

@@ -264,7 +264,7 @@ def multiplier(k: int = 0, *, direction: int = 0, terminal: bool | int = False) 
     Raises
     ------
     ValueError
-        ``k`` not an integer ≥ 0; at ``integrate``, ``direction`` not −1, 0 or 1 or a model
+        ``k`` not an integer ≥ 0; at ``integrate``, ``direction`` not a number or a model
         without row k (naming ``events``).
 
     Examples
@@ -431,10 +431,11 @@ def _check_signature(label: str, e: Event) -> None:
         raise TypeError(f"{label}: an event function takes (t, q, {x}), got {signature}") from None
 
 
-def specs(events: Sequence[Event | EventFunction], n: int, rows: int = 0) -> tuple[list[Event], list[tuple[str, int, int, str, Any]]]:
+def specs(events: Sequence[Event | EventFunction], model: Any) -> tuple[list[Event], list[tuple[str, int, int, str, Any]]]:
     """The events as Events, and the spec tuples the binding takes (name, direction, terminal,
-    kind, payload) for a model of n coordinates and ``rows`` constraint rows (holonomic and
+    kind, payload) for ``model`` (its coordinates, and its constraint rows, holonomic and
     velocity). Malformed ones are refused naming them."""
+    n, rows = model.dim, model.constraints + model.velocity_constraints
     if isinstance(events, (Event,)) or callable(events) or isinstance(events, (str, bytes)):
         raise TypeError("events: expected a list of event functions or varmech.events.Event")
     items = [_event(i, e) for i, e in enumerate(events)]
@@ -464,8 +465,8 @@ def specs(events: Sequence[Event | EventFunction], n: int, rows: int = 0) -> tup
     return items, out
 
 
-def occurrences(record: _core.TrajectoryRecord, events: Sequence[Event]) -> tuple[Occurrences, ...]:
-    """Each event's located crossings, from the binding's record of a run."""
+def occurrences(record: _core.TrajectoryRecord | _core.Stepper, events: Sequence[Event]) -> tuple[Occurrences, ...]:
+    """Each event's located crossings, from the binding's record of a run (or a stepper's so far)."""
     if not events:
         return ()
     index, t, q, p = record.events[:4]

@@ -350,7 +350,7 @@ def integrate(
     q, p = _initial_state(model, q0, p0, v0, t0)
     if model.velocity_constraints:
         warn_if_integrable(model, q)
-    watched, event_specs = _events.specs(events, model.dim, model.constraints + model.velocity_constraints) if events is not None else ([], [])
+    watched, event_specs = _events.specs(events, model) if events is not None else ([], [])
     # A horizon past the largest float is the core's to refuse (naming dt); probe finite times.
     t_end = t0 + nsteps * dt
     probes = (t0, t0 + dt, t0 + 0.5, t0 + 1.0, t0 + 0.37 * (t_end - t0), t_end)
@@ -438,7 +438,7 @@ def _go_on(
     nsteps = step_count(traj.dt, t_now, steps, t_end)
     save_every = positive_int("save_every", save_every)
     times = _sample_times(t_eval, t_now, t_now + nsteps * traj.dt, save_every, output)
-    watched, specs = _events.specs(events, traj.model.dim, traj.model.constraints + traj.model.velocity_constraints) if events is not None else ([], [])
+    watched, specs = _events.specs(events, traj.model) if events is not None else ([], [])
     found = _events.found_before(traj.events, watched)
     initial = _events.first_energy(traj.model, traj) if watched else None
     return _run(

@@ -9,10 +9,11 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from . import _core
+from . import events as _events
 from . import impacts as _impacts
 from . import impulses as _impulses
 from ._util import finite, positive, step_count
-from .events import Occurrences
+from .events import Event, EventFunction, Occurrences
 from .impacts import Contact
 from .impulses import Impulse
 from .integrate import _contacts_of, _initial_state, _model_of, _newton
@@ -33,7 +34,9 @@ class Stepper:
     ``integrate``'s: n calls of :meth:`step` land bit for bit on the final state of
     ``integrate(..., steps=n)`` with the same arguments, contacts included: a step that crosses
     a contact is split at the impact as a run's is (see :mod:`varmech.impacts`), and the
-    impacts gone through are :attr:`impacts`; so is a step that holds an impulse's time.
+    impacts gone through are :attr:`impacts`; so is a step that holds an impulse's time. Events
+    are located as a run's are (:attr:`events`); a terminal one stops :meth:`advance` at the end
+    of the step of its crossing (:attr:`terminated_by`), and the next call goes on.
 
     Parameters
     ----------
@@ -52,6 +55,11 @@ class Stepper:
     impulses : sequence of Impulse, optional
         Blows at their times ``impulse.t`` ≥ t0, as for :func:`varmech.integrate`: the step that
         holds one is split there (one at t0 acts at once).
+    events : sequence of callable or Event, optional
+        Event functions g(t, q, p) or :mod:`varmech.events` helpers, as for
+        :func:`varmech.integrate`: their crossings accumulate in :attr:`events`; terminal counts
+        carry over from call to call (as a run gone on from counts them), and ``energy_error``
+        measures from the state the stepper starts (or is reset) at.
 
     Raises
     ------
@@ -61,10 +69,12 @@ class Stepper:
         ``contacts`` for a contact that does not fit the model or method (a restitution outside
         [0, 1], a coordinate out of range, the variational law on a method without a discrete
         energy) and ``q0`` for an initial state outside a contact (φ < 0), as ``integrate``.
-        Naming ``impulses`` for an impulse before t0 or of another number of components.
+        Naming ``impulses`` for an impulse before t0 or of another number of components, and
+        ``events`` or ``events[i]`` for a malformed event, as ``integrate``.
     TypeError
         Naming ``contacts[i]`` or ``impulses[i]`` for an entry that is not a
-        :class:`~varmech.Contact` or :class:`~varmech.Impulse`.
+        :class:`~varmech.Contact` or :class:`~varmech.Impulse`, ``events`` for a single event
+        rather than a list.
 
     Notes
     -----
@@ -105,6 +115,16 @@ class Stepper:
     >>> traj = varmech.integrate(ball, dt=0.01, steps=300)
     >>> bool((stepper.q == traj.q[-1]).all() and (stepper.p == traj.p[-1]).all())
     True
+
+    A terminal event stops ``advance`` after the step of its crossing: the pendulum released
+    from q = 1 passes q = 0 downwards after a quarter period, K(sin ½) = 1.67499:
+
+    >>> from varmech.events import crossing
+    >>> stepper = varmech.Stepper(varmech.scenes.pendulum(), [1.0], [0.0], dt=0.01,
+    ...                           events=[crossing(0, 0.0, direction=-1, terminal=True)])
+    >>> stepper.advance(1000)
+    >>> stepper.terminated_by, stepper.steps, round(float(stepper.events[0].t[0]), 5)
+    ('q[0] = 0', 168, 1.67499)
     """
 
     def __init__(
@@ -122,11 +142,13 @@ class Stepper:
         newton_max_iterations: int = 50,
         contacts: Sequence[Contact] | None = None,
         impulses: Sequence[Impulse] | None = None,
+        events: Sequence[Event | EventFunction] | None = None,
     ) -> None:
         contacts = _contacts_of(model, contacts)
         specs = _impacts.specs(contacts)
         blows = _impulses.specs(impulses or (), finite("t0", t0), math.inf)
         model, q0, p0 = _model_of(model, q0, p0, v0)
+        self._watch_events(model, events)
         if method is None:
             method = model.kind.default_method
         dt = positive("dt", dt)
@@ -148,7 +170,12 @@ class Stepper:
             newton_max_iterations=newton_max_iterations,
             contacts=specs or None,
             impulses=blows or None,
+            events=self._event_specs or None,
         )
+
+    def _watch_events(self, model: Model, events: Sequence[Event | EventFunction] | None) -> None:
+        """Keeps the events as Events and their spec tuples, checked against the model."""
+        self._events, self._event_specs = _events.specs(events, model) if events is not None else ([], [])
 
     def step(self) -> None:
         """Advance one step, from tₙ to tₙ₊₁ = tₙ + h.
@@ -183,7 +210,8 @@ class Stepper:
     def advance(self, steps: int | None = None, *, t_end: float | None = None) -> None:
         """Advance ``steps`` steps, or to ``t_end``, a whole number of steps from :attr:`t`.
 
-        Ctrl-C stops it with KeyboardInterrupt, at the last step completed.
+        A terminal event stops it at the end of the step of its crossing (:attr:`terminated_by`
+        names it). Ctrl-C stops it with KeyboardInterrupt, at the last step completed.
 
         Parameters
         ----------
@@ -227,8 +255,9 @@ class Stepper:
 
     def reset(self, q0: ArrayLike, p0: ArrayLike | None = None, *, v0: ArrayLike | None = None, t0: float | None = None) -> None:
         """Start afresh from (q0, p0) (or q0 and the velocities v0) at ``t0`` (default: the
-        current time), with :attr:`steps` at 0 and no :attr:`impacts`: the next steps are those
-        of a new stepper from there. The work counts go on.
+        current time), with :attr:`steps` at 0, no :attr:`impacts` and no :attr:`events` (their
+        terminal counts whole again): the next steps are those of a new stepper from there. The
+        work counts go on.
 
         Parameters
         ----------
@@ -262,7 +291,7 @@ class Stepper:
         """
         t0 = self.t if t0 is None else finite("t0", t0)
         q, p = _initial_state(self._model, q0, p0, v0, t0)
-        self._stepper.reset(q, p, t0)
+        self._stepper.reset(q, p, t0, events=self._event_specs or None)
 
     @property
     def model(self) -> Model:
@@ -286,6 +315,19 @@ class Stepper:
         """As :attr:`impacts`, with the momenta p⁺ just after each jump (a run's saved state
         just after the impact)."""
         return _impacts.occurrences(self._stepper, self._contacts, after=True)
+
+    @property
+    def events(self) -> tuple[Occurrences, ...]:
+        """Each event's located crossings since the start or the last :meth:`reset`, in the order
+        of the ``events`` given, as a run's ``traj.events``."""
+        return _events.occurrences(self._stepper, self._events)
+
+    @property
+    def terminated_by(self) -> str | None:
+        """The name of the event whose terminal count stopped the last :meth:`step` or
+        :meth:`advance`, or None."""
+        i = self._stepper.terminated_by
+        return None if i is None else self.events[i].name
 
     @property
     def method(self) -> str:
@@ -374,10 +416,11 @@ class Stepper:
         dt: float | None = None,
         contacts: Sequence[Contact] | None = None,
         impulses: Sequence[Impulse] | None = None,
+        events: Sequence[Event | EventFunction] | None = None,
     ) -> Stepper:
         """The stepper of ``model`` at the state of ``checkpoint``, going through the impacts on
-        ``contacts`` (a scene's by default) and applying the ``impulses`` after the checkpoint's
-        time as the constructor's does.
+        ``contacts`` (a scene's by default), applying the ``impulses`` after the checkpoint's
+        time and watching the ``events`` from there as the constructor's does.
 
         A checkpoint records a fingerprint of what it was taken of: the model's kind, size and
         constraints, what the model computes at the checkpoint's state (its Lagrangian, forces
@@ -401,6 +444,9 @@ class Stepper:
         impulses : sequence of Impulse, optional
             The impulses the stepper goes on with; those at or before the checkpoint's time
             were its run's.
+        events : sequence of callable or Event, optional
+            The events the stepper watches from the checkpoint's state on (their counts and an
+            ``energy_error``'s E₀ start there).
 
         Returns
         -------
@@ -444,20 +490,24 @@ class Stepper:
         stepper._model = model
         stepper._contacts = contacts
         stepper._impulses = tuple(impulses or ())
+        stepper._watch_events(model, events)
         stepper._stepper = _core.Stepper.from_checkpoint(
-            model._core, bytes(checkpoint), method=method, dt=dt, contacts=specs or None, impulses=blows or None
+            model._core, bytes(checkpoint), method=method, dt=dt, contacts=specs or None, impulses=blows or None,
+            events=stepper._event_specs or None,
         )
         return stepper
 
     def __reduce__(self) -> tuple[object, ...]:
-        # By its model, checkpoint, contacts and impulses: the unpickled stepper goes on bit for
-        # bit (its impacts counted from there).
-        return (_unpickled, (self._model, self.checkpoint(), self._contacts, self._impulses))
+        # By its model, checkpoint, contacts, impulses and events: the unpickled stepper goes on
+        # bit for bit (its impacts and crossings counted from there).
+        return (_unpickled, (self._model, self.checkpoint(), self._contacts, self._impulses, tuple(self._events)))
 
     def __repr__(self) -> str:
         return f"Stepper({self._model.name!r}, method={self.method!r}, dt={self.dt:g}, t={self.t:g}, steps={self.steps})"
 
 
-def _unpickled(model: Model, checkpoint: bytes, contacts: tuple[Contact, ...], impulses: tuple[Impulse, ...] = ()) -> Stepper:
-    """A pickled stepper, from its model, checkpoint, contacts and impulses."""
-    return Stepper.from_checkpoint(model, checkpoint, contacts=contacts, impulses=impulses)
+def _unpickled(
+    model: Model, checkpoint: bytes, contacts: tuple[Contact, ...], impulses: tuple[Impulse, ...] = (), events: tuple[Event, ...] = ()
+) -> Stepper:
+    """A pickled stepper, from its model, checkpoint, contacts, impulses and events."""
+    return Stepper.from_checkpoint(model, checkpoint, contacts=contacts, impulses=impulses, events=events or None)

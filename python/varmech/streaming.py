@@ -328,7 +328,7 @@ def resume(
     more = step_count(stored.dt, t_now, steps, t_end)
     if save_every is None:
         save_every = files.save_every_of(path)
-    watched, specs = _events.specs(events, stored.model.dim) if events is not None else ([], [])
+    watched, specs = _events.specs(events, stored.model) if events is not None else ([], [])
     names = [o.name for o in _events.occurrences_of(watched)] + [c.name for c in going_on]
     writer = files.Writer.reopen(Path(path), stored, names)
     initial = _events.first_energy(stored.model, stored)

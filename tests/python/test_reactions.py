@@ -246,7 +246,8 @@ def test_a_string_whirled_too_slowly_goes_slack_where_its_tension_reaches_zero()
     slack = varmech.events.multiplier(0, direction=+1, terminal=True)
     errors = []
     for h in (0.02, 0.01, 0.005):
-        traj = varmech.integrate(varmech.scenes.cartesian_pendulum(), [0.0, -1.0], v0=[np.sqrt(3.5), 0.0], dt=h, t_end=10.0, method="rattle4", events=[slack])
+        start = dict(v0=[np.sqrt(3.5), 0.0], dt=h, t_end=10.0, method="rattle4", events=[slack])
+        traj = varmech.integrate(varmech.scenes.cartesian_pendulum(), [0.0, -1.0], **start)
         q = traj.events[0].q[0]
         assert traj.status == 1 and q[0] > 0, q
         errors.append(abs(-q[1] - (-0.5)))
