@@ -35,8 +35,8 @@ fn the_multiplier_of_each_saved_state_is_the_pendulums_tension_and_does_no_work(
         let (q, lambda) = (traj.q_at(k), r.multipliers[k]);
         let t = tension(q, traj.p_at(k));
         worst.0 = worst.0.max((lambda + t).abs() / t.abs().max(1.0));
-        for i in 0..2 {
-            assert!((r.force[2 * k + i] - lambda * q[i]).abs() <= 1e-14 * t.abs().max(1.0));
+        for (f, x) in r.force[2 * k..2 * k + 2].iter().zip(q) {
+            assert!((f - lambda * x).abs() <= 1e-14 * t.abs().max(1.0));
         }
         worst.1 = worst.1.max(r.power[k].abs() / r.power_size[k].max(f64::MIN_POSITIVE));
     }
