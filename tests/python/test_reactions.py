@@ -264,3 +264,36 @@ def test_multiplier_events_name_what_the_model_lacks():
         varmech.integrate(varmech.scenes.pendulum(), dt=0.01, steps=10, events=[varmech.events.multiplier(0)])
     with pytest.raises(ValueError, match="k: must be an integer ≥ 0"):
         varmech.events.multiplier(-1)
+
+
+def test_a_slack_string_flies_as_a_projectile_until_taut_again_and_loses_carnots_energy():
+    # The unit pendulum from the bottom at v₀² = 3.5 goes slack at r₀ = (√3/2, 1/2) with speed
+    # √(1/2) along the circle's tangent (−1/2, √3/2); the projectile r₀ + vt − ½gt²ŷ meets
+    # |r| = 1 again where t²/4 − v_y t + (v² − y₀) = 0, and v² = y₀ = 1/2: t = 4v_y. Taut, the
+    # string takes the radial velocity: Carnot's loss ½(v·r̂)².
+    slack = varmech.events.multiplier(0, direction=+1, terminal=True)
+    start = dict(v0=[np.sqrt(3.5), 0.0], dt=1e-3, t_end=10.0, method="rattle4", events=[slack])
+    held = varmech.integrate(varmech.scenes.cartesian_pendulum(), [0.0, -1.0], **start)
+    q0, p0, t0 = held.events[0].q[0], held.events[0].p[0], held.events[0].t[0]
+    r0, v0 = np.array([np.sqrt(3) / 2, 0.5]), np.sqrt(0.5) * np.array([-0.5, np.sqrt(3) / 2])
+    np.testing.assert_allclose(q0, r0, atol=1e-12)
+    np.testing.assert_allclose(p0, v0, atol=1e-12)
+
+    def inside(t, q, p):
+        return 1.0 - q @ q
+
+    inside.direction = -1  # type: ignore[attr-defined]
+    inside.terminal = True  # type: ignore[attr-defined]
+    free = varmech.MechanicalSystem(2, lambda q: q[1], lambda q: np.array([0.0, 1.0]))
+    flight = varmech.integrate(free, q0, p0, t0=t0, dt=1e-3, t_end=t0 + 5.0, events=[inside])
+    t_flight = 4 * v0[1]
+    q1, p1 = flight.events[0].q[0], flight.events[0].p[0]
+    np.testing.assert_allclose(flight.events[0].t[0] - t0, t_flight, atol=1e-10)
+    np.testing.assert_allclose(q1, r0 + v0 * t_flight - [0.0, t_flight**2 / 2], atol=1e-10)
+    taut = varmech.engage(free, q1, p1, constraints=lambda q: [0.5 * (q @ q - 1)], jacobian=lambda q: q[None, :].copy())
+    radial = p1 @ q1
+    np.testing.assert_allclose(taut.carnot, radial**2 / 2, rtol=1e-12)
+    np.testing.assert_allclose(taut.p, p1 - radial * q1, atol=1e-12)
+    # On the circle again, the string pulls with the tension of the state.
+    again = varmech.integrate(varmech.scenes.cartesian_pendulum(), q1, taut.p, t0=flight.events[0].t[0], dt=1e-3, steps=10)
+    np.testing.assert_allclose(again.reactions().multipliers[0, 0], -(-q1[1] + taut.p @ taut.p), rtol=1e-10)
