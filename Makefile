@@ -2,7 +2,7 @@
 # `make test` (build, run every test). PYTHON may name another interpreter.
 PYTHON ?= python3
 
-.PHONY: install tour lint test docs wheel-check test-aarch64 bench compare gallery
+.PHONY: install tour lint test test-rust test-python docs wheel-check test-aarch64 bench compare gallery
 
 install:
 	$(PYTHON) -m pip install -e ".[test,charts]"
@@ -28,10 +28,18 @@ docs: install
 # Every test but the packaging check (the tests marked `wheel`, run by `make wheel-check`).
 # --workspace: the features of the binding's build too, so that the core's release build from the
 # editable install is reused (rust/python/Cargo.toml's `either`); the binding itself has no tests.
+# The Rust tests and pytest run side by side (two jobs, each one's output kept together): the
+# release build of the Rust test crate (codegen-units = 1) keeps one core busy for minutes, and
+# pytest takes the other.
 test: lint
-	cargo test --release --workspace
-	$(PYTHON) -m pytest -q -m "not wheel"
+	$(MAKE) --jobs=2 --output-sync=target test-rust test-python
 	$(SPHINX) -E -a
+
+test-rust:
+	cargo test --release --workspace
+
+test-python:
+	$(PYTHON) -m pytest -q -m "not wheel"
 
 # The packaging check (tests/python/test_wheel.py): a manylinux2014 wheel built with zig, checked by
 # auditwheel, installed into a fresh venv and running the quickstart. A release build of its own
