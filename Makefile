@@ -35,8 +35,9 @@ test: lint
 	$(MAKE) --jobs=2 --output-sync=target test-rust test-python
 	$(SPHINX) -E -a
 
+# Cargo schedules its own jobs: without make's jobserver, which it cannot join from a sub-make.
 test-rust:
-	cargo test --release --workspace
+	env -u MAKEFLAGS -u MFLAGS cargo test --release --workspace
 
 test-python:
 	$(PYTHON) -m pytest -q -m "not wheel"

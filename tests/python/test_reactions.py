@@ -297,3 +297,23 @@ def test_a_slack_string_flies_as_a_projectile_until_taut_again_and_loses_carnots
     # On the circle again, the string pulls with the tension of the state.
     again = varmech.integrate(varmech.scenes.cartesian_pendulum(), q1, taut.p, t0=flight.events[0].t[0], dt=1e-3, steps=10)
     np.testing.assert_allclose(again.reactions().multipliers[0, 0], -(-q1[1] + taut.p @ taut.p), rtol=1e-10)
+
+
+@pytest.mark.parametrize("workers", [1, 2])
+def test_an_ensemble_of_whirled_strings_goes_slack_where_each_single_run_does(workers):
+    # From the bottom at v₀²: slack at cos θ = −(v₀² − 2)/3 while 2 < v₀² < 5; at v₀² ≥ 5 the
+    # string stays taut all round. Each member bit for bit its single run (threads: native scene).
+    scene = varmech.scenes.cartesian_pendulum()
+    speeds = np.sqrt([2.5, 3.0, 3.5, 4.0, 4.5, 5.5])
+    q0 = np.tile([0.0, -1.0], (len(speeds), 1))
+    v0 = np.stack([speeds, np.zeros_like(speeds)], axis=1)
+    run = dict(dt=0.005, t_end=6.0, method="rattle4", events=[varmech.events.multiplier(0, direction=+1, terminal=True)])
+    runs = varmech.ensemble(scene, q0, v0=v0, workers=workers, progress=False, **run)
+    for i, v in enumerate(speeds):
+        single = varmech.integrate(scene, q0[i], v0=v0[i], **run)
+        np.testing.assert_array_equal(runs[i].events[0].q, single.events[0].q)
+        np.testing.assert_array_equal(runs[i].reactions().multipliers, single.reactions().multipliers)
+        if v**2 < 5:
+            assert runs[i].status == 1 and abs(-runs[i].events[0].q[0, 1] + (v**2 - 2) / 3) < 1e-7
+        else:
+            assert runs[i].status == 0 and len(runs[i].events[0]) == 0
