@@ -312,6 +312,42 @@ fn the_event_loop_allocates_nothing() {
     assert_eq!(run(100), run(10_000));
 }
 
+/// A run watching a multiplier (λ of a link of the planar chain, which never reaches 0 within
+/// the run) allocates per run, not per step: the reaction's buffers are made at the run's start.
+#[test]
+fn a_multiplier_event_allocates_nothing_in_the_step_loop() {
+    use varmech::integrators::{integrate_with_events, Detector, EventSpec, NativeEvent};
+    let problem = scenes::planar_chain(8).unwrap();
+    let run = |steps: usize| {
+        let options = Options {
+            save_every: 10,
+            ..Options::new(0.01, steps)
+        };
+        let multiplier = NativeEvent::Multiplier { row: 0, reaction: None };
+        let specs = vec![EventSpec {
+            name: "lambda[0] = 0".into(),
+            direction: 1,
+            terminal: 1,
+        }];
+        let mut detector = Detector::new(Box::new(vec![multiplier]), specs).unwrap();
+        let (q0, p0) = (&problem.initial.q, &problem.initial.p);
+        let before = allocated();
+        let traj = integrate_with_events(
+            &problem.system,
+            Method::Rattle,
+            q0,
+            p0,
+            &options,
+            || Ok(()),
+            &mut detector,
+        )
+        .unwrap();
+        assert!(traj.events.is_empty() && traj.steps == steps);
+        allocated() - before
+    };
+    assert_eq!(run(100), run(2_000));
+}
+
 /// As [`counted`], for a nonholonomic catalogue scene (its ∂A/∂q by central differences, on
 /// per-thread scratch).
 fn nonholonomic_allocations(name: &str, method: Method, steps: usize) -> usize {
