@@ -12,8 +12,9 @@ use std::cell::Cell;
 use std::ops::Deref;
 
 use varmech::integrators::{
-    integrate, integrate_watching, Contact, Contacts, DiscreteEnergy, Dynamics, General, Law, Method, ModelKind,
-    NativeSurface, Options, Stepper, StepperState, Trajectory, Watch, Watcher,
+    integrate, integrate_watching, integrate_with_events, Contact, Contacts, Detector, DiscreteEnergy, Dynamics,
+    EventSpec, General, Law, Method, ModelKind, NativeEvent, NativeSurface, Options, Stepper, StepperState, Trajectory,
+    Watch, Watcher,
 };
 use varmech::model::Routhian;
 use varmech::scenes::{self, NBody, NonholonomicScene, SceneModel};
@@ -267,17 +268,43 @@ fn resuming_and_resetting_a_stepper_allocates_nothing() {
     }
 }
 
+/// The allocations of a run of `steps` steps of `sys` from `start` watching `events` (none of
+/// which may occur), every 10th state saved.
+fn event_allocations<S: Dynamics>(
+    sys: &S,
+    method: Method,
+    start: (&[f64], &[f64]),
+    dt: f64,
+    steps: usize,
+    events: Vec<(NativeEvent, i8)>,
+) -> usize {
+    let options = Options {
+        save_every: 10,
+        ..Options::new(dt, steps)
+    };
+    let specs = events
+        .iter()
+        .enumerate()
+        .map(|(i, (_, direction))| EventSpec {
+            name: format!("event {i}"),
+            direction: *direction,
+            terminal: 1,
+        })
+        .collect();
+    let functions = events.into_iter().map(|(e, _)| e).collect::<Vec<_>>();
+    let mut detector = Detector::new(Box::new(functions), specs).unwrap();
+    let before = allocated();
+    let traj = integrate_with_events(sys, method, start.0, start.1, &options, || Ok(()), &mut detector).unwrap();
+    assert!(traj.events.is_empty() && traj.steps == steps);
+    allocated() - before
+}
+
 /// A run with built-in events (an escape, an ellipsoid) that never occur allocates per run, not
 /// per step: the events' values, the state before each step and the partial steps' stepper are made once.
 #[test]
 fn the_event_loop_allocates_nothing() {
-    use varmech::integrators::{integrate_with_events, Detector, EventSpec, NativeEvent};
     let problem = NBody::outer_solar_system();
     let run = |steps: usize| {
-        let options = Options {
-            save_every: 10,
-            ..Options::new(10.0, steps)
-        };
         let groups = (0..6).map(|b| vec![3 * b, 3 * b + 1, 3 * b + 2]).collect::<Vec<_>>();
         let escape = NativeEvent::Escape { radius: 1e6, groups };
         // The Sun's position leaving a large ellipsoid about the origin.
@@ -287,27 +314,15 @@ fn the_event_loop_allocates_nothing() {
             semi_axes: vec![1e6, 2e6, 3e6],
             inside: true,
         };
-        let spec = |name: &str, direction| EventSpec {
-            name: name.into(),
-            direction,
-            terminal: 1,
-        };
-        let specs = vec![spec("escape", 1), spec("ellipsoid", -1)];
-        let mut detector = Detector::new(Box::new(vec![escape, ellipsoid]), specs).unwrap();
-        let (q0, p0) = (&problem.initial.q, &problem.initial.p);
-        let before = allocated();
-        let traj = integrate_with_events(
+        let start = (&problem.initial.q[..], &problem.initial.p[..]);
+        event_allocations(
             &problem.system,
             Method::Verlet,
-            q0,
-            p0,
-            &options,
-            || Ok(()),
-            &mut detector,
+            start,
+            10.0,
+            steps,
+            vec![(escape, 1), (ellipsoid, -1)],
         )
-        .unwrap();
-        assert!(traj.events.is_empty() && traj.steps == steps);
-        allocated() - before
     };
     assert_eq!(run(100), run(10_000));
 }
@@ -316,34 +331,18 @@ fn the_event_loop_allocates_nothing() {
 /// the run) allocates per run, not per step: the reaction's buffers are made at the run's start.
 #[test]
 fn a_multiplier_event_allocates_nothing_in_the_step_loop() {
-    use varmech::integrators::{integrate_with_events, Detector, EventSpec, NativeEvent};
     let problem = scenes::planar_chain(8).unwrap();
     let run = |steps: usize| {
-        let options = Options {
-            save_every: 10,
-            ..Options::new(0.01, steps)
-        };
         let multiplier = NativeEvent::Multiplier { row: 0, reaction: None };
-        let specs = vec![EventSpec {
-            name: "lambda[0] = 0".into(),
-            direction: 1,
-            terminal: 1,
-        }];
-        let mut detector = Detector::new(Box::new(vec![multiplier]), specs).unwrap();
-        let (q0, p0) = (&problem.initial.q, &problem.initial.p);
-        let before = allocated();
-        let traj = integrate_with_events(
+        let start = (&problem.initial.q[..], &problem.initial.p[..]);
+        event_allocations(
             &problem.system,
             Method::Rattle,
-            q0,
-            p0,
-            &options,
-            || Ok(()),
-            &mut detector,
+            start,
+            0.01,
+            steps,
+            vec![(multiplier, 1)],
         )
-        .unwrap();
-        assert!(traj.events.is_empty() && traj.steps == steps);
-        allocated() - before
     };
     assert_eq!(run(100), run(2_000));
 }
