@@ -327,7 +327,7 @@ class Stepper:
         """The name of the event whose terminal count stopped the last :meth:`step` or
         :meth:`advance`, or None."""
         i = self._stepper.terminated_by
-        return None if i is None else self.events[i].name
+        return None if i is None else str(self._event_specs[i][0])
 
     @property
     def method(self) -> str:
