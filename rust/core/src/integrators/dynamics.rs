@@ -1,5 +1,7 @@
 //! What a method integrates: the dynamics of a model, seen through one step's increments.
 
+use nalgebra::DMatrix;
+
 use super::{Gaps, Increment, Integrator, ModelKind, StepError, StepStart, StepperState};
 use crate::model::{
     self, Constrained, EnergyTerms, HolonomicConstraints, Lagrangian, MechanicalSystem, Mixed, Nonholonomic,
@@ -463,7 +465,7 @@ impl<L: Lagrangian, H: HolonomicConstraints, C: VelocityConstraints> Dynamics fo
     }
 
     fn reaction(&self, out: &mut model::Reaction, q: &[f64], p: &[f64], t: f64) -> Option<Result<(), ModelError>> {
-        let rows = model::mixed_rows(&self.holonomic, &self.velocity);
+        let rows = |q: &[f64], c: &mut DMatrix<f64>, b: &mut [f64]| self.rows(q, c, b);
         Some(out.solve(&self.system, &rows, (q, p, t)))
     }
 }

@@ -32,6 +32,15 @@ impl<S: Lagrangian, H: HolonomicConstraints, C: VelocityConstraints> Mixed<S, H,
         Ok((stacked, b))
     }
 
+    /// [G(q); A(q)] into `c` and [0; b(q)] into `b`: the rows of the forces of constraint
+    /// ([`super::Reaction::solve`]), allocated as [`Self::stacked`].
+    pub fn rows(&self, q: &[f64], c: &mut DMatrix<f64>, b: &mut [f64]) -> Result<(), ModelError> {
+        let (stacked, offset) = self.stacked(q)?;
+        c.copy_from(&stacked);
+        b.copy_from_slice(offset.as_slice());
+        Ok(())
+    }
+
     /// q̇(q, p), the inverse Legendre transform.
     fn velocity(&self) -> impl Fn(&[f64], &[f64], &mut [f64]) -> Result<(), ModelError> + '_ {
         |q, p, v| self.system.velocity(q, p, 0.0, v)

@@ -49,7 +49,7 @@ pub use mixed::Mixed;
 pub use natural::{differenced_kinetic_gradient, kinetic_gradient_from_mass_derivative, Natural, NaturalSystem};
 pub use nbody::{NBody, PairKernel};
 pub use nonholonomic::{differenced_derivative, Nonholonomic, VelocityConstraints};
-pub use reactions::{holonomic_rows, mixed_rows, velocity_rows, Reaction, Reactions, Rows};
+pub use reactions::{holonomic_rows, velocity_rows, Reaction, Reactions, Rows};
 pub use routh::Routhian;
 pub use scale::Scale;
 pub use symmetry::{momentum_along, Generator};

@@ -191,20 +191,3 @@ pub fn velocity_rows<C: VelocityConstraints + ?Sized>(
         constraints.offset(q, b)
     }
 }
-
-/// The rows of holonomic and velocity constraints together: [G(q); A(q)] and [0; b(q)].
-pub fn mixed_rows<'a, H: HolonomicConstraints + ?Sized, C: VelocityConstraints + ?Sized>(
-    holonomic: &'a H,
-    velocity: &'a C,
-) -> impl Fn(&[f64], &mut DMatrix<f64>, &mut [f64]) -> Result<(), ModelError> + 'a {
-    |q, c, b| {
-        let (k, m) = (holonomic.count(), velocity.count());
-        let (mut g, mut a) = (DMatrix::zeros(k, q.len()), DMatrix::zeros(m, q.len()));
-        holonomic.jacobian(q, &mut g)?;
-        velocity.matrix(q, &mut a)?;
-        c.rows_mut(0, k).copy_from(&g);
-        c.rows_mut(k, m).copy_from(&a);
-        b[..k].fill(0.0);
-        velocity.offset(q, &mut b[k..])
-    }
-}
