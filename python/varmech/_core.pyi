@@ -139,6 +139,10 @@ class TrajectoryRecord:
         """The impacts on the run's contacts in order of time: the contact's index (k,), t (k,),
         the contact configuration q and the momenta just before and just after (k, n)."""
     @property
+    def switches(self) -> tuple[NDArray[np.uint64], _FloatArray, NDArray[np.bool_], _FloatArray, _FloatArray]:
+        """The contacts' closures and releases in order of time: the contact's index (k,), t (k,),
+        whether it closed (k,), q and p (k, n)."""
+    @property
     def grazing(self) -> int:
         """Impacts under the variational law that took Newton's law for want of a discrete-energy
         root near the reflection (grazing)."""
@@ -216,6 +220,10 @@ class Stepper:
     def impacts(self) -> tuple[NDArray[np.uint64], _FloatArray, _FloatArray, _FloatArray, _FloatArray]:
         """The impacts gone through since the start or the last reset, as a run's record has them:
         the contact's index (k,), t (k,), q, p before and p after (k, n)."""
+    @property
+    def switches(self) -> tuple[NDArray[np.uint64], _FloatArray, NDArray[np.bool_], _FloatArray, _FloatArray]:
+        """The contacts' closures and releases since the start or the last reset, as a run's
+        record has them: the contact's index (k,), t (k,), closed (k,), q and p (k, n)."""
     @property
     def grazing(self) -> int:
         """Impacts under the variational law that took Newton's law (grazing), as a run's."""

@@ -281,6 +281,25 @@ def occurrences(record: Any, contacts: Sequence[Contact | str], *, after: bool =
     return tuple(Occurrences(name(c), t[index == i], q[index == i], p[index == i]) for i, c in enumerate(contacts))
 
 
+def switches(record: Any, contacts: Sequence[Contact | str]) -> tuple[Occurrences, ...]:
+    """Each contact's closures in the binding's record of a run (or its stepper's), named
+    ``"<name>.closed"`` (at the limit of its bounces' Zeno series, with the state of the impact
+    that closed it), then each one's releases, ``"<name>.released"`` (at lift-off)."""
+    if not contacts:
+        return ()
+    index, t, closed, q, p = record.switches
+    names = occurrence_names(contacts)[len(contacts) :]
+    rows = [(index == i) & (closed == flag) for flag in (True, False) for i in range(len(contacts))]
+    return tuple(Occurrences(n, t[r], q[r], p[r]) for n, r in zip(names, rows))
+
+
+def occurrence_names(contacts: Sequence[Contact | str]) -> list[str]:
+    """The names of the contacts' occurrences in ``traj.events``: each contact's impacts
+    (:func:`occurrences`), then each one's closures and each one's releases (:func:`switches`)."""
+    names = [name(c) for c in contacts]
+    return names + [f"{n}.closed" for n in names] + [f"{n}.released" for n in names]
+
+
 def warn_grazing(count: int, stacklevel: int) -> None:
     """The RuntimeWarning of ``count`` grazing impacts (none: no warning), at the caller
     ``stacklevel`` frames up from here."""

@@ -501,7 +501,7 @@ def _run(
             target = files.writable(output, bool(overwrite), "output")
             streaming.checkpoint_period(checkpoint_every, save_every)
             columns = files.columns_of(model, method)
-            names = [o.name for o in _events.occurrences_of(watched)] + [c.name for c in contacts]
+            names = [o.name for o in _events.occurrences_of(watched)] + _impacts.occurrence_names(contacts)
             writer = files.Writer(
                 target,
                 model=model,

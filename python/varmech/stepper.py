@@ -317,6 +317,13 @@ class Stepper:
         return _impacts.occurrences(self._stepper, self._contacts, after=True)
 
     @property
+    def switches(self) -> tuple[Occurrences, ...]:
+        """Each contact's closures since the start or the last :meth:`reset`, in the order of
+        :attr:`contacts` (``"<name>.closed"``), then each one's releases (``"<name>.released"``),
+        as a run's ``traj.events`` holds them after the impacts (see :mod:`varmech.impacts`)."""
+        return _impacts.switches(self._stepper, self._contacts)
+
+    @property
     def events(self) -> tuple[Occurrences, ...]:
         """Each event's located crossings since the start or the last :meth:`reset`, in the order
         of the ``events`` given, as a run's ``traj.events``."""

@@ -329,7 +329,7 @@ def resume(
     if save_every is None:
         save_every = files.save_every_of(path)
     watched, specs = _events.specs(events, stored.model) if events is not None else ([], [])
-    names = [o.name for o in _events.occurrences_of(watched)] + [c.name for c in going_on]
+    names = [o.name for o in _events.occurrences_of(watched)] + _impacts.occurrence_names(going_on)
     writer = files.Writer.reopen(Path(path), stored, names)
     initial = _events.first_energy(stored.model, stored)
     counts = _events.found_before(stored.events, watched)

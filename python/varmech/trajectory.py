@@ -107,7 +107,9 @@ class Trajectory:
         The last state's checkpoint: ``integrate(traj, steps=)`` goes on from it, bit for bit.
     events : tuple of Occurrences
         Each event's located crossings, in the order the events were given, then each
-        contact's impacts (time, contact configuration, momenta just before).
+        contact's impacts (time, contact configuration, momenta just before), then each
+        contact's closures (``"<name>.closed"``) and each one's releases (``"<name>.released"``,
+        lift-off): see :mod:`varmech.impacts`.
     contacts : tuple of Contact
         The run's contacts (empty without them), which a continued run (``integrate(traj,
         steps=)``, :func:`varmech.resume`) goes on with. A file stores the native ones
@@ -448,8 +450,8 @@ def _trajectory(
 
 def crossings(record: Any, events: Sequence[_events.Event], contacts: Sequence[Contact | str]) -> tuple[Occurrences, ...]:
     """Each event's located crossings in the binding's record of a run, then each contact's
-    impacts."""
-    return _events.occurrences(record, events) + _impacts.occurrences(record, contacts)
+    impacts, closures and releases."""
+    return _events.occurrences(record, events) + _impacts.occurrences(record, contacts) + _impacts.switches(record, contacts)
 
 
 def load(

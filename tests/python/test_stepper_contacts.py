@@ -18,17 +18,19 @@ def _closure() -> varmech.Model:
     return varmech.MechanicalSystem(1, lambda q: G * q[0], lambda q: np.array([G]))
 
 
-def _python_floor(restitution: float = 0.9) -> varmech.Contact:
-    return varmech.Contact(lambda q: q[0], lambda q: [1.0], restitution=restitution, name="floor")
+def _python_floor(restitution: float = 0.9, law: str = "variational") -> varmech.Contact:
+    return varmech.Contact(lambda q: q[0], lambda q: [1.0], restitution=restitution, name="floor", law=law)
 
 
 # (model or scene, its stepper's and run's arguments, steps): the bouncing ball's native floor
-# (variational law), the elliptic billiard's native table, and a closure ball on a floor of
-# Python functions φ = q, ∇φ = 1 (e = 0.9, reflection).
+# (variational law), the elliptic billiard's native table, a closure ball on a floor of
+# Python functions φ = q, ∇φ = 1 (e = 0.9, reflection), and the ball with e = 0.5, which comes
+# to rest at t = 1.35 and rests on its floor, held.
 CASES = {
     "ball": (varmech.scenes.bouncing_ball, {"dt": 1e-2}, 600),
     "billiard": (varmech.scenes.elliptic_billiard, {"dt": 0.1}, 600),
     "closure": (_closure, {"q0": [1.0], "p0": [0.0], "dt": 1e-2, "contacts": [_python_floor()]}, 500),
+    "resting": (lambda: varmech.scenes.bouncing_ball(restitution=0.5), {"dt": 1e-2}, 300),
 }
 
 
@@ -45,7 +47,7 @@ def test_a_stepper_with_contacts_is_the_run_with_them_bit_for_bit(case):
     for _ in range(steps):
         single.step()
     many.advance(steps)
-    hits = traj.events[-1]
+    hits = traj.events[0]
     assert len(hits) >= 5
     for stepper in (single, many):
         assert stepper.steps == steps and stepper.t == traj.t[-1]
@@ -56,6 +58,9 @@ def test_a_stepper_with_contacts_is_the_run_with_them_bit_for_bit(case):
         for x, y in [(before.t, hits.t), (before.q, hits.q), (before.p, hits.p), (after.t, hits.t)]:
             assert np.array_equal(x, y)
         assert np.array_equal(after.p, _after_impacts(traj))
+        # Its closures and releases, as the run's.
+        for mine, theirs in zip(stepper.switches, traj.events[1:], strict=True):
+            assert mine.name == theirs.name and np.array_equal(mine.t, theirs.t) and np.array_equal(mine.p, theirs.p)
         # The impacts' partial steps are counted, as the run counts them.
         assert stepper.force_evaluations == traj.nfev
 
@@ -115,14 +120,14 @@ def test_contacts_given_override_the_scenes_and_none_steps_the_bare_model():
 
 
 def test_an_unresolvable_impact_raises_contact_error_with_the_stepper_at_its_last_good_state():
-    # e = 0.5: the bounces accumulate and the run fails at a step whose impact cannot be
-    # resolved, its partial trajectory ending at that step's start.
-    lossy = varmech.scenes.bouncing_ball(restitution=0.5)
+    # e = 0.5 under rk4, which cannot hold the floor: the bounces accumulate and the run fails
+    # at a step whose impact cannot be resolved, its partial trajectory ending at that step's start.
+    lossy = {"q0": [1.0], "p0": [0.0], "dt": 0.01, "method": "rk4", "contacts": [_python_floor(0.5, "reflect")]}
     with pytest.raises(varmech.ContactError) as run:
-        varmech.integrate(lossy, dt=0.01, t_end=2.0)
+        varmech.integrate(_closure(), t_end=2.0, **lossy)
     partial = run.value.partial
     for advancing in (True, False):
-        stepper = varmech.Stepper(lossy, dt=0.01)
+        stepper = varmech.Stepper(_closure(), **lossy)
         with pytest.raises(varmech.ContactError) as info:
             if advancing:
                 stepper.advance(200)

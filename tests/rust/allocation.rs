@@ -503,6 +503,43 @@ fn contacts_allocate_nothing_in_the_step_loop() {
     );
 }
 
+/// Allocations of a run of `steps` steps of 0.01 of the ball resting on its floor (e = 0.5),
+/// held closed from the start, saving its first and last states.
+fn resting(steps: usize) -> usize {
+    let ball = scenes::BouncingBall::new(9.81).unwrap();
+    let floor = Contact {
+        surface: Box::new(NativeSurface::Wall {
+            coordinate: 0,
+            value: 0.0,
+        }),
+        restitution: 0.5,
+        law: Law::Reflect,
+        name: "floor".into(),
+    };
+    let contacts = Contacts::new(vec![floor]).unwrap();
+    let options = Options {
+        save_every: steps,
+        ..Options::new(0.01, steps)
+    };
+    let watch = Watch {
+        contacts: Some(&contacts),
+        ..Watch::default()
+    };
+    let before = allocated();
+    let traj = integrate_watching(&ball, Method::Verlet, &[0.0], &[0.0], &options, || Ok(()), watch).unwrap();
+    let count = allocated() - before;
+    assert!(traj.impacts.is_empty() && traj.impacts.switches.is_empty());
+    assert_eq!((traj.q_at(1)[0], traj.p_at(1)[0]), (0.0, 0.0));
+    count
+}
+
+#[test]
+fn a_held_contact_allocates_nothing_in_the_step_loop() {
+    // The held steps (RATTLE on the floor) and the multiplier checked after each: a long run
+    // allocates as much as a short one.
+    assert_eq!(resting(100_000), resting(100));
+}
+
 /// Allocations of `steps` steps of `stepper` through a watcher of a wall q_k ≥ −10⁹ that it
 /// never reaches, after a first call (which sizes the watcher's buffers).
 fn watched_allocations<M>(model: M, mut stepper: Stepper<M>, coordinate: usize, steps: usize) -> usize

@@ -21,6 +21,7 @@ mod forcing;
 mod general_lagrangian;
 mod heavy_top;
 mod hessians;
+mod holds;
 mod impacts;
 mod impulses;
 #[cfg(feature = "jit")]

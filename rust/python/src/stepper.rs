@@ -18,7 +18,7 @@ use crate::errors::to_pyerr;
 use crate::events::{EventTuple, Events};
 use crate::run::{decode, detector_parts};
 use crate::schedule::{ImpulseTuple, ScheduleSpecs};
-use crate::trajectory::{event_arrays, impact_arrays, EventArrays, ImpactArrays};
+use crate::trajectory::{event_arrays, impact_arrays, switch_arrays, EventArrays, ImpactArrays, SwitchArrays};
 
 /// One model, one method and the state, advanced step by step
 /// ([`varmech::integrators::Stepper`]): native models with the GIL released, Ctrl-C honoured
@@ -367,6 +367,13 @@ impl Stepper {
     #[getter]
     fn impacts(&self, py: Python<'_>) -> PyResult<ImpactArrays> {
         impact_arrays(py, self.impacts.clone(), self.impacts.dim)
+    }
+
+    /// The contacts' closures and releases since the start or the last reset, as a run's
+    /// record has them: the contact's index (k,), t (k,), closed (k,), q and p (k, n).
+    #[getter]
+    fn switches(&self, py: Python<'_>) -> PyResult<SwitchArrays> {
+        switch_arrays(py, self.impacts.switches.clone(), self.impacts.dim)
     }
 
     /// Impacts under the variational law that took Newton's law (grazing), as a run's.

@@ -4,7 +4,7 @@ use numpy::{PyArray1, PyArray2, PyUntypedArrayMethods};
 
 use pyo3::prelude::*;
 use pyo3::types::PyBytes;
-use varmech::integrators::{Impacts, Occurrence, Trajectory};
+use varmech::integrators::{Impacts, Occurrence, Switches, Trajectory};
 
 use crate::convert::matrix;
 
@@ -41,6 +41,10 @@ pub struct TrajectoryRecord {
     /// the contact configuration q and the momenta just before and just after (k, n).
     #[pyo3(get)]
     impacts: ImpactArrays,
+    /// The contacts' closures and releases in order of time: the contact's index (k,), t (k,),
+    /// whether it closed (k,), q and p (k, n).
+    #[pyo3(get)]
+    switches: SwitchArrays,
     /// Impacts under the variational law that took Newton's law for want of a discrete-energy
     /// root near the reflection (grazing).
     #[pyo3(get)]
@@ -55,6 +59,26 @@ pub(crate) type ImpactArrays = (
     Py<PyArray2<f64>>,
     Py<PyArray2<f64>>,
 );
+
+/// Closures and releases as arrays: the contact's index (k,), t (k,), closed (k,), q and p (k, n).
+pub(crate) type SwitchArrays = (
+    Py<PyArray1<usize>>,
+    Py<PyArray1<f64>>,
+    Py<PyArray1<bool>>,
+    Py<PyArray2<f64>>,
+    Py<PyArray2<f64>>,
+);
+
+/// The arrays of `switches` (a run's, or a stepper's so far) of n coordinates.
+pub(crate) fn switch_arrays(py: Python<'_>, switches: Switches, n: usize) -> PyResult<SwitchArrays> {
+    Ok((
+        PyArray1::from_vec(py, switches.contact).unbind(),
+        PyArray1::from_vec(py, switches.t).unbind(),
+        PyArray1::from_vec(py, switches.closed).unbind(),
+        matrix(py, switches.q, n)?.unbind(),
+        matrix(py, switches.p, n)?.unbind(),
+    ))
+}
 
 /// Event crossings as arrays: the event's index (k,), t (k,), q and p (k, n), and the start of
 /// each one's step, q and p (k, n).
@@ -106,10 +130,11 @@ fn recorded<'py, T: numpy::Element>(py: Python<'py>, column: Vec<T>) -> Option<P
 }
 
 impl TrajectoryRecord {
-    pub fn new(py: Python<'_>, traj: Trajectory) -> PyResult<Self> {
+    pub fn new(py: Python<'_>, mut traj: Trajectory) -> PyResult<Self> {
         let n = traj.dim;
         let events = event_arrays(py, &traj.events, n)?;
         let grazing = traj.impacts.grazing;
+        let switches = switch_arrays(py, std::mem::take(&mut traj.impacts.switches), n)?;
         let impacts = impact_arrays(py, traj.impacts, n)?;
         Ok(TrajectoryRecord {
             t: PyArray1::from_vec(py, traj.t).unbind(),
@@ -123,6 +148,7 @@ impl TrajectoryRecord {
             events,
             terminated_by: traj.terminated_by,
             impacts,
+            switches,
             grazing,
         })
     }

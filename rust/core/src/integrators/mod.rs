@@ -65,7 +65,7 @@ pub use events::{Detector, EventFunctions, EventSpec, NativeEvent, Occurrence};
 pub use explicit_rk::ExplicitRk;
 pub use jumps::{
     impulsive, Blow, Contact, Contacts, Gaps, Generalized, Impacts, Impulse, Law, NativeContact, NativeSurface,
-    PointFunction, Schedule, Struck, Surface, Watch, Watcher, MAX_IMPACTS,
+    PointFunction, Schedule, Struck, Surface, Switches, Watch, Watcher, MAX_IMPACTS,
 };
 pub use kick_drift::KickDrift;
 pub use kind::ModelKind;

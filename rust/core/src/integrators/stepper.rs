@@ -215,6 +215,19 @@ where
         Ok(())
     }
 
+    /// One step on the clock, taken outside the method (the step of a held contact, which the
+    /// resolver takes), `poll` called before it when due as [`Stepper::advance`] calls it:
+    /// (q, p) are left for [`Stepper::jump_to`] to set.
+    pub(in crate::integrators) fn tick<P: Poll>(&mut self, poll: P) -> Result<(), Error> {
+        let state = self.state.borrow_mut();
+        state
+            .polled(1, poll, |state, _| {
+                state.steps += 1;
+                Ok(false)
+            })
+            .map(|_| ())
+    }
+
     /// Back to (q, p) one step before the last, after a step whose impacts could not be
     /// resolved: the run's last good state, restarted (carries and caches cleared).
     pub(in crate::integrators) fn rewind(&mut self, q: &[f64], p: &[f64]) -> Result<(), Error> {

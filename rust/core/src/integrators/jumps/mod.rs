@@ -8,7 +8,10 @@
 //!   [`Contacts`]: the set a run watches, checked once;
 //! - `resolve.rs`: a step that crosses a surface, redone in pieces at each contact;
 //!   `reflect.rs` and `variational.rs`: the laws that give the jump's multiplier λ;
-//! - [`Impacts`]: what a run reports of them ([`super::Trajectory::impacts`]);
+//! - `hold.rs`: a contact held closed (a body resting, sliding or rolling on it), by RATTLE on
+//!   the closed surfaces, until its multiplier crosses 0;
+//! - [`Impacts`]: what a run reports of them ([`super::Trajectory::impacts`]), with the
+//!   contacts' closures and releases ([`Switches`]);
 //! - [`Schedule`]: impulses ([`Impulse`], a [`Blow`] at a time) and samples (`t_eval`) at given
 //!   times, each splitting the step that holds it (`schedule.rs`);
 //! - [`Watch`]: the events, contacts and schedule a run or a stepper watches, and [`Watcher`],
@@ -17,6 +20,7 @@
 //!   response ([`impulsive::respond`]) and constraints that engage suddenly
 //!   ([`impulsive::engage`]).
 
+mod hold;
 pub mod impulsive;
 mod reflect;
 mod resolve;
@@ -187,7 +191,8 @@ impl<'s> Contacts<'s> {
 
     /// Whether a run of `method` on `model` from q (named `argument`: `q0`, or the checkpoint
     /// resumed) at time t can watch these contacts: each surface fits the model's coordinates, the
-    /// variational law fits the method and the model, and q lies in φ ≥ 0 for every contact.
+    /// variational law fits the method and the model, and q lies in φ ≥ 0 for every contact (on
+    /// the surface to round-off, [`on_surface`]).
     pub(in crate::integrators) fn check<S: Dynamics + ?Sized>(
         &self,
         model: &S,
@@ -202,18 +207,34 @@ impl<'s> Contacts<'s> {
                     return Err(c.refused(i, format!("the variational collision integrator {reason}")));
                 }
             }
-            let value = c.surface.phi(q).map_err(|source| Error::Model {
+            let model_error = |source| Error::Model {
                 step: 0,
                 time: t,
                 source,
-            })?;
-            if value.is_nan() || value < 0.0 {
+            };
+            let value = c.surface.phi(q).map_err(model_error)?;
+            if value.is_nan() || (value < 0.0 && value < -on_surface(c, q).map_err(model_error)?) {
                 let reason = format!("outside the contact {:?}: φ = {value} < 0", c.name);
                 return Err(Error::invalid(argument, reason));
             }
         }
         Ok(())
     }
+}
+
+/// How far from contact c's surface a state q on it lies at most, by round-off:
+/// 10³ε|∇φ(q)|∞ max(1, |q|∞). A held state's φ, solved to a few ε of q, lies well within; a
+/// run may start there (a point put on a curved surface in floating point).
+fn on_surface(c: &Contact<'_>, q: &[f64]) -> Result<f64, ModelError> {
+    let mut gradient = vec![0.0; q.len()];
+    c.surface.gradient(q, &mut gradient)?;
+    Ok(round_off(&gradient, q))
+}
+
+/// 10³ε|∇φ|∞ max(1, |q|∞), ∇φ at q given ([`on_surface`]).
+pub(super) fn round_off(gradient: &[f64], q: &[f64]) -> f64 {
+    let amax = |x: &[f64]| x.iter().fold(0.0_f64, |a, y| a.max(y.abs()));
+    1e3 * f64::EPSILON * amax(gradient) * amax(q).max(1.0)
 }
 
 /// The impacts of a run, in order of time, row by row: impact k on contact `contact[k]` during
@@ -231,6 +252,74 @@ pub struct Impacts {
     /// Impacts under the variational law that found no discrete-energy root near the reflection
     /// (grazing, |∇φ·q̇| of order h) and took Newton's law instead.
     pub grazing: usize,
+    /// The contacts' closures and releases.
+    pub switches: Switches,
+}
+
+/// The closures and releases of a run's contacts, in order of time: contact `contact[k]`
+/// closed (`closed[k]`) or released during step `step[k]`, at time `t[k]` and the state
+/// (`q_at(k)`, `p_at(k)`).
+///
+/// A contact closes at the impact that ends its bounces, when the rest of their Zeno series
+/// (flights 2v⁺/|a|, 2ev⁺/|a|, … under the normal acceleration a) sums to less than a step:
+/// t is then the series' limit t∞ = t_impact + 2v⁺/(|a|(1 − e)) and the state the impact's
+/// (the motion is held from the impact on). An arrival without normal velocity closes it at
+/// once. It is released at lift-off, where its multiplier λ crosses 0.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Switches {
+    pub contact: Vec<usize>,
+    pub step: Vec<usize>,
+    pub t: Vec<f64>,
+    pub closed: Vec<bool>,
+    pub q: Vec<f64>,
+    pub p: Vec<f64>,
+}
+
+impl Switches {
+    /// Adds a closure (`closed`) or release.
+    pub(in crate::integrators) fn push(
+        &mut self,
+        contact: usize,
+        step: usize,
+        t: f64,
+        closed: bool,
+        (q, p): (&[f64], &[f64]),
+    ) {
+        self.contact.push(contact);
+        self.step.push(step);
+        self.t.push(t);
+        self.closed.push(closed);
+        self.q.extend_from_slice(q);
+        self.p.extend_from_slice(p);
+    }
+
+    fn append(&mut self, other: &mut Switches) {
+        self.contact.append(&mut other.contact);
+        self.step.append(&mut other.step);
+        self.t.append(&mut other.t);
+        self.closed.append(&mut other.closed);
+        self.q.append(&mut other.q);
+        self.p.append(&mut other.p);
+    }
+
+    fn clear(&mut self) {
+        self.contact.clear();
+        self.step.clear();
+        self.t.clear();
+        self.closed.clear();
+        self.q.clear();
+        self.p.clear();
+    }
+
+    /// The number of closures and releases.
+    pub fn len(&self) -> usize {
+        self.t.len()
+    }
+
+    /// Whether there were none.
+    pub fn is_empty(&self) -> bool {
+        self.t.is_empty()
+    }
 }
 
 impl Impacts {
@@ -245,6 +334,7 @@ impl Impacts {
             p_before: Vec::with_capacity(rows * n),
             p_after: Vec::with_capacity(rows * n),
             grazing: 0,
+            switches: Switches::default(),
         }
     }
 
@@ -275,6 +365,7 @@ impl Impacts {
         self.p_before.append(&mut other.p_before);
         self.p_after.append(&mut other.p_after);
         self.grazing += std::mem::take(&mut other.grazing);
+        self.switches.append(&mut other.switches);
     }
 
     /// Forgets every impact, keeping the storage.
@@ -286,6 +377,7 @@ impl Impacts {
         self.p_before.clear();
         self.p_after.clear();
         self.grazing = 0;
+        self.switches.clear();
     }
 
     /// The number of impacts.

@@ -7,7 +7,10 @@
 use std::borrow::{Borrow, BorrowMut};
 use std::ops::Deref;
 
-use super::{reflect, variational, Contact, Contacts, Impacts, Law, NativeSurface, Schedule, Surface, MAX_IMPACTS};
+use super::hold::Hold;
+use super::{
+    reflect, round_off, variational, Contact, Contacts, Impacts, Law, NativeSurface, Schedule, Surface, MAX_IMPACTS,
+};
 use crate::integrators::events::Search;
 use crate::integrators::DiscreteEnergy;
 use crate::integrators::{Counting, Dynamics, Method, Occurrence, Poll, Stepper, StepperState, Trajectory};
@@ -79,6 +82,21 @@ pub(in crate::integrators) struct Resolver<'c, 's, M> {
     energy_jump: f64,
     /// The method's discrete energy, for the variational law.
     discrete: Option<DiscreteEnergy>,
+    /// The contacts held closed, in order (indices into `contacts`), and the held step (None
+    /// where the method or the model cannot hold one: a contact that would close then bounces
+    /// on until [`Error::Contact`]).
+    closed: Vec<usize>,
+    hold: Option<Hold>,
+    /// The closed set at the step's start, restored when the step fails.
+    closed_start: Vec<usize>,
+    /// The closed set at a sample's time, and the multipliers of a closed set.
+    closed_then: Vec<usize>,
+    lambda: Vec<f64>,
+    lambda_end: Vec<f64>,
+    /// The step's releases (their states, to start its samples from) and its changes of the
+    /// closed set in order, (time in the run, contact, closed), to undo back to a sample's time.
+    released: Impacts,
+    changes: Vec<(f64, usize, bool)>,
 }
 
 impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
@@ -97,6 +115,9 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
             schedule.fit(n)?;
         }
         let contacts = contacts.map_or(&[][..], |c| c.contacts());
+        // RATTLE on the closed surfaces alone: a model without forces or constraints of its own.
+        let constrained = model.constraint_counts() != (0, 0) || model.velocity_constraints().is_some();
+        let holds = !model.as_lagrangian().is_forced() && !constrained;
         let scratch = Stepper::resume(model, StepperState::clone(stepper))?;
         let m = contacts.len();
         let t0 = stepper.t();
@@ -129,9 +150,18 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
             discrete: (contacts.iter().any(|c| c.law == Law::Variational))
                 .then(|| DiscreteEnergy::new(stepper.method(), n))
                 .flatten(),
+            closed: Vec::with_capacity(m),
+            closed_start: Vec::with_capacity(m),
+            hold: (m > 0 && holds).then(|| Hold::new(stepper.method(), n, m)).flatten(),
+            closed_then: Vec::with_capacity(m),
+            lambda: vec![0.0; m],
+            lambda_end: vec![0.0; m],
+            released: Impacts::with_capacity(n, m),
+            changes: Vec::with_capacity(2 * m),
         };
         let (step, time) = (stepper.steps(), stepper.t());
         evaluate(contacts, stepper.q(), &mut resolver.phi, step, time)?;
+        resolver.close_resting((stepper.t(), stepper.q(), stepper.p()), step)?;
         Ok(resolver)
     }
 
@@ -177,7 +207,7 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
     ) -> Result<Option<usize>, Error> {
         let mut left = n;
         while left > 0 {
-            let free = if search.is_none() {
+            let free = if search.is_none() && self.closed.is_empty() {
                 self.free_steps(stepper, left)
             } else {
                 0
@@ -192,11 +222,18 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
             if let Some(search) = search.as_deref_mut() {
                 search.start_step(stepper);
             }
-            stepper.advance(1, Counting(|steps| poll.poll(steps)))?;
-            left -= 1;
             let first = traj.events.len();
-            evaluate(self.contacts, stepper.q(), &mut self.phi_end, stepper.steps(), self.t)?;
-            let crossed = crosses(&self.phi, &self.phi_end);
+            let crossed = if self.closed.is_empty() {
+                stepper.advance(1, Counting(|steps| poll.poll(steps)))?;
+                evaluate(self.contacts, stepper.q(), &mut self.phi_end, stepper.steps(), self.t)?;
+                crosses(&self.phi, &self.phi_end)
+            } else {
+                // A held step, which the resolver takes: the step on the clock, its state set
+                // at its end (`resolve`).
+                stepper.tick(Counting(|steps| poll.poll(steps)))?;
+                true
+            };
+            left -= 1;
             self.settle(stepper, crossed, search.as_deref_mut(), traj, first)?;
             if let Some(stop) = search.as_deref_mut().and_then(|s| s.count(&mut traj.events, first)) {
                 return Ok(Some(stop));
@@ -285,8 +322,11 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
             match self.resolve(stepper, search.as_deref_mut(), &mut traj.events) {
                 Ok(resolved) => resolved,
                 Err(error) => {
-                    // The run ends at the step's start, with none of the step's events.
+                    // The run ends at the step's start, with none of the step's events, and
+                    // the contacts closed there.
                     traj.events.truncate(first);
+                    self.closed.clear();
+                    self.closed.extend_from_slice(&self.closed_start);
                     stepper.rewind(&self.q, &self.p)?;
                     return Err(error);
                 }
@@ -359,6 +399,8 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
             self.contact_q.copy_from_slice(stepper.q());
             self.contact_p.copy_from_slice(stepper.p());
             self.blow(self.next_impulse, step, t)?;
+            self.after_jump(step, t)?;
+            traj.impacts.switches.append(&mut self.pending.switches);
             if !self.sampling() {
                 traj.push_state(t, &self.contact_q, &self.contact_p, stepper);
                 traj.push_state(t, &self.contact_q, &self.piece_p, stepper);
@@ -416,16 +458,18 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
                 traj.push_state(ts, stepper.q(), stepper.p(), stepper);
                 continue;
             }
-            // The last jump before ts, of the impacts and of the impulses.
+            // The last jump or release before ts (an impact before an impulse at its time).
             let last = |jumps: &Impacts| jumps.t.iter().rposition(|&t| t < ts).map(|k| (jumps.t[k], k));
-            let from = match (last(&self.pending), last(&self.blown)) {
-                (Some((ta, i)), Some((tb, _))) if ta >= tb => Some((&self.pending, i)),
-                (_, Some((_, k))) => Some((&self.blown, k)),
-                (Some((_, i)), None) => Some((&self.pending, i)),
-                (None, None) => None,
-            };
+            let mut from: Option<(&Impacts, usize, f64)> = None;
+            for jumps in [&self.pending, &self.released, &self.blown] {
+                if let Some((t, k)) = last(jumps) {
+                    if from.is_none_or(|(_, _, t0)| t > t0) {
+                        from = Some((jumps, k, t));
+                    }
+                }
+            }
             let ta = match from {
-                Some((jumps, k)) => {
+                Some((jumps, k, _)) => {
                     self.piece_q.copy_from_slice(jumps.q_at(k));
                     self.piece_p.copy_from_slice(jumps.p_after_at(k));
                     jumps.t[k]
@@ -436,7 +480,20 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
                     self.t
                 }
             };
-            self.partial(step, ta, ts - ta)?;
+            // The contacts closed at ts: the step's changes from ts on undone.
+            self.closed_then.clear();
+            self.closed_then.extend_from_slice(&self.closed);
+            for &(_, k, closed) in self.changes.iter().rev().take_while(|c| c.0 >= ts) {
+                if closed {
+                    self.closed_then.retain(|&j| j != k);
+                } else {
+                    insert(&mut self.closed_then, k);
+                }
+            }
+            std::mem::swap(&mut self.closed, &mut self.closed_then);
+            let sampled = self.partial(step, ta, ts - ta);
+            std::mem::swap(&mut self.closed, &mut self.closed_then);
+            sampled?;
             traj.push_state(ts, self.scratch.q(), self.scratch.p(), stepper);
         }
         Ok(())
@@ -444,8 +501,10 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
 
     /// The step just taken by `stepper` from the kept start, redone in pieces: false (nothing
     /// changed) when its first piece on the scratch stepper crosses no contact after all
-    /// (round-off at a grazing end) and holds no impulse; true with the stepper set to the
-    /// step's end state and its impacts in `pending`, its impulses in `blown`.
+    /// (round-off at a grazing end), holds no impulse and no contact was held; true with the
+    /// stepper set to the step's end state and its impacts in `pending`, its impulses in
+    /// `blown`. A held step (some contact closed) is always redone: its pieces are the held
+    /// steps of [`Hold`], each ended early at a lift-off.
     fn resolve<St: BorrowMut<StepperState>>(
         &mut self,
         stepper: &mut Stepper<M, St>,
@@ -455,31 +514,46 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
         let (step, h, t_end) = (stepper.steps(), stepper.dt(), stepper.t());
         let (contacts, time) = (self.contacts, self.t);
         let contact_error = |reason: String| Error::Contact { step, time, reason };
+        let held = !self.closed.is_empty();
         self.piece_q.copy_from_slice(&self.q);
         self.piece_p.copy_from_slice(&self.p);
         self.phi_start.copy_from_slice(&self.phi);
         self.pending.clear();
         self.blown.clear();
+        self.released.clear();
+        self.changes.clear();
+        self.closed_start.clear();
+        self.closed_start.extend_from_slice(&self.closed);
         let (mut ta, mut tau, mut last) = (self.t, h, None);
         loop {
-            // The piece to the next impulse inside the step, or to the step's end, and the
-            // first contact it crosses.
+            if search.is_some() && !self.closed.is_empty() {
+                return Err(contact_error(
+                    "events are not located on the motion of a held contact yet: run without events while a body \
+                     rests or slides on a contact (its closures and releases are reported with its impacts)"
+                        .into(),
+                ));
+            }
+            // The piece to the next impulse inside the step, or to the step's end, the first
+            // contact it crosses and the first held contact it releases.
             let inside = self.impulse_inside(t_end);
             let piece = inside.map_or(tau, |t| t - ta);
             self.partial(step, ta, piece)?;
             evaluate(contacts, self.scratch.q(), &mut self.phi_end, step, self.t)?;
+            let release = self.lift_off(step, (ta, piece))?;
             let mut first: Option<(f64, usize)> = None;
             for (j, contact) in contacts.iter().enumerate() {
                 let leaving = last == Some(j) || self.phi_start[j] <= 0.0;
-                if !below(self.phi_end[j] - floor(self.phi_start[j], leaving), leaving) {
+                if self.closed.contains(&j) || !below(self.phi_end[j] - floor(self.phi_start[j], leaving), leaving) {
                     continue;
                 }
                 let s = self.locate(j, step, (ta, piece), leaving).map_err(|e| match e {
                     Located::Error(e) => e,
                     Located::Resting => contact_error(format!(
                         "a body leaving the contact {} crosses it again at once (a resting or grazing contact, \
-                         such as e = 0 under a force pressing on it), which impacts cannot resolve",
-                        contact.name
+                         such as e = 0 under a force pressing on it), which impacts cannot resolve; {} hold such \
+                         a contact closed on a model without forces or constraints of its own",
+                        contact.name,
+                        Hold::methods()
                     )),
                 })?;
                 if let Some(s) = s {
@@ -487,6 +561,20 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
                         first = Some((s, j));
                     }
                 }
+            }
+            if let Some((s, k)) = release.filter(|&(s, _)| first.is_none_or(|(s0, _)| s < s0)) {
+                // Lift-off: the state there, the contact open from there on.
+                self.partial(step, ta, s)?;
+                self.contact_q.copy_from_slice(self.scratch.q());
+                self.contact_p.copy_from_slice(self.scratch.p());
+                self.piece_p.copy_from_slice(self.scratch.p());
+                let t = ta + s;
+                self.open(k, step, t);
+                self.released
+                    .push(k, step, t, &self.contact_q, &self.contact_p, &self.contact_p);
+                self.restart_piece(step, None, t)?;
+                (ta, tau, last) = (t, tau - s, Some(k));
+                continue;
             }
             let (s, j) = match (first, inside) {
                 (Some(first), _) => first,
@@ -499,6 +587,7 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
                     }
                     let k = self.next_impulse;
                     self.blow(k, step, t_blow)?;
+                    self.after_jump(step, t_blow)?;
                     self.blown
                         .push(k, step, t_blow, &self.contact_q, &self.contact_p, &self.piece_p);
                     self.next_impulse += 1;
@@ -506,14 +595,20 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
                     (ta, tau, last) = (t_blow, tau - piece, None);
                     continue;
                 }
-                (None, None) if self.pending.is_empty() && self.blown.is_empty() => return Ok(false),
+                (None, None)
+                    if !held && self.pending.is_empty() && self.blown.is_empty() && self.changes.is_empty() =>
+                {
+                    return Ok(false)
+                }
                 // The last piece ends the step: the scratch holds its end.
                 (None, None) => break,
             };
             if self.pending.len() == MAX_IMPACTS {
                 return Err(contact_error(format!(
                     "more than {MAX_IMPACTS} impacts in one step (an accumulation of impacts, as of a body \
-                     coming to rest on a surface); shorten the step or stop the run before"
+                     coming to rest on a surface); shorten the step or stop the run before, or hold the contact \
+                     ({} on a model without forces or constraints of its own, with e < 1)",
+                    Hold::methods()
                 )));
             }
             // The contact state (q̃, p⁻), the end of this piece.
@@ -525,7 +620,8 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
                 search.piece(step, (t_contact, &self.contact_q, &self.contact_p), s, occurrences)?;
             }
             let contact = &contacts[j];
-            self.jump(j, step, (ta, s, tau - s))?;
+            self.jump(j, step, (ta, s, tau - s), h)?;
+            self.after_jump(step, t_contact)?;
             if !self.piece_p.iter().all(|x| x.is_finite()) {
                 return Err(contact_error(format!(
                     "a non-finite state after the impact on {} at t = {t_contact}",
@@ -546,6 +642,162 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
         Ok(true)
     }
 
+    /// The first lift-off in the piece of size τ from ta, with the scratch at its end: among
+    /// the closed contacts whose multiplier λ is negative there, the earliest s where λ crosses
+    /// 0 along the held partial steps (Illinois, to round-off), and the contact. None when
+    /// every λ ≥ 0 at the piece's end.
+    fn lift_off(&mut self, step: usize, (ta, tau): (f64, f64)) -> Result<Option<(f64, usize)>, Error> {
+        let m = self.closed.len();
+        if m == 0 {
+            return Ok(None);
+        }
+        let mut lambda = std::mem::take(&mut self.lambda_end);
+        self.multipliers(ta + tau, &mut lambda, step)?;
+        let mut first: Option<(f64, usize)> = None;
+        for (a, &end) in lambda.iter().enumerate().take(m) {
+            if end >= 0.0 {
+                continue;
+            }
+            let at_start = self.lambda_along(a, step, ta, 0.0)?;
+            let s = if at_start <= 0.0 {
+                0.0
+            } else {
+                let tolerance = 4.0 * f64::EPSILON * tau;
+                illinois(
+                    |s| self.lambda_along(a, step, ta, s),
+                    (0.0, at_start),
+                    (tau, end),
+                    tolerance,
+                )?
+                .0
+            };
+            if first.is_none_or(|(s0, _)| s < s0) {
+                first = Some((s, self.closed[a]));
+            }
+        }
+        self.lambda_end = lambda;
+        Ok(first)
+    }
+
+    /// λ of the a-th closed contact at the end of the held partial step of size s from the
+    /// piece's start.
+    fn lambda_along(&mut self, a: usize, step: usize, ta: f64, s: f64) -> Result<f64, Error> {
+        self.partial(step, ta, s)?;
+        let mut lambda = std::mem::take(&mut self.lambda);
+        let result = self.multipliers(ta + s, &mut lambda, step);
+        let value = lambda[a];
+        self.lambda = lambda;
+        result.map(|()| value)
+    }
+
+    /// λ of the closed contacts at the scratch's state, at time t, into `out`.
+    fn multipliers(&mut self, t: f64, out: &mut [f64], step: usize) -> Result<(), Error> {
+        let time = self.t;
+        let Resolver {
+            hold,
+            scratch,
+            contacts,
+            closed,
+            ..
+        } = self;
+        let hold = hold.as_mut().expect("a contact closes only where it can be held");
+        let state = (scratch.q(), scratch.p(), t);
+        hold.multipliers(scratch.model().as_lagrangian(), (contacts, closed), state, out)
+            .map_err(|source| Error::Model { step, time, source })
+    }
+
+    /// Contact k released at time t, at the state (`contact_q`, `piece_p`): at lift-off, or
+    /// just after a jump that moves the body off its surface.
+    fn open(&mut self, k: usize, step: usize, t: f64) {
+        self.closed.retain(|&j| j != k);
+        self.changes.push((t, k, false));
+        self.pending
+            .switches
+            .push(k, step, t, false, (&self.contact_q, &self.piece_p));
+    }
+
+    /// After a jump at time t to (q̃, p⁺) (`contact_q`, `piece_p`) with contacts closed: those
+    /// the jump moves off their surface released, and p⁺ made tangent to the others (their
+    /// impulse, which keeps a body on a surface it presses on).
+    fn after_jump(&mut self, step: usize, t: f64) -> Result<(), Error> {
+        if self.closed.is_empty() {
+            return Ok(());
+        }
+        let time = self.t;
+        let model_error = |source| Error::Model { step, time, source };
+        self.scratch
+            .model()
+            .as_lagrangian()
+            .velocity(&self.contact_q, &self.piece_p, t, &mut self.v)
+            .map_err(model_error)?;
+        let speed = amax(&self.v);
+        let mut a = 0;
+        while a < self.closed.len() {
+            let k = self.closed[a];
+            self.contacts[k]
+                .surface
+                .gradient(&self.contact_q, &mut self.normal)
+                .map_err(model_error)?;
+            let normal_velocity = dot(&self.normal, &self.v);
+            if normal_velocity > 1e3 * f64::EPSILON * amax(&self.normal) * speed {
+                self.open(k, step, t);
+            } else {
+                a += 1;
+            }
+        }
+        if self.closed.is_empty() {
+            return Ok(());
+        }
+        let hold = self.hold.as_mut().expect("a contact closes only where it can be held");
+        hold.q.copy_from_slice(&self.contact_q);
+        hold.p.copy_from_slice(&self.piece_p);
+        let model = self.scratch.model().as_lagrangian();
+        hold.project(model, (self.contacts, &self.closed), t)
+            .map_err(model_error)?;
+        self.piece_p.copy_from_slice(&hold.p);
+        Ok(())
+    }
+
+    /// The contacts a body rests on at the state (t, q, p), closed: on the surface to
+    /// round-off (|φ| and the normal velocity's reach in a step, |∇φ·q̇|h, within
+    /// [`round_off`]) and pressing on it (λ ≥ 0). A run's held states are such, so a run
+    /// resumed holds what it held.
+    fn close_resting(&mut self, (t, q, p): (f64, &[f64], &[f64]), step: usize) -> Result<(), Error> {
+        if self.hold.is_none() {
+            return Ok(());
+        }
+        let model_error = |source| Error::Model { step, time: t, source };
+        let h = self.scratch.dt();
+        self.scratch
+            .model()
+            .as_lagrangian()
+            .velocity(q, p, t, &mut self.v)
+            .map_err(model_error)?;
+        for j in 0..self.contacts.len() {
+            self.contacts[j]
+                .surface
+                .gradient(q, &mut self.normal)
+                .map_err(model_error)?;
+            let tolerance = round_off(&self.normal, q);
+            let reach = dot(&self.normal, &self.v) * h;
+            if self.phi[j].abs() > tolerance || reach.abs() > tolerance {
+                continue;
+            }
+            self.closed.push(j);
+            self.scratch.restart(t, q, p, h);
+            let mut lambda = std::mem::take(&mut self.lambda);
+            let pressed = self
+                .multipliers(t, &mut lambda, step)
+                .map(|()| lambda[self.closed.len() - 1] >= 0.0);
+            self.lambda = lambda;
+            self.closed.pop();
+            if pressed? {
+                self.closed.push(j);
+            }
+        }
+        Ok(())
+    }
+
     /// The next piece from the jump at t, (q̃, p⁺) in the contact and piece buffers: its start
     /// kept, φ and the events evaluated there.
     fn restart_piece(&mut self, step: usize, search: Option<&mut Search<'_, '_, M>>, t: f64) -> Result<(), Error> {
@@ -557,8 +809,9 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
     }
 
     /// The jump on contact j at (q̃, p⁻) (the contact buffers), at the end of the piece of size s
-    /// from ta with `rest` of the step after it: p⁺ into `piece_p`.
-    fn jump(&mut self, j: usize, step: usize, (ta, s, rest): (f64, f64, f64)) -> Result<(), Error> {
+    /// from ta with `rest` of the step after it: p⁺ into `piece_p`. The contact closes there
+    /// ([`Resolver::closes`]) when the rest of its bounces would last less than the step h.
+    fn jump(&mut self, j: usize, step: usize, (ta, s, rest): (f64, f64, f64), h: f64) -> Result<(), Error> {
         let contacts = self.contacts;
         let contact = &contacts[j];
         let (t, time) = (ta + s, self.t);
@@ -588,8 +841,9 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
             vectors,
         )
         .map_err(model_error)?;
-        // For e < 1 both laws take Newton's law, the reflection.
-        let lambda = if contact.law == Law::Variational && contact.restitution == 1.0 && rest > 0.0 {
+        // For e < 1, and beside a held contact, both laws take Newton's law, the reflection.
+        let variational = contact.law == Law::Variational && contact.restitution == 1.0 && self.closed.is_empty();
+        let lambda = if variational && rest > 0.0 {
             let (lambda, found) = self.variational(step, (ta, s, rest), reflection)?;
             self.pending.grazing += usize::from(!found);
             lambda
@@ -599,7 +853,68 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
         for (x, (a, b)) in self.piece_p.iter_mut().zip(self.contact_p.iter().zip(&self.normal)) {
             *x = a + lambda * b;
         }
+        if let Some(t_rest) = self.closes(j, step, t, (reflection, h))? {
+            insert(&mut self.closed, j);
+            self.changes.push((t, j, true));
+            self.pending
+                .switches
+                .push(j, step, t_rest, true, (&self.contact_q, &self.piece_p));
+        }
         self.energy_change(step, t)
+    }
+
+    /// Whether contact j closes at its impact at time t, reflected with the multiplier
+    /// `reflection` (the normal, ∇φ, in `normal`): the body pressing on the surface once its
+    /// normal velocity is gone (λ > 0), and the Zeno series of the rebounds, flights of
+    /// 2v⁺/|a|, 2ev⁺/|a|, … under the normal acceleration a = −λ∇φᵀM⁻¹∇φ, summing to
+    /// T∞ = 2v⁺/(|a|(1 − e)) ≤ h (at once for v⁺ = 0). Then the momenta lose their normal
+    /// velocity (`piece_p`: the reflection with e = 0) and the contact is held from t: the
+    /// series' limit t + T∞, when the body comes to rest on the surface, is returned.
+    fn closes(&mut self, j: usize, step: usize, t: f64, (reflection, h): (f64, f64)) -> Result<Option<f64>, Error> {
+        let e = self.contacts[j].restitution;
+        // Elastic contacts close only on an arrival without normal velocity.
+        if self.hold.is_none() || (e == 1.0 && reflection != 0.0) {
+            return Ok(None);
+        }
+        let time = self.t;
+        let model_error = |source| Error::Model { step, time, source };
+        // p with the normal velocity gone, λ/(1 + e) along ∇φ; v⁺ = −e∇φ·q̇⁻ = eλ nᵀM⁻¹n/(1 + e).
+        for (x, (a, b)) in self.w.iter_mut().zip(self.contact_p.iter().zip(&self.normal)) {
+            *x = a + reflection / (1.0 + e) * b;
+        }
+        let model = self.scratch.model().as_lagrangian();
+        model
+            .velocity(&self.contact_q, &self.normal, t, &mut self.v)
+            .map_err(model_error)?;
+        let metric_plus = dot(&self.normal, &self.v);
+        model
+            .velocity(&self.contact_q, &self.zeros, t, &mut self.v)
+            .map_err(model_error)?;
+        let metric = metric_plus - dot(&self.normal, &self.v);
+        let rebound = e * reflection * metric / (1.0 + e);
+        insert(&mut self.closed, j);
+        let a = self.closed.iter().position(|&k| k == j).expect("just inserted");
+        self.scratch.restart(t, &self.contact_q, &self.w, h);
+        let mut lambda = std::mem::take(&mut self.lambda);
+        let pressed = self.multipliers(t, &mut lambda, step).map(|()| lambda[a]);
+        self.lambda = lambda;
+        self.closed.retain(|&k| k != j);
+        let pressed = pressed?;
+        if pressed.is_nan() || pressed <= 0.0 {
+            return Ok(None);
+        }
+        let tail = if rebound == 0.0 {
+            0.0
+        } else if e < 1.0 {
+            2.0 * rebound / (pressed * metric * (1.0 - e))
+        } else {
+            return Ok(None);
+        };
+        if tail.is_nan() || tail > h {
+            return Ok(None);
+        }
+        self.piece_p.copy_from_slice(&self.w);
+        Ok(Some(t + tail))
     }
 
     /// The change of energy at the jump at time t from (q̃, p⁻) (the contact buffers) to p⁺
@@ -745,6 +1060,23 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
     /// The scratch stepper at the end of the method's step of size s (0: none) from the
     /// piece's start at ta; an error names the run's step and its start.
     fn partial(&mut self, step: usize, ta: f64, s: f64) -> Result<(), Error> {
+        if let (Some(hold), false) = (self.hold.as_mut(), self.closed.is_empty() || s == 0.0) {
+            // The held step, its end set on the scratch as a free piece's would be.
+            let model = self.scratch.model().as_lagrangian();
+            hold.step(
+                model,
+                (self.contacts, &self.closed),
+                (ta, s),
+                (&self.piece_q, &self.piece_p),
+            )
+            .map_err(|source| Error::Model {
+                step,
+                time: self.t,
+                source,
+            })?;
+            self.scratch.restart(ta + s, &hold.q, &hold.p, s);
+            return Ok(());
+        }
         self.scratch
             .restart(ta, &self.piece_q, &self.piece_p, if s > 0.0 { s } else { 1.0 });
         if s > 0.0 {
@@ -872,4 +1204,19 @@ impl Gaps<'_, '_> {
         self.swapped = !self.swapped;
         true
     }
+}
+
+/// Inserts contact k into the ordered set `closed`.
+fn insert(closed: &mut Vec<usize>, k: usize) {
+    if let Err(at) = closed.binary_search(&k) {
+        closed.insert(at, k);
+    }
+}
+
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
+}
+
+fn amax(x: &[f64]) -> f64 {
+    x.iter().fold(0.0_f64, |a, y| a.max(y.abs()))
 }

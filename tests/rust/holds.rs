@@ -1,0 +1,222 @@
+//! Contacts that hold: a ball with e < 1 bouncing to rest at the limit of its Zeno series and
+//! then resting with λ = mg; a particle sliding from rest near the top of a smooth sphere, held on
+//! it until it leaves where cos θ = (2/3)cos θ₀, located at the method's order; a run resumed from
+//! a held state bit for bit; and a method that cannot hold a contact still ending an
+//! accumulation of impacts with `Error::Contact`.
+
+use nalgebra::DMatrix;
+use varmech::integrators::{
+    integrate_watching, resume_watching, Checkpoint, Contact, Contacts, Dynamics, Law, Method, NativeSurface, Options,
+    Trajectory,
+};
+use varmech::model::{Mass, MechanicalSystem, Reaction};
+use varmech::scenes::BouncingBall;
+use varmech::{Error, ModelError};
+
+use crate::impacts::{drop_ball, floor, with_contacts};
+
+const G: f64 = 9.81;
+
+/// A unit mass in the plane under gravity, V = g y.
+struct Particle(Mass);
+
+impl MechanicalSystem for Particle {
+    fn dim(&self) -> usize {
+        2
+    }
+
+    fn mass(&self) -> &Mass {
+        &self.0
+    }
+
+    fn potential(&self, q: &[f64]) -> Result<f64, ModelError> {
+        Ok(G * q[1])
+    }
+
+    fn gradient(&self, _q: &[f64], grad: &mut [f64]) -> Result<(), ModelError> {
+        (grad[0], grad[1]) = (0.0, G);
+        Ok(())
+    }
+}
+
+fn particle() -> Particle {
+    Particle(Mass::scalar(1.0).unwrap())
+}
+
+/// The outside of the unit circle, |q| ≥ 1 (a native ellipsoid, outside).
+fn sphere() -> Contacts<'static> {
+    let contact = Contact {
+        surface: Box::new(NativeSurface::Ellipsoid {
+            coordinates: vec![0, 1],
+            centre: vec![0.0, 0.0],
+            semi_axes: vec![1.0, 1.0],
+            inside: false,
+        }),
+        restitution: 0.0,
+        law: Law::Reflect,
+        name: "sphere".into(),
+    };
+    Contacts::new(vec![contact]).unwrap()
+}
+
+/// λ of the contact φ at a saved state of `traj` on `model`, ∇φ given.
+fn multiplier<S: Dynamics>(model: &S, traj: &Trajectory, k: usize, gradient: fn(&[f64]) -> Vec<f64>) -> f64 {
+    let n = traj.dim;
+    let rows = |q: &[f64], c: &mut DMatrix<f64>, b: &mut [f64]| -> Result<(), ModelError> {
+        b.fill(0.0);
+        for (i, g) in gradient(q).into_iter().enumerate() {
+            c[(0, i)] = g;
+        }
+        Ok(())
+    };
+    let mut reaction = Reaction::new(n, 1);
+    reaction
+        .solve(model.as_lagrangian(), &rows, (traj.q_at(k), traj.p_at(k), traj.t[k]))
+        .unwrap();
+    reaction.multipliers[0]
+}
+
+#[test]
+fn a_ball_with_e_below_1_comes_to_rest_at_the_zeno_limit_and_rests_with_lambda_mg() {
+    // Dropped from rest at h₀ = 1: the first impact at t₁ = √(2h₀/g), the rebounds' flights
+    // 2eᵏt₁ summing to t∞ = t₁(1 + e)/(1 − e).
+    let ball = BouncingBall::new(G).unwrap();
+    let e = 0.5;
+    let t_rest = (2.0 / G).sqrt() * (1.0 + e) / (1.0 - e);
+    for dt in [1e-3, 1e-2, 0.1] {
+        let contacts = floor(e, Law::Reflect);
+        let options = Options::new(dt, (3.0 / dt) as usize);
+        let traj = drop_ball(&options, with_contacts(&contacts)).unwrap();
+        let switches = &traj.impacts.switches;
+        assert_eq!(switches.len(), 1, "dt = {dt}: {:?}", switches.t);
+        assert!(switches.closed[0]);
+        // Verlet is exact on the parabolas and the impacts are located to round-off.
+        assert!(
+            (switches.t[0] - t_rest).abs() <= 1e-12,
+            "dt = {dt}: {} against {t_rest}",
+            switches.t[0]
+        );
+        // The contact closes at the impact whose rebounds last less than a step.
+        let last = *traj.impacts.t.last().unwrap();
+        assert!(t_rest - last <= dt, "dt = {dt}: closed at {last}");
+        assert_eq!(traj.impacts.p_after.last(), Some(&0.0));
+        // Resting from there: on the floor, at rest, pressed with λ = mg.
+        let resting: Vec<usize> = (0..traj.len()).filter(|&k| traj.t[k] > last).collect();
+        assert!(resting.len() >= 2, "dt = {dt}");
+        for &k in &resting {
+            assert!(traj.q_at(k)[0].abs() <= 1e-15, "dt = {dt}: q = {:?}", traj.q_at(k));
+            assert!(traj.p_at(k)[0].abs() <= 1e-15, "dt = {dt}: p = {:?}", traj.p_at(k));
+            let lambda = multiplier(&ball, &traj, k, |_| vec![1.0]);
+            assert!((lambda - G).abs() <= 1e-9 * G, "dt = {dt}: λ = {lambda}");
+        }
+        assert_eq!(traj.steps, options.steps);
+    }
+}
+
+#[test]
+fn a_method_that_cannot_hold_a_contact_ends_an_accumulation_of_impacts_with_a_contact_error() {
+    let ball = BouncingBall::new(G).unwrap();
+    let contacts = floor(0.5, Law::Reflect);
+    let options = Options::new(0.01, 300);
+    let failure = integrate_watching(
+        &ball,
+        Method::Rk4,
+        &[1.0],
+        &[0.0],
+        &options,
+        || Ok(()),
+        with_contacts(&contacts),
+    )
+    .unwrap_err();
+    let Error::Contact { time, ref reason, .. } = failure.error else {
+        panic!("{}", failure.error)
+    };
+    assert!(reason.contains("verlet and its compositions"), "{reason}");
+    assert!((time - 1.35).abs() < 0.05, "{}", failure.error);
+    assert!(failure.partial.impacts.switches.is_empty());
+}
+
+/// cos θ where the particle, from rest at θ₀ from the top of the unit sphere, leaves it with
+/// `method` and step h: the lift-off's state, its radius checked at 1.
+fn leaving(method: Method, theta0: f64, h: f64) -> f64 {
+    let model = particle();
+    let contacts = sphere();
+    let (mut q0, p0) = ([theta0.sin(), theta0.cos()], [0.0, 0.0]);
+    // On the surface to round-off, not inside it.
+    while q0[0] * q0[0] + q0[1] * q0[1] < 1.0 {
+        q0 = q0.map(|x| x * (1.0 + f64::EPSILON));
+    }
+    let options = Options::new(h, (1.5 / h) as usize);
+    let traj = integrate_watching(&model, method, &q0, &p0, &options, || Ok(()), with_contacts(&contacts)).unwrap();
+    let switches = &traj.impacts.switches;
+    assert!(
+        !switches.is_empty() && !switches.closed[0],
+        "{method:?}, h = {h}: {:?}",
+        switches.t
+    );
+    let q = &switches.q[..2];
+    let radius = q[0].hypot(q[1]);
+    assert!((radius - 1.0).abs() <= 1e-13, "{method:?}, h = {h}: |q| = {radius}");
+    // Held on the sphere up to there.
+    for k in (0..traj.len()).filter(|&k| traj.t[k] <= switches.t[0]) {
+        let (x, y) = (traj.q_at(k)[0], traj.q_at(k)[1]);
+        assert!(
+            (x.hypot(y) - 1.0).abs() <= 1e-13,
+            "{method:?}, h = {h}: |q| = {}",
+            x.hypot(y)
+        );
+    }
+    q[1] / radius
+}
+
+#[test]
+fn a_particle_sliding_on_a_smooth_sphere_leaves_it_where_cos_theta_is_two_thirds_of_cos_theta0_at_the_methods_order() {
+    let theta0 = 0.3_f64;
+    let exact = 2.0 / 3.0 * theta0.cos();
+    for (method, order, h) in [(Method::Verlet, 2.0, 0.01), (Method::Yoshida4, 4.0, 0.04)] {
+        let errors: Vec<f64> = [h, h / 2.0, h / 4.0]
+            .iter()
+            .map(|&h| (leaving(method, theta0, h) - exact).abs())
+            .collect();
+        let measured: Vec<f64> = errors.windows(2).map(|w| (w[0] / w[1]).log2()).collect();
+        for m in &measured {
+            assert!(
+                (m - order).abs() <= 0.25,
+                "{method:?}: orders {measured:?}, errors {errors:?}"
+            );
+        }
+    }
+}
+
+#[test]
+fn a_run_resumed_from_a_held_state_is_the_whole_run_bit_for_bit() {
+    let model = particle();
+    let contacts = sphere();
+    let (q0, p0) = ([0.0, 1.0], [0.3, 0.0]);
+    let whole = Options::new(0.01, 150);
+    let first = Options {
+        steps: 40,
+        ..whole.clone()
+    };
+    let run = |options: &Options| {
+        integrate_watching(
+            &model,
+            Method::Verlet,
+            &q0,
+            &p0,
+            options,
+            || Ok(()),
+            with_contacts(&contacts),
+        )
+        .unwrap()
+    };
+    let (all, part) = (run(&whole), run(&first));
+    // Held at the join, released after it.
+    assert!(part.impacts.switches.is_empty());
+    assert_eq!(all.impacts.switches.closed, vec![false]);
+    let checkpoint = Checkpoint::from_bytes(&part.checkpoint).unwrap();
+    let rest = resume_watching(&model, checkpoint, 110, 1, || Ok(()), with_contacts(&contacts)).unwrap();
+    assert_eq!(rest.impacts.switches, all.impacts.switches);
+    assert_eq!(&all.q[all.q.len() - rest.q.len()..], &rest.q[..]);
+    assert_eq!(&all.p[all.p.len() - rest.p.len()..], &rest.p[..]);
+}
