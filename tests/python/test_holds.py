@@ -1,0 +1,142 @@
+"""Contacts that hold (issue 34): a body resting, sliding or swinging on a contact is held on it
+by RATTLE while the contact pushes, and released where its multiplier crosses 0.
+
+- a particle sliding from rest near the top of a smooth sphere leaves it where
+  cos θ = (2/3)cos θ₀, at the method's order, and then flies as a projectile;
+- a pendulum on a string whirled too slowly goes slack where cos θ = (2gl − v₀²)/(3gl), flies
+  on the parabola and is caught by the string again where the parabola meets the circle;
+- samples (``t_eval``), files and their resume, ensembles and steppers go through holds as
+  through impacts; events on a held contact's motion are refused with ContactError.
+"""
+
+import math
+
+import numpy as np
+import pytest
+from scipy.optimize import brentq
+
+import varmech
+
+G = 9.81
+
+
+def _particle() -> varmech.Model:
+    """A unit mass in the plane under gravity, V = g y."""
+    return varmech.MechanicalSystem(2, lambda q: G * q[1], lambda q: np.array([0.0, G]), name="particle")
+
+
+def _on_circle(theta: float, radius: float = 1.0) -> np.ndarray:
+    """(sin θ, cos θ)·r, nudged outwards onto the floating-point circle's outside."""
+    q = radius * np.array([math.sin(theta), math.cos(theta)])
+    while q @ q < radius * radius:
+        q *= 1 + np.finfo(float).eps
+    return q
+
+
+SPHERE = varmech.Contact.ellipsoid([1.0, 1.0], inside=False, restitution=0.0, law="reflect", name="sphere")
+
+
+def _leaves(method: str, dt: float, theta0: float = 0.3, **kwargs):
+    traj = varmech.integrate(_particle(), _on_circle(theta0), [0.0, 0.0], method=method, dt=dt, t_end=1.6, contacts=[SPHERE], **kwargs)
+    impacts, closed, released = traj.events
+    assert len(impacts) == len(closed) == 0 and len(released) == 1
+    return traj, released
+
+
+@pytest.mark.parametrize(("method", "order", "dt"), [("verlet", 2, 0.01), ("yoshida4", 4, 0.04)])
+def test_a_particle_leaves_a_smooth_sphere_where_cos_theta_is_two_thirds_of_cos_theta0_at_the_methods_order(method, order, dt):
+    theta0 = 0.3
+    exact = 2 / 3 * math.cos(theta0)
+    errors = []
+    for h in (dt, dt / 2, dt / 4):
+        traj, released = _leaves(method, h, theta0)
+        (x, y) = released.q[0]
+        assert abs(math.hypot(x, y) - 1) < 1e-13
+        errors.append(abs(y - exact))
+        # On the sphere up to lift-off (held: |q| = 1 to round-off), off it after.
+        radius = np.hypot(traj.q[:, 0], traj.q[:, 1])
+        on = traj.t <= released.t[0]
+        assert np.max(np.abs(radius[on] - 1)) < 1e-13 and np.all(radius[~on] > 1)
+        # No work is done by the smooth sphere: H is the method's, O(h^order).
+        energy = 0.5 * np.sum(traj.p**2, axis=1) + G * traj.q[:, 1]
+        assert np.max(np.abs(energy - G * math.cos(theta0))) < 50 * h**order
+    orders = np.log2(np.array(errors[:-1]) / np.array(errors[1:]))
+    assert np.all(np.abs(orders - order) < 0.25), (orders, errors)
+
+
+def test_samples_and_a_stepper_go_through_a_hold_and_its_release_as_the_run_does():
+    # t_eval off the grid: each sample the held (or, after lift-off, free) partial step from the
+    # last state before it, on the sphere to round-off while held.
+    times = np.linspace(0.0, 1.6, 97)
+    traj, released = _leaves("verlet", 0.01, t_eval=times)
+    assert np.array_equal(traj.t, times)
+    radius = np.hypot(traj.q[:, 0], traj.q[:, 1])
+    on = traj.t <= released.t[0]
+    assert np.max(np.abs(radius[on] - 1)) < 1e-13 and np.all(radius[~on] > 1)
+    whole, released = _leaves("verlet", 0.01)
+    stepper = varmech.Stepper(_particle(), _on_circle(0.3), [0.0, 0.0], dt=0.01, contacts=[SPHERE])
+    while stepper.steps < whole.steps:
+        stepper.advance(min(7, whole.steps - stepper.steps))
+        stepper = varmech.Stepper.from_checkpoint(_particle(), stepper.checkpoint(), contacts=[SPHERE])
+    assert np.array_equal(stepper.q, whole.q[-1]) and np.array_equal(stepper.p, whole.p[-1])
+
+
+def test_a_string_whirled_too_slowly_goes_slack_and_is_caught_again_where_the_parabola_meets_the_circle():
+    # The string |q| ≤ l as a contact that holds (e = 0: it catches the bob without rebound).
+    # From the bottom with v₀² = 3.5gl the bob rises past the horizontal and the tension
+    # m(v²/l + g cos θ), θ from the downward vertical, falls to 0 where v² = −gl cos θ:
+    # cos θ = (2gl − v₀²)/(3gl). It then flies on the parabola until |q| = l again.
+    length, v0 = 1.0, math.sqrt(3.5 * G)
+    string = varmech.Contact.ellipsoid([length, length], restitution=0.0, law="reflect", name="string")
+    q0 = np.array([0.0, -length])
+    traj = varmech.integrate(_particle(), q0, [v0, 0.0], method="yoshida4", dt=1e-3, t_end=1.6, contacts=[string])
+    impacts, closed, released = traj.events
+    assert len(released) == 1 and len(impacts) == 1 and len(closed) == 1
+    (x, y) = released.q[0]
+    cos_slack = (2 * G * length - v0**2) / (3 * G * length)
+    assert abs(-y / length - cos_slack) < 1e-9 and abs(math.hypot(x, y) - length) < 1e-13
+    # The flight: the parabola from the slack point, with the velocity there, meets the circle.
+    (vx, vy), t_slack = released.p[0], released.t[0]
+
+    def radius(s: float) -> float:
+        return math.hypot(x + vx * s, y + vy * s - G * s * s / 2) - length
+
+    flight = brentq(radius, 1e-3, 2.0, xtol=1e-15)
+    assert abs(impacts.t[0] - (t_slack + flight)) < 1e-9
+    np.testing.assert_allclose(impacts.q[0], [x + vx * flight, y + vy * flight - G * flight**2 / 2], atol=1e-9)
+    # Caught: the radial velocity lost (Carnot), the contact closed at once, held after.
+    assert closed.t[0] == impacts.t[0]
+    after = traj.t > impacts.t[0]
+    assert np.max(np.abs(np.hypot(traj.q[after, 0], traj.q[after, 1]) - length)) < 1e-13
+
+
+def test_an_ensemble_of_sliders_leaves_at_each_members_angle_bit_for_bit_its_single_runs():
+    thetas = np.array([0.1, 0.2, 0.3, 0.4])
+    q0 = np.array([_on_circle(t) for t in thetas])
+    p0 = np.zeros_like(q0)
+    runs = varmech.ensemble(_particle(), q0, p0, dt=0.01, t_end=1.5, contacts=[SPHERE], workers=2)
+    for k, member in enumerate(runs):
+        single = varmech.integrate(_particle(), q0[k], p0[k], dt=0.01, t_end=1.5, contacts=[SPHERE])
+        assert np.array_equal(member.q, single.q) and np.array_equal(member.p, single.p)
+        released = member.events[2]
+        assert len(released) == 1 and abs(released.q[0][1] - 2 / 3 * math.cos(thetas[k])) < 1e-3
+
+
+def test_events_on_a_held_contacts_motion_are_refused_with_a_contact_error():
+    with pytest.raises(varmech.ContactError, match="events are not located on the motion of a held contact"):
+        varmech.integrate(_particle(), _on_circle(0.3), [0.0, 0.0], dt=0.01, steps=10, contacts=[SPHERE], events=[varmech.events.crossing(0, 0.5)])
+
+
+def test_a_slider_streamed_to_a_file_and_resumed_is_one_run_with_its_release(tmp_path):
+    # Killed (here: stopped) while held on the sphere, resumed from the file's checkpoint: the
+    # held state is recognised as resting there, and the run goes on bit for bit, its release
+    # stored in the file with the impacts.
+    whole, released = _leaves("verlet", 0.01)
+    path = tmp_path / "slider.h5"
+    varmech.integrate(_particle(), _on_circle(0.3), [0.0, 0.0], dt=0.01, steps=40, contacts=[SPHERE], output=path, checkpoint_every=7)
+    resumed = varmech.resume(path, steps=whole.steps - 40, model=_particle())
+    for x, y in [(resumed.t, whole.t), (resumed.q, whole.q), (resumed.p, whole.p)]:
+        np.testing.assert_array_equal(x, y)
+    assert [o.name for o in resumed.events] == ["sphere", "sphere.closed", "sphere.released"]
+    np.testing.assert_array_equal(resumed.events[2].t, released.t)
+    np.testing.assert_array_equal(varmech.load(path, model=_particle()).events[2].q, released.q)
