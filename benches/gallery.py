@@ -7,7 +7,8 @@ docs/gallery/ (PNG) with its data (CSV).
 scene selects every chart of that kind). Needs the ``bench`` extra (matplotlib, scipy, rebound).
 Takes a few minutes; each chart's sweep shows a progress bar and Ctrl-C stops it. The impact
 chart (``--only impacts``) races a rival that is no library code, so benches/impacts.py draws it;
-benches/reactions.py draws the tension of a pendulum (``--only reactions``).
+benches/reactions.py draws the tension of a pendulum (``--only reactions``), benches/holds.py the
+particle leaving the sphere (``--figure``).
 """
 
 from __future__ import annotations

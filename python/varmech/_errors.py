@@ -158,9 +158,11 @@ _CONTACT_ERROR = """An impact could not be resolved: a non-finite state through 
     surface again at once after leaving it (a resting or grazing contact), or more than 64
     impacts in one step (an accumulation of impacts, as of a ball coming to rest).
 
-    Impacts model collisions, not resting contact: a ball with e < 1 bounces ever lower and
-    faster, and its impacts accumulate at a finite time; stop the run before it (a terminal
-    event) or model the resting phase as a constraint.
+    A ball with e < 1 bounces ever lower and faster, and its impacts accumulate at a finite
+    time. Under verlet and its compositions the contact then closes and holds the ball (see
+    :mod:`varmech.impacts`); other methods cannot hold it, and raise this error there: stop
+    the run before it (a terminal event), or take such a method. Events are not yet located on
+    a held contact's motion: a run with events raises this error when a contact closes.
 
     Attributes
     ----------
@@ -178,11 +180,14 @@ _CONTACT_ERROR = """An impact could not be resolved: a non-finite state through 
 
     Examples
     --------
-    A ball with e = 0.5 comes to rest on the floor at t = (1 + 2e/(1 − e))√(2h₀/g) ≈ 1.35:
+    A ball with e = 0.5 comes to rest on the floor at t = (1 + 2e/(1 − e))√(2h₀/g) ≈ 1.35;
+    rk4 cannot hold the floor:
 
-    >>> import varmech
+    >>> import numpy as np, varmech
+    >>> ball = varmech.MechanicalSystem(1, lambda q: 9.81 * q[0], lambda q: np.array([9.81]))
+    >>> floor = varmech.Contact.wall(0, restitution=0.5, law="reflect")
     >>> try:
-    ...     varmech.integrate(varmech.scenes.bouncing_ball(restitution=0.5), dt=0.01, t_end=2.0)
+    ...     varmech.integrate(ball, [1.0], [0.0], dt=0.01, t_end=2.0, contacts=[floor], method="rk4")
     ... except varmech.ContactError as err:
     ...     print(err.step, round(err.time, 2), len(err.partial.events[0]), err.partial.status)
     136 1.35 8 -1

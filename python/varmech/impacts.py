@@ -37,9 +37,14 @@ after each impact (one time, two rows).
 
 After a jump the rest of the step is checked against every contact: one crossed before its end
 (a corner, or a ball's next bounce within the step) is located on that piece and taken in turn,
-up to 64 impacts in one step. A body that cannot leave a surface (a resting contact: e = 0 under
-a force pressing it on, or a ball whose bounces accumulate) raises :class:`ContactError` with
-the step, the time and the run up to that step. A piece is checked at its end only: a contact
+up to 64 impacts in one step. A contact closes where a body comes to rest on it (the impact whose
+rebounds' Zeno series sums to less than a step, reported at the series' limit, or an arrival
+without normal velocity), is held by RATTLE while it pushes, composed as the run's method
+composes Verlet, and is released where its multiplier λ crosses 0 (lift-off); the closures
+(``"<name>.closed"``) and releases (``"<name>.released"``) follow the impacts in
+``traj.events``. Where the method cannot hold a contact (not a Verlet composition, or a model with
+forces or constraints of its own) a body that cannot leave a surface raises
+:class:`ContactError` with the step, the time and the run up to that step. A piece is checked at its end only: a contact
 entered and left again within one piece is missed, so steps must be short against the time a
 body spends beyond a curved surface's chord.
 """

@@ -8,8 +8,8 @@
 //!
 //! composed with the fractions γ of the run's method where it is Verlet or a composition of it
 //! (yoshida4, …): symplectic on the contact manifold at the method's order. The held state's
-//! multipliers λ are [`Reaction`]'s, with the closed surfaces' gradients as rows; a contact is
-//! released where its λ crosses 0.
+//! multipliers λ are those of [`crate::model::Reaction`] (the state's own), on the closed
+//! surfaces; a contact is released where its λ crosses 0.
 
 use std::cell::RefCell;
 
@@ -17,7 +17,7 @@ use nalgebra::DMatrix;
 
 use super::Contact;
 use crate::integrators::{Composition, Method};
-use crate::model::{Lagrangian, Reaction};
+use crate::model::Lagrangian;
 use crate::solve::lu::{lu_in_place, lu_solve};
 use crate::ModelError;
 
@@ -45,9 +45,12 @@ pub(super) struct Hold {
     systems: Vec<(DMatrix<f64>, Vec<usize>)>,
     c: Vec<f64>,
     r: Vec<f64>,
-    /// λ of a held state, the (m−1)-th for m closed contacts.
-    reactions: Vec<Reaction>,
     gradient: RefCell<Vec<f64>>,
+    /// The time t at which `force`, `normals` and `inverse` hold ∂L/∂q and the normals of the
+    /// contacts `cached_for` at `q` (the end of the last step, where the run checks λ and the
+    /// next step starts), if they do.
+    cached: Option<f64>,
+    cached_for: Vec<usize>,
 }
 
 impl Hold {
@@ -70,8 +73,9 @@ impl Hold {
             systems: (1..=contacts).map(|m| (DMatrix::zeros(m, m), vec![0; m])).collect(),
             c: vec![0.0; contacts],
             r: vec![0.0; contacts],
-            reactions: (1..=contacts).map(|m| Reaction::new(n, m)).collect(),
             gradient: RefCell::new(v()),
+            cached: None,
+            cached_for: Vec::with_capacity(contacts),
         })
     }
 
@@ -93,31 +97,54 @@ impl Hold {
         (t, tau): (f64, f64),
         (q, p): (&[f64], &[f64]),
     ) -> Result<(), ModelError> {
-        self.q.copy_from_slice(q);
+        // The last step's end, where the next starts: its force and normals are kept.
+        let mut warm = self.at(q, t, closed);
+        if !warm {
+            self.q.copy_from_slice(q);
+            model.dl_dq(&self.q, &self.zeros, t, &mut self.force)?;
+        }
         self.p.copy_from_slice(p);
-        model.dl_dq(&self.q, &self.zeros, t, &mut self.force)?;
+        self.cached = None;
         let mut time = t;
         for k in 0..self.gamma.len() {
             let s = self.gamma[k] * tau;
-            self.substep(model, (contacts, closed), time, s)?;
+            self.substep(model, (contacts, closed), (time, s), warm)?;
             time += s;
+            warm = true;
         }
+        self.cache(t + tau, closed);
         Ok(())
     }
 
-    /// One RATTLE step of size s from (q, p), with ∂L/∂q(q) in `force`, left at its end.
+    /// Whether `force`, `normals` and `inverse` are those of the `closed` contacts at (q, t): the
+    /// last step ended there.
+    fn at(&self, q: &[f64], t: f64, closed: &[usize]) -> bool {
+        self.cached == Some(t) && self.q == q && self.cached_for == closed
+    }
+
+    /// `force`, `normals` and `inverse` marked as those of the `closed` contacts at (q, t).
+    fn cache(&mut self, t: f64, closed: &[usize]) {
+        self.cached = Some(t);
+        self.cached_for.clear();
+        self.cached_for.extend_from_slice(closed);
+    }
+
+    /// One RATTLE step of size s from (q, p) at t, with ∂L/∂q(q) in `force` (and the
+    /// normals at q in `normals` and `inverse` if `warm`), left at its end.
     fn substep(
         &mut self,
         model: &dyn Lagrangian,
         (contacts, closed): (&[Contact<'_>], &[usize]),
-        t: f64,
-        s: f64,
+        (t, s): (f64, f64),
+        warm: bool,
     ) -> Result<(), ModelError> {
         let (n, m) = (self.q.len(), closed.len());
         for (x, f) in self.p.iter_mut().zip(&self.force) {
             *x += 0.5 * s * f;
         }
-        self.normals_at(model, (contacts, closed), t)?;
+        if !warm {
+            self.normals_at(model, (contacts, closed), t)?;
+        }
         // q₁(c) = q₀ + s(q̇(q₀, p½) + Σ cₖ M⁻¹∇φₖ(q₀)): Newton on Φ(q₁(c)) = 0.
         model.velocity(&self.q, &self.p, t, &mut self.v)?;
         self.start.copy_from_slice(&self.q);
@@ -184,6 +211,7 @@ impl Hold {
         t: f64,
     ) -> Result<(), ModelError> {
         let (n, m) = (self.q.len(), closed.len());
+        self.cached = None;
         self.normals_at(model, (contacts, closed), t)?;
         model.velocity(&self.q, &self.p, t, &mut self.v)?;
         let (system, pivots) = &mut self.systems[m - 1];
@@ -205,7 +233,8 @@ impl Hold {
         Ok(())
     }
 
-    /// ∇φₖ(q) and M⁻¹∇φₖ = q̇(q, ∇φₖ) − q̇(q, 0) of the closed contacts, at q.
+    /// ∇φₖ(q) and M⁻¹∇φₖ = q̇(q, ∇φₖ) of the closed contacts, at q (q̇ linear in p: the
+    /// kick–drift methods' models have T = ½pᵀM⁻¹p).
     fn normals_at(
         &mut self,
         model: &dyn Lagrangian,
@@ -213,19 +242,19 @@ impl Hold {
         t: f64,
     ) -> Result<(), ModelError> {
         let n = self.q.len();
-        model.velocity(&self.q, &self.zeros, t, &mut self.w)?;
         for (a, &j) in closed.iter().enumerate() {
             let normal = &mut self.normals[a * n..(a + 1) * n];
             contacts[j].surface.gradient(&self.q, normal)?;
-            let inverse = &mut self.inverse[a * n..(a + 1) * n];
-            model.velocity(&self.q, normal, t, inverse)?;
-            inverse.iter_mut().zip(&self.w).for_each(|(x, b)| *x -= b);
+            model.velocity(&self.q, normal, t, &mut self.inverse[a * n..(a + 1) * n])?;
         }
         Ok(())
     }
 
-    /// λ of the `closed` contacts at (q, p, t) ([`Reaction::solve`], their gradients the rows):
-    /// the k-th into `out[k]`.
+    /// λ of the `closed` contacts at (q, p, t): the k-th into `out[k]`. For the models a held
+    /// step integrates (H = ½pᵀM⁻¹p + V(q), M constant, no forces) [`Reaction::solve`]'s
+    /// equations read (∇Φ M⁻¹∇Φᵀ)λ = −(∇²φₖ[q̇, q̇] + ∇φₖ·M⁻¹∂L/∂q), and the curvature term is
+    /// a central difference of ∇φₖ·q̇ along q̇, exact for quadrics: two gradients a contact
+    /// instead of the general difference's four evaluations of the whole motion.
     pub(super) fn multipliers(
         &mut self,
         model: &dyn Lagrangian,
@@ -233,22 +262,44 @@ impl Hold {
         (q, p, t): (&[f64], &[f64], f64),
         out: &mut [f64],
     ) -> Result<(), ModelError> {
-        let m = closed.len();
-        let gradient = &self.gradient;
-        let rows = |q: &[f64], c: &mut DMatrix<f64>, b: &mut [f64]| -> Result<(), ModelError> {
-            b.fill(0.0);
-            let mut g = gradient.borrow_mut();
-            for (a, &j) in closed.iter().enumerate() {
-                contacts[j].surface.gradient(q, &mut g)?;
-                for (i, x) in g.iter().enumerate() {
-                    c[(a, i)] = *x;
+        let (n, m) = (q.len(), closed.len());
+        if !self.at(q, t, closed) {
+            self.q.copy_from_slice(q);
+            self.normals_at(model, (contacts, closed), t)?;
+            model.dl_dq(q, &self.zeros, t, &mut self.force)?;
+            self.cache(t, closed);
+        }
+        model.velocity(q, p, t, &mut self.v)?;
+        model.velocity(q, &self.force, t, &mut self.w)?;
+        let amax = |x: &[f64]| x.iter().fold(0.0_f64, |a, y| a.max(y.abs()));
+        let speed = amax(&self.v);
+        // The difference's step: truncation (s²) and rounding (ε/s) both near ε^(2/3).
+        let s = f64::EPSILON.cbrt() * amax(q).max(1.0) / speed;
+        let (system, pivots) = &mut self.systems[m - 1];
+        for (a, &j) in closed.iter().enumerate() {
+            let normal = &self.normals[a * n..(a + 1) * n];
+            let mut curvature = 0.0;
+            if speed > 0.0 {
+                let mut gradient = self.gradient.borrow_mut();
+                for sign in [1.0, -1.0] {
+                    for i in 0..n {
+                        self.start[i] = q[i] + sign * s * self.v[i];
+                    }
+                    contacts[j].surface.gradient(&self.start, &mut gradient)?;
+                    curvature += sign * gradient.iter().zip(&self.v).map(|(g, v)| g * v).sum::<f64>();
                 }
+                curvature /= 2.0 * s;
             }
-            Ok(())
-        };
-        let reaction = &mut self.reactions[m - 1];
-        reaction.solve(model, &rows, (q, p, t))?;
-        out[..m].copy_from_slice(&reaction.multipliers);
+            out[a] = -(curvature + normal.iter().zip(&self.w).map(|(g, x)| g * x).sum::<f64>());
+            for b in 0..m {
+                let w = &self.inverse[b * n..(b + 1) * n];
+                system[(a, b)] = normal.iter().zip(w).map(|(g, w)| g * w).sum();
+            }
+        }
+        if lu_in_place(system, pivots).is_none() {
+            return Err("the held contacts' surfaces are not independent here".into());
+        }
+        lu_solve(system, pivots, &mut out[..m]);
         Ok(())
     }
 }
