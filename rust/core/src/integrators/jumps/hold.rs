@@ -282,8 +282,8 @@ impl Hold {
             if speed > 0.0 {
                 let mut gradient = self.gradient.borrow_mut();
                 for sign in [1.0, -1.0] {
-                    for (x, (a, v)) in self.start.iter_mut().zip(q.iter().zip(&self.v)) {
-                        *x = a + sign * s * v;
+                    for (x, (qi, vi)) in self.start.iter_mut().zip(q.iter().zip(&self.v)) {
+                        *x = qi + sign * s * vi;
                     }
                     contacts[j].surface.gradient(&self.start, &mut gradient)?;
                     curvature += sign * gradient.iter().zip(&self.v).map(|(g, v)| g * v).sum::<f64>();
