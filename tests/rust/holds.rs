@@ -6,14 +6,13 @@
 
 use nalgebra::DMatrix;
 use varmech::integrators::{
-    integrate_watching, resume_watching, Checkpoint, Contact, Contacts, Dynamics, Law, Method, NativeSurface, Options,
-    Trajectory,
+    integrate_watching, Contact, Contacts, Dynamics, Law, Method, NativeSurface, Options, Trajectory,
 };
 use varmech::model::{Mass, MechanicalSystem, Reaction};
 use varmech::scenes::BouncingBall;
 use varmech::{Error, ModelError};
 
-use crate::impacts::{drop_ball, floor, with_contacts};
+use crate::impacts::{drop_ball, floor, split_run, with_contacts};
 
 const G: f64 = 9.81;
 
@@ -192,30 +191,10 @@ fn a_particle_sliding_on_a_smooth_sphere_leaves_it_where_cos_theta_is_two_thirds
 fn a_run_resumed_from_a_held_state_is_the_whole_run_bit_for_bit() {
     let model = particle();
     let contacts = sphere();
-    let (q0, p0) = ([0.0, 1.0], [0.3, 0.0]);
-    let whole = Options::new(0.01, 150);
-    let first = Options {
-        steps: 40,
-        ..whole.clone()
-    };
-    let run = |options: &Options| {
-        integrate_watching(
-            &model,
-            Method::Verlet,
-            &q0,
-            &p0,
-            options,
-            || Ok(()),
-            with_contacts(&contacts),
-        )
-        .unwrap()
-    };
-    let (all, part) = (run(&whole), run(&first));
+    let [all, part, rest] = split_run(&model, &contacts, (&[0.0, 1.0], &[0.3, 0.0]), (0.01, 150, 40, 1));
     // Held at the join, released after it.
     assert!(part.impacts.switches.is_empty());
     assert_eq!(all.impacts.switches.closed, vec![false]);
-    let checkpoint = Checkpoint::from_bytes(&part.checkpoint).unwrap();
-    let rest = resume_watching(&model, checkpoint, 110, 1, || Ok(()), with_contacts(&contacts)).unwrap();
     assert_eq!(rest.impacts.switches, all.impacts.switches);
     assert_eq!(&all.q[all.q.len() - rest.q.len()..], &rest.q[..]);
     assert_eq!(&all.p[all.p.len() - rest.p.len()..], &rest.p[..]);

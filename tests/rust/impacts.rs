@@ -261,34 +261,52 @@ fn events_are_located_on_the_pieces_of_a_step_with_an_impact() {
     assert!(on_pieces >= 4, "{on_pieces} events in steps with an impact");
 }
 
+/// The run of `steps` steps of h with verlet from `start` watching `contacts` (saving every
+/// `save_every`-th state), the run of its `first` steps, and that one resumed from its checkpoint
+/// for the rest.
+pub(crate) fn split_run<S: Dynamics>(
+    model: &S,
+    contacts: &Contacts<'static>,
+    (q0, p0): (&[f64], &[f64]),
+    (h, steps, first, save_every): (f64, usize, usize, usize),
+) -> [Trajectory; 3] {
+    let whole = Options {
+        save_every,
+        ..Options::new(h, steps)
+    };
+    let run = |steps: usize| {
+        let options = Options { steps, ..whole.clone() };
+        integrate_watching(
+            model,
+            Method::Verlet,
+            q0,
+            p0,
+            &options,
+            || Ok(()),
+            with_contacts(contacts),
+        )
+        .unwrap()
+    };
+    let (all, part) = (run(steps), run(first));
+    let checkpoint = Checkpoint::from_bytes(&part.checkpoint).unwrap();
+    let rest = resume_watching(
+        model,
+        checkpoint,
+        steps - first,
+        save_every,
+        || Ok(()),
+        with_contacts(contacts),
+    )
+    .unwrap();
+    [all, part, rest]
+}
+
 #[test]
 fn a_resumed_run_with_its_contacts_is_the_whole_run_bit_for_bit() {
     let free = EllipticBilliard::new(1.0, 1.0).unwrap();
     let contacts = circle(1.0, Law::Reflect);
-    let (q0, p0) = ([0.3, -0.2], [0.6, 0.8]);
-    let whole = Options {
-        save_every: 10,
-        ..Options::new(0.01, 3000)
-    };
-    let first = Options {
-        steps: 1234,
-        ..whole.clone()
-    };
-    let run = |options: &Options| {
-        integrate_watching(
-            &free,
-            Method::Verlet,
-            &q0,
-            &p0,
-            options,
-            || Ok(()),
-            with_contacts(&contacts),
-        )
-        .unwrap()
-    };
-    let (all, part) = (run(&whole), run(&first));
-    let checkpoint = Checkpoint::from_bytes(&part.checkpoint).unwrap();
-    let rest = resume_watching(&free, checkpoint, 3000 - 1234, 10, || Ok(()), with_contacts(&contacts)).unwrap();
+    let start = ([0.3, -0.2], [0.6, 0.8]);
+    let [all, part, rest] = split_run(&free, &contacts, (&start.0, &start.1), (0.01, 3000, 1234, 10));
     assert!(part.impacts.len() >= 5 && rest.impacts.len() >= 5);
     assert_eq!(rest.steps, 3000);
     // The impacts of the two runs are the whole run's, and so are the states saved after the join.
