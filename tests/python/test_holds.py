@@ -73,6 +73,18 @@ def test_samples_and_a_stepper_go_through_a_hold_and_its_release_as_the_run_does
     radius = np.hypot(traj.q[:, 0], traj.q[:, 1])
     on = traj.t <= released.t[0]
     assert np.max(np.abs(radius[on] - 1)) < 1e-13 and np.all(radius[~on] > 1)
+    # A spring across the flight (V = gy + x²/2: no parabola, which a partial step of any size
+    # would follow exactly): each sample after lift-off is the partial step from its own step's
+    # start, within O(h²) of the states saved at every step around it.
+    spring = varmech.MechanicalSystem(2, lambda q: G * q[1] + q[0] ** 2 / 2, lambda q: np.array([q[0], G]), name="spring")
+    off_grid = np.arange(0.005, 1.6, 0.01)
+    sampled = varmech.integrate(spring, _on_circle(0.3), [0.0, 0.0], dt=0.01, t_end=1.6, contacts=[SPHERE], t_eval=off_grid)
+    saved = varmech.integrate(spring, _on_circle(0.3), [0.0, 0.0], dt=0.01, t_end=1.6, contacts=[SPHERE])
+    after = off_grid > sampled.events[2].t[0] + 0.01
+    for k in np.flatnonzero(after):
+        row = np.searchsorted(saved.t, off_grid[k])
+        midpoint = (saved.q[row - 1] + saved.q[row]) / 2
+        assert np.max(np.abs(sampled.q[k] - midpoint)) < 2.5e-4, (off_grid[k], sampled.q[k], midpoint)
     whole, released = _leaves("verlet", 0.01)
     stepper = varmech.Stepper(_particle(), _on_circle(0.3), [0.0, 0.0], dt=0.01, contacts=[SPHERE])
     while stepper.steps < whole.steps:

@@ -378,6 +378,8 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
             }
         }
         self.blown.clear();
+        self.released.clear();
+        self.changes.clear();
         traj.impacts.append(&mut self.pending);
     }
 
