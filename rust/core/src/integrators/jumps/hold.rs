@@ -11,8 +11,6 @@
 //! multipliers λ are those of [`crate::model::Reaction`] (the state's own), on the closed
 //! surfaces; a contact is released where its λ crosses 0.
 
-use std::cell::RefCell;
-
 use nalgebra::DMatrix;
 
 use super::Contact;
@@ -45,7 +43,7 @@ pub(super) struct Hold {
     systems: Vec<(DMatrix<f64>, Vec<usize>)>,
     c: Vec<f64>,
     r: Vec<f64>,
-    gradient: RefCell<Vec<f64>>,
+    gradient: Vec<f64>,
     /// The time t at which `force`, `normals` and `inverse` hold ∂L/∂q and the normals of the
     /// contacts `cached_for` at `q` (the end of the last step, where the run checks λ and the
     /// next step starts), if they do.
@@ -73,7 +71,7 @@ impl Hold {
             systems: (1..=contacts).map(|m| (DMatrix::zeros(m, m), vec![0; m])).collect(),
             c: vec![0.0; contacts],
             r: vec![0.0; contacts],
-            gradient: RefCell::new(v()),
+            gradient: v(),
             cached: None,
             cached_for: Vec::with_capacity(contacts),
         })
@@ -159,11 +157,10 @@ impl Hold {
             let (system, pivots) = &mut self.systems[m - 1];
             for (a, &j) in closed.iter().enumerate() {
                 let contact = &contacts[j];
-                let mut gradient = self.gradient.borrow_mut();
-                contact.surface.gradient(&self.q, &mut gradient)?;
+                contact.surface.gradient(&self.q, &mut self.gradient)?;
                 for b in 0..m {
                     let w = &self.inverse[b * n..(b + 1) * n];
-                    system[(a, b)] = s * gradient.iter().zip(w).map(|(g, w)| g * w).sum::<f64>();
+                    system[(a, b)] = s * self.gradient.iter().zip(w).map(|(g, w)| g * w).sum::<f64>();
                 }
                 self.r[a] = -contact.surface.phi(&self.q)?;
             }
@@ -280,13 +277,12 @@ impl Hold {
             let normal = &self.normals[a * n..(a + 1) * n];
             let mut curvature = 0.0;
             if speed > 0.0 {
-                let mut gradient = self.gradient.borrow_mut();
                 for sign in [1.0, -1.0] {
                     for (x, (qi, vi)) in self.start.iter_mut().zip(q.iter().zip(&self.v)) {
                         *x = qi + sign * s * vi;
                     }
-                    contacts[j].surface.gradient(&self.start, &mut gradient)?;
-                    curvature += sign * gradient.iter().zip(&self.v).map(|(g, v)| g * v).sum::<f64>();
+                    contacts[j].surface.gradient(&self.start, &mut self.gradient)?;
+                    curvature += sign * self.gradient.iter().zip(&self.v).map(|(g, v)| g * v).sum::<f64>();
                 }
                 curvature /= 2.0 * s;
             }
