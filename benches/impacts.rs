@@ -28,6 +28,7 @@ fn table(radius: f64, law: Law) -> Contacts<'static> {
         }),
         restitution: 1.0,
         law,
+        friction: None,
         name: "table".into(),
     };
     Contacts::new(vec![contact]).unwrap()

@@ -43,7 +43,7 @@ from .conservation import ConservationReport, InvariantStatistics, check_conserv
 from .constraints import IntegrableConstraintsWarning, project
 from .derivatives import DerivativeCheck, check_derivatives
 from .ensemble import Ensemble, EnsembleConservation, ensemble
-from .impacts import Contact, ContactError
+from .impacts import Contact, ContactError, Friction
 from .impulses import Engagement, Impulse, ImpulseResponse, engage, impulse_response
 from .integrate import integrate, symplecticity_defect
 from .methods import MethodInfo, methods
@@ -65,6 +65,7 @@ __all__ = [
     "Engagement",
     "Ensemble",
     "EnsembleConservation",
+    "Friction",
     "Impulse",
     "ImpulseResponse",
     "IntegrableConstraintsWarning",

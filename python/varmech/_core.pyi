@@ -139,7 +139,7 @@ class TrajectoryRecord:
         """The impacts on the run's contacts in order of time: the contact's index (k,), t (k,),
         the contact configuration q and the momenta just before and just after (k, n)."""
     @property
-    def switches(self) -> tuple[NDArray[np.uint64], _FloatArray, NDArray[np.bool_], _FloatArray, _FloatArray]:
+    def switches(self) -> tuple[NDArray[np.uint64], _FloatArray, NDArray[np.uint8], _FloatArray, _FloatArray]:
         """The contacts' closures and releases in order of time: the contact's index (k,), t (k,),
         whether it closed (k,), q and p (k, n)."""
     @property
@@ -165,7 +165,7 @@ class Stepper:
         compensated: bool = True,
         newton_tolerance: float = 1e-14,
         newton_max_iterations: int = 50,
-        contacts: list[tuple[str, float, str, str, Any]] | None = None,
+        contacts: list[tuple[str, float, str, str, Any, Any]] | None = None,
         impulses: list[tuple[float, str, Any]] | None = None,
         events: list[tuple[str, int, int, str, Any]] | None = None,
     ) -> Stepper: ...
@@ -178,7 +178,7 @@ class Stepper:
         *,
         method: str | None = None,
         dt: float | None = None,
-        contacts: list[tuple[str, float, str, str, Any]] | None = None,
+        contacts: list[tuple[str, float, str, str, Any, Any]] | None = None,
         impulses: list[tuple[float, str, Any]] | None = None,
         events: list[tuple[str, int, int, str, Any]] | None = None,
     ) -> Stepper:
@@ -221,7 +221,7 @@ class Stepper:
         """The impacts gone through since the start or the last reset, as a run's record has them:
         the contact's index (k,), t (k,), q, p before and p after (k, n)."""
     @property
-    def switches(self) -> tuple[NDArray[np.uint64], _FloatArray, NDArray[np.bool_], _FloatArray, _FloatArray]:
+    def switches(self) -> tuple[NDArray[np.uint64], _FloatArray, NDArray[np.uint8], _FloatArray, _FloatArray]:
         """The contacts' closures and releases since the start or the last reset, as a run's
         record has them: the contact's index (k,), t (k,), closed (k,), q and p (k, n)."""
     @property
@@ -577,7 +577,7 @@ def ensemble(
     chunk_size: int | None = None,
     progress: Callable[[int], object] | None = None,
     events: list[tuple[str, int, int, str, Any]] | None = None,
-    contacts: list[tuple[str, float, str, str, Any]] | None = None,
+    contacts: list[tuple[str, float, str, str, Any, Any]] | None = None,
     impulses: list[tuple[float, str, Any]] | None = None,
     t_eval: _FloatArray | list[float] | None = None,
 ) -> tuple[list[tuple[TrajectoryRecord, BaseException | None]], BaseException | None]:
@@ -604,7 +604,7 @@ def integrate(
     newton_max_iterations: int = 50,
     progress: Callable[[int], object] | None = None,
     events: list[tuple[str, int, int, str, Any]] | None = None,
-    contacts: list[tuple[str, float, str, str, Any]] | None = None,
+    contacts: list[tuple[str, float, str, str, Any, Any]] | None = None,
     impulses: list[tuple[float, str, Any]] | None = None,
     t_eval: _FloatArray | list[float] | None = None,
 ) -> TrajectoryRecord:
@@ -632,7 +632,7 @@ def resume(
     events: list[tuple[str, int, int, str, Any]] | None = None,
     method: str | None = None,
     dt: float | None = None,
-    contacts: list[tuple[str, float, str, str, Any]] | None = None,
+    contacts: list[tuple[str, float, str, str, Any, Any]] | None = None,
     impulses: list[tuple[float, str, Any]] | None = None,
     t_eval: _FloatArray | list[float] | None = None,
 ) -> TrajectoryRecord:

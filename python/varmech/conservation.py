@@ -17,6 +17,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from . import _core
+from . import impacts as _impacts
 from ._util import returned
 from .integrate import integrate
 from .model import Cyclic, Generator, Model, Rotation, Translation
@@ -491,13 +492,15 @@ def check_conservation(traj: Trajectory, generators: Sequence[Generator] | None 
     t, steps = np.asarray(traj.t), int(traj.steps)
     energy = balance = None
     affine = bool(model.velocity_constraints) and model.affine
+    # Forces that do work: the model's own, or the friction of its contacts.
+    forced = model.forced or _impacts.frictional(traj.contacts)
     if not model.time_dependent and not affine:
-        stats = energy_statistics(model, t, *traj._arrays()[1:], steps=steps, work=np.asarray(traj.work) if model.forced else None)
+        stats = energy_statistics(model, t, *traj._arrays()[1:], steps=steps, work=np.asarray(traj.work) if forced else None)
         if stats.verdict == "failed":
             stats = replace(stats, advice=f"{stats.advice}; {_failure_advice(traj)}")
-        elif model.forced and stats.verdict == "secular drift" and refine:
+        elif forced and stats.verdict == "secular drift" and refine:
             stats = _refined(traj, stats)
-        energy, balance = (None, stats) if model.forced else (stats, None)
+        energy, balance = (None, stats) if forced else (stats, None)
     else:
         # Not conserved, so not judged; but a non-finite energy fails the run all the same.
         stats = energy_statistics(model, t, *traj._arrays()[1:], steps=steps)

@@ -42,7 +42,10 @@ rebounds' Zeno series sums to less than a step, reported at the series' limit, o
 without normal velocity), is held by RATTLE while it pushes, composed as the run's method
 composes Verlet, and is released where its multiplier λ crosses 0 (lift-off); the closures
 (``"<name>.closed"``) and releases (``"<name>.released"``) follow the impacts in
-``traj.events``. Where the method cannot hold a contact (not a Verlet composition, or a model with
+``traj.events``. A held contact with :class:`Friction` slides under the force μ_k N against its
+slip and sticks where its slip stops and the force that holds it is within μ_s N (N = λ|∇φ|),
+each switch located to round-off (``"<name>.stuck"``, ``"<name>.slipped"``); the work of the
+sliding force is ``traj.work``. Where the method cannot hold a contact (not a Verlet composition, or a model with
 forces or constraints of its own) a body that cannot leave a surface raises
 :class:`ContactError` with the step, the time and the run up to that step. A piece is checked at its end only: a contact
 entered and left again within one piece is missed, so steps must be short against the time a
@@ -66,7 +69,91 @@ from ._util import floats, integer, number
 from .events import Occurrences
 
 #: The public API; the rest serves :func:`varmech.integrate`.
-__all__ = ["Contact", "ContactError"]
+__all__ = ["Contact", "ContactError", "Friction"]
+
+#: The kinds of a contact's switches, by the code the core reports them with.
+SWITCHES = ("closed", "released", "stuck", "slipped")
+
+
+@dataclass(frozen=True)
+class Friction:
+    """Coulomb friction on a held contact: the force μ_k N against the slip of the contact point
+    while it slides, and none needed beyond μ_s N while it sticks (N = λ|∇φ|, the normal force of
+    the contact's multiplier: φ written as a distance makes N the force itself).
+
+    The slip is s = J q̇, the velocity of the contact point along the surface. For a particle's
+    own coordinates (n = 2 or 3) J is the tangent plane of ∇φ and need not be given; a body that
+    turns gives its rows (``slip``). A sliding contact sticks where its slip comes to rest and the
+    force that holds it there is within μ_s N (a block stopping on a slope, a ball that starts to
+    roll), and a stuck one slips where that force reaches μ_s N; both are located to round-off
+    on the held steps, and reported as ``"<name>.stuck"`` and ``"<name>.slipped"`` in
+    ``traj.events``. The work of the sliding force is ``traj.work`` (the discrete
+    Lagrange–d'Alembert work ½(F₀ + F₁)·(q₁ − q₀) a step), which
+    :func:`varmech.check_conservation` balances against the energy.
+
+    Friction acts on held contacts, so it needs a method that holds one (verlet and its
+    compositions) and a model without forces or constraints of its own.
+
+    Attributes
+    ----------
+    mu_s : float
+        The static coefficient μ_s ≥ μ_k.
+    mu_k : float, optional
+        The kinetic coefficient μ_k ≥ 0 (default μ_s).
+    slip : array_like, shape (k, n), optional
+        The slip's rows J, constant: s = J q̇ (default: a particle's tangent plane, n = 2 or 3).
+
+    Raises
+    ------
+    ValueError
+        A coefficient negative or not finite, ``mu_s`` < ``mu_k``, or ``slip`` not a
+        non-empty finite matrix.
+
+    Examples
+    --------
+    A block at rest on a slope of 30° stays for μ_s ≥ tan 30° and slides down at
+    g(sin α − μ_k cos α) otherwise.
+
+    >>> import numpy as np, varmech
+    >>> g, a = 9.81, np.radians(30)
+    >>> block = varmech.MechanicalSystem(2, lambda q: g * q[1], lambda q: np.array([0.0, g]))
+    >>> def slope(mu):
+    ...     plane = varmech.Contact(lambda q: q[1] * np.cos(a) - q[0] * np.sin(a),
+    ...                             lambda q: np.array([-np.sin(a), np.cos(a)]), name="slope",
+    ...                             restitution=0.0, law="reflect", friction=varmech.Friction(mu, 0.8 * mu))
+    ...     return varmech.integrate(block, [0.0, 0.0], [0.0, 0.0], dt=0.01, steps=100, contacts=[plane])
+    >>> bool(np.all(slope(0.6).q == 0.0))
+    True
+    >>> down = slope(0.3).q[-1] @ [-np.cos(a), -np.sin(a)]
+    >>> bool(abs(down - 0.5 * g * (np.sin(a) - 0.24 * np.cos(a))) < 1e-12)
+    True
+    """
+
+    mu_s: float
+    mu_k: float | None = None
+    slip: Any = None
+
+    def __post_init__(self) -> None:
+        mu_s = number("mu_s", self.mu_s)
+        mu_k = mu_s if self.mu_k is None else number("mu_k", self.mu_k)
+        if not (np.isfinite(mu_k) and mu_k >= 0.0):
+            raise ValueError(f"mu_k: must be a finite number ≥ 0, got {self.mu_k!r}")
+        if not (np.isfinite(mu_s) and mu_s >= mu_k):
+            raise ValueError(f"mu_s: must be finite and at least mu_k = {mu_k:g} (static friction holds what sliding does), got {self.mu_s!r}")
+        object.__setattr__(self, "mu_s", mu_s)
+        object.__setattr__(self, "mu_k", mu_k)
+        if self.slip is not None:
+            rows = np.array(floats("slip", self.slip), dtype=float)
+            if rows.ndim == 1:
+                rows = rows[None, :]
+            if rows.ndim != 2 or rows.size == 0 or not np.all(np.isfinite(rows)):
+                raise ValueError(f"slip: must be a finite (k, n) matrix, the rows J of the contact point's slip s = J q̇, got {rows.tolist()}")
+            object.__setattr__(self, "slip", tuple(tuple(float(x) for x in row) for row in rows))
+
+    def spec(self) -> tuple[float, float, tuple[int, list[float]] | None]:
+        """The binding's tuple: μ_s, μ_k and the slip rows (their number and entries), if given."""
+        slip = None if self.slip is None else (len(self.slip), [x for row in self.slip for x in row])
+        return (float(self.mu_s), float(self.mu_k if self.mu_k is not None else self.mu_s), slip)
 
 
 @dataclass(frozen=True)
@@ -95,11 +182,15 @@ class Contact:
         kick–drift methods, the two-point rules ``midpoint`` and ``trapezoid`` and the Galerkin
         rules ``galerkin4`` and ``galerkin6``, elastic contacts only), or the exact reflection of the momenta between the method's partial
         steps (any method; symplectic across an impact only to the method's order).
+    friction : Friction, optional
+        Coulomb friction while the contact is held (see :class:`Friction`).
 
     Raises
     ------
     ValueError
         ``restitution`` not in [0, 1], or an unknown ``law``.
+    TypeError
+        ``friction`` not a :class:`Friction`.
 
     See Also
     --------
@@ -131,12 +222,16 @@ class Contact:
     #: ``"reflect"``, the exact reflection of the momenta between the method's partial steps (any
     #: method; symplectic across an impact only to the method's order).
     law: Literal["variational", "reflect"] = "variational"
+    #: Coulomb friction while the contact is held, if any.
+    friction: Friction | None = None
 
     def __post_init__(self) -> None:
         if not (isinstance(self.restitution, (int, float)) and 0.0 <= float(self.restitution) <= 1.0):
             raise ValueError(f"restitution: must lie in [0, 1], got {self.restitution!r}")
         if self.law not in ("variational", "reflect"):
             raise ValueError(f"law: 'variational' or 'reflect', got {self.law!r}")
+        if self.friction is not None and not isinstance(self.friction, Friction):
+            raise TypeError(f"friction: expected a varmech.Friction, got {type(self.friction).__name__}")
 
     @classmethod
     def wall(
@@ -147,6 +242,7 @@ class Contact:
         restitution: float = 1.0,
         name: str | None = None,
         law: Literal["variational", "reflect"] = "variational",
+        friction: Friction | None = None,
     ) -> Contact:
         """The wall q_k ≥ ``value`` (a floor, a side of a box): φ = q_k − value, watched in the
         core (the native ``crossing`` event), with no Python call per step; φ and ∇φ are
@@ -164,6 +260,8 @@ class Contact:
             The contact's name (default ``"q[k] ≥ value"``).
         law : {"variational", "reflect"}, default "variational"
             The impact law (see :class:`Contact`).
+        friction : Friction, optional
+            Coulomb friction while the contact is held (see :class:`Friction`).
 
         Returns
         -------
@@ -187,7 +285,7 @@ class Contact:
 
         surface = _surfaces.Wall(integer("k", k), number("value", value))
         label = name if name is not None else f"q[{k}] ≥ {value:g}"
-        return cls(surface, _surfaces.Gradient(surface), restitution, label, law)
+        return cls(surface, _surfaces.Gradient(surface), restitution, label, law, friction)
 
     @classmethod
     def ellipsoid(
@@ -200,6 +298,7 @@ class Contact:
         restitution: float = 1.0,
         name: str | None = None,
         law: Literal["variational", "reflect"] = "variational",
+        friction: Friction | None = None,
     ) -> Contact:
         """The ellipsoid Σᵢ ((q_{kᵢ} − cᵢ)/aᵢ)² ≤ 1 in the ``coordinates`` kᵢ (default the first
         len(semi_axes)) about the ``centre`` c (default the origin), with ``semi_axes`` a:
@@ -226,6 +325,8 @@ class Contact:
             The contact's name (default ``"ellipsoid"`` or ``"outside an ellipsoid"``).
         law : {"variational", "reflect"}, default "variational"
             The impact law (see :class:`Contact`).
+        friction : Friction, optional
+            Coulomb friction while the contact is held (see :class:`Friction`).
 
         Returns
         -------
@@ -256,12 +357,13 @@ class Contact:
         c = (0.0,) * len(ks) if centre is None else tuple(float(x) for x in np.atleast_1d(floats("centre", centre)))
         surface = _surfaces.Ellipsoid(ks, c, axes, bool(inside))
         label = name if name is not None else ("ellipsoid" if inside else "outside an ellipsoid")
-        return cls(surface, _surfaces.Gradient(surface), restitution, label, law)
+        return cls(surface, _surfaces.Gradient(surface), restitution, label, law, friction)
 
 
-#: A contact as the binding takes it: (name, restitution, law, kind, payload), the kind and
-#: payload a native surface's (``Surface.native``) or ``("functions", (phi, gradient))``.
-Spec = tuple[str, float, str, str, Any]
+#: A contact as the binding takes it: (name, restitution, law, kind, payload, friction), the kind
+#: and payload a native surface's (``Surface.native``) or ``("functions", (phi, gradient))``, the
+#: friction ``Friction.spec()`` or None.
+Spec = tuple[str, float, str, str, Any, Any]
 
 
 def specs(contacts: Sequence[Contact]) -> list[Spec]:
@@ -272,7 +374,8 @@ def specs(contacts: Sequence[Contact]) -> list[Spec]:
         if not isinstance(c, Contact):
             raise TypeError(f"contacts[{i}]: expected a varmech.Contact, got {type(c).__name__}")
         kind, payload = c.phi.native if isinstance(c.phi, _surfaces.Surface) else ("functions", (c.phi, c.gradient))
-        out.append((c.name, float(c.restitution), c.law, kind, payload))
+        friction = None if c.friction is None else c.friction.spec()
+        out.append((c.name, float(c.restitution), c.law, kind, payload, friction))
     return out
 
 
@@ -287,22 +390,28 @@ def occurrences(record: Any, contacts: Sequence[Contact | str], *, after: bool =
 
 
 def switches(record: Any, contacts: Sequence[Contact | str]) -> tuple[Occurrences, ...]:
-    """Each contact's closures in the binding's record of a run (or its stepper's), named
-    ``"<name>.closed"`` (at the limit of its bounces' Zeno series, with the state of the impact
-    that closed it), then each one's releases, ``"<name>.released"`` (at lift-off)."""
+    """Each contact's switches in the binding's record of a run (or its stepper's), kind by kind
+    (:data:`SWITCHES`): its closures, ``"<name>.closed"`` (at the limit of its bounces' Zeno
+    series, with the state of the impact that closed it), its releases, ``"<name>.released"`` (at
+    lift-off), and its friction's, ``"<name>.stuck"`` and ``"<name>.slipped"``."""
     if not contacts:
         return ()
-    index, t, closed, q, p = record.switches
+    index, t, kind, q, p = record.switches
     names = occurrence_names(contacts)[len(contacts) :]
-    rows = [(index == i) & (closed == flag) for flag in (True, False) for i in range(len(contacts))]
+    rows = [(index == i) & (kind == code) for code in range(len(SWITCHES)) for i in range(len(contacts))]
     return tuple(Occurrences(n, t[r], q[r], p[r]) for n, r in zip(names, rows))
 
 
 def occurrence_names(contacts: Sequence[Contact | str]) -> list[str]:
     """The names of the contacts' occurrences in ``traj.events``: each contact's impacts
-    (:func:`occurrences`), then each one's closures and each one's releases (:func:`switches`)."""
+    (:func:`occurrences`), then their switches kind by kind (:func:`switches`)."""
     names = [name(c) for c in contacts]
-    return names + [f"{n}.closed" for n in names] + [f"{n}.released" for n in names]
+    return names + [f"{n}.{kind}" for kind in SWITCHES for n in names]
+
+
+def frictional(contacts: Sequence[Contact | str]) -> bool:
+    """Whether some contact has friction, whose work a run then reports (``traj.work``)."""
+    return any(isinstance(c, Contact) and c.friction is not None for c in contacts)
 
 
 def warn_grazing(count: int, stacklevel: int) -> None:
@@ -322,10 +431,13 @@ def name(contact: Contact | str) -> str:
 
 
 def stored(contacts: Sequence[Contact | str]) -> str:
-    """The contacts as a file stores them, JSON: each native one's name, restitution, law and
-    surface (``Surface.native``), and null for one given by Python functions (no code is stored)."""
+    """The contacts as a file stores them, JSON: each native one's name, restitution, law,
+    surface (``Surface.native``) and friction (``Friction.spec()`` or null), and null for one given
+    by Python functions (no code is stored)."""
     rows = [
-        [c.name, c.restitution, c.law, *c.phi.native] if isinstance(c, Contact) and isinstance(c.phi, _surfaces.Surface) else None
+        [c.name, c.restitution, c.law, *c.phi.native, None if c.friction is None else c.friction.spec()]
+        if isinstance(c, Contact) and isinstance(c.phi, _surfaces.Surface)
+        else None
         for c in contacts
     ]
     return json.dumps(rows)
@@ -341,7 +453,11 @@ def restored(text: str, names: Sequence[str]) -> tuple[Contact | str, ...]:
             if row is None:
                 out.append(str(label))
                 continue
-            name, restitution, law, kind, payload = row
+            name, restitution, law, kind, payload, *rest = row
+            friction = None
+            if rest and rest[0] is not None:
+                mu_s, mu_k, slip = rest[0]
+                friction = Friction(mu_s, mu_k, None if slip is None else np.reshape(slip[1], (slip[0], -1)))
             surface: _surfaces.Surface
             if kind == "crossing":
                 k, value = payload
@@ -349,7 +465,7 @@ def restored(text: str, names: Sequence[str]) -> tuple[Contact | str, ...]:
             else:
                 ks, centre, axes, inside = payload
                 surface = _surfaces.Ellipsoid(tuple(ks), tuple(centre), tuple(axes), bool(inside))
-            out.append(Contact(surface, _surfaces.Gradient(surface), restitution, name, law))
+            out.append(Contact(surface, _surfaces.Gradient(surface), restitution, name, law, friction))
         return tuple(out)
     except (ValueError, TypeError) as e:
         raise ValueError(f"path: its contacts are not a stored contact list ({e})") from None

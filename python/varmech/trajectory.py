@@ -95,7 +95,8 @@ class Trajectory:
     newton_iterations_per_step : ndarray, shape (N − 1,)
         Mean Newton iterations a step between consecutive saved states.
     work : ndarray, shape (N,) or None
-        Work done by the non-conservative forces up to each saved state.
+        Work done by the non-conservative forces up to each saved state: a forced model's, and
+        the friction of its contacts (:class:`varmech.Friction`).
     status : int
         0: the run reached its end; 1: a terminal event stopped it; -1: the partial trajectory
         of a failed run (``err.partial``).
@@ -108,8 +109,9 @@ class Trajectory:
     events : tuple of Occurrences
         Each event's located crossings, in the order the events were given, then each
         contact's impacts (time, contact configuration, momenta just before), then each
-        contact's closures (``"<name>.closed"``) and each one's releases (``"<name>.released"``,
-        lift-off): see :mod:`varmech.impacts`.
+        contact's closures (``"<name>.closed"``), each one's releases (``"<name>.released"``,
+        lift-off), and the friction's switches, ``"<name>.stuck"`` and ``"<name>.slipped"``:
+        see :mod:`varmech.impacts`.
     contacts : tuple of Contact
         The run's contacts (empty without them), which a continued run (``integrate(traj,
         steps=)``, :func:`varmech.resume`) goes on with. A file stores the native ones

@@ -38,7 +38,8 @@ SPHERE = varmech.Contact.ellipsoid([1.0, 1.0], inside=False, restitution=0.0, la
 
 def _leaves(method: str, dt: float, theta0: float = 0.3, **kwargs):
     traj = varmech.integrate(_particle(), _on_circle(theta0), [0.0, 0.0], method=method, dt=dt, t_end=1.6, contacts=[SPHERE], **kwargs)
-    impacts, closed, released = traj.events
+    impacts, closed, released, stuck, slipped = traj.events
+    assert len(stuck) == len(slipped) == 0, "no friction, no friction switches"
     assert len(impacts) == len(closed) == 0 and len(released) == 1
     return traj, released
 
@@ -102,7 +103,8 @@ def test_a_string_whirled_too_slowly_goes_slack_and_is_caught_again_where_the_pa
     string = varmech.Contact.ellipsoid([length, length], restitution=0.0, law="reflect", name="string")
     q0 = np.array([0.0, -length])
     traj = varmech.integrate(_particle(), q0, [v0, 0.0], method="yoshida4", dt=1e-3, t_end=1.6, contacts=[string])
-    impacts, closed, released = traj.events
+    impacts, closed, released, stuck, slipped = traj.events
+    assert len(stuck) == len(slipped) == 0, "no friction, no friction switches"
     assert len(released) == 1 and len(impacts) == 1 and len(closed) == 1
     (x, y) = released.q[0]
     cos_slack = (2 * G * length - v0**2) / (3 * G * length)
@@ -149,6 +151,6 @@ def test_a_slider_streamed_to_a_file_and_resumed_is_one_run_with_its_release(tmp
     resumed = varmech.resume(path, steps=whole.steps - 40, model=_particle())
     for x, y in [(resumed.t, whole.t), (resumed.q, whole.q), (resumed.p, whole.p)]:
         np.testing.assert_array_equal(x, y)
-    assert [o.name for o in resumed.events] == ["sphere", "sphere.closed", "sphere.released"]
+    assert [o.name for o in resumed.events] == ["sphere", "sphere.closed", "sphere.released", "sphere.stuck", "sphere.slipped"]
     np.testing.assert_array_equal(resumed.events[2].t, released.t)
     np.testing.assert_array_equal(varmech.load(path, model=_particle()).events[2].q, released.q)

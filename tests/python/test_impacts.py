@@ -185,7 +185,8 @@ def test_a_ball_with_e_below_1_comes_to_rest_at_the_zeno_limit_and_then_rests_on
     rest = math.sqrt(2 / G) * (1 + e) / (1 - e)
     floor = varmech.Contact(lambda q: q[0], lambda q: [1.0], restitution=e, name="floor")
     traj = varmech.integrate(_ball(), [1.0], [0.0], dt=1e-3, steps=3000, contacts=[floor])
-    impacts, closed, released = traj.events
+    impacts, closed, released, stuck, slipped = traj.events
+    assert len(stuck) == len(slipped) == 0, "no friction, no friction switches"
     assert (closed.name, released.name) == ("floor.closed", "floor.released")
     assert len(closed) == 1 and len(released) == 0 and abs(closed.t[0] - rest) < 1e-12
     np.testing.assert_allclose(impacts.t[:3], math.sqrt(2 / G) * np.array([1, 1 + 2 * e, 1 + 2 * e + 2 * e * e]), rtol=1e-12)

@@ -13,8 +13,8 @@ use std::ops::Deref;
 
 use varmech::integrators::{
     integrate, integrate_watching, integrate_with_events, Contact, Contacts, Detector, DiscreteEnergy, Dynamics,
-    EventSpec, General, Law, Method, ModelKind, NativeEvent, NativeSurface, Options, Stepper, StepperState, Trajectory,
-    Watch, Watcher,
+    EventSpec, Friction, General, Law, Method, ModelKind, NativeEvent, NativeSurface, Options, Slip, Stepper,
+    StepperState, Trajectory, Watch, Watcher,
 };
 use varmech::model::Routhian;
 use varmech::scenes::{self, NBody, NonholonomicScene, SceneModel};
@@ -457,6 +457,7 @@ fn billiard(steps: usize, radius: f64) -> (usize, usize) {
         }),
         restitution: 1.0,
         law: Law::Reflect,
+        friction: None,
         name: "table".into(),
     };
     let contacts = Contacts::new(vec![table]).unwrap();
@@ -514,6 +515,7 @@ fn resting(steps: usize) -> usize {
         }),
         restitution: 0.5,
         law: Law::Reflect,
+        friction: None,
         name: "floor".into(),
     };
     let contacts = Contacts::new(vec![floor]).unwrap();
@@ -540,6 +542,59 @@ fn a_held_contact_allocates_nothing_in_the_step_loop() {
     assert_eq!(resting(100_000), resting(100));
 }
 
+/// Allocations of a run of `steps` steps of 0.001 of a particle sliding inside a rough circle
+/// (μ = 0.5, no other force: N = mv²/r changes with the speed), saving its first and last states.
+fn sliding(steps: usize) -> usize {
+    let free = scenes::FreeBody::new(vec![1.0, 1.0]).unwrap();
+    let rim = Contact {
+        surface: Box::new(NativeSurface::Ellipsoid {
+            coordinates: vec![0, 1],
+            centre: vec![0.0, 0.0],
+            semi_axes: vec![1.0, 1.0],
+            inside: true,
+        }),
+        restitution: 0.0,
+        law: Law::Reflect,
+        friction: Some(Friction {
+            static_coefficient: 0.5,
+            kinetic: 0.5,
+            slip: Slip::Tangent,
+        }),
+        name: "rim".into(),
+    };
+    let contacts = Contacts::new(vec![rim]).unwrap();
+    let options = Options {
+        save_every: steps,
+        ..Options::new(0.001, steps)
+    };
+    let watch = Watch {
+        contacts: Some(&contacts),
+        ..Watch::default()
+    };
+    let before = allocated();
+    let traj = integrate_watching(
+        &free,
+        Method::Verlet,
+        &[1.0, 0.0],
+        &[0.0, 1.0],
+        &options,
+        || Ok(()),
+        watch,
+    )
+    .unwrap();
+    let count = allocated() - before;
+    assert!(traj.impacts.is_empty() && traj.impacts.switches.is_empty());
+    assert!(traj.work[1] < 0.0);
+    count
+}
+
+#[test]
+fn a_sliding_contact_with_friction_allocates_nothing_in_the_step_loop() {
+    // The held steps with the friction's fixed point and the multipliers of each: a long run
+    // allocates as much as a short one.
+    assert_eq!(sliding(20_000), sliding(100));
+}
+
 /// Allocations of `steps` steps of `stepper` through a watcher of a wall q_k ≥ −10⁹ that it
 /// never reaches, after a first call (which sizes the watcher's buffers).
 fn watched_allocations<M>(model: M, mut stepper: Stepper<M>, coordinate: usize, steps: usize) -> usize
@@ -553,6 +608,7 @@ where
         }),
         restitution: 1.0,
         law: Law::Reflect,
+        friction: None,
         name: "far".into(),
     };
     let contacts = Contacts::new(vec![far]).unwrap();
@@ -560,7 +616,7 @@ where
         contacts: Some(&contacts),
         ..Watch::default()
     };
-    let mut watcher = Watcher::begin(model, &stepper, watch, "q0", false).unwrap();
+    let mut watcher = Watcher::begin(model, &mut stepper, watch, "q0", false).unwrap();
     let mut record = Trajectory::default();
     let mut poll = || Ok(());
     watcher.advance(&mut stepper, 1, &mut record, &mut poll).unwrap();

@@ -1,12 +1,14 @@
 //! Contacts that hold: a ball with e < 1 bouncing to rest at the limit of its Zeno series and
 //! then resting with λ = mg; a particle sliding from rest near the top of a smooth sphere, held on
 //! it until it leaves where cos θ = (2/3)cos θ₀, located at the method's order; a run resumed from
-//! a held state bit for bit; and a method that cannot hold a contact still ending an
-//! accumulation of impacts with `Error::Contact`.
+//! a held state bit for bit; a method that cannot hold a contact still ending an accumulation
+//! of impacts with `Error::Contact`; and Byerly's billiard ball, sliding on a rough table until
+//! it rolls at 5v₀/7 from t = 2v₀/(7μg), exactly, its run resumed bit for bit.
 
 use nalgebra::DMatrix;
 use varmech::integrators::{
-    integrate_watching, Contact, Contacts, Dynamics, Law, Method, NativeSurface, Options, Trajectory,
+    integrate_watching, Contact, Contacts, Dynamics, Friction, Law, Method, NativeSurface, Options, Slip, Switch,
+    Trajectory,
 };
 use varmech::model::{Mass, MechanicalSystem, Reaction};
 use varmech::scenes::BouncingBall;
@@ -53,6 +55,7 @@ fn sphere() -> Contacts<'static> {
         }),
         restitution: 0.0,
         law: Law::Reflect,
+        friction: None,
         name: "sphere".into(),
     };
     Contacts::new(vec![contact]).unwrap()
@@ -88,7 +91,7 @@ fn a_ball_with_e_below_1_comes_to_rest_at_the_zeno_limit_and_rests_with_lambda_m
         let traj = drop_ball(&options, with_contacts(&contacts)).unwrap();
         let switches = &traj.impacts.switches;
         assert_eq!(switches.len(), 1, "dt = {dt}: {:?}", switches.t);
-        assert!(switches.closed[0]);
+        assert_eq!(switches.kind[0], Switch::Closed);
         // Verlet is exact on the parabolas and the impacts are located to round-off.
         assert!(
             (switches.t[0] - t_rest).abs() <= 1e-12,
@@ -149,7 +152,7 @@ fn leaving(method: Method, theta0: f64, h: f64) -> f64 {
     let traj = integrate_watching(&model, method, &q0, &p0, &options, || Ok(()), with_contacts(&contacts)).unwrap();
     let switches = &traj.impacts.switches;
     assert!(
-        !switches.is_empty() && !switches.closed[0],
+        !switches.is_empty() && switches.kind[0] == Switch::Released,
         "{method:?}, h = {h}: {:?}",
         switches.t
     );
@@ -194,8 +197,95 @@ fn a_run_resumed_from_a_held_state_is_the_whole_run_bit_for_bit() {
     let [all, part, rest] = split_run(&model, &contacts, (&[0.0, 1.0], &[0.3, 0.0]), (0.01, 150, 40, 1));
     // Held at the join, released after it.
     assert!(part.impacts.switches.is_empty());
-    assert_eq!(all.impacts.switches.closed, vec![false]);
+    assert_eq!(all.impacts.switches.kind, vec![Switch::Released]);
     assert_eq!(rest.impacts.switches, all.impacts.switches);
     assert_eq!(&all.q[all.q.len() - rest.q.len()..], &rest.q[..]);
     assert_eq!(&all.p[all.p.len() - rest.p.len()..], &rest.p[..]);
+}
+
+/// A uniform ball (x, y, θ) of unit mass and radius R on a floor under gravity.
+struct Ball(Mass);
+
+const R: f64 = 0.1;
+const INERTIA: f64 = 0.4 * R * R;
+
+impl MechanicalSystem for Ball {
+    fn dim(&self) -> usize {
+        3
+    }
+
+    fn mass(&self) -> &Mass {
+        &self.0
+    }
+
+    fn potential(&self, q: &[f64]) -> Result<f64, ModelError> {
+        Ok(G * q[1])
+    }
+
+    fn gradient(&self, _q: &[f64], grad: &mut [f64]) -> Result<(), ModelError> {
+        grad.copy_from_slice(&[0.0, G, 0.0]);
+        Ok(())
+    }
+}
+
+/// The floor y ≥ R with friction μ, the contact point slipping at ẋ − Rθ̇.
+fn rough_floor(mu: f64) -> Contacts<'static> {
+    let contact = Contact {
+        surface: Box::new(NativeSurface::Wall {
+            coordinate: 1,
+            value: R,
+        }),
+        restitution: 0.0,
+        law: Law::Reflect,
+        friction: Some(Friction {
+            static_coefficient: mu,
+            kinetic: mu,
+            slip: Slip::Rows {
+                rows: 1,
+                jacobian: vec![1.0, 0.0, -R],
+            },
+        }),
+        name: "table".into(),
+    };
+    Contacts::new(vec![contact]).unwrap()
+}
+
+#[test]
+fn byerlys_billiard_ball_slides_and_then_rolls_at_five_sevenths_of_its_speed_from_2v0_over_7_mu_g() {
+    let (v0, mu) = (2.0, 0.2);
+    let ball = Ball(Mass::diagonal(vec![1.0, 1.0, INERTIA]).unwrap());
+    let contacts = rough_floor(mu);
+    let rolls = 2.0 * v0 / (7.0 * mu * G);
+    let (q0, p0) = ([0.0, R, 0.0], [v0, 0.0, 0.0]);
+    for method in [Method::Verlet, Method::Yoshida4] {
+        let options = Options::new(0.01, 200);
+        let watch = with_contacts(&contacts);
+        let traj = integrate_watching(&ball, method, &q0, &p0, &options, || Ok(()), watch).unwrap();
+        let switches = &traj.impacts.switches;
+        assert_eq!(switches.kind, vec![Switch::Stuck], "{method:?}");
+        assert!(
+            (switches.t[0] - rolls).abs() < 1e-13,
+            "{method:?}: {} against {rolls}",
+            switches.t[0]
+        );
+        // Constant forces: the held step is exact, sliding and rolling.
+        for k in 0..traj.len() {
+            let (t, p) = (traj.t[k], traj.p_at(k));
+            let v = if t < rolls { v0 - mu * G * t } else { 5.0 * v0 / 7.0 };
+            assert!((p[0] - v).abs() < 1e-13, "{method:?} at t = {t}: {} against {v}", p[0]);
+        }
+        let lost = -(2.0 / 7.0) * v0 * v0 / 2.0;
+        let work = traj.work[traj.len() - 1];
+        assert!(
+            (work - lost).abs() < 1e-13,
+            "{method:?}: the work {work} against {lost}"
+        );
+    }
+    // Resumed while it slides, it rolls from the same time, its work counted on.
+    let [all, part, rest] = split_run(&ball, &contacts, (&q0, &p0), (0.01, 100, 20, 1));
+    assert!(part.impacts.switches.is_empty());
+    assert_eq!(rest.impacts.switches, all.impacts.switches);
+    assert_eq!(&all.q[all.q.len() - rest.q.len()..], &rest.q[..]);
+    assert_eq!(&all.p[all.p.len() - rest.p.len()..], &rest.p[..]);
+    assert_eq!(&all.work[all.work.len() - rest.work.len()..], &rest.work[..]);
 }

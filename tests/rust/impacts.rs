@@ -24,6 +24,7 @@ pub(crate) fn floor(restitution: f64, law: Law) -> Contacts<'static> {
         }),
         restitution,
         law,
+        friction: None,
         name: "floor".into(),
     };
     Contacts::new(vec![contact]).unwrap()
@@ -104,6 +105,7 @@ fn circle(r: f64, law: Law) -> Contacts<'static> {
         }),
         restitution: 1.0,
         law,
+        friction: None,
         name: "table".into(),
     };
     Contacts::new(vec![contact]).unwrap()
@@ -173,6 +175,7 @@ fn a_step_without_an_impact_is_bit_for_bit_the_step_without_contacts() {
         }),
         restitution: 1.0,
         law: Law::Reflect,
+        friction: None,
         name: "far".into(),
     };
     let contacts = Contacts::new(vec![far]).unwrap();
@@ -332,6 +335,7 @@ fn an_ensemble_member_is_its_single_run_bit_for_bit() {
         },
         restitution: 1.0,
         law: Law::Reflect,
+        friction: None,
         name: "table".into(),
     };
     let members = 6;
@@ -462,6 +466,7 @@ fn contacts_that_do_not_fit_are_refused_by_name() {
         }),
         restitution: 1.0,
         law: Law::Reflect,
+        friction: None,
         name: "wall".into(),
     };
     let (argument, reason) = refusal(&Contacts::new(vec![wrong]).unwrap(), Method::Verlet, 1.0);
@@ -476,6 +481,7 @@ fn contacts_that_do_not_fit_are_refused_by_name() {
         }),
         restitution: 1.5,
         law: Law::Reflect,
+        friction: None,
         name: "wall".into(),
     };
     assert!(Contacts::new(vec![elastic]).is_err());
@@ -499,7 +505,7 @@ fn a_stepper_stepped_through_a_watcher_is_the_run_bit_for_bit() {
     )
     .unwrap();
     let mut stepper = Stepper::new(&free, Method::Verlet, &q0, &p0, &options).unwrap();
-    let mut watcher = Watcher::begin(&free, &stepper, with_contacts(&contacts), "q0", false).unwrap();
+    let mut watcher = Watcher::begin(&free, &mut stepper, with_contacts(&contacts), "q0", false).unwrap();
     let mut record = Trajectory::default();
     record.impacts.dim = 2;
     let mut poll = || -> Result<(), ModelError> { Ok(()) };
@@ -524,14 +530,14 @@ fn stepped_one_call_at_a_time<S: varmech::integrators::Dynamics>(
     contacts: &Contacts<'static>,
 ) -> (Vec<f64>, Vec<f64>, Impacts) {
     let mut stepper = Stepper::new(sys, Method::Verlet, q0, p0, options).unwrap();
-    drop(Watcher::begin(sys, &stepper, with_contacts(contacts), "q0", false).unwrap());
+    drop(Watcher::begin(sys, &mut stepper, with_contacts(contacts), "q0", false).unwrap());
     let mut impacts = Impacts {
         dim: q0.len(),
         ..Impacts::default()
     };
     let mut poll = || -> Result<(), ModelError> { Ok(()) };
     for _ in 0..options.steps {
-        let mut watcher = Watcher::resume(sys, &stepper, with_contacts(contacts), false).unwrap();
+        let mut watcher = Watcher::resume(sys, &mut stepper, with_contacts(contacts), false).unwrap();
         let mut record = Trajectory::default();
         record.impacts.dim = q0.len();
         assert_eq!(watcher.advance(&mut stepper, 1, &mut record, &mut poll).unwrap(), None);
@@ -597,7 +603,7 @@ fn a_state_a_round_off_past_a_surface_leaves_it_and_one_further_past_is_refused(
     let options = Options::new(1e-3, 1);
     let (q0, p0) = ([-1e-17], [1.0]);
     let outside = Stepper::new(&ball, Method::Verlet, &[-1e-9], &p0, &options).unwrap();
-    match Watcher::begin(&ball, &outside, with_contacts(&contacts), "q0", false) {
+    match Watcher::begin(&ball, &mut outside, with_contacts(&contacts), "q0", false) {
         Err(Error::InvalidArgument { argument, reason }) => {
             assert_eq!(argument, "q0");
             assert!(reason.contains("floor"), "{reason}");
@@ -609,9 +615,9 @@ fn a_state_a_round_off_past_a_surface_leaves_it_and_one_further_past_is_refused(
     for begun in [true, false] {
         let mut stepper = Stepper::new(&ball, Method::Verlet, &q0, &p0, &options).unwrap();
         let mut watcher = if begun {
-            Watcher::begin(&ball, &stepper, with_contacts(&contacts), "q0", false).unwrap()
+            Watcher::begin(&ball, &mut stepper, with_contacts(&contacts), "q0", false).unwrap()
         } else {
-            Watcher::resume(&ball, &stepper, with_contacts(&contacts), false).unwrap()
+            Watcher::resume(&ball, &mut stepper, with_contacts(&contacts), false).unwrap()
         };
         let mut record = Trajectory::default();
         record.impacts.dim = 1;
@@ -629,6 +635,7 @@ fn wall(coordinate: usize, value: f64, law: Law) -> Contacts<'static> {
         surface: Box::new(NativeSurface::Wall { coordinate, value }),
         restitution: 1.0,
         law,
+        friction: None,
         name: "wall".into(),
     };
     Contacts::new(vec![contact]).unwrap()

@@ -325,6 +325,7 @@ fn an_ensemble_member_with_impulses_samples_and_contacts_is_its_single_run_bit_f
             },
             restitution: 1.0,
             law: Law::Reflect,
+            friction: None,
             name: "floor".into(),
         }],
         impulses: vec![(0.2345, Generalized(vec![2.0])), (1.5, Generalized(vec![-1.0]))],

@@ -1,18 +1,21 @@
-//! Contacts as Python gives them: each a tuple `(name, restitution, law, kind, payload)`, a
-//! native surface (kinds `"crossing"` and `"ellipsoid"`, the payloads of the native events)
-//! evaluated without the GIL, or Python's functions φ(q) and ∇φ(q) (kind `"functions"`) called
-//! with it.
+//! Contacts as Python gives them: each a tuple `(name, restitution, law, kind, payload,
+//! friction)`, a native surface (kinds `"crossing"` and `"ellipsoid"`, the payloads of the native
+//! events) evaluated without the GIL, or Python's functions φ(q) and ∇φ(q) (kind `"functions"`)
+//! called with it; friction None or `(mu_s, mu_k, slip)`, slip None or its rows (k, flat).
 
 use numpy::PyArray1;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
-use varmech::integrators::{Contact, Contacts, Law, NativeContact, NativeSurface, Surface};
+use varmech::integrators::{Contact, Contacts, Friction, Law, NativeContact, NativeSurface, Slip, Surface};
 use varmech::ModelError;
 
 use crate::closure::readers::{call_scalar, call_vector};
 
-/// The tuple Python passes: name, restitution, law, kind and payload.
-pub type ContactTuple<'py> = (String, f64, String, String, Bound<'py, PyAny>);
+/// The tuple Python passes: name, restitution, law, kind, payload and friction.
+pub type ContactTuple<'py> = (String, f64, String, String, Bound<'py, PyAny>, Option<FrictionTuple>);
+
+/// Friction as Python passes it: μ_s, μ_k and the slip rows (their number and entries), if given.
+pub type FrictionTuple = (f64, f64, Option<(usize, Vec<f64>)>);
 
 /// A surface given as Python functions φ(q) -> float and ∇φ(q) -> array (n,).
 struct Functions {
@@ -41,13 +44,13 @@ enum Kind {
 }
 
 /// A run's contacts as Python gave them, in order.
-pub struct ContactSpecs(Vec<(Kind, f64, Law, String)>);
+pub struct ContactSpecs(Vec<(Kind, f64, Law, Option<Friction>, String)>);
 
 impl ContactSpecs {
     /// The contacts of the tuples; a malformed one is a ValueError naming `contacts`.
     pub fn new(tuples: Vec<ContactTuple<'_>>) -> PyResult<Self> {
         let mut contacts = Vec::with_capacity(tuples.len());
-        for (name, restitution, law, kind, payload) in tuples {
+        for (name, restitution, law, kind, payload, friction) in tuples {
             let law = match law.as_str() {
                 "reflect" => Law::Reflect,
                 "variational" => Law::Variational,
@@ -80,20 +83,26 @@ impl ContactSpecs {
                     )))
                 }
             };
-            contacts.push((kind, restitution, law, name));
+            let friction = friction.map(|(static_coefficient, kinetic, slip)| Friction {
+                static_coefficient,
+                kinetic,
+                slip: slip.map_or(Slip::Tangent, |(rows, jacobian)| Slip::Rows { rows, jacobian }),
+            });
+            contacts.push((kind, restitution, law, friction, name));
         }
         Ok(ContactSpecs(contacts))
     }
 
     /// The core's contacts, their surfaces borrowed from these.
     pub fn contacts(&self) -> Result<Contacts<'_>, varmech::Error> {
-        let contacts = self.0.iter().map(|(kind, restitution, law, name)| Contact {
+        let contacts = self.0.iter().map(|(kind, restitution, law, friction, name)| Contact {
             surface: match kind {
                 Kind::Native(native) => Box::new(native.clone()) as Box<dyn Surface>,
                 Kind::Functions(functions) => Box::new(functions),
             },
             restitution: *restitution,
             law: *law,
+            friction: friction.clone(),
             name: name.clone(),
         });
         Contacts::new(contacts.collect())
@@ -104,11 +113,12 @@ impl ContactSpecs {
     pub fn into_native(self) -> PyResult<Vec<NativeContact>> {
         self.0
             .into_iter()
-            .map(|(kind, restitution, law, name)| match kind {
+            .map(|(kind, restitution, law, friction, name)| match kind {
                 Kind::Native(surface) => Ok(NativeContact {
                     surface,
                     restitution,
                     law,
+                    friction,
                     name,
                 }),
                 Kind::Functions(_) => Err(PyValueError::new_err(format!(

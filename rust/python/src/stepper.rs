@@ -103,7 +103,7 @@ impl Stepper {
             let mut stepper = integrators::Stepper::resume(sys, state)?;
             let watched = Watched::new(specs, impulses)?;
             let mut detector = lend(events)?;
-            let mut watcher = Watcher::begin(sys, &stepper, watched.watch(detector.as_mut()), argument, false)?;
+            let mut watcher = Watcher::begin(sys, &mut stepper, watched.watch(detector.as_mut()), argument, false)?;
             if fresh {
                 watcher.start(&mut stepper, &mut Trajectory::default())?;
             }
@@ -146,7 +146,7 @@ impl Stepper {
             let mut stepper = integrators::Stepper::resume(sys, state)?;
             let watched = Watched::new(specs, impulses)?;
             let mut detector = lend(events)?;
-            let mut watcher = Watcher::resume(sys, &stepper, watched.watch(detector.as_mut()), false)?;
+            let mut watcher = Watcher::resume(sys, &mut stepper, watched.watch(detector.as_mut()), false)?;
             let mut record = Trajectory::default();
             let advanced = watcher.advance(&mut stepper, n, &mut record, &mut poll);
             // The impacts and crossings of the steps completed, a failed step's excepted.
@@ -369,8 +369,8 @@ impl Stepper {
         impact_arrays(py, self.impacts.clone(), self.impacts.dim)
     }
 
-    /// The contacts' closures and releases since the start or the last reset, as a run's
-    /// record has them: the contact's index (k,), t (k,), closed (k,), q and p (k, n).
+    /// The contacts' switches since the start or the last reset, as a run's record has them:
+    /// the contact's index (k,), t (k,), the kind (k,), q and p (k, n).
     #[getter]
     fn switches(&self, py: Python<'_>) -> PyResult<SwitchArrays> {
         switch_arrays(py, self.impacts.switches.clone(), self.impacts.dim)

@@ -4,7 +4,7 @@ use numpy::{PyArray1, PyArray2, PyUntypedArrayMethods};
 
 use pyo3::prelude::*;
 use pyo3::types::PyBytes;
-use varmech::integrators::{Impacts, Occurrence, Switches, Trajectory};
+use varmech::integrators::{Impacts, Occurrence, Switch, Switches, Trajectory};
 
 use crate::convert::matrix;
 
@@ -41,8 +41,8 @@ pub struct TrajectoryRecord {
     /// the contact configuration q and the momenta just before and just after (k, n).
     #[pyo3(get)]
     impacts: ImpactArrays,
-    /// The contacts' closures and releases in order of time: the contact's index (k,), t (k,),
-    /// whether it closed (k,), q and p (k, n).
+    /// The contacts' switches in order of time: the contact's index (k,), t (k,), the kind (k,:
+    /// 0 closed, 1 released, 2 stuck, 3 slipped), q and p (k, n).
     #[pyo3(get)]
     switches: SwitchArrays,
     /// Impacts under the variational law that took Newton's law for want of a discrete-energy
@@ -60,21 +60,32 @@ pub(crate) type ImpactArrays = (
     Py<PyArray2<f64>>,
 );
 
-/// Closures and releases as arrays: the contact's index (k,), t (k,), closed (k,), q and p (k, n).
+/// Switches as arrays: the contact's index (k,), t (k,), the kind's code (k,: [`switch_code`]),
+/// q and p (k, n).
 pub(crate) type SwitchArrays = (
     Py<PyArray1<usize>>,
     Py<PyArray1<f64>>,
-    Py<PyArray1<bool>>,
+    Py<PyArray1<u8>>,
     Py<PyArray2<f64>>,
     Py<PyArray2<f64>>,
 );
+
+/// A switch's code, as Python's `impacts.SWITCHES` spells them.
+fn switch_code(kind: Switch) -> u8 {
+    match kind {
+        Switch::Closed => 0,
+        Switch::Released => 1,
+        Switch::Stuck => 2,
+        Switch::Slipped => 3,
+    }
+}
 
 /// The arrays of `switches` (a run's, or a stepper's so far) of n coordinates.
 pub(crate) fn switch_arrays(py: Python<'_>, switches: Switches, n: usize) -> PyResult<SwitchArrays> {
     Ok((
         PyArray1::from_vec(py, switches.contact).unbind(),
         PyArray1::from_vec(py, switches.t).unbind(),
-        PyArray1::from_vec(py, switches.closed).unbind(),
+        PyArray1::from_iter(py, switches.kind.into_iter().map(switch_code)).unbind(),
         matrix(py, switches.q, n)?.unbind(),
         matrix(py, switches.p, n)?.unbind(),
     ))

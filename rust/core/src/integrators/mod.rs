@@ -64,8 +64,8 @@ pub use ensemble::{
 pub use events::{Detector, EventFunctions, EventSpec, NativeEvent, Occurrence};
 pub use explicit_rk::ExplicitRk;
 pub use jumps::{
-    impulsive, Blow, Contact, Contacts, Gaps, Generalized, Impacts, Impulse, Law, NativeContact, NativeSurface,
-    PointFunction, Schedule, Struck, Surface, Switches, Watch, Watcher, MAX_IMPACTS,
+    impulsive, Blow, Contact, Contacts, Friction, Gaps, Generalized, Impacts, Impulse, Law, NativeContact,
+    NativeSurface, PointFunction, Schedule, Slip, Struck, Surface, Switch, Switches, Watch, Watcher, MAX_IMPACTS,
 };
 pub use kick_drift::KickDrift;
 pub use kind::ModelKind;

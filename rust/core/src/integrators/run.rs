@@ -187,9 +187,9 @@ where
 /// The run of `stepper` to step `end` watching `watch` (its [`Watcher`] begun on the
 /// stepper's state): a `fresh` run (its schedule's times at t0 taken, a state outside a contact
 /// named `q0`) or a resumed one (named `checkpoint`).
-fn watched<S, P>(
-    sys: &S,
-    stepper: Stepper<&S>,
+fn watched<'s, S, P>(
+    sys: &'s S,
+    mut stepper: Stepper<&'s S>,
     energy: Option<EnergyWatch>,
     (end, save_every): (usize, usize),
     poll: P,
@@ -201,7 +201,7 @@ where
     P: Poll,
 {
     let argument = if fresh { "q0" } else { "checkpoint" };
-    match Watcher::begin(sys, &stepper, watch, argument, energy.is_some()) {
+    match Watcher::begin(sys, &mut stepper, watch, argument, energy.is_some()) {
         Ok(watcher) => run(sys, stepper, energy, end, save_every, poll, (watcher, fresh)),
         Err(error) => Err(fail(error, first_state(sys, &stepper))),
     }

@@ -53,6 +53,10 @@ pub struct StepperState {
     p_next: Vec<f64>,
     eq_next: Vec<f64>,
     ep_next: Vec<f64>,
+    /// The work of the held contacts' friction so far, and whether it is counted (a stepper
+    /// watching contacts with friction).
+    contact_work: f64,
+    frictional: bool,
     // Wall-clock pacing, not state: a restored state starts a fresh one.
     #[serde(skip)]
     interrupt: InterruptPoll,
@@ -215,6 +219,17 @@ where
         Ok(())
     }
 
+    /// Counts the work of contact friction from now on (a watcher of frictional contacts
+    /// begun on this stepper): its work is then reported, as a forced model's is.
+    pub(in crate::integrators) fn count_contact_work(&mut self) {
+        self.state.borrow_mut().frictional = true;
+    }
+
+    /// Adds w to the work of contact friction.
+    pub(in crate::integrators) fn add_contact_work(&mut self, w: f64) {
+        self.state.borrow_mut().contact_work += w;
+    }
+
     /// One step on the clock, taken outside the method (the step of a held contact, which the
     /// resolver takes), `poll` called before it when due as [`Stepper::advance`] calls it:
     /// (q, p) are left for [`Stepper::jump_to`] to set.
@@ -285,6 +300,8 @@ impl StepperState {
             p_next: zeros(),
             eq_next: zeros(),
             ep_next: zeros(),
+            contact_work: 0.0,
+            frictional: false,
             interrupt: InterruptPoll::new(),
         }
     }
@@ -641,16 +658,18 @@ impl StepperState {
         self.integrator.newton()
     }
 
-    /// The work done by non-conservative forces so far (forced Lagrangians; 0 otherwise).
+    /// The work done by non-conservative forces so far: a forced Lagrangian's, and the held
+    /// contacts' friction's.
     pub fn work(&self) -> f64 {
-        self.integrator.work()
+        self.integrator.work() + self.contact_work
     }
 }
 
 impl<M: Deref<Target: Dynamics>, St: Borrow<StepperState>> Stepper<M, St> {
-    /// The work done by the non-conservative forces so far; None for a model without them.
+    /// The work done by the non-conservative forces so far; None for a model without them
+    /// watched without friction.
     pub fn forced_work(&self) -> Option<f64> {
-        self.model.as_lagrangian().is_forced().then(|| self.work())
+        (self.model.as_lagrangian().is_forced() || self.frictional).then(|| self.work())
     }
 }
 

@@ -10,10 +10,16 @@
 //! (yoshida4, …): symplectic on the contact manifold at the method's order. The held state's
 //! multipliers λ are those of [`crate::model::Reaction`] (the state's own), on the closed
 //! surfaces; a contact is released where its λ crosses 0.
+//!
+//! Coulomb friction ([`super::Friction`]) adds to it: a sliding contact's force F = −μ_k N u
+//! (u = Jᵀŝ, the slip's direction; N = λ|∇φ|) enters both kicks, the second implicitly at the
+//! step's end (F(q₁, p₁), by fixed point), so the step stays symmetric (order 2, and its
+//! compositions' order); a sticking contact's slip rows J join ∇Φ as constraints, on the
+//! velocities at both kicks. The work of the sliding forces is ½(F₀ + F₁)·(q₁ − q₀) a step.
 
 use nalgebra::DMatrix;
 
-use super::Contact;
+use super::{Contact, Friction};
 use crate::integrators::{Composition, Method};
 use crate::model::Lagrangian;
 use crate::solve::lu::{lu_in_place, lu_solve};
@@ -22,6 +28,31 @@ use crate::ModelError;
 /// Newton iterations of the position constraint at most: it starts O(τ²) off and converges
 /// quadratically, so a step that needs more is far too large for the surface's curvature.
 const ITERATIONS: usize = 30;
+
+/// What a held step holds: the `closed` contacts (indices into `contacts`, in order), those of
+/// them whose friction `stuck`, and each contact's slip direction u at the piece's start
+/// (`directions`, n entries a contact, the j-th at j·n: the direction a sliding contact's
+/// force keeps while its slip has not turned against it).
+#[derive(Clone, Copy)]
+pub(super) struct Held<'h, 's> {
+    pub contacts: &'h [Contact<'s>],
+    pub closed: &'h [usize],
+    pub stuck: &'h [usize],
+    pub directions: &'h [f64],
+}
+
+impl Held<'_, '_> {
+    /// The friction of the a-th closed contact, if it slides.
+    fn sliding(&self, a: usize) -> Option<&Friction> {
+        let j = self.closed[a];
+        self.contacts[j].friction.as_ref().filter(|_| !self.stuck.contains(&j))
+    }
+
+    /// Whether any closed contact has friction.
+    fn frictional(&self) -> bool {
+        self.closed.iter().any(|&j| self.contacts[j].friction.is_some())
+    }
+}
 
 /// The held step of one method on a run's contacts, with every buffer it needs (made once: a
 /// step allocates nothing).
@@ -34,28 +65,53 @@ pub(super) struct Hold {
     v: Vec<f64>,
     w: Vec<f64>,
     zeros: Vec<f64>,
+    /// ∂L/∂q and the sliding contacts' friction force at the state.
     force: Vec<f64>,
+    friction: Vec<f64>,
     start: Vec<f64>,
-    /// ∇φₖ and M⁻¹∇φₖ of the closed contacts, k-th row at k·n.
-    normals: Vec<f64>,
+    half: Vec<f64>,
+    previous: Vec<f64>,
+    shifted: Vec<f64>,
+    /// The constraint rows at q, k-th at k·n: ∇φ of the closed contacts, then the slip rows J
+    /// of those stuck; and M⁻¹ times each.
+    rows: Vec<f64>,
     inverse: Vec<f64>,
-    /// The m × m systems and their pivots, the (m−1)-th for m closed contacts.
+    /// The sliding contacts' directions u at the state, and M⁻¹u, a-th at a·n.
+    units: Vec<f64>,
+    units_inverse: Vec<f64>,
+    /// The R × R systems and their pivots, the (R−1)-th for R rows.
     systems: Vec<(DMatrix<f64>, Vec<usize>)>,
     c: Vec<f64>,
     r: Vec<f64>,
+    /// The multipliers of the state: λ of the closed contacts, then of the stuck slip rows.
+    lambda: Vec<f64>,
     gradient: Vec<f64>,
-    /// The time t at which `force`, `normals` and `inverse` hold ∂L/∂q and the normals of the
-    /// contacts `cached_for` at `q` (the end of the last step, where the run checks λ and the
-    /// next step starts), if they do.
+    slip: Vec<f64>,
+    /// The work of the sliding forces in the last step.
+    pub(super) work: f64,
+    /// The time t at which `force`, `rows` and `inverse` hold ∂L/∂q and the rows of the
+    /// contacts `cached_for` (closed, then stuck) at `q` (the end of the last step, where the
+    /// run checks λ and the next step starts), if they do.
     cached: Option<f64>,
     cached_for: Vec<usize>,
 }
 
 impl Hold {
-    /// The held step of `method` on n coordinates and up to `contacts` closed at once; None
-    /// where the method is not Verlet or a composition of it.
-    pub(super) fn new(method: Method, n: usize, contacts: usize) -> Option<Hold> {
+    /// The held step of `method` on n coordinates and `contacts` (any of them closed at once,
+    /// and stuck if they have friction); None where the method is not Verlet or a composition
+    /// of it.
+    pub(super) fn new(method: Method, n: usize, contacts: &[Contact<'_>]) -> Option<Hold> {
         let gamma = Composition::of(method)?.gamma().to_vec();
+        let m = contacts.len();
+        let rows = m + contacts
+            .iter()
+            .filter_map(|c| c.friction.as_ref().map(|f| f.rows(n)))
+            .sum::<usize>();
+        let slip = contacts
+            .iter()
+            .filter_map(|c| c.friction.as_ref().map(|f| f.rows(n)))
+            .max()
+            .unwrap_or(0);
         let v = || vec![0.0; n];
         Some(Hold {
             gamma,
@@ -65,15 +121,24 @@ impl Hold {
             w: v(),
             zeros: v(),
             force: v(),
+            friction: v(),
             start: v(),
-            normals: vec![0.0; n * contacts],
-            inverse: vec![0.0; n * contacts],
-            systems: (1..=contacts).map(|m| (DMatrix::zeros(m, m), vec![0; m])).collect(),
-            c: vec![0.0; contacts],
-            r: vec![0.0; contacts],
+            half: v(),
+            previous: v(),
+            shifted: v(),
+            rows: vec![0.0; n * rows],
+            inverse: vec![0.0; n * rows],
+            units: vec![0.0; n * m],
+            units_inverse: vec![0.0; n * m],
+            systems: (1..=rows).map(|k| (DMatrix::zeros(k, k), vec![0; k])).collect(),
+            c: vec![0.0; rows],
+            r: vec![0.0; rows],
+            lambda: vec![0.0; rows],
             gradient: v(),
+            slip: vec![0.0; slip * n],
+            work: 0.0,
             cached: None,
-            cached_for: Vec::with_capacity(contacts),
+            cached_for: Vec::with_capacity(2 * m),
         })
     }
 
@@ -82,98 +147,129 @@ impl Hold {
         "verlet and its compositions (yoshida4, suzuki4, mclachlan4, yoshida6, kahan_li6, kahan_li8, …)"
     }
 
-    /// The held step of size τ from (t, q, p) on the `closed` contacts (indices into
-    /// `contacts`): its end in `q` and `p`.
+    /// The held step of size τ from (t, q, p) on `held`: its end in `q` and `p`, the work of
+    /// its sliding forces in `work`.
     ///
     /// # Errors
     /// The model's or a surface's own error; the position constraint not solved (a step too
-    /// large for the surface's curvature, or surfaces that are not independent there).
+    /// large for the surface's curvature, or surfaces that are not independent there); the
+    /// friction's fixed point not reached.
     pub(super) fn step(
         &mut self,
         model: &dyn Lagrangian,
-        (contacts, closed): (&[Contact<'_>], &[usize]),
+        held: Held<'_, '_>,
         (t, tau): (f64, f64),
         (q, p): (&[f64], &[f64]),
     ) -> Result<(), ModelError> {
-        // The last step's end, where the next starts: its force and normals are kept.
-        let mut warm = self.at(q, t, closed);
+        // The last step's end, where the next starts: its force and rows are kept.
+        let mut warm = self.at(q, t, held);
         if !warm {
             self.q.copy_from_slice(q);
             model.dl_dq(&self.q, &self.zeros, t, &mut self.force)?;
         }
         self.p.copy_from_slice(p);
+        self.work = 0.0;
+        let frictional = held.frictional();
+        if frictional {
+            if !warm {
+                self.rows_at(model, held, t)?;
+                warm = true;
+            }
+            self.forces(model, held, t)?;
+        } else {
+            self.friction.fill(0.0);
+        }
         self.cached = None;
         let mut time = t;
         for k in 0..self.gamma.len() {
             let s = self.gamma[k] * tau;
-            self.substep(model, (contacts, closed), (time, s), warm)?;
+            self.substep(model, held, (time, s), warm, frictional)?;
             time += s;
             warm = true;
         }
-        self.cache(t + tau, closed);
+        self.cache(t + tau, held);
         Ok(())
     }
 
-    /// Whether `force`, `normals` and `inverse` are those of the `closed` contacts at (q, t): the
-    /// last step ended there.
-    fn at(&self, q: &[f64], t: f64, closed: &[usize]) -> bool {
-        self.cached == Some(t) && self.q == q && self.cached_for == closed
+    /// Whether `force`, `rows` and `inverse` are those of `held` at (q, t): the last step
+    /// ended there.
+    fn at(&self, q: &[f64], t: f64, held: Held<'_, '_>) -> bool {
+        let m = held.closed.len();
+        self.cached == Some(t)
+            && self.q == q
+            && self.cached_for.len() == m + held.stuck.len()
+            && self.cached_for[..m] == *held.closed
+            && self.cached_for[m..] == *held.stuck
     }
 
-    /// `force`, `normals` and `inverse` marked as those of the `closed` contacts at (q, t).
-    fn cache(&mut self, t: f64, closed: &[usize]) {
+    /// `force`, `rows` and `inverse` marked as those of `held` at (q, t).
+    fn cache(&mut self, t: f64, held: Held<'_, '_>) {
         self.cached = Some(t);
         self.cached_for.clear();
-        self.cached_for.extend_from_slice(closed);
+        self.cached_for.extend_from_slice(held.closed);
+        self.cached_for.extend_from_slice(held.stuck);
     }
 
-    /// One RATTLE step of size s from (q, p) at t, with ∂L/∂q(q) in `force` (and the
-    /// normals at q in `normals` and `inverse` if `warm`), left at its end.
+    /// One RATTLE step of size s from (q, p) at t, with ∂L/∂q(q) in `force` and the friction
+    /// there in `friction` (and the rows at q in `rows` and `inverse` if `warm`), left at its
+    /// end, its work added to `work`.
     fn substep(
         &mut self,
         model: &dyn Lagrangian,
-        (contacts, closed): (&[Contact<'_>], &[usize]),
+        held: Held<'_, '_>,
         (t, s): (f64, f64),
         warm: bool,
+        frictional: bool,
     ) -> Result<(), ModelError> {
-        let (n, m) = (self.q.len(), closed.len());
-        for (x, f) in self.p.iter_mut().zip(&self.force) {
-            *x += 0.5 * s * f;
+        let n = self.q.len();
+        for ((x, f), g) in self.p.iter_mut().zip(&self.force).zip(&self.friction) {
+            *x += 0.5 * s * (f + g);
         }
-        if !warm {
-            self.normals_at(model, (contacts, closed), t)?;
-        }
-        // q₁(c) = q₀ + s(q̇(q₀, p½) + Σ cₖ M⁻¹∇φₖ(q₀)): Newton on Φ(q₁(c)) = 0.
+        let rows = if warm {
+            held.closed.len() + self.stuck_rows(held)
+        } else {
+            self.rows_at(model, held, t)?
+        };
+        let m = held.closed.len();
+        // q₁(c) = q₀ + s(q̇(q₀, p½) + Σ c_b M⁻¹row_b(q₀)): Newton on Φ(q₁(c)) = 0 and, for the
+        // stuck rows, J(q₀)(q₁ − q₀) = 0.
         model.velocity(&self.q, &self.p, t, &mut self.v)?;
         self.start.copy_from_slice(&self.q);
-        self.c[..m].fill(0.0);
+        self.c[..rows].fill(0.0);
         let scale = self.start.iter().fold(1.0_f64, |a, x| a.max(x.abs()));
         let mut converged = false;
         for _ in 0..ITERATIONS {
             for i in 0..n {
-                let shift: f64 = (0..m).map(|k| self.c[k] * self.inverse[k * n + i]).sum();
+                let shift: f64 = (0..rows).map(|k| self.c[k] * self.inverse[k * n + i]).sum();
                 self.q[i] = self.start[i] + s * (self.v[i] + shift);
             }
-            let (system, pivots) = &mut self.systems[m - 1];
-            for (a, &j) in closed.iter().enumerate() {
-                let contact = &contacts[j];
-                contact.surface.gradient(&self.q, &mut self.gradient)?;
-                for b in 0..m {
+            let (system, pivots) = &mut self.systems[rows - 1];
+            for a in 0..rows {
+                let row = if a < m {
+                    let surface = &held.contacts[held.closed[a]].surface;
+                    surface.gradient(&self.q, &mut self.gradient)?;
+                    self.r[a] = -surface.phi(&self.q)?;
+                    &self.gradient[..]
+                } else {
+                    let row = &self.rows[a * n..(a + 1) * n];
+                    self.r[a] = -(0..n).map(|i| row[i] * (self.q[i] - self.start[i])).sum::<f64>();
+                    row
+                };
+                for b in 0..rows {
                     let w = &self.inverse[b * n..(b + 1) * n];
-                    system[(a, b)] = s * self.gradient.iter().zip(w).map(|(g, w)| g * w).sum::<f64>();
+                    system[(a, b)] = s * row.iter().zip(w).map(|(g, w)| g * w).sum::<f64>();
                 }
-                self.r[a] = -contact.surface.phi(&self.q)?;
             }
             if lu_in_place(system, pivots).is_none() {
                 return Err("the held contacts' surfaces are not independent here".into());
             }
-            lu_solve(system, pivots, &mut self.r[..m]);
+            lu_solve(system, pivots, &mut self.r[..rows]);
             let mut change = 0.0_f64;
             for i in 0..n {
-                let shift: f64 = (0..m).map(|k| self.r[k] * self.inverse[k * n + i]).sum();
+                let shift: f64 = (0..rows).map(|k| self.r[k] * self.inverse[k * n + i]).sum();
                 change = change.max((s * shift).abs());
             }
-            for k in 0..m {
+            for k in 0..rows {
                 self.c[k] += self.r[k];
             }
             if change <= 4.0 * f64::EPSILON * scale {
@@ -189,113 +285,325 @@ impl Hold {
             .into());
         }
         for i in 0..n {
-            let shift: f64 = (0..m).map(|k| self.c[k] * self.inverse[k * n + i]).sum();
+            let shift: f64 = (0..rows).map(|k| self.c[k] * self.inverse[k * n + i]).sum();
             self.q[i] = self.start[i] + s * (self.v[i] + shift);
-            self.p[i] += (0..m).map(|k| self.c[k] * self.normals[k * n + i]).sum::<f64>();
+            self.p[i] += (0..rows).map(|k| self.c[k] * self.rows[k * n + i]).sum::<f64>();
         }
         model.dl_dq(&self.q, &self.zeros, t + s, &mut self.force)?;
         for (x, f) in self.p.iter_mut().zip(&self.force) {
             *x += 0.5 * s * f;
         }
-        self.project(model, (contacts, closed), t + s)
+        if !frictional {
+            return self.project(model, held, t + s);
+        }
+        // p₁ = p½ + (s/2)(∂L/∂q(q₁) + F(q₁, p₁)), projected: by fixed point from F(q₀, p₀).
+        self.half.copy_from_slice(&self.p);
+        let mut work = 0.5
+            * (0..n)
+                .map(|i| self.friction[i] * (self.q[i] - self.start[i]))
+                .sum::<f64>();
+        let mut settled = false;
+        let mut last = f64::INFINITY;
+        for _ in 0..ITERATIONS {
+            for ((x, h), f) in self.p.iter_mut().zip(&self.half).zip(&self.friction) {
+                *x = h + 0.5 * s * f;
+            }
+            self.project(model, held, t + s)?;
+            self.previous.copy_from_slice(&self.friction);
+            self.forces(model, held, t + s)?;
+            let size = self.previous.iter().fold(0.0_f64, |a, x| a.max(x.abs()));
+            let change = self
+                .previous
+                .iter()
+                .zip(&self.friction)
+                .fold(0.0_f64, |a, (x, y)| a.max((x - y).abs()));
+            // λ's curvature term is a difference, smooth in p to ε^(2/3) only: the iteration
+            // settles where its change stops falling, within that.
+            if change <= 4.0 * f64::EPSILON * size || (change >= last && change <= 1e-8 * size) {
+                settled = true;
+                break;
+            }
+            last = change;
+        }
+        if !settled {
+            return Err(format!(
+                "the sliding friction at a held step's end did not settle in {ITERATIONS} iterations (a step too large \
+                 for the friction's change)"
+            )
+            .into());
+        }
+        work += 0.5
+            * (0..n)
+                .map(|i| self.friction[i] * (self.q[i] - self.start[i]))
+                .sum::<f64>();
+        self.work += work;
+        Ok(())
     }
 
-    /// p made tangent to the closed contacts at q: p + ∇Φᵀμ with ∇Φ q̇(q, p + ∇Φᵀμ) = 0.
-    pub(super) fn project(
-        &mut self,
-        model: &dyn Lagrangian,
-        (contacts, closed): (&[Contact<'_>], &[usize]),
-        t: f64,
-    ) -> Result<(), ModelError> {
-        let (n, m) = (self.q.len(), closed.len());
+    /// The number of slip rows of the stuck contacts.
+    fn stuck_rows(&self, held: Held<'_, '_>) -> usize {
+        let n = self.q.len();
+        held.stuck
+            .iter()
+            .map(|&j| held.contacts[j].friction.as_ref().map_or(0, |f| f.rows(n)))
+            .sum()
+    }
+
+    /// p made tangent to the closed contacts at q and free of the stuck ones' slip: p + Σ c_b
+    /// row_b with rows · q̇(q, p + Σ c_b row_b) = 0.
+    pub(super) fn project(&mut self, model: &dyn Lagrangian, held: Held<'_, '_>, t: f64) -> Result<(), ModelError> {
+        let n = self.q.len();
         self.cached = None;
-        self.normals_at(model, (contacts, closed), t)?;
+        let rows = self.rows_at(model, held, t)?;
         model.velocity(&self.q, &self.p, t, &mut self.v)?;
-        let (system, pivots) = &mut self.systems[m - 1];
-        for a in 0..m {
-            let normal = &self.normals[a * n..(a + 1) * n];
-            for b in 0..m {
+        let (system, pivots) = &mut self.systems[rows - 1];
+        for a in 0..rows {
+            let row = &self.rows[a * n..(a + 1) * n];
+            for b in 0..rows {
                 let w = &self.inverse[b * n..(b + 1) * n];
-                system[(a, b)] = normal.iter().zip(w).map(|(g, w)| g * w).sum();
+                system[(a, b)] = row.iter().zip(w).map(|(g, w)| g * w).sum();
             }
-            self.c[a] = -normal.iter().zip(&self.v).map(|(g, v)| g * v).sum::<f64>();
+            self.c[a] = -row.iter().zip(&self.v).map(|(g, v)| g * v).sum::<f64>();
         }
         if lu_in_place(system, pivots).is_none() {
             return Err("the held contacts' surfaces are not independent here".into());
         }
-        lu_solve(system, pivots, &mut self.c[..m]);
+        lu_solve(system, pivots, &mut self.c[..rows]);
         for i in 0..n {
-            self.p[i] += (0..m).map(|k| self.c[k] * self.normals[k * n + i]).sum::<f64>();
+            self.p[i] += (0..rows).map(|k| self.c[k] * self.rows[k * n + i]).sum::<f64>();
         }
         Ok(())
     }
 
-    /// ∇φₖ(q) and M⁻¹∇φₖ = q̇(q, ∇φₖ) of the closed contacts, at q (q̇ linear in p: the
-    /// kick–drift methods' models have T = ½pᵀM⁻¹p).
-    fn normals_at(
-        &mut self,
-        model: &dyn Lagrangian,
-        (contacts, closed): (&[Contact<'_>], &[usize]),
-        t: f64,
-    ) -> Result<(), ModelError> {
+    /// The rows at q (∇φ of the closed contacts, then the stuck ones' slip rows) and M⁻¹
+    /// times each, q̇(q, row) (q̇ linear in p: the kick–drift methods' models have
+    /// T = ½pᵀM⁻¹p): their number.
+    fn rows_at(&mut self, model: &dyn Lagrangian, held: Held<'_, '_>, t: f64) -> Result<usize, ModelError> {
         let n = self.q.len();
-        for (a, &j) in closed.iter().enumerate() {
-            let normal = &mut self.normals[a * n..(a + 1) * n];
-            contacts[j].surface.gradient(&self.q, normal)?;
-            model.velocity(&self.q, normal, t, &mut self.inverse[a * n..(a + 1) * n])?;
+        for (a, &j) in held.closed.iter().enumerate() {
+            held.contacts[j]
+                .surface
+                .gradient(&self.q, &mut self.rows[a * n..(a + 1) * n])?;
         }
-        Ok(())
+        let mut next = held.closed.len();
+        for &j in held.stuck {
+            let a = held
+                .closed
+                .iter()
+                .position(|&k| k == j)
+                .expect("a stuck contact is closed");
+            let friction = held.contacts[j]
+                .friction
+                .as_ref()
+                .expect("a stuck contact has friction");
+            let k = friction.rows(n);
+            let (normals, slips) = self.rows.split_at_mut(next * n);
+            friction.jacobian(&normals[a * n..(a + 1) * n], &mut slips[..k * n])?;
+            next += k;
+        }
+        for a in 0..next {
+            model.velocity(
+                &self.q,
+                &self.rows[a * n..(a + 1) * n],
+                t,
+                &mut self.inverse[a * n..(a + 1) * n],
+            )?;
+        }
+        Ok(next)
     }
 
-    /// λ of the `closed` contacts at (q, p, t): the k-th into `out[k]`. For the models a held
-    /// step integrates (H = ½pᵀM⁻¹p + V(q), M constant, no forces) [`Reaction::solve`]'s
-    /// equations read (∇Φ M⁻¹∇Φᵀ)λ = −(∇²φₖ[q̇, q̇] + ∇φₖ·M⁻¹∂L/∂q), and the curvature term is
-    /// a central difference of ∇φₖ·q̇ along q̇, exact for quadrics: two gradients a contact
-    /// instead of the general difference's four evaluations of the whole motion.
-    pub(super) fn multipliers(
-        &mut self,
-        model: &dyn Lagrangian,
-        (contacts, closed): (&[Contact<'_>], &[usize]),
-        (q, p, t): (&[f64], &[f64], f64),
-        out: &mut [f64],
-    ) -> Result<(), ModelError> {
-        let (n, m) = (q.len(), closed.len());
-        if !self.at(q, t, closed) {
-            self.q.copy_from_slice(q);
-            self.normals_at(model, (contacts, closed), t)?;
-            model.dl_dq(q, &self.zeros, t, &mut self.force)?;
-            self.cache(t, closed);
-        }
-        model.velocity(q, p, t, &mut self.v)?;
-        model.velocity(q, &self.force, t, &mut self.w)?;
+    /// The multipliers of the state (q, p) at t (`q` and `p`, the rows at q in `rows`, ∂L/∂q
+    /// in `force`) into `lambda`, and the sliding contacts' friction force into `friction`.
+    ///
+    /// [`Reaction::solve`]'s equations, for the models a held step integrates (H = ½pᵀM⁻¹p +
+    /// V(q), M constant, no forces of their own): row_a·q̈ + (d row_a/dt)·q̇ = 0 with
+    /// q̈ = M⁻¹(∂L/∂q + Σ_b f_b λ_b), f_b = ∇φ_b − μ_k|∇φ_b|u_b for a closed contact (its
+    /// sliding force with it), row_b for a stuck slip row. The curvature term is a central
+    /// difference of row_a·q̇ along q̇, exact for quadrics: two gradients a row instead of the
+    /// general difference's four evaluations of the whole motion.
+    fn forces(&mut self, model: &dyn Lagrangian, held: Held<'_, '_>, t: f64) -> Result<usize, ModelError> {
+        let (n, m) = (self.q.len(), held.closed.len());
+        let rows = m + self.stuck_rows(held);
+        model.velocity(&self.q, &self.p, t, &mut self.v)?;
+        model.velocity(&self.q, &self.force, t, &mut self.w)?;
+        self.directions(model, held, t)?;
         let amax = |x: &[f64]| x.iter().fold(0.0_f64, |a, y| a.max(y.abs()));
         let speed = amax(&self.v);
         // The difference's step: truncation (s²) and rounding (ε/s) both near ε^(2/3).
-        let s = f64::EPSILON.cbrt() * amax(q).max(1.0) / speed;
-        let (system, pivots) = &mut self.systems[m - 1];
-        for (a, &j) in closed.iter().enumerate() {
-            let normal = &self.normals[a * n..(a + 1) * n];
+        let s = f64::EPSILON.cbrt() * amax(&self.q).max(1.0) / speed;
+        let (system, pivots) = &mut self.systems[rows - 1];
+        for a in 0..rows {
+            let row = &self.rows[a * n..(a + 1) * n];
             let mut curvature = 0.0;
             if speed > 0.0 {
                 for sign in [1.0, -1.0] {
-                    for (x, (qi, vi)) in self.start.iter_mut().zip(q.iter().zip(&self.v)) {
+                    for (x, (qi, vi)) in self.shifted.iter_mut().zip(self.q.iter().zip(&self.v)) {
                         *x = qi + sign * s * vi;
                     }
-                    contacts[j].surface.gradient(&self.start, &mut self.gradient)?;
-                    curvature += sign * self.gradient.iter().zip(&self.v).map(|(g, v)| g * v).sum::<f64>();
+                    row_at(held, a, &self.shifted, &mut self.gradient, &mut self.slip)?;
+                    let shifted = if a < m { &self.gradient[..] } else { &self.slip[..n] };
+                    curvature += sign * shifted.iter().zip(&self.v).map(|(g, v)| g * v).sum::<f64>();
                 }
                 curvature /= 2.0 * s;
             }
-            out[a] = -(curvature + normal.iter().zip(&self.w).map(|(g, x)| g * x).sum::<f64>());
-            for b in 0..m {
+            self.lambda[a] = -(curvature + row.iter().zip(&self.w).map(|(g, x)| g * x).sum::<f64>());
+            for b in 0..rows {
                 let w = &self.inverse[b * n..(b + 1) * n];
-                system[(a, b)] = normal.iter().zip(w).map(|(g, w)| g * w).sum();
+                let mut entry: f64 = row.iter().zip(w).map(|(g, w)| g * w).sum();
+                if let Some(friction) = (b < m).then(|| held.sliding(b)).flatten() {
+                    let normal = norm(&self.rows[b * n..(b + 1) * n]);
+                    let u = &self.units_inverse[b * n..(b + 1) * n];
+                    entry -= friction.kinetic * normal * row.iter().zip(u).map(|(g, u)| g * u).sum::<f64>();
+                }
+                system[(a, b)] = entry;
             }
         }
         if lu_in_place(system, pivots).is_none() {
             return Err("the held contacts' surfaces are not independent here".into());
         }
-        lu_solve(system, pivots, &mut out[..m]);
+        lu_solve(system, pivots, &mut self.lambda[..rows]);
+        self.friction.fill(0.0);
+        for b in 0..m {
+            if let Some(friction) = held.sliding(b) {
+                let size = friction.kinetic * norm(&self.rows[b * n..(b + 1) * n]) * self.lambda[b];
+                for (f, u) in self.friction.iter_mut().zip(&self.units[b * n..(b + 1) * n]) {
+                    *f -= size * u;
+                }
+            }
+        }
+        Ok(rows)
+    }
+
+    /// The sliding contacts' directions u = Jᵀŝ at the state (ŝ = s/|s|, s = Jq̇), or the
+    /// piece's where the slip has turned against it (or stopped), and M⁻¹u, into `units` and
+    /// `units_inverse`.
+    fn directions(&mut self, model: &dyn Lagrangian, held: Held<'_, '_>, t: f64) -> Result<(), ModelError> {
+        let n = self.q.len();
+        for a in 0..held.closed.len() {
+            let Some(friction) = held.sliding(a) else {
+                continue;
+            };
+            let k = friction.rows(n);
+            friction.jacobian(&self.rows[a * n..(a + 1) * n], &mut self.slip[..k * n])?;
+            let unit = &mut self.units[a * n..(a + 1) * n];
+            unit.fill(0.0);
+            let mut size = 0.0;
+            for r in 0..k {
+                let row = &self.slip[r * n..(r + 1) * n];
+                let s: f64 = row.iter().zip(&self.v).map(|(j, v)| j * v).sum();
+                size += s * s;
+                for (u, j) in unit.iter_mut().zip(row) {
+                    *u += s * j;
+                }
+            }
+            let j = held.closed[a];
+            let given = &held.directions[j * n..(j + 1) * n];
+            let along: f64 = unit.iter().zip(given).map(|(u, g)| u * g).sum();
+            if size > 0.0 && along > 0.0 {
+                let size = size.sqrt();
+                unit.iter_mut().for_each(|u| *u /= size);
+            } else {
+                unit.copy_from_slice(given);
+            }
+            model.velocity(&self.q, unit, t, &mut self.units_inverse[a * n..(a + 1) * n])?;
+        }
         Ok(())
     }
+
+    /// The multipliers of `held` at (q, p, t) into `out`: λ of the closed contacts (the k-th
+    /// into `out[k]`), then of the stuck contacts' slip rows (the force along each); the
+    /// number written.
+    pub(super) fn multipliers(
+        &mut self,
+        model: &dyn Lagrangian,
+        held: Held<'_, '_>,
+        (q, p, t): (&[f64], &[f64], f64),
+        out: &mut [f64],
+    ) -> Result<usize, ModelError> {
+        if !self.at(q, t, held) {
+            self.q.copy_from_slice(q);
+            self.rows_at(model, held, t)?;
+            model.dl_dq(q, &self.zeros, t, &mut self.force)?;
+            self.cache(t, held);
+        }
+        self.p.copy_from_slice(p);
+        let rows = self.forces(model, held, t)?;
+        out[..rows].copy_from_slice(&self.lambda[..rows]);
+        Ok(rows)
+    }
+
+    /// The slip s = J(q)q̇ of a contact at (q, p, t) into `out` (k entries), and its direction
+    /// in q, Jᵀs, into `direction`: the size of J's entries, max |J|.
+    pub(super) fn slip(
+        &mut self,
+        model: &dyn Lagrangian,
+        (contact, friction): (&Contact<'_>, &Friction),
+        (q, p, t): (&[f64], &[f64], f64),
+        (out, direction): (&mut [f64], &mut [f64]),
+    ) -> Result<f64, ModelError> {
+        let n = q.len();
+        let k = friction.rows(n);
+        contact.surface.gradient(q, &mut self.gradient)?;
+        friction.jacobian(&self.gradient, &mut self.slip[..k * n])?;
+        model.velocity(q, p, t, &mut self.v)?;
+        direction.fill(0.0);
+        for (s, row) in out.iter_mut().zip(self.slip[..k * n].chunks_exact(n)) {
+            *s = row.iter().zip(&self.v).map(|(j, v)| j * v).sum();
+            for (d, j) in direction.iter_mut().zip(row) {
+                *d += *s * j;
+            }
+        }
+        Ok(self.slip[..k * n].iter().fold(0.0_f64, |a, x| a.max(x.abs())))
+    }
+
+    /// Jᵀx for a contact's slip rows at q, x given (k entries), into `out`.
+    pub(super) fn slip_force(
+        &mut self,
+        (contact, friction): (&Contact<'_>, &Friction),
+        q: &[f64],
+        x: &[f64],
+        out: &mut [f64],
+    ) -> Result<(), ModelError> {
+        let n = q.len();
+        let k = friction.rows(n);
+        contact.surface.gradient(q, &mut self.gradient)?;
+        friction.jacobian(&self.gradient, &mut self.slip[..k * n])?;
+        out.fill(0.0);
+        for (x, row) in x.iter().zip(self.slip[..k * n].chunks_exact(n)) {
+            for (o, j) in out.iter_mut().zip(row) {
+                *o += x * j;
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Row a of `held`'s rows at q: a closed contact's ∇φ into `gradient` (a < m), or a stuck
+/// contact's slip row into `slip[..n]` (its gradient in `gradient`).
+fn row_at(held: Held<'_, '_>, a: usize, q: &[f64], gradient: &mut [f64], slip: &mut [f64]) -> Result<(), ModelError> {
+    let (n, m) = (q.len(), held.closed.len());
+    if a < m {
+        return held.contacts[held.closed[a]].surface.gradient(q, gradient);
+    }
+    let mut first = m;
+    for &j in held.stuck {
+        let friction = held.contacts[j]
+            .friction
+            .as_ref()
+            .expect("a stuck contact has friction");
+        let k = friction.rows(n);
+        if a < first + k {
+            held.contacts[j].surface.gradient(q, gradient)?;
+            friction.jacobian(gradient, &mut slip[..k * n])?;
+            slip.copy_within((a - first) * n..(a - first + 1) * n, 0);
+            return Ok(());
+        }
+        first += k;
+    }
+    unreachable!("row {a} of {first}")
+}
+
+/// |x|₂: the size of ∇φ, which turns λ into the normal force N = λ|∇φ|.
+fn norm(x: &[f64]) -> f64 {
+    x.iter().map(|y| y * y).sum::<f64>().sqrt()
 }

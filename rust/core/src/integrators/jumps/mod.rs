@@ -9,7 +9,8 @@
 //! - `resolve.rs`: a step that crosses a surface, redone in pieces at each contact;
 //!   `reflect.rs` and `variational.rs`: the laws that give the jump's multiplier λ;
 //! - `hold.rs`: a contact held closed (a body resting, sliding or rolling on it), by RATTLE on
-//!   the closed surfaces, until its multiplier crosses 0;
+//!   the closed surfaces, until its multiplier crosses 0; `friction.rs`: Coulomb friction on
+//!   it ([`Friction`]), sliding or sticking;
 //! - [`Impacts`]: what a run reports of them ([`super::Trajectory::impacts`]), with the
 //!   contacts' closures and releases ([`Switches`]);
 //! - [`Schedule`]: impulses ([`Impulse`], a [`Blow`] at a time) and samples (`t_eval`) at given
@@ -20,6 +21,7 @@
 //!   response ([`impulsive::respond`]) and constraints that engage suddenly
 //!   ([`impulsive::engage`]).
 
+mod friction;
 mod hold;
 pub mod impulsive;
 mod reflect;
@@ -29,6 +31,7 @@ mod surfaces;
 mod variational;
 mod watch;
 
+pub use friction::{Friction, Slip};
 pub use resolve::Gaps;
 pub(in crate::integrators) use resolve::Resolver;
 pub use schedule::{Blow, Generalized, Impulse, PointFunction, Schedule, Struck};
@@ -94,11 +97,13 @@ impl Law {
 }
 
 /// A unilateral constraint φ(q) ≥ 0 with its coefficient of restitution e ∈ [0, 1] (1:
-/// elastic), its impact law and its name (in errors, and as the Python API names it).
+/// elastic), its impact law, its friction while held, if any, and its name (in errors, and as
+/// the Python API names it).
 pub struct Contact<'s> {
     pub surface: Box<dyn Surface + 's>,
     pub restitution: f64,
     pub law: Law,
+    pub friction: Option<Friction>,
     pub name: String,
 }
 
@@ -115,6 +120,7 @@ impl std::fmt::Debug for Contact<'_> {
             .field("name", &self.name)
             .field("restitution", &self.restitution)
             .field("law", &self.law)
+            .field("friction", &self.friction)
             .finish_non_exhaustive()
     }
 }
@@ -126,6 +132,7 @@ pub struct NativeContact {
     pub surface: NativeSurface,
     pub restitution: f64,
     pub law: Law,
+    pub friction: Option<Friction>,
     pub name: String,
 }
 
@@ -136,6 +143,7 @@ impl NativeContact {
             surface: Box::new(self.surface.clone()),
             restitution: self.restitution,
             law: self.law,
+            friction: self.friction.clone(),
             name: self.name.clone(),
         }
     }
@@ -149,11 +157,14 @@ pub struct Contacts<'s> {
 
 impl<'s> Contacts<'s> {
     /// The set of `contacts`. Refuses (naming `contacts` and the contact) a restitution outside
-    /// [0, 1].
+    /// [0, 1] and friction coefficients that are not a law's (μ_s ≥ μ_k ≥ 0, finite).
     pub fn new(contacts: Vec<Contact<'s>>) -> Result<Self, Error> {
         for (i, c) in contacts.iter().enumerate() {
             if !(0.0..=1.0).contains(&c.restitution) {
                 return Err(c.refused(i, format!("restitution must lie in [0, 1], got {}", c.restitution)));
+            }
+            if let Some(reason) = c.friction.as_ref().and_then(Friction::invalid) {
+                return Err(c.refused(i, reason));
             }
         }
         Ok(Contacts { contacts })
@@ -179,10 +190,12 @@ impl<'s> Contacts<'s> {
         &self.contacts
     }
 
-    /// Whether every surface acts on n coordinates (a native surface's coordinates in range).
+    /// Whether every surface and slip acts on n coordinates (a native surface's coordinates in
+    /// range, slip rows of n columns).
     pub fn fit(&self, n: usize) -> Result<(), Error> {
         for (i, c) in self.contacts.iter().enumerate() {
-            if let Some(reason) = c.surface.misfit(n) {
+            let friction = c.friction.as_ref().and_then(|f| f.misfit(n));
+            if let Some(reason) = c.surface.misfit(n).or(friction) {
                 return Err(c.refused(i, reason));
             }
         }
@@ -256,39 +269,51 @@ pub struct Impacts {
     pub switches: Switches,
 }
 
-/// The closures and releases of a run's contacts, in order of time: contact `contact[k]`
-/// closed (`closed[k]`) or released during step `step[k]`, at time `t[k]` and the state
-/// (`q_at(k)`, `p_at(k)`).
+/// A change of a contact's state: closed, released, stuck (its friction holding its slip at 0:
+/// a body resting or rolling) or slipped (sliding from then on).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Switch {
+    Closed,
+    Released,
+    Stuck,
+    Slipped,
+}
+
+/// The closures, releases and friction switches of a run's contacts, in order of time:
+/// contact `contact[k]` switched (`kind[k]`) during step `step[k]`, at time `t[k]` and the
+/// state (`q_at(k)`, `p_at(k)`).
 ///
 /// A contact closes at the impact that ends its bounces, when the rest of their Zeno series
 /// (flights 2v⁺/|a|, 2ev⁺/|a|, … under the normal acceleration a) sums to less than a step:
 /// t is then the series' limit t∞ = t_impact + 2v⁺/(|a|(1 − e)) and the state the impact's
 /// (the motion is held from the impact on). An arrival without normal velocity closes it at
-/// once. It is released at lift-off, where its multiplier λ crosses 0.
+/// once. It is released at lift-off, where its multiplier λ crosses 0. With friction, a
+/// sliding contact sticks where its slip comes to rest with the force it needs within μ_s N,
+/// and a stuck one slips where that force reaches μ_s N.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Switches {
     pub contact: Vec<usize>,
     pub step: Vec<usize>,
     pub t: Vec<f64>,
-    pub closed: Vec<bool>,
+    pub kind: Vec<Switch>,
     pub q: Vec<f64>,
     pub p: Vec<f64>,
 }
 
 impl Switches {
-    /// Adds a closure (`closed`) or release.
+    /// Adds a switch.
     pub(in crate::integrators) fn push(
         &mut self,
         contact: usize,
         step: usize,
         t: f64,
-        closed: bool,
+        kind: Switch,
         (q, p): (&[f64], &[f64]),
     ) {
         self.contact.push(contact);
         self.step.push(step);
         self.t.push(t);
-        self.closed.push(closed);
+        self.kind.push(kind);
         self.q.extend_from_slice(q);
         self.p.extend_from_slice(p);
     }
@@ -297,7 +322,7 @@ impl Switches {
         self.contact.append(&mut other.contact);
         self.step.append(&mut other.step);
         self.t.append(&mut other.t);
-        self.closed.append(&mut other.closed);
+        self.kind.append(&mut other.kind);
         self.q.append(&mut other.q);
         self.p.append(&mut other.p);
     }
@@ -306,12 +331,12 @@ impl Switches {
         self.contact.clear();
         self.step.clear();
         self.t.clear();
-        self.closed.clear();
+        self.kind.clear();
         self.q.clear();
         self.p.clear();
     }
 
-    /// The number of closures and releases.
+    /// The number of switches.
     pub fn len(&self) -> usize {
         self.t.len()
     }

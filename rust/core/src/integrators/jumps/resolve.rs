@@ -7,9 +7,10 @@
 use std::borrow::{Borrow, BorrowMut};
 use std::ops::Deref;
 
-use super::hold::Hold;
+use super::hold::{Held, Hold};
 use super::{
-    reflect, round_off, variational, Contact, Contacts, Impacts, Law, NativeSurface, Schedule, Surface, MAX_IMPACTS,
+    reflect, round_off, variational, Contact, Contacts, Impacts, Law, NativeSurface, Schedule, Surface, Switch,
+    MAX_IMPACTS,
 };
 use crate::integrators::events::Search;
 use crate::integrators::DiscreteEnergy;
@@ -93,11 +94,30 @@ pub(in crate::integrators) struct Resolver<'c, 's, M> {
     closed_then: Vec<usize>,
     lambda: Vec<f64>,
     lambda_end: Vec<f64>,
-    /// The step's releases (their states, to start its samples from) and its changes of the
-    /// closed set in order, (time in the run, contact, closed), to undo back to a sample's time.
+    /// The step's releases and friction switches (their states, to start its samples from)
+    /// and its changes of the closed and stuck sets in order, (time in the run, contact,
+    /// switch), to undo back to a sample's time.
     released: Impacts,
-    changes: Vec<(f64, usize, bool)>,
+    changes: Vec<(f64, usize, Switch)>,
+    /// Whether some contact has friction; the closed contacts whose friction sticks, in
+    /// order, at the step's start and at a sample's time.
+    frictional: bool,
+    stuck: Vec<usize>,
+    stuck_start: Vec<usize>,
+    stuck_then: Vec<usize>,
+    /// Each contact's slip direction at the piece's start ([`Held`]), a contact's slip and its
+    /// direction in q.
+    directions: Vec<f64>,
+    slip: Vec<f64>,
+    direction: Vec<f64>,
+    /// The friction work of the last partial step, and of the step's pieces so far.
+    piece_work: f64,
+    step_work: f64,
 }
+
+/// Friction switches in one step at most: more is a stick–slip chatter the step cannot
+/// resolve, which ends the run with [`Error::Contact`].
+const MAX_SWITCHES: usize = 4 * MAX_IMPACTS;
 
 impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
     /// The resolver of `contacts` (checked by the caller, [`Contacts::check`]) and `schedule`
@@ -120,6 +140,11 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
         let holds = !model.as_lagrangian().is_forced() && !constrained;
         let scratch = Stepper::resume(model, StepperState::clone(stepper))?;
         let m = contacts.len();
+        // The multipliers of every contact closed and stuck at once.
+        let rows = m + contacts
+            .iter()
+            .filter_map(|c| c.friction.as_ref().map(|f| f.rows(n)))
+            .sum::<usize>();
         let t0 = stepper.t();
         let mut resolver = Resolver {
             contacts,
@@ -152,13 +177,35 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
                 .flatten(),
             closed: Vec::with_capacity(m),
             closed_start: Vec::with_capacity(m),
-            hold: (m > 0 && holds).then(|| Hold::new(stepper.method(), n, m)).flatten(),
+            hold: (m > 0 && holds)
+                .then(|| Hold::new(stepper.method(), n, contacts))
+                .flatten(),
             closed_then: Vec::with_capacity(m),
-            lambda: vec![0.0; m],
-            lambda_end: vec![0.0; m],
+            lambda: vec![0.0; rows],
+            lambda_end: vec![0.0; rows],
             released: Impacts::with_capacity(n, m),
             changes: Vec::with_capacity(2 * m),
+            frictional: contacts.iter().any(|c| c.friction.is_some()),
+            stuck: Vec::with_capacity(m),
+            stuck_start: Vec::with_capacity(m),
+            stuck_then: Vec::with_capacity(m),
+            directions: vec![0.0; n * m],
+            slip: vec![0.0; n],
+            direction: vec![0.0; n],
+            piece_work: 0.0,
+            step_work: 0.0,
         };
+        if resolver.frictional && resolver.hold.is_none() {
+            return Err(Error::invalid(
+                "contacts",
+                format!(
+                    "friction acts on held contacts, which {} hold on a model without forces or constraints of its \
+                     own, not {}",
+                    Hold::methods(),
+                    stepper.method().info().name
+                ),
+            ));
+        }
         let (step, time) = (stepper.steps(), stepper.t());
         evaluate(contacts, stepper.q(), &mut resolver.phi, step, time)?;
         resolver.close_resting((stepper.t(), stepper.q(), stepper.p()), step)?;
@@ -327,6 +374,8 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
                     traj.events.truncate(first);
                     self.closed.clear();
                     self.closed.extend_from_slice(&self.closed_start);
+                    self.stuck.clear();
+                    self.stuck.extend_from_slice(&self.stuck_start);
                     stepper.rewind(&self.q, &self.p)?;
                     return Err(error);
                 }
@@ -482,19 +531,24 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
                     self.t
                 }
             };
-            // The contacts closed at ts: the step's changes from ts on undone.
+            // The contacts closed and stuck at ts: the step's changes from ts on undone.
             self.closed_then.clear();
             self.closed_then.extend_from_slice(&self.closed);
-            for &(_, k, closed) in self.changes.iter().rev().take_while(|c| c.0 >= ts) {
-                if closed {
-                    self.closed_then.retain(|&j| j != k);
-                } else {
-                    insert(&mut self.closed_then, k);
+            self.stuck_then.clear();
+            self.stuck_then.extend_from_slice(&self.stuck);
+            for &(_, k, switch) in self.changes.iter().rev().take_while(|c| c.0 >= ts) {
+                match switch {
+                    Switch::Closed => self.closed_then.retain(|&j| j != k),
+                    Switch::Released => insert(&mut self.closed_then, k),
+                    Switch::Stuck => self.stuck_then.retain(|&j| j != k),
+                    Switch::Slipped => insert(&mut self.stuck_then, k),
                 }
             }
             std::mem::swap(&mut self.closed, &mut self.closed_then);
-            let sampled = self.partial(step, ta, ts - ta);
+            std::mem::swap(&mut self.stuck, &mut self.stuck_then);
+            let sampled = self.aim_piece(step, ta).and_then(|()| self.partial(step, ta, ts - ta));
             std::mem::swap(&mut self.closed, &mut self.closed_then);
+            std::mem::swap(&mut self.stuck, &mut self.stuck_then);
             sampled?;
             traj.push_state(ts, self.scratch.q(), self.scratch.p(), stepper);
         }
@@ -526,7 +580,12 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
         self.changes.clear();
         self.closed_start.clear();
         self.closed_start.extend_from_slice(&self.closed);
+        self.stuck_start.clear();
+        self.stuck_start.extend_from_slice(&self.stuck);
+        self.step_work = 0.0;
+        self.aim_piece(step, self.t)?;
         let (mut ta, mut tau, mut last) = (self.t, h, None);
+        let mut switches = 0;
         loop {
             if search.is_some() && !self.closed.is_empty() {
                 return Err(contact_error(
@@ -541,6 +600,7 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
             let piece = inside.map_or(tau, |t| t - ta);
             self.partial(step, ta, piece)?;
             evaluate(contacts, self.scratch.q(), &mut self.phi_end, step, self.t)?;
+            let switch = self.friction_switch(step, (ta, piece))?;
             let release = self.lift_off(step, (ta, piece))?;
             let mut first: Option<(f64, usize)> = None;
             for (j, contact) in contacts.iter().enumerate() {
@@ -564,9 +624,11 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
                     }
                 }
             }
-            if let Some((s, k)) = release.filter(|&(s, _)| first.is_none_or(|(s0, _)| s < s0)) {
+            let before = |s: f64| first.is_none_or(|(s0, _)| s < s0);
+            if let Some((s, k)) = release.filter(|&(s, _)| before(s) && switch.is_none_or(|(s1, ..)| s <= s1)) {
                 // Lift-off: the state there, the contact open from there on.
                 self.partial(step, ta, s)?;
+                self.step_work += self.piece_work;
                 self.contact_q.copy_from_slice(self.scratch.q());
                 self.contact_p.copy_from_slice(self.scratch.p());
                 self.piece_p.copy_from_slice(self.scratch.p());
@@ -578,10 +640,32 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
                 (ta, tau, last) = (t, tau - s, Some(k));
                 continue;
             }
+            if let Some((s, k, kind)) = switch.filter(|&(s, ..)| before(s)) {
+                // Stick or slip: the state there, the contact's friction switched from there on.
+                switches += 1;
+                if switches > MAX_SWITCHES {
+                    return Err(contact_error(format!(
+                        "the friction of {} switched between sticking and sliding more than {MAX_SWITCHES} times in \
+                         one step; shorten the step",
+                        contacts[k].name
+                    )));
+                }
+                self.partial(step, ta, s)?;
+                self.step_work += self.piece_work;
+                self.contact_q.copy_from_slice(self.scratch.q());
+                self.contact_p.copy_from_slice(self.scratch.p());
+                self.piece_p.copy_from_slice(self.scratch.p());
+                let t = ta + s;
+                self.switch_friction(k, kind, step, t)?;
+                self.restart_piece(step, None, t)?;
+                (ta, tau) = (t, tau - s);
+                continue;
+            }
             let (s, j) = match (first, inside) {
                 (Some(first), _) => first,
                 (None, Some(t_blow)) => {
                     // The piece reaches the impulse: the scratch holds (q, p⁻) there.
+                    self.step_work += self.piece_work;
                     self.contact_q.copy_from_slice(self.scratch.q());
                     self.contact_p.copy_from_slice(self.scratch.p());
                     if let Some(search) = search.as_deref_mut() {
@@ -603,7 +687,10 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
                     return Ok(false)
                 }
                 // The last piece ends the step: the scratch holds its end.
-                (None, None) => break,
+                (None, None) => {
+                    self.step_work += self.piece_work;
+                    break;
+                }
             };
             if self.pending.len() == MAX_IMPACTS {
                 return Err(contact_error(format!(
@@ -615,6 +702,7 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
             }
             // The contact state (q̃, p⁻), the end of this piece.
             self.partial(step, ta, s)?;
+            self.step_work += self.piece_work;
             self.contact_q.copy_from_slice(self.scratch.q());
             self.contact_p.copy_from_slice(self.scratch.p());
             let t_contact = ta + s;
@@ -637,6 +725,9 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
         }
         // The step's end: the last piece's, at tₙ₊₁.
         stepper.jump_to(self.scratch.q(), self.scratch.p())?;
+        if self.frictional {
+            stepper.add_contact_work(self.step_work);
+        }
         std::mem::swap(&mut self.phi, &mut self.phi_end);
         if let Some(search) = search {
             search.piece(step, (stepper.t(), stepper.q(), stepper.p()), tau, occurrences)?;
@@ -692,7 +783,8 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
         result.map(|()| value)
     }
 
-    /// λ of the closed contacts at the scratch's state, at time t, into `out`.
+    /// The multipliers of the closed contacts at the scratch's state, at time t, into `out`:
+    /// λ of each, then the force along each slip row of the stuck ones ([`Hold::multipliers`]).
     fn multipliers(&mut self, t: f64, out: &mut [f64], step: usize) -> Result<(), Error> {
         let time = self.t;
         let Resolver {
@@ -700,22 +792,296 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
             scratch,
             contacts,
             closed,
+            stuck,
+            directions,
             ..
         } = self;
         let hold = hold.as_mut().expect("a contact closes only where it can be held");
         let state = (scratch.q(), scratch.p(), t);
-        hold.multipliers(scratch.model().as_lagrangian(), (contacts, closed), state, out)
+        let held = Held {
+            contacts,
+            closed,
+            stuck,
+            directions,
+        };
+        hold.multipliers(scratch.model().as_lagrangian(), held, state, out)
+            .map(|_| ())
             .map_err(|source| Error::Model { step, time, source })
     }
 
     /// Contact k released at time t, at the state (`contact_q`, `piece_p`): at lift-off, or
-    /// just after a jump that moves the body off its surface.
+    /// just after a jump that moves the body off its surface. A stuck contact's sticking ends
+    /// with it (a change of its own, for the samples to undo).
     fn open(&mut self, k: usize, step: usize, t: f64) {
+        if self.stuck.contains(&k) {
+            self.stuck.retain(|&j| j != k);
+            self.changes.push((t, k, Switch::Slipped));
+        }
         self.closed.retain(|&j| j != k);
-        self.changes.push((t, k, false));
+        self.changes.push((t, k, Switch::Released));
         self.pending
             .switches
-            .push(k, step, t, false, (&self.contact_q, &self.piece_p));
+            .push(k, step, t, Switch::Released, (&self.contact_q, &self.piece_p));
+    }
+
+    /// The first friction switch in the piece of size τ from ta, with the scratch at its end
+    /// (and left there): a stuck contact that slips where the force its slip rows need, |λ_t|,
+    /// reaches μ_s N; a sliding one whose slip turns against its direction at the piece's
+    /// start, where it stops (it sticks there if it can, [`Resolver::switch_friction`]). Each
+    /// located by the Illinois method along the held partial steps, to round-off. None when
+    /// neither happens in the piece.
+    fn friction_switch(&mut self, step: usize, (ta, tau): (f64, f64)) -> Result<Option<(f64, usize, Switch)>, Error> {
+        if !self.frictional || self.closed.is_empty() {
+            return Ok(None);
+        }
+        let tolerance = 4.0 * f64::EPSILON * tau;
+        let mut first: Option<(f64, usize, Switch)> = None;
+        let mut searched = false;
+        for a in 0..self.closed.len() {
+            let j = self.closed[a];
+            if self.contacts[j].friction.is_none() {
+                continue;
+            }
+            let (kind, end) = if self.stuck.contains(&j) {
+                (Switch::Slipped, -self.excess(j, step, ta + tau)?)
+            } else {
+                (Switch::Stuck, self.along(j, step, ta + tau)?)
+            };
+            if end >= 0.0 {
+                continue;
+            }
+            searched = true;
+            let mut value = |s: f64| -> Result<f64, Error> {
+                self.partial(step, ta, s)?;
+                match kind {
+                    Switch::Slipped => Ok(-self.excess(j, step, ta + s)?),
+                    _ => self.along(j, step, ta + s),
+                }
+            };
+            let start = value(0.0)?;
+            let s = if start <= 0.0 {
+                if kind == Switch::Stuck {
+                    // Stopped at the piece's start already: its direction came from there.
+                    continue;
+                }
+                0.0
+            } else {
+                illinois(value, (0.0, start), (tau, end), tolerance)?.0
+            };
+            if first.is_none_or(|(s0, ..)| s < s0) {
+                first = Some((s, j, kind));
+            }
+        }
+        if searched {
+            self.partial(step, ta, tau)?;
+        }
+        Ok(first)
+    }
+
+    /// The multipliers at the scratch's state at time t into `lambda` ([`Resolver::multipliers`]),
+    /// stuck contact j's among them: its place among the closed (its λ) and its first slip row.
+    fn stuck_multipliers(&mut self, j: usize, step: usize, t: f64) -> Result<(usize, usize), Error> {
+        let n = self.scratch.q().len();
+        let mut lambda = std::mem::take(&mut self.lambda);
+        let result = self.multipliers(t, &mut lambda, step);
+        self.lambda = lambda;
+        result?;
+        let a = self
+            .closed
+            .iter()
+            .position(|&k| k == j)
+            .expect("a stuck contact is closed");
+        let mut row = self.closed.len();
+        for &k in self.stuck.iter().take_while(|&&k| k != j) {
+            row += self.contacts[k].friction.as_ref().map_or(0, |f| f.rows(n));
+        }
+        Ok((a, row))
+    }
+
+    /// |λ_t| − μ_s N of stuck contact j at the scratch's state at time t: the force its slip
+    /// rows need beyond what friction can give (N = λ|∇φ|).
+    fn excess(&mut self, j: usize, step: usize, t: f64) -> Result<f64, Error> {
+        let (a, row) = self.stuck_multipliers(j, step, t)?;
+        let friction = self.contacts[j]
+            .friction
+            .as_ref()
+            .expect("a stuck contact has friction");
+        let rows = friction.rows(self.normal.len());
+        let tangential = self.lambda[row..row + rows].iter().map(|x| x * x).sum::<f64>().sqrt();
+        self.contacts[j]
+            .surface
+            .gradient(self.scratch.q(), &mut self.normal)
+            .map_err(|source| Error::Model {
+                step,
+                time: self.t,
+                source,
+            })?;
+        let size = self.normal.iter().map(|x| x * x).sum::<f64>().sqrt();
+        Ok(tangential - friction.static_coefficient * self.lambda[a] * size)
+    }
+
+    /// Contact k's friction switched at time t, at the state (`contact_q`, `piece_p`), which
+    /// the scratch holds: slipped, or stopped sliding (`Switch::Stuck`), when it sticks if the
+    /// force that holds its slip at 0 is within μ_s N (the slip's round-off then projected
+    /// away), and slides on otherwise, from rest in a direction of its own
+    /// ([`Resolver::aim`]). The state is kept for the samples after it.
+    fn switch_friction(&mut self, k: usize, kind: Switch, step: usize, t: f64) -> Result<(), Error> {
+        let switched = if kind == Switch::Slipped {
+            self.stuck.retain(|&j| j != k);
+            true
+        } else {
+            insert(&mut self.stuck, k);
+            let sticks = self.excess(k, step, t)? <= 0.0;
+            if sticks {
+                self.project_piece(step, t)?;
+            } else {
+                self.stuck.retain(|&j| j != k);
+            }
+            sticks
+        };
+        if switched {
+            self.changes.push((t, k, kind));
+            self.pending
+                .switches
+                .push(k, step, t, kind, (&self.contact_q, &self.piece_p));
+        }
+        self.released
+            .push(k, step, t, &self.contact_q, &self.piece_p, &self.piece_p);
+        Ok(())
+    }
+
+    /// Whether closed contact j, just closed at the scratch's state at time t, sticks: its slip
+    /// round-off ([`Resolver::slip_at`]) and the force that holds it at 0 within μ_s N. It is
+    /// then stuck.
+    fn sticks(&mut self, j: usize, step: usize, t: f64) -> Result<bool, Error> {
+        if self.contacts[j].friction.is_none() {
+            return Ok(false);
+        }
+        let (size, tolerance) = self.slip_at(j, step, t)?;
+        if size > tolerance {
+            return Ok(false);
+        }
+        insert(&mut self.stuck, j);
+        if self.excess(j, step, t)? <= 0.0 {
+            return Ok(true);
+        }
+        self.stuck.retain(|&k| k != j);
+        Ok(false)
+    }
+
+    /// The sliding contacts' directions at the scratch's state at time t, a piece's start: each
+    /// its slip's, Jᵀs/|s|; from rest (a slip of round-off), the way the force that would hold
+    /// it points against, −Jᵀλ_t/|λ_t|.
+    fn aim(&mut self, step: usize, t: f64) -> Result<(), Error> {
+        let n = self.scratch.q().len();
+        for a in 0..self.closed.len() {
+            let j = self.closed[a];
+            if self.contacts[j].friction.is_none() || self.stuck.contains(&j) {
+                continue;
+            }
+            let time = self.t;
+            let (size, tolerance) = self.slip_at(j, step, t)?;
+            let scale = if size > tolerance {
+                size
+            } else {
+                insert(&mut self.stuck, j);
+                let held = self.stuck_multipliers(j, step, t);
+                self.stuck.retain(|&k| k != j);
+                let (_, row) = held?;
+                let Resolver {
+                    hold,
+                    scratch,
+                    contacts,
+                    lambda,
+                    direction,
+                    ..
+                } = self;
+                let hold = hold.as_mut().expect("a contact closes only where it can be held");
+                let contact = &contacts[j];
+                let friction = contact.friction.as_ref().expect("a sliding contact has friction");
+                let x = &lambda[row..row + friction.rows(n)];
+                hold.slip_force((contact, friction), scratch.q(), x, direction)
+                    .map_err(|source| Error::Model { step, time, source })?;
+                -x.iter().map(|y| y * y).sum::<f64>().sqrt()
+            };
+            let target = &mut self.directions[j * n..(j + 1) * n];
+            for (d, x) in target.iter_mut().zip(&self.direction) {
+                *d = if scale == 0.0 { 0.0 } else { x / scale };
+            }
+        }
+        Ok(())
+    }
+
+    /// `piece_p` made tangent to the closed contacts at `contact_q` and free of the stuck
+    /// ones' slip, at time t ([`Hold::project`]).
+    fn project_piece(&mut self, step: usize, t: f64) -> Result<(), Error> {
+        let time = self.t;
+        let Resolver {
+            hold,
+            scratch,
+            contacts,
+            closed,
+            stuck,
+            directions,
+            contact_q,
+            piece_p,
+            ..
+        } = self;
+        let hold = hold.as_mut().expect("a contact closes only where it can be held");
+        hold.q.copy_from_slice(contact_q);
+        hold.p.copy_from_slice(piece_p);
+        let held = Held {
+            contacts,
+            closed,
+            stuck,
+            directions,
+        };
+        hold.project(scratch.model().as_lagrangian(), held, t)
+            .map_err(|source| Error::Model { step, time, source })?;
+        piece_p.copy_from_slice(&hold.p);
+        Ok(())
+    }
+
+    /// The slip of sliding contact j at the scratch's state at time t along its direction at
+    /// the piece's start: negative once it has turned against it.
+    fn along(&mut self, j: usize, step: usize, t: f64) -> Result<f64, Error> {
+        let n = self.scratch.q().len();
+        self.slip_at(j, step, t)?;
+        Ok(dot(&self.direction, &self.directions[j * n..(j + 1) * n]))
+    }
+
+    /// The slip s = Jq̇ of contact j at the scratch's state at time t into `slip`, Jᵀs into
+    /// `direction`: its size |s|, and the size below which it is round-off,
+    /// 10³ε|J|∞(|q̇|∞ + h|M⁻¹∂L/∂q|∞) (a slip that the step's acceleration would reverse).
+    fn slip_at(&mut self, j: usize, step: usize, t: f64) -> Result<(f64, f64), Error> {
+        let time = self.t;
+        let h = self.scratch.dt();
+        let Resolver {
+            hold,
+            scratch,
+            contacts,
+            slip,
+            direction,
+            v,
+            w,
+            zeros,
+            ..
+        } = self;
+        let hold = hold.as_mut().expect("a contact closes only where it can be held");
+        let contact = &contacts[j];
+        let friction = contact.friction.as_ref().expect("a sliding contact has friction");
+        let model = scratch.model().as_lagrangian();
+        let (q, p) = (scratch.q(), scratch.p());
+        let model_error = |source| Error::Model { step, time, source };
+        let scale = hold
+            .slip(model, (contact, friction), (q, p, t), (slip, direction))
+            .map_err(model_error)?;
+        let size = slip[..friction.rows(q.len())].iter().map(|x| x * x).sum::<f64>().sqrt();
+        model.velocity(q, p, t, v).map_err(model_error)?;
+        let speed = amax(v);
+        model.dl_dq(q, zeros, t, w).map_err(model_error)?;
+        model.velocity(q, w, t, v).map_err(model_error)?;
+        Ok((size, 1e3 * f64::EPSILON * scale * (speed + h * amax(v))))
     }
 
     /// After a jump at time t to (q̃, p⁺) (`contact_q`, `piece_p`) with contacts closed: those
@@ -750,20 +1116,14 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
         if self.closed.is_empty() {
             return Ok(());
         }
-        let hold = self.hold.as_mut().expect("a contact closes only where it can be held");
-        hold.q.copy_from_slice(&self.contact_q);
-        hold.p.copy_from_slice(&self.piece_p);
-        let model = self.scratch.model().as_lagrangian();
-        hold.project(model, (self.contacts, &self.closed), t)
-            .map_err(model_error)?;
-        self.piece_p.copy_from_slice(&hold.p);
-        Ok(())
+        self.project_piece(step, t)
     }
 
     /// The contacts a body rests on at the state (t, q, p), closed: on the surface to
     /// round-off (|φ| and the normal velocity's reach in a step, |∇φ·q̇|h, within
-    /// [`round_off`]) and pressing on it (λ ≥ 0). A run's held states are such, so a run
-    /// resumed holds what it held.
+    /// [`round_off`]) and pressing on it (λ ≥ 0); those with friction stuck where they stick
+    /// ([`Resolver::sticks`]). A run's held states are such, so a run resumed holds what it
+    /// held.
     fn close_resting(&mut self, (t, q, p): (f64, &[f64], &[f64]), step: usize) -> Result<(), Error> {
         if self.hold.is_none() {
             return Ok(());
@@ -792,10 +1152,13 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
                 .multipliers(t, &mut lambda, step)
                 .map(|()| lambda[self.closed.len() - 1] >= 0.0);
             self.lambda = lambda;
-            self.closed.pop();
-            if pressed? {
-                self.closed.push(j);
+            if !pressed? {
+                self.closed.pop();
             }
+        }
+        // Stuck where their slip is at rest and friction can hold it.
+        for a in 0..self.closed.len() {
+            self.sticks(self.closed[a], step, t)?;
         }
         Ok(())
     }
@@ -807,7 +1170,18 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
             search.restart_piece(step, (t, &self.contact_q, &self.piece_p))?;
         }
         self.piece_q.copy_from_slice(&self.contact_q);
-        evaluate(self.contacts, &self.piece_q, &mut self.phi_start, step, self.t)
+        evaluate(self.contacts, &self.piece_q, &mut self.phi_start, step, self.t)?;
+        self.aim_piece(step, t)
+    }
+
+    /// The sliding contacts' directions at the piece's start (`piece_q`, `piece_p`) at time t
+    /// ([`Resolver::aim`]).
+    fn aim_piece(&mut self, step: usize, t: f64) -> Result<(), Error> {
+        if self.frictional && !self.closed.is_empty() {
+            self.scratch.restart(t, &self.piece_q, &self.piece_p, self.scratch.dt());
+            self.aim(step, t)?;
+        }
+        Ok(())
     }
 
     /// The jump on contact j at (q̃, p⁻) (the contact buffers), at the end of the piece of size s
@@ -857,10 +1231,18 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
         }
         if let Some(t_rest) = self.closes(j, step, t, (reflection, h))? {
             insert(&mut self.closed, j);
-            self.changes.push((t, j, true));
+            self.changes.push((t, j, Switch::Closed));
             self.pending
                 .switches
-                .push(j, step, t_rest, true, (&self.contact_q, &self.piece_p));
+                .push(j, step, t_rest, Switch::Closed, (&self.contact_q, &self.piece_p));
+            self.scratch.restart(t, &self.contact_q, &self.piece_p, h);
+            if self.sticks(j, step, t)? {
+                self.project_piece(step, t)?;
+                self.changes.push((t, j, Switch::Stuck));
+                self.pending
+                    .switches
+                    .push(j, step, t_rest, Switch::Stuck, (&self.contact_q, &self.piece_p));
+            }
         }
         self.energy_change(step, t)
     }
@@ -1062,20 +1444,23 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
     /// The scratch stepper at the end of the method's step of size s (0: none) from the
     /// piece's start at ta; an error names the run's step and its start.
     fn partial(&mut self, step: usize, ta: f64, s: f64) -> Result<(), Error> {
+        self.piece_work = 0.0;
         if let (Some(hold), false) = (self.hold.as_mut(), self.closed.is_empty() || s == 0.0) {
             // The held step, its end set on the scratch as a free piece's would be.
             let model = self.scratch.model().as_lagrangian();
-            hold.step(
-                model,
-                (self.contacts, &self.closed),
-                (ta, s),
-                (&self.piece_q, &self.piece_p),
-            )
-            .map_err(|source| Error::Model {
-                step,
-                time: self.t,
-                source,
-            })?;
+            let held = Held {
+                contacts: self.contacts,
+                closed: &self.closed,
+                stuck: &self.stuck,
+                directions: &self.directions,
+            };
+            hold.step(model, held, (ta, s), (&self.piece_q, &self.piece_p))
+                .map_err(|source| Error::Model {
+                    step,
+                    time: self.t,
+                    source,
+                })?;
+            self.piece_work = hold.work;
             self.scratch.restart(ta + s, &hold.q, &hold.p, s);
             return Ok(());
         }

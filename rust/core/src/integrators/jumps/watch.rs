@@ -1,7 +1,7 @@
 //! What a run or a stepper watches besides its states: events, contacts and a schedule of
 //! impulses and samples, begun once on a stepper's state and checked after every step.
 
-use std::borrow::{Borrow, BorrowMut};
+use std::borrow::BorrowMut;
 use std::ops::Deref;
 
 use super::{Resolver, Schedule};
@@ -41,10 +41,11 @@ where
     /// The watcher of `watch` for `stepper` on `model` from its state: the events started
     /// there, the contacts checked against the model and its method and the state (named
     /// `argument`, `q0` or `checkpoint`, if outside a contact). `energy`: the caller checks the
-    /// energy, and takes the change at the jumps from [`Watcher::take_energy_jump`].
-    pub fn begin<St: Borrow<StepperState>>(
+    /// energy, and takes the change at the jumps from [`Watcher::take_energy_jump`]. A stepper
+    /// watching contacts with friction counts their work from then on ([`Stepper::work`]).
+    pub fn begin<St: BorrowMut<StepperState>>(
         model: M,
-        stepper: &Stepper<M, St>,
+        stepper: &mut Stepper<M, St>,
         watch: Watch<'w, 'e, 'c>,
         argument: &'static str,
         energy: bool,
@@ -58,9 +59,9 @@ where
     /// (φ ≈ −1e-17) is then taken, as within one run, for one leaving the surface, so that a
     /// stepper advanced through a watcher resumed for each call is bit for bit one run (the
     /// binding's `Stepper`).
-    pub fn resume<St: Borrow<StepperState>>(
+    pub fn resume<St: BorrowMut<StepperState>>(
         model: M,
-        stepper: &Stepper<M, St>,
+        stepper: &mut Stepper<M, St>,
         watch: Watch<'w, 'e, 'c>,
         energy: bool,
     ) -> Result<Self, Error> {
@@ -68,14 +69,14 @@ where
     }
 
     /// The watcher, its contacts checked at the state named `argument` if given.
-    fn make<St: Borrow<StepperState>>(
+    fn make<St: BorrowMut<StepperState>>(
         model: M,
-        stepper: &Stepper<M, St>,
+        stepper: &mut Stepper<M, St>,
         watch: Watch<'w, 'e, 'c>,
         argument: Option<&'static str>,
         energy: bool,
     ) -> Result<Self, Error> {
-        let search = watch.events.map(|events| events.begin(model, stepper)).transpose()?;
+        let search = watch.events.map(|events| events.begin(model, &*stepper)).transpose()?;
         let resolver = (watch.contacts.is_some() || watch.schedule.is_some())
             .then(|| {
                 if let (Some(argument), Some(contacts)) = (argument, watch.contacts) {
@@ -84,6 +85,12 @@ where
                 Resolver::begin(model, stepper, (watch.contacts, watch.schedule), energy)
             })
             .transpose()?;
+        if watch
+            .contacts
+            .is_some_and(|c| c.contacts().iter().any(|c| c.friction.is_some()))
+        {
+            stepper.count_contact_work();
+        }
         Ok(Watcher { search, resolver })
     }
 
