@@ -131,6 +131,21 @@ def test_byerlys_billiard_ball_slides_and_then_rolls_at_five_sevenths_of_its_spe
     assert _energy_balance(traj, np.array([M, M, INERTIA]), traj.q[:, 1]) < 1e-13
 
 
+def test_a_rolling_ball_struck_slides_and_rolls_again_at_v_plus_five_sevenths_of_the_blow_over_m():
+    # A blow P at the centre has no friction: the ball slides at slip P/m, which friction takes
+    # at (7/2)μg, and rolls again at v + (5/7)P/m (its angular momentum about the contact point
+    # kept while it slides).
+    v, blow, mu, t_blow = 1.0, 0.7, 0.2, 0.5
+    strike = varmech.Impulse(generalized=[blow, 0.0, 0.0], t=t_blow)
+    traj = varmech.integrate(_ball(), [0.0, R, 0.0], [M * v, 0.0, INERTIA * v / R], dt=0.01, steps=150, contacts=[_floor(mu)], impulses=[strike])
+    _, _, _, stuck, slipped = traj.events
+    again = t_blow + 2 * blow / (7 * mu * G * M)
+    assert len(slipped) == 1 and slipped.t[0] == t_blow
+    assert len(stuck) == 1 and abs(stuck.t[0] - again) < 1e-13
+    np.testing.assert_allclose(traj.p[-1, 0] / M, v + 5 / 7 * blow / M, rtol=1e-13)
+    np.testing.assert_allclose(traj.p[traj.t < t_blow, 0], M * v, rtol=1e-15)
+
+
 def _rough_circle(method: str, dt: float, mu: float = 0.5, t_end: float = 2.0) -> tuple[varmech.Trajectory, np.ndarray]:
     """A particle sliding inside a rough circle of radius 1 at speed 1, no other force: its angle."""
     free = varmech.MechanicalSystem(2, lambda q: 0.0, lambda q: np.zeros(2), name="free")

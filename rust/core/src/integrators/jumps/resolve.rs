@@ -1085,8 +1085,9 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
     }
 
     /// After a jump at time t to (q̃, p⁺) (`contact_q`, `piece_p`) with contacts closed: those
-    /// the jump moves off their surface released, and p⁺ made tangent to the others (their
-    /// impulse, which keeps a body on a surface it presses on).
+    /// the jump moves off their surface released, the stuck ones it sets slipping slipped (a
+    /// jump has no friction: a ball struck while it rolls slides), and p⁺ made tangent to the
+    /// others (their impulse, which keeps a body on a surface it presses on).
     fn after_jump(&mut self, step: usize, t: f64) -> Result<(), Error> {
         if self.closed.is_empty() {
             return Ok(());
@@ -1115,6 +1116,24 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
         }
         if self.closed.is_empty() {
             return Ok(());
+        }
+        if !self.stuck.is_empty() {
+            let h = self.scratch.dt();
+            self.scratch.restart(t, &self.contact_q, &self.piece_p, h);
+            let mut a = 0;
+            while a < self.stuck.len() {
+                let k = self.stuck[a];
+                let (size, tolerance) = self.slip_at(k, step, t)?;
+                if size > tolerance {
+                    self.stuck.remove(a);
+                    self.changes.push((t, k, Switch::Slipped));
+                    self.pending
+                        .switches
+                        .push(k, step, t, Switch::Slipped, (&self.contact_q, &self.piece_p));
+                } else {
+                    a += 1;
+                }
+            }
         }
         self.project_piece(step, t)
     }
