@@ -504,8 +504,31 @@ fn contacts_allocate_nothing_in_the_step_loop() {
     );
 }
 
-/// Allocations of a run of `steps` steps of 0.01 of the ball resting on its floor (e = 0.5),
-/// held closed from the start, saving its first and last states.
+/// Allocations of a run of `model` from (q0, p0) of `steps` steps of h watching `contact`, held
+/// closed from the start and never released, saving its first and last states: that run.
+fn held_run<S: Dynamics>(
+    model: &S,
+    contact: Contact<'static>,
+    (q0, p0): (&[f64], &[f64]),
+    (h, steps): (f64, usize),
+) -> (usize, Trajectory) {
+    let contacts = Contacts::new(vec![contact]).unwrap();
+    let options = Options {
+        save_every: steps,
+        ..Options::new(h, steps)
+    };
+    let watch = Watch {
+        contacts: Some(&contacts),
+        ..Watch::default()
+    };
+    let before = allocated();
+    let traj = integrate_watching(model, Method::Verlet, q0, p0, &options, || Ok(()), watch).unwrap();
+    let count = allocated() - before;
+    assert!(traj.impacts.is_empty() && traj.impacts.switches.is_empty());
+    (count, traj)
+}
+
+/// Allocations of a run of `steps` steps of 0.01 of the ball resting on its floor (e = 0.5).
 fn resting(steps: usize) -> usize {
     let ball = scenes::BouncingBall::new(9.81).unwrap();
     let floor = Contact {
@@ -518,19 +541,7 @@ fn resting(steps: usize) -> usize {
         friction: None,
         name: "floor".into(),
     };
-    let contacts = Contacts::new(vec![floor]).unwrap();
-    let options = Options {
-        save_every: steps,
-        ..Options::new(0.01, steps)
-    };
-    let watch = Watch {
-        contacts: Some(&contacts),
-        ..Watch::default()
-    };
-    let before = allocated();
-    let traj = integrate_watching(&ball, Method::Verlet, &[0.0], &[0.0], &options, || Ok(()), watch).unwrap();
-    let count = allocated() - before;
-    assert!(traj.impacts.is_empty() && traj.impacts.switches.is_empty());
+    let (count, traj) = held_run(&ball, floor, (&[0.0], &[0.0]), (0.01, steps));
     assert_eq!((traj.q_at(1)[0], traj.p_at(1)[0]), (0.0, 0.0));
     count
 }
@@ -543,7 +554,7 @@ fn a_held_contact_allocates_nothing_in_the_step_loop() {
 }
 
 /// Allocations of a run of `steps` steps of 0.001 of a particle sliding inside a rough circle
-/// (μ = 0.5, no other force: N = mv²/r changes with the speed), saving its first and last states.
+/// (μ = 0.5, no other force: N = mv²/r changes with the speed).
 fn sliding(steps: usize) -> usize {
     let free = scenes::FreeBody::new(vec![1.0, 1.0]).unwrap();
     let rim = Contact {
@@ -562,28 +573,7 @@ fn sliding(steps: usize) -> usize {
         }),
         name: "rim".into(),
     };
-    let contacts = Contacts::new(vec![rim]).unwrap();
-    let options = Options {
-        save_every: steps,
-        ..Options::new(0.001, steps)
-    };
-    let watch = Watch {
-        contacts: Some(&contacts),
-        ..Watch::default()
-    };
-    let before = allocated();
-    let traj = integrate_watching(
-        &free,
-        Method::Verlet,
-        &[1.0, 0.0],
-        &[0.0, 1.0],
-        &options,
-        || Ok(()),
-        watch,
-    )
-    .unwrap();
-    let count = allocated() - before;
-    assert!(traj.impacts.is_empty() && traj.impacts.switches.is_empty());
+    let (count, traj) = held_run(&free, rim, (&[1.0, 0.0], &[0.0, 1.0]), (0.001, steps));
     assert!(traj.work[1] < 0.0);
     count
 }

@@ -18,12 +18,13 @@ use crate::impacts::{drop_ball, floor, split_run, with_contacts};
 
 const G: f64 = 9.81;
 
-/// A unit mass in the plane under gravity, V = g y.
-struct Particle(Mass);
+/// A body of unit mass under gravity, V = g y (y = q[1]), its coordinates' masses given: a
+/// particle in the plane, a ball (x, y, θ).
+struct Weighed(Mass, usize);
 
-impl MechanicalSystem for Particle {
+impl MechanicalSystem for Weighed {
     fn dim(&self) -> usize {
-        2
+        self.1
     }
 
     fn mass(&self) -> &Mass {
@@ -35,13 +36,15 @@ impl MechanicalSystem for Particle {
     }
 
     fn gradient(&self, _q: &[f64], grad: &mut [f64]) -> Result<(), ModelError> {
-        (grad[0], grad[1]) = (0.0, G);
+        grad.fill(0.0);
+        grad[1] = G;
         Ok(())
     }
 }
 
-fn particle() -> Particle {
-    Particle(Mass::scalar(1.0).unwrap())
+/// A unit mass in the plane under gravity.
+fn particle() -> Weighed {
+    Weighed(Mass::scalar(1.0).unwrap(), 2)
 }
 
 /// The outside of the unit circle, |q| ≥ 1 (a native ellipsoid, outside).
@@ -203,30 +206,8 @@ fn a_run_resumed_from_a_held_state_is_the_whole_run_bit_for_bit() {
     assert_eq!(&all.p[all.p.len() - rest.p.len()..], &rest.p[..]);
 }
 
-/// A uniform ball (x, y, θ) of unit mass and radius R on a floor under gravity.
-struct Ball(Mass);
-
 const R: f64 = 0.1;
 const INERTIA: f64 = 0.4 * R * R;
-
-impl MechanicalSystem for Ball {
-    fn dim(&self) -> usize {
-        3
-    }
-
-    fn mass(&self) -> &Mass {
-        &self.0
-    }
-
-    fn potential(&self, q: &[f64]) -> Result<f64, ModelError> {
-        Ok(G * q[1])
-    }
-
-    fn gradient(&self, _q: &[f64], grad: &mut [f64]) -> Result<(), ModelError> {
-        grad.copy_from_slice(&[0.0, G, 0.0]);
-        Ok(())
-    }
-}
 
 /// The floor y ≥ R with friction μ, the contact point slipping at ẋ − Rθ̇.
 fn rough_floor(mu: f64) -> Contacts<'static> {
@@ -253,7 +234,8 @@ fn rough_floor(mu: f64) -> Contacts<'static> {
 #[test]
 fn byerlys_billiard_ball_slides_and_then_rolls_at_five_sevenths_of_its_speed_from_2v0_over_7_mu_g() {
     let (v0, mu) = (2.0, 0.2);
-    let ball = Ball(Mass::diagonal(vec![1.0, 1.0, INERTIA]).unwrap());
+    // A uniform ball (x, y, θ) of unit mass and radius R.
+    let ball = Weighed(Mass::diagonal(vec![1.0, 1.0, INERTIA]).unwrap(), 3);
     let contacts = rough_floor(mu);
     let rolls = 2.0 * v0 / (7.0 * mu * G);
     let (q0, p0) = ([0.0, R, 0.0], [v0, 0.0, 0.0]);

@@ -602,7 +602,7 @@ fn a_state_a_round_off_past_a_surface_leaves_it_and_one_further_past_is_refused(
     let contacts = floor(1.0, Law::Variational);
     let options = Options::new(1e-3, 1);
     let (q0, p0) = ([-1e-17], [1.0]);
-    let outside = Stepper::new(&ball, Method::Verlet, &[-1e-9], &p0, &options).unwrap();
+    let mut outside = Stepper::new(&ball, Method::Verlet, &[-1e-9], &p0, &options).unwrap();
     match Watcher::begin(&ball, &mut outside, with_contacts(&contacts), "q0", false) {
         Err(Error::InvalidArgument { argument, reason }) => {
             assert_eq!(argument, "q0");

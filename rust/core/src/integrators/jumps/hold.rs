@@ -43,14 +43,16 @@ pub(super) struct Held<'h, 's> {
 
 impl Held<'_, '_> {
     /// The friction of the a-th closed contact, if it slides.
+    #[inline]
     fn sliding(&self, a: usize) -> Option<&Friction> {
         let j = self.closed[a];
         self.contacts[j].friction.as_ref().filter(|_| !self.stuck.contains(&j))
     }
 
-    /// Whether any closed contact has friction.
-    fn frictional(&self) -> bool {
-        self.closed.iter().any(|&j| self.contacts[j].friction.is_some())
+    /// Whether any closed contact slides with friction (a force in the kicks).
+    #[inline]
+    fn slides(&self) -> bool {
+        (0..self.closed.len()).any(|a| self.sliding(a).is_some())
     }
 }
 
@@ -169,8 +171,8 @@ impl Hold {
         }
         self.p.copy_from_slice(p);
         self.work = 0.0;
-        let frictional = held.frictional();
-        if frictional {
+        let sliding = held.slides();
+        if sliding {
             if !warm {
                 self.rows_at(model, held, t)?;
                 warm = true;
@@ -183,7 +185,7 @@ impl Hold {
         let mut time = t;
         for k in 0..self.gamma.len() {
             let s = self.gamma[k] * tau;
-            self.substep(model, held, (time, s), warm, frictional)?;
+            self.substep(model, held, (time, s), warm, sliding)?;
             time += s;
             warm = true;
         }
@@ -193,6 +195,7 @@ impl Hold {
 
     /// Whether `force`, `rows` and `inverse` are those of `held` at (q, t): the last step
     /// ended there.
+    #[inline]
     fn at(&self, q: &[f64], t: f64, held: Held<'_, '_>) -> bool {
         let m = held.closed.len();
         self.cached == Some(t)
@@ -219,7 +222,7 @@ impl Hold {
         held: Held<'_, '_>,
         (t, s): (f64, f64),
         warm: bool,
-        frictional: bool,
+        sliding: bool,
     ) -> Result<(), ModelError> {
         let n = self.q.len();
         for ((x, f), g) in self.p.iter_mut().zip(&self.force).zip(&self.friction) {
@@ -293,7 +296,7 @@ impl Hold {
         for (x, f) in self.p.iter_mut().zip(&self.force) {
             *x += 0.5 * s * f;
         }
-        if !frictional {
+        if !sliding {
             return self.project(model, held, t + s);
         }
         // p₁ = p½ + (s/2)(∂L/∂q(q₁) + F(q₁, p₁)), projected: by fixed point from F(q₀, p₀).
@@ -426,7 +429,10 @@ impl Hold {
         let rows = m + self.stuck_rows(held);
         model.velocity(&self.q, &self.p, t, &mut self.v)?;
         model.velocity(&self.q, &self.force, t, &mut self.w)?;
-        self.directions(model, held, t)?;
+        let slides = held.slides();
+        if slides {
+            self.directions(model, held, t)?;
+        }
         let amax = |x: &[f64]| x.iter().fold(0.0_f64, |a, y| a.max(y.abs()));
         let speed = amax(&self.v);
         // The difference's step: truncation (s²) and rounding (ε/s) both near ε^(2/3).
@@ -450,7 +456,7 @@ impl Hold {
             for b in 0..rows {
                 let w = &self.inverse[b * n..(b + 1) * n];
                 let mut entry: f64 = row.iter().zip(w).map(|(g, w)| g * w).sum();
-                if let Some(friction) = (b < m).then(|| held.sliding(b)).flatten() {
+                if let Some(friction) = (slides && b < m).then(|| held.sliding(b)).flatten() {
                     let normal = norm(&self.rows[b * n..(b + 1) * n]);
                     let u = &self.units_inverse[b * n..(b + 1) * n];
                     entry -= friction.kinetic * normal * row.iter().zip(u).map(|(g, u)| g * u).sum::<f64>();
@@ -463,7 +469,7 @@ impl Hold {
         }
         lu_solve(system, pivots, &mut self.lambda[..rows]);
         self.friction.fill(0.0);
-        for b in 0..m {
+        for b in (0..m).filter(|_| slides) {
             if let Some(friction) = held.sliding(b) {
                 let size = friction.kinetic * norm(&self.rows[b * n..(b + 1) * n]) * self.lambda[b];
                 for (f, u) in self.friction.iter_mut().zip(&self.units[b * n..(b + 1) * n]) {
@@ -474,9 +480,10 @@ impl Hold {
         Ok(rows)
     }
 
-    /// The sliding contacts' directions u = Jᵀŝ at the state (ŝ = s/|s|, s = Jq̇), or the
-    /// piece's where the slip has turned against it (or stopped), and M⁻¹u, into `units` and
-    /// `units_inverse`.
+    /// The sliding contacts' directions u = Jᵀŝ at the state (ŝ = s/|s|, s = Jq̇), or, where
+    /// the slip has turned against the piece's direction u₀ (or stopped), u₀ on the rows at the
+    /// state, ŝ = Ju₀/|Ju₀| (the same rows as the slip's, so that the force does not jump
+    /// between the two as the slip hovers at 0); and M⁻¹u, into `units` and `units_inverse`.
     fn directions(&mut self, model: &dyn Lagrangian, held: Held<'_, '_>, t: f64) -> Result<(), ModelError> {
         let n = self.q.len();
         for a in 0..held.closed.len() {
@@ -485,25 +492,27 @@ impl Hold {
             };
             let k = friction.rows(n);
             friction.jacobian(&self.rows[a * n..(a + 1) * n], &mut self.slip[..k * n])?;
-            let unit = &mut self.units[a * n..(a + 1) * n];
-            unit.fill(0.0);
-            let mut size = 0.0;
-            for r in 0..k {
-                let row = &self.slip[r * n..(r + 1) * n];
-                let s: f64 = row.iter().zip(&self.v).map(|(j, v)| j * v).sum();
-                size += s * s;
-                for (u, j) in unit.iter_mut().zip(row) {
-                    *u += s * j;
-                }
-            }
             let j = held.closed[a];
             let given = &held.directions[j * n..(j + 1) * n];
-            let along: f64 = unit.iter().zip(given).map(|(u, g)| u * g).sum();
-            if size > 0.0 && along > 0.0 {
-                let size = size.sqrt();
+            let along = |unit: &mut [f64], x: &[f64]| {
+                unit.fill(0.0);
+                let mut size = 0.0;
+                for row in self.slip[..k * n].chunks_exact(n) {
+                    let s: f64 = row.iter().zip(x).map(|(j, x)| j * x).sum();
+                    size += s * s;
+                    for (u, j) in unit.iter_mut().zip(row) {
+                        *u += s * j;
+                    }
+                }
+                size.sqrt()
+            };
+            let unit = &mut self.units[a * n..(a + 1) * n];
+            let mut size = along(unit, &self.v);
+            if !(size > 0.0 && unit.iter().zip(given).map(|(u, g)| u * g).sum::<f64>() > 0.0) {
+                size = along(unit, given);
+            }
+            if size > 0.0 {
                 unit.iter_mut().for_each(|u| *u /= size);
-            } else {
-                unit.copy_from_slice(given);
             }
             model.velocity(&self.q, unit, t, &mut self.units_inverse[a * n..(a + 1) * n])?;
         }
@@ -580,6 +589,7 @@ impl Hold {
 
 /// Row a of `held`'s rows at q: a closed contact's ∇φ into `gradient` (a < m), or a stuck
 /// contact's slip row into `slip[..n]` (its gradient in `gradient`).
+#[inline]
 fn row_at(held: Held<'_, '_>, a: usize, q: &[f64], gradient: &mut [f64], slip: &mut [f64]) -> Result<(), ModelError> {
     let (n, m) = (q.len(), held.closed.len());
     if a < m {

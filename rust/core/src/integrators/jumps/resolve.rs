@@ -787,26 +787,23 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
     /// λ of each, then the force along each slip row of the stuck ones ([`Hold::multipliers`]).
     fn multipliers(&mut self, t: f64, out: &mut [f64], step: usize) -> Result<(), Error> {
         let time = self.t;
-        let Resolver {
-            hold,
-            scratch,
-            contacts,
-            closed,
-            stuck,
-            directions,
-            ..
-        } = self;
-        let hold = hold.as_mut().expect("a contact closes only where it can be held");
+        let (hold, held, scratch) = self.holding();
         let state = (scratch.q(), scratch.p(), t);
-        let held = Held {
-            contacts,
-            closed,
-            stuck,
-            directions,
-        };
         hold.multipliers(scratch.model().as_lagrangian(), held, state, out)
             .map(|_| ())
             .map_err(|source| Error::Model { step, time, source })
+    }
+
+    /// The held step, what it holds now, and the scratch stepper.
+    fn holding(&mut self) -> (&mut Hold, Held<'_, 's>, &Stepper<M>) {
+        let hold = self.hold.as_mut().expect("a contact closes only where it can be held");
+        let held = Held {
+            contacts: self.contacts,
+            closed: &self.closed,
+            stuck: &self.stuck,
+            directions: &self.directions,
+        };
+        (hold, held, &self.scratch)
     }
 
     /// Contact k released at time t, at the state (`contact_q`, `piece_p`): at lift-off, or
@@ -1016,30 +1013,15 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
     /// ones' slip, at time t ([`Hold::project`]).
     fn project_piece(&mut self, step: usize, t: f64) -> Result<(), Error> {
         let time = self.t;
-        let Resolver {
-            hold,
-            scratch,
-            contacts,
-            closed,
-            stuck,
-            directions,
-            contact_q,
-            piece_p,
-            ..
-        } = self;
-        let hold = hold.as_mut().expect("a contact closes only where it can be held");
-        hold.q.copy_from_slice(contact_q);
-        hold.p.copy_from_slice(piece_p);
-        let held = Held {
-            contacts,
-            closed,
-            stuck,
-            directions,
-        };
-        hold.project(scratch.model().as_lagrangian(), held, t)
-            .map_err(|source| Error::Model { step, time, source })?;
-        piece_p.copy_from_slice(&hold.p);
-        Ok(())
+        // Lent out while the held step is borrowed with the rest (moves, no copies).
+        let (q, mut p) = (std::mem::take(&mut self.contact_q), std::mem::take(&mut self.piece_p));
+        let (hold, held, scratch) = self.holding();
+        hold.q.copy_from_slice(&q);
+        hold.p.copy_from_slice(&p);
+        let projected = hold.project(scratch.model().as_lagrangian(), held, t);
+        p.copy_from_slice(&hold.p);
+        (self.contact_q, self.piece_p) = (q, p);
+        projected.map_err(|source| Error::Model { step, time, source })
     }
 
     /// The slip of sliding contact j at the scratch's state at time t along its direction at
@@ -1466,13 +1448,13 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
         self.piece_work = 0.0;
         if let (Some(hold), false) = (self.hold.as_mut(), self.closed.is_empty() || s == 0.0) {
             // The held step, its end set on the scratch as a free piece's would be.
-            let model = self.scratch.model().as_lagrangian();
             let held = Held {
                 contacts: self.contacts,
                 closed: &self.closed,
                 stuck: &self.stuck,
                 directions: &self.directions,
             };
+            let model = self.scratch.model().as_lagrangian();
             hold.step(model, held, (ta, s), (&self.piece_q, &self.piece_p))
                 .map_err(|source| Error::Model {
                     step,
