@@ -170,6 +170,22 @@ def test_a_particle_on_a_rough_circle_slows_as_v0_over_1_plus_mu_v0_t_at_the_met
     assert balances[1] < balances[0] / 2 ** (order - 0.1)
 
 
+def test_a_bob_swinging_in_a_rough_bowl_turns_back_until_it_sticks_where_tan_theta_is_within_mu_s():
+    # Each turn of the swing stops the slip and slides it back (|λ_t| > μ_s N there), until a
+    # turn comes within tan θ ≤ μ_s: it sticks there for good. The energy only falls.
+    mu = 0.1
+    bowl = varmech.Contact.ellipsoid([1.0, 1.0], restitution=0.0, law="reflect", name="bowl", friction=varmech.Friction(mu))
+    q0 = np.array([math.sin(1.0), -math.cos(1.0)])
+    traj = varmech.integrate(_block(), q0 / np.hypot(*q0), [0.0, 0.0], dt=0.01, t_end=40.0, contacts=[bowl])
+    _, closed, released, stuck, slipped = traj.events
+    assert len(closed) == len(released) == len(slipped) == 0 and len(stuck) == 1
+    x, y = stuck.q[0]
+    assert abs(x / y) <= mu and abs(x / y) > mu / 3, "it stops at a turn, short of the bottom"
+    assert np.all(np.abs(traj.q[traj.t > stuck.t[0]] - stuck.q[0]) < 1e-15)
+    energy = 0.5 * np.sum(traj.p**2, axis=1) + G * traj.q[:, 1]
+    assert np.all(np.diff(energy) <= 1e-12) and _energy_balance(traj, np.ones(2), traj.q[:, 1]) < 1e-3
+
+
 @pytest.mark.parametrize(("method", "order"), [("verlet", 2), ("yoshida4", 4)])
 def test_a_ball_rolling_on_a_spring_slips_where_rolling_needs_mu_s_mg_at_the_methods_order(method, order):
     k, v0, mu_s = 10.0, 1.0, 0.1
