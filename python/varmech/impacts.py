@@ -151,7 +151,21 @@ class Friction:
             object.__setattr__(self, "slip", tuple(tuple(float(x) for x in row) for row in rows))
 
     def spec(self) -> tuple[float, float, tuple[int, list[float]] | None]:
-        """The binding's tuple: μ_s, μ_k and the slip rows (their number and entries), if given."""
+        """The friction as the binding takes it (and a file stores it).
+
+        Returns
+        -------
+        tuple
+            (μ_s, μ_k, slip): slip None for a particle's tangent plane, or (k, the k × n rows
+            J row by row).
+
+        Examples
+        --------
+        >>> Friction(0.5, 0.4).spec()
+        (0.5, 0.4, None)
+        >>> Friction(0.2, slip=[[1.0, 0.0, -0.1]]).spec()
+        (0.2, 0.2, (1, [1.0, 0.0, -0.1]))
+        """
         slip = None if self.slip is None else (len(self.slip), [x for row in self.slip for x in row])
         return (float(self.mu_s), float(self.mu_k if self.mu_k is not None else self.mu_s), slip)
 

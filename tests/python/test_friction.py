@@ -63,7 +63,7 @@ def test_a_block_on_a_slope_stays_at_tan_alpha_below_mu_s_and_slides_at_g_sin_mi
     mu_k = 0.2
     slides = varmech.integrate(_block(), TOP, [0.0, 0.0], dt=0.01, steps=200, method=method, contacts=[_slope(tan * (1 - 1e-9), mu_k)])
     a = G * (math.sin(ALPHA) - mu_k * math.cos(ALPHA))
-    np.testing.assert_allclose((slides.q - TOP) @ DOWN, a * slides.t**2 / 2, rtol=0, atol=1e-13)
+    np.testing.assert_allclose((slides.q - TOP) @ DOWN, a * slides.t**2 / 2, rtol=1e-13, atol=1e-13)
     assert all(len(e) == 0 for e in slides.events), "slides from the start, never sticks"
     # Sliding with constant force the held step is exact, and so is the balance with W = −μ_k N d.
     np.testing.assert_allclose(slides.work, -mu_k * G * math.cos(ALPHA) * ((slides.q - TOP) @ DOWN), rtol=1e-13, atol=1e-15)
@@ -168,6 +168,38 @@ def test_a_particle_on_a_rough_circle_slows_as_v0_over_1_plus_mu_v0_t_at_the_met
     assert abs(math.log2(errors[0] / errors[1]) - order) < 0.05
     # The balance's error is the method's: it falls at its order too.
     assert balances[1] < balances[0] / 2 ** (order - 0.1)
+
+
+@pytest.mark.parametrize(("method", "order"), [("verlet", 2), ("yoshida4", 4)])
+def test_a_block_pushed_across_a_rough_slope_curves_and_stops_where_scipy_stops_it_at_the_methods_order(method, order):
+    # A slip in two dimensions: the force turns with it, and the stop (|s| = 0, not a sign change)
+    # is located where the slip turns against its direction at the step's start. Reference: the
+    # sliding equations in the slope's plane by DOP853 at 1e-13, stopped where |v| = 1e-9.
+    from scipy.integrate import solve_ivp
+
+    alpha, mu = math.radians(20), 0.5
+    normal, up = np.array([-math.sin(alpha), 0.0, math.cos(alpha)]), np.array([math.cos(alpha), 0.0, math.sin(alpha)])
+    block = varmech.MechanicalSystem(3, lambda q: G * q[2], lambda q: np.array([0.0, 0.0, G]), name="block")
+    slope = varmech.Contact(lambda q: q @ normal, lambda q: normal, restitution=0.0, law="reflect", name="slope", friction=varmech.Friction(0.6, mu))
+
+    def sliding(t, y):
+        v = y[2:]
+        return [*v, *(np.array([-G * math.sin(alpha), 0.0]) - mu * G * math.cos(alpha) * v / np.linalg.norm(v))]
+
+    def stops(t, y):
+        return np.linalg.norm(y[2:]) - 1e-9
+
+    stops.terminal = True  # type: ignore[attr-defined]
+    exact = solve_ivp(sliding, (0.0, 2.0), [0.0, 0.0, 0.0, 2.0], method="DOP853", rtol=1e-13, atol=1e-15, events=stops)
+    t_stop, (u_stop, w_stop, *_) = exact.t_events[0][0], exact.y_events[0][0]
+    errors = []
+    for dt in (0.01, 0.005):
+        traj = varmech.integrate(block, [0.0, 0.0, 0.0], [0.0, 2.0, 0.0], dt=dt, t_end=1.5, method=method, contacts=[slope])
+        stuck = traj.events[3]
+        assert len(stuck) == 1 and len(traj.events[4]) == 0
+        errors.append(max(abs(stuck.t[0] - t_stop), abs(stuck.q[0] @ up - u_stop), abs(stuck.q[0][1] - w_stop)))
+        assert np.all(traj.q[traj.t > stuck.t[0]] == stuck.q[0])
+    assert math.log2(errors[0] / errors[1]) > order - 0.25, errors
 
 
 def test_a_bob_swinging_in_a_rough_bowl_turns_back_until_it_sticks_where_tan_theta_is_within_mu_s():

@@ -56,6 +56,14 @@ impl Held<'_, '_> {
     }
 }
 
+/// Whose slip a sliding force opposes: the state's, or, at a step's end, that of the state
+/// before the friction kick (`Hold::along`).
+#[derive(Clone, Copy)]
+enum Slipping {
+    Now,
+    Before,
+}
+
 /// The held step of one method on a run's contacts, with every buffer it needs (made once: a
 /// step allocates nothing).
 #[derive(Debug)]
@@ -72,6 +80,8 @@ pub(super) struct Hold {
     friction: Vec<f64>,
     start: Vec<f64>,
     half: Vec<f64>,
+    /// q̇ at p̃, the step's end before its friction kick, whose slip the force opposes.
+    along: Vec<f64>,
     previous: Vec<f64>,
     shifted: Vec<f64>,
     /// The constraint rows at q, k-th at k·n: ∇φ of the closed contacts, then the slip rows J
@@ -126,6 +136,7 @@ impl Hold {
             friction: v(),
             start: v(),
             half: v(),
+            along: v(),
             previous: v(),
             shifted: v(),
             rows: vec![0.0; n * rows],
@@ -177,7 +188,7 @@ impl Hold {
                 self.rows_at(model, held, t)?;
                 warm = true;
             }
-            self.forces(model, held, t)?;
+            self.forces(model, held, t, Slipping::Now)?;
         } else {
             self.friction.fill(0.0);
         }
@@ -299,8 +310,13 @@ impl Hold {
         if !sliding {
             return self.project(model, held, t + s);
         }
-        // p₁ = p½ + (s/2)(∂L/∂q(q₁) + F(q₁, p₁)), projected: by fixed point from F(q₀, p₀).
+        // p₁ = p̃ + (s/2)F(q₁, p₁), projected, p̃ = p½ + (s/2)∂L/∂q(q₁): by fixed point from
+        // F(q₀, p₀). The force's direction is p̃'s slip's: p₁'s where the kick leaves the slip's
+        // direction as it is (a metric isotropic on the slip), which the fixed point cannot
+        // find where the slip is about to stop; the iteration then settles N alone.
+        self.project(model, held, t + s)?;
         self.half.copy_from_slice(&self.p);
+        model.velocity(&self.q, &self.p, t + s, &mut self.along)?;
         let mut work = 0.5
             * (0..n)
                 .map(|i| self.friction[i] * (self.q[i] - self.start[i]))
@@ -313,7 +329,7 @@ impl Hold {
             }
             self.project(model, held, t + s)?;
             self.previous.copy_from_slice(&self.friction);
-            self.forces(model, held, t + s)?;
+            self.forces(model, held, t + s, Slipping::Before)?;
             let size = self.previous.iter().fold(0.0_f64, |a, x| a.max(x.abs()));
             let change = self
                 .previous
@@ -424,14 +440,20 @@ impl Hold {
     /// sliding force with it), row_b for a stuck slip row. The curvature term is a central
     /// difference of row_a·q̇ along q̇, exact for quadrics: two gradients a row instead of the
     /// general difference's four evaluations of the whole motion.
-    fn forces(&mut self, model: &dyn Lagrangian, held: Held<'_, '_>, t: f64) -> Result<usize, ModelError> {
+    fn forces(
+        &mut self,
+        model: &dyn Lagrangian,
+        held: Held<'_, '_>,
+        t: f64,
+        slipping: Slipping,
+    ) -> Result<usize, ModelError> {
         let (n, m) = (self.q.len(), held.closed.len());
         let rows = m + self.stuck_rows(held);
         model.velocity(&self.q, &self.p, t, &mut self.v)?;
         model.velocity(&self.q, &self.force, t, &mut self.w)?;
         let slides = held.slides();
         if slides {
-            self.directions(model, held, t)?;
+            self.directions(model, held, t, slipping)?;
         }
         let amax = |x: &[f64]| x.iter().fold(0.0_f64, |a, y| a.max(y.abs()));
         let speed = amax(&self.v);
@@ -480,11 +502,18 @@ impl Hold {
         Ok(rows)
     }
 
-    /// The sliding contacts' directions u = Jᵀŝ at the state (ŝ = s/|s|, s = Jq̇), or, where
-    /// the slip has turned against the piece's direction u₀ (or stopped), u₀ on the rows at the
-    /// state, ŝ = Ju₀/|Ju₀| (the same rows as the slip's, so that the force does not jump
-    /// between the two as the slip hovers at 0); and M⁻¹u, into `units` and `units_inverse`.
-    fn directions(&mut self, model: &dyn Lagrangian, held: Held<'_, '_>, t: f64) -> Result<(), ModelError> {
+    /// The sliding contacts' directions u = Jᵀŝ at the state (ŝ = s/|s|, s = Jq̇, of the
+    /// velocity `slipping` names), or, where the slip has turned against the piece's direction
+    /// u₀ (or stopped), u₀ on the rows at the state, ŝ = Ju₀/|Ju₀| (the same rows as the slip's,
+    /// so that the force does not jump between the two as the slip hovers at 0); and M⁻¹u, into
+    /// `units` and `units_inverse`.
+    fn directions(
+        &mut self,
+        model: &dyn Lagrangian,
+        held: Held<'_, '_>,
+        t: f64,
+        slipping: Slipping,
+    ) -> Result<(), ModelError> {
         let n = self.q.len();
         for a in 0..held.closed.len() {
             let Some(friction) = held.sliding(a) else {
@@ -507,7 +536,11 @@ impl Hold {
                 size.sqrt()
             };
             let unit = &mut self.units[a * n..(a + 1) * n];
-            let mut size = along(unit, &self.v);
+            let velocity = match slipping {
+                Slipping::Now => &self.v,
+                Slipping::Before => &self.along,
+            };
+            let mut size = along(unit, velocity);
             if !(size > 0.0 && unit.iter().zip(given).map(|(u, g)| u * g).sum::<f64>() > 0.0) {
                 size = along(unit, given);
             }
@@ -536,7 +569,7 @@ impl Hold {
             self.cache(t, held);
         }
         self.p.copy_from_slice(p);
-        let rows = self.forces(model, held, t)?;
+        let rows = self.forces(model, held, t, Slipping::Now)?;
         out[..rows].copy_from_slice(&self.lambda[..rows]);
         Ok(rows)
     }
