@@ -415,7 +415,7 @@ def ensemble(
     released = [c for c in cores if isinstance(c, (_core.NativeModel, _core.CompiledModel))]
     native = (
         all(e.native is not None for e in watched)
-        and all(spec[3] != "functions" for spec in contact_specs)
+        and all(c.native for c in contacts)
         and all(kind == "generalized" for _, kind, _ in impulse_specs)
     )
     if len(released) == len(cores) and native:

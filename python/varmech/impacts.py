@@ -83,7 +83,10 @@ class Friction:
 
     The slip is s = J q̇, the velocity of the contact point along the surface. For a particle's
     own coordinates (n = 2 or 3) J is the tangent plane of ∇φ and need not be given; a body that
-    turns gives its rows (``slip``). A sliding contact sticks where its slip comes to rest and the
+    turns gives its rows (``slip``), constant, or as a function J(q) where they turn with the
+    body: a velocity constraint J(q)q̇ = 0 then holds while the contact sticks, and gives way to
+    sliding where it needs more than μ_s N (a wheel rolling on its heading φ, slip
+    J = [[1, 0, −r cos φ], [0, 1, −r sin φ]] in (x, y, θ), skids). A sliding contact sticks where its slip comes to rest and the
     force that holds it there is within μ_s N (a block stopping on a slope, a ball that starts to
     roll), and a stuck one slips where that force reaches μ_s N; both are located to round-off
     on the held steps, and reported as ``"<name>.stuck"`` and ``"<name>.slipped"`` in
@@ -100,14 +103,18 @@ class Friction:
         The static coefficient μ_s ≥ μ_k.
     mu_k : float, optional
         The kinetic coefficient μ_k ≥ 0 (default μ_s).
-    slip : array_like, shape (k, n), optional
-        The slip's rows J, constant: s = J q̇ (default: a particle's tangent plane, n = 2 or 3).
+    slip : array_like, shape (k, n), or callable, optional
+        The slip's rows J: s = J q̇. Constant rows, or a function ``slip(q)`` returning them
+        (k, n); default: a particle's tangent plane (n = 2 or 3).
+    slip_count : int, optional
+        k, the number of rows a ``slip`` function returns (required with one).
 
     Raises
     ------
     ValueError
-        A coefficient negative or not finite, ``mu_s`` < ``mu_k``, or ``slip`` not a
-        non-empty finite matrix.
+        A coefficient negative or not finite, ``mu_s`` < ``mu_k``, ``slip`` not a
+        non-empty finite matrix or a function, or ``slip_count`` not a positive integer given
+        with a function (and only with one).
 
     Examples
     --------
@@ -132,6 +139,7 @@ class Friction:
     mu_s: float
     mu_k: float | None = None
     slip: Any = None
+    slip_count: int | None = None
 
     def __post_init__(self) -> None:
         mu_s = number("mu_s", self.mu_s)
@@ -142,7 +150,16 @@ class Friction:
             raise ValueError(f"mu_s: must be finite and at least mu_k = {mu_k:g} (static friction holds what sliding does), got {self.mu_s!r}")
         object.__setattr__(self, "mu_s", mu_s)
         object.__setattr__(self, "mu_k", mu_k)
-        if self.slip is not None:
+        if callable(self.slip):
+            if self.slip_count is None:
+                raise ValueError("slip_count: required with a slip function, the number k of the rows (k, n) it returns")
+            count = integer("slip_count", self.slip_count)
+            if count < 1:
+                raise ValueError(f"slip_count: must be at least 1, got {self.slip_count!r}")
+            object.__setattr__(self, "slip_count", count)
+        elif self.slip_count is not None:
+            raise ValueError("slip_count: only with a slip function (constant rows count themselves)")
+        elif self.slip is not None:
             rows = np.array(floats("slip", self.slip), dtype=float)
             if rows.ndim == 1:
                 rows = rows[None, :]
@@ -150,14 +167,14 @@ class Friction:
                 raise ValueError(f"slip: must be a finite (k, n) matrix, the rows J of the contact point's slip s = J q̇, got {rows.tolist()}")
             object.__setattr__(self, "slip", tuple(tuple(float(x) for x in row) for row in rows))
 
-    def spec(self) -> tuple[float, float, tuple[int, list[float]] | None]:
+    def spec(self) -> tuple[float, float, tuple[int, list[float] | Callable[[np.ndarray], ArrayLike]] | None]:
         """The friction as the binding takes it (and a file stores it).
 
         Returns
         -------
         tuple
-            (μ_s, μ_k, slip): slip None for a particle's tangent plane, or (k, the k × n rows
-            J row by row).
+            (μ_s, μ_k, slip): slip None for a particle's tangent plane, (k, the k × n rows
+            J row by row), or (k, the function J(q)).
 
         Examples
         --------
@@ -166,8 +183,12 @@ class Friction:
         >>> Friction(0.2, slip=[[1.0, 0.0, -0.1]]).spec()
         (0.2, 0.2, (1, [1.0, 0.0, -0.1]))
         """
-        slip = None if self.slip is None else (len(self.slip), [x for row in self.slip for x in row])
-        return (float(self.mu_s), float(self.mu_k if self.mu_k is not None else self.mu_s), slip)
+        slip: tuple[int, list[float] | Callable[[np.ndarray], ArrayLike]] | None
+        if callable(self.slip):
+            slip = (int(self.slip_count or 0), self.slip)
+        else:
+            slip = None if self.slip is None else (len(self.slip), [x for row in self.slip for x in row])
+        return (float(self.mu_s), float(self.mu_k or 0.0), slip)
 
 
 @dataclass(frozen=True)
@@ -198,6 +219,8 @@ class Contact:
         steps (any method; symplectic across an impact only to the method's order).
     friction : Friction, optional
         Coulomb friction while the contact is held (see :class:`Friction`).
+    native : bool
+        Whether the core evaluates the contact without Python (read-only).
 
     Raises
     ------
@@ -246,6 +269,24 @@ class Contact:
             raise ValueError(f"law: 'variational' or 'reflect', got {self.law!r}")
         if self.friction is not None and not isinstance(self.friction, Friction):
             raise TypeError(f"friction: expected a varmech.Friction, got {type(self.friction).__name__}")
+
+    @property
+    def native(self) -> bool:
+        """Whether the core evaluates the contact without Python: a native surface
+        (:meth:`wall`, :meth:`ellipsoid`) and no slip function; such a contact runs in the
+        parallel ensemble and a file stores it.
+
+        Returns
+        -------
+        bool
+
+        Examples
+        --------
+        >>> import varmech
+        >>> varmech.Contact.wall(0).native, varmech.Contact(lambda q: q[0], lambda q: [1.0]).native
+        (True, False)
+        """
+        return isinstance(self.phi, _surfaces.Surface) and (self.friction is None or not callable(self.friction.slip))
 
     @classmethod
     def wall(
@@ -450,7 +491,7 @@ def stored(contacts: Sequence[Contact | str]) -> str:
     by Python functions (no code is stored)."""
     rows = [
         [c.name, c.restitution, c.law, *c.phi.native, None if c.friction is None else c.friction.spec()]
-        if isinstance(c, Contact) and isinstance(c.phi, _surfaces.Surface)
+        if isinstance(c, Contact) and c.native and isinstance(c.phi, _surfaces.Surface)
         else None
         for c in contacts
     ]

@@ -303,3 +303,150 @@ def test_friction_that_cannot_act_is_refused_naming_contacts():
     # A method that cannot hold the contact friction acts on.
     with pytest.raises(ValueError, match=r"^contacts: friction acts on held contacts, which verlet .* not rk4"):
         varmech.integrate(_ball(), [0.0, R, 0.0], [1.0, 0.0, 0.0], dt=0.01, steps=5, method="rk4", contacts=[_floor(0.2)])
+
+
+# A wheel (a disk held upright) on a rough floor, (x, y, z, φ, θ): its centre, heading and spin.
+# Its contact point slips at s = (ẋ − rθ̇ cos φ, ẏ − rθ̇ sin φ), rows that turn with φ: while it
+# sticks they are the nonholonomic rolling constraint, which gives way where rolling needs more
+# than μ_s N. Rolling at spin w and turn rate Ω it keeps a circle of radius rw/Ω, needing the
+# sideways force m(rw)Ω from friction.
+WHEEL = 0.3
+SPIN_INERTIA, TURN_INERTIA = 0.5 * M * WHEEL**2, 0.25 * M * WHEEL**2
+WHEEL_MASS = np.array([M, M, M, TURN_INERTIA, SPIN_INERTIA])
+
+
+def _wheel() -> varmech.Model:
+    """The upright disk under gravity, V = mgz."""
+    return varmech.MechanicalSystem(5, lambda q: M * G * q[2], lambda q: np.array([0.0, 0.0, M * G, 0.0, 0.0]), mass=WHEEL_MASS, name="wheel")
+
+
+def _rolling_rows(q: np.ndarray) -> np.ndarray:
+    c, s = math.cos(q[3]), math.sin(q[3])
+    return np.array([[1.0, 0.0, 0.0, 0.0, -WHEEL * c], [0.0, 1.0, 0.0, 0.0, -WHEEL * s]])
+
+
+def _ground(mu_s: float, mu_k: float | None = None) -> varmech.Contact:
+    """The floor z ≥ 0 under the wheel, slipping along the rolling rows."""
+    friction = varmech.Friction(mu_s, mu_k, slip=_rolling_rows, slip_count=2)
+    return varmech.Contact.wall(2, 0.0, restitution=0.0, law="reflect", name="ground", friction=friction)
+
+
+def _rolling(spin: float, turn: float) -> tuple[list[float], list[float]]:
+    """The wheel at the origin rolling along x at spin w, turning at Ω."""
+    return [0.0] * 5, [M * WHEEL * spin, 0.0, 0.0, TURN_INERTIA * turn, SPIN_INERTIA * spin]
+
+
+@pytest.mark.parametrize(("method", "order"), [("verlet", 2), ("yoshida4", 4)])
+def test_a_wheel_rolls_on_its_circle_at_the_methods_order_while_friction_holds_it(method, order):
+    # The stuck rows J(q½)(q₁ − q₀) = 0 at each step's midpoint: the rolling constraint along
+    # the chord keeps the step symmetric.
+    spin, turn = 10.0, 2.0
+    radius = WHEEL * spin / turn
+    errors = []
+    for dt in (0.02, 0.01):
+        traj = varmech.integrate(_wheel(), *_rolling(spin, turn), dt=dt, t_end=2.0, method=method, contacts=[_ground(1.0)])
+        assert all(len(e) == 0 for e in traj.events) and np.all(traj.work == 0.0)
+        phi = turn * traj.t
+        exact = np.column_stack([radius * np.sin(phi), radius * (1 - np.cos(phi)), 0 * phi, phi, spin * traj.t])
+        errors.append(np.max(np.abs(traj.q - exact)))
+        slip = (_rolling_rows(q) @ (p / WHEEL_MASS) for q, p in zip(traj.q, traj.p))
+        assert max(np.max(np.abs(s)) for s in slip) < 1e-13
+    assert abs(math.log2(errors[0] / errors[1]) - order) < 0.05, errors
+
+
+@pytest.mark.parametrize(("margin", "skids"), [(1 + 1e-9, False), (1 - 1e-9, True)])
+def test_a_wheel_skids_where_rolling_on_its_circle_needs_more_than_mu_s_mg(margin, skids):
+    spin, turn = 10.0, 2.0
+    needs = WHEEL * spin * turn / G
+    traj = varmech.integrate(_wheel(), *_rolling(spin, turn), dt=0.01, steps=50, contacts=[_ground(needs * margin, needs * margin / 2)])
+    radius = WHEEL * spin / turn
+    off_circle = np.max(np.abs(np.hypot(traj.q[:, 0], traj.q[:, 1] - radius) - radius))
+    if skids:
+        assert traj.work[-1] < 0 and off_circle > 0.01
+    else:
+        assert np.all(traj.work == 0.0) and off_circle < 1e-3
+
+
+@pytest.mark.parametrize(("method", "order"), [("verlet", 2), ("yoshida4", 4)])
+def test_a_wheel_set_down_spinning_skids_then_rolls_as_scipy_integrates_its_sliding(method, order):
+    # Set down spinning at w₀ without speed: friction drives it on and slows its spin, on a
+    # straight line (Ω = 0: constant forces) until rw = v = rw₀/3 at t = rw₀/(3μg), exactly;
+    # turning (Ω = 2) its sliding curves, and is the sliding equations' by DOP853 at 1e-13, the
+    # method's order, up to the stop, which is located at order 2 at least: where the slip's
+    # metric J M⁻¹ Jᵀ is not isotropic, the last step before it opposes the slip before the
+    # kick.
+    from scipy.integrate import solve_ivp
+
+    mu, w0 = 0.5, 10.0
+    straight = varmech.integrate(_wheel(), [0.0] * 5, [0, 0, 0, 0, SPIN_INERTIA * w0], dt=0.01, t_end=0.5, method=method, contacts=[_ground(mu)])
+    stuck = straight.events[3]
+    assert len(stuck) == 1 and abs(stuck.t[0] - WHEEL * w0 / (3 * mu * G)) < 1e-13
+    np.testing.assert_allclose(straight.p[straight.t > stuck.t[0], 0] / M, WHEEL * w0 / 3, rtol=1e-13)
+    assert _energy_balance(straight, WHEEL_MASS, straight.q[:, 2]) < 1e-13
+
+    turn = 2.0
+
+    def sliding(t, y):
+        heading = np.array([math.cos(y[2]), math.sin(y[2])])
+        slip = y[4:6] - WHEEL * y[7] * heading
+        force = -mu * M * G * slip / np.linalg.norm(slip)
+        return [*y[4:8], *(force / M), 0.0, -WHEEL * (force @ heading) / SPIN_INERTIA]
+
+    def stops(t, y):
+        return np.linalg.norm(y[4:6] - WHEEL * y[7] * np.array([math.cos(y[2]), math.sin(y[2])])) - 1e-9
+
+    stops.terminal = True  # type: ignore[attr-defined]
+    exact = solve_ivp(sliding, (0.0, 1.0), [0, 0, 0, 0, 0, 0, turn, w0], method="DOP853", rtol=1e-13, atol=1e-15, events=stops, dense_output=True)
+    t_stop = exact.t_events[0][0]
+    slides, stops_at = [], []
+    for dt in (0.01, 0.005):
+        p0 = [0, 0, 0, TURN_INERTIA * turn, SPIN_INERTIA * w0]
+        traj = varmech.integrate(_wheel(), [0.0] * 5, p0, dt=dt, t_end=0.4, method=method, contacts=[_ground(mu)])
+        at = np.searchsorted(traj.t, 0.2)
+        slides.append(np.max(np.abs(traj.q[at][[0, 1, 3, 4]] - exact.sol(traj.t[at])[:4])))
+        stuck = traj.events[3]
+        assert len(stuck) == 1 and len(traj.events[4]) == 0
+        stops_at.append(abs(stuck.t[0] - t_stop))
+        assert np.all(np.diff(traj.work) <= 0.0)
+    assert math.log2(slides[0] / slides[1]) > order - 0.3, slides
+    assert math.log2(stops_at[0] / stops_at[1]) > 1.7 and stops_at[1] < 1e-3, stops_at
+
+
+def test_slip_rows_given_as_a_function_are_checked_and_their_errors_propagate():
+    with pytest.raises(ValueError, match="^slip_count: required with a slip function"):
+        varmech.Friction(0.5, slip=_rolling_rows)
+    with pytest.raises(ValueError, match="^slip_count: must be at least 1"):
+        varmech.Friction(0.5, slip=_rolling_rows, slip_count=0)
+    with pytest.raises(ValueError, match="^slip_count: only with a slip function"):
+        varmech.Friction(0.5, slip=[[1.0, 0.0, -R]], slip_count=1)
+    q0, p0 = _rolling(10.0, 2.0)
+    wrong = varmech.Contact.wall(2, 0.0, restitution=0.0, law="reflect", friction=varmech.Friction(1.0, slip=_rolling_rows, slip_count=3))
+    with pytest.raises(ValueError, match=r"slip returned an array of shape \[2, 5\], expected \[3, 5\]"):
+        varmech.integrate(_wheel(), q0, p0, dt=0.01, steps=5, contacts=[wrong])
+
+    class Mine(Exception):
+        pass
+
+    def broken(q):
+        raise Mine("the user's own")
+
+    own = varmech.Contact.wall(2, 0.0, restitution=0.0, law="reflect", friction=varmech.Friction(1.0, slip=broken, slip_count=2))
+    with pytest.raises(Mine, match="the user's own"):
+        varmech.integrate(_wheel(), q0, p0, dt=0.01, steps=5, contacts=[own])
+
+
+def test_slip_functions_compose_with_files_resume_and_ensembles(tmp_path):
+    # A file does not store the function: the resume is given the contact again, and goes on
+    # bit for bit; the ensemble runs its members as single runs.
+    q0, p0 = _rolling(10.0, 2.0)
+    whole = varmech.integrate(_wheel(), q0, p0, dt=0.01, steps=60, contacts=[_ground(0.5, 0.3)])
+    path = tmp_path / "wheel.h5"
+    varmech.integrate(_wheel(), q0, p0, dt=0.01, steps=25, contacts=[_ground(0.5, 0.3)], output=path, checkpoint_every=10)
+    with pytest.raises(ValueError, match="^contacts"):
+        varmech.resume(path, steps=35, model=_wheel())
+    resumed = varmech.resume(path, steps=35, model=_wheel(), contacts=[_ground(0.5, 0.3)])
+    for x, y in [(resumed.q, whole.q), (resumed.p, whole.p), (resumed.work, whole.work)]:
+        np.testing.assert_array_equal(x, y)
+    runs = varmech.ensemble(_wheel(), np.tile(q0, (2, 1)), np.tile(p0, (2, 1)), dt=0.01, steps=60, contacts=[_ground(0.5, 0.3)], progress=False)
+    for member in runs:
+        np.testing.assert_array_equal(member.q, whole.q)

@@ -1,21 +1,51 @@
 //! Contacts as Python gives them: each a tuple `(name, restitution, law, kind, payload,
 //! friction)`, a native surface (kinds `"crossing"` and `"ellipsoid"`, the payloads of the native
 //! events) evaluated without the GIL, or Python's functions φ(q) and ∇φ(q) (kind `"functions"`)
-//! called with it; friction None or `(mu_s, mu_k, slip)`, slip None or its rows (k, flat).
+//! called with it; friction None or `(mu_s, mu_k, slip)`, slip None, its rows `(k, flat)`, or
+//! `(k, function)`, a Python function of q returning them (k, n).
+
+use std::sync::Arc;
 
 use numpy::PyArray1;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
-use varmech::integrators::{Contact, Contacts, Friction, Law, NativeContact, NativeSurface, Slip, Surface};
+use varmech::integrators::{Contact, Contacts, Friction, Law, NativeContact, NativeSurface, Slip, SlipRows, Surface};
 use varmech::ModelError;
 
-use crate::closure::readers::{call_scalar, call_vector};
+use crate::closure::readers::{call_array, call_scalar, call_vector};
 
 /// The tuple Python passes: name, restitution, law, kind, payload and friction.
 pub type ContactTuple<'py> = (String, f64, String, String, Bound<'py, PyAny>, Option<FrictionTuple>);
 
-/// Friction as Python passes it: μ_s, μ_k and the slip rows (their number and entries), if given.
-pub type FrictionTuple = (f64, f64, Option<(usize, Vec<f64>)>);
+/// Friction as Python passes it: μ_s, μ_k and the slip rows, if given.
+pub type FrictionTuple = (f64, f64, Option<SlipTuple>);
+
+/// Slip rows as Python passes them: their number and entries, or their number and a function
+/// of q that returns them.
+#[derive(FromPyObject)]
+pub enum SlipTuple {
+    Rows(usize, Vec<f64>),
+    Field(usize, Py<PyAny>),
+}
+
+/// Slip rows J(q) given as a Python function of q returning a (k, n) array.
+struct SlipFunction {
+    rows: usize,
+    function: Py<PyAny>,
+}
+
+impl SlipRows for SlipFunction {
+    fn count(&self) -> usize {
+        self.rows
+    }
+
+    fn jacobian(&self, q: &[f64], out: &mut [f64]) -> Result<(), ModelError> {
+        Python::attach(|py| {
+            let result = self.function.bind(py).call1((PyArray1::from_slice(py, q),));
+            call_array(result, "slip", &[self.rows, q.len()], out)
+        })
+    }
+}
 
 /// A surface given as Python functions φ(q) -> float and ∇φ(q) -> array (n,).
 struct Functions {
@@ -86,7 +116,11 @@ impl ContactSpecs {
             let friction = friction.map(|(static_coefficient, kinetic, slip)| Friction {
                 static_coefficient,
                 kinetic,
-                slip: slip.map_or(Slip::Tangent, |(rows, jacobian)| Slip::Rows { rows, jacobian }),
+                slip: match slip {
+                    None => Slip::Tangent,
+                    Some(SlipTuple::Rows(rows, jacobian)) => Slip::Rows { rows, jacobian },
+                    Some(SlipTuple::Field(rows, function)) => Slip::Field(Arc::new(SlipFunction { rows, function })),
+                },
             });
             contacts.push((kind, restitution, law, friction, name));
         }
@@ -114,6 +148,12 @@ impl ContactSpecs {
         self.0
             .into_iter()
             .map(|(kind, restitution, law, friction, name)| match kind {
+                _ if friction.as_ref().is_some_and(|f| matches!(f.slip, Slip::Field(_))) => {
+                    Err(PyValueError::new_err(format!(
+                        "contacts: {name}'s friction has slip rows given by a Python function; the parallel ensemble \
+                         takes only constant rows"
+                    )))
+                }
                 Kind::Native(surface) => Ok(NativeContact {
                     surface,
                     restitution,

@@ -65,7 +65,8 @@ pub use events::{Detector, EventFunctions, EventSpec, NativeEvent, Occurrence};
 pub use explicit_rk::ExplicitRk;
 pub use jumps::{
     impulsive, Blow, Contact, Contacts, Friction, Gaps, Generalized, Impacts, Impulse, Law, NativeContact,
-    NativeSurface, PointFunction, Schedule, Slip, Struck, Surface, Switch, Switches, Watch, Watcher, MAX_IMPACTS,
+    NativeSurface, PointFunction, Schedule, Slip, SlipRows, Struck, Surface, Switch, Switches, Watch, Watcher,
+    MAX_IMPACTS,
 };
 pub use kick_drift::KickDrift;
 pub use kind::ModelKind;

@@ -5,18 +5,63 @@
 //! The slip is s = J(q)q̇, k rows J: the velocity of the contact point along the surface. A
 //! particle's own coordinates (n = 2 or 3) need none given: J is then an orthonormal basis of
 //! the tangent plane of ∇φ. A body that turns gives its rows (a ball of radius r on a floor,
-//! slip ẋ − rθ̇: J = (1, 0, −r) in (x, y, θ)).
+//! slip ẋ − rθ̇: J = (1, 0, −r) in (x, y, θ)); rows that turn with q ([`SlipRows`]) are a
+//! velocity constraint J(q)q̇ = 0 that holds while it sticks: a wheel rolling on its heading φ,
+//! J = (1, 0, −r cos φ; 0, 1, −r sin φ) in (x, y, θ, …), skids where rolling needs more than μ_s N.
+
+use std::sync::Arc;
 
 use crate::ModelError;
 
+/// Slip rows J(q) that depend on the configuration, k × n: a velocity constraint J(q)q̇ = 0,
+/// nonholonomic as a rolling wheel's, kept while the contact sticks.
+pub trait SlipRows: Send + Sync {
+    /// k, the number of rows.
+    fn count(&self) -> usize;
+
+    /// Writes J(q), k × n row by row, into `out`.
+    fn jacobian(&self, q: &[f64], out: &mut [f64]) -> Result<(), ModelError>;
+}
+
 /// The slip of a contact point, s = J(q)q̇.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone)]
 pub enum Slip {
     /// A particle's own coordinates (n = 2 or 3): J an orthonormal basis of the tangent plane
     /// of ∇φ(q).
     Tangent,
     /// Constant rows J, k × n, row by row.
     Rows { rows: usize, jacobian: Vec<f64> },
+    /// Rows J(q) that turn with the configuration.
+    Field(Arc<dyn SlipRows>),
+}
+
+impl std::fmt::Debug for Slip {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Slip::Tangent => f.write_str("Tangent"),
+            Slip::Rows { rows, jacobian } => f
+                .debug_struct("Rows")
+                .field("rows", rows)
+                .field("jacobian", jacobian)
+                .finish(),
+            Slip::Field(field) => f
+                .debug_struct("Field")
+                .field("rows", &field.count())
+                .finish_non_exhaustive(),
+        }
+    }
+}
+
+/// Rows given as functions are the same where they are the same functions.
+impl PartialEq for Slip {
+    fn eq(&self, other: &Slip) -> bool {
+        match (self, other) {
+            (Slip::Tangent, Slip::Tangent) => true,
+            (Slip::Rows { rows, jacobian }, Slip::Rows { rows: r, jacobian: j }) => rows == r && jacobian == j,
+            (Slip::Field(a), Slip::Field(b)) => Arc::ptr_eq(a, b),
+            _ => false,
+        }
+    }
 }
 
 /// Coulomb friction on a contact: the static coefficient μ_s ≥ μ_k, the kinetic μ_k ≥ 0, and
@@ -54,6 +99,9 @@ impl Friction {
                 "friction: the slip rows must be k × {n} (k ≥ 1), got {} entries for {rows} rows",
                 jacobian.len()
             )),
+            Slip::Field(field) if field.count() == 0 => {
+                Some("friction: the slip rows J(q) must number at least one".to_string())
+            }
             _ => None,
         }
     }
@@ -63,16 +111,25 @@ impl Friction {
         match &self.slip {
             Slip::Tangent => n - 1,
             Slip::Rows { rows, .. } => *rows,
+            Slip::Field(field) => field.count(),
         }
     }
 
-    /// J at a state where the surface's gradient is `gradient`, into `out` (k × n).
-    pub(super) fn jacobian(&self, gradient: &[f64], out: &mut [f64]) -> Result<(), ModelError> {
+    /// Whether J is made of the surface's gradient ([`Self::jacobian`] reads it).
+    #[inline]
+    pub(super) fn on_gradient(&self) -> bool {
+        matches!(self.slip, Slip::Tangent)
+    }
+
+    /// J at q, where the surface's gradient is `gradient` (read only [`Self::on_gradient`]),
+    /// into `out` (k × n).
+    pub(super) fn jacobian(&self, q: &[f64], gradient: &[f64], out: &mut [f64]) -> Result<(), ModelError> {
         let gradient = match &self.slip {
             Slip::Rows { jacobian, .. } => {
                 out.copy_from_slice(jacobian);
                 return Ok(());
             }
+            Slip::Field(field) => return field.jacobian(q, out),
             Slip::Tangent => gradient,
         };
         let norm = gradient.iter().map(|g| g * g).sum::<f64>().sqrt();

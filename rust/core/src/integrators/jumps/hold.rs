@@ -78,6 +78,8 @@ pub(super) struct Hold {
     /// ∂L/∂q and the sliding contacts' friction force at the state.
     force: Vec<f64>,
     friction: Vec<f64>,
+    /// The friction force at a step's start, where its end's fixed point starts.
+    initial: Vec<f64>,
     start: Vec<f64>,
     half: Vec<f64>,
     /// q̇ at p̃, the step's end before its friction kick, whose slip the force opposes.
@@ -134,6 +136,7 @@ impl Hold {
             zeros: v(),
             force: v(),
             friction: v(),
+            initial: v(),
             start: v(),
             half: v(),
             along: v(),
@@ -246,7 +249,8 @@ impl Hold {
         };
         let m = held.closed.len();
         // q₁(c) = q₀ + s(q̇(q₀, p½) + Σ c_b M⁻¹row_b(q₀)): Newton on Φ(q₁(c)) = 0 and, for the
-        // stuck rows, J(q₀)(q₁ − q₀) = 0.
+        // stuck rows, J(q½)(q₁ − q₀) = 0 at the midpoint q½: rows that turn with q (a wheel's)
+        // then hold along the chord, and the step stays symmetric.
         model.velocity(&self.q, &self.p, t, &mut self.v)?;
         self.start.copy_from_slice(&self.q);
         self.c[..rows].fill(0.0);
@@ -257,6 +261,11 @@ impl Hold {
                 let shift: f64 = (0..rows).map(|k| self.c[k] * self.inverse[k * n + i]).sum();
                 self.q[i] = self.start[i] + s * (self.v[i] + shift);
             }
+            if rows > m {
+                for ((x, x0), x1) in self.shifted.iter_mut().zip(&self.start).zip(&self.q) {
+                    *x = 0.5 * (x0 + x1);
+                }
+            }
             let (system, pivots) = &mut self.systems[rows - 1];
             for a in 0..rows {
                 let row = if a < m {
@@ -265,7 +274,8 @@ impl Hold {
                     self.r[a] = -surface.phi(&self.q)?;
                     &self.gradient[..]
                 } else {
-                    let row = &self.rows[a * n..(a + 1) * n];
+                    row_at(held, a, &self.shifted, &mut self.gradient, &mut self.slip)?;
+                    let row = &self.slip[..n];
                     self.r[a] = -(0..n).map(|i| row[i] * (self.q[i] - self.start[i])).sum::<f64>();
                     row
                 };
@@ -311,9 +321,10 @@ impl Hold {
             return self.project(model, held, t + s);
         }
         // p₁ = p̃ + (s/2)F(q₁, p₁), projected, p̃ = p½ + (s/2)∂L/∂q(q₁): by fixed point from
-        // F(q₀, p₀). The force's direction is p̃'s slip's: p₁'s where the kick leaves the slip's
-        // direction as it is (a metric isotropic on the slip), which the fixed point cannot
-        // find where the slip is about to stop; the iteration then settles N alone.
+        // F(q₀, p₀), the force against p₁'s own slip. Where the kick turns the slip more than
+        // the slip is (it is about to stop), that iteration does not contract: the force then
+        // opposes p̃'s slip, and the iteration settles N alone (p₁'s direction where the kick
+        // leaves the slip's as it is, a metric isotropic on the slip).
         self.project(model, held, t + s)?;
         self.half.copy_from_slice(&self.p);
         model.velocity(&self.q, &self.p, t + s, &mut self.along)?;
@@ -321,15 +332,43 @@ impl Hold {
             * (0..n)
                 .map(|i| self.friction[i] * (self.q[i] - self.start[i]))
                 .sum::<f64>();
-        let mut settled = false;
+        self.initial.copy_from_slice(&self.friction);
+        if !self.settle(model, held, (t + s, s), Slipping::Now)? {
+            self.friction.copy_from_slice(&self.initial);
+            if !self.settle(model, held, (t + s, s), Slipping::Before)? {
+                return Err(format!(
+                    "the sliding friction at a held step's end did not settle in {ITERATIONS} iterations (a step \
+                     too large for the friction's change)"
+                )
+                .into());
+            }
+        }
+        work += 0.5
+            * (0..n)
+                .map(|i| self.friction[i] * (self.q[i] - self.start[i]))
+                .sum::<f64>();
+        self.work += work;
+        Ok(())
+    }
+
+    /// The fixed point p = p̃ + (s/2)F(q, p) at t, projected (p̃ in `half`, F from `friction`), F
+    /// against the slip `slipping` names: whether it settled. Against p₁'s own slip it gives up
+    /// as soon as it stops contracting.
+    fn settle(
+        &mut self,
+        model: &dyn Lagrangian,
+        held: Held<'_, '_>,
+        (t, s): (f64, f64),
+        slipping: Slipping,
+    ) -> Result<bool, ModelError> {
         let mut last = f64::INFINITY;
         for _ in 0..ITERATIONS {
             for ((x, h), f) in self.p.iter_mut().zip(&self.half).zip(&self.friction) {
                 *x = h + 0.5 * s * f;
             }
-            self.project(model, held, t + s)?;
+            self.project(model, held, t)?;
             self.previous.copy_from_slice(&self.friction);
-            self.forces(model, held, t + s, Slipping::Before)?;
+            self.forces(model, held, t, slipping)?;
             let size = self.previous.iter().fold(0.0_f64, |a, x| a.max(x.abs()));
             let change = self
                 .previous
@@ -339,24 +378,14 @@ impl Hold {
             // λ's curvature term is a difference, smooth in p to ε^(2/3) only: the iteration
             // settles where its change stops falling, within that.
             if change <= 4.0 * f64::EPSILON * size || (change >= last && change <= 1e-8 * size) {
-                settled = true;
-                break;
+                return Ok(true);
+            }
+            if change >= last && matches!(slipping, Slipping::Now) {
+                return Ok(false);
             }
             last = change;
         }
-        if !settled {
-            return Err(format!(
-                "the sliding friction at a held step's end did not settle in {ITERATIONS} iterations (a step too large \
-                 for the friction's change)"
-            )
-            .into());
-        }
-        work += 0.5
-            * (0..n)
-                .map(|i| self.friction[i] * (self.q[i] - self.start[i]))
-                .sum::<f64>();
-        self.work += work;
-        Ok(())
+        Ok(false)
     }
 
     /// The number of slip rows of the stuck contacts.
@@ -417,7 +446,7 @@ impl Hold {
                 .expect("a stuck contact has friction");
             let k = friction.rows(n);
             let (normals, slips) = self.rows.split_at_mut(next * n);
-            friction.jacobian(&normals[a * n..(a + 1) * n], &mut slips[..k * n])?;
+            friction.jacobian(&self.q, &normals[a * n..(a + 1) * n], &mut slips[..k * n])?;
             next += k;
         }
         for a in 0..next {
@@ -479,9 +508,10 @@ impl Hold {
                 let w = &self.inverse[b * n..(b + 1) * n];
                 let mut entry: f64 = row.iter().zip(w).map(|(g, w)| g * w).sum();
                 if let Some(friction) = (slides && b < m).then(|| held.sliding(b)).flatten() {
-                    let normal = norm(&self.rows[b * n..(b + 1) * n]);
                     let u = &self.units_inverse[b * n..(b + 1) * n];
-                    entry -= friction.kinetic * normal * row.iter().zip(u).map(|(g, u)| g * u).sum::<f64>();
+                    entry -= friction.kinetic
+                        * normal_force(&self.rows, n, b, 1.0)
+                        * row.iter().zip(u).map(|(g, u)| g * u).sum::<f64>();
                 }
                 system[(a, b)] = entry;
             }
@@ -493,13 +523,20 @@ impl Hold {
         self.friction.fill(0.0);
         for b in (0..m).filter(|_| slides) {
             if let Some(friction) = held.sliding(b) {
-                let size = friction.kinetic * norm(&self.rows[b * n..(b + 1) * n]) * self.lambda[b];
+                let size = friction.kinetic * normal_force(&self.rows, n, b, self.lambda[b]);
                 for (f, u) in self.friction.iter_mut().zip(&self.units[b * n..(b + 1) * n]) {
                     *f -= size * u;
                 }
             }
         }
         Ok(rows)
+    }
+
+    /// N = λ|∇φ|, the normal force of the a-th closed contact's multiplier λ at the state whose
+    /// rows `rows` holds (its ∇φ the a-th).
+    #[inline]
+    pub(super) fn normal_force(&self, a: usize, lambda: f64) -> f64 {
+        normal_force(&self.rows, self.q.len(), a, lambda)
     }
 
     /// The sliding contacts' directions u = Jᵀŝ at the state (ŝ = s/|s|, s = Jq̇, of the
@@ -520,7 +557,7 @@ impl Hold {
                 continue;
             };
             let k = friction.rows(n);
-            friction.jacobian(&self.rows[a * n..(a + 1) * n], &mut self.slip[..k * n])?;
+            friction.jacobian(&self.q, &self.rows[a * n..(a + 1) * n], &mut self.slip[..k * n])?;
             let j = held.closed[a];
             let given = &held.directions[j * n..(j + 1) * n];
             let along = |unit: &mut [f64], x: &[f64]| {
@@ -583,10 +620,8 @@ impl Hold {
         (q, p, t): (&[f64], &[f64], f64),
         (out, direction): (&mut [f64], &mut [f64]),
     ) -> Result<f64, ModelError> {
+        let k = self.slip_rows((contact, friction), q)?;
         let n = q.len();
-        let k = friction.rows(n);
-        contact.surface.gradient(q, &mut self.gradient)?;
-        friction.jacobian(&self.gradient, &mut self.slip[..k * n])?;
         model.velocity(q, p, t, &mut self.v)?;
         direction.fill(0.0);
         for (s, row) in out.iter_mut().zip(self.slip[..k * n].chunks_exact(n)) {
@@ -606,10 +641,8 @@ impl Hold {
         x: &[f64],
         out: &mut [f64],
     ) -> Result<(), ModelError> {
+        let k = self.slip_rows((contact, friction), q)?;
         let n = q.len();
-        let k = friction.rows(n);
-        contact.surface.gradient(q, &mut self.gradient)?;
-        friction.jacobian(&self.gradient, &mut self.slip[..k * n])?;
         out.fill(0.0);
         for (x, row) in x.iter().zip(self.slip[..k * n].chunks_exact(n)) {
             for (o, j) in out.iter_mut().zip(row) {
@@ -617,6 +650,16 @@ impl Hold {
             }
         }
         Ok(())
+    }
+
+    /// A contact's slip rows J at q into `slip`: their number k.
+    fn slip_rows(&mut self, (contact, friction): (&Contact<'_>, &Friction), q: &[f64]) -> Result<usize, ModelError> {
+        let k = friction.rows(q.len());
+        if friction.on_gradient() {
+            contact.surface.gradient(q, &mut self.gradient)?;
+        }
+        friction.jacobian(q, &self.gradient, &mut self.slip[..k * q.len()])?;
+        Ok(k)
     }
 }
 
@@ -636,8 +679,10 @@ fn row_at(held: Held<'_, '_>, a: usize, q: &[f64], gradient: &mut [f64], slip: &
             .expect("a stuck contact has friction");
         let k = friction.rows(n);
         if a < first + k {
-            held.contacts[j].surface.gradient(q, gradient)?;
-            friction.jacobian(gradient, &mut slip[..k * n])?;
+            if friction.on_gradient() {
+                held.contacts[j].surface.gradient(q, gradient)?;
+            }
+            friction.jacobian(q, gradient, &mut slip[..k * n])?;
             slip.copy_within((a - first) * n..(a - first + 1) * n, 0);
             return Ok(());
         }
@@ -646,7 +691,8 @@ fn row_at(held: Held<'_, '_>, a: usize, q: &[f64], gradient: &mut [f64], slip: &
     unreachable!("row {a} of {first}")
 }
 
-/// |x|₂: the size of ∇φ, which turns λ into the normal force N = λ|∇φ|.
-fn norm(x: &[f64]) -> f64 {
-    x.iter().map(|y| y * y).sum::<f64>().sqrt()
+/// N = λ|∇φ| of row a of `rows` (n entries a row).
+#[inline]
+fn normal_force(rows: &[f64], n: usize, a: usize, lambda: f64) -> f64 {
+    lambda * rows[a * n..(a + 1) * n].iter().map(|g| g * g).sum::<f64>().sqrt()
 }

@@ -815,10 +815,16 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
             self.changes.push((t, k, Switch::Slipped));
         }
         self.closed.retain(|&j| j != k);
-        self.changes.push((t, k, Switch::Released));
+        self.switched(k, Switch::Released, step, (t, t));
+    }
+
+    /// Contact k's switch `kind` at time t, recorded for the samples to undo and reported at
+    /// `reported` (t, or the limit of a Zeno series), at the state (`contact_q`, `piece_p`).
+    fn switched(&mut self, k: usize, kind: Switch, step: usize, (t, reported): (f64, f64)) {
+        self.changes.push((t, k, kind));
         self.pending
             .switches
-            .push(k, step, t, Switch::Released, (&self.contact_q, &self.piece_p));
+            .push(k, step, reported, kind, (&self.contact_q, &self.piece_p));
     }
 
     /// The first friction switch in the piece of size τ from ta, with the scratch at its end
@@ -905,16 +911,8 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
             .expect("a stuck contact has friction");
         let rows = friction.rows(self.normal.len());
         let tangential = self.lambda[row..row + rows].iter().map(|x| x * x).sum::<f64>().sqrt();
-        self.contacts[j]
-            .surface
-            .gradient(self.scratch.q(), &mut self.normal)
-            .map_err(|source| Error::Model {
-                step,
-                time: self.t,
-                source,
-            })?;
-        let size = self.normal.iter().map(|x| x * x).sum::<f64>().sqrt();
-        Ok(tangential - friction.static_coefficient * self.lambda[a] * size)
+        let hold = self.hold.as_ref().expect("a contact closes only where it can be held");
+        Ok(tangential - friction.static_coefficient * hold.normal_force(a, self.lambda[a]))
     }
 
     /// Contact k's friction switched at time t, at the state (`contact_q`, `piece_p`), which
@@ -937,10 +935,7 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
             sticks
         };
         if switched {
-            self.changes.push((t, k, kind));
-            self.pending
-                .switches
-                .push(k, step, t, kind, (&self.contact_q, &self.piece_p));
+            self.switched(k, kind, step, (t, t));
         }
         self.released
             .push(k, step, t, &self.contact_q, &self.piece_p, &self.piece_p);
@@ -948,14 +943,13 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
     }
 
     /// Whether closed contact j, just closed at the scratch's state at time t, sticks: its slip
-    /// round-off ([`Resolver::slip_at`]) and the force that holds it at 0 within μ_s N. It is
+    /// round-off ([`Resolver::slip_size`]) and the force that holds it at 0 within μ_s N. It is
     /// then stuck.
     fn sticks(&mut self, j: usize, step: usize, t: f64) -> Result<bool, Error> {
         if self.contacts[j].friction.is_none() {
             return Ok(false);
         }
-        let (size, tolerance) = self.slip_at(j, step, t)?;
-        if size > tolerance {
+        if !self.slip_size(j, step, t)?.1 {
             return Ok(false);
         }
         insert(&mut self.stuck, j);
@@ -977,8 +971,8 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
                 continue;
             }
             let time = self.t;
-            let (size, tolerance) = self.slip_at(j, step, t)?;
-            let scale = if size > tolerance {
+            let (size, round_off) = self.slip_size(j, step, t)?;
+            let scale = if !round_off {
                 size
             } else {
                 insert(&mut self.stuck, j);
@@ -1033,37 +1027,50 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
     }
 
     /// The slip s = Jq̇ of contact j at the scratch's state at time t into `slip`, Jᵀs into
-    /// `direction`: its size |s|, and the size below which it is round-off,
-    /// 10³ε|J|∞(|q̇|∞ + h|M⁻¹∂L/∂q|∞) (a slip that the step's acceleration would reverse).
+    /// `direction`: its size |s|, and that of J's entries, max |J|.
     fn slip_at(&mut self, j: usize, step: usize, t: f64) -> Result<(f64, f64), Error> {
         let time = self.t;
-        let h = self.scratch.dt();
         let Resolver {
             hold,
             scratch,
             contacts,
             slip,
             direction,
-            v,
-            w,
-            zeros,
             ..
         } = self;
         let hold = hold.as_mut().expect("a contact closes only where it can be held");
         let contact = &contacts[j];
         let friction = contact.friction.as_ref().expect("a sliding contact has friction");
+        let (q, p) = (scratch.q(), scratch.p());
+        let scale = hold
+            .slip(
+                scratch.model().as_lagrangian(),
+                (contact, friction),
+                (q, p, t),
+                (slip, direction),
+            )
+            .map_err(|source| Error::Model { step, time, source })?;
+        let size = slip[..friction.rows(q.len())].iter().map(|x| x * x).sum::<f64>().sqrt();
+        Ok((size, scale))
+    }
+
+    /// Contact j's slip at the scratch's state at time t ([`Resolver::slip_at`]): its size,
+    /// and whether that is round-off, within 10³ε|J|∞(|q̇|∞ + h|M⁻¹∂L/∂q|∞) (a slip that the
+    /// step's acceleration would reverse).
+    fn slip_size(&mut self, j: usize, step: usize, t: f64) -> Result<(f64, bool), Error> {
+        let (size, scale) = self.slip_at(j, step, t)?;
+        let (time, h) = (self.t, self.scratch.dt());
+        let Resolver {
+            scratch, v, w, zeros, ..
+        } = self;
         let model = scratch.model().as_lagrangian();
         let (q, p) = (scratch.q(), scratch.p());
         let model_error = |source| Error::Model { step, time, source };
-        let scale = hold
-            .slip(model, (contact, friction), (q, p, t), (slip, direction))
-            .map_err(model_error)?;
-        let size = slip[..friction.rows(q.len())].iter().map(|x| x * x).sum::<f64>().sqrt();
         model.velocity(q, p, t, v).map_err(model_error)?;
         let speed = amax(v);
         model.dl_dq(q, zeros, t, w).map_err(model_error)?;
         model.velocity(q, w, t, v).map_err(model_error)?;
-        Ok((size, 1e3 * f64::EPSILON * scale * (speed + h * amax(v))))
+        Ok((size, size <= 1e3 * f64::EPSILON * scale * (speed + h * amax(v))))
     }
 
     /// After a jump at time t to (q̃, p⁺) (`contact_q`, `piece_p`) with contacts closed: those
@@ -1105,13 +1112,9 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
             let mut a = 0;
             while a < self.stuck.len() {
                 let k = self.stuck[a];
-                let (size, tolerance) = self.slip_at(k, step, t)?;
-                if size > tolerance {
+                if !self.slip_size(k, step, t)?.1 {
                     self.stuck.remove(a);
-                    self.changes.push((t, k, Switch::Slipped));
-                    self.pending
-                        .switches
-                        .push(k, step, t, Switch::Slipped, (&self.contact_q, &self.piece_p));
+                    self.switched(k, Switch::Slipped, step, (t, t));
                 } else {
                     a += 1;
                 }
@@ -1232,17 +1235,11 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
         }
         if let Some(t_rest) = self.closes(j, step, t, (reflection, h))? {
             insert(&mut self.closed, j);
-            self.changes.push((t, j, Switch::Closed));
-            self.pending
-                .switches
-                .push(j, step, t_rest, Switch::Closed, (&self.contact_q, &self.piece_p));
+            self.switched(j, Switch::Closed, step, (t, t_rest));
             self.scratch.restart(t, &self.contact_q, &self.piece_p, h);
             if self.sticks(j, step, t)? {
                 self.project_piece(step, t)?;
-                self.changes.push((t, j, Switch::Stuck));
-                self.pending
-                    .switches
-                    .push(j, step, t_rest, Switch::Stuck, (&self.contact_q, &self.piece_p));
+                self.switched(j, Switch::Stuck, step, (t, t_rest));
             }
         }
         self.energy_change(step, t)
