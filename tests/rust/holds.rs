@@ -3,12 +3,14 @@
 //! it until it leaves where cos θ = (2/3)cos θ₀, located at the method's order; a run resumed from
 //! a held state bit for bit; a method that cannot hold a contact still ending an accumulation
 //! of impacts with `Error::Contact`; and Byerly's billiard ball, sliding on a rough table until
-//! it rolls at 5v₀/7 from t = 2v₀/(7μg), exactly, its run resumed bit for bit.
+//! it rolls at 5v₀/7 from t = 2v₀/(7μg), exactly, its run resumed bit for bit; and a wheel whose
+//! slip rows turn with its heading, rolling on its circle at the method's order while friction
+//! holds it, and skidding where that needs more than μ_s mg.
 
 use nalgebra::DMatrix;
 use varmech::integrators::{
-    integrate_watching, Contact, Contacts, Dynamics, Friction, Law, Method, NativeSurface, Options, Slip, Switch,
-    Trajectory,
+    integrate_watching, Contact, Contacts, Dynamics, Friction, Law, Method, NativeSurface, Options, Slip, SlipRows,
+    Switch, Trajectory,
 };
 use varmech::model::{Mass, MechanicalSystem, Reaction};
 use varmech::scenes::BouncingBall;
@@ -270,4 +272,89 @@ fn byerlys_billiard_ball_slides_and_then_rolls_at_five_sevenths_of_its_speed_fro
     assert_eq!(&all.q[all.q.len() - rest.q.len()..], &rest.q[..]);
     assert_eq!(&all.p[all.p.len() - rest.p.len()..], &rest.p[..]);
     assert_eq!(&all.work[all.work.len() - rest.work.len()..], &rest.work[..]);
+}
+
+/// The rows of a wheel of radius r held upright, on (x, z, y, φ, θ) (its height z second, where
+/// [`Weighed`] puts gravity): its contact point slips at (ẋ − rθ̇ cos φ, ẏ − rθ̇ sin φ).
+struct Rolling(f64);
+
+impl SlipRows for Rolling {
+    fn count(&self) -> usize {
+        2
+    }
+
+    fn jacobian(&self, q: &[f64], out: &mut [f64]) -> Result<(), ModelError> {
+        let (r, c, s) = (self.0, q[3].cos(), q[3].sin());
+        out.copy_from_slice(&[1.0, 0.0, 0.0, 0.0, -r * c, 0.0, 0.0, 1.0, 0.0, -r * s]);
+        Ok(())
+    }
+}
+
+#[test]
+fn a_wheel_whose_slip_rows_turn_with_it_rolls_on_its_circle_at_the_methods_order_and_skids_past_mu_s() {
+    // Unit mass, radius 0.3, spin w = 10, turning at Ω = 2: a circle of radius rw/Ω while the
+    // sideways force rwΩ is within μ_s g.
+    let (r, w, turn) = (0.3, 10.0, 2.0);
+    let wheel = Weighed(
+        Mass::diagonal(vec![1.0, 1.0, 1.0, 0.25 * r * r, 0.5 * r * r]).unwrap(),
+        5,
+    );
+    let ground = |mu: f64| {
+        let friction = Friction {
+            static_coefficient: mu,
+            kinetic: mu / 2.0,
+            slip: Slip::Field(std::sync::Arc::new(Rolling(r))),
+        };
+        let surface = Box::new(NativeSurface::Wall {
+            coordinate: 1,
+            value: 0.0,
+        });
+        let contact = Contact {
+            surface,
+            restitution: 0.0,
+            law: Law::Reflect,
+            friction: Some(friction),
+            name: "ground".into(),
+        };
+        Contacts::new(vec![contact]).unwrap()
+    };
+    let (q0, p0) = ([0.0; 5], [r * w, 0.0, 0.0, 0.25 * r * r * turn, 0.5 * r * r * w]);
+    let needs = r * w * turn / G;
+    let radius = r * w / turn;
+    for (method, order) in [(Method::Verlet, 2.0), (Method::Yoshida4, 4.0)] {
+        let contacts = ground(needs * (1.0 + 1e-9));
+        let errors: Vec<f64> = [0.02, 0.01]
+            .iter()
+            .map(|&dt| {
+                let options = Options::new(dt, (2.0 / dt).round() as usize);
+                let traj = integrate_watching(&wheel, method, &q0, &p0, &options, || Ok(()), with_contacts(&contacts))
+                    .unwrap();
+                assert!(traj.impacts.switches.is_empty() && traj.work.iter().all(|&x| x == 0.0));
+                (0..traj.len())
+                    .map(|k| {
+                        let (q, phi) = (traj.q_at(k), turn * traj.t[k]);
+                        let exact = [radius * phi.sin(), 0.0, radius * (1.0 - phi.cos()), phi, w * traj.t[k]];
+                        q.iter().zip(exact).fold(0.0_f64, |a, (x, y)| a.max((x - y).abs()))
+                    })
+                    .fold(0.0, f64::max)
+            })
+            .collect();
+        let measured = (errors[0] / errors[1]).log2();
+        assert!(
+            (measured - order).abs() < 0.05,
+            "{method:?}: order {measured} ({errors:?})"
+        );
+    }
+    let contacts = ground(needs * (1.0 - 1e-9));
+    let traj = integrate_watching(
+        &wheel,
+        Method::Verlet,
+        &q0,
+        &p0,
+        &Options::new(0.01, 50),
+        || Ok(()),
+        with_contacts(&contacts),
+    )
+    .unwrap();
+    assert!(traj.work[traj.len() - 1] < 0.0, "it skids: friction does work");
 }
