@@ -2,7 +2,7 @@
 # `make test` (build, run every test). PYTHON may name another interpreter.
 PYTHON ?= python3
 
-.PHONY: install tour lint test test-rust test-python docs wheel-check test-aarch64 bench compare gallery
+.PHONY: install tour lint guards test guards-then-rust test-rust test-python docs wheel-check test-aarch64 bench compare gallery
 
 install:
 	$(PYTHON) -m pip install -e ".[test,charts]"
@@ -12,7 +12,9 @@ tour: install
 
 # The guards: formatting, clippy on every target of both crates, ruff, mypy on the package, and
 # stubtest of the binding against its stub _core.pyi.
-lint: install
+lint: install guards
+
+guards:
 	cargo fmt --all --check
 	cargo clippy --workspace --all-targets -- -D warnings
 	$(PYTHON) -m ruff check python tests benches docs
@@ -28,12 +30,15 @@ docs: install
 # Every test but the packaging check (the tests marked `wheel`, run by `make wheel-check`).
 # --workspace: the features of the binding's build too, so that the core's release build from the
 # editable install is reused (rust/python/Cargo.toml's `either`); the binding itself has no tests.
-# The Rust tests and pytest run side by side (two jobs, each one's output kept together): the
-# release build of the Rust test crate (codegen-units = 1) keeps one core busy for minutes, and
-# pytest takes the other.
-test: lint
-	$(MAKE) --jobs=2 --output-sync=target test-rust test-python
+# Two jobs side by side, each one's output kept together: the guards and then the Rust tests,
+# and pytest. The release build of the Rust test crate (codegen-units = 1) and pytest each keep a
+# core busy for minutes, so pytest starts with the guards (CI is bound by the two cores' work).
+test: install
+	$(MAKE) --jobs=2 --output-sync=target guards-then-rust test-python
 	$(SPHINX) -E -a
+
+guards-then-rust: guards
+	$(MAKE) test-rust
 
 # Cargo schedules its own jobs: without make's jobserver, which it cannot join from a sub-make.
 test-rust:
