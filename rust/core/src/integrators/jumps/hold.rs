@@ -56,12 +56,13 @@ impl Held<'_, '_> {
     }
 }
 
-/// Whose slip a sliding force opposes: the state's, or, at a step's end, that of the state
-/// before the friction kick (`Hold::along`).
+/// Whose slip a sliding force opposes: the state's, or, at a step's end, the slip that the
+/// state before the friction kick (`Hold::along`) has after a kick of `kick` times the force
+/// ([`slip_after_kick`]).
 #[derive(Clone, Copy)]
 enum Slipping {
     Now,
-    Before,
+    Before { kick: f64 },
 }
 
 /// The held step of one method on a run's contacts, with every buffer it needs (made once: a
@@ -101,6 +102,10 @@ pub(super) struct Hold {
     lambda: Vec<f64>,
     gradient: Vec<f64>,
     slip: Vec<f64>,
+    /// The slip's metric JM⁻¹Jᵀ (k × k) and its factor, and [`slip_after_kick`]'s vectors.
+    metric: Vec<f64>,
+    factor: Vec<f64>,
+    kicked: Vec<f64>,
     /// The work of the sliding forces in the last step.
     pub(super) work: f64,
     /// The time t at which `force`, `rows` and `inverse` hold ∂L/∂q and the rows of the
@@ -152,6 +157,9 @@ impl Hold {
             lambda: vec![0.0; rows],
             gradient: v(),
             slip: vec![0.0; slip * n],
+            metric: vec![0.0; slip * slip],
+            factor: vec![0.0; slip * slip],
+            kicked: vec![0.0; 4 * slip],
             work: 0.0,
             cached: None,
             cached_for: Vec::with_capacity(2 * m),
@@ -322,9 +330,9 @@ impl Hold {
         }
         // p₁ = p̃ + (s/2)F(q₁, p₁), projected, p̃ = p½ + (s/2)∂L/∂q(q₁): by fixed point from
         // F(q₀, p₀), the force against p₁'s own slip. Where the kick turns the slip more than
-        // the slip is (it is about to stop), that iteration does not contract: the force then
-        // opposes p̃'s slip, and the iteration settles N alone (p₁'s direction where the kick
-        // leaves the slip's as it is, a metric isotropic on the slip).
+        // the slip is (it is about to stop), that iteration does not contract: p₁'s slip is
+        // then found from p̃'s, the kick's in the slip's metric solved for, and the iteration
+        // settles N alone.
         self.project(model, held, t + s)?;
         self.half.copy_from_slice(&self.p);
         model.velocity(&self.q, &self.p, t + s, &mut self.along)?;
@@ -335,7 +343,7 @@ impl Hold {
         self.initial.copy_from_slice(&self.friction);
         if !self.settle(model, held, (t + s, s), Slipping::Now)? {
             self.friction.copy_from_slice(&self.initial);
-            if !self.settle(model, held, (t + s, s), Slipping::Before)? {
+            if !self.settle(model, held, (t + s, s), Slipping::Before { kick: 0.5 * s })? {
                 return Err(format!(
                     "the sliding friction at a held step's end did not settle in {ITERATIONS} iterations (a step \
                      too large for the friction's change)"
@@ -573,11 +581,36 @@ impl Hold {
                 size.sqrt()
             };
             let unit = &mut self.units[a * n..(a + 1) * n];
-            let velocity = match slipping {
-                Slipping::Now => &self.v,
-                Slipping::Before => &self.along,
+            let mut size = match slipping {
+                Slipping::Now => along(unit, &self.v),
+                Slipping::Before { kick } => {
+                    // s̃ = Jq̇(p̃), W = JM⁻¹Jᵀ, and ŝ after the kick −kick μ_k N Jᵀŝ.
+                    let (slipped, rest) = self.kicked.split_at_mut(k);
+                    let rows = &self.slip[..k * n];
+                    for (x, row) in slipped.iter_mut().zip(rows.chunks_exact(n)) {
+                        *x = row.iter().zip(&self.along).map(|(j, v)| j * v).sum();
+                    }
+                    for (c, column) in rows.chunks_exact(n).enumerate() {
+                        model.velocity(&self.q, column, t, &mut self.gradient)?;
+                        for (r, row) in rows.chunks_exact(n).enumerate() {
+                            self.metric[r * k + c] = row.iter().zip(&self.gradient).map(|(j, w)| j * w).sum();
+                        }
+                    }
+                    let c = kick * friction.kinetic * normal_force(&self.rows, n, a, self.lambda[a]).max(0.0);
+                    let (direction, work) = rest.split_at_mut(k);
+                    slip_after_kick(
+                        (&self.metric[..k * k], &mut self.factor[..k * k]),
+                        slipped,
+                        c,
+                        (direction, work),
+                    );
+                    unit.fill(0.0);
+                    for (x, row) in direction.iter().zip(rows.chunks_exact(n)) {
+                        unit.iter_mut().zip(row).for_each(|(u, j)| *u += x * j);
+                    }
+                    f64::from(u8::from(direction.iter().any(|x| *x != 0.0)))
+                }
             };
-            let mut size = along(unit, velocity);
             if !(size > 0.0 && unit.iter().zip(given).map(|(u, g)| u * g).sum::<f64>() > 0.0) {
                 size = along(unit, given);
             }
@@ -695,4 +728,103 @@ fn row_at(held: Held<'_, '_>, a: usize, q: &[f64], gradient: &mut [f64], slip: &
 #[inline]
 fn normal_force(rows: &[f64], n: usize, a: usize, lambda: f64) -> f64 {
     lambda * rows[a * n..(a + 1) * n].iter().map(|g| g * g).sum::<f64>().sqrt()
+}
+
+/// The direction ŝ of the slip s̃ (`slipped`, k entries) after a kick −cWŝ against itself, W =
+/// JM⁻¹Jᵀ the slip's metric (`metric`, k × k; `factor` its scratch): ŝ = x/|x| with
+/// x = (ρI + cW)⁻¹s̃ and |x| = 1, the slip after the kick ρŝ (ρ ≥ 0). ρ by Newton on
+/// 1/|x(ρ)| − 1 (Moré and Sorensen's secular equation: concave, increasing, nearly linear)
+/// from ρ = 0, safeguarded by bisection; ρ = 0 where the kick stops the slip. A backward kick
+/// (c < 0, a composition's backward substep) keeps s̃'s direction: its equation has a root near
+/// each of W's eigenvectors once the slip is small. `direction` gets ŝ (0 for s̃ = 0); `work`
+/// holds 2k entries.
+fn slip_after_kick(
+    (metric, factor): (&[f64], &mut [f64]),
+    slipped: &[f64],
+    c: f64,
+    (direction, work): (&mut [f64], &mut [f64]),
+) {
+    let k = slipped.len();
+    let size = slipped.iter().map(|x| x * x).sum::<f64>().sqrt();
+    let unit = |direction: &mut [f64], x: &[f64]| {
+        let size = x.iter().map(|y| y * y).sum::<f64>().sqrt();
+        for (d, y) in direction.iter_mut().zip(x) {
+            *d = if size > 0.0 { y / size } else { 0.0 };
+        }
+    };
+    unit(direction, slipped);
+    if !(size > 0.0 && c > 0.0 && c.is_finite()) {
+        return;
+    }
+    let (x, w) = work.split_at_mut(k);
+    let trace: f64 = (0..k).map(|i| metric[i * k + i]).sum();
+    // At ρ = |s̃|, |x| ≤ 1: the root lies in [0, |s̃|].
+    let (mut low, mut high, mut rho) = (0.0, size, 0.0);
+    let tolerance = 4.0 * f64::EPSILON * (size + c * trace);
+    for _ in 0..100 {
+        if !cholesky(metric, c, rho, factor, k) {
+            // W singular: the root is to the right of 0.
+            low = rho;
+            rho = 0.5 * (low + high);
+            continue;
+        }
+        // x = (ρI + cW)⁻¹s̃ = L⁻ᵀL⁻¹s̃, then w = L⁻¹x: |w|² = xᵀ(ρI + cW)⁻¹x.
+        forward(factor, slipped, w, k);
+        for i in (0..k).rev() {
+            let sum: f64 = (i + 1..k).map(|l| factor[l * k + i] * x[l]).sum();
+            x[i] = (w[i] - sum) / factor[i * k + i];
+        }
+        forward(factor, x, w, k);
+        let length = x.iter().map(|y| y * y).sum::<f64>().sqrt();
+        let curvature = w.iter().map(|y| y * y).sum::<f64>();
+        unit(direction, x);
+        let g = 1.0 / length - 1.0;
+        if g >= 0.0 {
+            if rho == 0.0 {
+                return;
+            }
+            high = rho;
+        } else {
+            low = rho;
+        }
+        let mut next = rho - g * length.powi(3) / curvature;
+        if !(next > low && next < high) {
+            next = 0.5 * (low + high);
+        }
+        if (next - rho).abs() <= tolerance {
+            return;
+        }
+        rho = next;
+    }
+}
+
+/// The Cholesky factor L of ρI + cW (k × k) into `factor`'s lower triangle: whether it is
+/// positive definite.
+fn cholesky(metric: &[f64], c: f64, rho: f64, factor: &mut [f64], k: usize) -> bool {
+    for i in 0..k {
+        for j in 0..=i {
+            let mut sum = c * metric[i * k + j] + if i == j { rho } else { 0.0 };
+            for l in 0..j {
+                sum -= factor[i * k + l] * factor[j * k + l];
+            }
+            if i == j {
+                // Not positive, or NaN: not positive definite.
+                if sum.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
+                    return false;
+                }
+                factor[i * k + i] = sum.sqrt();
+            } else {
+                factor[i * k + j] = sum / factor[j * k + j];
+            }
+        }
+    }
+    true
+}
+
+/// y = L⁻¹b for the lower triangle L in `factor` (k × k).
+fn forward(factor: &[f64], b: &[f64], y: &mut [f64], k: usize) {
+    for i in 0..k {
+        let sum: f64 = (0..i).map(|l| factor[i * k + l] * y[l]).sum();
+        y[i] = (b[i] - sum) / factor[i * k + i];
+    }
 }
