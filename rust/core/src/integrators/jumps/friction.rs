@@ -115,6 +115,13 @@ impl Friction {
         }
     }
 
+    /// Whether J turns with q of its own ([`Slip::Field`]): a stuck step holds it at its
+    /// midpoint.
+    #[inline]
+    pub(super) fn turns(&self) -> bool {
+        matches!(self.slip, Slip::Field(_))
+    }
+
     /// Whether J is made of the surface's gradient ([`Self::jacobian`] reads it).
     #[inline]
     pub(super) fn on_gradient(&self) -> bool {

@@ -258,7 +258,13 @@ impl Hold {
         let m = held.closed.len();
         // q₁(c) = q₀ + s(q̇(q₀, p½) + Σ c_b M⁻¹row_b(q₀)): Newton on Φ(q₁(c)) = 0 and, for the
         // stuck rows, J(q½)(q₁ − q₀) = 0 at the midpoint q½: rows that turn with q (a wheel's)
-        // then hold along the chord, and the step stays symmetric.
+        // then hold along the chord, and the step stays symmetric. The others are J(q₀): constant,
+        // or a particle's tangent plane, which does not move while it sticks.
+        let midpoint = rows > m
+            && held
+                .stuck
+                .iter()
+                .any(|&j| held.contacts[j].friction.as_ref().is_some_and(Friction::turns));
         model.velocity(&self.q, &self.p, t, &mut self.v)?;
         self.start.copy_from_slice(&self.q);
         self.c[..rows].fill(0.0);
@@ -269,7 +275,7 @@ impl Hold {
                 let shift: f64 = (0..rows).map(|k| self.c[k] * self.inverse[k * n + i]).sum();
                 self.q[i] = self.start[i] + s * (self.v[i] + shift);
             }
-            if rows > m {
+            if midpoint {
                 for ((x, x0), x1) in self.shifted.iter_mut().zip(&self.start).zip(&self.q) {
                     *x = 0.5 * (x0 + x1);
                 }
@@ -282,8 +288,12 @@ impl Hold {
                     self.r[a] = -surface.phi(&self.q)?;
                     &self.gradient[..]
                 } else {
-                    row_at(held, a, &self.shifted, &mut self.gradient, &mut self.slip)?;
-                    let row = &self.slip[..n];
+                    let row = if midpoint {
+                        row_at(held, a, &self.shifted, &mut self.gradient, &mut self.slip)?;
+                        &self.slip[..n]
+                    } else {
+                        &self.rows[a * n..(a + 1) * n]
+                    };
                     self.r[a] = -(0..n).map(|i| row[i] * (self.q[i] - self.start[i])).sum::<f64>();
                     row
                 };
