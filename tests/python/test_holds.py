@@ -124,6 +124,25 @@ def test_a_string_whirled_too_slowly_goes_slack_and_is_caught_again_where_the_pa
     assert np.max(np.abs(np.hypot(traj.q[after, 0], traj.q[after, 1]) - length)) < 1e-13
 
 
+def test_held_steps_in_the_holds_own_loop_are_the_one_at_a_time_loops_bit_for_bit():
+    # Without samples the held steps run in the hold's own loop, which leaves the step that
+    # releases or crosses a contact to the general loop; a sample at every step's end takes
+    # every step in the general loop. One motion, through the slack string's release, its
+    # flight and the catch that holds it again.
+    length, v0, dt = 1.0, math.sqrt(3.5 * G), 1e-3
+    string = varmech.Contact.ellipsoid([length, length], restitution=0.0, law="reflect", name="string")
+    run = {"method": "yoshida4", "dt": dt, "steps": 1600, "contacts": [string]}
+    whole = varmech.integrate(_particle(), [0.0, -length], [v0, 0.0], **run)
+    grid = np.arange(1601) * dt
+    stepwise = varmech.integrate(_particle(), [0.0, -length], [v0, 0.0], t_eval=grid, **run)
+    on_grid = np.isin(whole.t, grid)
+    assert np.array_equal(whole.t[on_grid], grid)
+    assert np.array_equal(whole.q[on_grid], stepwise.q) and np.array_equal(whole.p[on_grid], stepwise.p)
+    for ours, theirs in zip(whole.events, stepwise.events):
+        assert np.array_equal(ours.t, theirs.t) and np.array_equal(ours.q, theirs.q)
+    assert [len(e) for e in whole.events] == [1, 1, 1, 0, 0]
+
+
 def test_an_ensemble_of_sliders_leaves_at_each_members_angle_bit_for_bit_its_single_runs():
     thetas = np.array([0.1, 0.2, 0.3, 0.4])
     q0 = np.array([_on_circle(t) for t in thetas])

@@ -4,6 +4,7 @@ use nalgebra::{DMatrix, DVector};
 
 use super::constraints::{momentum_projection, row_norm};
 use super::{inverse_mass, Lagrangian, Residuals};
+use crate::solve::difference;
 use crate::solve::scratch::with_scratch;
 use crate::{Error, ModelError};
 
@@ -46,7 +47,7 @@ pub trait VelocityConstraints {
             out.fill(0.0);
             return Ok(());
         }
-        let h = f64::EPSILON.cbrt() * q[i].abs().max(1.0);
+        let h = difference::step(q[i].abs().max(1.0));
         shifted(q, |x, _, minus| {
             minus.resize(out.len(), 0.0);
             x[i] = q[i] + h;
@@ -69,7 +70,7 @@ pub fn differenced_derivative<C: VelocityConstraints + ?Sized>(
     i: usize,
     out: &mut DMatrix<f64>,
 ) -> Result<(), ModelError> {
-    let h = f64::EPSILON.cbrt() * q[i].abs().max(1.0);
+    let h = difference::step(q[i].abs().max(1.0));
     shifted(q, |x, minus, _| {
         if minus.shape() != out.shape() {
             *minus = DMatrix::zeros(out.nrows(), out.ncols());

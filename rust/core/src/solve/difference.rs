@@ -13,9 +13,14 @@ use crate::ModelError;
 /// Newton step cannot halve means the iteration has converged as far as it can.
 pub const NOISE_FLOOR: f64 = 1.5e-8;
 
+/// ε^{1/3}, written out: `f64::cbrt` is not a `const fn`, and a libm call per difference costs
+/// as much as a cheap model's gradient.
+pub const CBRT_EPSILON: f64 = 6.055_454_452_393_339_5e-6;
+
 /// The central-difference step for a variable of magnitude `size`: ε^{1/3}·size.
-fn step(size: f64) -> f64 {
-    f64::EPSILON.cbrt() * size
+#[inline]
+pub fn step(size: f64) -> f64 {
+    CBRT_EPSILON * size
 }
 
 /// The magnitude a variable's difference step is relative to: max(|x|, 1).
@@ -81,4 +86,12 @@ where
         }
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn cbrt_epsilon_is_the_cube_root_of_epsilon() {
+        assert_eq!(super::CBRT_EPSILON.to_bits(), f64::EPSILON.cbrt().to_bits());
+    }
 }

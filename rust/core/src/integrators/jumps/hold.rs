@@ -22,6 +22,7 @@ use nalgebra::DMatrix;
 use super::{Contact, Friction};
 use crate::integrators::{Composition, Method};
 use crate::model::Lagrangian;
+use crate::solve::difference;
 use crate::solve::lu::{lu_in_place, lu_solve};
 use crate::ModelError;
 
@@ -505,7 +506,7 @@ impl Hold {
         let amax = |x: &[f64]| x.iter().fold(0.0_f64, |a, y| a.max(y.abs()));
         let speed = amax(&self.v);
         // The difference's step: truncation (s²) and rounding (ε/s) both near ε^(2/3).
-        let s = f64::EPSILON.cbrt() * amax(&self.q).max(1.0) / speed;
+        let s = difference::step(amax(&self.q).max(1.0)) / speed;
         let (system, pivots) = &mut self.systems[rows - 1];
         for a in 0..rows {
             let row = &self.rows[a * n..(a + 1) * n];
@@ -630,6 +631,15 @@ impl Hold {
             model.velocity(&self.q, unit, t, &mut self.units_inverse[a * n..(a + 1) * n])?;
         }
         Ok(())
+    }
+
+    /// Whether every closed contact of `held` still presses (λ ≥ 0) at the end of the step just
+    /// taken, at time t: its multipliers from the force and rows the step kept there, the
+    /// numbers [`Hold::multipliers`] gives for that state.
+    pub(super) fn pressing(&mut self, model: &dyn Lagrangian, held: Held<'_, '_>, t: f64) -> Result<bool, ModelError> {
+        debug_assert!(self.at(&self.q, t, held), "the last step ended at t");
+        self.forces(model, held, t, Slipping::Now)?;
+        Ok(self.lambda[..held.closed.len()].iter().all(|&l| l >= 0.0))
     }
 
     /// The multipliers of `held` at (q, p, t) into `out`: λ of the closed contacts (the k-th

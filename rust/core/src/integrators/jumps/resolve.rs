@@ -263,6 +263,18 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
                 left -= self.advance_clear(stepper, free, traj, poll)?;
                 continue;
             }
+            let plain = if search.is_none() && !self.closed.is_empty() && !self.frictional {
+                self.free_steps(stepper, left)
+            } else {
+                0
+            };
+            if plain > 0 {
+                let taken = self.advance_held(stepper, plain, poll)?;
+                left -= taken;
+                if taken == plain {
+                    continue;
+                }
+            }
             self.t = stepper.t();
             self.q.copy_from_slice(stepper.q());
             self.p.copy_from_slice(stepper.p());
@@ -348,6 +360,72 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
             self.settle(stepper, true, None, traj, traj.events.len())?;
         }
         Ok(stepper.steps() - before)
+    }
+
+    /// Up to `n` steps with the closed contacts (frictionless) held as they are, in the hold's
+    /// own loop: each the held step from the last's end, kept where every closed contact still
+    /// presses at its end and no open one is crossed. The first step that would release or
+    /// cross a contact, or that fails, is not taken: the one-at-a-time loop redoes it
+    /// ([`Resolver::resolve`]), from the same state to the same end. The steps taken.
+    fn advance_held<St: BorrowMut<StepperState>, P: Poll>(
+        &mut self,
+        stepper: &mut Stepper<M, St>,
+        n: usize,
+        poll: &mut P,
+    ) -> Result<usize, Error> {
+        let (Some(hold), h) = (self.hold.as_mut(), stepper.dt()) else {
+            return Ok(0);
+        };
+        let held = Held {
+            contacts: self.contacts,
+            closed: &self.closed,
+            stuck: &self.stuck,
+            directions: &self.directions,
+        };
+        let model = self.scratch.model().as_lagrangian();
+        self.t = stepper.t();
+        self.q.copy_from_slice(stepper.q());
+        self.p.copy_from_slice(stepper.p());
+        let mut taken = 0;
+        let mut ticked = Ok(());
+        while taken < n {
+            let t = self.t;
+            // φ of the open contacts alone: the closed ones' is needed only where the loop stops.
+            let open = |j: &usize| !self.closed.contains(j);
+            let kept = hold.step(model, held, (t, h), (&self.q, &self.p)).is_ok()
+                && hold.pressing(model, held, t + h).unwrap_or(false)
+                && (0..self.contacts.len()).filter(open).all(|j| {
+                    gap(&self.contacts[j], None, &hold.q).is_ok_and(|phi| {
+                        self.phi_end[j] = phi;
+                        !crossing(self.phi[j], phi)
+                    })
+                });
+            if !kept {
+                break;
+            }
+            ticked = stepper.tick(Counting(|steps| poll.poll(steps)));
+            if ticked.is_err() {
+                break;
+            }
+            self.t = stepper.t();
+            self.q.copy_from_slice(&hold.q);
+            self.p.copy_from_slice(&hold.p);
+            for j in (0..self.contacts.len()).filter(open) {
+                self.phi[j] = self.phi_end[j];
+            }
+            taken += 1;
+        }
+        if taken > 0 {
+            stepper.jump_to(&self.q, &self.p)?;
+            for &j in &self.closed {
+                self.phi[j] = gap(&self.contacts[j], None, &self.q).map_err(|source| Error::Model {
+                    step: stepper.steps(),
+                    time: self.t,
+                    source,
+                })?;
+            }
+        }
+        ticked.map(|()| taken)
     }
 
     /// The step just taken by `stepper` from the kept start (t, q, p), with φ at its end in
