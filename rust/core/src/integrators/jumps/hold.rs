@@ -87,7 +87,9 @@ pub(super) struct Hold {
     /// q̇ at p̃, the step's end before its friction kick, whose slip the force opposes.
     along: Vec<f64>,
     previous: Vec<f64>,
+    /// A point beside the state, and the rows there (as `rows`).
     shifted: Vec<f64>,
+    shifted_rows: Vec<f64>,
     /// The constraint rows at q, k-th at k·n: ∇φ of the closed contacts, then the slip rows J
     /// of those stuck; and M⁻¹ times each.
     rows: Vec<f64>,
@@ -148,6 +150,7 @@ impl Hold {
             along: v(),
             previous: v(),
             shifted: v(),
+            shifted_rows: vec![0.0; n * rows],
             rows: vec![0.0; n * rows],
             inverse: vec![0.0; n * rows],
             units: vec![0.0; n * m],
@@ -280,6 +283,7 @@ impl Hold {
                 for ((x, x0), x1) in self.shifted.iter_mut().zip(&self.start).zip(&self.q) {
                     *x = 0.5 * (x0 + x1);
                 }
+                rows_into(held, &self.shifted, &mut self.shifted_rows, false)?;
             }
             let (system, pivots) = &mut self.systems[rows - 1];
             for a in 0..rows {
@@ -289,12 +293,8 @@ impl Hold {
                     self.r[a] = -surface.phi(&self.q)?;
                     &self.gradient[..]
                 } else {
-                    let row = if midpoint {
-                        row_at(held, a, &self.shifted, &mut self.gradient, &mut self.slip)?;
-                        &self.slip[..n]
-                    } else {
-                        &self.rows[a * n..(a + 1) * n]
-                    };
+                    let rows = if midpoint { &self.shifted_rows } else { &self.rows };
+                    let row = &rows[a * n..(a + 1) * n];
                     self.r[a] = -(0..n).map(|i| row[i] * (self.q[i] - self.start[i])).sum::<f64>();
                     row
                 };
@@ -447,27 +447,7 @@ impl Hold {
     /// T = ½pᵀM⁻¹p): their number.
     fn rows_at(&mut self, model: &dyn Lagrangian, held: Held<'_, '_>, t: f64) -> Result<usize, ModelError> {
         let n = self.q.len();
-        for (a, &j) in held.closed.iter().enumerate() {
-            held.contacts[j]
-                .surface
-                .gradient(&self.q, &mut self.rows[a * n..(a + 1) * n])?;
-        }
-        let mut next = held.closed.len();
-        for &j in held.stuck {
-            let a = held
-                .closed
-                .iter()
-                .position(|&k| k == j)
-                .expect("a stuck contact is closed");
-            let friction = held.contacts[j]
-                .friction
-                .as_ref()
-                .expect("a stuck contact has friction");
-            let k = friction.rows(n);
-            let (normals, slips) = self.rows.split_at_mut(next * n);
-            friction.jacobian(&self.q, &normals[a * n..(a + 1) * n], &mut slips[..k * n])?;
-            next += k;
-        }
+        let next = rows_into(held, &self.q, &mut self.rows, true)?;
         for a in 0..next {
             model.velocity(
                 &self.q,
@@ -507,22 +487,24 @@ impl Hold {
         let speed = amax(&self.v);
         // The difference's step: truncation (s²) and rounding (ε/s) both near ε^(2/3).
         let s = difference::step(amax(&self.q).max(1.0)) / speed;
+        // The curvature terms (d row_a/dt)·q̇ into `r`.
+        self.r[..rows].fill(0.0);
+        if speed > 0.0 {
+            for sign in [1.0, -1.0] {
+                for (x, (qi, vi)) in self.shifted.iter_mut().zip(self.q.iter().zip(&self.v)) {
+                    *x = qi + sign * s * vi;
+                }
+                rows_into(held, &self.shifted, &mut self.shifted_rows, true)?;
+                for (curvature, shifted) in self.r[..rows].iter_mut().zip(self.shifted_rows.chunks_exact(n)) {
+                    *curvature += sign * shifted.iter().zip(&self.v).map(|(g, v)| g * v).sum::<f64>();
+                }
+            }
+            self.r[..rows].iter_mut().for_each(|c| *c /= 2.0 * s);
+        }
         let (system, pivots) = &mut self.systems[rows - 1];
         for a in 0..rows {
             let row = &self.rows[a * n..(a + 1) * n];
-            let mut curvature = 0.0;
-            if speed > 0.0 {
-                for sign in [1.0, -1.0] {
-                    for (x, (qi, vi)) in self.shifted.iter_mut().zip(self.q.iter().zip(&self.v)) {
-                        *x = qi + sign * s * vi;
-                    }
-                    row_at(held, a, &self.shifted, &mut self.gradient, &mut self.slip)?;
-                    let shifted = if a < m { &self.gradient[..] } else { &self.slip[..n] };
-                    curvature += sign * shifted.iter().zip(&self.v).map(|(g, v)| g * v).sum::<f64>();
-                }
-                curvature /= 2.0 * s;
-            }
-            self.lambda[a] = -(curvature + row.iter().zip(&self.w).map(|(g, x)| g * x).sum::<f64>());
+            self.lambda[a] = -(self.r[a] + row.iter().zip(&self.w).map(|(g, x)| g * x).sum::<f64>());
             for b in 0..rows {
                 let w = &self.inverse[b * n..(b + 1) * n];
                 let mut entry: f64 = row.iter().zip(w).map(|(g, w)| g * w).sum();
@@ -716,32 +698,37 @@ impl Hold {
     }
 }
 
-/// Row a of `held`'s rows at q: a closed contact's ∇φ into `gradient` (a < m), or a stuck
-/// contact's slip row into `slip[..n]` (its gradient in `gradient`).
-#[inline]
-fn row_at(held: Held<'_, '_>, a: usize, q: &[f64], gradient: &mut [f64], slip: &mut [f64]) -> Result<(), ModelError> {
-    let (n, m) = (q.len(), held.closed.len());
-    if a < m {
-        return held.contacts[held.closed[a]].surface.gradient(q, gradient);
+/// The rows of `held` at q into `out` (the k-th at k·n): ∇φ of the closed contacts, then the
+/// stuck ones' slip rows, each contact's J evaluated once; their number. Without `normals` the
+/// closed contacts' rows are not evaluated, but for a stuck contact whose J is made from its ∇φ.
+fn rows_into(held: Held<'_, '_>, q: &[f64], out: &mut [f64], normals: bool) -> Result<usize, ModelError> {
+    let n = q.len();
+    if normals {
+        for (a, &j) in held.closed.iter().enumerate() {
+            held.contacts[j].surface.gradient(q, &mut out[a * n..(a + 1) * n])?;
+        }
     }
-    let mut first = m;
+    let mut next = held.closed.len();
     for &j in held.stuck {
+        let a = held
+            .closed
+            .iter()
+            .position(|&k| k == j)
+            .expect("a stuck contact is closed");
         let friction = held.contacts[j]
             .friction
             .as_ref()
             .expect("a stuck contact has friction");
         let k = friction.rows(n);
-        if a < first + k {
-            if friction.on_gradient() {
-                held.contacts[j].surface.gradient(q, gradient)?;
-            }
-            friction.jacobian(q, gradient, &mut slip[..k * n])?;
-            slip.copy_within((a - first) * n..(a - first + 1) * n, 0);
-            return Ok(());
+        let (front, slips) = out.split_at_mut(next * n);
+        let normal = &mut front[a * n..(a + 1) * n];
+        if !normals && friction.on_gradient() {
+            held.contacts[j].surface.gradient(q, normal)?;
         }
-        first += k;
+        friction.jacobian(q, normal, &mut slips[..k * n])?;
+        next += k;
     }
-    unreachable!("row {a} of {first}")
+    Ok(next)
 }
 
 /// N = λ|∇φ| of row a of `rows` (n entries a row).
