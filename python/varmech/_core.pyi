@@ -37,6 +37,7 @@ __all__ = [
     "Stepper",
     "TrajectoryRecord",
     "VarmechError",
+    "accurate_step",
     "amended_potential",
     "catalogue",
     "central_differences",
@@ -49,6 +50,7 @@ __all__ = [
     "energy_terms",
     "engage",
     "ensemble",
+    "equilibrium",
     "impulse_components",
     "impulse_response",
     "integrate",
@@ -57,15 +59,18 @@ __all__ = [
     "is_forced",
     "is_time_dependent",
     "kind_of",
+    "linearize",
     "methods",
     "momentum",
     "momentum_along",
     "nbody",
+    "normal_modes",
     "project",
     "reactions",
     "resume",
     "routh",
     "scene",
+    "stable_step",
     "statistics",
     "symplecticity_defect",
 ]
@@ -757,3 +762,28 @@ def catalogue() -> list[CatalogueEntry]:
     """Every scene of the catalogue, in the order of the tour."""
 
 def nbody(g: float, masses: Sequence[float]) -> NativeModel: ...
+
+def linearize(
+    model: _Model, q: _FloatArray, t: float = 0.0
+) -> tuple[_FloatArray, _FloatArray, _FloatArray, _FloatArray]:
+    """(M, K, G, D) of the linearized equations at (q, q̇ = 0, t), each (n, n)."""
+
+def normal_modes(
+    model: _Model, q: _FloatArray, t: float = 0.0
+) -> tuple[_FloatArray, _FloatArray, _FloatArray, list[int], _FloatArray | None]:
+    """(ω, σ, κ, K's inertia, M-orthonormal shapes or None) of the modes at (q, t)."""
+
+def equilibrium(
+    model: _Model,
+    guess: _FloatArray,
+    t: float = 0.0,
+    newton_tolerance: float = 1e-14,
+    newton_max_iterations: int = 50,
+) -> tuple[_FloatArray, float, int]:
+    """(q, ‖∂L/∂q + Q‖∞, Newton iterations) of the equilibrium nearest the guess."""
+
+def stable_step(method: str, omega_max: float) -> float:
+    """The largest stable step of the method on frequencies up to omega_max."""
+
+def accurate_step(method: str, omega_max: float, accuracy: float) -> float:
+    """The largest step with a phase error a period of at most accuracy on omega_max."""

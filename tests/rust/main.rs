@@ -29,6 +29,7 @@ mod jit;
 mod kepler;
 mod kepler_polar;
 mod mixed_constraints;
+mod modes;
 mod nbody_kernel;
 mod nonholonomic;
 mod nonholonomic_scenes;

@@ -22,6 +22,7 @@ mod errors;
 mod events;
 mod generator;
 mod impulsive;
+mod modes;
 mod native;
 mod pointers;
 mod routh;
@@ -49,5 +50,6 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     diagnostics::register(m)?;
     constraints::register(m)?;
     impulsive::register(m)?;
+    modes::register(m)?;
     Ok(())
 }

@@ -1,0 +1,477 @@
+"""Small oscillations: equilibria, the linearized equations and normal modes at a point, and the
+step a method can take on them, before the run.
+
+About a point q (an equilibrium, or any configuration for its local frequencies) the equations
+of motion linearize to
+
+    M δq̈ + (G + D) δq̇ + K δq = 0,   M = ∂²L/∂q̇²,  K = −∂²L/∂q² − ∂Q/∂q,
+    G = ∂²L/∂q̇∂q − ∂²L/∂q∂q̇ (antisymmetric),  D = −∂Q/∂q̇,
+
+at q̇ = 0, Q the model's own forces. The core computes them (exact second derivatives where the
+model supplies them: compiled symbolic models, native scenes; central differences otherwise),
+finds equilibria by Newton on the generalized force, and solves the eigenproblems. A
+Routh-reduced model (:func:`varmech.routh`) linearizes its Routhian: its equilibria are the full
+model's steady motions (relative equilibria), its G their Coriolis coupling.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from . import _core
+from ._util import finite, integer, number, vector
+from .methods import methods
+from .model import Model
+
+__all__ = ["Equilibrium", "Linearization", "NormalModes", "StepSuggestion", "equilibria", "linearize", "normal_modes", "suggest_dt"]
+
+
+def _point(model: Model, name: str, q: ArrayLike) -> np.ndarray:
+    if not isinstance(model, Model):
+        raise TypeError(f"model: expected a varmech model, got {type(model).__name__}")
+    return vector(name, q, model.dim)
+
+
+@dataclass(frozen=True)
+class Linearization:
+    """The linearized equations M δq̈ + (G + D) δq̇ + K δq = 0 at (q, q̇ = 0, t).
+
+    Attributes
+    ----------
+    q : numpy.ndarray
+        The point, shape (n,).
+    t : float
+        The time.
+    mass : numpy.ndarray
+        M = ∂²L/∂q̇², shape (n, n).
+    stiffness : numpy.ndarray
+        K = −∂²L/∂q² − ∂Q/∂q.
+    gyroscopic : numpy.ndarray
+        G = ∂²L/∂q̇∂q − ∂²L/∂q∂q̇, antisymmetric (magnetic fields, rotating frames).
+    damping : numpy.ndarray
+        D = −∂Q/∂q̇ (zero for a model without forces).
+
+    Examples
+    --------
+    >>> import numpy as np, varmech
+    >>> k = 2.0
+    >>> def V(q): return 0.5 * k * ((q[1] - q[0]) ** 2 + (q[2] - q[1]) ** 2)
+    >>> def dV(q): return k * np.array([q[0] - q[1], 2 * q[1] - q[0] - q[2], q[2] - q[1]])
+    >>> molecule = varmech.MechanicalSystem(3, V, dV, mass=[1.0, 3.0, 1.0])
+    >>> varmech.linearize(molecule, np.zeros(3)).stiffness + 0.0  # + 0.0: no −0
+    array([[ 2., -2.,  0.],
+           [-2.,  4., -2.],
+           [ 0., -2.,  2.]])
+    """
+
+    q: np.ndarray
+    t: float
+    mass: np.ndarray
+    stiffness: np.ndarray
+    gyroscopic: np.ndarray
+    damping: np.ndarray
+
+
+def linearize(model: Model, q: ArrayLike, *, t: float = 0.0) -> Linearization:
+    """The linearized equations of ``model`` at (q, q̇ = 0, t).
+
+    Parameters
+    ----------
+    model
+        Any model without constraints of its own (closures, compiled symbolic, native scenes,
+        Routh-reduced).
+    q
+        The point, shape (n,).
+    t
+        The time (for a time-dependent model, the instantaneous linearization).
+
+    Returns
+    -------
+    Linearization
+        M, K, G and D.
+
+    Raises
+    ------
+    ValueError
+        ``q`` or ``t`` malformed, a constrained model, or the model's derivatives not finite.
+
+    Examples
+    --------
+    >>> import numpy as np, varmech
+    >>> spring = varmech.MechanicalSystem(1, lambda q: 2.0 * q[0] ** 2, lambda q: 4.0 * q, mass=[0.5])
+    >>> lin = varmech.linearize(spring, [0.0])
+    >>> lin.mass, lin.stiffness
+    (array([[0.5]]), array([[4.]]))
+    """
+    q = _point(model, "q", q)
+    t = finite("t", t)
+    mass, stiffness, gyroscopic, damping = _core.linearize(model._core, q, t)
+    return Linearization(q, t, mass, stiffness, gyroscopic, damping)
+
+
+@dataclass(frozen=True)
+class NormalModes:
+    """The normal modes of the linearized equations at a point.
+
+    Each mode is one eigenvalue pair λ = σ ± iω of the linearized equations: a stable undamped
+    mode has σ = 0, a damped one σ < 0, an unstable one σ > 0 (ω = 0 where it grows without
+    oscillating). A zero mode (ω = σ = 0) is a neutral direction: a symmetry's (a translation,
+    a rotation) or a degenerate equilibrium's.
+
+    Attributes
+    ----------
+    q : numpy.ndarray
+        The point.
+    frequencies : numpy.ndarray
+        ω of each mode, ascending.
+    growth : numpy.ndarray
+        σ of each mode.
+    curvatures : numpy.ndarray
+        The eigenvalues κ of K̄x = κMx (K̄ the symmetric part of K), ascending: ω² where G = D = 0.
+    inertia : tuple of int
+        How many κ are positive, zero and negative: K's inertia relative to M.
+    shapes : numpy.ndarray or None
+        The mode shapes, M-orthonormal columns (xᵀMx = 1) in the order of ``frequencies``, where
+        G = D = 0 and K is symmetric; None otherwise.
+    stable : bool
+        Whether no mode grows.
+    omega_max : float
+        The largest |λ| = √(ω² + σ²): what bounds a method's step.
+    zero_modes : numpy.ndarray
+        The indices of the zero modes.
+    unstable_modes : numpy.ndarray
+        The indices of the modes that grow.
+    gyroscopically_stable : bool
+        Stable although K is not positive semidefinite (some κ < 0): stabilized by G (a
+        spinning top, a Penning trap).
+
+    Examples
+    --------
+    >>> import numpy as np, varmech
+    >>> k = 2.0
+    >>> def V(q): return 0.5 * k * ((q[1] - q[0]) ** 2 + (q[2] - q[1]) ** 2)
+    >>> def dV(q): return k * np.array([q[0] - q[1], 2 * q[1] - q[0] - q[2], q[2] - q[1]])
+    >>> molecule = varmech.MechanicalSystem(3, V, dV, mass=[1.0, 3.0, 1.0])
+    >>> modes = varmech.normal_modes(molecule, np.zeros(3))
+    >>> modes.stable, modes.inertia, round(modes.omega_max, 6)
+    (True, (2, 1, 0), 1.825742)
+    """
+
+    q: np.ndarray
+    frequencies: np.ndarray
+    growth: np.ndarray
+    curvatures: np.ndarray
+    inertia: tuple[int, int, int]
+    shapes: np.ndarray | None
+
+    @property
+    def stable(self) -> bool:
+        return bool(np.all(self.growth <= 0.0))
+
+    @property
+    def omega_max(self) -> float:
+        return float(np.max(np.hypot(self.frequencies, self.growth), initial=0.0))
+
+    @property
+    def zero_modes(self) -> np.ndarray:
+        return np.flatnonzero((self.frequencies == 0.0) & (self.growth == 0.0))
+
+    @property
+    def unstable_modes(self) -> np.ndarray:
+        return np.flatnonzero(self.growth > 0.0)
+
+    @property
+    def gyroscopically_stable(self) -> bool:
+        return self.stable and self.inertia[2] > 0
+
+    def __str__(self) -> str:
+        rows = [f"{'mode':>4}  {'ω':>14}  {'σ':>14}"]
+        rows += [f"{k:>4}  {w:>14.8g}  {s:>14.8g}" for k, (w, s) in enumerate(zip(self.frequencies, self.growth))]
+        verdict = "stable" if self.stable else f"unstable ({len(self.unstable_modes)} growing)"
+        if self.gyroscopically_stable:
+            verdict += ", gyroscopically (K has negative curvatures)"
+        return "\n".join([*rows, f"{verdict}; {len(self.zero_modes)} zero modes; ω_max = {self.omega_max:.8g}"])
+
+
+def normal_modes(model: Model, q: ArrayLike, *, t: float = 0.0) -> NormalModes:
+    """The normal modes of ``model`` linearized at (q, q̇ = 0, t).
+
+    Where G = D = 0 (a model without velocity-linear terms or forces) the generalized symmetric
+    eigenproblem K x = ω² M x, with M-orthonormal shapes; otherwise the eigenvalues of the
+    first-order system (the quadratic eigenproblem), which finds gyroscopic stabilization.
+
+    Parameters
+    ----------
+    model
+        Any model without constraints of its own.
+    q
+        The point: an equilibrium for the small oscillations about it, or any configuration for
+        the local frequencies (what bounds a method's step there).
+    t
+        The time.
+
+    Returns
+    -------
+    NormalModes
+        Frequencies, growth rates, shapes; printing it gives the table.
+
+    Raises
+    ------
+    ValueError
+        ``q`` or ``t`` malformed, a constrained model, M not positive definite or a non-finite
+        second derivative at q (the message says which).
+
+    Examples
+    --------
+    The linear triatomic molecule (masses 1, 3, 1, springs 2): a translation and two vibrations.
+
+    >>> import numpy as np, varmech
+    >>> k = 2.0
+    >>> def V(q): return 0.5 * k * ((q[1] - q[0]) ** 2 + (q[2] - q[1]) ** 2)
+    >>> def dV(q): return k * np.array([q[0] - q[1], 2 * q[1] - q[0] - q[2], q[2] - q[1]])
+    >>> molecule = varmech.MechanicalSystem(3, V, dV, mass=[1.0, 3.0, 1.0])
+    >>> modes = varmech.normal_modes(molecule, np.zeros(3))
+    >>> np.round(modes.frequencies, 6), modes.zero_modes
+    (array([0.      , 1.414214, 1.825742]), array([0]))
+    """
+    q = _point(model, "q", q)
+    t = finite("t", t)
+    frequencies, growth, curvatures, inertia, shapes = _core.normal_modes(model._core, q, t)
+    positive, zero, negative = inertia
+    return NormalModes(q, frequencies, growth, curvatures, (positive, zero, negative), shapes)
+
+
+@dataclass(frozen=True)
+class Equilibrium:
+    """An equilibrium found by Newton on the generalized force, with its normal modes.
+
+    Attributes
+    ----------
+    q : numpy.ndarray
+        The equilibrium.
+    residual : float
+        ‖∂L/∂q + Q‖∞ there.
+    iterations : int
+        Newton iterations from the guess.
+    modes : NormalModes
+        The small oscillations about it.
+    kind : str
+        ``"minimum"`` (every curvature positive), ``"maximum"``, ``"saddle"``, or
+        ``"degenerate"`` (zero curvatures besides the others'); of the potential (amended, for a
+        reduced model), whatever G makes of it (``modes.stable``).
+
+    Examples
+    --------
+    >>> import numpy as np, varmech
+    >>> pendulum = varmech.MechanicalSystem(1, lambda q: -np.cos(q[0]), lambda q: np.sin(q))
+    >>> [(round(float(e.q[0]), 12), e.kind) for e in varmech.equilibria(pendulum, [[0.3], [3.0]])]
+    [(0.0, 'minimum'), (3.14159265359, 'maximum')]
+    """
+
+    q: np.ndarray
+    residual: float
+    iterations: int
+    modes: NormalModes
+
+    @property
+    def kind(self) -> str:
+        positive, zero, negative = self.modes.inertia
+        if zero:
+            return "degenerate"
+        if negative == 0:
+            return "minimum"
+        return "maximum" if positive == 0 else "saddle"
+
+
+def equilibria(
+    model: Model,
+    guesses: ArrayLike,
+    *,
+    t: float = 0.0,
+    newton_tolerance: float = 1e-14,
+    newton_max_iterations: int = 50,
+) -> list[Equilibrium]:
+    """The equilibria of ``model`` nearest each guess: ∂L/∂q(q, 0, t) + Q(q, 0, t) = 0 by the
+    core's Newton, with the exact Hessian where the model supplies it.
+
+    Guesses that converge to the same point (to 1e-8 relative) give it once.
+
+    Parameters
+    ----------
+    model
+        Any model without constraints of its own; a Routh-reduced model for steady motions.
+    guesses
+        One guess, shape (n,), or several, shape (k, n).
+    t
+        The time.
+    newton_tolerance, newton_max_iterations
+        Newton's stopping rule (relative correction) and cap.
+
+    Returns
+    -------
+    list of Equilibrium
+        In the order of the guesses.
+
+    Raises
+    ------
+    varmech.ConvergenceError
+        No equilibrium near a guess (Newton did not converge, or K is singular there): its
+        ``residual`` and ``iterations``.
+    ValueError
+        Malformed guesses, ``t`` or Newton options; a constrained model.
+
+    Examples
+    --------
+    A bead on a hoop of radius R spinning at Ω about its vertical diameter: the bottom is
+    unstable for Ω² > g/R, and the bead rests where cos θ = g/(RΩ²).
+
+    >>> import math, varmech, sympy as sp
+    >>> th, w = sp.symbols("theta omega")
+    >>> g, R, Omega = 9.81, 1.0, 5.0
+    >>> L = R**2 * (w**2 + Omega**2 * sp.sin(th) ** 2) / 2 + g * R * sp.cos(th)
+    >>> bead = varmech.symbolic.lagrangian(L, [th], [w])
+    >>> bottom, off = varmech.equilibria(bead, [[0.0], [1.0]])
+    >>> bottom.kind, off.kind, round(math.cos(off.q[0]), 12) == round(g / (R * Omega**2), 12)
+    ('maximum', 'minimum', True)
+    """
+    if not isinstance(model, Model):
+        raise TypeError(f"model: expected a varmech model, got {type(model).__name__}")
+    points = np.asarray(guesses, dtype=float) if not isinstance(guesses, str) else None
+    if points is None or points.ndim not in (1, 2) or points.shape[-1] != model.dim or points.size == 0:
+        shape = None if points is None else points.shape
+        raise ValueError(f"guesses: must have shape ({model.dim},) or (k, {model.dim}), got {shape}")
+    t = finite("t", t)
+    tolerance = number("newton_tolerance", newton_tolerance)
+    iterations = integer("newton_max_iterations", newton_max_iterations, 1)
+    found: list[Equilibrium] = []
+    for k, guess in enumerate(np.atleast_2d(points)):
+        q = _point(model, f"guesses[{k}]" if points.ndim == 2 else "guesses", guess)
+        q, residual, steps = _core.equilibrium(model._core, q, t, tolerance, iterations)
+        if any(np.allclose(q, e.q, rtol=1e-8, atol=1e-8) for e in found):
+            continue
+        found.append(Equilibrium(q, residual, steps, normal_modes(model, q, t=t)))
+    return found
+
+
+@dataclass(frozen=True)
+class StepSuggestion:
+    """The step a method can take on a model, from its frequencies.
+
+    Attributes
+    ----------
+    method : str
+        The method.
+    dt : float
+        The suggested step: ``(1 − margin)·stable_dt``, or ``accurate_dt`` where smaller.
+    stable_dt : float
+        The stability limit h_ω/ω_max: the method blows up on the fastest mode above it.
+    accurate_dt : float or None
+        The largest step with a phase error of at most ``accuracy`` a period on the fastest
+        mode (None without ``accuracy``).
+    omega_max : float
+        The largest |λ| of the modes at the point.
+    h_omega_max : float
+        The method's stability limit on q̈ = −ω²q (inf for an unconditionally stable one).
+    margin : float
+        The fraction of ``stable_dt`` kept in reserve (the frequencies change along the run).
+    accuracy : float or None
+        The phase error a period asked for (radians).
+
+    Examples
+    --------
+    >>> import numpy as np, varmech
+    >>> k = 2.0
+    >>> def V(q): return 0.5 * k * ((q[1] - q[0]) ** 2 + (q[2] - q[1]) ** 2)
+    >>> def dV(q): return k * np.array([q[0] - q[1], 2 * q[1] - q[0] - q[2], q[2] - q[1]])
+    >>> molecule = varmech.MechanicalSystem(3, V, dV, mass=[1.0, 3.0, 1.0])
+    >>> s = varmech.suggest_dt(molecule, "verlet", np.zeros(3), accuracy=1e-3)
+    >>> s.dt == s.accurate_dt < s.stable_dt
+    True
+    """
+
+    method: str
+    dt: float
+    stable_dt: float
+    accurate_dt: float | None
+    omega_max: float
+    h_omega_max: float
+    margin: float
+    accuracy: float | None
+
+
+def suggest_dt(
+    model: Model,
+    method: str,
+    q: ArrayLike,
+    *,
+    t: float = 0.0,
+    accuracy: float | None = None,
+    margin: float = 0.1,
+) -> StepSuggestion:
+    """The step ``method`` can take on ``model`` near q: its stability limit over the fastest
+    mode there, and, with ``accuracy``, the step that keeps the fastest mode's phase error a
+    period within it.
+
+    A method is stable on q̈ = −ω²q while hω < h_ω, its limit (2 for verlet; see
+    :func:`varmech.methods`); on a model the fastest mode at q sets the step. The phase error a
+    period is measured on the method's own one-step map of the oscillator (it grows as (hω)^p,
+    p the method's order). Frequencies change along a nonlinear run: ``margin`` keeps a fraction
+    of the limit in reserve.
+
+    Parameters
+    ----------
+    model
+        Any model without constraints of its own.
+    method
+        A method's name.
+    q
+        The point whose frequencies bound the step (an equilibrium, or the run's start).
+    t
+        The time.
+    accuracy
+        The largest phase error a period on the fastest mode, in radians (default: none).
+    margin
+        The fraction of the stability limit kept in reserve, in [0, 1).
+
+    Returns
+    -------
+    StepSuggestion
+        ``dt``, and what it comes from.
+
+    Raises
+    ------
+    ValueError
+        An unknown method, or one with no stable step on an oscillator (explicit Euler, the
+        Wisdom–Holman methods); malformed ``q``, ``t``, ``accuracy`` or ``margin``.
+
+    Examples
+    --------
+    >>> import numpy as np, varmech
+    >>> k = 2.0
+    >>> def V(q): return 0.5 * k * ((q[1] - q[0]) ** 2 + (q[2] - q[1]) ** 2)
+    >>> def dV(q): return k * np.array([q[0] - q[1], 2 * q[1] - q[0] - q[2], q[2] - q[1]])
+    >>> molecule = varmech.MechanicalSystem(3, V, dV, mass=[1.0, 3.0, 1.0])
+    >>> s = varmech.suggest_dt(molecule, "verlet", np.zeros(3))
+    >>> round(s.stable_dt, 6), round(s.dt, 6)  # 2/ω_max, ω_max = √((k/m)(1 + 2m/M))
+    (1.095445, 0.985901)
+    """
+    names = {m.name for m in methods()}
+    if not isinstance(method, str) or method not in names:
+        raise ValueError(f"method: expected one of {sorted(names)}, got {method!r}")
+    margin = finite("margin", margin)
+    if not 0.0 <= margin < 1.0:
+        raise ValueError(f"margin: must be in [0, 1), got {margin}")
+    if accuracy is not None:
+        accuracy = finite("accuracy", accuracy)
+    modes = normal_modes(model, q, t=t)
+    omega = modes.omega_max
+    stable = _core.stable_step(method, omega)
+    accurate = None if accuracy is None else _core.accurate_step(method, omega, accuracy)
+    dt = (1.0 - margin) * stable
+    if accurate is not None:
+        dt = min(dt, accurate)
+    limit = next(m.h_omega_max for m in methods() if m.name == method)
+    return StepSuggestion(method, dt, stable, accurate, omega, limit, margin, accuracy)
