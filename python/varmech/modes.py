@@ -449,9 +449,9 @@ def suggest_dt(
     >>> round(s.stable_dt * 7**0.5, 6), s.dt / s.stable_dt
     (2.0, 0.9)
     """
-    names = {m.name for m in methods()}
-    if not isinstance(method, str) or method not in names:
-        raise ValueError(f"method: expected one of {sorted(names)}, got {method!r}")
+    infos = {m.name: m for m in methods()}
+    if not isinstance(method, str) or method not in infos:
+        raise ValueError(f"method: expected one of {sorted(infos)}, got {method!r}")
     margin = finite("margin", margin)
     if not 0.0 <= margin < 1.0:
         raise ValueError(f"margin: must be in [0, 1), got {margin}")
@@ -464,5 +464,4 @@ def suggest_dt(
     dt = (1.0 - margin) * stable
     if accurate is not None:
         dt = min(dt, accurate)
-    limit = next(m.h_omega_max for m in methods() if m.name == method)
-    return StepSuggestion(method, dt, stable, accurate, omega, limit, margin, accuracy)
+    return StepSuggestion(method, dt, stable, accurate, omega, infos[method].h_omega_max, margin, accuracy)

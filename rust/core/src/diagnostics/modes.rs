@@ -50,9 +50,10 @@ fn differenced(
     central_jacobian(f, &mut x, unit, at, out)
 }
 
-/// The second derivatives of L at (q, 0, t): the model's own where it supplies them, else
-/// central differences of its first derivatives.
-fn hessians(model: &dyn Lagrangian, q: &[f64], t: f64) -> Result<Hessians, ModelError> {
+/// ∂²L/∂q² at (q, 0, t) and, with `velocities`, ∂²L/∂q∂q̇ and ∂²L/∂q̇²: the model's own where it
+/// supplies them, else central differences of its first derivatives (only those asked for: a
+/// Newton iteration on the balance of forces needs ∂²L/∂q² alone).
+fn hessians(model: &dyn Lagrangian, q: &[f64], t: f64, velocities: bool) -> Result<Hessians, ModelError> {
     let n = q.len();
     let mut out = Hessians::zeros(n);
     let zeros = vec![0.0; n];
@@ -60,20 +61,24 @@ fn hessians(model: &dyn Lagrangian, q: &[f64], t: f64) -> Result<Hessians, Model
         return Ok(out);
     }
     differenced(|x, out| model.dl_dq(x, &zeros, t, out), q, &mut out.qq)?;
-    // Entry (i, j) of qv is ∂²L/∂qᵢ∂q̇ⱼ: row i of ∂(∂L/∂q)/∂q̇.
-    differenced(|v, out| model.dl_dq(q, v, t, out), &zeros, &mut out.qv)?;
-    differenced(|v, out| model.dl_dv(q, v, t, out), &zeros, &mut out.vv)?;
+    if velocities {
+        // Entry (i, j) of qv is ∂²L/∂qᵢ∂q̇ⱼ: row i of ∂(∂L/∂q)/∂q̇.
+        differenced(|v, out| model.dl_dq(q, v, t, out), &zeros, &mut out.qv)?;
+        differenced(|v, out| model.dl_dv(q, v, t, out), &zeros, &mut out.vv)?;
+    }
     Ok(out)
 }
 
-/// ∂Q/∂q and ∂Q/∂q̇ of the model's forces at (q, 0, t), by central differences.
-fn force_derivatives(model: &dyn Lagrangian, q: &[f64], t: f64) -> Result<(DMatrix<f64>, DMatrix<f64>), ModelError> {
-    let n = q.len();
-    let (mut dq, mut dv) = (DMatrix::zeros(n, n), DMatrix::zeros(n, n));
-    let zeros = vec![0.0; n];
-    differenced(|x, out| model.force(x, &zeros, t, out), q, &mut dq)?;
-    differenced(|v, out| model.force(q, v, t, out), &zeros, &mut dv)?;
-    Ok((dq, dv))
+/// K = −∂²L/∂q² − ∂Q/∂q at (q, 0, t), ∂²L/∂q² from `h`, ∂Q/∂q by central differences.
+fn stiffness(model: &dyn Lagrangian, q: &[f64], t: f64, h: &Hessians) -> Result<DMatrix<f64>, ModelError> {
+    let mut k = -&h.qq;
+    if model.is_forced() {
+        let (n, zeros) = (q.len(), vec![0.0; q.len()]);
+        let mut dq = DMatrix::zeros(n, n);
+        differenced(|x, out| model.force(x, &zeros, t, out), q, &mut dq)?;
+        k -= dq;
+    }
+    Ok(k)
 }
 
 /// The linearized equations of `model` at (q, q̇ = 0, t) ([`Linearization`]).
@@ -82,19 +87,19 @@ fn force_derivatives(model: &dyn Lagrangian, q: &[f64], t: f64) -> Result<(DMatr
 /// The model's own.
 pub fn linearize(model: &dyn Lagrangian, q: &[f64], t: f64) -> Result<Linearization, ModelError> {
     let n = q.len();
-    let h = hessians(model, q, t)?;
-    let mut linear = Linearization {
-        mass: h.vv,
-        stiffness: -h.qq,
-        gyroscopic: h.qv.transpose() - &h.qv,
-        damping: DMatrix::zeros(n, n),
-    };
+    let h = hessians(model, q, t, true)?;
+    let mut damping = DMatrix::zeros(n, n);
     if model.is_forced() {
-        let (dq, dv) = force_derivatives(model, q, t)?;
-        linear.stiffness -= dq;
-        linear.damping = -dv;
+        let zeros = vec![0.0; n];
+        differenced(|v, out| model.force(q, v, t, out), &zeros, &mut damping)?;
+        damping.neg_mut();
     }
-    Ok(linear)
+    Ok(Linearization {
+        stiffness: stiffness(model, q, t, &h)?,
+        gyroscopic: h.qv.transpose() - &h.qv,
+        mass: h.vv,
+        damping,
+    })
 }
 
 /// The balance of forces at rest, ∂L/∂q(q, 0, t) + Q(q, 0, t) = 0, in q.
@@ -124,7 +129,8 @@ impl NewtonProblem for Balance<'_> {
     }
 
     fn jacobian(&mut self, jac: &mut DMatrix<f64>) -> Result<(), StepError> {
-        jac.copy_from(&(-linearize(self.model, &self.q, self.t)?.stiffness));
+        let h = hessians(self.model, &self.q, self.t, false)?;
+        jac.copy_from(&(-stiffness(self.model, &self.q, self.t, &h)?));
         Ok(())
     }
 
@@ -228,7 +234,7 @@ pub fn modes(linear: &Linearization) -> Result<Modes, ModelError> {
         .clone()
         .cholesky()
         .ok_or("the mass matrix M = ∂²L/∂q̇² is not positive definite at q")?;
-    let scale = size(stiffness).max(size(mass) * 1e-300);
+    let scale = size(stiffness);
     let symmetric = (stiffness - stiffness.transpose())
         .iter()
         .all(|x| x.abs() <= ZERO * scale);
