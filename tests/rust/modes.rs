@@ -1,17 +1,19 @@
 //! Small oscillations in the core: equilibria by Newton on the generalized force, the
-//! linearized equations and their modes against closed forms, and the step from the modes.
+//! linearized equations and their modes against closed forms (on constraints too), the fastest
+//! frequency by Lanczos against the dense modes', and the step from the modes.
 
-use varmech::diagnostics::{accurate_step, equilibrium, linearize, modes, phase_error, stable_step};
-use varmech::integrators::{Method, NewtonOptions};
-use varmech::scenes::DoublePendulum;
+use varmech::diagnostics::{accurate_step, equilibrium, linearize, modes, phase_error, stable_step, Model, Shapes};
+use varmech::integrators::{Dynamics, General, Method, NewtonOptions};
+use varmech::scenes::{cartesian_spherical_pendulum, planar_chain, DoublePendulum, FermiPastaUlam};
 
 #[test]
 fn the_double_pendulum_hangs_with_omega_squared_two_plus_or_minus_root_two_g_over_l() {
     let (l, g) = (0.8, 9.81);
     let pendulum = DoublePendulum::new(1.0, 1.0, l, l, g).unwrap();
-    let found = equilibrium(&pendulum, &[0.3, -0.2], 0.0, &NewtonOptions::default()).unwrap();
+    let model = Model::from(&pendulum);
+    let found = equilibrium(model, &[0.3, -0.2], 0.0, &NewtonOptions::default()).unwrap();
     assert!(found.q.iter().all(|x| x.abs() < 1e-14), "{:?}", found.q);
-    let linear = linearize(&pendulum, &found.q, 0.0).unwrap();
+    let linear = linearize(model, &found.q, 0.0).unwrap();
     assert!(linear.gyroscopic.iter().all(|x| *x == 0.0));
     let modes = modes(&linear).unwrap();
     for (omega, sign) in modes.frequencies.iter().zip([-1.0, 1.0]) {
@@ -20,14 +22,78 @@ fn the_double_pendulum_hangs_with_omega_squared_two_plus_or_minus_root_two_g_ove
     }
     assert_eq!(modes.inertia, [2, 0, 0]);
     // M-orthonormal shapes.
-    let shapes = modes.shapes.unwrap();
+    let Shapes::Real(shapes) = modes.shapes else {
+        panic!("complex shapes")
+    };
     let gram = shapes.transpose() * &linear.mass * &shapes;
     assert!((gram - nalgebra::DMatrix::identity(2, 2)).amax() < 1e-13);
     // Upside down: both modes grow.
-    let top = equilibrium(&pendulum, &[3.0, 3.3], 0.0, &NewtonOptions::default()).unwrap();
-    let unstable = varmech::diagnostics::modes(&linearize(&pendulum, &top.q, 0.0).unwrap()).unwrap();
+    let top = equilibrium(model, &[3.0, 3.3], 0.0, &NewtonOptions::default()).unwrap();
+    let unstable = varmech::diagnostics::modes(&linearize(model, &top.q, 0.0).unwrap()).unwrap();
     assert_eq!(unstable.inertia, [0, 0, 2]);
     assert!(unstable.growth.iter().all(|s| *s > 0.0));
+}
+
+#[test]
+fn the_spherical_pendulum_in_cartesian_coordinates_has_two_modes_on_its_sphere_and_none_across() {
+    // m = l = g = 1 on |x| = 1: the tension λ = −1 (g = ½(|x|² − 1), ∇g = x: ṗ = −e_z + λx = 0 at the bottom).
+    let scene = cartesian_spherical_pendulum().system;
+    let model = Model::of(&scene).unwrap();
+    // A guess off the sphere is brought onto it.
+    let found = equilibrium(model, &[0.1, -0.05, -0.7], 0.0, &NewtonOptions::default()).unwrap();
+    assert!(
+        (found.q[0].abs() + found.q[1].abs() + (found.q[2] + 1.0).abs()) < 1e-14,
+        "{:?}",
+        found.q
+    );
+    assert!((found.multipliers[0] + 1.0).abs() < 1e-13, "{:?}", found.multipliers);
+    let linear = linearize(model, &found.q, 0.0).unwrap();
+    assert_eq!(linear.basis.shape(), (3, 2));
+    assert!((linear.multipliers[0] - found.multipliers[0]).abs() < 1e-10);
+    let modes = modes(&linear).unwrap();
+    assert_eq!(modes.frequencies.len(), 2);
+    assert!(
+        modes.frequencies.iter().all(|w| (w - 1.0).abs() < 1e-9),
+        "{:?}",
+        modes.frequencies
+    );
+    let Shapes::Real(shapes) = modes.shapes else {
+        panic!("complex shapes")
+    };
+    // Horizontal shapes, unit kinetic energy.
+    assert!(shapes.row(2).amax() < 1e-13 && (shapes.column(0).norm() - 1.0).abs() < 1e-12);
+    assert!((Model::of(&scene).unwrap().fastest(&found.q, 0.0).unwrap().omega - 1.0).abs() < 1e-8);
+}
+
+#[test]
+fn the_fastest_frequency_by_lanczos_is_the_dense_modes_largest() {
+    let fpu = FermiPastaUlam::problem();
+    let chain = planar_chain(6).unwrap();
+    let pendulum = DoublePendulum::new(1.0, 2.0, 1.0, 0.5, 9.81).unwrap();
+    let general = General(&pendulum);
+    let cases: [(&dyn Dynamics, Vec<f64>); 3] = [
+        (&fpu.system, fpu.initial.q.clone()),
+        (&chain.system, chain.initial.q.clone()),
+        (&general, vec![0.4, -1.1]),
+    ];
+    for (system, q) in cases {
+        let model = Model::of(system).unwrap();
+        let dense = modes(&linearize(model, &q, 0.0).unwrap()).unwrap();
+        let largest = dense
+            .frequencies
+            .iter()
+            .zip(&dense.growth)
+            .fold(0.0_f64, |a, (w, s)| a.max(w.hypot(*s)));
+        let fastest = model.fastest(&q, 0.0).unwrap();
+        assert!(fastest.converged, "{fastest:?}");
+        assert!(
+            (fastest.omega / largest - 1.0).abs() < 1e-6,
+            "{fastest:?} against {largest}"
+        );
+    }
+    // The FPU chain at rest: its stiff springs alone, ω = 50.
+    let at_rest = Model::of(&fpu.system).unwrap().fastest(&[0.0; 6], 0.0).unwrap();
+    assert!((at_rest.omega / 50.0 - 1.0).abs() < 1e-7, "{at_rest:?}");
 }
 
 #[test]

@@ -6,7 +6,8 @@
 //!   rate, and a [`Verdict`] ("conserved to round-off", "bounded", "too short to judge",
 //!   "secular drift", "too coarse", "failed"); [`energy_statistics`] builds them for the energy or a forced run's balance;
 //! - [`symplecticity_defect`]: ‖ΨᵀJΨ − J‖ of a one-step map;
-//! - [`equilibrium`], [`linearize`] and [`modes`]: small oscillations about an equilibrium, and
+//! - [`equilibrium`], [`linearize`] and [`modes`]: small oscillations about an equilibrium, on
+//!   holonomic constraints too, and
 //!   [`stable_step`] and [`accurate_step`]: the step a method takes on them.
 
 mod conservation;
@@ -17,6 +18,7 @@ mod symplecticity;
 pub use conservation::{Series, Statistics, Verdict};
 pub use energy::{energies, energy_statistics, energy_terms};
 pub use modes::{
-    accurate_step, equilibrium, linearize, modes, phase_error, stable_step, Equilibrium, Linearization, Modes,
+    accurate_step, equilibrium, linearize, modes, phase_error, stable_step, Equilibrium, Linearization, Model, Modes,
+    Shapes,
 };
 pub use symplecticity::symplecticity_defect;

@@ -1,38 +1,93 @@
-//! Small oscillations: an equilibrium (Newton on the generalized force at rest), the linearized
-//! equations there,
+//! Small oscillations: an equilibrium (Newton on the generalized force at rest, with the
+//! constraints' multipliers), the linearized equations there,
 //!
-//! M δq̈ + (G + D) δq̇ + K δq = 0,   M = ∂²L/∂q̇²,  K = −∂²L/∂q² − ∂Q/∂q,
+//! M δq̈ + (G + D) δq̇ + K δq = 0,   M = ∂²L/∂q̇²,  K = −∂²L/∂q² − ∂Q/∂q − Σᵢλᵢ∇²gᵢ,
 //! G = ∂²L/∂q̇∂q − ∂²L/∂q∂q̇ (antisymmetric: magnetic fields, rotating frames),  D = −∂Q/∂q̇,
 //!
-//! all at (q, q̇ = 0, t), Q the model's own forces; their normal modes; and the largest step a
-//! method takes on them, stably (hω_max below the method's limit) or to a phase accuracy.
+//! all at (q, q̇ = 0, t), Q the model's own forces, λ the multipliers that hold q at rest on
+//! holonomic constraints g(q) = 0 ([`Rest`]), each matrix restricted to the tangent space ker G(q)
+//! (δq = T y, T an orthonormal basis: the fewest coordinates); their normal modes, real or complex,
+//! the zero modes along the model's symmetries named; and the largest step a method takes on
+//! them, stably (hω_max below the method's limit) or to a phase accuracy.
 //!
 //! A Routh-reduced model's Lagrangian is its Routhian, whose potential is the amended one: its
 //! equilibria are the full model's relative equilibria (steady motions), its G their Coriolis
 //! coupling.
 
-use nalgebra::{DMatrix, Schur, SymmetricEigen};
+use nalgebra::{Complex, DMatrix, DVector, Schur, SymmetricEigen};
 
 use crate::error::StepError;
-use crate::integrators::{integrate, Method, Options};
-use crate::model::{Hessians, Lagrangian};
+use crate::integrators::{integrate, Dynamics, Method, Options};
+use crate::model::{Fastest, Hessians, HolonomicConstraints, Lagrangian, Rest};
 use crate::scenes::HarmonicOscillator;
 use crate::solve::difference::{central_jacobian, unit, Evaluations};
 use crate::solve::newton::{Correction, Newton, NewtonProblem, Reasons, Rules};
 use crate::solve::NewtonOptions;
 use crate::{Error, ModelError};
 
-/// The linearized equations at a point: n × n each.
+/// A model at a point: its Lagrangian and, if it has them, its holonomic constraints.
+#[derive(Clone, Copy)]
+pub struct Model<'a> {
+    pub system: &'a dyn Lagrangian,
+    pub constraints: Option<&'a dyn HolonomicConstraints>,
+}
+
+impl<'a, L: Lagrangian + 'a> From<&'a L> for Model<'a> {
+    fn from(system: &'a L) -> Self {
+        Model {
+            system,
+            constraints: None,
+        }
+    }
+}
+
+impl<'a> Model<'a> {
+    /// A run's model: its Lagrangian and holonomic constraints.
+    ///
+    /// # Errors
+    /// Velocity constraints, whose small oscillations are not those of a Lagrangian on a
+    /// manifold (named `model`).
+    pub fn of(dynamics: &'a dyn Dynamics) -> Result<Self, Error> {
+        if dynamics.velocity_constraints().is_some() {
+            return Err(Error::invalid(
+                "model",
+                "velocity constraints A(q)q̇ = 0 restrict the velocities but not the positions: a \
+                 nonholonomic model's equilibria come in families and its small oscillations are not a \
+                 Lagrangian's on a manifold; linearize a model of its holonomic part",
+            ));
+        }
+        Ok(Model {
+            system: dynamics.as_lagrangian(),
+            constraints: dynamics.holonomic(),
+        })
+    }
+
+    /// The fastest frequency of the small oscillations at (q, t) ([`Rest::fastest`]): what bounds
+    /// a method's step, from [`Rest::BEFORE_RUN`] force evaluations at most.
+    ///
+    /// # Errors
+    /// The model's own.
+    pub fn fastest(&self, q: &[f64], t: f64) -> Result<Fastest, ModelError> {
+        Rest::new(self.system, self.constraints, q, t)?.fastest(Rest::BEFORE_RUN)
+    }
+}
+
+/// The linearized equations at a point in the tangent coordinates y (δq = T y): r × r each,
+/// r = n − rank G (n without constraints, T = I).
 #[derive(Clone, Debug)]
 pub struct Linearization {
-    /// M = ∂²L/∂q̇².
+    /// M = Tᵀ ∂²L/∂q̇² T.
     pub mass: DMatrix<f64>,
-    /// K = −∂²L/∂q² − ∂Q/∂q (symmetric but for circulatory forces).
+    /// K = Tᵀ(−∂²L/∂q² − ∂Q/∂q − Σλᵢ∇²gᵢ)T (symmetric but for circulatory forces).
     pub stiffness: DMatrix<f64>,
-    /// G = ∂²L/∂q̇∂q − ∂²L/∂q∂q̇, antisymmetric.
+    /// G = Tᵀ(∂²L/∂q̇∂q − ∂²L/∂q∂q̇)T, antisymmetric.
     pub gyroscopic: DMatrix<f64>,
-    /// D = −∂Q/∂q̇ (zero for a model without forces).
+    /// D = −Tᵀ ∂Q/∂q̇ T (zero for a model without forces).
     pub damping: DMatrix<f64>,
+    /// T, n × r: orthonormal columns spanning ker G(q).
+    pub basis: DMatrix<f64>,
+    /// λ at rest (Lagrange's sign: ṗ = ∂L/∂q + Q + Gᵀλ); empty without constraints.
+    pub multipliers: Vec<f64>,
 }
 
 /// ∂f/∂x at x by central differences ([`central_jacobian`]), into `out`.
@@ -69,45 +124,76 @@ fn hessians(model: &dyn Lagrangian, q: &[f64], t: f64, velocities: bool) -> Resu
     Ok(out)
 }
 
-/// K = −∂²L/∂q² − ∂Q/∂q at (q, 0, t), ∂²L/∂q² from `h`, ∂Q/∂q by central differences.
-fn stiffness(model: &dyn Lagrangian, q: &[f64], t: f64, h: &Hessians) -> Result<DMatrix<f64>, ModelError> {
+/// K = −∂²L/∂q² − ∂Q/∂q − Σλᵢ∇²gᵢ at (q, 0, t) in q's coordinates, ∂²L/∂q² from `h`, the rest
+/// by central differences (of Q, and of G(x)ᵀλ).
+fn stiffness(model: Model<'_>, q: &[f64], t: f64, h: &Hessians, lambda: &[f64]) -> Result<DMatrix<f64>, ModelError> {
+    let system = model.system;
+    let (n, zeros) = (q.len(), vec![0.0; q.len()]);
     let mut k = -&h.qq;
-    if model.is_forced() {
-        let (n, zeros) = (q.len(), vec![0.0; q.len()]);
-        let mut dq = DMatrix::zeros(n, n);
-        differenced(|x, out| model.force(x, &zeros, t, out), q, &mut dq)?;
+    let mut dq = DMatrix::zeros(n, n);
+    if system.is_forced() {
+        differenced(|x, out| system.force(x, &zeros, t, out), q, &mut dq)?;
+        k -= &dq;
+    }
+    if let Some(c) = model.constraints {
+        let mut g = DMatrix::zeros(c.count(), n);
+        differenced(|x, out| reaction_force(c, x, lambda, &mut g, out), q, &mut dq)?;
         k -= dq;
     }
     Ok(k)
 }
 
-/// The linearized equations of `model` at (q, q̇ = 0, t) ([`Linearization`]).
+/// G(x)ᵀλ into `out`, G(x) into `g`.
+fn reaction_force(
+    c: &dyn HolonomicConstraints,
+    x: &[f64],
+    lambda: &[f64],
+    g: &mut DMatrix<f64>,
+    out: &mut [f64],
+) -> Result<(), ModelError> {
+    c.jacobian(x, g)?;
+    for (i, o) in out.iter_mut().enumerate() {
+        *o = lambda.iter().enumerate().map(|(k, l)| g[(k, i)] * l).sum();
+    }
+    Ok(())
+}
+
+/// The linearized equations of `model` at (q, q̇ = 0, t) ([`Linearization`]), on its constraints'
+/// tangent space where it has constraints.
 ///
 /// # Errors
-/// The model's own.
-pub fn linearize(model: &dyn Lagrangian, q: &[f64], t: f64) -> Result<Linearization, ModelError> {
-    let n = q.len();
-    let h = hessians(model, q, t, true)?;
+/// The model's own; dependent constraints at q.
+pub fn linearize(model: Model<'_>, q: &[f64], t: f64) -> Result<Linearization, ModelError> {
+    let (system, n) = (model.system, q.len());
+    let rest = Rest::new(system, model.constraints, q, t)?;
+    let h = hessians(system, q, t, true)?;
     let mut damping = DMatrix::zeros(n, n);
-    if model.is_forced() {
+    if system.is_forced() {
         let zeros = vec![0.0; n];
-        differenced(|v, out| model.force(q, v, t, out), &zeros, &mut damping)?;
+        differenced(|v, out| system.force(q, v, t, out), &zeros, &mut damping)?;
         damping.neg_mut();
     }
+    let basis = rest.tangent();
+    let restrict = |a: &DMatrix<f64>| basis.transpose() * a * &basis;
     Ok(Linearization {
-        stiffness: stiffness(model, q, t, &h)?,
-        gyroscopic: h.qv.transpose() - &h.qv,
-        mass: h.vv,
-        damping,
+        stiffness: restrict(&stiffness(model, q, t, &h, rest.multipliers())?),
+        gyroscopic: restrict(&(h.qv.transpose() - &h.qv)),
+        mass: restrict(&h.vv),
+        damping: restrict(&damping),
+        multipliers: rest.multipliers().to_vec(),
+        basis,
     })
 }
 
-/// The balance of forces at rest, ∂L/∂q(q, 0, t) + Q(q, 0, t) = 0, in q.
+/// The balance of forces at rest on the constraints, in (q, λ):
+/// ∂L/∂q(q, 0, t) + Q(q, 0, t) + G(q)ᵀλ = 0 and g(q) = 0.
 struct Balance<'a> {
-    model: &'a dyn Lagrangian,
+    model: Model<'a>,
     q: Vec<f64>,
+    lambda: Vec<f64>,
     zeros: Vec<f64>,
     force: Vec<f64>,
+    g: DMatrix<f64>,
     t: f64,
 }
 
@@ -120,67 +206,129 @@ impl NewtonProblem for Balance<'_> {
     };
 
     fn residual(&mut self, r: &mut [f64]) -> Result<(), StepError> {
-        self.model.dl_dq(&self.q, &self.zeros, self.t, r)?;
-        if self.model.is_forced() {
-            self.model.force(&self.q, &self.zeros, self.t, &mut self.force)?;
-            r.iter_mut().zip(&self.force).for_each(|(r, f)| *r += f);
+        let (system, n) = (self.model.system, self.q.len());
+        let (balance, on) = r.split_at_mut(n);
+        system.dl_dq(&self.q, &self.zeros, self.t, balance)?;
+        if system.is_forced() {
+            system.force(&self.q, &self.zeros, self.t, &mut self.force)?;
+            balance.iter_mut().zip(&self.force).for_each(|(r, f)| *r += f);
+        }
+        if let Some(c) = self.model.constraints {
+            reaction_force(c, &self.q, &self.lambda, &mut self.g, &mut self.force)?;
+            balance.iter_mut().zip(&self.force).for_each(|(r, f)| *r += f);
+            c.residual(&self.q, on)?;
         }
         Ok(())
     }
 
+    /// [−K G(q)ᵀ; G(q) 0], K the stiffness on the constraints at the current λ.
     fn jacobian(&mut self, jac: &mut DMatrix<f64>) -> Result<(), StepError> {
-        let h = hessians(self.model, &self.q, self.t, false)?;
-        jac.copy_from(&(-stiffness(self.model, &self.q, self.t, &h)?));
+        let n = self.q.len();
+        let h = hessians(self.model.system, &self.q, self.t, false)?;
+        let k = stiffness(self.model, &self.q, self.t, &h, &self.lambda)?;
+        jac.fill(0.0);
+        jac.view_mut((0, 0), (n, n)).copy_from(&(-k));
+        if let Some(c) = self.model.constraints {
+            c.jacobian(&self.q, &mut self.g)?;
+            jac.view_mut((0, n), (n, self.lambda.len()))
+                .copy_from(&self.g.transpose());
+            jac.view_mut((n, 0), (self.lambda.len(), n)).copy_from(&self.g);
+        }
         Ok(())
     }
 
     fn correct(&mut self, delta: &[f64]) -> Correction {
-        Correction::relative(&mut self.q, delta)
+        let (dq, dl) = delta.split_at(self.q.len());
+        let (a, b) = (
+            Correction::relative(&mut self.q, dq),
+            Correction::relative(&mut self.lambda, dl),
+        );
+        Correction {
+            size: a.size.max(b.size),
+            scale: 1.0,
+        }
     }
+}
+
+/// The multipliers that best balance the force at the guess, min ‖F + Gᵀλ‖ (GGᵀλ = −GF): the
+/// Newton iteration's start, where λ = 0 would leave a potential linear in q (gravity) a
+/// singular Jacobian.
+fn least_squares_multipliers(balance: &mut Balance<'_>) -> Result<Vec<f64>, StepError> {
+    let (n, m) = (balance.q.len(), balance.lambda.len());
+    let mut r = vec![0.0; n + m];
+    balance.residual(&mut r)?;
+    let Some(c) = balance.model.constraints else {
+        return Ok(Vec::new());
+    };
+    c.jacobian(&balance.q, &mut balance.g)?;
+    let g = &balance.g;
+    let rhs = -(g * DVector::from_column_slice(&r[..n]));
+    let lambda = (g * g.transpose())
+        .lu()
+        .solve(&rhs)
+        .ok_or_else(|| StepError::Model("the constraints' Jacobian G has dependent rows at the guess".into()))?;
+    Ok(lambda.iter().copied().collect())
 }
 
 /// An equilibrium found from a guess.
 #[derive(Clone, Debug)]
 pub struct Equilibrium {
     pub q: Vec<f64>,
-    /// ‖∂L/∂q + Q‖∞ there.
+    /// λ there (Lagrange's sign); empty without constraints.
+    pub multipliers: Vec<f64>,
+    /// ‖(∂L/∂q + Q + Gᵀλ, g)‖∞ there.
     pub residual: f64,
     pub iterations: usize,
 }
 
 /// The equilibrium of `model` at time t nearest `guess`: Newton on the generalized force at
-/// rest, with the Jacobian −K (exact where the model supplies its Hessians).
+/// rest and, on constraints, on g(q) = 0 with the multipliers λ (a guess off the constraints
+/// is brought onto them), with the Jacobian [−K Gᵀ; G 0] (∂²L/∂q² exact where the model
+/// supplies its Hessians).
 ///
 /// # Errors
 /// [`Error::Convergence`] (step 0, time t) with the residual where Newton fails: no equilibrium
 /// near the guess, or a K singular there; the model's own.
-pub fn equilibrium(
-    model: &dyn Lagrangian,
-    guess: &[f64],
-    t: f64,
-    options: &NewtonOptions,
-) -> Result<Equilibrium, Error> {
+pub fn equilibrium(model: Model<'_>, guess: &[f64], t: f64, options: &NewtonOptions) -> Result<Equilibrium, Error> {
     options.check()?;
     let n = guess.len();
+    let m = model.constraints.map_or(0, |c| c.count());
     let mut balance = Balance {
         model,
         q: guess.to_vec(),
+        lambda: vec![0.0; m],
         zeros: vec![0.0; n],
         force: vec![0.0; n],
+        g: DMatrix::zeros(m, n),
         t,
     };
+    if m > 0 {
+        balance.lambda = least_squares_multipliers(&mut balance).map_err(|e| e.at(0, t))?;
+    }
     let rules = Rules {
         simplified: false,
         noise_floor: true,
     };
-    let solution = Newton::new(n)
+    let solution = Newton::new(n + m)
         .solve(&mut balance, options, rules)
         .map_err(|e| e.at(0, t))?;
     Ok(Equilibrium {
         q: balance.q,
+        multipliers: balance.lambda,
         residual: solution.residual,
         iterations: solution.iterations,
     })
+}
+
+/// The shapes of the modes, columns in q's coordinates (δq = x), in the order of the
+/// frequencies.
+#[derive(Clone, Debug)]
+pub enum Shapes {
+    /// G = D = 0 and K symmetric: real, M-orthonormal (xᵀMx = 1).
+    Real(DMatrix<f64>),
+    /// Otherwise: x with (λ²M + λ(G + D) + K)x = 0 at the mode's λ = σ + iω (the one of larger σ
+    /// for a mode of two real λ), xᴴMx = 1, its largest entry real and positive.
+    Complex(DMatrix<Complex<f64>>),
 }
 
 /// The normal modes of a linearization.
@@ -198,20 +346,26 @@ pub struct Modes {
     pub curvatures: Vec<f64>,
     /// How many κ are positive, zero (to `ZERO` relative) and negative.
     pub inertia: [usize; 3],
-    /// The mode shapes, M-orthonormal columns in the order of `frequencies`, where G = D = 0
-    /// and K is symmetric; else None (the modes of the quadratic eigenproblem are complex).
-    pub shapes: Option<DMatrix<f64>>,
+    pub shapes: Shapes,
+    /// For each mode, the symmetry whose direction it is (an index into the fields given to
+    /// [`Modes::name_symmetries`]): zero modes only; None until named.
+    pub symmetries: Vec<Option<usize>>,
 }
 
 /// Relative size below which an entry of a linearization counts as zero: central differences
 /// are accurate to about ε^{2/3} ≈ 4e-11.
 const ZERO: f64 = 1e-8;
 
+/// How far (relative, in M's norm) a symmetry's direction may be from the zero modes' span and
+/// still be one of them: differenced second derivatives put the shapes about 1e-8 off.
+const ALONG: f64 = 1e-6;
+
 /// The normal modes of `linear`: the generalized symmetric eigenproblem K x = ω² M x where
 /// G = D = 0 and K is symmetric (zero modes, κ = 0 to `ZERO` relative, have ω = σ = 0), else
-/// the eigenvalues of the first-order system (δq, δq̇)' = [0 I; −M⁻¹K −M⁻¹(G + D)](δq, δq̇),
+/// the eigenvalues of the first-order system (y, ẏ)' = [0 I; −M⁻¹K −M⁻¹(G + D)](y, ẏ),
 /// paired into modes: a complex pair σ ± iω is one mode, two real eigenvalues one mode (the
-/// larger its σ).
+/// larger its σ), each shape the null vector of the quadratic pencil at its λ. Shapes are
+/// returned in q's coordinates, x = T y.
 ///
 /// # Errors
 /// M not symmetric positive definite; a non-finite entry.
@@ -221,6 +375,8 @@ pub fn modes(linear: &Linearization) -> Result<Modes, ModelError> {
         stiffness,
         gyroscopic,
         damping,
+        basis,
+        ..
     } = linear;
     let n = mass.nrows();
     let finite = |m: &DMatrix<f64>| m.iter().all(|x| x.is_finite());
@@ -268,7 +424,8 @@ pub fn modes(linear: &Linearization) -> Result<Modes, ModelError> {
                 .collect(),
             curvatures,
             inertia,
-            shapes: Some(shapes),
+            shapes: Shapes::Real(basis * shapes),
+            symmetries: vec![None; n],
         });
     }
     let mut system = DMatrix::zeros(2 * n, 2 * n);
@@ -295,13 +452,119 @@ pub fn modes(linear: &Linearization) -> Result<Modes, ModelError> {
     real.sort_by(|a, b| b.total_cmp(a));
     pairs.extend(real.chunks(2).map(|pair| (0.0, pair[0])));
     pairs.sort_by(|a, b| a.0.total_cmp(&b.0).then(b.1.total_cmp(&a.1)));
+    let shapes = complex_shapes(linear, &pairs, tiny.max(f64::MIN_POSITIVE));
     Ok(Modes {
         frequencies: pairs.iter().map(|p| p.0).collect(),
         growth: pairs.iter().map(|p| p.1).collect(),
         curvatures,
         inertia,
-        shapes: None,
+        shapes: Shapes::Complex(basis.map(Complex::from) * shapes),
+        symmetries: vec![None; n],
     })
+}
+
+/// The shape of each mode (ω, σ) of `pairs`: the right singular vector of the quadratic pencil
+/// Q(λ) = λ²M + λ(G + D) + K at λ = σ + iω for its smallest singular value; the k-th mode of
+/// a λ repeated (to `tiny`) takes the k-th smallest, so that a degenerate pair gets two
+/// independent shapes. Normalized xᴴMx = 1, the largest entry real and positive.
+fn complex_shapes(linear: &Linearization, pairs: &[(f64, f64)], tiny: f64) -> DMatrix<Complex<f64>> {
+    let n = linear.mass.nrows();
+    let c = |m: &DMatrix<f64>| m.map(Complex::from);
+    let (mass, first, stiffness) = (
+        c(&linear.mass),
+        c(&(&linear.gyroscopic + &linear.damping)),
+        c(&linear.stiffness),
+    );
+    let mut shapes = DMatrix::zeros(n, pairs.len());
+    for (j, &(omega, sigma)) in pairs.iter().enumerate() {
+        let lambda = Complex::new(sigma, omega);
+        let repeat = pairs[..j]
+            .iter()
+            .filter(|p| (p.0 - omega).abs() <= tiny && (p.1 - sigma).abs() <= tiny)
+            .count();
+        let pencil = &mass * (lambda * lambda) + &first * lambda + &stiffness;
+        let svd = pencil.svd(false, true);
+        let mut order: Vec<usize> = (0..n).collect();
+        order.sort_by(|&a, &b| svd.singular_values[a].total_cmp(&svd.singular_values[b]));
+        let Some(v_t) = svd.v_t else { continue };
+        let mut x: DVector<Complex<f64>> = v_t.row(order[repeat.min(n - 1)]).adjoint();
+        let norm = (x.adjoint() * &mass * &x)[(0, 0)].re.max(0.0).sqrt();
+        let big = x
+            .iter()
+            .copied()
+            .fold(Complex::new(0.0, 0.0), |a, z| if z.norm() > a.norm() { z } else { a });
+        if norm > 0.0 && big.norm() > 0.0 {
+            x *= big.conj() / (big.norm() * norm);
+        }
+        shapes.column_mut(j).copy_from(&x);
+    }
+    shapes
+}
+
+impl Modes {
+    /// Names the zero modes after the symmetries whose directions they are: `fields` are the
+    /// generators ξ(q) of the model's symmetries at the point (n entries each, in q's
+    /// coordinates). A ξ tangent to the constraints and within the zero modes' span (to
+    /// `ALONG`) becomes a zero mode's shape, M-normalized (and M-orthogonalized against the
+    /// earlier ones); the remaining zero modes span the rest of that space, unnamed. Only real
+    /// shapes are named (G = D = 0).
+    pub fn name_symmetries(&mut self, linear: &Linearization, fields: &[Vec<f64>]) {
+        let Shapes::Real(shapes) = &mut self.shapes else {
+            return;
+        };
+        let zero: Vec<usize> = (0..self.frequencies.len())
+            .filter(|&k| self.frequencies[k] == 0.0 && self.growth[k] == 0.0)
+            .collect();
+        if zero.is_empty() {
+            return;
+        }
+        let (t, mass) = (&linear.basis, &linear.mass);
+        let inner = |a: &DVector<f64>, b: &DVector<f64>| (a.transpose() * mass * b)[(0, 0)];
+        // The zero modes in tangent coordinates, y = Tᵀx (T orthonormal).
+        let span: Vec<DVector<f64>> = zero.iter().map(|&k| t.transpose() * shapes.column(k)).collect();
+        let mut named: Vec<(usize, DVector<f64>)> = Vec::new();
+        for (g, xi) in fields.iter().enumerate() {
+            let xi = DVector::from_column_slice(xi);
+            let mut y = t.transpose() * &xi;
+            let size = inner(&y, &y).sqrt();
+            if size == 0.0 || (t * &y - &xi).norm() > ALONG * xi.norm() {
+                continue;
+            }
+            let outside = span.iter().fold(y.clone(), |r, z| &r - z * inner(z, &y));
+            if inner(&outside, &outside).sqrt() > ALONG * size {
+                continue;
+            }
+            for (_, e) in &named {
+                y -= e * inner(e, &y);
+            }
+            let norm = inner(&y, &y).sqrt();
+            if norm > ALONG * size && named.len() < zero.len() {
+                named.push((g, y / norm));
+            }
+        }
+        if named.is_empty() {
+            return;
+        }
+        let mut rest: Vec<DVector<f64>> = Vec::new();
+        for z in &span {
+            let mut y = z.clone();
+            for e in named.iter().map(|(_, e)| e).chain(&rest) {
+                y -= e * inner(e, &y);
+            }
+            let norm = inner(&y, &y).sqrt();
+            if norm > ALONG && named.len() + rest.len() < zero.len() {
+                rest.push(y / norm);
+            }
+        }
+        let chosen = named
+            .iter()
+            .map(|(g, y)| (Some(*g), y))
+            .chain(rest.iter().map(|y| (None, y)));
+        for (&k, (symmetry, y)) in zero.iter().zip(chosen) {
+            shapes.column_mut(k).copy_from(&(t * y));
+            self.symmetries[k] = symmetry;
+        }
+    }
 }
 
 /// The eigenvalues of a real square matrix by the shifted QR (Schur) iteration, capped: its

@@ -96,6 +96,11 @@ pub trait Dynamics {
         None
     }
 
+    /// The holonomic constraints g(q) = 0 of a constrained system; None for the others.
+    fn holonomic(&self) -> Option<&dyn HolonomicConstraints> {
+        None
+    }
+
     /// The forces of constraint at (q, p, t) into `out` ([`model::Reaction::solve`], made for
     /// this model's n and m); None without constraints.
     fn reaction(&self, _out: &mut model::Reaction, _q: &[f64], _p: &[f64], _t: f64) -> Option<Result<(), ModelError>> {
@@ -246,6 +251,10 @@ impl<S: MechanicalSystem, C: HolonomicConstraints> Dynamics for Constrained<S, C
         Some(self.residuals(q, p))
     }
 
+    fn holonomic(&self) -> Option<&dyn HolonomicConstraints> {
+        Some(&self.constraints)
+    }
+
     fn project(&self, q: &[f64], p: &[f64]) -> Option<Result<PhaseState, Error>> {
         Some(Constrained::project(self, q, p))
     }
@@ -294,6 +303,10 @@ impl<L: Lagrangian, C: HolonomicConstraints> Dynamics for Constrained<General<'_
 
     fn constraint_residuals(&self, q: &[f64], p: &[f64]) -> Option<Result<model::Residuals, ModelError>> {
         Some(self.residuals_general(q, p))
+    }
+
+    fn holonomic(&self) -> Option<&dyn HolonomicConstraints> {
+        Some(&self.constraints)
     }
 
     fn project(&self, q: &[f64], p: &[f64]) -> Option<Result<PhaseState, Error>> {
@@ -458,6 +471,10 @@ impl<L: Lagrangian, H: HolonomicConstraints, C: VelocityConstraints> Dynamics fo
 
     fn velocity_constraints(&self) -> Option<&dyn VelocityConstraints> {
         Some(&self.velocity)
+    }
+
+    fn holonomic(&self) -> Option<&dyn HolonomicConstraints> {
+        Some(&self.holonomic)
     }
 
     fn project(&self, q: &[f64], p: &[f64]) -> Option<Result<PhaseState, Error>> {

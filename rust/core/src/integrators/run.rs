@@ -4,7 +4,7 @@ use serde::{Deserialize, Serialize};
 
 use super::jumps::{Watch, Watcher};
 use super::{Checkpoint, Detector, Dynamics, Failure, Method, NewtonOptions, Poll, Stepper, Trajectory};
-use crate::model::{EnergyTerms, Scale};
+use crate::model::{EnergyTerms, Rest, Scale};
 use crate::{memory, Error};
 
 /// Options of a fixed-step run.
@@ -380,6 +380,8 @@ where
         return Err(fail(Error::invalid("save_every", reason), traj));
     }
 
+    // The first state, which a divergence's diagnosis linearizes at.
+    let first = (stepper.q().to_vec(), stepper.t());
     let mut outcome = if fresh {
         watcher.start(&mut stepper, &mut traj)
     } else {
@@ -428,11 +430,45 @@ where
     traj.count(&stepper);
     // Events: the partial steps' force evaluations are the run's too.
     traj.force_evaluations += watcher.force_evaluations();
+    let (method, dt) = (stepper.method(), stepper.dt());
     traj.checkpoint = Checkpoint::new(sys, stepper.into_state(), watch).to_bytes();
     match outcome {
         Ok(()) => Ok(traj),
-        Err(error) => Err(fail(error, traj)),
+        Err(error) => Err(fail(diagnosed(error, sys, (method, dt), first), traj)),
     }
+}
+
+/// A divergence with its likely cause named: h·ω_max at the run's first state beyond the
+/// method's stability limit on q̈ = −ω²q (ω_max the fastest frequency of the small
+/// oscillations there, [`Rest::fastest`]). Other errors, and divergences within the limit, as
+/// they are.
+fn diagnosed<S: Dynamics + ?Sized>(
+    error: Error,
+    sys: &S,
+    (method, dt): (Method, f64),
+    (q, t): (Vec<f64>, f64),
+) -> Error {
+    let Error::Divergence { step, time, reason } = error else {
+        return error;
+    };
+    let info = method.info();
+    let limit = info.h_omega_max;
+    let fastest = (limit.is_finite() && limit > 0.0 && sys.velocity_constraints().is_none()).then(|| {
+        Rest::new(sys.as_lagrangian(), sys.holonomic(), &q, t).and_then(|mut r| r.fastest(Rest::AFTER_FAILURE))
+    });
+    let reason = match fastest {
+        Some(Ok(fastest)) if dt * fastest.omega > limit => format!(
+            "{reason}; h·ω_max = {:.4} at the run's first state (t = {t}) is beyond {}'s stability limit {limit} \
+             (ω_max = {:.6e}, the fastest frequency of the small oscillations there): take dt below {:.6e} \
+             (varmech.suggest_dt)",
+            dt * fastest.omega,
+            info.name,
+            fastest.omega,
+            limit / fastest.omega
+        ),
+        _ => reason,
+    };
+    Error::Divergence { step, time, reason }
 }
 
 /// The steps between two checks of the energy of a run that saves its samples alone.

@@ -13,6 +13,7 @@
 //! - [`Mixed`]: a Lagrangian system on holonomic and velocity constraints together;
 //! - [`NBody`]: point masses under Newtonian gravity, the model of the N-body scenes and of
 //!   the Wisdom–Holman methods;
+//! - [`Rest`]: a model held at rest at q, its multipliers, tangent space and fastest frequency;
 //! - [`Routhian`]: Routh reduction, R = L − μ·ċ on the non-cyclic coordinates;
 //! - [`Scale`]: the size a conserved quantity's error is judged against;
 //! - [`Generator`]: infinitesimal symmetries ξ(q) and their Noether momenta J = p·ξ(q);
@@ -32,6 +33,7 @@ mod natural;
 mod nbody;
 mod nonholonomic;
 mod reactions;
+mod rest;
 mod routh;
 mod scale;
 mod symmetry;
@@ -50,6 +52,7 @@ pub use natural::{differenced_kinetic_gradient, kinetic_gradient_from_mass_deriv
 pub use nbody::{NBody, PairKernel};
 pub use nonholonomic::{differenced_derivative, Nonholonomic, VelocityConstraints};
 pub use reactions::{holonomic_rows, velocity_rows, Reaction, Reactions, Rows};
+pub use rest::{Fastest, Rest};
 pub use routh::Routhian;
 pub use scale::Scale;
 pub use symmetry::{momentum_along, Generator};

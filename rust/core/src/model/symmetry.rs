@@ -48,6 +48,29 @@ impl Generator {
         }
     }
 
+    /// Writes ξ(q) into `out` (n entries): eₐ at each body for a translation along axis a, eₐ × xᵦ
+    /// (in the plane (−y, x)) for a rotation, e_index for a cyclic coordinate.
+    pub fn field(&self, q: &[f64], out: &mut [f64]) {
+        out.fill(0.0);
+        match *self {
+            Generator::Translation { axis, spatial_dim } => {
+                out.iter_mut().skip(axis).step_by(spatial_dim).for_each(|x| *x = 1.0);
+            }
+            Generator::Rotation { spatial_dim: 2, .. } => {
+                for (x, o) in q.chunks_exact(2).zip(out.chunks_exact_mut(2)) {
+                    (o[0], o[1]) = (-x[1], x[0]);
+                }
+            }
+            Generator::Rotation { axis, .. } => {
+                let (a, b) = ((axis + 1) % 3, (axis + 2) % 3);
+                for (x, o) in q.chunks_exact(3).zip(out.chunks_exact_mut(3)) {
+                    (o[a], o[b]) = (-x[b], x[a]);
+                }
+            }
+            Generator::Cyclic { index } => out[index] = 1.0,
+        }
+    }
+
     /// J(q, p) = p·ξ(q).
     pub fn momentum(&self, q: &[f64], p: &[f64]) -> f64 {
         self.momentum_terms(q, p).0

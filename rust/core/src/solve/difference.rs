@@ -23,6 +23,13 @@ pub fn step(size: f64) -> f64 {
     CBRT_EPSILON * size
 }
 
+/// The forward-difference step for a variable of magnitude `size`: √ε·size, which balances a
+/// one-sided difference's O(h) truncation against its O(ε/h) round-off (error about √ε).
+#[inline]
+pub fn forward_step(size: f64) -> f64 {
+    f64::EPSILON.sqrt() * size
+}
+
 /// The magnitude a variable's difference step is relative to: max(|x|, 1).
 pub fn unit(_: usize, x: f64) -> f64 {
     x.abs().max(1.0)

@@ -5,6 +5,7 @@
 //!   equations built from them;
 //! - `newton`: Newton's method, simplified (a kept Jacobian) or full, with [`NewtonOptions`];
 //! - [`bracket`]: a root of a function on a bracket (Illinois), for locating events;
+//! - [`lanczos`]: the extreme eigenvalues of a symmetric-definite pencil, from its products;
 //! - [`interrupt`]: when to poll for Ctrl-C, and the check the iterative solves poll;
 //! - `scratch`: per-thread workspaces, for functions whose signatures take none.
 
@@ -31,6 +32,7 @@ pub(crate) use sized;
 pub mod bracket;
 pub mod difference;
 pub mod interrupt;
+pub mod lanczos;
 pub(crate) mod lu;
 pub(crate) mod newton;
 pub(crate) mod scratch;
