@@ -51,6 +51,7 @@ __all__ = [
     "engage",
     "ensemble",
     "equilibrium",
+    "fastest_frequency",
     "impulse_components",
     "impulse_response",
     "integrate",
@@ -765,13 +766,15 @@ def nbody(g: float, masses: Sequence[float]) -> NativeModel: ...
 
 def linearize(
     model: _Model, q: _FloatArray, t: float = 0.0
-) -> tuple[_FloatArray, _FloatArray, _FloatArray, _FloatArray]:
-    """(M, K, G, D) of the linearized equations at (q, q̇ = 0, t), each (n, n)."""
+) -> tuple[_FloatArray, _FloatArray, _FloatArray, _FloatArray, _FloatArray, _FloatArray]:
+    """(M, K, G, D, T, λ) of the linearized equations at (q, q̇ = 0, t) in the tangent
+    coordinates δq = T y: each matrix (r, r), T (n, r), λ the multipliers at rest."""
 
 def normal_modes(
-    model: _Model, q: _FloatArray, t: float = 0.0
-) -> tuple[_FloatArray, _FloatArray, _FloatArray, list[int], _FloatArray | None]:
-    """(ω, σ, κ, K's inertia, M-orthonormal shapes or None) of the modes at (q, t)."""
+    model: _Model, q: _FloatArray, t: float = 0.0, symmetries: list[Generator] = ...
+) -> tuple[_FloatArray, _FloatArray, _FloatArray, list[int], np.ndarray, list[int | None]]:
+    """(ω, σ, κ, K's inertia, shapes (n, r), real or complex, the symmetry of each mode) of the
+    modes at (q, t)."""
 
 def equilibrium(
     model: _Model,
@@ -779,8 +782,11 @@ def equilibrium(
     t: float = 0.0,
     newton_tolerance: float = 1e-14,
     newton_max_iterations: int = 50,
-) -> tuple[_FloatArray, float, int]:
-    """(q, ‖∂L/∂q + Q‖∞, Newton iterations) of the equilibrium nearest the guess."""
+) -> tuple[_FloatArray, _FloatArray, float, int]:
+    """(q, λ, residual, Newton iterations) of the equilibrium nearest the guess."""
+
+def fastest_frequency(model: _Model, q: _FloatArray, t: float = 0.0) -> tuple[float, int, bool]:
+    """(ω_max, Lanczos iterations, converged) of the small oscillations at (q, t)."""
 
 def stable_step(method: str, omega_max: float) -> float:
     """The largest stable step of the method on frequencies up to omega_max."""

@@ -21,6 +21,7 @@ from ._progress import progress_bar
 from ._util import finite, positive, positive_int, returned_scalar, step_count, vector
 from .constraints import warn_if_integrable
 from .model import Lagrangian, Model
+from .modes import warn_if_unstable
 from .scenes import Scene
 
 # Trajectory lives in varmech.trajectory; imported here, it is still found under its old name
@@ -356,6 +357,7 @@ def integrate(
     probes = (t0, t0 + dt, t0 + 0.5, t0 + 1.0, t0 + 0.37 * (t_end - t0), t_end)
     starts = "q0, v0" if v0 is not None else "q0, p0"
     _check_time_independent(model, q, p, tuple(s for s in probes if math.isfinite(s)), starts)
+    warn_if_unstable(model, method, q, dt, t0)
 
     contact_specs = _impacts.specs(contacts or ())
     impulse_specs = _impulses.specs(impulses, t0, t_end) if impulses is not None else []

@@ -1,6 +1,6 @@
 """The docstring examples run as written (numpydoc ``Examples``): the symbolic front end, events,
 files, long runs, dense output, impulses, impacts and their surfaces, the scenes, the stepper, the
-conservation report, ensembles and constraints."""
+conservation report, ensembles, constraints and small oscillations."""
 
 import doctest
 import importlib
@@ -35,6 +35,7 @@ pytest.importorskip("sympy")
         "varmech.constraints",
         "varmech.derivatives",
         "varmech.reduction",
+        "varmech.modes",
         "varmech.methods",
         "varmech.analysis.work_precision",
         "varmech._errors",

@@ -1,31 +1,33 @@
 //! Small oscillations: equilibria, the linearized equations and their normal modes at a point,
-//! and the step a method takes on them ([`varmech::diagnostics`]'s `modes`).
+//! on holonomic constraints too, the fastest frequency there, and the step a method takes on
+//! them ([`varmech::diagnostics`]'s `modes`).
 
-use nalgebra::DMatrix;
-use numpy::{PyArray1, PyArray2, PyReadonlyArray1};
+use nalgebra::{Complex, DMatrix};
+use numpy::{PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray1};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
-use varmech::diagnostics::{self, Equilibrium, Linearization, Modes};
-use varmech::integrators::Dynamics;
+use varmech::diagnostics::{self, Equilibrium, Linearization, Model, Modes, Shapes};
 use varmech::integrators::NewtonOptions;
+use varmech::model::Fastest;
 use varmech::{Error, ModelError};
 
 use crate::bind::{bind_model, dim_of};
 use crate::convert::{self, slice};
 use crate::errors::{model_error, to_pyerr};
+use crate::generator::{generators, Generator};
 
-/// A square matrix as a NumPy array (row-major).
+/// A matrix as a NumPy array (row-major).
 fn array<'py>(py: Python<'py>, m: &DMatrix<f64>) -> PyResult<Bound<'py, PyArray2<f64>>> {
     convert::matrix(py, m.transpose().as_slice().to_vec(), m.ncols())
 }
 
-/// `body` on the model's Lagrangian at q (its dimension checked), for the models that have
-/// no constraints of their own.
+/// `body` on the model at q (its dimension checked): its Lagrangian and holonomic constraints
+/// (`Model::of`, which refuses velocity constraints).
 fn on_model<R: Send>(
     model: &Bound<'_, PyAny>,
     q: &PyReadonlyArray1<'_, f64>,
     name: &str,
-    body: impl for<'s> FnOnce(&'s dyn Dynamics, &[f64]) -> R + Send,
+    body: impl for<'s> FnOnce(Model<'s>, &[f64]) -> R + Send,
 ) -> PyResult<R> {
     let py = model.py();
     let n = dim_of(py, model)?;
@@ -36,18 +38,11 @@ fn on_model<R: Send>(
             q.len()
         )));
     }
-    bind_model(py, model, |sys, _poll| {
-        if sys.constraint_counts() != (0, 0) || sys.velocity_constraints().is_some() {
-            return Err(PyValueError::new_err(
-                "model: a constrained model's small oscillations are not linearized on its constraints yet; \
-                 write the model in coordinates that satisfy them (the fewest coordinates)",
-            ));
-        }
-        Ok(body(sys, q))
-    })?
+    let found: Result<R, Error> = bind_model(py, model, |sys, _poll| Ok(body(Model::of(sys)?, q)))?;
+    found.map_err(|e| to_pyerr(py, e))
 }
 
-/// The linearized equations at (q, q̇ = 0, t): (M, K, G, D), each (n, n).
+/// The linearized equations at (q, q̇ = 0, t) in the tangent coordinates: (M, K, G, D, T, λ).
 #[pyfunction]
 #[pyo3(signature = (model, q, t=0.0))]
 #[allow(clippy::type_complexity)]
@@ -60,70 +55,120 @@ fn linearize<'py>(
     Bound<'py, PyArray2<f64>>,
     Bound<'py, PyArray2<f64>>,
     Bound<'py, PyArray2<f64>>,
+    Bound<'py, PyArray2<f64>>,
+    Bound<'py, PyArray1<f64>>,
 )> {
     let py = model.py();
-    let linear: Result<Linearization, ModelError> = on_model(model, &q, "q", |sys, q| {
-        diagnostics::linearize(sys.as_lagrangian(), q, t)
-    })?;
+    let linear: Result<Linearization, ModelError> = on_model(model, &q, "q", |m, q| diagnostics::linearize(m, q, t))?;
     let l = linear.map_err(model_error)?;
     Ok((
         array(py, &l.mass)?,
         array(py, &l.stiffness)?,
         array(py, &l.gyroscopic)?,
         array(py, &l.damping)?,
+        array(py, &l.basis)?,
+        PyArray1::from_vec(py, l.multipliers),
     ))
 }
 
-/// The normal modes at (q, t): (frequencies, growth, curvatures, inertia, shapes or None).
+/// The normal modes at (q, t), the zero modes named after `symmetries` (the model's generators):
+/// (frequencies, growth, curvatures, inertia, shapes (real or complex, n × r), the index of the
+/// symmetry of each mode or None).
 #[pyfunction]
-#[pyo3(signature = (model, q, t=0.0))]
+#[pyo3(signature = (model, q, t=0.0, symmetries=Vec::new()))]
 #[allow(clippy::type_complexity)]
 fn normal_modes<'py>(
     model: &Bound<'py, PyAny>,
     q: PyReadonlyArray1<'py, f64>,
     t: f64,
+    symmetries: Vec<Generator>,
 ) -> PyResult<(
     Bound<'py, PyArray1<f64>>,
     Bound<'py, PyArray1<f64>>,
     Bound<'py, PyArray1<f64>>,
     [usize; 3],
-    Option<Bound<'py, PyArray2<f64>>>,
+    Bound<'py, PyAny>,
+    Vec<Option<usize>>,
 )> {
     let py = model.py();
-    let modes: Result<Modes, ModelError> = on_model(model, &q, "q", |sys, q| {
-        diagnostics::modes(&diagnostics::linearize(sys.as_lagrangian(), q, t)?)
+    let fields = {
+        let q = slice("q", &q)?;
+        let n = dim_of(py, model)?;
+        generators(py, symmetries, n)?
+            .iter()
+            .map(|g| {
+                let mut xi = vec![0.0; q.len()];
+                g.field(q, &mut xi);
+                xi
+            })
+            .collect::<Vec<_>>()
+    };
+    let modes: Result<Modes, ModelError> = on_model(model, &q, "q", |m, q| {
+        let linear = diagnostics::linearize(m, q, t)?;
+        let mut modes = diagnostics::modes(&linear)?;
+        modes.name_symmetries(&linear, &fields);
+        Ok(modes)
     })?;
     let modes = modes.map_err(model_error)?;
-    let shapes = modes.shapes.as_ref().map(|s| array(py, s)).transpose()?;
+    let shapes = match &modes.shapes {
+        Shapes::Real(s) => array(py, s)?.into_any(),
+        Shapes::Complex(s) => complex_array(py, s)?.into_any(),
+    };
     Ok((
         PyArray1::from_vec(py, modes.frequencies),
         PyArray1::from_vec(py, modes.growth),
         PyArray1::from_vec(py, modes.curvatures),
         modes.inertia,
         shapes,
+        modes.symmetries,
     ))
 }
 
-/// The equilibrium nearest `guess` at time t: (q, residual, iterations).
+/// A complex matrix as a NumPy array (row-major).
+fn complex_array<'py>(py: Python<'py>, m: &DMatrix<Complex<f64>>) -> PyResult<Bound<'py, PyArray2<Complex<f64>>>> {
+    PyArray1::from_vec(py, m.transpose().as_slice().to_vec()).reshape([m.nrows(), m.ncols()])
+}
+
+/// The equilibrium nearest `guess` at time t: (q, λ, residual, iterations).
 #[pyfunction]
 #[pyo3(signature = (model, guess, t=0.0, newton_tolerance=1e-14, newton_max_iterations=50))]
+#[allow(clippy::type_complexity)]
 fn equilibrium<'py>(
     model: &Bound<'py, PyAny>,
     guess: PyReadonlyArray1<'py, f64>,
     t: f64,
     newton_tolerance: f64,
     newton_max_iterations: usize,
-) -> PyResult<(Bound<'py, PyArray1<f64>>, f64, usize)> {
+) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>, f64, usize)> {
     let py = model.py();
     let options = NewtonOptions {
         tolerance: newton_tolerance,
         max_iterations: newton_max_iterations,
     };
-    let found: Result<Equilibrium, Error> = on_model(model, &guess, "guess", |sys, guess| {
-        diagnostics::equilibrium(sys.as_lagrangian(), guess, t, &options)
+    let found: Result<Equilibrium, Error> = on_model(model, &guess, "guess", |m, guess| {
+        diagnostics::equilibrium(m, guess, t, &options)
     })?;
     let found = found.map_err(|e| to_pyerr(py, e))?;
-    Ok((PyArray1::from_vec(py, found.q), found.residual, found.iterations))
+    Ok((
+        PyArray1::from_vec(py, found.q),
+        PyArray1::from_vec(py, found.multipliers),
+        found.residual,
+        found.iterations,
+    ))
+}
+
+/// The fastest frequency of the small oscillations at (q, t), by Lanczos: (ω_max, iterations,
+/// converged).
+#[pyfunction]
+#[pyo3(signature = (model, q, t=0.0))]
+fn fastest_frequency<'py>(
+    model: &Bound<'py, PyAny>,
+    q: PyReadonlyArray1<'py, f64>,
+    t: f64,
+) -> PyResult<(f64, usize, bool)> {
+    let found: Result<Fastest, ModelError> = on_model(model, &q, "q", |m, q| m.fastest(q, t))?;
+    let found = found.map_err(model_error)?;
+    Ok((found.omega, found.iterations, found.converged))
 }
 
 /// The largest stable step of `method` on frequencies up to `omega_max`.
@@ -146,6 +191,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(linearize, m)?)?;
     m.add_function(wrap_pyfunction!(normal_modes, m)?)?;
     m.add_function(wrap_pyfunction!(equilibrium, m)?)?;
+    m.add_function(wrap_pyfunction!(fastest_frequency, m)?)?;
     m.add_function(wrap_pyfunction!(stable_step, m)?)?;
     m.add_function(wrap_pyfunction!(accurate_step, m)?)?;
     Ok(())
