@@ -7,8 +7,9 @@ docs/gallery/ (PNG) with its data (CSV).
 scene selects every chart of that kind). Needs the ``bench`` extra (matplotlib, scipy, rebound).
 Takes a few minutes; each chart's sweep shows a progress bar and Ctrl-C stops it. The impact
 chart (``--only impacts``) races a rival that is no library code, so benches/impacts.py draws it;
-benches/reactions.py draws the tension of a pendulum (``--only reactions``), benches/holds.py the
-particle leaving the sphere (``--figure``).
+benches/reactions.py draws the tension of a pendulum (``--only reactions``), benches/modes.py the
+triatomic molecule's spectrum against the stability intervals (``--only spectrum``),
+benches/holds.py the particle leaving the sphere (``--figure``).
 """
 
 from __future__ import annotations
@@ -18,6 +19,7 @@ import time
 from pathlib import Path
 
 from impacts import billiard_chart
+from modes import spectrum_figure
 from reactions import tension_chart
 
 from varmech.charts.recipes import KINDS, chart
@@ -40,8 +42,12 @@ GALLERY = [
     ("nonholonomic", None, None),
 ]
 #: (kind, scene, draw(out, quick) → paths): charts drawn by a bench script, for their rival is
-#: no library code (the naive "reflect at the end of the step" scheme).
-BENCHED = [("impacts", "billiard", billiard_chart), ("reactions", "pendulum", tension_chart)]
+#: no library code (the naive "reflect at the end of the step" scheme) or their model no scene.
+BENCHED = [
+    ("impacts", "billiard", billiard_chart),
+    ("reactions", "pendulum", tension_chart),
+    ("spectrum", "triatomic", spectrum_figure),
+]
 
 
 def selected(kind: str, scene: str | None, only: list[str]) -> bool:

@@ -3,7 +3,8 @@
 - :mod:`.work_precision`: cost against accuracy over a sweep of steps and tolerances;
 - :mod:`.energy_growth`: the energy error over a long run, log-spaced in t, with verdicts;
 - :mod:`.baselines`: SciPy's ``solve_ivp`` and REBOUND driven on a varmech scene;
-- :mod:`.stability`: linear stability on q̈ = −ω²q and the implicit methods' failure regions;
+- :mod:`.stability`: linear stability on q̈ = −ω²q, the implicit methods' failure regions, and a
+  model's spectrum against the stability intervals;
 - :mod:`.sections`: Poincaré sections and orbit divergence (a chaos indicator);
 - :mod:`.phase_portrait`: orbits of one degree of freedom, librations and rotations;
 - :mod:`.nonholonomic`: a rolling disk's energy over a long run, the discrete

@@ -36,6 +36,10 @@ with reference/compositions.json.
 and initial angle: Newton's iteration failing, a spurious branch beyond a fold of the discrete
 Euler–Lagrange map, a blow-up, or an energy error past a threshold.
 
+:func:`spectrum` puts a model's own frequencies against those intervals: the modes of its
+linearization at a point (:func:`varmech.normal_modes`), scaled by a step, and each method's
+stability interval hω < h_ω, so that which methods take that step on that model is read off.
+
 Everything returns a :class:`~varmech.Table`; :mod:`varmech.charts.stability` draws them (this
 module does not import matplotlib).
 """
@@ -43,6 +47,7 @@ module does not import matplotlib).
 from __future__ import annotations
 
 import math
+import warnings
 from collections.abc import Iterable, Sequence
 from typing import Any
 
@@ -52,10 +57,12 @@ from numpy.typing import ArrayLike
 from .. import scenes
 from .._core import ConvergenceError, DivergenceError, SpuriousBranchError
 from .._progress import progress as _progress
-from .._util import positive
+from .._util import finite, positive, vector
 from ..integrate import integrate
 from ..methods import MethodInfo
 from ..methods import methods as _methods
+from ..model import Model
+from ..modes import StabilityWarning, normal_modes
 from ..table import Table
 from ._energy import relative_error
 from ._interrupt import interruptible
@@ -148,10 +155,18 @@ def _unconstrained() -> list[str]:
     return [m.name for m in _methods() if not m.constrained and not m.nonholonomic and not m.nbody]
 
 
+def _probe(*args: Any, **kwargs: Any) -> Any:
+    """:func:`~varmech.integrate` where a measurement steps beyond a method's limit on
+    purpose: without the :class:`~varmech.StabilityWarning` it would give."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", StabilityWarning)
+        return integrate(*args, **kwargs)
+
+
 def _step_matrix(method: str, y: float) -> np.ndarray:
     model = _oscillator()
-    a = integrate(model, [1.0], [0.0], dt=y, steps=1, method=method, max_energy_error=None)
-    b = integrate(model, [0.0], [1.0], dt=y, steps=1, method=method, max_energy_error=None)
+    a = _probe(model, [1.0], [0.0], dt=y, steps=1, method=method, max_energy_error=None)
+    b = _probe(model, [0.0], [1.0], dt=y, steps=1, method=method, max_energy_error=None)
     return np.array([[a.q[-1, 0], b.q[-1, 0]], [a.p[-1, 0], b.p[-1, 0]]])
 
 
@@ -774,7 +789,7 @@ def implicit_regions(
             p = np.zeros(n)
             outcome, traj = "ok", None
             try:
-                traj = integrate(sc.model, q, p, dt=h, steps=int(steps), method=name, max_energy_error=None)
+                traj = _probe(sc.model, q, p, dt=h, steps=int(steps), method=name, max_energy_error=None)
             except SpuriousBranchError as err:
                 outcome, traj = "spurious branch", getattr(err, "partial", None)
             except ConvergenceError as err:
@@ -810,8 +825,103 @@ __all__ = [
     "growth_table",
     "implicit_regions",
     "relative_difference",
+    "spectrum",
     "stability_scan",
     "stability_table",
     "step_matrix",
     "unstable_intervals",
 ]
+
+
+def spectrum(
+    model: Model | scenes.Scene,
+    methods: Iterable[str] | str | None = None,
+    *,
+    q: ArrayLike | None = None,
+    dt: float | None = None,
+    t: float = 0.0,
+) -> Table:
+    """A model's spectrum against each method's stability interval: the frequencies of its
+    small oscillations at q (:func:`varmech.normal_modes`), as hω at the step ``dt``, beside
+    each method's interval 0 < hω < h_ω.
+
+    Parameters
+    ----------
+    model : Model or Scene
+        The model (any but one with velocity constraints); a scene gives its q₀ and dt as the
+        defaults.
+    methods : str or iterable of str, optional
+        The methods; default: every method with a finite stability limit that integrates the
+        model.
+    q : array_like, optional
+        The point (an equilibrium, or a state whose local frequencies bound the step); default
+        the scene's q₀.
+    dt : float, optional
+        The step; default the scene's.
+    t : float, default 0.0
+        The time.
+
+    Returns
+    -------
+    Table
+        One row per method: ``method``, ``h_omega_max`` (h_ω, inf for an unconditionally stable
+        method), ``stable_dt`` (h_ω/ω_max) and ``stable`` (whether dt·ω_max < h_ω); ``meta``
+        holds ``"frequencies"`` (each mode's |λ| = √(ω² + σ²)), ``"dt"``, ``"omega_max"``,
+        ``"model"`` and ``"q"``. :func:`varmech.charts.spectrum_chart` draws it.
+
+    Raises
+    ------
+    ValueError
+        No ``q`` or ``dt`` for a model that is not a scene; an unknown method, or one that does
+        not integrate the model or has no stability limit on an oscillator.
+
+    Examples
+    --------
+    The FPU chain at rest: its stiff springs at ω = 50 take Verlet's step 0.03 but not
+    Yoshida's fourth-order one.
+
+    >>> import varmech
+    >>> table = varmech.analysis.stability.spectrum(varmech.scenes.fermi_pasta_ulam(), ["verlet", "yoshida4"],
+    ...                                             q=[0.0] * 6, dt=0.035)
+    >>> [(row["method"], row["stable"]) for row in table], round(table.meta["omega_max"], 9)
+    ([('verlet', True), ('yoshida4', False)], 50.0)
+    """
+    scene = model if isinstance(model, scenes.Scene) else None
+    model = scene.model if scene is not None else model
+    if not isinstance(model, Model):
+        raise TypeError(f"model: expected a varmech model or scene, got {type(model).__name__}")
+    if q is None:
+        if scene is None:
+            raise ValueError("q: the point is required for a model that is not a scene")
+        q = scene.q0
+    if dt is None:
+        if scene is None:
+            raise ValueError("dt: the step is required for a model that is not a scene")
+        dt = scene.dt
+    dt = positive("dt", dt)
+    point = vector("q", q, model.dim)
+    infos = {m.name: m for m in _methods()}
+    if methods is None:
+        names = [m.name for m in infos.values() if model.kind.admits(m.name) and 0 < m.h_omega_max]
+    else:
+        names = [methods] if isinstance(methods, str) else list(methods)
+    for name in names:
+        info = infos.get(name) if isinstance(name, str) else None
+        if info is None:
+            raise ValueError(f"methods: expected names among {sorted(infos)}, got {name!r}")
+        if not model.kind.admits(name):
+            raise ValueError(f"methods: {name} does not integrate {model.name}, a {model.kind.name} model")
+        if not info.h_omega_max > 0:
+            raise ValueError(f"methods: {name} has no stability interval on an oscillator")
+    modes = normal_modes(model, point, t=finite("t", t))
+    frequencies = np.hypot(modes.frequencies, modes.growth)
+    omega = modes.omega_max
+    table = Table(
+        ("method", "h_omega_max", "stable_dt", "stable"),
+        title=f"{model.name}: its spectrum hω at dt = {dt:g} against each method's stability interval",
+        meta={"frequencies": frequencies.tolist(), "dt": dt, "omega_max": omega, "model": model.name, "q": point.tolist()},
+    )
+    for name in names:
+        limit = infos[name].h_omega_max
+        table.append(name, limit, limit / omega if omega > 0 else math.inf, bool(dt * omega < limit))
+    return table

@@ -7,7 +7,7 @@ trajectories) and writes a PNG or SVG file; the measurements themselves need no 
 from .energy import energy_error
 from .nonholonomic import nonholonomic_energy_chart
 from .sections import phase_portrait_chart, poincare_chart
-from .stability import implicit_regions_chart, stability_chart
+from .stability import implicit_regions_chart, spectrum_chart, stability_chart
 from .work_precision import energy_growth_chart, work_precision_chart
 
 __all__ = [
@@ -17,6 +17,7 @@ __all__ = [
     "nonholonomic_energy_chart",
     "phase_portrait_chart",
     "poincare_chart",
+    "spectrum_chart",
     "stability_chart",
     "work_precision_chart",
 ]

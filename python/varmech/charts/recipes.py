@@ -18,7 +18,7 @@ from ..analysis.phase_portrait import phase_portrait
 from ..table import Table
 from .nonholonomic import nonholonomic_energy_chart
 from .sections import phase_portrait_chart, poincare_chart
-from .stability import implicit_regions_chart, stability_chart
+from .stability import implicit_regions_chart, spectrum_chart, stability_chart
 from .work_precision import energy_growth_chart, work_precision_chart
 
 __all__ = [
@@ -122,6 +122,17 @@ def _stability(scene, methods, quick, progress, options):
     ]
 
 
+def _linearizable(scene: scenes.Scene) -> str | None:
+    if scene.model.velocity_constraints:
+        return f"{scene.name} has velocity constraints, whose small oscillations are not a Lagrangian's on a manifold"
+    return None
+
+
+def _spectrum(scene, methods, quick, progress, options):
+    table = stability.spectrum(scenes.get(scene), methods)
+    return [("spectrum", table, {"spectrum": lambda t, p: spectrum_chart(t, p)})]
+
+
 def _implicit_regions(scene, methods, quick, progress, options):
     table = stability.implicit_regions(methods, scene=scene, progress=progress)
     draw = lambda t, p: implicit_regions_chart(t, p, title=f"{scene}: outcome of the implicit steps by step and initial angle")  # noqa: E731
@@ -193,6 +204,11 @@ KINDS: dict[str, ChartKind] = {
         None, ("symplectic_euler", "verlet", "yoshida4", "mclachlan4", "kahan_li8", "rk4", "midpoint"),
         "growth factor against hω with each stability limit", _stability, _no_scene,
     ),
+    "spectrum": ChartKind(
+        "fermi_pasta_ulam", ("verlet", "yoshida4", "mclachlan4", "kahan_li8", "rk4", "midpoint"),
+        "the scene's normal-mode frequencies hω at its q0 and dt against each method's stability interval",
+        _spectrum, _linearizable,
+    ),
     "implicit-regions": ChartKind(
         "pendulum", ("midpoint", "trapezoid", "galerkin4", "galerkin6"),
         "where the implicit methods' Newton iterations fail or jump branches", _implicit_regions, _implicit,
@@ -233,8 +249,8 @@ def chart(
     Parameters
     ----------
     kind : str
-        One of ``work-precision``, ``energy``, ``stability``, ``implicit-regions``,
-        ``poincare``, ``phase``, ``nonholonomic``.
+        One of ``work-precision``, ``energy``, ``stability``, ``spectrum``,
+        ``implicit-regions``, ``poincare``, ``phase``, ``nonholonomic``.
     scene : str, optional
         A scene of :data:`varmech.scenes.CATALOGUE` or a symbolic one; default: the kind's own
         (:func:`scenes_for` lists those the kind applies to).

@@ -204,3 +204,76 @@ def implicit_regions_chart(table: Table, path: str | Path, title: str = "") -> P
 
 
 __all__ = ["implicit_regions_chart", "stability_chart"]
+
+
+@documented
+def spectrum_chart(table: Table, path: str | Path, title: str = "") -> Path:
+    """A model's spectrum against each method's stability interval, from
+    :func:`~varmech.analysis.stability.spectrum`: one row per method, its interval 0 < hω < h_ω
+    a bar (green where the step dt takes the model's fastest mode inside it, red where not), and
+    each mode's h|λ| at the table's dt a vertical line across all of them, so that which methods
+    take that step is read off; the top axis gives the same positions as frequencies ω and the
+    right one each method's largest stable step h_ω/ω_max. An unconditionally stable method's bar
+    runs off the chart, with an arrow. Writes ``path`` (PNG or SVG).
+
+    Parameters
+    ----------
+    table : Table
+        A table returned by :func:`~varmech.analysis.stability.spectrum`.
+    {path}
+    title : str, optional
+        The figure's title (default: the table's).
+
+    {returns}
+
+    {raises}.
+
+    See Also
+    --------
+    varmech.analysis.stability.spectrum : The measurements.
+    varmech.suggest_dt : The step from the same modes.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> import matplotlib.pyplot as plt
+    >>> import varmech
+    >>> from varmech.charts import spectrum_chart
+    >>> table = varmech.analysis.stability.spectrum(varmech.scenes.fermi_pasta_ulam(), ["verlet", "yoshida4", "midpoint"])
+    >>> with tempfile.TemporaryDirectory() as folder:
+    ...     path = spectrum_chart(table, Path(folder) / "spectrum.png")
+    ...     print(path.name, plt.imread(path).shape)
+    spectrum.png (354, 1080, 4)
+    """
+    plt = pyplot()
+    dt = float(table.meta["dt"])
+    frequencies = np.asarray(table.meta["frequencies"], dtype=float)
+    names = [row["method"] for row in table]
+    limits = [float(row["h_omega_max"]) for row in table]
+    finite = [x for x in limits if math.isfinite(x)]
+    fastest = dt * float(table.meta["omega_max"])
+    right = 1.15 * max([fastest, *finite, 1e-300])
+    fig, ax = plt.subplots(figsize=(9.0, 1.6 + 0.45 * max(len(names), 2)), layout="constrained")
+    for i, (row, limit) in enumerate(zip(table, limits)):
+        colour = "#4daf4a" if row["stable"] else "#e41a1c"
+        ax.barh(i, min(limit, right), height=0.55, color=colour, alpha=0.55, edgecolor=colour)
+        if math.isinf(limit):
+            ax.annotate("", xy=(right, i), xytext=(0.93 * right, i), arrowprops={"arrowstyle": "->", "color": colour})
+        else:
+            ax.text(limit, i, f" {limit:g}", va="center", ha="left", fontsize=7.5, color="0.2")
+    for x in dt * frequencies:
+        if 0 < x <= right:
+            ax.axvline(x, color="#377eb8", lw=1.4 if x == fastest else 0.7, alpha=0.9 if x == fastest else 0.5)
+    ax.set_yticks(range(len(names)), names)
+    ax.invert_yaxis()
+    ax.set_xlim(0.0, right)
+    ax.set_xlabel(f"hω at dt = {dt:g} (blue: the modes, the fastest bold)")
+    top_axis = ax.secondary_xaxis("top", functions=(lambda x: x / dt, lambda w: w * dt))
+    top_axis.set_xlabel("ω (angular frequency)")
+    steps = ax.secondary_yaxis("right")
+    words = [f"dt < {row['stable_dt']:.4g}" if math.isfinite(row["stable_dt"]) else "any dt" for row in table]
+    steps.set_yticks(range(len(names)), words, fontsize=7.5)
+    ax.set_title(title or table.title, fontsize=10)
+    ax.grid(True, axis="x", alpha=0.3)
+    return save(fig, path)
