@@ -88,6 +88,8 @@ pub struct Linearization {
     pub basis: DMatrix<f64>,
     /// λ at rest (Lagrange's sign: ṗ = ∂L/∂q + Q + Gᵀλ); empty without constraints.
     pub multipliers: Vec<f64>,
+    /// The point, q.
+    pub q: Vec<f64>,
 }
 
 /// ∂f/∂x at x by central differences ([`central_jacobian`]), into `out`.
@@ -182,6 +184,7 @@ pub fn linearize(model: Model<'_>, q: &[f64], t: f64) -> Result<Linearization, M
         damping: restrict(&damping),
         multipliers: rest.multipliers().to_vec(),
         basis,
+        q: q.to_vec(),
     })
 }
 
@@ -381,15 +384,19 @@ pub fn modes(linear: &Linearization) -> Result<Modes, ModelError> {
     let n = mass.nrows();
     let finite = |m: &DMatrix<f64>| m.iter().all(|x| x.is_finite());
     if ![mass, stiffness, gyroscopic, damping].into_iter().all(finite) {
-        return Err(
-            "the linearization has non-finite entries: the model's second derivatives are not finite at q".into(),
-        );
+        return Err(format!(
+            "the linearization has non-finite entries: the model's second derivatives are not finite at q = {:?}",
+            linear.q
+        )
+        .into());
     }
     let size = |m: &DMatrix<f64>| m.iter().fold(0.0_f64, |a, x| a.max(x.abs()));
-    let cholesky = mass
-        .clone()
-        .cholesky()
-        .ok_or("the mass matrix M = ∂²L/∂q̇² is not positive definite at q")?;
+    let cholesky = mass.clone().cholesky().ok_or_else(|| {
+        format!(
+            "the mass matrix M = ∂²L/∂q̇² is not positive definite at q = {:?}",
+            linear.q
+        )
+    })?;
     let scale = size(stiffness);
     let symmetric = (stiffness - stiffness.transpose())
         .iter()
