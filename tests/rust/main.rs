@@ -41,5 +41,6 @@ mod splitting;
 mod spurious_branch;
 mod stability;
 mod stepper;
+mod time_dependent;
 mod variational;
 mod wisdom_holman;

@@ -126,6 +126,7 @@ impl CompiledModel {
                 "gradients",
                 "hessians",
                 "force",
+                "dl_dt",
                 "constraints",
                 "constraint_jacobian",
                 "velocity_constraints",
@@ -222,7 +223,7 @@ impl CompiledModel {
                     required("gradients", f("gradients")?)?,
                     required("hessians", f("hessians")?)?,
                     force,
-                    time_dependent,
+                    (f("dl_dt")?, time_dependent),
                 )
                 .map_err(err)?;
                 match (constraint_functions, rolling) {

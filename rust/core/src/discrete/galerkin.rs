@@ -100,6 +100,26 @@ impl Quadrature {
         }
     }
 
+    /// ∂L_d/∂t = h Σᵢ bᵢ ∂L/∂t(q(cᵢh), q̇(cᵢh), t + cᵢh) over the step at `at`: what L's
+    /// dependence on t takes from the energy, E₁ − E₀ = W − ∂L_d/∂t to the method's order (W
+    /// the forces' work); 0 for an L that does not depend on t.
+    pub(crate) fn time_derivative<S: Lagrangian + ?Sized>(
+        &mut self,
+        sys: &S,
+        at: Segment<'_>,
+    ) -> Result<f64, ModelError> {
+        if !sys.is_time_dependent() {
+            return Ok(0.0);
+        }
+        let mut sum = 0.0;
+        // Over the nodes: as many as the degree for Gauss's rules, two for the trapezoid's.
+        for i in 0..self.nodes.len() {
+            self.node_state(i, &at);
+            sum += self.weights[i] * sys.dl_dt(&self.pos, &self.vel, at.t + self.nodes[i] * at.h)?;
+        }
+        Ok(at.h * sum)
+    }
+
     /// The sign of det ∂F/∂x as h → 0: sign(det K)ⁿ·sign(det ∂²L/∂q̇²)ˢ.
     pub(crate) fn continuum_sign(&self, n: usize, hessian_sign: f64) -> f64 {
         self.k_sign.powi(n as i32) * hessian_sign.powi(self.s as i32)
@@ -206,7 +226,8 @@ impl Galerkin {
     }
 
     /// ∂L/∂q + f and ∂L/∂q̇ at every quadrature node, for the control increments `at.dq`
-    /// (Q₀ = q₀); returns the forces' work over the step, h Σᵢ bᵢ f(cᵢ)·q̇(cᵢ). A force f enters
+    /// (Q₀ = q₀); returns the energy put in over the step, the forces' work h Σᵢ bᵢ f(cᵢ)·q̇(cᵢ)
+    /// less ∂L_d/∂t ([`Quadrature::time_derivative`]). A force f enters
     /// where ∂L/∂q does: the discrete Lagrange–d'Alembert principle adds the virtual work
     /// h Σᵢ bᵢ f(cᵢ)·δq(cᵢh) to δL_d, and δq(cᵢh) = Σⱼ ℓⱼ(cᵢ)δQⱼ.
     pub(crate) fn derivatives<S: Lagrangian + ?Sized>(&mut self, sys: &S, at: Segment<'_>) -> Result<f64, ModelError> {
@@ -226,7 +247,7 @@ impl Galerkin {
                 work += at.h * quad.weights[i] * power;
             }
         }
-        Ok(work)
+        Ok(work - quad.time_derivative(sys, at)?)
     }
 
     /// out = ∂L_d/∂Qⱼ = Σᵢ bᵢ[hℓⱼ(cᵢ)∂L/∂q + ℓⱼ'(cᵢ)∂L/∂q̇] from the last

@@ -71,8 +71,9 @@ pub trait Dynamics {
         state.step_while(self, steps, &mut |q: &[f64]| gaps.clear(q))
     }
 
-    /// The energy function and its terms at (q, p, t), where L does not depend on t and no
-    /// constraint does work (forced or not: a forced run balances it against the work done).
+    /// The energy function and its terms at (q, p, t), where no constraint does work (a forced
+    /// run, or one of an L that depends on t, balances it against the energy put in,
+    /// [`super::Stepper::work`]).
     fn energy(&self, q: &[f64], p: &[f64], t: f64) -> Option<Result<EnergyTerms, ModelError>>;
 
     /// The system as a Lagrangian, for the diagnostics (energy function, Legendre transforms).
@@ -198,9 +199,9 @@ impl<L: Lagrangian> Dynamics for General<'_, L> {
         state.advance_lagrangian_while(self.0, steps, &mut |q: &[f64]| gaps.clear(q))
     }
 
-    /// E = p·q̇ − L, unless L depends on t.
+    /// E = p·q̇ − L: conserved, or (forced, L depending on t) balanced against the work.
     fn energy(&self, q: &[f64], p: &[f64], t: f64) -> Option<Result<EnergyTerms, ModelError>> {
-        (!self.0.is_time_dependent()).then(|| self.0.energy_terms(q, p, t))
+        Some(self.0.energy_terms(q, p, t))
     }
 
     fn as_lagrangian(&self) -> &dyn Lagrangian {
@@ -377,11 +378,11 @@ impl<L: Lagrangian, C: VelocityConstraints> Dynamics for Nonholonomic<L, C> {
         integrator.increment_nonholonomic(&self.system, &self.constraints, start, increment)
     }
 
-    /// E = p·q̇ − L, unless L depends on t or the constraints are affine
-    /// ([`VelocityConstraints::is_affine`]): linear constraints' forces do no work, affine
-    /// ones' do, so that their runs have no energy to watch.
+    /// E = p·q̇ − L, unless the constraints are affine ([`VelocityConstraints::is_affine`]):
+    /// linear constraints' forces do no work, affine ones' do, so that their runs have no
+    /// energy to watch.
     fn energy(&self, q: &[f64], p: &[f64], t: f64) -> Option<Result<EnergyTerms, ModelError>> {
-        let conserved = !self.system.is_time_dependent() && !self.constraints.is_affine();
+        let conserved = !self.constraints.is_affine();
         conserved.then(|| self.system.energy_terms(q, p, t))
     }
 
@@ -450,10 +451,10 @@ impl<L: Lagrangian, H: HolonomicConstraints, C: VelocityConstraints> Dynamics fo
         integrator.increment_mixed(&self.system, (&self.holonomic, &self.velocity), start, increment)
     }
 
-    /// E = p·q̇ − L, unless L depends on t or the velocity constraints are affine (the
-    /// holonomic ones, fixed, do no work).
+    /// E = p·q̇ − L, unless the velocity constraints are affine (the holonomic ones, fixed, do
+    /// no work).
     fn energy(&self, q: &[f64], p: &[f64], t: f64) -> Option<Result<EnergyTerms, ModelError>> {
-        let conserved = !self.system.is_time_dependent() && !self.velocity.is_affine();
+        let conserved = !self.velocity.is_affine();
         conserved.then(|| self.system.energy_terms(q, p, t))
     }
 

@@ -247,7 +247,8 @@ impl Integrator {
         }
     }
 
-    /// The work done by non-conservative forces so far (implicit methods; 0 otherwise).
+    /// The energy put in so far by non-conservative forces and by L's dependence on t,
+    /// −Σ∂L_d/∂t (implicit methods; 0 otherwise).
     pub fn work(&self) -> f64 {
         match &self.scheme {
             Scheme::Midpoint(s) => s.work(),

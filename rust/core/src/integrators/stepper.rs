@@ -658,18 +658,21 @@ impl StepperState {
         self.integrator.newton()
     }
 
-    /// The work done by non-conservative forces so far: a forced Lagrangian's, and the held
-    /// contacts' friction's.
+    /// The energy put in so far, against which E − E₀ balances: the work of a forced
+    /// Lagrangian's forces and of the held contacts' friction, less Σ∂L_d/∂t, what an L that
+    /// depends on t takes.
     pub fn work(&self) -> f64 {
         self.integrator.work() + self.contact_work
     }
 }
 
 impl<M: Deref<Target: Dynamics>, St: Borrow<StepperState>> Stepper<M, St> {
-    /// The work done by the non-conservative forces so far; None for a model without them
+    /// The energy put in so far by the non-conservative forces and by L's dependence on t
+    /// (−Σ∂L_d/∂t); None for a model with neither
     /// watched without friction.
     pub fn forced_work(&self) -> Option<f64> {
-        (self.model.as_lagrangian().is_forced() || self.frictional).then(|| self.work())
+        let lagrangian = self.model.as_lagrangian();
+        (lagrangian.is_forced() || lagrangian.is_time_dependent() || self.frictional).then(|| self.work())
     }
 }
 

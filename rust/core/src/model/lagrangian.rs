@@ -88,9 +88,16 @@ pub trait Lagrangian {
     }
 
     /// Whether L depends on t explicitly; if it does, the energy function E = p·q̇ − L is not
-    /// conserved and no report may claim it is.
+    /// conserved and no report may claim it is: it changes by −∫∂L/∂t dt (with the forces'
+    /// work), which the run tracks ([`Lagrangian::dl_dt`]).
     fn is_time_dependent(&self) -> bool {
         false
+    }
+
+    /// ∂L/∂t at (q, q̇, t). Default: 0 where L does not depend on t, else
+    /// [`differenced_dl_dt`].
+    fn dl_dt(&self, q: &[f64], v: &[f64], t: f64) -> Result<f64, ModelError> {
+        differenced_dl_dt(self, q, v, t)
     }
 
     /// Whether non-conservative generalized forces act (then the energy is not conserved, and
@@ -160,6 +167,16 @@ pub trait Lagrangian {
             potential,
         })
     }
+}
+
+/// ∂L/∂t by a central difference in t (two evaluations of L, about 1e-10 relative); 0 where L
+/// does not depend on t.
+pub fn differenced_dl_dt<L: Lagrangian + ?Sized>(l: &L, q: &[f64], v: &[f64], t: f64) -> Result<f64, ModelError> {
+    if !l.is_time_dependent() {
+        return Ok(0.0);
+    }
+    let h = difference::step(t.abs().max(1.0));
+    Ok((l.lagrangian(q, v, t + h)? - l.lagrangian(q, v, t - h)?) / (2.0 * h))
 }
 
 /// L = ½ q̇ᵀ M q̇ − V(q): ∂L/∂q = −∇V(q), ∂L/∂q̇ = M q̇.

@@ -6,7 +6,7 @@ use std::cell::RefCell;
 use numpy::PyArray1;
 use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
-use varmech::model::{Hessians, Lagrangian};
+use varmech::model::{differenced_dl_dt, Hessians, Lagrangian};
 use varmech::solve::difference::central_gradient;
 use varmech::ModelError;
 
@@ -17,7 +17,8 @@ use crate::generator::{self, Generator as Spec};
 /// A general Lagrangian L(q, q̇, t) given by Python closures: `lagrangian(q, v, t) -> float`
 /// and, optionally, `dl_dq(q, v, t)` and `dl_dv(q, v, t)` (arrays (n,)); missing derivatives
 /// come from central differences of L. An optional `force(q, v, t)` (array (n,)) is a
-/// non-conservative generalized force.
+/// non-conservative generalized force; an optional `dl_dt(q, v, t) -> float`, ∂L/∂t of an L that
+/// depends on t (else a central difference of L in t).
 #[pyclass(frozen, module = "varmech._core")]
 pub struct ClosureLagrangian {
     dim: usize,
@@ -26,6 +27,7 @@ pub struct ClosureLagrangian {
     dl_dv: Option<Py<PyAny>>,
     hessians: Option<Py<PyAny>>,
     force: Option<Py<PyAny>>,
+    dl_dt: Option<Py<PyAny>>,
     time_dependent: bool,
 }
 
@@ -34,7 +36,7 @@ impl ClosureLagrangian {
     #[new]
     /// `symmetries` are only checked here (the core's Lagrangian trait declares none); the
     /// Python model keeps them for the conservation report.
-    #[pyo3(signature = (dim, lagrangian, dl_dq, dl_dv, hessians, force, time_dependent, symmetries))]
+    #[pyo3(signature = (dim, lagrangian, dl_dq, dl_dv, hessians, force, time_dependent, symmetries, dl_dt=None))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         py: Python<'_>,
@@ -46,6 +48,7 @@ impl ClosureLagrangian {
         force: Option<Bound<'_, PyAny>>,
         time_dependent: bool,
         symmetries: Vec<Spec>,
+        dl_dt: Option<Bound<'_, PyAny>>,
     ) -> PyResult<Self> {
         generator::generators(py, symmetries, dim)?;
         check_closures(
@@ -56,6 +59,7 @@ impl ClosureLagrangian {
                 ("dl_dv", dl_dv.as_ref()),
                 ("hessians", hessians.as_ref()),
                 ("force", force.as_ref()),
+                ("dl_dt", dl_dt.as_ref()),
             ],
         )?;
         Ok(ClosureLagrangian {
@@ -65,6 +69,7 @@ impl ClosureLagrangian {
             dl_dv: dl_dv.map(Bound::unbind),
             hessians: hessians.map(Bound::unbind),
             force: force.map(Bound::unbind),
+            dl_dt: dl_dt.map(Bound::unbind),
             time_dependent,
         })
     }
@@ -88,6 +93,7 @@ pub struct ClosureLagrangianSystem<'a, 'py> {
     dl_dv: Option<Bound<'py, PyAny>>,
     hessians: Option<Bound<'py, PyAny>>,
     force: Option<Bound<'py, PyAny>>,
+    dl_dt: Option<Bound<'py, PyAny>>,
     work: RefCell<Vec<f64>>,
 }
 
@@ -101,6 +107,7 @@ impl<'a, 'py> ClosureLagrangianSystem<'a, 'py> {
             dl_dv: model.dl_dv.as_ref().map(|f| f.bind(py).clone()),
             hessians: model.hessians.as_ref().map(|f| f.bind(py).clone()),
             force: model.force.as_ref().map(|f| f.bind(py).clone()),
+            dl_dt: model.dl_dt.as_ref().map(|f| f.bind(py).clone()),
             work: RefCell::new(vec![0.0; model.dim]),
         }
     }
@@ -165,6 +172,13 @@ impl Lagrangian for ClosureLagrangianSystem<'_, '_> {
 
     fn is_time_dependent(&self) -> bool {
         self.model.time_dependent
+    }
+
+    fn dl_dt(&self, q: &[f64], v: &[f64], t: f64) -> Result<f64, ModelError> {
+        match &self.dl_dt {
+            Some(f) => call_scalar(f.call1(self.args(q, v, t)), "dl_dt(q, v, t)"),
+            None => differenced_dl_dt(self, q, v, t),
+        }
     }
 
     fn is_forced(&self) -> bool {

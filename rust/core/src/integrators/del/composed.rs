@@ -44,7 +44,7 @@ impl<Sc: StepEquations + Clone> Composed<Sc> {
         self.stages.iter().map(Del::iterations).sum()
     }
 
-    /// The work done by the generalized forces so far.
+    /// The energy put in so far: the generalized forces' work, less Σ∂L_d/∂t.
     pub fn work(&self) -> f64 {
         self.stages.iter().map(Del::work).sum()
     }

@@ -133,7 +133,8 @@ impl<R: DiscreteLagrangian> Del<TwoPoint<R>> {
             }
             self.same_branch(sign)?;
             evaluations += 1;
-            self.scheme.momentum_change_in(&mut ws, sys, start, &x, &r, dp)?;
+            // No force here, but L may depend on t: its ∂L_d/∂t is the energy the step puts in.
+            self.work += self.scheme.momentum_change_in(&mut ws, sys, start, &x, &r, dp)?;
             *dq = x;
             (before_last, last) = (last, x);
             history = (history + 1).min(2);

@@ -284,7 +284,7 @@ impl<Sc: StepEquations> Del<Sc> {
         self.newton.iterations()
     }
 
-    /// The work done by the generalized forces so far.
+    /// The energy put in so far: the generalized forces' work, less Σ∂L_d/∂t.
     pub fn work(&self) -> f64 {
         self.work
     }

@@ -83,7 +83,13 @@ impl<R: DiscreteLagrangian> TwoPoint<R> {
         residual: &[f64],
         dp: &mut [f64],
     ) -> Result<f64, ModelError> {
-        momentum_change(&self.rule, &mut self.forcing, ws, sys, start, x, residual, dp)
+        let TwoPoint {
+            rule,
+            forcing,
+            quadrature,
+            ..
+        } = self;
+        momentum_change(rule, (forcing, quadrature), ws, sys, start, x, residual, dp)
     }
 }
 
@@ -109,13 +115,14 @@ fn equations<R: DiscreteLagrangian, S: Lagrangian + ?Sized, V: Vector>(
 }
 
 /// p₁ − p₀ = D₁L_d + D₂L_d + h·f(q̄, v) − F into `dp`, since F = p₀ + D₁L_d + f_d⁻; returns the
-/// forces' work. Called after [`equations`] at the same x, as Newton's method leaves it: the
-/// rule reuses that D₁L_d's evaluation in `ws`.
+/// energy put in over the step: the forces' work, less ∂L_d/∂t where L depends on t (on the
+/// rule's own `quadrature`). Called after [`equations`] at the same x, as Newton's method leaves
+/// it: the rule reuses that D₁L_d's evaluation in `ws`.
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
 fn momentum_change<R: DiscreteLagrangian, S: Lagrangian + ?Sized, V: Vector>(
     rule: &R,
-    forcing: &mut Forcing,
+    (forcing, quadrature): (&mut Forcing, &mut Quadrature),
     ws: &mut Workspace<V>,
     sys: &S,
     start: StepStart<'_>,
@@ -126,11 +133,12 @@ fn momentum_change<R: DiscreteLagrangian, S: Lagrangian + ?Sized, V: Vector>(
     let at = segment(&start, x);
     rule.momentum_change_after_d1(sys, at, dp, ws)?;
     dp.iter_mut().zip(residual).for_each(|(d, r)| *d -= r);
+    let time = quadrature.time_derivative(sys, at)?;
     if !sys.is_forced() {
-        return Ok(0.0);
+        return Ok(-time);
     }
     let f = forcing.evaluate(sys, at)?;
-    let mut work = 0.0;
+    let mut work = -time;
     for ((d, f), x) in dp.iter_mut().zip(f).zip(x) {
         *d += start.h * f;
         work += f * x;
@@ -164,8 +172,13 @@ impl<R: DiscreteLagrangian> StepEquations for TwoPoint<R> {
         residual: &[f64],
         dp: &mut [f64],
     ) -> Result<f64, ModelError> {
-        let TwoPoint { rule, ws, forcing, .. } = self;
-        momentum_change(rule, forcing, ws, sys, start, x, residual, dp)
+        let TwoPoint {
+            rule,
+            ws,
+            forcing,
+            quadrature,
+        } = self;
+        momentum_change(rule, (forcing, quadrature), ws, sys, start, x, residual, dp)
     }
 
     fn predict(&self, dq: &[f64], x: &mut [f64]) {

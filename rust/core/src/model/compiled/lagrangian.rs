@@ -2,12 +2,13 @@
 
 use super::function::{check, check_parameters, Inputs};
 use super::Function;
-use crate::model::{Hessians, Lagrangian};
+use crate::model::{differenced_dl_dt, Hessians, Lagrangian};
 use crate::{Error, ModelError};
 
 /// L(q, q̇, t; parameters) with its exact derivatives, each a [`Function`] of the slots
 /// [q, q̇, t]: L; (∂L/∂q, ∂L/∂q̇) together; the Hessians (∂²L/∂q², ∂²L/∂q∂q̇, ∂²L/∂q̇²) row by
-/// row; and, for a forced system, the generalized force Q(q, q̇, t).
+/// row; for a forced system, the generalized force Q(q, q̇, t); and, for an L that depends on t,
+/// ∂L/∂t (differenced from L where a model stored before it was compiled lacks it).
 #[derive(Clone, Debug)]
 pub struct CompiledLagrangian {
     n: usize,
@@ -16,6 +17,7 @@ pub struct CompiledLagrangian {
     gradients: Function,
     hessians: Function,
     force: Option<Function>,
+    dl_dt: Option<Function>,
     time_dependent: bool,
 }
 
@@ -28,7 +30,7 @@ impl CompiledLagrangian {
         gradients: Function,
         hessians: Function,
         force: Option<Function>,
-        time_dependent: bool,
+        (dl_dt, time_dependent): (Option<Function>, bool),
     ) -> Result<Self, Error> {
         check_parameters(&params, lagrangian.tape().params())?;
         check("lagrangian", &lagrangian, 1, n, Inputs::All, &params)?;
@@ -37,6 +39,12 @@ impl CompiledLagrangian {
         if let Some(f) = &force {
             check("force", f, n, n, Inputs::All, &params)?;
         }
+        if let Some(f) = &dl_dt {
+            if !time_dependent {
+                return Err(Error::invalid("dl_dt", "given for an L that does not depend on t"));
+            }
+            check("dl_dt", f, 1, n, Inputs::All, &params)?;
+        }
         Ok(CompiledLagrangian {
             n,
             params,
@@ -44,6 +52,7 @@ impl CompiledLagrangian {
             gradients,
             hessians,
             force,
+            dl_dt,
             time_dependent,
         })
     }
@@ -100,6 +109,15 @@ impl Lagrangian for CompiledLagrangian {
 
     fn is_time_dependent(&self) -> bool {
         self.time_dependent
+    }
+
+    fn dl_dt(&self, q: &[f64], v: &[f64], t: f64) -> Result<f64, ModelError> {
+        let Some(f) = &self.dl_dt else {
+            return differenced_dl_dt(self, q, v, t);
+        };
+        let mut out = [0.0];
+        f.eval(q, v, t, &self.params, &mut out);
+        Ok(out[0])
     }
 
     fn is_forced(&self) -> bool {
