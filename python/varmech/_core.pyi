@@ -451,6 +451,7 @@ class ClosureLagrangian(_ModelProperties):
         force: Callable[[_FloatArray, _FloatArray, float], Any] | None,
         time_dependent: bool,
         symmetries: Sequence[Generator],
+        dl_dt: Callable[[_FloatArray, _FloatArray, float], float] | None = None,
     ) -> ClosureLagrangian: ...
 
 #: A function pointer as varmech.pointers hands it over: (address, the object that owns it).

@@ -310,7 +310,7 @@ def _statistics(record: _core.Statistics, name: str, initial: float, scale_name:
     )
 
 
-NOT_CONSERVED = "not conserved (L depends on t)"
+NOT_CONSERVED = "not conserved (L depends on t); see the energy balance"
 FORCED = "not conserved (forced); see the energy balance"
 AFFINE = "not conserved (affine velocity constraints: the moving surface does work)"
 
@@ -333,13 +333,14 @@ class ConservationReport:
     t_end : float
         The last saved time.
     energy : InvariantStatistics or None
-        The energy E = p·q̇ − L; None when L depends on t or forces act (the energy is then not
-        conserved; see ``energy_balance``).
+        The energy E = p·q̇ − L; None when L depends on t, forces act or affine constraints do
+        work (the energy is then not conserved; see ``energy_balance``).
     momenta : tuple of InvariantStatistics
         Each Noether momentum judged, in the order of the generators.
     energy_balance : InvariantStatistics or None
-        For forced systems: the balance E(t) − W(t), W the work of the forces (the discrete
-        Lagrange–d'Alembert energy balance), judged as the energy is.
+        For forced systems and for an L that depends on t: the balance E(t) − W(t), W the energy
+        put in (``traj.work``: the forces' work, the discrete Lagrange–d'Alembert energy
+        balance, less ∫∂L/∂t dt on the method's quadrature), judged as the energy is.
     constraints : tuple of InvariantStatistics or None
         For constrained models: |g(q)|∞ and |G(q)M⁻¹p|∞ over the run; with velocity
         constraints |A(q)q̇ + b(q)|∞ alone; with both, |g(q)|∞ and |G(q)q̇, A(q)q̇ + b(q)|∞.
@@ -351,6 +352,8 @@ class ConservationReport:
         (:meth:`Trajectory.reactions`), which vanishes on the exact motion: a work-free check of
         the multipliers and of the velocities' constraint together, against Σ|(Cᵀλ)ᵢq̇ᵢ|.
         None without constraints, or with affine ones (their forces do work).
+    time_dependent : bool
+        Whether L depends on t: then its energy balance, not its energy, is judged.
     verdict : str
         The energy's verdict, or why the energy is not conserved (L depends on t, forces act:
         then see ``energy_balance``, or affine constraints do work).
@@ -378,8 +381,8 @@ class ConservationReport:
     #: None when L depends on t or forces act: the energy is then not conserved.
     energy: InvariantStatistics | None
     momenta: tuple[InvariantStatistics, ...]
-    #: For forced systems: the balance E(t) − W(t), W the work of the forces (the discrete
-    #: Lagrange–d'Alembert energy balance), judged as the energy is.
+    #: For forced systems and an L that depends on t: the balance E(t) − W(t), W the energy put
+    #: in (the forces' work less ∫∂L/∂t dt), judged as the energy is.
     energy_balance: InvariantStatistics | None = None
     #: For constrained models: |g(q)|∞ and |G(q)M⁻¹p|∞ over the run; with velocity constraints
     #: |A(q)q̇ + b(q)|∞ alone; with both, |g(q)|∞ and |G(q)q̇, A(q)q̇ + b(q)|∞.
@@ -388,6 +391,8 @@ class ConservationReport:
     affine: bool = False
     #: For fixed constraints: the power Cᵀλ·q̇ of the constraint forces, 0 on the exact motion.
     constraint_power: InvariantStatistics | None = None
+    #: Whether L depends on t (then the balance, not the energy, is judged).
+    time_dependent: bool = False
 
     @property
     def verdict(self) -> str:
@@ -397,7 +402,7 @@ class ConservationReport:
             return self.energy.verdict
         if self.affine:
             return AFFINE
-        return FORCED if self.energy_balance is not None else NOT_CONSERVED
+        return NOT_CONSERVED if self.time_dependent else FORCED
 
     @property
     def constraint_residuals(self) -> tuple[float, float] | None:
@@ -439,9 +444,11 @@ def check_conservation(traj: Trajectory, generators: Sequence[Generator] | None 
     """Check the energy, the Noether momenta and the constraints of ``traj``, and the power of the constraint forces.
 
     The energy function E = p·q̇ − L is judged when L does not depend on t and no constraint
-    does work (affine velocity constraints A(q)q̇ + b(q) = 0 do); with forces acting the report
-    judges the balance E − W, W the work of the forces, instead. An energy that is not finite
-    at a saved state fails the report in every case, L depending on t included. With velocity
+    does work (affine velocity constraints A(q)q̇ + b(q) = 0 do); with forces acting, or L
+    depending on t, the report judges the balance E − W instead, W the energy put in (the
+    forces' work less ∫∂L/∂t dt, which the run tracks on its method's quadrature:
+    ``traj.work``). An energy that is not finite at a saved state fails the report in every
+    case. With velocity
     constraints the report judges the residuals |A(q)q̇ + b(q)| and only the momenta of the
     symmetries the model declares: a nonholonomic system need not conserve the momenta of the
     symmetries of its L (the native scenes declare those they conserve). Each quantity's error
@@ -456,7 +463,7 @@ def check_conservation(traj: Trajectory, generators: Sequence[Generator] | None 
         The symmetries whose momenta J = p·ξ(q) are judged. Default: those the model declares;
         a closure generator ``xi(q)`` is named ``xi[k]``.
     refine : bool, default True
-        For a forced run whose balance would be "secular drift": run the same motion again at
+        For a balance (forced, or L depending on t) that would be "secular drift": run the same motion again at
         h/2 and call the balance "bounded" when its error falls at the method's order (the
         discretisation error of the work, not a drift), with the measured order in the advice.
         This costs twice the run; ``False`` skips it.
@@ -493,14 +500,18 @@ def check_conservation(traj: Trajectory, generators: Sequence[Generator] | None 
     energy = balance = None
     affine = bool(model.velocity_constraints) and model.affine
     # Forces that do work: the model's own, or the friction of its contacts.
-    forced = model.forced or _impacts.frictional(traj.contacts)
-    if not model.time_dependent and not affine:
+    # The energy put in: by those forces, and by L's dependence on t.
+    forced = model.forced or _impacts.frictional(traj.contacts) or model.time_dependent
+    if not affine:
         stats = energy_statistics(model, t, *traj._arrays()[1:], steps=steps, work=np.asarray(traj.work) if forced else None)
         if stats.verdict == "failed":
             stats = replace(stats, advice=f"{stats.advice}; {_failure_advice(traj)}")
         elif forced and stats.verdict == "secular drift" and refine:
             stats = _refined(traj, stats)
         energy, balance = (None, stats) if forced else (stats, None)
+        if forced and stats.first_non_finite is not None:
+            # A balance whose energy is not finite fails the report as the energy would.
+            energy = replace(stats, advice=f"{stats.advice}: the model's energy p·q̇ − L does not evaluate there")
     else:
         # Not conserved, so not judged; but a non-finite energy fails the run all the same.
         stats = energy_statistics(model, t, *traj._arrays()[1:], steps=steps)
@@ -529,7 +540,9 @@ def check_conservation(traj: Trajectory, generators: Sequence[Generator] | None 
     if constraints is not None and not affine:
         _, _, (p, p_size) = _core.reactions(model._core, *traj._arrays())
         power = _statistics(_core.statistics(t, p, p_size, p_size, steps), "power", p[0], "mean Σ|(Cᵀλ)ᵢq̇ᵢ|", t)
-    return ConservationReport(model.name, traj.method, traj.dt, float(t[-1]), energy, tuple(momenta), balance, constraints, affine, power)
+    return ConservationReport(
+        model.name, traj.method, traj.dt, float(t[-1]), energy, tuple(momenta), balance, constraints, affine, power, model.time_dependent
+    )
 
 
 def energy_statistics(

@@ -419,7 +419,7 @@ def ensemble(
         and all(kind == "generalized" for _, kind, _ in impulse_specs)
     )
     if len(released) == len(cores) and native:
-        threshold = _energy_threshold(model, max_energy_error)
+        threshold = _energy_threshold(max_energy_error)
         bar = progress_bar(total=nsteps * members, unit="step", desc=f"{method} ×{members}", enabled=progress)
         try:
             report = None if bar.disable else (lambda done: bar.update(done - bar.n))

@@ -523,10 +523,10 @@ def save(traj: Trajectory, path: str | os.PathLike[str], *, overwrite: bool = Fa
 
 def columns_of(model: Model, method: str, contacts: Sequence[Contact | str] = ()) -> tuple[str, ...]:
     """The optional columns of a run of ``method`` on ``model`` watching ``contacts``: Newton
-    counts for the methods that solve equations, work for forced models and contacts with
-    friction."""
+    counts for the methods that solve equations, work for forced models, contacts with
+    friction and an L that depends on t."""
     info = method_info(method)
-    worked = model.forced or _impacts.frictional(contacts)
+    worked = model.forced or model.time_dependent or _impacts.frictional(contacts)
     return (*(("newton",) if info.implicit or info.constrained else ()), *(("work",) if worked else ()))
 
 

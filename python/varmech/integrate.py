@@ -86,17 +86,15 @@ def _check_rolling(model: Model, q: np.ndarray, v: np.ndarray, p: np.ndarray) ->
         )
 
 
-def _energy_threshold(model: Model, max_energy_error: float | None | Literal["auto"]) -> float | None:
-    """The run's energy threshold: ``"auto"`` is the failure level of the verdicts where the
-    model has an energy (L does not depend on t), and off where it has none."""
+def _energy_threshold(max_energy_error: float | None | Literal["auto"]) -> float | None:
+    """The run's energy threshold: ``"auto"`` is the failure level of the verdicts, for the
+    energy or its balance E − W (forced, L depending on t); the core checks neither where
+    affine constraints do work."""
     if max_energy_error is None:
         return None
     if isinstance(max_energy_error, str) and max_energy_error == "auto":
-        return None if model.time_dependent else _core.FAILURE
-    threshold = positive("max_energy_error", max_energy_error)
-    if model.time_dependent:
-        raise ValueError("max_energy_error: needs an energy to check, and a Lagrangian that depends on t has none")
-    return threshold
+        return _core.FAILURE
+    return positive("max_energy_error", max_energy_error)
 
 
 def _check_time_independent(
@@ -182,12 +180,12 @@ def integrate(
         Stop with :class:`~varmech.DivergenceError` when the energy error |E − E₀| at a saved
         state exceeds this times the energy's scale, the mean kinetic energy of the states saved
         so far (errors at round-off never stop a run; see
-        :class:`~varmech.InvariantStatistics`), or when the energy is not finite. A forced run
-        checks its balance E − W with the work W of the forces instead. ``"auto"`` (default):
-        1 (:data:`varmech.conservation.FAILURE`), the error at which the verdict is "failed",
-        for every model with an energy, and no check for a Lagrangian that depends on t (a
-        number is refused there). ``None``: no energy check; non-finite states still stop the
-        run. The check costs one energy evaluation per saved state.
+        :class:`~varmech.InvariantStatistics`), or when the energy is not finite. A forced run,
+        or one of a Lagrangian that depends on t, checks its balance E − W instead, W the energy
+        put in (the forces' work less ∫∂L/∂t dt, ``traj.work``). ``"auto"`` (default): 1
+        (:data:`varmech.conservation.FAILURE`), the error at which the verdict is "failed"; no
+        check where affine velocity constraints do work. ``None``: no energy check; non-finite
+        states still stop the run. The check costs one energy evaluation per saved state.
     t0
         The initial time (default 0). It restarts a run from a state saved by hand: give that
         state's q, p and time, ``integrate(model, traj.q[-1], traj.p[-1], dt=dt, steps=n,
@@ -346,7 +344,7 @@ def integrate(
     t0 = 0.0 if t0 is None else finite("t0", t0)
     nsteps = step_count(dt, t0, steps, t_end)
     save_every = positive_int("save_every", save_every)
-    threshold = _energy_threshold(model, max_energy_error)
+    threshold = _energy_threshold(max_energy_error)
     newton_tolerance, newton_max_iterations = _newton(newton_tolerance, newton_max_iterations)
     q, p = _initial_state(model, q0, p0, v0, t0)
     if model.velocity_constraints:

@@ -938,8 +938,13 @@ class Lagrangian(Model):
         A Rayleigh dissipation R(q̇) = ½q̇ᵀCq̇, given by C (a scalar, a vector (n,) for a
         diagonal, or a matrix (n, n)); adds the force −Cq̇.
     time_dependent
-        Whether L depends on t; then the energy function p·q̇ − L is not conserved and the
-        conservation report says so instead of judging it.
+        Whether L depends on t; then the energy function E = p·q̇ − L is not conserved: it
+        changes by −∫∂L/∂t dt, which the run tracks with the forces' work (``traj.work``, the
+        energy put in), so that the conservation report judges the balance E − W.
+    dl_dt
+        ``dl_dt(q, v, t) -> float``, ∂L/∂t, for an L that depends on t (closures only).
+        Optional: missing, it comes from a central difference of L in t (two calls of L per
+        quadrature node and step, about 1e-10 relative), and a warning says so.
     velocity_constraints, velocity_constraint_count
         Velocity constraints A(q)q̇ = 0, ``velocity_constraints(q) -> array (m, n)`` with
         ``velocity_constraint_count`` = m, as for :class:`MechanicalSystem`; closures only.
@@ -1000,6 +1005,7 @@ class Lagrangian(Model):
         velocity_constraint_offset: Callable[[np.ndarray], ArrayLike] | None = None,
         symmetries: Sequence[Symmetry] = (),
         name: str = "lagrangian",
+        dl_dt: Callable[[np.ndarray, np.ndarray, float], float] | None = None,
     ):
         self._arguments = {
             "dim": dim,
@@ -1015,9 +1021,14 @@ class Lagrangian(Model):
             "velocity_constraint_offset": velocity_constraint_offset,
             "symmetries": symmetries,
             "name": name,
+            "dl_dt": dl_dt,
         }
         dim = positive_int("dim", dim)
         _check_velocity_constraints(velocity_constraints, velocity_constraint_count, velocity_constraint_offset)
+        if dl_dt is not None and not time_dependent:
+            raise ValueError("dl_dt: given for an L declared independent of t; pass time_dependent=True with it")
+        if dl_dt is not None and pointers.is_pointer(dl_dt):
+            raise TypeError("dl_dt: a closure; with function pointers ∂L/∂t comes from differences of the L pointer")
         functions = {"lagrangian": lagrangian, "dl_dq": dl_dq, "dl_dv": dl_dv, "hessians": hessians, "force": force}
         native = pointers.functions(functions, int(dim))
         for key, f in (("velocity_constraints", velocity_constraints), ("velocity_constraint_offset", velocity_constraint_offset)):
@@ -1026,6 +1037,12 @@ class Lagrangian(Model):
         if native is not None and rayleigh is not None:
             raise TypeError("rayleigh: not with function pointers; add −Cq̇ to the force pointer instead")
         missing = [n for n, f in (("dl_dq", dl_dq), ("dl_dv", dl_dv)) if f is None]
+        if time_dependent and dl_dt is None and native is None:
+            warnings.warn(
+                f"{name}: no dl_dt given; ∂L/∂t, which the energy balance tracks, comes from a central difference of L "
+                "in t (two calls of L per quadrature node and step, about 1e-10 relative accuracy)",
+                stacklevel=2,
+            )
         if missing:
             warnings.warn(
                 f"{name}: no {' and no '.join(missing)} given; central differences of L are used "
@@ -1056,7 +1073,7 @@ class Lagrangian(Model):
         else:
             self._core = _roll(
                 _core.ClosureLagrangian(
-                    int(dim), lagrangian, dl_dq, dl_dv, hessians, total_force, bool(time_dependent), _specs(symmetries)
+                    int(dim), lagrangian, dl_dq, dl_dv, hessians, total_force, bool(time_dependent), _specs(symmetries), dl_dt
                 ),
                 velocity_constraints,
                 velocity_constraint_count,
@@ -1067,5 +1084,6 @@ class Lagrangian(Model):
         self.dl_dq = dl_dq
         self.dl_dv = dl_dv
         self.hessians = hessians
+        self.dl_dt = dl_dt
         self.symmetries = tuple(symmetries)
         self.name = name

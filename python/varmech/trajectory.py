@@ -95,8 +95,10 @@ class Trajectory:
     newton_iterations_per_step : ndarray, shape (N − 1,)
         Mean Newton iterations a step between consecutive saved states.
     work : ndarray, shape (N,) or None
-        Work done by the non-conservative forces up to each saved state: a forced model's, and
-        the friction of its contacts (:class:`varmech.Friction`).
+        The energy put in up to each saved state, which E − E₀ balances: the work of a forced
+        model's forces and of its contacts' friction (:class:`varmech.Friction`), less
+        ∫∂L/∂t dt for an L that depends on t (on the method's quadrature, Σ∂L_d/∂t). None for a
+        model with none of them.
     status : int
         0: the run reached its end; 1: a terminal event stopped it; -1: the partial trajectory
         of a failed run (``err.partial``).

@@ -158,7 +158,8 @@ def test_a_hidden_time_dependence_is_refused():
     with pytest.warns(UserWarning):
         declared = varmech.Lagrangian(1, lagrangian, time_dependent=True)
     report = varmech.check_conservation(varmech.integrate(declared, [0.5], [0.0], dt=0.01, steps=100, method="midpoint"))
-    assert report.verdict == "not conserved (L depends on t)"
+    assert report.verdict == "not conserved (L depends on t); see the energy balance"
+    assert report.energy_balance.verdict == "bounded"
 
 
 def test_every_verdict_word_is_reached():
@@ -294,16 +295,23 @@ DERIVATIVES = {"dl_dq": lambda q, v, t: -np.asarray(q, dtype=float), "dl_dv": la
 def test_a_non_finite_energy_fails_the_report_even_when_l_depends_on_t():
     # Issue 32 fuzz signature: L = −∞ with finite derivatives gave status 0 and the verdict
     # "not conserved (L depends on t)". The motion is finite (the run uses only the
-    # derivatives), but the model's energy is not: the report fails, naming where.
-    model = varmech.Lagrangian(3, lambda q, v, t: -math.inf, time_dependent=True, **DERIVATIVES)
-    traj = varmech.integrate(model, [2.0, 0.0, 0.05], v0=[2.0, 2.0, 0.3], dt=2 * np.pi / 50, steps=1, method="galerkin6")
+    # derivatives), but the model's energy is not: the run's check of the energy balance
+    # stops it at once, and without that check the report fails, naming where.
+    model = varmech.Lagrangian(3, lambda q, v, t: -math.inf, time_dependent=True, dl_dt=lambda q, v, t: 0.0, **DERIVATIVES)
+    with pytest.raises(varmech.DivergenceError, match="step 0 .*the energy is not finite"):
+        varmech.integrate(model, [2.0, 0.0, 0.05], v0=[2.0, 2.0, 0.3], dt=2 * np.pi / 50, steps=1, method="galerkin6")
+    traj = varmech.integrate(
+        model, [2.0, 0.0, 0.05], v0=[2.0, 2.0, 0.3], dt=2 * np.pi / 50, steps=1, method="galerkin6", max_energy_error=None
+    )
     report = varmech.check_conservation(traj)
     assert report.verdict == "failed" and report.energy.first_non_finite == 0
     assert "not finite from saved state 0" in str(report) and "does not evaluate" in str(report)
-    # With a finite L the time-dependent energy is still not judged.
-    finite = varmech.Lagrangian(1, lambda q, v, t: 0.5 * v @ v - 0.5 * (1 + 0.1 * math.cos(t)) * q @ q, time_dependent=True)
+    # With a finite L the time-dependent energy is not judged: its balance is.
+    with pytest.warns(UserWarning, match="no dl_dt"):
+        finite = varmech.Lagrangian(1, lambda q, v, t: 0.5 * v @ v - 0.5 * (1 + 0.1 * math.cos(t)) * q @ q, time_dependent=True)
     traj = varmech.integrate(finite, [1.0], [0.0], dt=0.1, steps=10, method="midpoint")
-    assert varmech.check_conservation(traj).verdict == "not conserved (L depends on t)"
+    report = varmech.check_conservation(traj)
+    assert report.verdict == "not conserved (L depends on t); see the energy balance" and report.energy_balance is not None
 
 
 def test_a_lagrangian_that_turns_nan_after_the_run_fails_the_report():
