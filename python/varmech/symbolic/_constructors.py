@@ -36,6 +36,7 @@ def lagrangian(
     velocity_constraints: Any = None,
     force: Any = None,
     rayleigh: Any = None,
+    added_mass: Any = None,
     symmetries: Sequence[Symmetry] = (),
     jit: bool = True,
     name: str = "symbolic lagrangian",
@@ -73,6 +74,14 @@ def lagrangian(
         A generalized force Q(q, q̇, t), one expression per coordinate (friction, driving).
     rayleigh
         A Rayleigh dissipation function R(q, q̇), which adds the force −∂R/∂q̇.
+    added_mass
+        A force of the acceleration, −A(q)q̈ (the fluid a body drags along: a pendulum in water,
+        the Kirchhoff–Thomson added mass), given by A: a symmetric n×n matrix (SymPy or nested
+        lists) of q, or a scalar a for A = a·I. It is folded into the metric, L + ½q̇ᵀA(q)q̇,
+        so that the variational step integrates it as the source states it; where A depends on
+        q, the force Ȧq̇ − ½q̇ᵀ(∂A/∂q)q̇ that the fold adds is taken back (the model is then
+        forced). A not symmetric is refused: its antisymmetric part is no mass, and would need
+        q̈ in a force.
     symmetries
         Declared symmetries (:class:`~varmech.Translation`, :class:`~varmech.Rotation`,
         :class:`~varmech.Cyclic`); each cyclic coordinate found is added as a
@@ -103,7 +112,8 @@ def lagrangian(
         parameter), naming it and why; more than :data:`MAX_COORDINATES` coordinates, naming
         ``q``; constraints of the wrong number or depending on q̇ or t;
         velocity constraints not linear in q̇, with a part free of q̇, depending on t, or with
-        ``constraints`` n or more together, naming them; a force with the wrong number of components.
+        ``constraints`` n or more together, naming them; a force with the wrong number of
+        components; an ``added_mass`` of the wrong shape, not symmetric or depending on q̇ or t.
 
     Examples
     --------
@@ -119,7 +129,7 @@ def lagrangian(
     variables_ = _sized(variables(q, v, t))
     return _build(
         variables_, variables_.plain(L, "L"), parameters, constraints, force, rayleigh, symmetries, jit, name, started,
-        velocity_constraints=velocity_constraints, progress=progress,
+        velocity_constraints=velocity_constraints, progress=progress, added_mass=added_mass,
     )
 
 
@@ -135,6 +145,7 @@ def mechanical(
     velocity_constraints: Any = None,
     force: Any = None,
     rayleigh: Any = None,
+    added_mass: Any = None,
     symmetries: Sequence[Symmetry] = (),
     jit: bool = True,
     name: str = "symbolic mechanical system",
@@ -157,7 +168,7 @@ def mechanical(
     v
         The velocity symbols; may be omitted (V and M hold no velocities: fresh symbols
         ``<q>_dot`` stand for them, as in ``expressions``).
-    t, parameters, constraints, velocity_constraints, force, rayleigh, symmetries, jit, name, progress
+    t, parameters, constraints, velocity_constraints, force, rayleigh, added_mass, symmetries, jit, name, progress
         As for :func:`lagrangian`.
 
     Returns
@@ -185,14 +196,14 @@ def mechanical(
     """
     started = time.perf_counter()
     variables_ = _sized(variables(q, v, t, fresh_velocities=True))
-    m = _mass_matrix(mass, variables_)
+    m = _mass_matrix(mass, variables_, "mass")
     potential = variables_.plain(V, "V")
     check_compilable(potential, "V")
     velocity = sp.Matrix(variables_.v)
     L = (velocity.T * m * velocity)[0, 0] / 2 - potential
     return _build(
         variables_, L, parameters, constraints, force, rayleigh, symmetries, jit, name, started,
-        velocity_constraints=velocity_constraints, progress=progress,
+        velocity_constraints=velocity_constraints, progress=progress, added_mass=added_mass,
     )
 
 
@@ -267,23 +278,56 @@ def _sized(variables: Variables) -> Variables:
     return variables
 
 
-def _mass_matrix(mass: Any, variables: Variables) -> sp.Matrix:
-    """M as an n×n SymPy Matrix in the plain symbols; ValueError naming ``mass`` unless it is
-    a scalar or a symmetric n×n matrix."""
+def _mass_matrix(mass: Any, variables: Variables, name: str) -> sp.Matrix:
+    """A mass matrix (the argument ``name``) as an n×n SymPy Matrix in the plain symbols;
+    ValueError naming ``name`` unless it is a scalar or a symmetric n×n matrix."""
     n = len(variables.q)
     if not isinstance(mass, (sp.MatrixBase, list, tuple)):
-        scalar = variables.plain(mass, "mass")
-        check_compilable(scalar, "mass")
+        scalar = variables.plain(mass, name)
+        check_compilable(scalar, name)
         return scalar * sp.eye(n)
     m = sp.Matrix(mass)
     if m.shape != (n, n):
-        raise ValueError(f"mass: must be a scalar or a {n}×{n} matrix, got shape {m.shape}")
-    m = m.applyfunc(lambda x: variables.plain(x, "mass"))
+        raise ValueError(f"{name}: must be a scalar or a {n}×{n} matrix, got shape {m.shape}")
+    m = m.applyfunc(lambda x: variables.plain(x, name))
     for x in m:
-        check_compilable(x, "mass")
+        check_compilable(x, name)
     if not all(vanishes(m[i, j] - m[j, i]) for i in range(n) for j in range(i)):
-        raise ValueError(f"mass: must be symmetric, got {m.tolist()}")
+        raise ValueError(f"{name}: must be symmetric, got {m.tolist()}")
     return m
+
+
+def _added_mass(added_mass: Any, variables: Variables) -> tuple[sp.Expr, list[sp.Expr] | None]:
+    """The force −A(q)q̈ folded into the metric: the term ½q̇ᵀAq̇ of L, and the force the fold
+    adds and the model takes back where A depends on q, Ȧq̇ − ½q̇ᵀ(∂A/∂q)q̇ (None for a constant
+    A). ValueError naming ``added_mass`` for a malformed or non-symmetric A, or one that
+    depends on q̇ or t."""
+    try:
+        a = _mass_matrix(added_mass, variables, "added_mass")
+    except ValueError as e:
+        if "symmetric" in str(e):
+            raise ValueError(
+                f"{e}: only its symmetric part is a mass (a metric the variational step folds it into); an "
+                "antisymmetric part would leave q̈ in the force"
+            ) from None
+        raise
+    q, v = list(variables.q), list(variables.v)
+    held = {s for x in a for s in x.free_symbols}
+    if any(s in held for s in v) or variables.t in held:
+        raise ValueError("added_mass: must depend on the positions q alone (the fold into the metric needs it)")
+    velocity = sp.Matrix(v)
+    term = (velocity.T * a * velocity)[0, 0] / 2
+    if not any(s in held for s in q):
+        return term, None
+    n = len(q)
+    force = [
+        sp.Add(
+            *(sp.diff(a[i, j], q[k]) * v[k] * v[j] for j in range(n) for k in range(n)),
+            *(-sp.diff(a[j, k], q[i]) * v[j] * v[k] / 2 for j in range(n) for k in range(n)),
+        )
+        for i in range(n)
+    ]
+    return term, force
 
 
 def _build(
@@ -300,10 +344,16 @@ def _build(
     *,
     velocity_constraints: Any = None,
     progress: bool | None = None,
+    added_mass: Any = None,
 ) -> SymbolicModel:
     """Checks, derives, lowers and compiles: the common path of :func:`lagrangian` and
     :func:`mechanical`."""
     forces = expressions(force, "force", variables) if force is not None else None
+    if added_mass is not None:
+        term, taken_back = _added_mass(added_mass, variables)
+        L = L + term
+        if taken_back is not None:
+            forces = [a + b for a, b in zip(forces or [sp.S.Zero] * len(taken_back), taken_back)]
     dissipation = variables.plain(rayleigh, "rayleigh") if rayleigh is not None else None
     holonomic = expressions(constraints, "constraints", variables) if constraints is not None else None
     nonholonomic = None
