@@ -39,6 +39,7 @@ __all__ = [
     "VarmechError",
     "accurate_step",
     "amended_potential",
+    "beyond_limit",
     "catalogue",
     "central_differences",
     "constraint_curvature",
@@ -788,6 +789,11 @@ def equilibrium(
 
 def fastest_frequency(model: _Model, q: _FloatArray, t: float = 0.0) -> tuple[float, int, bool]:
     """(ω_max, Lanczos iterations, converged) of the small oscillations at (q, t)."""
+
+def beyond_limit(
+    model: _Model, method: str, q: _FloatArray, dt: float, t: float = 0.0
+) -> tuple[float, float, float] | None:
+    """(h·ω_max, the method's limit, ω_max) where the step is beyond the limit at (q, t), else None."""
 
 def stable_step(method: str, omega_max: float) -> float:
     """The largest stable step of the method on frequencies up to omega_max."""

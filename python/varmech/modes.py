@@ -24,7 +24,6 @@ dozen force evaluations, by Lanczos's method) with the method's stability limit 
 from __future__ import annotations
 
 import functools
-import math
 import warnings
 from dataclasses import dataclass
 
@@ -518,9 +517,9 @@ def suggest_dt(
     >>> round(s.stable_dt * 7**0.5, 6), s.dt / s.stable_dt
     (2.0, 0.9)
     """
-    infos = {m.name: m for m in methods()}
-    if not isinstance(method, str) or method not in infos:
-        raise ValueError(f"method: expected one of {sorted(infos)}, got {method!r}")
+    limits = stability_limits()
+    if not isinstance(method, str) or method not in limits:
+        raise ValueError(f"method: expected one of {sorted(limits)}, got {method!r}")
     margin = finite("margin", margin)
     if not 0.0 <= margin < 1.0:
         raise ValueError(f"margin: must be in [0, 1), got {margin}")
@@ -533,7 +532,7 @@ def suggest_dt(
     dt = (1.0 - margin) * stable
     if accurate is not None:
         dt = min(dt, accurate)
-    return StepSuggestion(method, dt, stable, accurate, omega, infos[method].h_omega_max, margin, accuracy)
+    return StepSuggestion(method, dt, stable, accurate, omega, limits[method], margin, accuracy)
 
 
 def fastest_frequency(model: Model, q: ArrayLike, *, t: float = 0.0) -> float:
@@ -613,26 +612,37 @@ class StabilityWarning(UserWarning):
 
 
 @functools.cache
-def _limits() -> dict[str, float]:
-    """Each method's stability limit h_ω, read once."""
+def stability_limits() -> dict[str, float]:
+    """Each method's stability limit h_ω on q̈ = −ω²q by name (:func:`varmech.methods`), read once.
+
+    Returns
+    -------
+    dict of str to float
+        inf for an unconditionally stable method, nan for one without an oscillator's limit.
+
+    Examples
+    --------
+    >>> from varmech.modes import stability_limits
+    >>> stability_limits()["verlet"], stability_limits()["midpoint"]
+    (2.0, inf)
+    """
     return {m.name: m.h_omega_max for m in methods()}
 
 
 def warn_if_unstable(model: Model, method: str, q: np.ndarray, dt: float, t: float) -> None:
     """Warns with a :class:`StabilityWarning` where h·ω_max at (q, t) is beyond ``method``'s
-    stability limit; silent for unconditionally stable methods (and names that are no method's:
-    the run refuses them), models with velocity constraints, and models whose frequencies do not
-    evaluate there (a user's exception included: the run raises it, with its partial trajectory)."""
-    limit = _limits().get(method, math.inf) if isinstance(method, str) else math.inf
-    if not (0.0 < limit < math.inf) or model.velocity_constraints:
-        return
+    stability limit (the core's test, which a divergence's diagnosis shares); silent for
+    unconditionally stable methods (and names that are no method's: the run refuses them),
+    models with velocity constraints, and models whose frequencies do not evaluate there (a
+    user's exception included: the run raises it, with its partial trajectory)."""
     try:
-        omega, _, _ = _core.fastest_frequency(model._core, q, t)
+        beyond = _core.beyond_limit(model._core, method, q, dt, t)
     except Exception:  # noqa: BLE001 - the run's to report, with its step and partial trajectory
         return
-    if dt * omega > limit:
+    if beyond is not None:
+        h_omega, limit, omega = beyond
         warnings.warn(
-            f"dt: h·ω_max = {dt * omega:.4g} at the first state is beyond {method}'s stability limit {limit:.6g} "
+            f"dt: h·ω_max = {h_omega:.4g} at the first state is beyond {method}'s stability limit {limit:.6g} "
             f"(ω_max = {omega:.6g}, the fastest frequency of the small oscillations there): the run will blow up; "
             f"take dt below {limit / omega:.6g} (varmech.suggest_dt)",
             StabilityWarning,

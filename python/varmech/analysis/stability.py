@@ -62,7 +62,7 @@ from ..integrate import integrate
 from ..methods import MethodInfo
 from ..methods import methods as _methods
 from ..model import Model
-from ..modes import StabilityWarning, normal_modes
+from ..modes import StabilityWarning, normal_modes, stability_limits
 from ..table import Table
 from ._energy import relative_error
 from ._interrupt import interruptible
@@ -900,18 +900,17 @@ def spectrum(
         dt = scene.dt
     dt = positive("dt", dt)
     point = vector("q", q, model.dim)
-    infos = {m.name: m for m in _methods()}
+    limits = stability_limits()
     if methods is None:
-        names = [m.name for m in infos.values() if model.kind.admits(m.name) and 0 < m.h_omega_max]
+        names = [name for name, limit in limits.items() if model.kind.admits(name) and 0 < limit]
     else:
         names = [methods] if isinstance(methods, str) else list(methods)
     for name in names:
-        info = infos.get(name) if isinstance(name, str) else None
-        if info is None:
-            raise ValueError(f"methods: expected names among {sorted(infos)}, got {name!r}")
+        if not isinstance(name, str) or name not in limits:
+            raise ValueError(f"methods: expected names among {sorted(limits)}, got {name!r}")
         if not model.kind.admits(name):
             raise ValueError(f"methods: {name} does not integrate {model.name}, a {model.kind.name} model")
-        if not info.h_omega_max > 0:
+        if not limits[name] > 0:
             raise ValueError(f"methods: {name} has no stability interval on an oscillator")
     modes = normal_modes(model, point, t=finite("t", t))
     frequencies = np.hypot(modes.frequencies, modes.growth)
@@ -922,6 +921,6 @@ def spectrum(
         meta={"frequencies": frequencies.tolist(), "dt": dt, "omega_max": omega, "model": model.name, "q": point.tolist()},
     )
     for name in names:
-        limit = infos[name].h_omega_max
+        limit = limits[name]
         table.append(name, limit, limit / omega if omega > 0 else math.inf, bool(dt * omega < limit))
     return table

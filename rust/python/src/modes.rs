@@ -7,8 +7,8 @@ use numpy::{PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray1};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use varmech::diagnostics::{self, Equilibrium, Linearization, Model, Modes, Shapes};
-use varmech::integrators::NewtonOptions;
-use varmech::model::Fastest;
+use varmech::integrators::{self, NewtonOptions};
+use varmech::model::{Fastest, Rest};
 use varmech::{Error, ModelError};
 
 use crate::bind::{bind_model, dim_of};
@@ -171,6 +171,33 @@ fn fastest_frequency<'py>(
     Ok((found.omega, found.iterations, found.converged))
 }
 
+/// (h·ω_max, the limit, ω_max) where a step `dt` of `method` at (q, t) is beyond its stability
+/// limit ([`varmech::integrators::beyond_limit`], the check before a run), else None.
+#[pyfunction]
+#[pyo3(signature = (model, method, q, dt, t=0.0))]
+fn beyond_limit<'py>(
+    model: &Bound<'py, PyAny>,
+    method: &Bound<'py, PyAny>,
+    q: PyReadonlyArray1<'py, f64>,
+    dt: f64,
+    t: f64,
+) -> PyResult<Option<(f64, f64, f64)>> {
+    let py = model.py();
+    let method = convert::method(method)?;
+    let n = dim_of(py, model)?;
+    let q = slice("q", &q)?;
+    if q.len() != n {
+        return Err(PyValueError::new_err(format!(
+            "q: has length {}, the model has dim = {n}",
+            q.len()
+        )));
+    }
+    let found = bind_model(py, model, |sys, _poll| {
+        integrators::beyond_limit(sys, (method, dt), (q, t), Rest::BEFORE_RUN)
+    })?;
+    Ok(found.map_err(model_error)?.map(|b| (b.h_omega, b.limit, b.omega)))
+}
+
 /// The largest stable step of `method` on frequencies up to `omega_max`.
 #[pyfunction]
 fn stable_step(method: &Bound<'_, PyAny>, omega_max: f64) -> PyResult<f64> {
@@ -192,6 +219,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(normal_modes, m)?)?;
     m.add_function(wrap_pyfunction!(equilibrium, m)?)?;
     m.add_function(wrap_pyfunction!(fastest_frequency, m)?)?;
+    m.add_function(wrap_pyfunction!(beyond_limit, m)?)?;
     m.add_function(wrap_pyfunction!(stable_step, m)?)?;
     m.add_function(wrap_pyfunction!(accurate_step, m)?)?;
     Ok(())

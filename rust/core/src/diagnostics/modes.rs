@@ -18,7 +18,7 @@ use nalgebra::{Complex, DMatrix, DVector, Schur, SymmetricEigen};
 
 use crate::error::StepError;
 use crate::integrators::{integrate, Dynamics, Method, Options};
-use crate::model::{Fastest, Hessians, HolonomicConstraints, Lagrangian, Rest};
+use crate::model::{reaction_force, Fastest, ForceAtRest, Hessians, HolonomicConstraints, Lagrangian, Rest};
 use crate::scenes::HarmonicOscillator;
 use crate::solve::difference::{central_jacobian, unit, Evaluations};
 use crate::solve::newton::{Correction, Newton, NewtonProblem, Reasons, Rules};
@@ -145,21 +145,6 @@ fn stiffness(model: Model<'_>, q: &[f64], t: f64, h: &Hessians, lambda: &[f64]) 
     Ok(k)
 }
 
-/// G(x)ᵀλ into `out`, G(x) into `g`.
-fn reaction_force(
-    c: &dyn HolonomicConstraints,
-    x: &[f64],
-    lambda: &[f64],
-    g: &mut DMatrix<f64>,
-    out: &mut [f64],
-) -> Result<(), ModelError> {
-    c.jacobian(x, g)?;
-    for (i, o) in out.iter_mut().enumerate() {
-        *o = lambda.iter().enumerate().map(|(k, l)| g[(k, i)] * l).sum();
-    }
-    Ok(())
-}
-
 /// The linearized equations of `model` at (q, q̇ = 0, t) ([`Linearization`]), on its constraints'
 /// tangent space where it has constraints.
 ///
@@ -194,8 +179,7 @@ struct Balance<'a> {
     model: Model<'a>,
     q: Vec<f64>,
     lambda: Vec<f64>,
-    zeros: Vec<f64>,
-    force: Vec<f64>,
+    force: ForceAtRest,
     g: DMatrix<f64>,
     t: f64,
 }
@@ -209,16 +193,11 @@ impl NewtonProblem for Balance<'_> {
     };
 
     fn residual(&mut self, r: &mut [f64]) -> Result<(), StepError> {
-        let (system, n) = (self.model.system, self.q.len());
-        let (balance, on) = r.split_at_mut(n);
-        system.dl_dq(&self.q, &self.zeros, self.t, balance)?;
-        if system.is_forced() {
-            system.force(&self.q, &self.zeros, self.t, &mut self.force)?;
-            balance.iter_mut().zip(&self.force).for_each(|(r, f)| *r += f);
-        }
-        if let Some(c) = self.model.constraints {
-            reaction_force(c, &self.q, &self.lambda, &mut self.g, &mut self.force)?;
-            balance.iter_mut().zip(&self.force).for_each(|(r, f)| *r += f);
+        let Model { system, constraints } = self.model;
+        let (balance, on) = r.split_at_mut(self.q.len());
+        self.force
+            .evaluate(system, constraints, (&self.q, self.t), &self.lambda, balance)?;
+        if let Some(c) = constraints {
             c.residual(&self.q, on)?;
         }
         Ok(())
@@ -300,8 +279,7 @@ pub fn equilibrium(model: Model<'_>, guess: &[f64], t: f64, options: &NewtonOpti
         model,
         q: guess.to_vec(),
         lambda: vec![0.0; m],
-        zeros: vec![0.0; n],
-        force: vec![0.0; n],
+        force: ForceAtRest::new(n, m),
         g: DMatrix::zeros(m, n),
         t,
     };

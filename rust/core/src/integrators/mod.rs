@@ -74,7 +74,8 @@ pub use method::{Method, MethodInfo};
 pub use poll::{Counting, Poll};
 pub use rattle::Rattle;
 pub use run::{
-    integrate, integrate_watching, integrate_with_events, resume, resume_watching, resume_with_events, Options,
+    beyond_limit, integrate, integrate_watching, integrate_with_events, resume, resume_watching, resume_with_events,
+    BeyondLimit, Options,
 };
 pub use splitting::{Leading, Splitting};
 pub use step::{Increment, StepStart};

@@ -5,7 +5,7 @@ use serde::{Deserialize, Serialize};
 use super::jumps::{Watch, Watcher};
 use super::{Checkpoint, Detector, Dynamics, Failure, Method, NewtonOptions, Poll, Stepper, Trajectory};
 use crate::model::{EnergyTerms, Rest, Scale};
-use crate::{memory, Error};
+use crate::{memory, Error, ModelError};
 
 /// Options of a fixed-step run.
 #[derive(Clone, Debug, PartialEq)]
@@ -438,10 +438,46 @@ where
     }
 }
 
+/// A step beyond the method's stability limit on the model's fastest mode: h·ω_max, the limit
+/// h_ω on q̈ = −ω²q, and ω_max.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BeyondLimit {
+    pub h_omega: f64,
+    pub limit: f64,
+    pub omega: f64,
+}
+
+/// Whether a step `dt` of `method` at (q, t) is beyond its stability limit, ω_max the fastest
+/// frequency of the small oscillations there from at most `iterations` of Lanczos
+/// ([`Rest::fastest`]): the one test of the check before a run and of a divergence's diagnosis.
+/// None within the limit, for a method without a finite one (unconditionally stable, or with
+/// none on an oscillator) and for a model with velocity constraints.
+///
+/// # Errors
+/// The model's own.
+pub fn beyond_limit<S: Dynamics + ?Sized>(
+    sys: &S,
+    (method, dt): (Method, f64),
+    (q, t): (&[f64], f64),
+    iterations: usize,
+) -> Result<Option<BeyondLimit>, ModelError> {
+    let limit = method.info().h_omega_max;
+    if !(limit.is_finite() && limit > 0.0) || sys.velocity_constraints().is_some() {
+        return Ok(None);
+    }
+    let omega = Rest::new(sys.as_lagrangian(), sys.holonomic(), q, t)?
+        .fastest(iterations)?
+        .omega;
+    Ok((dt * omega > limit).then_some(BeyondLimit {
+        h_omega: dt * omega,
+        limit,
+        omega,
+    }))
+}
+
 /// A divergence with its likely cause named: h·ω_max at the run's first state beyond the
-/// method's stability limit on q̈ = −ω²q (ω_max the fastest frequency of the small
-/// oscillations there, [`Rest::fastest`]). Other errors, and divergences within the limit, as
-/// they are.
+/// method's stability limit ([`beyond_limit`]). Other errors, and divergences within the limit
+/// (or where the frequency does not evaluate), as they are.
 fn diagnosed<S: Dynamics + ?Sized>(
     error: Error,
     sys: &S,
@@ -451,20 +487,13 @@ fn diagnosed<S: Dynamics + ?Sized>(
     let Error::Divergence { step, time, reason } = error else {
         return error;
     };
-    let info = method.info();
-    let limit = info.h_omega_max;
-    let fastest = (limit.is_finite() && limit > 0.0 && sys.velocity_constraints().is_none()).then(|| {
-        Rest::new(sys.as_lagrangian(), sys.holonomic(), &q, t).and_then(|mut r| r.fastest(Rest::AFTER_FAILURE))
-    });
-    let reason = match fastest {
-        Some(Ok(fastest)) if dt * fastest.omega > limit => format!(
-            "{reason}; h·ω_max = {:.4} at the run's first state (t = {t}) is beyond {}'s stability limit {limit} \
-             (ω_max = {:.6e}, the fastest frequency of the small oscillations there): take dt below {:.6e} \
+    let reason = match beyond_limit(sys, (method, dt), (&q, t), Rest::AFTER_FAILURE) {
+        Ok(Some(BeyondLimit { h_omega, limit, omega })) => format!(
+            "{reason}; h·ω_max = {h_omega:.4} at the run's first state (t = {t}) is beyond {}'s stability limit {limit} \
+             (ω_max = {omega:.6e}, the fastest frequency of the small oscillations there): take dt below {:.6e} \
              (varmech.suggest_dt)",
-            dt * fastest.omega,
-            info.name,
-            fastest.omega,
-            limit / fastest.omega
+            method.info().name,
+            limit / omega
         ),
         _ => reason,
     };

@@ -163,7 +163,7 @@ fn jacobians<C: HolonomicConstraints + ?Sized>(
 }
 
 /// W = M(q)⁻¹Gᵀ (n × m) for a constraint matrix G (m × n), allocated.
-fn weighted(jac: &DMatrix<f64>, minv: Action<'_>, q: &[f64]) -> Result<DMatrix<f64>, ModelError> {
+pub(super) fn weighted(jac: &DMatrix<f64>, minv: Action<'_>, q: &[f64]) -> Result<DMatrix<f64>, ModelError> {
     let (m, n) = jac.shape();
     let mut w = DMatrix::zeros(n, m);
     let mut column = vec![0.0; n];

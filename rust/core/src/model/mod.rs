@@ -52,7 +52,7 @@ pub use natural::{differenced_kinetic_gradient, kinetic_gradient_from_mass_deriv
 pub use nbody::{NBody, PairKernel};
 pub use nonholonomic::{differenced_derivative, Nonholonomic, VelocityConstraints};
 pub use reactions::{holonomic_rows, velocity_rows, Reaction, Reactions, Rows};
-pub use rest::{Fastest, Rest};
+pub use rest::{reaction_force, Fastest, ForceAtRest, Rest};
 pub use routh::Routhian;
 pub use scale::Scale;
 pub use symmetry::{momentum_along, Generator};

@@ -17,6 +17,7 @@
 
 use nalgebra::DMatrix;
 
+use super::constraints::weighted;
 use super::{holonomic_rows, HolonomicConstraints, Lagrangian, Reaction};
 use crate::solve::difference::forward_step;
 use crate::solve::lanczos::extremes;
@@ -32,10 +33,71 @@ pub struct Rest<'a> {
     multipliers: Vec<f64>,
     /// G(q), m × n.
     jacobian: DMatrix<f64>,
+    force: ForceAtRest,
+}
+
+/// G(x)ᵀλ into `out`, G(x) into `g`: the constraints' force at x with the multipliers λ held.
+///
+/// # Errors
+/// The constraints' own.
+pub fn reaction_force(
+    c: &dyn HolonomicConstraints,
+    x: &[f64],
+    lambda: &[f64],
+    g: &mut DMatrix<f64>,
+    out: &mut [f64],
+) -> Result<(), ModelError> {
+    c.jacobian(x, g)?;
+    for (i, o) in out.iter_mut().enumerate() {
+        *o = lambda.iter().enumerate().map(|(k, l)| g[(k, i)] * l).sum();
+    }
+    Ok(())
+}
+
+/// The generalized force at rest with the constraints' multipliers held,
+/// F(x) = ∂L/∂q(x, 0, t) + Q(x, 0, t) + G(x)ᵀλ, with the buffers it takes (made once, so that a
+/// Newton iteration or a Lanczos one allocates nothing for it).
+pub struct ForceAtRest {
     zeros: Vec<f64>,
-    /// Q(x, 0, t), and G(x) at the points F is evaluated at.
-    forces: Vec<f64>,
+    /// Q(x, 0, t), then G(x)ᵀλ.
+    terms: Vec<f64>,
+    /// G(x).
     rows: DMatrix<f64>,
+}
+
+impl ForceAtRest {
+    /// For n coordinates and m constraints.
+    pub fn new(n: usize, m: usize) -> Self {
+        ForceAtRest {
+            zeros: vec![0.0; n],
+            terms: vec![0.0; n],
+            rows: DMatrix::zeros(m, n),
+        }
+    }
+
+    /// Writes F(x) of `system` on `constraints` (none: no G(x)ᵀλ) at time t into `out`.
+    ///
+    /// # Errors
+    /// The model's own.
+    pub fn evaluate(
+        &mut self,
+        system: &dyn Lagrangian,
+        constraints: Option<&dyn HolonomicConstraints>,
+        (x, t): (&[f64], f64),
+        lambda: &[f64],
+        out: &mut [f64],
+    ) -> Result<(), ModelError> {
+        system.dl_dq(x, &self.zeros, t, out)?;
+        if system.is_forced() {
+            system.force(x, &self.zeros, t, &mut self.terms)?;
+            out.iter_mut().zip(&self.terms).for_each(|(o, f)| *o += f);
+        }
+        if let Some(c) = constraints {
+            reaction_force(c, x, lambda, &mut self.rows, &mut self.terms)?;
+            out.iter_mut().zip(&self.terms).for_each(|(o, f)| *o += f);
+        }
+        Ok(())
+    }
 }
 
 /// The fastest frequency of the small oscillations at a point.
@@ -83,15 +145,13 @@ impl<'a> Rest<'a> {
             t,
             multipliers: vec![0.0; m],
             jacobian: DMatrix::zeros(m, n),
-            zeros: vec![0.0; n],
-            forces: vec![0.0; n],
-            rows: DMatrix::zeros(m, n),
+            force: ForceAtRest::new(n, m),
         };
         if let Some(c) = constraints {
             c.jacobian(q, &mut rest.jacobian)?;
             // At rest q̇ = 0: p = ∂L/∂q̇(q, 0, t), nonzero with velocity-linear terms.
             let mut p = vec![0.0; n];
-            system.dl_dv(q, &rest.zeros, t, &mut p)?;
+            system.dl_dv(q, &vec![0.0; n], t, &mut p)?;
             let mut reaction = Reaction::new(n, m);
             reaction.solve(system, &holonomic_rows(c), (q, &p, t))?;
             rest.multipliers = reaction.multipliers;
@@ -104,33 +164,11 @@ impl<'a> Rest<'a> {
         &self.multipliers
     }
 
-    /// G(q), m × n.
-    pub fn jacobian(&self) -> &DMatrix<f64> {
-        &self.jacobian
-    }
-
     /// Writes F(x) = ∂L/∂q(x, 0, t) + Q(x, 0, t) + G(x)ᵀλ into `out`, λ held at q's.
-    ///
-    /// # Errors
-    /// The model's own.
-    pub fn force(&mut self, x: &[f64], out: &mut [f64]) -> Result<(), ModelError> {
-        self.system.dl_dq(x, &self.zeros, self.t, out)?;
-        if self.system.is_forced() {
-            self.system.force(x, &self.zeros, self.t, &mut self.forces)?;
-            out.iter_mut().zip(&self.forces).for_each(|(o, f)| *o += f);
-        }
-        if let Some(c) = self.constraints {
-            c.jacobian(x, &mut self.rows)?;
-            for (i, o) in out.iter_mut().enumerate() {
-                *o += self
-                    .multipliers
-                    .iter()
-                    .enumerate()
-                    .map(|(k, l)| self.rows[(k, i)] * l)
-                    .sum::<f64>();
-            }
-        }
-        Ok(())
+    fn force(&mut self, x: &[f64], out: &mut [f64]) -> Result<(), ModelError> {
+        let at = (x, self.t);
+        self.force
+            .evaluate(self.system, self.constraints, at, &self.multipliers, out)
     }
 
     /// An orthonormal basis of the tangent space ker G(q) as columns (n × (n − rank G)): the
@@ -176,13 +214,11 @@ impl<'a> Rest<'a> {
         // W = M⁻¹Gᵀ and the LU of S = GW: H r = M⁻¹r − W S⁻¹ G M⁻¹r, the M-orthogonal
         // projection of M⁻¹r onto ker G.
         let m = self.jacobian.nrows();
-        let mut w = DMatrix::zeros(n, m);
-        let mut column = vec![0.0; n];
-        for k in 0..m {
-            let row: Vec<f64> = self.jacobian.row(k).iter().copied().collect();
-            minv(&row, &mut column)?;
-            w.column_mut(k).copy_from_slice(&column);
-        }
+        let w = weighted(
+            &self.jacobian,
+            &|_: &[f64], x: &[f64], out: &mut [f64]| minv(x, out),
+            &q,
+        )?;
         let mut gram = &self.jacobian * &w;
         let mut pivots = vec![0; m];
         if m > 0 && lu_in_place(&mut gram, &mut pivots).is_none() {
