@@ -30,7 +30,14 @@ fn on_model<R: Send>(
     body: impl for<'s> FnOnce(Model<'s>, &[f64]) -> R + Send,
 ) -> PyResult<R> {
     let py = model.py();
-    let n = dim_of(py, model)?;
+    let q = point(model, q, name)?;
+    let found: Result<R, Error> = bind_model(py, model, |sys, _poll| Ok(body(Model::of(sys)?, q)))?;
+    found.map_err(|e| to_pyerr(py, e))
+}
+
+/// The point `q` (the argument `name`), of the model's dimension.
+fn point<'a>(model: &Bound<'_, PyAny>, q: &'a PyReadonlyArray1<'_, f64>, name: &str) -> PyResult<&'a [f64]> {
+    let n = dim_of(model.py(), model)?;
     let q = slice(name, q)?;
     if q.len() != n {
         return Err(PyValueError::new_err(format!(
@@ -38,8 +45,7 @@ fn on_model<R: Send>(
             q.len()
         )));
     }
-    let found: Result<R, Error> = bind_model(py, model, |sys, _poll| Ok(body(Model::of(sys)?, q)))?;
-    found.map_err(|e| to_pyerr(py, e))
+    Ok(q)
 }
 
 /// The linearized equations at (q, q̇ = 0, t) in the tangent coordinates: (M, K, G, D, T, λ).
@@ -91,19 +97,16 @@ fn normal_modes<'py>(
     Vec<Option<usize>>,
 )> {
     let py = model.py();
-    let fields = {
-        let q = slice("q", &q)?;
-        let n = dim_of(py, model)?;
-        generators(py, symmetries, n)?
+    let symmetries = generators(py, symmetries, dim_of(py, model)?)?;
+    let modes: Result<Modes, ModelError> = on_model(model, &q, "q", |m, q| {
+        let fields: Vec<Vec<f64>> = symmetries
             .iter()
             .map(|g| {
                 let mut xi = vec![0.0; q.len()];
                 g.field(q, &mut xi);
                 xi
             })
-            .collect::<Vec<_>>()
-    };
-    let modes: Result<Modes, ModelError> = on_model(model, &q, "q", |m, q| {
+            .collect();
         let linear = diagnostics::linearize(m, q, t)?;
         let mut modes = diagnostics::modes(&linear)?;
         modes.name_symmetries(&linear, &fields);
@@ -184,14 +187,7 @@ fn beyond_limit<'py>(
 ) -> PyResult<Option<(f64, f64, f64)>> {
     let py = model.py();
     let method = convert::method(method)?;
-    let n = dim_of(py, model)?;
-    let q = slice("q", &q)?;
-    if q.len() != n {
-        return Err(PyValueError::new_err(format!(
-            "q: has length {}, the model has dim = {n}",
-            q.len()
-        )));
-    }
+    let q = point(model, &q, "q")?;
     let found = bind_model(py, model, |sys, _poll| {
         integrators::beyond_limit(sys, (method, dt), (q, t), Rest::BEFORE_RUN)
     })?;
