@@ -9,7 +9,9 @@ Takes a few minutes; each chart's sweep shows a progress bar and Ctrl-C stops it
 chart (``--only impacts``) races a rival that is no library code, so benches/impacts.py draws it;
 benches/reactions.py draws the tension of a pendulum (``--only reactions``), benches/modes.py the
 triatomic molecule's spectrum against the stability intervals (``--only spectrum``),
-benches/holds.py the particle leaving the sphere (``--figure``).
+benches/holds.py the particle leaving the sphere (``--figure``), benches/variable_mass.py the
+rocket and Cayley's chain (``--only variable-mass``), benches/delays.py the delayed feedback
+oscillator's stability boundary (``--only delays``).
 """
 
 from __future__ import annotations
@@ -18,9 +20,11 @@ import argparse
 import time
 from pathlib import Path
 
+from delays import delays_figure
 from impacts import billiard_chart
 from modes import spectrum_figure
 from reactions import tension_chart
+from variable_mass import variable_mass_figure
 
 from varmech.charts.recipes import KINDS, chart
 
@@ -47,6 +51,8 @@ BENCHED = [
     ("impacts", "billiard", billiard_chart),
     ("reactions", "pendulum", tension_chart),
     ("spectrum", "triatomic", spectrum_figure),
+    ("variable-mass", "rocket", variable_mass_figure),
+    ("delays", "oscillator", delays_figure),
 ]
 
 

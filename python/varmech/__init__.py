@@ -47,7 +47,7 @@ from .impacts import Contact, ContactError, Friction
 from .impulses import Engagement, Impulse, ImpulseResponse, engage, impulse_response
 from .integrate import integrate, symplecticity_defect
 from .methods import MethodInfo, methods
-from .model import Cyclic, Lagrangian, MechanicalSystem, Model, NativeSystem, Rotation, Translation
+from .model import Cyclic, Lagrangian, MechanicalSystem, Model, NativeSystem, Rotation, Translation, reactive_force
 from .modes import (
     Equilibrium,
     Linearization,
@@ -125,6 +125,7 @@ __all__ = [
     "poincare_section",
     "pointers",
     "project",
+    "reactive_force",
     "resume",
     "routh",
     "scenes",

@@ -20,7 +20,7 @@ from . import impulses as _impulses
 from ._progress import progress_bar
 from ._util import finite, positive, positive_int, returned_scalar, step_count, vector
 from .constraints import warn_if_integrable
-from .model import Lagrangian, Model
+from .model import Lagrangian, Model, check_delays
 from .modes import warn_if_unstable
 from .scenes import Scene
 
@@ -350,6 +350,7 @@ def integrate(
     if model.velocity_constraints:
         warn_if_integrable(model, q)
     watched, event_specs = _events.specs(events, model) if events is not None else ([], [])
+    check_delays(model, bool(event_specs or contacts or impulses), nsteps * dt)
     # A horizon past the largest float is the core's to refuse (naming dt); probe finite times.
     t_end = t0 + nsteps * dt
     probes = (t0, t0 + dt, t0 + 0.5, t0 + 1.0, t0 + 0.37 * (t_end - t0), t_end)

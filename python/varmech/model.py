@@ -327,6 +327,11 @@ class Model:
         return _core.is_forced(self._core)
 
     @property
+    def delays(self) -> tuple[float, ...]:
+        """The delays τ of the model's delayed forces (none for most models)."""
+        return ()
+
+    @property
     def constraints(self) -> int:
         """Number of holonomic constraints g(q) = 0 (0 for unconstrained models); constrained
         models take ``rattle``, ``rattle4`` and ``shake`` only."""
@@ -903,6 +908,101 @@ def _roll(
     if matrix is None or count is None:
         return core
     return _core.ClosureNonholonomic(core, int(count), matrix, offset)
+
+
+def check_delays(model: Model, watched: bool, horizon: float | None = None) -> None:
+    """ValueError naming ``delayed`` for a model with delayed forces run with events, contacts or
+    impulses (their partial steps would need the history at other steps), or over a
+    ``horizon`` no longer than its longest delay (the delayed term would never act)."""
+    if not model.delays:
+        return
+    if watched:
+        raise ValueError(
+            "delayed: a model with delayed forces takes no events, contacts or impulses yet (their partial steps "
+            "would read the history between its steps)"
+        )
+    longest = max(model.delays)
+    if horizon is not None and horizon <= longest:
+        raise ValueError(
+            f"delayed: τ = {longest:g} is as long as the run ({horizon:g}): the delayed term would never act; run "
+            "longer or shorten τ"
+        )
+
+
+def reactive_force(
+    mass: Callable[[np.ndarray, float], float],
+    velocity: Callable[[np.ndarray, np.ndarray, float], ArrayLike],
+    *,
+    mass_rate: Callable[[np.ndarray, float], float],
+    mass_gradient: Callable[[np.ndarray, float], ArrayLike] | None = None,
+    force: Callable[[np.ndarray, np.ndarray, float], ArrayLike] | None = None,
+) -> Callable[[np.ndarray, np.ndarray, float], np.ndarray]:
+    """Meshchersky's reactive force of a body of variable mass, as a ``force`` closure for
+    :class:`Lagrangian`: the closure form of :class:`varmech.symbolic.MassFlow`.
+
+    The body's position is q (Cartesian coordinates) and its kinetic energy ½m(q, t)|q̇|² is in
+    L; matter leaves or joins it with the absolute velocity u, so that d(mq̇)/dt = F + ṁu. The
+    force returned is ``force`` + Q_r with
+
+    Q_r = ṁu − ½|q̇|² ∂m/∂q,   ṁ = ∂m/∂t + (∂m/∂q)·q̇.
+
+    Parameters
+    ----------
+    mass
+        ``mass(q, t) -> float``, m; it must stay positive. The run stops at the step where
+        it does not: a :class:`~varmech.VarmechError` where L's ∂²L/∂q̇² is singular there
+        first, else the force's ValueError naming ``mass``.
+    velocity
+        ``velocity(q, v, t) -> array (n,)``, the velocity u of the matter ejected or accreted.
+    mass_rate
+        ``mass_rate(q, t) -> float``, ∂m/∂t.
+    mass_gradient
+        ``mass_gradient(q, t) -> array (n,)``, ∂m/∂q; default: m does not depend on q.
+    force
+        Another generalized force ``force(q, v, t) -> array (n,)``, added.
+
+    Returns
+    -------
+    callable
+        ``force(q, v, t) -> ndarray (n,)``.
+
+    Raises
+    ------
+    TypeError
+        An argument that is not callable, naming it.
+
+    Examples
+    --------
+    The rocket of :func:`varmech.symbolic.examples.rocket` from closures:
+
+    >>> import math
+    >>> import numpy as np
+    >>> import varmech
+    >>> m = lambda q, t: 10.0 - 0.4 * t
+    >>> rocket = varmech.Lagrangian(
+    ...     1, lambda q, v, t: m(q, t) * (v[0] ** 2 / 2 - 9.81 * q[0]), time_dependent=True,
+    ...     dl_dt=lambda q, v, t: -0.4 * (v[0] ** 2 / 2 - 9.81 * q[0]),
+    ...     force=varmech.reactive_force(m, lambda q, v, t: v - 400.0, mass_rate=lambda q, t: -0.4))
+    >>> traj = varmech.integrate(rocket, [0.0], v0=[0.0], dt=0.01, t_end=10.0)
+    >>> bool(abs(traj.v[-1, 0] - (400.0 * math.log(10.0 / 6.0) - 98.1)) < 1e-3)
+    True
+    """
+    for name, f in (("mass", mass), ("velocity", velocity), ("mass_rate", mass_rate),
+                    ("mass_gradient", mass_gradient), ("force", force)):
+        if f is not None and not callable(f):
+            raise TypeError(f"{name}: expected a callable, got {type(f).__name__}: {f!r}")
+
+    def reactive(q: np.ndarray, v: np.ndarray, t: float) -> np.ndarray:
+        m = float(mass(q, t))
+        if not (math.isfinite(m) and m > 0.0):
+            raise ValueError(f"mass: the mass is {m} at t = {t}: it must stay positive and finite (the body has run "
+                             "out of mass; end the run before)")
+        gradient = np.zeros(len(q)) if mass_gradient is None else np.asarray(mass_gradient(q, t), dtype=np.float64)
+        rate = float(mass_rate(q, t)) + float(gradient @ v)
+        total = rate * np.asarray(velocity(q, v, t), dtype=np.float64) - 0.5 * float(v @ v) * gradient
+        return total if force is None else total + np.asarray(force(q, v, t), dtype=np.float64)
+
+    return reactive
 
 
 class Lagrangian(Model):

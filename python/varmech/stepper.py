@@ -17,7 +17,7 @@ from .events import Event, EventFunction, Occurrences
 from .impacts import Contact
 from .impulses import Impulse
 from .integrate import _contacts_of, _initial_state, _model_of, _newton
-from .model import Model
+from .model import Model, check_delays
 from .scenes import Scene
 
 __all__ = [
@@ -149,6 +149,7 @@ class Stepper:
         blows = _impulses.specs(impulses or (), finite("t0", t0), math.inf)
         model, q0, p0 = _model_of(model, q0, p0, v0)
         self._watch_events(model, events)
+        check_delays(model, bool(specs or blows or self._event_specs))
         if method is None:
             method = model.kind.default_method
         dt = positive("dt", dt)

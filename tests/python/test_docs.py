@@ -18,6 +18,8 @@ pytest.importorskip("sympy")
         "varmech.symbolic._lower",
         "varmech.symbolic._derive",
         "varmech.symbolic._model",
+        "varmech.symbolic._mass_flow",
+        "varmech.symbolic._delays",
         "varmech.events",
         "varmech.files",
         "varmech.streaming",

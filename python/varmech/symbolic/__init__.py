@@ -33,7 +33,9 @@ except ImportError as err:  # pragma: no cover - exercised without SymPy only
 
 from . import examples
 from ._constructors import MAX_COORDINATES, lagrangian, mechanical, routh
+from ._delays import Delayed
 from ._lower import TAPE_OPS
+from ._mass_flow import MassFlow
 from ._model import SymbolicModel
 
-__all__ = ["MAX_COORDINATES", "TAPE_OPS", "SymbolicModel", "examples", "lagrangian", "mechanical", "routh"]
+__all__ = ["MAX_COORDINATES", "TAPE_OPS", "Delayed", "MassFlow", "SymbolicModel", "examples", "lagrangian", "mechanical", "routh"]

@@ -14,6 +14,8 @@ from ..model import Cyclic, Symmetry
 from ._derive import derive, vanishes
 from ._inputs import Variables, check_symbols, expressions, parameters, variables
 from ._lower import check_compilable, lower
+from ._delays import Delayed, delayed_forces, delayed_tape
+from ._mass_flow import MassFlow, reactive_force
 from ._model import Spec, Symbolic, SymbolicModel
 from ._routh import routhian
 
@@ -37,6 +39,8 @@ def lagrangian(
     force: Any = None,
     rayleigh: Any = None,
     added_mass: Any = None,
+    mass_flow: MassFlow | Sequence[MassFlow] | None = None,
+    delayed: Delayed | Sequence[Delayed] | None = None,
     symmetries: Sequence[Symmetry] = (),
     jit: bool = True,
     name: str = "symbolic lagrangian",
@@ -82,6 +86,16 @@ def lagrangian(
         q, the force Ȧq̇ − ½q̇ᵀ(∂A/∂q)q̇ that the fold adds is taken back (the model is then
         forced). A not symmetric is refused: its antisymmetric part is no mass, and would need
         q̈ in a force.
+    mass_flow
+        Variable mass: a :class:`MassFlow` (or a list of them) for each body whose mass changes
+        by matter ejected or accreted (a rocket, a falling chain, a snowplough). Its reactive
+        force (Meshchersky) is added to the model's forces; the run stops with a
+        :class:`~varmech.VarmechError` at a step where a mass is not positive.
+    delayed
+        Delayed forces: a :class:`Delayed` (or a list of them), each a force of the state now
+        and of the state τ ago, read from the run's own history (``midpoint`` and
+        ``trapezoid``, at a step no longer than τ). Not with ``constraints`` or
+        ``velocity_constraints``.
     symmetries
         Declared symmetries (:class:`~varmech.Translation`, :class:`~varmech.Rotation`,
         :class:`~varmech.Cyclic`); each cyclic coordinate found is added as a
@@ -113,7 +127,11 @@ def lagrangian(
         ``q``; constraints of the wrong number or depending on q̇ or t;
         velocity constraints not linear in q̇, with a part free of q̇, depending on t, or with
         ``constraints`` n or more together, naming them; a force with the wrong number of
-        components; an ``added_mass`` of the wrong shape, not symmetric or depending on q̇ or t.
+        components; an ``added_mass`` of the wrong shape, not symmetric or depending on q̇ or t;
+        a ``mass_flow`` whose mass depends on q̇, whose point depends on q̇ or t, or whose
+        velocity has another number of components than its point; a ``delayed`` term whose τ
+        is not positive, whose past symbols are not one new symbol per coordinate, or with
+        constraints.
 
     Examples
     --------
@@ -130,6 +148,7 @@ def lagrangian(
     return _build(
         variables_, variables_.plain(L, "L"), parameters, constraints, force, rayleigh, symmetries, jit, name, started,
         velocity_constraints=velocity_constraints, progress=progress, added_mass=added_mass,
+        mass_flow=mass_flow, delayed=delayed,
     )
 
 
@@ -146,6 +165,8 @@ def mechanical(
     force: Any = None,
     rayleigh: Any = None,
     added_mass: Any = None,
+    mass_flow: MassFlow | Sequence[MassFlow] | None = None,
+    delayed: Delayed | Sequence[Delayed] | None = None,
     symmetries: Sequence[Symmetry] = (),
     jit: bool = True,
     name: str = "symbolic mechanical system",
@@ -168,7 +189,7 @@ def mechanical(
     v
         The velocity symbols; may be omitted (V and M hold no velocities: fresh symbols
         ``<q>_dot`` stand for them, as in ``expressions``).
-    t, parameters, constraints, velocity_constraints, force, rayleigh, added_mass, symmetries, jit, name, progress
+    t, parameters, constraints, velocity_constraints, force, rayleigh, added_mass, mass_flow, delayed, symmetries, jit, name, progress
         As for :func:`lagrangian`.
 
     Returns
@@ -204,6 +225,7 @@ def mechanical(
     return _build(
         variables_, L, parameters, constraints, force, rayleigh, symmetries, jit, name, started,
         velocity_constraints=velocity_constraints, progress=progress, added_mass=added_mass,
+        mass_flow=mass_flow, delayed=delayed,
     )
 
 
@@ -345,15 +367,31 @@ def _build(
     velocity_constraints: Any = None,
     progress: bool | None = None,
     added_mass: Any = None,
+    mass_flow: Any = None,
+    delayed: Any = None,
 ) -> SymbolicModel:
     """Checks, derives, lowers and compiles: the common path of :func:`lagrangian` and
     :func:`mechanical`."""
+    n = len(variables.q)
     forces = expressions(force, "force", variables) if force is not None else None
+    if forces is not None and len(forces) != n:
+        raise ValueError(f"force: must have one component per coordinate ({n}), got {len(forces)}: {forces}")
     if added_mass is not None:
         term, taken_back = _added_mass(added_mass, variables)
         L = L + term
         if taken_back is not None:
-            forces = [a + b for a, b in zip(forces or [sp.S.Zero] * len(taken_back), taken_back)]
+            forces = [a + b for a, b in zip(forces or [sp.S.Zero] * n, taken_back)]
+    masses: list[sp.Expr] = []
+    if mass_flow is not None:
+        reactive, masses = reactive_force(mass_flow, variables)
+        forces = [a + b for a, b in zip(forces or [sp.S.Zero] * n, reactive)]
+    delays: tuple[float, ...] = ()
+    if delayed is not None:
+        if constraints is not None or velocity_constraints is not None:
+            raise ValueError("delayed: delayed forces are not taken with constraints or velocity_constraints yet")
+        delays, delayed_exprs, q_past, v_past = delayed_forces(delayed, variables)
+        # The delayed forces act beside Q: the model is forced, its work tracked.
+        forces = forces or [sp.S.Zero] * n
     dissipation = variables.plain(rayleigh, "rayleigh") if rayleigh is not None else None
     holonomic = expressions(constraints, "constraints", variables) if constraints is not None else None
     nonholonomic = None
@@ -363,11 +401,15 @@ def _build(
     parts += [("rayleigh", dissipation)] if dissipation is not None else []
     parts += [(f"constraints[{i}]", x) for i, x in enumerate(holonomic or [])]
     parts += [(f"velocity_constraints[{i}]", x) for i, x in enumerate(nonholonomic or [])]
+    parts += [(f"mass_flow[{i}].mass", x) for i, x in enumerate(masses)]
+    if delays:
+        # The past symbols are inputs of the delayed forces' tape, not parameters.
+        past = dict.fromkeys([*q_past, *v_past], sp.S.Zero)
+        parts += [(f"delayed[{i // n}].force[{i % n}]", x.xreplace(past)) for i, x in enumerate(delayed_exprs)]
     params = parameters(given_parameters, {s for _, x in parts for s in x.free_symbols}, variables)
     for what, x in parts:
         check_compilable(x, what)
         check_symbols(x, what, variables, params.index)
-    n = len(variables.q)
     # Derivation, then lowering, row by row and function by function: a bar after a second.
     bar = progress_bar(total=3 * n + 2, unit="row", desc=f"{name}: deriving", enabled=progress)
     try:
@@ -375,12 +417,18 @@ def _build(
             L, variables.q, variables.v, variables.t, force=forces, rayleigh=dissipation, constraints=holonomic,
             velocity_constraints=nonholonomic, tick=bar.update,
         )
+        functions = {**derivation.functions, **({"masses": tuple(masses)} if masses else {})}
         bar.set_description(f"{name}: lowering", refresh=False)
-        bar.reset(total=len(derivation.functions))
+        bar.reset(total=len(functions))
         tapes = {}
-        for fn, exprs in derivation.functions.items():
+        for fn, exprs in functions.items():
             tapes[fn] = lower(exprs, variables.slots, params.index)
             bar.update()
+        if delays:
+            # Q first, then the delayed terms: the step evaluates all of them in one call.
+            now = list(functions["force"])
+            tapes["delayed_force"] = delayed_tape(now + delayed_exprs, q_past, v_past, variables, params.index)
+            functions["delayed_force"] = (*now, *delayed_exprs)
         bar.set_description(f"{name}: compiling")
         declared = tuple(symmetries)
         found = tuple(Cyclic(i) for i in derivation.cyclic if Cyclic(i) not in declared)
@@ -393,11 +441,12 @@ def _build(
             constraints=len(derivation.functions.get("constraints", ())),
             velocity_constraints=len(nonholonomic or ()),
             time_dependent=derivation.time_dependent,
-            forced="force" in derivation.functions,
+            forced="force" in functions,
             symmetries=declared + found,
             jit=bool(jit),
+            delays=delays,
         )
-        symbolic = Symbolic(variables.q, variables.v, variables.t, L, derivation.functions, derivation.cyclic, name)
+        symbolic = Symbolic(variables.q, variables.v, variables.t, L, functions, derivation.cyclic, name)
         return SymbolicModel(spec, symbolic, started=started)
     finally:
         bar.close()

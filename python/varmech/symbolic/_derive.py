@@ -191,8 +191,6 @@ def _generalized_force(
     if force is None and rayleigh is None:
         return None
     q_force = list(force) if force is not None else [sp.Integer(0)] * n
-    if len(q_force) != n:
-        raise ValueError(f"force: must have one component per coordinate ({n}), got {len(q_force)}: {list(q_force)}")
     if rayleigh is not None:
         q_force = [f - sp.diff(rayleigh, s) for f, s in zip(q_force, v)]
     return tuple(q_force)

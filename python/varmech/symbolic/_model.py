@@ -36,6 +36,7 @@ class Spec:
     symmetries: tuple[Symmetry, ...]
     jit: bool
     velocity_constraints: int = 0
+    delays: tuple[float, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -65,6 +66,7 @@ def _compile(spec: Spec) -> _core.CompiledModel:
         forced=spec.forced,
         symmetries=_specs(spec.symmetries),
         jit=spec.jit,
+        delays=list(spec.delays),
     )
 
 
@@ -285,6 +287,11 @@ class SymbolicModel(Model):
         """
         return FirstOrder.build(self)
 
+    @property
+    def delays(self) -> tuple[float, ...]:
+        """The delays τ of the model's delayed forces (``delayed=`` of its constructor)."""
+        return self._spec.delays
+
     def __reduce__(self) -> tuple[Any, ...]:
         # The tapes and expressions, never the compiled code: unpickling compiles them again.
         return (SymbolicModel, (self._spec, self._symbolic))
@@ -319,6 +326,7 @@ class SymbolicModel(Model):
             "forced": spec.forced,
             "symmetries": [symmetry_data(x) for x in spec.symmetries],
             "jit": spec.jit,
+            "delays": list(spec.delays),
         }
 
 
@@ -347,6 +355,8 @@ def _of_recipe(recipe: dict[str, Any]) -> SymbolicModel:
         symmetries=tuple(symmetry_of(x) for x in field(recipe, "symmetries", list)),
         jit=field(recipe, "jit", bool),
         velocity_constraints=field(recipe, "velocity_constraints", int),
+        # A file written before delays were known has none.
+        delays=tuple(float(x) for x in numbers(recipe.get("delays", []), "delays")),
     )
     expressions = field(recipe, "expressions", dict)
     symbolic = Symbolic(

@@ -1,7 +1,8 @@
 """Symbolic models: a twin of every closure example of :mod:`varmech.examples` with a
-Lagrangian (each the native scene's L in SymPy, with the scene's parameters as defaults), and
+Lagrangian (each the native scene's L in SymPy, with the scene's parameters as defaults),
 two systems that only the symbolic path makes easy, the elastic pendulum and the bead on a
-rotating hoop.
+rotating hoop, and four bodies of variable mass (:class:`~varmech.symbolic.MassFlow`): the
+rocket, Cayley's falling chain, the snowplough and the conveyor belt.
 
 Each function returns a :class:`~varmech.symbolic.SymbolicModel` whose parameters are named
 after its symbols: change them per run with ``model.with_parameters(...)`` or
@@ -33,21 +34,26 @@ import sympy as sp
 from ..model import Rotation
 from ..scenes import CATALOGUE, Scene
 from ._constructors import lagrangian, mechanical
+from ._mass_flow import MassFlow
 from ._model import SymbolicModel
 
 __all__ = [
     "cartesian_pendulum",
     "charged_particle",
     "charged_particle_nonuniform",
+    "conveyor_belt",
     "damped_driven_pendulum",
     "double_pendulum",
     "elastic_pendulum",
     "elastic_pendulum_cartesian",
+    "falling_chain",
     "heavy_top",
     "kepler",
     "kepler_polar",
+    "rocket",
     "rotating_hoop",
     "scene",
+    "snowplough",
     "spherical_pendulum",
     "symbolic_of",
 ]
@@ -660,6 +666,199 @@ def rotating_hoop(
     L = sp.trigsimp(m_ * velocity.dot(velocity) / 2 - m_ * g_ * position[2])
     return lagrangian(
         L, [th], [om], t=t, parameters={m_: m, R_: R, Omega_: Omega, g_: g}, jit=jit, name="rotating_hoop (symbolic)"
+    )
+
+
+def rocket(
+    m0: float = 10.0, burn: float = 0.4, exhaust: float = 400.0, g: float = _G, *, jit: bool = True
+) -> SymbolicModel:
+    """A rocket rising vertically in uniform gravity, burning its mass at a constant rate: its
+    height x, its mass m(t) = m₀ − kt, its exhaust leaving at the speed c relative to it.
+
+    L = ½m(t)ẋ² − m(t)gx, with the mass flow u = ẋ − c (:class:`~varmech.symbolic.MassFlow`):
+    Meshchersky's d(mẋ)/dt = −mg + ṁu is m ẍ = −mg + kc, whose solution from (x₀, v₀) is
+    Tsiolkovsky's with gravity:
+
+        v(t) = v₀ + c ln(m₀/m(t)) − gt,
+        x(t) = x₀ + v₀t + c(t + (m(t)/k) ln(m(t)/m₀)) − ½gt².
+
+    The run stops with a :class:`~varmech.VarmechError` at the step where the mass has burnt
+    out, t = m₀/k. Defaults: m₀ = 10, k = 0.4, c = 400, g = 9.80665: a thrust kc = 160 above
+    the weight m₀g ≈ 98, burn-out at t = 25.
+
+    Parameters
+    ----------
+    m0 : float, default 10.0
+        The initial mass m₀.
+    burn : float, default 0.4
+        The burn rate k = −ṁ.
+    exhaust : float, default 400.0
+        The exhaust speed c relative to the rocket.
+    g : float, default 9.80665
+        The gravitational acceleration.
+    jit : bool, default True
+        Compile the model's tapes (Cranelift), or interpret them.
+
+    Returns
+    -------
+    SymbolicModel
+        A Lagrangian that depends on t, forced by the reactive force, n = 1.
+
+    Examples
+    --------
+    >>> import math
+    >>> import varmech
+    >>> from varmech.symbolic import examples
+    >>> traj = varmech.integrate(examples.rocket(), [0.0], v0=[0.0], dt=0.01, t_end=10.0)
+    >>> exact = 400.0 * math.log(10.0 / 6.0) - 9.80665 * 10.0
+    >>> bool(abs(traj.v[-1, 0] - exact) < 1e-3 * exact)
+    True
+    """
+    x, w, t = sp.symbols("x w t")
+    m0_, k_, c_, g_ = sp.symbols("m0 k c g", positive=True)
+    m = m0_ - k_ * t
+    return lagrangian(
+        m * w**2 / 2 - m * g_ * x, [x], [w], t=t, parameters={m0_: m0, k_: burn, c_: exhaust, g_: g},
+        mass_flow=MassFlow(m, w - c_), jit=jit, name="rocket (symbolic)",
+    )
+
+
+def falling_chain(rho: float = 1.0, g: float = _G, *, jit: bool = True) -> SymbolicModel:
+    """Cayley's falling chain: a chain heaped at the edge of a hole falls through it, its
+    hanging part (length x, mass ρx) picking up links at rest from the heap.
+
+    L = ½ρxẋ² + ½ρgx², with the mass flow u = 0 (the links join from rest): Meshchersky's
+    d(ρxẋ)/dt = ρgx. From rest at x₀ (Cayley 1857)
+
+        ẋ² = (2g/3)(x³ − x₀³)/x²,
+
+    and the acceleration tends to g/3, not g. The energy E = ½ρxẋ² − ½ρgx² is not conserved:
+    each link's pickup is an inelastic collision, and E − E₀ balances the reactive force's work
+    −∫½ρẋ³ dt, which the run tracks (``traj.work``). The chain needs x₀ > 0 (no mass hangs at
+    x = 0). Defaults: ρ = 1, g = 9.80665.
+
+    Parameters
+    ----------
+    rho : float, default 1.0
+        The chain's mass per length ρ.
+    g : float, default 9.80665
+        The gravitational acceleration.
+    jit : bool, default True
+        Compile the model's tapes (Cranelift), or interpret them.
+
+    Returns
+    -------
+    SymbolicModel
+        An autonomous Lagrangian forced by the reactive force, n = 1.
+
+    Examples
+    --------
+    >>> import math
+    >>> import varmech
+    >>> from varmech.symbolic import examples
+    >>> traj = varmech.integrate(examples.falling_chain(), [0.1], v0=[0.0], dt=0.001, t_end=1.0)
+    >>> x, v = traj.q[-1, 0], traj.v[-1, 0]
+    >>> bool(abs(v**2 - 2 * 9.80665 / 3 * (x**3 - 0.1**3) / x**2) < 1e-4)
+    True
+    """
+    x, w = sp.symbols("x w")
+    rho_, g_ = sp.symbols("rho g", positive=True)
+    return lagrangian(
+        rho_ * x * w**2 / 2 + rho_ * g_ * x**2 / 2, [x], [w], parameters={rho_: rho, g_: g},
+        mass_flow=MassFlow(rho_ * x, 0), jit=jit, name="falling_chain (symbolic)",
+    )
+
+
+def snowplough(m0: float = 1.0, rho: float = 0.5, push: float = 0.0, *, jit: bool = True) -> SymbolicModel:
+    """A snowplough of mass m₀ driven by a constant force F into snow of mass ρ per length at
+    rest, which it gathers: at x its mass is m₀ + ρx.
+
+    L = ½(m₀ + ρx)ẋ² + Fx, with the mass flow u = 0: d((m₀ + ρx)ẋ)/dt = F, so the momentum
+    P = (m₀ + ρx)ẋ grows as P₀ + Ft (conserved when F = 0, a plough coasting), and
+
+        m₀x + ½ρx² = P₀t + ½Ft²,   x(t) = (√(m₀² + 2ρ(P₀t + ½Ft²)) − m₀)/ρ   from x = 0.
+
+    The kinetic energy is not conserved even coasting: gathering the snow is inelastic.
+    Defaults: m₀ = 1, ρ = 0.5, F = 0.
+
+    Parameters
+    ----------
+    m0 : float, default 1.0
+        The plough's own mass m₀.
+    rho : float, default 0.5
+        The snow's mass per length ρ.
+    push : float, default 0.0
+        The driving force F.
+    jit : bool, default True
+        Compile the model's tapes (Cranelift), or interpret them.
+
+    Returns
+    -------
+    SymbolicModel
+        An autonomous Lagrangian forced by the reactive force, n = 1.
+
+    Examples
+    --------
+    >>> import varmech
+    >>> from varmech.symbolic import examples
+    >>> traj = varmech.integrate(examples.snowplough(), [0.0], v0=[2.0], dt=0.01, t_end=5.0)
+    >>> P = (1.0 + 0.5 * traj.q[:, 0]) * traj.v[:, 0]   # coasting: P = m₀v₀ = 2
+    >>> bool(abs(P - 2.0).max() < 1e-12)
+    True
+    """
+    x, w = sp.symbols("x w")
+    m0_, rho_, F_ = sp.symbols("m0 rho F")
+    m = m0_ + rho_ * x
+    return lagrangian(
+        m * w**2 / 2 + F_ * x, [x], [w], parameters={m0_: m0, rho_: rho, F_: push},
+        mass_flow=MassFlow(m, 0), jit=jit, name="snowplough (symbolic)",
+    )
+
+
+def conveyor_belt(m0: float = 1.0, rate: float = 0.2, push: float = 0.2, *, jit: bool = True) -> SymbolicModel:
+    """A conveyor belt of mass m₀ onto which sand falls vertically at the rate k (so that the
+    mass it carries is m₀ + kt), driven along by a constant force F; its position x.
+
+    L = ½(m₀ + kt)ẋ² + Fx, with the mass flow u = 0 (the sand has no horizontal velocity):
+    d((m₀ + kt)ẋ)/dt = F, so
+
+        v(t) = (m₀v₀ + Ft)/(m₀ + kt).
+
+    With F = kv₀ the belt keeps its speed v₀: the force's power Fv₀ = kv₀² is twice the rate
+    ½kv₀² at which the kinetic energy grows, the other half lost as the sand is brought up to
+    speed (the energy balance carries it as −∂L/∂t = −½kẋ²). Defaults: m₀ = 1, k = 0.2,
+    F = 0.2 (a belt at v₀ = 1 keeps its speed).
+
+    Parameters
+    ----------
+    m0 : float, default 1.0
+        The belt's own mass m₀.
+    rate : float, default 0.2
+        The rate k at which sand falls on it.
+    push : float, default 0.2
+        The driving force F.
+    jit : bool, default True
+        Compile the model's tapes (Cranelift), or interpret them.
+
+    Returns
+    -------
+    SymbolicModel
+        A Lagrangian that depends on t, forced by the reactive force, n = 1.
+
+    Examples
+    --------
+    >>> import varmech
+    >>> from varmech.symbolic import examples
+    >>> traj = varmech.integrate(examples.conveyor_belt(), [0.0], v0=[1.0], dt=0.01, t_end=10.0)
+    >>> bool(abs(traj.v[:, 0] - 1.0).max() < 1e-12)
+    True
+    """
+    x, w, t = sp.symbols("x w t")
+    m0_, k_, F_ = sp.symbols("m0 k F")
+    m = m0_ + k_ * t
+    return lagrangian(
+        m * w**2 / 2 + F_ * x, [x], [w], t=t, parameters={m0_: m0, k_: rate, F_: push},
+        mass_flow=MassFlow(m, 0), jit=jit, name="conveyor_belt (symbolic)",
     )
 
 

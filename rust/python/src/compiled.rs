@@ -95,7 +95,7 @@ fn required(name: &'static str, f: Option<Function>) -> PyResult<Function> {
 #[pymethods]
 impl CompiledModel {
     #[new]
-    #[pyo3(signature = (kind, dim, functions, parameters, *, constraints=0, velocity_constraints=0, time_dependent=false, forced=false, symmetries=Vec::new(), jit=true))]
+    #[pyo3(signature = (kind, dim, functions, parameters, *, constraints=0, velocity_constraints=0, time_dependent=false, forced=false, symmetries=Vec::new(), jit=true, delays=Vec::new()))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         py: Python<'_>,
@@ -109,6 +109,7 @@ impl CompiledModel {
         forced: bool,
         symmetries: Vec<Spec>,
         jit: bool,
+        delays: Vec<f64>,
     ) -> PyResult<Self> {
         generator::generators(py, symmetries, dim)?;
         let known: &[&str] = match kind {
@@ -127,6 +128,8 @@ impl CompiledModel {
                 "hessians",
                 "force",
                 "dl_dt",
+                "masses",
+                "delayed_force",
                 "constraints",
                 "constraint_jacobian",
                 "velocity_constraints",
@@ -185,9 +188,9 @@ impl CompiledModel {
         };
         let model = match kind {
             "separable" => {
-                if time_dependent || forced {
+                if time_dependent || forced || !delays.is_empty() {
                     return Err(PyValueError::new_err(
-                        "kind: a separable model depends neither on t nor on a force",
+                        "kind: a separable model depends neither on t nor on a force or a delay",
                     ));
                 }
                 let s = CompiledSeparable::new(
@@ -224,6 +227,15 @@ impl CompiledModel {
                     required("hessians", f("hessians")?)?,
                     force,
                     (f("dl_dt")?, time_dependent),
+                    f("masses")?,
+                    match delays.len() {
+                        0 => None,
+                        d => {
+                            // Its slots: [q, q(t − τ₁) …, q̇, q̇(t − τ₁) …, t], (1 + d)n of each.
+                            let f = function(py, &functions, "delayed_force", dim * (1 + d), k, jit)?;
+                            Some((required("delayed_force", f)?, delays))
+                        }
+                    },
                 )
                 .map_err(err)?;
                 match (constraint_functions, rolling) {

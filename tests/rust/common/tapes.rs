@@ -96,5 +96,16 @@ pub fn pendulum_lagrangian() -> CompiledLagrangian {
     let qq = b.unary(Unary::Neg, c);
     let (zero, one) = (b.op(Op::Const(0.0)), b.op(Op::Const(1.0)));
     let hessians = b.function(vec![qq, zero, one], n, 0);
-    CompiledLagrangian::new(n, vec![], lagrangian, gradients, hessians, None, (None, false)).unwrap()
+    CompiledLagrangian::new(
+        n,
+        vec![],
+        lagrangian,
+        gradients,
+        hessians,
+        None,
+        (None, false),
+        None,
+        None,
+    )
+    .unwrap()
 }

@@ -106,6 +106,28 @@ enum Scheme {
     WisdomHolman(WisdomHolman),
 }
 
+/// Refuses delayed forces with a method other than the two-point rules (whose one force node
+/// a step the history keeps), and a delay shorter than the step h (the history holds whole
+/// steps).
+pub(in crate::integrators) fn check_delays(delays: &[f64], method: Method, h: f64) -> Result<(), crate::Error> {
+    if delays.is_empty() {
+        return Ok(());
+    }
+    if !matches!(method, Method::Midpoint | Method::Trapezoid) {
+        let reason = format!(
+            "{} does not take delayed forces; use midpoint or trapezoid, whose one force node a step \
+             the run's history keeps",
+            method.info().name
+        );
+        return Err(crate::Error::invalid("method", reason));
+    }
+    if let Some(tau) = delays.iter().find(|tau| **tau < h) {
+        let reason = format!("τ = {tau} is shorter than the step dt = {h}: the history holds whole steps; take dt ≤ τ");
+        return Err(crate::Error::invalid("delays", reason));
+    }
+    Ok(())
+}
+
 impl Integrator {
     /// An integrator of `method` for n coordinates; buffers are allocated here, not per step.
     pub fn new(method: Method, n: usize) -> Self {
@@ -195,6 +217,16 @@ impl Integrator {
             Scheme::Rattle(s) => s.size_for(m),
             Scheme::WisdomHolman(s) => s.prepare(n),
             Scheme::KickDrift(_) | Scheme::ExplicitRk(_) => {}
+        }
+    }
+
+    /// Keeps the history of delayed forces with `delays` at the step h: the two-point rules
+    /// alone take them ([`check_delays`] refuses the other methods).
+    pub(super) fn keep_history(&mut self, n: usize, delays: &[f64], h: f64) {
+        match &mut self.scheme {
+            Scheme::Midpoint(s) => s.keep_history(n, delays, h),
+            Scheme::Trapezoid(s) => s.keep_history(n, delays, h),
+            _ => {}
         }
     }
 

@@ -7,7 +7,10 @@ use std::borrow::{Borrow, BorrowMut};
 use std::ops::Deref;
 
 use super::checkpoint::shape::shape;
-use super::{compensated, Dynamics, Gaps, General, Increment, Integrator, Method, Options, Poll, StepError, StepStart};
+use super::{
+    check_delays, compensated, Dynamics, Gaps, General, Increment, Integrator, Method, Options, Poll, StepError,
+    StepStart,
+};
 use crate::error::check_vector;
 use crate::model::{Lagrangian, MechanicalSystem};
 use crate::solve::interrupt::InterruptPoll;
@@ -79,8 +82,11 @@ where
         check_vector("p0", p0, n)?;
         options.check()?;
         method.check(model.kind())?;
+        let delays = model.as_lagrangian().delays();
+        check_delays(delays, method, options.dt)?;
         check_initial(&*model, q0, p0, options.t0)?;
-        let state = StepperState::fresh(method, q0, p0, options);
+        let mut state = StepperState::fresh(method, q0, p0, options);
+        state.integrator.keep_history(n, delays, options.dt);
         Ok(Stepper { model, state })
     }
 }
@@ -194,6 +200,8 @@ where
         check_initial(&*self.model, q0, p0, t0)?;
         let h = state.clock.h;
         state.restart(t0, q0, p0, h);
+        // A new initial state has no past.
+        state.integrator.keep_history(n, self.model.as_lagrangian().delays(), h);
         Ok(())
     }
 
@@ -257,6 +265,10 @@ where
     pub fn set_dt(&mut self, h: f64) -> Result<(), Error> {
         if !(h.is_finite() && h > 0.0) {
             return Err(Error::invalid("dt", format!("must be finite and positive, got {h}")));
+        }
+        if !self.model.as_lagrangian().delays().is_empty() {
+            let reason = "a model with delayed forces keeps its step: its history holds the steps taken";
+            return Err(Error::invalid("dt", reason));
         }
         let state = self.state.borrow_mut();
         state.clock = Clock {
@@ -351,6 +363,9 @@ impl StepperState {
         let mut stepped = fresh.clone();
         let (m, holonomic) = model.constraint_counts();
         stepped.integrator.prepare(model.dim(), m, holonomic);
+        stepped
+            .integrator
+            .keep_history(model.dim(), model.as_lagrangian().delays(), h);
         let (found, fresh, stepped) = (shape(self), shape(&fresh), shape(&stepped));
         if found == fresh || found == stepped {
             return None;

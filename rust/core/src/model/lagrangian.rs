@@ -113,38 +113,30 @@ pub trait Lagrangian {
         Ok(())
     }
 
+    /// The delays τ₁ … τ_d of the model's delayed forces (each τⱼ > 0); none by default. A
+    /// model with delays is forced ([`Lagrangian::is_forced`]).
+    fn delays(&self) -> &[f64] {
+        &[]
+    }
+
+    /// Writes the forces of a model with delays into `out`, n(1 + d): first the force now,
+    /// Q(q, q̇, t), then for each delay j the term of the state now and of the state τⱼ ago, each
+    /// its own block so that a term whose past does not exist yet is left out (one evaluation
+    /// for all, the step's hot path). `q` holds q(t), then q(t − τ₁) … q(t − τ_d), n each; `v`
+    /// the velocities likewise. Default: Q from [`Lagrangian::force`], no delayed term.
+    fn delayed_force(&self, q: &[f64], v: &[f64], t: f64, out: &mut [f64]) -> Result<(), ModelError> {
+        let n = out.len() / (1 + self.delays().len());
+        out[n..].fill(0.0);
+        self.force(&q[..n], &v[..n], t, &mut out[..n])
+    }
+
     /// Writes the velocity q̇ with ∂L/∂q̇(q, q̇, t) = p into `v`: the inverse Legendre
     /// transform, unique for a regular Lagrangian. Default: Newton's method from `v` as given,
     /// with the exact ∂²L/∂q̇² where [`Lagrangian::hessians`] supplies it and a difference
     /// Jacobian otherwise (either exact in one step when L is quadratic in q̇), to round-off or
     /// to the noise floor of difference derivatives.
     fn velocity(&self, q: &[f64], p: &[f64], t: f64, v: &mut [f64]) -> Result<(), ModelError> {
-        with_legendre_scratch(v.len(), |scratch| {
-            let LegendreScratch {
-                newton,
-                plus,
-                minus,
-                hessians,
-            } = scratch;
-            let mut problem = InverseLegendre {
-                sys: self,
-                q,
-                p,
-                t,
-                v,
-                plus,
-                minus,
-                hessians: Some(hessians),
-            };
-            let rules = Rules {
-                simplified: false,
-                noise_floor: true,
-            };
-            newton
-                .solve(&mut problem, &NewtonOptions::default(), rules)
-                .map_err(model_error)?;
-            Ok(())
-        })
+        inverse_legendre(self, q, p, t, v)
     }
 
     /// The energy function E(q, p, t) = p·q̇ − L(q, q̇, t), with q̇ from [`Lagrangian::velocity`];
@@ -167,6 +159,43 @@ pub trait Lagrangian {
             potential,
         })
     }
+}
+
+/// The inverse Legendre transform by Newton's method: [`Lagrangian::velocity`]'s default,
+/// for models that check something before it.
+pub fn inverse_legendre<L: Lagrangian + ?Sized>(
+    sys: &L,
+    q: &[f64],
+    p: &[f64],
+    t: f64,
+    v: &mut [f64],
+) -> Result<(), ModelError> {
+    with_legendre_scratch(v.len(), |scratch| {
+        let LegendreScratch {
+            newton,
+            plus,
+            minus,
+            hessians,
+        } = scratch;
+        let mut problem = InverseLegendre {
+            sys,
+            q,
+            p,
+            t,
+            v,
+            plus,
+            minus,
+            hessians: Some(hessians),
+        };
+        let rules = Rules {
+            simplified: false,
+            noise_floor: true,
+        };
+        newton
+            .solve(&mut problem, &NewtonOptions::default(), rules)
+            .map_err(model_error)?;
+        Ok(())
+    })
 }
 
 /// ∂L/∂t by a central difference in t (two evaluations of L, about 1e-10 relative); 0 where L

@@ -7,6 +7,7 @@ mod composed;
 mod constrained;
 mod fixed;
 mod galerkin;
+mod history;
 mod nonholonomic;
 mod two_point;
 

@@ -1,3 +1,4 @@
+use super::history::History;
 use super::{segment, StepEquations};
 use crate::discrete::{DiscreteLagrangian, Quadrature, Segment, Vector, Workspace};
 use crate::integrators::StepStart;
@@ -5,12 +6,14 @@ use crate::model::Lagrangian;
 use crate::ModelError;
 use serde::{Deserialize, Serialize};
 
-/// The generalized force at a step's midpoint, f(q₀ + δq/2, δq/h, t + h/2), with its buffers.
+/// The generalized force at a step's midpoint, f(q₀ + δq/2, δq/h, t + h/2), with its buffers,
+/// and the delayed forces' history of the midpoints of the steps taken.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 struct Forcing {
     mid: Vec<f64>,
     vel: Vec<f64>,
     f: Vec<f64>,
+    history: Option<History>,
 }
 
 impl Forcing {
@@ -19,6 +22,7 @@ impl Forcing {
             mid: vec![0.0; n],
             vel: vec![0.0; n],
             f: vec![0.0; n],
+            history: None,
         }
     }
 
@@ -27,8 +31,19 @@ impl Forcing {
             *m = q + 0.5 * d;
             *v = d / at.h;
         }
-        sys.force(&self.mid, &self.vel, at.t + 0.5 * at.h, &mut self.f)?;
+        let t = at.t + 0.5 * at.h;
+        match &mut self.history {
+            Some(history) => history.forces(sys, (&self.mid, &self.vel, t), &mut self.f)?,
+            None => sys.force(&self.mid, &self.vel, t, &mut self.f)?,
+        }
         Ok(&self.f)
+    }
+
+    /// Records the step just solved, whose midpoint [`Forcing::evaluate`] holds, in the history.
+    fn record(&mut self, at: Segment<'_>) {
+        if let Some(history) = &mut self.history {
+            history.record(&self.mid, &self.vel, at.t + 0.5 * at.h);
+        }
     }
 }
 
@@ -53,6 +68,14 @@ impl<R: DiscreteLagrangian> TwoPoint<R> {
             ws: Workspace::new(n),
             forcing: Forcing::new(n),
         }
+    }
+}
+
+impl<R: DiscreteLagrangian> super::Del<TwoPoint<R>> {
+    /// Keeps the history that delayed forces with `delays` read, at the step h (none without
+    /// delays): sized here, before the run's loop.
+    pub(in crate::integrators) fn keep_history(&mut self, n: usize, delays: &[f64], h: f64) {
+        self.scheme.forcing.history = (!delays.is_empty()).then(|| History::new(n, delays, h));
     }
 }
 
@@ -143,6 +166,7 @@ fn momentum_change<R: DiscreteLagrangian, S: Lagrangian + ?Sized, V: Vector>(
         *d += start.h * f;
         work += f * x;
     }
+    forcing.record(at);
     Ok(work)
 }
 

@@ -2,13 +2,16 @@
 
 use super::function::{check, check_parameters, Inputs};
 use super::Function;
-use crate::model::{differenced_dl_dt, Hessians, Lagrangian};
+use crate::model::{differenced_dl_dt, inverse_legendre, Hessians, Lagrangian};
 use crate::{Error, ModelError};
 
 /// L(q, q̇, t; parameters) with its exact derivatives, each a [`Function`] of the slots
 /// [q, q̇, t]: L; (∂L/∂q, ∂L/∂q̇) together; the Hessians (∂²L/∂q², ∂²L/∂q∂q̇, ∂²L/∂q̇²) row by
 /// row; for a forced system, the generalized force Q(q, q̇, t); and, for an L that depends on t,
-/// ∂L/∂t (differenced from L where a model stored before it was compiled lacks it).
+/// ∂L/∂t (differenced from L where a model stored before it was compiled lacks it); for a
+/// model of variable mass, its masses m(q, t), which must stay positive and finite; for delayed
+/// forces, their delays and one function of the slots [q, q(t − τ₁) …, q̇, q̇(t − τ₁) …, t]
+/// whose outputs are Q, then a block of n a delay.
 #[derive(Clone, Debug)]
 pub struct CompiledLagrangian {
     n: usize,
@@ -19,10 +22,15 @@ pub struct CompiledLagrangian {
     force: Option<Function>,
     dl_dt: Option<Function>,
     time_dependent: bool,
+    masses: Option<Function>,
+    delayed: Option<(Function, Vec<f64>)>,
 }
 
 impl CompiledLagrangian {
-    /// Refuses functions with the wrong number of outputs or parameters, naming the function.
+    /// Refuses functions with the wrong number of outputs or parameters, naming the function,
+    /// masses without a force (the reactive force of a changing mass is one), and delays that
+    /// are not positive and finite.
+    #[allow(clippy::too_many_arguments)]
     pub fn new(
         n: usize,
         params: Vec<f64>,
@@ -31,6 +39,8 @@ impl CompiledLagrangian {
         hessians: Function,
         force: Option<Function>,
         (dl_dt, time_dependent): (Option<Function>, bool),
+        masses: Option<Function>,
+        delayed: Option<(Function, Vec<f64>)>,
     ) -> Result<Self, Error> {
         check_parameters(&params, lagrangian.tape().params())?;
         check("lagrangian", &lagrangian, 1, n, Inputs::All, &params)?;
@@ -45,6 +55,22 @@ impl CompiledLagrangian {
             }
             check("dl_dt", f, 1, n, Inputs::All, &params)?;
         }
+        if let Some(m) = &masses {
+            if force.is_none() {
+                return Err(Error::invalid("masses", "given without a force (the reactive force)"));
+            }
+            check("masses", m, m.outputs().max(1), n, Inputs::All, &params)?;
+        }
+        if let Some((f, delays)) = &delayed {
+            if delays.is_empty() || !delays.iter().all(|tau| tau.is_finite() && *tau > 0.0) {
+                return Err(Error::invalid(
+                    "delays",
+                    format!("must be positive and finite, got {delays:?}"),
+                ));
+            }
+            let d = delays.len();
+            check("delayed_force", f, n * (1 + d), n * (1 + d), Inputs::All, &params)?;
+        }
         Ok(CompiledLagrangian {
             n,
             params,
@@ -54,6 +80,8 @@ impl CompiledLagrangian {
             force,
             dl_dt,
             time_dependent,
+            masses,
+            delayed,
         })
     }
 
@@ -68,6 +96,23 @@ impl CompiledLagrangian {
 
     pub fn parameters(&self) -> &[f64] {
         &self.params
+    }
+
+    /// Refuses a state where a variable mass is not positive and finite (masses depend on q
+    /// and t alone).
+    fn check_masses(&self, q: &[f64], v: &[f64], t: f64) -> Result<(), ModelError> {
+        let Some(m) = &self.masses else { return Ok(()) };
+        let lost = m.eval_into(q, v, t, &self.params, |m| {
+            m.iter().position(|m| *m <= 0.0 || !m.is_finite()).map(|i| (i, m[i]))
+        });
+        match lost {
+            Some((i, m)) => Err(format!(
+                "mass_flow[{i}]: the mass is {m} at t = {t}: it must stay positive and finite (the body \
+                 has run out of mass; end the run before)"
+            )
+            .into()),
+            None => Ok(()),
+        }
     }
 }
 
@@ -111,6 +156,12 @@ impl Lagrangian for CompiledLagrangian {
         self.time_dependent
     }
 
+    // A state whose mass has run out has no velocity: said so, before Newton finds ∂²L/∂q̇² singular.
+    fn velocity(&self, q: &[f64], p: &[f64], t: f64, v: &mut [f64]) -> Result<(), ModelError> {
+        self.check_masses(q, v, t)?;
+        inverse_legendre(self, q, p, t, v)
+    }
+
     fn dl_dt(&self, q: &[f64], v: &[f64], t: f64) -> Result<f64, ModelError> {
         let Some(f) = &self.dl_dt else {
             return differenced_dl_dt(self, q, v, t);
@@ -121,10 +172,24 @@ impl Lagrangian for CompiledLagrangian {
     }
 
     fn is_forced(&self) -> bool {
-        self.force.is_some()
+        self.force.is_some() || self.delayed.is_some()
+    }
+
+    fn delays(&self) -> &[f64] {
+        self.delayed.as_ref().map_or(&[], |(_, d)| d)
+    }
+
+    fn delayed_force(&self, q: &[f64], v: &[f64], t: f64, out: &mut [f64]) -> Result<(), ModelError> {
+        let Some((f, _)) = &self.delayed else {
+            return self.force(q, v, t, out);
+        };
+        self.check_masses(&q[..self.n], &v[..self.n], t)?;
+        f.eval(q, v, t, &self.params, out);
+        Ok(())
     }
 
     fn force(&self, q: &[f64], v: &[f64], t: f64, out: &mut [f64]) -> Result<(), ModelError> {
+        self.check_masses(q, v, t)?;
         match &self.force {
             Some(f) => f.eval(q, v, t, &self.params, out),
             None => out.fill(0.0),

@@ -1,0 +1,111 @@
+"""Delayed forces (issue 36): a force of the state τ ago (``varmech.symbolic.Delayed``), read
+from the run's own history:
+
+- the delayed feedback oscillator q̈ + ω²q = −k q̇(t − τ): its stability boundary in k against
+  the exact Hopf crossing of s² + ω² + k s e^(−sτ) = 0 (s = iΩ, Ωτ = π/2, k = (Ω² − ω²)/Ω),
+  runs at 0.5% either side decaying and growing, for τ a whole number of steps (the method's own
+  past) and not (the interpolant);
+- the term acts only once its past exists (t ≥ τ): before, the run is the undelayed model's;
+- a stream resumed from its checkpoint, a Stepper in pieces and an ensemble: bit for bit the
+  whole run (the history is part of the state);
+- bad input named: τ ≤ 0, τ shorter than the step, a method without a history, constraints, a
+  delay as long as the run.
+"""
+
+import math
+
+import numpy as np
+import pytest
+import sympy as sp
+
+import varmech
+from varmech.symbolic import Delayed
+
+q, w, w_past, k = sp.symbols("q w w_past k")
+
+
+def _oscillator(tau: float) -> varmech.Model:
+    return varmech.symbolic.lagrangian(
+        (w**2 - q**2) / 2, [q], [w], parameters={k: 0.5}, delayed=Delayed(tau, [-k * w_past], v_past=[w_past])
+    )
+
+
+def _critical_gain(tau: float, omega: float = 1.0) -> float:
+    big_omega = math.pi / (2 * tau)
+    return (big_omega**2 - omega**2) / big_omega
+
+
+def _growth_rate(model, gain, dt=0.01, t_end=600.0):
+    traj = varmech.integrate(model, [1.0], v0=[0.0], dt=dt, t_end=t_end, parameters={"k": gain})
+    x, quarter = traj.q[:, 0], len(traj) // 4
+    early, late = abs(x[quarter : 2 * quarter]).max(), abs(x[3 * quarter :]).max()
+    return math.log(late / early) / (traj.t[3 * quarter] - traj.t[quarter])
+
+
+@pytest.mark.parametrize("tau", [1.0, 1.0037])
+def test_the_delayed_oscillators_stability_boundary_is_the_hopf_crossing(tau):
+    model, critical = _oscillator(tau), _critical_gain(tau)
+    assert _growth_rate(model, 0.995 * critical) < 0 < _growth_rate(model, 1.005 * critical)
+    # far from it, the rates have the size the linearized roots give (decay, growth)
+    assert _growth_rate(model, 0.5 * critical) < -0.05 and _growth_rate(model, 1.5 * critical) > 0.05
+
+
+def test_the_delayed_term_acts_only_once_its_past_exists():
+    tau, dt = 0.5, 0.01
+    delayed = varmech.integrate(_oscillator(tau), [1.0], v0=[0.0], dt=dt, t_end=2.0)
+    free = varmech.integrate(varmech.symbolic.lagrangian((w**2 - q**2) / 2, [q], [w], force=[0 * w]),
+                             [1.0], v0=[0.0], dt=dt, t_end=2.0)
+    before = int(round(tau / dt))
+    # Steps 0 … τ/h − 1 have force nodes before τ: no past, no force; then the term acts.
+    assert np.array_equal(delayed.q[: before + 1], free.q[: before + 1])
+    assert abs(delayed.q[before + 2 :] - free.q[before + 2 :]).max() > 1e-4
+
+
+def test_a_delayed_run_resumes_from_its_checkpoint_bit_for_bit(tmp_path):
+    pytest.importorskip("h5py")
+    model = _oscillator(0.73)
+    whole = varmech.integrate(model, [1.0], v0=[0.0], dt=0.01, t_end=20.0)
+    path = tmp_path / "delayed.h5"
+    varmech.integrate(model, [1.0], v0=[0.0], dt=0.01, t_end=10.0, output=path)
+    resumed = varmech.resume(path, t_end=20.0)
+    assert np.array_equal(resumed.q[-1], whole.q[-1]) and np.array_equal(resumed.p[-1], whole.p[-1])
+
+
+def test_a_stepper_in_pieces_and_an_ensemble_are_the_whole_run_bit_for_bit():
+    model = _oscillator(0.5)
+    whole = varmech.integrate(model, [1.0], v0=[0.0], dt=0.01, steps=2000)
+    stepper = varmech.Stepper(model, [1.0], whole.p[0], dt=0.01)
+    stepper.advance(700)
+    stepper.step()
+    stepper.advance(1299)
+    assert np.array_equal(stepper.q, whole.q[-1]) and np.array_equal(stepper.p, whole.p[-1])
+    runs = varmech.ensemble(model, np.ones((3, 1)), np.zeros((3, 1)), dt=0.01, steps=2000,
+                            parameters={"k": [0.3, 0.5, 0.7]}, workers=2)
+    assert np.array_equal(runs.q[1, -1], whole.q[-1])
+    assert not np.array_equal(runs.q[0, -1], whole.q[-1])
+
+
+@pytest.mark.parametrize(
+    ("build", "run", "error", "match"),
+    [
+        (dict(tau=0.0), {}, ValueError, r"^delayed\[0\].tau: must be positive and finite"),
+        (dict(tau="1"), {}, TypeError, r"^delayed\[0\].tau: expected a number"),
+        (dict(v_past=[q]), {}, ValueError, r"^delayed\[0\].v_past: .* must be new symbols"),
+        (dict(tau=0.005), {}, ValueError, r"^delays: τ = 0.005 is shorter than the step dt = 0.01"),
+        ({}, dict(method="galerkin4"), ValueError, r"^method: galerkin4 does not take delayed forces"),
+        ({}, dict(t_end=0.4), ValueError, r"^delayed: τ = 0.5 is as long as the run"),
+    ],
+)
+def test_bad_delays_are_refused_naming_them(build, run, error, match):
+    args = dict(tau=0.5, v_past=[w_past]) | build
+    with pytest.raises(error, match=match):
+        model = varmech.symbolic.lagrangian((w**2 - q**2) / 2, [q], [w], parameters={k: 0.5},
+                                            delayed=Delayed(args["tau"], [-k * w_past], v_past=args["v_past"]))
+        varmech.integrate(model, [1.0], v0=[0.0], **({"dt": 0.01, "t_end": 2.0} | run))
+
+
+def test_delays_with_constraints_are_refused():
+    x, y, vx, vy = sp.symbols("x y vx vy")
+    with pytest.raises(ValueError, match=r"^delayed: delayed forces are not taken with constraints"):
+        varmech.symbolic.lagrangian((vx**2 + vy**2) / 2 - y, [x, y], [vx, vy], constraints=[x**2 + y**2 - 1],
+                                    delayed=Delayed(0.5, [-vx, -vy]))
