@@ -504,6 +504,7 @@ class CompiledModel(_ModelProperties):
         forced: bool = False,
         symmetries: Sequence[Generator] = ...,
         jit: bool = True,
+        delays: Sequence[float] = ...,
     ) -> CompiledModel: ...
     @property
     def constraints(self) -> int: ...

@@ -11,10 +11,10 @@ import sympy as sp
 
 from .._progress import progress_bar
 from ..model import Cyclic, Symmetry
+from ._delays import Delayed, delayed_forces, delayed_tape
 from ._derive import derive, vanishes
 from ._inputs import Variables, check_symbols, expressions, parameters, variables
 from ._lower import check_compilable, lower
-from ._delays import Delayed, delayed_forces, delayed_tape
 from ._mass_flow import MassFlow, reactive_force
 from ._model import Spec, Symbolic, SymbolicModel
 from ._routh import routhian
