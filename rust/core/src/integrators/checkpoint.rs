@@ -6,7 +6,7 @@ pub(super) mod shape;
 use serde::{Deserialize, Serialize};
 
 use super::run::EnergyWatch;
-use super::{Dynamics, Method, NewtonOptions, StepperState};
+use super::{check_method, Dynamics, Method, NewtonOptions, StepperState};
 use crate::Error;
 
 /// Everything a run needs to go on from step n as if it had never stopped: the stepper's state
@@ -203,7 +203,7 @@ impl Checkpoint {
             );
             return Err(Error::invalid("model", reason));
         }
-        state.method().check(model.kind())?;
+        check_method(model, state.method(), state.dt())?;
         if let Some(reason) = state.misfit(model) {
             return Err(refuse(reason));
         }

@@ -106,10 +106,17 @@ enum Scheme {
     WisdomHolman(WisdomHolman),
 }
 
-/// Refuses delayed forces with a method other than the two-point rules (whose one force node
-/// a step the history keeps), and a delay shorter than the step h (the history holds whole
-/// steps).
-pub(in crate::integrators) fn check_delays(delays: &[f64], method: Method, h: f64) -> Result<(), crate::Error> {
+/// Refuses a method that does not integrate the model's kind ([`Method::check`]) and, for a
+/// model with delayed forces, a method other than the two-point rules (whose one force node a
+/// step the history keeps) or a delay shorter than the step h (the history holds whole steps):
+/// for a new stepper, a resumed state and a checkpoint alike.
+pub(in crate::integrators) fn check_method<S: Dynamics + ?Sized>(
+    model: &S,
+    method: Method,
+    h: f64,
+) -> Result<(), crate::Error> {
+    method.check(model.kind())?;
+    let delays = model.as_lagrangian().delays();
     if delays.is_empty() {
         return Ok(());
     }
@@ -221,7 +228,7 @@ impl Integrator {
     }
 
     /// Keeps the history of delayed forces with `delays` at the step h: the two-point rules
-    /// alone take them ([`check_delays`] refuses the other methods).
+    /// alone take them ([`check_method`] refuses the other methods).
     pub(super) fn keep_history(&mut self, n: usize, delays: &[f64], h: f64) {
         match &mut self.scheme {
             Scheme::Midpoint(s) => s.keep_history(n, delays, h),

@@ -8,7 +8,7 @@ use std::ops::Deref;
 
 use super::checkpoint::shape::shape;
 use super::{
-    check_delays, compensated, Dynamics, Gaps, General, Increment, Integrator, Method, Options, Poll, StepError,
+    check_method, compensated, Dynamics, Gaps, General, Increment, Integrator, Method, Options, Poll, StepError,
     StepStart,
 };
 use crate::error::check_vector;
@@ -74,19 +74,19 @@ where
     /// methods.
     ///
     /// Refuses, in this order: q0 or p0 of the wrong length or not finite, malformed options, a
-    /// method that does not integrate the model's kind ([`Method::check`]), and initial data off
-    /// the constraints ([`Dynamics::check_initial`]).
+    /// method that does not integrate the model's kind or its delays ([`check_method`]), and
+    /// initial data off the constraints ([`Dynamics::check_initial`]).
     pub fn new(model: M, method: Method, q0: &[f64], p0: &[f64], options: &Options) -> Result<Self, Error> {
         let n = model.dim();
         check_vector("q0", q0, n)?;
         check_vector("p0", p0, n)?;
         options.check()?;
-        method.check(model.kind())?;
-        let delays = model.as_lagrangian().delays();
-        check_delays(delays, method, options.dt)?;
+        check_method(&*model, method, options.dt)?;
         check_initial(&*model, q0, p0, options.t0)?;
         let mut state = StepperState::fresh(method, q0, p0, options);
-        state.integrator.keep_history(n, delays, options.dt);
+        state
+            .integrator
+            .keep_history(n, model.as_lagrangian().delays(), options.dt);
         Ok(Stepper { model, state })
     }
 }
@@ -99,7 +99,7 @@ where
     /// The stepper of `state` on `model`, continuing where [`Stepper::into_state`] left it.
     ///
     /// `model` must be the one the state was stepped on: a model with another number of
-    /// coordinates, or of a kind the state's method does not integrate, is refused (the state,
+    /// coordinates, or of a kind or delays the state's method does not integrate, is refused (the state,
     /// if owned, is dropped; pass `&mut state` to keep it whatever happens).
     pub fn resume(model: M, state: St) -> Result<Self, Error> {
         let s = state.borrow();
@@ -107,7 +107,7 @@ where
             let reason = format!("has {} coordinates, the stepper's state {}", model.dim(), s.q.len());
             return Err(Error::invalid("model", reason));
         }
-        s.method().check(model.kind())?;
+        check_method(&*model, s.method(), s.dt())?;
         Ok(Stepper { model, state })
     }
 
