@@ -81,8 +81,7 @@ def tour_reduced(quick: bool, summary: Table) -> None:
             print(f"--- {method}: {elapsed:.3f} s with reconstruction; x ranges over {lo} … {hi}")
             print(check_conservation(full))
             reduced_report = check_conservation(traj)
-            energy = reduced_report.energy
-            summary.append(reduced.name, method, steps, elapsed, energy.max_rel_error if energy else float("nan"), reduced_report.verdict)
+            summary.append(reduced.name, method, steps, elapsed, reduced_report.energy.max_rel_error, reduced_report.verdict)
 
 
 def tour(out: Path, quick: bool) -> int:
@@ -109,10 +108,9 @@ def tour(out: Path, quick: bool) -> int:
             print(f"--- {method}: {traj.nfev} force evaluations in {elapsed:.3f} s")
             report = check_conservation(traj)
             print(report)
-            stats, verdict = report.energy, report.verdict
-            if report.energy_balance is not None:
-                stats, verdict = report.energy_balance, f"balance E − W {report.energy_balance.verdict}"
-            summary.append(name, method, steps, elapsed, stats.max_rel_error if stats else float("nan"), verdict)
+            stats = report.energy
+            verdict = report.verdict if stats.name == "energy" else f"{stats.name} {report.verdict}"
+            summary.append(name, method, steps, elapsed, stats.max_rel_error, verdict)
         if plots:
             try:
                 path = charts.energy_error(

@@ -25,6 +25,7 @@ from .trajectory import Trajectory
 
 __all__ = [
     "FAILURE",
+    "NOT_JUDGED",
     "ROUND_OFF",
     "TOO_COARSE",
     "VERDICTS",
@@ -142,7 +143,7 @@ class InvariantStatistics:
     Attributes
     ----------
     name : str
-        The quantity: ``"energy"``, ``"energy balance"``, a momentum (``"L"``, ``"P_x"``,
+        The quantity: ``"energy"``, ``"Jacobi integral"``, ``"energy balance"``, a momentum (``"L"``, ``"P_x"``,
         ``"p[0]"``, ``"xi[k]"``) or a constraint level (``"|g(q)|"``, ``"|G q̇|"``, ``"|A q̇|"``).
     initial : float
         Its value at the first saved state (H₀, J₀; 0 for a constraint residual).
@@ -166,7 +167,8 @@ class InvariantStatistics:
     first_non_finite : int or None
         The first saved state where the quantity is not finite (None: it is finite throughout).
     verdict : str
-        One of :data:`VERDICTS`.
+        One of :data:`VERDICTS`; :data:`NOT_JUDGED` for an energy that is not conserved and has
+        no tracked balance to judge instead (affine velocity constraints).
     advice : str
         For a failure or a too coarse run, where and how large and what to do; for a run too
         short, why; for a coarse band, to reduce dt; for a forced balance, its measured order;
@@ -242,7 +244,7 @@ class InvariantStatistics:
         (3, 'energy      verdict: bounded')
         """
         error = error or f"Δ{symbol}"
-        head = f"{self.name:<12}verdict: {self.verdict}"
+        head = f"{self.name + ' ':<12}verdict: {self.verdict}"
         if self.advice:
             head += f" ({self.advice})"
         lines = [
@@ -254,7 +256,7 @@ class InvariantStatistics:
         ]
         if self.representative:
             lines[1] += f"   (max |{error}/{symbol}0| = {self.max_abs_error / abs(self.initial):.3e})"
-        elif self.name == "energy":
+        elif self.name in _SYMBOLS:
             lines.append(f"{'':12}|{symbol}0| is not representative of the energy's size: errors are against the scale")
         return lines
 
@@ -310,9 +312,12 @@ def _statistics(record: _core.Statistics, name: str, initial: float, scale_name:
     )
 
 
-NOT_CONSERVED = "not conserved (L depends on t); see the energy balance"
-FORCED = "not conserved (forced); see the energy balance"
-AFFINE = "not conserved (affine velocity constraints: the moving surface does work)"
+#: The verdict of an energy that is not conserved and has no tracked balance to judge instead.
+NOT_JUDGED = "not judged"
+#: Why: affine velocity constraints' forces do work.
+AFFINE = "not conserved: the affine velocity constraints' moving surface does work, which the run does not track"
+#: The names ``report.energy`` takes, and their symbols in the report's text.
+_SYMBOLS = {"energy": "H", "Jacobi integral": "h", "energy balance": "(E − W)"}
 
 
 @dataclass(frozen=True)
@@ -332,15 +337,18 @@ class ConservationReport:
         The step.
     t_end : float
         The last saved time.
-    energy : InvariantStatistics or None
-        The energy E = p·q̇ − L; None when L depends on t, forces act or affine constraints do
-        work (the energy is then not conserved; see ``energy_balance``).
+    energy : InvariantStatistics
+        Always present; its ``name`` says what it is. The energy function E = p·q̇ − L
+        (``"energy"``; ``"Jacobi integral"`` for a model that names it so, such as an L from
+        inertial coordinates whose t cancels: a moving frame); for forced systems and for an L
+        that depends on t, the balance E(t) − W(t) (``"energy balance"``), W the energy put in
+        (``traj.work``: the forces' work, the discrete Lagrange–d'Alembert energy balance, less
+        ∫∂L/∂t dt on the method's quadrature), judged as the energy is; with affine velocity
+        constraints, whose forces do work no run tracks, the energy's statistics with the
+        verdict :data:`NOT_JUDGED` and the reason in ``advice`` (a non-finite energy still
+        fails).
     momenta : tuple of InvariantStatistics
         Each Noether momentum judged, in the order of the generators.
-    energy_balance : InvariantStatistics or None
-        For forced systems and for an L that depends on t: the balance E(t) − W(t), W the energy
-        put in (``traj.work``: the forces' work, the discrete Lagrange–d'Alembert energy
-        balance, less ∫∂L/∂t dt on the method's quadrature), judged as the energy is.
     constraints : tuple of InvariantStatistics or None
         For constrained models: |g(q)|∞ and |G(q)M⁻¹p|∞ over the run; with velocity
         constraints |A(q)q̇ + b(q)|∞ alone; with both, |g(q)|∞ and |G(q)q̇, A(q)q̇ + b(q)|∞.
@@ -355,13 +363,12 @@ class ConservationReport:
     time_dependent : bool
         Whether L depends on t: then its energy balance, not its energy, is judged.
     verdict : str
-        The energy's verdict, or why the energy is not conserved (L depends on t, forces act:
-        then see ``energy_balance``, or affine constraints do work).
+        ``energy.verdict``: the energy's, the Jacobi integral's or the balance's.
     constraint_residuals : tuple of float or None
         max |g(q)|∞ and max |G(q)M⁻¹p|∞ over the run, for constrained models (0 and max
         |A(q)q̇|∞ with velocity constraints); None without constraints.
     quantities : tuple of InvariantStatistics
-        Every quantity judged: energy or balance, momenta, constraints.
+        Every quantity judged: energy (or balance) unless not judged, momenta, constraints.
 
     Examples
     --------
@@ -378,12 +385,10 @@ class ConservationReport:
     method: str
     dt: float
     t_end: float
-    #: None when L depends on t or forces act: the energy is then not conserved.
-    energy: InvariantStatistics | None
+    #: The energy, the Jacobi integral, or for forced systems and an L that depends on t the
+    #: balance E(t) − W(t) (W the forces' work less ∫∂L/∂t dt): ``energy.name`` says which.
+    energy: InvariantStatistics
     momenta: tuple[InvariantStatistics, ...]
-    #: For forced systems and an L that depends on t: the balance E(t) − W(t), W the energy put
-    #: in (the forces' work less ∫∂L/∂t dt), judged as the energy is.
-    energy_balance: InvariantStatistics | None = None
     #: For constrained models: |g(q)|∞ and |G(q)M⁻¹p|∞ over the run; with velocity constraints
     #: |A(q)q̇ + b(q)|∞ alone; with both, |g(q)|∞ and |G(q)q̇, A(q)q̇ + b(q)|∞.
     constraints: tuple[InvariantStatistics, ...] | None = None
@@ -396,13 +401,9 @@ class ConservationReport:
 
     @property
     def verdict(self) -> str:
-        """The energy verdict (see :class:`InvariantStatistics`), or why the energy is not
-        conserved."""
-        if self.energy is not None:
-            return self.energy.verdict
-        if self.affine:
-            return AFFINE
-        return NOT_CONSERVED if self.time_dependent else FORCED
+        """The verdict of ``energy`` (see :class:`InvariantStatistics`): the energy's, the Jacobi
+        integral's or the balance's."""
+        return self.energy.verdict
 
     @property
     def constraint_residuals(self) -> tuple[float, float] | None:
@@ -416,18 +417,15 @@ class ConservationReport:
 
     @property
     def quantities(self) -> tuple[InvariantStatistics, ...]:
-        """Every quantity judged: energy or balance, momenta, constraints and their power."""
-        energy = tuple(e for e in (self.energy, self.energy_balance) if e is not None)
+        """Every quantity judged: energy (or balance) unless :data:`NOT_JUDGED`, momenta,
+        constraints and their power."""
+        energy = (self.energy,) if self.energy.verdict != NOT_JUDGED else ()
         power = (self.constraint_power,) if self.constraint_power is not None else ()
         return energy + self.momenta + (self.constraints or ()) + power
 
     def __str__(self) -> str:
         lines = [f"Conservation report: {self.model}, {self.method}, dt = {self.dt:g}, t = 0 … {self.t_end:g}"]
-        if self.energy is None:
-            lines.append(f"  {'energy':<12}{self.verdict}")
-        for stats, symbol in [(self.energy, "H"), (self.energy_balance, "(E − W)")]:
-            if stats is not None:
-                lines += ["  " + line for line in stats.describe(symbol)]
+        lines += ["  " + line for line in self.energy.describe(_SYMBOLS.get(self.energy.name, "H"))]
         for m in self.momenta:
             lines += ["  " + line for line in m.describe("J")]
         residuals = ("g(q)", "G M⁻¹ p") if len(self.constraints or ()) == 2 else ("A q̇ + b" if self.affine else "A q̇",)
@@ -497,26 +495,23 @@ def check_conservation(traj: Trajectory, generators: Sequence[Generator] | None 
         generators = traj.model.symmetries
     model = traj.model
     t, steps = np.asarray(traj.t), int(traj.steps)
-    energy = balance = None
     affine = bool(model.velocity_constraints) and model.affine
     # Forces that do work: the model's own, or the friction of its contacts.
     # The energy put in: by those forces, and by L's dependence on t.
     forced = model.forced or _impacts.frictional(traj.contacts) or model.time_dependent
     if not affine:
-        stats = energy_statistics(model, t, *traj._arrays()[1:], steps=steps, work=np.asarray(traj.work) if forced else None)
-        if stats.verdict == "failed":
-            stats = replace(stats, advice=f"{stats.advice}; {_failure_advice(traj)}")
-        elif forced and stats.verdict == "secular drift" and refine:
-            stats = _refined(traj, stats)
-        energy, balance = (None, stats) if forced else (stats, None)
-        if forced and stats.first_non_finite is not None:
-            # A balance whose energy is not finite fails the report as the energy would.
-            energy = replace(stats, advice=f"{stats.advice}: the model's energy p·q̇ − L does not evaluate there")
+        energy = energy_statistics(model, t, *traj._arrays()[1:], steps=steps, work=np.asarray(traj.work) if forced else None)
+        if energy.verdict == "failed":
+            energy = replace(energy, advice=f"{energy.advice}; {_failure_advice(traj)}")
+        elif forced and energy.verdict == "secular drift" and refine:
+            energy = _refined(traj, energy)
     else:
+        energy = energy_statistics(model, t, *traj._arrays()[1:], steps=steps)
         # Not conserved, so not judged; but a non-finite energy fails the run all the same.
-        stats = energy_statistics(model, t, *traj._arrays()[1:], steps=steps)
-        if stats.first_non_finite is not None:
-            energy = replace(stats, advice=f"{stats.advice}: the model's energy p·q̇ − L does not evaluate there")
+        if energy.first_non_finite is None:
+            energy = replace(energy, verdict=NOT_JUDGED, advice=AFFINE)
+    if energy.first_non_finite is not None:
+        energy = replace(energy, advice=f"{energy.advice}: the model's energy p·q̇ − L does not evaluate there")
     momenta = []
     for k, xi in enumerate(generators):
         name = xi.name if isinstance(xi, (Translation, Rotation, Cyclic)) else f"xi[{k}]"
@@ -541,7 +536,7 @@ def check_conservation(traj: Trajectory, generators: Sequence[Generator] | None 
         _, _, (p, p_size) = _core.reactions(model._core, *traj._arrays())
         power = _statistics(_core.statistics(t, p, p_size, p_size, steps), "power", p[0], "mean Σ|(Cᵀλ)ᵢq̇ᵢ|", t)
     return ConservationReport(
-        model.name, traj.method, traj.dt, float(t[-1]), energy, tuple(momenta), balance, constraints, affine, power, model.time_dependent
+        model.name, traj.method, traj.dt, float(t[-1]), energy, tuple(momenta), constraints, affine, power, model.time_dependent
     )
 
 
@@ -555,7 +550,7 @@ def energy_statistics(
     e, kinetic, potential = _core.energy_terms(model._core, t, q, p)
     w = np.zeros(len(t)) if work is None else np.ascontiguousarray(work, dtype=float)
     record = _core.energy_statistics(t, e, kinetic, potential, w, int(steps))
-    return _statistics(record, "energy" if work is None else "balance", e[0] - w[0], "mean kinetic energy", t)
+    return _statistics(record, model.energy_name if work is None else "energy balance", e[0] - w[0], "mean kinetic energy", t)
 
 
 def _refined(traj: Trajectory, stats: InvariantStatistics) -> InvariantStatistics:

@@ -25,7 +25,7 @@ from . import impacts as _impacts
 from . import impulses as _impulses
 from ._progress import progress_bar, thread_lock
 from ._util import finite, floats, positive, positive_int, step_count
-from .conservation import VERDICTS, ConservationReport, check_conservation
+from .conservation import NOT_JUDGED, VERDICTS, ConservationReport, check_conservation
 from .impacts import Contact
 from .impulses import Impulse
 from .integrate import _contacts_of, _energy_threshold, _model_of, _newton, _sample_times, integrate
@@ -209,8 +209,8 @@ class Ensemble:
         reports = [check_conservation(tr) if len(tr) >= 2 else None for tr in self.trajectories]
         worst, not_bounded = 0.0, []
         for i, report in enumerate(reports):
-            stats = None if report is None else report.energy or report.energy_balance
-            if stats is None:
+            stats = None if report is None else report.energy
+            if stats is None or stats.verdict == NOT_JUDGED:
                 continue
             worst = max(worst, stats.max_rel_error)
             if VERDICTS.index(stats.verdict) > VERDICTS.index("bounded"):

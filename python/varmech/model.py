@@ -327,9 +327,21 @@ class Model:
         return _core.is_forced(self._core)
 
     @property
+    def energy_name(self) -> str:
+        """What reports call the energy function E = p·q̇ − L: ``"energy"``, or ``"Jacobi
+        integral"`` for an L autonomous in a moving frame (a symbolic L from inertial
+        coordinates whose t cancels; a closure model that says so)."""
+        return "energy"
+
+    @property
     def delays(self) -> tuple[float, ...]:
         """The delays τ of the model's delayed forces (none for most models)."""
         return ()
+
+    @property
+    def has_history(self) -> bool:
+        """Whether the model gives the state before the run that its delayed forces read."""
+        return False
 
     @property
     def constraints(self) -> int:
@@ -913,7 +925,8 @@ def _roll(
 def check_delays(model: Model, watched: bool, horizon: float | None = None) -> None:
     """ValueError naming ``delayed`` for a model with delayed forces run with events, contacts or
     impulses (their partial steps would need the history at other steps), or over a
-    ``horizon`` no longer than its longest delay (the delayed term would never act)."""
+    ``horizon`` no longer than its longest delay without a history (the delayed term would
+    never act)."""
     if not model.delays:
         return
     if watched:
@@ -922,10 +935,10 @@ def check_delays(model: Model, watched: bool, horizon: float | None = None) -> N
             "would read the history between its steps)"
         )
     longest = max(model.delays)
-    if horizon is not None and horizon <= longest:
+    if horizon is not None and horizon <= longest and not model.has_history:
         raise ValueError(
             f"delayed: τ = {longest:g} is as long as the run ({horizon:g}): the delayed term would never act; run "
-            "longer or shorten τ"
+            "longer, shorten τ, or give the model its history="
         )
 
 
@@ -1055,6 +1068,9 @@ class Lagrangian(Model):
         Symmetries of L whose Noether momenta :func:`varmech.check_conservation` checks.
     name
         A label for reports.
+    energy_name
+        What reports call E = p·q̇ − L: ``"Jacobi integral"`` for an L written in a moving
+        (rotating) frame, whose conserved E is not the inertial energy.
 
     Raises
     ------
@@ -1063,7 +1079,8 @@ class Lagrangian(Model):
         shape, a count without its velocity constraints or constraints without their count.
     TypeError
         A function pointer with another signature than :data:`varmech.pointers.SIGNATURE`,
-        pointers and closures mixed, or a pointer model with ``rayleigh``, naming the argument.
+        pointers and closures mixed, or a pointer model with ``rayleigh``, naming the argument;
+        an ``energy_name`` that is not a non-empty str.
 
     See Also
     --------
@@ -1106,6 +1123,7 @@ class Lagrangian(Model):
         symmetries: Sequence[Symmetry] = (),
         name: str = "lagrangian",
         dl_dt: Callable[[np.ndarray, np.ndarray, float], float] | None = None,
+        energy_name: str = "energy",
     ):
         self._arguments = {
             "dim": dim,
@@ -1122,8 +1140,11 @@ class Lagrangian(Model):
             "symmetries": symmetries,
             "name": name,
             "dl_dt": dl_dt,
+            "energy_name": energy_name,
         }
         dim = positive_int("dim", dim)
+        if not isinstance(energy_name, str) or not energy_name.strip():
+            raise TypeError(f"energy_name: a non-empty str, such as 'Jacobi integral', not {energy_name!r}")
         _check_velocity_constraints(velocity_constraints, velocity_constraint_count, velocity_constraint_offset)
         if dl_dt is not None and not time_dependent:
             raise ValueError("dl_dt: given for an L declared independent of t; pass time_dependent=True with it")
@@ -1187,3 +1208,9 @@ class Lagrangian(Model):
         self.dl_dt = dl_dt
         self.symmetries = tuple(symmetries)
         self.name = name
+        self._energy_name = energy_name
+
+    @property
+    def energy_name(self) -> str:
+        """What reports call E = p·q̇ − L (the ``energy_name`` given)."""
+        return self._energy_name

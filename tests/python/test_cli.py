@@ -33,7 +33,7 @@ def test_tour_prints_reports_and_writes_plots(tmp_path, run_cli):
         # the ball on the incline accelerates (its energy error grows with it over its t_end)
         # and the turntable's energy is not conserved.
         if info[method].symplectic and scene.strip("| `") not in rolling:
-            assert verdict.removeprefix("balance E − W ") in ("conserved to round-off", "bounded"), (scene, method, verdict)
+            assert verdict.removeprefix("energy balance ") in ("conserved to round-off", "bounded"), (scene, method, verdict)
         if method == "rk4":
             assert verdict == "secular drift", scene
     written = sorted(p.name for p in tmp_path.glob("*_energy.png"))

@@ -6,6 +6,9 @@ from the run's own history:
   runs at 0.5% either side decaying and growing, for τ a whole number of steps (the method's own
   past) and not (the interpolant);
 - the term acts only once its past exists (t ≥ τ): before, the run is the undelayed model's;
+- with the state before the run given (``history=``), q̈ = −k q(t − τ) from a constant past:
+  exact (round-off) over [0, τ], where it reads the history alone, and at order 2 over
+  [τ, 2τ], against the method of steps' closed form;
 - a stream resumed from its checkpoint, a Stepper in pieces and an ensemble: bit for bit the
   whole run (the history is part of the state);
 - bad input named: τ ≤ 0, τ shorter than the step, a method without a history, constraints, a
@@ -59,6 +62,72 @@ def test_the_delayed_term_acts_only_once_its_past_exists():
     # Steps 0 … τ/h − 1 have force nodes before τ: no past, no force; then the term acts.
     assert np.array_equal(delayed.q[: before + 1], free.q[: before + 1])
     assert abs(delayed.q[before + 2 :] - free.q[before + 2 :]).max() > 1e-4
+
+
+x, x_past, t = sp.symbols("x x_past t")
+
+
+def _retarded(tau: float, history=None, **kw) -> varmech.Model:
+    """q̈ = −k q(t − τ) (L = ½q̇²), from the past q(s) = ``history`` (none: no past)."""
+    return varmech.symbolic.lagrangian(
+        w**2 / 2, [x], [w], t=t, parameters={k: 2.0}, delayed=Delayed(tau, [-k * x_past], q_past=[x_past]),
+        history=history, **kw,
+    )
+
+
+def _steps_solution(t, tau, gain=2.0):
+    """q̈ = −k q(t − τ) with q = 1 for t ≤ 0, by the method of steps over [0, 2τ]."""
+    u = t - tau
+    first = 1 - gain * t**2 / 2
+    second = 1 - gain * tau**2 / 2 - gain * tau * u - gain * u**2 / 2 + gain**2 * u**4 / 24
+    return np.where(t <= tau, first, second)
+
+
+@pytest.mark.parametrize("tau", [0.5, 0.5037])
+def test_a_given_history_makes_the_delayed_term_act_from_the_start(tau):
+    model = _retarded(tau, history=[sp.Integer(1)])
+    assert model.has_history and not _retarded(tau).has_history
+    errors = []
+    for dt in (0.01, 0.005, 0.0025):
+        traj = varmech.integrate(model, [1.0], v0=[0.0], dt=dt, steps=int(2 * tau / dt))
+        error = np.abs(traj.q[:, 0] - _steps_solution(traj.t, tau))
+        early = traj.t <= tau - dt
+        # Over [0, τ] the past is the history's, constant: the midpoint rule is exact for the
+        # parabola, to round-off, where τ is a whole number of steps (else the interpolant's
+        # first steps between the history and the first node cost O(h²)).
+        if tau == 0.5:
+            assert error[early].max() < 1e-13, (dt, error[early].max())
+        errors.append(error.max())
+    orders = [math.log2(a / b) for a, b in zip(errors, errors[1:])]
+    assert all(abs(p - 2) < 0.2 for p in orders), (errors, orders)
+    # Without a history nothing acts before τ: the state stays at rest.
+    untold = varmech.integrate(_retarded(tau), [1.0], v0=[0.0], dt=0.01, steps=int(2 * tau / 0.01))
+    assert np.all(untold.q[untold.t <= tau - 0.01, 0] == 1.0)
+
+
+def test_a_history_with_a_delay_longer_than_the_run_is_taken():
+    # The term reads the history throughout, q(s) = cos s: q̈ = −k cos(t − τ).
+    tau, gain = 3.0, 2.0
+    model = _retarded(tau, history=[sp.cos(t)])
+    traj = varmech.integrate(model, [1.0], v0=[0.0], dt=0.01, t_end=2.0)
+    exact = 1 + gain * (np.cos(traj.t - tau) - math.cos(tau) - traj.t * math.sin(tau))
+    assert np.abs(traj.q[:, 0] - exact).max() < 1e-4
+
+
+@pytest.mark.parametrize(
+    ("history", "delayed", "match"),
+    [
+        ([sp.Integer(1)], False, r"^history: the state before the run, which only delayed forces read"),
+        ([1, 2], True, r"^history: must give q\(t\) for each coordinate \(1\)"),
+        ([x], True, r"^history\[0\]: the state before the run is a function of t alone"),
+    ],
+)
+def test_a_bad_history_is_refused_naming_it(history, delayed, match):
+    with pytest.raises(ValueError, match=match):
+        if delayed:
+            _retarded(0.5, history=history)
+        else:
+            varmech.symbolic.lagrangian(w**2 / 2, [x], [w], t=t, history=history)
 
 
 def test_a_delayed_run_resumes_from_its_checkpoint_bit_for_bit(tmp_path):

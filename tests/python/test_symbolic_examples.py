@@ -7,6 +7,7 @@ top is the textbook one and runs as the numerical Routh reduction. The trajector
 twins against their native scenes are in test_symbolic.py. Needs the binding's CompiledModel."""
 
 import math
+import pickle
 
 import numpy as np
 import pytest
@@ -167,7 +168,15 @@ def test_rotating_hoop_conserves_its_jacobi_integral_not_its_inertial_energy():
     E, _, _ = _core.energy_terms(model._core, traj.t, traj.q, traj.p)
     np.testing.assert_allclose(E, h, rtol=1e-13, atol=1e-13 * abs(h[0]))
     assert np.max(np.abs(h - h[0])) <= 1e-6 * abs(h[0])  # measured 7.3e-7 (midpoint, h = 0.001)
-    assert varmech.check_conservation(traj).verdict in ("conserved to round-off", "bounded")
+    # The report names it: the t of the inertial position cancelled (a moving frame).
+    report = varmech.check_conservation(traj)
+    assert model.energy_name == report.energy.name == "Jacobi integral"
+    assert report.verdict in ("conserved to round-off", "bounded") and "Jacobi integral verdict" in str(report)
+    assert pickle.loads(pickle.dumps(model)).energy_name == "Jacobi integral"
+    # The same bead in L's simplified form, given without t, is an energy like any other.
+    simplified = sp.trigsimp(model.L)
+    given = {s: model.parameters[s.name] for s in simplified.free_symbols if s.name in model.parameters}
+    assert varmech.symbolic.lagrangian(simplified, model.q, model.v, parameters=given).energy_name == "energy"
     # The inertial energy T + V = h + mR²Ω² sin²θ changes by the motor's work: the bead swings
     # from θ = 0.3 through its relative equilibrium and back.
     inertial = 0.5 * m * R**2 * (omega**2 + W**2 * np.sin(theta) ** 2) - m * g * R * np.cos(theta)

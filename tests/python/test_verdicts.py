@@ -10,7 +10,7 @@ from hypothesis import strategies as st
 
 import varmech
 from varmech import examples, scenes
-from varmech.conservation import FAILURE, TOO_COARSE, VERDICTS
+from varmech.conservation import FAILURE, NOT_JUDGED, TOO_COARSE, VERDICTS
 
 INFO = {m.name: m for m in varmech.methods()}
 EXPLICIT_SYMPLECTIC = [m.name for m in varmech.methods() if m.symplectic and not m.implicit and not m.constrained and not m.nbody]
@@ -35,10 +35,12 @@ def test_a_rotating_frame_jacobi_integral_is_conserved_to_round_off():
         lambda q, v, t: 0.5 * v @ v + omega * (q[0] * v[1] - q[1] * v[0]) + 0.5 * (omega**2 - k) * q @ q,
         dl_dq=lambda q, v, t: omega * np.array([v[1], -v[0]]) + (omega**2 - k) * q,
         dl_dv=lambda q, v, t: v + omega * np.array([-q[1], q[0]]),
+        energy_name="Jacobi integral",
     )
     traj = varmech.integrate(model, [1.0, 0.0], v0=[0.0, 0.5], dt=0.05, steps=4000, method="midpoint")
     report = varmech.check_conservation(traj)
-    assert report.verdict == "conserved to round-off", report
+    assert report.verdict == "conserved to round-off" and report.energy.name == "Jacobi integral", report
+    assert "Jacobi integral verdict: conserved to round-off" in str(report) and "h0 = " in str(report)
     # The error against the scale is round-off, whatever |H₀| is.
     assert report.energy.max_rel_error < 1e-13
 
@@ -158,8 +160,34 @@ def test_a_hidden_time_dependence_is_refused():
     with pytest.warns(UserWarning):
         declared = varmech.Lagrangian(1, lagrangian, time_dependent=True)
     report = varmech.check_conservation(varmech.integrate(declared, [0.5], [0.0], dt=0.01, steps=100, method="midpoint"))
-    assert report.verdict == "not conserved (L depends on t); see the energy balance"
-    assert report.energy_balance.verdict == "bounded"
+    assert report.energy.name == "energy balance" and report.verdict == "bounded"
+
+
+@pytest.mark.parametrize(
+    ("name", "energy"),
+    [
+        ("harmonic_oscillator", "energy"),
+        ("damped_driven_pendulum", "energy balance"),
+        ("ball_on_turntable", "energy"),
+        ("double_pendulum", "energy"),
+    ],
+)
+def test_every_report_has_an_energy_with_a_verdict(name, energy):
+    # Issue 36: report.energy is never None; its name says what was judged, and only affine
+    # constraints' work, which no run tracks, leaves it not judged.
+    scene = scenes.get(name)
+    report = varmech.check_conservation(varmech.integrate(scene, dt=scene.dt, steps=400))
+    assert report.energy.name == energy and report.verdict == report.energy.verdict
+    if scene.model.affine:
+        assert report.verdict == NOT_JUDGED and "moving surface does work" in report.energy.advice
+        assert report.energy not in report.quantities
+    else:
+        assert report.verdict in VERDICTS and report.energy in report.quantities
+
+
+def test_a_closure_energy_name_must_be_a_name():
+    with pytest.raises(TypeError, match="^energy_name: a non-empty str"):
+        varmech.Lagrangian(1, lambda q, v, t: 0.5 * v @ v, dl_dq=lambda q, v, t: 0 * q, dl_dv=lambda q, v, t: v, energy_name="")
 
 
 def test_every_verdict_word_is_reached():
@@ -294,7 +322,7 @@ DERIVATIVES = {"dl_dq": lambda q, v, t: -np.asarray(q, dtype=float), "dl_dv": la
 
 def test_a_non_finite_energy_fails_the_report_even_when_l_depends_on_t():
     # Issue 32 fuzz signature: L = −∞ with finite derivatives gave status 0 and the verdict
-    # "not conserved (L depends on t)". The motion is finite (the run uses only the
+    # "not conserved (L depends on t)", which judged nothing. The motion is finite (the run uses only the
     # derivatives), but the model's energy is not: the run's check of the energy balance
     # stops it at once, and without that check the report fails, naming where.
     model = varmech.Lagrangian(3, lambda q, v, t: -math.inf, time_dependent=True, dl_dt=lambda q, v, t: 0.0, **DERIVATIVES)
@@ -311,7 +339,7 @@ def test_a_non_finite_energy_fails_the_report_even_when_l_depends_on_t():
         finite = varmech.Lagrangian(1, lambda q, v, t: 0.5 * v @ v - 0.5 * (1 + 0.1 * math.cos(t)) * q @ q, time_dependent=True)
     traj = varmech.integrate(finite, [1.0], [0.0], dt=0.1, steps=10, method="midpoint")
     report = varmech.check_conservation(traj)
-    assert report.verdict == "not conserved (L depends on t); see the energy balance" and report.energy_balance is not None
+    assert report.energy.name == "energy balance"
 
 
 def test_a_lagrangian_that_turns_nan_after_the_run_fails_the_report():
@@ -337,9 +365,9 @@ def test_a_forced_balance_that_converges_at_the_methods_order_is_bounded():
     scene = scenes.damped_driven_pendulum()
     for method, order in [("midpoint", 2), ("galerkin4", 4)]:
         traj = varmech.integrate(scene, dt=scene.dt, t_end=1000.0, method=method, save_every=10)
-        unrefined = varmech.check_conservation(traj, refine=False).energy_balance
+        unrefined = varmech.check_conservation(traj, refine=False).energy
         assert unrefined.verdict == "secular drift"
-        balance = varmech.check_conservation(traj).energy_balance
+        balance = varmech.check_conservation(traj).energy
         assert balance.verdict == "bounded", balance
         measured = float(balance.advice.split("h^")[1].split()[0])
         assert order - 0.5 <= measured <= order + 0.7

@@ -85,6 +85,22 @@ fn a_compiled_lagrangian_follows_the_native_pendulum() {
 }
 
 #[test]
+fn a_tape_says_which_outputs_read_which_slots() {
+    // Outputs [sin q₀ · q̇₁, 2·q̇₁, t] of the slots [q₀, q₁, q̇₀, q̇₁, t]: what the delayed forces
+    // ask of their function (whether a term reads the state now).
+    let mut b = Builder::default();
+    let (q0, v1, t) = (b.input(0), b.input(3), b.input(4));
+    let s = b.unary(Unary::Sin, q0);
+    let product = b.binary(Binary::Mul, s, v1);
+    let two = b.op(Op::Const(2.0));
+    let double = b.binary(Binary::Mul, two, v1);
+    let tape = b.tape(vec![product, double, t], 2, 0);
+    assert!(tape.reads(0..1, |slot| slot == 0) && !tape.reads(1..3, |slot| slot == 0));
+    assert!(tape.reads(1..2, |slot| slot == 3) && !tape.reads(2..3, |slot| slot < 4));
+    assert!(!tape.reads(0..3, |slot| slot == 1 || slot == 2));
+}
+
+#[test]
 fn malformed_tapes_are_refused_with_their_name() {
     let later = Tape::new("gradient", vec![Op::Unary(Unary::Sin, 0)], vec![0], 3, 0);
     assert!(later.unwrap_err().to_string().starts_with("gradient: instruction 0"));

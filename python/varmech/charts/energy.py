@@ -61,9 +61,9 @@ def energy_error(trajectories: Mapping[str, Trajectory], path: str | Path, title
     fig, ax = plt.subplots(figsize=(7, 4.2), layout="constrained")
     for label, traj in trajectories.items():
         report = check_conservation(traj, generators=())
-        stats = report.energy or report.energy_balance
-        h = traj.energy() - (traj.work if traj.work is not None and traj.model.forced else 0.0)
-        scale = stats.scale if stats is not None and stats.scale > 0 else 1.0
+        stats = report.energy
+        h = traj.energy() - (traj.work if stats.name == "energy balance" else 0.0)
+        scale = stats.scale if stats.scale > 0 else 1.0
         err = np.abs(h - h[0]) / scale
         keep = (traj.t > 0) & (err > 0)
         ax.loglog(traj.t[keep], err[keep], label=f"{label}: {report.verdict}", lw=0.8)

@@ -11,7 +11,7 @@ import sympy as sp
 
 from .._progress import progress_bar
 from ..model import Cyclic, Symmetry
-from ._delays import Delayed, delayed_forces, delayed_tape
+from ._delays import Delayed, delayed_forces, delayed_tape, history_functions, history_tape
 from ._derive import derive, vanishes
 from ._inputs import Variables, check_symbols, expressions, parameters, variables
 from ._lower import check_compilable, lower
@@ -41,6 +41,7 @@ def lagrangian(
     added_mass: Any = None,
     mass_flow: MassFlow | Sequence[MassFlow] | None = None,
     delayed: Delayed | Sequence[Delayed] | None = None,
+    history: Any = None,
     symmetries: Sequence[Symmetry] = (),
     jit: bool = True,
     name: str = "symbolic lagrangian",
@@ -96,6 +97,11 @@ def lagrangian(
         and of the state τ ago, read from the run's own history (``midpoint`` and
         ``trapezoid``, at a step no longer than τ). Not with ``constraints`` or
         ``velocity_constraints``.
+    history
+        The state before the run for the delayed forces: q(t) for t ≤ t₀, one expression of t
+        (and the parameters) per coordinate, q̇ its derivative. Then every delayed term acts
+        from the start, reading the history where its past is before the run's first step;
+        without it, a term acts only once its past exists.
     symmetries
         Declared symmetries (:class:`~varmech.Translation`, :class:`~varmech.Rotation`,
         :class:`~varmech.Cyclic`); each cyclic coordinate found is added as a
@@ -131,7 +137,8 @@ def lagrangian(
         a ``mass_flow`` whose mass depends on q̇, whose point depends on q̇ or t, or whose
         velocity has another number of components than its point; a ``delayed`` term whose τ
         is not positive, whose past symbols are not one new symbol per coordinate, or with
-        constraints.
+        constraints; a ``history`` without ``delayed``, of the wrong length or depending on the
+        state.
 
     Examples
     --------
@@ -148,7 +155,7 @@ def lagrangian(
     return _build(
         variables_, variables_.plain(L, "L"), parameters, constraints, force, rayleigh, symmetries, jit, name, started,
         velocity_constraints=velocity_constraints, progress=progress, added_mass=added_mass,
-        mass_flow=mass_flow, delayed=delayed,
+        mass_flow=mass_flow, delayed=delayed, history=history,
     )
 
 
@@ -167,6 +174,7 @@ def mechanical(
     added_mass: Any = None,
     mass_flow: MassFlow | Sequence[MassFlow] | None = None,
     delayed: Delayed | Sequence[Delayed] | None = None,
+    history: Any = None,
     symmetries: Sequence[Symmetry] = (),
     jit: bool = True,
     name: str = "symbolic mechanical system",
@@ -189,7 +197,7 @@ def mechanical(
     v
         The velocity symbols; may be omitted (V and M hold no velocities: fresh symbols
         ``<q>_dot`` stand for them, as in ``expressions``).
-    t, parameters, constraints, velocity_constraints, force, rayleigh, added_mass, mass_flow, delayed, symmetries, jit, name, progress
+    t, parameters, constraints, velocity_constraints, force, rayleigh, added_mass, mass_flow, delayed, history, symmetries, jit, name, progress
         As for :func:`lagrangian`.
 
     Returns
@@ -225,7 +233,7 @@ def mechanical(
     return _build(
         variables_, L, parameters, constraints, force, rayleigh, symmetries, jit, name, started,
         velocity_constraints=velocity_constraints, progress=progress, added_mass=added_mass,
-        mass_flow=mass_flow, delayed=delayed,
+        mass_flow=mass_flow, delayed=delayed, history=history,
     )
 
 
@@ -369,6 +377,7 @@ def _build(
     added_mass: Any = None,
     mass_flow: Any = None,
     delayed: Any = None,
+    history: Any = None,
 ) -> SymbolicModel:
     """Checks, derives, lowers and compiles: the common path of :func:`lagrangian` and
     :func:`mechanical`."""
@@ -392,6 +401,9 @@ def _build(
         delays, delayed_exprs, q_past, v_past = delayed_forces(delayed, variables)
         # The delayed forces act beside Q: the model is forced, its work tracked.
         forces = forces or [sp.S.Zero] * n
+    if history is not None and delayed is None:
+        raise ValueError("history: the state before the run, which only delayed forces read; give delayed= with it")
+    past_state = history_functions(history, variables) if history is not None else []
     dissipation = variables.plain(rayleigh, "rayleigh") if rayleigh is not None else None
     holonomic = expressions(constraints, "constraints", variables) if constraints is not None else None
     nonholonomic = None
@@ -406,6 +418,7 @@ def _build(
         # The past symbols are inputs of the delayed forces' tape, not parameters.
         past = dict.fromkeys([*q_past, *v_past], sp.S.Zero)
         parts += [(f"delayed[{i // n}].force[{i % n}]", x.xreplace(past)) for i, x in enumerate(delayed_exprs)]
+    parts += [(f"history[{i}]", x) for i, x in enumerate(past_state[:n])]
     params = parameters(given_parameters, {s for _, x in parts for s in x.free_symbols}, variables)
     for what, x in parts:
         check_compilable(x, what)
@@ -429,6 +442,9 @@ def _build(
             now = list(functions["force"])
             tapes["delayed_force"] = delayed_tape(now + delayed_exprs, q_past, v_past, variables, params.index)
             functions["delayed_force"] = (*now, *delayed_exprs)
+        if past_state:
+            tapes["history"] = history_tape(past_state, variables, params.index)
+            functions["history"] = tuple(past_state)
         bar.set_description(f"{name}: compiling")
         declared = tuple(symmetries)
         found = tuple(Cyclic(i) for i in derivation.cyclic if Cyclic(i) not in declared)
@@ -445,6 +461,7 @@ def _build(
             symmetries=declared + found,
             jit=bool(jit),
             delays=delays,
+            energy_name="Jacobi integral" if derivation.moving_frame else "energy",
         )
         symbolic = Symbolic(variables.q, variables.v, variables.t, L, functions, derivation.cyclic, name)
         return SymbolicModel(spec, symbolic, started=started)

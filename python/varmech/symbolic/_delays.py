@@ -25,8 +25,9 @@ class Delayed:
     ``q_past`` and ``v_past`` are the symbols that stand for q(t − τ) and q̇(t − τ) in
     ``force``. The run reads them from its own history: exactly the method's own state τ ago
     when τ is a whole number of steps, its cubic Hermite interpolant otherwise. As the source
-    insists, the term acts only once its past exists, from t₀ + τ on (before, no history is
-    assumed). The delayed forces take the two-point rules (``midpoint``, ``trapezoid``) and a
+    insists, the term acts only once its past exists, from t₀ + τ on, unless the model is
+    given its state before the run (``history=`` of :func:`~varmech.symbolic.lagrangian`: then
+    the past before the run's first node is the history's). The delayed forces take the two-point rules (``midpoint``, ``trapezoid``) and a
     step no longer than τ.
 
     Attributes
@@ -98,6 +99,27 @@ def delayed_forces(delayed: Any, variables: Variables) -> tuple[tuple[float, ...
         q_past += past[0]
         v_past += past[1]
     return tuple(taus), forces, q_past, v_past
+
+
+def history_functions(history: Any, variables: Variables) -> list[sp.Expr]:
+    """q(s) and q̇(s) = dq/ds of ``history`` (n expressions of t and the parameters: the state
+    before the run), 2n; ValueError naming ``history`` for the wrong number or an expression of
+    the coordinates or velocities."""
+    n = len(variables.q)
+    q = expressions(history, "history", variables)
+    if len(q) != n:
+        raise ValueError(f"history: must give q(t) for each coordinate ({n}), got {len(q)}: {q}")
+    state = {*variables.q, *variables.v}
+    for i, x in enumerate(q):
+        if state & x.free_symbols:
+            raise ValueError(f"history[{i}]: the state before the run is a function of t alone, got {x}")
+        check_compilable(x, f"history[{i}]")
+    return [*q, *(sp.diff(x, variables.t) for x in q)]
+
+
+def history_tape(history: list[sp.Expr], variables: Variables, parameters: dict[sp.Symbol, int]) -> Tape:
+    """The tape of the history (q(s), q̇(s)), of the one slot [s]."""
+    return lower(history, {variables.t: 0}, parameters)
 
 
 def delayed_tape(

@@ -19,13 +19,15 @@ import sympy as sp
 @dataclass(frozen=True)
 class Derivation:
     """What the core needs of a model: its kind (``"lagrangian"`` or ``"separable"``), the
-    expressions of each function by name (outputs row-major), the cyclic coordinates, and
-    whether L depends on t."""
+    expressions of each function by name (outputs row-major), the cyclic coordinates,
+    whether L depends on t, and whether a t it held cancelled (a moving frame: its energy
+    function is a Jacobi integral)."""
 
     kind: str
     functions: dict[str, tuple[sp.Expr, ...]]
     cyclic: tuple[int, ...]
     time_dependent: bool
+    moving_frame: bool = False
 
 
 def vanishes(expr: sp.Expr) -> bool:
@@ -143,7 +145,8 @@ def _derive(
     """:func:`derive` over real symbols."""
     n = len(q)
     time_dependent = not _free_of(L, [t])
-    if not time_dependent and t in L.free_symbols:
+    moving_frame = not time_dependent and t in L.free_symbols
+    if moving_frame:
         # t cancels (a bead on a spinning hoop written in inertial coordinates: sin² + cos²):
         # L is the same at every t, so at t = 0, and every function derived from it is free of t.
         L = L.xreplace({t: sp.Integer(0)})
@@ -181,7 +184,7 @@ def _derive(
         # The coordinates a velocity constraint moves take its force Aᵀλ: their momenta change.
         and all(_free_of(c, [v[i]]) for c in velocity_constraints or ())
     )
-    return Derivation("lagrangian" if mass is None else "separable", functions, cyclic, time_dependent)
+    return Derivation("lagrangian" if mass is None else "separable", functions, cyclic, time_dependent, moving_frame)
 
 
 def _generalized_force(

@@ -37,6 +37,8 @@ class Spec:
     jit: bool
     velocity_constraints: int = 0
     delays: tuple[float, ...] = ()
+    #: What reports call E = p·q̇ − L: "Jacobi integral" for an L whose t cancelled.
+    energy_name: str = "energy"
 
 
 @dataclass(frozen=True)
@@ -292,6 +294,17 @@ class SymbolicModel(Model):
         """The delays τ of the model's delayed forces (``delayed=`` of its constructor)."""
         return self._spec.delays
 
+    @property
+    def has_history(self) -> bool:
+        """Whether ``history=`` gave the state before the run for the delayed forces."""
+        return "history" in self._spec.functions
+
+    @property
+    def energy_name(self) -> str:
+        """``"Jacobi integral"`` for an L from inertial coordinates whose t cancelled (a moving
+        frame), else ``"energy"``."""
+        return self._spec.energy_name
+
     def __reduce__(self) -> tuple[Any, ...]:
         # The tapes and expressions, never the compiled code: unpickling compiles them again.
         return (SymbolicModel, (self._spec, self._symbolic))
@@ -327,6 +340,7 @@ class SymbolicModel(Model):
             "symmetries": [symmetry_data(x) for x in spec.symmetries],
             "jit": spec.jit,
             "delays": list(spec.delays),
+            "energy_name": spec.energy_name,
         }
 
 
@@ -357,6 +371,7 @@ def _of_recipe(recipe: dict[str, Any]) -> SymbolicModel:
         velocity_constraints=field(recipe, "velocity_constraints", int),
         # A file written before delays were known has none.
         delays=tuple(float(x) for x in numbers(recipe.get("delays", []), "delays")),
+        energy_name=str(recipe.get("energy_name", "energy")),
     )
     expressions = field(recipe, "expressions", dict)
     symbolic = Symbolic(

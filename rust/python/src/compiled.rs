@@ -130,6 +130,7 @@ impl CompiledModel {
                 "dl_dt",
                 "masses",
                 "delayed_force",
+                "history",
                 "constraints",
                 "constraint_jacobian",
                 "velocity_constraints",
@@ -228,14 +229,18 @@ impl CompiledModel {
                     force,
                     (f("dl_dt")?, time_dependent),
                     f("masses")?,
-                    match delays.len() {
-                        0 => None,
-                        d => {
-                            // Its slots: [q, q(t − τ₁) …, q̇, q̇(t − τ₁) …, t], (1 + d)n of each.
-                            let f = function(py, &functions, "delayed_force", dim * (1 + d), k, jit)?;
-                            Some((required("delayed_force", f)?, delays))
-                        }
-                    },
+                    (
+                        match delays.len() {
+                            0 => None,
+                            d => {
+                                // Its slots: [q, q(t − τ₁) …, q̇, q̇(t − τ₁) …, t], (1 + d)n of each.
+                                let f = function(py, &functions, "delayed_force", dim * (1 + d), k, jit)?;
+                                Some((required("delayed_force", f)?, delays))
+                            }
+                        },
+                        // The state before the run, a function of the one slot [s].
+                        function(py, &functions, "history", 0, k, jit)?,
+                    ),
                 )
                 .map_err(err)?;
                 match (constraint_functions, rolling) {

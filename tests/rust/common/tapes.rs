@@ -105,7 +105,7 @@ pub fn pendulum_lagrangian() -> CompiledLagrangian {
         None,
         (None, false),
         None,
-        None,
+        (None, None),
     )
     .unwrap()
 }

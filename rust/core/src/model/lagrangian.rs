@@ -119,6 +119,21 @@ pub trait Lagrangian {
         &[]
     }
 
+    /// Writes the state before the run, q(s) and q̇(s) at s, into `q` and `v` where the model
+    /// gives its history (the initial function of its delayed forces) and returns true; false
+    /// where it gives none (then a delayed term acts only once its past exists). Default: none.
+    fn history(&self, _s: f64, _q: &mut [f64], _v: &mut [f64]) -> Result<bool, ModelError> {
+        Ok(false)
+    }
+
+    /// Whether the delayed terms of [`Lagrangian::delayed_force`] read the past alone (and t),
+    /// not the state now: then a step, whose force node keeps its t, evaluates them once and
+    /// Q alone ([`Lagrangian::force`], the same values as the first block) at each Newton
+    /// iteration. Default: false, every evaluation takes them all.
+    fn delayed_of_past_alone(&self) -> bool {
+        false
+    }
+
     /// Writes the forces of a model with delays into `out`, n(1 + d): first the force now,
     /// Q(q, q̇, t), then for each delay j the term of the state now and of the state τⱼ ago, each
     /// its own block so that a term whose past does not exist yet is left out (one evaluation

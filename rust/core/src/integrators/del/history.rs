@@ -11,8 +11,9 @@ use crate::ModelError;
 ///
 /// The state τ ago is a node's own state where t − τ falls on a node (τ a whole number of
 /// steps: exact, the method's own values), else the cubic Hermite interpolant of the two nodes
-/// about it (their q̄ and v̄). Before the run's first node nothing is known: a term whose past
-/// does not exist acts only once it does, as the source insists.
+/// about it (their q̄ and v̄). Before the run's first node the model's history gives it where
+/// the model has one ([`Lagrangian::history`]); otherwise nothing is known, and a term whose
+/// past does not exist acts only once it does, as the source insists.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub(super) struct History {
     n: usize,
@@ -24,14 +25,16 @@ pub(super) struct History {
     head: usize,
     filled: usize,
     /// [q, q(t − τ₁) …] and [v, v(t − τ₁) …], the delayed forces' arguments, and their
-    /// values [Q, the term of τ₁ …].
+    /// values [Q, the term of τ₁ …]; the sum of the terms acting.
     past_q: Vec<f64>,
     past_v: Vec<f64>,
     terms: Vec<f64>,
+    delayed: Vec<f64>,
     /// Whether each term's past exists at this evaluation.
     acting: Vec<bool>,
     /// The time whose past the arguments hold (NaN: none): a step evaluates its forces at one
-    /// node many times (Newton's iterations, a differenced Jacobian), its past read once.
+    /// node many times (Newton's iterations, a differenced Jacobian), its past read once, and
+    /// the delayed terms too where they read the past alone.
     #[serde(skip, default = "no_past")]
     read_at: f64,
 }
@@ -57,6 +60,7 @@ impl History {
             past_q: vec![0.0; (1 + d) * n],
             past_v: vec![0.0; (1 + d) * n],
             terms: vec![0.0; (1 + d) * n],
+            delayed: vec![0.0; n],
             acting: vec![false; d],
             read_at: no_past(),
         }
@@ -89,33 +93,46 @@ impl History {
         f: &mut [f64],
     ) -> Result<(), ModelError> {
         let n = self.n;
-        let delays = sys.delays();
-        self.past_q[..n].copy_from_slice(q);
-        self.past_v[..n].copy_from_slice(v);
-        if t != self.read_at {
-            for (j, tau) in delays.iter().enumerate() {
-                self.acting[j] = self.state_at(t - tau, j)?;
+        if t == self.read_at && sys.delayed_of_past_alone() {
+            sys.force(q, v, t, f)?;
+        } else {
+            if t != self.read_at {
+                for (j, tau) in sys.delays().iter().enumerate() {
+                    self.acting[j] = self.state_at(sys, t - tau, j)?;
+                }
+                self.read_at = t;
             }
-            self.read_at = t;
+            self.past_q[..n].copy_from_slice(q);
+            self.past_v[..n].copy_from_slice(v);
+            sys.delayed_force(&self.past_q, &self.past_v, t, &mut self.terms)?;
+            let (now, terms) = self.terms.split_at(n);
+            f.copy_from_slice(now);
+            self.delayed.fill(0.0);
+            for (block, _) in terms.chunks_exact(n).zip(&self.acting).filter(|(_, on)| **on) {
+                self.delayed.iter_mut().zip(block).for_each(|(d, x)| *d += x);
+            }
         }
-        sys.delayed_force(&self.past_q, &self.past_v, t, &mut self.terms)?;
-        let (now, terms) = self.terms.split_at(n);
-        f.copy_from_slice(now);
-        for (block, _) in terms.chunks_exact(n).zip(&self.acting).filter(|(_, on)| **on) {
-            f.iter_mut().zip(block).for_each(|(f, x)| *f += x);
-        }
+        f.iter_mut().zip(&self.delayed).for_each(|(f, d)| *f += d);
         Ok(())
     }
 
     /// Writes the state at time s into the block j + 1 of the arguments; false where s is
-    /// before the run's first node. Refuses a history that no longer reaches s (a step made
-    /// smaller since the ring was sized).
-    fn state_at(&mut self, s: f64, j: usize) -> Result<bool, ModelError> {
+    /// before the run's first node and the model gives no history. Refuses a history that no
+    /// longer reaches s (a step made smaller since the ring was sized).
+    fn state_at<S: Lagrangian + ?Sized>(&mut self, sys: &S, s: f64, j: usize) -> Result<bool, ModelError> {
         // Once a read, not a division a node: head is a value a checkpoint brings.
         self.head %= self.len();
         let (n, held) = (self.n, self.held());
+        let block = (j + 1) * n;
+        let before = |this: &mut Self| {
+            sys.history(
+                s,
+                &mut this.past_q[block..block + n],
+                &mut this.past_v[block..block + n],
+            )
+        };
         if held == 0 {
-            return Ok(false);
+            return before(self);
         }
         let time = |i: usize| self.times[self.slot(i)];
         let first = time(0);
@@ -130,7 +147,7 @@ impl History {
                 )
                 .into());
             }
-            return Ok(false);
+            return before(self);
         }
         // The last node at or before s: the nodes are a step apart (the step is kept), so its
         // index is the quotient, corrected by one either way for round-off in the times.
@@ -146,7 +163,6 @@ impl History {
         } else if lo < last && time(lo + 1) <= s + tolerance {
             lo += 1;
         }
-        let block = (j + 1) * n;
         let a = self.slot(lo) * n;
         if (time(lo) - s).abs() <= tolerance || lo + 1 >= held {
             self.past_q[block..block + n].copy_from_slice(&self.q[a..a + n]);

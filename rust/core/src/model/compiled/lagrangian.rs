@@ -11,7 +11,9 @@ use crate::{Error, ModelError};
 /// ∂L/∂t (differenced from L where a model stored before it was compiled lacks it); for a
 /// model of variable mass, its masses m(q, t), which must stay positive and finite; for delayed
 /// forces, their delays and one function of the slots [q, q(t − τ₁) …, q̇, q̇(t − τ₁) …, t]
-/// whose outputs are Q, then a block of n a delay.
+/// whose outputs are Q, then a block of n a delay (and whether those blocks read the past
+/// alone, not the state now), with the history before the run where given: (q(s), q̇(s)), a
+/// function of the one slot [s].
 #[derive(Clone, Debug)]
 pub struct CompiledLagrangian {
     n: usize,
@@ -24,6 +26,8 @@ pub struct CompiledLagrangian {
     time_dependent: bool,
     masses: Option<Function>,
     delayed: Option<(Function, Vec<f64>)>,
+    delayed_of_past_alone: bool,
+    history: Option<Function>,
 }
 
 impl CompiledLagrangian {
@@ -40,7 +44,7 @@ impl CompiledLagrangian {
         force: Option<Function>,
         (dl_dt, time_dependent): (Option<Function>, bool),
         masses: Option<Function>,
-        delayed: Option<(Function, Vec<f64>)>,
+        (delayed, history): (Option<(Function, Vec<f64>)>, Option<Function>),
     ) -> Result<Self, Error> {
         check_parameters(&params, lagrangian.tape().params())?;
         check("lagrangian", &lagrangian, 1, n, Inputs::All, &params)?;
@@ -71,6 +75,20 @@ impl CompiledLagrangian {
             let d = delays.len();
             check("delayed_force", f, n * (1 + d), n * (1 + d), Inputs::All, &params)?;
         }
+        if let Some(f) = &history {
+            if delayed.is_none() {
+                return Err(Error::invalid(
+                    "history",
+                    "given without delayed forces, which alone read it",
+                ));
+            }
+            check("history", f, 2 * n, 0, Inputs::All, &params)?;
+        }
+        let delayed_of_past_alone = delayed.as_ref().is_some_and(|(f, delays)| {
+            let m = n * (1 + delays.len());
+            // The slots of q and q̇ now: the first n of each block of m.
+            !f.tape().reads(n..m, |s| s < n || (m..m + n).contains(&s))
+        });
         Ok(CompiledLagrangian {
             n,
             params,
@@ -82,6 +100,8 @@ impl CompiledLagrangian {
             time_dependent,
             masses,
             delayed,
+            delayed_of_past_alone,
+            history,
         })
     }
 
@@ -177,6 +197,22 @@ impl Lagrangian for CompiledLagrangian {
 
     fn delays(&self) -> &[f64] {
         self.delayed.as_ref().map_or(&[], |(_, d)| d)
+    }
+
+    fn delayed_of_past_alone(&self) -> bool {
+        self.delayed_of_past_alone
+    }
+
+    fn history(&self, s: f64, q: &mut [f64], v: &mut [f64]) -> Result<bool, ModelError> {
+        let Some(f) = &self.history else {
+            return Ok(false);
+        };
+        f.eval_into(&[], &[], s, &self.params, |state| {
+            let (at, rate) = state.split_at(self.n);
+            q.copy_from_slice(at);
+            v.copy_from_slice(rate);
+        });
+        Ok(true)
     }
 
     fn delayed_force(&self, q: &[f64], v: &[f64], t: f64, out: &mut [f64]) -> Result<(), ModelError> {

@@ -272,6 +272,21 @@ impl Tape {
             .unwrap_or(0)
     }
 
+    /// Whether any of the outputs `outputs` reads an input slot for which `slot` is true,
+    /// directly or through earlier registers.
+    pub fn reads(&self, outputs: std::ops::Range<usize>, slot: impl Fn(usize) -> bool) -> bool {
+        let mut reads = vec![false; self.ops.len()];
+        for i in 0..self.ops.len() {
+            reads[i] = match self.ops[i] {
+                Op::Input(s) => slot(s as usize),
+                Op::Const(_) | Op::Param(_) => false,
+                Op::Unary(_, a) | Op::Powi(a, _) => reads[a as usize],
+                Op::Binary(_, a, b) => reads[a as usize] || reads[b as usize],
+            };
+        }
+        self.outputs[outputs].iter().any(|&r| reads[r as usize])
+    }
+
     /// Runs the tape: registers in `regs` (at least as many as instructions), outputs into
     /// `out` (as many as outputs). `inputs` and `params` have the tape's lengths.
     pub fn eval(&self, inputs: &[f64], params: &[f64], regs: &mut [f64], out: &mut [f64]) {
