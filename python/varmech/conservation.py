@@ -316,8 +316,10 @@ def _statistics(record: _core.Statistics, name: str, initial: float, scale_name:
 NOT_JUDGED = "not judged"
 #: Why: affine velocity constraints' forces do work.
 AFFINE = "not conserved: the affine velocity constraints' moving surface does work, which the run does not track"
+#: The name of ``report.energy`` for a forced model or an L that depends on t: E − W is judged.
+BALANCE = "energy balance"
 #: The names ``report.energy`` takes, and their symbols in the report's text.
-_SYMBOLS = {"energy": "H", "Jacobi integral": "h", "energy balance": "(E − W)"}
+_SYMBOLS = {"energy": "H", "Jacobi integral": "h", BALANCE: "(E − W)"}
 
 
 @dataclass(frozen=True)
@@ -550,7 +552,7 @@ def energy_statistics(
     e, kinetic, potential = _core.energy_terms(model._core, t, q, p)
     w = np.zeros(len(t)) if work is None else np.ascontiguousarray(work, dtype=float)
     record = _core.energy_statistics(t, e, kinetic, potential, w, int(steps))
-    return _statistics(record, model.energy_name if work is None else "energy balance", e[0] - w[0], "mean kinetic energy", t)
+    return _statistics(record, model.energy_name if work is None else BALANCE, e[0] - w[0], "mean kinetic energy", t)
 
 
 def _refined(traj: Trajectory, stats: InvariantStatistics) -> InvariantStatistics:

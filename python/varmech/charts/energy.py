@@ -7,7 +7,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..conservation import check_conservation
+from ..conservation import BALANCE, check_conservation
 from ..trajectory import Trajectory
 from ._figure import documented, pyplot, save, time_label
 
@@ -62,7 +62,7 @@ def energy_error(trajectories: Mapping[str, Trajectory], path: str | Path, title
     for label, traj in trajectories.items():
         report = check_conservation(traj, generators=())
         stats = report.energy
-        h = traj.energy() - (traj.work if stats.name == "energy balance" else 0.0)
+        h = traj.energy() - (traj.work if stats.name == BALANCE else 0.0)
         scale = stats.scale if stats.scale > 0 else 1.0
         err = np.abs(h - h[0]) / scale
         keep = (traj.t > 0) & (err > 0)

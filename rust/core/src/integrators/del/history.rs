@@ -25,11 +25,11 @@ pub(super) struct History {
     head: usize,
     filled: usize,
     /// [q, q(t − τ₁) …] and [v, v(t − τ₁) …], the delayed forces' arguments, and their
-    /// values [Q, the term of τ₁ …]; the sum of the terms acting.
+    /// values [Q, the term of τ₁ …], Q's block then overwritten by the sum of the terms acting
+    /// (kept for the step's later evaluations: no state of its own to checkpoint).
     past_q: Vec<f64>,
     past_v: Vec<f64>,
     terms: Vec<f64>,
-    delayed: Vec<f64>,
     /// Whether each term's past exists at this evaluation.
     acting: Vec<bool>,
     /// The time whose past the arguments hold (NaN: none): a step evaluates its forces at one
@@ -60,7 +60,6 @@ impl History {
             past_q: vec![0.0; (1 + d) * n],
             past_v: vec![0.0; (1 + d) * n],
             terms: vec![0.0; (1 + d) * n],
-            delayed: vec![0.0; n],
             acting: vec![false; d],
             read_at: no_past(),
         }
@@ -105,14 +104,14 @@ impl History {
             self.past_q[..n].copy_from_slice(q);
             self.past_v[..n].copy_from_slice(v);
             sys.delayed_force(&self.past_q, &self.past_v, t, &mut self.terms)?;
-            let (now, terms) = self.terms.split_at(n);
-            f.copy_from_slice(now);
-            self.delayed.fill(0.0);
+            let (sum, terms) = self.terms.split_at_mut(n);
+            f.copy_from_slice(sum);
+            sum.fill(0.0);
             for (block, _) in terms.chunks_exact(n).zip(&self.acting).filter(|(_, on)| **on) {
-                self.delayed.iter_mut().zip(block).for_each(|(d, x)| *d += x);
+                sum.iter_mut().zip(block).for_each(|(d, x)| *d += x);
             }
         }
-        f.iter_mut().zip(&self.delayed).for_each(|(f, d)| *f += d);
+        f.iter_mut().zip(&self.terms[..n]).for_each(|(f, d)| *f += d);
         Ok(())
     }
 
