@@ -1,4 +1,4 @@
-//! Events: the Illinois root finder, and crossings of the harmonic oscillator located by the
+//! Events: the Illinois and bracketed Newton root finders, and crossings of the harmonic oscillator located by the
 //! method's partial step, at the method's order, with directions and terminal counts; a
 //! billiard's ellipse located at the exact time.
 
@@ -6,7 +6,7 @@ use std::f64::consts::PI;
 
 use varmech::integrators::{integrate, integrate_with_events, Detector, EventSpec, Method, NativeEvent, Options};
 use varmech::scenes::{EllipticBilliard, HarmonicOscillator};
-use varmech::solve::bracket::illinois;
+use varmech::solve::bracket::{illinois, newton};
 
 #[test]
 fn illinois_finds_a_root_to_round_off_in_few_evaluations() {
@@ -22,6 +22,41 @@ fn illinois_finds_a_root_to_round_off_in_few_evaluations() {
     assert!(calls <= 8, "{calls} evaluations");
     // A failing function's error comes back.
     let failing = illinois(|_| Err("model failed"), (0.0, -1.0), (1.0, 1.0), 0.0);
+    assert_eq!(failing, Err("model failed"));
+}
+
+#[test]
+fn newton_in_the_bracket_finds_a_root_to_round_off_in_fewer_evaluations() {
+    // cos on [0, 2], a tolerance of 4 ulps of the bracket (as contacts locate): with the exact
+    // derivative, quadratic convergence (Illinois takes 6 here); with one 0.1% off, as an
+    // impact's ∇φ·q̇ is off the partial step's rate, nearly so; with one 30% off, linear at rate
+    // 1 − 1/1.3 = 0.23; with a useless one (of the wrong sign), the bracket's bisection (2⁻⁵⁰);
+    // each to round-off of π/2.
+    let tolerance = 4.0 * f64::EPSILON * 2.0;
+    for (scale, most) in [(1.0, 5), (1.001, 7), (1.3, 27), (-1.0, 52)] {
+        let mut calls = 0;
+        let f = |x: f64| {
+            calls += 1;
+            Ok::<_, ()>((x.cos(), -scale * x.sin()))
+        };
+        let (x, fx) = newton(f, (0.0, 1.0), (2.0, 2.0_f64.cos()), tolerance).unwrap();
+        assert!((x - PI / 2.0).abs() <= tolerance, "{x}, derivative × {scale}");
+        assert!(fx.abs() <= 1e-15, "{fx}");
+        assert!(calls <= most, "{calls} evaluations, derivative × {scale}");
+    }
+    // A root at an end of the bracket, and tolerance 0 (4 ulps of the root).
+    let (x, fx) = newton(|x: f64| Ok::<_, ()>((x - 1.0, 1.0)), (1.0, 0.0), (3.0, 2.0), 0.0).unwrap();
+    assert_eq!((x, fx), (1.0, 0.0));
+    let mut calls = 0;
+    let f = |x: f64| {
+        calls += 1;
+        Ok::<_, ()>((x * x - 2.0, 2.0 * x))
+    };
+    let (x, _) = newton(f, (0.0, -2.0), (2.0, 2.0), 0.0).unwrap();
+    assert!((x - 2.0_f64.sqrt()).abs() <= 4.0 * f64::EPSILON * 2.0, "{x}");
+    assert!(calls <= 7, "{calls} evaluations");
+    // A failing function's error comes back.
+    let failing = newton(|_| Err("model failed"), (0.0, -1.0), (1.0, 1.0), 0.0);
     assert_eq!(failing, Err("model failed"));
 }
 

@@ -68,7 +68,7 @@ pub trait Dynamics {
     /// stops after the first step that is not clear ([`Gaps::clear`]), which is kept; true
     /// then. By default, one step after the other.
     fn advance_while(&self, state: &mut StepperState, steps: usize, gaps: &mut Gaps<'_, '_>) -> Result<bool, Error> {
-        state.step_while(self, steps, &mut |q: &[f64]| gaps.clear(q))
+        state.step_while(self, steps, gaps)
     }
 
     /// The energy function and its terms at (q, p, t), where no constraint does work (a forced
@@ -154,7 +154,7 @@ impl<S: MechanicalSystem> Dynamics for S {
     }
 
     fn advance_while(&self, state: &mut StepperState, steps: usize, gaps: &mut Gaps<'_, '_>) -> Result<bool, Error> {
-        state.advance_separable_while(self, steps, &mut |q: &[f64]| gaps.clear(q))
+        state.advance_separable_while(self, steps, gaps)
     }
 
     fn energy(&self, q: &[f64], p: &[f64], t: f64) -> Option<Result<EnergyTerms, ModelError>> {
@@ -196,7 +196,7 @@ impl<L: Lagrangian> Dynamics for General<'_, L> {
     }
 
     fn advance_while(&self, state: &mut StepperState, steps: usize, gaps: &mut Gaps<'_, '_>) -> Result<bool, Error> {
-        state.advance_lagrangian_while(self.0, steps, &mut |q: &[f64]| gaps.clear(q))
+        state.advance_lagrangian_while(self.0, steps, gaps)
     }
 
     /// E = p·q̇ − L: conserved, or (forced, L depending on t) balanced against the work.

@@ -1,4 +1,4 @@
-use super::stepper::Phase;
+use super::stepper::{Clear, Phase};
 use super::{Increment, Splitting, StepError, StepStart};
 use crate::model::MechanicalSystem;
 use crate::{Error, ModelError};
@@ -87,7 +87,7 @@ impl KickDrift {
     /// so that the results agree bit for bit. Called by the stepper for small separable
     /// systems ([`StepperState`](super::StepperState)), stopping after a step whose end is
     /// not `clear` ([`Phase::run`]).
-    pub(super) fn run<S: MechanicalSystem + ?Sized, const N: usize, C: FnMut(&[f64]) -> bool + ?Sized>(
+    pub(super) fn run<S: MechanicalSystem + ?Sized, const N: usize, C: Clear + ?Sized>(
         &mut self,
         sys: &S,
         state: Phase<'_>,

@@ -80,7 +80,7 @@ pub use run::{
 pub use splitting::{Leading, Splitting};
 pub use step::{Increment, StepStart};
 use stepper::Phase;
-pub use stepper::{Stepper, StepperState};
+pub use stepper::{Clear, Stepper, StepperState};
 pub use trajectory::{Failure, Trajectory};
 pub use wisdom_holman::{Kernel, WisdomHolman};
 
@@ -328,7 +328,7 @@ impl Integrator {
     /// loop of the two-point DEL methods ([`Del::run`]); None where it does not apply (another
     /// method, constraints, forces, or the run's first step, which the general step makes),
     /// stopping after a step whose end is not `clear` (true then, [`Phase::run`]).
-    fn run_two_point<S: Lagrangian + ?Sized, const N: usize, C: FnMut(&[f64]) -> bool + ?Sized>(
+    fn run_two_point<S: Lagrangian + ?Sized, const N: usize, C: Clear + ?Sized>(
         &mut self,
         sys: &S,
         phase: Phase<'_>,

@@ -7,7 +7,7 @@
 use super::{correct, finite_jacobian, segment, Constraints, Del, Equations, TwoPoint, REASONS};
 use crate::discrete::{DiscreteLagrangian, Workspace};
 use crate::integrators::del::StepEquations;
-use crate::integrators::stepper::Phase;
+use crate::integrators::stepper::{Clear, Phase};
 use crate::integrators::{StepError, StepStart};
 use crate::model::Lagrangian;
 use crate::solve::lu::{factorise, substitute};
@@ -24,7 +24,7 @@ impl<R: DiscreteLagrangian> Del<TwoPoint<R>> {
     /// `steps` steps of N coordinates, as [`Del::increment`] makes them when
     /// [`Del::runs_fixed`] holds. The Jacobian is [`Equations`]' own (exact, or by differences
     /// for a model without second derivatives), factorised on the stack.
-    pub(in crate::integrators) fn run<S: Lagrangian + ?Sized, const N: usize, C: FnMut(&[f64]) -> bool + ?Sized>(
+    pub(in crate::integrators) fn run<S: Lagrangian + ?Sized, const N: usize, C: Clear + ?Sized>(
         &mut self,
         sys: &S,
         phase: Phase<'_>,

@@ -68,10 +68,11 @@ pub(crate) fn check_ellipsoid(coordinates: &[usize], centre: &[f64], semi_axes: 
         .map(|a| format!("semi-axis must be finite and positive, got {a}"))
 }
 
-impl Surface for NativeSurface {
+impl NativeSurface {
+    /// φ(q), which a native surface always has.
     #[inline(always)]
-    fn phi(&self, q: &[f64]) -> Result<f64, ModelError> {
-        Ok(match self {
+    pub(crate) fn value(&self, q: &[f64]) -> f64 {
+        match self {
             NativeSurface::Wall { coordinate, value } => wall(q, *coordinate, *value),
             NativeSurface::Ellipsoid {
                 coordinates,
@@ -79,7 +80,14 @@ impl Surface for NativeSurface {
                 semi_axes,
                 inside,
             } => ellipsoid(q, coordinates, centre, semi_axes, *inside),
-        })
+        }
+    }
+}
+
+impl Surface for NativeSurface {
+    #[inline(always)]
+    fn phi(&self, q: &[f64]) -> Result<f64, ModelError> {
+        Ok(self.value(q))
     }
 
     /// ∇φ: the unit vector e_k of the wall; −2s uᵢ/aᵢ in coordinate kᵢ of the ellipsoid.
