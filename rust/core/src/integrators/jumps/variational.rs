@@ -18,12 +18,18 @@ pub(super) fn multiplier(
 ) -> Result<(f64, bool), Error> {
     // An implicit rule's E_d(λ), from a Newton solve, can stall a few ulps from the root, where
     // the secant sees no slope.
+    // A λ whose E_d is within that noise of the target is the root as far as E_d can tell:
+    // no further secant could tell a better one (the billiard's, where the laws coincide, is
+    // the reflection's at once).
     let noise = 16.0 * f64::EPSILON * (target.abs() + scale.abs());
     let (mut lam0, mut lam1) = (exact, exact * (1.0 + 1e-6));
     let mut f0 = after(lam0)? - target;
+    if f0.abs() <= noise {
+        return Ok((exact, true));
+    }
     for _ in 0..40 {
         let f1 = after(lam1)? - target;
-        if f1 == 0.0 || (lam1 - lam0).abs() <= 4.0 * f64::EPSILON * lam1.abs() || (f1 == f0 && f1.abs() <= noise) {
+        if f1.abs() <= noise || (lam1 - lam0).abs() <= 4.0 * f64::EPSILON * lam1.abs() {
             let (lo, hi) = if exact > 0.0 {
                 (0.5 * exact, 1.5 * exact)
             } else {
