@@ -441,6 +441,9 @@ def occurrences(record: Any, contacts: Sequence[Contact | str], *, after: bool =
         return ()
     index, t, q, before, p_after = record.impacts
     p = p_after if after else before
+    if len(contacts) == 1:
+        # Every impact is the one contact's: no mask (an ensemble makes these for every member).
+        return (Occurrences(name(contacts[0]), t, q, p),)
     return tuple(Occurrences(name(c), t[index == i], q[index == i], p[index == i]) for i, c in enumerate(contacts))
 
 
@@ -453,6 +456,8 @@ def switches(record: Any, contacts: Sequence[Contact | str]) -> tuple[Occurrence
         return ()
     index, t, kind, q, p = record.switches
     names = occurrence_names(contacts)[len(contacts) :]
+    if len(t) == 0:
+        return tuple(Occurrences(n, t, q, p) for n in names)
     rows = [(index == i) & (kind == code) for code in range(len(SWITCHES)) for i in range(len(contacts))]
     return tuple(Occurrences(n, t[r], q[r], p[r]) for n, r in zip(names, rows))
 
