@@ -1667,9 +1667,10 @@ pub struct Gaps<'g, 's> {
     phi: &'g mut [f64],
     phi_end: &'g mut [f64],
     swapped: bool,
-    /// Every φ at the next step's start is > 0, and `phi` is not kept; `phi` has not been kept
-    /// since some step.
+    /// Flight mode: every φ at the next step's start is > 0, and `phi` is not kept.
     above: bool,
+    /// `phi` may not hold φ at the next step's start (flight mode was entered): the resolver
+    /// evaluates it again.
     stale: bool,
     error: Option<ModelError>,
 }
