@@ -125,12 +125,10 @@ where
     /// names the step (counted from 1) and the time it started at.
     pub fn step(&mut self) -> Result<(), Error> {
         let state = self.state.borrow_mut();
-        let result = if state.integrator.own_variables().is_some() {
-            // The method's own loop, which a step from (q, p) would restart.
-            self.model.advance(state, 1)
-        } else {
-            state.step(&*self.model)
-        };
+        // The model's own loop, one step long: the fixed-size loops of small systems (the bits
+        // of a generic step, at half its cost: the partial steps of impacts take it), and the
+        // own variables of a method that has them, which a step from (q, p) would restart.
+        let result = self.model.advance(state, 1);
         state.synchronise();
         result
     }
