@@ -39,24 +39,36 @@ fn newton_in_the_bracket_finds_a_root_to_round_off_in_fewer_evaluations() {
             calls += 1;
             Ok::<_, ()>((x.cos(), -scale * x.sin()))
         };
-        let (x, fx) = newton(f, (0.0, 1.0), (2.0, 2.0_f64.cos()), tolerance).unwrap();
+        let (x, fx) = newton(f, (0.0, 1.0), (2.0, 2.0_f64.cos()), None, tolerance).unwrap();
         assert!((x - PI / 2.0).abs() <= tolerance, "{x}, derivative × {scale}");
         assert!(fx.abs() <= 1e-15, "{fx}");
         assert!(calls <= most, "{calls} evaluations, derivative × {scale}");
     }
     // A root at an end of the bracket, and tolerance 0 (4 ulps of the root).
-    let (x, fx) = newton(|x: f64| Ok::<_, ()>((x - 1.0, 1.0)), (1.0, 0.0), (3.0, 2.0), 0.0).unwrap();
+    let (x, fx) = newton(|x: f64| Ok::<_, ()>((x - 1.0, 1.0)), (1.0, 0.0), (3.0, 2.0), None, 0.0).unwrap();
     assert_eq!((x, fx), (1.0, 0.0));
     let mut calls = 0;
     let f = |x: f64| {
         calls += 1;
         Ok::<_, ()>((x * x - 2.0, 2.0 * x))
     };
-    let (x, _) = newton(f, (0.0, -2.0), (2.0, 2.0), 0.0).unwrap();
+    let (x, _) = newton(f, (0.0, -2.0), (2.0, 2.0), None, 0.0).unwrap();
     assert!((x - 2.0_f64.sqrt()).abs() <= 4.0 * f64::EPSILON * 2.0, "{x}");
     assert!(calls <= 7, "{calls} evaluations");
+    // From a guess at the root (an interpolant's, as an impact's): that point and the probe
+    // past it. A guess outside the bracket is not taken: the secant point's evaluations.
+    for (guess, most) in [(Some(2.0_f64.sqrt()), 2), (Some(-1.0), 7), (Some(f64::NAN), 7)] {
+        let mut calls = 0;
+        let f = |x: f64| {
+            calls += 1;
+            Ok::<_, ()>((x * x - 2.0, 2.0 * x))
+        };
+        let (x, _) = newton(f, (0.0, -2.0), (2.0, 2.0), guess, 0.0).unwrap();
+        assert!((x - 2.0_f64.sqrt()).abs() <= 4.0 * f64::EPSILON * 2.0, "{x}");
+        assert!(calls <= most, "{calls} evaluations from {guess:?}");
+    }
     // A failing function's error comes back.
-    let failing = newton(|_| Err("model failed"), (0.0, -1.0), (1.0, 1.0), 0.0);
+    let failing = newton(|_| Err("model failed"), (0.0, -1.0), (1.0, 1.0), None, 0.0);
     assert_eq!(failing, Err("model failed"));
 }
 

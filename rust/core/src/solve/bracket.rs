@@ -58,8 +58,10 @@ pub fn illinois<E>(
 }
 
 /// A root x* of f on the bracket [a, b], as [`illinois`], by Newton's method kept inside the
-/// bracket: `f` gives the value and an estimate of the derivative at a point. From the secant
-/// point, each next point is the Newton point from the last; where that leaves the bracket, or
+/// bracket: `f` gives the value and an estimate of the derivative at a point. From `guess`
+/// where it lies inside the bracket (an interpolant's root: an impact's is the quadratic's
+/// through φ at both ends with the rate at the start, exact on a straight or parabolic flight),
+/// else from the secant point, each next point is the Newton point from the last; where that leaves the bracket, or
 /// moves more than half the step before (convergence slower than bisection's), the bracket's
 /// midpoint. Once a Newton step is within half the tolerance (or 4 ulps), the next point goes a
 /// quarter of it past, to close the bracket on the root's other side. With an exact
@@ -71,9 +73,11 @@ pub fn newton<E>(
     mut f: impl FnMut(f64) -> Result<(f64, f64), E>,
     (mut a, mut fa): (f64, f64),
     (mut b, mut fb): (f64, f64),
+    guess: Option<f64>,
     tolerance: f64,
 ) -> Result<(f64, f64), E> {
-    let mut x = b - fb * (b - a) / (fb - fa);
+    let inside = |x: f64| a.min(b) < x && x < a.max(b);
+    let mut x = guess.filter(|&x| inside(x)).unwrap_or(b - fb * (b - a) / (fb - fa));
     let mut last_step = f64::INFINITY;
     for _ in 0..MAX_EVALUATIONS {
         if fa == 0.0 || fb == 0.0 || converged(a, b, tolerance) {

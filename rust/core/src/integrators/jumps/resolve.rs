@@ -15,6 +15,7 @@ use crate::integrators::events::Search;
 use crate::integrators::DiscreteEnergy;
 use crate::integrators::{Clear, Counting, Dynamics, Method, Occurrence, Poll, Stepper, StepperState, Trajectory};
 use crate::solve::bracket::{illinois, newton};
+use crate::model::Lagrangian;
 use crate::{Error, ModelError};
 
 /// Why the variational law does not fit `method` on `model`, if it does not: it needs the
@@ -112,6 +113,18 @@ pub(in crate::integrators) struct Resolver<'c, 's, M> {
     /// The friction work of the last partial step, and of the step's pieces so far.
     piece_work: f64,
     step_work: f64,
+    /// The end of the partial step nearest the surface that the last location stepped to.
+    nearest: Nearest,
+}
+
+/// The end (q, p) of the partial step of size s from a piece's start at ta, `at` = (ta, s),
+/// and its friction work: kept by [`Resolver::locate`], so that the contact state is not
+/// stepped to again.
+struct Nearest {
+    at: Option<(f64, f64)>,
+    q: Vec<f64>,
+    p: Vec<f64>,
+    work: f64,
 }
 
 /// Friction switches in one step at most: more is a stick–slip chatter the step cannot
@@ -193,6 +206,12 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
             direction: vec![0.0; n],
             piece_work: 0.0,
             step_work: 0.0,
+            nearest: Nearest {
+                at: None,
+                q: vec![0.0; n],
+                p: vec![0.0; n],
+                work: 0.0,
+            },
         };
         if resolver.frictional && resolver.hold.is_none() {
             return Err(Error::invalid(
@@ -775,11 +794,8 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
                     Hold::methods()
                 )));
             }
-            // The contact state (q̃, p⁻), the end of this piece.
-            self.partial(step, ta, s)?;
+            self.contact_state(step, ta, s)?;
             self.step_work += self.piece_work;
-            self.contact_q.copy_from_slice(self.scratch.q());
-            self.contact_p.copy_from_slice(self.scratch.p());
             let t_contact = ta + s;
             if let Some(search) = search.as_deref_mut() {
                 search.piece(step, (t_contact, &self.contact_q, &self.contact_p), s, occurrences)?;
@@ -1449,22 +1465,39 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
     fn locate(&mut self, j: usize, step: usize, (ta, tau): (f64, f64), leaving: bool) -> Result<Option<f64>, Located> {
         let floor = floor(self.phi_start[j], leaving);
         let start = (0.0, self.phi_start[j] - floor);
-        let (a, b) = if leaving {
+        let ((a, b), guess) = if leaving {
             match self.leaving_bracket(j, step, (ta, tau), start, floor)? {
-                Some(bracket) => bracket,
+                Some(bracket) => (bracket, None),
                 None => return Ok(None),
             }
         } else {
-            (start, (tau, self.phi_end[j]))
+            // The partial steps' q(s) leaves with the velocity q̇ at the piece's start.
+            let (model, time) = (self.scratch.model().as_lagrangian(), self.t);
+            let vectors = (&mut self.normal[..], &mut self.v[..]);
+            let rate = phi_rate(&self.contacts[j], model, (ta, &self.piece_q, &self.piece_p), vectors)
+                .map_err(|source| Error::Model { step, time, source })?;
+            let end = (tau, self.phi_end[j]);
+            ((start, end), Some(quadratic_root(start.1, rate, end)))
         };
         let tolerance = 4.0 * f64::EPSILON * tau;
+        self.nearest.at = None;
+        let mut least = f64::INFINITY;
         let (s, _) = newton(
             |s| {
                 let (phi, rate) = self.phi_rate_along(j, step, ta, s)?;
+                if (phi - floor).abs() < least {
+                    least = (phi - floor).abs();
+                    let Nearest { at, q, p, work } = &mut self.nearest;
+                    *at = Some((ta, s));
+                    q.copy_from_slice(self.scratch.q());
+                    p.copy_from_slice(self.scratch.p());
+                    *work = self.piece_work;
+                }
                 Ok::<_, Error>((phi - floor, rate))
             },
             a,
             b,
+            guess,
             tolerance,
         )?;
         Ok(Some(s))
@@ -1475,19 +1508,11 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
     /// steps' own rate in s, which is what [`newton`] needs.
     fn phi_rate_along(&mut self, j: usize, step: usize, ta: f64, s: f64) -> Result<(f64, f64), Error> {
         let phi = self.phi_along(j, step, ta, s)?;
-        let model_error = |source| Error::Model {
-            step,
-            time: self.t,
-            source,
-        };
-        let (q, p) = (self.scratch.q(), self.scratch.p());
-        self.contacts[j]
-            .surface
-            .gradient(q, &mut self.normal)
-            .map_err(model_error)?;
-        let model = self.scratch.model().as_lagrangian();
-        model.velocity(q, p, ta + s, &mut self.v).map_err(model_error)?;
-        Ok((phi, dot(&self.normal, &self.v)))
+        let (model, time) = (self.scratch.model().as_lagrangian(), self.t);
+        let state = (ta + s, self.scratch.q(), self.scratch.p());
+        let rate = phi_rate(&self.contacts[j], model, state, (&mut self.normal, &mut self.v))
+            .map_err(|source| Error::Model { step, time, source })?;
+        Ok((phi, rate))
     }
 
     /// The bracket of a crossing of φⱼ − `floor` (`start` its value at s = 0) on a piece
@@ -1524,6 +1549,22 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
             hi = x;
         }
         Err(Located::Resting)
+    }
+
+    /// The contact state (q̃, p⁻) into the contact buffers, and its work: the end of the
+    /// partial step of size s from the piece's start at ta, kept by the location where it is
+    /// that one.
+    fn contact_state(&mut self, step: usize, ta: f64, s: f64) -> Result<(), Error> {
+        if self.nearest.at == Some((ta, s)) {
+            self.contact_q.copy_from_slice(&self.nearest.q);
+            self.contact_p.copy_from_slice(&self.nearest.p);
+            self.piece_work = self.nearest.work;
+            return Ok(());
+        }
+        self.partial(step, ta, s)?;
+        self.contact_q.copy_from_slice(self.scratch.q());
+        self.contact_p.copy_from_slice(self.scratch.p());
+        Ok(())
     }
 
     /// φⱼ at the end of the partial step of size s from the piece's start.
@@ -1593,6 +1634,27 @@ impl From<Error> for Located {
     fn from(e: Error) -> Self {
         Located::Error(e)
     }
+}
+
+/// ∇φ·q̇ of `contact` at the state (t, q, p), with ∇φ and q̇ left in `normal` and `v`.
+fn phi_rate(
+    contact: &Contact<'_>,
+    model: &dyn Lagrangian,
+    (t, q, p): (f64, &[f64], &[f64]),
+    (normal, v): (&mut [f64], &mut [f64]),
+) -> Result<f64, ModelError> {
+    contact.surface.gradient(q, normal)?;
+    model.velocity(q, p, t, v)?;
+    Ok(dot(normal, v))
+}
+
+/// The root in (0, τ) of the quadratic through φ(0) = φ₀ > 0 with φ′(0) = r₀ and φ(τ) = φ₁ ≤ 0
+/// (NaN where round-off leaves it none): the crossing of a flight whose φ is quadratic in
+/// time (a straight chord of a circle, a parabola over a wall) to round-off, in the form
+/// 2φ₀/(√(r₀² − 4cφ₀) − r₀), which does not cancel.
+fn quadratic_root(phi0: f64, r0: f64, (tau, phi1): (f64, f64)) -> f64 {
+    let c = (phi1 - phi0 - r0 * tau) / (tau * tau);
+    2.0 * phi0 / ((r0 * r0 - 4.0 * c * phi0).sqrt() - r0)
 }
 
 /// The level a piece's φ must fall below to cross again: 0, or φ at its start for a piece that
