@@ -28,6 +28,7 @@ from ._core import ConvergenceError, DivergenceError, SpuriousBranchError, Varme
 from ._version import __version__ as __version__
 from .analysis import sections, stability
 from .analysis.energy_growth import energy_growth
+from .analysis.lyapunov import LyapunovSpectrum, lyapunov_spectrum
 from .analysis.phase_portrait import phase_portrait
 from .analysis.sections import poincare_section
 from .analysis.stability import (
@@ -85,6 +86,7 @@ __all__ = [
     "InvariantStatistics",
     "Lagrangian",
     "Linearization",
+    "LyapunovSpectrum",
     "MechanicalSystem",
     "MethodInfo",
     "Model",
@@ -118,6 +120,7 @@ __all__ = [
     "integrate",
     "linearize",
     "load",
+    "lyapunov_spectrum",
     "methods",
     "momentum",
     "normal_modes",

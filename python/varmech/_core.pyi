@@ -62,6 +62,7 @@ __all__ = [
     "is_time_dependent",
     "kind_of",
     "linearize",
+    "lyapunov",
     "methods",
     "momentum",
     "momentum_along",
@@ -704,6 +705,18 @@ def energy_statistics(
 ) -> Statistics: ...
 def statistics(t: _FloatArray, error: _FloatArray, size: _FloatArray, terms: _FloatArray, steps: int) -> Statistics: ...
 def symplecticity_defect(model: _Model, method: str, q: _FloatArray, p: _FloatArray, dt: float) -> float: ...
+def lyapunov(
+    model: _Model,
+    method: str,
+    q0: _FloatArray,
+    p0: _FloatArray,
+    *,
+    t0: float,
+    dt: float,
+    steps: int,
+    k: int,
+    every: int,
+) -> tuple[_FloatArray, NDArray[np.float64], tuple[_FloatArray, _FloatArray], int]: ...
 def methods() -> list[MethodInfo]: ...
 @final
 class CatalogueEntry:

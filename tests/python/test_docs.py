@@ -44,6 +44,7 @@ pytest.importorskip("sympy")
         "varmech.table",
         "varmech.analysis.energy_growth",
         "varmech.analysis.sections",
+        "varmech.analysis.lyapunov",
         "varmech.analysis.phase_portrait",
         "varmech.analysis.stability",
         "varmech.analysis.nonholonomic",

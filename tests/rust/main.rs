@@ -28,6 +28,7 @@ mod impulses;
 mod jit;
 mod kepler;
 mod kepler_polar;
+mod lyapunov;
 mod mixed_constraints;
 mod modes;
 mod nbody_kernel;

@@ -1,11 +1,12 @@
 //! Diagnostics of saved states: the energy function, first derivatives of L, Noether momenta,
 //! and statistics of conserved quantities.
 
-use numpy::{PyArray1, PyReadonlyArray1, PyReadonlyArray2};
+use numpy::{PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyTuple;
-use varmech::diagnostics::{self, Series, Verdict};
+use varmech::diagnostics::{self, LyapunovOptions, Series, Stretching, Verdict};
+use varmech::integrators::Method;
 use varmech::model::{self, EnergyTerms, Scale};
 use varmech::ModelError;
 
@@ -13,6 +14,7 @@ use crate::bind::{bind_model, dim_of};
 use crate::convert::{self, rows, slice, states, ArrayPair};
 use crate::errors::{model_error, model_error_at, to_pyerr};
 use crate::generator::Generator;
+use crate::run::steps_count;
 
 /// Three arrays: the energy and its two terms.
 type EnergyArrays<'py> = (
@@ -253,7 +255,63 @@ fn constraint_curvature(
     result.transpose().map_err(model_error)
 }
 
+/// The arrays of a Lyapunov run: the times of the re-orthonormalizations, the sums Σ ln Rⱼⱼ
+/// there (rows × k), the run's end (q, p) and the tangent map's evaluations.
+type StretchingArrays<'py> = (
+    Bound<'py, PyArray1<f64>>,
+    Bound<'py, PyArray2<f64>>,
+    ArrayPair<'py>,
+    u64,
+);
+
+/// The stretching of k tangent vectors carried by the step's tangent map along a run
+/// (`varmech.lyapunov_spectrum` turns it into exponents).
+#[pyfunction]
+#[allow(clippy::too_many_arguments)]
+#[pyo3(signature = (model, method, q0, p0, *, t0, dt, steps, k, every))]
+fn lyapunov<'py>(
+    py: Python<'py>,
+    model: &Bound<'py, PyAny>,
+    #[pyo3(from_py_with = convert::method)] method: Method,
+    q0: PyReadonlyArray1<'py, f64>,
+    p0: PyReadonlyArray1<'py, f64>,
+    t0: f64,
+    dt: f64,
+    #[pyo3(from_py_with = steps_count)] steps: usize,
+    k: usize,
+    every: usize,
+) -> PyResult<StretchingArrays<'py>> {
+    let (q0, p0) = (slice("q0", &q0)?, slice("p0", &p0)?);
+    let options = LyapunovOptions {
+        t0,
+        dt,
+        steps,
+        k,
+        every,
+    };
+    let stretching = bind_model(py, model, |sys, poll| {
+        diagnostics::lyapunov(sys, method, q0, p0, &options, poll)
+    })?
+    .map_err(|e| to_pyerr(py, e))?;
+    let Stretching {
+        k,
+        t,
+        sums,
+        q,
+        p,
+        evaluations,
+    } = stretching;
+    let state = (PyArray1::from_vec(py, q), PyArray1::from_vec(py, p));
+    Ok((
+        PyArray1::from_vec(py, t),
+        convert::matrix(py, sums, k)?,
+        state,
+        evaluations,
+    ))
+}
+
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(lyapunov, m)?)?;
     m.add_function(wrap_pyfunction!(constraint_curvature, m)?)?;
     m.add_function(wrap_pyfunction!(energy_terms, m)?)?;
     m.add_function(wrap_pyfunction!(derivative, m)?)?;

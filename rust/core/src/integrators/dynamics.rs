@@ -82,6 +82,12 @@ pub trait Dynamics {
     /// The system as a trait object, for what a generic run hands on (event functions).
     fn as_dynamics(&self) -> &dyn Dynamics;
 
+    /// The system as a separable one, H = ½pᵀM⁻¹p + V(q), for the kick–drift methods' tangent
+    /// map ([`super::Tangent`]); None for the others.
+    fn as_mechanical(&self) -> Option<&dyn MechanicalSystem> {
+        None
+    }
+
     /// |g(q)|∞ and |G(q)M⁻¹p|∞, with their sizes, for a constrained system; None for the others.
     fn constraint_residuals(&self, _q: &[f64], _p: &[f64]) -> Option<Result<model::Residuals, ModelError>> {
         None
@@ -167,6 +173,10 @@ impl<S: MechanicalSystem> Dynamics for S {
 
     fn as_dynamics(&self) -> &dyn Dynamics {
         self
+    }
+
+    fn as_mechanical(&self) -> Option<&dyn MechanicalSystem> {
+        Some(self)
     }
 }
 

@@ -45,6 +45,7 @@ mod run;
 mod splitting;
 mod step;
 mod stepper;
+mod tangent;
 mod trajectory;
 pub mod wisdom_holman;
 
@@ -81,6 +82,7 @@ pub use splitting::{Leading, Splitting};
 pub use step::{Increment, StepStart};
 use stepper::Phase;
 pub use stepper::{Clear, Stepper, StepperState};
+pub use tangent::Tangent;
 pub use trajectory::{Failure, Trajectory};
 pub use wisdom_holman::{Kernel, WisdomHolman};
 

@@ -114,6 +114,7 @@ impl Mass {
     }
 
     /// v = M⁻¹p.
+    #[inline]
     pub fn velocity(&self, p: &[f64], v: &mut [f64]) {
         match self {
             Mass::Scalar(m) => v.iter_mut().zip(p).for_each(|(vi, pi)| *vi = pi / m),

@@ -56,4 +56,9 @@ impl MechanicalSystem for HenonHeiles {
         grad[1] = y + x * x - y * y;
         Ok(())
     }
+    fn hessian(&self, q: &[f64], out: &mut [f64]) -> Option<Result<(), ModelError>> {
+        let (x, y) = (q[0], q[1]);
+        out.copy_from_slice(&[1.0 + 2.0 * y, 2.0 * x, 2.0 * x, 1.0 - 2.0 * y]);
+        Some(Ok(()))
+    }
 }

@@ -130,6 +130,9 @@ impl MechanicalSystem for Scene {
     fn gradient(&self, q: &[f64], grad: &mut [f64]) -> Result<(), ModelError> {
         dispatch!(self, s => s.gradient(q, grad))
     }
+    fn hessian(&self, q: &[f64], out: &mut [f64]) -> Option<Result<(), ModelError>> {
+        dispatch!(self, s => s.hessian(q, out))
+    }
     fn symmetries(&self) -> Vec<Generator> {
         dispatch!(self, s => s.symmetries())
     }

@@ -14,8 +14,8 @@ use super::{
 use crate::integrators::events::Search;
 use crate::integrators::DiscreteEnergy;
 use crate::integrators::{Clear, Counting, Dynamics, Method, Occurrence, Poll, Stepper, StepperState, Trajectory};
-use crate::solve::bracket::{illinois, newton};
 use crate::model::Lagrangian;
+use crate::solve::bracket::{illinois, newton};
 use crate::{Error, ModelError};
 
 /// Why the variational law does not fit `method` on `model`, if it does not: it needs the

@@ -1,0 +1,189 @@
+"""Lyapunov exponents from the integrator's own tangent map.
+
+A kick–drift step is a composition of shears, and so is its linearization: the core carries k
+tangent vectors along the run with that exact tangent map (symplectic, determinant 1 to
+round-off), re-orthonormalizes them every few steps by a QR factorization and sums the
+logarithms of R's diagonal (Benettin, Galgani, Giorgilli & Strelcyn 1980). Python declares the
+run and turns the sums into exponents and their standard errors.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from .. import _core
+from .._util import finite, positive, positive_int, vector
+from ..model import Model
+
+__all__ = ["LyapunovSpectrum", "lyapunov_spectrum"]
+
+
+@dataclass(frozen=True)
+class LyapunovSpectrum:
+    """The Lyapunov exponents of one run, as :func:`lyapunov_spectrum` measures them.
+
+    Attributes
+    ----------
+    exponents : ndarray, shape (k,)
+        λ₁ ≥ … ≥ λ_k at the run's end: Σ ln Rⱼⱼ over the run's time.
+    stderr : ndarray, shape (k,)
+        The standard error of each, from ``segments`` consecutive pieces of the run taken as
+        independent estimates.
+    t : ndarray, shape (m,)
+        The times of the re-orthonormalizations.
+    running : ndarray, shape (m, k)
+        The running estimates λⱼ(t) = Σ ln Rⱼⱼ / (t − t₀) there: their convergence.
+    q, p : ndarray, shape (n,)
+        The run's end.
+    method : str
+    t0 : float
+    dt : float
+    steps : int
+    every : int
+        Steps between re-orthonormalizations.
+    evaluations : int
+        Evaluations of ∇V and of its Hessian the tangent map made (a differenced Hessian counts
+        its 2n gradients).
+    """
+
+    exponents: np.ndarray
+    stderr: np.ndarray
+    t: np.ndarray
+    running: np.ndarray
+    q: np.ndarray
+    p: np.ndarray
+    method: str
+    t0: float
+    dt: float
+    steps: int
+    every: int
+    evaluations: int
+
+    @property
+    def sum(self) -> float:
+        """Σλⱼ: for the full spectrum the tangent map's volume change per unit time, 0 to
+        round-off for a Hamiltonian model."""
+        return float(np.sum(self.exponents))
+
+    def __str__(self) -> str:
+        lines = [f"{'j':>3} {'λ':>14} {'± stderr':>11}"]
+        lines += [f"{j + 1:>3} {lam:>14.6e} {err:>11.2e}" for j, (lam, err) in enumerate(zip(self.exponents, self.stderr))]
+        span = self.t[-1] - self.t0
+        lines.append(f"{self.method}, dt = {self.dt:g}, {self.steps} steps (t = {span:g}); Σλ = {self.sum:.3e}")
+        return "\n".join(lines)
+
+
+def lyapunov_spectrum(
+    model: Model,
+    q0: ArrayLike,
+    p0: ArrayLike,
+    *,
+    dt: float,
+    steps: int,
+    method: str = "verlet",
+    k: int | None = None,
+    every: int = 10,
+    segments: int = 10,
+    t0: float = 0.0,
+) -> LyapunovSpectrum:
+    """The Lyapunov spectrum of the orbit from (q0, p0), from the step's own tangent map.
+
+    The run is the plain run of ``method`` (the same states, bit for bit); its tangent map,
+    exact for a kick–drift step (shears: δq += bh M⁻¹δp at each drift, δp −= ah H(q) δq at each
+    kick, H the Hessian of V where the kick acts), carries k tangent vectors, re-orthonormalized
+    every ``every`` steps. The model's own Hessian is used where it has one (native scenes
+    such as Hénon–Heiles), else central differences of ∇V, symmetrized: the map stays
+    symplectic either way.
+
+    Parameters
+    ----------
+    model
+        A separable model, L = ½q̇ᵀMq̇ − V(q) (a native scene, a SymPy model of that form, or
+        closures of V and ∇V).
+    q0, p0
+        The initial state, shape (n,) each.
+    dt
+        The step.
+    steps
+        Steps of the run.
+    method
+        A kick–drift method (``"verlet"``, ``"yoshida4"``, ``"blanes_moan4"``, ``"aba864"``, …).
+    k
+        How many exponents, the k largest: 1 … 2n; default 2n, the full spectrum.
+    every
+        Steps between re-orthonormalizations (a vector that grows past 1e100 is
+        re-orthonormalized at once, so it never overflows).
+    segments
+        The run's pieces whose estimates give the standard errors (at least 2).
+    t0
+        The initial time.
+
+    Returns
+    -------
+    LyapunovSpectrum
+
+    Raises
+    ------
+    ValueError
+        ``k`` outside 1 … 2n, ``every`` or ``steps`` not a positive integer, ``segments`` < 2 or
+        more than the run's re-orthonormalizations, a model that is not separable or a method
+        without a tangent map, naming the argument.
+    VarmechError
+        The model failing during the run, with the step and time.
+
+    Examples
+    --------
+    The Hénon–Heiles system in its chaotic sea: one positive exponent, its mirror image
+    negative, two near 0 (the flow's direction and the energy), and a sum of 0 to round-off.
+
+    >>> import varmech
+    >>> hh = varmech.scenes.henon_heiles().model
+    >>> s = varmech.lyapunov_spectrum(hh, [0.0, -0.25], [0.42, 0.0], dt=0.05, steps=20_000)
+    >>> bool(s.exponents[0] > 0.02), bool(abs(s.sum) < 1e-12)
+    (True, True)
+    """
+    n = model.dim
+    q0, p0 = vector("q0", q0, n), vector("p0", p0, n)
+    dt, t0 = positive("dt", dt), finite("t0", t0)
+    steps, every = positive_int("steps", steps), positive_int("every", every)
+    k = 2 * n if k is None else positive_int("k", k)
+    if k > 2 * n:
+        raise ValueError(f"k: must be 1 … {2 * n} (the phase space's dimension 2n), got {k}")
+    segments = positive_int("segments", segments)
+    if segments < 2:
+        raise ValueError(f"segments: must be at least 2 (the standard error compares pieces of the run), got {segments}")
+    if segments > steps // every:
+        raise ValueError(
+            f"segments: the run re-orthonormalizes {steps // every} times, fewer than its {segments} segments; "
+            "run more steps, re-orthonormalize more often (a smaller every), or take fewer segments"
+        )
+    t, sums, (q, p), evaluations = _core.lyapunov(model._core, method, q0, p0, t0=t0, dt=dt, steps=steps, k=k, every=every)
+    elapsed = t - t0
+    running = sums / elapsed[:, None]
+    exponents = running[-1]
+    # Each segment's estimate, over the rows that close its share of the run's time.
+    edges = np.searchsorted(elapsed, elapsed[-1] * np.arange(1, segments + 1) / segments, side="left")
+    ends = np.minimum(edges, len(t) - 1)
+    starts = np.concatenate(([-1], ends[:-1]))
+    start_sums = np.where(starts[:, None] < 0, 0.0, sums[np.maximum(starts, 0)])
+    start_t = np.where(starts < 0, 0.0, elapsed[np.maximum(starts, 0)])
+    pieces = (sums[ends] - start_sums) / (elapsed[ends] - start_t)[:, None]
+    stderr = pieces.std(axis=0, ddof=1) / math.sqrt(segments)
+    return LyapunovSpectrum(
+        exponents=exponents,
+        stderr=stderr,
+        t=t,
+        running=running,
+        q=q,
+        p=p,
+        method=method,
+        t0=t0,
+        dt=dt,
+        steps=steps,
+        every=every,
+        evaluations=int(evaluations),
+    )

@@ -1,0 +1,108 @@
+"""Lyapunov spectra from the step's tangent map (issue 37): the Hénon–Heiles chaotic sea and a
+torus, the same spectrum from a native scene (exact Hessian), closures and a SymPy model
+(differenced Hessians), the run's states bit for bit, and bad requests refused by name."""
+
+import math
+
+import numpy as np
+import pytest
+import sympy as sp
+
+import varmech
+
+CHAOTIC = ([0.0, -0.25], [0.42, 0.0])  # H = 0.1247, in the chaotic sea
+REGULAR = ([0.1, 0.0], [0.0, 0.5])  # H = 0.13, on a torus
+
+
+def henon_heiles_closures():
+    def potential(q):
+        x, y = q
+        return 0.5 * (x * x + y * y) + x * x * y - y**3 / 3
+
+    def gradient(q):
+        x, y = q
+        return np.array([x + 2 * x * y, y + x * x - y * y])
+
+    return varmech.MechanicalSystem(2, potential, gradient)
+
+
+def henon_heiles_sympy():
+    x, y, vx, vy = sp.symbols("x y vx vy")
+    L = (vx**2 + vy**2) / 2 - ((x**2 + y**2) / 2 + x**2 * y - y**3 / 3)
+    return varmech.symbolic.lagrangian(L, [x, y], [vx, vy])
+
+
+def test_the_chaotic_sea_has_one_positive_exponent_its_mirror_and_two_near_zero():
+    hh = varmech.scenes.henon_heiles().model
+    s = varmech.lyapunov_spectrum(hh, *CHAOTIC, dt=0.05, steps=200_000)
+    lam, err = s.exponents, s.stderr
+    assert lam[0] > 10 * err[0] and lam[0] > 0.04
+    # Symplectic: the pairs are mirror images within their errors, and the sum is 0 at every time.
+    assert abs(lam[0] + lam[3]) < err[0] + err[3]
+    assert abs(lam[1] + lam[2]) < err[1] + err[2]
+    assert np.all(np.abs(s.running.sum(axis=1)) < 1e-13)
+    # The two along the flow and across the shell: 0 within 3 standard errors.
+    assert abs(lam[1]) < 3 * err[1] and abs(lam[2]) < 3 * err[2]
+    assert s.running.shape == (len(s.t), 4) and s.t[-1] == pytest.approx(1e4)
+    # The run is the plain run, bit for bit.
+    traj = varmech.integrate(hh, *CHAOTIC, dt=0.05, steps=200_000, method="verlet", save_every=200_000)
+    np.testing.assert_array_equal(s.q, traj.q[-1])
+    np.testing.assert_array_equal(s.p, traj.p[-1])
+    assert "Σλ" in str(s)
+
+
+def test_a_torus_exponents_fall_towards_zero():
+    hh = varmech.scenes.henon_heiles().model
+    s = varmech.lyapunov_spectrum(hh, *REGULAR, dt=0.05, steps=200_000, k=1)
+    early = s.running[np.searchsorted(s.t, 1e3), 0]
+    assert s.exponents.shape == (1,)
+    # λ₁ ≈ c ln T/T: a factor ln(10³)/ln(10⁴)·10 ≈ 7.7 from T = 10³ to 10⁴.
+    assert 0 < s.exponents[0] < early / 4
+
+
+@pytest.mark.parametrize("build", [henon_heiles_closures, henon_heiles_sympy], ids=["closures", "sympy"])
+def test_a_differenced_hessian_gives_the_exact_ones_spectrum(build):
+    # The largest exponent of the chaotic orbit over T = 10³: a Hessian right to ~1e-10 moves
+    # the tangent vectors by that much a step, which the exponent's average keeps small.
+    exact = varmech.lyapunov_spectrum(varmech.scenes.henon_heiles().model, *CHAOTIC, dt=0.05, steps=20_000)
+    other = varmech.lyapunov_spectrum(build(), *CHAOTIC, dt=0.05, steps=20_000)
+    np.testing.assert_allclose(other.exponents, exact.exponents, atol=1e-6)
+    assert abs(other.sum) < 1e-13
+    assert other.evaluations > exact.evaluations  # 2n gradients a Hessian
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "name"),
+    [
+        ({"k": 5}, "k"),
+        ({"k": 0}, "k"),
+        ({"every": 0}, "every"),
+        ({"segments": 1}, "segments"),
+        ({"steps": 50}, "segments"),
+        ({"method": "rk4"}, "method"),
+        ({"method": "midpoint"}, "method"),
+        ({"dt": -0.1}, "dt"),
+    ],
+)
+def test_bad_requests_are_refused_naming_the_argument(kwargs, name):
+    hh = varmech.scenes.henon_heiles().model
+    args = {"dt": 0.05, "steps": 1000, **kwargs}
+    with pytest.raises(ValueError, match=f"^{name}:"):
+        varmech.lyapunov_spectrum(hh, *CHAOTIC, **args)
+
+
+def test_a_model_that_is_not_separable_is_refused_naming_it():
+    pendulum = varmech.scenes.double_pendulum().model
+    with pytest.raises(ValueError, match="^model:.*separable"):
+        varmech.lyapunov_spectrum(pendulum, [0.1, 0.2], [0.0, 0.0], dt=0.01, steps=1000, method="verlet")
+
+
+def test_the_standard_error_comes_from_the_segments():
+    hh = varmech.scenes.henon_heiles().model
+    s = varmech.lyapunov_spectrum(hh, *CHAOTIC, dt=0.05, steps=20_000, segments=4)
+    sums = s.running * s.t[:, None]
+    quarters = [np.searchsorted(s.t, s.t[-1] * f) for f in (0.25, 0.5, 0.75, 1.0)]
+    ends = [sums[i] for i in quarters]
+    times = [s.t[i] for i in quarters]
+    pieces = np.array([(b - a) / (tb - ta) for a, b, ta, tb in zip([np.zeros(4)] + ends[:-1], ends, [0.0] + times[:-1], times)])
+    np.testing.assert_allclose(s.stderr, pieces.std(axis=0, ddof=1) / math.sqrt(4), rtol=1e-12)
