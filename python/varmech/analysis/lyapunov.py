@@ -28,16 +28,18 @@ class LyapunovSpectrum:
 
     Attributes
     ----------
-    exponents : ndarray, shape (k,)
-        λ₁ ≥ … ≥ λ_k at the run's end: Σ ln Rⱼⱼ over the run's time.
-    stderr : ndarray, shape (k,)
-        The standard error of each, from ``segments`` consecutive pieces of the run taken as
-        independent estimates.
-    t : ndarray, shape (m,)
-        The times of the re-orthonormalizations.
-    running : ndarray, shape (m, k)
-        The running estimates λⱼ(t) = Σ ln Rⱼⱼ / (t − t₀) there: their convergence.
-    q, p : ndarray, shape (n,)
+    exponents : numpy.ndarray
+        λ₁ ≥ … ≥ λ_k at the run's end, shape (k,): Σ ln Rⱼⱼ over the run's time.
+    stderr : numpy.ndarray
+        The standard error of each, shape (k,), from ``segments`` consecutive pieces of the run
+        taken as independent estimates.
+    t : numpy.ndarray
+        The times of the re-orthonormalizations, shape (m,).
+    running : numpy.ndarray
+        The running estimates λⱼ(t) = Σ ln Rⱼⱼ / (t − t₀) there, shape (m, k): their convergence.
+    q : numpy.ndarray
+        The run's end.
+    p : numpy.ndarray
         The run's end.
     method : str
     t0 : float
