@@ -39,6 +39,7 @@ from .analysis.stability import (
     stability_table,
     unstable_intervals,
 )
+from .analysis.strobe import orbit_diagram, stroboscopic_section
 from .analysis.work_precision import work_precision
 from .conservation import ConservationReport, InvariantStatistics, check_conservation, momentum
 from .constraints import IntegrableConstraintsWarning, project
@@ -124,6 +125,7 @@ __all__ = [
     "methods",
     "momentum",
     "normal_modes",
+    "orbit_diagram",
     "phase_portrait",
     "poincare_section",
     "pointers",
@@ -136,6 +138,7 @@ __all__ = [
     "stability",
     "stability_scan",
     "stability_table",
+    "stroboscopic_section",
     "suggest_dt",
     "symplecticity_defect",
     "unstable_intervals",

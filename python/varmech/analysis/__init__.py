@@ -6,6 +6,8 @@
 - :mod:`.stability`: linear stability on q̈ = −ω²q, the implicit methods' failure regions, and a
   model's spectrum against the stability intervals;
 - :mod:`.sections`: Poincaré sections and orbit divergence (a chaos indicator);
+- :mod:`.lyapunov`: Lyapunov spectra from the step's tangent map;
+- :mod:`.strobe`: stroboscopic sections of time-periodic models and orbit diagrams;
 - :mod:`.phase_portrait`: orbits of one degree of freedom, librations and rotations;
 - :mod:`.nonholonomic`: a rolling disk's energy over a long run, the discrete
   Lagrange–d'Alembert integrators against RK4 with a velocity projection.

@@ -4,6 +4,7 @@ Each chart takes the measurements a data function returns (a :class:`~varmech.Ta
 trajectories) and writes a PNG or SVG file; the measurements themselves need no matplotlib.
 """
 
+from .chaos import lyapunov_chart, orbit_diagram_chart
 from .energy import energy_error
 from .nonholonomic import nonholonomic_energy_chart
 from .sections import phase_portrait_chart, poincare_chart
@@ -14,7 +15,9 @@ __all__ = [
     "energy_error",
     "energy_growth_chart",
     "implicit_regions_chart",
+    "lyapunov_chart",
     "nonholonomic_energy_chart",
+    "orbit_diagram_chart",
     "phase_portrait_chart",
     "poincare_chart",
     "spectrum_chart",

@@ -1,0 +1,101 @@
+"""Chaos: the orbit diagram of :func:`varmech.orbit_diagram` and the convergence of a
+:class:`varmech.LyapunovSpectrum`."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from ..analysis.lyapunov import LyapunovSpectrum
+from ..table import Table
+from ._figure import documented, pyplot, save
+
+
+@documented
+def orbit_diagram_chart(table: Table, path: str | Path, coordinate: str = "p0", title: str = "") -> Path:
+    """Dot each strobe point of an orbit diagram at its parameter value: one dot for a period-1
+    orbit, two for period 2, a band where the strobe is chaotic. Writes ``path`` (PNG or SVG by
+    its suffix).
+
+    Parameters
+    ----------
+    table : Table
+        The table of :func:`varmech.orbit_diagram`.
+    {path}
+    coordinate : str, optional
+        The strobe's column drawn (default ``p0``, the first momentum).
+    title : str, optional
+        The figure's title (default: the table's).
+
+    {returns}
+
+    {raises}, or ``coordinate`` is not a column.
+
+    Examples
+    --------
+    >>> import math, tempfile
+    >>> from pathlib import Path
+    >>> import varmech
+    >>> from varmech.charts import orbit_diagram_chart
+    >>> scene = varmech.scenes.get("damped_driven_pendulum")
+    >>> table = varmech.orbit_diagram(scene, [-math.pi / 2], [0.0], parameter="amplitude",
+    ...                               values=[1.06, 1.075], period=3 * math.pi, periods=8, transient=50)
+    >>> with tempfile.TemporaryDirectory() as folder:
+    ...     print(orbit_diagram_chart(table, Path(folder) / "orbits.png").name)
+    orbits.png
+    """
+    if coordinate not in table.columns[2:]:
+        raise ValueError(f"coordinate: must be one of {', '.join(table.columns[2:])}, got {coordinate!r}")
+    plt = pyplot()
+    fig, ax = plt.subplots(figsize=(7.0, 4.5), layout="constrained")
+    ax.scatter(table.column("value"), table.column(coordinate), s=1.0, color="black", linewidths=0, rasterized=True)
+    ax.set_xlabel(str(table.meta.get("parameter", "value")))
+    ax.set_ylabel(f"{coordinate} at t₀ + kT")
+    ax.set_title(title or table.title)
+    return save(fig, path)
+
+
+@documented
+def lyapunov_chart(spectrum: LyapunovSpectrum, path: str | Path, title: str = "") -> Path:
+    """The running estimates λⱼ(t) of a Lyapunov spectrum against t (log-scaled), and their sum:
+    converging exponents level off, a regular orbit's fall as ln t/t, and a Hamiltonian model's
+    sum stays at round-off. Writes ``path`` (PNG or SVG by its suffix).
+
+    Parameters
+    ----------
+    spectrum : LyapunovSpectrum
+        The result of :func:`varmech.lyapunov_spectrum`.
+    {path}
+    title : str, optional
+        The figure's title.
+
+    {returns}
+
+    {raises}.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> import varmech
+    >>> from varmech.charts import lyapunov_chart
+    >>> hh = varmech.scenes.henon_heiles().model
+    >>> s = varmech.lyapunov_spectrum(hh, [0.0, -0.25], [0.42, 0.0], dt=0.05, steps=2000)
+    >>> with tempfile.TemporaryDirectory() as folder:
+    ...     print(lyapunov_chart(s, Path(folder) / "spectrum.png").name)
+    spectrum.png
+    """
+    plt = pyplot()
+    fig, ax = plt.subplots(figsize=(7.0, 4.5), layout="constrained")
+    elapsed = spectrum.t - spectrum.t0
+    for j in range(spectrum.running.shape[1]):
+        ax.plot(elapsed, spectrum.running[:, j], lw=1.0, label=f"λ{j + 1} = {spectrum.exponents[j]:.4g} ± {spectrum.stderr[j]:.1g}")
+    ax.plot(elapsed, np.sum(spectrum.running, axis=1), lw=1.0, color="black", ls=":", label="Σλ")
+    ax.set_xscale("log")
+    ax.set_xlabel("t − t₀")
+    ax.set_ylabel("λ(t)")
+    ax.axhline(0.0, color="grey", lw=0.5)
+    ax.legend(fontsize="small")
+    ax.set_title(title or f"Lyapunov spectrum, {spectrum.method}, dt = {spectrum.dt:g}")
+    return save(fig, path)
