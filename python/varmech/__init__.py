@@ -28,7 +28,7 @@ from ._core import ConvergenceError, DivergenceError, SpuriousBranchError, Varme
 from ._version import __version__ as __version__
 from .analysis import sections, stability
 from .analysis.energy_growth import energy_growth
-from .analysis.lyapunov import LyapunovSpectrum, lyapunov_spectrum
+from .analysis.lyapunov import LyapunovSpectrum, Megno, lyapunov_spectrum, megno
 from .analysis.phase_portrait import phase_portrait
 from .analysis.sections import poincare_section
 from .analysis.stability import (
@@ -89,6 +89,7 @@ __all__ = [
     "Linearization",
     "LyapunovSpectrum",
     "MechanicalSystem",
+    "Megno",
     "MethodInfo",
     "Model",
     "NativeSystem",
@@ -122,6 +123,7 @@ __all__ = [
     "linearize",
     "load",
     "lyapunov_spectrum",
+    "megno",
     "methods",
     "momentum",
     "normal_modes",

@@ -106,3 +106,18 @@ def test_the_standard_error_comes_from_the_segments():
     times = [s.t[i] for i in quarters]
     pieces = np.array([(b - a) / (tb - ta) for a, b, ta, tb in zip([np.zeros(4)] + ends[:-1], ends, [0.0] + times[:-1], times)])
     np.testing.assert_allclose(s.stderr, pieces.std(axis=0, ddof=1) / math.sqrt(4), rtol=1e-12)
+
+
+def test_megno_is_two_on_quasi_periodic_orbits_zero_near_a_centre_and_grows_as_lambda_t_over_two_in_chaos():
+    kepler = varmech.scenes.get("kepler", e=0.5)
+    m = varmech.megno(kepler.model, kepler.q0, kepler.p0, dt=0.01, steps=200_000)
+    assert abs(m.value - 2.0) < 0.01 and m.y.shape == m.t.shape == m.mean.shape
+    torus = varmech.megno(varmech.scenes.henon_heiles().model, *REGULAR, dt=0.05, steps=200_000)
+    assert abs(torus.value - 2.0) < 0.1
+    oscillator = varmech.megno(varmech.scenes.get("harmonic_oscillator").model, [1.0], [0.0], dt=0.05, steps=20_000)
+    assert abs(oscillator.value) < 1e-6
+    # Chaos: ⟨Y⟩ ≈ λ₁t/2, λ₁ that of the spectrum on the same orbit.
+    hh = varmech.scenes.henon_heiles().model
+    chaotic = varmech.megno(hh, *CHAOTIC, dt=0.05, steps=200_000)
+    spectrum = varmech.lyapunov_spectrum(hh, *CHAOTIC, dt=0.05, steps=200_000, k=1)
+    assert 2 * chaotic.value / chaotic.t[-1] == pytest.approx(spectrum.exponents[0], rel=0.05)
