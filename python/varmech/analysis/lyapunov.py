@@ -50,6 +50,17 @@ class LyapunovSpectrum:
     evaluations : int
         Evaluations of ∇V and of its Hessian the tangent map made (a differenced Hessian counts
         its 2n gradients).
+    sum : float
+        Σλⱼ: for the full spectrum the tangent map's volume change per unit time, 0 to round-off
+        for a Hamiltonian model.
+
+    Examples
+    --------
+    >>> import varmech
+    >>> hh = varmech.scenes.henon_heiles().model
+    >>> s = varmech.lyapunov_spectrum(hh, [0.1, 0.0], [0.0, 0.5], dt=0.05, steps=2000, k=2)
+    >>> s.exponents.shape, s.running.shape, bool(s.t[-1] == 100.0)
+    ((2,), (200, 2), True)
     """
 
     exponents: np.ndarray
@@ -67,8 +78,7 @@ class LyapunovSpectrum:
 
     @property
     def sum(self) -> float:
-        """Σλⱼ: for the full spectrum the tangent map's volume change per unit time, 0 to
-        round-off for a Hamiltonian model."""
+        """Σλⱼ (see the class's attributes)."""
         return float(np.sum(self.exponents))
 
     def __str__(self) -> str:
@@ -207,6 +217,15 @@ class Megno:
         → 2 for a quasi-periodic orbit (δ growing linearly), ≈ λ₁t/2 for a chaotic one.
     method : str
     dt : float
+    value : float
+        ⟨Y⟩ at the run's end.
+
+    Examples
+    --------
+    >>> import varmech
+    >>> m = varmech.megno(varmech.scenes.get("harmonic_oscillator").model, [1.0], [0.0], dt=0.05, steps=1000)
+    >>> m.t.shape, bool(abs(m.value) < 1e-5)
+    ((1000,), True)
     """
 
     t: np.ndarray
@@ -217,7 +236,7 @@ class Megno:
 
     @property
     def value(self) -> float:
-        """⟨Y⟩ at the run's end."""
+        """⟨Y⟩ at the run's end (see the class's attributes)."""
         return float(self.mean[-1])
 
 

@@ -141,12 +141,36 @@ def strobe_period(x: ArrayLike, most: int = 64, tolerance: float = 1e-6) -> int 
     """The least P ≤ ``most`` with |x[k + P] − x[k]| ≤ ``tolerance``·max(1, |x|) for every k (a
     period-P orbit's strobe), or None: longer, quasi-periodic or chaotic.
 
+    Parameters
+    ----------
+    x : array_like
+        One coordinate of a strobe, in order.
+    most : int, optional
+        The longest period looked for.
+    tolerance : float, optional
+        The agreement, relative to max(1, |x|), that counts as a repeat.
+
+    Returns
+    -------
+    int or None
+        The period, or None.
+
+    Raises
+    ------
+    ValueError
+        ``x`` not one-dimensional, or ``most`` not a positive integer.
+
+    Examples
+    --------
     >>> strobe_period([1.0, 2.0, 1.0, 2.0, 1.0])
     2
     >>> strobe_period([0.1, 0.5, 0.3, 0.9]) is None
     True
     """
     x = np.asarray(x, dtype=float)
+    if x.ndim != 1:
+        raise ValueError(f"x: must be one coordinate of a strobe, shape (k,), got shape {x.shape}")
+    most = positive_int("most", most)
     bound = tolerance * max(1.0, float(np.max(np.abs(x)))) if x.size else tolerance
     for p in range(1, min(most, len(x) - 1) + 1):
         if np.max(np.abs(x[p:] - x[:-p])) <= bound:
@@ -198,6 +222,12 @@ def orbit_diagram(
     -------
     Table
         Columns ``value``, ``k``, then q and p by coordinate.
+
+    Raises
+    ------
+    ValueError
+        ``values`` empty or not finite, ``coordinate`` not a column, a model without the period
+        (as for :func:`stroboscopic_section`), or a parameter the model has not, naming it.
 
     Examples
     --------

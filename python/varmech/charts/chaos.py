@@ -11,6 +11,11 @@ from ..analysis.lyapunov import LyapunovSpectrum
 from ..table import Table
 from ._figure import documented, pyplot, save
 
+__all__ = [
+    "lyapunov_chart",
+    "orbit_diagram_chart",
+]
+
 
 @documented
 def orbit_diagram_chart(table: Table, path: str | Path, coordinate: str = "p0", title: str = "") -> Path:
