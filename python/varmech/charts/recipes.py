@@ -5,9 +5,12 @@ call it."""
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
+
+import numpy as np
 
 from .. import scenes
 from ..analysis import energy_growth, sections, stability, work_precision
@@ -15,7 +18,9 @@ from ..analysis._orbits import energy_at
 from ..analysis.baselines import REBOUND_METHODS
 from ..analysis.nonholonomic import nonholonomic_energy
 from ..analysis.phase_portrait import phase_portrait
+from ..analysis.strobe import orbit_diagram
 from ..table import Table
+from .chaos import orbit_diagram_chart
 from .nonholonomic import nonholonomic_energy_chart
 from .sections import phase_portrait_chart, poincare_chart
 from .stability import implicit_regions_chart, spectrum_chart, stability_chart
@@ -181,6 +186,26 @@ def _phase(scene, methods, quick, progress, options):
     return [("phase_portrait", table, {"phase_portrait": draw})]
 
 
+def _driven_only(scene: scenes.Scene) -> str | None:
+    if scene.name == "damped_driven_pendulum":
+        return None
+    return "the orbit diagram is of the damped, driven pendulum, strobed at its drive's period over the drive's amplitude"
+
+
+def _orbit_diagram(scene, methods, quick, progress, options):
+    sc = scenes.get(scene)
+    # Taylor's cascade (§12.5): γ from 1.06 to 1.09, from φ = −π/2 at rest.
+    period = 2 * math.pi / sc.parameters["drive"]
+    values = np.linspace(1.06, 1.09, 31 if quick else 301)
+    table = orbit_diagram(
+        sc, [-math.pi / 2], [0.0], parameter="amplitude", values=values, period=period, periods=16 if quick else 64,
+        transient=100 if quick else 300, method=methods[0],
+    )  # fmt: skip
+    title = f"{scene}: φ̇ strobed at the drive's period{' (--quick)' if quick else ''}"
+    draw = lambda t, p: orbit_diagram_chart(t, p, title=title)  # noqa: E731
+    return [("orbit_diagram", table, {"orbit_diagram": draw})]
+
+
 def _disk_only(scene: scenes.Scene) -> str | None:
     return "the nonholonomic chart is of the rolling disk (its closure model and RK4 with a projection); it takes no scene"
 
@@ -218,6 +243,11 @@ KINDS: dict[str, ChartKind] = {
         _two_freedoms,
     ),
     "phase": ChartKind("pendulum", ("kahan_li6",), "phase portrait: librations, separatrix, rotations", _phase, _one_freedom),
+    "orbit-diagram": ChartKind(
+        "damped_driven_pendulum", ("galerkin6",),
+        "the strobe's attractor over the drive's amplitude: Taylor's period-doubling cascade into chaos", _orbit_diagram,
+        _driven_only,
+    ),
     "nonholonomic": ChartKind(
         None, ("midpoint", "cortes_martinez", "rk4_projection"),
         "a rolling disk's energy error against time: the discrete Lagrange–d'Alembert integrators and RK4 with a "
