@@ -3,7 +3,7 @@
 //! West 2003), for an autonomous L.
 
 use super::{Dynamics, Increment, Integrator, Method, Splitting, StepStart};
-use crate::model::Lagrangian;
+use crate::model::{Lagrangian, MechanicalSystem};
 use crate::{ModelError, StepError};
 
 /// The methods with a discrete energy here, and their data.
@@ -96,7 +96,10 @@ impl DiscreteEnergy {
         Ok(match &mut self.rule {
             Rule::KickDrift(splitting) => {
                 let buffers = (&mut self.q[..], &mut self.p[..], &mut self.v[..], &mut self.force[..]);
-                kick_drift(splitting, buffers, &self.zeros, lagrangian, t, tau, start)?
+                match sys.as_mechanical() {
+                    Some(separable) => kick_drift(splitting, buffers, &Separable(separable), t, tau, start)?,
+                    None => kick_drift(splitting, buffers, &ThroughL(lagrangian, &self.zeros), t, tau, start)?,
+                }
             }
             Rule::Midpoint => {
                 self.mean(start, end);
@@ -199,14 +202,52 @@ impl DiscreteEnergy {
     }
 }
 
-/// Σᵢ bᵢ T(pᵢ) + Σⱼ aⱼ V(q⁽ʲ⁾) along the stages from (q₀, p₀), with T = ½p·q̇(q, p) and
-/// V = −L(q, 0): the last kick's force is not needed.
-#[allow(clippy::too_many_arguments)]
-fn kick_drift(
+/// What a kick–drift step's E_d reads of a model: q̇(q, p), V(q) and −∇V(q), from a separable
+/// model's own M and V (a fifth of the calls through L), or through a Lagrangian's L at q̇ = 0.
+trait Stages {
+    fn velocity(&self, q: &[f64], p: &[f64], t: f64, v: &mut [f64]) -> Result<(), ModelError>;
+    fn potential(&self, q: &[f64], t: f64) -> Result<f64, ModelError>;
+    fn force(&self, q: &[f64], t: f64, out: &mut [f64]) -> Result<(), ModelError>;
+}
+
+struct Separable<'a>(&'a dyn MechanicalSystem);
+
+impl Stages for Separable<'_> {
+    fn velocity(&self, _q: &[f64], p: &[f64], _t: f64, v: &mut [f64]) -> Result<(), ModelError> {
+        self.0.mass().velocity(p, v);
+        Ok(())
+    }
+    fn potential(&self, q: &[f64], _t: f64) -> Result<f64, ModelError> {
+        self.0.potential(q)
+    }
+    fn force(&self, q: &[f64], _t: f64, out: &mut [f64]) -> Result<(), ModelError> {
+        self.0.gradient(q, out)?;
+        out.iter_mut().for_each(|x| *x = -*x);
+        Ok(())
+    }
+}
+
+/// A Lagrangian, with the zero velocity its V = −L(q, 0) is read at.
+struct ThroughL<'a>(&'a dyn Lagrangian, &'a [f64]);
+
+impl Stages for ThroughL<'_> {
+    fn velocity(&self, q: &[f64], p: &[f64], t: f64, v: &mut [f64]) -> Result<(), ModelError> {
+        self.0.velocity(q, p, t, v)
+    }
+    fn potential(&self, q: &[f64], t: f64) -> Result<f64, ModelError> {
+        Ok(-self.0.lagrangian(q, self.1, t)?)
+    }
+    fn force(&self, q: &[f64], t: f64, out: &mut [f64]) -> Result<(), ModelError> {
+        self.0.dl_dq(q, self.1, t, out)
+    }
+}
+
+/// Σᵢ bᵢ T(pᵢ) + Σⱼ aⱼ V(q⁽ʲ⁾) along the stages from (q₀, p₀), with T = ½p·q̇(q, p): the last
+/// kick's force is not needed.
+fn kick_drift<S: Stages>(
     splitting: &Splitting,
     (q, p, v, force): (&mut [f64], &mut [f64], &mut [f64], &mut [f64]),
-    zeros: &[f64],
-    sys: &dyn Lagrangian,
+    sys: &S,
     t: f64,
     tau: f64,
     (q0, p0): (&[f64], &[f64]),
@@ -227,9 +268,9 @@ fn kick_drift(
         if a == 0.0 {
             continue;
         }
-        energy -= a * sys.lagrangian(q, zeros, t)?;
+        energy += a * sys.potential(q, t)?;
         if j + 1 < kicks.len() {
-            sys.dl_dq(q, zeros, t, force)?;
+            sys.force(q, t, force)?;
             for (x, f) in p.iter_mut().zip(force.iter()) {
                 *x += a * tau * f;
             }

@@ -113,18 +113,19 @@ pub(in crate::integrators) struct Resolver<'c, 's, M> {
     /// The friction work of the last partial step, and of the step's pieces so far.
     piece_work: f64,
     step_work: f64,
-    /// The end of the partial step nearest the surface that the last location stepped to.
-    nearest: Nearest,
+    /// A partial step's end kept to be taken again: the location's nearest to the surface,
+    /// the contact state; the variational law's last, the next piece.
+    kept: Kept,
 }
 
-/// The end (q, p) of the partial step of size s from a piece's start at ta, `at` = (ta, s),
-/// and its friction work: kept by [`Resolver::locate`], so that the contact state is not
-/// stepped to again.
-struct Nearest {
+/// The end (q, p) of the free partial step of size s from ta, `at` = (ta, s), started from the
+/// momenta `from` (the piece's start q is the piece's own): [`Resolver::partial`] takes it
+/// instead of stepping again.
+struct Kept {
     at: Option<(f64, f64)>,
+    from: Vec<f64>,
     q: Vec<f64>,
     p: Vec<f64>,
-    work: f64,
 }
 
 /// Friction switches in one step at most: more is a stick–slip chatter the step cannot
@@ -206,11 +207,11 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
             direction: vec![0.0; n],
             piece_work: 0.0,
             step_work: 0.0,
-            nearest: Nearest {
+            kept: Kept {
                 at: None,
+                from: vec![0.0; n],
                 q: vec![0.0; n],
                 p: vec![0.0; n],
-                work: 0.0,
             },
         };
         if resolver.frictional && resolver.hold.is_none() {
@@ -794,8 +795,11 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
                     Hold::methods()
                 )));
             }
-            self.contact_state(step, ta, s)?;
+            // The contact state (q̃, p⁻), the end of this piece.
+            self.partial(step, ta, s)?;
             self.step_work += self.piece_work;
+            self.contact_q.copy_from_slice(self.scratch.q());
+            self.contact_p.copy_from_slice(self.scratch.p());
             let t_contact = ta + s;
             if let Some(search) = search.as_deref_mut() {
                 search.piece(step, (t_contact, &self.contact_q, &self.contact_p), s, occurrences)?;
@@ -1442,7 +1446,9 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
             .map_err(model_error)?;
         let scale = contact_p.iter().zip(v.iter()).map(|(a, b)| a * b).sum::<f64>();
         piece_q.copy_from_slice(contact_q);
+        let mut last = f64::NAN;
         let after = |lambda: f64| {
+            last = lambda;
             for (x, (a, b)) in piece_p.iter_mut().zip(contact_p.iter().zip(normal.iter())) {
                 *x = a + lambda * b;
             }
@@ -1453,7 +1459,12 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
                 .energy(scratch.model(), t, rest, (piece_q, piece_p), end)
                 .map_err(|e| e.at(step, time))
         };
-        variational::multiplier(after, reflection, target, scale)
+        let found = variational::multiplier(after, reflection, target, scale)?;
+        // The scratch holds the piece after the jump for the λ taken: the next piece's first step.
+        if last == found.0 {
+            self.keep(t, rest);
+        }
+        Ok(found)
     }
 
     /// The s ∈ (0, τ] where φⱼ along the piece from (ta, piece_q, piece_p) falls through 0,
@@ -1480,18 +1491,14 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
             ((start, end), Some(quadratic_root(start.1, rate, end)))
         };
         let tolerance = 4.0 * f64::EPSILON * tau;
-        self.nearest.at = None;
         let mut least = f64::INFINITY;
         let (s, _) = newton(
             |s| {
                 let (phi, rate) = self.phi_rate_along(j, step, ta, s)?;
+                // The nearest so far, which the contact state will be.
                 if (phi - floor).abs() < least {
                     least = (phi - floor).abs();
-                    let Nearest { at, q, p, work } = &mut self.nearest;
-                    *at = Some((ta, s));
-                    q.copy_from_slice(self.scratch.q());
-                    p.copy_from_slice(self.scratch.p());
-                    *work = self.piece_work;
+                    self.keep(ta, s);
                 }
                 Ok::<_, Error>((phi - floor, rate))
             },
@@ -1551,20 +1558,16 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
         Err(Located::Resting)
     }
 
-    /// The contact state (q̃, p⁻) into the contact buffers, and its work: the end of the
-    /// partial step of size s from the piece's start at ta, kept by the location where it is
-    /// that one.
-    fn contact_state(&mut self, step: usize, ta: f64, s: f64) -> Result<(), Error> {
-        if self.nearest.at == Some((ta, s)) {
-            self.contact_q.copy_from_slice(&self.nearest.q);
-            self.contact_p.copy_from_slice(&self.nearest.p);
-            self.piece_work = self.nearest.work;
-            return Ok(());
+    /// Keeps the scratch's end as that of the free partial step of size s from ta and the
+    /// piece's start, for [`Resolver::partial`] to take again.
+    fn keep(&mut self, ta: f64, s: f64) {
+        if self.closed.is_empty() {
+            let Kept { at, from, q, p } = &mut self.kept;
+            *at = Some((ta, s));
+            from.copy_from_slice(&self.piece_p);
+            q.copy_from_slice(self.scratch.q());
+            p.copy_from_slice(self.scratch.p());
         }
-        self.partial(step, ta, s)?;
-        self.contact_q.copy_from_slice(self.scratch.q());
-        self.contact_p.copy_from_slice(self.scratch.p());
-        Ok(())
     }
 
     /// φⱼ at the end of the partial step of size s from the piece's start.
@@ -1582,6 +1585,11 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
     /// piece's start at ta; an error names the run's step and its start.
     fn partial(&mut self, step: usize, ta: f64, s: f64) -> Result<(), Error> {
         self.piece_work = 0.0;
+        let Kept { at, from, q, p } = &self.kept;
+        if s > 0.0 && self.closed.is_empty() && *at == Some((ta, s)) && *from == self.piece_p {
+            self.scratch.restart(ta + s, q, p, s);
+            return Ok(());
+        }
         if let (Some(hold), false) = (self.hold.as_mut(), self.closed.is_empty() || s == 0.0) {
             // The held step, its end set on the scratch as a free piece's would be.
             let held = Held {
