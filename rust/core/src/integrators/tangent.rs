@@ -7,8 +7,11 @@
 //! determinant 1 and is symplectic, so the tangent map is, to round-off, whatever H's accuracy:
 //! a differenced H is symmetrized.
 
+use nalgebra::DMatrix;
+
 use super::{Method, Splitting};
 use crate::model::MechanicalSystem;
+use crate::solve::difference::{central_jacobian, unit, Evaluations};
 use crate::{Error, ModelError};
 
 /// The tangent map of one method's step on n coordinates, with its buffers: [`Tangent::apply`]
@@ -17,12 +20,12 @@ use crate::{Error, ModelError};
 pub struct Tangent {
     splitting: Splitting,
     n: usize,
-    /// The stage's (q, p), its velocity, the force at it and H there (n × n, row-major).
+    /// The stage's (q, p), its velocity, the force at it and H there.
     q: Vec<f64>,
     p: Vec<f64>,
     v: Vec<f64>,
     force: Vec<f64>,
-    hessian: Vec<f64>,
+    hessian: DMatrix<f64>,
     /// A tangent vector's δp through M⁻¹, and the gradients a differenced H takes.
     velocity: Vec<f64>,
     plus: Vec<f64>,
@@ -53,7 +56,7 @@ impl Tangent {
             p: buffer(),
             v: buffer(),
             force: buffer(),
-            hessian: vec![0.0; n * n],
+            hessian: DMatrix::zeros(n, n),
             velocity: buffer(),
             plus: buffer(),
             minus: buffer(),
@@ -99,8 +102,9 @@ impl Tangent {
             self.hessian(sys)?;
             for column in x.chunks_exact_mut(2 * n) {
                 let (dq, dp) = column.split_at_mut(n);
+                // H is symmetric: its column r is its row r.
                 for (r, d) in dp.iter_mut().enumerate() {
-                    let row = &self.hessian[r * n..(r + 1) * n];
+                    let row = self.hessian.column(r);
                     *d -= a * row.iter().zip(dq.iter()).map(|(h, x)| h * x).sum::<f64>();
                 }
             }
@@ -114,34 +118,24 @@ impl Tangent {
         Ok(())
     }
 
-    /// H = ∂²V/∂q² at the stage's q: the model's own, or central differences of ∇V with steps
-    /// ε^⅓·max(|qⱼ|, 1) (truncation and round-off both near ε^⅔), symmetrized.
+    /// H = ∂²V/∂q² at the stage's q: the model's own, or central differences of ∇V
+    /// ([`central_jacobian`]), symmetrized.
     fn hessian<S: MechanicalSystem + ?Sized>(&mut self, sys: &S) -> Result<(), ModelError> {
         self.evaluations += 1;
-        if let Some(exact) = sys.hessian(&self.q, &mut self.hessian) {
+        if let Some(exact) = sys.hessian(&self.q, self.hessian.as_mut_slice()) {
             return exact;
         }
-        let n = self.n;
-        for j in 0..n {
-            let x = self.q[j];
-            let delta = f64::EPSILON.cbrt() * x.abs().max(1.0);
-            self.q[j] = x + delta;
-            sys.gradient(&self.q, &mut self.plus)?;
-            self.q[j] = x - delta;
-            sys.gradient(&self.q, &mut self.minus)?;
-            self.q[j] = x;
-            // The difference of the two points actually taken, which round-off moves off 2δ.
-            let width = (x + delta) - (x - delta);
-            for i in 0..n {
-                self.hessian[i * n + j] = (self.plus[i] - self.minus[i]) / width;
-            }
-        }
-        self.evaluations += 2 * n as u64 - 1;
-        for i in 0..n {
+        let at = Evaluations {
+            plus: &mut self.plus,
+            minus: &mut self.minus,
+        };
+        central_jacobian(|q, out| sys.gradient(q, out), &mut self.q, unit, at, &mut self.hessian)?;
+        self.evaluations += 2 * self.n as u64 - 1;
+        for i in 0..self.n {
             for j in 0..i {
-                let mean = 0.5 * (self.hessian[i * n + j] + self.hessian[j * n + i]);
-                self.hessian[i * n + j] = mean;
-                self.hessian[j * n + i] = mean;
+                let mean = 0.5 * (self.hessian[(i, j)] + self.hessian[(j, i)]);
+                self.hessian[(i, j)] = mean;
+                self.hessian[(j, i)] = mean;
             }
         }
         Ok(())

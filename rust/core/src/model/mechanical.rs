@@ -18,7 +18,7 @@ pub trait MechanicalSystem {
     /// Writes ∇V(q) into `grad` (length n). Step loops call this; it must not allocate.
     fn gradient(&self, q: &[f64], grad: &mut [f64]) -> Result<(), ModelError>;
 
-    /// Writes ∂²V/∂q² at q into `out` (n × n, row-major), where the model has it; None where it
+    /// Writes ∂²V/∂q² at q into `out` (n × n, symmetric), where the model has it; None where it
     /// has not, and the tangent map differences the gradient ([`crate::integrators::Tangent`]).
     fn hessian(&self, _q: &[f64], _out: &mut [f64]) -> Option<Result<(), ModelError>> {
         None
