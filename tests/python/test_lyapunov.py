@@ -1,6 +1,8 @@
 """Lyapunov spectra from the step's tangent map (issue 37): the Hénon–Heiles chaotic sea and a
 torus, the same spectrum from a native scene (exact Hessian), closures and a SymPy model
-(differenced Hessians), the run's states bit for bit, and bad requests refused by name."""
+(differenced Hessians), the run's states bit for bit, the implicit rules' tangent maps on the
+damped, driven pendulum (Taylor's chaos past his cascade, Σλ = −2β to order 2, the same
+spectrum from the scene, closures and SymPy), and bad requests refused by name."""
 
 import math
 
@@ -80,7 +82,7 @@ def test_a_differenced_hessian_gives_the_exact_ones_spectrum(build):
         ({"segments": 1}, "segments"),
         ({"steps": 50}, "segments"),
         ({"method": "rk4"}, "method"),
-        ({"method": "midpoint"}, "method"),
+        ({"method": "rattle"}, "method"),
         ({"dt": -0.1}, "dt"),
     ],
 )
@@ -121,3 +123,83 @@ def test_megno_is_two_on_quasi_periodic_orbits_zero_near_a_centre_and_grows_as_l
     chaotic = varmech.megno(hh, *CHAOTIC, dt=0.05, steps=200_000)
     spectrum = varmech.lyapunov_spectrum(hh, *CHAOTIC, dt=0.05, steps=200_000, k=1)
     assert 2 * chaotic.value / chaotic.t[-1] == pytest.approx(spectrum.exponents[0], rel=0.05)
+
+
+# The damped, driven pendulum at Taylor's parameters in the scene's time unit 1/ω₀: damping
+# 2β/ω₀ = 0.5, drive 2/3 (period 3π), amplitude γ; from φ = −π/2 at rest.
+TAYLOR = ([-math.pi / 2], [0.0])
+
+
+def taylor(gamma):
+    return varmech.scenes.get("damped_driven_pendulum", amplitude=gamma).model
+
+
+def test_the_driven_pendulum_has_a_negative_spectrum_on_its_attractor_and_a_positive_exponent_past_the_cascade():
+    # Each run ~ 200 drive periods after none discarded: λ₁(1.06) < 0 (the period-1 orbit), and
+    # λ₁ > 0 in Taylor's chaotic example γ = 1.105; both sum to the damping's −0.5.
+    periodic = varmech.lyapunov_spectrum(taylor(1.06), *TAYLOR, dt=3 * math.pi / 200, steps=40_000)
+    chaotic = varmech.lyapunov_spectrum(taylor(1.105), *TAYLOR, dt=3 * math.pi / 200, steps=40_000)
+    assert periodic.method == "midpoint"
+    assert periodic.exponents[0] < -0.02 < 0.05 < chaotic.exponents[0]
+    for s in (periodic, chaotic):
+        assert s.sum == pytest.approx(-0.5, abs=2e-4)
+
+
+def test_chaos_sets_in_past_taylors_accumulation_point():
+    # λ₁ over γ ∈ [1.080, 1.086] by 0.0005 (200 drive periods each, from φ = −π/2): negative
+    # through the last doublings, positive from the first γ past Taylor's γ∞ ≈ 1.0829 on.
+    gammas = np.round(np.arange(1.080, 1.08601, 0.0005), 4)
+    lam = np.array([
+        varmech.lyapunov_spectrum(taylor(g), *TAYLOR, dt=3 * math.pi / 100, steps=20_000, k=1).exponents[0] for g in gammas
+    ])
+    onset = gammas[np.argmax(lam > 0)]
+    assert onset == pytest.approx(1.0829, abs=0.0005), list(zip(gammas, lam))
+    assert np.all(lam[gammas < onset] < 0) and np.all(lam[gammas >= onset] > 0), list(zip(gammas, lam))
+
+
+def test_the_driven_pendulums_sum_is_minus_two_beta_to_second_order():
+    # Σλ = (1/T)Σ ln det DΨ_h = −2β(1 + O(h²)): the error falls by 4 from h to h/2.
+    errors = []
+    for dt in (3 * math.pi / 100, 3 * math.pi / 200):
+        s = varmech.lyapunov_spectrum(taylor(1.077), *TAYLOR, dt=dt, steps=round(60 * math.pi / dt), every=5)
+        errors.append(abs(s.sum + 0.5))
+    assert math.log2(errors[0] / errors[1]) == pytest.approx(2.0, abs=0.1)
+
+
+def driven_closures(gamma):
+    return varmech.Lagrangian(
+        1,
+        lambda q, v, t: 0.5 * v[0] ** 2 + math.cos(q[0]),
+        force=lambda q, v, t: np.array([-0.5 * v[0] + gamma * math.cos(2.0 / 3.0 * t)]),
+        dl_dq=lambda q, v, t: np.array([-math.sin(q[0])]),
+        dl_dv=lambda q, v, t: v.copy(),
+    )
+
+
+def driven_sympy(gamma):
+    phi, w, t = sp.symbols("phi w t")
+    return varmech.symbolic.lagrangian(
+        w**2 / 2 + sp.cos(phi), [phi], [w], t=t, rayleigh=w**2 / 4, force=[gamma * sp.cos(2 * t / 3)]
+    )
+
+
+@pytest.mark.parametrize("build", [driven_closures, driven_sympy])
+def test_the_implicit_spectrum_of_a_users_model_is_the_scenes(build):
+    # Chaotic: round-off apart, the orbits part as e^(λ₁t), 1e-8 of the state by the end here.
+    args = {"dt": 3 * math.pi / 200, "steps": 2000}
+    native = varmech.lyapunov_spectrum(taylor(1.105), *TAYLOR, **args)
+    own = varmech.lyapunov_spectrum(build(1.105), *TAYLOR, **args)
+    np.testing.assert_allclose(own.exponents, native.exponents, rtol=1e-6, atol=1e-8)
+    np.testing.assert_allclose(own.q, native.q, rtol=1e-6)
+
+
+def test_a_constrained_model_or_delayed_forces_are_refused_naming_the_model():
+    pendulum = varmech.scenes.get("cartesian_pendulum")
+    with pytest.raises(ValueError, match="^model:.*constraints"):
+        varmech.lyapunov_spectrum(pendulum.model, pendulum.q0, pendulum.p0, dt=0.01, steps=1000, method="trapezoid")
+    q, w, w_past = sp.symbols("q w w_past")
+    delayed = varmech.symbolic.lagrangian(
+        (w**2 - q**2) / 2, [q], [w], delayed=varmech.symbolic.Delayed(1.0, [-0.5 * w_past], v_past=[w_past])
+    )
+    with pytest.raises(ValueError, match="^model:.*delayed forces"):
+        varmech.lyapunov_spectrum(delayed, [1.0], [0.0], dt=0.01, steps=1000)

@@ -5,7 +5,8 @@
 //! stepper's steps make none at all, nor does taking it apart, resuming and resetting it, nor
 //! does a discrete energy E_d once made. A run with contacts allocates nothing in its steps
 //! either, impacts included, but for the growth of its output (the impacts and the states at
-//! them).
+//! them). Steps that carry tangent vectors allocate nothing after the first, which sizes the
+//! tangent map's buffers.
 
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
@@ -14,7 +15,7 @@ use std::ops::Deref;
 use varmech::integrators::{
     integrate, integrate_watching, integrate_with_events, Contact, Contacts, Detector, DiscreteEnergy, Dynamics,
     EventSpec, Friction, General, Law, Method, ModelKind, NativeEvent, NativeSurface, Options, Slip, SlipRows, Stepper,
-    StepperState, Trajectory, Watch, Watcher,
+    StepperState, Tangent, Trajectory, Watch, Watcher,
 };
 use varmech::model::Routhian;
 use varmech::scenes::{self, NBody, NonholonomicScene, SceneModel};
@@ -671,4 +672,29 @@ fn a_stepper_watching_a_contact_never_hit_allocates_nothing() {
     )
     .unwrap();
     assert_eq!(watched_allocations(&chain.system, stepper, 1, 2000), 0);
+}
+
+#[test]
+fn steps_with_tangent_vectors_allocate_nothing_after_the_first() {
+    let hh = scenes::HenonHeiles::new();
+    let double = scenes::DoublePendulum::new(1.0, 2.0, 2.0, 3.0, 9.80665).unwrap();
+    let general = General(&double);
+    let cases: [(&dyn Dynamics, Method); 4] = [
+        (&hh, Method::Verlet),
+        (&hh, Method::Yoshida4),
+        (&general, Method::Midpoint),
+        (&general, Method::Galerkin4),
+    ];
+    for (sys, method) in cases {
+        let mut tangent = Tangent::new(method, sys).unwrap();
+        let mut stepper = Stepper::new(sys, method, &[0.1, -0.2], &[0.3, 0.25], &Options::new(0.01, 0)).unwrap();
+        let mut x = vec![0.5; 16];
+        stepper.step_with_tangent(&mut tangent, &mut x).unwrap();
+        let before = allocated();
+        for _ in 0..1000 {
+            stepper.step_with_tangent(&mut tangent, &mut x).unwrap();
+            x.iter_mut().for_each(|v| *v *= 1e-3);
+        }
+        assert_eq!(allocated() - before, 0, "{method:?}");
+    }
 }

@@ -1,12 +1,13 @@
-//! The tangent map of a kick–drift step against differences of two nearby steps, its
-//! symplecticity, and the Lyapunov spectra it gives: Hénon–Heiles chaotic (a positive exponent
-//! and its mirror, a sum of 0 to round-off at every time) and regular (λ₁ falling as log T/T),
-//! the harmonic oscillator's all falling to 0.
+//! The tangent map of a kick–drift step and of the implicit rules' steps against differences of
+//! two nearby steps, its symplecticity, and the Lyapunov spectra it gives: Hénon–Heiles chaotic
+//! (a positive exponent and its mirror, a sum of 0 to round-off at every time) and regular (λ₁
+//! falling as log T/T), the harmonic oscillator's all falling to 0, the double pendulum's pairs
+//! under the midpoint rule, and the damped, driven pendulum's sum: the discrete map's exact
+//! volume change, and −2β to the method's order.
 
 use varmech::diagnostics::{lyapunov, LyapunovOptions, Stretching};
 use varmech::integrators::{Dynamics, General, Method, Options, Stepper, Tangent};
-use varmech::model::MechanicalSystem;
-use varmech::scenes::{DoublePendulum, FermiPastaUlam, HarmonicOscillator, HenonHeiles};
+use varmech::scenes::{DampedDrivenPendulum, DoublePendulum, FermiPastaUlam, HarmonicOscillator, HenonHeiles};
 use varmech::Error;
 
 /// One step of `method` from (q, p): the end (q, p) as one vector.
@@ -18,18 +19,18 @@ fn step<S: Dynamics>(sys: &S, method: Method, h: f64, x: &[f64]) -> Vec<f64> {
 }
 
 /// The tangent map applied to the 2n unit vectors: the step's Jacobian Ψ, column-major.
-fn jacobian<S: MechanicalSystem>(sys: &S, method: Method, h: f64, x: &[f64]) -> Vec<f64> {
-    let dim = x.len();
+fn jacobian<S: Dynamics>(sys: &S, method: Method, h: f64, x: &[f64]) -> Vec<f64> {
+    let (dim, n) = (x.len(), x.len() / 2);
     let mut psi = vec![0.0; dim * dim];
     (0..dim).for_each(|j| psi[j * dim + j] = 1.0);
-    let mut tangent = Tangent::new(method, dim / 2).unwrap();
-    let n = dim / 2;
-    tangent.apply(sys, h, (&x[..n], &x[n..]), &mut psi).unwrap();
+    let mut tangent = Tangent::new(method, sys).unwrap();
+    let mut stepper = Stepper::new(sys, method, &x[..n], &x[n..], &Options::new(h, 1)).unwrap();
+    stepper.step_with_tangent(&mut tangent, &mut psi).unwrap();
     psi
 }
 
 /// max |Ψ − central differences of the step| over max |Ψ|, and ‖ΨᵀJΨ − J‖_max.
-fn check<S: MechanicalSystem + Dynamics>(sys: &S, method: Method, h: f64, x: &[f64]) -> (f64, f64) {
+fn check<S: Dynamics>(sys: &S, method: Method, h: f64, x: &[f64]) -> (f64, f64) {
     let dim = x.len();
     let psi = jacobian(sys, method, h, x);
     let (mut error, mut size) = (0.0_f64, 0.0_f64);
@@ -92,6 +93,10 @@ fn the_tangent_map_is_the_steps_jacobian_and_symplectic() {
 }
 
 fn spectrum<S: Dynamics>(sys: &S, q0: &[f64], p0: &[f64], (dt, steps): (f64, usize)) -> Stretching {
+    spectrum_of(sys, Method::Verlet, q0, p0, (dt, steps))
+}
+
+fn spectrum_of<S: Dynamics>(sys: &S, method: Method, q0: &[f64], p0: &[f64], (dt, steps): (f64, usize)) -> Stretching {
     let options = LyapunovOptions {
         t0: 0.0,
         dt,
@@ -99,7 +104,7 @@ fn spectrum<S: Dynamics>(sys: &S, q0: &[f64], p0: &[f64], (dt, steps): (f64, usi
         k: 2 * q0.len(),
         every: 10,
     };
-    lyapunov(sys, Method::Verlet, q0, p0, &options, || Ok(())).unwrap()
+    lyapunov(sys, method, q0, p0, &options, || Ok(())).unwrap()
 }
 
 /// λⱼ at row r of the run.
@@ -190,6 +195,129 @@ fn bad_requests_are_refused_naming_the_argument() {
         "every"
     );
     assert_eq!(refused(&hh, Method::Rk4, options), "method");
+    // A kick–drift method on a general Lagrangian; its implicit rules take it.
     let pendulum = DoublePendulum::new(1.0, 1.0, 1.0, 1.0, 9.81).unwrap();
-    assert_eq!(refused(&General(&pendulum), Method::Midpoint, options), "model");
+    assert_eq!(refused(&General(&pendulum), Method::Verlet, options), "model");
+    assert!(lyapunov(
+        &General(&pendulum),
+        Method::Midpoint,
+        &[0.1, 0.0],
+        &[0.0, 0.5],
+        &options,
+        || Ok(())
+    )
+    .is_ok());
+}
+
+#[test]
+fn the_implicit_rules_tangent_maps_are_their_steps_jacobians() {
+    // The double pendulum (M(q): a general Lagrangian) and Hénon–Heiles through its Lagrangian:
+    // symplectic to the differencing error; the damped, driven pendulum (forced, its drive
+    // depending on t): its Jacobian, whose determinant is the step's volume change. Measured:
+    // 1e-11–7e-11 from the differences of the step (themselves right to about 1e-10), ΨᵀJΨ − J
+    // 3e-12–1.4e-11.
+    let double = DoublePendulum::new(1.0, 2.0, 2.0, 3.0, 9.81).unwrap();
+    let hh = HenonHeiles::new();
+    let (damped, _) = taylor(1.077);
+    for method in [
+        Method::Midpoint,
+        Method::Trapezoid,
+        Method::Galerkin4,
+        Method::Galerkin6,
+    ] {
+        let (error, defect) = check(&General(&double), method, 0.01, &[0.5, 1.0, 0.3, -0.2]);
+        assert!(error < 1e-9, "{method:?} on the double pendulum: {error:e}");
+        assert!(
+            defect < 1e-10,
+            "{method:?} on the double pendulum: ΨᵀJΨ − J = {defect:e}"
+        );
+        let (error, defect) = check(&hh, method, 0.1, &[0.1, -0.2, 0.3, 0.25]);
+        assert!(error < 1e-9, "{method:?} on Hénon–Heiles: {error:e}");
+        assert!(defect < 1e-10, "{method:?} on Hénon–Heiles: ΨᵀJΨ − J = {defect:e}");
+        let (error, _) = check(&General(&damped), method, 0.005, &[0.4, 2.0]);
+        assert!(error < 1e-9, "{method:?} on the damped pendulum: {error:e}");
+    }
+}
+
+#[test]
+fn the_double_pendulums_exponents_come_in_pairs_under_the_midpoint_rule() {
+    // Chaotic (both arms swinging from 90°): λ₁ > 0, λ₁ + λ₄ and λ₂ + λ₃ near 0, and Σλ, the
+    // tangent map's log-determinant per unit time, 0 to the differencing error.
+    let double = DoublePendulum::new(1.0, 1.0, 1.0, 1.0, 9.81).unwrap();
+    let half = std::f64::consts::FRAC_PI_2;
+    let s = spectrum_of(
+        &General(&double),
+        Method::Midpoint,
+        &[half, half],
+        &[0.0, 0.0],
+        (0.01, 50_000),
+    );
+    let last = exponents(&s, s.t.len() - 1);
+    assert!(last[0] > 0.5, "{last:?}");
+    assert!((last[0] + last[3]).abs() < 0.05 * last[0], "{last:?}");
+    assert!((last[1] + last[2]).abs() < 0.05 * last[0], "{last:?}");
+    assert!(last.iter().sum::<f64>().abs() < 1e-8, "{last:?}");
+}
+
+/// The damped, driven pendulum in Taylor's form φ̈ + 2βφ̇ + ω₀² sin φ = γω₀² cos ωt (ω = 2π,
+/// ω₀ = 1.5ω, β = ω₀/4): m = l = 1, g = ω₀², damping 2β, amplitude γω₀², drive ω.
+fn taylor(gamma: f64) -> (DampedDrivenPendulum, f64) {
+    let omega = 2.0 * std::f64::consts::PI;
+    let (omega0, beta) = (1.5 * omega, 0.375 * omega);
+    let sys = DampedDrivenPendulum::new(1.0, 1.0, omega0 * omega0, 2.0 * beta, gamma * omega0 * omega0, omega).unwrap();
+    (sys, beta)
+}
+
+#[test]
+fn the_driven_pendulums_exponents_sum_to_the_steps_exact_volume_change_and_to_minus_two_beta() {
+    // The forced midpoint step's determinant, from its equations p₀ = (1 + hb/2)v + (h/2)K sin q̄ + …,
+    // p₁ = (1 − hb/2)v − (h/2)K sin q̄ + … in (q₀, v): (1 − hb/2 + c)/(1 + hb/2 + c), c = (h²/4)K cos q̄,
+    // q̄ the step's midpoint. Σ ln det over the run is Σλ·T to the differencing error, and
+    // Σλ = −2β + O(h²).
+    let (sys, beta) = taylor(1.077);
+    let omega0_sq = (3.0 * std::f64::consts::PI).powi(2);
+    let mut errors = Vec::new();
+    for h in [1.0 / 100.0, 1.0 / 200.0] {
+        let steps = (100.0 / h) as usize;
+        let s = spectrum_of(&General(&sys), Method::Midpoint, &[0.0], &[0.0], (h, steps));
+        let total: f64 = s.sums[s.sums.len() - 2..].iter().sum();
+        let model = General(&sys);
+        let mut stepper = Stepper::new(&model, Method::Midpoint, &[0.0], &[0.0], &Options::new(h, 1)).unwrap();
+        let mut exact = 0.0;
+        for _ in 0..steps {
+            let q0 = stepper.q()[0];
+            stepper.step().unwrap();
+            let c = 0.25 * h * h * omega0_sq * (0.5 * (q0 + stepper.q()[0])).cos();
+            exact += ((1.0 - h * beta + c) / (1.0 + h * beta + c)).ln();
+        }
+        assert!(
+            (total - exact).abs() < 1e-10 * exact.abs(),
+            "h = {h}: Σ ln R = {total}, Σ ln det = {exact}"
+        );
+        errors.push(total / 100.0 + 2.0 * beta);
+    }
+    // Second order: the error falls by 4 from h to h/2.
+    let order = (errors[0] / errors[1]).log2();
+    assert!((order - 2.0).abs() < 0.1, "Σλ + 2β = {errors:?}, order {order}");
+}
+
+#[test]
+fn the_driven_pendulum_is_chaotic_past_taylors_cascade_and_periodic_before_it() {
+    // γ = 1.06: the period-1 attractor, both exponents negative; γ = 1.105 (Taylor's chaotic
+    // example, past γ ≈ 1.0829): λ₁ > 0.
+    let lambda = |gamma: f64| {
+        let (sys, _) = taylor(gamma);
+        let s = spectrum_of(
+            &General(&sys),
+            Method::Midpoint,
+            &[-std::f64::consts::FRAC_PI_2],
+            &[0.0],
+            (0.005, 60_000),
+        );
+        exponents(&s, s.t.len() - 1)
+    };
+    let periodic = lambda(1.06);
+    assert!(periodic[0] < -0.1, "{periodic:?}");
+    let chaotic = lambda(1.105);
+    assert!(chaotic[0] > 0.1, "{chaotic:?}");
 }

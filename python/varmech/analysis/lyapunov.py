@@ -1,10 +1,11 @@
 """Lyapunov exponents from the integrator's own tangent map.
 
-A kick–drift step is a composition of shears, and so is its linearization: the core carries k
-tangent vectors along the run with that exact tangent map (symplectic, determinant 1 to
-round-off), re-orthonormalizes them every few steps by a QR factorization and sums the
-logarithms of R's diagonal (Benettin, Galgani, Giorgilli & Strelcyn 1980). Python declares the
-run and turns the sums into exponents and their standard errors.
+A kick–drift step is a composition of shears, and so is its linearization (symplectic,
+determinant 1 to round-off); an implicit step (midpoint, trapezoid, Galerkin, forced or not) is
+linearized through its own equations at their solution. The core carries k tangent vectors along
+the run with that tangent map, re-orthonormalizes them every few steps by a QR factorization and
+sums the logarithms of R's diagonal (Benettin, Galgani, Giorgilli & Strelcyn 1980). Python
+declares the run and turns the sums into exponents and their standard errors.
 """
 
 from __future__ import annotations
@@ -48,11 +49,12 @@ class LyapunovSpectrum:
     every : int
         Steps between re-orthonormalizations.
     evaluations : int
-        Evaluations of ∇V and of its Hessian the tangent map made (a differenced Hessian counts
-        its 2n gradients).
+        Evaluations the tangent map made: of ∇V and of its Hessian for a kick–drift method (a
+        differenced Hessian counts its 2n gradients), of the step's equations for an implicit one.
     sum : float
-        Σλⱼ: for the full spectrum the tangent map's volume change per unit time, 0 to round-off
-        for a Hamiltonian model.
+        Σλⱼ: for the full spectrum the tangent map's volume change per unit time, 0 for a
+        Hamiltonian model (to round-off under a kick–drift method, to about 1e-10 under an
+        implicit one), the step's own contraction for a damped one.
 
     Examples
     --------
@@ -96,7 +98,7 @@ def lyapunov_spectrum(
     *,
     dt: float,
     steps: int,
-    method: str = "verlet",
+    method: str | None = None,
     k: int | None = None,
     every: int = 10,
     segments: int = 10,
@@ -104,18 +106,23 @@ def lyapunov_spectrum(
 ) -> LyapunovSpectrum:
     """The Lyapunov spectrum of the orbit from (q0, p0), from the step's own tangent map.
 
-    The run is the plain run of ``method`` (the same states, bit for bit); its tangent map,
-    exact for a kick–drift step (shears: δq += bh M⁻¹δp at each drift, δp −= ah H(q) δq at each
-    kick, H the Hessian of V where the kick acts), carries k tangent vectors, re-orthonormalized
-    every ``every`` steps. The model's own Hessian is used where it has one (native scenes
-    such as Hénon–Heiles), else central differences of ∇V, symmetrized: the map stays
-    symplectic either way.
+    The run is the plain run of ``method`` (the same states, bit for bit); its tangent map
+    carries k tangent vectors, re-orthonormalized every ``every`` steps. For a kick–drift step
+    it is exact (shears: δq += bh M⁻¹δp at each drift, δp −= ah H(q) δq at each kick, H the
+    Hessian of V where the kick acts), with the model's own Hessian where it has one (native
+    scenes such as Hénon–Heiles), else central differences of ∇V, symmetrized: the map stays
+    symplectic either way. For an implicit step, which solves F(x; q₀, p₀) = 0 and ends at
+    p₁ = P(x; q₀, p₀), it is the implicit function theorem's, δx = −F_x⁻¹(F_q₀δq₀ + F_p₀δp₀),
+    the step's equations differentiated at their solution (central differences, error about
+    1e-11): for any Lagrangian, with its forces, so that a damped, driven model's Σλ is the
+    step's own volume change.
 
     Parameters
     ----------
     model
-        A separable model, L = ½q̇ᵀMq̇ − V(q) (a native scene, a SymPy model of that form, or
-        closures of V and ∇V).
+        An unconstrained model without delayed forces: separable, L = ½q̇ᵀMq̇ − V(q), for the
+        kick–drift methods; any Lagrangian, forced or not, for the implicit ones (a native
+        scene, a SymPy model, or closures).
     q0, p0
         The initial state, shape (n,) each.
     dt
@@ -123,7 +130,10 @@ def lyapunov_spectrum(
     steps
         Steps of the run.
     method
-        A kick–drift method (``"verlet"``, ``"yoshida4"``, ``"blanes_moan4"``, ``"aba864"``, …).
+        A kick–drift method (``"verlet"``, ``"yoshida4"``, ``"blanes_moan4"``, ``"aba864"``, …)
+        or an implicit rule (``"midpoint"``, ``"trapezoid"``, ``"galerkin4"``, ``"galerkin6"``).
+        Default: the model's default method (``"verlet"`` for a separable model, ``"midpoint"``
+        for any other).
     k
         How many exponents, the k largest: 1 … 2n; default 2n, the full spectrum.
     every
@@ -142,8 +152,9 @@ def lyapunov_spectrum(
     ------
     ValueError
         ``k`` outside 1 … 2n, ``every`` or ``steps`` not a positive integer, ``segments`` < 2 or
-        more than the run's re-orthonormalizations, a model that is not separable or a method
-        without a tangent map, naming the argument.
+        more than the run's re-orthonormalizations, a kick–drift method on a model that is not
+        separable, a model with constraints or delayed forces, or a method without a tangent
+        map, naming the argument.
     VarmechError
         The model failing during the run, with the step and time.
 
@@ -156,6 +167,16 @@ def lyapunov_spectrum(
     >>> hh = varmech.scenes.henon_heiles().model
     >>> s = varmech.lyapunov_spectrum(hh, [0.0, -0.25], [0.42, 0.0], dt=0.05, steps=20_000)
     >>> bool(s.exponents[0] > 0.02), bool(abs(s.sum) < 1e-12)
+    (True, True)
+
+    The damped, driven pendulum in Taylor's chaotic regime (γ = 1.105; the scene's time unit
+    is 1/ω₀, its damping 2β/ω₀ = 0.5), under the midpoint rule: λ₁ > 0, and Σλ the damping's
+    −2β to the method's order.
+
+    >>> import math
+    >>> pendulum = varmech.scenes.get("damped_driven_pendulum", amplitude=1.105).model
+    >>> s = varmech.lyapunov_spectrum(pendulum, [-math.pi / 2], [0.0], dt=0.02, steps=50_000)
+    >>> bool(s.exponents[0] > 0.05), bool(abs(s.sum + 0.5) < 1e-4)
     (True, True)
     """
     n = model.dim
@@ -173,6 +194,7 @@ def lyapunov_spectrum(
             f"segments: the run re-orthonormalizes {steps // every} times, fewer than its {segments} segments; "
             "run more steps, re-orthonormalize more often (a smaller every), or take fewer segments"
         )
+    method = model.kind.default_method if method is None else method
     t, sums, (q, p), evaluations = _core.lyapunov(model._core, method, q0, p0, t0=t0, dt=dt, steps=steps, k=k, every=every)
     elapsed = t - t0
     running = sums / elapsed[:, None]
@@ -247,7 +269,7 @@ def megno(
     *,
     dt: float,
     steps: int,
-    method: str = "verlet",
+    method: str | None = None,
     t0: float = 0.0,
 ) -> Megno:
     """MEGNO along the orbit from (q0, p0), from the step's own tangent map.
@@ -284,6 +306,7 @@ def megno(
     q0, p0 = vector("q0", q0, n), vector("p0", p0, n)
     dt, t0 = positive("dt", dt), finite("t0", t0)
     steps = positive_int("steps", steps)
+    method = model.kind.default_method if method is None else method
     t, sums, _, _ = _core.lyapunov(model._core, method, q0, p0, t0=t0, dt=dt, steps=steps, k=1, every=1)
     elapsed = t - t0
     growth = np.diff(sums[:, 0], prepend=0.0)

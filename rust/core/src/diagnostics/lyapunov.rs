@@ -75,12 +75,7 @@ pub fn lyapunov<S: Dynamics + ?Sized, P: Poll>(
             "must be at least 1 (steps between re-orthonormalizations)",
         ));
     }
-    let Some(separable) = sys.as_mechanical() else {
-        let reason = "the tangent map is that of a kick–drift step, which needs a separable model \
-                      (L = ½q̇ᵀMq̇ − V(q)); this one is not";
-        return Err(Error::invalid("model", reason));
-    };
-    let mut tangent = Tangent::new(method, n)?;
+    let mut tangent = Tangent::new(method, sys)?;
     let run = Options {
         t0,
         ..Options::new(dt, steps)
@@ -100,7 +95,6 @@ pub fn lyapunov<S: Dynamics + ?Sized, P: Poll>(
         p: p0.to_vec(),
         evaluations: 0,
     };
-    let (mut q, mut p) = (q0.to_vec(), p0.to_vec());
     let mut interrupt = InterruptPoll::new();
     for step in 1..=steps {
         let time = stepper.t();
@@ -108,12 +102,7 @@ pub fn lyapunov<S: Dynamics + ?Sized, P: Poll>(
             poll.poll(step - 1)
                 .map_err(|source| Error::Interrupted { step, time, source })?;
         }
-        q.copy_from_slice(stepper.q());
-        p.copy_from_slice(stepper.p());
-        stepper.step()?;
-        tangent
-            .apply(separable, dt, (&q, &p), &mut x)
-            .map_err(|source| Error::Model { step, time, source })?;
+        stepper.step_with_tangent(&mut tangent, &mut x)?;
         if step % every == 0 || step == steps || x.iter().any(|v| v.abs() > LARGE) {
             orthonormalize(&mut x, dim, &mut row);
             stretching.t.push(stepper.t());

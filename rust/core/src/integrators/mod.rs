@@ -261,6 +261,17 @@ impl Integrator {
         }
     }
 
+    /// The step map of an implicit method's last unconstrained step, for its tangent map; None
+    /// for the methods that solve no DEL equations.
+    pub(in crate::integrators) fn step_map(&mut self) -> Option<&mut dyn tangent::StepMap> {
+        match &mut self.scheme {
+            Scheme::Midpoint(s) => Some(s),
+            Scheme::Trapezoid(s) => Some(s),
+            Scheme::Galerkin(s) => Some(s),
+            _ => None,
+        }
+    }
+
     /// The discrete energy of a Galerkin method's last step, from `start`; None for the other
     /// methods.
     pub(super) fn galerkin_energy(

@@ -9,7 +9,7 @@ use std::ops::Deref;
 use super::checkpoint::shape::shape;
 use super::{
     check_method, compensated, Dynamics, Gaps, General, Increment, Integrator, Method, Options, Poll, StepError,
-    StepStart,
+    StepStart, Tangent,
 };
 use crate::error::check_vector;
 use crate::model::{Lagrangian, MechanicalSystem};
@@ -131,6 +131,21 @@ where
         let result = self.model.advance(state, 1);
         state.synchronise();
         result
+    }
+
+    /// Advances one step, as [`Stepper::step`], and carries the tangent vectors in `x` (2n × k,
+    /// column-major, a column (δq, δp)) by the step's tangent map DΨ_h from its start
+    /// ([`Tangent`], made for this stepper's method and model). The states are those of
+    /// [`Stepper::step`], bit for bit.
+    pub fn step_with_tangent(&mut self, tangent: &mut Tangent, x: &mut [f64]) -> Result<(), Error> {
+        let state = self.state.borrow();
+        let (step, time) = (state.steps + 1, state.t());
+        tangent.begin(time, &state.q, &state.p);
+        self.step()?;
+        let state = self.state.borrow_mut();
+        tangent
+            .apply(self.model.as_dynamics(), &mut state.integrator, state.clock.h, x)
+            .map_err(|source| Error::Model { step, time, source })
     }
 
     /// Advances `n` steps, calling `poll` before a step every 10–40 ms of run time; an error

@@ -389,6 +389,31 @@ impl<Sc: StepEquations> Del<Sc> {
         self.finish(sys, constraints, start, out)
     }
 
+    /// The unknowns of the last unconstrained step, as Newton's method left them at its
+    /// solution: the increments from q₀ of every point the step solved for, δq last.
+    pub(in crate::integrators) fn solution(&self) -> &[f64] {
+        &self.x[self.m..]
+    }
+
+    /// The unconstrained step's map at unknowns `x` from `start`, without the run's
+    /// bookkeeping (work, predictor, history): its equations F(x) into `out[..u]` and the end
+    /// momentum p₁ = p₀ + δp into `out[u..]` (n more). At the solution F = 0, and the
+    /// linearization of (F, p₁) in (x, q₀, p₀) is the step's tangent map
+    /// ([`crate::integrators::Tangent`]).
+    pub(in crate::integrators) fn step_map<S: Lagrangian + ?Sized>(
+        &mut self,
+        sys: &S,
+        start: StepStart<'_>,
+        x: &[f64],
+        out: &mut [f64],
+    ) -> Result<(), ModelError> {
+        let (residual, p1) = out.split_at_mut(x.len());
+        self.scheme.equations(sys, start, x, residual)?;
+        self.scheme.momentum_change(sys, start, x, residual, p1)?;
+        p1.iter_mut().zip(start.p).for_each(|(p1, p0)| *p1 += p0);
+        Ok(())
+    }
+
     /// Refuses a solution whose Jacobian's determinant has the sign `sign`, opposite to the
     /// continuum limit's: beyond a fold of the DEL map.
     #[inline(always)]
