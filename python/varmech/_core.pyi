@@ -716,6 +716,7 @@ def lyapunov(
     steps: int,
     k: int,
     every: int,
+    start: _FloatArray | None = None,
 ) -> tuple[_FloatArray, NDArray[np.float64], tuple[_FloatArray, _FloatArray], int]: ...
 def methods() -> list[MethodInfo]: ...
 @final

@@ -103,6 +103,7 @@ fn spectrum_of<S: Dynamics>(sys: &S, method: Method, q0: &[f64], p0: &[f64], (dt
         steps,
         k: 2 * q0.len(),
         every: 10,
+        start: None,
     };
     lyapunov(sys, method, q0, p0, &options, || Ok(())).unwrap()
 }
@@ -176,6 +177,7 @@ fn bad_requests_are_refused_naming_the_argument() {
         steps: 100,
         k: 4,
         every: 10,
+        start: None,
     };
     let refused = |sys: &dyn Dynamics, method, options: LyapunovOptions| match lyapunov(
         sys,
@@ -195,6 +197,12 @@ fn bad_requests_are_refused_naming_the_argument() {
         "every"
     );
     assert_eq!(refused(&hh, Method::Rk4, options), "method");
+    let twice = [1.0, 0.0, 0.0, 0.0].repeat(4);
+    let start = LyapunovOptions {
+        start: Some(&twice),
+        ..options
+    };
+    assert_eq!(refused(&hh, Method::Verlet, start), "tangent0");
     // A kick–drift method on a general Lagrangian; its implicit rules take it.
     let pendulum = DoublePendulum::new(1.0, 1.0, 1.0, 1.0, 9.81).unwrap();
     assert_eq!(refused(&General(&pendulum), Method::Verlet, options), "model");

@@ -17,7 +17,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .. import _core
-from .._util import finite, positive, positive_int, vector
+from .._util import finite, floats, positive, positive_int, vector
 from ..model import Model
 
 __all__ = ["LyapunovSpectrum", "Megno", "lyapunov_spectrum", "megno"]
@@ -103,6 +103,7 @@ def lyapunov_spectrum(
     every: int = 10,
     segments: int = 10,
     t0: float = 0.0,
+    tangent0: ArrayLike | None = None,
 ) -> LyapunovSpectrum:
     """The Lyapunov spectrum of the orbit from (q0, p0), from the step's own tangent map.
 
@@ -143,6 +144,10 @@ def lyapunov_spectrum(
         The run's pieces whose estimates give the standard errors (at least 2).
     t0
         The initial time.
+    tangent0
+        The tangent vectors' start, the k columns (δq, δq̇) of an array of shape (2n, k)
+        (shape (2n,) for k = 1), linearly independent; δp is the Legendre transform's
+        differential at (q0, p0). Default: fixed pseudo-random directions of (δq, δq̇).
 
     Returns
     -------
@@ -153,8 +158,8 @@ def lyapunov_spectrum(
     ValueError
         ``k`` outside 1 … 2n, ``every`` or ``steps`` not a positive integer, ``segments`` < 2 or
         more than the run's re-orthonormalizations, a kick–drift method on a model that is not
-        separable, a model with constraints or delayed forces, or a method without a tangent
-        map, naming the argument.
+        separable, a model with constraints or delayed forces, a method without a tangent
+        map, or a ``tangent0`` of another shape or of dependent columns, naming the argument.
     VarmechError
         The model failing during the run, with the step and time.
 
@@ -195,7 +200,8 @@ def lyapunov_spectrum(
             "run more steps, re-orthonormalize more often (a smaller every), or take fewer segments"
         )
     method = model.kind.default_method if method is None else method
-    t, sums, (q, p), evaluations = _core.lyapunov(model._core, method, q0, p0, t0=t0, dt=dt, steps=steps, k=k, every=every)
+    start = _tangent0(tangent0, 2 * n, k)
+    t, sums, (q, p), evaluations = _core.lyapunov(model._core, method, q0, p0, t0=t0, dt=dt, steps=steps, k=k, every=every, start=start)
     elapsed = t - t0
     running = sums / elapsed[:, None]
     exponents = running[-1]
@@ -221,6 +227,21 @@ def lyapunov_spectrum(
         every=every,
         evaluations=int(evaluations),
     )
+
+
+def _tangent0(tangent0: ArrayLike | None, dim: int, k: int) -> np.ndarray | None:
+    """``tangent0`` as the core takes it (its k columns of ``dim`` one after the other), or
+    ValueError naming it; the core checks that the columns are independent."""
+    if tangent0 is None:
+        return None
+    a = floats("tangent0", tangent0)
+    if a.shape == (dim,):
+        a = a[:, None]
+    if a.shape != (dim, k):
+        raise ValueError(f"tangent0: must have shape ({dim}, {k}) (k columns (δq, δq̇)), got {a.shape}")
+    if not np.all(np.isfinite(a)):
+        raise ValueError("tangent0: must be finite")
+    return np.ascontiguousarray(a.T).ravel()
 
 
 @dataclass(frozen=True)
@@ -271,6 +292,7 @@ def megno(
     steps: int,
     method: str | None = None,
     t0: float = 0.0,
+    tangent0: ArrayLike | None = None,
 ) -> Megno:
     """MEGNO along the orbit from (q0, p0), from the step's own tangent map.
 
@@ -282,6 +304,12 @@ def megno(
     ----------
     model, q0, p0, dt, steps, method, t0
         As for :func:`lyapunov_spectrum`.
+    tangent0
+        The tangent vector's start (δq, δq̇), shape (2n,); δp is the Legendre transform's
+        differential at (q0, p0) (for an N-body model pᵢ = mᵢvᵢ, so δpᵢ = mᵢδvᵢ). Default: a
+        fixed pseudo-random direction. ⟨Y⟩ → 2 from any start on a quasi-periodic orbit, but its
+        approach depends on the start: REBOUND's ``init_megno`` draws (δx, δv) at random, and
+        from the same start the two agree (``benches/megno.py``).
 
     Returns
     -------
@@ -307,7 +335,8 @@ def megno(
     dt, t0 = positive("dt", dt), finite("t0", t0)
     steps = positive_int("steps", steps)
     method = model.kind.default_method if method is None else method
-    t, sums, _, _ = _core.lyapunov(model._core, method, q0, p0, t0=t0, dt=dt, steps=steps, k=1, every=1)
+    start = _tangent0(tangent0, 2 * n, 1)
+    t, sums, _, _ = _core.lyapunov(model._core, method, q0, p0, t0=t0, dt=dt, steps=steps, k=1, every=1, start=start)
     elapsed = t - t0
     growth = np.diff(sums[:, 0], prepend=0.0)
     y = 2.0 * np.cumsum((elapsed - 0.5 * dt) * growth) / elapsed

@@ -264,11 +264,12 @@ type StretchingArrays<'py> = (
     u64,
 );
 
-/// The stretching of k tangent vectors carried by the step's tangent map along a run
-/// (`varmech.lyapunov_spectrum` turns it into exponents).
+/// The stretching of k tangent vectors carried by the step's tangent map along a run, from the
+/// columns (δq, δq̇) of `start` (column-major) where given (`varmech.lyapunov_spectrum` turns it
+/// into exponents).
 #[pyfunction]
 #[allow(clippy::too_many_arguments)]
-#[pyo3(signature = (model, method, q0, p0, *, t0, dt, steps, k, every))]
+#[pyo3(signature = (model, method, q0, p0, *, t0, dt, steps, k, every, start=None))]
 fn lyapunov<'py>(
     py: Python<'py>,
     model: &Bound<'py, PyAny>,
@@ -280,14 +281,17 @@ fn lyapunov<'py>(
     #[pyo3(from_py_with = steps_count)] steps: usize,
     k: usize,
     every: usize,
+    start: Option<PyReadonlyArray1<'py, f64>>,
 ) -> PyResult<StretchingArrays<'py>> {
     let (q0, p0) = (slice("q0", &q0)?, slice("p0", &p0)?);
+    let start = start.as_ref().map(|s| slice("start", s)).transpose()?;
     let options = LyapunovOptions {
         t0,
         dt,
         steps,
         k,
         every,
+        start,
     };
     let stretching = bind_model(py, model, |sys, poll| {
         diagnostics::lyapunov(sys, method, q0, p0, &options, poll)

@@ -5,18 +5,22 @@
 
 use crate::error::check_vector;
 use crate::integrators::{Dynamics, Method, Options, Poll, Stepper, Tangent};
+use crate::model::Lagrangian;
+use crate::solve::difference;
 use crate::solve::interrupt::InterruptPoll;
-use crate::Error;
+use crate::{Error, ModelError};
 
 /// What [`lyapunov`] is asked: `steps` steps of size `dt` from time `t0`, `k` tangent vectors
-/// (1 ≤ k ≤ 2n; 2n for the full spectrum), re-orthonormalized every `every` ≥ 1 steps.
+/// (1 ≤ k ≤ 2n; 2n for the full spectrum), re-orthonormalized every `every` ≥ 1 steps, starting
+/// from the columns (δq, δq̇) of `start` (2n × k, column-major) where given.
 #[derive(Clone, Copy, Debug)]
-pub struct LyapunovOptions {
+pub struct LyapunovOptions<'a> {
     pub t0: f64,
     pub dt: f64,
     pub steps: usize,
     pub k: usize,
     pub every: usize,
+    pub start: Option<&'a [f64]>,
 }
 
 /// The stretching of k tangent vectors along a run: at each re-orthonormalization its time
@@ -38,21 +42,23 @@ const LARGE: f64 = 1e100;
 
 /// The stretching of k tangent vectors along the run of `method` on `sys` from (q0, p0): each
 /// step taken as a [`Stepper`] takes it (the run's states are the plain run's, bit for bit),
-/// the vectors carried by the step's tangent map from its start. They start orthonormal, in
-/// fixed pseudo-random directions (none is special to a model), and are re-orthonormalized
-/// (modified Gram–Schmidt, twice) every `options.every` steps, at the run's end, and whenever
-/// one grows past 10¹⁰⁰. `poll` is called every 10–40 ms.
+/// the vectors carried by the step's tangent map from its start. They start in fixed
+/// pseudo-random directions of (δq, δq̇) (none special to a model), their δp the Legendre
+/// transform's differential at (q0, p0), so that no small mass makes its velocity's
+/// perturbation dominate (REBOUND's MEGNO starts so too); then they are orthonormal, and are
+/// re-orthonormalized (modified Gram–Schmidt, twice) every `options.every` steps, at the run's
+/// end, and whenever one grows past 10¹⁰⁰. `poll` is called every 10–40 ms.
 ///
 /// # Errors
-/// Invalid arguments, naming them (k outside 1 … 2n, `every` = 0, a model that is not
-/// separable or a method without a tangent map); the model's errors and the run's, with the
-/// step and time; [`Error::Interrupted`] from `poll`.
+/// Invalid arguments, naming them (k outside 1 … 2n, `every` = 0, a model or method without a
+/// tangent map, [`Tangent::new`]); the model's errors and the run's, with the step and time;
+/// [`Error::Interrupted`] from `poll`.
 pub fn lyapunov<S: Dynamics + ?Sized, P: Poll>(
     sys: &S,
     method: Method,
     q0: &[f64],
     p0: &[f64],
-    options: &LyapunovOptions,
+    options: &LyapunovOptions<'_>,
     mut poll: P,
 ) -> Result<Stretching, Error> {
     let n = sys.dim();
@@ -64,6 +70,7 @@ pub fn lyapunov<S: Dynamics + ?Sized, P: Poll>(
         steps,
         k,
         every,
+        start,
     } = *options;
     if !(1..=2 * n).contains(&k) {
         let reason = format!("must be 1 … {} (the phase space's dimension 2n), got {k}", 2 * n);
@@ -82,7 +89,25 @@ pub fn lyapunov<S: Dynamics + ?Sized, P: Poll>(
     };
     let mut stepper = Stepper::new(sys, method, q0, p0, &run)?;
     let dim = 2 * n;
-    let mut x = start_vectors(dim, k);
+    let mut x = match start {
+        None => start_vectors(dim, k),
+        Some(given) => {
+            let independent = given.len() == dim * k && given.iter().all(|x| x.is_finite()) && rank(given, dim) == k;
+            if !independent {
+                let reason = format!(
+                    "must be {k} finite, linearly independent columns (δq, δq̇) of {dim} entries, got {} entries",
+                    given.len()
+                );
+                return Err(Error::invalid("tangent0", reason));
+            }
+            given.to_vec()
+        }
+    };
+    to_momenta(sys.as_lagrangian(), (t0, q0, p0), &mut x).map_err(|source| Error::Model {
+        step: 1,
+        time: t0,
+        source,
+    })?;
     let mut row = vec![0.0; k];
     orthonormalize(&mut x, dim, &mut row);
     row.fill(0.0);
@@ -129,6 +154,47 @@ fn start_vectors(dim: usize, k: usize) -> Vec<f64> {
             (z >> 11) as f64 / (1u64 << 52) as f64 - 1.0
         })
         .collect()
+}
+
+/// The number of the columns of `x` (each of `dim`) independent to working precision: those
+/// whose Gram–Schmidt remainder keeps more than 1e-12 of their norm.
+fn rank(x: &[f64], dim: usize) -> usize {
+    let mut work = x.to_vec();
+    let mut sums = vec![0.0; x.len() / dim];
+    let norms: Vec<f64> = x.chunks_exact(dim).map(|c| dot(c, c).sqrt()).collect();
+    orthonormalize(&mut work, dim, &mut sums);
+    sums.iter()
+        .zip(&norms)
+        .filter(|(ln_r, norm)| ln_r.exp() > 1e-12 * **norm)
+        .count()
+}
+
+/// Each column (δq, δq̇) of `x` made (δq, δp), δp = ∂p/∂q δq + ∂p/∂q̇ δq̇ the differential of
+/// p = ∂L/∂q̇ at (q, q̇(q, p), t): a central difference along the column (exact for an L
+/// quadratic in q̇ but for round-off; a start direction needs no more).
+fn to_momenta(sys: &dyn Lagrangian, (t, q, p): (f64, &[f64], &[f64]), x: &mut [f64]) -> Result<(), ModelError> {
+    let n = q.len();
+    let mut v = vec![0.0; n];
+    sys.velocity(q, p, t, &mut v)?;
+    let size = q.iter().chain(&v).fold(1.0_f64, |m, x| m.max(x.abs()));
+    let h = difference::step(size);
+    let (mut at, mut rate, mut plus, mut minus) = (vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n]);
+    for column in x.chunks_exact_mut(2 * n) {
+        let (dq, dv) = column.split_at_mut(n);
+        for (sign, out) in [(1.0, &mut plus), (-1.0, &mut minus)] {
+            at.iter_mut()
+                .zip(q.iter().zip(dq.iter()))
+                .for_each(|(a, (q, d))| *a = q + sign * h * d);
+            rate.iter_mut()
+                .zip(v.iter().zip(dv.iter()))
+                .for_each(|(r, (v, d))| *r = v + sign * h * d);
+            sys.dl_dv(&at, &rate, t, out)?;
+        }
+        dv.iter_mut()
+            .zip(plus.iter().zip(&minus))
+            .for_each(|(d, (a, b))| *d = (a - b) / (2.0 * h));
+    }
+    Ok(())
 }
 
 /// The k columns of `x` (each of `dim`) orthonormalized in order by modified Gram–Schmidt,
