@@ -198,6 +198,8 @@ class Stepper:
         """Advances one step."""
     def advance(self, n: int) -> None:
         """Advances `n` steps, checking for Ctrl-C on the way."""
+    def advance_tangent(self, n: int, x: _FloatArray) -> _FloatArray:
+        """Advances `n` steps carrying the tangent vectors `x` by the steps' tangent map."""
     def reset(
         self, q0: _FloatArray, p0: _FloatArray, t0: float, *, events: list[tuple[str, int, int, str, Any]] | None = None
     ) -> None:

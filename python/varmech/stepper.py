@@ -12,7 +12,7 @@ from . import _core
 from . import events as _events
 from . import impacts as _impacts
 from . import impulses as _impulses
-from ._util import finite, positive, step_count
+from ._util import finite, floats, positive, step_count
 from .events import Event, EventFunction, Occurrences
 from .impacts import Contact
 from .impulses import Impulse
@@ -247,6 +247,61 @@ class Stepper:
         """
         n = step_count(self.dt, self.t, steps, t_end)
         self._stepping(lambda: self._stepper.advance(n))
+
+    def advance_tangent(self, tangent: ArrayLike, steps: int | None = None, *, t_end: float | None = None) -> np.ndarray:
+        """Advance as :meth:`advance` does, carrying tangent vectors by the steps' own tangent map.
+
+        Each step's linearization DΨ_h (a kick–drift step's shears, an implicit step's equations
+        differentiated at their solution; see :func:`varmech.lyapunov_spectrum`) maps each
+        vector (δq, δp) from the step's start to its end, in the core, with no Python call per
+        step. The states are those of :meth:`advance`, bit for bit. The vectors are not
+        renormalized: in a chaotic run they grow as e^(λ₁t), so a long one belongs to
+        :func:`varmech.lyapunov_spectrum`.
+
+        Parameters
+        ----------
+        tangent : array_like, shape (2n,) or (2n, k)
+            The vectors (δq, δp), one a column.
+        steps, t_end
+            As for :meth:`advance`.
+
+        Returns
+        -------
+        numpy.ndarray
+            The vectors carried to the last step, of ``tangent``'s shape.
+
+        Raises
+        ------
+        ValueError
+            ``tangent`` of another shape or not finite; a method or model without a tangent
+            map (a kick–drift method on a model that is not separable, constraints, delayed
+            forces), naming it; a stepper with contacts, impulses or events; ``steps, t_end``
+            as for :meth:`advance`.
+        DivergenceError, ConvergenceError
+            As :meth:`step`.
+
+        Examples
+        --------
+        One Verlet step of the harmonic oscillator (ω = 1) maps (δq, δp) by
+        [[1 − h²/2, h], [−h(1 − h²/4), 1 − h²/2]], of determinant 1.
+
+        >>> import numpy as np
+        >>> import varmech
+        >>> stepper = varmech.Stepper(varmech.scenes.get("harmonic_oscillator"), dt=0.1)
+        >>> psi = stepper.advance_tangent(np.eye(2), steps=1)
+        >>> psi.round(6).tolist(), bool(abs(np.linalg.det(psi) - 1) < 1e-15)
+        ([[0.995, 0.1], [-0.09975, 0.995]], True)
+        """
+        dim = 2 * self.model.dim
+        x = floats("tangent", tangent)
+        if not (x.shape == (dim,) or (x.ndim == 2 and x.shape[0] == dim and x.shape[1] > 0)):
+            raise ValueError(f"tangent: must have shape ({dim},) or ({dim}, k), columns (δq, δp), got {x.shape}")
+        if not np.all(np.isfinite(x)):
+            raise ValueError("tangent: must be finite")
+        columns = x.reshape(dim, -1)
+        n = step_count(self.dt, self.t, steps, t_end)
+        carried = self._stepper.advance_tangent(n, np.ascontiguousarray(columns.T).ravel())
+        return carried.reshape(-1, dim).T.reshape(x.shape).copy()
 
     def _stepping(self, steps: Callable[[], None]) -> None:
         """Takes the ``steps``, warning of their grazing impacts (as a run does)."""

@@ -233,3 +233,51 @@ def test_tangent0_is_checked_by_name():
         varmech.lyapunov_spectrum(hh, *CHAOTIC, dt=0.05, steps=1000, k=2, tangent0=np.ones((4, 2)))
     s = varmech.lyapunov_spectrum(hh, *CHAOTIC, dt=0.05, steps=1000, k=2, tangent0=np.eye(4)[:, :2])
     assert s.exponents.shape == (2,)
+
+
+def test_a_steppers_tangent_map_is_the_closed_form_and_leaves_its_states_as_they_are():
+    # Verlet on the oscillator ω = 1: DΨ_h = [[1 − h²/2, h], [−h(1 − h²/4), 1 − h²/2]], ten steps its
+    # tenth power (to the round-off of the scene's differenced Hessian, ε/ε^⅓); the states those
+    # of advance, bit for bit.
+    h = 0.1
+    scene = varmech.scenes.get("harmonic_oscillator")
+    stepper, plain = varmech.Stepper(scene, dt=h), varmech.Stepper(scene, dt=h)
+    psi = stepper.advance_tangent(np.eye(2), steps=10)
+    plain.advance(10)
+    one = np.array([[1 - h**2 / 2, h], [-h * (1 - h**2 / 4), 1 - h**2 / 2]])
+    np.testing.assert_allclose(psi, np.linalg.matrix_power(one, 10), rtol=0, atol=1e-11)
+    np.testing.assert_array_equal(stepper.q, plain.q)
+    np.testing.assert_array_equal(stepper.p, plain.p)
+    assert stepper.advance_tangent([1.0, 0.0], steps=1).shape == (2,)
+
+
+def test_a_steppers_implicit_tangent_map_is_the_difference_of_its_steps():
+    # The driven pendulum under the midpoint rule, 20 steps: against central differences of two
+    # nearby runs (1e-6 apart, right to about 1e-10).
+    model = taylor(1.105)
+    dt, x0 = 3 * math.pi / 200, np.array([0.3, 0.2])
+    psi = varmech.Stepper(model, x0[:1], x0[1:], dt=dt).advance_tangent(np.eye(2), steps=20)
+    columns = []
+    for j in range(2):
+        ends = []
+        for sign in (1, -1):
+            x = x0.copy()
+            x[j] += sign * 1e-6
+            s = varmech.Stepper(model, x[:1], x[1:], dt=dt)
+            s.advance(20)
+            ends.append(np.concatenate([s.q, s.p]))
+        columns.append((ends[0] - ends[1]) / 2e-6)
+    np.testing.assert_allclose(psi, np.array(columns).T, rtol=1e-8)
+
+
+def test_a_steppers_tangent_is_refused_where_it_has_none():
+    stepper = varmech.Stepper(varmech.scenes.get("harmonic_oscillator"), dt=0.1)
+    with pytest.raises(ValueError, match="^tangent: must have shape"):
+        stepper.advance_tangent(np.eye(3), steps=1)
+    ball = varmech.scenes.get("bouncing_ball")
+    watched = varmech.Stepper(ball, dt=0.01)
+    with pytest.raises(ValueError, match="^tangent: a stepper with contacts"):
+        watched.advance_tangent(np.eye(2), steps=1)
+    rk4 = varmech.Stepper(varmech.scenes.get("harmonic_oscillator"), dt=0.1, method="rk4")
+    with pytest.raises(ValueError, match="^method:"):
+        rk4.advance_tangent(np.eye(2), steps=1)

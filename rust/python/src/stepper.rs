@@ -3,11 +3,12 @@
 //! events, each call's steps go through a [`Watcher`] resumed on that state.
 
 use numpy::{PyArray1, PyReadonlyArray1};
+use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyBytes;
 use varmech::integrators::{
     self, Checkpoint, Contacts, Detector, Dynamics, EventSpec, Impacts, Method, NewtonOptions, Occurrence, Options,
-    Schedule, StepperState, Trajectory, Watch, Watcher,
+    Schedule, StepperState, Tangent, Trajectory, Watch, Watcher,
 };
 use varmech::Error;
 
@@ -279,6 +280,31 @@ impl Stepper {
     /// Advances `n` steps, checking for Ctrl-C on the way.
     fn advance(&mut self, py: Python<'_>, n: usize) -> PyResult<()> {
         self.go(py, n, false)
+    }
+
+    /// Advances `n` steps as `advance` does, carrying the tangent vectors `x` (k columns (δq, δp)
+    /// of 2n entries one after the other) by the steps' tangent map, and returns them carried.
+    /// A stepper that watches contacts, impulses or events is refused: their jumps have no
+    /// tangent map here.
+    fn advance_tangent<'py>(
+        &mut self,
+        py: Python<'py>,
+        n: usize,
+        x: PyReadonlyArray1<'py, f64>,
+    ) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        if !self.unwatched() {
+            return Err(PyValueError::new_err(
+                "tangent: a stepper with contacts, impulses or events has jumps, which have no tangent map here; \
+                 carry tangent vectors on a stepper of the model alone",
+            ));
+        }
+        let mut x = slice("tangent", &x)?.to_vec();
+        let vectors = &mut x;
+        self.with(py, |stepper, poll| {
+            let mut tangent = Tangent::new(stepper.method(), stepper.model())?;
+            stepper.advance_with_tangent(n, &mut tangent, vectors, poll)
+        })?;
+        Ok(PyArray1::from_vec(py, x))
     }
 
     /// Starts afresh from (q0, p0) at t0, with the step count at 0, no impacts and no event

@@ -138,14 +138,26 @@ where
     /// ([`Tangent`], made for this stepper's method and model). The states are those of
     /// [`Stepper::step`], bit for bit.
     pub fn step_with_tangent(&mut self, tangent: &mut Tangent, x: &mut [f64]) -> Result<(), Error> {
-        let state = self.state.borrow();
-        let (step, time) = (state.steps + 1, state.t());
-        tangent.begin(time, &state.q, &state.p);
-        self.step()?;
-        let state = self.state.borrow_mut();
-        tangent
-            .apply(self.model.as_dynamics(), &mut state.integrator, state.clock.h, x)
-            .map_err(|source| Error::Model { step, time, source })
+        self.state.borrow_mut().step_with_tangent(&*self.model, tangent, x)
+    }
+
+    /// As [`Stepper::step_with_tangent`], `n` steps, `poll` called as [`Stepper::advance`]
+    /// calls it. The vectors are not renormalized: over many steps of a chaotic run they grow
+    /// past any float ([`crate::diagnostics::lyapunov`] renormalizes them).
+    pub fn advance_with_tangent<P: Poll>(
+        &mut self,
+        n: usize,
+        tangent: &mut Tangent,
+        x: &mut [f64],
+        poll: P,
+    ) -> Result<(), Error> {
+        let (state, model) = (self.state.borrow_mut(), &*self.model);
+        state
+            .polled(n, poll, |state, steps| {
+                (0..steps).try_for_each(|_| state.step_with_tangent(model, tangent, x))?;
+                Ok(false)
+            })
+            .map(drop)
     }
 
     /// Advances `n` steps, calling `poll` before a step every 10–40 ms of run time; an error
@@ -438,6 +450,24 @@ impl StepperState {
         }
         self.steps = step;
         Ok(())
+    }
+
+    /// One step of `model` as [`Stepper::step`] takes it, with the tangent vectors `x` carried
+    /// by its tangent map.
+    fn step_with_tangent<S: Dynamics + ?Sized>(
+        &mut self,
+        model: &S,
+        tangent: &mut Tangent,
+        x: &mut [f64],
+    ) -> Result<(), Error> {
+        let (step, time) = (self.steps + 1, self.t());
+        tangent.begin(time, &self.q, &self.p);
+        let result = model.advance(self, 1);
+        self.synchronise();
+        result?;
+        tangent
+            .apply(model.as_dynamics(), &mut self.integrator, (self.clock.h, &self.q), x)
+            .map_err(|source| Error::Model { step, time, source })
     }
 
     /// `n` steps of `model`, `poll` called before a step when due.

@@ -116,13 +116,13 @@ impl Tangent {
     }
 
     /// Applies DΨ_h of the step of size h just taken by `integrator` on `model` from the start
-    /// kept by [`Tangent::begin`] to the tangent vectors in `x`, in place: column j of the
-    /// 2n × k column-major `x` is (δq, δp).
+    /// kept by [`Tangent::begin`] to its end q₁ (`end`) to the tangent vectors in `x`, in place:
+    /// column j of the 2n × k column-major `x` is (δq, δp).
     pub(super) fn apply(
         &mut self,
         model: &dyn Dynamics,
         integrator: &mut Integrator,
-        h: f64,
+        (h, end): (f64, &[f64]),
         x: &mut [f64],
     ) -> Result<(), ModelError> {
         let start = StepStart {
@@ -136,7 +136,7 @@ impl Tangent {
                 let sys = model
                     .as_mechanical()
                     .expect("a separable model, checked by Tangent::new");
-                s.apply(sys, start, x)
+                s.apply(sys, start, end, x)
             }
             Map::Implicit(s) => {
                 let del = integrator
@@ -151,7 +151,7 @@ impl Tangent {
 }
 
 /// A kick–drift step's tangent map: its shears replayed from the step's start, with the stage's
-/// (q, p), its velocity, the force at it and H there.
+/// (q, p), its velocity, the force at it and H there, and the q that H was taken at.
 #[derive(Clone, Debug)]
 struct Shears {
     splitting: Splitting,
@@ -161,6 +161,7 @@ struct Shears {
     v: Vec<f64>,
     force: Vec<f64>,
     hessian: DMatrix<f64>,
+    hessian_at: Option<Vec<f64>>,
     /// A tangent vector's δp through M⁻¹, and the gradients a differenced H takes.
     velocity: Vec<f64>,
     plus: Vec<f64>,
@@ -180,6 +181,7 @@ impl Shears {
             v: buffer(),
             force: buffer(),
             hessian: DMatrix::zeros(n, n),
+            hessian_at: None,
             velocity: buffer(),
             plus: buffer(),
             minus: buffer(),
@@ -187,11 +189,14 @@ impl Shears {
         }
     }
 
-    /// The stages replayed from `start`, so that each kick's H is taken where that kick acts.
+    /// The stages replayed from `start`, so that each kick's H is taken where that kick acts;
+    /// a last kick after a drift acts at the step's end q₁, `end` (the replay's last q but for
+    /// round-off), where the next step's first kick takes the same H again.
     fn apply<S: MechanicalSystem + ?Sized>(
         &mut self,
         sys: &S,
         start: StepStart<'_>,
+        end: &[f64],
         x: &mut [f64],
     ) -> Result<(), ModelError> {
         let (n, mass, h) = (self.n, sys.mass(), start.h);
@@ -202,8 +207,12 @@ impl Shears {
             let a = self.splitting.kicks()[i];
             if i > 0 {
                 let b = self.splitting.drifts()[i - 1] * h;
-                mass.velocity(&self.p, &mut self.v);
-                self.q.iter_mut().zip(&self.v).for_each(|(q, v)| *q += b * v);
+                if i == last {
+                    self.q.copy_from_slice(end);
+                } else {
+                    mass.velocity(&self.p, &mut self.v);
+                    self.q.iter_mut().zip(&self.v).for_each(|(q, v)| *q += b * v);
+                }
                 for column in x.chunks_exact_mut(2 * n) {
                     let (dq, dp) = column.split_at_mut(n);
                     mass.velocity(dp, &mut self.velocity);
@@ -215,16 +224,16 @@ impl Shears {
             }
             let a = a * h;
             self.hessian(sys)?;
+            // H is symmetric: its column r, contiguous, is its row r.
+            let hessian = self.hessian.as_slice();
             for column in x.chunks_exact_mut(2 * n) {
                 let (dq, dp) = column.split_at_mut(n);
-                // H is symmetric: its column r is its row r.
-                for (r, d) in dp.iter_mut().enumerate() {
-                    let row = self.hessian.column(r);
+                for (d, row) in dp.iter_mut().zip(hessian.chunks_exact(n)) {
                     *d -= a * row.iter().zip(dq.iter()).map(|(h, x)| h * x).sum::<f64>();
                 }
             }
-            // The stage momenta, for the drifts after this kick; the last kick's are not needed.
-            if i < last {
+            // The stage momenta, for the drifts after this kick but the last, which ends at q₁.
+            if i + 1 < last {
                 self.evaluations += 1;
                 sys.gradient(&self.q, &mut self.force)?;
                 self.p.iter_mut().zip(&self.force).for_each(|(p, f)| *p -= a * f);
@@ -233,9 +242,22 @@ impl Shears {
         Ok(())
     }
 
-    /// H = ∂²V/∂q² at the stage's q: the model's own, or central differences of ∇V
-    /// ([`central_jacobian`]), symmetrized.
+    /// H = ∂²V/∂q² at the stage's q: the one kept where it was taken at that q (a kick at the
+    /// end of one step and the start of the next), else the model's own, or central differences
+    /// of ∇V ([`central_jacobian`]), symmetrized.
     fn hessian<S: MechanicalSystem + ?Sized>(&mut self, sys: &S) -> Result<(), ModelError> {
+        if self.hessian_at.as_deref() == Some(&self.q[..]) {
+            return Ok(());
+        }
+        // Forgotten until it is whole, so that a failed evaluation is not kept.
+        let mut at = self.hessian_at.take().unwrap_or_else(|| vec![0.0; self.n]);
+        self.evaluate_hessian(sys)?;
+        at.copy_from_slice(&self.q);
+        self.hessian_at = Some(at);
+        Ok(())
+    }
+
+    fn evaluate_hessian<S: MechanicalSystem + ?Sized>(&mut self, sys: &S) -> Result<(), ModelError> {
         self.evaluations += 1;
         if let Some(exact) = sys.hessian(&self.q, self.hessian.as_mut_slice()) {
             return exact;
