@@ -281,3 +281,21 @@ def test_a_steppers_tangent_is_refused_where_it_has_none():
     rk4 = varmech.Stepper(varmech.scenes.get("harmonic_oscillator"), dt=0.1, method="rk4")
     with pytest.raises(ValueError, match="^method:"):
         rk4.advance_tangent(np.eye(2), steps=1)
+
+
+def test_the_exponents_along_the_flow_fall_as_one_over_t_and_keplers_all_fall_to_zero():
+    # Hénon–Heiles' chaotic orbit: λ₂ and λ₃ (along the flow and across the energy shell) fall
+    # as 1/T, λ₂T staying of order 1 (measured 3.1, 5.1, 7.0 at T = 10², 10³, 10⁴) while λ₁
+    # converges. Kepler (e = 0.5, integrable): all four fall, λ₁ as ln T/T (λ₁T = 6.8, 9.0,
+    # 10.6), λ₁ + λ₄ ≈ 0.
+    hh = varmech.lyapunov_spectrum(varmech.scenes.henon_heiles().model, *CHAOTIC, dt=0.05, steps=200_000)
+    at = lambda s, T: s.running[np.searchsorted(s.t, T)]  # noqa: E731
+    for j in (1, 2):
+        early, late = abs(at(hh, 1e3)[j]), abs(at(hh, 1e4 - 1)[j])
+        assert late < early / 4 and late * 1e4 < 20, (early, late)
+    assert at(hh, 1e4 - 1)[0] > 0.05
+    kepler = varmech.scenes.get("kepler", e=0.5)
+    s = varmech.lyapunov_spectrum(kepler.model, kepler.q0, kepler.p0, dt=0.01, steps=1_000_000)
+    early, late = at(s, 1e3), at(s, 1e4 - 1)
+    assert np.all(np.abs(late) < 2e-3), late
+    assert late[0] < early[0] / 5 and late[0] * 1e4 < 3 * early[0] * 1e3, (early, late)
