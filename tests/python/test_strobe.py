@@ -83,3 +83,21 @@ def test_a_model_without_the_period_is_refused_naming_why():
         stroboscopic_section(driven, *START, period=PERIOD, periods=0)
     with pytest.raises(ValueError, match="^coordinate:"):
         orbit_diagram(driven, *START, parameter="amplitude", values=[1.07], period=PERIOD, coordinate="z")
+
+
+def test_the_strobe_chart_draws_the_attractor_with_its_angle_wrapped(tmp_path):
+    # Baker & Gollub's chaotic drive (the scene's default): hundreds of distinct points, φ taken
+    # into [−π, π); its axes say so.
+    pytest.importorskip("matplotlib")
+    from varmech.charts import strobe_chart
+
+    scene = varmech.scenes.get("damped_driven_pendulum")
+    table = stroboscopic_section(scene, *START, period=PERIOD, periods=400, transient=50)
+    assert len(np.unique(np.round(table.column("p0"), 6))) > 300
+    path = strobe_chart(table, tmp_path / "attractor.svg", wrap=2 * math.pi)
+    text = path.read_text()
+    assert "q0 at t₀ + kT (mod 6.283)" in text and "p0 at t₀ + kT" in text
+    with pytest.raises(ValueError, match="^coordinate:"):
+        strobe_chart(table, tmp_path / "bad.svg", coordinate=1)
+    with pytest.raises(ValueError, match="^wrap:"):
+        strobe_chart(table, tmp_path / "bad.svg", wrap=0.0)

@@ -4,7 +4,7 @@ Each chart takes the measurements a data function returns (a :class:`~varmech.Ta
 trajectories) and writes a PNG or SVG file; the measurements themselves need no matplotlib.
 """
 
-from .chaos import lyapunov_chart, orbit_diagram_chart
+from .chaos import lyapunov_chart, orbit_diagram_chart, strobe_chart
 from .energy import energy_error
 from .nonholonomic import nonholonomic_energy_chart
 from .sections import phase_portrait_chart, poincare_chart
@@ -22,5 +22,6 @@ __all__ = [
     "poincare_chart",
     "spectrum_chart",
     "stability_chart",
+    "strobe_chart",
     "work_precision_chart",
 ]

@@ -1,4 +1,5 @@
-"""Chaos: the orbit diagram of :func:`varmech.orbit_diagram` and the convergence of a
+"""Chaos: the orbit diagram of :func:`varmech.orbit_diagram`, a stroboscopic section's
+attractor (:func:`varmech.stroboscopic_section`) and the convergence of a
 :class:`varmech.LyapunovSpectrum`."""
 
 from __future__ import annotations
@@ -14,6 +15,7 @@ from ._figure import documented, pyplot, save
 __all__ = [
     "lyapunov_chart",
     "orbit_diagram_chart",
+    "strobe_chart",
 ]
 
 
@@ -58,6 +60,59 @@ def orbit_diagram_chart(table: Table, path: str | Path, coordinate: str = "p0", 
     ax.set_xlabel(str(table.meta.get("parameter", "value")))
     ax.set_ylabel(f"{coordinate} at t₀ + kT")
     ax.set_title(title or table.title)
+    return save(fig, path)
+
+
+@documented
+def strobe_chart(table: Table, path: str | Path, coordinate: int = 0, wrap: float | None = None, title: str = "") -> Path:
+    """Dot the states of a stroboscopic section in the (q, p) plane of one coordinate: a
+    periodic orbit's few points, or a strange attractor's folded sheets. Writes ``path`` (PNG or
+    SVG by its suffix).
+
+    Parameters
+    ----------
+    table : Table
+        The table of :func:`varmech.stroboscopic_section`.
+    {path}
+    coordinate : int, optional
+        The coordinate drawn, its q against its p (default 0).
+    wrap : float, optional
+        A period to take q modulo, into [−wrap/2, wrap/2) (2π for an angle that turns over);
+        default none.
+    title : str, optional
+        The figure's title (default: the table's, with the points' count).
+
+    {returns}
+
+    {raises}, or ``coordinate`` is not one of the table's, or ``wrap`` is not positive.
+
+    Examples
+    --------
+    >>> import math, tempfile
+    >>> from pathlib import Path
+    >>> import varmech
+    >>> from varmech.charts import strobe_chart
+    >>> scene = varmech.scenes.get("damped_driven_pendulum")
+    >>> table = varmech.stroboscopic_section(scene, [-math.pi / 2], [0.0], period=3 * math.pi, periods=200)
+    >>> with tempfile.TemporaryDirectory() as folder:
+    ...     print(strobe_chart(table, Path(folder) / "attractor.png", wrap=2 * math.pi).name)
+    attractor.png
+    """
+    q, p = f"q{coordinate}", f"p{coordinate}"
+    if q not in table.columns:
+        count = sum(c.startswith("q") for c in table.columns)
+        raise ValueError(f"coordinate: must be 0 … {count - 1} (the table's coordinates), got {coordinate!r}")
+    x = np.asarray(table.column(q))
+    if wrap is not None:
+        if not wrap > 0:
+            raise ValueError(f"wrap: must be a positive period, got {wrap!r}")
+        x = (x + wrap / 2) % wrap - wrap / 2
+    plt = pyplot()
+    fig, ax = plt.subplots(figsize=(6.5, 5.0), layout="constrained")
+    ax.scatter(x, table.column(p), s=1.0, color="black", linewidths=0, rasterized=True)
+    ax.set_xlabel(f"{q} at t₀ + kT" + (f" (mod {wrap:.4g})" if wrap is not None else ""))
+    ax.set_ylabel(f"{p} at t₀ + kT")
+    ax.set_title(title or f"{table.title} ({len(x)} points)")
     return save(fig, path)
 
 

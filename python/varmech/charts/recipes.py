@@ -18,9 +18,9 @@ from ..analysis._orbits import energy_at
 from ..analysis.baselines import REBOUND_METHODS
 from ..analysis.nonholonomic import nonholonomic_energy
 from ..analysis.phase_portrait import phase_portrait
-from ..analysis.strobe import orbit_diagram
+from ..analysis.strobe import orbit_diagram, stroboscopic_section
 from ..table import Table
-from .chaos import orbit_diagram_chart
+from .chaos import orbit_diagram_chart, strobe_chart
 from .nonholonomic import nonholonomic_energy_chart
 from .sections import phase_portrait_chart, poincare_chart
 from .stability import implicit_regions_chart, spectrum_chart, stability_chart
@@ -189,7 +189,7 @@ def _phase(scene, methods, quick, progress, options):
 def _driven_only(scene: scenes.Scene) -> str | None:
     if scene.name == "damped_driven_pendulum":
         return None
-    return "the orbit diagram is of the damped, driven pendulum, strobed at its drive's period over the drive's amplitude"
+    return "the orbit diagram and the strobe are of the damped, driven pendulum, strobed at its drive's period"
 
 
 def _orbit_diagram(scene, methods, quick, progress, options):
@@ -204,6 +204,18 @@ def _orbit_diagram(scene, methods, quick, progress, options):
     title = f"{scene}: φ̇ strobed at the drive's period{' (--quick)' if quick else ''}"
     draw = lambda t, p: orbit_diagram_chart(t, p, title=title)  # noqa: E731
     return [("orbit_diagram", table, {"orbit_diagram": draw})]
+
+
+def _strobe(scene, methods, quick, progress, options):
+    sc = scenes.get(scene)
+    # The scene's own drive (Baker & Gollub's chaotic γ = 1.5 by default), from φ = −π/2 at rest.
+    period = 2 * math.pi / sc.parameters["drive"]
+    table = stroboscopic_section(
+        sc, [-math.pi / 2], [0.0], period=period, periods=1_000 if quick else 20_000, transient=100, method=methods[0]
+    )
+    title = f"{scene}: the attractor strobed at the drive's period{' (--quick)' if quick else ''}"
+    draw = lambda t, p: strobe_chart(t, p, wrap=2 * math.pi, title=title)  # noqa: E731
+    return [("strobe", table, {"strobe": draw})]
 
 
 def _disk_only(scene: scenes.Scene) -> str | None:
@@ -248,6 +260,11 @@ KINDS: dict[str, ChartKind] = {
         "the strobe's attractor over the drive's amplitude: Taylor's period-doubling cascade into chaos", _orbit_diagram,
         _driven_only,
     ),
+    "strobe": ChartKind(
+        "damped_driven_pendulum", ("galerkin6",),
+        "the state at each period of the drive, φ mod 2π against φ̇: the strange attractor of the chaotic pendulum",
+        _strobe, _driven_only,
+    ),
     "nonholonomic": ChartKind(
         None, ("midpoint", "cortes_martinez", "rk4_projection"),
         "a rolling disk's energy error against time: the discrete Lagrange–d'Alembert integrators and RK4 with a "
@@ -280,7 +297,8 @@ def chart(
     ----------
     kind : str
         One of ``work-precision``, ``energy``, ``stability``, ``spectrum``,
-        ``implicit-regions``, ``poincare``, ``phase``, ``nonholonomic``.
+        ``implicit-regions``, ``poincare``, ``phase``, ``orbit-diagram``, ``strobe``,
+        ``nonholonomic``.
     scene : str, optional
         A scene of :data:`varmech.scenes.CATALOGUE` or a symbolic one; default: the kind's own
         (:func:`scenes_for` lists those the kind applies to).
