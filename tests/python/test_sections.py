@@ -235,3 +235,53 @@ def test_a_sections_orbits_are_their_single_runs_with_the_crossing_event(model, 
         assert len(found) >= 5 and rows.shape == (len(found), 5)
         assert np.array_equal(rows[:, 0], found.t)
         assert np.array_equal(rows[:, 1:3], found.q) and np.array_equal(rows[:, 3:5], found.p)
+
+
+def forced_henon_heiles():
+    """Hénon–Heiles with a weak drag and a weak periodic push along y: forced, L depending on
+    no t but its force on t."""
+    sp = pytest.importorskip("sympy")
+    x, y, vx, vy, t = sp.symbols("x y vx vy t")
+    V = (x**2 + y**2) / 2 + x**2 * y - y**3 / 3
+    return varmech.symbolic.lagrangian(
+        (vx**2 + vy**2) / 2 - V, [x, y], [vx, vy], t=t, rayleigh=0.001 * (vx**2 + vy**2) / 2, force=[0, 0.002 * sp.cos(t)]
+    )
+
+
+FORCED_SEEDS = [[0.0, 0.1, 0.45, 0.0], [0.0, -0.2, 0.4, 0.1]]
+
+
+def test_a_forced_models_section_is_judged_by_its_energy_balance():
+    # The crossings are the integrator's own partial steps, on x = 0 to round-off; the balance
+    # E − W at the step before each holds to the method's accuracy (galerkin6: below 1e-11),
+    # and under the midpoint rule it falls at order 2 from h to h/2.
+    model = forced_henon_heiles()
+    table = sections.poincare_section(model, None, seeds=FORCED_SEEDS, dt=0.05, t_end=400.0, progress=False)
+    assert table.columns[-1] == "balance_error" and table.title.endswith("forced")
+    assert len(table.rows) > 100
+    assert table.meta["max_section_residual"] < 1e-15
+    assert table.meta["max_balance_error"] < 1e-11
+    errors = [
+        sections.poincare_section(model, None, seeds=FORCED_SEEDS, dt=dt, t_end=400.0, method="midpoint", progress=False).meta["max_balance_error"]
+        for dt in (0.05, 0.025)
+    ]
+    assert math.log2(errors[0] / errors[1]) == pytest.approx(2.0, abs=0.2), errors
+
+
+@pytest.mark.parametrize(
+    ("energy", "kwargs", "name"),
+    [
+        (0.1, {"seeds": FORCED_SEEDS}, "energy"),
+        (None, {"seeds": "random"}, "seeds"),
+        (None, {"seeds": [[0.0, 0.1, 0.4]]}, "seeds"),
+        (None, {"seeds": FORCED_SEEDS, "locate": "hermite"}, "locate"),
+    ],
+)
+def test_a_forced_sections_bad_requests_name_the_argument(energy, kwargs, name):
+    with pytest.raises(ValueError, match=f"^{name}:"):
+        sections.poincare_section(forced_henon_heiles(), energy, dt=0.05, t_end=10.0, progress=False, **kwargs)
+
+
+def test_a_conservative_section_needs_its_energy():
+    with pytest.raises(ValueError, match="^energy:"):
+        sections.poincare_section(varmech.scenes.henon_heiles(), None, progress=False)

@@ -17,13 +17,14 @@ from ._energy import conserves_energy, energy_of
 ModelLike = Model | Scene
 
 
-def model_of(model_or_scene: ModelLike) -> Model:
+def model_of(model_or_scene: ModelLike, forced: bool = False) -> Model:
+    """The model of ``model_or_scene``, unconstrained, and conservative unless ``forced``."""
     model = model_or_scene.model if isinstance(model_or_scene, Scene) else model_or_scene
     if not isinstance(model, Model):
         raise TypeError(f"model_or_scene: expected a varmech model or scene, got {type(model_or_scene).__name__}")
     if model.constraints:
         raise ValueError(f"model_or_scene: {model.name} is constrained; sections need an unconstrained model")
-    if not conserves_energy(model):
+    if not forced and not conserves_energy(model):
         raise ValueError(f"model_or_scene: {model.name} does not conserve its energy (time-dependent or forced)")
     return model
 

@@ -50,6 +50,7 @@ from ..events import crossing
 from ..model import Model
 from ..table import Table
 from ..trajectory import Trajectory
+from ._energy import conserves_energy
 from ._interrupt import interruptible
 from ._orbits import ModelLike, default_method, energy_at, model_of, relative, run_orbits, solve_momentum
 
@@ -202,6 +203,24 @@ def _orbits(
     return k, c, direction, dt, t_end, method, q_seed, p_seed
 
 
+def _states(model: Model, seeds: ArrayLike | str) -> tuple[np.ndarray, np.ndarray]:
+    """A forced model's initial states, rows (q, p) of 2n, as (q, p) rows."""
+    n = model.dim
+    s = None if isinstance(seeds, str) else np.atleast_2d(np.array(seeds, dtype=float))
+    if s is None or s.ndim != 2 or s.shape[1] != 2 * n or not np.all(np.isfinite(s)):
+        shape = seeds if isinstance(seeds, str) else np.shape(seeds)
+        raise ValueError(f"seeds: a forced model's orbits start from given states, rows of {2 * n} finite numbers (q, then p), got {shape!r}")
+    return s[:, :n].copy(), s[:, n:].copy()
+
+
+def _balance_before(traj: Trajectory, idx: np.ndarray) -> np.ndarray:
+    """The balance (E − W) − (E₀ − W₀) at the states before the crossings ``idx``, relative to
+    the largest |E| of the orbit: the run's own accuracy where its energy is not conserved."""
+    balance = traj.energy() - np.asarray(traj.work)
+    scale = max(float(np.max(np.abs(traj.energy()))), np.finfo(float).tiny)
+    return (balance[idx] - balance[0]) / scale
+
+
 def _hermite(x0, v0, x1, v1, h, s):
     """Cubic Hermite interpolant on [0, h] at s = τ/h (arrays broadcast), and its τ-derivative."""
     s2, s3 = s * s, s * s * s
@@ -238,7 +257,7 @@ def _hermite_points(model: Model, traj: Trajectory, idx: np.ndarray, k: int, c: 
 
 def poincare_section(
     model_or_scene: ModelLike,
-    energy: float,
+    energy: float | None,
     *,
     orbits: int = 24,
     seeds: ArrayLike | str = "random",
@@ -252,22 +271,26 @@ def poincare_section(
     seed: int = 0,
     progress: bool | None = None,
 ) -> Table:
-    """The points where orbits of energy ``energy`` pierce the section q_k = c.
+    """The points where orbits of energy ``energy`` (or of a forced model) pierce the section q_k = c.
 
     One row per crossing: ``orbit`` (0, 1, …), the crossing time ``t``, the state (a column per
     coordinate, e.g. ``x``, ``y``, then ``p_x``, ``p_y``), and ``energy_error`` = (H − E)/|E| at
     the located point. ``meta["plane"]`` names the two columns to plot (the first other
     coordinate and its momentum), ``meta["seeds"]`` the orbits' initial states, and
     ``meta["max_section_residual"]``, ``meta["max_energy_error"]`` the largest |q_k − c| and
-    |ΔH|/|E| over all points.
+    |ΔH|/|E| over all points. A forced model (or one whose L depends on t) has no energy shell:
+    its orbits start from given states, and its accuracy column is ``balance_error``, the run's
+    energy balance (E − W) − (E₀ − W₀) at the step before each crossing over the orbit's largest
+    |E| (``meta["max_balance_error"]``), W the energy put in (``traj.work``).
 
     Parameters
     ----------
     model_or_scene
-        An unconstrained, conservative model or scene, e.g. :func:`varmech.scenes.henon_heiles`
-        (H = ½(p_x² + p_y²) + ½(x² + y²) + x²y − y³/3).
+        An unconstrained model or scene, e.g. :func:`varmech.scenes.henon_heiles`
+        (H = ½(p_x² + p_y²) + ½(x² + y²) + x²y − y³/3), conservative or forced.
     energy
-        The energy shell, e.g. 1/12 or 1/8 (:data:`HENON_HEILES_ENERGIES`).
+        The energy shell, e.g. 1/12 or 1/8 (:data:`HENON_HEILES_ENERGIES`); None for a forced
+        model, whose ``seeds`` are then its orbits' initial states, rows (q, then p) of 2n.
     orbits, seeds, box, seed
         Where the orbits start, on the section: ``seeds="random"`` draws ``orbits`` points
         uniformly (``numpy.random.default_rng(seed)``) from the energy-allowed part of the
@@ -310,7 +333,9 @@ def poincare_section(
     TypeError
         ``model_or_scene`` is neither a model nor a scene.
     ValueError
-        A constrained or non-conservative model; ``energy`` not finite; ``names``, ``section``,
+        A constrained model; ``energy`` not finite, or given for a forced model, or None for a
+        conservative one; a forced model's ``seeds`` not rows of 2n states, or ``locate`` other
+        than ``"step"``; ``names``, ``section``,
         ``locate``, ``seeds``, ``orbits``, ``dt`` or ``t_end`` malformed; no ``box`` where one is
         needed (any model but Hénon–Heiles on x = 0), or too few energy-allowed seeds in it; an
         explicit seed outside the energy-allowed region; or an unknown ``method``.
@@ -347,21 +372,35 @@ def poincare_section(
     >>> table.meta["max_section_residual"] < 1e-12, table.meta["max_energy_error"] < 1e-8
     (True, True)
     """
-    model = model_of(model_or_scene)
-    energy = float(energy)
-    if not math.isfinite(energy):
-        raise ValueError(f"energy: must be finite, got {energy}")
+    model = model_of(model_or_scene, forced=True)
+    forced = not conserves_energy(model)
     cols = _names(model, names)
     if locate not in ("step", "hermite"):
         raise ValueError(f"locate: 'step' or 'hermite', got {locate!r}")
-    k, c, direction, dt, t_end, method, q_seed, p_seed = _orbits(model, energy, section, dt, t_end, method, seeds, orbits, box, seed)
+    if forced:
+        if energy is not None:
+            raise ValueError(f"energy: {model.name} is forced or depends on t, so it has no energy shell; pass energy=None and seeds")
+        if locate != "step":
+            raise ValueError("locate: a forced model's crossings are the integrator's own partial steps ('step'); its ṗ is not ∂L/∂q")
+        k, c, direction = _section(model, section)
+        dt, t_end, method = positive("dt", dt), positive("t_end", t_end), default_method(model, method)
+        q_seed, p_seed = _states(model, seeds)
+    else:
+        if energy is None:
+            raise ValueError(f"energy: the energy shell of {model.name}'s orbits is needed (a forced model takes None)")
+        energy = float(energy)
+        if not math.isfinite(energy):
+            raise ValueError(f"energy: must be finite, got {energy}")
+        k, c, direction, dt, t_end, method, q_seed, p_seed = _orbits(model, energy, section, dt, t_end, method, seeds, orbits, box, seed)
     others = [i for i in range(model.dim) if i != k]
     plane = others[0]
-    columns = ("orbit", "t", *cols, *(f"p_{s}" for s in cols), "energy_error")
+    error = "balance_error" if forced else "energy_error"
+    columns = ("orbit", "t", *cols, *(f"p_{s}" for s in cols), error)
     arrow = {1: f"p_{cols[k]} > 0", -1: f"p_{cols[k]} < 0", 0: "both directions"}[direction]
+    shell = "forced" if energy is None else f"E = {energy:.6g}"
     table = Table(
         columns,
-        title=f"Poincaré section {cols[k]} = {c:g} ({arrow}): {model.name}, E = {energy:.6g}",
+        title=f"Poincaré section {cols[k]} = {c:g} ({arrow}): {model.name}, {shell}",
         meta={
             "model": model.name,
             "energy": energy,
@@ -394,13 +433,13 @@ def poincare_section(
             gap = np.max(np.abs(np.concatenate([found.q - qs, found.p - ps], axis=1)))
             worst["hermite_gap"] = max(worst["hermite_gap"], float(gap))
             times, qs, ps = found.t, found.q, found.p
-        errs = relative(energy_at(model, qs, ps), energy)
+        errs = _balance_before(traj, idx) if energy is None else relative(energy_at(model, qs, ps), energy)
         worst["residual"] = max(worst["residual"], float(np.max(np.abs(qs[:, k] - c))))
         worst["energy"] = max(worst["energy"], float(np.max(np.abs(errs))))
         for j in range(len(idx)):
             table.rows.append((o, float(times[j]), *map(float, qs[j]), *map(float, ps[j]), float(errs[j])))
         table.meta["max_section_residual"] = worst["residual"]
-        table.meta["max_energy_error"] = worst["energy"]
+        table.meta[f"max_{error}"] = worst["energy"]
         if locate == "step":
             table.meta["max_hermite_gap"] = worst["hermite_gap"]
 
