@@ -55,15 +55,22 @@ def scipy_spectrum(rtol: float, interval: float = 0.5) -> float:
         f = [px, py, -(x + 2 * x * yy), -(yy + x * x - yy * yy)]
         return np.concatenate([f, (jac @ w).ravel()])
 
-    state, w, sums, t = np.array(Q0 + P0), np.eye(4), np.zeros(4), 0.0
-    while t < T - 1e-9:
+    return benettin(rhs, np.array(Q0 + P0), T, rtol, interval)
+
+
+def benettin(rhs, state: np.ndarray, horizon: float, rtol: float, interval: float) -> float:
+    """λ₁ from DOP853 on the state and its d × d tangent matrix (``rhs`` of both), re-orthonormalized
+    by NumPy's QR every ``interval`` (Benettin's method)."""
+    d = len(state)
+    w, sums, t = np.eye(d), np.zeros(d), 0.0
+    while t < horizon - 1e-9:
         sol = solve_ivp(rhs, (t, t + interval), np.concatenate([state, w.ravel()]), method="DOP853", rtol=rtol, atol=rtol * 1e-3)
         y = sol.y[:, -1]
-        state, (w, r) = y[:4], np.linalg.qr(y[4:].reshape(4, 4))
+        state, (w, r) = y[:d], np.linalg.qr(y[d:].reshape(d, d))
         sums += np.log(np.abs(np.diag(r)))
         w = w * np.sign(np.diag(r))
         t += interval
-    return sums[0] / T
+    return sums[0] / horizon
 
 
 GAMMA, PERIOD = 1.105, 3 * np.pi
@@ -79,15 +86,7 @@ def scipy_driven(rtol: float, horizon: float, interval: float = 0.5) -> float:
         f = [w, -0.5 * w - np.sin(phi) + GAMMA * np.cos(2 * t / 3)]
         return np.concatenate([f, (jac @ y[2:].reshape(2, 2)).ravel()])
 
-    state, w, sums, t = np.array([-np.pi / 2, 0.0]), np.eye(2), np.zeros(2), 0.0
-    while t < horizon - 1e-9:
-        sol = solve_ivp(rhs, (t, t + interval), np.concatenate([state, w.ravel()]), method="DOP853", rtol=rtol, atol=rtol * 1e-3)
-        y = sol.y[:, -1]
-        state, (w, r) = y[:2], np.linalg.qr(y[2:].reshape(2, 2))
-        sums += np.log(np.abs(np.diag(r)))
-        w = w * np.sign(np.diag(r))
-        t += interval
-    return sums[0] / horizon
+    return benettin(rhs, np.array([-np.pi / 2, 0.0]), horizon, rtol, interval)
 
 
 def implicit_section(repeat: int) -> list[str]:

@@ -11,6 +11,7 @@ import pytest
 import sympy as sp
 
 import varmech
+from varmech.analysis.baselines import restore_sigint
 
 CHAOTIC = ([0.0, -0.25], [0.42, 0.0])  # H = 0.1247, in the chaotic sea
 REGULAR = ([0.1, 0.0], [0.0, 0.5])  # H = 0.13, on a torus
@@ -219,7 +220,10 @@ def test_megno_of_the_outer_solar_system_is_rebounds_from_the_same_start():
     sim.init_megno(seed=1)
     particles = sim.var_config[0].particles
     start = [c for b in particles for c in (b.x, b.y, b.z)] + [c for b in particles for c in (b.vx, b.vy, b.vz)]
-    sim.integrate(1e6, exact_finish_time=0)
+    try:
+        sim.integrate(1e6, exact_finish_time=0)
+    finally:
+        restore_sigint()  # REBOUND keeps SIGINT, which the later tests' Ctrl-C needs
     mine = varmech.megno(scene.model, scene.q0, scene.p0, dt=50.0, steps=20_000, method="verlet", tangent0=start)
     assert mine.value == pytest.approx(sim.megno(), abs=2e-3)
     assert abs(mine.value - 2.0) < 0.1

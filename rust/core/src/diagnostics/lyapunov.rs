@@ -6,8 +6,8 @@
 use crate::error::check_vector;
 use crate::integrators::{Dynamics, Method, Options, Poll, Stepper, Tangent};
 use crate::model::Lagrangian;
-use crate::solve::difference;
 use crate::solve::interrupt::InterruptPoll;
+use crate::solve::{difference, splitmix};
 use crate::{Error, ModelError};
 
 /// What [`lyapunov`] is asked: `steps` steps of size `dt` from time `t0`, `k` tangent vectors
@@ -143,17 +143,8 @@ pub fn lyapunov<S: Dynamics + ?Sized, P: Poll>(
 /// k vectors of `dim` components in fixed pseudo-random directions (SplitMix64, uniform in
 /// [−1, 1)), column-major: independent of any model's coordinates.
 fn start_vectors(dim: usize, k: usize) -> Vec<f64> {
-    let mut state: u64 = 0x9E37_79B9_7F4A_7C15;
-    (0..dim * k)
-        .map(|_| {
-            state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
-            let mut z = state;
-            z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-            z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-            z ^= z >> 31;
-            (z >> 11) as f64 / (1u64 << 52) as f64 - 1.0
-        })
-        .collect()
+    // 2u − 1: the doubling is exact, so these are SplitMix64's 53 bits over 2⁵² less 1.
+    splitmix::uniform(dim * k).map(|u| 2.0 * u - 1.0).collect()
 }
 
 /// The number of the columns of `x` (each of `dim`) independent to working precision: those

@@ -22,6 +22,7 @@ use super::{holonomic_rows, HolonomicConstraints, Lagrangian, Reaction};
 use crate::solve::difference::forward_step;
 use crate::solve::lanczos::extremes;
 use crate::solve::lu::{lu_in_place, lu_solve};
+use crate::solve::splitmix;
 use crate::ModelError;
 
 /// A model at rest at q, with the buffers its force and frequencies take.
@@ -275,20 +276,7 @@ impl<'a> Rest<'a> {
 /// modes share (SplitMix64's outputs in [−1, 1] with their magnitude at least ½), so that it
 /// has a component along the fastest mode, and the estimate is the same on every run.
 fn start(n: usize) -> Vec<f64> {
-    let mut state: u64 = 0x9E37_79B9_7F4A_7C15;
-    (0..n)
-        .map(|_| {
-            state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
-            let mut z = state;
-            z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-            z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-            z ^= z >> 31;
-            let u = (z >> 11) as f64 / (1u64 << 53) as f64;
-            if u < 0.5 {
-                -0.5 - u
-            } else {
-                u
-            }
-        })
+    splitmix::uniform(n)
+        .map(|u| if u < 0.5 { -0.5 - u } else { u })
         .collect()
 }

@@ -36,5 +36,6 @@ pub mod lanczos;
 pub(crate) mod lu;
 pub(crate) mod newton;
 pub(crate) mod scratch;
+pub(crate) mod splitmix;
 
 pub use newton::NewtonOptions;
