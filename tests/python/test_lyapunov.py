@@ -303,3 +303,30 @@ def test_the_exponents_along_the_flow_fall_as_one_over_t_and_keplers_all_fall_to
     early, late = at(s, 1e3), at(s, 1e4 - 1)
     assert np.all(np.abs(late) < 2e-3), late
     assert late[0] < early[0] / 5 and late[0] * 1e4 < 3 * early[0] * 1e3, (early, late)
+
+
+def test_rattle_gives_the_cartesian_double_pendulum_the_angle_pendulums_spectrum():
+    # The same double pendulum (unit masses and links, g = 1, both arms horizontal at rest):
+    # in its two angles under the midpoint rule, and in the Cartesian coordinates of its two
+    # bodies on their two links under RATTLE, whose tangent map acts on the constraint
+    # manifold's tangent space (4 exponents of the 8 coordinates). λ₁ 0.309 ± 0.024 and
+    # 0.311 ± 0.021. RATTLE's Σλ·T, the log of the Euclidean volume of the tangent space's
+    # parallelepiped, stays bounded (1/T in Σλ): that volume is not the symplectic one, which
+    # the step keeps, but their ratio is a function of the state.
+    q1, q2, v1, v2 = sp.symbols("q1 q2 v1 v2")
+    angles = varmech.symbolic.lagrangian(v1**2 + v2**2 / 2 + v1 * v2 * sp.cos(q1 - q2) + 2 * sp.cos(q1) + sp.cos(q2), [q1, q2], [v1, v2])
+    chain = varmech.scenes.get("planar_chain", links=2).model
+    a = varmech.lyapunov_spectrum(angles, [math.pi / 2, math.pi / 2], [0.0, 0.0], dt=0.01, steps=50_000)
+    c = varmech.lyapunov_spectrum(chain, [1.0, 0.0, 2.0, 0.0], [0.0] * 4, dt=0.01, steps=50_000, method="rattle")
+    assert c.exponents.shape == (4,)
+    assert abs(a.exponents[0] - c.exponents[0]) < 2 * (a.stderr[0] + c.stderr[0])
+    assert c.exponents[0] > 0.2 and abs(c.exponents[0] + c.exponents[3]) < 2 * c.stderr[0]
+    assert np.max(np.abs(c.running.sum(axis=1) * (c.t - c.t0))) < 3.0
+
+
+@pytest.mark.parametrize(("kwargs", "name"), [({"k": 5}, "k"), ({"method": "rattle4"}, "method"), ({"method": "trapezoid"}, "model")])
+def test_a_constrained_spectrum_is_refused_by_name_where_it_has_none(kwargs, name):
+    chain = varmech.scenes.get("planar_chain", links=2).model
+    args = {"method": "rattle", **kwargs}
+    with pytest.raises(ValueError, match=f"^{name}:"):
+        varmech.lyapunov_spectrum(chain, [1.0, 0.0, 2.0, 0.0], [0.0] * 4, dt=0.01, steps=100, **args)

@@ -685,9 +685,15 @@ fn steps_with_tangent_vectors_allocate_nothing_after_the_first() {
         (&general, Method::Midpoint),
         (&general, Method::Galerkin4),
     ];
-    for (sys, method) in cases {
+    let chain = scenes::planar_chain(2).unwrap();
+    let start = |sys: &dyn Dynamics| match sys.dim() {
+        2 => (vec![0.1, -0.2], vec![0.3, 0.25]),
+        _ => (chain.initial.q.clone(), chain.initial.p.clone()),
+    };
+    for (sys, method) in cases.into_iter().chain([(&chain.system as &dyn Dynamics, Method::Rattle)]) {
         let mut tangent = Tangent::new(method, sys).unwrap();
-        let mut stepper = Stepper::new(sys, method, &[0.1, -0.2], &[0.3, 0.25], &Options::new(0.01, 0)).unwrap();
+        let (q0, p0) = start(sys);
+        let mut stepper = Stepper::new(sys, method, &q0, &p0, &Options::new(0.01, 0)).unwrap();
         let mut x = vec![0.5; 16];
         stepper.step_with_tangent(&mut tangent, &mut x).unwrap();
         let before = allocated();

@@ -329,3 +329,60 @@ fn the_driven_pendulum_is_chaotic_past_taylors_cascade_and_periodic_before_it() 
     let chaotic = lambda(1.105);
     assert!(chaotic[0] > 0.1, "{chaotic:?}");
 }
+
+#[test]
+fn rattles_tangent_map_is_its_steps_jacobian_on_the_constraint_manifold() {
+    // The double pendulum in Cartesian coordinates (two unit masses on unit links, 4
+    // coordinates, 2 constraints), moving: Ψ maps every vector into the tangent space at the
+    // step's end (G(q₁)δq₁ = 0), and on the manifold it is the Jacobian of RATTLE's step,
+    // against differences of steps from states projected onto it (1e-5 apart; right to about
+    // 1e-10). Measured: 7.6e-12 and 2.9e-11.
+    let chain = varmech::scenes::planar_chain(2).unwrap();
+    let sys = &chain.system;
+    let h = 0.01;
+    let mut stepper = Stepper::new(
+        sys,
+        Method::Rattle,
+        &chain.initial.q,
+        &chain.initial.p,
+        &Options::new(h, 1),
+    )
+    .unwrap();
+    stepper.advance(50, || Ok(())).unwrap();
+    let (q, p) = (stepper.q().to_vec(), stepper.p().to_vec());
+    let x: Vec<f64> = q.iter().chain(&p).copied().collect();
+    let psi = jacobian(sys, Method::Rattle, h, &x);
+    let end = step(sys, Method::Rattle, h, &x);
+    let mut g1 = nalgebra::DMatrix::zeros(2, 4);
+    sys.holonomic().unwrap().jacobian(&end[..4], &mut g1).unwrap();
+    let (mut worst_tangency, mut worst_error) = (0.0_f64, 0.0_f64);
+    for j in 0..8 {
+        let v: Vec<f64> = (0..8).map(|i| ((3 * i + 5 * j) % 7) as f64 / 7.0 - 0.4).collect();
+        let image: Vec<f64> = (0..8).map(|i| (0..8).map(|c| psi[c * 8 + i] * v[c]).sum()).collect();
+        let tangency = (0..2)
+            .map(|r| (0..4).map(|c| g1[(r, c)] * image[c]).sum::<f64>().abs())
+            .fold(0.0, f64::max);
+        worst_tangency = worst_tangency.max(tangency);
+        // A tangent vector w at (q, p) from states projected onto the manifold, and the steps
+        // from them.
+        let delta = 1e-5;
+        let onto = |s: f64| {
+            let moved: Vec<f64> = x.iter().zip(&v).map(|(x, v)| x + s * delta * v).collect();
+            let (q, p) = sys.project(&moved[..4], &moved[4..]).unwrap();
+            q.into_iter().chain(p).collect::<Vec<f64>>()
+        };
+        let (plus, minus) = (onto(1.0), onto(-1.0));
+        let w: Vec<f64> = plus.iter().zip(&minus).map(|(a, b)| (a - b) / (2.0 * delta)).collect();
+        let (a, b) = (
+            step(sys, Method::Rattle, h, &plus),
+            step(sys, Method::Rattle, h, &minus),
+        );
+        for i in 0..8 {
+            let difference = (a[i] - b[i]) / (2.0 * delta);
+            let mapped: f64 = (0..8).map(|c| psi[c * 8 + i] * w[c]).sum();
+            worst_error = worst_error.max((mapped - difference).abs());
+        }
+    }
+    assert!(worst_tangency < 1e-10, "G(q₁)δq₁ = {worst_tangency:e}");
+    assert!(worst_error < 1e-9, "{worst_error:e}");
+}

@@ -121,9 +121,9 @@ def lyapunov_spectrum(
     Parameters
     ----------
     model
-        An unconstrained model without delayed forces: separable, L = ½q̇ᵀMq̇ − V(q), for the
-        kick–drift methods; any Lagrangian, forced or not, for the implicit ones (a native
-        scene, a SymPy model, or closures).
+        A model without delayed forces: separable, L = ½q̇ᵀMq̇ − V(q), for the kick–drift
+        methods; any unconstrained Lagrangian, forced or not, for the implicit ones; a separable
+        model on holonomic constraints for RATTLE (a native scene, a SymPy model, or closures).
     q0, p0
         The initial state, shape (n,) each.
     dt
@@ -132,11 +132,13 @@ def lyapunov_spectrum(
         Steps of the run.
     method
         A kick–drift method (``"verlet"``, ``"yoshida4"``, ``"blanes_moan4"``, ``"aba864"``, …)
-        or an implicit rule (``"midpoint"``, ``"trapezoid"``, ``"galerkin4"``, ``"galerkin6"``).
+        or an implicit rule (``"midpoint"``, ``"trapezoid"``, ``"galerkin4"``, ``"galerkin6"``),
+        or ``"rattle"`` on holonomic constraints.
         Default: the model's default method (``"verlet"`` for a separable model, ``"midpoint"``
         for any other).
     k
-        How many exponents, the k largest: 1 … 2n; default 2n, the full spectrum.
+        How many exponents, the k largest: 1 … 2n (2(n − m) on m holonomic constraints); default
+        all of them, the full spectrum.
     every
         Steps between re-orthonormalizations (a vector that grows past 1e100 is
         re-orthonormalized at once, so it never overflows).
@@ -188,9 +190,12 @@ def lyapunov_spectrum(
     q0, p0 = vector("q0", q0, n), vector("p0", p0, n)
     dt, t0 = positive("dt", dt), finite("t0", t0)
     steps, every = positive_int("steps", steps), positive_int("every", every)
-    k = 2 * n if k is None else positive_int("k", k)
-    if k > 2 * n:
-        raise ValueError(f"k: must be 1 … {2 * n} (the phase space's dimension 2n), got {k}")
+    # On holonomic constraints the motion's phase space is the constraint manifold's, 2(n − m).
+    dimension = 2 * (n - model.constraints)
+    k = dimension if k is None else positive_int("k", k)
+    if k > dimension:
+        where = "the phase space's dimension 2n" if not model.constraints else "the constraint manifold's phase space, 2(n − m)"
+        raise ValueError(f"k: must be 1 … {dimension} ({where}), got {k}")
     segments = positive_int("segments", segments)
     if segments < 2:
         raise ValueError(f"segments: must be at least 2 (the standard error compares pieces of the run), got {segments}")

@@ -72,8 +72,16 @@ pub fn lyapunov<S: Dynamics + ?Sized, P: Poll>(
         every,
         start,
     } = *options;
-    if !(1..=2 * n).contains(&k) {
-        let reason = format!("must be 1 … {} (the phase space's dimension 2n), got {k}", 2 * n);
+    let m = sys.holonomic().map_or(0, |c| c.count());
+    if !(1..=2 * (n - m.min(n))).contains(&k) {
+        let reason = match m {
+            0 => format!("must be 1 … {} (the phase space's dimension 2n), got {k}", 2 * n),
+            _ => format!(
+                "must be 1 … {} (the constraint manifold's phase space, 2(n − m) for n = {n} coordinates and m = {m} \
+                 constraints), got {k}",
+                2 * (n - m.min(n))
+            ),
+        };
         return Err(Error::invalid("k", reason));
     }
     if every == 0 {
@@ -108,6 +116,7 @@ pub fn lyapunov<S: Dynamics + ?Sized, P: Poll>(
         time: t0,
         source,
     })?;
+    onto_tangent_space(sys, (q0, p0), &mut x)?;
     let mut row = vec![0.0; k];
     orthonormalize(&mut x, dim, &mut row);
     row.fill(0.0);
@@ -145,6 +154,36 @@ pub fn lyapunov<S: Dynamics + ?Sized, P: Poll>(
 fn start_vectors(dim: usize, k: usize) -> Vec<f64> {
     // 2u − 1: the doubling is exact, so these are SplitMix64's 53 bits over 2⁵² less 1.
     splitmix::uniform(dim * k).map(|u| 2.0 * u - 1.0).collect()
+}
+
+/// On holonomic constraints, each column of `x` taken into the constraint manifold's tangent
+/// space at (q, p): the derivative of the model's projection onto the manifold along it, by a
+/// central difference, so that the vectors start where the motion's tangent map acts (off it,
+/// a step would collapse them onto it at once, and that collapse would count as stretching).
+fn onto_tangent_space<S: Dynamics + ?Sized>(sys: &S, (q, p): (&[f64], &[f64]), x: &mut [f64]) -> Result<(), Error> {
+    if sys.holonomic().is_none() {
+        return Ok(());
+    }
+    let n = q.len();
+    let size = q.iter().chain(p).fold(1.0_f64, |m, x| m.max(x.abs()));
+    let h = difference::step(size);
+    for column in x.chunks_exact_mut(2 * n) {
+        let moved = |sign: f64| -> Result<Vec<f64>, Error> {
+            let (dq, dp) = column.split_at(n);
+            let at: Vec<f64> = q.iter().zip(dq).map(|(q, d)| q + sign * h * d).collect();
+            let rate: Vec<f64> = p.iter().zip(dp).map(|(p, d)| p + sign * h * d).collect();
+            let (q, p) = sys
+                .project(&at, &rate)
+                .expect("a model with holonomic constraints projects")?;
+            Ok(q.into_iter().chain(p).collect())
+        };
+        let (plus, minus) = (moved(1.0)?, moved(-1.0)?);
+        column
+            .iter_mut()
+            .zip(plus.iter().zip(&minus))
+            .for_each(|(c, (a, b))| *c = (a - b) / (2.0 * h));
+    }
+    Ok(())
 }
 
 /// The number of the columns of `x` (each of `dim`) independent to working precision: those

@@ -82,8 +82,9 @@ pub trait Dynamics {
     /// The system as a trait object, for what a generic run hands on (event functions).
     fn as_dynamics(&self) -> &dyn Dynamics;
 
-    /// The system as a separable one, H = ½pᵀM⁻¹p + V(q), for the kick–drift methods' tangent
-    /// map ([`super::Tangent`]); None for the others.
+    /// The system as a separable one, H = ½pᵀM⁻¹p + V(q), for the tangent maps of the kick–drift
+    /// methods and of RATTLE ([`super::Tangent`]): a separable model's, or the unconstrained
+    /// system of one on holonomic constraints; None for the others.
     fn as_mechanical(&self) -> Option<&dyn MechanicalSystem> {
         None
     }
@@ -264,6 +265,10 @@ impl<S: MechanicalSystem, C: HolonomicConstraints> Dynamics for Constrained<S, C
 
     fn holonomic(&self) -> Option<&dyn HolonomicConstraints> {
         Some(&self.constraints)
+    }
+
+    fn as_mechanical(&self) -> Option<&dyn MechanicalSystem> {
+        Some(&self.system)
     }
 
     fn project(&self, q: &[f64], p: &[f64]) -> Option<Result<PhaseState, Error>> {

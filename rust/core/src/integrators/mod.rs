@@ -268,6 +268,7 @@ impl Integrator {
             Scheme::Midpoint(s) => Some(s),
             Scheme::Trapezoid(s) => Some(s),
             Scheme::Galerkin(s) => Some(s),
+            Scheme::Rattle(s) => Some(s),
             _ => None,
         }
     }

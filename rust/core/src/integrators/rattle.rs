@@ -6,6 +6,7 @@ use crate::model::{HolonomicConstraints, MechanicalSystem};
 use crate::solve::interrupt::{check_interrupt, InterruptPoll};
 use crate::solve::lu::{lu_in_place, lu_solve};
 use crate::solve::newton::{Correction, Newton, NewtonOptions, NewtonProblem, Reasons, Rules};
+use crate::ModelError;
 
 /// RATTLE (Andersen 1983; HLW VII.1.4) for H = ½pᵀM⁻¹p + V(q) on g(q) = 0:
 ///
@@ -53,6 +54,9 @@ pub struct Rattle {
     // Wall-clock pacing, not state: a restored state starts a fresh one.
     #[serde(skip)]
     interrupt: InterruptPoll,
+    /// The tangent map's copy of the buffers, made at its first use; not state.
+    #[serde(skip)]
+    scratch: Option<Box<Rattle>>,
 }
 
 impl Rattle {
@@ -86,6 +90,7 @@ impl Rattle {
             evaluations: 0,
             sweeps: 0,
             interrupt: InterruptPoll::new(),
+            scratch: None,
         }
     }
 
@@ -179,17 +184,7 @@ impl Rattle {
         S: MechanicalSystem + ?Sized,
         C: HolonomicConstraints + ?Sized,
     {
-        if !self.cached {
-            sys.gradient(q0, &mut self.grad0)?;
-            constraints.jacobian(q0, &mut self.jac0)?;
-            self.evaluations += 1;
-        }
-        Self::minv_transpose(sys, &self.jac0, &mut self.row, &mut self.column, &mut self.minv_jac0t);
-        // The unconstrained drift q̃ = q₀ + hM⁻¹(p₀ − (h/2)∇V₀); then q₁ = q̃ − (h²/2)M⁻¹G₀ᵀλ.
-        for ((hf, p), g) in self.half.iter_mut().zip(p0).zip(&self.grad0) {
-            *hf = p - 0.5 * h * g;
-        }
-        sys.mass().velocity(&self.half, &mut self.column);
+        self.begin(sys, constraints, q0, p0, h)?;
         let scale = q0.iter().fold(1.0_f64, |m, x| m.max(x.abs()));
         // The predictor is the last step's λ (a force, smooth in time); 0 after a reset.
         if !self.cached {
@@ -216,6 +211,37 @@ impl Rattle {
             };
             self.newton.solve(&mut multipliers, &self.options, rules)?;
         }
+        self.end(sys, constraints, q0, p0, h)
+    }
+
+    /// The step's start: ∇V and G at q₀ (kept from the last step's end where it ended there),
+    /// M⁻¹G₀ᵀ, and the unconstrained drift M⁻¹(p₀ − (h/2)∇V₀) in `column`.
+    fn begin<S, C>(&mut self, sys: &S, constraints: &C, q0: &[f64], p0: &[f64], h: f64) -> Result<(), StepError>
+    where
+        S: MechanicalSystem + ?Sized,
+        C: HolonomicConstraints + ?Sized,
+    {
+        if !self.cached {
+            sys.gradient(q0, &mut self.grad0)?;
+            constraints.jacobian(q0, &mut self.jac0)?;
+            self.evaluations += 1;
+        }
+        Self::minv_transpose(sys, &self.jac0, &mut self.row, &mut self.column, &mut self.minv_jac0t);
+        // The unconstrained drift q̃ = q₀ + hM⁻¹(p₀ − (h/2)∇V₀); then q₁ = q̃ − (h²/2)M⁻¹G₀ᵀλ.
+        for ((hf, p), g) in self.half.iter_mut().zip(p0).zip(&self.grad0) {
+            *hf = p - 0.5 * h * g;
+        }
+        sys.mass().velocity(&self.half, &mut self.column);
+        Ok(())
+    }
+
+    /// The step's end from its multipliers λ: (dq_stage, dp_stage), with μ putting p₁ on the
+    /// hidden constraint (RATTLE), and ∇V, G at q₁ kept for the next step.
+    fn end<S, C>(&mut self, sys: &S, constraints: &C, q0: &[f64], p0: &[f64], h: f64) -> Result<(), StepError>
+    where
+        S: MechanicalSystem + ?Sized,
+        C: HolonomicConstraints + ?Sized,
+    {
         // δp = −(h/2)(∇V₀ + G₀ᵀλ) so far, p½ = p₀ + δp, δq = hM⁻¹p½.
         for (j, (d, hf)) in self.dp_stage.iter_mut().zip(self.half.iter_mut()).enumerate() {
             *d = -0.5
@@ -268,6 +294,54 @@ impl Rattle {
         std::mem::swap(&mut self.jac0, &mut self.jac1);
         self.cached = true;
         Ok(())
+    }
+
+    /// The plain RATTLE step's map at multipliers λ = `x` from `start`, for its tangent map: the
+    /// position constraints g(q₁(λ)) into `out[..m]`, then the end q₁ and p₁ (n each), from a
+    /// scratch copy of the step's buffers (the step's own cache stays as it is).
+    pub(super) fn step_map<S, C>(
+        &mut self,
+        (sys, constraints): (&S, &C),
+        start: StepStart<'_>,
+        x: &[f64],
+        out: &mut [f64],
+    ) -> Result<(), ModelError>
+    where
+        S: MechanicalSystem + ?Sized,
+        C: HolonomicConstraints + ?Sized,
+    {
+        let (n, m) = (start.q.len(), x.len());
+        let scratch = self
+            .scratch
+            .get_or_insert_with(|| Box::new(Rattle::new(false, vec![1.0], self.options, n, m)));
+        scratch.cached = false;
+        let (q0, p0, h) = (start.q, start.p, start.h);
+        let step = |s: &mut Rattle| -> Result<(), StepError> {
+            s.begin(sys, constraints, q0, p0, h)?;
+            s.lambda.copy_from_slice(x);
+            s.end(sys, constraints, q0, p0, h)
+        };
+        step(scratch).map_err(|e| -> ModelError {
+            match e {
+                StepError::Model(source) => source,
+                StepError::Convergence { reason, .. } => reason.into(),
+                _ => "the tangent map: RATTLE's step from a nearby state failed".into(),
+            }
+        })?;
+        let (g, end) = out.split_at_mut(m);
+        let (q1, p1) = end.split_at_mut(n);
+        q1.iter_mut()
+            .zip(q0.iter().zip(&scratch.dq_stage))
+            .for_each(|(a, (q, d))| *a = q + d);
+        p1.iter_mut()
+            .zip(p0.iter().zip(&scratch.dp_stage))
+            .for_each(|(a, (p, d))| *a = p + d);
+        constraints.residual(q1, g)
+    }
+
+    /// The last step's multipliers λ (the plain RATTLE step's, for its tangent map).
+    pub(super) fn multipliers(&self) -> &[f64] {
+        &self.lambda
     }
 
     /// SHAKE: sweeps until |g(q₁)|∞ ≤ tolerance.

@@ -6,22 +6,24 @@
 //!   δp ← δp − ahH(q)δq with H = ∂²V/∂q² at the kick's point. With H symmetric each factor has
 //!   determinant 1 and is symplectic, so the tangent map is, to round-off, whatever H's
 //!   accuracy: a differenced H is symmetrized.
-//! - An implicit (DEL, forced Lagrange–d'Alembert) step solves F(x; q₀, p₀) = 0 for its unknowns
-//!   x and ends at q₁ = q₀ + δq, p₁ = P(x; q₀, p₀). At the solution, by the implicit function
-//!   theorem, δx = −F_x⁻¹(F_q₀δq₀ + F_p₀δp₀), so that
+//! - An implicit step (DEL, forced Lagrange–d'Alembert, RATTLE) solves F(x; z₀) = 0 for its
+//!   unknowns x (increments, or RATTLE's multipliers λ) from z₀ = (q₀, p₀) and ends at
+//!   E(x; z₀) = (q₁, p₁). At the solution, by the implicit function theorem,
+//!   δx = −F_x⁻¹F_z₀δz₀, so that
 //!
-//!   DΨ_h = [I 0; P_q₀ P_p₀] + [E; P_x]·(−F_x⁻¹[F_q₀ F_p₀]),   E picking δq out of δx:
+//!   DΨ_h = E_z₀ − E_x F_x⁻¹F_z₀:
 //!
-//!   the step's own equations differentiated at their solution (central differences of (F, P)
-//!   in (x, q₀, p₀), error about ε^⅔), not differences of whole steps, which would carry
-//!   Newton's tolerance. It holds for every rule's equations alike (midpoint, trapezoid,
-//!   Galerkin) and for forces: a damped step's volume change det DΨ_h comes out as the step
-//!   makes it.
+//!   the step's own equations differentiated at their solution (central differences of (F, E)
+//!   in (x, z₀), error about ε^⅔), not differences of whole steps, which would carry Newton's
+//!   tolerance. It holds for every rule's equations alike (midpoint, trapezoid, Galerkin) and
+//!   for forces: a damped step's volume change det DΨ_h comes out as the step makes it. RATTLE's
+//!   step maps every (q₀, p₀) onto the constraint manifold, so DΨ_h maps every vector into its
+//!   tangent space there (and its rank is 2(n − m)).
 
 use nalgebra::DMatrix;
 
-use super::{Del, Dynamics, Integrator, Method, ModelKind, Splitting, StepEquations, StepStart};
-use crate::model::{Lagrangian, MechanicalSystem};
+use super::{Del, Dynamics, Integrator, Method, ModelKind, Rattle, Splitting, StepEquations, StepStart};
+use crate::model::MechanicalSystem;
 use crate::solve::difference::{central_jacobian, unit, Evaluations};
 use crate::solve::lu::{lu_in_place, lu_solve};
 use crate::{Error, ModelError};
@@ -47,13 +49,15 @@ enum Map {
 impl Tangent {
     /// The tangent map of `method`'s step on `model`: the explicit kick–drift methods on a
     /// separable model, the implicit midpoint, trapezoid and Galerkin rules on an unconstrained
-    /// Lagrangian (forced or not). Refused, naming the argument: another method, a kick–drift
-    /// method on a model that is not separable, constraints, and delayed forces (the step then
-    /// depends on the run's past, so it is no map of (q, p) alone).
+    /// Lagrangian (forced or not), RATTLE on a separable model with holonomic constraints.
+    /// Refused, naming the argument: another method (SHAKE, RATTLE's compositions), a kick–drift
+    /// method on a model that is not separable, other constraints, and delayed forces (the step
+    /// then depends on the run's past, so it is no map of (q, p) alone).
     pub fn new<S: Dynamics + ?Sized>(method: Method, model: &S) -> Result<Tangent, Error> {
         let n = model.dim();
         let map = if let Some(splitting) = Splitting::of(method) {
-            if model.as_mechanical().is_none() {
+            // A constrained model's system is separable too, but its steps are RATTLE's.
+            if model.as_mechanical().is_none() || model.holonomic().is_some() {
                 let reason = format!(
                     "the tangent map of {} (a kick–drift step) needs a separable model, L = ½q̇ᵀMq̇ − V(q); \
                      this one is not: take midpoint, trapezoid, galerkin4 or galerkin6, whose implicit \
@@ -63,6 +67,11 @@ impl Tangent {
                 return Err(Error::invalid("model", reason));
             }
             Map::Shears(Shears::new(splitting, n))
+        } else if method == Method::Rattle {
+            // RATTLE integrates separable models on holonomic constraints alone: the method
+            // check refuses the others, naming the method.
+            method.check(model.kind())?;
+            Map::Implicit(Implicit::default())
         } else if matches!(
             method,
             Method::Midpoint | Method::Trapezoid | Method::Galerkin4 | Method::Galerkin6
@@ -71,8 +80,9 @@ impl Tangent {
                 model.kind(),
                 ModelKind::Separable | ModelKind::Lagrangian | ModelKind::Gravitational
             ) {
-                let reason = "has constraints: the tangent map here is that of an unconstrained step in (q, p), \
-                              and a constrained step's maps the constraint manifold's tangent space";
+                let reason = "has constraints: the implicit rules' tangent map here is that of an unconstrained step; \
+                              on holonomic constraints of a separable model, RATTLE's (method rattle) maps the \
+                              constraint manifold's tangent space";
                 return Err(Error::invalid("model", reason));
             }
             if !model.as_lagrangian().delays().is_empty() {
@@ -86,7 +96,7 @@ impl Tangent {
                 "method",
                 format!(
                     "{} has no tangent map here: the kick–drift methods (verlet, yoshida4, blanes_moan4, \
-                     aba864, …) and the implicit rules (midpoint, trapezoid, galerkin4, galerkin6) have one",
+                     aba864, …), the implicit rules (midpoint, trapezoid, galerkin4, galerkin6) and rattle have one",
                     method.info().name
                 ),
             ));
@@ -139,10 +149,10 @@ impl Tangent {
                 s.apply(sys, start, end, x)
             }
             Map::Implicit(s) => {
-                let del = integrator
+                let step = integrator
                     .step_map()
                     .expect("an implicit method, checked by Tangent::new");
-                s.linearize(del, model.as_lagrangian(), start)?;
+                s.linearize(step, model, start)?;
                 s.apply(x);
                 Ok(())
             }
@@ -279,18 +289,50 @@ impl Shears {
     }
 }
 
-/// An implicit step's map as its tangent map linearizes it: [`Del::step_map`] and the solution
-/// its Newton iteration left.
+/// An implicit step's map as its tangent map linearizes it: the solution x of its equations
+/// that the step left, and at any (x, q₀, p₀) the equations F and the end (q₁, p₁)
+/// ([`Del::step_map`], [`super::Rattle::step_map`]).
 pub(super) trait StepMap {
     fn solution(&self) -> &[f64];
 
+    /// The size of the unknowns at the step h below which their differences are not taken:
+    /// where a change of about that size moves the step's end by a change of order 1 (h, times
+    /// the velocities, for increments; 2/h² for multipliers, which move q₁ by (h²/2)M⁻¹Gᵀλ).
+    fn unknowns_scale(&self, h: f64) -> f64;
+
     fn step_map(
         &mut self,
-        sys: &dyn Lagrangian,
+        model: &dyn Dynamics,
         start: StepStart<'_>,
         x: &[f64],
         out: &mut [f64],
     ) -> Result<(), ModelError>;
+}
+
+impl StepMap for Rattle {
+    fn solution(&self) -> &[f64] {
+        self.multipliers()
+    }
+
+    fn unknowns_scale(&self, h: f64) -> f64 {
+        2.0 / (h * h)
+    }
+
+    fn step_map(
+        &mut self,
+        model: &dyn Dynamics,
+        start: StepStart<'_>,
+        x: &[f64],
+        out: &mut [f64],
+    ) -> Result<(), ModelError> {
+        let sys = model
+            .as_mechanical()
+            .expect("RATTLE's model is separable, checked by Tangent::new");
+        let constraints = model
+            .holonomic()
+            .expect("RATTLE's model is constrained, checked by Tangent::new");
+        Rattle::step_map(self, (sys, constraints), start, x, out)
+    }
 }
 
 impl<Sc: StepEquations> StepMap for Del<Sc> {
@@ -298,20 +340,24 @@ impl<Sc: StepEquations> StepMap for Del<Sc> {
         Del::solution(self)
     }
 
+    fn unknowns_scale(&self, h: f64) -> f64 {
+        h
+    }
+
     fn step_map(
         &mut self,
-        sys: &dyn Lagrangian,
+        model: &dyn Dynamics,
         start: StepStart<'_>,
         x: &[f64],
         out: &mut [f64],
     ) -> Result<(), ModelError> {
-        Del::step_map(self, sys, start, x, out)
+        Del::step_map(self, model.as_lagrangian(), start, x, out)
     }
 }
 
 /// The tangent map of an implicit step, with its buffers (sized at the first step: u unknowns,
-/// n coordinates): z = (x, q₀, p₀), the Jacobian of (F, P) in z, F_x's factors, Y = F_x⁻¹[F_q₀ F_p₀]
-/// and DΨ_h itself.
+/// n coordinates): z = (x, q₀, p₀), the Jacobian of (F, q₁, p₁) in z, F_x's factors,
+/// Y = F_x⁻¹F_z₀ and DΨ_h itself.
 #[derive(Clone, Debug, Default)]
 struct Implicit {
     z: Vec<f64>,
@@ -323,7 +369,7 @@ struct Implicit {
     y: DMatrix<f64>,
     map: DMatrix<f64>,
     column: Vec<f64>,
-    /// Evaluations of the step's map (F and P together).
+    /// Evaluations of the step's map (F and the end together).
     evaluations: u64,
 }
 
@@ -332,11 +378,12 @@ impl Implicit {
         if self.z.len() == u + 2 * n && self.map.nrows() == 2 * n {
             return;
         }
+        let w = u + 2 * n;
         *self = Implicit {
-            z: vec![0.0; u + 2 * n],
-            plus: vec![0.0; u + n],
-            minus: vec![0.0; u + n],
-            jacobian: DMatrix::zeros(u + n, u + 2 * n),
+            z: vec![0.0; w],
+            plus: vec![0.0; w],
+            minus: vec![0.0; w],
+            jacobian: DMatrix::zeros(w, w),
             lu: DMatrix::zeros(u, u),
             pivots: vec![0; u],
             y: DMatrix::zeros(u, 2 * n),
@@ -346,30 +393,32 @@ impl Implicit {
         };
     }
 
-    /// DΨ_h of the step from `start` whose solution `del` holds.
+    /// DΨ_h of the step from `start` whose solution `step` holds: with E = (q₁, p₁) and the
+    /// unknowns' δx = −F_x⁻¹F_z₀δz₀, DΨ_h = E_z₀ − E_x F_x⁻¹F_z₀.
     fn linearize(
         &mut self,
-        del: &mut dyn StepMap,
-        sys: &dyn Lagrangian,
+        step: &mut dyn StepMap,
+        model: &dyn Dynamics,
         start: StepStart<'_>,
     ) -> Result<(), ModelError> {
         let n = start.q.len();
-        let u = del.solution().len();
+        let u = step.solution().len();
         self.size(u, n);
-        self.z[..u].copy_from_slice(del.solution());
+        self.z[..u].copy_from_slice(step.solution());
         self.z[u..u + n].copy_from_slice(start.q);
         self.z[u + n..].copy_from_slice(start.p);
         let (t, h) = (start.t, start.h);
+        // The unknowns' steps are relative to their scale at least, so that the difference's
+        // error stays at ε^⅔ of the end it moves (a rule's 1/h in q̇ = δq/h, RATTLE's h² in q₁).
+        let floor = step.unknowns_scale(h);
+        let size = move |j: usize, x: f64| if j < u { x.abs().max(floor) } else { unit(j, x) };
         let evaluations = &mut self.evaluations;
         let map = |z: &[f64], out: &mut [f64]| {
             *evaluations += 1;
             let (x, state) = z.split_at(u);
             let (q, p) = state.split_at(n);
-            del.step_map(sys, StepStart { t, h, q, p }, x, out)
+            step.step_map(model, StepStart { t, h, q, p }, x, out)
         };
-        // The unknowns are increments of size about h·q̇: their steps are relative to h at least,
-        // so that the rule's 1/h in q̇ = δq/h keeps the difference's error at ε^⅔.
-        let size = |j: usize, x: f64| if j < u { x.abs().max(h) } else { unit(j, x) };
         let at = Evaluations {
             plus: &mut self.plus,
             minus: &mut self.minus,
@@ -383,13 +432,10 @@ impl Implicit {
         for mut column in self.y.column_iter_mut() {
             lu_solve(&self.lu, &self.pivots, column.as_mut_slice());
         }
-        // δq₁ = δq₀ + δx's last n, δp₁ = P_z₀δz₀ + P_x δx, δx = −Y δz₀.
         for c in 0..2 * n {
-            for i in 0..n {
-                let identity = if i == c { 1.0 } else { 0.0 };
-                self.map[(i, c)] = identity - self.y[(u - n + i, c)];
+            for i in 0..2 * n {
                 let through: f64 = (0..u).map(|j| self.jacobian[(u + i, j)] * self.y[(j, c)]).sum();
-                self.map[(n + i, c)] = self.jacobian[(u + i, u + c)] - through;
+                self.map[(i, c)] = self.jacobian[(u + i, u + c)] - through;
             }
         }
         Ok(())

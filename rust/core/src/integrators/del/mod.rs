@@ -396,10 +396,9 @@ impl<Sc: StepEquations> Del<Sc> {
     }
 
     /// The unconstrained step's map at unknowns `x` from `start`, without the run's
-    /// bookkeeping (work, predictor, history): its equations F(x) into `out[..u]` and the end
-    /// momentum p₁ = p₀ + δp into `out[u..]` (n more). At the solution F = 0, and the
-    /// linearization of (F, p₁) in (x, q₀, p₀) is the step's tangent map
-    /// ([`crate::integrators::Tangent`]).
+    /// bookkeeping (work, predictor, history): its equations F(x) into `out[..u]`, then its end
+    /// q₁ = q₀ + δq and p₁ = p₀ + δp (n each). At the solution F = 0, and the linearization of
+    /// (F, q₁, p₁) in (x, q₀, p₀) gives the step's tangent map ([`crate::integrators::Tangent`]).
     pub(in crate::integrators) fn step_map<S: Lagrangian + ?Sized>(
         &mut self,
         sys: &S,
@@ -407,10 +406,16 @@ impl<Sc: StepEquations> Del<Sc> {
         x: &[f64],
         out: &mut [f64],
     ) -> Result<(), ModelError> {
-        let (residual, p1) = out.split_at_mut(x.len());
+        let n = start.q.len();
+        let (residual, end) = out.split_at_mut(x.len());
+        let (q1, p1) = end.split_at_mut(n);
         self.scheme.equations(sys, start, x, residual)?;
         self.scheme.momentum_change(sys, start, x, residual, p1)?;
         p1.iter_mut().zip(start.p).for_each(|(p1, p0)| *p1 += p0);
+        let dq = &x[x.len() - n..];
+        q1.iter_mut()
+            .zip(start.q.iter().zip(dq))
+            .for_each(|(q1, (q0, d))| *q1 = q0 + d);
         Ok(())
     }
 
