@@ -1,8 +1,8 @@
 """Lyapunov exponents from the integrator's own tangent map.
 
 A kick–drift step is a composition of shears, and so is its linearization (symplectic,
-determinant 1 to round-off); an implicit step (midpoint, trapezoid, Galerkin, forced or not) is
-linearized through its own equations at their solution. The core carries k tangent vectors along
+determinant 1 to round-off); an implicit step (midpoint, trapezoid, Galerkin, forced or not;
+RATTLE on holonomic constraints) is linearized through its own equations at their solution. The core carries k tangent vectors along
 the run with that tangent map, re-orthonormalizes them every few steps by a QR factorization and
 sums the logarithms of R's diagonal (Benettin, Galgani, Giorgilli & Strelcyn 1980). Python
 declares the run and turns the sums into exponents and their standard errors.
