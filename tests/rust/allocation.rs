@@ -690,7 +690,10 @@ fn steps_with_tangent_vectors_allocate_nothing_after_the_first() {
         2 => (vec![0.1, -0.2], vec![0.3, 0.25]),
         _ => (chain.initial.q.clone(), chain.initial.p.clone()),
     };
-    for (sys, method) in cases.into_iter().chain([(&chain.system as &dyn Dynamics, Method::Rattle)]) {
+    for (sys, method) in cases
+        .into_iter()
+        .chain([(&chain.system as &dyn Dynamics, Method::Rattle)])
+    {
         let mut tangent = Tangent::new(method, sys).unwrap();
         let (q0, p0) = start(sys);
         let mut stepper = Stepper::new(sys, method, &q0, &p0, &Options::new(0.01, 0)).unwrap();
