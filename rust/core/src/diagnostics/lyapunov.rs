@@ -7,7 +7,7 @@ use crate::error::check_vector;
 use crate::integrators::{Dynamics, Method, Options, Poll, Stepper, Tangent};
 use crate::model::Lagrangian;
 use crate::solve::interrupt::InterruptPoll;
-use crate::solve::{difference, splitmix};
+use crate::solve::{difference, sized, splitmix};
 use crate::{Error, ModelError};
 
 /// What [`lyapunov`] is asked: `steps` steps of size `dt` from time `t0`, `k` tangent vectors
@@ -230,6 +230,13 @@ fn to_momenta(sys: &dyn Lagrangian, (t, q, p): (f64, &[f64], &[f64]), x: &mut [f
 /// The k columns of `x` (each of `dim`) orthonormalized in order by modified Gram–Schmidt,
 /// each projection done twice (its R to working precision), ln Rⱼⱼ added to `sums[j]`.
 fn orthonormalize(x: &mut [f64], dim: usize, sums: &mut [f64]) {
+    sized!(gram_schmidt(x, sums; dim));
+}
+
+/// [`orthonormalize`] with `dim` a literal for small dimensions ([`sized!`]): the columns'
+/// loops unroll.
+#[inline(always)]
+fn gram_schmidt(x: &mut [f64], sums: &mut [f64], dim: usize) {
     for (j, sum) in sums.iter_mut().enumerate() {
         let (before, rest) = x.split_at_mut(j * dim);
         let column = &mut rest[..dim];

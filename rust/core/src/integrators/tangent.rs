@@ -23,9 +23,10 @@
 use nalgebra::DMatrix;
 
 use super::{Del, Dynamics, Integrator, Method, ModelKind, Rattle, Splitting, StepEquations, StepStart};
-use crate::model::MechanicalSystem;
+use crate::model::{Mass, MechanicalSystem};
 use crate::solve::difference::{central_jacobian, unit, Evaluations};
 use crate::solve::lu::{lu_in_place, lu_solve};
+use crate::solve::sized;
 use crate::{Error, ModelError};
 
 /// The tangent map of one method's step on a model, with its buffers: carrying vectors
@@ -209,56 +210,14 @@ impl Shears {
         end: &[f64],
         x: &mut [f64],
     ) -> Result<(), ModelError> {
-        let (n, mass, h) = (self.n, sys.mass(), start.h);
-        self.q.copy_from_slice(start.q);
-        self.p.copy_from_slice(start.p);
-        let last = self.splitting.kicks().len() - 1;
-        for i in 0..=last {
-            let a = self.splitting.kicks()[i];
-            if i > 0 {
-                let b = self.splitting.drifts()[i - 1] * h;
-                if i == last {
-                    self.q.copy_from_slice(end);
-                } else {
-                    mass.velocity(&self.p, &mut self.v);
-                    self.q.iter_mut().zip(&self.v).for_each(|(q, v)| *q += b * v);
-                }
-                for column in x.chunks_exact_mut(2 * n) {
-                    let (dq, dp) = column.split_at_mut(n);
-                    mass.velocity(dp, &mut self.velocity);
-                    dq.iter_mut().zip(&self.velocity).for_each(|(d, v)| *d += b * v);
-                }
-            }
-            if a == 0.0 {
-                continue;
-            }
-            let a = a * h;
-            self.hessian(sys)?;
-            // H is symmetric: its column r, contiguous, is its row r.
-            let hessian = self.hessian.as_slice();
-            for column in x.chunks_exact_mut(2 * n) {
-                let (dq, dp) = column.split_at_mut(n);
-                for (d, row) in dp.iter_mut().zip(hessian.chunks_exact(n)) {
-                    *d -= a * row.iter().zip(dq.iter()).map(|(h, x)| h * x).sum::<f64>();
-                }
-            }
-            // The stage momenta, for the drifts after this kick but the last, which ends at q₁.
-            if i + 1 < last {
-                self.evaluations += 1;
-                sys.gradient(&self.q, &mut self.force)?;
-                self.p.iter_mut().zip(&self.force).for_each(|(p, f)| *p -= a * f);
-            }
-        }
-        Ok(())
+        let n = self.n;
+        sized!(replay(self, sys, start, end, x; n))
     }
 
-    /// H = ∂²V/∂q² at the stage's q: the one kept where it was taken at that q (a kick at the
-    /// end of one step and the start of the next), else the model's own, or central differences
+    /// H = ∂²V/∂q² at the stage's q (where it is not the one kept from a kick at the same q,
+    /// the end of one step and the start of the next): the model's own, or central differences
     /// of ∇V ([`central_jacobian`]), symmetrized.
     fn hessian<S: MechanicalSystem + ?Sized>(&mut self, sys: &S) -> Result<(), ModelError> {
-        if self.hessian_at.as_deref() == Some(&self.q[..]) {
-            return Ok(());
-        }
         // Forgotten until it is whole, so that a failed evaluation is not kept.
         let mut at = self.hessian_at.take().unwrap_or_else(|| vec![0.0; self.n]);
         self.evaluate_hessian(sys)?;
@@ -286,6 +245,75 @@ impl Shears {
             }
         }
         Ok(())
+    }
+}
+
+/// [`Shears::apply`] on n coordinates, a literal for small n ([`sized!`]): the stages' copies,
+/// H's check and the columns' loops then unroll.
+#[inline(always)]
+fn replay<S: MechanicalSystem + ?Sized>(
+    shears: &mut Shears,
+    sys: &S,
+    start: StepStart<'_>,
+    end: &[f64],
+    x: &mut [f64],
+    n: usize,
+) -> Result<(), ModelError> {
+    let (mass, h) = (sys.mass(), start.h);
+    shears.q[..n].copy_from_slice(&start.q[..n]);
+    shears.p[..n].copy_from_slice(&start.p[..n]);
+    let last = shears.splitting.kicks().len() - 1;
+    for i in 0..=last {
+        let a = shears.splitting.kicks()[i];
+        if i > 0 {
+            let b = shears.splitting.drifts()[i - 1] * h;
+            if i == last {
+                shears.q[..n].copy_from_slice(&end[..n]);
+            } else {
+                mass.velocity(&shears.p, &mut shears.v);
+                shears.q.iter_mut().zip(&shears.v).for_each(|(q, v)| *q += b * v);
+            }
+            drift(x, mass, b, &mut shears.velocity, n);
+        }
+        if a == 0.0 {
+            continue;
+        }
+        let a = a * h;
+        let kept = shears.hessian_at.as_deref().is_some_and(|at| at[..n] == shears.q[..n]);
+        if !kept {
+            shears.hessian(sys)?;
+        }
+        kick(x, shears.hessian.as_slice(), a, n);
+        // The stage momenta, for the drifts after this kick but the last, which ends at q₁.
+        if i + 1 < last {
+            shears.evaluations += 1;
+            sys.gradient(&shears.q, &mut shears.force)?;
+            shears.p.iter_mut().zip(&shears.force).for_each(|(p, f)| *p -= a * f);
+        }
+    }
+    Ok(())
+}
+
+/// A drift's shear on every column (δq, δp) of `x`: δq += b M⁻¹δp. Of n coordinates, a literal
+/// for small n ([`sized!`]), so that the columns' short loops unroll.
+#[inline(always)]
+fn drift(x: &mut [f64], mass: &Mass, b: f64, velocity: &mut [f64], n: usize) {
+    for column in x.chunks_exact_mut(2 * n) {
+        let (dq, dp) = column.split_at_mut(n);
+        mass.velocity(dp, &mut velocity[..n]);
+        dq.iter_mut().zip(&velocity[..n]).for_each(|(d, v)| *d += b * v);
+    }
+}
+
+/// A kick's shear on every column of `x`: δp −= a H δq, H symmetric (its column r, contiguous,
+/// is its row r); n as for [`drift`].
+#[inline(always)]
+fn kick(x: &mut [f64], hessian: &[f64], a: f64, n: usize) {
+    for column in x.chunks_exact_mut(2 * n) {
+        let (dq, dp) = column.split_at_mut(n);
+        for (d, row) in dp.iter_mut().zip(hessian.chunks_exact(n)) {
+            *d -= a * row.iter().zip(dq.iter()).map(|(h, x)| h * x).sum::<f64>();
+        }
     }
 }
 
