@@ -1,7 +1,7 @@
 """Stroboscopic sections and orbit diagrams (issue 37) on the damped, driven pendulum at Taylor's
 parameters (Classical Mechanics §12.5: ω = 2π, ω₀ = 1.5ω, β = ω₀/4, φ(0) = −π/2; the scene in
 the time unit 1/ω₀, damping 2β/ω₀ = 0.5, drive frequency ω/ω₀ = 2/3, period 3π): the period
-doublings at γ = 1.0663 and 1.0793 located from the strobe's own splits and confirmed by SciPy,
+doublings at γ = 1.0663, 1.0793 and 1.0821 located from the strobe's own splits and confirmed by SciPy,
 the cascade's periods 1, 2, 4, 8, and bad requests refused by name."""
 
 import math
@@ -39,23 +39,31 @@ def test_the_period_doubling_cascade_has_periods_one_two_four_eight_then_chaos()
     assert len(table) == 65 * len(values) and table.columns == ("value", "k", "q0", "p0")
 
 
-def test_the_first_two_doublings_are_taylors_and_scipys():
-    # Past γc the split grows as √(γ − γc): its square, extrapolated to 0 from three drives, is
-    # the onset, to about 1e-4 (Taylor gives four digits).
-    first, second = [1.068, 1.070, 1.072], [1.0800, 1.0805, 1.0810]
-    d2, d4 = splits(first, 1), splits(second, 2)
-    assert onset(first, d2) == pytest.approx(1.0663, abs=2e-4)
-    assert onset(second, d4) == pytest.approx(1.0793, abs=2e-4)
-    # SciPy's DOP853 on the same equation finds the same split at γ = 1.070.
+def scipy_split(gamma, lag, k=300):
+    """|φ̇ₖ − φ̇ₖ₋ₗₐ₉| at the strobe k from SciPy's DOP853 on the same equation (tolerance 1e-11)."""
     scipy = pytest.importorskip("scipy.integrate")
-    gamma = 1.070
 
     def rhs(t, y):
         return [y[1], -0.5 * y[1] - math.sin(y[0]) + gamma * math.cos(2.0 / 3.0 * t)]
 
-    strobes = PERIOD * np.arange(298, 301)
+    strobes = PERIOD * np.array([k - lag, k])
     sol = scipy.solve_ivp(rhs, (0.0, strobes[-1]), [-math.pi / 2, 0.0], method="DOP853", rtol=1e-11, atol=1e-12, t_eval=strobes)
-    assert abs(sol.y[1, -1] - sol.y[1, -2]) == pytest.approx(d2[1], rel=1e-6)
+    return abs(sol.y[1, -1] - sol.y[1, 0])
+
+
+def test_the_three_doublings_are_taylors_and_scipys():
+    # Past γc the split grows as √(γ − γc): its square, extrapolated to 0 from three drives, is
+    # the onset, to about 1e-4 (Taylor gives four digits): period 2 (lag 1), 4 (lag 2), 8 (lag 4).
+    first, second, third = [1.068, 1.070, 1.072], [1.0800, 1.0805, 1.0810], [1.0822, 1.0823, 1.0824]
+    d2, d4, d8 = splits(first, 1), splits(second, 2), splits(third, 4)
+    assert onset(first, d2) == pytest.approx(1.0663, abs=2e-4)
+    assert onset(second, d4) == pytest.approx(1.0793, abs=2e-4)
+    assert onset(third, d8) == pytest.approx(1.0821, abs=2e-4)
+    # SciPy's DOP853 on the same equation finds the same splits at the strobe k = 308 (its
+    # transient 300 periods and 8 more): the period-2 orbit's at γ = 1.070, the period-8 one's
+    # at γ = 1.0823.
+    assert scipy_split(1.070, 1, k=308) == pytest.approx(d2[1], rel=1e-6)
+    assert scipy_split(1.0823, 4, k=308) == pytest.approx(d8[1], rel=1e-6)
 
 
 def test_the_strobe_is_the_runs_own_states():

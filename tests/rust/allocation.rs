@@ -705,5 +705,11 @@ fn steps_with_tangent_vectors_allocate_nothing_after_the_first() {
             x.iter_mut().for_each(|v| *v *= 1e-3);
         }
         assert_eq!(allocated() - before, 0, "{method:?}");
+        // Carried in the method's own loop (a kick–drift step's shears), likewise.
+        let before = allocated();
+        stepper
+            .advance_with_tangent_below(1000, (&mut tangent, &mut x), 1e100, || Ok(()))
+            .unwrap();
+        assert_eq!(allocated() - before, 0, "{method:?} in the method's loop");
     }
 }

@@ -92,6 +92,60 @@ fn the_tangent_map_is_the_steps_jacobian_and_symplectic() {
     }
 }
 
+#[test]
+fn vectors_carried_in_the_methods_loop_are_the_step_by_step_ones_to_the_bit() {
+    // Hénon–Heiles (n = 2, the fixed-size loop, exact H) and FPU (n = 6, step by step,
+    // differenced H); BAB, a composition with stage momenta, ABA and a first-order splitting.
+    let hh = HenonHeiles::new();
+    let fpu = FermiPastaUlam::new(3, 10.0).unwrap();
+    let fpu_start: Vec<f64> = (0..12).map(|i| 0.1 * ((i * 7 % 5) as f64 - 2.0)).collect();
+    let cases: [(&dyn Dynamics, Vec<f64>, f64); 2] =
+        [(&hh, vec![0.0, -0.25, 0.42, 0.0], 0.05), (&fpu, fpu_start, 0.01)];
+    for method in [
+        Method::Verlet,
+        Method::Yoshida4,
+        Method::Aba864,
+        Method::SymplecticEuler,
+    ] {
+        for (sys, x0, h) in &cases {
+            let (n, steps) = (sys.dim(), 500);
+            let start = |steps| Stepper::new(*sys, method, &x0[..n], &x0[n..], &Options::new(*h, steps)).unwrap();
+            let vectors = || -> Vec<f64> { (0..4 * n * n).map(|i| ((i * 37 % 11) as f64 - 5.0) / 7.0).collect() };
+            let (mut one, mut by_step) = (start(steps), vectors());
+            let mut tangent = Tangent::new(method, *sys).unwrap();
+            for _ in 0..steps {
+                one.step_with_tangent(&mut tangent, &mut by_step).unwrap();
+            }
+            let (mut loop_, mut carried) = (start(steps), vectors());
+            let mut tangent = Tangent::new(method, *sys).unwrap();
+            loop_
+                .advance_with_tangent(steps, &mut tangent, &mut carried, || Ok(()))
+                .unwrap();
+            let mut plain = start(steps);
+            plain.advance(steps, || Ok(())).unwrap();
+            let bits = |x: &[f64]| x.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+            assert_eq!(bits(&carried), bits(&by_step), "{method:?}, n = {n}");
+            assert_eq!(bits(loop_.q()), bits(plain.q()), "{method:?}, n = {n}");
+            assert_eq!(bits(loop_.p()), bits(plain.p()), "{method:?}, n = {n}");
+            assert_eq!(loop_.steps(), steps);
+            // Past a bound that the run reaches: the loop stops after the step that first takes
+            // a component past it, the vectors as step by step there.
+            let large = 0.5 * by_step.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+            let (mut bounded, mut x, mut tangent) = (start(steps), vectors(), Tangent::new(method, *sys).unwrap());
+            let stopped = bounded
+                .advance_with_tangent_below(steps, (&mut tangent, &mut x), large, || Ok(()))
+                .unwrap();
+            let (mut again, mut bound_x, mut tangent) = (start(steps), vectors(), Tangent::new(method, *sys).unwrap());
+            let first = (1..=steps).find(|_| {
+                again.step_with_tangent(&mut tangent, &mut bound_x).unwrap();
+                bound_x.iter().any(|v| v.abs() > large)
+            });
+            assert_eq!((stopped, Some(bounded.steps())), (true, first), "{method:?}, n = {n}");
+            assert_eq!(bits(&x), bits(&bound_x), "{method:?}, n = {n}");
+        }
+    }
+}
+
 fn spectrum<S: Dynamics>(sys: &S, q0: &[f64], p0: &[f64], (dt, steps): (f64, usize)) -> Stretching {
     spectrum_of(sys, Method::Verlet, q0, p0, (dt, steps))
 }

@@ -4,9 +4,8 @@
 //! R's diagonal summed.
 
 use crate::error::check_vector;
-use crate::integrators::{Dynamics, Method, Options, Poll, Stepper, Tangent};
+use crate::integrators::{Counting, Dynamics, Method, Options, Poll, Stepper, Tangent};
 use crate::model::Lagrangian;
-use crate::solve::interrupt::InterruptPoll;
 use crate::solve::{difference, sized, splitmix};
 use crate::{Error, ModelError};
 
@@ -40,9 +39,10 @@ pub struct Stretching {
 /// A vector past this is re-orthonormalized at once, before its growth can overflow.
 const LARGE: f64 = 1e100;
 
-/// The stretching of k tangent vectors along the run of `method` on `sys` from (q0, p0): each
-/// step taken as a [`Stepper`] takes it (the run's states are the plain run's, bit for bit),
-/// the vectors carried by the step's tangent map from its start. They start in fixed
+/// The stretching of k tangent vectors along the run of `method` on `sys` from (q0, p0): the
+/// steps taken as a [`Stepper`] takes them (the run's states are the plain run's, bit for bit),
+/// the vectors carried by each step's tangent map from its start
+/// ([`Stepper::advance_with_tangent_below`], inside the method's own loop where it has one). They start in fixed
 /// pseudo-random directions of (δq, δq̇) (none special to a model), their δp the Legendre
 /// transform's differential at (q0, p0), so that no small mass makes its velocity's
 /// perturbation dominate (REBOUND's MEGNO starts so too); then they are orthonormal, and are
@@ -129,19 +129,16 @@ pub fn lyapunov<S: Dynamics + ?Sized, P: Poll>(
         p: p0.to_vec(),
         evaluations: 0,
     };
-    let mut interrupt = InterruptPoll::new();
-    for step in 1..=steps {
-        let time = stepper.t();
-        if interrupt.due() {
-            poll.poll(step - 1)
-                .map_err(|source| Error::Interrupted { step, time, source })?;
-        }
-        stepper.step_with_tangent(&mut tangent, &mut x)?;
-        if step % every == 0 || step == steps || x.iter().any(|v| v.abs() > LARGE) {
-            orthonormalize(&mut x, dim, &mut row);
-            stretching.t.push(stepper.t());
-            stretching.sums.extend_from_slice(&row);
-        }
+    // To the next re-orthonormalization, or sooner where a vector grows past LARGE.
+    let mut done = 0;
+    while done < steps {
+        let due = (done / every + 1) * every;
+        let carry = (&mut tangent, &mut x[..]);
+        stepper.advance_with_tangent_below(due.min(steps) - done, carry, LARGE, Counting(|s| poll.poll(s)))?;
+        done = stepper.steps();
+        orthonormalize(&mut x, dim, &mut row);
+        stretching.t.push(stepper.t());
+        stretching.sums.extend_from_slice(&row);
     }
     stretching.q.copy_from_slice(stepper.q());
     stretching.p.copy_from_slice(stepper.p());

@@ -2,7 +2,7 @@
 
 use nalgebra::DMatrix;
 
-use super::{Gaps, Increment, Integrator, ModelKind, StepError, StepStart, StepperState};
+use super::{Gaps, Increment, Integrator, ModelKind, StepError, StepStart, StepperState, Tangent};
 use crate::model::{
     self, Constrained, EnergyTerms, HolonomicConstraints, Lagrangian, MechanicalSystem, Mixed, Nonholonomic,
     PhaseState, VelocityConstraints,
@@ -69,6 +69,20 @@ pub trait Dynamics {
     /// then. By default, one step after the other.
     fn advance_while(&self, state: &mut StepperState, steps: usize, gaps: &mut Gaps<'_, '_>) -> Result<bool, Error> {
         state.step_while(self, steps, gaps)
+    }
+
+    /// As [`Dynamics::advance`], the tangent vectors `x` carried by each step's tangent map
+    /// ([`Tangent`]), stopping after the first step that takes one past `large` (true then).
+    /// By default one step after the other, each as [`super::Stepper::step_with_tangent`]
+    /// takes it.
+    fn advance_with_tangent(
+        &self,
+        state: &mut StepperState,
+        steps: usize,
+        carry: (&mut Tangent, &mut [f64]),
+        large: f64,
+    ) -> Result<bool, Error> {
+        state.step_with_tangent_while(self.as_dynamics(), steps, carry, large)
     }
 
     /// The energy function and its terms at (q, p, t), where no constraint does work (a forced
@@ -162,6 +176,16 @@ impl<S: MechanicalSystem> Dynamics for S {
 
     fn advance_while(&self, state: &mut StepperState, steps: usize, gaps: &mut Gaps<'_, '_>) -> Result<bool, Error> {
         state.advance_separable_while(self, steps, gaps)
+    }
+
+    fn advance_with_tangent(
+        &self,
+        state: &mut StepperState,
+        steps: usize,
+        carry: (&mut Tangent, &mut [f64]),
+        large: f64,
+    ) -> Result<bool, Error> {
+        state.advance_separable_with_tangent(self, steps, carry, large)
     }
 
     fn energy(&self, q: &[f64], p: &[f64], t: f64) -> Option<Result<EnergyTerms, ModelError>> {

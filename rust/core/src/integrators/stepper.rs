@@ -7,6 +7,7 @@ use std::borrow::{Borrow, BorrowMut};
 use std::ops::Deref;
 
 use super::checkpoint::shape::shape;
+use super::tangent;
 use super::{
     check_method, compensated, Dynamics, Gaps, General, Increment, Integrator, Method, Options, Poll, StepError,
     StepStart, Tangent,
@@ -151,13 +152,25 @@ where
         x: &mut [f64],
         poll: P,
     ) -> Result<(), Error> {
-        let (state, model) = (self.state.borrow_mut(), &*self.model);
-        state
-            .polled(n, poll, |state, steps| {
-                (0..steps).try_for_each(|_| state.step_with_tangent(model, tangent, x))?;
-                Ok(false)
-            })
+        self.advance_with_tangent_below(n, (tangent, x), f64::INFINITY, poll)
             .map(drop)
+    }
+
+    /// As [`Stepper::advance_with_tangent`], stopping after the first step that takes a
+    /// component of the vectors past `large` in magnitude: true then. A kick–drift step's
+    /// tangent map is carried inside the method's own loop ([`super::tangent::Carried`]), so
+    /// that the states are those of [`Stepper::advance`] at its cost per step.
+    pub fn advance_with_tangent_below<P: Poll>(
+        &mut self,
+        n: usize,
+        (tangent, x): (&mut Tangent, &mut [f64]),
+        large: f64,
+        poll: P,
+    ) -> Result<bool, Error> {
+        let (state, model) = (self.state.borrow_mut(), &*self.model);
+        state.polled(n, poll, |state, steps| {
+            model.advance_with_tangent(state, steps, (&mut *tangent, &mut *x), large)
+        })
     }
 
     /// Advances `n` steps, calling `poll` before a step every 10–40 ms of run time; an error
@@ -470,6 +483,50 @@ impl StepperState {
             .map_err(|source| Error::Model { step, time, source })
     }
 
+    /// Steps of `model` one at a time, each as [`StepperState::step_with_tangent`], stopping
+    /// after the first that takes a component of `x` past `large` (true then).
+    pub(super) fn step_with_tangent_while<S: Dynamics + ?Sized>(
+        &mut self,
+        model: &S,
+        steps: usize,
+        (tangent, x): (&mut Tangent, &mut [f64]),
+        large: f64,
+    ) -> Result<bool, Error> {
+        for _ in 0..steps {
+            self.step_with_tangent(model, tangent, x)?;
+            if tangent::past(x, large) {
+                return Ok(true);
+            }
+        }
+        Ok(false)
+    }
+
+    /// As [`StepperState::step_with_tangent_while`] on a separable system: a kick–drift step's
+    /// tangent map carried as the check at each step's end ([`super::tangent::Carried`]) of the
+    /// loop that [`StepperState::advance_separable_while`] runs; other maps step by step.
+    pub(super) fn advance_separable_with_tangent<S: MechanicalSystem>(
+        &mut self,
+        sys: &S,
+        steps: usize,
+        (tangent, x): (&mut Tangent, &mut [f64]),
+        large: f64,
+    ) -> Result<bool, Error> {
+        let h = self.clock.h;
+        let Some(mut carried) = tangent.carried(sys, h, (&self.q, &self.p), &mut *x, large) else {
+            return self.step_with_tangent_while(sys, steps, (tangent, x), large);
+        };
+        let stopped = self.advance_separable_while(sys, steps, &mut carried)?;
+        match carried.failed.take() {
+            // The step whose map failed is kept, as a step of the stepper's own keeps it.
+            Some(source) => Err(Error::Model {
+                step: self.steps,
+                time: self.clock.at(self.steps - 1),
+                source,
+            }),
+            None => Ok(stopped),
+        }
+    }
+
     /// `n` steps of `model`, `poll` called before a step when due.
     fn advance_polled<S, P>(&mut self, model: &S, n: usize, poll: P) -> Result<(), Error>
     where
@@ -523,7 +580,7 @@ impl StepperState {
     {
         for _ in 0..steps {
             self.step(model)?;
-            if !clear.clear(&self.q) {
+            if !clear.clear(&self.q, &self.p) {
                 return Ok(true);
             }
         }
@@ -544,7 +601,7 @@ impl StepperState {
             let result = model.advance(self, 1);
             self.synchronise();
             result?;
-            if !gaps.clear(&self.q) {
+            if !gaps.clear(&self.q, &self.p) {
                 return Ok(true);
             }
         }
@@ -642,7 +699,7 @@ impl StepperState {
             }
             self.step(&General(sys))?;
             left -= 1;
-            if !clear.clear(&self.q) {
+            if !clear.clear(&self.q, &self.p) {
                 return Ok(true);
             }
             // Only a run's first step makes the loop apply (it judges the continuum limit's
@@ -811,7 +868,7 @@ impl Phase<'_> {
                 result = Err(diverged(n + 1, clock.at(n)));
                 break;
             }
-            let stop = !clear.clear(&q_next);
+            let stop = !clear.clear(&q_next, &p_next);
             if stop {
                 start_q.copy_from_slice(&q);
                 start_p.copy_from_slice(&p);
@@ -836,11 +893,12 @@ impl Phase<'_> {
 }
 
 /// What a method's own loop checks at the end of each step: whether the step is clear, so that
-/// the loop goes on ([`Gaps`]: it crosses no contact). A trait, not a closure, so that the check
-/// is inlined into the loop: as a closure it was called out of line, a third of a Verlet step.
+/// the loop goes on ([`Gaps`]: it crosses no contact; [`super::tangent::Carried`]: its tangent
+/// map carried the vectors, none past a bound). A trait, not a closure, so that the check is
+/// inlined into the loop: as a closure it was called out of line, a third of a Verlet step.
 pub trait Clear {
-    /// Whether the step ending at q is clear.
-    fn clear(&mut self, q: &[f64]) -> bool;
+    /// Whether the step ending at (q, p) is clear.
+    fn clear(&mut self, q: &[f64], p: &[f64]) -> bool;
 }
 
 /// Nothing watched: every step is clear.
@@ -848,7 +906,7 @@ pub(super) struct Always;
 
 impl Clear for Always {
     #[inline(always)]
-    fn clear(&mut self, _: &[f64]) -> bool {
+    fn clear(&mut self, _: &[f64], _: &[f64]) -> bool {
         true
     }
 }

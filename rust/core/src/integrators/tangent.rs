@@ -22,6 +22,7 @@
 
 use nalgebra::DMatrix;
 
+use super::stepper::Clear;
 use super::{Del, Dynamics, Integrator, Method, ModelKind, Rattle, Splitting, StepEquations, StepStart};
 use crate::model::{Mass, MechanicalSystem};
 use crate::solve::difference::{central_jacobian, unit, Evaluations};
@@ -147,7 +148,7 @@ impl Tangent {
                 let sys = model
                     .as_mechanical()
                     .expect("a separable model, checked by Tangent::new");
-                s.apply(sys, start, end, x)
+                s.apply(sys, h, (&self.q, &self.p), end, x)
             }
             Map::Implicit(s) => {
                 let step = integrator
@@ -161,8 +162,73 @@ impl Tangent {
     }
 }
 
-/// A kick–drift step's tangent map: its shears replayed from the step's start, with the stage's
-/// (q, p), its velocity, the force at it and H there, and the q that H was taken at.
+impl Tangent {
+    /// The vectors `x` carried through steps of size h of a kick–drift method on `sys` from
+    /// (q, p), each step's shears applied at the check ([`Clear`]) at its end inside the
+    /// method's own loop; None for an implicit step's map, which needs the step's solution
+    /// from its integrator (the loop holds it).
+    pub(super) fn carried<'a, S: MechanicalSystem + ?Sized>(
+        &'a mut self,
+        sys: &'a S,
+        h: f64,
+        (q, p): (&[f64], &[f64]),
+        x: &'a mut [f64],
+        large: f64,
+    ) -> Option<Carried<'a, S>> {
+        let Map::Shears(shears) = &mut self.map else {
+            return None;
+        };
+        self.q.copy_from_slice(q);
+        self.p.copy_from_slice(p);
+        Some(Carried {
+            sys,
+            shears,
+            h,
+            start: (&mut self.q, &mut self.p),
+            x,
+            large,
+            failed: None,
+        })
+    }
+}
+
+/// Tangent vectors carried by a kick–drift step's shears as the check at each step's end
+/// ([`Clear`]): the step clear once its map has carried them and none is past `large`; its
+/// map's failure kept in `failed`, the loop stopped.
+pub(super) struct Carried<'a, S: ?Sized> {
+    sys: &'a S,
+    shears: &'a mut Shears,
+    h: f64,
+    /// The step's start (q₀, p₀): the last step's end.
+    start: (&'a mut Vec<f64>, &'a mut Vec<f64>),
+    x: &'a mut [f64],
+    large: f64,
+    pub(super) failed: Option<ModelError>,
+}
+
+impl<S: MechanicalSystem + ?Sized> Clear for Carried<'_, S> {
+    // Inlined into the method's loop, where q and p are arrays: their copies then unroll.
+    #[inline(always)]
+    fn clear(&mut self, q: &[f64], p: &[f64]) -> bool {
+        let (q0, p0) = (&mut *self.start.0, &mut *self.start.1);
+        if let Err(e) = self.shears.apply(self.sys, self.h, (q0, p0), q, self.x) {
+            self.failed = Some(e);
+            return false;
+        }
+        q0.copy_from_slice(q);
+        p0.copy_from_slice(p);
+        !past(self.x, self.large)
+    }
+}
+
+/// Whether a component of `x` is past `large` in magnitude.
+pub(super) fn past(x: &[f64], large: f64) -> bool {
+    x.iter().any(|v| v.abs() > large)
+}
+
+/// A kick–drift step's tangent map: its stages replayed from the step's start for H at each
+/// kick's q (the stage momenta where a later drift reads them), then each column carried
+/// through all the shears at once, so that its entries stay in registers between them.
 #[derive(Clone, Debug)]
 struct Shears {
     splitting: Splitting,
@@ -171,10 +237,14 @@ struct Shears {
     p: Vec<f64>,
     v: Vec<f64>,
     force: Vec<f64>,
-    hessian: DMatrix<f64>,
-    hessian_at: Option<Vec<f64>>,
-    /// A tangent vector's δp through M⁻¹, and the gradients a differenced H takes.
-    velocity: Vec<f64>,
+    /// H at each kick's q (n × n, symmetric, so that column r is row r), kick by kick.
+    hessians: Vec<f64>,
+    /// The q of the last kick's H, where the next step's first kick takes it again, while
+    /// `last_kept` holds.
+    last_at: Vec<f64>,
+    last_kept: bool,
+    /// A differenced H, and the gradients it takes.
+    differenced: DMatrix<f64>,
     plus: Vec<f64>,
     minus: Vec<f64>,
     /// Evaluations of ∇V and of H (exact or differenced) made.
@@ -185,83 +255,86 @@ impl Shears {
     fn new(splitting: Splitting, n: usize) -> Self {
         let buffer = || vec![0.0; n];
         Shears {
+            hessians: vec![0.0; splitting.kicks().len() * n * n],
             splitting,
             n,
             q: buffer(),
             p: buffer(),
             v: buffer(),
             force: buffer(),
-            hessian: DMatrix::zeros(n, n),
-            hessian_at: None,
-            velocity: buffer(),
+            last_at: buffer(),
+            last_kept: false,
+            differenced: DMatrix::zeros(n, n),
             plus: buffer(),
             minus: buffer(),
             evaluations: 0,
         }
     }
 
-    /// The stages replayed from `start`, so that each kick's H is taken where that kick acts;
-    /// a last kick after a drift acts at the step's end q₁, `end` (the replay's last q but for
-    /// round-off), where the next step's first kick takes the same H again.
+    /// The step of size h from (q₀, p₀) to q₁ = `end` applied to the columns of `x`: each
+    /// kick's H taken where that kick acts (a last kick after a drift acts at q₁, the replay's
+    /// last q but for round-off, where the next step's first kick takes the same H again).
     fn apply<S: MechanicalSystem + ?Sized>(
         &mut self,
         sys: &S,
-        start: StepStart<'_>,
+        h: f64,
+        start: (&[f64], &[f64]),
         end: &[f64],
         x: &mut [f64],
     ) -> Result<(), ModelError> {
         let n = self.n;
-        sized!(replay(self, sys, start, end, x; n))
-    }
-
-    /// H = ∂²V/∂q² at the stage's q (where it is not the one kept from a kick at the same q,
-    /// the end of one step and the start of the next): the model's own, or central differences
-    /// of ∇V ([`central_jacobian`]), symmetrized.
-    fn hessian<S: MechanicalSystem + ?Sized>(&mut self, sys: &S) -> Result<(), ModelError> {
-        // Forgotten until it is whole, so that a failed evaluation is not kept.
-        let mut at = self.hessian_at.take().unwrap_or_else(|| vec![0.0; self.n]);
-        self.evaluate_hessian(sys)?;
-        at.copy_from_slice(&self.q);
-        self.hessian_at = Some(at);
+        sized!(replay(self, sys, h, start, end; n))?;
+        sized!(shear(&self.splitting, h, sys.mass(), &self.hessians, &mut self.v, x; n));
         Ok(())
     }
 
-    fn evaluate_hessian<S: MechanicalSystem + ?Sized>(&mut self, sys: &S) -> Result<(), ModelError> {
+    /// H = ∂²V/∂q² at the stage's q into kick i's place: the model's own, or central
+    /// differences of ∇V ([`central_jacobian`]), symmetrized.
+    fn hessian<S: MechanicalSystem + ?Sized>(&mut self, sys: &S, i: usize) -> Result<(), ModelError> {
+        let n = self.n;
+        let slot = &mut self.hessians[i * n * n..(i + 1) * n * n];
         self.evaluations += 1;
-        if let Some(exact) = sys.hessian(&self.q, self.hessian.as_mut_slice()) {
+        if let Some(exact) = sys.hessian(&self.q, slot) {
             return exact;
         }
         let at = Evaluations {
             plus: &mut self.plus,
             minus: &mut self.minus,
         };
-        central_jacobian(|q, out| sys.gradient(q, out), &mut self.q, unit, at, &mut self.hessian)?;
-        self.evaluations += 2 * self.n as u64 - 1;
-        for i in 0..self.n {
-            for j in 0..i {
-                let mean = 0.5 * (self.hessian[(i, j)] + self.hessian[(j, i)]);
-                self.hessian[(i, j)] = mean;
-                self.hessian[(j, i)] = mean;
+        central_jacobian(
+            |q, out| sys.gradient(q, out),
+            &mut self.q,
+            unit,
+            at,
+            &mut self.differenced,
+        )?;
+        self.evaluations += 2 * n as u64 - 1;
+        for i in 0..n {
+            for j in 0..n {
+                slot[i * n + j] = 0.5 * (self.differenced[(i, j)] + self.differenced[(j, i)]);
             }
         }
         Ok(())
     }
 }
 
-/// [`Shears::apply`] on n coordinates, a literal for small n ([`sized!`]): the stages' copies,
-/// H's check and the columns' loops then unroll.
+/// The stages of [`Shears::apply`] on n coordinates, a literal for small n ([`sized!`]): each
+/// kick's H, the kept one at the step's start where it is the last step's last.
 #[inline(always)]
 fn replay<S: MechanicalSystem + ?Sized>(
     shears: &mut Shears,
     sys: &S,
-    start: StepStart<'_>,
+    h: f64,
+    (q0, p0): (&[f64], &[f64]),
     end: &[f64],
-    x: &mut [f64],
     n: usize,
 ) -> Result<(), ModelError> {
-    let (mass, h) = (sys.mass(), start.h);
-    shears.q[..n].copy_from_slice(&start.q[..n]);
-    shears.p[..n].copy_from_slice(&start.p[..n]);
+    let mass = sys.mass();
+    shears.q[..n].copy_from_slice(&q0[..n]);
+    shears.p[..n].copy_from_slice(&p0[..n]);
+    let kept = shears.last_kept && shears.last_at[..n] == q0[..n];
+    // Forgotten until this step's last H is whole, so that a failed evaluation is not kept.
+    shears.last_kept = false;
     let last = shears.splitting.kicks().len() - 1;
     for i in 0..=last {
         let a = shears.splitting.kicks()[i];
@@ -273,46 +346,57 @@ fn replay<S: MechanicalSystem + ?Sized>(
                 mass.velocity(&shears.p, &mut shears.v);
                 shears.q.iter_mut().zip(&shears.v).for_each(|(q, v)| *q += b * v);
             }
-            drift(x, mass, b, &mut shears.velocity, n);
         }
         if a == 0.0 {
             continue;
         }
-        let a = a * h;
-        let kept = shears.hessian_at.as_deref().is_some_and(|at| at[..n] == shears.q[..n]);
-        if !kept {
-            shears.hessian(sys)?;
+        if i == 0 && kept {
+            shears.hessians.copy_within(last * n * n..(last + 1) * n * n, 0);
+        } else {
+            shears.hessian(sys, i)?;
         }
-        kick(x, shears.hessian.as_slice(), a, n);
         // The stage momenta, for the drifts after this kick but the last, which ends at q₁.
         if i + 1 < last {
             shears.evaluations += 1;
             sys.gradient(&shears.q, &mut shears.force)?;
-            shears.p.iter_mut().zip(&shears.force).for_each(|(p, f)| *p -= a * f);
+            shears
+                .p
+                .iter_mut()
+                .zip(&shears.force)
+                .for_each(|(p, f)| *p -= a * h * f);
         }
+    }
+    if shears.splitting.kicks()[last] != 0.0 {
+        shears.last_at[..n].copy_from_slice(&end[..n]);
+        shears.last_kept = true;
     }
     Ok(())
 }
 
-/// A drift's shear on every column (δq, δp) of `x`: δq += b M⁻¹δp. Of n coordinates, a literal
-/// for small n ([`sized!`]), so that the columns' short loops unroll.
+/// Every column (δq, δp) of `x` through the step's shears in turn, of n coordinates (a literal
+/// for small n, [`sized!`], so that the column's loops unroll): a drift δq += bhM⁻¹δp, a kick
+/// δp −= ahH δq with kick i's H. Column by column, so that no shear's loads wait on the last
+/// one's stores.
 #[inline(always)]
-fn drift(x: &mut [f64], mass: &Mass, b: f64, velocity: &mut [f64], n: usize) {
+fn shear(splitting: &Splitting, h: f64, mass: &Mass, hessians: &[f64], velocity: &mut [f64], x: &mut [f64], n: usize) {
+    let (kicks, drifts) = (splitting.kicks(), splitting.drifts());
+    let velocity = &mut velocity[..n];
     for column in x.chunks_exact_mut(2 * n) {
         let (dq, dp) = column.split_at_mut(n);
-        mass.velocity(dp, &mut velocity[..n]);
-        dq.iter_mut().zip(&velocity[..n]).for_each(|(d, v)| *d += b * v);
-    }
-}
-
-/// A kick's shear on every column of `x`: δp −= a H δq, H symmetric (its column r, contiguous,
-/// is its row r); n as for [`drift`].
-#[inline(always)]
-fn kick(x: &mut [f64], hessian: &[f64], a: f64, n: usize) {
-    for column in x.chunks_exact_mut(2 * n) {
-        let (dq, dp) = column.split_at_mut(n);
-        for (d, row) in dp.iter_mut().zip(hessian.chunks_exact(n)) {
-            *d -= a * row.iter().zip(dq.iter()).map(|(h, x)| h * x).sum::<f64>();
+        for (i, &a) in kicks.iter().enumerate() {
+            if i > 0 {
+                let b = drifts[i - 1] * h;
+                mass.velocity(dp, velocity);
+                dq.iter_mut().zip(&*velocity).for_each(|(d, v)| *d += b * v);
+            }
+            if a == 0.0 {
+                continue;
+            }
+            let a = a * h;
+            let hessian = &hessians[i * n * n..(i + 1) * n * n];
+            for (d, row) in dp.iter_mut().zip(hessian.chunks_exact(n)) {
+                *d -= a * row.iter().zip(dq.iter()).map(|(h, x)| h * x).sum::<f64>();
+            }
         }
     }
 }

@@ -1825,7 +1825,7 @@ impl Clear for Gaps<'_, '_> {
     /// Whether a step ending at q crosses no contact, each φ evaluated (finite); φ at q is
     /// then the next step's start.
     #[inline(always)]
-    fn clear(&mut self, q: &[f64]) -> bool {
+    fn clear(&mut self, q: &[f64], _: &[f64]) -> bool {
         (self.above && self.flying(q)) || self.judge(q)
     }
 }
