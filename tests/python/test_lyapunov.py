@@ -100,6 +100,18 @@ def test_a_model_that_is_not_separable_is_refused_naming_it():
         varmech.lyapunov_spectrum(pendulum, [0.1, 0.2], [0.0, 0.0], dt=0.01, steps=1000, method="verlet")
 
 
+def test_a_vector_that_would_overflow_is_renormalized_first():
+    # λ₁ ≈ 0.059: between re-orthonormalizations 5000 time units apart the vector would grow
+    # by e²⁹⁵, past any float; it is renormalized once past 1e100 (230 e-folds, t ≈ 3900),
+    # and λ₁ is that of frequent re-orthonormalizations (one vector's direction does not
+    # depend on when it is rescaled).
+    hh = varmech.scenes.henon_heiles().model
+    rare = varmech.lyapunov_spectrum(hh, *CHAOTIC, dt=0.05, steps=200_000, k=1, every=100_000, segments=2)
+    often = varmech.lyapunov_spectrum(hh, *CHAOTIC, dt=0.05, steps=200_000, k=1, every=10, segments=2)
+    assert np.isfinite(rare.running).all() and 3500 < rare.t[0] < 4500 and 5000.0 in rare.t
+    np.testing.assert_allclose(rare.exponents, often.exponents, rtol=1e-9)
+
+
 def test_the_standard_error_comes_from_the_segments():
     hh = varmech.scenes.henon_heiles().model
     s = varmech.lyapunov_spectrum(hh, *CHAOTIC, dt=0.05, steps=20_000, segments=4)
