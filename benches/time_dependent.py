@@ -3,7 +3,8 @@ that tracks −Σ∂L_d/∂t against the same run of the same functions declared
 (built on the binding directly, past the Python check that would refuse it), side by side,
 interleaved, best of ``--repeat``.
 
-Two models: a pendulum on a vertically driven support compiled from SymPy (∂L/∂t compiled) under
+Two models: a pendulum on a vertically driven support compiled from SymPy (∂L/∂t compiled, the
+gradients' last output, so that a step keeps it from its last evaluation of them) under
 the midpoint rule and Galerkin's fourth-order rule, and the parametric oscillator from closures
 with its ∂L/∂t closure (midpoint).
 
@@ -24,6 +25,7 @@ import sympy as sp
 
 import varmech
 from varmech import _core
+from varmech.symbolic._lower import lower
 from varmech.symbolic._model import _compile
 
 G = 9.81
@@ -36,8 +38,11 @@ def pendulum() -> tuple[object, object]:
     ydot = sp.diff(y, t)
     L = (0.64 * w**2 + ydot**2 + 2 * ydot * 0.8 * sp.sin(theta) * w) / 2 - G * (y - 0.8 * sp.cos(theta))
     model = varmech.symbolic.lagrangian(L, [theta], [w], t=t)
-    spec = model._spec
-    functions = {k: v for k, v in spec.functions.items() if k != "dl_dt"}
+    spec, symbols = model._spec, model._symbolic
+    # Untracked: the gradients' tape without ∂L/∂t, its last output, lowered afresh.
+    slots = {s: i for i, s in enumerate((*symbols.q, *symbols.v, symbols.t))}
+    gradients = lower(symbols.expressions["gradients"][: 2 * spec.dim], slots, {})
+    functions = {k: v for k, v in spec.functions.items() if k != "dl_dt"} | {"gradients": gradients}
     untracked = _compile(dataclasses.replace(spec, functions=functions, time_dependent=False))
     return model._core, untracked
 

@@ -168,8 +168,12 @@ def _derive(
         if generalized is not None:
             functions["force"] = generalized
         if time_dependent:
-            # The energy E = p·q̇ − L changes by −∂L/∂t, which the run tracks.
-            functions["dl_dt"] = (sp.diff(L, t),)
+            # The energy E = p·q̇ − L changes by −∂L/∂t, which the run tracks: also the
+            # gradients' last output, their common subexpressions shared, so that a step keeps
+            # it from its last evaluation of them.
+            dl_dt = sp.diff(L, t)
+            functions["dl_dt"] = (dl_dt,)
+            functions["gradients"] += (dl_dt,)
     else:
         potential = -L.xreplace(dict.fromkeys(v, sp.Integer(0)))
         functions["potential"] = (potential,)

@@ -85,7 +85,8 @@ class SymbolicModel(Model):
         The Lagrangian L(q, v, t).
     expressions
         The derived expressions of each compiled function by name (outputs row-major):
-        ``lagrangian``, ``gradients`` (∂L/∂q, ∂L/∂q̇), ``hessians`` (∂²L/∂q², ∂²L/∂q∂q̇,
+        ``lagrangian``, ``gradients`` (∂L/∂q, ∂L/∂q̇, and ∂L/∂t last for an L of t, also
+        ``dl_dt``), ``hessians`` (∂²L/∂q², ∂²L/∂q∂q̇,
         ∂²L/∂q̇²) and ``force`` for a general Lagrangian; ``potential``, ``gradient`` (∇V) and
         ``mass`` (1, n or n² entries) for a separable one; ``constraints`` and
         ``constraint_jacobian`` with constraints; ``velocity_constraints`` (A, m·n) and

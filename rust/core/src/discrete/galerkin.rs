@@ -102,11 +102,14 @@ impl Quadrature {
 
     /// ∂L_d/∂t = h Σᵢ bᵢ ∂L/∂t(q(cᵢh), q̇(cᵢh), t + cᵢh) over the step at `at`: what L's
     /// dependence on t takes from the energy, E₁ − E₀ = W − ∂L_d/∂t to the method's order (W
-    /// the forces' work); 0 for an L that does not depend on t.
+    /// the forces' work); 0 for an L that does not depend on t. ∂L/∂t at node i is `kept[i]`
+    /// where the gradients' last evaluation there gave it
+    /// ([`Lagrangian::gradients_and_dl_dt`]), else [`Lagrangian::dl_dt`] evaluated.
     pub(crate) fn time_derivative<S: Lagrangian + ?Sized>(
         &mut self,
         sys: &S,
         at: Segment<'_>,
+        kept: &[Option<f64>],
     ) -> Result<f64, ModelError> {
         if !sys.is_time_dependent() {
             return Ok(0.0);
@@ -114,8 +117,14 @@ impl Quadrature {
         let mut sum = 0.0;
         // Over the nodes: as many as the degree for Gauss's rules, two for the trapezoid's.
         for i in 0..self.nodes.len() {
-            self.node_state(i, &at);
-            sum += self.weights[i] * sys.dl_dt(&self.pos, &self.vel, at.t + self.nodes[i] * at.h)?;
+            let dl_dt = match kept.get(i).copied().flatten() {
+                Some(dl_dt) => dl_dt,
+                None => {
+                    self.node_state(i, &at);
+                    sys.dl_dt(&self.pos, &self.vel, at.t + self.nodes[i] * at.h)?
+                }
+            };
+            sum += self.weights[i] * dl_dt;
         }
         Ok(at.h * sum)
     }
@@ -200,6 +209,9 @@ pub struct Galerkin {
     pub(crate) quadrature: Quadrature,
     lq: Vec<Vec<f64>>,
     lv: Vec<Vec<f64>>,
+    /// ∂L/∂t at each node where the model gives it with the gradients; not state.
+    #[serde(skip)]
+    dl_dt: Vec<Option<f64>>,
     f: Vec<f64>,
 }
 
@@ -221,22 +233,25 @@ impl Galerkin {
             quadrature: Quadrature::new(s, &nodes, &weights, n),
             lq: vec![vec![0.0; n]; s],
             lv: vec![vec![0.0; n]; s],
+            dl_dt: vec![None; s],
             f: vec![0.0; n],
         }
     }
 
     /// ∂L/∂q + f and ∂L/∂q̇ at every quadrature node, for the control increments `at.dq`
-    /// (Q₀ = q₀); returns the energy put in over the step, the forces' work h Σᵢ bᵢ f(cᵢ)·q̇(cᵢ)
-    /// less ∂L_d/∂t ([`Quadrature::time_derivative`]). A force f enters
+    /// (Q₀ = q₀), with ∂L/∂t where the model gives it with them; returns the forces' work over
+    /// the step, h Σᵢ bᵢ f(cᵢ)·q̇(cᵢ). A force f enters
     /// where ∂L/∂q does: the discrete Lagrange–d'Alembert principle adds the virtual work
     /// h Σᵢ bᵢ f(cᵢ)·δq(cᵢh) to δL_d, and δq(cᵢh) = Σⱼ ℓⱼ(cᵢ)δQⱼ.
     pub(crate) fn derivatives<S: Lagrangian + ?Sized>(&mut self, sys: &S, at: Segment<'_>) -> Result<f64, ModelError> {
         let quad = &mut self.quadrature;
+        // A scheme read from a checkpoint has none kept.
+        self.dl_dt.resize(quad.s, None);
         let mut work = 0.0;
         for i in 0..quad.s {
             quad.node_state(i, &at);
             let ti = at.t + quad.nodes[i] * at.h;
-            sys.gradients(&quad.pos, &quad.vel, ti, &mut self.lq[i], &mut self.lv[i])?;
+            self.dl_dt[i] = sys.gradients_and_dl_dt(&quad.pos, &quad.vel, ti, &mut self.lq[i], &mut self.lv[i])?;
             if sys.is_forced() {
                 sys.force(&quad.pos, &quad.vel, ti, &mut self.f)?;
                 let mut power = 0.0;
@@ -247,7 +262,19 @@ impl Galerkin {
                 work += at.h * quad.weights[i] * power;
             }
         }
-        Ok(work - quad.time_derivative(sys, at)?)
+        Ok(work)
+    }
+
+    /// The energy put in over the step whose [`Galerkin::derivatives`] were the last taken, at
+    /// `at`, their work `work` less ∂L_d/∂t ([`Quadrature::time_derivative`], from ∂L/∂t kept
+    /// there).
+    pub(crate) fn energy_put_in<S: Lagrangian + ?Sized>(
+        &mut self,
+        sys: &S,
+        at: Segment<'_>,
+        work: f64,
+    ) -> Result<f64, ModelError> {
+        Ok(work - self.quadrature.time_derivative(sys, at, &self.dl_dt)?)
     }
 
     /// out = ∂L_d/∂Qⱼ = Σᵢ bᵢ[hℓⱼ(cᵢ)∂L/∂q + ℓⱼ'(cᵢ)∂L/∂q̇] from the last

@@ -12,7 +12,8 @@ use serde::{Deserialize, Serialize};
 pub struct Midpoint;
 
 impl Midpoint {
-    /// ∂L/∂q into ws.a and ∂L/∂q̇ into ws.b, at the midpoint.
+    /// ∂L/∂q into ws.a and ∂L/∂q̇ into ws.b, at the midpoint (∂L/∂t into ws.dl_dt where the
+    /// model gives it with them).
     #[inline(always)]
     fn derivatives<S: Lagrangian + ?Sized, V: Vector>(
         sys: &S,
@@ -20,19 +21,24 @@ impl Midpoint {
         ws: &mut Workspace<V>,
     ) -> Result<(), ModelError> {
         ws.set(at, 0.5);
-        sys.gradients(
+        ws.dl_dt[0] = sys.gradients_and_dl_dt(
             ws.x.as_ref(),
             ws.v.as_ref(),
             at.t + 0.5 * at.h,
             ws.a.as_mut(),
             ws.b.as_mut(),
-        )
+        )?;
+        Ok(())
     }
 }
 
 impl DiscreteLagrangian for Midpoint {
     fn quadrature(&self) -> (&'static [f64], &'static [f64]) {
         (&[0.5], &[1.0])
+    }
+
+    fn kept_dl_dt<'w, V: Vector>(&self, ws: &'w Workspace<V>) -> &'w [Option<f64>] {
+        &ws.dl_dt
     }
 
     fn value<S: Lagrangian + ?Sized>(&self, sys: &S, at: Segment<'_>) -> Result<f64, ModelError> {

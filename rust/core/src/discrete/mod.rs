@@ -41,6 +41,10 @@ pub struct Workspace<V = Vec<f64>> {
     a: V,
     b: V,
     c: V,
+    /// ∂L/∂t at the rule's node from the last evaluation of the gradients, where the model
+    /// gives it with them ([`Lagrangian::gradients_and_dl_dt`]); not state, so not kept.
+    #[serde(skip)]
+    dl_dt: [Option<f64>; 1],
 }
 
 impl Workspace {
@@ -51,6 +55,7 @@ impl Workspace {
             a: vec![0.0; n],
             b: vec![0.0; n],
             c: vec![0.0; n],
+            dl_dt: [None],
         }
     }
 }
@@ -63,6 +68,7 @@ impl<const N: usize> Default for Workspace<[f64; N]> {
             a: [0.0; N],
             b: [0.0; N],
             c: [0.0; N],
+            dl_dt: [None],
         }
     }
 }
@@ -96,6 +102,13 @@ pub trait DiscreteLagrangian {
     /// The quadrature (nodes cᵢ, weights bᵢ) that defines the rule along the straight line:
     /// L_d = h Σᵢ bᵢ L(q₀ + cᵢδq, δq/h, t + cᵢh).
     fn quadrature(&self) -> (&'static [f64], &'static [f64]);
+
+    /// ∂L/∂t at the quadrature's nodes as the last D₁L_d's evaluation left it in `ws`, node by
+    /// node (None, or fewer, where it did not): for [`Quadrature::time_derivative`]. None by
+    /// default.
+    fn kept_dl_dt<'w, V: Vector>(&self, _ws: &'w Workspace<V>) -> &'w [Option<f64>] {
+        &[]
+    }
 
     /// L_d(q₀, q₀ + δq, h).
     fn value<S: Lagrangian + ?Sized>(&self, sys: &S, at: Segment<'_>) -> Result<f64, ModelError>;

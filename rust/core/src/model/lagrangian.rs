@@ -80,6 +80,22 @@ pub trait Lagrangian {
         self.dl_dv(q, v, t, dv)
     }
 
+    /// [`Lagrangian::gradients`], with ∂L/∂t where the model takes it from the same evaluation
+    /// (a compiled L of t: one tape, its common subexpressions shared), so that the discrete
+    /// rules keep it from Newton's last evaluation for the energy balance
+    /// ([`crate::discrete::Quadrature::time_derivative`]) instead of evaluating
+    /// [`Lagrangian::dl_dt`] again; None (the default) where it does not.
+    fn gradients_and_dl_dt(
+        &self,
+        q: &[f64],
+        v: &[f64],
+        t: f64,
+        dq: &mut [f64],
+        dv: &mut [f64],
+    ) -> Result<Option<f64>, ModelError> {
+        self.gradients(q, v, t, dq, dv).map(|()| None)
+    }
+
     /// Writes the exact second derivatives of L at (q, q̇, t) into `out` and returns true, or
     /// returns false (the default) when the model does not supply them; the implicit
     /// integrators then difference their equations for Newton's Jacobian.

@@ -41,12 +41,14 @@ impl StepEquations for Galerkin {
         residual: &[f64],
         dp: &mut [f64],
     ) -> Result<f64, ModelError> {
-        let work = self.derivatives(sys, segment(&start, x))?;
+        let at = segment(&start, x);
+        let work = self.derivatives(sys, at)?;
         self.slot_sum(start.h, dp);
         for block in residual.chunks_exact(start.q.len()) {
             dp.iter_mut().zip(block).for_each(|(d, r)| *d -= r);
         }
-        Ok(work)
+        // ∂L_d/∂t at the solution alone, not at each of Newton's iterates.
+        self.energy_put_in(sys, at, work)
     }
 
     /// The control points along the predicted increment: Qⱼ − q₀ = (j/s)·δq.

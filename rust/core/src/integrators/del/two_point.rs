@@ -156,7 +156,7 @@ fn momentum_change<R: DiscreteLagrangian, S: Lagrangian + ?Sized, V: Vector>(
     let at = segment(&start, x);
     rule.momentum_change_after_d1(sys, at, dp, ws)?;
     dp.iter_mut().zip(residual).for_each(|(d, r)| *d -= r);
-    let time = quadrature.time_derivative(sys, at)?;
+    let time = quadrature.time_derivative(sys, at, rule.kept_dl_dt(ws))?;
     if !sys.is_forced() {
         return Ok(-time);
     }

@@ -48,7 +48,16 @@ impl CompiledLagrangian {
     ) -> Result<Self, Error> {
         check_parameters(&params, lagrangian.tape().params())?;
         check("lagrangian", &lagrangian, 1, n, Inputs::All, &params)?;
-        check("gradients", &gradients, 2 * n, n, Inputs::All, &params)?;
+        // With ∂L/∂t as a last output for an L of t (a model stored before has 2n).
+        let with_time = time_dependent && gradients.outputs() == 2 * n + 1;
+        check(
+            "gradients",
+            &gradients,
+            2 * n + usize::from(with_time),
+            n,
+            Inputs::All,
+            &params,
+        )?;
         check("hessians", &hessians, 3 * n * n, n, Inputs::All, &params)?;
         if let Some(f) = &force {
             check("force", f, n, n, Inputs::All, &params)?;
@@ -155,16 +164,28 @@ impl Lagrangian for CompiledLagrangian {
 
     fn dl_dv(&self, q: &[f64], v: &[f64], t: f64, out: &mut [f64]) -> Result<(), ModelError> {
         self.gradients
-            .eval_into(q, v, t, &self.params, |g| out.copy_from_slice(&g[self.n..]));
+            .eval_into(q, v, t, &self.params, |g| out.copy_from_slice(&g[self.n..2 * self.n]));
         Ok(())
     }
 
     fn gradients(&self, q: &[f64], v: &[f64], t: f64, dq: &mut [f64], dv: &mut [f64]) -> Result<(), ModelError> {
-        self.gradients.eval_into(q, v, t, &self.params, |g| {
-            dq.copy_from_slice(&g[..self.n]);
-            dv.copy_from_slice(&g[self.n..]);
-        });
-        Ok(())
+        self.gradients_and_dl_dt(q, v, t, dq, dv).map(drop)
+    }
+
+    fn gradients_and_dl_dt(
+        &self,
+        q: &[f64],
+        v: &[f64],
+        t: f64,
+        dq: &mut [f64],
+        dv: &mut [f64],
+    ) -> Result<Option<f64>, ModelError> {
+        let n = self.n;
+        Ok(self.gradients.eval_into(q, v, t, &self.params, |g| {
+            dq.copy_from_slice(&g[..n]);
+            dv.copy_from_slice(&g[n..2 * n]);
+            g.get(2 * n).copied()
+        }))
     }
 
     fn hessians(&self, q: &[f64], v: &[f64], t: f64, out: &mut Hessians) -> Result<bool, ModelError> {
