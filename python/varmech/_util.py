@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import inspect
 import math
 from typing import Any
 
@@ -19,9 +20,9 @@ def _shown(x: Any) -> str:
 
 
 def floats(name: str, x: Any) -> np.ndarray:
-    """``x`` as a float64 array of its own shape, or ValueError naming ``name``: numbers only
-    (bools and ints included), never strings or bytes read as numbers, none beyond a float's
-    range."""
+    """``x`` as a float64 array of its own shape, or an error naming ``name``: numbers only
+    (bools and ints included), never strings or bytes read as numbers (TypeError, as NumPy's
+    ufuncs refuse them), none beyond a float's range (ValueError)."""
     if type(x) is np.ndarray and x.dtype == np.float64:
         return x
     try:
@@ -31,7 +32,9 @@ def floats(name: str, x: Any) -> np.ndarray:
     if a.dtype.kind in "biuf":
         return a.astype(float, copy=False)
     # An object array holds ints too large for int64, Fractions, or a mix that includes strings.
-    if a.dtype.kind != "O" or any(isinstance(e, (str, bytes)) or e is None for e in a.flat):
+    if a.dtype.kind in "USV" or any(isinstance(e, (str, bytes)) or e is None for e in a.flat):
+        raise TypeError(f"{name}: must be numbers, not strings or None, got {_shown(x)}")
+    if a.dtype.kind != "O":
         raise ValueError(f"{name}: must be numbers, got {_shown(x)}")
     try:
         return a.astype(float)
@@ -39,6 +42,23 @@ def floats(name: str, x: Any) -> np.ndarray:
         raise ValueError(f"{name}: must be finite, got a number beyond the float range in {_shown(x)}") from None
     except (TypeError, ValueError) as e:
         raise ValueError(f"{name}: must be numbers, got {_shown(x)} ({e})") from None
+
+
+def callable_as(name: str, f: Any, arguments: str) -> None:
+    """TypeError naming ``name`` unless ``f`` is a callable that takes the positional
+    ``arguments`` (their names, comma-separated, as the message shows them): a closure of
+    another signature would fail at its first call with Python's bare message, naming no
+    argument. A callable whose signature Python cannot read (a builtin) is taken as it is."""
+    if not callable(f):
+        raise TypeError(f"{name}: expected a callable {name}({arguments}), got {type(f).__name__}: {_shown(f)}")
+    try:
+        signature = inspect.signature(f)
+    except (TypeError, ValueError):
+        return
+    try:
+        signature.bind(*arguments.split(","))
+    except TypeError:
+        raise TypeError(f"{name}: must be callable as {name}({arguments}), but it takes {signature}") from None
 
 
 def vector(name: str, x: ArrayLike, n: int) -> np.ndarray:
@@ -52,15 +72,17 @@ def vector(name: str, x: ArrayLike, n: int) -> np.ndarray:
 
 
 def number(name: str, x: float) -> float:
-    """``x`` as a float, or ValueError naming ``name``: a string is not read as a number, and an
-    int beyond the float range is refused."""
-    if isinstance(x, (str, bytes)):
-        raise ValueError(f"{name}: must be a number, got {_shown(x)}")
+    """``x`` as a float, or an error naming ``name``: TypeError for what is not a number (a
+    string is not read as one), ValueError for an int beyond the float range."""
+    if isinstance(x, (str, bytes)) or x is None:
+        raise TypeError(f"{name}: must be a number, not {type(x).__name__}, got {_shown(x)}")
     try:
         return float(x)
     except OverflowError:
         raise ValueError(f"{name}: must be finite, got {_shown(x)}") from None
-    except (TypeError, ValueError):
+    except TypeError:
+        raise TypeError(f"{name}: must be a number, got {_shown(x)}") from None
+    except ValueError:
         raise ValueError(f"{name}: must be a number, got {_shown(x)}") from None
 
 

@@ -20,7 +20,8 @@ from . import impulses as _impulses
 from ._progress import progress_bar
 from ._util import finite, positive, positive_int, returned_scalar, step_count, vector
 from .constraints import warn_if_integrable
-from .model import Lagrangian, Model, check_delays
+from .derivatives import check_derivatives
+from .model import Lagrangian, MechanicalSystem, Model, check_delays
 from .modes import warn_if_unstable
 from .scenes import Scene
 
@@ -573,6 +574,8 @@ def _run(
                 err.partial = _trajectory(  # type: ignore[attr-defined]
                     partial, model, method, dt, watched, contacts, impulses, status=-1, message=str(err)
                 )
+                if isinstance(err, _core.DivergenceError):
+                    _blame_derivatives(err, model)
             raise
     finally:
         bar.close()
@@ -618,3 +621,27 @@ def symplecticity_defect(model: Model, method: str, q: ArrayLike, p: ArrayLike, 
     """
     n = model.dim
     return _core.symplecticity_defect(model._core, method, vector("q", q, n), vector("p", p, n), positive("dt", dt))
+
+
+def _blame_derivatives(err: BaseException, model: Model) -> None:
+    """Where a closure model's supplied derivatives disagree with differences of its functions
+    at the run's last good state, a divergence is theirs, and reducing dt (which its message
+    advises) cannot help: the message says so instead, naming the derivative and
+    :func:`varmech.check_derivatives`."""
+    if not isinstance(model, (MechanicalSystem, Lagrangian)):
+        return
+    last = err.partial  # type: ignore[attr-defined]
+    try:
+        check = check_derivatives(model, last.q[-1], last.v[-1], float(last.t[-1]))
+    except Exception:
+        # Pointers, or no derivatives supplied, or a closure that fails there: nothing to blame.
+        return
+    if check.ok:
+        return
+    name, mismatch = check.worst
+    message = str(err).replace("; reduce dt", "", 1)
+    err.args = (
+        f"{message}; but the model's {name} disagrees with central differences at the last good state "
+        f"(t = {float(last.t[-1]):g}) by {mismatch:.2e} (relative, above {check.rtol:g}), so reducing dt cannot help: "
+        f"mend {name} (varmech.check_derivatives(model, q) compares it at any q)",
+    )

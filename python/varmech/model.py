@@ -14,7 +14,7 @@ from numpy.typing import ArrayLike
 
 from . import _core, pointers
 from ._core import ModelKind
-from ._util import floats, integer, positive_int, returned
+from ._util import callable_as, floats, integer, positive_int, returned
 
 __all__ = [
     "Cyclic",
@@ -829,6 +829,11 @@ class MechanicalSystem(Model):
         others |= {"constraints": constraints, "constraint_jacobian": constraint_jacobian}
         others |= {"velocity_constraints": velocity_constraints, "velocity_constraint_offset": velocity_constraint_offset}
         refused = [k for k, f in others.items() if f is not None and (native is not None or pointers.is_pointer(f))]
+        if native is None and not refused:
+            closures = {"potential": potential, "gradient": gradient, **others}
+            for key, f in closures.items():
+                if f is not None:
+                    callable_as(key, f, "q")
         refused += ["gradient"] if native is not None and "gradient" not in native else []
         if refused:
             raise TypeError(
@@ -1152,6 +1157,13 @@ class Lagrangian(Model):
             raise TypeError("dl_dt: a closure; with function pointers ∂L/∂t comes from differences of the L pointer")
         functions = {"lagrangian": lagrangian, "dl_dq": dl_dq, "dl_dv": dl_dv, "hessians": hessians, "force": force}
         native = pointers.functions(functions, int(dim))
+        if native is None:
+            for key, f in (functions | {"dl_dt": dl_dt}).items():
+                if f is not None:
+                    callable_as(key, f, "q, v, t")
+            for key, f in (("velocity_constraints", velocity_constraints), ("velocity_constraint_offset", velocity_constraint_offset)):
+                if f is not None:
+                    callable_as(key, f, "q")
         for key, f in (("velocity_constraints", velocity_constraints), ("velocity_constraint_offset", velocity_constraint_offset)):
             if f is not None and (native is not None or pointers.is_pointer(f)):
                 raise TypeError(f"{key}: only with closures (not with function pointers), and as a closure")

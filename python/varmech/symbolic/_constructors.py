@@ -138,7 +138,8 @@ def lagrangian(
         velocity has another number of components than its point; a ``delayed`` term whose τ
         is not positive, whose past symbols are not one new symbol per coordinate, or with
         constraints; a ``history`` without ``delayed``, of the wrong length or depending on the
-        state.
+        state; an L whose kinetic energy is not positive definite in the velocities (a constant
+        ∂²L/∂q̇² that is singular or indefinite), naming ``L``.
 
     Examples
     --------
@@ -152,11 +153,22 @@ def lagrangian(
     """
     started = time.perf_counter()
     variables_ = _sized(variables(q, v, t))
-    return _build(
-        variables_, variables_.plain(L, "L"), parameters, constraints, force, rayleigh, symmetries, jit, name, started,
-        velocity_constraints=velocity_constraints, progress=progress, added_mass=added_mass,
-        mass_flow=mass_flow, delayed=delayed, history=history,
-    )
+    try:
+        return _build(
+            variables_, variables_.plain(L, "L"), parameters, constraints, force, rayleigh, symmetries, jit, name, started,
+            velocity_constraints=velocity_constraints, progress=progress, added_mass=added_mass,
+            mass_flow=mass_flow, delayed=delayed, history=history,
+        )
+    except ValueError as e:
+        # Here the mass matrix is derived from L's kinetic terms, not an argument the user passed.
+        if not str(e).startswith("mass:"):
+            raise
+        raise ValueError(
+            f"L: ∂²L/∂q̇², the constant mass matrix derived from L,{str(e)[len('mass:'):]}: its kinetic energy must "
+            "be positive definite in the velocities. A singular one leaves q̈ undetermined (L is not regular); a "
+            "negative one is that of −L, which has the same motion. Check the signs of the kinetic terms and that "
+            "every velocity enters them"
+        ) from None
 
 
 def mechanical(

@@ -2,6 +2,9 @@
 
 use std::fmt;
 
+/// SHAKE's failure to reach its tolerance in its sweeps: its advice is not a smaller step.
+pub(crate) const SHAKE_UNCONVERGED: &str = "SHAKE did not reach its tolerance on the constraints";
+
 /// An error raised by a model while it is evaluated (for instance a Python exception inside a
 /// user closure). The core carries it unchanged so that the binding can re-raise the original.
 pub type ModelError = Box<dyn std::error::Error + Send + Sync + 'static>;
@@ -88,11 +91,19 @@ impl fmt::Display for Error {
                 residual,
                 iterations,
                 reason,
-            } => write!(
-                f,
-                "{reason} at step {step} (t = {time}): residual {residual:.3e} after {iterations} iterations; \
-                 a smaller step usually helps"
-            ),
+            } => {
+                // SHAKE's sweeps converge linearly at a rate the constraints' coupling sets, not h.
+                let advice = if *reason == SHAKE_UNCONVERGED {
+                    "more sweeps help (newton_max_iterations), or rattle, whose Newton iteration converges \
+                     quadratically"
+                } else {
+                    "a smaller step usually helps"
+                };
+                write!(
+                    f,
+                    "{reason} at step {step} (t = {time}): residual {residual:.3e} after {iterations} iterations; {advice}"
+                )
+            }
             Error::SpuriousBranch { step, time, reason } => {
                 write!(
                     f,

@@ -2,6 +2,7 @@ use nalgebra::{DMatrix, DVector};
 use serde::{Deserialize, Serialize};
 
 use super::{Increment, StepError, StepStart};
+use crate::error::SHAKE_UNCONVERGED;
 use crate::model::{HolonomicConstraints, MechanicalSystem};
 use crate::solve::interrupt::{check_interrupt, InterruptPoll};
 use crate::solve::lu::{lu_in_place, lu_solve};
@@ -344,9 +345,11 @@ impl Rattle {
         &self.lambda
     }
 
-    /// SHAKE: sweeps until |g(q₁)|∞ ≤ tolerance.
+    /// SHAKE: sweeps until |g(q₁)|∞ ≤ tolerance, at most `max_iterations` of them (the residual
+    /// after the last judged too, so that no failure reports a residual within tolerance).
     fn shake<C: HolonomicConstraints + ?Sized>(&mut self, constraints: &C, h: f64) -> Result<(), StepError> {
-        for _ in 0..self.options.max_iterations {
+        let mut sweeps = 0;
+        loop {
             if self.interrupt.due() {
                 check_interrupt().map_err(StepError::Interrupted)?;
             }
@@ -360,16 +363,18 @@ impl Rattle {
             if residual <= self.options.tolerance {
                 return Ok(());
             }
+            if sweeps == self.options.max_iterations {
+                return Err(StepError::Convergence {
+                    residual,
+                    iterations: sweeps,
+                    reason: SHAKE_UNCONVERGED,
+                });
+            }
+            sweeps += 1;
             self.sweeps += 1;
             // The sweep moves q₁ with each multiplier it changes.
             self.shake_sweep(constraints, h)?;
         }
-        constraints.residual(&self.q1, self.g.as_mut_slice())?;
-        Err(StepError::Convergence {
-            residual: self.g.amax(),
-            iterations: self.options.max_iterations,
-            reason: "SHAKE did not reach its tolerance on the constraints",
-        })
     }
 
     /// One SHAKE sweep: each constraint in turn, λₖ −= gₖ(q₁)/(−(h²/2)Gₖ(q₁)·M⁻¹Gₖ(q₀)ᵀ), with

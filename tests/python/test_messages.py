@@ -1,0 +1,61 @@
+"""Messages that lead to the fix (issue 38): each provoked as a new user met it, the error naming
+what the user passed and the next step that helps."""
+
+import numpy as np
+import pytest
+import sympy as sp
+
+import varmech
+
+
+def test_a_closure_of_the_wrong_signature_is_named_when_the_model_is_made():
+    with pytest.raises(TypeError, match=r"^potential: must be callable as potential\(q\), but it takes \(q, t\)"):
+        varmech.MechanicalSystem(1, lambda q, t: 0.5 * q[0] ** 2, lambda q: q)
+    with pytest.raises(TypeError, match=r"^gradient: must be callable as gradient\(q\)"):
+        varmech.MechanicalSystem(1, lambda q: 0.5 * q[0] ** 2, lambda: 0.0)
+    with pytest.raises(TypeError, match=r"^dl_dv: must be callable as dl_dv\(q, v, t\), but it takes \(q, v\)"):
+        varmech.Lagrangian(1, lambda q, v, t: 0.5 * v[0] ** 2, dl_dv=lambda q, v: v)
+    with pytest.raises(TypeError, match=r"^force: expected a callable force\(q, v, t\), got float"):
+        varmech.Lagrangian(1, lambda q, v, t: 0.5 * v[0] ** 2, force=1.0)
+    # Defaults, *args and builtins' unreadable signatures are taken as they are.
+    varmech.MechanicalSystem(1, lambda q, scale=1.0: scale * q[0] ** 2, lambda *a: 2.0 * a[0])
+
+
+def test_a_symbolic_l_whose_kinetic_energy_is_not_positive_definite_names_l_not_mass():
+    x, y, v, w = sp.symbols("x y v w")
+    with pytest.raises(ValueError, match=r"^L: ∂²L/∂q̇², the constant mass matrix derived from L, must be positive definite"):
+        varmech.symbolic.lagrangian((v + w) ** 2 / 2 - x**2 / 2 - y**2 / 2, [x, y], [v, w])
+    with pytest.raises(ValueError, match=r"^L: .*a negative one is that of −L"):
+        varmech.symbolic.lagrangian(-(v**2) / 2 - x**2 / 2, [x], [v])
+    # mechanical's mass is the user's own argument, and keeps its name.
+    with pytest.raises(ValueError, match="^mass:"):
+        varmech.symbolic.mechanical(x**2 / 2, [x], mass=-1)
+
+
+def test_a_divergence_from_a_wrong_gradient_blames_the_gradient_not_dt():
+    # ∇V off by a factor of 40: the run blows up at once, and a smaller dt cannot help.
+    wrong = varmech.MechanicalSystem(1, lambda q: 0.5 * q[0] ** 2, lambda q: 40.0 * q)
+    with pytest.raises(varmech.DivergenceError) as err:
+        varmech.integrate(wrong, [1.0], [0.0], dt=0.1, steps=100)
+    message = str(err.value)
+    assert "the model's gradient disagrees with central differences" in message
+    assert "reducing dt cannot help" in message and "; reduce dt" not in message
+    assert err.value.partial.status == -1
+    # A right gradient at too large a step is told to reduce dt, as before.
+    right = varmech.MechanicalSystem(1, lambda q: 800.0 * q[0] ** 2, lambda q: 1600.0 * q)
+    with pytest.raises(varmech.DivergenceError, match="; reduce dt") as err, pytest.warns(varmech.StabilityWarning):
+        varmech.integrate(right, [1.0], [0.0], dt=0.1, steps=100)
+    assert "disagrees" not in str(err.value)
+
+
+def test_shake_on_a_linkage_asks_for_more_sweeps_not_a_smaller_step():
+    # Four links: SHAKE's sweeps converge linearly, about 90 a step here; a tenth of the step
+    # does not bring them under the default 50, more sweeps do.
+    chain = varmech.scenes.planar_chain(4)
+    for dt in (0.01, 0.001):
+        with pytest.raises(varmech.ConvergenceError, match="more sweeps help .newton_max_iterations., or rattle") as err:
+            varmech.integrate(chain, dt=dt, steps=20, method="shake")
+        # The reported residual is the one that failed the tolerance, never one within it.
+        assert err.value.residual > 1e-14 and err.value.iterations == 50
+    traj = varmech.integrate(chain, dt=0.01, steps=20, method="shake", newton_max_iterations=500)
+    assert np.all(np.isfinite(traj.q))
