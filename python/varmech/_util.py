@@ -50,7 +50,7 @@ def callable_as(name: str, f: Any, arguments: str) -> None:
     another signature would fail at its first call with Python's bare message, naming no
     argument. A callable whose signature Python cannot read (a builtin) is taken as it is."""
     if not callable(f):
-        raise TypeError(f"{name}: expected a callable {name}({arguments}), got {type(f).__name__}: {_shown(f)}")
+        raise TypeError(f"{name}: must be callable as {name}({arguments}), got {type(f).__name__}: {_shown(f)}")
     try:
         signature = inspect.signature(f)
     except (TypeError, ValueError):

@@ -3,10 +3,13 @@
 from __future__ import annotations
 
 import argparse
+import os
+import sys
 import time
 from pathlib import Path
 
 from . import charts, scenes
+from ._version import __version__
 from .charts.recipes import KINDS, chart
 from .conservation import check_conservation
 from .integrate import integrate
@@ -152,7 +155,28 @@ def _box(text: str) -> tuple[tuple[float, float], tuple[float, float]]:
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="python -m varmech", description=__doc__)
+    """The command line's entry (``varmech`` and ``python -m varmech``): its exit status."""
+    try:
+        status = _main(argv)
+        sys.stdout.flush()
+        return status
+    except BrokenPipeError:
+        # The reader closed the pipe (`varmech methods | head`): stop quietly, as Unix tools do
+        # (status 128 + SIGPIPE), with the interpreter's last flush sent nowhere.
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 141
+
+
+def _prog() -> str:
+    """The name the command was run by: ``varmech`` (the script) or ``python -m varmech``."""
+    name = Path(sys.argv[0]).name if sys.argv and sys.argv[0] else ""
+    return "python -m varmech" if name in ("__main__.py", "-m", "") else name
+
+
+def _main(argv: list[str] | None) -> int:
+    # The module's docstring is reStructuredText; the help shows it as plain text.
+    parser = argparse.ArgumentParser(prog=_prog(), description=(__doc__ or "").replace("``", ""))
+    parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
     t = sub.add_parser("tour", help="integrate every scene, print conservation reports, plot energy errors")
     t.add_argument("--out", type=Path, default=Path("out/tour"), help="folder for the plots (default out/tour)")

@@ -411,6 +411,8 @@ def _terminal(label: str, terminal: Any) -> int:
 def _direction(label: str, direction: Any) -> int:
     try:
         d = number("direction", direction)
+    except TypeError:
+        raise TypeError(f"{label}: direction must be a number (its sign counts), got {direction!r}") from None
     except ValueError:
         raise ValueError(f"{label}: direction must be a number (its sign counts), got {direction!r}") from None
     if math.isnan(d):

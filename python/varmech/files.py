@@ -123,6 +123,7 @@ class Writer:
         argument: str = "path",
         contacts: Sequence[Contact | str] = (),
         impulses: Sequence[Impulse | float] = (),
+        planned: int | None = None,
     ):
         h5py = _h5py()
         self.path = path
@@ -148,6 +149,8 @@ class Writer:
                     "message": "The run stopped before closing its file.",
                 }
             )
+            if planned is not None:
+                f.attrs["planned_steps"] = planned
             if contacts:
                 # The native ones as data; one of Python functions by its name (resume takes it again).
                 f.attrs["contacts"] = [_impacts.name(c) for c in contacts]
@@ -183,10 +186,10 @@ class Writer:
         self._datasets: dict[str, Any] | None = None
 
     @classmethod
-    def reopen(cls, path: Path, stored: Trajectory, events: Sequence[str] = ()) -> Writer:
+    def reopen(cls, path: Path, stored: Trajectory, events: Sequence[str] = (), planned: int | None = None) -> Writer:
         """The writer appending to the file ``path`` (loaded as ``stored``) after its committed
         rows, marked incomplete until it closes again, with the crossings of ``events`` (named
-        as the file's, if it has any)."""
+        as the file's, if it has any), its run's planned end now step ``planned``."""
         h5py = _h5py()
         writer = cls.__new__(cls)
         writer.path, writer._argument = path, "path"
@@ -202,6 +205,8 @@ class Writer:
                 _recover(path)
                 f = h5py.File(path, "r+", libver="latest")
             f.attrs.update({"complete": False, "status": -1, "message": "The run stopped before closing its file."})
+            if planned is not None:
+                f.attrs["planned_steps"] = planned
             rows, slot = (int(x) for x in f["committed"][:2])
             stored_names = [o.name for o in stored.events]
             if events and stored_names and list(events) != stored_names:
@@ -620,6 +625,14 @@ class Rows:
 
     def __repr__(self) -> str:
         return f"Rows({str(self._path)!r}, {self._name!r}, shape={self.shape})"
+
+
+def planned_steps_of(path: str | os.PathLike[str]) -> int | None:
+    """The step at which the run in ``path`` was asked to end (its ``planned_steps``), or None
+    for a file that does not record it (a saved trajectory, or one from before format 3.1)."""
+    with open_read(Path(path)) as f:
+        planned = f.attrs.get("planned_steps")
+    return None if planned is None else int(planned)
 
 
 def save_every_of(path: str | os.PathLike[str]) -> int:

@@ -515,6 +515,7 @@ def _run(
                 argument="output",
                 contacts=contacts,
                 impulses=impulses,
+                planned=base + nsteps,
             )
             try:
                 streaming.stream(

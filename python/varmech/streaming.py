@@ -244,7 +244,9 @@ def resume(
     impulses: Sequence[Impulse] | None = None,
 ) -> Trajectory:
     """Goes on with the run in the file ``path`` (from ``integrate(output=)``, or
-    :meth:`Trajectory.save`) for ``steps`` more steps or to ``t_end``, appending to the file.
+    :meth:`Trajectory.save`) for ``steps`` more steps or to ``t_end``, appending to the file;
+    with neither, to the end its run was asked for (a killed ``integrate(steps=10**9,
+    output=...)`` finishes its 10⁹ steps), which the file records.
 
     The run goes on from the file's last committed checkpoint, so the states are those of one
     run of the whole length, bit for bit, whether the run ended, failed, was stopped by Ctrl-C,
@@ -269,7 +271,9 @@ def resume(
     path : str or os.PathLike
         The run's HDF5 file.
     steps, t_end : int or float, optional
-        How much further: a number of steps, or a final time that is a whole number of steps.
+        How much further: a number of steps more, or a final time that is a whole number of
+        steps. Neither: to the end the run was asked for (``planned_steps``), which
+        ``integrate(output=)`` records and each ``resume`` moves to its own end.
     save_every : int, optional
         The saving period; default the file's.
     checkpoint_every : int or datetime.timedelta, optional
@@ -302,7 +306,8 @@ def resume(
         Naming ``path`` for a file without a checkpoint, a missing, truncated or damaged one
         (failed checksums, non-finite rows, a checkpoint that is not the last row's state),
         one that cannot be written (a full disk: the rows committed before are kept), a
-        pickled model without ``model=`` or ``allow_pickle=True``; naming ``contacts`` for
+        pickled model without ``model=`` or ``allow_pickle=True``; naming ``steps, t_end`` for
+        neither given where the file records no planned end, or its run has reached it; naming ``contacts`` for
         contacts of Python functions not given again, or given with other names, and
         ``impulses`` likewise (other times); the arguments of
         :func:`varmech.integrate` as it names them.
@@ -325,12 +330,12 @@ def resume(
     _check_checkpoint(path, stored)
     t_now = float(stored.t[-1])
     _, blows = _impulses.going_on(stored.impulses, impulses, t_now)
-    more = step_count(stored.dt, t_now, steps, t_end)
+    more = _further(path, stored, steps, t_end)
     if save_every is None:
         save_every = files.save_every_of(path)
     watched, specs = _events.specs(events, stored.model) if events is not None else ([], [])
     names = [o.name for o in _events.occurrences_of(watched)] + _impacts.occurrence_names(going_on)
-    writer = files.Writer.reopen(Path(path), stored, names)
+    writer = files.Writer.reopen(Path(path), stored, names, planned=stored.steps + more)
     initial = _events.first_energy(stored.model, stored)
     counts = _events.found_before(stored.events, watched)
     bar = progress_bar(total=more, unit="step", desc=stored.method, enabled=progress)
@@ -355,6 +360,26 @@ def resume(
     finally:
         bar.close()
     return load(path, model=stored.model, lazy=files.larger_than_memory(path))
+
+
+def _further(path: str | os.PathLike[str], stored: Trajectory, steps: int | None, t_end: float | None) -> int:
+    """The steps :func:`resume` takes: ``steps`` more, or to ``t_end``; with neither, to the end
+    the run was asked for (``planned_steps``), or ValueError naming ``steps, t_end`` where the
+    file records none or the run reached it."""
+    if steps is not None or t_end is not None:
+        return step_count(stored.dt, float(stored.t[-1]), steps, t_end)
+    planned = files.planned_steps_of(path)
+    if planned is None:
+        raise ValueError(
+            f"steps, t_end: give how much further: {str(path)!r} does not record the end its run was asked for "
+            "(a saved trajectory, or a file of an older varmech)"
+        )
+    if planned <= stored.steps:
+        raise ValueError(
+            f"steps, t_end: the run in {str(path)!r} has reached the end it was asked for (step {planned}, "
+            f"t = {float(stored.t[-1]):g}); give steps= (how many more) or t_end= to go further"
+        )
+    return planned - stored.steps
 
 
 def _check_checkpoint(path: str | os.PathLike[str], stored: Trajectory) -> None:

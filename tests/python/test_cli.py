@@ -1,5 +1,8 @@
 """The command line writes what it says."""
 
+import subprocess
+import sys
+
 import pytest
 
 import varmech
@@ -11,6 +14,23 @@ from varmech.cli import TOUR, TOUR_REDUCED, tour_runs
 def test_methods_table(run_cli):
     out = run_cli("methods").stdout
     assert "| `kahan_li8` | 8 | 17 |" in out
+
+
+def test_a_pipe_closed_early_ends_quietly():
+    # `varmech methods | head -1`: the reader closes the pipe (here before the table is written,
+    # which its import takes long enough for); no BrokenPipeError traceback, status 141
+    # (128 + SIGPIPE) as Unix tools end.
+    reader = subprocess.Popen([sys.executable, "-m", "varmech", "methods"], stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    assert reader.stdout is not None
+    reader.stdout.close()
+    _, err = reader.communicate()
+    assert reader.returncode == 141 and b"Traceback" not in err and b"BrokenPipe" not in err, err
+
+
+def test_version_and_plain_help(run_cli):
+    assert run_cli("--version").stdout == f"python -m varmech {varmech.__version__}\n"
+    out = run_cli("--help").stdout
+    assert out.startswith("usage: python -m varmech") and "``" not in out
 
 
 def test_tour_prints_reports_and_writes_plots(tmp_path, run_cli):

@@ -282,12 +282,14 @@ def test_check_conservation_judges_the_balance_with_the_work_of_friction():
         ({"mu_s": 0.2, "mu_k": float("inf")}, "^mu_k: must be a finite number ≥ 0"),
         ({"mu_s": 0.2, "slip": [[1.0, float("nan"), 0.0]]}, "^slip: must be a finite"),
         ({"mu_s": 0.2, "slip": [[[1.0]]]}, "^slip: must be a finite"),
-        ({"mu_s": "0.2"}, "^mu_s: must be a number"),
     ],
 )
 def test_bad_friction_is_a_value_error_naming_the_argument(kwargs, match):
     with pytest.raises(ValueError, match=match):
         varmech.Friction(**kwargs)
+    # A string is no number: a TypeError, named likewise.
+    with pytest.raises(TypeError, match="^mu_s: must be a number"):
+        varmech.Friction(mu_s="0.2")
 
 
 def test_friction_that_cannot_act_is_refused_naming_contacts():

@@ -15,7 +15,7 @@ def test_a_closure_of_the_wrong_signature_is_named_when_the_model_is_made():
         varmech.MechanicalSystem(1, lambda q: 0.5 * q[0] ** 2, lambda: 0.0)
     with pytest.raises(TypeError, match=r"^dl_dv: must be callable as dl_dv\(q, v, t\), but it takes \(q, v\)"):
         varmech.Lagrangian(1, lambda q, v, t: 0.5 * v[0] ** 2, dl_dv=lambda q, v: v)
-    with pytest.raises(TypeError, match=r"^force: expected a callable force\(q, v, t\), got float"):
+    with pytest.raises(TypeError, match=r"^force: must be callable as force\(q, v, t\), got float"):
         varmech.Lagrangian(1, lambda q, v, t: 0.5 * v[0] ** 2, force=1.0)
     # Defaults, *args and builtins' unreadable signatures are taken as they are.
     varmech.MechanicalSystem(1, lambda q, scale=1.0: scale * q[0] ** 2, lambda *a: 2.0 * a[0])

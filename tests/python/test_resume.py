@@ -112,6 +112,31 @@ def test_resume_goes_on_in_the_same_file(tmp_path):
     assert traj.steps == 25 * EVERY and traj.status == 0
 
 
+def test_resume_without_steps_goes_on_to_the_end_the_run_was_asked_for(tmp_path):
+    # A run asked for 25·EVERY steps stops early (here a terminal event, as a kill would):
+    # resume(path) goes on to those 25·EVERY, one run to the bit; then it has reached its end.
+    s = scenes.kepler()
+    path = tmp_path / "k.h5"
+    stop = varmech.events.crossing(1, 0.0, direction=-1, terminal=True)
+    early = varmech.integrate(s, dt=s.dt, steps=25 * EVERY, save_every=EVERY, output=path, events=[stop])
+    assert early.steps < 25 * EVERY
+    traj = varmech.resume(path)
+    whole = varmech.integrate(s, dt=s.dt, steps=25 * EVERY, save_every=EVERY)
+    assert traj.steps == 25 * EVERY and traj.status == 0
+    assert _same(traj.q[-1], whole.q[-1]) and _same(traj.p[-1], whole.p[-1])
+    with pytest.raises(ValueError, match=rf"^steps, t_end: the run in .* has reached the end it was asked for \(step {25 * EVERY}"):
+        varmech.resume(path)
+    # steps= is how many more, and moves the planned end with it.
+    assert varmech.resume(path, steps=EVERY).steps == 26 * EVERY
+    with pytest.raises(ValueError, match=rf"\(step {26 * EVERY}"):
+        varmech.resume(path)
+    # A saved trajectory records no planned end: resume asks how much further.
+    saved = tmp_path / "saved.h5"
+    whole.save(saved)
+    with pytest.raises(ValueError, match="^steps, t_end: give how much further: .* does not record"):
+        varmech.resume(saved)
+
+
 RUN = """
 import sys, varmech
 s = varmech.scenes.kepler()

@@ -115,5 +115,5 @@ def test_malformed_events_are_refused_by_name():
         varmech.Stepper(varmech.scenes.pendulum(), dt=0.01, events=crossing(0, 0.0))  # type: ignore[arg-type]
     with pytest.raises(ValueError, match=r"events\[0\].*the model has no constraints"):
         varmech.Stepper(varmech.scenes.pendulum(), dt=0.01, events=[multiplier(0)])
-    with pytest.raises(ValueError, match=r"events\[0\] \(q\[0\] = 0\): direction must be a number"):
+    with pytest.raises(TypeError, match=r"events\[0\] \(q\[0\] = 0\): direction must be a number"):
         varmech.Stepper(varmech.scenes.pendulum(), dt=0.01, events=[crossing(0, 0.0, direction="up")])  # type: ignore[arg-type]
