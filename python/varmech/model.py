@@ -1005,10 +1005,10 @@ def reactive_force(
     >>> bool(abs(traj.v[-1, 0] - (400.0 * math.log(10.0 / 6.0) - 98.1)) < 1e-3)
     True
     """
-    for name, f in (("mass", mass), ("velocity", velocity), ("mass_rate", mass_rate),
-                    ("mass_gradient", mass_gradient), ("force", force)):
-        if f is not None and not callable(f):
-            raise TypeError(f"{name}: expected a callable, got {type(f).__name__}: {f!r}")
+    for name, f, arguments in (("mass", mass, "q, t"), ("velocity", velocity, "q, v, t"), ("mass_rate", mass_rate, "q, t"),
+                               ("mass_gradient", mass_gradient, "q, t"), ("force", force, "q, v, t")):
+        if f is not None:
+            callable_as(name, f, arguments)
 
     def reactive(q: np.ndarray, v: np.ndarray, t: float) -> np.ndarray:
         m = float(mass(q, t))

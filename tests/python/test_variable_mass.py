@@ -190,7 +190,7 @@ def test_a_closure_mass_that_runs_out_stops_the_run_naming_mass():
     force = varmech.reactive_force(lambda q, t: 1.0 - q[0], lambda q, v, t: np.zeros(1), mass_rate=lambda q, t: 0.0)
     with pytest.raises(ValueError, match=r"^mass: the mass is -0.5 at t = 1"):
         force(np.array([1.5]), np.array([0.0]), 1.0)
-    with pytest.raises(TypeError, match=r"^mass_rate: expected a callable"):
+    with pytest.raises(TypeError, match=r"^mass_rate: must be callable as mass_rate\(q, t\), got float"):
         varmech.reactive_force(lambda q, t: 1.0, lambda q, v, t: np.zeros(1), mass_rate=0.5)
 
 

@@ -120,6 +120,34 @@ impl Tangent {
         }
     }
 
+    /// The vectors `x` carried through steps of size h of a kick–drift method on `sys` from
+    /// (q, p), each step's shears applied at the check ([`Clear`]) at its end inside the
+    /// method's own loop; None for an implicit step's map, which needs the step's solution
+    /// from its integrator (the loop holds it).
+    pub(super) fn carried<'a, S: MechanicalSystem + ?Sized>(
+        &'a mut self,
+        sys: &'a S,
+        h: f64,
+        (q, p): (&[f64], &[f64]),
+        x: &'a mut [f64],
+        large: f64,
+    ) -> Option<Carried<'a, S>> {
+        let Map::Shears(shears) = &mut self.map else {
+            return None;
+        };
+        self.q.copy_from_slice(q);
+        self.p.copy_from_slice(p);
+        Some(Carried {
+            sys,
+            shears,
+            h,
+            start: (&mut self.q, &mut self.p),
+            x,
+            large,
+            failed: None,
+        })
+    }
+
     /// Keeps the start (t, q₀, p₀) of the step about to be taken.
     pub(super) fn begin(&mut self, t: f64, q: &[f64], p: &[f64]) {
         self.t = t;
@@ -159,36 +187,6 @@ impl Tangent {
                 Ok(())
             }
         }
-    }
-}
-
-impl Tangent {
-    /// The vectors `x` carried through steps of size h of a kick–drift method on `sys` from
-    /// (q, p), each step's shears applied at the check ([`Clear`]) at its end inside the
-    /// method's own loop; None for an implicit step's map, which needs the step's solution
-    /// from its integrator (the loop holds it).
-    pub(super) fn carried<'a, S: MechanicalSystem + ?Sized>(
-        &'a mut self,
-        sys: &'a S,
-        h: f64,
-        (q, p): (&[f64], &[f64]),
-        x: &'a mut [f64],
-        large: f64,
-    ) -> Option<Carried<'a, S>> {
-        let Map::Shears(shears) = &mut self.map else {
-            return None;
-        };
-        self.q.copy_from_slice(q);
-        self.p.copy_from_slice(p);
-        Some(Carried {
-            sys,
-            shears,
-            h,
-            start: (&mut self.q, &mut self.p),
-            x,
-            large,
-            failed: None,
-        })
     }
 }
 
