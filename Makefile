@@ -4,6 +4,8 @@ PYTHON ?= python3
 
 .PHONY: install tour lint guards test guards-then-rust test-rust test-python docs wheel-check test-aarch64 bench compare gallery
 
+# The extra `test` is the dependency groups test and dev of pyproject.toml, which need pip >= 25.1
+# (`pip install --group dev`): the extra keeps `make test` working with the pip a fresh Python has.
 install:
 	$(PYTHON) -m pip install -e ".[test,charts]"
 

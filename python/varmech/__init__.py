@@ -24,6 +24,7 @@ import importlib
 from types import ModuleType
 
 from . import _errors, analysis, events, pointers, scenes
+from ._cite import cite
 from ._core import ConvergenceError, DivergenceError, SpuriousBranchError, VarmechError
 from ._version import __version__ as __version__
 from .analysis import sections, stability
@@ -108,6 +109,7 @@ __all__ = [
     "analysis",
     "check_conservation",
     "check_derivatives",
+    "cite",
     "cyclic_coordinates",
     "energy_growth",
     "engage",

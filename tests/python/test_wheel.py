@@ -14,6 +14,7 @@ from pathlib import Path
 
 import pytest
 
+import varmech
 from test_readme import quickstart
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -40,11 +41,16 @@ def test_a_manylinux2014_wheel_installs_in_a_fresh_venv_and_runs_the_quickstart(
     )  # fmt: skip
     (wheel,) = (tmp_path / "dist").glob("*.whl")
     tag = f"cp{sys.version_info.major}{sys.version_info.minor}"
-    assert wheel.name.startswith(f"varmech-0.1.0-{tag}-{tag}-manylinux2014_x86_64.manylinux_2_17_x86_64")
+    version = varmech.__version__
+    assert wheel.name.startswith(f"varmech-{version}-{tag}-{tag}-manylinux2014_x86_64.manylinux_2_17_x86_64")
     shown = run(sys.executable, "-m", "auditwheel", "show", wheel).stdout
     assert '"manylinux_2_17_x86_64"' in " ".join(shown.split()), shown
     names = zipfile.ZipFile(wheel).namelist()
-    assert {"varmech-0.1.0.dist-info/licenses/LICENSE-MIT", "varmech-0.1.0.dist-info/licenses/LICENSE-APACHE"} <= set(names)
+    licenses = {f"varmech-{version}.dist-info/licenses/LICENSE-{kind}" for kind in ("MIT", "APACHE")}
+    assert licenses <= set(names)
+    # Stripped ([tool.maturin] strip): the module has no symbol table, whose section is named .symtab.
+    (module,) = [name for name in names if name.startswith("varmech/_core")]
+    assert b".symtab" not in zipfile.ZipFile(wheel).read(module)
 
     # A clean venv (no system site-packages): the wheel's dependencies come from the index.
     venv = tmp_path / "venv"
