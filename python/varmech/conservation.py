@@ -461,7 +461,8 @@ def check_conservation(traj: Trajectory, generators: Sequence[Generator] | None 
         A run, as :func:`varmech.integrate` returns it.
     generators : sequence of Translation, Rotation, Cyclic or callable, optional
         The symmetries whose momenta J = p·ξ(q) are judged. Default: those the model declares;
-        a closure generator ``xi(q)`` is named ``xi[k]``.
+        a cyclic coordinate's momentum is named as the model names it (``p_phi``, from
+        :attr:`Model.momentum_names`), a closure generator ``xi(q)`` ``xi[k]``.
     refine : bool, default True
         For a balance (forced, or L depending on t) that would be "secular drift": run the same motion again at
         h/2 and call the balance "bounded" when its error falls at the method's order (the
@@ -516,7 +517,8 @@ def check_conservation(traj: Trajectory, generators: Sequence[Generator] | None 
         energy = replace(energy, advice=f"{energy.advice}: the model's energy p·q̇ − L does not evaluate there")
     momenta = []
     for k, xi in enumerate(generators):
-        name = xi.name if isinstance(xi, (Translation, Rotation, Cyclic)) else f"xi[{k}]"
+        # A cyclic coordinate's momentum by its name (p_phi), as the model knows it.
+        name = model.momentum_names[xi.index] if isinstance(xi, Cyclic) else xi.name if isinstance(xi, (Translation, Rotation)) else f"xi[{k}]"
         j, size = _momentum_terms(traj, xi)
         record = _core.statistics(t, j - j[0], size, size, steps)
         momenta.append(_statistics(record, name, j[0], "mean max(Σ|pᵢξᵢ|, ‖p‖‖ξ‖)", t))

@@ -21,7 +21,7 @@ from ._progress import progress_bar
 from ._util import finite, positive, positive_int, returned_scalar, step_count, vector
 from .constraints import warn_if_integrable
 from .derivatives import check_derivatives
-from .model import Lagrangian, MechanicalSystem, Model, check_delays
+from .model import Lagrangian, MechanicalSystem, Model, check_delays, initial_state
 from .modes import warn_if_unstable
 from .scenes import Scene
 
@@ -54,37 +54,6 @@ def _contacts_of(model: Model | Scene, contacts: Sequence[_impacts.Contact] | No
     """The contacts a run or a stepper of ``model`` watches: ``contacts``, a scene's by default
     (``[]``: none)."""
     return tuple(model.contacts if contacts is None and isinstance(model, Scene) else contacts or ())
-
-
-def _initial_state(
-    model: Model, q0: ArrayLike | None, p0: ArrayLike | None, v0: ArrayLike | None, t0: float
-) -> tuple[np.ndarray, np.ndarray]:
-    """(q0, p0) checked, p0 from the velocities v0 (p0 = ∂L/∂q̇(q0, v0, t0)) when given instead."""
-    n = model.dim
-    if q0 is None:
-        raise ValueError("q0: the initial positions are required")
-    q = vector("q0", q0, n)
-    if p0 is not None and v0 is None:
-        return q, vector("p0", p0, n)
-    if v0 is not None and p0 is None:
-        v = vector("v0", v0, n)
-        p = model.momentum(q, v, t0)
-        if model.velocity_constraints:
-            _check_rolling(model, q, v, p)
-        return q, p
-    raise ValueError("p0, v0: give exactly one of the initial momenta p0 and velocities v0")
-
-
-def _check_rolling(model: Model, q: np.ndarray, v: np.ndarray, p: np.ndarray) -> None:
-    """Refuses velocities ``v0`` off the velocity constraints, |A(q0)v0|∞ above 1e-10 of the
-    state's size, as the core refuses momenta off them (naming ``p0``)."""
-    (_, off), _ = _core.constraint_residuals(model._core, q[None], p[None])
-    scale = max(1.0, float(np.max(np.abs(q))), float(np.max(np.abs(p))))
-    if off[0] > 1e-10 * scale:
-        raise ValueError(
-            f"v0: is off the velocity constraints: |A(q0)v0| = {off[0]:.3e}; project the initial state first "
-            "(varmech.project)"
-        )
 
 
 def _energy_threshold(max_energy_error: float | None | Literal["auto"]) -> float | None:
@@ -347,7 +316,7 @@ def integrate(
     save_every = positive_int("save_every", save_every)
     threshold = _energy_threshold(max_energy_error)
     newton_tolerance, newton_max_iterations = _newton(newton_tolerance, newton_max_iterations)
-    q, p = _initial_state(model, q0, p0, v0, t0)
+    q, p = initial_state(model, q0, p0, v0, t0)
     if model.velocity_constraints:
         warn_if_integrable(model, q)
     watched, event_specs = _events.specs(events, model) if events is not None else ([], [])

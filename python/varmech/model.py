@@ -14,7 +14,7 @@ from numpy.typing import ArrayLike
 
 from . import _core, pointers
 from ._core import ModelKind
-from ._util import callable_as, floats, integer, positive_int, returned
+from ._util import callable_as, floats, integer, positive_int, returned, vector
 
 __all__ = [
     "Cyclic",
@@ -254,6 +254,25 @@ def _symmetry_from_spec(g: _core.Generator) -> Symmetry:
     raise TypeError(f"symmetries: expected a generator, got {g!r}")
 
 
+def coordinate_names(names: Sequence[str] | None, dim: int, argument: str = "coordinates") -> tuple[str, ...] | None:
+    """``names`` checked as the names of ``dim`` coordinates (None: unnamed): ``dim`` distinct,
+    non-empty strings; ValueError or TypeError naming ``argument`` otherwise."""
+    if names is None:
+        return None
+    if isinstance(names, str) or not all(isinstance(x, str) for x in names):
+        raise TypeError(f"{argument}: a sequence of {dim} names (str), such as ('x', 'theta'), not {names!r}")
+    names = tuple(x.strip() for x in names)
+    if len(names) != dim or len(set(names)) != dim or not all(names):
+        raise ValueError(f"{argument}: need {dim} distinct non-empty names, one a coordinate, got {names}")
+    return names
+
+
+def momentum_name(coordinate: str, index: int) -> str:
+    """The momentum conjugate to ``coordinate`` (the ``index``-th): ``p_theta``, or ``p[i]`` where the
+    coordinate has no name of its own (``q[i]``)."""
+    return f"p[{index}]" if coordinate == f"q[{index}]" else f"p_{coordinate}"
+
+
 def _handed(function: pointers.Function) -> tuple[int, pointers.Function]:
     """A pointer as the binding takes it: its address, and the object it keeps alive."""
     return function.address, function
@@ -332,6 +351,19 @@ class Model:
         integral"`` for an L autonomous in a moving frame (a symbolic L from inertial
         coordinates whose t cancels; a closure model that says so)."""
         return "energy"
+
+    @property
+    def coordinates(self) -> tuple[str, ...]:
+        """The coordinates' names, which reports, tables and charts use: a symbolic model's
+        symbols, a scene's own (``theta1``, ``theta2`` of the double pendulum), the ``coordinates=``
+        given to a closure model; ``q[0]``, ``q[1]``, … otherwise."""
+        return getattr(self, "_coordinates", None) or tuple(f"q[{i}]" for i in range(self.dim))
+
+    @property
+    def momentum_names(self) -> tuple[str, ...]:
+        """The conjugate momenta's names: ``p_theta`` for a coordinate named ``theta``, ``p[i]`` for an
+        unnamed one."""
+        return tuple(momentum_name(name, i) for i, name in enumerate(self.coordinates))
 
     @property
     def delays(self) -> tuple[float, ...]:
@@ -499,6 +531,38 @@ class Model:
         return None
 
 
+def initial_state(
+    model: Model, q0: ArrayLike | None, p0: ArrayLike | None, v0: ArrayLike | None, t0: float
+) -> tuple[np.ndarray, np.ndarray]:
+    """(q0, p0) checked, p0 from the velocities v0 (p0 = ∂L/∂q̇(q0, v0, t0)) when given instead:
+    a run's, a stepper's and a scene's initial state."""
+    n = model.dim
+    if q0 is None:
+        raise ValueError("q0: the initial positions are required")
+    q = vector("q0", q0, n)
+    if p0 is not None and v0 is None:
+        return q, vector("p0", p0, n)
+    if v0 is not None and p0 is None:
+        v = vector("v0", v0, n)
+        p = model.momentum(q, v, t0)
+        if model.velocity_constraints:
+            _check_rolling(model, q, v, p)
+        return q, p
+    raise ValueError("p0, v0: give exactly one of the initial momenta p0 and velocities v0")
+
+
+def _check_rolling(model: Model, q: np.ndarray, v: np.ndarray, p: np.ndarray) -> None:
+    """Refuses velocities ``v0`` off the velocity constraints, |A(q0)v0|∞ above 1e-10 of the
+    state's size, as the core refuses momenta off them (naming ``p0``)."""
+    (_, off), _ = _core.constraint_residuals(model._core, q[None], p[None])
+    scale = max(1.0, float(np.max(np.abs(q))), float(np.max(np.abs(p))))
+    if off[0] > 1e-10 * scale:
+        raise ValueError(
+            f"v0: is off the velocity constraints: |A(q0)v0| = {off[0]:.3e}; project the initial state first "
+            "(varmech.project)"
+        )
+
+
 #: The builders of models from their recipes (:meth:`Model._recipe`) by kind: the module of each
 #: model class adds its own.
 RECIPES: dict[str, Callable[[dict[str, Any]], Model]] = {}
@@ -616,6 +680,8 @@ class NativeSystem(Model):
         The core's model.
     parameters : mapping of str to float, optional
         The catalogue parameters it was built with (None for an N-body model).
+    coordinates : sequence of str, optional
+        The coordinates' names (:data:`SCENE_COORDINATES` for a scene); default ``q[0]``, ….
 
     Examples
     --------
@@ -627,8 +693,11 @@ class NativeSystem(Model):
     {'e': 0.3}
     """
 
-    def __init__(self, core: _core.NativeModel, parameters: Mapping[str, float] | None = None):
+    def __init__(
+        self, core: _core.NativeModel, parameters: Mapping[str, float] | None = None, coordinates: Sequence[str] | None = None
+    ):
         self._core: _core.NativeModel = core
+        self._coordinates = coordinate_names(coordinates, core.dim)
         self.name = core.name
         self.symmetries = tuple(_symmetry_from_spec(g) for g in core.symmetries)
         self.parameters = None if parameters is None else dict(parameters)
@@ -655,9 +724,34 @@ class NativeSystem(Model):
         return None
 
 
+#: The coordinates' names of the catalogue's scenes of a fixed dimension, spelled as the names of
+#: their invariants (``p_phi``); the chains, the planets and the quaternion go by index.
+SCENE_COORDINATES: dict[str, tuple[str, ...]] = {
+    "harmonic_oscillator": ("x",),
+    "pendulum": ("theta",),
+    "kepler": ("x", "y"),
+    "henon_heiles": ("x", "y"),
+    "double_pendulum": ("theta1", "theta2"),
+    "spherical_pendulum": ("theta", "phi"),
+    "heavy_top": ("theta", "phi", "psi"),
+    "kepler_polar": ("r", "theta"),
+    "charged_particle": ("x", "y"),
+    "charged_particle_nonuniform": ("x", "y"),
+    "damped_driven_pendulum": ("phi",),
+    "cartesian_pendulum": ("x", "y"),
+    "cartesian_spherical_pendulum": ("x", "y", "z"),
+    "bouncing_ball": ("y",),
+    "elliptic_billiard": ("x", "y"),
+    "rolling_disk": ("x", "y", "theta", "phi"),
+    "chaplygin_sleigh": ("x", "y", "theta"),
+    "rolling_sphere": ("x", "y", "phi", "theta", "psi"),
+    "ball_on_turntable": ("x", "y", "phi", "theta", "psi"),
+}
+
+
 def _scene_model(name: str, parameters: dict[str, float]) -> NativeSystem:
-    """The native model of catalogue scene ``name`` with ``parameters`` (a pickle's)."""
-    return NativeSystem(_core.scene(name, **parameters).model, parameters)
+    """The native model of catalogue scene ``name`` with ``parameters`` (a scene's, a pickle's)."""
+    return NativeSystem(_core.scene(name, **parameters).model, parameters, SCENE_COORDINATES.get(name))
 
 
 def _nbody_model(gravitational_constant: float, masses: list[float]) -> NativeSystem:
@@ -740,6 +834,9 @@ class MechanicalSystem(Model):
         momenta are checked by :func:`varmech.check_conservation`.
     name
         A label for reports.
+    coordinates
+        The coordinates' names (n distinct strings, such as ``("x", "theta")``), which
+        reports, tables and charts use (``p_theta`` for a momentum); default ``q[0]``, ….
 
     Raises
     ------
@@ -804,6 +901,7 @@ class MechanicalSystem(Model):
         velocity_constraint_offset: Callable[[np.ndarray], ArrayLike] | None = None,
         symmetries: Sequence[Symmetry] = (),
         name: str = "mechanical system",
+        coordinates: Sequence[str] | None = None,
     ):
         self._arguments = {
             "dim": dim,
@@ -819,8 +917,10 @@ class MechanicalSystem(Model):
             "velocity_constraint_offset": velocity_constraint_offset,
             "symmetries": symmetries,
             "name": name,
+            "coordinates": coordinates,
         }
         dim = positive_int("dim", dim)
+        self._coordinates = coordinate_names(coordinates, dim)
         if (constraints is None) != (constraint_count is None) or (constraint_jacobian is not None and constraints is None):
             raise ValueError("constraints: give constraints(q) with constraint_count (and optionally constraint_jacobian)")
         _check_velocity_constraints(velocity_constraints, velocity_constraint_count, velocity_constraint_offset)
@@ -1076,6 +1176,8 @@ class Lagrangian(Model):
     energy_name
         What reports call E = p·q̇ − L: ``"Jacobi integral"`` for an L written in a moving
         (rotating) frame, whose conserved E is not the inertial energy.
+    coordinates
+        The coordinates' names, as for :class:`MechanicalSystem`.
 
     Raises
     ------
@@ -1129,6 +1231,7 @@ class Lagrangian(Model):
         name: str = "lagrangian",
         dl_dt: Callable[[np.ndarray, np.ndarray, float], float] | None = None,
         energy_name: str = "energy",
+        coordinates: Sequence[str] | None = None,
     ):
         self._arguments = {
             "dim": dim,
@@ -1146,8 +1249,10 @@ class Lagrangian(Model):
             "name": name,
             "dl_dt": dl_dt,
             "energy_name": energy_name,
+            "coordinates": coordinates,
         }
         dim = positive_int("dim", dim)
+        self._coordinates = coordinate_names(coordinates, dim)
         if not isinstance(energy_name, str) or not energy_name.strip():
             raise TypeError(f"energy_name: a non-empty str, such as 'Jacobi integral', not {energy_name!r}")
         _check_velocity_constraints(velocity_constraints, velocity_constraint_count, velocity_constraint_offset)

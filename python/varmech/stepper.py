@@ -16,8 +16,8 @@ from ._util import finite, floats, positive, step_count
 from .events import Event, EventFunction, Occurrences
 from .impacts import Contact
 from .impulses import Impulse
-from .integrate import _contacts_of, _initial_state, _model_of, _newton
-from .model import Model, check_delays
+from .integrate import _contacts_of, _model_of, _newton
+from .model import Model, check_delays, initial_state
 from .scenes import Scene
 
 __all__ = [
@@ -155,7 +155,7 @@ class Stepper:
         dt = positive("dt", dt)
         t0 = finite("t0", t0)
         newton_tolerance, newton_max_iterations = _newton(newton_tolerance, newton_max_iterations)
-        q, p = _initial_state(model, q0, p0, v0, t0)
+        q, p = initial_state(model, q0, p0, v0, t0)
         self._model = model
         self._contacts = contacts
         self._impulses = tuple(impulses or ())
@@ -346,7 +346,7 @@ class Stepper:
         (0, 0.1, [2.0])
         """
         t0 = self.t if t0 is None else finite("t0", t0)
-        q, p = _initial_state(self._model, q0, p0, v0, t0)
+        q, p = initial_state(self._model, q0, p0, v0, t0)
         self._stepper.reset(q, p, t0, events=self._event_specs or None)
 
     @property

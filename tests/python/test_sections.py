@@ -138,7 +138,8 @@ def test_chaotic_fraction_grows_from_1_12_to_1_8():
 def test_closure_model_gives_the_native_section(henon_heiles_closure):
     """The general path (velocity and ∂L/∂q from the model) on a closure twin of Hénon–Heiles,
     with explicit seeds and a box-free set-up, reproduces the native section."""
-    closure = henon_heiles_closure(name="henon_heiles closure")
+    # Its coordinates named as the native scene's, so that the tables' columns are the same.
+    closure = henon_heiles_closure(name="henon_heiles closure", coordinates=("x", "y"))
     seeds = [(0.2, 0.1), (-0.1, 0.2)]
     a = sections.poincare_section(closure, E12, seeds=seeds, t_end=100.0)
     b = sections.poincare_section(HH, E12, seeds=seeds, t_end=100.0)

@@ -153,7 +153,10 @@ def phase_portrait(
     table = Table(
         ("orbit", "energy", "motion", "t", "q", "p", "energy_error"),
         title=f"Phase portrait: {model.name}, t = 0 … {t_end:g}",
-        meta={"model": model.name, "method": method, "dt": dt, "t_end": t_end, "max_energy_error": 0.0, "notes": []},
+        meta={
+            "model": model.name, "method": method, "dt": dt, "t_end": t_end, "max_energy_error": 0.0, "notes": [],
+            "coordinates": model.coordinates, "momenta": model.momentum_names,
+        },  # fmt: skip
     )
     if _is_pendulum(model):
         table.meta["separatrix_energy"] = 1.0

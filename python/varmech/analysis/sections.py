@@ -47,7 +47,7 @@ from numpy.typing import ArrayLike
 
 from .._util import positive
 from ..events import crossing
-from ..model import Model
+from ..model import Model, coordinate_names, momentum_name
 from ..table import Table
 from ..trajectory import Trajectory
 from ._energy import conserves_energy
@@ -71,14 +71,10 @@ def _is_henon_heiles(model: Model) -> bool:
     return model.name == "henon_heiles"
 
 
-def _names(model: Model, names: Sequence[str] | None) -> tuple[str, ...]:
-    n = model.dim
-    if names is None:
-        names = ("x", "y") if n == 2 else tuple(f"q{i}" for i in range(n))
-    names = tuple(str(s) for s in names)
-    if len(names) != n or len(set(names)) != n:
-        raise ValueError(f"names: need {n} distinct coordinate names, got {names}")
-    return names
+def _names(model: Model, names: Sequence[str] | None) -> tuple[tuple[str, ...], tuple[str, ...]]:
+    """The coordinates' and momenta's column names: ``names``, or the model's own."""
+    cols = coordinate_names(names, model.dim, "names") or model.coordinates
+    return cols, tuple(momentum_name(name, i) for i, name in enumerate(cols))
 
 
 def _section(model: Model, section: Sequence[Any] | None) -> tuple[int, float, int]:
@@ -313,7 +309,7 @@ def poincare_section(
         section to round-off; ``"hermite"``: the cubic Hermite interpolant's root (O(dt⁴)). See
         the module docstring.
     names
-        Coordinate names for the columns (default ``x, y`` for two coordinates, else ``q0`` …).
+        Coordinate names for the columns (default: the model's, :attr:`~varmech.Model.coordinates`).
     progress
         Show a progress bar: None on a terminal only, True or False to force it.
 
@@ -374,7 +370,7 @@ def poincare_section(
     """
     model = model_of(model_or_scene, forced=True)
     forced = not conserves_energy(model)
-    cols = _names(model, names)
+    cols, momenta = _names(model, names)
     if locate not in ("step", "hermite"):
         raise ValueError(f"locate: 'step' or 'hermite', got {locate!r}")
     if forced:
@@ -395,8 +391,8 @@ def poincare_section(
     others = [i for i in range(model.dim) if i != k]
     plane = others[0]
     error = "balance_error" if forced else "energy_error"
-    columns = ("orbit", "t", *cols, *(f"p_{s}" for s in cols), error)
-    arrow = {1: f"p_{cols[k]} > 0", -1: f"p_{cols[k]} < 0", 0: "both directions"}[direction]
+    columns = ("orbit", "t", *cols, *momenta, error)
+    arrow = {1: f"{momenta[k]} > 0", -1: f"{momenta[k]} < 0", 0: "both directions"}[direction]
     shell = "forced" if energy is None else f"E = {energy:.6g}"
     table = Table(
         columns,
@@ -405,7 +401,7 @@ def poincare_section(
             "model": model.name,
             "energy": energy,
             "section": (k, c, direction),
-            "plane": (cols[plane], f"p_{cols[plane]}"),
+            "plane": (cols[plane], momenta[plane]),
             "method": method,
             "dt": dt,
             "t_end": t_end,
@@ -535,7 +531,7 @@ def orbit_divergence(
     """
     model = model_of(model_or_scene)
     energy = float(energy)
-    cols = _names(model, None)
+    cols, momenta = _names(model, None)
     separation = positive("separation", separation)
     k, c, direction, dt, t_end, method, q_seed, p_seed = _orbits(model, energy, section, dt, t_end, method, seeds, orbits, box, seed)
     j = [i for i in range(model.dim) if i != k][0]
@@ -549,7 +545,7 @@ def orbit_divergence(
         p_twin[~ok] = p_twin2
         ok[~ok] = ok2
     table = Table(
-        ("orbit", f"{cols[j]}0", f"p_{cols[j]}0", "divergence", "chaotic"),
+        ("orbit", f"{cols[j]}0", f"{momenta[j]}0", "divergence", "chaotic"),
         title=f"Orbit divergence: {model.name}, E = {energy:.6g}, t = 0 … {t_end:g}",
         meta={"model": model.name, "energy": energy, "method": method, "dt": dt, "t_end": t_end, "separation": separation,
               "threshold": threshold, "notes": []},

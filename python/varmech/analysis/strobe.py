@@ -131,7 +131,8 @@ def stroboscopic_section(
     traj = integrate(model, q0, p0, dt=dt, steps=m * (transient + periods), method=method, save_every=m, t0=t0, progress=False)
     keep = slice(transient, transient + periods + 1)
     columns = ("k", "t", *(f"q{j}" for j in range(n)), *(f"p{j}" for j in range(n)))
-    table = Table(columns, title=f"Stroboscopic section of {model.name}", meta={"dt": dt, "method": method, "period": period})
+    names = {"coordinates": model.coordinates, "momenta": model.momentum_names}
+    table = Table(columns, title=f"Stroboscopic section of {model.name}", meta={"dt": dt, "method": method, "period": period, **names})
     for k, (t, q, p) in enumerate(zip(traj.t[keep], traj.q[keep], traj.p[keep]), start=transient):
         table.append(k, float(t), *map(float, q), *map(float, p))
     return table
@@ -275,4 +276,5 @@ def orbit_diagram(
         for k, row in enumerate(state, start=transient):
             table.append(float(value), k, *map(float, row))
     table.meta.update({"parameter": parameter, "period": period, "dt": period / m, "method": method, "periods": found})
+    table.meta.update(coordinates=model.coordinates, momenta=model.momentum_names)
     return table

@@ -150,6 +150,11 @@ class SymbolicModel(Model):
         return self._symbolic.q
 
     @property
+    def coordinates(self) -> tuple[str, ...]:
+        """The coordinates' names: their symbols' (``theta`` of ``theta(t)``)."""
+        return tuple(getattr(x, "name", None) or type(x).__name__ for x in self._symbolic.q)
+
+    @property
     def v(self) -> tuple[sp.Symbol, ...]:
         """The velocities as SymPy symbols."""
         return self._symbolic.v
