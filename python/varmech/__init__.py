@@ -64,6 +64,7 @@ from .modes import (
     suggest_dt,
 )
 from .reduction import ReducedModel, cyclic_coordinates, routh
+from .scenes import Reference, Scene
 from .stepper import Stepper
 from .streaming import resume
 from .table import Table
@@ -97,7 +98,9 @@ __all__ = [
     "NormalModes",
     "Reactions",
     "ReducedModel",
+    "Reference",
     "Rotation",
+    "Scene",
     "SpuriousBranchError",
     "StabilityWarning",
     "StepSuggestion",

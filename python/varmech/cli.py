@@ -1,19 +1,29 @@
-"""The command line: ``python -m varmech tour | methods | chart <kind> [scene]``."""
+"""The command line: ``python -m varmech tour | methods | scenes | run SCENE | chart KIND [SCENE]``.
+
+SCENE is a scene's name (``varmech scenes`` lists them) or one's own: FILE.py:NAME or
+MODULE:NAME naming a varmech Scene, a Model (with --q0, --p0 or --v0, and --t-end), a function
+that returns one of them, or a SymPy Lagrangian L (the file defines its coordinates as ``q``, their
+velocities as ``v`` unless q are dynamicsymbols, and may define ``parameters``)."""
 
 from __future__ import annotations
 
 import argparse
+import importlib
+import importlib.util
+import math
 import os
 import sys
 import time
 from pathlib import Path
+from typing import Any
 
-from . import charts, scenes
+from . import _core, charts, scenes
 from ._version import __version__
 from .charts.recipes import KINDS, chart
 from .conservation import check_conservation
 from .integrate import integrate
 from .methods import format_table
+from .model import Model
 from .reduction import routh
 from .table import Table
 
@@ -136,8 +146,105 @@ def tour(out: Path, quick: bool) -> int:
 
 
 def _note(note: str) -> None:
-    """Say a measurement's note (a skipped baseline, a stopped sweep) on screen."""
-    print(f"note: {note}")
+    """Say a measurement's note (a skipped baseline, a stopped sweep) on standard error, apart
+    from the output."""
+    print(f"note: {note}", file=sys.stderr)
+
+
+def _module(where: str) -> Any:
+    """The module of FILE.py (run as a script's module) or of an importable MODULE name."""
+    if where.endswith(".py"):
+        path = Path(where)
+        if not path.is_file():
+            raise ValueError(f"scene: no file {where}")
+        spec = importlib.util.spec_from_file_location(path.stem, path)
+        assert spec is not None and spec.loader is not None
+        module = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(module)
+        return module
+    try:
+        return importlib.import_module(where)
+    except ModuleNotFoundError as e:
+        raise ValueError(f"scene: no module {where!r} ({e}); give FILE.py:NAME or an importable MODULE:NAME") from None
+
+
+def load_subject(text: str) -> scenes.Scene | Model:
+    """The Scene or Model that ``FILE.py:NAME`` or ``MODULE:NAME`` names: the object itself, what
+    a function of that name returns, or a SymPy Lagrangian compiled (the module's ``q`` its
+    coordinates, ``v`` their velocities, ``parameters`` the values of its symbols)."""
+    where, _, name = text.rpartition(":")
+    if not where or not name:
+        raise ValueError(f"scene: expected a scene's name, FILE.py:NAME or MODULE:NAME, got {text!r}")
+    module = _module(where)
+    if not hasattr(module, name):
+        public = sorted(k for k in vars(module) if not k.startswith("_"))
+        raise ValueError(f"scene: {where} defines no {name!r}; it defines {', '.join(public)}")
+    obj = getattr(module, name)
+    if callable(obj) and not isinstance(obj, (scenes.Scene, Model)):
+        obj = obj()
+    if type(obj).__module__.startswith("sympy"):
+        if not hasattr(module, "q"):
+            raise ValueError(f"scene: {where} gives the Lagrangian {name} but no coordinates: define q = [the coordinates]")
+        from .symbolic import lagrangian
+
+        obj = lagrangian(obj, module.q, getattr(module, "v", None), parameters=getattr(module, "parameters", None), name=name)
+    if not isinstance(obj, (scenes.Scene, Model)):
+        raise ValueError(f"scene: {text} is a {type(obj).__name__}, not a varmech Scene, Model or SymPy Lagrangian")
+    return obj
+
+
+def _scene(args: argparse.Namespace) -> scenes.Scene | str | None:
+    """The scene the command line names: a name as it is (the recipes know the catalogue), or the
+    user's own object, a Model made a Scene with --q0, --p0/--v0, --t-end and --dt."""
+    if args.scene is None or args.scene in scenes.CATALOGUE or args.scene in scenes.SYMBOLIC or ":" not in args.scene:
+        given = [flag for flag, value in (("--q0", args.q0), ("--p0", args.p0), ("--v0", args.v0)) if value is not None]
+        if given and args.scene is not None:
+            raise ValueError(f"{', '.join(given)}: a built-in scene has its own initial state; these are for a model of one's own")
+        return args.scene
+    subject = load_subject(args.scene)
+    if isinstance(subject, scenes.Scene):
+        return subject
+    missing = [flag for flag, value in (("--q0", args.q0), ("--t-end", args.t_end)) if value is None]
+    if missing:
+        raise ValueError(f"{' and '.join(missing)}: {args.scene} is a model; give its initial state and horizon (--q0, --p0 or --v0, --t-end)")
+    if args.p0 is None and args.v0 is None:
+        args.v0 = (0.0,) * len(args.q0)
+    return scenes.Scene.of(subject, args.q0, args.p0, v0=args.v0, t_end=args.t_end, dt=args.dt, name=args.scene.rpartition(":")[2])
+
+
+def _run(args: argparse.Namespace) -> int:
+    """One integration of a scene, its conservation report, and its final state."""
+    sc = _scene(args)
+    scene = scenes.get(sc) if isinstance(sc, str) else sc
+    assert scene is not None
+    method = args.method or scene.model.kind.default_method
+    t_end = args.t_end or scene.t_end
+    # The scene's step fitted to the horizon, or the step given (the horizon then rounded to it).
+    steps = max(1, round(t_end / args.dt) if args.dt else math.ceil(t_end / scene.dt - 1e-9))
+    dt = args.dt or t_end / steps
+    print(f"{scene.name}: {scene.description or scene.model.name}; {method}, dt = {dt:g}, {steps} steps to t = {steps * dt:g} {scene.time_unit}")
+    try:
+        traj = integrate(scene, dt=dt, steps=steps, method=method, save_every=max(1, steps // 20000))
+    except _core.VarmechError as e:
+        print(f"error: {type(e).__name__}: {e}", file=sys.stderr)
+        return 1
+    print(check_conservation(traj))
+    names = (*scene.model.coordinates, *scene.model.momentum_names)
+    values = (*traj.q[-1], *traj.p[-1])
+    print("final state: " + ", ".join(f"{n} = {v:.12g}" for n, v in zip(names, values)))
+    return 0
+
+
+def _scenes_table() -> Table:
+    """The scenes by name: degrees of freedom, model kind, description."""
+    table = Table(("scene", "dof", "kind", "description"), title="Scenes (varmech.scenes.get(name); python -m varmech run NAME)")
+    for name in (*scenes.CATALOGUE, *scenes.SYMBOLIC):
+        try:
+            scene = scenes.get(name)
+        except ImportError:
+            continue
+        table.append(name, scene.model.dim, scene.model.kind.name, scene.description)
+    return table
 
 
 def _floats(text: str) -> tuple[float, ...]:
@@ -145,6 +252,22 @@ def _floats(text: str) -> tuple[float, ...]:
         return tuple(float(x) for x in text.split(","))
     except ValueError:
         raise argparse.ArgumentTypeError(f"expected comma-separated numbers, got {text!r}") from None
+
+
+def _positive(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a number, got {text!r}") from None
+    if not (value > 0 and value < float("inf")):
+        raise argparse.ArgumentTypeError(f"expected a positive number, got {text!r}")
+    return value
+
+
+def _state_arguments(parser: argparse.ArgumentParser) -> None:
+    """--q0, --p0, --v0: the initial state of one's own model."""
+    for flag, what in (("--q0", "positions"), ("--p0", "momenta"), ("--v0", "velocities (default: at rest)")):
+        parser.add_argument(flag, type=_floats, metavar="X,Y,...", help=f"one's own model: the initial {what}")
 
 
 def _box(text: str) -> tuple[tuple[float, float], tuple[float, float]]:
@@ -182,11 +305,22 @@ def _main(argv: list[str] | None) -> int:
     t.add_argument("--out", type=Path, default=Path("out/tour"), help="folder for the plots (default out/tour)")
     t.add_argument("--quick", action="store_true", help="a tenth of each horizon")
     sub.add_parser("methods", help="print the table of methods")
+    sub.add_parser("scenes", help="print the table of scenes")
+    r = sub.add_parser("run", help="integrate one scene (or one's own model) and print its conservation report")
+    r.add_argument("scene", help="a scene name, or FILE.py:NAME / MODULE:NAME naming one's own Scene, Model or SymPy L")
+    r.add_argument("--method", help="the method (default: the model's kind's default)")
+    r.add_argument("--dt", type=_positive, help="the step (default: the scene's)")
+    r.add_argument("--t-end", type=_positive, help="the horizon (default: the scene's; required for a model)")
+    _state_arguments(r)
     c = sub.add_parser("chart", help="measure and write a chart (PNG or SVG) with its data (CSV)")
     c.add_argument("kind", choices=sorted(KINDS), help="; ".join(f"{k}: {v.description}" for k, v in KINDS.items()))
     c.add_argument(
-        "scene", nargs="?", help="a scene name (default: the kind's own; varmech.charts.recipes.scenes_for(kind) lists those it takes)"
-    )
+        "scene", nargs="?", help="a scene name (default: the kind's own; varmech.charts.recipes.scenes_for(kind) lists those it takes), "
+        "or FILE.py:NAME / MODULE:NAME naming one's own Scene, Model or SymPy L",
+    )  # fmt: skip
+    c.add_argument("--dt", type=_positive, help="one's own model: a step that resolves it (default: from its fastest frequency)")
+    c.add_argument("--t-end", type=_positive, help="one's own model: the horizon (required)")
+    _state_arguments(c)
     c.add_argument(
         "--methods", help="comma-separated method names (default: the kind's own that fit the scene, else the scene's kind's)"
     )
@@ -205,14 +339,25 @@ def _main(argv: list[str] | None) -> int:
     args = parser.parse_args(argv)
     if args.command == "tour":
         return tour(args.out, args.quick)
+    if args.command == "scenes":
+        print(_scenes_table().format(max_rows=None))
+        return 0
+    if args.command == "run":
+        try:
+            return _run(args)
+        except (ValueError, TypeError) as e:
+            parser.error(str(e))
     if args.command == "chart":
         methods = tuple(args.methods.split(",")) if args.methods else None
         try:
+            subject = _scene(args)
+            if not isinstance(subject, scenes.Scene) and (args.dt or args.t_end):
+                raise ValueError("--dt, --t-end: for one's own model; a chart of a built-in scene follows its own protocol")
             paths = chart(
-                args.kind, args.scene, methods=methods, out=args.out, fmt=args.format, quick=args.quick, energies=args.energy,
+                args.kind, subject, methods=methods, out=args.out, fmt=args.format, quick=args.quick, energies=args.energy,
                 box=args.box, say=_note,
             )  # fmt: skip
-        except ValueError as e:
+        except (ValueError, TypeError) as e:
             parser.error(str(e))
         for path in paths:
             print(f"wrote {path}")

@@ -8,16 +8,19 @@ functions below name them with their parameters for the reader."""
 
 from __future__ import annotations
 
-from collections.abc import Callable
+import math
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import ArrayLike
 
 from . import _core
+from ._core import energy_terms
 from ._util import floats, positive
 from .impacts import Contact
-from .model import Model, NativeSystem
+from .model import SCENE_COORDINATES, Model, NativeSystem, initial_state
+from .modes import fastest_frequency
 
 __all__ = [
     "CATALOGUE",
@@ -25,6 +28,7 @@ __all__ = [
     "TIME_UNITS",
     "Reference",
     "Scene",
+    "as_scene",
     "ball_on_turntable",
     "bouncing_ball",
     "cartesian_pendulum",
@@ -65,7 +69,11 @@ class Reference:
         The positions and momenta there (NaN where the source gives none, as the spherical
         pendulum's p_θ).
     source : str
-        Where it comes from: "exact: …", a publication, or a file of ``reference/``.
+        Where it comes from: "exact: …", a publication, a file of ``reference/``, or "computed: …"
+        (:func:`varmech.analysis.reference.reference_solution`).
+    tolerance : float or None
+        The error the reference is known to within, where stated (a computed one's: the
+        difference of its last two refinements); None for an exact or published one.
 
     Examples
     --------
@@ -81,12 +89,14 @@ class Reference:
     q: np.ndarray
     p: np.ndarray
     source: str
+    tolerance: float | None = None
 
 
 @dataclass(frozen=True)
 class Scene:
     """A model with its initial state and test protocol: a native one of the core's catalogue
-    (:func:`get`), or a symbolic one (:func:`varmech.symbolic.examples.scene`).
+    (:func:`get`), a symbolic one (:func:`varmech.symbolic.examples.scene`), or the user's own
+    model with its initial state and horizon (:meth:`Scene.of`).
 
     ``dt`` is a step that resolves the scene for a quick look (the tour uses it);
     ``invariants`` holds the values of the conserved quantities at t = 0; ``parameters`` the
@@ -127,6 +137,15 @@ class Scene:
     >>> scene.q0, scene.reference.source
     (array([0.4, 0. ]), 'exact: 200 whole periods')
     >>> traj = varmech.integrate(scene, dt=scene.dt, steps=100)
+
+    A model of one's own, with its initial state and horizon (:meth:`Scene.of`):
+
+    >>> import numpy as np
+    >>> def V(q): return -np.cos(q[0])
+    >>> def dV(q): return np.sin(q)
+    >>> mine = varmech.Scene.of(varmech.MechanicalSystem(1, V, dV), [1.0], [0.0], t_end=100.0)
+    >>> mine.name, mine.dt          # 20 steps a period of the small oscillations at q0
+    ('mechanical system', 0.427)
     """
 
     name: str
@@ -141,6 +160,169 @@ class Scene:
     parameters: dict[str, float] = field(default_factory=dict)
     contacts: tuple[Contact, ...] = ()
     time_unit: str = "time units"
+
+    @classmethod
+    def of(
+        cls,
+        model: Model,
+        q0: ArrayLike,
+        p0: ArrayLike | None = None,
+        *,
+        v0: ArrayLike | None = None,
+        t_end: float,
+        dt: float | None = None,
+        name: str | None = None,
+        description: str = "",
+        reference: Reference | None = None,
+        contacts: Sequence[Contact] = (),
+        time_unit: str = "time units",
+    ) -> Scene:
+        """A scene of one's own model: what :func:`varmech.work_precision`,
+        :func:`varmech.energy_growth`, the charts and the CLI take.
+
+        Parameters
+        ----------
+        model : Model
+            Any model (native, symbolic, closures, C pointers).
+        q0, p0, v0 : array_like, shape (n,)
+            The initial positions, and the momenta p0 or the velocities v0 (one of them).
+        t_end : float
+            The horizon of the scene's runs.
+        dt : float, optional
+            A step that resolves the motion for a quick look; the measurements sweep around
+            it. Default: a twentieth of the fastest small-oscillation period at q0
+            (:func:`varmech.fastest_frequency`), at most ``t_end``/100 (``t_end``/1000 where the
+            model has no oscillation there).
+        name, description : str, optional
+            What charts and tables call it (default: the model's ``name``).
+        reference : Reference, optional
+            The solution at some time, where one is known; without it, the measurements that
+            need one compute it (:func:`varmech.analysis.reference.reference_solution`).
+        contacts : sequence of Contact, optional
+            Contact surfaces that the runs go through.
+        time_unit : str, default "time units"
+            The unit of t on charts' axes.
+
+        Returns
+        -------
+        Scene
+            With ``invariants`` = {the energy's name: its value at t = 0} where the energy is
+            conserved, empty otherwise.
+
+        Raises
+        ------
+        TypeError
+            ``model`` is not a varmech Model; a string where a number belongs.
+        ValueError
+            Malformed ``q0``, ``p0``/``v0``, ``t_end`` or ``dt``, named.
+
+        Examples
+        --------
+        The elastic pendulum of :mod:`varmech.symbolic.examples`, released 0.6 off the vertical:
+
+        >>> import varmech
+        >>> from varmech.symbolic import examples
+        >>> model = examples.elastic_pendulum_cartesian()
+        >>> scene = varmech.Scene.of(model, [0.85, -1.24], v0=[0.0, 0.0], t_end=100.0)
+        >>> scene.model.coordinates, round(scene.dt, 4), sorted(scene.invariants)
+        (('x', 'y'), 0.0993, ['energy'])
+        """
+        if not isinstance(model, Model):
+            raise TypeError(f"model: expected a varmech Model (MechanicalSystem, Lagrangian, symbolic, ...), got {type(model).__name__}")
+        q, p = initial_state(model, q0, p0, v0, 0.0)
+        horizon = positive("t_end", t_end)
+        step = _default_dt(model, q, horizon) if dt is None else positive("dt", dt)
+        if step > horizon:
+            raise ValueError(f"dt: must not exceed t_end = {horizon:g}, got {step:g}")
+        if reference is not None and not isinstance(reference, Reference):
+            raise TypeError(f"reference: expected a varmech.scenes.Reference, got {type(reference).__name__}")
+        invariants = {}
+        if not (model.time_dependent or model.forced):
+            invariants[model.energy_name] = float(energy_terms(model._core, np.zeros(1), q[None], p[None])[0][0])
+        label = model.name if name is None else name
+        for argument, text in (("name", label), ("description", description), ("time_unit", time_unit)):
+            if not isinstance(text, str):
+                raise TypeError(f"{argument}: expected a str, got {type(text).__name__}")
+        surfaces = tuple(contacts)
+        if not all(isinstance(c, Contact) for c in surfaces):
+            raise TypeError("contacts: expected varmech.Contact surfaces")
+        parameters = dict(getattr(model, "parameters", None) or {})
+        return cls(label, description, model, q, p, horizon, step, invariants, reference, parameters, surfaces, time_unit)
+
+
+def _default_dt(model: Model, q: np.ndarray, t_end: float) -> float:
+    """A twentieth of the fastest small-oscillation period at q, at most t_end/100; t_end/1000
+    where the model has no oscillation there (or its frequencies cannot be had: velocity
+    constraints). Rounded to three significant digits, for tables and chart titles."""
+    try:
+        omega = fastest_frequency(model, q)
+    except ValueError:
+        omega = 0.0
+    dt = min(2 * math.pi / omega / 20, t_end / 100) if math.isfinite(omega) and omega > 0 else t_end / 1000
+    return float(f"{dt:.3g}")
+
+
+def as_scene(
+    subject: Scene | Model | str,
+    *,
+    q0: ArrayLike | None = None,
+    p0: ArrayLike | None = None,
+    v0: ArrayLike | None = None,
+    t_end: float | None = None,
+    dt: float | None = None,
+    argument: str = "scene",
+) -> Scene:
+    """The scene a measurement runs: ``subject`` itself (a Scene), the built-in or symbolic scene
+    of that name, or :meth:`Scene.of` a model with ``q0``, ``p0``/``v0``, ``t_end`` and ``dt``.
+
+    Parameters
+    ----------
+    subject : Scene, Model or str
+        What the measurement was given.
+    q0, p0, v0 : array_like, optional
+        A model's initial state (ignored for a scene, which has its own).
+    t_end, dt : float, optional
+        A model's horizon (required) and step (default: :meth:`Scene.of`'s).
+    argument : str, default "scene"
+        The name of the measurement's argument, for the messages.
+
+    Returns
+    -------
+    Scene
+        The scene.
+
+    Raises
+    ------
+    TypeError
+        A model without ``q0`` or ``t_end`` (naming them, as for a missing argument), or a
+        ``subject`` that is none of the three.
+    ValueError
+        An unknown scene name; a malformed state, horizon or step.
+
+    Examples
+    --------
+    >>> import varmech
+    >>> from varmech.scenes import as_scene
+    >>> model = varmech.scenes.pendulum().model
+    >>> as_scene(model, q0=[0.5], p0=[0.0], t_end=10.0).dt
+    0.1
+    >>> as_scene("kepler").name
+    'kepler'
+    """
+    if isinstance(subject, Scene):
+        return subject
+    if isinstance(subject, str):
+        return get(subject)
+    if isinstance(subject, Model):
+        missing = [name for name, value in (("q0", q0), ("t_end", t_end)) if value is None]
+        if missing:
+            raise TypeError(
+                f"{argument}: a model needs its initial state and horizon: pass {' and '.join(missing)} "
+                "(and p0 or v0), or a varmech.Scene.of(model, q0, p0, t_end=...)"
+            )
+        assert q0 is not None and t_end is not None
+        return Scene.of(subject, q0, p0, v0=v0, t_end=t_end, dt=dt)
+    raise TypeError(f"{argument}: expected a varmech Scene, a scene's name or a Model, got {type(subject).__name__}")
 
 
 #: The core's catalogue of scenes by name, in the order of the tour: each entry's
@@ -207,7 +389,7 @@ def get(name: str, **parameters: float) -> Scene:
     return Scene(
         record.name,
         record.description,
-        NativeSystem(record.model, record.parameters),
+        NativeSystem(record.model, record.parameters, SCENE_COORDINATES.get(name)),
         record.q0,
         record.p0,
         record.t_end,
@@ -1007,7 +1189,7 @@ def rolling_disk(radius: float = 1.0, turn: float = 0.7, roll: float = 2.0) -> S
     >>> traj = varmech.integrate(scene, dt=scene.dt, t_end=scene.t_end, save_every=10)
     >>> report = varmech.check_conservation(traj)
     >>> report.verdict, [m.name for m in report.momenta], report.constraints[0].verdict
-    ('conserved to round-off', ['p[2]', 'p[3]'], 'conserved to round-off')
+    ('conserved to round-off', ['p_theta', 'p_phi'], 'conserved to round-off')
     """
     return get("rolling_disk", radius=radius, turn=turn, roll=roll)
 

@@ -137,11 +137,11 @@ def test_the_refused_scenes_are_those_a_chart_cannot_show():
 
 def test_energy_and_work_precision_default_to_the_scenes_kind(tmp_path, run_cli):
     pytest.importorskip("matplotlib")
-    out = run_cli("chart", "energy", "double_pendulum", "--quick", "--format", "svg", "--out", tmp_path).stdout
+    out = run_cli("chart", "energy", "double_pendulum", "--quick", "--format", "svg", "--out", tmp_path).stderr
     texts = svg_texts(tmp_path / "energy_growth_double_pendulum.svg")
     assert "double_pendulum: max energy error up to t, over t = 0 … 50 time units" in texts
     assert "t (time units)" in texts and any(t.startswith("galerkin6: ") for t in texts), texts
-    # SciPy's baselines ran to a shorter horizon: said on screen.
+    # SciPy's baselines ran to a shorter horizon: said on screen (standard error, with the notes).
     assert "note: solve_ivp baselines run to t = 5" in out
 
 
@@ -157,7 +157,7 @@ def test_work_precision_titles_and_units_in_days(tmp_path, run_cli):
 
 def test_skipped_baselines_are_said_on_screen_and_drawn_on_the_chart(tmp_path, run_cli):
     pytest.importorskip("matplotlib")
-    out = run_cli("chart", "energy", "cartesian_pendulum", "--quick", "--format", "svg", "--out", tmp_path).stdout
+    out = run_cli("chart", "energy", "cartesian_pendulum", "--quick", "--format", "svg", "--out", tmp_path).stderr
     # solve_ivp does not integrate a constrained scene (a DAE).
     note = "solve_ivp baselines skipped: the scene is constrained (a DAE; solve_ivp baselines do not apply)"
     assert f"note: {note}" in out.splitlines()

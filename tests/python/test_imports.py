@@ -21,6 +21,8 @@ LAZY = {
     # SymPy is an optional extra: scenes.get imports the symbolic examples only for a symbolic
     # scene, so that the scenes (and the whole package) import without SymPy.
     ("varmech.scenes", "varmech.symbolic.examples"),
+    # The command line compiles a SymPy Lagrangian that a user's file names, and only then.
+    ("varmech.cli", "varmech.symbolic"),
 }
 
 

@@ -64,7 +64,7 @@ def test_the_chart_says_what_it_plots(table, tmp_path, monkeypatch):
     path = chart_module.nonholonomic_energy_chart(table, tmp_path / "nonholonomic_energy.png")
     assert path.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     figures = []
-    monkeypatch.setattr(chart_module, "save", lambda fig, path: figures.append(fig) or path)
+    monkeypatch.setattr(chart_module, "save", lambda fig, path, meta=None: figures.append(fig) or path)
     chart_module.nonholonomic_energy_chart(table, tmp_path / "again.png")
     (ax,) = figures[0].axes
     assert ax.get_title() == "rolling disk: relative energy error over 5000 steps of dt = 0.1"

@@ -65,3 +65,19 @@ def test_every_readme_block_runs_as_it_stands(index, tmp_path, monkeypatch):
 def test_the_readme_shows_output_for_its_blocks():
     shown = [verdicts(s) for _, lang, s in blocks(README.read_text()) if not lang]
     assert sum(len(v) for v in shown) == 8 and len(shown) == 4
+
+
+def test_the_own_model_walkthrough_runs_and_prints_what_it_shows(tmp_path, monkeypatch):
+    """The getting-started page's own model, from SymPy to a work–precision chart: the names,
+    the step and the computed reference it prints are those the page shows."""
+    pytest.importorskip("scipy")
+    pytest.importorskip("matplotlib")
+    text = GETTING_STARTED.read_text()
+    section = text[text.index("## Your own model, measured against SciPy") :]
+    code, shown = re.findall(r"```python\n(.*?)```\s*```text\n(.*?)```", section, flags=re.S)[0]
+    monkeypatch.chdir(tmp_path)
+    out = io.StringIO()
+    with contextlib.redirect_stdout(out):
+        exec(compile(code, str(GETTING_STARTED), "exec"), {"__name__": "__walkthrough__"})
+    assert out.getvalue() == shown
+    assert (tmp_path / "elastic_pendulum_work_precision.png").exists()

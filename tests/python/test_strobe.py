@@ -104,7 +104,8 @@ def test_the_strobe_chart_draws_the_attractor_with_its_angle_wrapped(tmp_path):
     assert len(np.unique(np.round(table.column("p0"), 6))) > 300
     path = strobe_chart(table, tmp_path / "attractor.svg", wrap=2 * math.pi)
     text = path.read_text()
-    assert "q0 at t₀ + kT (mod 6.283)" in text and "p0 at t₀ + kT" in text
+    # The axes in the model's own names: φ, and its momentum.
+    assert "phi at t₀ + kT (mod 6.283)" in text and "p_phi at t₀ + kT" in text
     with pytest.raises(ValueError, match="^coordinate:"):
         strobe_chart(table, tmp_path / "bad.svg", coordinate=1)
     with pytest.raises(ValueError, match="^wrap:"):

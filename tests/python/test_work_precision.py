@@ -80,10 +80,16 @@ def test_final_error_skips_unknown_reference_components():
     assert np.all(np.isfinite(err)) and err[0] / err[1] == pytest.approx(4.0, rel=0.2)
 
 
-def test_no_reference_at_the_horizon_gives_nan_and_a_note():
+def test_a_reference_at_another_horizon_is_computed_there_and_none_gives_nan():
     scene = scenes.kepler()
-    t = work_precision(scene, ["verlet"], steps=[1000], baselines=(), t_end=100 * scene.dt, repeat=1, progress=False)
-    assert math.isnan(t.rows[0][7]) and "final_error is NaN" in t.meta["notes"][0]
+    kwargs = dict(steps=[1000], baselines=(), t_end=100 * scene.dt, repeat=1, progress=False)
+    computed = work_precision(scene, ["verlet"], **kwargs)
+    assert computed.meta["notes"][0].startswith("reference computed: kahan_li6 at ") and computed.meta["reference_tolerance"] < 1e-9
+    exact = work_precision(scene, ["verlet"], reference=scene.reference, **kwargs)
+    assert math.isnan(exact.rows[0][7]) and exact.meta["notes"][0].startswith("no reference at t = 3.14159 (the reference given is at t = 1256.64)")
+    none = work_precision(scene, ["verlet"], reference=None, **kwargs)
+    assert math.isnan(none.rows[0][7]) and none.meta["notes"] == ["no reference (reference=None): final_error is NaN"]
+    assert computed.rows[0][8] == none.rows[0][8]  # the energy error is measured all the same
 
 
 def test_scipy_baselines_sweep_tolerances():

@@ -15,11 +15,14 @@ from collections.abc import Iterable, Sequence
 from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from .._progress import progress as _progress
+from .._util import positive
 from ..conservation import InvariantStatistics, check_conservation, energy_statistics
 from ..integrate import integrate
-from ..scenes import Scene
+from ..model import Model
+from ..scenes import Scene, as_scene
 from ..table import Table
 from . import baselines as _baselines
 from ._energy import conserves_energy, energy_of, relative_error
@@ -86,9 +89,12 @@ def _tenths(uniform: np.ndarray) -> tuple[float, float]:
 
 
 def energy_growth(
-    scene: Scene,
+    scene: Scene | Model | str,
     methods: Iterable[str],
     *,
+    q0: ArrayLike | None = None,
+    p0: ArrayLike | None = None,
+    v0: ArrayLike | None = None,
     t_end: float | None = None,
     dt: float | None = None,
     samples: int = 2000,
@@ -115,12 +121,17 @@ def energy_growth(
     Parameters
     ----------
     scene
-        A :class:`~varmech.scenes.Scene` whose energy is conserved.
+        A :class:`~varmech.Scene` whose energy is conserved (built-in, symbolic, or
+        :meth:`~varmech.Scene.of` a model), a scene's name, or such a model with ``q0``, ``p0``
+        or ``v0``, and ``t_end``.
+    q0, p0, v0
+        A model's initial state: positions, and momenta or velocities.
     methods
         varmech method names.
     t_end, dt
-        The horizon (default 50 × ``scene.t_end``: 10⁴ periods for :func:`~varmech.scenes.kepler`)
-        and the step (default ``scene.dt``); the horizon is rounded to whole steps.
+        The horizon (default 50 × ``scene.t_end``: 10⁴ periods for :func:`~varmech.scenes.kepler`;
+        a model's, as given) and the step (default ``scene.dt``; a model's from
+        :meth:`~varmech.Scene.of`); the horizon is rounded to whole steps.
     samples
         Log-spaced bins of t per method (and the number of evenly spaced states for the
         verdicts, at least 1000).
@@ -188,6 +199,7 @@ def energy_growth(
     >>> verdicts(table).column("verdict").tolist()
     ['bounded', 'secular drift']
     """
+    scene = as_scene(scene, q0=q0, p0=p0, v0=v0, t_end=t_end, dt=dt)
     if not conserves_energy(scene.model):
         raise ValueError(f"scene: the energy of {scene.name!r} is not conserved (L depends on t, or forces act)")
     methods = list(methods)
@@ -195,10 +207,8 @@ def energy_growth(
     bad = [b for b in baselines if b not in _baselines.SCIPY_METHODS + _baselines.REBOUND_METHODS]
     if bad:
         raise ValueError(f"baselines: unknown method(s) {bad}; choose from {_baselines.SCIPY_METHODS + _baselines.REBOUND_METHODS}")
-    h = float(scene.dt if dt is None else dt)
-    if not (math.isfinite(h) and h > 0):
-        raise ValueError(f"dt: must be positive and finite, got {h}")
-    T = 50 * scene.t_end if t_end is None else float(t_end)
+    h = positive("dt", scene.dt if dt is None else dt)
+    T = 50 * scene.t_end if t_end is None else positive("t_end", t_end)
     n = max(1, round(T / h))
     T = n * h
     Tb = T / 10 if baseline_t_end is None else float(baseline_t_end)

@@ -17,22 +17,28 @@ from __future__ import annotations
 import math
 import time
 from collections.abc import Callable, Iterable, Sequence
-from typing import Any
+from typing import Any, Literal
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from .. import _core
 from .._progress import progress as _progress
+from .._util import positive
 from ..integrate import integrate
-from ..scenes import Reference, Scene
+from ..methods import method_info
+from ..model import Model
+from ..scenes import Reference, Scene, as_scene
 from ..table import Table
 from . import baselines as _baselines
 from ._energy import conserves_energy, energy_of, relative_error
 from ._interrupt import interruptible
+from .reference import reference_solution
 
 __all__ = [
     "DEFAULT_EPSILONS",
     "DEFAULT_RTOLS",
+    "EVALUATION_UNITS",
     "WORK_PRECISION_COLUMNS",
     "work_precision",
 ]
@@ -86,21 +92,28 @@ def _best_time(run: Callable[[Any], Any], repeat: int, prepare: Callable[[], Any
     return best, result
 
 
-def _horizon(scene: Scene, t_end: float | None, reference: Reference | None) -> tuple[float, Reference | None, str | None]:
-    """The horizon of a work–precision sweep and the reference at it (None when there is none)."""
-    ref = reference if reference is not None else scene.reference
+def _horizon(
+    scene: Scene, t_end: float | None, reference: Reference | str | None, tolerance: float
+) -> tuple[float, Reference | None, str | None]:
+    """The horizon of a work–precision sweep, the reference at it (None when there is none) and
+    a note on where it comes from, where that is not the scene's own."""
+    if reference is not None and not isinstance(reference, Reference) and reference != "auto":
+        raise TypeError(f"reference: expected a varmech.scenes.Reference, 'auto' or None, got {reference!r}")
+    given = reference if isinstance(reference, Reference) else None
+    own = given if given is not None else scene.reference
     if t_end is None:
-        t_end = ref.t if ref is not None else scene.t_end
-    t_end = float(t_end)
-    if not (math.isfinite(t_end) and t_end > 0):
-        raise ValueError(f"t_end: must be positive and finite, got {t_end}")
-    note = None
-    if ref is not None and not math.isclose(ref.t, t_end, rel_tol=1e-12):
-        note = f"no reference at t = {t_end:g} (the reference is at t = {ref.t:g}): final_error is NaN"
-        ref = None
-    elif ref is None:
-        note = "the scene has no reference solution: final_error is NaN"
-    return t_end, ref, note
+        t_end = own.t if own is not None else scene.t_end
+    t_end = positive("t_end", t_end)
+    if reference is None:
+        return t_end, None, "no reference (reference=None): final_error is NaN"
+    if own is not None and math.isclose(own.t, t_end, rel_tol=1e-12):
+        return t_end, own, None
+    if given is not None:
+        return t_end, None, f"no reference at t = {t_end:g} (the reference given is at t = {given.t:g}): final_error is NaN"
+    computed = reference_solution(scene, t_end=t_end, tolerance=tolerance)
+    why = "the scene has none" if own is None else f"the scene's is at t = {own.t:g}"
+    note = f"reference {computed.source} ({why}); errors below {computed.tolerance:.1e} are not measured"
+    return t_end, computed, note
 
 
 # --------------------------------------------------------------------------------- sweeps
@@ -110,6 +123,26 @@ def _default_start(scene: Scene, t_end: float) -> int:
     """A quarter of the scene's quick-look steps over the horizon, rounded down to a power of 2."""
     base = max(t_end / scene.dt / 4, 16.0)
     return 2 ** int(math.floor(math.log2(base)))
+
+
+#: What one of the column ``evaluations`` is, for each family of methods (the charts say it).
+EVALUATION_UNITS = {
+    "varmech, explicit": "one force ∇V (or ∂L/∂q) evaluation",
+    "varmech, implicit": "one evaluation of the discrete Lagrangian's slot derivatives "
+    "(∂L/∂q, ∂L/∂q̇ at each quadrature node, with their Hessians for Newton)",
+    "scipy": "one right-hand side column, finite-difference Jacobian columns included",
+    "rebound": "one gravity evaluation (an additional-force call)",
+}
+
+
+def _evaluation_units(plan: list[tuple[str, str, list[float], bool]]) -> dict[str, str]:
+    """The units of ``evaluations`` of the families in ``plan``, in its order."""
+    families = []
+    for tool, method, _, _ in plan:
+        if tool == "varmech":
+            tool += ", implicit" if method_info(method).implicit else ", explicit"
+        families.append(tool)
+    return {family: EVALUATION_UNITS[family] for family in dict.fromkeys(families)}
 
 
 def _done_refining(errors: list[float]) -> bool:
@@ -123,9 +156,12 @@ def _done_refining(errors: list[float]) -> bool:
 
 
 def work_precision(
-    scene: Scene,
+    scene: Scene | Model | str,
     methods: Iterable[str],
     *,
+    q0: ArrayLike | None = None,
+    p0: ArrayLike | None = None,
+    v0: ArrayLike | None = None,
     steps: Sequence[int] | dict[str, Sequence[int]] | None = None,
     baselines: Iterable[str] = ("RK45", "DOP853", "Radau"),
     rtols: Sequence[float] = DEFAULT_RTOLS,
@@ -133,7 +169,8 @@ def work_precision(
     rebound: Iterable[str] = _baselines.REBOUND_DEFAULTS,
     epsilons: Sequence[float] = DEFAULT_EPSILONS,
     t_end: float | None = None,
-    reference: Reference | None = None,
+    reference: Reference | Literal["auto"] | None = "auto",
+    reference_tolerance: float = 1e-10,
     repeat: int = 3,
     sweep_length: int = 11,
     max_seconds: float | None = 5.0,
@@ -141,7 +178,8 @@ def work_precision(
 ) -> Table:
     """Measure cost against accuracy over a sweep of steps (varmech) and tolerances (baselines).
 
-    Each row is one run to ``t_end`` (by default the time of the scene's reference solution):
+    Each row is one run to ``t_end`` (by default the time of the scene's reference solution, or
+    its horizon):
     ``tool`` ("varmech", "scipy", "rebound"), ``method``, the swept ``parameter`` ("steps",
     "rtol" or "epsilon") and its ``value``, the ``steps`` taken, the force (right-hand side)
     ``evaluations``, the wall time ``seconds``, ``final_error`` = ‖(q, p) − (q_ref, p_ref)‖₂ at
@@ -151,7 +189,10 @@ def work_precision(
     Parameters
     ----------
     scene
-        A :class:`~varmech.scenes.Scene`.
+        A :class:`~varmech.Scene` (built-in, symbolic, or :meth:`~varmech.Scene.of` a model), a
+        scene's name, or a model with ``q0``, ``p0`` or ``v0``, and ``t_end``.
+    q0, p0, v0
+        A model's initial state: positions, and momenta or velocities.
     methods
         varmech method names (``"verlet"``, ``"kahan_li8"``, ``"rk4"``, ...).
     steps
@@ -172,9 +213,13 @@ def work_precision(
         ``steps[name]``), ``"IAS15"`` over the precisions ``epsilons``. They run on N-body
         scenes, and ``"leapfrog order=8"`` also on the Kepler scene; skipped with a note without
         REBOUND. Their force evaluations are counted in a separate untimed run.
-    t_end, reference
-        The horizon, and the solution there (default: the scene's reference, and its time).
-        Without a reference at ``t_end``, ``final_error`` is NaN.
+    t_end, reference, reference_tolerance
+        The horizon (default: the time of the scene's reference, else its horizon), and the
+        solution there: a :class:`~varmech.scenes.Reference`; ``"auto"``, the scene's own where
+        it has one at ``t_end``, else one computed by the model's most accurate method to
+        ``reference_tolerance`` (relative; :func:`varmech.analysis.reference.reference_solution`,
+        noted in ``meta["notes"]``, its tolerance ``meta["reference_tolerance"]``); or None, none
+        (``final_error`` is NaN, the energy error alone is measured).
     sweep_length
         The most settings of a default sweep of steps.
     repeat
@@ -190,7 +235,8 @@ def work_precision(
     Returns
     -------
     Table
-        One row a run, with the columns above; ``meta["notes"]`` says what was skipped and why.
+        One row a run, with the columns above; ``meta["notes"]`` says what was skipped and why,
+        ``meta["reference"]`` where the reference comes from.
         :func:`varmech.charts.work_precision_chart` draws it.
 
     Raises
@@ -209,13 +255,21 @@ def work_precision(
     >>> round(float(error[0] / error[1]), 1)         # order 2: half the step, a quarter the error
     4.0
     """
+    scene = as_scene(scene, q0=q0, p0=p0, v0=v0, t_end=t_end)
     methods = list(methods)
     baselines = list(baselines)
-    T, ref, ref_note = _horizon(scene, t_end, reference)
+    T, ref, ref_note = _horizon(scene, t_end, reference, positive("reference_tolerance", reference_tolerance))
     table = Table(
         WORK_PRECISION_COLUMNS,
         title=f"Work–precision: {scene.name}, t = 0 … {T:g}",
-        meta={"scene": scene.name, "time_unit": scene.time_unit, "t_end": T, "reference": ref.source if ref is not None else None, "notes": []},
+        meta={
+            "scene": scene.name,
+            "time_unit": scene.time_unit,
+            "t_end": T,
+            "reference": ref.source if ref is not None else None,
+            "reference_tolerance": ref.tolerance if ref is not None else None,
+            "notes": [],
+        },
     )
     notes: list[str] = table.meta["notes"]
     if ref_note:
@@ -251,6 +305,7 @@ def work_precision(
             plan.append(("rebound", r, [float(e) for e in epsilons], False))
         else:
             plan.append(("rebound", r, *sweep_of(r if isinstance(steps, dict) and r in steps else "verlet")))  # type: ignore[arg-type]
+    table.meta["evaluation_units"] = _evaluation_units(plan)
     total = sum(len(values) for _, _, values, _ in plan)
     bar = _progress(range(total), total=total, desc=f"work–precision {scene.name}", enabled=progress)
 

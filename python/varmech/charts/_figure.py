@@ -50,11 +50,20 @@ def pyplot() -> Any:
     return plt
 
 
-def save(fig: Any, path: str | Path) -> Path:
-    """Write ``fig`` to ``path`` (PNG or SVG by its suffix), creating the folder, and close it."""
+#: What a chart of a ``--quick`` measurement says on its face (``meta["quick"]``).
+QUICK_NOTE = "--quick: a short measurement (fewer settings, orbits and repeats), a first look, not a comparison"
+
+
+def save(fig: Any, path: str | Path, meta: dict[str, Any] | None = None) -> Path:
+    """Write ``fig`` to ``path`` (PNG or SVG by its suffix), creating the folder, and close it;
+    a chart of a quick measurement (``meta["quick"]``) says so above its title."""
     path = Path(path)
     if path.suffix.lower() not in (".png", ".svg"):
         raise ValueError(f"path: must end in .png or .svg, got {path.name!r}")
+    if meta and meta.get("quick"):
+        # A figure's own suptitle (panels side by side) keeps its place, the note under it.
+        own = fig._suptitle.get_text() if fig._suptitle is not None else ""
+        fig.suptitle(f"{own}\n{QUICK_NOTE}" if own else QUICK_NOTE, fontsize=10 if own else 8, color="black" if own else "C3")
     path.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(path, dpi=120)
     pyplot().close(fig)
@@ -67,10 +76,18 @@ def time_label(meta: dict[str, Any], name: str = "t") -> str:
     return f"{name} ({meta.get('time_unit', 'time units')})"
 
 
-def skipped_note(ax: Any, notes: list[str]) -> None:
-    """Write the notes of baselines that were skipped (``meta["notes"]`` entries that say
-    "skipped") under the legend at the right of ``ax``, so that the chart says what it lacks."""
-    skipped = [note for note in notes if "skipped" in note]
-    if skipped:
-        text = "\n".join(textwrap.fill(f"note: {note}", 38) for note in skipped)
-        ax.text(1.01, 0.0, text, transform=ax.transAxes, fontsize=6.5, va="bottom", ha="left", color="0.25")
+def state_label(meta: dict[str, Any], column: str) -> str:
+    """The axis label of a state column (``q0``, ``p1``): the name the model gives it
+    (``meta["coordinates"]``, ``meta["momenta"]``), else the column's."""
+    names = meta.get({"q": "coordinates", "p": "momenta"}.get(column[:1], ""))
+    index = column[1:]
+    return str(names[int(index)]) if names and index.isdigit() and int(index) < len(names) else column
+
+
+def measurement_notes(ax: Any, notes: list[str]) -> None:
+    """Write the measurement's notes (``meta["notes"]``: skipped or shortened baselines, a
+    computed reference, stopped sweeps) under the legend at the right of ``ax``, so that the
+    chart says what the console said."""
+    if notes:
+        text = "\n".join(textwrap.fill(f"note: {note}", 44) for note in notes)
+        ax.text(1.01, 0.0, text, transform=ax.transAxes, fontsize=6, va="bottom", ha="left", color="0.25")

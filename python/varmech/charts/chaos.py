@@ -10,7 +10,7 @@ import numpy as np
 
 from ..analysis.lyapunov import LyapunovSpectrum
 from ..table import Table
-from ._figure import documented, pyplot, save
+from ._figure import documented, pyplot, save, state_label
 
 __all__ = [
     "lyapunov_chart",
@@ -58,9 +58,9 @@ def orbit_diagram_chart(table: Table, path: str | Path, coordinate: str = "p0", 
     fig, ax = plt.subplots(figsize=(7.0, 4.5), layout="constrained")
     ax.scatter(table.column("value"), table.column(coordinate), s=1.0, color="black", linewidths=0, rasterized=True)
     ax.set_xlabel(str(table.meta.get("parameter", "value")))
-    ax.set_ylabel(f"{coordinate} at t₀ + kT")
+    ax.set_ylabel(f"{state_label(table.meta, coordinate)} at t₀ + kT")
     ax.set_title(title or table.title)
-    return save(fig, path)
+    return save(fig, path, table.meta)
 
 
 @documented
@@ -110,10 +110,10 @@ def strobe_chart(table: Table, path: str | Path, coordinate: int = 0, wrap: floa
     plt = pyplot()
     fig, ax = plt.subplots(figsize=(6.5, 5.0), layout="constrained")
     ax.scatter(x, table.column(p), s=1.0, color="black", linewidths=0, rasterized=True)
-    ax.set_xlabel(f"{q} at t₀ + kT" + (f" (mod {wrap:.4g})" if wrap is not None else ""))
-    ax.set_ylabel(f"{p} at t₀ + kT")
+    ax.set_xlabel(f"{state_label(table.meta, q)} at t₀ + kT" + (f" (mod {wrap:.4g})" if wrap is not None else ""))
+    ax.set_ylabel(f"{state_label(table.meta, p)} at t₀ + kT")
     ax.set_title(title or f"{table.title} ({len(x)} points)")
-    return save(fig, path)
+    return save(fig, path, table.meta)
 
 
 @documented

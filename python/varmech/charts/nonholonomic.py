@@ -79,4 +79,4 @@ def nonholonomic_energy_chart(table: Table, path: str | Path, title: str = "") -
     ax.set_title(title or table.title)
     ax.grid(True, which="major", alpha=0.3)
     ax.legend(fontsize=8)
-    return save(fig, path)
+    return save(fig, path, table.meta)

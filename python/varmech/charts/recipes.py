@@ -6,6 +6,7 @@ call it."""
 from __future__ import annotations
 
 import math
+import re
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
@@ -86,40 +87,40 @@ def _two_freedoms(scene: scenes.Scene) -> str | None:
     return _unconstrained(scene)
 
 
-def _work_precision(scene, methods, quick, progress, options):
-    sc = scenes.get(scene)
+def _work_precision(sc, methods, quick, progress, options):
     # Every REBOUND baseline that applies to the scene (none but leapfrog order=8 on Kepler).
     table = work_precision.work_precision(
         sc, methods, rebound=REBOUND_METHODS, repeat=1 if quick else 3, sweep_length=4 if quick else 11,
         max_seconds=1.0 if quick else 5.0, progress=progress,
     )
     horizon = f"{table.meta.get('t_end', sc.t_end):g} {sc.time_unit}"
-    title = f"{scene}: error in (q, p) at t = {horizon} against cost"
-    energy_title = f"{scene}: max energy error over t = 0 … {horizon} against cost"
+    title = f"{sc.name}: error in (q, p) at t = {horizon} against cost"
+    energy_title = f"{sc.name}: max energy error over t = 0 … {horizon} against cost"
     figures = {
         "work_precision": lambda t, p: work_precision_chart(t, p, x="seconds", title=title),
         "work_precision_evaluations": lambda t, p: work_precision_chart(t, p, x="evaluations", title=title),
         "work_precision_energy": lambda t, p: work_precision_chart(t, p, y="max_energy_error", title=energy_title),
     }
     if table.meta["reference"] is None:
-        # No reference solution (a chaotic scene has none at long times): only the energy error
-        # is measured, so only its chart is drawn.
+        # No reference solution (a computed one could not be had): only the energy error is
+        # measured, so only its chart is drawn.
         figures = {"work_precision_energy": figures["work_precision_energy"]}
     return [("work_precision", table, figures)]
 
 
-def _energy(scene, methods, quick, progress, options):
-    sc = scenes.get(scene)
-    t_end = (5 if quick else 50) * sc.t_end
+def _energy(sc, methods, quick, progress, options):
+    # A built-in scene's long run is 50 of its horizons; one's own model runs to the horizon given.
+    builtin = sc.name in scenes.CATALOGUE or sc.name in scenes.SYMBOLIC
+    t_end = (50 if builtin else 1) * sc.t_end / (10 if quick else 1)
     table = energy_growth.energy_growth(sc, methods, t_end=t_end, samples=500 if quick else 2000, progress=progress)
-    title = f"{scene}: max energy error up to t, over t = 0 … {t_end:g} {sc.time_unit}"
+    title = f"{sc.name}: max energy error up to t, over t = 0 … {t_end:g} {sc.time_unit}"
     return [
         ("energy_growth", table, {"energy_growth": lambda t, p: energy_growth_chart(t, p, title=title)}),
         ("energy_verdicts", energy_growth.verdicts(table), {}),
     ]
 
 
-def _stability(scene, methods, quick, progress, options):
+def _stability(sc, methods, quick, progress, options):
     table = stability.growth_table(methods, progress=progress)
     return [
         ("stability", table, {"stability": lambda t, p: stability_chart(t, p)}),
@@ -133,23 +134,23 @@ def _linearizable(scene: scenes.Scene) -> str | None:
     return None
 
 
-def _spectrum(scene, methods, quick, progress, options):
-    table = stability.spectrum(scenes.get(scene), methods)
+def _spectrum(sc, methods, quick, progress, options):
+    table = stability.spectrum(sc, methods)
     return [("spectrum", table, {"spectrum": lambda t, p: spectrum_chart(t, p)})]
 
 
-def _implicit_regions(scene, methods, quick, progress, options):
-    table = stability.implicit_regions(methods, scene=scene, progress=progress)
-    draw = lambda t, p: implicit_regions_chart(t, p, title=f"{scene}: outcome of the implicit steps by step and initial angle")  # noqa: E731
+def _implicit_regions(sc, methods, quick, progress, options):
+    table = stability.implicit_regions(methods, scene=sc, progress=progress)
+    draw = lambda t, p: implicit_regions_chart(t, p, title=f"{sc.name}: outcome of the implicit steps by step and initial angle")  # noqa: E731
     return [("implicit_regions", table, {"implicit_regions": draw})]
 
 
-def _poincare(scene, methods, quick, progress, options):
-    sc = scenes.get(scene)
+def _poincare(sc, methods, quick, progress, options):
+    henon_heiles = sc.name == "henon_heiles"
     out = []
     box = options.get("box")
     section = (0, 0.0, 1)
-    if scene != "henon_heiles":
+    if not henon_heiles:
         # The section through the scene's own state, q₀ = q₀(0), and a box about the state's
         # (q₁, p₁), a quarter of its size: the seeds find the energy shell there.
         section = (0, float(sc.q0[0]), 1)
@@ -159,8 +160,8 @@ def _poincare(scene, methods, quick, progress, options):
             box = ((q - dq, q + dq), (p - dp, p + dp))
     energies = options.get("energies")
     if energies is None:
-        energies = sections.HENON_HEILES_ENERGIES if scene == "henon_heiles" else (float(energy_at(sc.model, sc.q0, sc.p0)[0]),)
-    dt = 0.05 if scene == "henon_heiles" else sc.dt
+        energies = sections.HENON_HEILES_ENERGIES if henon_heiles else (float(energy_at(sc.model, sc.q0, sc.p0)[0]),)
+    dt = 0.05 if henon_heiles else sc.dt
     t_end = dt * round((300.0 if quick else 2000.0) / dt)
     for energy in energies:
         table = sections.poincare_section(
@@ -168,21 +169,21 @@ def _poincare(scene, methods, quick, progress, options):
             progress=progress,
         )  # fmt: skip
         label = f"{energy:.4f}".rstrip("0")
-        title = f"{scene}: Poincaré section x = {section[1]:.4g} (p_x > 0), H = {label}"
+        x = sc.model.coordinates[0]
+        title = f"{sc.name}: Poincaré section {x} = {section[1]:.4g} ({sc.model.momentum_names[0]} > 0), {sc.model.energy_name} = {label}"
         name = f"poincare_H{label.replace('.', '_')}"
         out.append((name, table, {name: lambda t, p, title=title: poincare_chart(t, p, title=title)}))
     return out
 
 
-def _phase(scene, methods, quick, progress, options):
-    sc = scenes.get(scene)
+def _phase(sc, methods, quick, progress, options):
     energies = options.get("energies")
-    if energies is None and scene != "pendulum":
+    if energies is None and sc.name != "pendulum":
         # Orbits about the scene's own, from a quarter of its energy to four times it.
         e0 = float(energy_at(sc.model, sc.q0, sc.p0)[0])
         energies = tuple(e0 * f for f in (0.25, 0.5, 1.0, 2.0, 4.0)) if e0 > 0 else (e0,)
     table = phase_portrait(sc, energies=energies, method=methods[0], progress=progress)
-    draw = lambda t, p: phase_portrait_chart(t, p, title=f"{scene}: phase portrait")  # noqa: E731
+    draw = lambda t, p: phase_portrait_chart(t, p, title=f"{sc.name}: phase portrait")  # noqa: E731
     return [("phase_portrait", table, {"phase_portrait": draw})]
 
 
@@ -192,8 +193,7 @@ def _driven_only(scene: scenes.Scene) -> str | None:
     return "the orbit diagram and the strobe are of the damped, driven pendulum, strobed at its drive's period"
 
 
-def _orbit_diagram(scene, methods, quick, progress, options):
-    sc = scenes.get(scene)
+def _orbit_diagram(sc, methods, quick, progress, options):
     # Taylor's cascade (§12.5): γ from 1.06 to 1.09, from φ = −π/2 at rest.
     period = 2 * math.pi / sc.parameters["drive"]
     values = np.linspace(1.06, 1.09, 31 if quick else 301)
@@ -201,19 +201,18 @@ def _orbit_diagram(scene, methods, quick, progress, options):
         sc, [-math.pi / 2], [0.0], parameter="amplitude", values=values, period=period, periods=16 if quick else 64,
         transient=100 if quick else 300, method=methods[0],
     )  # fmt: skip
-    title = f"{scene}: φ̇ strobed at the drive's period{' (--quick)' if quick else ''}"
+    title = f"{sc.name}: φ̇ strobed at the drive's period"
     draw = lambda t, p: orbit_diagram_chart(t, p, title=title)  # noqa: E731
     return [("orbit_diagram", table, {"orbit_diagram": draw})]
 
 
-def _strobe(scene, methods, quick, progress, options):
-    sc = scenes.get(scene)
+def _strobe(sc, methods, quick, progress, options):
     # The scene's own drive (Baker & Gollub's chaotic γ = 1.5 by default), from φ = −π/2 at rest.
     period = 2 * math.pi / sc.parameters["drive"]
     table = stroboscopic_section(
         sc, [-math.pi / 2], [0.0], period=period, periods=1_000 if quick else 20_000, transient=100, method=methods[0]
     )
-    title = f"{scene}: the attractor strobed at the drive's period{' (--quick)' if quick else ''}"
+    title = f"{sc.name}: the attractor strobed at the drive's period"
     draw = lambda t, p: strobe_chart(t, p, wrap=2 * math.pi, title=title)  # noqa: E731
     return [("strobe", table, {"strobe": draw})]
 
@@ -222,7 +221,7 @@ def _disk_only(scene: scenes.Scene) -> str | None:
     return "the nonholonomic chart is of the rolling disk (its closure model and RK4 with a projection); it takes no scene"
 
 
-def _nonholonomic(scene, methods, quick, progress, options):
+def _nonholonomic(sc, methods, quick, progress, options):
     table = nonholonomic_energy(methods, steps=5_000 if quick else 100_000, progress=progress)
     draw = lambda t, p: nonholonomic_energy_chart(t, p)  # noqa: E731
     return [("nonholonomic_energy", table, {"nonholonomic_energy": draw})]
@@ -275,7 +274,7 @@ KINDS: dict[str, ChartKind] = {
 
 def chart(
     kind: str,
-    scene: str | None = None,
+    scene: str | scenes.Scene | None = None,
     *,
     methods: tuple[str, ...] | None = None,
     out: Path = Path("out/charts"),
@@ -289,8 +288,9 @@ def chart(
     """Measure chart ``kind`` on ``scene`` and write its figures and data: the Python form of
     ``python -m varmech chart KIND [SCENE]``.
 
-    For each figure, ``<out>/<name>_<scene>.<fmt>`` is written, and the measured table as
-    ``.csv``. ``methods`` default to the kind's own that integrate the scene, or else the
+    For each figure, ``<out>/<name>_<scene>.<fmt>`` is written (the scene's name, its spaces and
+    punctuation as ``_``), and the measured table as ``.csv``; with ``quick``, the tables say so
+    (``meta["quick"]``) and the figures too. ``methods`` default to the kind's own that integrate the scene, or else the
     scene's kind's accurate and default methods.
 
     Parameters
@@ -299,9 +299,10 @@ def chart(
         One of ``work-precision``, ``energy``, ``stability``, ``spectrum``,
         ``implicit-regions``, ``poincare``, ``phase``, ``orbit-diagram``, ``strobe``,
         ``nonholonomic``.
-    scene : str, optional
-        A scene of :data:`varmech.scenes.CATALOGUE` or a symbolic one; default: the kind's own
-        (:func:`scenes_for` lists those the kind applies to).
+    scene : str or Scene, optional
+        A scene of :data:`varmech.scenes.CATALOGUE` or a symbolic one by name, or a
+        :class:`~varmech.Scene` (one's own model: :meth:`varmech.Scene.of`); default: the kind's
+        own (:func:`scenes_for` lists the named ones the kind applies to).
     methods : tuple of str, optional
         The methods to measure; default as above.
     out : pathlib.Path, default Path("out/charts")
@@ -351,20 +352,25 @@ def chart(
     if fmt not in ("png", "svg"):
         raise ValueError(f"format: expected png or svg, got {fmt!r}")
     spec = KINDS[kind]
-    scene = scene or spec.scene
-    known = (*scenes.CATALOGUE, *scenes.SYMBOLIC)
-    if scene is not None and scene not in known:
-        raise ValueError(f"scene: expected one of {', '.join(known)}, got {scene!r}")
-    if scene is not None:
-        sc = scenes.get(scene)
+    sc = None
+    if isinstance(scene, scenes.Scene):
+        sc = scene
+    elif scene is not None or spec.scene is not None:
+        name = scene or spec.scene
+        known = (*scenes.CATALOGUE, *scenes.SYMBOLIC)
+        if name not in known:
+            raise ValueError(f"scene: expected one of {', '.join(known)}, or a varmech.Scene, got {name!r}")
+        sc = scenes.get(name)
+    if sc is not None:
         why = spec.refuses(sc)
         if why is not None:
             raise ValueError(f"scene: {why}")
         methods = methods or fitting_methods(spec.methods, sc)
-    stem = f"_{scene}" if scene else ""
+    stem = "_" + re.sub(r"[^A-Za-z0-9_.-]+", "_", sc.name).strip("_") if sc is not None else ""
     written = []
     options = {"energies": energies, "box": box}
-    for name, table, figures in spec.draw(scene, tuple(methods or spec.methods), quick, progress, options):
+    for name, table, figures in spec.draw(sc, tuple(methods or spec.methods), quick, progress, options):
+        table.meta["quick"] = quick
         if say is not None:
             for note in table.meta.get("notes", []):
                 say(note)

@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 
 from ..table import Table
-from ._figure import documented, pyplot, save
+from ._figure import documented, pyplot, save, state_label
 
 
 def _henon_heiles_boundary(energy: float) -> tuple[np.ndarray, np.ndarray] | None:
@@ -90,7 +90,7 @@ def poincare_chart(table: Table | Sequence[Table], path: str | Path, title: str 
         ax.set_title(label, fontsize=10)
     if title:
         fig.suptitle(title, fontsize=10)
-    return save(fig, path)
+    return save(fig, path, tables[0].meta)
 
 
 @documented
@@ -160,12 +160,13 @@ def phase_portrait_chart(table: Table, path: str | Path, title: str = "") -> Pat
         s = np.linspace(-math.pi, math.pi, 400)
         ax.plot(s, 2 * np.cos(s / 2), "k--", lw=0.8, label="separatrix (H = 1)")
         ax.plot(s, -2 * np.cos(s / 2), "k--", lw=0.8)
-    ax.set_xlabel("q (mod 2π)" if wrap else "q")
-    ax.set_ylabel("p")
+    q_name, p_name = state_label(table.meta, "q0"), state_label(table.meta, "p0")
+    ax.set_xlabel(f"{q_name} (mod 2π)" if wrap else q_name)
+    ax.set_ylabel(p_name)
     ax.set_title(title)
     ax.grid(True, alpha=0.3)
     fig.legend(fontsize=8, loc="outside lower center", ncol=3)
-    return save(fig, path)
+    return save(fig, path, table.meta)
 
 
 __all__ = ["phase_portrait_chart", "poincare_chart"]

@@ -125,7 +125,7 @@ def stability_chart(
     ax.set_title(title or default, fontsize=10, pad=10)
     ax.grid(True, which="major", alpha=0.3)
     ax.legend(fontsize=7.5, loc="upper left", bbox_to_anchor=(1.01, 1.0))
-    return save(fig, path)
+    return save(fig, path, table.meta)
 
 
 @documented
@@ -200,7 +200,7 @@ def implicit_regions_chart(table: Table, path: str | Path, title: str = "") -> P
     scene = table.meta.get("scene", "")
     steps = table.meta.get("steps", "")
     fig.suptitle(title or f"Implicit methods on the {scene}: outcome of {steps} steps", fontsize=10)
-    return save(fig, path)
+    return save(fig, path, table.meta)
 
 
 __all__ = ["implicit_regions_chart", "stability_chart"]
@@ -276,4 +276,4 @@ def spectrum_chart(table: Table, path: str | Path, title: str = "") -> Path:
     steps.set_yticks(range(len(names)), words, fontsize=7.5)
     ax.set_title(title or table.title, fontsize=10)
     ax.grid(True, axis="x", alpha=0.3)
-    return save(fig, path)
+    return save(fig, path, table.meta)

@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 
 from ..table import Table
-from ._figure import documented, pyplot, save, skipped_note, time_label
+from ._figure import documented, measurement_notes, pyplot, save, time_label
 
 __all__ = [
     "energy_growth_chart",
@@ -34,8 +34,11 @@ def work_precision_chart(table: Table, path: str | Path, *, x: str = "seconds", 
     :func:`~varmech.work_precision` table, and write the figure to ``path`` (PNG or SVG).
 
     Lower left is better: less work for a smaller error. Each line follows its sweep (steps, or
-    tolerances); points with a non-finite or zero value are left out. Skipped baselines
-    (``meta["notes"]``) are noted beside the legend.
+    tolerances); points with a non-finite or zero value are left out. The measurement's notes
+    (``meta["notes"]``: skipped baselines, a computed reference, stopped sweeps) are written beside
+    the legend; so is what one evaluation is for each family of methods
+    (``meta["evaluation_units"]``) when ``x`` is ``"evaluations"``, and a computed reference's
+    tolerance is drawn as a line (errors below it are not measured).
 
     Parameters
     ----------
@@ -93,10 +96,18 @@ def work_precision_chart(table: Table, path: str | Path, *, x: str = "seconds", 
     t_end = table.meta.get("t_end")
     unit = table.meta.get("time_unit", "time units")
     ax.set_title(title or (f"{table.meta.get('scene', '')}, t = 0 … {t_end:g} {unit}" if t_end else table.title), fontsize=10)
+    tolerance = table.meta.get("reference_tolerance")
+    if y == "final_error" and tolerance:
+        # A computed reference is known to its tolerance: errors below it are not measured.
+        ax.axhline(tolerance, color="0.4", ls="-.", lw=0.8, label=f"reference tolerance {tolerance:.1e}")
     ax.grid(True, which="major", alpha=0.3)
     ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0))
-    skipped_note(ax, table.meta.get("notes", []))
-    return save(fig, path)
+    notes = list(table.meta.get("notes", []))
+    if x == "evaluations":
+        units = table.meta.get("evaluation_units", {})
+        notes += [f"{family}: {unit}" for family, unit in units.items()]
+    measurement_notes(ax, notes)
+    return save(fig, path, table.meta)
 
 
 @documented
@@ -111,7 +122,9 @@ def energy_growth_chart(table: Table, path: str | Path, title: str = "", *, samp
     log-spaced bin) are drawn faintly behind, showing the oscillation. A dashed √t line (Brouwer's
     law, the growth of random round-off) and a dotted ∝ t line go through the first drifting curve
     (the first with the verdict "secular drift"), two decades before its end, so that its slope
-    reads against them. Skipped baselines (``meta["notes"]``) are noted beside the legend.
+    reads against them. A baseline run to a shorter horizon (``meta["baseline_t_end"]``) ends at a
+    dotted vertical line that says so; the measurement's notes (``meta["notes"]``) are written
+    beside the legend.
 
     Parameters
     ----------
@@ -164,6 +177,8 @@ def energy_growth_chart(table: Table, path: str | Path, title: str = "", *, samp
                 continue
             v = verdicts.get(method, {})
             label = method if tool == "varmech" else f"{method} ({tool}, rtol {v['rtol']:g})" if "rtol" in v else f"{method} ({tool})"
+            if v.get("t_end") and table.meta.get("t_end") and v["t_end"] < 0.999 * table.meta["t_end"]:
+                label += f", run to t = {v['t_end']:g} only"
             if v:
                 label += f": {v['verdict']}"
                 if v["verdict"] == "secular drift":
@@ -182,11 +197,18 @@ def energy_growth_chart(table: Table, path: str | Path, title: str = "", *, samp
         ax.loglog(tt, ea * np.sqrt(tt / ta), "k--", lw=0.8, alpha=0.7, label="∝ √t (Brouwer's law)")
         ax.loglog(tt, ea * (tt / ta), "k:", lw=0.8, alpha=0.7, label="∝ t")
     meta = table.meta
+    short = meta.get("baseline_t_end")
+    if short and meta.get("t_end") and short < meta["t_end"] and any(tool != "varmech" for tool in table.unique("tool")):
+        ax.axvline(short, color="0.4", ls=":", lw=0.9)
+        ax.annotate(
+            f"baselines end at t = {short:g}", (short, 1.0), xycoords=("data", "axes fraction"), rotation=90,
+            va="top", ha="right", fontsize=7, color="0.3",
+        )  # fmt: skip
     ax.set_xlabel(time_label(meta))
     ax.set_ylabel("relative energy error |H − H₀|/|H₀|, max up to t")
     default = f"{meta.get('scene', '')}, dt = {meta['dt']:g} {meta.get('time_unit', 'time units')}" if "dt" in meta else table.title
     ax.set_title(title or default, fontsize=10)
     ax.grid(True, which="major", alpha=0.3)
     ax.legend(fontsize=7.5, loc="upper left", bbox_to_anchor=(1.01, 1.0))
-    skipped_note(ax, meta.get("notes", []))
-    return save(fig, path)
+    measurement_notes(ax, meta.get("notes", []))
+    return save(fig, path, table.meta)
