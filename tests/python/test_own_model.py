@@ -320,3 +320,21 @@ def test_every_chart_kind_takes_ones_own_scene_or_says_why_not(tmp_path):
         chart("strobe", spring, out=tmp_path)
     with pytest.raises(ValueError, match="scene: the stability chart is of the linear test equation"):
         chart("stability", spring, out=tmp_path)
+
+
+def test_energy_growth_of_the_sympy_elastic_pendulum_and_implicit_regions_of_a_bare_model():
+    model = examples.elastic_pendulum_cartesian()
+    table = varmech.energy_growth(model, ["verlet", "rk4"], q0=ELASTIC_Q0, v0=[0.0, 0.0], t_end=200.0, samples=50, baselines=(), progress=False)
+    assert {m: v["verdict"] for m, v in table.meta["verdicts"].items()} == {"verlet": "bounded", "rk4": "secular drift"}
+    regions = varmech.implicit_regions("midpoint", scene=duffing(), h_values=(0.1,), q0_values=(0.5,))
+    assert regions.column("outcome").tolist() == ["ok"] and regions.meta["scene"] == "mechanical system"
+    with pytest.raises(TypeError, match="scene: expected a varmech Scene, a scene's name or a Model"):
+        varmech.implicit_regions("midpoint", scene=3.0)
+
+
+def test_chart_of_a_sympy_lagrangian_from_the_command_line(own, tmp_path, run_cli):
+    pytest.importorskip("matplotlib")
+    done = run_cli("chart", "energy", f"{own}:L", "--q0", "1.2,0.5", "--t-end", "200", "--quick", "--out", tmp_path)
+    assert (tmp_path / "energy_growth_L.png").exists(), done.stdout
+    verdicts = (tmp_path / "energy_verdicts_L.csv").read_text()
+    assert "galerkin6" in verdicts and "midpoint" in verdicts

@@ -715,8 +715,8 @@ def implicit_regions(
     ----------
     method : str or sequence of str, optional
         Implicit varmech methods; default :data:`IMPLICIT_METHODS`.
-    scene : str or Scene, default "pendulum"
-        A :mod:`varmech.scenes` name or a Scene.
+    scene : str, Scene or Model, default "pendulum"
+        A :mod:`varmech.scenes` name, a Scene, or a model (its other coordinates at 0).
     steps : int, default 20
         Steps per run.
     h_values : sequence of float, default (0.1, 0.25, … 6.0)
@@ -737,7 +737,7 @@ def implicit_regions(
     Raises
     ------
     TypeError
-        ``scene`` is neither a scene name nor a Scene.
+        ``scene`` is neither a scene name, a Scene nor a Model.
     ValueError
         An unknown method, or one for constrained systems or the N-body problem only; an
         unknown scene name; ``steps`` not a positive integer; ``h_values`` or
@@ -764,9 +764,9 @@ def implicit_regions(
     names = list(IMPLICIT_METHODS) if method is None else ([method] if isinstance(method, str) else list(method))
     for name in names:
         _method(name)
-    sc = scenes.get(scene) if isinstance(scene, str) else scene
-    if not isinstance(sc, scenes.Scene):
-        raise TypeError(f"scene: expected a scene name or a varmech Scene, got {type(scene).__name__}")
+    # A model's runs start from rest, its other coordinates at 0; the horizon is the runs' own.
+    origin = np.zeros(scene.dim) if isinstance(scene, Model) else None
+    sc = scenes.as_scene(scene, q0=origin, p0=origin, t_end=1.0, dt=1.0)
     if isinstance(steps, bool) or not isinstance(steps, (int, np.integer)) or steps < 1:
         raise ValueError(f"steps: must be a positive integer, got {steps!r}")
     hs = [positive("h_values", h) for h in h_values]
