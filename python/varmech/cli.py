@@ -196,7 +196,7 @@ def load_subject(text: str) -> scenes.Scene | Model:
 def _scene(args: argparse.Namespace) -> scenes.Scene | str | None:
     """The scene the command line names: a name as it is (the recipes know the catalogue), or the
     user's own object, a Model made a Scene with --q0, --p0/--v0, --t-end and --dt."""
-    if args.scene is None or args.scene in scenes.CATALOGUE or args.scene in scenes.SYMBOLIC or ":" not in args.scene:
+    if args.scene is None or ":" not in args.scene:
         given = [flag for flag, value in (("--q0", args.q0), ("--p0", args.p0), ("--v0", args.v0)) if value is not None]
         if given and args.scene is not None:
             raise ValueError(f"{', '.join(given)}: a built-in scene has its own initial state; these are for a model of one's own")
@@ -207,16 +207,16 @@ def _scene(args: argparse.Namespace) -> scenes.Scene | str | None:
     missing = [flag for flag, value in (("--q0", args.q0), ("--t-end", args.t_end)) if value is None]
     if missing:
         raise ValueError(f"{' and '.join(missing)}: {args.scene} is a model; give its initial state and horizon (--q0, --p0 or --v0, --t-end)")
-    if args.p0 is None and args.v0 is None:
-        args.v0 = (0.0,) * len(args.q0)
-    return scenes.Scene.of(subject, args.q0, args.p0, v0=args.v0, t_end=args.t_end, dt=args.dt, name=args.scene.rpartition(":")[2])
+    # From rest unless momenta or velocities are given.
+    v0 = (0.0,) * len(args.q0) if args.p0 is None and args.v0 is None else args.v0
+    return scenes.Scene.of(subject, args.q0, args.p0, v0=v0, t_end=args.t_end, dt=args.dt, name=args.scene.rpartition(":")[2])
 
 
 def _run(args: argparse.Namespace) -> int:
     """One integration of a scene, its conservation report, and its final state."""
-    sc = _scene(args)
-    scene = scenes.get(sc) if isinstance(sc, str) else sc
-    assert scene is not None
+    subject = _scene(args)
+    assert subject is not None  # run's SCENE is a required argument
+    scene = scenes.as_scene(subject)
     method = args.method or scene.model.kind.default_method
     t_end = args.t_end or scene.t_end
     # The scene's step fitted to the horizon, or the step given (the horizon then rounded to it).

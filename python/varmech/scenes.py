@@ -270,7 +270,6 @@ def as_scene(
     v0: ArrayLike | None = None,
     t_end: float | None = None,
     dt: float | None = None,
-    argument: str = "scene",
 ) -> Scene:
     """The scene a measurement runs: ``subject`` itself (a Scene), the built-in or symbolic scene
     of that name, or :meth:`Scene.of` a model with ``q0``, ``p0``/``v0``, ``t_end`` and ``dt``.
@@ -283,8 +282,6 @@ def as_scene(
         A model's initial state (ignored for a scene, which has its own).
     t_end, dt : float, optional
         A model's horizon (required) and step (default: :meth:`Scene.of`'s).
-    argument : str, default "scene"
-        The name of the measurement's argument, for the messages.
 
     Returns
     -------
@@ -317,12 +314,12 @@ def as_scene(
         missing = [name for name, value in (("q0", q0), ("t_end", t_end)) if value is None]
         if missing:
             raise TypeError(
-                f"{argument}: a model needs its initial state and horizon: pass {' and '.join(missing)} "
+                f"scene: a model needs its initial state and horizon: pass {' and '.join(missing)} "
                 "(and p0 or v0), or a varmech.Scene.of(model, q0, p0, t_end=...)"
             )
         assert q0 is not None and t_end is not None
         return Scene.of(subject, q0, p0, v0=v0, t_end=t_end, dt=dt)
-    raise TypeError(f"{argument}: expected a varmech Scene, a scene's name or a Model, got {type(subject).__name__}")
+    raise TypeError(f"scene: expected a varmech Scene, a scene's name or a Model, got {type(subject).__name__}")
 
 
 #: The core's catalogue of scenes by name, in the order of the tour: each entry's

@@ -163,14 +163,14 @@ def _poincare(sc, methods, quick, progress, options):
         energies = sections.HENON_HEILES_ENERGIES if henon_heiles else (float(energy_at(sc.model, sc.q0, sc.p0)[0]),)
     dt = 0.05 if henon_heiles else sc.dt
     t_end = dt * round((300.0 if quick else 2000.0) / dt)
+    x, p_x = sc.model.coordinates[section[0]], sc.model.momentum_names[section[0]]
     for energy in energies:
         table = sections.poincare_section(
             sc, energy, orbits=12 if quick else 40, t_end=t_end, dt=dt, method=methods[0], box=box, section=section,
             progress=progress,
         )  # fmt: skip
         label = f"{energy:.4f}".rstrip("0")
-        x = sc.model.coordinates[0]
-        title = f"{sc.name}: Poincaré section {x} = {section[1]:.4g} ({sc.model.momentum_names[0]} > 0), {sc.model.energy_name} = {label}"
+        title = f"{sc.name}: Poincaré section {x} = {section[1]:.4g} ({p_x} > 0), {sc.model.energy_name} = {label}"
         name = f"poincare_H{label.replace('.', '_')}"
         out.append((name, table, {name: lambda t, p, title=title: poincare_chart(t, p, title=title)}))
     return out
