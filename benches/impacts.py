@@ -46,7 +46,6 @@ from pathlib import Path
 import numpy as np
 
 import varmech
-from varmech.charts._figure import pyplot, save
 
 G = 9.81
 #: The elliptic billiard x²/A² + y²/B² ≤ 1 of tests/python/test_impacts.py, foci (±c, 0).
@@ -477,8 +476,10 @@ def billiard_chart(out: Path, quick: bool = False) -> list[Path]:
             table.append(name, k, float(e))
     written = [table.to_csv(out / "impacts_billiard.csv")]
 
-    plt = pyplot()
-    fig, (left, right) = plt.subplots(1, 2, figsize=(11, 4.4), layout="constrained", gridspec_kw={"width_ratios": [1, 1.25]})
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(11, 4.4), layout="constrained")
+    left, right = fig.subplots(1, 2, gridspec_kw={"width_ratios": [1, 1.25]})
     angle = np.linspace(0, 2 * np.pi, 400)
     left.plot(A * np.cos(angle), B * np.sin(angle), color="k", lw=1)
     left.plot([-C, C], [0, 0], "k+", ms=8)
@@ -500,7 +501,8 @@ def billiard_chart(out: Path, quick: bool = False) -> list[Path]:
     right.set_title("focal invariant L₁L₂ after each impact")
     right.grid(True, which="major", alpha=0.3)
     right.legend(fontsize=8)
-    written.append(save(fig, out / "impacts_billiard.png"))
+    fig.savefig(out / "impacts_billiard.png", dpi=120)
+    written.append(out / "impacts_billiard.png")
     return written
 
 

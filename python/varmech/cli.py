@@ -126,9 +126,8 @@ def tour(out: Path, quick: bool) -> int:
             summary.append(name, method, steps, elapsed, stats.max_rel_error, verdict)
         if plots:
             try:
-                path = charts.energy_error(
-                    runs, out / f"{name}_energy.png", title=f"{name}: energy error, dt = {scene.dt:g} {scene.time_unit}", time_unit=scene.time_unit
-                )
+                path = out / f"{name}_energy.png"
+                charts.energy_error(runs, path, title=f"{name}: energy error, dt = {scene.dt:g} {scene.time_unit}", time_unit=scene.time_unit)
                 print(f"wrote {path}")
             except ImportError as e:
                 print(f"(no plots: {e})")

@@ -102,7 +102,8 @@ def test_the_strobe_chart_draws_the_attractor_with_its_angle_wrapped(tmp_path):
     scene = varmech.scenes.get("damped_driven_pendulum")
     table = stroboscopic_section(scene, *START, period=PERIOD, periods=400, transient=50)
     assert len(np.unique(np.round(table.column("p0"), 6))) > 300
-    path = strobe_chart(table, tmp_path / "attractor.svg", wrap=2 * math.pi)
+    path = tmp_path / "attractor.svg"
+    strobe_chart(table, path, wrap=2 * math.pi)
     text = path.read_text()
     # The axes in the model's own names: φ, and its momentum.
     assert "phi at t₀ + kT (mod 6.283)" in text and "p_phi at t₀ + kT" in text

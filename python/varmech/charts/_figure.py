@@ -5,26 +5,40 @@ from __future__ import annotations
 import textwrap
 from collections.abc import Callable
 from pathlib import Path
-from typing import Any, TypeVar
+from typing import TYPE_CHECKING, Any, TypeVar
+
+import numpy as np
+
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+    from matplotlib.figure import Figure
 
 _F = TypeVar("_F", bound=Callable[..., Any])
 
-# The docstring sections every chart shares (it writes ``path`` and returns it), put in for the
-# placeholders ``{path}``, ``{returns}`` and ``{raises}`` by :func:`documented`, as matplotlib's
-# and SciPy's docstring templates do. ``{raises}`` ends mid-sentence, for a chart's own cases.
+# The docstring sections every chart shares, put in for the placeholders ``{path}``, ``{ax}``,
+# ``{returns}`` and ``{raises}`` by :func:`documented`, as matplotlib's and SciPy's docstring
+# templates do. ``{raises}`` ends mid-sentence, for a chart's own cases.
 _SECTIONS = {
-    "{path}": """path : str or pathlib.Path
-        The file to write, ending in ``.png`` or ``.svg``; its folder is created.""",
+    "{path}": """path : str or pathlib.Path, optional
+        A file to write the figure to, ending in ``.png`` or ``.svg`` (its folder is created);
+        default: none written.""",
+    "{ax}": """ax : matplotlib.axes.Axes, optional
+        The axes to draw into, in the user's own figure (a sequence of them, one a panel, for a
+        chart of several panels); default: a new figure's, made without pyplot. The chart never
+        chooses or changes matplotlib's backend.""",
     "{returns}": """Returns
     -------
-    pathlib.Path
-        ``path``, written (the figure is closed).""",
+    matplotlib.figure.Figure
+        The figure drawn into (``ax``'s own where given), written to ``path`` where given.""",
     "{raises}": """Raises
     ------
     ImportError
         matplotlib is missing (``pip install 'varmech[charts]'``).
+    TypeError
+        ``ax`` is not a matplotlib Axes.
     ValueError
-        ``path`` does not end in ``.png`` or ``.svg``""",
+        ``path`` does not end in ``.png`` or ``.svg``, or ``ax`` holds another number of Axes
+        than the chart has panels""",
 }
 
 
@@ -37,37 +51,96 @@ def documented(chart: _F) -> _F:
     return chart
 
 
-def pyplot() -> Any:
-    """matplotlib.pyplot with the non-interactive Agg backend, or ImportError saying how to
-    install it."""
-    try:
-        import matplotlib
+def colormap(name: str) -> Any:
+    """matplotlib's colour map ``name``, from its registry (no pyplot)."""
+    import matplotlib
 
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-    except ImportError as e:
-        raise ImportError("charts need matplotlib: pip install 'varmech[charts]'") from e
-    return plt
+    return matplotlib.colormaps[name]
 
 
 #: What a chart of a ``--quick`` measurement says on its face (``meta["quick"]``).
 QUICK_NOTE = "--quick: a short measurement (fewer settings, orbits and repeats), a first look, not a comparison"
 
 
-def save(fig: Any, path: str | Path, meta: dict[str, Any] | None = None) -> Path:
-    """Write ``fig`` to ``path`` (PNG or SVG by its suffix), creating the folder, and close it;
-    a chart of a quick measurement (``meta["quick"]``) says so above its title."""
-    path = Path(path)
-    if path.suffix.lower() not in (".png", ".svg"):
-        raise ValueError(f"path: must end in .png or .svg, got {path.name!r}")
-    if meta and meta.get("quick"):
-        # A figure's own suptitle (panels side by side) keeps its place, the note under it.
-        own = fig._suptitle.get_text() if fig._suptitle is not None else ""
-        fig.suptitle(f"{own}\n{QUICK_NOTE}" if own else QUICK_NOTE, fontsize=10 if own else 8, color="black" if own else "C3")
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=120)
-    pyplot().close(fig)
-    return path
+class Canvas:
+    """Where a chart draws: the user's Axes (``ax``), or a new Figure of ``figsize`` with
+    ``shape`` (rows, columns), ``panels`` of them drawn (all by default; the user gives as many
+    Axes). A new figure is made without pyplot, so that no backend is chosen or changed and
+    nothing is left open in pyplot's list of figures; ``path`` is checked before anything is
+    drawn."""
+
+    def __init__(
+        self, ax: Any, path: str | Path | None, figsize: tuple[float, float], shape: tuple[int, int] = (1, 1), panels: int | None = None
+    ):
+        if path is not None:
+            path = Path(path)
+            if path.suffix.lower() not in (".png", ".svg"):
+                raise ValueError(f"path: must end in .png or .svg, got {path.name!r}")
+        self.path = path
+        rows, cols = shape
+        panels = rows * cols if panels is None else panels
+        try:
+            from matplotlib.axes import Axes
+            from matplotlib.figure import Figure
+        except ImportError as e:
+            raise ImportError("charts need matplotlib: pip install 'varmech[charts]'") from e
+        self.own = ax is None
+        self.figure: Figure
+        self.axes: list[Axes]
+        if ax is None:
+            self.figure = Figure(figsize=figsize, layout="constrained")
+            grid = list(self.figure.subplots(rows, cols, squeeze=False).flat)
+            for spare in grid[panels:]:
+                spare.set_visible(False)
+            self.axes = grid[:panels]
+            return
+        given = [ax] if isinstance(ax, Axes) else list(np.ravel(np.asarray(ax, dtype=object))) if isinstance(ax, (list, tuple, np.ndarray)) else None
+        if given is None or not all(isinstance(a, Axes) for a in given):
+            raise TypeError(f"ax: expected a matplotlib Axes (or a sequence of them), got {type(ax).__name__}")
+        if len(given) != panels:
+            raise ValueError(f"ax: this chart draws {panels} panels, got {len(given)} Axes")
+        # A subfigure's Axes: the root figure is the one written.
+        self.figure = given[0].figure.figure
+        self.axes = given
+
+    @property
+    def ax(self) -> Axes:
+        """The first (or only) panel."""
+        return self.axes[0]
+
+    def title(self, text: str) -> None:
+        """The chart's title over all its panels: the figure's own where the chart made it,
+        else over the first of the user's panels, above its own title."""
+        if not text:
+            return
+        if self.own:
+            self.figure.suptitle(text, fontsize=10)
+        else:
+            own = self.ax.get_title()
+            self.ax.set_title(f"{text}\n{own}" if own else text, fontsize=10)
+
+    def legend(self, **kwargs: Any) -> None:
+        """A legend under all the panels where the chart made the figure, else in the first
+        of the user's panels."""
+        if self.own:
+            self.figure.legend(loc="outside lower center", **kwargs)
+        else:
+            self.ax.legend(**kwargs)
+
+    def done(self, meta: dict[str, Any] | None = None) -> Figure:
+        """The figure, written to ``path`` where given; a chart of a quick measurement
+        (``meta["quick"]``) says so above its title."""
+        if meta and meta.get("quick"):
+            if self.own:
+                # A figure's own suptitle (panels side by side) keeps its place, the note under it.
+                own = self.figure.get_suptitle()
+                self.figure.suptitle(f"{own}\n{QUICK_NOTE}" if own else QUICK_NOTE, fontsize=10 if own else 8, color="black" if own else "C3")
+            else:
+                self.ax.set_title(f"{QUICK_NOTE}\n{self.ax.get_title()}", fontsize=8)
+        if self.path is not None:
+            self.path.parent.mkdir(parents=True, exist_ok=True)
+            self.figure.savefig(self.path, dpi=120)
+        return self.figure
 
 
 def time_label(meta: dict[str, Any], name: str = "t") -> str:

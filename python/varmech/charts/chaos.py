@@ -5,12 +5,17 @@ attractor (:func:`varmech.stroboscopic_section`) and the convergence of a
 from __future__ import annotations
 
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+    from matplotlib.figure import Figure
+
 from ..analysis.lyapunov import LyapunovSpectrum
 from ..table import Table
-from ._figure import documented, pyplot, save, state_label
+from ._figure import Canvas, documented, state_label
 
 __all__ = [
     "lyapunov_chart",
@@ -20,7 +25,7 @@ __all__ = [
 
 
 @documented
-def orbit_diagram_chart(table: Table, path: str | Path, coordinate: str = "p0", title: str = "") -> Path:
+def orbit_diagram_chart(table: Table, path: str | Path | None = None, coordinate: str = "p0", title: str = "", *, ax: Axes | None = None) -> Figure:
     """Dot each strobe point of an orbit diagram at its parameter value: one dot for a period-1
     orbit, two for period 2, a band where the strobe is chaotic. Writes ``path`` (PNG or SVG by
     its suffix).
@@ -34,6 +39,7 @@ def orbit_diagram_chart(table: Table, path: str | Path, coordinate: str = "p0", 
         The strobe's column drawn (default ``p0``, the first momentum).
     title : str, optional
         The figure's title (default: the table's).
+    {ax}
 
     {returns}
 
@@ -41,30 +47,31 @@ def orbit_diagram_chart(table: Table, path: str | Path, coordinate: str = "p0", 
 
     Examples
     --------
-    >>> import math, tempfile
-    >>> from pathlib import Path
+    >>> import math
     >>> import varmech
     >>> from varmech.charts import orbit_diagram_chart
     >>> scene = varmech.scenes.get("damped_driven_pendulum")
     >>> table = varmech.orbit_diagram(scene, [-math.pi / 2], [0.0], parameter="amplitude",
     ...                               values=[1.06, 1.075], period=3 * math.pi, periods=8, transient=50)
-    >>> with tempfile.TemporaryDirectory() as folder:
-    ...     print(orbit_diagram_chart(table, Path(folder) / "orbits.png").name)
-    orbits.png
+    >>> fig = orbit_diagram_chart(table)   # a new figure: fig.savefig(...), or path= to write it
+    >>> fig.axes[0].get_xlabel()
+    'amplitude'
     """
     if coordinate not in table.columns[2:]:
         raise ValueError(f"coordinate: must be one of {', '.join(table.columns[2:])}, got {coordinate!r}")
-    plt = pyplot()
-    fig, ax = plt.subplots(figsize=(7.0, 4.5), layout="constrained")
+    canvas = Canvas(ax, path, figsize=(7.0, 4.5))
+    ax = canvas.ax
     ax.scatter(table.column("value"), table.column(coordinate), s=1.0, color="black", linewidths=0, rasterized=True)
     ax.set_xlabel(str(table.meta.get("parameter", "value")))
     ax.set_ylabel(f"{state_label(table.meta, coordinate)} at t₀ + kT")
     ax.set_title(title or table.title)
-    return save(fig, path, table.meta)
+    return canvas.done(table.meta)
 
 
 @documented
-def strobe_chart(table: Table, path: str | Path, coordinate: int = 0, wrap: float | None = None, title: str = "") -> Path:
+def strobe_chart(
+    table: Table, path: str | Path | None = None, coordinate: int = 0, wrap: float | None = None, title: str = "", *, ax: Axes | None = None
+) -> Figure:
     """Dot the states of a stroboscopic section in the (q, p) plane of one coordinate: a
     periodic orbit's few points, or a strange attractor's folded sheets. Writes ``path`` (PNG or
     SVG by its suffix).
@@ -81,6 +88,7 @@ def strobe_chart(table: Table, path: str | Path, coordinate: int = 0, wrap: floa
         default none.
     title : str, optional
         The figure's title (default: the table's, with the points' count).
+    {ax}
 
     {returns}
 
@@ -88,15 +96,16 @@ def strobe_chart(table: Table, path: str | Path, coordinate: int = 0, wrap: floa
 
     Examples
     --------
-    >>> import math, tempfile
-    >>> from pathlib import Path
+    >>> import math
+    >>> import matplotlib.pyplot as plt
     >>> import varmech
     >>> from varmech.charts import strobe_chart
     >>> scene = varmech.scenes.get("damped_driven_pendulum")
     >>> table = varmech.stroboscopic_section(scene, [-math.pi / 2], [0.0], period=3 * math.pi, periods=200)
-    >>> with tempfile.TemporaryDirectory() as folder:
-    ...     print(strobe_chart(table, Path(folder) / "attractor.png", wrap=2 * math.pi).name)
-    attractor.png
+    >>> fig, (left, right) = plt.subplots(1, 2)   # one's own figure: the chart draws into right
+    >>> strobe_chart(table, wrap=2 * math.pi, ax=right) is fig
+    True
+    >>> plt.close(fig)
     """
     q, p = f"q{coordinate}", f"p{coordinate}"
     if q not in table.columns:
@@ -107,17 +116,17 @@ def strobe_chart(table: Table, path: str | Path, coordinate: int = 0, wrap: floa
         if not wrap > 0:
             raise ValueError(f"wrap: must be a positive period, got {wrap!r}")
         x = (x + wrap / 2) % wrap - wrap / 2
-    plt = pyplot()
-    fig, ax = plt.subplots(figsize=(6.5, 5.0), layout="constrained")
+    canvas = Canvas(ax, path, figsize=(6.5, 5.0))
+    ax = canvas.ax
     ax.scatter(x, table.column(p), s=1.0, color="black", linewidths=0, rasterized=True)
     ax.set_xlabel(f"{state_label(table.meta, q)} at t₀ + kT" + (f" (mod {wrap:.4g})" if wrap is not None else ""))
     ax.set_ylabel(f"{state_label(table.meta, p)} at t₀ + kT")
     ax.set_title(title or f"{table.title} ({len(x)} points)")
-    return save(fig, path, table.meta)
+    return canvas.done(table.meta)
 
 
 @documented
-def lyapunov_chart(spectrum: LyapunovSpectrum, path: str | Path, title: str = "") -> Path:
+def lyapunov_chart(spectrum: LyapunovSpectrum, path: str | Path | None = None, title: str = "", *, ax: Axes | None = None) -> Figure:
     """The running estimates λⱼ(t) of a Lyapunov spectrum against t (log-scaled), and their sum:
     converging exponents level off, a regular orbit's fall as ln t/t, and a Hamiltonian model's
     sum stays at round-off. Writes ``path`` (PNG or SVG by its suffix).
@@ -129,6 +138,7 @@ def lyapunov_chart(spectrum: LyapunovSpectrum, path: str | Path, title: str = ""
     {path}
     title : str, optional
         The figure's title.
+    {ax}
 
     {returns}
 
@@ -143,11 +153,13 @@ def lyapunov_chart(spectrum: LyapunovSpectrum, path: str | Path, title: str = ""
     >>> hh = varmech.scenes.henon_heiles().model
     >>> s = varmech.lyapunov_spectrum(hh, [0.0, -0.25], [0.42, 0.0], dt=0.05, steps=2000)
     >>> with tempfile.TemporaryDirectory() as folder:
-    ...     print(lyapunov_chart(s, Path(folder) / "spectrum.png").name)
+    ...     path = Path(folder) / "spectrum.png"
+    ...     fig = lyapunov_chart(s, path)
+    ...     print(path.name)
     spectrum.png
     """
-    plt = pyplot()
-    fig, ax = plt.subplots(figsize=(7.0, 4.5), layout="constrained")
+    canvas = Canvas(ax, path, figsize=(7.0, 4.5))
+    ax = canvas.ax
     elapsed = spectrum.t - spectrum.t0
     for j in range(spectrum.running.shape[1]):
         ax.plot(elapsed, spectrum.running[:, j], lw=1.0, label=f"λ{j + 1} = {spectrum.exponents[j]:.4g} ± {spectrum.stderr[j]:.1g}")
@@ -158,4 +170,4 @@ def lyapunov_chart(spectrum: LyapunovSpectrum, path: str | Path, title: str = ""
     ax.axhline(0.0, color="grey", lw=0.5)
     ax.legend(fontsize="small")
     ax.set_title(title or f"Lyapunov spectrum, {spectrum.method}, dt = {spectrum.dt:g}")
-    return save(fig, path)
+    return canvas.done()

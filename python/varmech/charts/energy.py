@@ -4,12 +4,17 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+    from matplotlib.figure import Figure
+
 from ..conservation import BALANCE, check_conservation
 from ..trajectory import Trajectory
-from ._figure import documented, pyplot, save, time_label
+from ._figure import Canvas, documented, time_label
 
 __all__ = [
     "energy_error",
@@ -17,7 +22,9 @@ __all__ = [
 
 
 @documented
-def energy_error(trajectories: Mapping[str, Trajectory], path: str | Path, title: str = "", time_unit: str = "time units") -> Path:
+def energy_error(
+    trajectories: Mapping[str, Trajectory], path: str | Path | None = None, title: str = "", time_unit: str = "time units", *, ax: Axes | None = None
+) -> Figure:
     """Plot the energy error |H(t) − H₀| against t on log–log axes, relative to the energy's
     scale (the run's mean kinetic energy; see :class:`~varmech.InvariantStatistics`), one line
     per labelled trajectory with its verdict in the legend, and write the figure to ``path``
@@ -33,6 +40,7 @@ def energy_error(trajectories: Mapping[str, Trajectory], path: str | Path, title
         The figure's title (default none).
     time_unit : str, default "time units"
         The unit of the t axis.
+    {ax}
 
     {returns}
 
@@ -53,12 +61,13 @@ def energy_error(trajectories: Mapping[str, Trajectory], path: str | Path, title
     >>> scene = varmech.scenes.harmonic_oscillator()
     >>> runs = {m: varmech.integrate(scene, dt=0.1, steps=200, method=m) for m in ("verlet", "rk4")}
     >>> with tempfile.TemporaryDirectory() as folder:
-    ...     path = energy_error(runs, Path(folder) / "energy.png", title="harmonic oscillator")
+    ...     path = Path(folder) / "energy.png"
+    ...     fig = energy_error(runs, path, title="harmonic oscillator")
     ...     print(path.name, plt.imread(path).shape)   # 7 × 4.2 inches at 120 dpi, RGBA
     energy.png (504, 840, 4)
     """
-    plt = pyplot()
-    fig, ax = plt.subplots(figsize=(7, 4.2), layout="constrained")
+    canvas = Canvas(ax, path, figsize=(7, 4.2))
+    ax = canvas.ax
     for label, traj in trajectories.items():
         report = check_conservation(traj, generators=())
         stats = report.energy
@@ -72,4 +81,4 @@ def energy_error(trajectories: Mapping[str, Trajectory], path: str | Path, title
     ax.set_title(title)
     ax.grid(True, which="major", alpha=0.3)
     ax.legend(fontsize=8)
-    return save(fig, path)
+    return canvas.done()

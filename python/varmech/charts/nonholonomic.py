@@ -4,11 +4,16 @@ method over a long run (:func:`varmech.analysis.nonholonomic.nonholonomic_energy
 from __future__ import annotations
 
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+    from matplotlib.figure import Figure
+
 from ..table import Table
-from ._figure import documented, pyplot, save, time_label
+from ._figure import Canvas, documented, time_label
 
 __all__ = [
     "nonholonomic_energy_chart",
@@ -24,7 +29,7 @@ LABELS = {
 
 
 @documented
-def nonholonomic_energy_chart(table: Table, path: str | Path, title: str = "") -> Path:
+def nonholonomic_energy_chart(table: Table, path: str | Path | None = None, title: str = "", *, ax: Axes | None = None) -> Figure:
     """Plot the relative energy error |E − E₀|/E₀ of a
     :func:`~varmech.analysis.nonholonomic.nonholonomic_energy` table against t on log–log axes,
     one line per method with its verdict in the legend, and a dotted ∝ t line through the end of
@@ -38,6 +43,7 @@ def nonholonomic_energy_chart(table: Table, path: str | Path, title: str = "") -
     {path}
     title : str, optional
         The figure's title (default the table's title).
+    {ax}
 
     {returns}
 
@@ -57,13 +63,14 @@ def nonholonomic_energy_chart(table: Table, path: str | Path, title: str = "") -
     >>> from varmech.charts import nonholonomic_energy_chart
     >>> table = nonholonomic_energy(steps=200, samples=10)
     >>> with tempfile.TemporaryDirectory() as folder:
-    ...     path = nonholonomic_energy_chart(table, Path(folder) / "rolling_disk.png")
+    ...     path = Path(folder) / "rolling_disk.png"
+    ...     fig = nonholonomic_energy_chart(table, path)
     ...     print(path.name, plt.imread(path).shape)
     rolling_disk.png (552, 960, 4)
     """
-    plt = pyplot()
     verdicts = table.meta.get("verdicts", {})
-    fig, ax = plt.subplots(figsize=(8, 4.6), layout="constrained")
+    canvas = Canvas(ax, path, figsize=(8, 4.6))
+    ax = canvas.ax
     for method in table.unique("method"):
         rows = table.where(method=method)
         t, e = rows.column("t"), rows.column("energy_error")
@@ -79,4 +86,4 @@ def nonholonomic_energy_chart(table: Table, path: str | Path, title: str = "") -
     ax.set_title(title or table.title)
     ax.grid(True, which="major", alpha=0.3)
     ax.legend(fontsize=8)
-    return save(fig, path, table.meta)
+    return canvas.done(table.meta)

@@ -375,7 +375,9 @@ def chart(
             for note in table.meta.get("notes", []):
                 say(note)
         written.append(table.to_csv(out / f"{name}{stem}.csv"))
-        written += [draw(table, out / f"{figure}{stem}.{fmt}") for figure, draw in figures.items()]
+        for figure, draw in figures.items():
+            written.append(out / f"{figure}{stem}.{fmt}")
+            draw(table, written[-1])
     return written
 
 

@@ -5,11 +5,16 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+    from matplotlib.figure import Figure
+
 from ..table import Table
-from ._figure import documented, pyplot, save, state_label
+from ._figure import Canvas, colormap, documented, state_label
 
 
 def _henon_heiles_boundary(energy: float) -> tuple[np.ndarray, np.ndarray] | None:
@@ -23,7 +28,9 @@ def _henon_heiles_boundary(energy: float) -> tuple[np.ndarray, np.ndarray] | Non
 
 
 @documented
-def poincare_chart(table: Table | Sequence[Table], path: str | Path, title: str = "") -> Path:
+def poincare_chart(
+    table: Table | Sequence[Table], path: str | Path | None = None, title: str = "", *, ax: Axes | Sequence[Axes] | None = None
+) -> Figure:
     """Scatter the section points of :func:`varmech.analysis.sections.poincare_section` in the table's
     plane (``meta["plane"]``, e.g. (y, p_y)), small dots, one colour per orbit, one panel per
     table (pass several tables, e.g. H = 1/12 and 1/8, for panels side by side). The boundary of
@@ -37,6 +44,7 @@ def poincare_chart(table: Table | Sequence[Table], path: str | Path, title: str 
     {path}
     title : str, optional
         The figure's title (default none; each panel is titled with its energy).
+    {ax}
 
     {returns}
 
@@ -57,44 +65,43 @@ def poincare_chart(table: Table | Sequence[Table], path: str | Path, title: str 
     >>> tables = [poincare_section(varmech.scenes.henon_heiles(), energy, orbits=2, dt=0.1,
     ...                            t_end=60.0, progress=False) for energy in (1 / 12, 1 / 8)]
     >>> with tempfile.TemporaryDirectory() as folder:
-    ...     path = poincare_chart(tables, Path(folder) / "henon_heiles.png")
+    ...     path = Path(folder) / "henon_heiles.png"
+    ...     fig = poincare_chart(tables, path)
     ...     print(path.name, plt.imread(path).shape)   # two panels side by side
     henon_heiles.png (600, 1248, 4)
     """
     tables = [table] if isinstance(table, Table) else list(table)
     if not tables:
         raise ValueError("table: give at least one table")
-    plt = pyplot()
-    fig, axes = plt.subplots(1, len(tables), figsize=(5.2 * len(tables), 5.0), layout="constrained", squeeze=False)
-    cmap = plt.get_cmap("tab20")
-    for ax, tab in zip(axes[0], tables):
+    canvas = Canvas(ax, path, figsize=(5.2 * len(tables), 5.0), shape=(1, len(tables)))
+    cmap = colormap("tab20")
+    for panel, tab in zip(canvas.axes, tables):
         a_name, b_name = tab.meta.get("plane", ("y", "p_y"))
         a, b, orbit = tab.column(a_name), tab.column(b_name), tab.column("orbit")
         for i, o in enumerate(tab.unique("orbit")):
             sel = orbit == o
-            ax.scatter(a[sel], b[sel], s=0.6, color=cmap(i % cmap.N), linewidths=0, rasterized=True)
+            panel.scatter(a[sel], b[sel], s=0.6, color=cmap(i % cmap.N), linewidths=0, rasterized=True)
         energy = tab.meta.get("energy")
-        ax.set_xlabel(a_name)
-        ax.set_ylabel(b_name)
+        panel.set_xlabel(a_name)
+        panel.set_ylabel(b_name)
         if tab.meta.get("model") == "henon_heiles" and tuple(tab.meta.get("section", ()))[:2] == (0, 0.0) and energy is not None:
             curve = _henon_heiles_boundary(float(energy))
             if curve is not None:
-                ax.plot(*curve, color="0.3", lw=0.6)
+                panel.plot(*curve, color="0.3", lw=0.6)
             # y and p_y on one scale there, the allowed region's true shape.
-            ax.set_aspect("equal", adjustable="datalim")
+            panel.set_aspect("equal", adjustable="datalim")
         label = f"E = {energy:.4g}" if energy is not None else ""
         if energy is not None:
             for frac in (12, 8, 6):
                 if abs(float(energy) - 1 / frac) < 1e-12:
                     label = f"E = 1/{frac}"
-        ax.set_title(label, fontsize=10)
-    if title:
-        fig.suptitle(title, fontsize=10)
-    return save(fig, path, tables[0].meta)
+        panel.set_title(label, fontsize=10)
+    canvas.title(title)
+    return canvas.done(tables[0].meta)
 
 
 @documented
-def phase_portrait_chart(table: Table, path: str | Path, title: str = "") -> Path:
+def phase_portrait_chart(table: Table, path: str | Path | None = None, title: str = "", *, ax: Axes | None = None) -> Figure:
     """Draw the orbits of :func:`varmech.analysis.phase_portrait.phase_portrait` in the (q, p) plane:
     librations in blues, rotations in oranges (darker for higher energy), undetermined orbits
     in grey. When rotations are present q is taken modulo 2π into (−π, π]; for the pendulum the
@@ -107,6 +114,7 @@ def phase_portrait_chart(table: Table, path: str | Path, title: str = "") -> Pat
     {path}
     title : str, optional
         The figure's title (default none).
+    {ax}
 
     {returns}
 
@@ -127,17 +135,18 @@ def phase_portrait_chart(table: Table, path: str | Path, title: str = "") -> Pat
     >>> table = phase_portrait(varmech.scenes.pendulum(), [-0.5, 2.0], dt=0.05, t_end=20.0,
     ...                        progress=False)
     >>> with tempfile.TemporaryDirectory() as folder:
-    ...     path = phase_portrait_chart(table, Path(folder) / "pendulum.png")
+    ...     path = Path(folder) / "pendulum.png"
+    ...     fig = phase_portrait_chart(table, path)
     ...     print(path.name, plt.imread(path).shape)
     pendulum.png (552, 900, 4)
     """
-    plt = pyplot()
-    fig, ax = plt.subplots(figsize=(7.5, 4.6), layout="constrained")
+    canvas = Canvas(ax, path, figsize=(7.5, 4.6))
+    ax = canvas.ax
     orbit, q, p, e = table.column("orbit"), table.column("q"), table.column("p"), table.column("energy")
     motions = table.column("motion")
     wrap = bool(np.any(motions == "rotation"))
     energies = {m: sorted({float(x) for x in e[motions == m]}) for m in ("libration", "rotation", "undetermined")}
-    maps = {"libration": plt.get_cmap("Blues"), "rotation": plt.get_cmap("Oranges")}
+    maps = {"libration": colormap("Blues"), "rotation": colormap("Oranges")}
     seen: set[str] = set()
     for o in table.unique("orbit"):
         sel = orbit == o
@@ -165,8 +174,8 @@ def phase_portrait_chart(table: Table, path: str | Path, title: str = "") -> Pat
     ax.set_ylabel(p_name)
     ax.set_title(title)
     ax.grid(True, alpha=0.3)
-    fig.legend(fontsize=8, loc="outside lower center", ncol=3)
-    return save(fig, path, table.meta)
+    canvas.legend(fontsize=8, ncol=3)
+    return canvas.done(table.meta)
 
 
 __all__ = ["phase_portrait_chart", "poincare_chart"]

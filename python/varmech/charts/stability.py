@@ -4,14 +4,19 @@
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+    from matplotlib.figure import Figure
+
 from ..analysis.stability import OUTCOMES, REFERENCE_LIMITS
 from ..table import Table
-from ._figure import documented, pyplot, save, time_label
+from ._figure import Canvas, documented, time_label
 
 # Outcome colours of the implicit-regions map, in the order of OUTCOMES.
 _OUTCOME_COLOURS = {
@@ -31,8 +36,8 @@ _LINESTYLES = ("-", "--", "-.", (0, (3, 1, 1, 1, 1, 1)), ":")
 
 @documented
 def stability_chart(
-    table: Table, path: str | Path, title: str = "", limits: Mapping[str, float] | None = None
-) -> Path:
+    table: Table, path: str | Path | None = None, title: str = "", limits: Mapping[str, float] | None = None, *, ax: Axes | None = None
+) -> Figure:
     """Plot the growth factor ρ against hω, one line per method, from a
     :func:`~varmech.analysis.stability.growth_table`, on a logarithmic ρ axis (ρ = 1 is the dotted
     horizontal line: symplectic methods lie on it inside their stability interval, RK4 dips
@@ -54,6 +59,7 @@ def stability_chart(
         The figure's title (default: what is plotted).
     limits : mapping of str to float, optional
         The stability limit hω_max of each method to mark.
+    {ax}
 
     {returns}
 
@@ -72,20 +78,21 @@ def stability_chart(
     >>> from varmech.charts import stability_chart
     >>> table = growth_table(["verlet", "rk4"], [0.5, 1.0, 2.5, 3.0], limits=False)
     >>> with tempfile.TemporaryDirectory() as folder:   # the reference limits are marked
-    ...     path = stability_chart(table, Path(folder) / "stability.png")
+    ...     path = Path(folder) / "stability.png"
+    ...     fig = stability_chart(table, path)
     ...     print(path.name, plt.imread(path).shape)
     stability.png (624, 1140, 4)
     """
-    plt = pyplot()
     if limits is None:
         limits = table.meta.get("limits") or REFERENCE_LIMITS
-    fig, ax = plt.subplots(figsize=(9.5, 5.2), layout="constrained")
+    canvas = Canvas(ax, path, figsize=(9.5, 5.2))
+    ax = canvas.ax
     h_all = table.column("h_omega")
     top = float(np.nanmax(h_all)) if len(h_all) else 1.0
     lowest = 1.0
     names = table.unique("method")
     curves: dict[str, tuple[np.ndarray, np.ndarray]] = {}
-    at_limit: dict[float, list[tuple[str, str]]] = {}
+    at_limit: dict[float, list[tuple[str, Any]]] = {}
     for i, name in enumerate(names):
         rows = table.where(method=name)
         h, g = rows.column("h_omega"), rows.column("growth")
@@ -125,11 +132,11 @@ def stability_chart(
     ax.set_title(title or default, fontsize=10, pad=10)
     ax.grid(True, which="major", alpha=0.3)
     ax.legend(fontsize=7.5, loc="upper left", bbox_to_anchor=(1.01, 1.0))
-    return save(fig, path, table.meta)
+    return canvas.done(table.meta)
 
 
 @documented
-def implicit_regions_chart(table: Table, path: str | Path, title: str = "") -> Path:
+def implicit_regions_chart(table: Table, path: str | Path | None = None, title: str = "", *, ax: Axes | Sequence[Axes] | None = None) -> Figure:
     """A categorical map of the outcome over step size h (columns) and initial angle q₀ (rows),
     one panel per method, from :func:`~varmech.analysis.stability.implicit_regions`. Writes ``path``
     (PNG or SVG).
@@ -141,6 +148,7 @@ def implicit_regions_chart(table: Table, path: str | Path, title: str = "") -> P
     {path}
     title : str, optional
         The figure's title (default: the scene and the number of steps).
+    {ax}
 
     {returns}
 
@@ -159,11 +167,11 @@ def implicit_regions_chart(table: Table, path: str | Path, title: str = "") -> P
     >>> from varmech.charts import implicit_regions_chart
     >>> table = implicit_regions("midpoint", h_values=(0.5, 3.0), q0_values=(1.0, 3.0))
     >>> with tempfile.TemporaryDirectory() as folder:
-    ...     path = implicit_regions_chart(table, Path(folder) / "implicit.png")
+    ...     path = Path(folder) / "implicit.png"
+    ...     fig = implicit_regions_chart(table, path)
     ...     print(path.name, plt.imread(path).shape)
     implicit.png (432, 624, 4)
     """
-    plt = pyplot()
     from matplotlib.colors import BoundaryNorm, ListedColormap
     from matplotlib.patches import Patch
 
@@ -175,39 +183,30 @@ def implicit_regions_chart(table: Table, path: str | Path, title: str = "") -> P
     norm = BoundaryNorm(np.arange(len(OUTCOMES) + 1) - 0.5, cmap.N)
     cols = min(len(names), 2) or 1
     rows_n = max(1, math.ceil(len(names) / cols))
-    fig, axes = plt.subplots(rows_n, cols, figsize=(5.2 * cols, 3.6 * rows_n), layout="constrained", squeeze=False)
-    for k, ax in enumerate(axes.flat):
-        if k >= len(names):
-            ax.set_visible(False)
-            continue
-        name = names[k]
+    canvas = Canvas(ax, path, figsize=(5.2 * cols, 3.6 * rows_n), shape=(rows_n, cols), panels=len(names))
+    for panel, name in zip(canvas.axes, names):
         grid = np.full((len(q0s), len(hs)), np.nan)
         for row in table.where(method=name):
             grid[q0s.index(float(row["q0"])), hs.index(float(row["h"]))] = code[row["outcome"]]
-        ax.imshow(np.ma.masked_invalid(grid), cmap=cmap, norm=norm, origin="lower", aspect="auto", interpolation="nearest")
-        ax.set_xticks(range(len(hs)), [f"{h:g}" for h in hs], fontsize=7)
-        ax.set_yticks(range(len(q0s)), [f"{q:g}" for q in q0s], fontsize=7)
-        ax.set_xlabel(time_label(table.meta, "step h"))
-        ax.set_ylabel("initial angle q₀ (from rest)")
-        ax.set_title(name, fontsize=9)
+        panel.imshow(np.ma.masked_invalid(grid), cmap=cmap, norm=norm, origin="lower", aspect="auto", interpolation="nearest")
+        panel.set_xticks(range(len(hs)), [f"{h:g}" for h in hs], fontsize=7)
+        panel.set_yticks(range(len(q0s)), [f"{q:g}" for q in q0s], fontsize=7)
+        panel.set_xlabel(time_label(table.meta, "step h"))
+        panel.set_ylabel("initial angle q₀ (from rest)")
+        panel.set_title(name, fontsize=9)
     present = [o for o in OUTCOMES if o in set(table.column("outcome"))]
-    fig.legend(
-        handles=[Patch(color=_OUTCOME_COLOURS[o], label=o) for o in present],
-        loc="outside lower center",
-        ncol=len(present),
-        fontsize=8,
-    )
+    canvas.legend(handles=[Patch(color=_OUTCOME_COLOURS[o], label=o) for o in present], ncol=len(present), fontsize=8)
     scene = table.meta.get("scene", "")
     steps = table.meta.get("steps", "")
-    fig.suptitle(title or f"Implicit methods on the {scene}: outcome of {steps} steps", fontsize=10)
-    return save(fig, path, table.meta)
+    canvas.title(title or f"Implicit methods on the {scene}: outcome of {steps} steps")
+    return canvas.done(table.meta)
 
 
 __all__ = ["implicit_regions_chart", "stability_chart"]
 
 
 @documented
-def spectrum_chart(table: Table, path: str | Path, title: str = "") -> Path:
+def spectrum_chart(table: Table, path: str | Path | None = None, title: str = "", *, ax: Axes | None = None) -> Figure:
     """A model's spectrum against each method's stability interval, from
     :func:`~varmech.analysis.stability.spectrum`: one row per method, its interval 0 < hω < h_ω
     a bar (green where the step dt takes the model's fastest mode inside it, red where not), and
@@ -223,6 +222,7 @@ def spectrum_chart(table: Table, path: str | Path, title: str = "") -> Path:
     {path}
     title : str, optional
         The figure's title (default: the table's).
+    {ax}
 
     {returns}
 
@@ -242,11 +242,11 @@ def spectrum_chart(table: Table, path: str | Path, title: str = "") -> Path:
     >>> from varmech.charts import spectrum_chart
     >>> table = varmech.analysis.stability.spectrum(varmech.scenes.fermi_pasta_ulam(), ["verlet", "yoshida4", "midpoint"])
     >>> with tempfile.TemporaryDirectory() as folder:
-    ...     path = spectrum_chart(table, Path(folder) / "spectrum.png")
+    ...     path = Path(folder) / "spectrum.png"
+    ...     fig = spectrum_chart(table, path)
     ...     print(path.name, plt.imread(path).shape)
     spectrum.png (354, 1080, 4)
     """
-    plt = pyplot()
     dt = float(table.meta["dt"])
     frequencies = np.asarray(table.meta["frequencies"], dtype=float)
     names = [row["method"] for row in table]
@@ -254,7 +254,8 @@ def spectrum_chart(table: Table, path: str | Path, title: str = "") -> Path:
     finite = [x for x in limits if math.isfinite(x)]
     fastest = dt * float(table.meta["omega_max"])
     right = 1.15 * max([fastest, *finite, 1e-300])
-    fig, ax = plt.subplots(figsize=(9.0, 1.6 + 0.45 * max(len(names), 2)), layout="constrained")
+    canvas = Canvas(ax, path, figsize=(9.0, 1.6 + 0.45 * max(len(names), 2)))
+    ax = canvas.ax
     for i, (row, limit) in enumerate(zip(table, limits)):
         colour = "#4daf4a" if row["stable"] else "#e41a1c"
         ax.barh(i, min(limit, right), height=0.55, color=colour, alpha=0.55, edgecolor=colour)
@@ -269,11 +270,11 @@ def spectrum_chart(table: Table, path: str | Path, title: str = "") -> Path:
     ax.invert_yaxis()
     ax.set_xlim(0.0, right)
     ax.set_xlabel(f"hω at dt = {dt:g} (blue: the modes, the fastest bold)")
-    top_axis = ax.secondary_xaxis("top", functions=(lambda x: x / dt, lambda w: w * dt))
+    top_axis = ax.secondary_xaxis("top", functions=(lambda x: np.asarray(x) / dt, lambda w: np.asarray(w) * dt))
     top_axis.set_xlabel("ω (angular frequency)")
     steps = ax.secondary_yaxis("right")
     words = [f"dt < {row['stable_dt']:.4g}" if math.isfinite(row["stable_dt"]) else "any dt" for row in table]
     steps.set_yticks(range(len(names)), words, fontsize=7.5)
     ax.set_title(title or table.title, fontsize=10)
     ax.grid(True, axis="x", alpha=0.3)
-    return save(fig, path, table.meta)
+    return canvas.done(table.meta)

@@ -5,11 +5,16 @@
 from __future__ import annotations
 
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+    from matplotlib.figure import Figure
+
 from ..table import Table
-from ._figure import documented, measurement_notes, pyplot, save, time_label
+from ._figure import Canvas, documented, measurement_notes, time_label
 
 __all__ = [
     "energy_growth_chart",
@@ -28,7 +33,9 @@ _STYLE = {"varmech": dict(ls="-", marker="o"), "scipy": dict(ls="--", marker="s"
 
 
 @documented
-def work_precision_chart(table: Table, path: str | Path, *, x: str = "seconds", y: str = "final_error", title: str = "") -> Path:
+def work_precision_chart(
+    table: Table, path: str | Path | None = None, *, x: str = "seconds", y: str = "final_error", title: str = "", ax: Axes | None = None
+) -> Figure:
     """Plot ``y`` (``"final_error"`` or ``"max_energy_error"``) against ``x`` (``"seconds"`` or
     ``"evaluations"``) on log–log axes, one line per (tool, method) of a
     :func:`~varmech.work_precision` table, and write the figure to ``path`` (PNG or SVG).
@@ -51,6 +58,7 @@ def work_precision_chart(table: Table, path: str | Path, *, x: str = "seconds", 
         The column of the vertical axis (error).
     title : str, optional
         The figure's title (default: the scene and the horizon).
+    {ax}
 
     {returns}
 
@@ -70,16 +78,16 @@ def work_precision_chart(table: Table, path: str | Path, *, x: str = "seconds", 
     >>> table = varmech.work_precision(varmech.scenes.harmonic_oscillator(), ["verlet"],
     ...                                steps=[64, 128], baselines=(), rebound=(), repeat=1)
     >>> with tempfile.TemporaryDirectory() as folder:
-    ...     path = work_precision_chart(table, Path(folder) / "work_precision.png",
-    ...                                 x="evaluations")
+    ...     path = Path(folder) / "work_precision.png"
+    ...     fig = work_precision_chart(table, path, x="evaluations")
     ...     print(path.name, plt.imread(path).shape)
     work_precision.png (576, 1020, 4)
     """
     for name in (x, y):
         if name not in table.columns:
             raise ValueError(f"x, y: no column {name!r} in {table.columns}")
-    plt = pyplot()
-    fig, ax = plt.subplots(figsize=(8.5, 4.8), layout="constrained")
+    canvas = Canvas(ax, path, figsize=(8.5, 4.8))
+    ax = canvas.ax
     for tool in table.unique("tool"):
         sub = table.where(tool=tool)
         for method in sub.unique("method"):
@@ -107,11 +115,11 @@ def work_precision_chart(table: Table, path: str | Path, *, x: str = "seconds", 
         units = table.meta.get("evaluation_units", {})
         notes += [f"{family}: {unit}" for family, unit in units.items()]
     measurement_notes(ax, notes)
-    return save(fig, path, table.meta)
+    return canvas.done(table.meta)
 
 
 @documented
-def energy_growth_chart(table: Table, path: str | Path, title: str = "", *, samples: bool = True) -> Path:
+def energy_growth_chart(table: Table, path: str | Path | None = None, title: str = "", *, samples: bool = True, ax: Axes | None = None) -> Figure:
     """Plot the energy error of an :func:`~varmech.energy_growth` table against t on log–log
     axes, one line per method with its verdict in the legend, and write the figure to ``path``
     (PNG or SVG).
@@ -135,6 +143,7 @@ def energy_growth_chart(table: Table, path: str | Path, title: str = "", *, samp
         The figure's title (default: the scene and the step).
     samples : bool, default True
         Also draw the sampled errors, faintly.
+    {ax}
 
     {returns}
 
@@ -159,13 +168,14 @@ def energy_growth_chart(table: Table, path: str | Path, title: str = "", *, samp
     >>> table = varmech.energy_growth(varmech.scenes.harmonic_oscillator(), ["verlet", "rk4"],
     ...                               t_end=100.0, samples=10, baselines=())
     >>> with tempfile.TemporaryDirectory() as folder:
-    ...     path = energy_growth_chart(table, Path(folder) / "energy_growth.png")
+    ...     path = Path(folder) / "energy_growth.png"
+    ...     fig = energy_growth_chart(table, path)
     ...     print(path.name, plt.imread(path).shape)
     energy_growth.png (576, 1140, 4)
     """
-    plt = pyplot()
     verdicts = table.meta.get("verdicts", {})
-    fig, ax = plt.subplots(figsize=(9.5, 4.8), layout="constrained")
+    canvas = Canvas(ax, path, figsize=(9.5, 4.8))
+    ax = canvas.ax
     anchor = None
     for tool in table.unique("tool"):
         sub = table.where(tool=tool)
@@ -211,4 +221,4 @@ def energy_growth_chart(table: Table, path: str | Path, title: str = "", *, samp
     ax.grid(True, which="major", alpha=0.3)
     ax.legend(fontsize=7.5, loc="upper left", bbox_to_anchor=(1.01, 1.0))
     measurement_notes(ax, meta.get("notes", []))
-    return save(fig, path, table.meta)
+    return canvas.done(table.meta)
