@@ -31,7 +31,7 @@ from .impulses import Impulse
 from .integrate import _contacts_of, _energy_threshold, _model_of, _newton, _sample_times, integrate
 from .model import Model, NativeSystem, _scene_model
 from .scenes import Scene
-from .trajectory import Trajectory, _trajectory
+from .trajectory import Trajectory, _trajectory, labelled_dataset
 
 if TYPE_CHECKING:
     import xarray
@@ -223,8 +223,12 @@ class Ensemble:
         Returns
         -------
         xarray.Dataset
-            ``q`` and ``p`` with dims (member, time, coordinate), ``status`` by member, the
-            parameters as coordinates of ``member``.
+            ``q`` and ``p`` with dims (member, time, coordinate), the coordinate axis labelled
+            with the model's names, ``status`` by member, the parameters as coordinates of
+            ``member``; each variable's ``long_name`` and (where the model states them)
+            ``units``, and the run's ``method``, ``dt``, ``model``, ``members`` and
+            ``varmech_version`` as attributes, as :meth:`varmech.Trajectory.to_xarray` gives
+            them.
 
         Raises
         ------
@@ -242,19 +246,12 @@ class Ensemble:
         >>> dict(data.sizes), list(data.data_vars)
         ({'member': 2, 'time': 5, 'coordinate': 2}, ['q', 'p', 'status'])
         """
-        try:
-            import xarray
-        except ImportError as err:
-            raise ImportError("to_xarray needs xarray: pip install 'varmech[xarray]'") from err
         dims = ("member", "time", "coordinate")
-        coords: dict[str, Any] = {
-            "member": np.arange(len(self)),
-            "time": self.t,
-            "coordinate": np.arange(self.q.shape[2]),
-        }
+        coords: dict[str, Any] = {"member": np.arange(len(self)), "time": self.t}
         coords.update({name: ("member", values) for name, values in self.parameters.items()})
         data = {"q": (dims, self.q), "p": (dims, self.p), "status": ("member", self.status)}
-        return xarray.Dataset(data, coords=coords)
+        first = self.trajectories[0]
+        return labelled_dataset(data, coords, first.model, first.method, first.dt, {"members": len(self)})
 
     def __repr__(self) -> str:
         shape = "×".join(map(str, self.q.shape))

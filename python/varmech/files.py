@@ -56,7 +56,7 @@ from .events import Occurrences
 from .impacts import Contact
 from .impulses import Impulse
 from .methods import method_info
-from .model import Model, from_recipe
+from .model import Model, from_recipe, variable_attributes
 
 if TYPE_CHECKING:
     from .trajectory import Trajectory
@@ -158,6 +158,7 @@ class Writer:
             if impulses:
                 # Likewise: the components given as numbers; one of Python functions by its time.
                 f.attrs["impulses"] = _impulses.stored(impulses)
+            labels = variable_attributes(model)
             for name in ("t", "q", "p", *columns):
                 shape = (0, n) if name in ("q", "p") else (0,)
                 f.create_dataset(
@@ -167,14 +168,14 @@ class Writer:
                     chunks=(CHUNK_ROWS, *shape[1:]),
                     dtype=_DTYPES.get(name, np.float64),
                     fletcher32=True,
-                )
+                ).attrs.update(labels[name])
             for slot in (0, 1):
                 f.create_dataset(
                     f"checkpoint{slot}", shape=(0,), maxshape=(None,), chunks=(4096,), dtype=np.uint8, fletcher32=True
                 )
             f.create_dataset("committed", data=np.zeros(5, dtype=np.int64), chunks=(5,), fletcher32=True)
             _store_model(f, model)
-            _create_events(f, events, n)
+            _create_events(f, events, n, labels)
             f.swmr_mode = True
         except OSError as e:
             raise ValueError(f"{argument}: cannot write {str(path)!r}: {e}") from e
@@ -213,7 +214,7 @@ class Writer:
                 f.close()
                 raise ValueError(f"events: the file's events are {stored_names}, not {list(events)}")
             if events and "events" not in f:
-                _create_events(f, events, int(f.attrs["dim"]))
+                _create_events(f, events, int(f.attrs["dim"]), variable_attributes(stored.model))
             f.swmr_mode = True
         except OSError as e:
             raise ValueError(f"path: cannot append to {str(path)!r}: {e}") from e
@@ -368,8 +369,9 @@ def stored_model(f: Any, source: Path, version: int, allow_pickle: bool) -> Mode
     return model
 
 
-def _create_events(f: Any, names: Sequence[str], n: int) -> None:
-    """The groups ``/events/<k>`` of the events ``names``, empty and growing."""
+def _create_events(f: Any, names: Sequence[str], n: int, labels: dict[str, dict[str, Any]]) -> None:
+    """The groups ``/events/<k>`` of the events ``names``, empty and growing, their columns
+    labelled as the run's (``labels``, :func:`varmech.model.variable_attributes`)."""
     if not names:
         return
     group = f.create_group("events")
@@ -379,7 +381,7 @@ def _create_events(f: Any, names: Sequence[str], n: int) -> None:
         for column, shape in (("t", (0,)), ("q", (0, n)), ("p", (0, n))):
             g.create_dataset(
                 column, shape=shape, maxshape=(None, *shape[1:]), chunks=(256, *shape[1:]), dtype=np.float64, fletcher32=True
-            )
+            ).attrs.update(labels[column])
 
 
 def _recover(path: Path) -> None:

@@ -366,6 +366,14 @@ class Model:
         return tuple(momentum_name(name, i) for i, name in enumerate(self.coordinates))
 
     @property
+    def units(self) -> dict[str, str]:
+        """The units of t, q, p, q̇ and the energy E (keys ``"t"``, ``"q"``, ``"p"``, ``"v"``,
+        ``"E"``) where the model states them: a catalogue scene's (:data:`SCENE_UNITS`;
+        dimensionless, ``"1"``, unless listed there); none for one's own model, whose units are
+        its author's."""
+        return {}
+
+    @property
     def delays(self) -> tuple[float, ...]:
         """The delays τ of the model's delayed forces (none for most models)."""
         return ()
@@ -715,6 +723,12 @@ class NativeSystem(Model):
             "build it with varmech.scenes.get(name, **parameters)"
         )
 
+    @property
+    def units(self) -> dict[str, str]:
+        if self.parameters is None:
+            return {}
+        return dict(SCENE_UNITS.get(self.name, DIMENSIONLESS))
+
     def _recipe(self) -> dict[str, Any] | None:
         if self.parameters is not None:
             return {"kind": "scene", "name": self.name, "parameters": dict(self.parameters)}
@@ -747,6 +761,33 @@ SCENE_COORDINATES: dict[str, tuple[str, ...]] = {
     "rolling_sphere": ("x", "y", "phi", "theta", "psi"),
     "ball_on_turntable": ("x", "y", "phi", "theta", "psi"),
 }
+
+
+#: The units of a scene without its own: every quantity dimensionless.
+DIMENSIONLESS = {"t": "1", "q": "1", "p": "1", "v": "1", "E": "1"}
+
+#: The units of the catalogue's scenes that have them, by name (as :attr:`Model.units` gives
+#: them); every other scene is dimensionless. The outer solar system is Hairer, Lubich and
+#: Wanner's: distances in astronomical units, time in days, masses in the Sun's.
+SCENE_UNITS: dict[str, dict[str, str]] = {
+    "outer_solar_system": {"t": "days", "q": "AU", "p": "solar masses AU/day", "v": "AU/day", "E": "solar masses AU^2/day^2"},
+}
+
+
+def variable_attributes(model: Model) -> dict[str, dict[str, Any]]:
+    """What a run's variables are, as files and labelled arrays carry it: each one's
+    ``long_name`` and ``units`` (CF's attribute names; ``units`` only where the model states
+    them, :attr:`Model.units`), and the names of q's and p's columns (``names``)."""
+    units = model.units
+    attributes: dict[str, dict[str, Any]] = {
+        "t": {"long_name": "time", "units": units.get("t")},
+        "q": {"long_name": "generalized coordinates q", "units": units.get("q"), "names": list(model.coordinates)},
+        "p": {"long_name": "conjugate momenta p = dL/dq'", "units": units.get("p"), "names": list(model.momentum_names)},
+        "v": {"long_name": "generalized velocities q'", "units": units.get("v"), "names": list(model.coordinates)},
+        "newton": {"long_name": "Newton iterations up to the state", "units": "1"},
+        "work": {"long_name": "energy put in up to the state: the forces' work less the integral of dL/dt", "units": units.get("E")},
+    }
+    return {name: {k: v for k, v in attrs.items() if v is not None} for name, attrs in attributes.items()}
 
 
 def _scene_model(name: str, parameters: dict[str, float]) -> NativeSystem:

@@ -19,7 +19,7 @@ from . import _core
 from ._core import energy_terms
 from ._util import floats, positive
 from .impacts import Contact
-from .model import SCENE_COORDINATES, Model, NativeSystem, initial_state
+from .model import SCENE_COORDINATES, SCENE_UNITS, Model, NativeSystem, initial_state
 from .modes import fastest_frequency
 
 __all__ = [
@@ -335,9 +335,9 @@ CONTACTS: dict[str, Callable[[dict[str, float]], tuple[Contact, ...]]] = {
 }
 
 
-#: The unit of t of the scenes that have one, by name; every other scene is in the model's own
-#: (dimensionless) "time units".
-TIME_UNITS: dict[str, str] = {"outer_solar_system": "days"}
+#: The unit of t of the scenes that have one, by name (:data:`varmech.model.SCENE_UNITS`); every
+#: other scene is in the model's own (dimensionless) "time units".
+TIME_UNITS: dict[str, str] = {name: units["t"] for name, units in SCENE_UNITS.items()}
 
 
 #: The symbolic scenes (:func:`varmech.symbolic.examples.scene`), which need SymPy.

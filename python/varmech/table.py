@@ -2,14 +2,18 @@
 
 from __future__ import annotations
 
+import copy
 import csv
 import math
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+
+if TYPE_CHECKING:
+    import pandas
 
 __all__ = [
     "Table",
@@ -236,6 +240,37 @@ class Table:
             writer.writerow(self.columns)
             writer.writerows(self.rows)
         return path
+
+    def to_pandas(self) -> pandas.DataFrame:
+        """The table as a :class:`pandas.DataFrame` (needs pandas, which the extra ``xarray``
+        brings): one column per column, one row per row, and the title and metadata, which say
+        what was measured and how, in ``DataFrame.attrs`` (``"title"`` and ``meta``'s entries).
+
+        Returns
+        -------
+        pandas.DataFrame
+            The rows under the table's column names.
+
+        Raises
+        ------
+        ImportError
+            pandas is missing.
+
+        Examples
+        --------
+        >>> table = Table(("method", "h", "error"), [("verlet", 0.1, 3.2e-3), ("rk4", 0.1, 2.0e-6)],
+        ...               title="Energy error", meta={"scene": "kepler"})
+        >>> frame = table.to_pandas()
+        >>> frame.loc[frame.error.idxmin(), "method"], frame.attrs
+        ('rk4', {'title': 'Energy error', 'scene': 'kepler'})
+        """
+        try:
+            import pandas
+        except ImportError as err:
+            raise ImportError("to_pandas needs pandas: pip install pandas (or 'varmech[xarray]')") from err
+        frame = pandas.DataFrame.from_records(self.rows, columns=list(self.columns))
+        frame.attrs = {"title": self.title, **copy.deepcopy(self.meta)}
+        return frame
 
     def __len__(self) -> int:
         return len(self.rows)

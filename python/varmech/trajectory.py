@@ -7,7 +7,7 @@ import os
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -16,10 +16,14 @@ from . import _core, dense, files
 from . import events as _events
 from . import impacts as _impacts
 from . import impulses as _impulses
+from ._version import __version__
 from .events import Occurrences
 from .impacts import Contact
 from .impulses import Impulse
-from .model import Model
+from .model import Model, variable_attributes
+
+if TYPE_CHECKING:
+    import xarray
 
 __all__ = [
     "Reactions",
@@ -393,6 +397,44 @@ class Trajectory:
         multipliers, force, (power, _) = _core.reactions(self.model._core, *self._arrays())
         return Reactions(multipliers, force, power)
 
+    def to_xarray(self) -> xarray.Dataset:
+        """The run as a labelled :class:`xarray.Dataset` (needs xarray, the extra ``xarray``).
+
+        Returns
+        -------
+        xarray.Dataset
+            ``q``, ``p`` and ``v`` with dims (time, coordinate), the coordinate axis labelled
+            with the model's names (:attr:`varmech.Model.coordinates`), and ``work`` and
+            ``newton`` by time where the run has them. Each variable's ``long_name`` and, where
+            the model states them, ``units`` are its attributes (p's ``names`` the momenta's);
+            the dataset's are the run's ``method``, ``dt``, ``model``, ``steps``, ``nfev``,
+            ``status``, ``message`` and the ``varmech_version`` that ran it.
+
+        Raises
+        ------
+        ImportError
+            xarray is missing.
+
+        See Also
+        --------
+        varmech.Ensemble.to_xarray : The same of many runs, by member.
+
+        Examples
+        --------
+        >>> import varmech
+        >>> traj = varmech.integrate(varmech.scenes.double_pendulum(), dt=0.01, steps=100, save_every=50)
+        >>> data = traj.to_xarray()
+        >>> dict(data.sizes), data.coordinate.values.tolist(), data.attrs["method"]
+        ({'time': 3, 'coordinate': 2}, ['theta1', 'theta2'], 'midpoint')
+        >>> data.p.attrs["names"], data.time.attrs["units"]
+        (['p_theta1', 'p_theta2'], '1')
+        """
+        dims = ("time", "coordinate")
+        data: dict[str, Any] = {"q": (dims, self.q), "p": (dims, self.p), "v": (dims, self.v)}
+        data.update({name: ("time", values) for name, values in (("work", self.work), ("newton", self.newton)) if values is not None})
+        run = {"steps": self.steps, "nfev": self.nfev, "status": self.status, "message": self.message}
+        return labelled_dataset(data, {"time": self.t}, self.model, self.method, self.dt, run)
+
     def _arrays(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(t, q, p) as arrays (read now from a file loaded lazily)."""
         return np.asarray(self.t), np.asarray(self.q), np.asarray(self.p)
@@ -405,6 +447,28 @@ class Trajectory:
             f"Trajectory({self.model.name!r}, method={self.method!r}, dt={self.dt:g}, steps={self.steps}, "
             f"saved={len(self.t)}, nfev={self.nfev}, status={self.status})"
         )
+
+
+def labelled_dataset(
+    data: dict[str, Any], coords: dict[str, Any], model: Model, method: str, dt: float, run: dict[str, Any]
+) -> xarray.Dataset:
+    """The xarray Dataset of a run's (or an ensemble's) ``data``, labelled: the coordinate axis
+    with the model's names, each variable (and the time axis) with its long name and unit
+    (:func:`varmech.model.variable_attributes`), the dataset with the method, the step, the
+    model, the varmech version and ``run``'s entries."""
+    try:
+        import xarray
+    except ImportError as err:
+        raise ImportError("to_xarray needs xarray: pip install 'varmech[xarray]'") from err
+    labels = variable_attributes(model)
+    coords = {
+        **coords,
+        "time": ("time", coords["time"], labels["t"]),
+        "coordinate": ("coordinate", list(model.coordinates), {"long_name": "the model's coordinates"}),
+    }
+    data = {name: (*value, labels[name]) if name in labels else value for name, value in data.items()}
+    attrs = {"method": method, "dt": dt, "model": repr(model), "varmech_version": __version__, **run}
+    return xarray.Dataset(data, coords=coords, attrs=attrs)
 
 
 def take_partial(err: BaseException) -> _core.TrajectoryRecord | None:
