@@ -27,10 +27,12 @@ from . import _errors, analysis, events, pointers, scenes
 from ._cite import cite
 from ._core import ConvergenceError, DivergenceError, SpuriousBranchError, VarmechError
 from ._version import __version__ as __version__
+from ._warnings import DerivativeWarning, VarmechWarning
 from .analysis import sections, stability
 from .analysis.energy_growth import energy_growth
 from .analysis.lyapunov import LyapunovSpectrum, Megno, lyapunov_spectrum, megno
 from .analysis.phase_portrait import phase_portrait
+from .analysis.reference import ReferenceWarning
 from .analysis.sections import poincare_section
 from .analysis.stability import (
     growth_factor,
@@ -46,7 +48,7 @@ from .conservation import ConservationReport, InvariantStatistics, check_conserv
 from .constraints import IntegrableConstraintsWarning, project
 from .derivatives import DerivativeCheck, check_derivatives
 from .ensemble import Ensemble, EnsembleConservation, ensemble
-from .impacts import Contact, ContactError, Friction
+from .impacts import Contact, ContactError, Friction, ImpactWarning
 from .impulses import Engagement, Impulse, ImpulseResponse, engage, impulse_response
 from .integrate import integrate, symplecticity_defect
 from .methods import MethodInfo, methods
@@ -77,12 +79,14 @@ __all__ = [
     "ConvergenceError",
     "Cyclic",
     "DerivativeCheck",
+    "DerivativeWarning",
     "DivergenceError",
     "Engagement",
     "Ensemble",
     "EnsembleConservation",
     "Equilibrium",
     "Friction",
+    "ImpactWarning",
     "Impulse",
     "ImpulseResponse",
     "IntegrableConstraintsWarning",
@@ -99,6 +103,7 @@ __all__ = [
     "Reactions",
     "ReducedModel",
     "Reference",
+    "ReferenceWarning",
     "Rotation",
     "Scene",
     "SpuriousBranchError",
@@ -109,6 +114,7 @@ __all__ = [
     "Trajectory",
     "Translation",
     "VarmechError",
+    "VarmechWarning",
     "analysis",
     "check_conservation",
     "check_derivatives",

@@ -9,6 +9,7 @@ from numpy.typing import ArrayLike
 
 from . import _core
 from ._util import vector
+from ._warnings import VarmechWarning
 from .model import Model
 
 __all__ = [
@@ -72,7 +73,7 @@ def project(model: Model, q0: ArrayLike, p0: ArrayLike | None = None, *, v0: Arr
     return _core.project(model._core, q0, p0)
 
 
-class IntegrableConstraintsWarning(UserWarning):
+class IntegrableConstraintsWarning(VarmechWarning):
     """Velocity constraints that integrate to holonomic ones near the initial state: give them
     as g(q) = 0 (``constraints=``), for RATTLE or the constrained DEL step.
 

@@ -282,7 +282,7 @@ def ensemble(
     workers: int | None = None,
     client: Any = None,
     chunk_size: int | None = None,
-    progress: bool | None = True,
+    progress: bool | None = None,
 ) -> Ensemble:
     """Integrate many members of ``model`` at once: member i from (``q0[i]``, ``p0[i]``).
 
@@ -343,7 +343,8 @@ def ensemble(
         ``client`` or closure processes, about four chunks a worker thread or process).
     progress
         A progress bar of the steps of all members (tqdm, on stderr) once the run has taken a
-        second; ``None``: only when stderr is a terminal.
+        second; ``None`` (default): only on a terminal (stderr) or in a Jupyter notebook, unless
+        ``TQDM_DISABLE`` is set, so that a log file gets none.
 
     Returns
     -------

@@ -66,10 +66,11 @@ from numpy.typing import ArrayLike
 from . import surfaces as _surfaces
 from ._core import ContactError
 from ._util import floats, integer, number
+from ._warnings import VarmechWarning
 from .events import Occurrences
 
 #: The public API; the rest serves :func:`varmech.integrate`.
-__all__ = ["Contact", "ContactError", "Friction"]
+__all__ = ["Contact", "ContactError", "Friction", "ImpactWarning"]
 
 #: The kinds of a contact's switches, by the code the core reports them with.
 SWITCHES = ("closed", "released", "stuck", "slipped")
@@ -474,13 +475,30 @@ def frictional(contacts: Sequence[Contact | str]) -> bool:
     return any(isinstance(c, Contact) and c.friction is not None for c in contacts)
 
 
+class ImpactWarning(VarmechWarning, RuntimeWarning):
+    """Grazing impacts whose discrete-energy equation had no solution near the reflection, and
+    which took Newton's law of restitution instead (a :class:`RuntimeWarning` too, as it was).
+
+    :func:`varmech.integrate` issues it once a run, with the count, where a contact's
+    ``law="variational"`` met such impacts; the run goes on.
+
+    Examples
+    --------
+    >>> import warnings, varmech
+    >>> issubclass(varmech.ImpactWarning, (varmech.VarmechWarning, RuntimeWarning))
+    True
+    >>> with warnings.catch_warnings():   # one's grazing impacts, expected
+    ...     warnings.simplefilter("ignore", varmech.ImpactWarning)
+    """
+
+
 def warn_grazing(count: int, stacklevel: int) -> None:
-    """The RuntimeWarning of ``count`` grazing impacts (none: no warning), at the caller
+    """The :class:`ImpactWarning` of ``count`` grazing impacts (none: no warning), at the caller
     ``stacklevel`` frames up from here."""
     if count:
         warnings.warn(
             f"{count} grazing impact(s) had no discrete-energy solution near the reflection and took Newton's law",
-            RuntimeWarning,
+            ImpactWarning,
             stacklevel=stacklevel + 1,
         )
 

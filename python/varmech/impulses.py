@@ -39,6 +39,7 @@ from numpy.typing import ArrayLike
 
 from . import _core
 from ._util import floats, vector
+from ._warnings import DerivativeWarning
 from .model import Model
 
 #: The public API; the rest serves :func:`varmech.integrate`.
@@ -134,7 +135,7 @@ class Impulse:
         if self.impulse is None:
             raise ValueError("impulse: a point struck needs the impulse vector, impulse=")
         if self.jacobian is None:
-            warnings.warn("impulse: no jacobian of the point given; central differences are used", stacklevel=4)
+            warnings.warn("impulse: no jacobian of the point given; central differences are used", DerivativeWarning, stacklevel=4)
         blow = np.asarray(self.impulse, dtype=float).reshape(-1).tolist()
         return "point", (self.point, self.jacobian, blow)
 
@@ -411,7 +412,7 @@ def engage(
         if jacobian is not None:
             a = np.atleast_2d(np.asarray(jacobian(qq.copy()), dtype=float))
         else:
-            warnings.warn("engage: no jacobian of the constraints given; central differences are used", stacklevel=2)
+            warnings.warn("engage: no jacobian of the constraints given; central differences are used", DerivativeWarning, stacklevel=2)
             a = _core.central_differences(constraints, qq, "constraints")
         name = "jacobian"
     if a.ndim != 2 or a.shape[1] != n:

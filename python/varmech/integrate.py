@@ -175,7 +175,7 @@ def integrate(
         compiled code. Other models have none (TypeError naming ``parameters``).
     progress
         Show a progress bar (tqdm, on stderr: steps, steps/s, time left) once the run has taken a
-        second. ``None`` (default): only when stderr is a terminal. It is updated at the stride
+        second. ``None`` (default): only on a terminal (stderr) or in a Jupyter notebook, unless TQDM_DISABLE is set. It is updated at the stride
         of the Ctrl-C check (every 10–40 ms), so it costs the step loop nothing measurable.
     output, overwrite
         Stream the saved states to the HDF5 file ``output`` (h5py, the extra ``io``; layout in

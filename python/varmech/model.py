@@ -15,6 +15,7 @@ from numpy.typing import ArrayLike
 from . import _core, pointers
 from ._core import ModelKind
 from ._util import callable_as, floats, integer, positive_int, returned, vector
+from ._warnings import DerivativeWarning
 
 __all__ = [
     "Cyclic",
@@ -992,6 +993,7 @@ class MechanicalSystem(Model):
             warnings.warn(
                 f"{name}: no {' and no '.join(missing)} given; central differences are used "
                 f"({2 * dim} calls each per force, about 1e-10 relative accuracy)",
+                DerivativeWarning,
                 stacklevel=2,
             )
         if native is not None:
@@ -1320,12 +1322,14 @@ class Lagrangian(Model):
             warnings.warn(
                 f"{name}: no dl_dt given; ∂L/∂t, which the energy balance tracks, comes from a central difference of L "
                 "in t (two calls of L per quadrature node and step, about 1e-10 relative accuracy)",
+                DerivativeWarning,
                 stacklevel=2,
             )
         if missing:
             warnings.warn(
                 f"{name}: no {' and no '.join(missing)} given; central differences of L are used "
                 f"({2 * dim} calls of L each, about 1e-10 relative accuracy)",
+                DerivativeWarning,
                 stacklevel=2,
             )
         total_force = force

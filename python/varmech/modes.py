@@ -32,6 +32,7 @@ from numpy.typing import ArrayLike
 
 from . import _core
 from ._util import finite, integer, number, vector
+from ._warnings import VarmechWarning
 from .methods import methods
 from .model import Model, Symmetry
 
@@ -589,7 +590,7 @@ def fastest_frequency(model: Model, q: ArrayLike, *, t: float = 0.0) -> float:
     return float(omega)
 
 
-class StabilityWarning(UserWarning):
+class StabilityWarning(VarmechWarning):
     """The step is beyond the method's stability limit on the model's fastest mode: the run will
     blow up (or, for a nonlinear model, stay where its frequencies are lower).
 

@@ -55,7 +55,7 @@ def test_closure_symmetries_are_checked_like_native_ones():
 
 
 def test_missing_gradient_warns_and_uses_central_differences():
-    with pytest.warns(UserWarning, match="central differences"):
+    with pytest.warns(varmech.DerivativeWarning, match="central differences"):
         fd = varmech.MechanicalSystem(2, examples.henon_heiles().potential)
     exact = examples.henon_heiles()
     scene = scenes.henon_heiles()

@@ -73,7 +73,7 @@ def test_time_dependent_lagrangian_is_judged_on_its_energy_balance():
     varmech.integrate(model, [1.0], [0.0], dt=0.05, steps=10, method="midpoint", max_energy_error=1.0)
     with pytest.raises(ValueError, match="^dl_dt: given for an L declared independent of t"):
         varmech.Lagrangian(1, model.lagrangian, dl_dq=model.dl_dq, dl_dv=model.dl_dv, dl_dt=model.dl_dt)
-    with pytest.warns(UserWarning, match="no dl_dt given"):
+    with pytest.warns(varmech.DerivativeWarning, match="no dl_dt given"):
         varmech.Lagrangian(1, model.lagrangian, dl_dq=model.dl_dq, dl_dv=model.dl_dv, time_dependent=True)
 
 
@@ -120,7 +120,7 @@ def test_check_derivatives_checks_second_derivatives_and_mass_derivatives():
 
 def test_lagrangian_without_derivatives_warns_and_uses_differences():
     exact = examples.double_pendulum()
-    with pytest.warns(UserWarning, match="no dl_dq and no dl_dv"):
+    with pytest.warns(varmech.DerivativeWarning, match="no dl_dq and no dl_dv"):
         fd = varmech.Lagrangian(2, exact.lagrangian)
     scene = scenes.double_pendulum()
     a = varmech.integrate(exact, scene.q0, scene.p0, dt=0.01, steps=100, method="midpoint")
@@ -192,7 +192,7 @@ def test_native_charged_particle_in_a_non_uniform_field_is_the_readme_closure():
     def A(q):
         return 0.5 * (1 + q @ q / 8) * np.array([-q[1], q[0]])
 
-    with pytest.warns(UserWarning, match="central differences"):
+    with pytest.warns(varmech.DerivativeWarning, match="central differences"):
         readme = varmech.Lagrangian(2, lambda q, v, t: 0.5 * v @ v + A(q) @ v, symmetries=[varmech.Rotation(spatial_dim=2)])
     scene = scenes.charged_particle_nonuniform()
     assert scene.model.symmetries == readme.symmetries

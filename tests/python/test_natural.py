@@ -48,7 +48,7 @@ def test_mass_closure_matches_the_native_double_pendulum(method):
 
 def test_mass_derivative_by_differences_warns_and_agrees():
     scene = scenes.double_pendulum()
-    with pytest.warns(UserWarning, match="no mass_derivative given"):
+    with pytest.warns(varmech.DerivativeWarning, match="no mass_derivative given"):
         model = double_pendulum()
     native = varmech.integrate(scene, dt=0.01, steps=200, method="midpoint")
     closure = varmech.integrate(model, scene.q0, scene.p0, dt=0.01, steps=200, method="midpoint")

@@ -152,7 +152,7 @@ def test_closure_models_with_module_level_functions_pickle():
 
 
 def test_a_closure_model_rebuilt_from_a_pickle_warns_no_more():
-    with pytest.warns(UserWarning, match="central differences"):
+    with pytest.warns(varmech.DerivativeWarning, match="central differences"):
         model = varmech.MechanicalSystem(1, pendulum_potential)
     with warnings.catch_warnings():
         warnings.simplefilter("error")

@@ -158,7 +158,7 @@ def test_pointer_functions_are_callable_from_python_and_checked_like_closures(nu
 
 def test_missing_derivatives_of_a_pointer_lagrangian_are_differenced(numba_double_pendulum):
     closure = examples.double_pendulum()
-    with pytest.warns(UserWarning, match="no dl_dq and no dl_dv"):
+    with pytest.warns(varmech.DerivativeWarning, match="no dl_dq and no dl_dv"):
         model = varmech.Lagrangian(2, numba_double_pendulum["lagrangian"])
     q, v = np.array([0.3, -0.7]), np.array([0.4, 1.1])
     # Central differences: about 1e-10 relative accuracy.

@@ -4,6 +4,7 @@ draws a tqdm bar that ends at the run's steps."""
 
 import importlib
 import io
+import sys
 
 import numpy as np
 import pytest
@@ -79,3 +80,37 @@ def test_no_bar_off_a_terminal_by_default(monkeypatch):
     s = varmech.scenes.kepler()
     varmech.integrate(s, dt=s.dt, steps=1000)
     assert len(bars) == 1 and bars[0].disable  # pytest's stderr is not a terminal
+
+
+class ZMQInteractiveShell:
+    """Stands for a Jupyter kernel's shell, by its class's name as IPython's is."""
+
+
+def test_a_notebook_shows_bars_by_default_and_tqdm_disable_turns_them_off(monkeypatch):
+    from varmech import _progress
+
+    monkeypatch.delenv("TQDM_DISABLE", raising=False)
+    assert not _progress._shown(None)   # pytest's stderr is not a terminal, and no kernel runs
+    fake = type(sys)("IPython")
+    fake.get_ipython = ZMQInteractiveShell
+    monkeypatch.setitem(sys.modules, "IPython", fake)
+    assert _progress._shown(None) and not _progress._shown(False)
+    monkeypatch.setenv("TQDM_DISABLE", "1")
+    assert not _progress._shown(None) and _progress._shown(True)
+
+
+def test_an_ensemble_draws_no_bar_into_a_log_by_default(monkeypatch):
+    ensemble_module = importlib.import_module("varmech.ensemble")
+    disabled = []
+    shown = ensemble_module.progress_bar
+
+    def record(**kwargs):
+        bar = shown(**kwargs)
+        disabled.append(bar.disable)   # as made: closing a bar disables it
+        return bar
+
+    monkeypatch.setattr(ensemble_module, "progress_bar", record)
+    s = varmech.scenes.pendulum()
+    varmech.ensemble(s, np.zeros((2, 1)), np.full((2, 1), 0.5), dt=0.01, steps=100)
+    varmech.ensemble(s, np.zeros((2, 1)), np.full((2, 1), 0.5), dt=0.01, steps=100, progress=True)
+    assert disabled == [True, False]

@@ -50,7 +50,7 @@ def test_the_multiplier_is_the_pendulums_tension_for_every_model_source(source, 
         "closure without its jacobian": lambda: pendulum(jacobian=False),
     }
     if "without" in source:
-        with pytest.warns(UserWarning, match="no constraint_jacobian given"):
+        with pytest.warns(varmech.DerivativeWarning, match="no constraint_jacobian given"):
             model = makers[source]()
     else:
         model = makers[source]()

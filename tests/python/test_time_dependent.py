@@ -104,7 +104,7 @@ def test_a_pendulum_on_a_driven_support_keeps_its_balance_bounded_with_a_compile
     f = sp.lambdify((theta, w, t), L)
     fq = sp.lambdify((theta, w, t), sp.diff(L, theta))
     fv = sp.lambdify((theta, w, t), sp.diff(L, w))
-    with pytest.warns(UserWarning, match="no dl_dt"):
+    with pytest.warns(varmech.DerivativeWarning, match="no dl_dt"):
         closures = varmech.Lagrangian(
             1,
             lambda q, v, s: f(q[0], v[0], s),

@@ -335,7 +335,7 @@ def test_a_non_finite_energy_fails_the_report_even_when_l_depends_on_t():
     assert report.verdict == "failed" and report.energy.first_non_finite == 0
     assert "not finite from saved state 0" in str(report) and "does not evaluate" in str(report)
     # With a finite L the time-dependent energy is not judged: its balance is.
-    with pytest.warns(UserWarning, match="no dl_dt"):
+    with pytest.warns(varmech.DerivativeWarning, match="no dl_dt"):
         finite = varmech.Lagrangian(1, lambda q, v, t: 0.5 * v @ v - 0.5 * (1 + 0.1 * math.cos(t)) * q @ q, time_dependent=True)
     traj = varmech.integrate(finite, [1.0], [0.0], dt=0.1, steps=10, method="midpoint")
     report = varmech.check_conservation(traj)

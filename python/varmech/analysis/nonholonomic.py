@@ -141,7 +141,7 @@ def nonholonomic_energy(
     samples : int, default 2000
         Evenly spaced times at which the energy error is recorded.
     progress : bool, optional
-        Show a progress bar; default: when standard error is a terminal.
+        Show a progress bar; default: on a terminal (stderr) or in a Jupyter notebook, unless TQDM_DISABLE is set.
 
     Returns
     -------

@@ -15,6 +15,7 @@ from numpy.typing import ArrayLike
 
 from .. import _core
 from .._util import positive, positive_int
+from .._warnings import VarmechWarning
 from ..integrate import integrate
 from ..model import Model
 from ..scenes import Reference, Scene, as_scene
@@ -22,7 +23,7 @@ from ..scenes import Reference, Scene, as_scene
 __all__ = ["ReferenceWarning", "reference_solution"]
 
 
-class ReferenceWarning(UserWarning):
+class ReferenceWarning(VarmechWarning):
     """A computed reference did not reach the tolerance asked for (round-off or the step budget
     came first): its ``tolerance`` says what it did reach.
 

@@ -312,7 +312,7 @@ def chart(
     quick : bool, default False
         A short measurement (fewer steps, orbits and tolerances), for a first look and tests.
     progress : bool, optional
-        Show progress bars; default: when standard error is a terminal.
+        Show progress bars; default: on a terminal (stderr) or in a Jupyter notebook, unless TQDM_DISABLE is set.
     energies : tuple of float, optional
         The Poincaré sections' energy shells (default: Hénon–Heiles' 1/12 and 1/8, another
         scene's own energy) or the phase portrait's orbits (default: the pendulum's own, another
