@@ -22,12 +22,12 @@ import varmech
 M, m, l, g = 2.0, 1.0, 1.0, 9.81
 
 
-def mass(q):
+def mass(q: np.ndarray) -> np.ndarray:
     c = m * l * np.cos(q[1])
     return np.array([[M + m, c], [c, m * l**2]])
 
 
-def mass_derivative(q):  # index i is ∂M/∂qᵢ
+def mass_derivative(q: np.ndarray) -> np.ndarray:  # index i is ∂M/∂qᵢ
     dM = np.zeros((2, 2, 2))
     dM[1] = [[0.0, -m * l * np.sin(q[1])], [-m * l * np.sin(q[1]), 0.0]]
     return dM

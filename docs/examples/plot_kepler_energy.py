@@ -24,7 +24,7 @@ for method in ["verlet", "kahan_li8", "rk4"]:
 try:
     from scipy.integrate import solve_ivp
 
-    def rhs(t, y):
+    def rhs(t: float, y: np.ndarray) -> np.ndarray:
         q, p = y[:2], y[2:]
         return np.concatenate([p, -q / np.linalg.norm(q) ** 3])
 
