@@ -100,7 +100,9 @@ def tour_reduced(quick: bool, summary: Table) -> None:
 def tour(out: Path, quick: bool) -> int:
     """Integrate every scene with a few methods, print their conservation reports, and write
     energy-error plots and the charts of :data:`TOUR_CHARTS` to ``out`` (without matplotlib,
-    the reports only)."""
+    the reports only). Its exit status: 0, or 1 where a run or a chart failed (a varmech error,
+    which the tour says and goes on past) or a run's verdict is "failed"."""
+    problems: list[str] = []
     plots = True
     summary = Table(
         ("scene", "method", "steps", "seconds", "max_error", "verdict"),
@@ -115,7 +117,12 @@ def tour(out: Path, quick: bool) -> int:
         runs = {}
         for method in methods:
             start = time.perf_counter()
-            traj = integrate(scene, dt=scene.dt, steps=steps, method=method, save_every=save_every)
+            try:
+                traj = integrate(scene, dt=scene.dt, steps=steps, method=method, save_every=save_every)
+            except _core.VarmechError as e:
+                problems.append(f"{name}, {method}: {type(e).__name__}: {e}")
+                print(f"--- {method}: failed: {e}")
+                continue
             elapsed = time.perf_counter() - start
             runs[method] = traj
             print(f"--- {method}: {traj.nfev} force evaluations in {elapsed:.3f} s")
@@ -124,7 +131,9 @@ def tour(out: Path, quick: bool) -> int:
             stats = report.energy
             verdict = report.verdict if stats.name == "energy" else f"{stats.name} {report.verdict}"
             summary.append(name, method, steps, elapsed, stats.max_rel_error, verdict)
-        if plots:
+            if report.verdict == "failed":
+                problems.append(f"{name}, {method}: the verdict is failed")
+        if plots and runs:
             try:
                 path = out / f"{name}_energy.png"
                 charts.energy_error(runs, path, title=f"{name}: energy error, dt = {scene.dt:g} {scene.time_unit}", time_unit=scene.time_unit)
@@ -136,12 +145,17 @@ def tour(out: Path, quick: bool) -> int:
     if plots:
         print("\n=== charts: accuracy against cost, energy over long runs, stability, sections")
         for kind in TOUR_CHARTS:
-            for path in chart(kind, out=out, quick=quick, say=_note):
-                print(f"wrote {path}")
-    # The summary last, where the reader's eye lands.
+            try:
+                for path in chart(kind, out=out, quick=quick, say=_note):
+                    print(f"wrote {path}")
+            except _core.VarmechError as e:
+                problems.append(f"chart {kind}: {type(e).__name__}: {e}")
+    # The summary last, where the reader's eye lands, and what went wrong under it.
     print()
     print(summary.format(max_rows=None))
-    return 0
+    for problem in problems:
+        print(f"tour: {problem}", file=sys.stderr)
+    return 1 if problems else 0
 
 
 def _note(note: str) -> None:

@@ -77,6 +77,24 @@ def test_the_tour_runs_every_scene_with_its_showcase_or_its_kinds_methods():
     assert runs["damped_driven_pendulum"] == ((kind.default_method, kind.accurate_method), 100.0)
 
 
+def test_the_tour_exits_1_naming_what_failed_and_goes_on_past_it(tmp_path, monkeypatch, capsys):
+    import dataclasses
+
+    from varmech import cli
+
+    pendulum = scenes.pendulum()
+    # A step of half the period blows up at once; the run after it is the tour's own.
+    blowing_up = dataclasses.replace(pendulum, dt=3.0)
+    monkeypatch.setattr(cli, "tour_runs", lambda: [(blowing_up, ("verlet",), 30.0), (pendulum, ("verlet",), 10.0)])
+    monkeypatch.setattr(cli, "TOUR_REDUCED", [])
+    monkeypatch.setattr(cli, "TOUR_CHARTS", ())
+    assert cli.tour(tmp_path, quick=False) == 1
+    out, err = capsys.readouterr()
+    assert "tour: pendulum, verlet: DivergenceError" in err and out.count("Conservation report") == 1
+    monkeypatch.setattr(cli, "tour_runs", lambda: [(pendulum, ("verlet",), 10.0)])
+    assert cli.tour(tmp_path, quick=False) == 0
+
+
 def chart_from_the_command_line(run_cli, kind, out):
     """Runs ``chart <kind> --quick --format svg`` and checks that it wrote the files it names,
     figures and their data, with the CSV header of the kind."""
