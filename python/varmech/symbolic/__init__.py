@@ -36,6 +36,7 @@ from ._constructors import MAX_COORDINATES, lagrangian, mechanical, routh
 from ._delays import Delayed
 from ._lower import TAPE_OPS
 from ._mass_flow import MassFlow
+from ._mechanics import from_mechanics
 from ._model import SymbolicModel
 
-__all__ = ["MAX_COORDINATES", "TAPE_OPS", "Delayed", "MassFlow", "SymbolicModel", "examples", "lagrangian", "mechanical", "routh"]
+__all__ = ["MAX_COORDINATES", "TAPE_OPS", "Delayed", "MassFlow", "SymbolicModel", "examples", "from_mechanics", "lagrangian", "mechanical", "routh"]
