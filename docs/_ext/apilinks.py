@@ -15,13 +15,18 @@ from sphinx import addnodes
 _NAME = re.compile(r"^(?:varmech\.)?([A-Za-z_][\w]*(?:\.[A-Za-z_]\w*)*)(?:\(.*\))?$", re.S)
 
 
+# Where a name the guide writes without its module is looked for, after the top level.
+MODULES = ("charts", "analysis", "analysis.stability", "analysis.sections", "analysis.reference", "symbolic", "events", "scenes")
+
+
 def api_name(text: str, objects: dict[str, Any]) -> str | None:
-    """The documented object ``text`` names, or None."""
+    """The documented object ``text`` names (at varmech's top level, else in one of
+    :data:`MODULES`), or None."""
     match = _NAME.match(text.strip())
     if match is None:
         return None
-    name = f"varmech.{match.group(1)}"
-    return name if name in objects else None
+    candidates = [f"varmech.{match.group(1)}", *(f"varmech.{module}.{match.group(1)}" for module in MODULES)]
+    return next((name for name in candidates if name in objects), None)
 
 
 def link_literals(app: Any, doctree: nodes.document, docname: str) -> None:

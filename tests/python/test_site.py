@@ -39,10 +39,13 @@ def test_the_guides_inline_names_find_their_api_pages():
         from apilinks import api_name
     finally:
         sys.path.remove(str(ROOT / "docs" / "_ext"))
-    objects = dict.fromkeys(["varmech.integrate", "varmech.Trajectory.to_xarray", "varmech.symbolic.from_mechanics"])
+    objects = dict.fromkeys(
+        ["varmech.integrate", "varmech.Trajectory.to_xarray", "varmech.symbolic.from_mechanics", "varmech.charts.strobe_chart"]
+    )
     assert api_name("varmech.integrate", objects) == "varmech.integrate"
     assert api_name("integrate(model, q0, dt=0.1)", objects) == "varmech.integrate"
     assert api_name("Trajectory.to_xarray()", objects) == "varmech.Trajectory.to_xarray"
     assert api_name("symbolic.from_mechanics", objects) == "varmech.symbolic.from_mechanics"
+    assert api_name("strobe_chart(table, path)", objects) == "varmech.charts.strobe_chart"
     # A variable's method, an argument, a shell command: text.
     assert [api_name(t, objects) for t in ("traj.to_xarray()", "dt=0.1", "python -m varmech tour")] == [None] * 3
