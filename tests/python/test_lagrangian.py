@@ -242,3 +242,25 @@ def test_uniform_field_scene_reaches_its_exact_reference_and_validates_its_field
         scenes.charged_particle(float("nan"))
     with pytest.raises(ValueError, match="^gamma:"):
         scenes.damped_driven_pendulum(gamma=-1.0)
+
+
+@pytest.mark.parametrize("method", ["midpoint", "trapezoid"])
+def test_a_forced_two_point_step_takes_its_solutions_force_from_newtons_last_evaluation(method):
+    # One force call an evaluation of the step's equations, none more for the momentum change
+    # (nfev counts that change as one evaluation a step), and the same run as evaluating again.
+    calls = []
+
+    def force(q, v, t):
+        calls.append(t)
+        return -0.1 * v
+
+    model = varmech.Lagrangian(1, lambda q, v, t: 0.5 * v @ v - 0.5 * q @ q, dl_dq=lambda q, v, t: -q, dl_dv=lambda q, v, t: v, force=force)
+    counts = []
+    for steps in (1000, 2000):
+        calls.clear()
+        traj = varmech.integrate(model, [1.0], v0=[0.0], dt=0.01, steps=steps, method=method)
+        counts.append((len(calls), traj.nfev - traj.steps))
+    (short_calls, short_evaluations), (long_calls, long_evaluations) = counts
+    assert long_calls - short_calls == long_evaluations - short_evaluations > 0
+    # Damped at the exact rate to the method's order: E ∝ e^(−0.1 t) on average.
+    assert abs(traj.energy()[-1] / traj.energy()[0] / np.exp(-0.1 * 20.0) - 1) < 0.05

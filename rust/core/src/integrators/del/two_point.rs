@@ -13,6 +13,15 @@ struct Forcing {
     mid: Vec<f64>,
     vel: Vec<f64>,
     f: Vec<f64>,
+    /// The segment f was last evaluated on (q₀, δq, t, h): the solution's force is Newton's last
+    /// evaluation's, taken again only where the segment differs. A cache, not state: a restored
+    /// step evaluates afresh.
+    #[serde(skip)]
+    q0: Vec<f64>,
+    #[serde(skip)]
+    dq: Vec<f64>,
+    #[serde(skip)]
+    t_h: (f64, f64),
     history: Option<History>,
 }
 
@@ -22,6 +31,9 @@ impl Forcing {
             mid: vec![0.0; n],
             vel: vec![0.0; n],
             f: vec![0.0; n],
+            q0: vec![0.0; n],
+            dq: vec![0.0; n],
+            t_h: (f64::NAN, f64::NAN),
             history: None,
         }
     }
@@ -32,11 +44,27 @@ impl Forcing {
             *v = d / at.h;
         }
         let t = at.t + 0.5 * at.h;
+        self.t_h = (f64::NAN, f64::NAN);
         match &mut self.history {
             Some(history) => history.forces(sys, (&self.mid, &self.vel, t), &mut self.f)?,
             None => sys.force(&self.mid, &self.vel, t, &mut self.f)?,
         }
+        // Sized at the first evaluation after a restore (a cache is not in a checkpoint).
+        self.q0.clear();
+        self.q0.extend_from_slice(at.q0);
+        self.dq.clear();
+        self.dq.extend_from_slice(at.dq);
+        self.t_h = (at.t, at.h);
         Ok(&self.f)
+    }
+
+    /// The force on `at`: the last evaluation's where it was on the same segment (Newton's
+    /// last, at the solution: the same bits, one evaluation fewer a step), else a new one.
+    fn on<S: Lagrangian + ?Sized>(&mut self, sys: &S, at: Segment<'_>) -> Result<&[f64], ModelError> {
+        if self.t_h == (at.t, at.h) && self.q0 == at.q0 && self.dq == at.dq {
+            return Ok(&self.f);
+        }
+        self.evaluate(sys, at)
     }
 
     /// Records the step just solved, whose midpoint [`Forcing::evaluate`] holds, in the history.
@@ -160,7 +188,7 @@ fn momentum_change<R: DiscreteLagrangian, S: Lagrangian + ?Sized, V: Vector>(
     if !sys.is_forced() {
         return Ok(-time);
     }
-    let f = forcing.evaluate(sys, at)?;
+    let f = forcing.on(sys, at)?;
     let mut work = -time;
     for ((d, f), x) in dp.iter_mut().zip(f).zip(x) {
         *d += start.h * f;
