@@ -94,8 +94,13 @@ class Canvas:
                 spare.set_visible(False)
             self.axes = grid[:panels]
             return
-        given = [ax] if isinstance(ax, Axes) else list(np.ravel(np.asarray(ax, dtype=object))) if isinstance(ax, (list, tuple, np.ndarray)) else None
-        if given is None or not all(isinstance(a, Axes) for a in given):
+        if isinstance(ax, Axes):
+            given = [ax]
+        elif isinstance(ax, (list, tuple, np.ndarray)):
+            given = list(np.ravel(np.asarray(ax, dtype=object)))
+        else:
+            given = [ax]  # refused just below, by its type
+        if not all(isinstance(a, Axes) for a in given):
             raise TypeError(f"ax: expected a matplotlib Axes (or a sequence of them), got {type(ax).__name__}")
         if len(given) != panels:
             raise ValueError(f"ax: this chart draws {panels} panels, got {len(given)} Axes")

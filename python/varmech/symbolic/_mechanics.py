@@ -136,9 +136,9 @@ def _lagranges(method: Any) -> _Parts:
     q = list(method.q)
     holonomic = list(method._hol_coneqs)
     velocity = list(method.coneqs[len(holonomic) :])
-    qdot = [x.diff(me.dynamicsymbols._t) for x in q]
+    qdot = _rates(q)
     force = _generalized_forces(method.loads, method.inertial, qdot, {})
-    return _Parts(sp.sympify(method._L[0]), q, force, holonomic, _affine(velocity, qdot))
+    return _Parts(sp.sympify(method._L[0]), q, force, holonomic, _affine(velocity, qdot, {}))
 
 
 def _kanes(method: Any) -> _Parts:
@@ -146,11 +146,11 @@ def _kanes(method: Any) -> _Parts:
     if len(method._uaux):
         raise ValueError("system: auxiliary speeds (u_auxiliary, for reaction forces) are not taken; build it without them")
     q, u = list(method.q), list(method.u)
-    qdot = [x.diff(me.dynamicsymbols._t) for x in q]
+    qdot = _rates(q)
     speeds = _speeds(list(method._k_kqdot * sp.Matrix(qdot) + method._k_ku * sp.Matrix(u) + method._f_k), u)
     holonomic = list(method._f_h)
     velocity = list(method._k_nh * sp.Matrix(u) + method._f_nh) if len(method._k_nh) else []
-    velocity = _independent(_affine([sp.sympify(c).xreplace(speeds) for c in velocity], qdot), holonomic, q, qdot)
+    velocity = _independent(_affine(velocity, qdot, speeds), holonomic, q, qdot)
     L = _lagrangian(method.bodies, method._inertial, q, speeds)
     force = _generalized_forces(method.loads, method._inertial, qdot, speeds)
     return _Parts(L, q, force, holonomic, velocity)
@@ -161,14 +161,19 @@ def _system(system: Any) -> _Parts:
     if len(system.u_aux):
         raise ValueError("system: auxiliary speeds (u_aux, for reaction forces) are not taken; build it without them")
     q, u = list(system.q), list(system.u)
-    qdot = [x.diff(me.dynamicsymbols._t) for x in q]
+    qdot = _rates(q)
     speeds = _speeds(list(system.kdes), u)
-    velocity = _affine([sp.sympify(c).xreplace(speeds) for c in system.nonholonomic_constraints], qdot)
+    velocity = _affine(list(system.nonholonomic_constraints), qdot, speeds)
     loads = [*system.loads, *(load for actuator in system.actuators for load in actuator.to_loads())]
     potential, loads = _uniform_potential(loads, system.frame, system.fixed_point)
     L = _lagrangian(system.bodies, system.frame, q, speeds) - potential
     force = _generalized_forces(loads, system.frame, qdot, speeds)
     return _Parts(L, q, force, list(system.holonomic_constraints), velocity)
+
+
+def _rates(q: Sequence[sp.Expr]) -> list[sp.Expr]:
+    """The coordinates' rates q̇, their derivatives in t."""
+    return [x.diff(me.dynamicsymbols._t) for x in q]
 
 
 def _speeds(kinematics: Sequence[sp.Expr], u: Sequence[sp.Expr]) -> dict[sp.Expr, sp.Expr]:
@@ -254,13 +259,14 @@ def _generalized_forces(
     return force
 
 
-def _affine(constraints: Sequence[sp.Expr], qdot: Sequence[sp.Expr]) -> list[sp.Expr]:
-    """Velocity constraints, each affine in q̇ as varmech takes them (A(q)q̇ + b(q) = 0);
-    ValueError naming ``system`` otherwise."""
-    for c in constraints:
+def _affine(constraints: Sequence[sp.Expr], qdot: Sequence[sp.Expr], speeds: Mapping[sp.Expr, sp.Expr]) -> list[sp.Expr]:
+    """Velocity constraints written in q̇ (the speeds replaced by ``speeds``), each affine in q̇ as
+    varmech takes them (A(q)q̇ + b(q) = 0); ValueError naming ``system`` otherwise."""
+    written = [sp.sympify(c).xreplace(speeds) for c in constraints]
+    for c in written:
         if any(sp.diff(c, a, b) != 0 for a in qdot for b in qdot):
             raise ValueError(f"system: the velocity constraint {c} = 0 is not affine in the rates q̇ (A(q)q̇ + b(q) = 0)")
-    return [sp.sympify(c) for c in constraints]
+    return written
 
 
 def _independent(velocity: list[sp.Expr], holonomic: Sequence[sp.Expr], q: Sequence[sp.Expr], qdot: Sequence[sp.Expr]) -> list[sp.Expr]:
@@ -273,11 +279,12 @@ def _independent(velocity: list[sp.Expr], holonomic: Sequence[sp.Expr], q: Seque
     state = [*q, *free]
     rng = random.Random(0)
     at = {s: sp.Float(rng.uniform(0.3, 1.7)) for s in state}
+    zero = lambda x: abs(x) < 1e-9  # noqa: E731 - round-off of the random point's arithmetic
     rows = sp.Matrix(list(holonomic)).jacobian(list(q)).xreplace(at)
+    rank = rows.rank(iszerofunc=zero)
     kept: list[sp.Expr] = []
     for c in velocity:
-        row = sp.Matrix([c]).jacobian(list(qdot)).xreplace(at)
-        stacked = rows.col_join(row)
-        if stacked.rank(iszerofunc=lambda x: abs(x) < 1e-9) > rows.rank(iszerofunc=lambda x: abs(x) < 1e-9):
-            rows, kept = stacked, [*kept, c]
+        stacked = rows.col_join(sp.Matrix([c]).jacobian(list(qdot)).xreplace(at))
+        if stacked.rank(iszerofunc=zero) > rank:
+            rows, rank, kept = stacked, rank + 1, [*kept, c]
     return kept

@@ -61,7 +61,10 @@ impl Forcing {
     /// The force on `at`: the last evaluation's where it was on the same segment (Newton's
     /// last, at the solution: the same bits, one evaluation fewer a step), else a new one.
     fn on<S: Lagrangian + ?Sized>(&mut self, sys: &S, at: Segment<'_>) -> Result<&[f64], ModelError> {
-        if self.t_h == (at.t, at.h) && self.q0 == at.q0 && self.dq == at.dq {
+        // Compared by their bits: 0.0 and −0.0 are equal as numbers, not as a force's arguments.
+        let same =
+            |a: &[f64], b: &[f64]| a.len() == b.len() && a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits());
+        if same(&[self.t_h.0, self.t_h.1], &[at.t, at.h]) && same(&self.q0, at.q0) && same(&self.dq, at.dq) {
             return Ok(&self.f);
         }
         self.evaluate(sys, at)
