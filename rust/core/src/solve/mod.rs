@@ -29,6 +29,19 @@ macro_rules! sized {
 }
 pub(crate) use sized;
 
+/// `dst.copy_from_slice(src)` unrolled for n ≤ 8 ([`sized!`]): a step copies a model's few
+/// coordinates many times (a force's arguments, the delayed forces' past), and a call to
+/// `memcpy` costs more than the copy of so few numbers. Panics where the lengths differ, as
+/// `copy_from_slice` does.
+#[inline(always)]
+pub(crate) fn copy(dst: &mut [f64], src: &[f64]) {
+    #[inline(always)]
+    fn fixed(dst: &mut [f64], src: &[f64], n: usize) {
+        dst.copy_from_slice(&src[..n]);
+    }
+    sized!(fixed(dst, src; src.len()))
+}
+
 pub mod bracket;
 pub mod difference;
 pub mod interrupt;

@@ -4,6 +4,7 @@
 use serde::{Deserialize, Serialize};
 
 use crate::model::Lagrangian;
+use crate::solve::copy;
 use crate::ModelError;
 
 /// The states (q̄, v̄) at the force nodes of the last steps, oldest first, in a ring of `len`
@@ -79,6 +80,14 @@ impl History {
         }
     }
 
+    /// Brings `head` into the ring: a value a checkpoint brings may lie past it. A division
+    /// only then, not at every read and record.
+    fn settle(&mut self) {
+        if self.head >= self.len() {
+            self.head %= self.len();
+        }
+    }
+
     fn held(&self) -> usize {
         self.filled.min(self.len())
     }
@@ -101,11 +110,11 @@ impl History {
                 }
                 self.read_at = t;
             }
-            self.past_q[..n].copy_from_slice(q);
-            self.past_v[..n].copy_from_slice(v);
+            copy(&mut self.past_q[..n], q);
+            copy(&mut self.past_v[..n], v);
             sys.delayed_force(&self.past_q, &self.past_v, t, &mut self.terms)?;
             let (sum, terms) = self.terms.split_at_mut(n);
-            f.copy_from_slice(sum);
+            copy(f, sum);
             sum.fill(0.0);
             for (block, _) in terms.chunks_exact(n).zip(&self.acting).filter(|(_, on)| **on) {
                 sum.iter_mut().zip(block).for_each(|(d, x)| *d += x);
@@ -119,8 +128,7 @@ impl History {
     /// before the run's first node and the model gives no history. Refuses a history that no
     /// longer reaches s (a step made smaller since the ring was sized).
     fn state_at<S: Lagrangian + ?Sized>(&mut self, sys: &S, s: f64, j: usize) -> Result<bool, ModelError> {
-        // Once a read, not a division a node: head is a value a checkpoint brings.
-        self.head %= self.len();
+        self.settle();
         let (n, held) = (self.n, self.held());
         let block = (j + 1) * n;
         let before = |this: &mut Self| {
@@ -164,8 +172,8 @@ impl History {
         }
         let a = self.slot(lo) * n;
         if (time(lo) - s).abs() <= tolerance || lo + 1 >= held {
-            self.past_q[block..block + n].copy_from_slice(&self.q[a..a + n]);
-            self.past_v[block..block + n].copy_from_slice(&self.v[a..a + n]);
+            copy(&mut self.past_q[block..block + n], &self.q[a..a + n]);
+            copy(&mut self.past_v[block..block + n], &self.v[a..a + n]);
             return Ok(true);
         }
         let b = self.slot(lo + 1) * n;
@@ -196,15 +204,16 @@ impl History {
     /// Records the node (q, v, t) of a step taken, the oldest one leaving a full ring.
     pub(super) fn record(&mut self, q: &[f64], v: &[f64], t: f64) {
         let n = self.n;
+        self.settle();
         let slot = if self.filled < self.len() {
             self.slot(self.filled)
         } else {
-            let oldest = self.head % self.len();
-            self.head = (oldest + 1) % self.len();
+            let oldest = self.head;
+            self.head = if oldest + 1 == self.len() { 0 } else { oldest + 1 };
             oldest
         };
-        self.q[slot * n..(slot + 1) * n].copy_from_slice(q);
-        self.v[slot * n..(slot + 1) * n].copy_from_slice(v);
+        copy(&mut self.q[slot * n..(slot + 1) * n], q);
+        copy(&mut self.v[slot * n..(slot + 1) * n], v);
         self.times[slot] = t;
         self.filled = self.filled.saturating_add(1);
         self.read_at = no_past();

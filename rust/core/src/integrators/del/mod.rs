@@ -453,13 +453,13 @@ impl<Sc: StepEquations> Del<Sc> {
         self.work += self
             .scheme
             .momentum_change(sys, start, &self.x[m..], &residual[..u], out.dp)?;
-        out.dq.copy_from_slice(&self.x[self.x.len() - n..]);
+        crate::solve::copy(out.dq, &self.x[self.x.len() - n..]);
         if m > 0 {
             self.multipliers
                 .project_momentum(sys, constraints, start, &mut out, &self.options)?;
         }
         std::mem::swap(&mut self.before_last_dq, &mut self.last_dq);
-        self.last_dq.copy_from_slice(out.dq);
+        crate::solve::copy(&mut self.last_dq, out.dq);
         self.history = (self.history + 1).min(2);
         Ok(())
     }

@@ -13,16 +13,16 @@ struct Forcing {
     mid: Vec<f64>,
     vel: Vec<f64>,
     f: Vec<f64>,
-    /// The segment f was last evaluated on (q₀, δq, t, h): the solution's force is Newton's last
-    /// evaluation's, taken again only where the segment differs. A cache, not state: a restored
-    /// step evaluates afresh.
-    #[serde(skip)]
-    q0: Vec<f64>,
-    #[serde(skip)]
-    dq: Vec<f64>,
-    #[serde(skip)]
-    t_h: (f64, f64),
+    /// The time f was last evaluated at (NaN: none), with `mid` and `vel` its arguments: the
+    /// solution's force is Newton's last evaluation's, taken again only where the arguments
+    /// differ. A cache, not state: a restored step evaluates afresh.
+    #[serde(skip, default = "nothing_evaluated")]
+    at: f64,
     history: Option<History>,
+}
+
+fn nothing_evaluated() -> f64 {
+    f64::NAN
 }
 
 impl Forcing {
@@ -31,40 +31,40 @@ impl Forcing {
             mid: vec![0.0; n],
             vel: vec![0.0; n],
             f: vec![0.0; n],
-            q0: vec![0.0; n],
-            dq: vec![0.0; n],
-            t_h: (f64::NAN, f64::NAN),
+            at: nothing_evaluated(),
             history: None,
         }
     }
 
+    /// The force's arguments on the segment `at`: the midpoint, the velocity and the time.
+    #[inline(always)]
+    fn arguments(at: Segment<'_>) -> impl Iterator<Item = (f64, f64)> + '_ {
+        at.q0.iter().zip(at.dq).map(move |(q, d)| (q + 0.5 * d, d / at.h))
+    }
+
     fn evaluate<S: Lagrangian + ?Sized>(&mut self, sys: &S, at: Segment<'_>) -> Result<&[f64], ModelError> {
-        for (((m, v), q), d) in self.mid.iter_mut().zip(self.vel.iter_mut()).zip(at.q0).zip(at.dq) {
-            *m = q + 0.5 * d;
-            *v = d / at.h;
+        for ((m, v), (mid, vel)) in self.mid.iter_mut().zip(self.vel.iter_mut()).zip(Self::arguments(at)) {
+            (*m, *v) = (mid, vel);
         }
         let t = at.t + 0.5 * at.h;
-        self.t_h = (f64::NAN, f64::NAN);
+        self.at = f64::NAN;
         match &mut self.history {
             Some(history) => history.forces(sys, (&self.mid, &self.vel, t), &mut self.f)?,
             None => sys.force(&self.mid, &self.vel, t, &mut self.f)?,
         }
-        // Sized at the first evaluation after a restore (a cache is not in a checkpoint).
-        self.q0.clear();
-        self.q0.extend_from_slice(at.q0);
-        self.dq.clear();
-        self.dq.extend_from_slice(at.dq);
-        self.t_h = (at.t, at.h);
+        self.at = t;
         Ok(&self.f)
     }
 
-    /// The force on `at`: the last evaluation's where it was on the same segment (Newton's
+    /// The force on `at`: the last evaluation's where its arguments were the same (Newton's
     /// last, at the solution: the same bits, one evaluation fewer a step), else a new one.
     fn on<S: Lagrangian + ?Sized>(&mut self, sys: &S, at: Segment<'_>) -> Result<&[f64], ModelError> {
         // Compared by their bits: 0.0 and −0.0 are equal as numbers, not as a force's arguments.
-        let same =
-            |a: &[f64], b: &[f64]| a.len() == b.len() && a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits());
-        if same(&[self.t_h.0, self.t_h.1], &[at.t, at.h]) && same(&self.q0, at.q0) && same(&self.dq, at.dq) {
+        let same = (at.t + 0.5 * at.h).to_bits() == self.at.to_bits()
+            && Self::arguments(at)
+                .zip(self.mid.iter().zip(&self.vel))
+                .all(|((m, v), (mid, vel))| m.to_bits() == mid.to_bits() && v.to_bits() == vel.to_bits());
+        if same {
             return Ok(&self.f);
         }
         self.evaluate(sys, at)
@@ -237,7 +237,7 @@ impl<R: DiscreteLagrangian> StepEquations for TwoPoint<R> {
     }
 
     fn predict(&self, dq: &[f64], x: &mut [f64]) {
-        x.copy_from_slice(dq);
+        crate::solve::copy(x, dq);
     }
 
     fn quadrature(&mut self) -> &mut Quadrature {

@@ -73,8 +73,8 @@ impl Function {
             let (slots, regs) = &mut *scratch.borrow_mut();
             let n = q.len();
             slots.resize(self.tape.inputs().max(2 * n + 1), 0.0);
-            slots[..n].copy_from_slice(q);
-            slots[n..n + v.len()].copy_from_slice(v);
+            crate::solve::copy(&mut slots[..n], q);
+            crate::solve::copy(&mut slots[n..n + v.len()], v);
             slots[2 * n] = t;
             #[cfg(feature = "jit")]
             if let Some(code) = &self.code {
