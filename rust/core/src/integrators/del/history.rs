@@ -101,26 +101,27 @@ impl History {
         f: &mut [f64],
     ) -> Result<(), ModelError> {
         let n = self.n;
-        if t == self.read_at && sys.delayed_of_past_alone() {
+        if t != self.read_at {
+            for (j, tau) in sys.delays().iter().enumerate() {
+                self.acting[j] = self.state_at(sys, t - tau, j)?;
+            }
+            self.read_at = t;
+        } else if sys.delayed_of_past_alone() {
             sys.force(q, v, t, f)?;
-        } else {
-            if t != self.read_at {
-                for (j, tau) in sys.delays().iter().enumerate() {
-                    self.acting[j] = self.state_at(sys, t - tau, j)?;
-                }
-                self.read_at = t;
-            }
-            copy(&mut self.past_q[..n], q);
-            copy(&mut self.past_v[..n], v);
-            sys.delayed_force(&self.past_q, &self.past_v, t, &mut self.terms)?;
-            let (sum, terms) = self.terms.split_at_mut(n);
-            copy(f, sum);
-            sum.fill(0.0);
-            for (block, _) in terms.chunks_exact(n).zip(&self.acting).filter(|(_, on)| **on) {
-                sum.iter_mut().zip(block).for_each(|(d, x)| *d += x);
-            }
+            f.iter_mut().zip(&self.terms[..n]).for_each(|(f, d)| *f += d);
+            return Ok(());
         }
-        f.iter_mut().zip(&self.terms[..n]).for_each(|(f, d)| *f += d);
+        copy(&mut self.past_q[..n], q);
+        copy(&mut self.past_v[..n], v);
+        sys.delayed_force(&self.past_q, &self.past_v, t, &mut self.terms)?;
+        // f = Q + the sum of the terms acting, which Q's block then keeps.
+        let (sum, terms) = self.terms.split_at_mut(n);
+        for (i, (f, sum)) in f.iter_mut().zip(sum).enumerate() {
+            let acting = terms[i..].iter().step_by(n).zip(&self.acting).filter(|(_, on)| **on);
+            let now = *sum;
+            *sum = acting.fold(0.0, |s, (x, _)| s + x);
+            *f = now + *sum;
+        }
         Ok(())
     }
 
