@@ -101,6 +101,34 @@ fn a_tape_says_which_outputs_read_which_slots() {
 }
 
 #[test]
+fn a_restricted_tape_keeps_its_outputs_instructions_and_their_bits() {
+    // [sin q₀ · q̇₀, cos t · q₀] restricted to its first output: cos t and its product go, and
+    // what stays computes the same bits, interpreted and compiled (the gradients without ∂L/∂t).
+    let mut b = Builder::default();
+    let (q0, v0, t) = (b.input(0), b.input(1), b.input(2));
+    let s = b.unary(Unary::Sin, q0);
+    let product = b.binary(Binary::Mul, s, v0);
+    let c = b.unary(Unary::Cos, t);
+    let late = b.binary(Binary::Mul, c, q0);
+    let tape = b.tape(vec![product, late], 1, 0);
+    let first = tape.restricted(0..1);
+    assert_eq!((first.ops().len(), first.outputs().len()), (4, 1), "{:?}", first.ops());
+    assert!(!first.reads(0..1, |slot| slot == 2));
+    let (mut all, mut alone) = ([0.0; 2], [0.0; 1]);
+    let inputs = [0.7, -1.3, 2.5];
+    tape.eval(&inputs, &[], &mut [0.0; 8], &mut all);
+    first.eval(&inputs, &[], &mut [0.0; 8], &mut alone);
+    assert_eq!(all[0].to_bits(), alone[0].to_bits());
+    let second = tape.restricted(1..2);
+    assert_eq!(second.ops().len(), 4, "{:?}", second.ops());
+    second.eval(&inputs, &[], &mut [0.0; 8], &mut alone);
+    assert_eq!(all[1].to_bits(), alone[0].to_bits());
+    let compiled = varmech::model::compiled::Function::compiled(tape).restricted(0..1);
+    compiled.eval(&inputs[..1], &inputs[1..2], inputs[2], &[], &mut alone);
+    assert_eq!(all[0].to_bits(), alone[0].to_bits());
+}
+
+#[test]
 fn malformed_tapes_are_refused_with_their_name() {
     let later = Tape::new("gradient", vec![Op::Unary(Unary::Sin, 0)], vec![0], 3, 0);
     assert!(later.unwrap_err().to_string().starts_with("gradient: instruction 0"));

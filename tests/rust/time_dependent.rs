@@ -2,6 +2,8 @@
 //! `Trajectory::work`): E − E₀ − W falls at the method's order on a parametric oscillator, with
 //! ∂L/∂t exact and differenced, and the run's energy check holds it.
 
+use std::cell::Cell;
+
 use varmech::integrators::{integrate, General, Method, Options};
 use varmech::model::Lagrangian;
 use varmech::ModelError;
@@ -75,5 +77,97 @@ fn the_balance_of_a_parametric_oscillator_falls_at_each_rules_order() {
             let measured = (pair[0] / pair[1]).log2();
             assert!((measured - order).abs() < 0.25, "{method:?}: {errors:?}");
         }
+    }
+}
+
+/// [`Parametric`] (∂L/∂t exact) that also gives ∂L/∂t with its gradients, as a compiled L of t
+/// does, counting how often each is asked for.
+struct Counted {
+    model: Parametric,
+    gradients: Cell<usize>,
+    with_dl_dt: Cell<usize>,
+    dl_dt: Cell<usize>,
+}
+
+impl Lagrangian for Counted {
+    fn dim(&self) -> usize {
+        1
+    }
+
+    fn lagrangian(&self, q: &[f64], v: &[f64], t: f64) -> Result<f64, ModelError> {
+        self.model.lagrangian(q, v, t)
+    }
+
+    fn dl_dq(&self, q: &[f64], v: &[f64], t: f64, out: &mut [f64]) -> Result<(), ModelError> {
+        self.model.dl_dq(q, v, t, out)
+    }
+
+    fn dl_dv(&self, q: &[f64], v: &[f64], t: f64, out: &mut [f64]) -> Result<(), ModelError> {
+        self.model.dl_dv(q, v, t, out)
+    }
+
+    fn gradients(&self, q: &[f64], v: &[f64], t: f64, dq: &mut [f64], dv: &mut [f64]) -> Result<(), ModelError> {
+        self.gradients.set(self.gradients.get() + 1);
+        self.model.gradients(q, v, t, dq, dv)
+    }
+
+    fn gradients_and_dl_dt(
+        &self,
+        q: &[f64],
+        v: &[f64],
+        t: f64,
+        dq: &mut [f64],
+        dv: &mut [f64],
+    ) -> Result<Option<f64>, ModelError> {
+        self.with_dl_dt.set(self.with_dl_dt.get() + 1);
+        self.model.gradients(q, v, t, dq, dv)?;
+        self.model.dl_dt(q, v, t).map(Some)
+    }
+
+    fn is_time_dependent(&self) -> bool {
+        true
+    }
+
+    fn dl_dt(&self, q: &[f64], v: &[f64], t: f64) -> Result<f64, ModelError> {
+        self.dl_dt.set(self.dl_dt.get() + 1);
+        self.model.dl_dt(q, v, t)
+    }
+}
+
+#[test]
+fn newton_takes_dl_dt_only_at_its_last_evaluation() {
+    // The midpoint rule: Newton asks for ∂L/∂t once a step, at the evaluation its correction
+    // ends on (the solution), and the gradients alone at its other evaluations; Galerkin's
+    // rule once a node and step, at the solution. The balance is the same, to the bit, as
+    // the model's own ∂L/∂t evaluated apart (the trait's default, `Parametric`).
+    let steps = 400;
+    for (method, nodes) in [(Method::Midpoint, 1), (Method::Galerkin4, 2)] {
+        let counted = Counted {
+            model: Parametric { exact: true },
+            gradients: Cell::new(0),
+            with_dl_dt: Cell::new(0),
+            dl_dt: Cell::new(0),
+        };
+        fn run<L: Lagrangian>(model: &L, method: Method, steps: usize) -> varmech::integrators::Trajectory {
+            integrate(
+                &General(model),
+                method,
+                &[1.0],
+                &[0.0],
+                &Options::new(0.05, steps),
+                || Ok(()),
+            )
+            .unwrap()
+        }
+        let (traj, plain) = (
+            run(&counted, method, steps),
+            run(&Parametric { exact: true }, method, steps),
+        );
+        assert_eq!(counted.with_dl_dt.get(), nodes * steps, "{method:?}");
+        assert_eq!(counted.dl_dt.get(), 0, "{method:?}");
+        assert!(counted.gradients.get() >= 2 * nodes * steps, "{method:?}");
+        let bits = |w: &[f64]| w.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        assert_eq!(bits(&traj.work), bits(&plain.work), "{method:?}");
+        assert_eq!(bits(&traj.q), bits(&plain.q), "{method:?}");
     }
 }

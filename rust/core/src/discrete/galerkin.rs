@@ -239,11 +239,17 @@ impl Galerkin {
     }
 
     /// ∂L/∂q + f and ∂L/∂q̇ at every quadrature node, for the control increments `at.dq`
-    /// (Q₀ = q₀), with ∂L/∂t where the model gives it with them; returns the forces' work over
+    /// (Q₀ = q₀), with ∂L/∂t where `with_dl_dt` asks (at the solution, for the energy balance)
+    /// and the model gives it with them; returns the forces' work over
     /// the step, h Σᵢ bᵢ f(cᵢ)·q̇(cᵢ). A force f enters
     /// where ∂L/∂q does: the discrete Lagrange–d'Alembert principle adds the virtual work
     /// h Σᵢ bᵢ f(cᵢ)·δq(cᵢh) to δL_d, and δq(cᵢh) = Σⱼ ℓⱼ(cᵢ)δQⱼ.
-    pub(crate) fn derivatives<S: Lagrangian + ?Sized>(&mut self, sys: &S, at: Segment<'_>) -> Result<f64, ModelError> {
+    pub(crate) fn derivatives<S: Lagrangian + ?Sized>(
+        &mut self,
+        sys: &S,
+        at: Segment<'_>,
+        with_dl_dt: bool,
+    ) -> Result<f64, ModelError> {
         let quad = &mut self.quadrature;
         // A scheme read from a checkpoint has none kept.
         self.dl_dt.resize(quad.s, None);
@@ -251,7 +257,13 @@ impl Galerkin {
         for i in 0..quad.s {
             quad.node_state(i, &at);
             let ti = at.t + quad.nodes[i] * at.h;
-            self.dl_dt[i] = sys.gradients_and_dl_dt(&quad.pos, &quad.vel, ti, &mut self.lq[i], &mut self.lv[i])?;
+            let (lq, lv) = (&mut self.lq[i], &mut self.lv[i]);
+            self.dl_dt[i] = if with_dl_dt {
+                sys.gradients_and_dl_dt(&quad.pos, &quad.vel, ti, lq, lv)?
+            } else {
+                sys.gradients(&quad.pos, &quad.vel, ti, lq, lv)?;
+                None
+            };
             if sys.is_forced() {
                 sys.force(&quad.pos, &quad.vel, ti, &mut self.f)?;
                 let mut power = 0.0;

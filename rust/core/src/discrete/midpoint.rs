@@ -12,8 +12,8 @@ use serde::{Deserialize, Serialize};
 pub struct Midpoint;
 
 impl Midpoint {
-    /// ∂L/∂q into ws.a and ∂L/∂q̇ into ws.b, at the midpoint (∂L/∂t into ws.dl_dt where the
-    /// model gives it with them).
+    /// ∂L/∂q into ws.a and ∂L/∂q̇ into ws.b, at the midpoint (∂L/∂t into ws.dl_dt where asked,
+    /// [`Workspace::keep_dl_dt`], and the model gives it with them).
     #[inline(always)]
     fn derivatives<S: Lagrangian + ?Sized, V: Vector>(
         sys: &S,
@@ -21,13 +21,13 @@ impl Midpoint {
         ws: &mut Workspace<V>,
     ) -> Result<(), ModelError> {
         ws.set(at, 0.5);
-        ws.dl_dt[0] = sys.gradients_and_dl_dt(
-            ws.x.as_ref(),
-            ws.v.as_ref(),
-            at.t + 0.5 * at.h,
-            ws.a.as_mut(),
-            ws.b.as_mut(),
-        )?;
+        let (x, v, t) = (ws.x.as_ref(), ws.v.as_ref(), at.t + 0.5 * at.h);
+        ws.dl_dt[0] = if std::mem::take(&mut ws.with_dl_dt) {
+            sys.gradients_and_dl_dt(x, v, t, ws.a.as_mut(), ws.b.as_mut())?
+        } else {
+            sys.gradients(x, v, t, ws.a.as_mut(), ws.b.as_mut())?;
+            None
+        };
         Ok(())
     }
 }

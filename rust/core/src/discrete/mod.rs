@@ -45,6 +45,18 @@ pub struct Workspace<V = Vec<f64>> {
     /// gives it with them ([`Lagrangian::gradients_and_dl_dt`]); not state, so not kept.
     #[serde(skip)]
     dl_dt: [Option<f64>; 1],
+    /// Whether the next evaluation of the gradients takes ∂L/∂t with them
+    /// ([`Workspace::keep_dl_dt`]).
+    #[serde(skip)]
+    with_dl_dt: bool,
+}
+
+impl<V> Workspace<V> {
+    /// Has the next evaluation of the gradients take ∂L/∂t with them, for the energy balance:
+    /// Newton's last evaluation, at the solution; the others take the gradients alone.
+    pub(crate) fn keep_dl_dt(&mut self) {
+        self.with_dl_dt = true;
+    }
 }
 
 impl Workspace {
@@ -56,6 +68,7 @@ impl Workspace {
             b: vec![0.0; n],
             c: vec![0.0; n],
             dl_dt: [None],
+            with_dl_dt: false,
         }
     }
 }
@@ -69,6 +82,7 @@ impl<const N: usize> Default for Workspace<[f64; N]> {
             b: [0.0; N],
             c: [0.0; N],
             dl_dt: [None],
+            with_dl_dt: false,
         }
     }
 }

@@ -137,6 +137,11 @@ pub(crate) trait NewtonProblem {
     fn solved(&self, _residual: f64) -> bool {
         false
     }
+
+    /// Told before the evaluation of F at which the iteration ends (its correction converged),
+    /// for a problem that takes more than F from that evaluation (the DEL step: ∂L/∂t for the
+    /// energy balance, which the others need not compute). Default: nothing.
+    fn finishing(&mut self) {}
 }
 
 /// An iteration's progress, by the sizes of its corrections: whether the next step factorises
@@ -325,6 +330,10 @@ impl Newton {
             self.iterations += 1;
             lu_solve(&self.jacobian, &self.pivots, self.residual.as_mut_slice());
             let correction = problem.correct(self.residual.as_slice());
+            let converged = progress.converged(fresh, correction, options.tolerance, rules);
+            if converged {
+                problem.finishing();
+            }
             problem.residual(self.residual.as_mut_slice())?;
             residual = norm(self.residual.as_slice());
             if !(correction.size.is_finite() && residual.is_finite()) {
@@ -332,7 +341,7 @@ impl Newton {
                     reason: reasons.non_finite,
                 });
             }
-            if progress.converged(fresh, correction, options.tolerance, rules) || problem.solved(residual) {
+            if converged || problem.solved(residual) {
                 return Ok(Solution {
                     iterations: iteration,
                     residual,

@@ -119,6 +119,10 @@ impl<R: DiscreteLagrangian> Del<TwoPoint<R>> {
                 iterations += 1;
                 substitute(lu.as_flattened(), &pivots, &mut r, N);
                 let correction = correct(&mut x, &r, 0, h);
+                let converged = progress.converged(fresh, correction, options.tolerance, rules);
+                if converged {
+                    ws.keep_dl_dt();
+                }
                 evaluations += 1;
                 self.scheme.equations_in(&mut ws, sys, start, &x, &mut r)?;
                 residual = norm(&r);
@@ -127,7 +131,7 @@ impl<R: DiscreteLagrangian> Del<TwoPoint<R>> {
                         reason: REASONS.non_finite,
                     });
                 }
-                if progress.converged(fresh, correction, options.tolerance, rules) {
+                if converged {
                     break;
                 }
             }

@@ -23,7 +23,7 @@ impl StepEquations for Galerkin {
         out: &mut [f64],
     ) -> Result<(), ModelError> {
         let (n, s, h) = (start.q.len(), self.quadrature.degree(), start.h);
-        self.derivatives(sys, segment(&start, x))?;
+        self.derivatives(sys, segment(&start, x), false)?;
         for j in 1..s {
             self.slot(j, h, &mut out[(j - 1) * n..j * n]);
         }
@@ -42,7 +42,7 @@ impl StepEquations for Galerkin {
         dp: &mut [f64],
     ) -> Result<f64, ModelError> {
         let at = segment(&start, x);
-        let work = self.derivatives(sys, at)?;
+        let work = self.derivatives(sys, at, true)?;
         self.slot_sum(start.h, dp);
         for block in residual.chunks_exact(start.q.len()) {
             dp.iter_mut().zip(block).for_each(|(d, r)| *d -= r);

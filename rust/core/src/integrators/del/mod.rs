@@ -62,6 +62,10 @@ pub trait StepEquations {
 
     /// The quadrature that defines the scheme's L_d.
     fn quadrature(&mut self) -> &mut Quadrature;
+
+    /// Told before the evaluation of F at which Newton's iteration ends
+    /// ([`NewtonProblem::finishing`]). Default: nothing.
+    fn finishing(&mut self) {}
 }
 
 /// The discrete Lagrangian's segment of a step whose unknowns are `x`.
@@ -553,6 +557,10 @@ impl<Sc: StepEquations, S: Lagrangian + ?Sized> NewtonProblem for Equations<'_, 
 
     fn correct(&mut self, delta: &[f64]) -> Correction {
         correct(self.x, delta, self.m, self.start.h)
+    }
+
+    fn finishing(&mut self) {
+        self.scheme.finishing();
     }
 }
 

@@ -243,4 +243,8 @@ impl<R: DiscreteLagrangian> StepEquations for TwoPoint<R> {
     fn quadrature(&mut self) -> &mut Quadrature {
         &mut self.quadrature
     }
+
+    fn finishing(&mut self) {
+        self.ws.keep_dl_dt();
+    }
 }

@@ -49,6 +49,17 @@ impl Function {
         Self::new(tape)
     }
 
+    /// The function of its outputs `outputs` alone ([`Tape::restricted`]), compiled where this
+    /// one is.
+    pub fn restricted(&self, outputs: std::ops::Range<usize>) -> Self {
+        let tape = self.tape.restricted(outputs);
+        if self.is_compiled() {
+            Self::compiled(tape)
+        } else {
+            Self::new(tape)
+        }
+    }
+
     /// Whether machine code runs this function.
     pub fn is_compiled(&self) -> bool {
         #[cfg(feature = "jit")]

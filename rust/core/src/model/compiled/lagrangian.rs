@@ -20,6 +20,9 @@ pub struct CompiledLagrangian {
     params: Vec<f64>,
     lagrangian: Function,
     gradients: Function,
+    /// (∂L/∂q, ∂L/∂q̇) without ∂L/∂t where `gradients` gives it too: a step's Newton
+    /// iterations need it only at their last evaluation.
+    gradients_alone: Option<Function>,
     hessians: Function,
     force: Option<Function>,
     dl_dt: Option<Function>,
@@ -102,6 +105,7 @@ impl CompiledLagrangian {
             n,
             params,
             lagrangian,
+            gradients_alone: with_time.then(|| gradients.restricted(0..2 * n)),
             gradients,
             hessians,
             force,
@@ -125,6 +129,11 @@ impl CompiledLagrangian {
 
     pub fn parameters(&self) -> &[f64] {
         &self.params
+    }
+
+    /// The gradients' function without ∂L/∂t where it has one of its own.
+    fn gradients_alone(&self) -> &Function {
+        self.gradients_alone.as_ref().unwrap_or(&self.gradients)
     }
 
     /// Refuses a state where a variable mass is not positive and finite (masses depend on q
@@ -157,19 +166,24 @@ impl Lagrangian for CompiledLagrangian {
     }
 
     fn dl_dq(&self, q: &[f64], v: &[f64], t: f64, out: &mut [f64]) -> Result<(), ModelError> {
-        self.gradients
+        self.gradients_alone()
             .eval_into(q, v, t, &self.params, |g| out.copy_from_slice(&g[..self.n]));
         Ok(())
     }
 
     fn dl_dv(&self, q: &[f64], v: &[f64], t: f64, out: &mut [f64]) -> Result<(), ModelError> {
-        self.gradients
+        self.gradients_alone()
             .eval_into(q, v, t, &self.params, |g| out.copy_from_slice(&g[self.n..2 * self.n]));
         Ok(())
     }
 
     fn gradients(&self, q: &[f64], v: &[f64], t: f64, dq: &mut [f64], dv: &mut [f64]) -> Result<(), ModelError> {
-        self.gradients_and_dl_dt(q, v, t, dq, dv).map(drop)
+        let n = self.n;
+        self.gradients_alone().eval_into(q, v, t, &self.params, |g| {
+            dq.copy_from_slice(&g[..n]);
+            dv.copy_from_slice(&g[n..2 * n]);
+        });
+        Ok(())
     }
 
     fn gradients_and_dl_dt(

@@ -287,6 +287,43 @@ impl Tape {
         self.outputs[outputs].iter().any(|&r| reads[r as usize])
     }
 
+    /// The tape of the outputs `outputs` alone: the instructions they do not read left out,
+    /// the others in their order (so the same arithmetic, to the bit).
+    pub fn restricted(&self, outputs: std::ops::Range<usize>) -> Tape {
+        let outputs = &self.outputs[outputs];
+        let mut live = vec![false; self.ops.len()];
+        outputs.iter().for_each(|&o| live[o as usize] = true);
+        for i in (0..self.ops.len()).rev() {
+            if !live[i] {
+                continue;
+            }
+            match self.ops[i] {
+                Op::Unary(_, a) | Op::Powi(a, _) => live[a as usize] = true,
+                Op::Binary(_, a, b) => (live[a as usize], live[b as usize]) = (true, true),
+                Op::Const(_) | Op::Input(_) | Op::Param(_) => {}
+            }
+        }
+        let mut register = vec![0; self.ops.len()];
+        let mut ops = Vec::new();
+        for (i, op) in self.ops.iter().enumerate().filter(|&(i, _)| live[i]) {
+            let r = |a: u32| register[a as usize];
+            let op = match *op {
+                Op::Unary(f, a) => Op::Unary(f, r(a)),
+                Op::Powi(a, n) => Op::Powi(r(a), n),
+                Op::Binary(f, a, b) => Op::Binary(f, r(a), r(b)),
+                op => op,
+            };
+            register[i] = ops.len() as u32;
+            ops.push(op);
+        }
+        Tape {
+            ops,
+            outputs: outputs.iter().map(|&o| register[o as usize]).collect(),
+            inputs: self.inputs,
+            params: self.params,
+        }
+    }
+
     /// Runs the tape: registers in `regs` (at least as many as instructions), outputs into
     /// `out` (as many as outputs). `inputs` and `params` have the tape's lengths.
     pub fn eval(&self, inputs: &[f64], params: &[f64], regs: &mut [f64], out: &mut [f64]) {
