@@ -3,10 +3,10 @@ that tracks −Σ∂L_d/∂t against the same run of the same functions declared
 (built on the binding directly, past the Python check that would refuse it), side by side,
 interleaved, best of ``--repeat``.
 
-Two models: a pendulum on a vertically driven support compiled from SymPy (∂L/∂t compiled, the
-gradients' last output, so that a step keeps it from its last evaluation of them) under
-the midpoint rule and Galerkin's fourth-order rule, and the parametric oscillator from closures
-with its ∂L/∂t closure (midpoint).
+Three models: a pendulum on a vertically driven support compiled from SymPy (∂L/∂t compiled, the
+gradients' last output, so that a step keeps it from Newton's last evaluation of them) under
+the midpoint rule and Galerkin's fourth-order rule, a double pendulum on the same support, and
+the parametric oscillator from closures with its ∂L/∂t closure (midpoint).
 
     PYTHONPATH=$PWD/python python benches/time_dependent.py [--repeat 7] [--markdown benches/time_dependent_results.md]
 """
@@ -37,7 +37,26 @@ def pendulum() -> tuple[object, object]:
     y = 0.05 * sp.cos(7.0 * t)
     ydot = sp.diff(y, t)
     L = (0.64 * w**2 + ydot**2 + 2 * ydot * 0.8 * sp.sin(theta) * w) / 2 - G * (y - 0.8 * sp.cos(theta))
-    model = varmech.symbolic.lagrangian(L, [theta], [w], t=t)
+    return compiled(varmech.symbolic.lagrangian(L, [theta], [w], t=t))
+
+
+def double_pendulum() -> tuple[object, object]:
+    """A double pendulum (unit masses and lengths) on the same driven support, compiled."""
+    q1, q2, w1, w2, t = sp.symbols("q1 q2 w1 w2 t")
+    y = 0.05 * sp.cos(7.0 * t)
+    x1, y1 = sp.sin(q1), y - sp.cos(q1)
+    x2, y2 = x1 + sp.sin(q2), y1 - sp.cos(q2)
+    rate = {q1: w1, q2: w2}
+
+    def d(e):
+        return sum(sp.diff(e, q) * rate[q] for q in (q1, q2)) + sp.diff(e, t)
+
+    L = (d(x1) ** 2 + d(y1) ** 2 + d(x2) ** 2 + d(y2) ** 2) / 2 - G * (y1 + y2)
+    return compiled(varmech.symbolic.lagrangian(L, [q1, q2], [w1, w2], t=t))
+
+
+def compiled(model: varmech.Model) -> tuple[object, object]:
+    """A compiled L of t, tracked, and its functions declared independent of t (untracked)."""
     spec, symbols = model._spec, model._symbolic
     # Untracked: the gradients' tape without ∂L/∂t, its last output, lowered afresh.
     slots = {s: i for i, s in enumerate((*symbols.q, *symbols.v, symbols.t))}
@@ -73,7 +92,8 @@ def oscillator() -> tuple[object, object]:
 
 def run(core, method: str, steps: int) -> float:
     start = time.perf_counter()
-    _core.integrate(core, np.array([0.6]), np.array([0.0]), dt=0.005, steps=steps, method=method, save_every=steps, max_energy_error=None)
+    n = core.dim
+    _core.integrate(core, np.full(n, 0.6), np.zeros(n), dt=0.005, steps=steps, method=method, save_every=steps, max_energy_error=None)
     return time.perf_counter() - start
 
 
@@ -85,6 +105,7 @@ def main() -> None:
     cases = [
         ("driven pendulum, compiled", "midpoint", *pendulum(), 200_000),
         ("driven pendulum, compiled", "galerkin4", *pendulum(), 50_000),
+        ("driven double pendulum, compiled", "midpoint", *double_pendulum(), 50_000),
         ("parametric oscillator, closures", "midpoint", *oscillator(), 20_000),
     ]
     rows = []
