@@ -347,6 +347,12 @@ class Model:
         return _core.is_forced(self._core)
 
     @property
+    def conserves_energy(self) -> bool:
+        """Whether its energy function is a first integral: L does not depend on t and no force
+        acts."""
+        return not (self.time_dependent or self.forced)
+
+    @property
     def energy_name(self) -> str:
         """What reports call the energy function E = p·q̇ − L: ``"energy"``, or ``"Jacobi
         integral"`` for an L autonomous in a moving frame (a symbolic L from inertial

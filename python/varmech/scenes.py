@@ -129,6 +129,9 @@ class Scene:
     time_unit : str
         The unit of t on charts' axes: ``"days"`` for the outer solar system, else
         ``"time units"``.
+    long_run : float
+        The horizon of its long runs (the energy-growth chart): 50 ``t_end`` for a built-in
+        scene, whose ``t_end`` is its test protocol's; ``t_end`` for one's own (:meth:`Scene.of`).
 
     Examples
     --------
@@ -160,6 +163,12 @@ class Scene:
     parameters: dict[str, float] = field(default_factory=dict)
     contacts: tuple[Contact, ...] = ()
     time_unit: str = "time units"
+    long_run: float = 0.0
+
+    def __post_init__(self) -> None:
+        # One's own scene's long run is the horizon given (a frozen dataclass: set once, here).
+        if not self.long_run:
+            object.__setattr__(self, "long_run", self.t_end)
 
     @classmethod
     def of(
@@ -237,7 +246,7 @@ class Scene:
         if reference is not None and not isinstance(reference, Reference):
             raise TypeError(f"reference: expected a varmech.scenes.Reference, got {type(reference).__name__}")
         invariants = {}
-        if not (model.time_dependent or model.forced):
+        if model.conserves_energy:
             invariants[model.energy_name] = float(energy_terms(model._core, np.zeros(1), q[None], p[None])[0][0])
         label = model.name if name is None else name
         for argument, text in (("name", label), ("description", description), ("time_unit", time_unit)):
@@ -343,6 +352,9 @@ TIME_UNITS: dict[str, str] = {name: units["t"] for name, units in SCENE_UNITS.it
 #: The symbolic scenes (:func:`varmech.symbolic.examples.scene`), which need SymPy.
 SYMBOLIC = ("elastic_pendulum",)
 
+#: A built-in scene's long run (:attr:`Scene.long_run`), in horizons of its test protocol.
+LONG_RUNS = 50
+
 
 def get(name: str, **parameters: float) -> Scene:
     """The scene called ``name`` (one of :data:`CATALOGUE`) with ``parameters`` set by keyword
@@ -396,6 +408,7 @@ def get(name: str, **parameters: float) -> Scene:
         record.parameters,
         CONTACTS[name](record.parameters) if name in CONTACTS else (),
         TIME_UNITS.get(name, "time units"),
+        LONG_RUNS * record.t_end,
     )
 
 

@@ -24,6 +24,3 @@ def relative_error(h: np.ndarray) -> np.ndarray:
     return np.abs(h - h[0]) / scale
 
 
-def conserves_energy(model: Model) -> bool:
-    """H is a first integral: L does not depend on t and no force acts."""
-    return not (model.time_dependent or model.forced)

@@ -12,7 +12,7 @@ from ..events import Event
 from ..model import Model
 from ..scenes import Scene
 from ..trajectory import Trajectory
-from ._energy import conserves_energy, energy_of
+from ._energy import energy_of
 
 ModelLike = Model | Scene
 
@@ -24,7 +24,7 @@ def model_of(model_or_scene: ModelLike, forced: bool = False) -> Model:
         raise TypeError(f"model_or_scene: expected a varmech model or scene, got {type(model_or_scene).__name__}")
     if model.constraints:
         raise ValueError(f"model_or_scene: {model.name} is constrained; sections need an unconstrained model")
-    if not forced and not conserves_energy(model):
+    if not forced and not model.conserves_energy:
         raise ValueError(f"model_or_scene: {model.name} does not conserve its energy (time-dependent or forced)")
     return model
 

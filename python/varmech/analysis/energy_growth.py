@@ -25,7 +25,7 @@ from ..model import Model
 from ..scenes import Scene, as_scene
 from ..table import Table
 from . import baselines as _baselines
-from ._energy import conserves_energy, energy_of, relative_error
+from ._energy import energy_of, relative_error
 from ._interrupt import interruptible
 
 __all__ = [
@@ -129,8 +129,9 @@ def energy_growth(
     methods
         varmech method names.
     t_end, dt
-        The horizon (default 50 × ``scene.t_end``: 10⁴ periods for :func:`~varmech.scenes.kepler`;
-        a model's, as given) and the step (default ``scene.dt``; a model's from
+        The horizon (default the scene's long run, :attr:`~varmech.Scene.long_run`: 50 ×
+        ``t_end`` for a built-in scene, 10⁴ periods for :func:`~varmech.scenes.kepler`; one's own
+        scene's ``t_end``; a model's, as given) and the step (default ``scene.dt``; a model's from
         :meth:`~varmech.Scene.of`); the horizon is rounded to whole steps.
     samples
         Log-spaced bins of t per method (and the number of evenly spaced states for the
@@ -200,7 +201,7 @@ def energy_growth(
     ['bounded', 'secular drift']
     """
     scene = as_scene(scene, q0=q0, p0=p0, v0=v0, t_end=t_end, dt=dt)
-    if not conserves_energy(scene.model):
+    if not scene.model.conserves_energy:
         raise ValueError(f"scene: the energy of {scene.name!r} is not conserved (L depends on t, or forces act)")
     methods = list(methods)
     baselines = list(baselines)
@@ -208,7 +209,7 @@ def energy_growth(
     if bad:
         raise ValueError(f"baselines: unknown method(s) {bad}; choose from {_baselines.SCIPY_METHODS + _baselines.REBOUND_METHODS}")
     h = positive("dt", scene.dt if dt is None else dt)
-    T = 50 * scene.t_end if t_end is None else positive("t_end", t_end)
+    T = scene.long_run if t_end is None else positive("t_end", t_end)
     n = max(1, round(T / h))
     T = n * h
     Tb = T / 10 if baseline_t_end is None else float(baseline_t_end)

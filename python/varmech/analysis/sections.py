@@ -50,7 +50,6 @@ from ..events import crossing
 from ..model import Model, coordinate_names, momentum_name
 from ..table import Table
 from ..trajectory import Trajectory
-from ._energy import conserves_energy
 from ._interrupt import interruptible
 from ._orbits import ModelLike, default_method, energy_at, model_of, relative, run_orbits, solve_momentum
 
@@ -369,7 +368,7 @@ def poincare_section(
     (True, True)
     """
     model = model_of(model_or_scene, forced=True)
-    forced = not conserves_energy(model)
+    forced = not model.conserves_energy
     cols, momenta = _names(model, names)
     if locate not in ("step", "hermite"):
         raise ValueError(f"locate: 'step' or 'hermite', got {locate!r}")

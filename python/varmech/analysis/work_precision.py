@@ -31,7 +31,7 @@ from ..model import Model
 from ..scenes import Reference, Scene, as_scene
 from ..table import Table
 from . import baselines as _baselines
-from ._energy import conserves_energy, energy_of, relative_error
+from ._energy import energy_of, relative_error
 from ._interrupt import interruptible
 from .reference import reference_solution
 
@@ -274,7 +274,7 @@ def work_precision(
     notes: list[str] = table.meta["notes"]
     if ref_note:
         notes.append(ref_note)
-    conserved = conserves_energy(scene.model)
+    conserved = scene.model.conserves_energy
     bad = [b for b in baselines if b not in _baselines.SCIPY_METHODS]
     if bad:
         raise ValueError(f"baselines: unknown solve_ivp method(s) {bad}; choose from {_baselines.SCIPY_METHODS}")

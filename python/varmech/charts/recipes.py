@@ -109,9 +109,7 @@ def _work_precision(sc, methods, quick, progress, options):
 
 
 def _energy(sc, methods, quick, progress, options):
-    # A built-in scene's long run is 50 of its horizons; one's own model runs to the horizon given.
-    builtin = sc.name in scenes.CATALOGUE or sc.name in scenes.SYMBOLIC
-    t_end = (50 if builtin else 1) * sc.t_end / (10 if quick else 1)
+    t_end = sc.long_run / (10 if quick else 1)
     table = energy_growth.energy_growth(sc, methods, t_end=t_end, samples=500 if quick else 2000, progress=progress)
     title = f"{sc.name}: max energy error up to t, over t = 0 … {t_end:g} {sc.time_unit}"
     return [

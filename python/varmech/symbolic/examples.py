@@ -32,7 +32,7 @@ import numpy as np
 import sympy as sp
 
 from ..model import Rotation
-from ..scenes import CATALOGUE, Scene
+from ..scenes import CATALOGUE, LONG_RUNS, Scene
 from ._constructors import lagrangian, mechanical
 from ._mass_flow import MassFlow
 from ._model import SymbolicModel
@@ -943,6 +943,7 @@ def _elastic_pendulum_scene() -> Scene:
         # Resolves the fastest (radial) period 2π/√10 ≈ 2 with 40 steps.
         dt=0.05,
         parameters=model.parameters,
+        long_run=LONG_RUNS * 1000.0,
     )
 
 
