@@ -30,9 +30,10 @@ macro_rules! sized {
 pub(crate) use sized;
 
 /// `dst.copy_from_slice(src)` unrolled for n ≤ 8 ([`sized!`]): a step copies a model's few
-/// coordinates many times (a force's arguments, the delayed forces' past), and a call to
-/// `memcpy` costs more than the copy of so few numbers. Panics where the lengths differ, as
-/// `copy_from_slice` does.
+/// coordinates many times (a force's arguments, the gradients out of their tape, the delayed
+/// forces' past), and a call to `memcpy` costs more than the copy of so few numbers (and its
+/// masked stores stall the loads that read them back, [`fill`]). Panics where the lengths
+/// differ, as `copy_from_slice` does.
 #[inline(always)]
 pub(crate) fn copy(dst: &mut [f64], src: &[f64]) {
     #[inline(always)]
@@ -40,6 +41,18 @@ pub(crate) fn copy(dst: &mut [f64], src: &[f64]) {
         dst.copy_from_slice(&src[..n]);
     }
     sized!(fixed(dst, src; src.len()))
+}
+
+/// `dst.fill(value)` unrolled for n ≤ 8, as [`copy`]: glibc's `memset` and `memmove` write so
+/// few bytes with masked vector stores, which the loads that soon read them back cannot take
+/// from the store buffer.
+#[inline(always)]
+pub(crate) fn fill(dst: &mut [f64], value: f64) {
+    #[inline(always)]
+    fn fixed(dst: &mut [f64], value: f64, n: usize) {
+        dst[..n].fill(value);
+    }
+    sized!(fixed(dst, value; dst.len()))
 }
 
 pub mod bracket;

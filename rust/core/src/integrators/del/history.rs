@@ -160,8 +160,10 @@ impl History {
         // The last node at or before s: the nodes are a step apart (the step is kept), so its
         // index is the quotient, corrected by one either way for round-off in the times.
         let last = held - 1;
+        // The cast truncates: the floor of a quotient ≥ 0, and 0 for one just below it as the
+        // floor's −1 would saturate to; without `floor`, which is a call to libm on x86-64.
         let guess = if spacing > 0.0 {
-            ((s - first) / spacing + 1e-9).floor() as usize
+            ((s - first) / spacing + 1e-9) as usize
         } else {
             0
         };

@@ -3,6 +3,7 @@
 use super::function::{check, check_parameters, Inputs};
 use super::Function;
 use crate::model::{differenced_dl_dt, inverse_legendre, Hessians, Lagrangian};
+use crate::solve::{copy, fill};
 use crate::{Error, ModelError};
 
 /// L(q, q̇, t; parameters) with its exact derivatives, each a [`Function`] of the slots
@@ -167,21 +168,21 @@ impl Lagrangian for CompiledLagrangian {
 
     fn dl_dq(&self, q: &[f64], v: &[f64], t: f64, out: &mut [f64]) -> Result<(), ModelError> {
         self.gradients_alone()
-            .eval_into(q, v, t, &self.params, |g| out.copy_from_slice(&g[..self.n]));
+            .eval_into(q, v, t, &self.params, |g| copy(out, &g[..self.n]));
         Ok(())
     }
 
     fn dl_dv(&self, q: &[f64], v: &[f64], t: f64, out: &mut [f64]) -> Result<(), ModelError> {
         self.gradients_alone()
-            .eval_into(q, v, t, &self.params, |g| out.copy_from_slice(&g[self.n..2 * self.n]));
+            .eval_into(q, v, t, &self.params, |g| copy(out, &g[self.n..2 * self.n]));
         Ok(())
     }
 
     fn gradients(&self, q: &[f64], v: &[f64], t: f64, dq: &mut [f64], dv: &mut [f64]) -> Result<(), ModelError> {
         let n = self.n;
         self.gradients_alone().eval_into(q, v, t, &self.params, |g| {
-            dq.copy_from_slice(&g[..n]);
-            dv.copy_from_slice(&g[n..2 * n]);
+            copy(dq, &g[..n]);
+            copy(dv, &g[n..2 * n]);
         });
         Ok(())
     }
@@ -196,8 +197,8 @@ impl Lagrangian for CompiledLagrangian {
     ) -> Result<Option<f64>, ModelError> {
         let n = self.n;
         Ok(self.gradients.eval_into(q, v, t, &self.params, |g| {
-            dq.copy_from_slice(&g[..n]);
-            dv.copy_from_slice(&g[n..2 * n]);
+            copy(dq, &g[..n]);
+            copy(dv, &g[n..2 * n]);
             g.get(2 * n).copied()
         }))
     }
@@ -244,8 +245,8 @@ impl Lagrangian for CompiledLagrangian {
         };
         f.eval_into(&[], &[], s, &self.params, |state| {
             let (at, rate) = state.split_at(self.n);
-            q.copy_from_slice(at);
-            v.copy_from_slice(rate);
+            copy(q, at);
+            copy(v, rate);
         });
         Ok(true)
     }
@@ -263,7 +264,7 @@ impl Lagrangian for CompiledLagrangian {
         self.check_masses(q, v, t)?;
         match &self.force {
             Some(f) => f.eval(q, v, t, &self.params, out),
-            None => out.fill(0.0),
+            None => fill(out, 0.0),
         }
         Ok(())
     }
