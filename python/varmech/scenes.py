@@ -129,9 +129,11 @@ class Scene:
     time_unit : str
         The unit of t on charts' axes: ``"days"`` for the outer solar system, else
         ``"time units"``.
+    long_runs : int
+        Its long runs' length in horizons ``t_end``: :data:`LONG_RUNS` for a built-in scene,
+        whose ``t_end`` is its test protocol's; 1 for one's own (:meth:`Scene.of`).
     long_run : float
-        The horizon of its long runs (the energy-growth chart): 50 ``t_end`` for a built-in
-        scene, whose ``t_end`` is its test protocol's; ``t_end`` for one's own (:meth:`Scene.of`).
+        The horizon of its long runs (the energy-growth chart): ``long_runs`` × ``t_end``.
 
     Examples
     --------
@@ -163,12 +165,12 @@ class Scene:
     parameters: dict[str, float] = field(default_factory=dict)
     contacts: tuple[Contact, ...] = ()
     time_unit: str = "time units"
-    long_run: float = 0.0
+    long_runs: int = 1
 
-    def __post_init__(self) -> None:
-        # One's own scene's long run is the horizon given (a frozen dataclass: set once, here).
-        if not self.long_run:
-            object.__setattr__(self, "long_run", self.t_end)
+    @property
+    def long_run(self) -> float:
+        """The horizon of its long runs (the energy-growth chart): ``long_runs`` × ``t_end``."""
+        return self.long_runs * self.t_end
 
     @classmethod
     def of(
@@ -352,7 +354,7 @@ TIME_UNITS: dict[str, str] = {name: units["t"] for name, units in SCENE_UNITS.it
 #: The symbolic scenes (:func:`varmech.symbolic.examples.scene`), which need SymPy.
 SYMBOLIC = ("elastic_pendulum",)
 
-#: A built-in scene's long run (:attr:`Scene.long_run`), in horizons of its test protocol.
+#: A built-in scene's long runs (:attr:`Scene.long_run`), in horizons of its test protocol.
 LONG_RUNS = 50
 
 
@@ -408,7 +410,7 @@ def get(name: str, **parameters: float) -> Scene:
         record.parameters,
         CONTACTS[name](record.parameters) if name in CONTACTS else (),
         TIME_UNITS.get(name, "time units"),
-        LONG_RUNS * record.t_end,
+        LONG_RUNS,
     )
 
 

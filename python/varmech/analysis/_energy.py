@@ -22,5 +22,3 @@ def relative_error(h: np.ndarray) -> np.ndarray:
     """|H − H₀|/|H₀| (absolute when H₀ = 0)."""
     scale = abs(h[0]) if h[0] != 0 else 1.0
     return np.abs(h - h[0]) / scale
-
-

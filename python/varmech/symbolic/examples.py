@@ -943,7 +943,7 @@ def _elastic_pendulum_scene() -> Scene:
         # Resolves the fastest (radial) period 2π/√10 ≈ 2 with 40 steps.
         dt=0.05,
         parameters=model.parameters,
-        long_run=LONG_RUNS * 1000.0,
+        long_runs=LONG_RUNS,
     )
 
 

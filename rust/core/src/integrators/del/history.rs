@@ -212,7 +212,7 @@ impl History {
             self.slot(self.filled)
         } else {
             let oldest = self.head;
-            self.head = if oldest + 1 == self.len() { 0 } else { oldest + 1 };
+            self.head = self.slot(1);
             oldest
         };
         copy(&mut self.q[slot * n..(slot + 1) * n], q);

@@ -21,9 +21,9 @@ pub struct CompiledLagrangian {
     params: Vec<f64>,
     lagrangian: Function,
     gradients: Function,
-    /// (∂L/∂q, ∂L/∂q̇) without ∂L/∂t where `gradients` gives it too: a step's Newton
-    /// iterations need it only at their last evaluation.
-    gradients_alone: Option<Function>,
+    /// (∂L/∂q, ∂L/∂q̇) without ∂L/∂t, `gradients` itself where it has none: a step's Newton
+    /// iterations need ∂L/∂t only at their last evaluation.
+    gradients_alone: Function,
     hessians: Function,
     force: Option<Function>,
     dl_dt: Option<Function>,
@@ -106,7 +106,11 @@ impl CompiledLagrangian {
             n,
             params,
             lagrangian,
-            gradients_alone: with_time.then(|| gradients.restricted(0..2 * n)),
+            gradients_alone: if with_time {
+                gradients.restricted(0..2 * n)
+            } else {
+                gradients.clone()
+            },
             gradients,
             hessians,
             force,
@@ -130,11 +134,6 @@ impl CompiledLagrangian {
 
     pub fn parameters(&self) -> &[f64] {
         &self.params
-    }
-
-    /// The gradients' function without ∂L/∂t where it has one of its own.
-    fn gradients_alone(&self) -> &Function {
-        self.gradients_alone.as_ref().unwrap_or(&self.gradients)
     }
 
     /// Refuses a state where a variable mass is not positive and finite (masses depend on q
@@ -167,20 +166,20 @@ impl Lagrangian for CompiledLagrangian {
     }
 
     fn dl_dq(&self, q: &[f64], v: &[f64], t: f64, out: &mut [f64]) -> Result<(), ModelError> {
-        self.gradients_alone()
+        self.gradients_alone
             .eval_into(q, v, t, &self.params, |g| copy(out, &g[..self.n]));
         Ok(())
     }
 
     fn dl_dv(&self, q: &[f64], v: &[f64], t: f64, out: &mut [f64]) -> Result<(), ModelError> {
-        self.gradients_alone()
+        self.gradients_alone
             .eval_into(q, v, t, &self.params, |g| copy(out, &g[self.n..2 * self.n]));
         Ok(())
     }
 
     fn gradients(&self, q: &[f64], v: &[f64], t: f64, dq: &mut [f64], dv: &mut [f64]) -> Result<(), ModelError> {
         let n = self.n;
-        self.gradients_alone().eval_into(q, v, t, &self.params, |g| {
+        self.gradients_alone.eval_into(q, v, t, &self.params, |g| {
             copy(dq, &g[..n]);
             copy(dv, &g[n..2 * n]);
         });
