@@ -114,3 +114,17 @@ fn a_forced_system_checks_its_energy_balance() {
     let balance = varmech::diagnostics::energy_statistics(&traj.t, &terms, &traj.work, traj.steps as u64).unwrap();
     assert!(balance.max_rel_error < 1e-6, "{balance:?}");
 }
+
+#[test]
+fn a_motion_damped_through_the_subnormal_numbers_to_rest_keeps_converging() {
+    // e^{−ct/2} falls below the smallest normal number (2.2e−308) at t ≈ 14 200 and below the
+    // smallest subnormal at t ≈ 14 900: there the increments carry no relative precision, and
+    // a relative test alone would never call Newton's corrections small enough.
+    for method in [Method::Midpoint, Method::Trapezoid, Method::Galerkin4] {
+        let traj = run(method, 0.1, 160_000, 1_000);
+        let subnormal = traj.q.iter().any(|q| q.abs() < f64::MIN_POSITIVE && *q != 0.0);
+        assert!(subnormal, "{method:?}: the run passes through the subnormal numbers");
+        let last = traj.q_at(traj.len() - 1)[0];
+        assert!(last.abs() < 1e-310, "{method:?}: at rest, q = {last:e}");
+    }
+}

@@ -172,7 +172,7 @@ impl Progress {
     /// Whether the iteration has converged after `correction`, made with a fresh Jacobian or
     /// a kept one: on the increment, or at the noise floor of the equations (round-off, or
     /// derivatives by differences), where even a fresh Newton step no longer halves the
-    /// smallest correction so far. If not, the Jacobian is kept while the corrections halve.
+    /// smallest correction so far, or below the normal numbers. If not, the Jacobian is kept while the corrections halve.
     #[inline(always)]
     pub fn converged(&mut self, fresh: bool, correction: Correction, tolerance: f64, rules: Rules) -> bool {
         let at_floor = rules.noise_floor
@@ -180,7 +180,10 @@ impl Progress {
             && correction.size > 0.5 * self.smallest
             && correction.size <= NOISE_FLOOR * correction.scale;
         self.smallest = self.smallest.min(correction.size);
-        if correction.size <= tolerance * correction.scale || at_floor {
+        // A subnormal correction has no relative precision left to gain: the unknowns have
+        // decayed below the smallest normal number (a motion damped to rest).
+        let underflow = correction.size < f64::MIN_POSITIVE;
+        if correction.size <= tolerance * correction.scale || at_floor || underflow {
             return true;
         }
         self.keep_jacobian = rules.simplified && correction.size <= 0.5 * self.last;
