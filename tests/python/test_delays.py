@@ -6,6 +6,9 @@ from the run's own history:
   runs at 0.5% either side decaying and growing, for τ a whole number of steps (the method's own
   past) and not (the interpolant);
 - the term acts only once its past exists (t ≥ τ): before, the run is the undelayed model's;
+- the past read is the method's own force nodes where τ is a whole number of steps, their cubic
+  Hermite interpolant otherwise: each step's momentum change against the force recomputed from
+  the run's midpoints, to round-off;
 - with the state before the run given (``history=``), q̈ = −k q(t − τ) from a constant past:
   exact (round-off) over [0, τ], where it reads the history alone, and at order 2 over
   [τ, 2τ], against the method of steps' closed form;
@@ -81,6 +84,30 @@ def _steps_solution(t, tau, gain=2.0):
     first = 1 - gain * t**2 / 2
     second = 1 - gain * tau**2 / 2 - gain * tau * u - gain * u**2 / 2 + gain**2 * u**4 / 24
     return np.where(t <= tau, first, second)
+
+
+@pytest.mark.parametrize("tau", [0.5, 0.5037])
+def test_the_past_is_the_methods_own_midpoints_or_their_hermite_interpolant(tau):
+    # q̈ = −k q(t − τ), L = ½q̇²: the midpoint rule's p₊ − p = h f(t + h/2), f = −k q(t + h/2 − τ)
+    # read from the force nodes (q̄ₘ, v̄ₘ) = ((qₘ + qₘ₊₁)/2, (qₘ₊₁ − qₘ)/h) at tₘ + h/2.
+    h, gain = 0.01, 2.0
+    traj = varmech.integrate(_retarded(tau), [1.0], v0=[0.3], dt=h, steps=300)
+    qs, ps = traj.q[:, 0], traj.p[:, 0]
+    mid, vel = (qs[:-1] + qs[1:]) / 2, np.diff(qs) / h
+    force = np.diff(ps) / h
+    for n in range(len(force)):
+        s = n * h + h / 2 - tau
+        older = math.floor(s / h - 0.5 + 1e-9)
+        if older < 0:
+            assert force[n] == pytest.approx(0.0, abs=1e-11), n
+            continue
+        x_ = (s - (older * h + h / 2)) / h
+        if abs(x_) < 1e-9:
+            past = mid[older]
+        else:
+            basis = ((1 + 2 * x_) * (1 - x_) ** 2, x_ * (1 - x_) ** 2 * h, x_**2 * (3 - 2 * x_), x_**2 * (x_ - 1) * h)
+            past = np.dot(basis, (mid[older], vel[older], mid[older + 1], vel[older + 1]))
+        assert force[n] == pytest.approx(-gain * past, rel=1e-10, abs=1e-11), n
 
 
 @pytest.mark.parametrize("tau", [0.5, 0.5037])

@@ -511,7 +511,7 @@ fn the_crafted_format_2_checkpoint_is_refused() {
         Ok(Err(Error::InvalidArgument {
             argument: "checkpoint",
             reason,
-        })) => assert!(reason.contains("format 2") && reason.contains("format 4"), "{reason}"),
+        })) => assert!(reason.contains("format 2") && reason.contains("format 5"), "{reason}"),
         other => panic!("{other:?}"),
     }
 }

@@ -229,12 +229,12 @@ impl Integrator {
         }
     }
 
-    /// Keeps the history of delayed forces with `delays` at the step h: the two-point rules
+    /// Keeps the history of the delayed forces of `sys` at the step h: the two-point rules
     /// alone take them ([`check_method`] refuses the other methods).
-    pub(super) fn keep_history(&mut self, n: usize, delays: &[f64], h: f64) {
+    pub(super) fn keep_history(&mut self, n: usize, sys: &dyn Lagrangian, h: f64) {
         match &mut self.scheme {
-            Scheme::Midpoint(s) => s.keep_history(n, delays, h),
-            Scheme::Trapezoid(s) => s.keep_history(n, delays, h),
+            Scheme::Midpoint(s) => s.keep_history(n, sys, h),
+            Scheme::Trapezoid(s) => s.keep_history(n, sys, h),
             _ => {}
         }
     }

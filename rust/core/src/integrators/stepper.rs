@@ -85,9 +85,7 @@ where
         check_method(&*model, method, options.dt)?;
         check_initial(&*model, q0, p0, options.t0)?;
         let mut state = StepperState::fresh(method, q0, p0, options);
-        state
-            .integrator
-            .keep_history(n, model.as_lagrangian().delays(), options.dt);
+        state.integrator.keep_history(n, model.as_lagrangian(), options.dt);
         Ok(Stepper { model, state })
     }
 }
@@ -239,7 +237,7 @@ where
         let h = state.clock.h;
         state.restart(t0, q0, p0, h);
         // A new initial state has no past.
-        state.integrator.keep_history(n, self.model.as_lagrangian().delays(), h);
+        state.integrator.keep_history(n, self.model.as_lagrangian(), h);
         Ok(())
     }
 
@@ -401,9 +399,7 @@ impl StepperState {
         let mut stepped = fresh.clone();
         let (m, holonomic) = model.constraint_counts();
         stepped.integrator.prepare(model.dim(), m, holonomic);
-        stepped
-            .integrator
-            .keep_history(model.dim(), model.as_lagrangian().delays(), h);
+        stepped.integrator.keep_history(model.dim(), model.as_lagrangian(), h);
         let (found, fresh, stepped) = (shape(self), shape(&fresh), shape(&stepped));
         if found == fresh || found == stepped {
             return None;

@@ -153,12 +153,14 @@ pub trait Lagrangian {
     /// Writes the forces of a model with delays into `out`, n(1 + d): first the force now,
     /// Q(q, q̇, t), then for each delay j the term of the state now and of the state τⱼ ago, each
     /// its own block so that a term whose past does not exist yet is left out (one evaluation
-    /// for all, the step's hot path). `q` holds q(t), then q(t − τ₁) … q(t − τ_d), n each; `v`
-    /// the velocities likewise. Default: Q from [`Lagrangian::force`], no delayed term.
-    fn delayed_force(&self, q: &[f64], v: &[f64], t: f64, out: &mut [f64]) -> Result<(), ModelError> {
+    /// for all, the step's hot path). `state` holds q(t), q(t − τ₁) … q(t − τ_d), then the
+    /// velocities likewise, n each, then t: a compiled function's own slots, passed as they
+    /// are. Default: Q from [`Lagrangian::force`], no delayed term.
+    fn delayed_force(&self, state: &[f64], out: &mut [f64]) -> Result<(), ModelError> {
+        let m = state.len() / 2;
         let n = out.len() / (1 + self.delays().len());
         out[n..].fill(0.0);
-        self.force(&q[..n], &v[..n], t, &mut out[..n])
+        self.force(&state[..n], &state[m..m + n], state[2 * m], &mut out[..n])
     }
 
     /// Writes the velocity q̇ with ∂L/∂q̇(q, q̇, t) = p into `v`: the inverse Legendre

@@ -10,10 +10,11 @@ use serde::{Deserialize, Serialize};
 /// and the delayed forces' history of the midpoints of the steps taken.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 struct Forcing {
-    mid: Vec<f64>,
-    vel: Vec<f64>,
+    /// The force's arguments as a compiled function's slots: the midpoint, then m − n more (the
+    /// past states the history writes, m = n(1 + d)), the velocity and its past likewise, t.
+    state: Vec<f64>,
     f: Vec<f64>,
-    /// The time f was last evaluated at (NaN: none), with `mid` and `vel` its arguments: the
+    /// The time f was last evaluated at (NaN: none), with `state` its arguments: the
     /// solution's force is Newton's last evaluation's, taken again only where the arguments
     /// differ. A cache, not state: a restored step evaluates afresh.
     #[serde(skip, default = "nothing_evaluated")]
@@ -28,8 +29,7 @@ fn nothing_evaluated() -> f64 {
 impl Forcing {
     fn new(n: usize) -> Self {
         Forcing {
-            mid: vec![0.0; n],
-            vel: vec![0.0; n],
+            state: vec![0.0; 2 * n + 1],
             f: vec![0.0; n],
             at: nothing_evaluated(),
             history: None,
@@ -42,15 +42,30 @@ impl Forcing {
         at.q0.iter().zip(at.dq).map(move |(q, d)| (q + 0.5 * d, d / at.h))
     }
 
+    /// The midpoint's block of `state`, the velocity's, and t's slot.
+    #[inline(always)]
+    fn blocks(&mut self) -> (&mut [f64], &mut [f64], &mut f64) {
+        let n = self.f.len();
+        let m = self.state.len() / 2;
+        let (q, rest) = self.state.split_at_mut(m);
+        let (v, t) = rest.split_at_mut(m);
+        (&mut q[..n], &mut v[..n], &mut t[0])
+    }
+
     fn evaluate<S: Lagrangian + ?Sized>(&mut self, sys: &S, at: Segment<'_>) -> Result<&[f64], ModelError> {
-        for ((m, v), (mid, vel)) in self.mid.iter_mut().zip(self.vel.iter_mut()).zip(Self::arguments(at)) {
-            (*m, *v) = (mid, vel);
+        let (mid, vel, time) = self.blocks();
+        for ((m, v), (x, u)) in mid.iter_mut().zip(vel.iter_mut()).zip(Self::arguments(at)) {
+            (*m, *v) = (x, u);
         }
         let t = at.t + 0.5 * at.h;
+        *time = t;
         self.at = f64::NAN;
         match &mut self.history {
-            Some(history) => history.forces(sys, (&self.mid, &self.vel, t), &mut self.f)?,
-            None => sys.force(&self.mid, &self.vel, t, &mut self.f)?,
+            Some(history) => history.forces(sys, &mut self.state, &mut self.f)?,
+            None => {
+                let n = self.f.len();
+                sys.force(&self.state[..n], &self.state[n..2 * n], t, &mut self.f)?
+            }
         }
         self.at = t;
         Ok(&self.f)
@@ -60,10 +75,12 @@ impl Forcing {
     /// last, at the solution: the same bits, one evaluation fewer a step), else a new one.
     fn on<S: Lagrangian + ?Sized>(&mut self, sys: &S, at: Segment<'_>) -> Result<&[f64], ModelError> {
         // Compared by their bits: 0.0 and −0.0 are equal as numbers, not as a force's arguments.
-        let same = (at.t + 0.5 * at.h).to_bits() == self.at.to_bits()
-            && Self::arguments(at)
-                .zip(self.mid.iter().zip(&self.vel))
-                .all(|((m, v), (mid, vel))| m.to_bits() == mid.to_bits() && v.to_bits() == vel.to_bits());
+        let same = (at.t + 0.5 * at.h).to_bits() == self.at.to_bits() && {
+            let (mid, vel, _) = self.blocks();
+            Self::arguments(at)
+                .zip(mid.iter().zip(vel.iter()))
+                .all(|((m, v), (mid, vel))| m.to_bits() == mid.to_bits() && v.to_bits() == vel.to_bits())
+        };
         if same {
             return Ok(&self.f);
         }
@@ -71,9 +88,9 @@ impl Forcing {
     }
 
     /// Records the step just solved, whose midpoint [`Forcing::evaluate`] holds, in the history.
-    fn record(&mut self, at: Segment<'_>) {
+    fn record(&mut self) {
         if let Some(history) = &mut self.history {
-            history.record(&self.mid, &self.vel, at.t + 0.5 * at.h);
+            history.record(&self.state);
         }
     }
 }
@@ -103,10 +120,14 @@ impl<R: DiscreteLagrangian> TwoPoint<R> {
 }
 
 impl<R: DiscreteLagrangian> super::Del<TwoPoint<R>> {
-    /// Keeps the history that delayed forces with `delays` read, at the step h (none without
+    /// Keeps the history that the delayed forces of `sys` read, at the step h (none without
     /// delays): sized here, before the run's loop.
-    pub(in crate::integrators) fn keep_history(&mut self, n: usize, delays: &[f64], h: f64) {
-        self.scheme.forcing.history = (!delays.is_empty()).then(|| History::new(n, delays, h));
+    pub(in crate::integrators) fn keep_history(&mut self, n: usize, sys: &dyn Lagrangian, h: f64) {
+        let forcing = &mut self.scheme.forcing;
+        forcing.history = (!sys.delays().is_empty()).then(|| History::new(n, sys, h));
+        // Resized, not made anew: a stepper's reset keeps its buffers (the values are written
+        // before each evaluation).
+        forcing.state.resize(2 * n * (1 + sys.delays().len()) + 1, 0.0);
     }
 }
 
@@ -197,7 +218,7 @@ fn momentum_change<R: DiscreteLagrangian, S: Lagrangian + ?Sized, V: Vector>(
         *d += start.h * f;
         work += f * x;
     }
-    forcing.record(at);
+    forcing.record();
     Ok(work)
 }
 

@@ -83,7 +83,12 @@ impl Function {
         SCRATCH.with(|scratch| {
             let (slots, regs) = &mut *scratch.borrow_mut();
             let n = q.len();
-            slots.resize(self.tape.inputs().max(2 * n + 1), 0.0);
+            // Grown, never shrunk: functions of other sizes share the slots, and a resize
+            // each call would clear them again (a memset an evaluation). The tape reads its own.
+            let needed = self.tape.inputs().max(2 * n + 1);
+            if slots.len() < needed {
+                slots.resize(needed, 0.0);
+            }
             crate::solve::copy(&mut slots[..n], q);
             crate::solve::copy(&mut slots[n..n + v.len()], v);
             slots[2 * n] = t;
@@ -91,11 +96,26 @@ impl Function {
             if let Some(code) = &self.code {
                 return code.call(slots, params, out);
             }
-            if regs.len() < self.tape.ops().len() {
-                regs.resize(self.tape.ops().len(), 0.0);
-            }
-            self.tape.eval(slots, params, regs, out);
+            self.interpret(slots, params, regs, out);
         })
+    }
+
+    /// The tape's interpreter, its registers `regs` grown to its length.
+    fn interpret(&self, slots: &[f64], params: &[f64], regs: &mut Vec<f64>, out: &mut [f64]) {
+        if regs.len() < self.tape.ops().len() {
+            regs.resize(self.tape.ops().len(), 0.0);
+        }
+        self.tape.eval(slots, params, regs, out);
+    }
+
+    /// f of the slots `slots` as the tape reads them (its inputs, in their order), into `out`:
+    /// for a caller that keeps its arguments laid out so, no copy.
+    pub fn eval_slots(&self, slots: &[f64], params: &[f64], out: &mut [f64]) {
+        #[cfg(feature = "jit")]
+        if let Some(code) = &self.code {
+            return code.call(slots, params, out);
+        }
+        SCRATCH.with(|scratch| self.interpret(slots, params, &mut scratch.borrow_mut().1, out))
     }
 
     /// f(q, q̇, t; params), its outputs handed to `scatter` (which must not evaluate another

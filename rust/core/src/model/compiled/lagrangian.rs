@@ -25,7 +25,9 @@ pub struct CompiledLagrangian {
     /// iterations need ∂L/∂t only at their last evaluation.
     gradients_alone: Function,
     hessians: Function,
+    /// Q, none where it is zero (a model forced by its delayed terms alone): not evaluated.
     force: Option<Function>,
+    forced: bool,
     dl_dt: Option<Function>,
     time_dependent: bool,
     masses: Option<Function>,
@@ -102,6 +104,7 @@ impl CompiledLagrangian {
             // The slots of q and q̇ now: the first n of each block of m.
             !f.tape().reads(n..m, |s| s < n || (m..m + n).contains(&s))
         });
+        let forced = force.is_some() || delayed.is_some();
         Ok(CompiledLagrangian {
             n,
             params,
@@ -113,7 +116,8 @@ impl CompiledLagrangian {
             },
             gradients,
             hessians,
-            force,
+            force: force.filter(|f| !f.tape().is_zero()),
+            forced,
             dl_dt,
             time_dependent,
             masses,
@@ -227,7 +231,7 @@ impl Lagrangian for CompiledLagrangian {
     }
 
     fn is_forced(&self) -> bool {
-        self.force.is_some() || self.delayed.is_some()
+        self.forced
     }
 
     fn delays(&self) -> &[f64] {
@@ -250,12 +254,14 @@ impl Lagrangian for CompiledLagrangian {
         Ok(true)
     }
 
-    fn delayed_force(&self, q: &[f64], v: &[f64], t: f64, out: &mut [f64]) -> Result<(), ModelError> {
+    fn delayed_force(&self, state: &[f64], out: &mut [f64]) -> Result<(), ModelError> {
+        let m = state.len() / 2;
+        let (q, v, t) = (&state[..self.n], &state[m..m + self.n], state[2 * m]);
         let Some((f, _)) = &self.delayed else {
             return self.force(q, v, t, out);
         };
-        self.check_masses(&q[..self.n], &v[..self.n], t)?;
-        f.eval(q, v, t, &self.params, out);
+        self.check_masses(q, v, t)?;
+        f.eval_slots(state, &self.params, out);
         Ok(())
     }
 

@@ -272,6 +272,13 @@ impl Tape {
             .unwrap_or(0)
     }
 
+    /// Whether every output is the constant 0.
+    pub fn is_zero(&self) -> bool {
+        self.outputs
+            .iter()
+            .all(|&r| matches!(self.ops[r as usize], Op::Const(c) if c == 0.0))
+    }
+
     /// Whether any of the outputs `outputs` reads an input slot for which `slot` is true,
     /// directly or through earlier registers.
     pub fn reads(&self, outputs: std::ops::Range<usize>, slot: impl Fn(usize) -> bool) -> bool {
