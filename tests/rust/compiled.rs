@@ -101,6 +101,27 @@ fn a_tape_says_which_outputs_read_which_slots() {
 }
 
 #[test]
+fn a_tape_of_zeros_is_zero_and_no_other_is() {
+    // A model forced by its delayed terms alone has Q = 0: its tape is not evaluated. Only +0
+    // counts (−0 + x is not 0 + x for x = −0), and only a constant (0·q is NaN for q = ∞).
+    let zeros = |outputs: &dyn Fn(&mut Builder) -> Vec<u32>| {
+        let mut b = Builder::default();
+        let outputs = outputs(&mut b);
+        b.tape(outputs, 1, 0).is_zero()
+    };
+    assert!(zeros(&|b| {
+        let z = b.op(Op::Const(0.0));
+        vec![z, z]
+    }));
+    assert!(!zeros(&|b| vec![b.op(Op::Const(-0.0))]));
+    assert!(!zeros(&|b| vec![b.op(Op::Const(1e-300))]));
+    assert!(!zeros(&|b| {
+        let (z, q0) = (b.op(Op::Const(0.0)), b.input(0));
+        vec![b.binary(Binary::Mul, z, q0)]
+    }));
+}
+
+#[test]
 fn a_restricted_tape_keeps_its_outputs_instructions_and_their_bits() {
     // [sin q₀ · q̇₀, cos t · q₀] restricted to its first output: cos t and its product go, and
     // what stays computes the same bits, interpreted and compiled (the gradients without ∂L/∂t).

@@ -272,11 +272,11 @@ impl Tape {
             .unwrap_or(0)
     }
 
-    /// Whether every output is the constant 0.
+    /// Whether every output is the constant +0 (not −0, which sums to other bits).
     pub fn is_zero(&self) -> bool {
         self.outputs
             .iter()
-            .all(|&r| matches!(self.ops[r as usize], Op::Const(c) if c == 0.0))
+            .all(|&r| matches!(self.ops[r as usize], Op::Const(c) if c.to_bits() == 0))
     }
 
     /// Whether any of the outputs `outputs` reads an input slot for which `slot` is true,
