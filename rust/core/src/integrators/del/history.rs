@@ -84,7 +84,7 @@ impl Hermite {
 
 impl Lag {
     /// The lag of τ at the step h (τ ≥ h): a whole number of steps where τ/h is one to within
-    /// round-off of the times (10⁻⁹ of a step).
+    /// its round-off (10⁻⁹ of it, and of a step at least).
     fn new(tau: f64, h: f64) -> Self {
         let steps = tau / h;
         let whole = steps.round();
@@ -210,12 +210,13 @@ impl History {
             Some(a) if a < held => a,
             _ => return sys.history(s, q, v),
         };
-        let (a, b) = (self.slot(a) * n, self.slot((a + 1).min(held - 1)) * n);
+        let (b, a) = ((a + 1).min(held - 1), self.slot(a) * n);
         let Some(Hermite { value, rate }) = &lag.hermite else {
             copy(q, &self.q[a..a + n]);
             copy(v, &self.v[a..a + n]);
             return Ok(true);
         };
+        let b = self.slot(b) * n;
         for k in 0..n {
             let (q0, v0, q1, v1) = (self.q[a + k], self.v[a + k], self.q[b + k], self.v[b + k]);
             q[k] = value[0] * q0 + value[1] * v0 + value[2] * q1 + value[3] * v1;
