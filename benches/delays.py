@@ -4,8 +4,10 @@ feedback oscillator q̈ + q = −k q̇(t − τ) about its Hopf boundary.
 The cost: the oscillator damped by its velocity τ = m·h ago against the same force of the
 velocity now, −k q̇(t) (no history kept or read), side by side, interleaved, best of
 ``--repeat``; τ a whole number of steps (the method's own past, the issue's case) and not (the
-Hermite interpolant); and the pendulum in a controlled wind, θ̈ + sin θ = −k θ̇(t − τ) cos θ,
-against −k θ̇ cos θ.
+Hermite interpolant); the pendulum in a controlled wind, θ̈ + sin θ = −k θ̇(t − τ) cos θ,
+against −k θ̇ cos θ; and the oscillator pushed by its acceleration τ ago, q̈ + q = −k q̈(t − τ), against the same
+oscillator pushed by its velocity τ ago (what reading the acceleration adds; the same force now,
+−k q̈(t), is added mass, a model with no force to evaluate at all, not a like run).
 
     PYTHONPATH=$PWD/python python benches/delays.py [--repeat 25] [--steps 50000] [--markdown benches/delays_results.md] [--figure docs/gallery]
 
@@ -27,7 +29,7 @@ import sympy as sp
 import varmech
 from varmech.symbolic import Delayed
 
-q, w, w_past, k = sp.symbols("q w w_past k")
+q, w, w_past, a_past, k = sp.symbols("q w w_past a_past k")
 L = (w**2 - q**2) / 2
 
 
@@ -86,6 +88,11 @@ def undelayed() -> varmech.Model:
     return varmech.symbolic.lagrangian(L, [q], [w], parameters={k: 0.5}, force=[-k * w])
 
 
+def neutral(tau: float) -> varmech.Model:
+    """q̈ + q = −k q̈(t − τ)."""
+    return varmech.symbolic.lagrangian(L, [q], [w], parameters={k: 0.5}, delayed=Delayed(tau, [-k * a_past], a_past=[a_past]))
+
+
 def wind(tau: float | None) -> varmech.Model:
     """The pendulum in a controlled wind, θ̈ + sin θ = −k θ̇(t − τ) cos θ (τ None: θ̇(t))."""
     pendulum = w**2 / 2 + sp.cos(q)
@@ -118,6 +125,7 @@ def main() -> None:
         ("oscillator, τ = 50 h (the method's own past)", delayed(0.5), undelayed()),
         ("oscillator, τ = 50.37 h (interpolated)", delayed(0.5037), undelayed()),
         ("pendulum in a controlled wind, τ = 50 h", wind(0.5), wind(None)),
+        ("oscillator, −k q̈(t − τ) against −k q̇(t − τ), τ = 50 h", neutral(0.5), delayed(0.5)),
     ]
     rows = []
     for name, model, baseline in cases:
@@ -137,8 +145,9 @@ def main() -> None:
 Command: `PYTHONPATH=$PWD/python python benches/delays.py --repeat {args.repeat} --steps {args.steps} --markdown benches/delays_results.md`
 Machine: {platform.processor() or platform.machine()}, {platform.system()}; load average {load} before.
 
-q̈ + q = −k q̇(t − τ) against q̈ + q = −k q̇(t), and θ̈ + sin θ = −k θ̇(t − τ) cos θ against
-−k θ̇ cos θ, each pair compiled from SymPy, midpoint rule, h = 0.01, {args.steps} steps, one
+q̈ + q = −k q̇(t − τ) against q̈ + q = −k q̇(t), θ̈ + sin θ = −k θ̇(t − τ) cos θ against
+−k θ̇ cos θ, and q̈ + q = −k q̈(t − τ) against q̈ + q = −k q̇(t − τ) (what reading the
+acceleration adds to reading the velocity), each pair compiled from SymPy, midpoint rule, h = 0.01, {args.steps} steps, one
 state saved; interleaved, best of {args.repeat}, the garbage collector off in the timed calls.
 
 | model, delay | delayed (ms) | undelayed (ms) | delayed / undelayed |

@@ -94,12 +94,12 @@ def lagrangian(
         :class:`~varmech.VarmechError` at a step where a mass is not positive.
     delayed
         Delayed forces: a :class:`Delayed` (or a list of them), each a force of the state now
-        and of the state τ ago, read from the run's own history (``midpoint`` and
-        ``trapezoid``, at a step no longer than τ). Not with ``constraints`` or
-        ``velocity_constraints``.
+        and of the state τ ago (its position, velocity and acceleration), read from the run's
+        own history (``midpoint`` and ``trapezoid``, at a step no longer than τ, or τ/1.5 where
+        the term reads the acceleration). Not with ``constraints`` or ``velocity_constraints``.
     history
         The state before the run for the delayed forces: q(t) for t ≤ t₀, one expression of t
-        (and the parameters) per coordinate, q̇ its derivative. Then every delayed term acts
+        (and the parameters) per coordinate, q̇ and q̈ its derivatives. Then every delayed term acts
         from the start, reading the history where its past is before the run's first step;
         without it, a term acts only once its past exists.
     symmetries
@@ -410,7 +410,7 @@ def _build(
     if delayed is not None:
         if constraints is not None or velocity_constraints is not None:
             raise ValueError("delayed: delayed forces are not taken with constraints or velocity_constraints yet")
-        delays, delayed_exprs, q_past, v_past = delayed_forces(delayed, variables)
+        delays, delayed_exprs, pasts = delayed_forces(delayed, variables)
         # The delayed forces act beside Q: the model is forced, its work tracked.
         forces = forces or [sp.S.Zero] * n
     if history is not None and delayed is None:
@@ -428,7 +428,7 @@ def _build(
     parts += [(f"mass_flow[{i}].mass", x) for i, x in enumerate(masses)]
     if delays:
         # The past symbols are inputs of the delayed forces' tape, not parameters.
-        past = dict.fromkeys([*q_past, *v_past], sp.S.Zero)
+        past = dict.fromkeys([s for symbols in pasts for s in symbols], sp.S.Zero)
         parts += [(f"delayed[{i // n}].force[{i % n}]", x.xreplace(past)) for i, x in enumerate(delayed_exprs)]
     parts += [(f"history[{i}]", x) for i, x in enumerate(past_state[:n])]
     params = parameters(given_parameters, {s for _, x in parts for s in x.free_symbols}, variables)
@@ -452,7 +452,7 @@ def _build(
         if delays:
             # Q first, then the delayed terms: the step evaluates all of them in one call.
             now = list(functions["force"])
-            tapes["delayed_force"] = delayed_tape(now + delayed_exprs, q_past, v_past, variables, params.index)
+            tapes["delayed_force"] = delayed_tape(now + delayed_exprs, pasts, variables, params.index)
             functions["delayed_force"] = (*now, *delayed_exprs)
         if past_state:
             tapes["history"] = history_tape(past_state, variables, params.index)

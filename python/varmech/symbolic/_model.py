@@ -346,6 +346,8 @@ class SymbolicModel(Model):
             "symmetries": [symmetry_data(x) for x in spec.symmetries],
             "jit": spec.jit,
             "delays": list(spec.delays),
+            # The delayed forces' slots [q …], [q̇ …], [q̈ …], t; 1 (absent) was [q …], [q̇ …], t.
+            "delayed_layout": 2,
             "energy_name": spec.energy_name,
         }
 
@@ -359,6 +361,11 @@ def _of_recipe(recipe: dict[str, Any]) -> SymbolicModel:
             np.array(ops, dtype=np.int64).reshape(-1, 3),
             np.array(numbers(constants, "constants"), dtype=np.float64),
             np.array(outputs, dtype=np.int64),
+        )
+    if recipe.get("delays") and recipe.get("delayed_layout", 1) != 2:
+        raise ValueError(
+            "delays: its delayed forces were stored in the slots of an earlier varmech, before they could read "
+            "q̈(t − τ); build the model again with varmech.symbolic.lagrangian"
         )
     names = field(recipe, "parameter_names", list)
     if not all(isinstance(x, str) for x in names):

@@ -53,13 +53,13 @@ impl CompiledModel {
     }
 }
 
-/// The named function of `functions`, decoded for a model with n coordinates, and compiled
+/// The named function of `functions`, decoded as a function of `slots` input slots, and compiled
 /// to machine code when `jit` holds.
 fn function(
     py: Python<'_>,
     functions: &HashMap<String, Encoded<'_>>,
     name: &'static str,
-    n: usize,
+    slots: usize,
     params: usize,
     jit: bool,
 ) -> PyResult<Option<Function>> {
@@ -80,7 +80,7 @@ fn function(
         .as_slice()
         .map_err(|_| PyValueError::new_err(format!("{name}: outputs must be a contiguous int64 array")))?;
     let tape =
-        Tape::decode(name, &rows, slice(name, constants)?, outputs, 2 * n + 1, params).map_err(|e| to_pyerr(py, e))?;
+        Tape::decode(name, &rows, slice(name, constants)?, outputs, slots, params).map_err(|e| to_pyerr(py, e))?;
     Ok(Some(if jit {
         Function::compiled(tape)
     } else {
@@ -147,7 +147,7 @@ impl CompiledModel {
         let k = params.len();
         let compiled = std::cell::Cell::new(false);
         let f = |name| {
-            let function = function(py, &functions, name, dim, k, jit)?;
+            let function = function(py, &functions, name, 2 * dim + 1, k, jit)?;
             compiled.set(compiled.get() || function.as_ref().is_some_and(Function::is_compiled));
             Ok::<_, PyErr>(function)
         };
@@ -233,13 +233,14 @@ impl CompiledModel {
                         match delays.len() {
                             0 => None,
                             d => {
-                                // Its slots: [q, q(t − τ₁) …, q̇, q̇(t − τ₁) …, t], (1 + d)n of each.
-                                let f = function(py, &functions, "delayed_force", dim * (1 + d), k, jit)?;
+                                // Its slots: [q, q(t − τ₁) …], [q̇ …], [q̈ …], (1 + d)n each, then t.
+                                let slots = 3 * dim * (1 + d) + 1;
+                                let f = function(py, &functions, "delayed_force", slots, k, jit)?;
                                 Some((required("delayed_force", f)?, delays))
                             }
                         },
                         // The state before the run, a function of the one slot [s].
-                        function(py, &functions, "history", 0, k, jit)?,
+                        function(py, &functions, "history", 1, k, jit)?,
                     ),
                 )
                 .map_err(err)?;

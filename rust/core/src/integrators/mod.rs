@@ -110,8 +110,8 @@ enum Scheme {
 
 /// Refuses a method that does not integrate the model's kind ([`Method::check`]) and, for a
 /// model with delayed forces, a method other than the two-point rules (whose one force node a
-/// step the history keeps) or a delay shorter than the step h (the history holds whole steps):
-/// for a new stepper, a resumed state and a checkpoint alike.
+/// step the history keeps) or a delay the history cannot read at the step h
+/// ([`del::check_delays`]): for a new stepper, a resumed state and a checkpoint alike.
 pub(in crate::integrators) fn check_method<S: Dynamics + ?Sized>(
     model: &S,
     method: Method,
@@ -130,11 +130,7 @@ pub(in crate::integrators) fn check_method<S: Dynamics + ?Sized>(
         );
         return Err(crate::Error::invalid("method", reason));
     }
-    if let Some(tau) = delays.iter().find(|tau| **tau < h) {
-        let reason = format!("τ = {tau} is shorter than the step dt = {h}: the history holds whole steps; take dt ≤ τ");
-        return Err(crate::Error::invalid("delays", reason));
-    }
-    Ok(())
+    del::check_delays(model.as_lagrangian(), h)
 }
 
 impl Integrator {

@@ -10,6 +10,13 @@ use crate::solve::newton::{model_error, Correction, Newton, NewtonOptions, Newto
 use crate::solve::scratch::with_scratch;
 use crate::ModelError;
 
+/// The length m = n(1 + d) of each block of the delayed forces' `slots` ([`Lagrangian::delayed_force`]):
+/// [q, q(t − τ₁) …], [q̇, q̇(t − τ₁) …], [q̈, q̈(t − τ₁) …], then t, 3m + 1 in all. q̈ now is
+/// what the step solves for, not known where it evaluates its force: its n slots are never read.
+pub fn delayed_block(slots: usize) -> usize {
+    slots / 3
+}
+
 /// The second derivatives of L at one point, n × n each.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Hessians {
@@ -135,11 +142,18 @@ pub trait Lagrangian {
         &[]
     }
 
-    /// Writes the state before the run, q(s) and q̇(s) at s, into `q` and `v` where the model
-    /// gives its history (the initial function of its delayed forces) and returns true; false
-    /// where it gives none (then a delayed term acts only once its past exists). Default: none.
-    fn history(&self, _s: f64, _q: &mut [f64], _v: &mut [f64]) -> Result<bool, ModelError> {
+    /// Writes the state before the run, q(s), q̇(s) and q̈(s) at s, into `q`, `v` and `a` where
+    /// the model gives its history (the initial function of its delayed forces) and returns
+    /// true; false where it gives none (then a delayed term acts only once its past exists).
+    /// Default: none.
+    fn history(&self, _s: f64, _q: &mut [f64], _v: &mut [f64], _a: &mut [f64]) -> Result<bool, ModelError> {
         Ok(false)
+    }
+
+    /// Whether the delayed term of τⱼ reads the acceleration q̈(t − τⱼ): then the run's history
+    /// gives it (from the velocities on either side of t − τⱼ). Default: none does.
+    fn delayed_reads_acceleration(&self, _j: usize) -> bool {
+        false
     }
 
     /// Whether the delayed terms of [`Lagrangian::delayed_force`] read the past alone (and t),
@@ -153,14 +167,13 @@ pub trait Lagrangian {
     /// Writes the forces of a model with delays into `out`, n(1 + d): first the force now,
     /// Q(q, q̇, t), then for each delay j the term of the state now and of the state τⱼ ago, each
     /// its own block so that a term whose past does not exist yet is left out (one evaluation
-    /// for all, the step's hot path). `state` holds q(t), q(t − τ₁) … q(t − τ_d), then the
-    /// velocities likewise, n each, then t: a compiled function's own slots, passed as they
-    /// are. Default: Q from [`Lagrangian::force`], no delayed term.
+    /// for all, the step's hot path). `state` holds a compiled function's own slots, passed as
+    /// they are ([`delayed_block`]). Default: Q from [`Lagrangian::force`], no delayed term.
     fn delayed_force(&self, state: &[f64], out: &mut [f64]) -> Result<(), ModelError> {
-        let m = state.len() / 2;
+        let m = delayed_block(state.len());
         let n = out.len() / (1 + self.delays().len());
         out[n..].fill(0.0);
-        self.force(&state[..n], &state[m..m + n], state[2 * m], &mut out[..n])
+        self.force(&state[..n], &state[m..m + n], state[3 * m], &mut out[..n])
     }
 
     /// Writes the velocity q̇ with ∂L/∂q̇(q, q̇, t) = p into `v`: the inverse Legendre

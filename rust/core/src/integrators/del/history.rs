@@ -3,7 +3,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::model::Lagrangian;
+use crate::model::{delayed_block, Lagrangian};
 use crate::solve::copy;
 use crate::ModelError;
 
@@ -13,9 +13,11 @@ use crate::ModelError;
 /// The step is kept while the history lives (a delayed model's stepper refuses another), so
 /// the nodes are a step apart and t − τ lies a fixed number of nodes back ([`Lag`]): on a node
 /// where τ is a whole number of steps (exact, the method's own values), else between two, read
-/// through the cubic Hermite interpolant of their q̄ and v̄. Before the run's first node the
-/// model's history gives it where the model has one ([`Lagrangian::history`]); otherwise nothing
-/// is known, and a term whose past does not exist acts only once it does, as the source insists.
+/// through the cubic Hermite interpolant of their q̄ and v̄. The acceleration, for a term that
+/// reads it, is the derivative of the parabola through the velocities of the three nodes about
+/// t − τ ([`Rate`]). Before the nodes a term reads exist, the model's history gives its past
+/// where the model has one ([`Lagrangian::history`]); otherwise nothing is known, and a term
+/// whose past does not exist acts only once it does, as the source insists.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub(super) struct History {
     n: usize,
@@ -48,11 +50,25 @@ pub(super) struct History {
 
 /// Where t − τ lies for τ = (steps − x)·h with x ∈ [0, 1): `steps` nodes back from the step's
 /// own force node where x = 0, else between the nodes `steps` and `steps − 1` back, at x from
-/// the older, where the interpolant's basis, the same at every step, is `hermite`.
+/// the older, where the interpolant's basis, the same at every step, is `hermite`; and, for a
+/// term that reads the acceleration, how it is taken.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 struct Lag {
     steps: usize,
     hermite: Option<Hermite>,
+    rate: Option<Rate>,
+}
+
+/// The acceleration at t − τ from the velocities v̄ of the nodes `back` + 1, `back` and
+/// `back` − 1 steps back (the node nearest t − τ and its neighbours), at y ∈ [−½, ½] steps from
+/// the middle one: the derivative of the parabola through them, ((y − ½)v̄₋ − 2y v̄₀ + (y + ½)v̄₊)/h,
+/// which `weights` hold. It is the linear interpolant of the second differences
+/// (v̄ₖ₊₁ − v̄ₖ)/h = (qₖ₊₂ − 2qₖ₊₁ + qₖ)/h², the discrete Euler–Lagrange equations' own
+/// acceleration, at the grid times between the nodes: O(h²), the method's order.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+struct Rate {
+    back: usize,
+    weights: [f64; 3],
 }
 
 /// The cubic Hermite basis at x ∈ (0, 1) of an interval of length h: the value's weights of
@@ -83,23 +99,61 @@ impl Hermite {
 }
 
 impl Lag {
-    /// The lag of τ at the step h (τ ≥ h): a whole number of steps where τ/h is one to within
-    /// its round-off (10⁻⁹ of it, and of a step at least).
-    fn new(tau: f64, h: f64) -> Self {
+    /// The lag of τ at the step h (τ ≥ h, and τ ≥ 3h/2 for one that reads the acceleration,
+    /// whose newest node must have been taken): a whole number of steps where τ/h is one to
+    /// within its round-off (10⁻⁹ of it, and of a step at least).
+    fn new(tau: f64, h: f64, acceleration: bool) -> Self {
         let steps = tau / h;
         let whole = steps.round();
-        if (steps - whole).abs() <= 1e-9 * whole.max(1.0) {
-            return Lag {
-                steps: whole as usize,
-                hermite: None,
+        let (steps, x) = if (steps - whole).abs() <= 1e-9 * whole.max(1.0) {
+            (whole, 0.0)
+        } else {
+            (steps.ceil(), steps.ceil() - steps)
+        };
+        let rate = acceleration.then(|| {
+            // The tolerance takes τ = 3h/2 to its node whatever τ/h rounds to.
+            let (back, y) = if x <= 0.5 + 1e-9 {
+                (steps, x)
+            } else {
+                (steps - 1.0, x - 1.0)
             };
-        }
-        let above = steps.ceil();
+            Rate {
+                back: back as usize,
+                weights: [(y - 0.5) / h, -2.0 * y / h, (y + 0.5) / h],
+            }
+        });
         Lag {
-            steps: above as usize,
-            hermite: Some(Hermite::at(above - steps, h)),
+            steps: steps as usize,
+            hermite: (x > 0.0).then(|| Hermite::at(x, h)),
+            rate,
         }
     }
+
+    /// The most nodes back the lag reads.
+    fn reach(&self) -> usize {
+        self.rate.as_ref().map_or(self.steps, |rate| rate.back + 1)
+    }
+}
+
+/// Refuses a delay that the history cannot read at the step h, naming `delays`: one shorter
+/// than the step (the history holds whole steps), or, for a term that reads the acceleration,
+/// than 3h/2 (the velocity a node after the one nearest t − τ must be known before the step).
+pub(in crate::integrators) fn check_delays(sys: &dyn Lagrangian, h: f64) -> Result<(), crate::Error> {
+    for (j, &tau) in sys.delays().iter().enumerate() {
+        if tau < h {
+            let reason =
+                format!("τ = {tau} is shorter than the step dt = {h}: the history holds whole steps; take dt ≤ τ");
+            return Err(crate::Error::invalid("delays", reason));
+        }
+        if (Lag::new(tau, h, sys.delayed_reads_acceleration(j)).rate).is_some_and(|rate| rate.back < 2) {
+            let reason = format!(
+                "τ = {tau} reads q̈(t − τ) and is shorter than 1.5 steps dt = {h}: the acceleration comes from \
+                 the velocities on either side of t − τ, the newer a step old at least; take dt ≤ τ/1.5"
+            );
+            return Err(crate::Error::invalid("delays", reason));
+        }
+    }
+    Ok(())
 }
 
 fn no_past() -> f64 {
@@ -111,8 +165,10 @@ impl History {
     /// the longest delay's ⌈τ/h⌉ steps and two more.
     pub(super) fn new<S: Lagrangian + ?Sized>(n: usize, sys: &S, h: f64) -> Self {
         let delays = sys.delays();
-        let lags: Vec<Lag> = delays.iter().map(|&tau| Lag::new(tau, h)).collect();
-        let len = lags.iter().map(|lag| lag.steps).max().unwrap_or(0) + 2;
+        let lags: Vec<Lag> = (delays.iter().enumerate())
+            .map(|(j, &tau)| Lag::new(tau, h, sys.delayed_reads_acceleration(j)))
+            .collect();
+        let len = lags.iter().map(Lag::reach).max().unwrap_or(0) + 2;
         let d = delays.len();
         History {
             n,
@@ -152,23 +208,26 @@ impl History {
     }
 
     /// Writes the force at the node `state` into `f`: Q and each delayed term whose past
-    /// exists. `state` holds the node's (q, v, t) as [`Lagrangian::delayed_force`] reads them,
-    /// [q, q(t − τ₁) …, v, v(t − τ₁) …, t]; the past blocks are written here.
+    /// exists. `state` holds the node's slots as [`Lagrangian::delayed_force`] reads them
+    /// ([`delayed_block`]); the past blocks are written here.
     pub(super) fn forces<S: Lagrangian + ?Sized>(
         &mut self,
         sys: &S,
         state: &mut [f64],
         f: &mut [f64],
     ) -> Result<(), ModelError> {
-        let (n, m) = (self.n, state.len() / 2);
-        let t = state[2 * m];
+        let (n, m) = (self.n, delayed_block(state.len()));
+        let t = state[3 * m];
         if t != self.read_at {
             self.settle();
-            let (q, v) = state.split_at_mut(m);
+            let (q, rest) = state.split_at_mut(m);
+            let (v, a) = rest.split_at_mut(m);
             // The blocks after the state now's, one a delay.
-            let past = q[n..].chunks_exact_mut(n).zip(v[n..m].chunks_exact_mut(n));
-            for (j, (tau, block)) in sys.delays().iter().zip(past).enumerate() {
-                self.acting[j] = self.state_at(sys, t - tau, j, block)?;
+            let past = (q[n..].chunks_exact_mut(n))
+                .zip(v[n..].chunks_exact_mut(n))
+                .zip(a[n..m].chunks_exact_mut(n));
+            for (j, (tau, ((q, v), a))) in sys.delays().iter().zip(past).enumerate() {
+                self.acting[j] = self.state_at(sys, t - tau, j, (q, v, a))?;
             }
             self.read_at = t;
         } else if self.past_alone {
@@ -192,24 +251,32 @@ impl History {
         Ok(())
     }
 
-    /// Writes the state at s = t − τⱼ into `(q, v)`; false where s is before the run's first
-    /// node and the model gives no history.
+    /// Writes the state at s = t − τⱼ into `(q, v, a)` (the acceleration for a term that reads
+    /// it); false where a node it reads is before the run's first and the model gives no
+    /// history.
     fn state_at<S: Lagrangian + ?Sized>(
         &self,
         sys: &S,
         s: f64,
         j: usize,
-        (q, v): (&mut [f64], &mut [f64]),
+        (q, v, acceleration): (&mut [f64], &mut [f64], &mut [f64]),
     ) -> Result<bool, ModelError> {
         let n = self.n;
         // The step's own force node would be the held + 1st: the past lies `steps` nodes back
-        // from it, the interpolant's newer node one after. None so far back: before the run.
+        // from it, the interpolant's newer node one after, the acceleration's `back` ± 1. None
+        // so far back: before the run.
         let held = self.filled.min(self.len);
         let lag = &self.lags[j];
-        let a = match held.checked_sub(lag.steps) {
-            Some(a) if a < held => a,
-            _ => return sys.history(s, q, v),
-        };
+        if held < lag.reach() {
+            return sys.history(s, q, v, acceleration);
+        }
+        if let Some(Rate { back, weights: w }) = &lag.rate {
+            let [older, node, newer] = [back + 1, *back, back - 1].map(|k| self.slot(held - k) * n);
+            for (k, a) in acceleration.iter_mut().enumerate() {
+                *a = w[0] * self.v[older + k] + w[1] * self.v[node + k] + w[2] * self.v[newer + k];
+            }
+        }
+        let a = held - lag.steps;
         let (b, a) = ((a + 1).min(held - 1), self.slot(a) * n);
         let Some(Hermite { value, rate }) = &lag.hermite else {
             copy(q, &self.q[a..a + n]);
@@ -228,7 +295,7 @@ impl History {
     /// Records the node (q, v) of a step taken, from its `state` as [`History::forces`] takes
     /// it, the oldest one leaving a full ring.
     pub(super) fn record(&mut self, state: &[f64]) {
-        let (n, m) = (self.n, state.len() / 2);
+        let (n, m) = (self.n, delayed_block(state.len()));
         let (q, v) = (&state[..n], &state[m..m + n]);
         self.settle();
         let slot = if self.filled < self.len {

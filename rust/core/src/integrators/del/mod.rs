@@ -14,6 +14,7 @@ mod two_point;
 pub use composed::Composed;
 pub(in crate::integrators) use nonholonomic::DiscreteConstraint;
 
+pub(in crate::integrators) use history::check_delays;
 pub use two_point::TwoPoint;
 
 use nalgebra::DMatrix;

@@ -2,7 +2,7 @@ use super::history::History;
 use super::{segment, StepEquations};
 use crate::discrete::{DiscreteLagrangian, Quadrature, Segment, Vector, Workspace};
 use crate::integrators::StepStart;
-use crate::model::Lagrangian;
+use crate::model::{delayed_block, Lagrangian};
 use crate::ModelError;
 use serde::{Deserialize, Serialize};
 
@@ -10,8 +10,9 @@ use serde::{Deserialize, Serialize};
 /// and the delayed forces' history of the midpoints of the steps taken.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 struct Forcing {
-    /// The force's arguments as a compiled function's slots: the midpoint, then m − n more (the
-    /// past states the history writes, m = n(1 + d)), the velocity and its past likewise, t.
+    /// The force's arguments as a compiled function's slots ([`delayed_block`]): the midpoint,
+    /// then m − n more (the past states the history writes, m = n(1 + d)), the velocity and its
+    /// past likewise, the past accelerations (after n slots never read), t.
     state: Vec<f64>,
     f: Vec<f64>,
     /// The time f was last evaluated at (NaN: none), with `state` its arguments: the
@@ -29,7 +30,7 @@ fn nothing_evaluated() -> f64 {
 impl Forcing {
     fn new(n: usize) -> Self {
         Forcing {
-            state: vec![0.0; 2 * n + 1],
+            state: vec![0.0; 3 * n + 1],
             f: vec![0.0; n],
             at: nothing_evaluated(),
             history: None,
@@ -46,10 +47,10 @@ impl Forcing {
     #[inline(always)]
     fn blocks(&mut self) -> (&mut [f64], &mut [f64], &mut f64) {
         let n = self.f.len();
-        let m = self.state.len() / 2;
+        let m = delayed_block(self.state.len());
         let (q, rest) = self.state.split_at_mut(m);
-        let (v, t) = rest.split_at_mut(m);
-        (&mut q[..n], &mut v[..n], &mut t[0])
+        let (v, rest) = rest.split_at_mut(m);
+        (&mut q[..n], &mut v[..n], &mut rest[m])
     }
 
     fn evaluate<S: Lagrangian + ?Sized>(&mut self, sys: &S, at: Segment<'_>) -> Result<&[f64], ModelError> {
@@ -127,7 +128,7 @@ impl<R: DiscreteLagrangian> super::Del<TwoPoint<R>> {
         forcing.history = (!sys.delays().is_empty()).then(|| History::new(n, sys, h));
         // Resized, not made anew: a stepper's reset keeps its buffers (the values are written
         // before each evaluation).
-        forcing.state.resize(2 * n * (1 + sys.delays().len()) + 1, 0.0);
+        forcing.state.resize(3 * n * (1 + sys.delays().len()) + 1, 0.0);
     }
 }
 

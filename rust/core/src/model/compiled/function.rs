@@ -140,15 +140,17 @@ pub fn rows_into(values: &[f64], m: &mut nalgebra::DMatrix<f64>) {
     }
 }
 
-/// What a function may read: all the slots [q, q̇, t], or q alone.
+/// What a function may read: all the slots [q, q̇, t], q alone, or the delayed forces' slots
+/// [q, q̇, q̈, t] (n of each, n = m of [`crate::model::delayed_block`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Inputs {
     All,
     Positions,
+    Delayed,
 }
 
 /// Refuses, naming the function, one with other than `outputs` outputs, slots other than
-/// [q, q̇, t] for n coordinates, reads beyond `inputs`, or other than the model's parameters
+/// those of `inputs` for n coordinates, reads beyond them, or other than the model's parameters
 /// (checked once per model by [`check_parameters`]).
 pub(super) fn check(
     name: &'static str,
@@ -165,14 +167,17 @@ pub(super) fn check(
             format!("has {} outputs where {outputs} are needed for n = {n}", f.outputs()),
         ));
     }
-    if tape.inputs() != 2 * n + 1 || tape.params() != params.len() {
+    let (slots, layout) = match inputs {
+        Inputs::Delayed => (3 * n + 1, "[q, q̇, q̈, t]"),
+        _ => (2 * n + 1, "[q, q̇, t]"),
+    };
+    if tape.inputs() != slots || tape.params() != params.len() {
         return Err(Error::invalid(
             name,
             format!(
-                "takes {} inputs and {} parameters where the model has {} ([q, q̇, t]) and {}",
+                "takes {} inputs and {} parameters where the model has {slots} ({layout}) and {}",
                 tape.inputs(),
                 tape.params(),
-                2 * n + 1,
                 params.len()
             ),
         ));

@@ -2,7 +2,7 @@
 
 use super::function::{check, check_parameters, Inputs};
 use super::Function;
-use crate::model::{differenced_dl_dt, inverse_legendre, Hessians, Lagrangian};
+use crate::model::{delayed_block, differenced_dl_dt, inverse_legendre, Hessians, Lagrangian};
 use crate::solve::{copy, fill};
 use crate::{Error, ModelError};
 
@@ -11,10 +11,10 @@ use crate::{Error, ModelError};
 /// row; for a forced system, the generalized force Q(q, q̇, t); and, for an L that depends on t,
 /// ∂L/∂t (differenced from L where a model stored before it was compiled lacks it); for a
 /// model of variable mass, its masses m(q, t), which must stay positive and finite; for delayed
-/// forces, their delays and one function of the slots [q, q(t − τ₁) …, q̇, q̇(t − τ₁) …, t]
-/// whose outputs are Q, then a block of n a delay (and whether those blocks read the past
-/// alone, not the state now), with the history before the run where given: (q(s), q̇(s)), a
-/// function of the one slot [s].
+/// forces, their delays and one function of their slots ([`crate::model::delayed_block`])
+/// whose outputs are Q, then a block of n a delay (with whether each reads the acceleration
+/// τ ago, and whether they read the past alone, not the state now), with the history before
+/// the run where given: (q(s), q̇(s), q̈(s)), a function of the one slot [s].
 #[derive(Clone, Debug)]
 pub struct CompiledLagrangian {
     n: usize,
@@ -32,6 +32,7 @@ pub struct CompiledLagrangian {
     time_dependent: bool,
     masses: Option<Function>,
     delayed: Option<(Function, Vec<f64>)>,
+    delayed_accelerations: Vec<bool>,
     delayed_of_past_alone: bool,
     history: Option<Function>,
 }
@@ -88,7 +89,7 @@ impl CompiledLagrangian {
                 ));
             }
             let d = delays.len();
-            check("delayed_force", f, n * (1 + d), n * (1 + d), Inputs::All, &params)?;
+            check("delayed_force", f, n * (1 + d), n * (1 + d), Inputs::Delayed, &params)?;
         }
         if let Some(f) = &history {
             if delayed.is_none() {
@@ -97,12 +98,21 @@ impl CompiledLagrangian {
                     "given without delayed forces, which alone read it",
                 ));
             }
-            check("history", f, 2 * n, 0, Inputs::All, &params)?;
+            check("history", f, 3 * n, 0, Inputs::All, &params)?;
         }
         let delayed_of_past_alone = delayed.as_ref().is_some_and(|(f, delays)| {
             let m = n * (1 + delays.len());
             // The slots of q and q̇ now: the first n of each block of m.
             !f.tape().reads(n..m, |s| s < n || (m..m + n).contains(&s))
+        });
+        let delayed_accelerations = delayed.as_ref().map_or(Vec::new(), |(f, delays)| {
+            let m = n * (1 + delays.len());
+            // q̈(t − τⱼ): the j + 1st n slots of the third block.
+            let reads = |j: usize| {
+                f.tape()
+                    .reads(n..m, |s| (2 * m + (j + 1) * n..2 * m + (j + 2) * n).contains(&s))
+            };
+            (0..delays.len()).map(reads).collect()
         });
         let forced = force.is_some() || delayed.is_some();
         Ok(CompiledLagrangian {
@@ -122,6 +132,7 @@ impl CompiledLagrangian {
             time_dependent,
             masses,
             delayed,
+            delayed_accelerations,
             delayed_of_past_alone,
             history,
         })
@@ -242,21 +253,26 @@ impl Lagrangian for CompiledLagrangian {
         self.delayed_of_past_alone
     }
 
-    fn history(&self, s: f64, q: &mut [f64], v: &mut [f64]) -> Result<bool, ModelError> {
+    fn history(&self, s: f64, q: &mut [f64], v: &mut [f64], a: &mut [f64]) -> Result<bool, ModelError> {
         let Some(f) = &self.history else {
             return Ok(false);
         };
         f.eval_into(&[], &[], s, &self.params, |state| {
-            let (at, rate) = state.split_at(self.n);
-            copy(q, at);
-            copy(v, rate);
+            let n = self.n;
+            copy(q, &state[..n]);
+            copy(v, &state[n..2 * n]);
+            copy(a, &state[2 * n..]);
         });
         Ok(true)
     }
 
+    fn delayed_reads_acceleration(&self, j: usize) -> bool {
+        self.delayed_accelerations[j]
+    }
+
     fn delayed_force(&self, state: &[f64], out: &mut [f64]) -> Result<(), ModelError> {
-        let m = state.len() / 2;
-        let (q, v, t) = (&state[..self.n], &state[m..m + self.n], state[2 * m]);
+        let m = delayed_block(state.len());
+        let (q, v, t) = (&state[..self.n], &state[m..m + self.n], state[3 * m]);
         let Some((f, _)) = &self.delayed else {
             return self.force(q, v, t, out);
         };
