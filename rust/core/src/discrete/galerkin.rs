@@ -117,16 +117,27 @@ impl Quadrature {
         let mut sum = 0.0;
         // Over the nodes: as many as the degree for Gauss's rules, two for the trapezoid's.
         for i in 0..self.nodes.len() {
-            let dl_dt = match kept.get(i).copied().flatten() {
-                Some(dl_dt) => dl_dt,
-                None => {
-                    self.node_state(i, &at);
-                    sys.dl_dt(&self.pos, &self.vel, at.t + self.nodes[i] * at.h)?
-                }
+            let dl_dt = match kept.get(i) {
+                Some(&Some(dl_dt)) => dl_dt,
+                _ => self.evaluated_dl_dt(sys, &at, i)?,
             };
             sum += self.weights[i] * dl_dt;
         }
         Ok(at.h * sum)
+    }
+
+    /// ∂L/∂t at node i, evaluated: out of line, so that the kept values' loop (a compiled
+    /// model's every step) carries none of its frame.
+    #[cold]
+    #[inline(never)]
+    fn evaluated_dl_dt<S: Lagrangian + ?Sized>(
+        &mut self,
+        sys: &S,
+        at: &Segment<'_>,
+        i: usize,
+    ) -> Result<f64, ModelError> {
+        self.node_state(i, at);
+        sys.dl_dt(&self.pos, &self.vel, at.t + self.nodes[i] * at.h)
     }
 
     /// The sign of det ∂F/∂x as h → 0: sign(det K)ⁿ·sign(det ∂²L/∂q̇²)ˢ.
