@@ -9,12 +9,18 @@
 //! - sign is two comparisons and two selects, [`sign`](super::sign) exactly (±0 and NaN pass through);
 //! - every other function (exp, log, the trigonometric and hyperbolic ones and their inverses,
 //!   pow, atan2, powi) is a call to the interpreter's own Rust function ([`Unary::apply`],
-//!   [`Binary::apply`], `f64::powi`) behind a C entry point, so that both share one libm.
+//!   [`Binary::apply`], `f64::powi`) behind a C entry point, so that both share one libm;
+//! - except a sine and a cosine of one register, which on glibc are one call of its `sincos`:
+//!   glibc computes them with the very code of its `sin` and `cos` (one argument reduction for
+//!   both), so the bits are the interpreter's (tests/rust/jit.rs holds it to that).
 
+use std::collections::{HashMap, HashSet};
 use std::sync::{Mutex, PoisonError};
 
 use cranelift_codegen::ir::condcodes::FloatCC;
-use cranelift_codegen::ir::{types, AbiParam, FuncRef, InstBuilder, MemFlagsData, Signature, Value};
+use cranelift_codegen::ir::{
+    types, AbiParam, FuncRef, InstBuilder, MemFlagsData, Signature, StackSlotData, StackSlotKind, Value,
+};
 use cranelift_codegen::settings::{self, Configurable};
 use cranelift_frontend::{FunctionBuilder, FunctionBuilderContext};
 use cranelift_jit::{JITBuilder, JITModule};
@@ -150,10 +156,49 @@ fn define(module: &mut JITModule, tape: &Tape) -> Result<FuncId, Box<dyn std::er
     stores.sort_unstable();
     let mut stores = stores.into_iter().peekable();
 
+    // The registers both a sine and a cosine take, and their (sin, cos) once computed.
+    let mut fused: HashMap<u32, Option<(Value, Value)>> = HashMap::new();
+    if SINCOS.is_some() {
+        let of = |f: Unary| {
+            (tape.ops().iter()).filter_map(move |op| match *op {
+                Op::Unary(g, a) if g == f => Some(a),
+                _ => None,
+            })
+        };
+        let sines: HashSet<u32> = of(Unary::Sin).collect();
+        fused.extend(of(Unary::Cos).filter(|a| sines.contains(a)).map(|a| (a, None)));
+    }
+    // Where `sincos` writes them: one slot for every call, each read back at once.
+    let mut pair = None;
+
     let mut registers: Vec<Value> = Vec::with_capacity(tape.ops().len());
     for (i, &op) in tape.ops().iter().enumerate() {
         let r = |a: u32| registers[a as usize];
         let value = match op {
+            Op::Unary(f @ (Unary::Sin | Unary::Cos), a) if fused.contains_key(&a) => {
+                let (sin, cos) = match fused[&a] {
+                    Some(both) => both,
+                    None => {
+                        let callee = library.import(module, &mut b, Callee::SinCos)?;
+                        let slot = *pair.get_or_insert_with(|| {
+                            b.create_sized_stack_slot(StackSlotData::new(StackSlotKind::ExplicitSlot, 16, 3))
+                        });
+                        let address = b.ins().stack_addr(pointer, slot, 0);
+                        b.ins().call(callee, &[r(a), address]);
+                        let both = (
+                            b.ins().load(types::F64, memory, address, 0),
+                            b.ins().load(types::F64, memory, address, 8),
+                        );
+                        fused.insert(a, Some(both));
+                        both
+                    }
+                };
+                if f == Unary::Sin {
+                    sin
+                } else {
+                    cos
+                }
+            }
             Op::Const(c) => b.ins().f64const(c),
             Op::Input(s) => b.ins().load(types::F64, memory, inputs, offset(s as usize)?),
             Op::Param(k) => b.ins().load(types::F64, memory, params, offset(k as usize)?),
@@ -218,6 +263,7 @@ enum Callee {
     Unary(Unary),
     Binary(Binary),
     Powi,
+    SinCos,
 }
 
 /// The interpreter's functions as C entry points, imported into the function being built on
@@ -226,8 +272,9 @@ struct Library {
     unary: Signature,
     binary: Signature,
     powi: Signature,
+    sincos: Signature,
     /// Each callee once imported, by [`Callee::index`].
-    imported: [Option<FuncRef>; Unary::ALL.len() + Binary::ALL.len() + 1],
+    imported: [Option<FuncRef>; Unary::ALL.len() + Binary::ALL.len() + 2],
 }
 
 /// `Unary::ALL[F].apply`, the interpreter's f(x), as a C function.
@@ -243,6 +290,25 @@ extern "C" fn binary<const F: usize>(a: f64, b: f64) -> f64 {
 /// aⁿ as the interpreter computes it, as a C function.
 extern "C" fn powi(a: f64, n: i32) -> f64 {
     a.powi(n)
+}
+
+#[cfg(all(target_os = "linux", target_env = "gnu"))]
+extern "C" {
+    /// glibc's libm: sin x and cos x, each to the bit its `sin` and `cos` give.
+    fn sincos(x: f64, sin: *mut f64, cos: *mut f64);
+}
+
+/// (sin x, cos x) into `out[0..2]`, where the C library computes them in one call with the
+/// bits of its `sin` and `cos`: glibc's `sincos`; elsewhere none, and each is its own call.
+#[cfg(all(target_os = "linux", target_env = "gnu"))]
+const SINCOS: Option<extern "C" fn(f64, *mut f64)> = Some(sin_cos);
+#[cfg(not(all(target_os = "linux", target_env = "gnu")))]
+const SINCOS: Option<extern "C" fn(f64, *mut f64)> = None;
+
+#[cfg(all(target_os = "linux", target_env = "gnu"))]
+extern "C" fn sin_cos(x: f64, out: *mut f64) {
+    // SAFETY: the code passes the address of its own 16-byte stack slot.
+    unsafe { sincos(x, out, out.add(1)) }
 }
 
 /// The unary entry points, indexed as [`Unary::ALL`].
@@ -294,12 +360,16 @@ impl Callee {
                         .expect("Binary::ALL lists every function")
             }
             Callee::Powi => Unary::ALL.len() + Binary::ALL.len(),
+            Callee::SinCos => Unary::ALL.len() + Binary::ALL.len() + 1,
         }
     }
 
     /// The symbol of the callee of `index`, after its op's name.
     fn name(index: usize) -> String {
-        format!("varmech_tape_{}", Tape::OPS[3 + index])
+        match Tape::OPS.get(3 + index) {
+            Some(op) => format!("varmech_tape_{op}"),
+            None => "varmech_tape_sincos".to_string(),
+        }
     }
 }
 
@@ -315,7 +385,13 @@ impl Library {
             unary: signature(&[types::F64]),
             binary: signature(&[types::F64, types::F64]),
             powi: signature(&[types::F64, types::I32]),
-            imported: [None; Unary::ALL.len() + Binary::ALL.len() + 1],
+            sincos: {
+                let mut s = module.make_signature();
+                let pointer = module.target_config().pointer_type();
+                s.params.extend([AbiParam::new(types::F64), AbiParam::new(pointer)]);
+                s
+            },
+            imported: [None; Unary::ALL.len() + Binary::ALL.len() + 2],
         }
     }
 
@@ -325,7 +401,8 @@ impl Library {
         let binary = BINARY.iter().map(|&f| f as *const u8);
         let all = unary
             .chain(binary)
-            .chain([powi as extern "C" fn(f64, i32) -> f64 as *const u8]);
+            .chain([powi as extern "C" fn(f64, i32) -> f64 as *const u8])
+            .chain(SINCOS.map(|f| f as *const u8));
         all.enumerate().map(|(i, address)| (Callee::name(i), address))
     }
 
@@ -344,6 +421,7 @@ impl Library {
             Callee::Unary(_) => &self.unary,
             Callee::Binary(_) => &self.binary,
             Callee::Powi => &self.powi,
+            Callee::SinCos => &self.sincos,
         };
         let id = module.declare_function(&Callee::name(index), Linkage::Import, signature)?;
         let reference = module.declare_func_in_func(id, builder.func);
