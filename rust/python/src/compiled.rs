@@ -11,7 +11,7 @@ use varmech::model::compiled::{
     CompiledConstraints, CompiledLagrangian, CompiledModel as Compiled, CompiledSeparable, CompiledVelocityConstraints,
     Function, Tape,
 };
-use varmech::model::{Constrained, HolonomicConstraints, Mixed, Nonholonomic, VelocityConstraints};
+use varmech::model::{delayed_slots, Constrained, HolonomicConstraints, Mixed, Nonholonomic, VelocityConstraints};
 
 use crate::closure::readers::check_total;
 use crate::convert::slice;
@@ -234,7 +234,7 @@ impl CompiledModel {
                             0 => None,
                             d => {
                                 // Its slots: [q, q(t − τ₁) …], [q̇ …], [q̈ …], (1 + d)n each, then t.
-                                let slots = 3 * dim * (1 + d) + 1;
+                                let slots = delayed_slots(dim, d);
                                 let f = function(py, &functions, "delayed_force", slots, k, jit)?;
                                 Some((required("delayed_force", f)?, delays))
                             }

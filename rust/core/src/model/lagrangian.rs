@@ -17,6 +17,11 @@ pub fn delayed_block(slots: usize) -> usize {
     slots / 3
 }
 
+/// The number of the delayed forces' slots for n coordinates and d delays: 3n(1 + d) + 1.
+pub fn delayed_slots(n: usize, d: usize) -> usize {
+    3 * n * (1 + d) + 1
+}
+
 /// The second derivatives of L at one point, n × n each.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Hessians {

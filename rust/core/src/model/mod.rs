@@ -44,7 +44,7 @@ pub use constraints::{
 };
 pub use energy::{hamiltonian, EnergyTerms};
 pub use frobenius::curvature;
-pub use lagrangian::{delayed_block, differenced_dl_dt, inverse_legendre, Hessians, Lagrangian};
+pub use lagrangian::{delayed_block, delayed_slots, differenced_dl_dt, inverse_legendre, Hessians, Lagrangian};
 pub use mass::Mass;
 pub use mechanical::MechanicalSystem;
 pub use mixed::Mixed;

@@ -2,7 +2,7 @@ use super::history::History;
 use super::{segment, StepEquations};
 use crate::discrete::{DiscreteLagrangian, Quadrature, Segment, Vector, Workspace};
 use crate::integrators::StepStart;
-use crate::model::{delayed_block, Lagrangian};
+use crate::model::{delayed_block, delayed_slots, Lagrangian};
 use crate::ModelError;
 use serde::{Deserialize, Serialize};
 
@@ -30,7 +30,7 @@ fn nothing_evaluated() -> f64 {
 impl Forcing {
     fn new(n: usize) -> Self {
         Forcing {
-            state: vec![0.0; 3 * n + 1],
+            state: vec![0.0; delayed_slots(n, 0)],
             f: vec![0.0; n],
             at: nothing_evaluated(),
             history: None,
@@ -128,7 +128,7 @@ impl<R: DiscreteLagrangian> super::Del<TwoPoint<R>> {
         forcing.history = (!sys.delays().is_empty()).then(|| History::new(n, sys, h));
         // Resized, not made anew: a stepper's reset keeps its buffers (the values are written
         // before each evaluation).
-        forcing.state.resize(3 * n * (1 + sys.delays().len()) + 1, 0.0);
+        forcing.state.resize(delayed_slots(n, sys.delays().len()), 0.0);
     }
 }
 

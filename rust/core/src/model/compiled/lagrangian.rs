@@ -100,20 +100,22 @@ impl CompiledLagrangian {
             }
             check("history", f, 3 * n, 0, Inputs::All, &params)?;
         }
-        let delayed_of_past_alone = delayed.as_ref().is_some_and(|(f, delays)| {
-            let m = n * (1 + delays.len());
-            // The slots of q and q̇ now: the first n of each block of m.
-            !f.tape().reads(n..m, |s| s < n || (m..m + n).contains(&s))
-        });
-        let delayed_accelerations = delayed.as_ref().map_or(Vec::new(), |(f, delays)| {
-            let m = n * (1 + delays.len());
-            // q̈(t − τⱼ): the j + 1st n slots of the third block.
-            let reads = |j: usize| {
-                f.tape()
-                    .reads(n..m, |s| (2 * m + (j + 1) * n..2 * m + (j + 2) * n).contains(&s))
-            };
-            (0..delays.len()).map(reads).collect()
-        });
+        // What the delayed terms (outputs n..m) read, in blocks of m = n(1 + d) slots.
+        let (delayed_of_past_alone, delayed_accelerations) = match &delayed {
+            Some((f, delays)) => {
+                let m = n * (1 + delays.len());
+                let terms_read = |slot: &dyn Fn(usize) -> bool| f.tape().reads(n..m, slot);
+                (
+                    // The slots of q and q̇ now: the first n of the first two blocks.
+                    !terms_read(&|s| s < n || (m..m + n).contains(&s)),
+                    // q̈(t − τⱼ): the j + 1st n slots of the third block.
+                    (0..delays.len())
+                        .map(|j| terms_read(&|s| (2 * m + (j + 1) * n..2 * m + (j + 2) * n).contains(&s)))
+                        .collect(),
+                )
+            }
+            None => (false, Vec::new()),
+        };
         let forced = force.is_some() || delayed.is_some();
         Ok(CompiledLagrangian {
             n,
