@@ -49,7 +49,9 @@ fn compensated<const N: usize>(x: &mut [f64; N], e: &mut [f64; N], dx: [f64; N])
 /// varmech's DEL solver runs it: the unknown is δq = q₁ − q₀, predicted by extrapolating the
 /// last two increments; F(δq) = p₀ + (h/2)∂L/∂q − ∂L/∂q̇ at (q₀ + δq/2, δq/h) is solved by
 /// simplified Newton with the exact Jacobian (h/4)L_qq + (L_qq̇ − L_q̇q)/2 − L_q̇q̇/h, kept while
-/// the corrections halve, stopping when ‖δ‖∞ ≤ tol·‖δq‖∞ or at the noise floor; then
+/// the corrections halve, stopping when ‖δ‖∞ ≤ tol·‖δq‖∞ or, where a correction with a fresh
+/// Jacobian does not halve the smallest, at the noise floor: ‖F‖∞ within 4 × the rounding of
+/// its terms, 4ε(‖J‖∞(‖δq‖∞ + ‖q₀‖∞) + ‖p₀‖∞) (the model's derivatives are exact); then
 /// δp = h∂L/∂q − F, and compensated summation. Returns the final state and the Newton
 /// iterations.
 pub fn midpoint<L: varmech::model::Lagrangian>(
@@ -60,7 +62,7 @@ pub fn midpoint<L: varmech::model::Lagrangian>(
     steps: usize,
 ) -> ([f64; 2], [f64; 2], u64) {
     const TOLERANCE: f64 = 1e-14;
-    const NOISE_FLOOR: f64 = 1.5e-8;
+    let norm = |x: [f64; 2]| x[0].abs().max(x[1].abs());
     let mut hessians = varmech::model::Hessians::zeros(2);
     let (mut q, mut p) = (q0, p0);
     let (mut eq, mut ep) = ([0.0; 2], [0.0; 2]);
@@ -84,6 +86,7 @@ pub fn midpoint<L: varmech::model::Lagrangian>(
         let mut r = equations(&q, &p, &x, &mut lq);
         let (mut lu, mut swap) = ([[0.0; 2]; 2], false);
         let (mut keep, mut previous, mut smallest) = (false, f64::INFINITY, f64::INFINITY);
+        let mut jacobian_norm = 0.0_f64;
         loop {
             let fresh = !keep;
             if fresh {
@@ -96,6 +99,7 @@ pub fn midpoint<L: varmech::model::Lagrangian>(
                 };
                 // Partial pivoting of a 2×2 matrix.
                 let mut m = [[j(0, 0), j(0, 1)], [j(1, 0), j(1, 1)]];
+                jacobian_norm = (m[0][0].abs() + m[0][1].abs()).max(m[1][0].abs() + m[1][1].abs());
                 swap = m[1][0].abs() > m[0][0].abs();
                 if swap {
                     m.swap(0, 1);
@@ -112,7 +116,8 @@ pub fn midpoint<L: varmech::model::Lagrangian>(
             let size = d0.abs().max(d1.abs());
             let scale = x[0].abs().max(x[1].abs());
             r = equations(&q, &p, &x, &mut lq);
-            let at_floor = fresh && size > 0.5 * smallest && size <= NOISE_FLOOR * scale;
+            let rounding = 4.0 * f64::EPSILON * (jacobian_norm * (scale + norm(q)) + norm(p));
+            let at_floor = fresh && size > 0.5 * smallest && norm(r) <= 4.0 * rounding;
             smallest = smallest.min(size);
             if size <= TOLERANCE * scale || at_floor {
                 break;

@@ -85,12 +85,16 @@ _DIVERGENCE_ERROR = """The solution blew up: a non-finite state, or an energy er
     1 3.0 [0. 3.]
     """
 
-_CONVERGENCE_ERROR = """Newton's method did not solve a step's implicit equations (a smaller step usually helps).
+_CONVERGENCE_ERROR = """Newton's method did not solve a step's implicit equations; the message says what helps.
 
     The implicit methods (``midpoint``, ``trapezoid``, the Galerkin and constrained ones) solve
     each step's discrete Euler–Lagrange equations D₂L_d(qₙ₋₁, qₙ) + D₁L_d(qₙ, qₙ₊₁) = 0 by
     Newton's method; it fails after ``newton_max_iterations`` iterations without reaching
-    ``newton_tolerance`` (arguments of :func:`varmech.integrate`).
+    ``newton_tolerance`` (arguments of :func:`varmech.integrate`) or the noise floor of the
+    equations. The advice comes from the iteration's course: a smaller step where the
+    predictor lies outside Newton's region, the model's second derivatives where they disagree
+    with the first, its smoothness where the corrections stall far above the noise, more
+    iterations where they were still falling.
 
     Attributes
     ----------

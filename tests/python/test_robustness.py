@@ -19,16 +19,32 @@ def test_newton_max_iterations_is_bounded():
             varmech.integrate(chain.model, chain.q0, chain.p0, dt=0.01, steps=1, method="rattle", newton_max_iterations=bad)
 
 
-def test_the_largest_iteration_cap_with_an_unreachable_tolerance_fails_quickly():
-    chain = scenes.planar_chain(30)
+def test_the_largest_iteration_cap_on_a_step_without_a_solution_fails_quickly():
+    # V = 5|q| from rest at its kink: the midpoint step's F jumps over 0 at q₁ = q₀ (its force
+    # is ±5 on either side), so Newton cycles there until the cap.
+    kink = varmech.Lagrangian(
+        1,
+        lambda q, v, t: 0.5 * v[0] ** 2 - 5 * abs(q[0]),
+        dl_dq=lambda q, v, t: np.array([-5.0 if q[0] >= 0 else 5.0]),
+        dl_dv=lambda q, v, t: v.copy(),
+        hessians=lambda q, v, t: (np.zeros((1, 1)), np.zeros((1, 1)), np.ones((1, 1))),
+    )
     start = time.perf_counter()
-    with pytest.raises(varmech.ConvergenceError) as info:
-        varmech.integrate(
-            chain.model, chain.q0, chain.p0, dt=0.01, steps=3, method="rattle",
-            newton_tolerance=1e-300, newton_max_iterations=10_000,
-        )
+    with pytest.raises(varmech.ConvergenceError, match="not smooth here") as info:
+        varmech.integrate(kink, [0.0], v0=[0.0], dt=0.1, steps=3, method="midpoint", newton_max_iterations=10_000)
     assert info.value.iterations == 10_000
     assert time.perf_counter() - start < 5.0
+
+
+def test_an_unreachable_tolerance_stops_at_the_noise_floor():
+    # RATTLE's multipliers to 1e-300: the iteration stops where its corrections stall at the
+    # rounding of the constraints, with the run the default tolerance gives to round-off.
+    chain = scenes.planar_chain(30)
+    runs = [
+        varmech.integrate(chain.model, chain.q0, chain.p0, dt=0.01, steps=3, method="rattle", newton_tolerance=tolerance)
+        for tolerance in (1e-14, 1e-300)
+    ]
+    np.testing.assert_allclose(runs[1].q, runs[0].q, rtol=0, atol=1e-13)
 
 
 def test_ctrl_c_stops_one_long_newton_iteration(interrupt_after):

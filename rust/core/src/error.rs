@@ -2,6 +2,8 @@
 
 use std::fmt;
 
+pub use crate::solve::Diagnosis;
+
 /// SHAKE's failure to reach its tolerance in its sweeps: its advice is not a smaller step.
 pub(crate) const SHAKE_UNCONVERGED: &str = "SHAKE did not reach its tolerance on the constraints";
 
@@ -17,13 +19,15 @@ pub enum Error {
     /// The numerical solution left every sensible bound: a non-finite state, or an energy error
     /// beyond the threshold the user set.
     Divergence { step: usize, time: f64, reason: String },
-    /// Newton's method did not solve the implicit equations of `step` (which starts at `time`).
+    /// Newton's method did not solve the implicit equations of `step` (which starts at `time`);
+    /// `diagnosis` says what would help.
     Convergence {
         step: usize,
         time: f64,
         residual: f64,
         iterations: usize,
         reason: &'static str,
+        diagnosis: Diagnosis,
     },
     /// The implicit equations of `step` (which starts at `time`) were solved, but on a branch
     /// that need not continue the trajectory: the step is too large for the dynamics there.
@@ -61,6 +65,7 @@ impl Error {
                 residual,
                 iterations,
                 reason,
+                diagnosis,
                 ..
             } => Error::Convergence {
                 step,
@@ -68,6 +73,7 @@ impl Error {
                 residual,
                 iterations,
                 reason,
+                diagnosis,
             },
             Error::SpuriousBranch { reason, .. } => Error::SpuriousBranch { step, time, reason },
             Error::Model { source, .. } => Error::Model { step, time, source },
@@ -91,13 +97,14 @@ impl fmt::Display for Error {
                 residual,
                 iterations,
                 reason,
+                diagnosis,
             } => {
                 // SHAKE's sweeps converge linearly at a rate the constraints' coupling sets, not h.
                 let advice = if *reason == SHAKE_UNCONVERGED {
                     "more sweeps help (newton_max_iterations), or rattle, whose Newton iteration converges \
                      quadratically"
                 } else {
-                    "a smaller step usually helps"
+                    diagnosis.advice()
                 };
                 write!(
                     f,
@@ -156,6 +163,7 @@ pub enum StepError {
         residual: f64,
         iterations: usize,
         reason: &'static str,
+        diagnosis: Diagnosis,
     },
     /// The step's equations became non-finite: the solution is blowing up.
     NonFinite { reason: &'static str },
@@ -177,12 +185,14 @@ impl StepError {
                 residual,
                 iterations,
                 reason,
+                diagnosis,
             } => Error::Convergence {
                 step,
                 time,
                 residual,
                 iterations,
                 reason,
+                diagnosis,
             },
             StepError::NonFinite { reason } => Error::Divergence {
                 step,

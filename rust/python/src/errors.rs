@@ -13,7 +13,7 @@ pyo3::create_exception!(
     varmech,
     ConvergenceError,
     VarmechError,
-    "Newton's method did not solve a step's implicit equations (a smaller step usually helps)."
+    "Newton's method did not solve a step's implicit equations; the message says what helps."
 );
 pyo3::create_exception!(
     varmech,

@@ -230,6 +230,11 @@ impl NewtonProblem for Balance<'_> {
             scale: 1.0,
         }
     }
+
+    /// Not known beyond what the iteration adds ([`NewtonProblem::noise`]).
+    fn noise(&self) -> f64 {
+        0.0
+    }
 }
 
 /// The multipliers that best balance the force at the guess, min ‖F + Gᵀλ‖ (GGᵀλ = −GF): the
@@ -286,10 +291,7 @@ pub fn equilibrium(model: Model<'_>, guess: &[f64], t: f64, options: &NewtonOpti
     if m > 0 {
         balance.lambda = least_squares_multipliers(&mut balance).map_err(|e| e.at(0, t))?;
     }
-    let rules = Rules {
-        simplified: false,
-        noise_floor: true,
-    };
+    let rules = Rules { simplified: false };
     let solution = Newton::new(n + m)
         .solve(&mut balance, options, rules)
         .map_err(|e| e.at(0, t))?;

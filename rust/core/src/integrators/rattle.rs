@@ -6,7 +6,7 @@ use crate::error::SHAKE_UNCONVERGED;
 use crate::model::{HolonomicConstraints, MechanicalSystem};
 use crate::solve::interrupt::{check_interrupt, InterruptPoll};
 use crate::solve::lu::{lu_in_place, lu_solve};
-use crate::solve::newton::{Correction, Newton, NewtonOptions, NewtonProblem, Reasons, Rules};
+use crate::solve::newton::{Correction, Diagnosis, Newton, NewtonOptions, NewtonProblem, Reasons, Rules};
 use crate::ModelError;
 
 /// RATTLE (Andersen 1983; HLW VII.1.4) for H = ½pᵀM⁻¹p + V(q) on g(q) = 0:
@@ -206,10 +206,7 @@ impl Rattle {
                 q1: &mut self.q1,
                 scale,
             };
-            let rules = Rules {
-                simplified: false,
-                noise_floor: false,
-            };
+            let rules = Rules { simplified: false };
             self.newton.solve(&mut multipliers, &self.options, rules)?;
         }
         self.end(sys, constraints, q0, p0, h)
@@ -283,6 +280,7 @@ impl Rattle {
                     residual: self.g.amax(),
                     iterations: 0,
                     reason: "G(q₁)M⁻¹G(q₁)ᵀ is singular: the constraints are not independent here",
+                    diagnosis: Diagnosis::Singular,
                 });
             }
             lu_solve(&self.gram, &self.pivots, self.g.as_mut_slice());
@@ -368,6 +366,7 @@ impl Rattle {
                     residual,
                     iterations: sweeps,
                     reason: SHAKE_UNCONVERGED,
+                    diagnosis: Diagnosis::Cap,
                 });
             }
             sweeps += 1;
@@ -481,6 +480,10 @@ impl<C: HolonomicConstraints + ?Sized> NewtonProblem for PositionConstraint<'_, 
 
     /// The constraints hold to round-off.
     fn solved(&self, residual: f64) -> bool {
-        residual <= 4.0 * f64::EPSILON
+        residual <= self.noise()
+    }
+
+    fn noise(&self) -> f64 {
+        4.0 * f64::EPSILON
     }
 }

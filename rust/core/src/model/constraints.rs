@@ -245,10 +245,7 @@ pub fn project<C: HolonomicConstraints + ?Sized>(
         tolerance: 4.0 * f64::EPSILON,
         ..NewtonOptions::default()
     };
-    let rules = Rules {
-        simplified: false,
-        noise_floor: false,
-    };
+    let rules = Rules { simplified: false };
     match Newton::new(m).solve(&mut problem, &options, rules) {
         Ok(_) => {}
         Err(StepError::Model(e) | StepError::Interrupted(e)) => return Err(model(e)),
@@ -345,6 +342,11 @@ impl<C: HolonomicConstraints + ?Sized> NewtonProblem for OntoConstraints<'_, C> 
             size: shift.amax(),
             scale: self.scale,
         }
+    }
+
+    /// g's rounding at q, a few ε of the scale of q.
+    fn noise(&self) -> f64 {
+        4.0 * f64::EPSILON * self.scale
     }
 }
 

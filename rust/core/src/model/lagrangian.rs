@@ -6,7 +6,7 @@ use serde::{Deserialize, Serialize};
 use super::{EnergyTerms, MechanicalSystem};
 use crate::error::StepError;
 use crate::solve::difference::{self, central_gradient, central_jacobian, Evaluations};
-use crate::solve::newton::{model_error, Correction, Newton, NewtonOptions, NewtonProblem, Reasons, Rules};
+use crate::solve::newton::{model_error, norm, Correction, Newton, NewtonOptions, NewtonProblem, Reasons, Rules};
 use crate::solve::scratch::with_scratch;
 use crate::ModelError;
 
@@ -238,10 +238,7 @@ pub fn inverse_legendre<L: Lagrangian + ?Sized>(
             minus,
             hessians: Some(hessians),
         };
-        let rules = Rules {
-            simplified: false,
-            noise_floor: true,
-        };
+        let rules = Rules { simplified: false };
         newton
             .solve(&mut problem, &NewtonOptions::default(), rules)
             .map_err(model_error)?;
@@ -394,5 +391,10 @@ impl<S: Lagrangian + ?Sized> NewtonProblem for InverseLegendre<'_, S> {
 
     fn correct(&mut self, delta: &[f64]) -> Correction {
         Correction::relative(self.v, delta)
+    }
+
+    /// The rounding of p.
+    fn noise(&self) -> f64 {
+        4.0 * f64::EPSILON * norm(self.p)
     }
 }

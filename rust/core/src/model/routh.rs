@@ -6,7 +6,7 @@ use super::{Hessians, Lagrangian};
 use crate::error::StepError;
 use crate::solve::difference::{self, central_jacobian, Evaluations};
 use crate::solve::lu::{lu_in_place, lu_solve};
-use crate::solve::newton::{model_error, Correction, Newton, NewtonOptions, NewtonProblem, Reasons, Rules};
+use crate::solve::newton::{model_error, norm, Correction, Newton, NewtonOptions, NewtonProblem, Reasons, Rules};
 use crate::{Error, ModelError};
 
 /// The Newton iteration for ċ: to a relative correction of 1e-15 (or the noise floor of a
@@ -322,10 +322,7 @@ impl<'a, L: Lagrangian + ?Sized> Routhian<'a, L> {
 
     /// [`Routhian::solve`] without the memo.
     fn newton(&self, s: &mut Scratch, nodes: &[Node]) -> Result<(), ModelError> {
-        let rules = Rules {
-            simplified: false,
-            noise_floor: true,
-        };
+        let rules = Rules { simplified: false };
         let mut problem = CyclicVelocities { routh: self, s, nodes };
         self.newton
             .borrow_mut()
@@ -471,6 +468,11 @@ impl<L: Lagrangian + ?Sized> NewtonProblem for CyclicVelocities<'_, '_, L> {
     fn solved(&self, residual: f64) -> bool {
         let scale = self.routh.momenta.iter().fold(f64::MIN_POSITIVE, |a, b| a.max(b.abs()));
         residual <= 4.0 * f64::EPSILON * scale
+    }
+
+    /// The rounding of μ.
+    fn noise(&self) -> f64 {
+        4.0 * f64::EPSILON * norm(&self.routh.momenta)
     }
 }
 

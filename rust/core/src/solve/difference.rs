@@ -4,14 +4,34 @@
 //! balances the O(h²) truncation against the O(ε/h) round-off, for an error of order
 //! ε^{2/3} ≈ 4e-11 relative.
 
+use std::cell::Cell;
+
 use nalgebra::DMatrix;
 
 use crate::ModelError;
 
-/// √ε: relative changes below this in a Newton iteration whose equations are built from central
-/// differences (accurate to about ε^{2/3}) are noise, and a correction there that a fresh
-/// Newton step cannot halve means the iteration has converged as far as it can.
-pub const NOISE_FLOOR: f64 = 1.5e-8;
+thread_local! {
+    /// The largest rounding error of a derivative taken by [`central_gradient`] on this thread
+    /// since the last [`take_noise`].
+    static NOISE: Cell<f64> = const { Cell::new(0.0) };
+}
+
+/// The largest rounding error of the derivatives taken by differences on this thread since the
+/// last call, and a fresh start: what an equation built from them carries as noise
+/// ([`crate::solve::newton`] judges a stall against it). Not the O(h²) truncation: that is
+/// smooth, and Newton solves through it; the rounding of f at x ± h, which the difference
+/// divides by 2h, is in steps, too flat over a Newton correction to sample (see
+/// [`central_gradient`] for its bound).
+pub fn take_noise() -> f64 {
+    NOISE.with(|n| n.replace(0.0))
+}
+
+/// Records `noise`, the rounding error of a derivative just taken by differences (or of a
+/// solution an equation takes from a solve of its own).
+#[inline]
+pub(crate) fn record(noise: f64) {
+    NOISE.with(|n| n.set(n.get().max(noise)));
+}
 
 /// ε^{1/3}, written out: `f64::cbrt` is not a `const fn`, and a libm call per difference costs
 /// as much as a cheap model's gradient.
@@ -38,12 +58,18 @@ pub fn unit(_: usize, x: f64) -> f64 {
 /// ∇f(q) by central differences, ∂f/∂qᵢ ≈ [f(q + hᵢeᵢ) − f(q − hᵢeᵢ)] / 2hᵢ, with the step
 /// hᵢ = ε^{1/3}·max(|qᵢ|, 1).
 ///
+/// Its rounding error is recorded for [`take_noise`]: f rounded at the size of its terms, which
+/// f's value alone understates where they cancel (L = T − V near T = V); they are bounded by
+/// |f| + Σⱼ|qⱼ∂f/∂qⱼ| (for L in q̇: |T − V| + 2T), and each difference divides their rounding,
+/// a few ε of them, by 2hᵢ.
+///
 /// `work` (length n) is scratch space, so the call allocates nothing.
 pub fn central_gradient<F>(mut f: F, q: &[f64], work: &mut [f64], grad: &mut [f64]) -> Result<(), ModelError>
 where
     F: FnMut(&[f64]) -> Result<f64, ModelError>,
 {
     work.copy_from_slice(q);
+    let (mut size, mut least) = (0.0_f64, f64::INFINITY);
     for i in 0..q.len() {
         let h = step(unit(i, q[i]));
         work[i] = q[i] + h;
@@ -52,7 +78,11 @@ where
         let backward = f(work)?;
         work[i] = q[i];
         grad[i] = (forward - backward) / (2.0 * h);
+        size = size.max(forward.abs()).max(backward.abs());
+        least = least.min(h);
     }
+    let terms = size + q.iter().zip(grad.iter()).map(|(x, g)| (x * g).abs()).sum::<f64>();
+    record(2.0 * f64::EPSILON * terms / (2.0 * least));
     Ok(())
 }
 

@@ -1,7 +1,7 @@
 //! Numerical solvers shared by every layer, each allocation-free in its loop:
 //!
 //! - `lu`: LU factorisation with partial pivoting, in place;
-//! - [`difference`]: gradients and Jacobians by central differences, and the noise floor of
+//! - [`difference`]: gradients and Jacobians by central differences;
 //!   equations built from them;
 //! - `newton`: Newton's method, simplified (a kept Jacobian) or full, with [`NewtonOptions`];
 //! - [`bracket`]: a root of a function on a bracket (Illinois), for locating events;
@@ -64,4 +64,4 @@ pub(crate) mod newton;
 pub(crate) mod scratch;
 pub(crate) mod splitmix;
 
-pub use newton::NewtonOptions;
+pub use newton::{Diagnosis, NewtonOptions};

@@ -5,13 +5,15 @@
 //!
 //! One iteration x ← x − J⁻¹F(x), with J factorised in place ([`super::lu`]) and, as an option,
 //! kept while the corrections at least halve (simplified Newton). It stops on the increment,
-//! ‖δ‖ ≤ tolerance·scale, at the noise floor of the equations, when the problem declares F
-//! small enough, or at the iteration cap.
+//! ‖δ‖ ≤ tolerance·scale, when the problem declares F small enough, at the iteration cap, or at
+//! the noise floor of the equations: where a Newton step with a fresh Jacobian no longer halves
+//! the corrections (a stall) and F is within the noise its evaluation carries
+//! ([`NewtonProblem::noise`]), x is as converged as F's evaluation allows ([`Progress`]).
 
 use nalgebra::{DMatrix, DVector};
 use serde::{Deserialize, Serialize};
 
-use super::difference::NOISE_FLOOR;
+use super::difference;
 use super::interrupt::{check_interrupt, InterruptPoll};
 use super::lu::{lu_in_place, lu_solve};
 use crate::error::StepError;
@@ -20,9 +22,9 @@ use crate::{Error, ModelError};
 /// Options of a Newton iteration.
 ///
 /// The implicit integrators stop when ‖δ‖∞ ≤ tolerance·‖x‖∞, x the unknowns as increments from
-/// q₀ (the step's δq, and the Galerkin control points' offsets), or when a Newton step with a
-/// freshly computed Jacobian no longer halves a correction that is already below √ε‖x‖∞ (the
-/// equations' own accuracy when derivatives come from differences). The scale is the increment,
+/// q₀ (the step's δq, and the Galerkin control points' offsets), or at the noise floor of the
+/// equations (their own accuracy, as when derivatives come from differences: see
+/// [`Progress`]). The scale is the increment,
 /// not the position: the discrete velocity δq/h, and so p₁, carries the increment's relative
 /// precision, which a scale of ‖q‖∞ would give away as a cyclic angle grows. The other
 /// iterations measure their corrections their own way (RATTLE: the move of q₁ against ‖q₀‖∞).
@@ -72,19 +74,17 @@ impl Default for NewtonOptions {
     }
 }
 
-/// How an iteration refreshes its Jacobian and when it may stop short of the tolerance.
+/// How an iteration refreshes its Jacobian.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct Rules {
     /// Keep the factorised Jacobian while the corrections at least halve (simplified Newton),
     /// refresh it otherwise; false: a fresh Jacobian every iteration.
     pub simplified: bool,
-    /// Also stop at the noise floor: when a step with a fresh Jacobian no longer halves the
-    /// smallest correction so far, and that correction is below [`NOISE_FLOOR`]·scale.
-    pub noise_floor: bool,
 }
 
 /// The size of a Newton correction and the scale the tolerance is relative to: converged when
-/// size ≤ tolerance·scale (a scale of 0 leaves convergence to [`NewtonProblem::solved`]).
+/// size ≤ tolerance·scale (a scale of 0 leaves convergence to [`NewtonProblem::solved`] and the
+/// noise floor).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct Correction {
     pub size: f64,
@@ -116,6 +116,62 @@ pub(crate) struct Reasons {
     pub not_converged: &'static str,
 }
 
+/// What the history of a failed iteration says would help: the advice of its error.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Diagnosis {
+    /// The corrections grew, never fell below the first, or fell only slowly with a Jacobian
+    /// that agrees with F: the start (the step's predictor) lies outside Newton's region of
+    /// convergence. A smaller step brings the predictor closer.
+    Diverged,
+    /// The corrections kept falling, but linearly with fresh Jacobians that disagree with
+    /// differences of F: a model's supplied second derivatives are not those of its first.
+    Linear,
+    /// The corrections stopped falling well above the noise of the equations there: they are
+    /// not smooth (a kink or jump in the model, or its derivatives).
+    Stalled,
+    /// Still converging fast at the cap: too few iterations allowed.
+    Cap,
+    /// The Jacobian is singular.
+    Singular,
+}
+
+impl Diagnosis {
+    /// The diagnosis once the Jacobian is checked against differences of F: a linear
+    /// convergence with a Jacobian that agrees is the iteration not yet near the root, where
+    /// F's curvature, not J, slows it.
+    pub(crate) fn confirmed(self, jacobian_agrees: bool) -> Self {
+        match self {
+            Diagnosis::Linear if jacobian_agrees => Diagnosis::Diverged,
+            other => other,
+        }
+    }
+
+    /// The advice for a failure so diagnosed.
+    pub fn advice(self) -> &'static str {
+        match self {
+            Diagnosis::Diverged => {
+                "the step's predictor lies outside the region where Newton's iteration converges: a smaller \
+                 step (dt) brings it closer"
+            }
+            Diagnosis::Linear => {
+                "the corrections fell only linearly, and the Jacobian disagrees with differences of the \
+                 equations: the model's second derivatives (hessians) are not those of its first; check them \
+                 (varmech.check_derivatives); a smaller step does not help"
+            }
+            Diagnosis::Stalled => {
+                "the corrections stopped falling far above the noise of the equations: the model is not smooth \
+                 here (a kink or jump in L, its derivatives or forces); a smaller step does not help"
+            }
+            Diagnosis::Cap => "it was still converging: allow more iterations (newton_max_iterations)",
+            Diagnosis::Singular => {
+                "the Jacobian is singular: ∂²L/∂q̇² is not invertible here (the Lagrangian is not regular) or \
+                 the constraints are dependent, unless the step lies at a fold of the discrete map, which a \
+                 smaller step avoids"
+            }
+        }
+    }
+}
+
 /// The equations F(x) = 0 of one Newton iteration. The problem keeps its unknowns x (the
 /// iteration only sees F, its Jacobian and the corrections), so that it may apply a correction
 /// as it must (the projection onto g(q) = 0 moves q along M⁻¹Gᵀ).
@@ -129,8 +185,27 @@ pub(crate) trait NewtonProblem {
     /// Writes ∂F/∂x into `jac` (it is factorised in place afterwards).
     fn jacobian(&mut self, jac: &mut DMatrix<f64>) -> Result<(), StepError>;
 
+    /// Whether the Jacobian the problem supplies agrees with differences of F at the current x
+    /// (a model's second derivatives need not be those of its first): asked only to diagnose a
+    /// failure. Default: it does (a Jacobian by differences of F agrees by construction).
+    fn jacobian_agrees(&mut self) -> Result<bool, StepError> {
+        Ok(true)
+    }
+
     /// Applies x ← x − δ (or the problem's own update along δ) and measures the correction.
     fn correct(&mut self, delta: &[f64]) -> Correction;
+
+    /// The rounding of F's terms at the last [`NewtonProblem::residual`], in the max norm,
+    /// where the problem knows them (the iteration adds the rounding of its terms where F is
+    /// linear in x, and of the derivatives taken by differences for F,
+    /// [`difference::take_noise`]). Newton's corrections fall no further than J⁻¹ of F's noise.
+    fn noise(&self) -> f64;
+
+    /// The size of what the unknowns are added to before F is evaluated (q₀ for a step's
+    /// increments): its rounding moves them by a few ε of it. Default: nothing.
+    fn offset(&self) -> f64 {
+        0.0
+    }
 
     /// Whether F, of norm ‖F‖∞ = `residual`, is small enough to stop at (checked at the start
     /// and after every correction). Default: never, the increment decides.
@@ -138,28 +213,73 @@ pub(crate) trait NewtonProblem {
         false
     }
 
-    /// Told before the evaluation of F at which the iteration ends (its correction converged),
-    /// for a problem that takes more than F from that evaluation (the DEL step: ∂L/∂t for the
-    /// energy balance, which the others need not compute). Default: nothing.
+    /// Told before the evaluation of F at which the iteration may end (its correction
+    /// converged, or stalled), for a problem that takes more than F from that evaluation (the
+    /// DEL step: ∂L/∂t for the energy balance, which the others need not compute). Default:
+    /// nothing.
     fn finishing(&mut self) {}
 }
 
+/// What an iteration's latest correction says.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Judgement {
+    /// Within the tolerance, or below the normal numbers.
+    Converged,
+    /// A correction made with a fresh Jacobian that did not halve the smallest so far: at the
+    /// noise floor of F, or failing; F's noise decides ([`Progress::at_floor`]).
+    Stalled,
+    /// Neither: iterate on.
+    Iterating,
+}
+
+/// How far F may lie above its estimated noise at a stall and count as converged: the
+/// estimate bounds each difference's rounding, and a sum of several (a step's quadrature nodes)
+/// adds theirs.
+const NOISE_MARGIN: f64 = 4.0;
+
 /// An iteration's progress, by the sizes of its corrections: whether the next step factorises
-/// a fresh Jacobian, and when to stop ([`Rules`]). Shared by [`Newton::solve`] and the
+/// a fresh Jacobian, when to stop, and why it failed. Shared by [`Newton::solve`] and the
 /// fixed-size DEL step, which must decide alike.
+///
+/// The noise floor: F evaluated in floating point (its derivatives by differences, a sum of
+/// large terms, points rounded) is F plus noise of some size σ, and Newton's corrections fall
+/// no further than J⁻¹σ. Where a correction made with a fresh Jacobian does not halve the
+/// smallest so far (a stall), the iteration has converged if ‖F‖ is within [`NOISE_MARGIN`]σ at
+/// the new iterate ([`Progress::noise`] estimates σ); a stall far above it is a failure to come
+/// (of the model's smoothness, or its Jacobian). The noise of differences is not random but in
+/// steps, flat or in line over several corrections, so it is bounded from the values differenced
+/// rather than sampled (Moré and Wild's estimate, "Estimating computational noise", SIAM J. Sci.
+/// Comput. 33, 2011, sees none along a line).
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Progress {
     keep_jacobian: bool,
+    first: f64,
     last: f64,
     smallest: f64,
+    /// The ratio of the last two corrections made with fresh Jacobians, the ratio before it,
+    /// and the last size made with one.
+    fresh_ratio: f64,
+    fresh_ratio_before: f64,
+    last_fresh: f64,
+    stalls: usize,
+    corrections: usize,
+    /// ‖J‖∞ of the last fresh Jacobian: with the unknowns' size, the size of F's terms.
+    jacobian_norm: f64,
 }
 
 impl Progress {
     pub fn new() -> Self {
         Progress {
             keep_jacobian: false,
+            first: f64::INFINITY,
             last: f64::INFINITY,
             smallest: f64::INFINITY,
+            fresh_ratio: f64::INFINITY,
+            fresh_ratio_before: f64::INFINITY,
+            last_fresh: f64::INFINITY,
+            stalls: 0,
+            corrections: 0,
+            jacobian_norm: 0.0,
         }
     }
 
@@ -169,26 +289,82 @@ impl Progress {
         !self.keep_jacobian
     }
 
-    /// Whether the iteration has converged after `correction`, made with a fresh Jacobian or
-    /// a kept one: on the increment, or at the noise floor of the equations (round-off, or
-    /// derivatives by differences), where even a fresh Newton step no longer halves the
-    /// smallest correction so far, or below the normal numbers. If not, the Jacobian is kept while the corrections halve.
+    /// Judges `correction`, made with a fresh Jacobian or a kept one, against `tolerance`; the
+    /// Jacobian is kept (with `simplified`) while the corrections halve.
     #[inline(always)]
-    pub fn converged(&mut self, fresh: bool, correction: Correction, tolerance: f64, rules: Rules) -> bool {
-        let at_floor = rules.noise_floor
-            && fresh
-            && correction.size > 0.5 * self.smallest
-            && correction.size <= NOISE_FLOOR * correction.scale;
-        self.smallest = self.smallest.min(correction.size);
+    pub fn judge(&mut self, fresh: bool, correction: Correction, tolerance: f64, simplified: bool) -> Judgement {
+        let size = correction.size;
+        if self.corrections == 0 {
+            self.first = size;
+        }
+        let stalled = fresh && size > 0.5 * self.smallest;
+        self.corrections += 1;
+        if fresh {
+            self.fresh_ratio_before = self.fresh_ratio;
+            self.fresh_ratio = size / self.last_fresh;
+            self.last_fresh = size;
+        }
+        self.smallest = self.smallest.min(size);
         // A subnormal correction has no relative precision left to gain: the unknowns have
         // decayed below the smallest normal number (a motion damped to rest).
-        let underflow = correction.size < f64::MIN_POSITIVE;
-        if correction.size <= tolerance * correction.scale || at_floor || underflow {
-            return true;
+        if size <= tolerance * correction.scale || size < f64::MIN_POSITIVE {
+            return Judgement::Converged;
         }
-        self.keep_jacobian = rules.simplified && correction.size <= 0.5 * self.last;
-        self.last = correction.size;
-        false
+        self.keep_jacobian = simplified && size <= 0.5 * self.last;
+        self.last = size;
+        if stalled {
+            self.stalls += 1;
+            return Judgement::Stalled;
+        }
+        Judgement::Iterating
+    }
+
+    /// Records a fresh Jacobian, `jac` (n × n, column-major), before it is factorised.
+    #[inline(always)]
+    pub fn jacobian(&mut self, jac: &[f64], n: usize) {
+        self.jacobian_norm = (0..n).fold(0.0_f64, |m, i| m.max((0..n).map(|j| jac[i + j * n].abs()).sum()));
+    }
+
+    /// F's noise σ near the last iterate: `rounding`, what the problem knows of its terms'
+    /// ([`NewtonProblem::noise`]); the rounding of the derivatives taken by differences since
+    /// the last call ([`difference::take_noise`]); and a few ε of ‖J‖∞ times the unknowns' size
+    /// (`correction.scale`: F's terms where F is linear in x) and what they are added to
+    /// (`offset`, [`NewtonProblem::offset`]).
+    #[inline(always)]
+    pub fn noise(&self, rounding: f64, correction: Correction, offset: f64) -> f64 {
+        rounding + difference::take_noise() + 4.0 * f64::EPSILON * self.jacobian_norm * (correction.scale + offset)
+    }
+
+    /// Whether a stalled iteration, ‖F‖∞ = `residual` at its new iterate and F's noise `noise`
+    /// ([`Progress::noise`]), has converged.
+    #[inline(always)]
+    pub fn at_floor(residual: f64, noise: f64) -> bool {
+        residual <= NOISE_MARGIN * noise
+    }
+
+    /// Why the iteration failed, having reached its cap: by the course of its corrections,
+    /// the last two made with fresh Jacobians in ratio θ.
+    pub fn diagnosis(&self) -> Diagnosis {
+        let ratio = self.fresh_ratio;
+        let same = |r: f64| (0.95..=1.05).contains(&r);
+        if self.corrections < 2 {
+            // Too few to tell.
+            Diagnosis::Cap
+        } else if same(ratio) && same(self.fresh_ratio_before) {
+            // The same size again and again: a cycle about a point where F jumps, or flat.
+            Diagnosis::Stalled
+        } else if self.last > self.first / 16.0 {
+            // No headway: wandering, or growing, far from a root.
+            Diagnosis::Diverged
+        } else if ratio <= 0.1 || self.last < 0.1 * self.last_fresh {
+            // Still falling fast (quadratically, or on a kept Jacobian).
+            Diagnosis::Cap
+        } else if ratio < 0.95 {
+            // Falling, but at a steady rate θ: J⁻¹ times the true Jacobian is not the identity.
+            Diagnosis::Linear
+        } else {
+            Diagnosis::Stalled
+        }
     }
 }
 
@@ -199,6 +375,8 @@ pub(crate) struct Solution {
     pub iterations: usize,
     /// ‖F‖∞ at the solution.
     pub residual: f64,
+    /// F's noise there ([`Progress::noise`]).
+    pub noise: f64,
 }
 
 /// The buffers of Newton's method for m equations: F, its Jacobian and LU factors; sized once,
@@ -299,6 +477,22 @@ impl Newton {
         options: &NewtonOptions,
         rules: Rules,
     ) -> Result<Solution, StepError> {
+        // A solve inside another's F (a Routhian's cyclic velocities, a step's q̇(q, p)) keeps
+        // the differences the outer F took before it, and adds its own solution's noise.
+        let outer = difference::take_noise();
+        let solution = self.iterate(problem, options, rules);
+        let own = solution.as_ref().map_or(0.0, |s| s.noise);
+        difference::record(outer.max(own));
+        solution
+    }
+
+    /// [`Newton::solve`]'s iteration.
+    fn iterate<P: NewtonProblem>(
+        &mut self,
+        problem: &mut P,
+        options: &NewtonOptions,
+        rules: Rules,
+    ) -> Result<Solution, StepError> {
         let reasons = P::REASONS;
         problem.residual(self.residual.as_mut_slice())?;
         let mut residual = norm(self.residual.as_slice());
@@ -311,6 +505,7 @@ impl Newton {
             return Ok(Solution {
                 iterations: 0,
                 residual,
+                noise: problem.noise() + difference::take_noise(),
             });
         }
         let mut progress = Progress::new();
@@ -319,6 +514,7 @@ impl Newton {
             let fresh = progress.fresh();
             if fresh {
                 problem.jacobian(&mut self.jacobian)?;
+                progress.jacobian(self.jacobian.as_slice(), self.jacobian.nrows());
                 self.sign = match lu_in_place(&mut self.jacobian, &mut self.pivots) {
                     Some(sign) => sign,
                     None => {
@@ -326,6 +522,7 @@ impl Newton {
                             residual,
                             iterations: iteration - 1,
                             reason: reasons.singular,
+                            diagnosis: Diagnosis::Singular,
                         })
                     }
                 };
@@ -333,8 +530,8 @@ impl Newton {
             self.iterations += 1;
             lu_solve(&self.jacobian, &self.pivots, self.residual.as_mut_slice());
             let correction = problem.correct(self.residual.as_slice());
-            let converged = progress.converged(fresh, correction, options.tolerance, rules);
-            if converged {
+            let judgement = progress.judge(fresh, correction, options.tolerance, rules.simplified);
+            if judgement != Judgement::Iterating {
                 problem.finishing();
             }
             problem.residual(self.residual.as_mut_slice())?;
@@ -344,10 +541,20 @@ impl Newton {
                     reason: reasons.non_finite,
                 });
             }
+            let noise = match judgement {
+                Judgement::Iterating => None,
+                _ => Some(progress.noise(problem.noise(), correction, problem.offset())),
+            };
+            let converged = match (judgement, noise) {
+                (Judgement::Converged, _) => true,
+                (Judgement::Stalled, Some(noise)) => Progress::at_floor(residual, noise),
+                _ => false,
+            };
             if converged || problem.solved(residual) {
                 return Ok(Solution {
                     iterations: iteration,
                     residual,
+                    noise: noise.unwrap_or_else(|| progress.noise(problem.noise(), correction, problem.offset())),
                 });
             }
         }
@@ -355,6 +562,7 @@ impl Newton {
             residual,
             iterations: options.max_iterations,
             reason: reasons.not_converged,
+            diagnosis: progress.diagnosis().confirmed(problem.jacobian_agrees()?),
         })
     }
 }

@@ -170,10 +170,7 @@ impl Multipliers {
             scale: p.iter().fold(1.0_f64, |a, x| a.max(x.abs())),
             speed: 1.0,
         };
-        let rules = Rules {
-            simplified: false,
-            noise_floor: false,
-        };
+        let rules = Rules { simplified: false };
         self.newton.solve(&mut problem, options, rules)?;
         let m = self.mu.len();
         for (j, d) in step.dp.iter_mut().enumerate() {
@@ -270,6 +267,10 @@ impl<S: Lagrangian + ?Sized> NewtonProblem for OntoHiddenConstraint<'_, S> {
     }
 
     fn solved(&self, residual: f64) -> bool {
-        residual <= 4.0 * f64::EPSILON * self.speed
+        residual <= self.noise()
+    }
+
+    fn noise(&self) -> f64 {
+        4.0 * f64::EPSILON * self.speed
     }
 }

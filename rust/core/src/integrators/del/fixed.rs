@@ -4,17 +4,42 @@
 //! every length known to the compiler. On a double pendulum the general step's runtime lengths,
 //! calls and buffers cost more than the model's own arithmetic (issue 15).
 
-use super::{correct, finite_jacobian, segment, Constraints, Del, Equations, TwoPoint, REASONS};
+use super::{correct, finite_jacobian, rounding, segment, Constraints, Del, Equations, TwoPoint, REASONS};
 use crate::discrete::{DiscreteLagrangian, Workspace};
 use crate::integrators::del::StepEquations;
 use crate::integrators::stepper::{Clear, Phase};
 use crate::integrators::{StepError, StepStart};
 use crate::model::Lagrangian;
+use crate::solve::difference;
 use crate::solve::lu::{factorise, substitute};
-use crate::solve::newton::{norm, NewtonProblem, Progress, Rules};
+use crate::solve::newton::{norm, Diagnosis, Judgement, NewtonProblem, Progress};
 use crate::Error;
 
 impl<R: DiscreteLagrangian> Del<TwoPoint<R>> {
+    /// The unconstrained step's equations at the unknowns `x`, counted in `evaluations`: for
+    /// the Jacobian where the model gives no second derivatives, and a failure's diagnosis.
+    fn unconstrained<'a, S: Lagrangian + ?Sized>(
+        &'a mut self,
+        sys: &'a S,
+        start: StepStart<'a>,
+        x: &'a mut [f64],
+        evaluations: &'a mut u64,
+    ) -> Equations<'a, TwoPoint<R>, S> {
+        Equations {
+            scheme: &mut self.scheme,
+            sys,
+            constraints: Constraints::None,
+            start,
+            m: 0,
+            multipliers: &mut self.multipliers,
+            block: &mut self.block,
+            x,
+            plus: &mut self.plus,
+            minus: &mut self.minus,
+            evaluations,
+        }
+    }
+
     /// Whether [`Del::run`] takes the next steps of `sys`: no constraints and no forces, and
     /// the run's first step made (which judges the continuum limit's determinant sign).
     pub(in crate::integrators) fn runs_fixed<S: Lagrangian + ?Sized>(&self, sys: &S) -> bool {
@@ -46,15 +71,11 @@ impl<R: DiscreteLagrangian> Del<TwoPoint<R>> {
         );
         // Counts in locals, written back once.
         let (mut evaluations, mut iterations) = (self.evaluations, 0);
-        let (options, rules) = (
-            self.options,
-            Rules {
-                simplified: true,
-                noise_floor: true,
-            },
-        );
+        let options = self.options;
         let increment = |t: f64, q: &[f64; N], p: &[f64; N], dq: &mut [f64; N], dp: &mut [f64; N]| {
             let start = StepStart { t, h, q, p };
+            // The differences' rounding from this step's evaluations alone (Progress::noise).
+            difference::take_noise();
             // The Newton iteration's values are the closure's own, so that they may stay in
             // registers: through memory, scalar stores feeding vector loads stall.
             let mut x: [f64; N] = std::array::from_fn(|i| match history {
@@ -76,10 +97,14 @@ impl<R: DiscreteLagrangian> Del<TwoPoint<R>> {
             let mut iteration = 0;
             loop {
                 if iteration == options.max_iterations {
+                    let agrees = self
+                        .unconstrained(sys, start, &mut x, &mut evaluations)
+                        .jacobian_agrees()?;
                     return Err(StepError::Convergence {
                         residual,
                         iterations: iteration,
                         reason: REASONS.not_converged,
+                        diagnosis: progress.diagnosis().confirmed(agrees),
                     });
                 }
                 iteration += 1;
@@ -93,34 +118,28 @@ impl<R: DiscreteLagrangian> Del<TwoPoint<R>> {
                     if exact {
                         finite_jacobian(lu.as_flattened())?;
                     } else {
-                        let mut equations = Equations {
-                            scheme: &mut self.scheme,
-                            sys,
-                            constraints: Constraints::None,
-                            start,
-                            m: 0,
-                            multipliers: &mut self.multipliers,
-                            block: &mut self.block,
-                            x: &mut x,
-                            plus: &mut self.plus,
-                            minus: &mut self.minus,
-                            evaluations: &mut evaluations,
-                        };
-                        let jacobian = self.newton.jacobian_mut();
-                        equations.jacobian(jacobian)?;
-                        lu.as_flattened_mut().copy_from_slice(jacobian.as_slice());
+                        let mut jacobian = std::mem::take(self.newton.jacobian_mut());
+                        let differenced = self
+                            .unconstrained(sys, start, &mut x, &mut evaluations)
+                            .jacobian(&mut jacobian);
+                        *self.newton.jacobian_mut() = jacobian;
+                        differenced?;
+                        lu.as_flattened_mut()
+                            .copy_from_slice(self.newton.jacobian_mut().as_slice());
                     }
+                    progress.jacobian(lu.as_flattened(), N);
                     sign = factorise(lu.as_flattened_mut(), &mut pivots, N).ok_or_else(|| StepError::Convergence {
                         residual,
                         iterations: iteration - 1,
                         reason: REASONS.singular,
+                        diagnosis: Diagnosis::Singular,
                     })?;
                 }
                 iterations += 1;
                 substitute(lu.as_flattened(), &pivots, &mut r, N);
                 let correction = correct(&mut x, &r, 0, h);
-                let converged = progress.converged(fresh, correction, options.tolerance, rules);
-                if converged {
+                let judgement = progress.judge(fresh, correction, options.tolerance, true);
+                if judgement != Judgement::Iterating {
                     ws.keep_dl_dt();
                 }
                 evaluations += 1;
@@ -131,6 +150,13 @@ impl<R: DiscreteLagrangian> Del<TwoPoint<R>> {
                         reason: REASONS.non_finite,
                     });
                 }
+                let converged = match judgement {
+                    Judgement::Converged => true,
+                    Judgement::Stalled => {
+                        Progress::at_floor(residual, progress.noise(rounding(p), correction, norm(q)))
+                    }
+                    Judgement::Iterating => false,
+                };
                 if converged {
                     break;
                 }

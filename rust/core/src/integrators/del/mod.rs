@@ -25,7 +25,7 @@ use crate::discrete::Segment;
 use crate::model::{HolonomicConstraints, Lagrangian, VelocityConstraints};
 use crate::solve::difference::{self, central_jacobian, Evaluations};
 use crate::solve::lu::lu_in_place;
-use crate::solve::newton::{Correction, Newton, NewtonProblem, Reasons, Rules};
+use crate::solve::newton::{norm, Correction, Newton, NewtonProblem, Reasons, Rules};
 use crate::solve::NewtonOptions;
 use crate::ModelError;
 use constrained::{constrained_equations, Multipliers, Parts};
@@ -382,11 +382,8 @@ impl<Sc: StepEquations> Del<Sc> {
             minus: &mut self.minus,
             evaluations: &mut self.evaluations,
         };
-        let rules = Rules {
-            simplified: true,
-            noise_floor: true,
-        };
-        self.newton.solve(&mut equations, &self.options, rules)?;
+        self.newton
+            .solve(&mut equations, &self.options, Rules { simplified: true })?;
         // The fold test knows the unconstrained equations' continuum limit only.
         if m == 0 {
             self.same_branch(self.newton.jacobian_sign())?;
@@ -511,49 +508,35 @@ impl<Sc: StepEquations, S: Lagrangian + ?Sized> NewtonProblem for Equations<'_, 
         )?)
     }
 
+    fn noise(&self) -> f64 {
+        rounding(self.start.p)
+    }
+
+    fn offset(&self) -> f64 {
+        norm(self.start.q)
+    }
+
     /// ∂F/∂x from the model's second derivatives where it supplies them and no force acts (the
     /// forces' derivatives are not supplied), with ∂A/∂q for velocity constraints; by central
     /// differences otherwise (and with holonomic constraints, alone or mixed), each unknown's step relative to
     /// the position it moves (λ: to itself).
     fn jacobian(&mut self, jac: &mut DMatrix<f64>) -> Result<(), StepError> {
-        let Equations {
-            scheme,
-            sys,
-            constraints,
-            start,
-            m,
-            multipliers,
-            block,
-            x,
-            plus,
-            minus,
-            evaluations,
-        } = self;
-        let (sys, constraints, start, m) = (*sys, *constraints, *start, *m);
-        let exact = !sys.is_forced()
-            && match constraints {
-                Constraints::None => scheme.quadrature().jacobian(sys, segment(&start, x), jac)?,
-                Constraints::Velocity(c, at) => {
-                    scheme.quadrature().jacobian(sys, segment(&start, &x[m..]), block)?
-                        && nonholonomic::jacobian((c, at), multipliers, block, (start.q, start.h), x, jac)
-                            .map(|_| true)?
-                }
-                Constraints::Holonomic(_) | Constraints::Mixed(..) => false,
-            };
-        if !exact {
-            let n = start.q.len();
-            let equations = |x: &[f64], out: &mut [f64]| {
-                **evaluations += 1;
-                constrained_equations(&mut **scheme, sys, constraints, multipliers, start, x, out)
-            };
-            let size = |j: usize, d: f64| {
-                let base = if j < m { 0.0 } else { start.q[(j - m) % n] };
-                (base + d).abs().max(1.0)
-            };
-            let at = Evaluations { plus, minus };
-            central_jacobian(equations, x, size, at, jac)?;
+        if !self.exact_jacobian(jac)? {
+            self.differenced_jacobian(jac)?;
         }
         finite_jacobian(jac.as_slice())
+    }
+
+    /// The exact Jacobian, where there is one, against differences of F (10⁻⁴ relative in the
+    /// max norm: the differences are good to about 10⁻⁸).
+    fn jacobian_agrees(&mut self) -> Result<bool, StepError> {
+        let u = self.x.len();
+        let (mut exact, mut differenced) = (DMatrix::zeros(u, u), DMatrix::zeros(u, u));
+        if !self.exact_jacobian(&mut exact)? {
+            return Ok(true);
+        }
+        self.differenced_jacobian(&mut differenced)?;
+        Ok((&exact - &differenced).amax() <= 1e-4 * differenced.amax())
     }
 
     fn correct(&mut self, delta: &[f64]) -> Correction {
@@ -562,6 +545,65 @@ impl<Sc: StepEquations, S: Lagrangian + ?Sized> NewtonProblem for Equations<'_, 
 
     fn finishing(&mut self) {
         self.scheme.finishing();
+    }
+}
+
+/// The rounding of a step's equations F = p₀ + D₁L_d + …: a few ε of their terms, of the size
+/// of p₀ ([`NewtonProblem::noise`]).
+#[inline(always)]
+fn rounding(p0: &[f64]) -> f64 {
+    4.0 * f64::EPSILON * norm(p0)
+}
+
+impl<Sc: StepEquations, S: Lagrangian + ?Sized> Equations<'_, Sc, S> {
+    /// Writes ∂F/∂x from the model's second derivatives and returns true, where it supplies
+    /// them and no force acts (the forces' derivatives are not supplied), with ∂A/∂q for
+    /// velocity constraints; false otherwise (and with holonomic constraints, alone or mixed).
+    fn exact_jacobian(&mut self, jac: &mut DMatrix<f64>) -> Result<bool, ModelError> {
+        let (sys, constraints, start, m) = (self.sys, self.constraints, self.start, self.m);
+        if sys.is_forced() {
+            return Ok(false);
+        }
+        Ok(match constraints {
+            Constraints::None => self.scheme.quadrature().jacobian(sys, segment(&start, self.x), jac)?,
+            Constraints::Velocity(c, at) => {
+                self.scheme
+                    .quadrature()
+                    .jacobian(sys, segment(&start, &self.x[m..]), self.block)?
+                    && nonholonomic::jacobian((c, at), self.multipliers, self.block, (start.q, start.h), self.x, jac)
+                        .map(|_| true)?
+            }
+            Constraints::Holonomic(_) | Constraints::Mixed(..) => false,
+        })
+    }
+
+    /// ∂F/∂x by central differences, each unknown's step relative to the position it moves
+    /// (λ: to itself).
+    fn differenced_jacobian(&mut self, jac: &mut DMatrix<f64>) -> Result<(), ModelError> {
+        let Equations {
+            scheme,
+            sys,
+            constraints,
+            start,
+            m,
+            multipliers,
+            x,
+            plus,
+            minus,
+            evaluations,
+            ..
+        } = self;
+        let (sys, constraints, start, m) = (*sys, *constraints, *start, *m);
+        let n = start.q.len();
+        let equations = |x: &[f64], out: &mut [f64]| {
+            **evaluations += 1;
+            constrained_equations(&mut **scheme, sys, constraints, multipliers, start, x, out)
+        };
+        let size = |j: usize, d: f64| {
+            let base = if j < m { 0.0 } else { start.q[(j - m) % n] };
+            (base + d).abs().max(1.0)
+        };
+        central_jacobian(equations, x, size, Evaluations { plus, minus }, jac)
     }
 }
 

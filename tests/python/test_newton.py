@@ -1,0 +1,109 @@
+"""Newton's method stops where its equations' evaluation allows, and says why when it fails
+(issue 64).
+
+A model of closures without derivatives gives the step's equations through central
+differences of L, whose rounding, ε|L|/h with h = ε^{1/3}, makes F an irregular staircase of
+steps near 1e-10: below it no correction can be resolved, and the iteration stalls there. The
+stall is convergence when F is within the noise its evaluation carries (the differences'
+rounding and the rounding of F's terms); a stall far above it, a cycle, a slow linear
+convergence or a growth is a failure whose advice comes from that course.
+"""
+
+import warnings
+
+import numpy as np
+import pytest
+
+import varmech
+
+G = 9.81
+
+
+def _pendulum(derivatives: bool) -> varmech.Model:
+    """L = ½q̇² + g cos q, from closures; with ∂L/∂q and ∂L/∂q̇, or without (differences)."""
+    if not derivatives:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", varmech.DerivativeWarning)
+            return varmech.Lagrangian(1, lambda q, v, t: 0.5 * v[0] ** 2 + G * np.cos(q[0]))
+    return varmech.Lagrangian(
+        1,
+        lambda q, v, t: 0.5 * v[0] ** 2 + G * np.cos(q[0]),
+        dl_dq=lambda q, v, t: np.array([-G * np.sin(q[0])]),
+        dl_dv=lambda q, v, t: v.copy(),
+    )
+
+
+@pytest.mark.parametrize("dt", [0.05, 0.01, 0.002])
+@pytest.mark.parametrize("method", ["midpoint", "trapezoid", "galerkin4"])
+@pytest.mark.parametrize("q0", [0.1, 2.0])
+def test_a_closure_pendulum_without_derivatives_runs_as_its_twin_with_them(q0, method, dt):
+    # The issue's table: 11 of these 18 runs failed at the fixed tolerance 1e-14, some at step 1.
+    runs = [varmech.integrate(_pendulum(d), [q0], v0=[0.0], dt=dt, t_end=50.0, method=method) for d in (False, True)]
+    assert all(r.status == 0 and r.t[-1] == pytest.approx(50.0) for r in runs)
+    # The differences' truncation (ε^{2/3} of L) and each step's stall at their rounding move
+    # the run by at most 3.1e-7 over these 1 000 – 25 000 steps (q0 = 2, midpoint, dt = 0.002):
+    # far below the method's own error, which is 1e-5 or more at every step here.
+    np.testing.assert_allclose(runs[0].q, runs[1].q, rtol=0, atol=1e-6)
+    assert varmech.check_conservation(runs[0]).energy.verdict == "bounded"
+
+
+def _diagnosed(model, q0, **options) -> str:
+    with pytest.raises(varmech.ConvergenceError) as info:
+        varmech.integrate(model, [q0], v0=[0.0], method="midpoint", **options)
+    return str(info.value)
+
+
+def test_a_step_without_a_solution_is_a_model_that_is_not_smooth_and_no_smaller_step_helps():
+    # V = 5|q| from rest at the kink: F jumps over 0 at q₁ = q₀ whatever the step.
+    kink = varmech.Lagrangian(
+        1,
+        lambda q, v, t: 0.5 * v[0] ** 2 - 5 * abs(q[0]),
+        dl_dq=lambda q, v, t: np.array([-5.0 if q[0] >= 0 else 5.0]),
+        dl_dv=lambda q, v, t: v.copy(),
+        hessians=lambda q, v, t: (np.zeros((1, 1)), np.zeros((1, 1)), np.ones((1, 1))),
+    )
+    for dt in (0.1, 0.001):
+        assert "not smooth here" in _diagnosed(kink, 0.0, dt=dt, steps=3)
+
+
+def test_wrong_second_derivatives_are_named_and_a_smaller_step_is_not_advised():
+    # ∂²L/∂q̇² given as 0.6 instead of 1: Newton converges linearly at |1 − 1/0.6| = 2/3.
+    wrong = varmech.Lagrangian(
+        1,
+        lambda q, v, t: 0.5 * v[0] ** 2 + G * np.cos(q[0]),
+        dl_dq=lambda q, v, t: np.array([-G * np.sin(q[0])]),
+        dl_dv=lambda q, v, t: v.copy(),
+        hessians=lambda q, v, t: (np.array([[-G * np.cos(q[0])]]), np.zeros((1, 1)), np.full((1, 1), 0.6)),
+    )
+    message = _diagnosed(wrong, 1.0, dt=0.1, steps=5, newton_max_iterations=20)
+    assert "second derivatives (hessians) are not those of its first" in message
+    assert "a smaller step does not help" in message
+
+
+def test_a_cap_reached_while_converging_advises_more_iterations_which_then_run():
+    message = _diagnosed(_pendulum(True), 1.0, dt=0.1, steps=5, newton_max_iterations=1)
+    assert "allow more iterations (newton_max_iterations)" in message
+    varmech.integrate(_pendulum(True), [1.0], v0=[0.0], dt=0.1, steps=5, method="midpoint", newton_max_iterations=10)
+
+
+def test_a_predictor_far_from_the_solution_advises_a_smaller_step_which_then_runs():
+    # Kepler e = 0.9 from its pericentre: the first step's predictor (rest) is far from the
+    # step's solution at dt = 0.05, and Newton wanders; at dt/4 it converges.
+    kepler = varmech.scenes.kepler(0.9)
+    with pytest.raises(varmech.ConvergenceError, match="a smaller step \\(dt\\) brings it closer"):
+        varmech.integrate(kepler, dt=0.05, steps=200, method="midpoint", max_energy_error=None)
+    varmech.integrate(kepler, dt=0.0125, steps=800, method="midpoint", max_energy_error=None)
+
+
+def test_a_routhian_of_closures_without_derivatives_runs_through_its_nested_solves():
+    # The Routhian's derivatives solve ∂L/∂ċ = μ at every evaluation: the step's equations
+    # carry that solve's noise as well as the differences'.
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", varmech.DerivativeWarning)
+        spherical = varmech.Lagrangian(
+            2, lambda q, v, t: 0.5 * (v[0] ** 2 + np.sin(q[0]) ** 2 * v[1] ** 2) + G * np.cos(q[0]), symmetries=[varmech.Cyclic(1)]
+        )
+        reduced = varmech.routh(spherical, cyclic=[1], momenta=[1.5])
+    for method in ("midpoint", "trapezoid", "galerkin4"):
+        traj = varmech.integrate(reduced, [1.0], v0=[0.0], dt=0.01, t_end=20.0, method=method)
+        assert varmech.check_conservation(traj).energy.verdict == "bounded"
