@@ -1,8 +1,10 @@
 """Models from sympy.physics.mechanics: a double pendulum (LagrangesMethod, and a System with
 uniform gravity) and a rolling disk (KanesMethod, velocity constraints) give the trajectories of
 the same models written as L for symbolic.lagrangian, bit for bit where the expressions are the
-same and to round-off where they are written by hand; what varmech cannot take is refused with
-the reason."""
+same and to round-off where they are written by hand; SymPy's own rolling disc, whose kinematics
+embed the rolling, is imported with its contact's coordinates and runs as Kane's equations do; a
+model that does not give its source's equations is refused naming the first differing one; what
+varmech cannot take is refused with the reason."""
 
 from __future__ import annotations
 
@@ -121,8 +123,9 @@ def test_a_kanes_method_rolling_disk_is_its_l_and_velocity_constraints_bit_for_b
     np.testing.assert_allclose(np.hypot(*mine.v[:, :2].T), 0.5, atol=1e-9)
 
 
-def test_a_kanes_method_with_a_configuration_constraint_drops_its_derivative():
-    # A point mass on a circle of radius l1 in Cartesian coordinates, a damping load on it.
+def bead_on_circle():
+    """A point mass on a circle of radius l1 in Cartesian coordinates, its gravity its
+    potential_energy, a damping load on it (KanesMethod, a configuration constraint)."""
     x, y = me.dynamicsymbols("x y")
     u = me.dynamicsymbols("u1 u2")
     c = sp.symbols("c", positive=True)
@@ -138,6 +141,11 @@ def test_a_kanes_method_with_a_configuration_constraint_drops_its_derivative():
         configuration_constraints=[x**2 + y**2 - l1**2], velocity_constraints=[x * u[0] + y * u[1]],
         bodies=[bob], forcelist=[(P, -c * P.vel(N))],
     )  # fmt: skip
+    return kane, c
+
+
+def test_a_kanes_method_with_a_configuration_constraint_drops_its_derivative():
+    kane, c = bead_on_circle()
     model = varmech.symbolic.from_mechanics(kane, parameters={**VALUES, c: 0.1})
     assert model.constraints == 1 and not model.velocity_constraints and model.forced
     X, Y, VX, VY = sp.symbols("X Y VX VY")
@@ -181,6 +189,136 @@ def test_the_coming_from_pydy_page_runs_and_prints_what_it_shows(capsys):
     from pathlib import Path
 
     page = (Path(__file__).resolve().parents[2] / "docs" / "coming_from.md").read_text()
-    (code, shown), = re.findall(r"```python\n(.*?)```\n\n```text\n(.*?)```", page, flags=re.S)
-    exec(compile(code, "coming_from.md", "exec"), {})
-    assert capsys.readouterr().out == shown
+    examples = re.findall(r"```python\n(.*?)```\n\n```text\n(.*?)```", page, flags=re.S)
+    assert len(examples) == 2
+    for code, shown in examples:
+        exec(compile(code, "coming_from.md", "exec"), {})
+        assert capsys.readouterr().out == shown
+
+
+def sympys_rolling_disc(centre_rolls=True):
+    """SymPy's rolling disc as its own tests build it (sympy/physics/mechanics/tests/test_kane.py,
+    test_rolling_disc): body-fixed speeds u (ω of the disc in the lean frame L), the rolling
+    built into the kinematics by the contact point C's velocity set to zero and the centre's
+    velocity ω × r from it; gravity a load. ``centre_rolls=False``: the centre set to move at
+    r·u2 along L.x instead, a constraint that is no rolling (ω × r adds −r·u1 L.y)."""
+    q1, q2, q3, u1, u2, u3 = me.dynamicsymbols("q1 q2 q3 u1 u2 u3")
+    r, m = sp.symbols("r m")
+    N = me.ReferenceFrame("N")
+    Y = N.orientnew("Y", "Axis", [q1, N.z])
+    L = Y.orientnew("L", "Axis", [q2, Y.x])
+    R = L.orientnew("R", "Axis", [q3, L.y])
+    w_R_N_qd = R.ang_vel_in(N)
+    R.set_ang_vel(N, u1 * L.x + u2 * L.y + u3 * L.z)
+    C = me.Point("C")
+    C.set_vel(N, 0)
+    Dmc = C.locatenew("Dmc", r * L.z)
+    if centre_rolls:
+        Dmc.v2pt_theory(C, N, R)
+    else:
+        Dmc.set_vel(N, r * u2 * L.x)
+    inertia = me.inertia(L, m / 4 * r**2, m / 2 * r**2, m / 4 * r**2)
+    kd = [(R.ang_vel_in(N) - w_R_N_qd).dot(e) for e in L]
+    disc = me.RigidBody("BodyD", Dmc, R, m, (inertia, Dmc))
+    kane = me.KanesMethod(N, q_ind=[q1, q2, q3], u_ind=[u1, u2, u3], kd_eqs=kd, bodies=[disc], forcelist=[(Dmc, -m * g * Y.z)])
+    return kane, {r: 1.0, m: 1.0, g: 1.0}
+
+
+def kanes_run(kane, values, x0, t_end):
+    """Kane's equations (kane.rhs()) and the contact's rolling ẋ = r q̇3 cos q1, ẏ = r q̇3 sin q1
+    (r = 1) under SciPy's DOP853 at rtol 1e-12: (q1, q2, q3, x, y) at t_end."""
+    from scipy.integrate import solve_ivp
+
+    q1 = kane.q[0]
+    kane.kanes_equations()
+    rhs = kane.rhs().xreplace(values)
+    f = sp.lambdify([*kane.q, *kane.u], [*rhs, rhs[2] * sp.cos(q1), rhs[2] * sp.sin(q1)])
+    sol = solve_ivp(lambda t, s: np.asarray(f(*s[:6]), float), (0, t_end), [*x0, 0.0, 0.0], method="DOP853", rtol=1e-12, atol=1e-14)
+    return sol.y[[0, 1, 2, 6, 7], -1]
+
+
+def test_sympys_rolling_disc_gets_its_contact_coordinates_and_runs_as_kanes_equations():
+    kane, values = sympys_rolling_disc()
+    model = varmech.symbolic.from_mechanics(kane, parameters=values)
+    assert model.coordinates == ("q1", "q2", "q3", "C_x", "C_y") and model.velocity_constraints
+    # Heading q1, lean q2, spin q3; u = (0, 2, 0.3): spinning fast enough to stay up (the
+    # critical u2 is 1/√3), leaning 0.2 rad; q̇ by the kinematic equations, the contact's rates
+    # by the rolling.
+    q0, (u1, u2, u3) = [0.0, 0.2, 0.0], (0.0, 2.0, 0.3)
+    rates = [u3 / np.cos(0.2), u1, u2 - u3 * np.tan(0.2)]
+    v0 = [*rates, rates[2], 0.0]
+    exact = kanes_run(kane, values, [*q0, u1, u2, u3], 10.0)
+    errors = []
+    for dt in (0.005, 0.0025):
+        traj = varmech.integrate(model, [*q0, 0.0, 0.0], v0=v0, dt=dt, t_end=10.0)
+        errors.append(np.abs(traj.q[-1] - exact).max())
+    # The midpoint rule's O(h²): the largest error at t = 10 (of q and the contact's C) falls 4
+    # times as h halves, 6.7e-5 → 1.7e-5 (the lean 0.28037 to 1.3e-5). Taken as L = T − V with
+    # the rolling in T (before the check), the lean at t = 10 was 0.2610.
+    assert 3.8 < errors[0] / errors[1] < 4.2 and errors[1] < 2e-5
+    report = varmech.check_conservation(traj)
+    assert report.energy.verdict == "bounded" and not report.momenta
+
+
+def test_the_check_catches_the_rolling_taken_into_t(monkeypatch):
+    # The import before the contact was given its coordinates: L = T − V with the rolling in T.
+    from varmech.symbolic import _contact
+
+    monkeypatch.setattr(_contact, "find", lambda *args: (None, ""))
+    kane, values = sympys_rolling_disc()
+    message = r"^system: the model from_mechanics builds .* du2/dt: Kane's equations fr \+ fr\* give -0.06111676\d+, the model \S+ \("
+    with pytest.raises(ValueError, match=message + r"tolerance .*other dynamics$"):
+        varmech.symbolic.from_mechanics(kane, parameters=values)
+
+
+def test_kinematics_embedding_another_constraint_are_refused_naming_the_first_differing_equation():
+    kane, values = sympys_rolling_disc(centre_rolls=False)
+    with pytest.raises(ValueError, match=(
+        r"^system: the model from_mechanics builds .* does not give its equations of motion: at \(q1 = .*\), du1/dt: "
+        r"Kane's equations fr \+ fr\* give -0.0599857\d+, the model -0.0771352\d+ .*; its kinematics embed a velocity "
+        r"constraint: body BodyD's centre has a velocity that is not the rate of its position from C .*velocity_constraints"
+    )):  # fmt: skip
+        varmech.symbolic.from_mechanics(kane, parameters=values)
+
+
+@pytest.mark.parametrize("source", ["KanesMethod", "LagrangesMethod"])
+def test_the_check_catches_a_load_the_import_drops(monkeypatch, source):
+    from varmech.symbolic import _mechanics
+
+    if source == "KanesMethod":
+        system, c = bead_on_circle()
+        values, first = {**VALUES, c: 0.1}, r"du1/dt: Kane's equations fr \+ fr\*"
+    else:
+        (q1, q2), N, O, bodies = double_pendulum_bodies()
+        push = (bodies[1].point, -0.5 * bodies[1].point.vel(N))
+        system = me.LagrangesMethod(me.Lagrangian(N, *bodies), [q1, q2], forcelist=[push], frame=N)
+        values, first = VALUES, "d²q1/dt²: the LagrangesMethod's equations"
+    assert varmech.symbolic.from_mechanics(system, parameters=values).forced
+    monkeypatch.setattr(_mechanics, "_generalized_forces", lambda *args, **kwargs: None)
+    with pytest.raises(ValueError, match=f"^system: the model from_mechanics builds .*, {first} give "):
+        varmech.symbolic.from_mechanics(system, parameters=values)
+
+
+def test_a_source_whose_equations_cannot_be_formed_is_refused():
+    # SymPy's rolling disc without its bodies: there is no fr* to form.
+    kane, _ = sympys_rolling_disc()
+    bare = me.KanesMethod(kane._inertial, q_ind=kane.q, u_ind=kane.u, kd_eqs=[rate - u for rate, u in kane.kindiffdict().items()])
+    message = r"^system: Kane's equations fr \+ fr\* could not be formed \(TypeError: Bodies must be supplied in an iterable.\); "
+    with pytest.raises(ValueError, match=message + ".*takes no model it cannot check$"):
+        varmech.symbolic.from_mechanics(bare, parameters={"r": 1.0, "m": 1.0, "g": 1.0})
+
+
+def test_a_system_of_sympys_rolling_disc_is_its_kanes_method():
+    kane, values = sympys_rolling_disc()
+    # The System's own fixed point has no path to the disc: its gravity stays a load.
+    system = me.System(kane._inertial)
+    system.add_coordinates(*kane.q)
+    system.add_speeds(*kane.u)
+    system.add_kdes(*[rate - u for rate, u in kane.kindiffdict().items()])
+    system.add_bodies(*kane.bodies)
+    system.add_loads(*kane.loads)
+    model = varmech.symbolic.from_mechanics(system, parameters=values)
+    assert model.coordinates == ("q1", "q2", "q3", "C_x", "C_y") and model.forced
+    rates = [0.3 / np.cos(0.2), 0.0, 2.0 - 0.3 * np.tan(0.2)]
+    mine, its = same_run(model, varmech.symbolic.from_mechanics(kane, parameters=values), [0.0, 0.2, 0.0, 0.0, 0.0], [*rates, rates[2], 0.0])
+    assert np.array_equal(mine.q, its.q) and np.array_equal(mine.p, its.p)

@@ -5,14 +5,17 @@ forces of the loads, and the holonomic and velocity constraints."""
 from __future__ import annotations
 
 import random
-from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import sympy as sp
 from sympy.physics import mechanics as me
 
+from . import _contact
 from ._constructors import lagrangian
+from ._mechanics_check import KaneEquations, LagrangeEquations, ModelEquations, check, formed
+from ._mechanics_check import rates as _rates
 from ._model import SymbolicModel
 
 __all__ = ["from_mechanics"]
@@ -28,6 +31,10 @@ class _Parts:
     force: list[sp.Expr] | None = None
     holonomic: list[sp.Expr] = field(default_factory=list)
     velocity: list[sp.Expr] = field(default_factory=list)
+    #: The speeds u in q̇ (Kane's, a System's); what the check compares is their rates u̇.
+    speeds: dict[sp.Expr, sp.Expr] = field(default_factory=dict)
+    #: Why the source's equations may not be those of L (for the check's message).
+    note: str = ""
 
 
 def from_mechanics(
@@ -54,6 +61,20 @@ def from_mechanics(
 
     Each load (a force at a point, a torque on a frame) becomes the generalized force
     Qᵢ = F·∂v/∂q̇ᵢ (T·∂ω/∂q̇ᵢ for a torque), and the model tracks its work.
+
+    Kinematics that embed a rolling contact, as SymPy's rolling disc does (a point C with
+    ``C.set_vel(N, 0)`` and no position in N, the body's centre moving at ω × r by
+    ``v2pt_theory(C, N, body)``), would put the rolling into T, which is other dynamics: the
+    model gives C its coordinates along N's axes that the rolling moves it along (``C_x``,
+    ``C_y``, after the system's own), takes T of the bodies' velocities from them, and holds the
+    rolling (the body's point at C at rest) as velocity constraints.
+
+    The model is checked against the source's own equations before it is compiled: at three
+    random states (a fixed seed), the accelerations of its Euler–Lagrange equations (with the
+    loads' generalized forces and the constraints' forces, solved for q̈ and the multipliers)
+    against those of Kane's fr + fr* (the speeds' rates u̇, through the kinematic differential
+    equations; with −∂V/∂q of the bodies' ``potential_energy``, which ``KanesMethod`` leaves out
+    and varmech takes) or of the ``LagrangesMethod``'s equations (q̈), to 1e-8 of their size.
 
     Parameters
     ----------
@@ -83,7 +104,11 @@ def from_mechanics(
         inertia changes with t (a variable mass needs its reactive force:
         :class:`MassFlow`), a load of the accelerations, kinematic differential equations that
         do not give u from q̇, a velocity constraint that is not affine in q̇, auxiliary speeds,
-        loads without an inertial frame; and what :func:`lagrangian` refuses.
+        loads without an inertial frame; a model that does not give the source's equations (the
+        first differing acceleration, its two values, and where the kinematics embed a
+        constraint that is not a rolling contact, how to state it); a source whose equations
+        cannot be formed or do not determine the accelerations (no model is taken unchecked);
+        and what :func:`lagrangian` refuses.
 
     See Also
     --------
@@ -115,15 +140,20 @@ def from_mechanics(
     """
     if isinstance(system, me.LagrangesMethod):
         parts, kind = _lagranges(system), "LagrangesMethod"
-    elif isinstance(system, me.KanesMethod):
-        parts, kind = _kanes(system), "KanesMethod"
-    elif isinstance(system, getattr(me, "System", ())):
-        parts, kind = _system(system), "System"
+        source: Any = LagrangeEquations(system)
+        outputs = [x.diff(me.dynamicsymbols._t, 2) for x in parts.q]
+    elif isinstance(system, (me.KanesMethod, getattr(me, "System", ()))):
+        kanes = isinstance(system, me.KanesMethod)
+        source = KaneEquations(system if kanes else formed("its KanesMethod", lambda: _kanes_method(system)))
+        parts, kind = (_kanes(system), "KanesMethod") if kanes else (_system(system), "System")
+        outputs = [parts.speeds[u].diff(me.dynamicsymbols._t) for u in source.u]
     else:
         raise TypeError(
             "system: expected a LagrangesMethod, KanesMethod or System of sympy.physics.mechanics, "
             f"got {type(system).__name__}"
         )
+    model = ModelEquations(parts.L, parts.q, parts.force, parts.holonomic, parts.velocity, outputs)
+    check(source, model, parameters, note=parts.note)
     return lagrangian(
         parts.L, parts.q, t=me.dynamicsymbols._t, parameters=parameters, force=parts.force,
         constraints=parts.holonomic or None, velocity_constraints=parts.velocity or None, jit=jit,
@@ -153,7 +183,8 @@ def _kanes(method: Any) -> _Parts:
     velocity = _independent(_affine(velocity, qdot, speeds), holonomic, q, qdot)
     L = _lagrangian(method.bodies, method._inertial, q, speeds)
     force = _generalized_forces(method.loads, method._inertial, qdot, speeds)
-    return _Parts(L, q, force, holonomic, velocity)
+    parts = _Parts(L, q, force, holonomic, velocity, speeds)
+    return _rolling(parts, method.bodies, method.loads, method._inertial, sp.S.Zero)
 
 
 def _system(system: Any) -> _Parts:
@@ -164,16 +195,49 @@ def _system(system: Any) -> _Parts:
     qdot = _rates(q)
     speeds = _speeds(list(system.kdes), u)
     velocity = _affine(list(system.nonholonomic_constraints), qdot, speeds)
-    loads = [*system.loads, *(load for actuator in system.actuators for load in actuator.to_loads())]
+    loads = _system_loads(system)
     potential, loads = _uniform_potential(loads, system.frame, system.fixed_point)
     L = _lagrangian(system.bodies, system.frame, q, speeds) - potential
     force = _generalized_forces(loads, system.frame, qdot, speeds)
-    return _Parts(L, q, force, list(system.holonomic_constraints), velocity)
+    parts = _Parts(L, q, force, list(system.holonomic_constraints), velocity, speeds)
+    return _rolling(parts, system.bodies, loads, system.frame, potential)
 
 
-def _rates(q: Sequence[sp.Expr]) -> list[sp.Expr]:
-    """The coordinates' rates q̇, their derivatives in t."""
-    return [x.diff(me.dynamicsymbols._t) for x in q]
+def _system_loads(system: Any) -> list[Any]:
+    """A System's loads and its actuators'."""
+    return [*system.loads, *(load for actuator in system.actuators for load in actuator.to_loads())]
+
+
+def _kanes_method(system: Any) -> Any:
+    """The KanesMethod of a System, as its ``form_eoms`` builds it (the System untouched)."""
+    loads = _system_loads(system)
+    return me.KanesMethod(
+        system.frame, q_ind=system.q_ind, u_ind=system.u_ind, kd_eqs=system.kdes, q_dependent=system.q_dep,
+        u_dependent=system.u_dep, configuration_constraints=system.holonomic_constraints,
+        velocity_constraints=system.velocity_constraints, forcelist=loads or None, bodies=system.bodies,
+    )  # fmt: skip
+
+
+def _rolling(parts: _Parts, bodies: Sequence[Any], loads: Sequence[Any] | None, frame: Any, potential: sp.Expr) -> _Parts:
+    """``parts``, or where the bodies' kinematics embed a rolling contact, the constrained system:
+    the contact's coordinates, T of the bodies' velocities from them, the loads' generalized
+    forces in them, and the rolling's velocity constraints (``potential``: the loads taken as
+    one). Where they embed a constraint of another kind, ``parts`` with a note for the check."""
+    contact, note = _contact.find(bodies, frame, parts.q, parts.speeds)
+    if contact is None:
+        return replace(parts, note=note)
+    q = [*parts.q, *contact.coordinates]
+    qdot = _rates(q)
+    velocity = _contact.velocity(contact, frame)
+    L = _lagrangian(bodies, frame, q, parts.speeds, velocity) - potential
+    force = _generalized_forces(loads or [], frame, qdot, parts.speeds, velocity)
+    rolling = [x - w for x, w in zip(_rates(contact.coordinates), contact.rates)]
+    note = (
+        f" (its kinematics embed the rolling of body {contact.body.name} on {contact.point.name}, whose velocity is set to "
+        f"zero: from_mechanics gave {contact.point.name} the coordinates {', '.join(x.func.__name__ for x in contact.coordinates)} "
+        "and the rolling as velocity constraints)"
+    )
+    return _Parts(L, q, force, parts.holonomic, [*parts.velocity, *rolling], parts.speeds, note)
 
 
 def _speeds(kinematics: Sequence[sp.Expr], u: Sequence[sp.Expr]) -> dict[sp.Expr, sp.Expr]:
@@ -193,9 +257,13 @@ def _speeds(kinematics: Sequence[sp.Expr], u: Sequence[sp.Expr]) -> dict[sp.Expr
     return {speed: sp.cancel(value) for speed, value in zip(u, solved)}
 
 
-def _lagrangian(bodies: Sequence[Any], frame: Any, coordinates: Sequence[sp.Expr], speeds: Mapping[sp.Expr, sp.Expr]) -> sp.Expr:
-    """T − V of ``bodies`` in ``frame`` (their ``potential_energy``), written in q̇; ValueError
-    naming ``system`` for a body varmech cannot take."""
+def _lagrangian(
+    bodies: Sequence[Any], frame: Any, coordinates: Sequence[sp.Expr], speeds: Mapping[sp.Expr, sp.Expr],
+    velocity: Callable[[Any], Any] | None = None,
+) -> sp.Expr:
+    """T − V of ``bodies`` in ``frame`` (their ``potential_energy``), written in q̇, their centres'
+    velocities given by ``velocity`` if given (else their own); ValueError naming ``system`` for
+    a body varmech cannot take."""
     if frame is None:
         raise ValueError("system: it has no inertial frame, in which the bodies' kinetic energy is taken")
     t = me.dynamicsymbols._t
@@ -215,7 +283,12 @@ def _lagrangian(bodies: Sequence[Any], frame: Any, coordinates: Sequence[sp.Expr
                 "needs the reactive force of the matter it gains or loses: give it as varmech.symbolic.lagrangian(..., "
                 "mass_flow=varmech.symbolic.MassFlow(...))"
             )
-        total += body.kinetic_energy(frame) - sp.sympify(body.potential_energy)
+        if velocity is None:
+            total += body.kinetic_energy(frame)
+        else:
+            v, omega = velocity(body.masscenter), body.frame.ang_vel_in(frame) if isinstance(body, me.RigidBody) else me.Vector(0)
+            total += body.mass * v.dot(v) / 2 + (omega.dot(body.central_inertia.dot(omega)) / 2 if omega != 0 else 0)
+        total -= sp.sympify(body.potential_energy)
     return total.xreplace(speeds)
 
 
@@ -227,16 +300,21 @@ def _uniform_potential(loads: Sequence[Any], frame: Any, origin: Any) -> tuple[s
         where, vector = load[0], load[1]
         components = [sp.sympify(c) for c in vector.to_matrix(frame)] if isinstance(where, me.Point) else []
         if components and not any(me.find_dynamicsymbols(c) or c.has(me.dynamicsymbols._t) for c in components):
-            potential -= vector.dot(where.pos_from(origin))
-        else:
-            left.append(load)
+            try:
+                potential -= vector.dot(where.pos_from(origin))
+                continue
+            except ValueError:
+                pass  # no position from the origin (a contact's body): its force is a load
+        left.append(load)
     return potential, left
 
 
 def _generalized_forces(
-    loads: Sequence[Any], frame: Any, qdot: Sequence[sp.Expr], speeds: Mapping[sp.Expr, sp.Expr]
+    loads: Sequence[Any], frame: Any, qdot: Sequence[sp.Expr], speeds: Mapping[sp.Expr, sp.Expr],
+    velocity: Callable[[Any], Any] | None = None,
 ) -> list[sp.Expr] | None:
-    """Qᵢ = Σ F·∂v/∂q̇ᵢ (+ T·∂ω/∂q̇ᵢ) of ``loads`` in ``frame``, v and ω in q̇; None without loads."""
+    """Qᵢ = Σ F·∂v/∂q̇ᵢ (+ T·∂ω/∂q̇ᵢ) of ``loads`` in ``frame``, v and ω in q̇ (a point's v given by
+    ``velocity`` if given); None without loads."""
     if not loads:
         return None
     if frame is None:
@@ -252,10 +330,13 @@ def _generalized_forces(
                 f"system: the load on {where} depends on the accelerations; a force linear in them is added mass "
                 "(varmech.symbolic.lagrangian(..., added_mass=A))"
             )
-        velocity = where.vel(frame) if isinstance(where, me.Point) else where.ang_vel_in(frame)
-        velocity = velocity.xreplace(speeds) if speeds else velocity
+        if isinstance(where, me.Point):
+            rate_of = where.vel(frame) if velocity is None else velocity(where)
+        else:
+            rate_of = where.ang_vel_in(frame)
+        rate_of = rate_of.xreplace(speeds) if speeds else rate_of
         for i, rate in enumerate(qdot):
-            force[i] += vector.dot(velocity.diff(rate, frame)).xreplace(speeds)
+            force[i] += vector.dot(rate_of.diff(rate, frame)).xreplace(speeds)
     return force
 
 
