@@ -158,9 +158,16 @@ _SPURIOUS_BRANCH_ERROR = """A step's implicit equations were solved beyond a fol
     1 0.0 1
     """
 
-_CONTACT_ERROR = """An impact could not be resolved: a non-finite state through it, a body that crosses the
-    surface again at once after leaving it (a resting or grazing contact), or more than 64
-    impacts in one step (an accumulation of impacts, as of a ball coming to rest).
+_CONTACT_ERROR = """A contact could not be resolved: a non-finite state through an impact, a body that
+    crosses the surface again at once after leaving it (a resting or grazing contact), more than
+    64 impacts in one step (an accumulation of impacts, as of a ball coming to rest), or a held
+    contact's solve that failed.
+
+    A held contact's solves (its position constraint, momentum projection and friction) stop at
+    the round-off floor of what they combine; one that fails says which, its residual against
+    that floor, and what its diagnosis found: a step past the surface's curvature radius (a
+    smaller step helps), a gradient that is not ∇φ, φ losing its precision, or dependent
+    normals (a smaller step does not help).
 
     A ball with e < 1 bounces ever lower and faster, and its impacts accumulate at a finite
     time. Under verlet and its compositions the contact then closes and holds the ball (see

@@ -5,7 +5,8 @@
 //! of impacts with `Error::Contact`; and Byerly's billiard ball, sliding on a rough table until
 //! it rolls at 5v₀/7 from t = 2v₀/(7μg), exactly, its run resumed bit for bit; and a wheel whose
 //! slip rows turn with its heading, rolling on its circle at the method's order while friction
-//! holds it, and skidding where that needs more than μ_s mg.
+//! holds it, and skidding where that needs more than μ_s mg; and a held step past the surface's
+//! curvature ending the run with `Error::Contact`, which advises the smaller step that runs.
 
 use nalgebra::DMatrix;
 use varmech::integrators::{
@@ -206,6 +207,54 @@ fn a_run_resumed_from_a_held_state_is_the_whole_run_bit_for_bit() {
     assert_eq!(rest.impacts.switches, all.impacts.switches);
     assert_eq!(&all.q[all.q.len() - rest.q.len()..], &rest.q[..]);
     assert_eq!(&all.p[all.p.len() - rest.p.len()..], &rest.p[..]);
+}
+
+#[test]
+fn a_held_step_past_the_surfaces_curvature_ends_the_run_with_a_contact_error_advising_a_smaller_step() {
+    // At the bottom of the inside of the unit circle at speed 1, pressed by v² + g: a step of 2
+    // moves it twice the radius, and no point of q₀ + s(q̇ + c∇φ) lies on the circle.
+    let model = particle();
+    let contact = Contact {
+        surface: Box::new(NativeSurface::Ellipsoid {
+            coordinates: vec![0, 1],
+            centre: vec![0.0, 0.0],
+            semi_axes: vec![1.0, 1.0],
+            inside: true,
+        }),
+        restitution: 0.0,
+        law: Law::Reflect,
+        friction: None,
+        name: "bowl".into(),
+    };
+    let contacts = Contacts::new(vec![contact]).unwrap();
+    let run = |h: f64| {
+        let options = Options::new(h, 10);
+        integrate_watching(
+            &model,
+            Method::Verlet,
+            &[0.0, -1.0],
+            &[1.0, 0.0],
+            &options,
+            || Ok(()),
+            with_contacts(&contacts),
+        )
+    };
+    let failure = run(2.0).unwrap_err();
+    let Error::Contact { step, time, ref reason } = failure.error else {
+        panic!("{}", failure.error)
+    };
+    assert_eq!((step, time), (1, 0.0));
+    assert!(
+        reason.contains("position constraint") && reason.contains("a smaller step helps"),
+        "{reason}"
+    );
+    assert_eq!(failure.partial.q, vec![0.0, -1.0]);
+    // As it advises: held on the circle at a step short against its radius.
+    let traj = run(0.1).unwrap();
+    for k in 0..traj.len() {
+        let (x, y) = (traj.q_at(k)[0], traj.q_at(k)[1]);
+        assert!((x.hypot(y) - 1.0).abs() <= 1e-15, "|q| = {}", x.hypot(y));
+    }
 }
 
 const R: f64 = 0.1;

@@ -40,10 +40,11 @@ pub enum Error {
     Model { step: usize, time: f64, source: ModelError },
     /// The interrupt poll (Ctrl-C) asked the run to stop before `step`.
     Interrupted { step: usize, time: f64, source: ModelError },
-    /// An impact in `step` (which starts at `time`) could not be resolved: a non-finite state
+    /// A contact in `step` (which starts at `time`) could not be resolved: a non-finite state
     /// after a jump, a body that crosses a surface again at once after leaving it (a resting or
-    /// grazing contact), or more than [`crate::integrators::MAX_IMPACTS`] impacts in the step
-    /// (an accumulation, as of a ball coming to rest). The run ends at the step's start.
+    /// grazing contact), more than [`crate::integrators::MAX_IMPACTS`] impacts in the step
+    /// (an accumulation, as of a ball coming to rest), or a held contact's solve that failed
+    /// (its reason says which, its residual and what helps). The run ends at the step's start.
     Contact { step: usize, time: f64, reason: String },
 }
 
@@ -124,7 +125,7 @@ impl fmt::Display for Error {
                 write!(f, "integration interrupted at step {step} (t = {time})")
             }
             Error::Contact { step, time, reason } => {
-                write!(f, "impact not resolved in step {step} (from t = {time}): {reason}")
+                write!(f, "contact not resolved in step {step} (from t = {time}): {reason}")
             }
         }
     }

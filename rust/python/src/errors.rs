@@ -26,7 +26,8 @@ pyo3::create_exception!(
     varmech,
     ContactError,
     VarmechError,
-    "An impact could not be resolved: a resting or grazing contact, or an accumulation of impacts."
+    "A contact could not be resolved: a resting or grazing contact, an accumulation of impacts, or a held \
+     contact's solve that failed."
 );
 pyo3::create_exception!(
     varmech,

@@ -19,6 +19,8 @@
 
 use nalgebra::DMatrix;
 
+use super::friction::slip_after_kick;
+use super::unsolved::{disagreement, Cause, Unsolved};
 use super::{Contact, Friction};
 use crate::integrators::{Composition, Method};
 use crate::model::Lagrangian;
@@ -29,6 +31,16 @@ use crate::ModelError;
 /// Newton iterations of the position constraint at most: it starts O(τ²) off and converges
 /// quadratically, so a step that needs more is far too large for the surface's curvature.
 const ITERATIONS: usize = 30;
+
+/// A residual within this many times its round-off floor that no longer falls is at its
+/// floor: φ rounds more than the coordinates it combines (10³ε relative).
+const STALLED: f64 = 1e3;
+
+/// The solves of a held step, as an [`Unsolved`] names them.
+const POSITION: &str = "position constraint Φ(q₁) = 0";
+const FRICTION: &str = "sliding friction's fixed point at a step's end";
+const PROJECTION: &str = "momentum projection onto the contacts' tangent space";
+const MULTIPLIERS: &str = "multipliers λ";
 
 /// What a held step holds: the `closed` contacts (indices into `contacts`, in order), those of
 /// them whose friction `stuck`, and each contact's slip direction u at the piece's start
@@ -87,6 +99,8 @@ pub(super) struct Hold {
     /// q̇ at p̃, the step's end before its friction kick, whose slip the force opposes.
     along: Vec<f64>,
     previous: Vec<f64>,
+    /// The rounding of each coordinate of the position Newton's iterate.
+    rounding: Vec<f64>,
     /// A point beside the state, and the rows there (as `rows`).
     shifted: Vec<f64>,
     shifted_rows: Vec<f64>,
@@ -149,6 +163,7 @@ impl Hold {
             half: v(),
             along: v(),
             previous: v(),
+            rounding: v(),
             shifted: v(),
             shifted_rows: vec![0.0; n * rows],
             rows: vec![0.0; n * rows],
@@ -179,9 +194,8 @@ impl Hold {
     /// its sliding forces in `work`.
     ///
     /// # Errors
-    /// The model's or a surface's own error; the position constraint not solved (a step too
-    /// large for the surface's curvature, or surfaces that are not independent there); the
-    /// friction's fixed point not reached.
+    /// The model's or a surface's own error; an [`Unsolved`] solve: the position constraint
+    /// or the friction's fixed point not reached, or rows dependent there.
     pub(super) fn step(
         &mut self,
         model: &dyn Lagrangian,
@@ -272,12 +286,24 @@ impl Hold {
         model.velocity(&self.q, &self.p, t, &mut self.v)?;
         self.start.copy_from_slice(&self.q);
         self.c[..rows].fill(0.0);
-        let scale = self.start.iter().fold(1.0_f64, |a, x| a.max(x.abs()));
+        // Each residual is judged against its round-off floor, the rounding of q₁'s every
+        // coordinate (of the terms q₀ + s(q̇ + shift) it sums) through its row: the iteration
+        // stops where it reaches that floor, or where it stops falling within 10³ of it (a φ
+        // rounding more than its terms), whatever the coordinates' sizes.
+        let mut last = f64::INFINITY;
+        let mut worst = (f64::NAN, f64::NAN, 0);
         let mut converged = false;
         for _ in 0..ITERATIONS {
             for i in 0..n {
-                let shift: f64 = (0..rows).map(|k| self.c[k] * self.inverse[k * n + i]).sum();
+                let (mut shift, mut size) = (0.0, 0.0);
+                for k in 0..rows {
+                    let x = self.c[k] * self.inverse[k * n + i];
+                    shift += x;
+                    size += x.abs();
+                }
                 self.q[i] = self.start[i] + s * (self.v[i] + shift);
+                self.rounding[i] =
+                    f64::EPSILON * (self.start[i].abs() + self.q[i].abs() + s.abs() * (self.v[i].abs() + size));
             }
             if midpoint {
                 for ((x, x0), x1) in self.shifted.iter_mut().zip(&self.start).zip(&self.q) {
@@ -286,6 +312,7 @@ impl Hold {
                 rows_into(held, &self.shifted, &mut self.shifted_rows, false)?;
             }
             let (system, pivots) = &mut self.systems[rows - 1];
+            let mut ratio = 0.0_f64;
             for a in 0..rows {
                 let row = if a < m {
                     let surface = &held.contacts[held.closed[a]].surface;
@@ -298,34 +325,44 @@ impl Hold {
                     self.r[a] = -(0..n).map(|i| row[i] * (self.q[i] - self.start[i])).sum::<f64>();
                     row
                 };
+                let floor: f64 = row.iter().zip(&self.rounding).map(|(g, d)| (g * d).abs()).sum();
+                let against = if self.r[a] == 0.0 { 0.0 } else { self.r[a].abs() / floor };
+                // NaN (a residual that left the numbers) is the worst.
+                if !(against <= ratio) {
+                    ratio = against;
+                    worst = (self.r[a].abs(), floor, a);
+                }
                 for b in 0..rows {
                     let w = &self.inverse[b * n..(b + 1) * n];
                     system[(a, b)] = s * row.iter().zip(w).map(|(g, w)| g * w).sum::<f64>();
                 }
             }
-            if lu_in_place(system, pivots).is_none() {
-                return Err("the held contacts' surfaces are not independent here".into());
-            }
-            lu_solve(system, pivots, &mut self.r[..rows]);
-            let mut change = 0.0_f64;
-            for i in 0..n {
-                let shift: f64 = (0..rows).map(|k| self.r[k] * self.inverse[k * n + i]).sum();
-                change = change.max((s * shift).abs());
-            }
-            for k in 0..rows {
-                self.c[k] += self.r[k];
-            }
-            if change <= 4.0 * f64::EPSILON * scale {
+            if ratio <= 4.0 || (ratio >= last && ratio <= STALLED) {
                 converged = true;
                 break;
             }
+            last = ratio;
+            if !ratio.is_finite() {
+                break;
+            }
+            if lu_in_place(system, pivots).is_none() {
+                return Err(Unsolved::dependent(POSITION));
+            }
+            lu_solve(system, pivots, &mut self.r[..rows]);
+            for k in 0..rows {
+                self.c[k] += self.r[k];
+            }
         }
         if !converged {
-            return Err(format!(
-                "the held contacts' position constraint did not converge in {ITERATIONS} Newton iterations (a step \
-                 too large for the surface's curvature)"
-            )
-            .into());
+            let (residual, floor, a) = worst;
+            let cause = self.diagnosis(held, s, (a, residual))?;
+            return Err(Box::new(Unsolved {
+                solve: POSITION,
+                cause,
+                residual,
+                floor,
+                iterations: ITERATIONS,
+            }));
         }
         for i in 0..n {
             let shift: f64 = (0..rows).map(|k| self.c[k] * self.inverse[k * n + i]).sum();
@@ -352,14 +389,10 @@ impl Hold {
                 .map(|i| self.friction[i] * (self.q[i] - self.start[i]))
                 .sum::<f64>();
         self.initial.copy_from_slice(&self.friction);
-        if !self.settle(model, held, (t + s, s), Slipping::Now)? {
+        if self.settle(model, held, (t + s, s), Slipping::Now)?.is_some() {
             self.friction.copy_from_slice(&self.initial);
-            if !self.settle(model, held, (t + s, s), Slipping::Before { kick: 0.5 * s })? {
-                return Err(format!(
-                    "the sliding friction at a held step's end did not settle in {ITERATIONS} iterations (a step \
-                     too large for the friction's change)"
-                )
-                .into());
+            if let Some(unsettled) = self.settle(model, held, (t + s, s), Slipping::Before { kick: 0.5 * s })? {
+                return Err(Box::new(unsettled));
             }
         }
         work += 0.5
@@ -370,41 +403,93 @@ impl Hold {
         Ok(())
     }
 
+    /// Why the position constraint's Newton failed at its last iterate `q` (from `start` by
+    /// the drift s·`v`), row a the worst with `residual`: a closed contact's gradient that is not
+    /// ∇φ ([`disagreement`] beyond 10⁻³), a residual near round-off far within the step's
+    /// reach (φ's precision), or else the step (past the surface's curvature).
+    #[cold]
+    fn diagnosis(&self, held: Held<'_, '_>, s: f64, (a, residual): (usize, f64)) -> Result<Cause, ModelError> {
+        let n = self.q.len();
+        let mut gradient = vec![0.0; n];
+        for &j in held.closed {
+            let contact = &held.contacts[j];
+            contact.surface.gradient(&self.q, &mut gradient)?;
+            let mismatch = disagreement(&*contact.surface, &self.q, &gradient, &gradient)?.max(disagreement(
+                &*contact.surface,
+                &self.q,
+                &gradient,
+                &self.v,
+            )?);
+            if mismatch > 1e-3 {
+                let contact = contact.name.clone();
+                return Ok(Cause::Gradient { contact, mismatch });
+            }
+        }
+        // The row's reach over the step: |row|·s|q̇|, coordinate by coordinate.
+        let row = if a < held.closed.len() {
+            held.contacts[held.closed[a]].surface.gradient(&self.q, &mut gradient)?;
+            &gradient[..]
+        } else {
+            &self.rows[a * n..(a + 1) * n]
+        };
+        let reach: f64 = row.iter().zip(&self.v).map(|(g, v)| (g * s * v).abs()).sum();
+        Ok(if residual <= 1e-8 * reach {
+            Cause::Precision
+        } else {
+            Cause::Step {
+                past: "the surface's curvature radius",
+            }
+        })
+    }
+
     /// The fixed point p = p̃ + (s/2)F(q, p) at t, projected (p̃ in `half`, F from `friction`), F
-    /// against the slip `slipping` names: whether it settled. Against p₁'s own slip it gives up
-    /// as soon as it stops contracting.
+    /// against the slip `slipping` names: None where it settled, else why not. Against p₁'s own
+    /// slip it gives up as soon as it stops contracting.
     fn settle(
         &mut self,
         model: &dyn Lagrangian,
         held: Held<'_, '_>,
         (t, s): (f64, f64),
         slipping: Slipping,
-    ) -> Result<bool, ModelError> {
-        let mut last = f64::INFINITY;
-        for _ in 0..ITERATIONS {
+    ) -> Result<Option<Unsolved>, ModelError> {
+        let (mut last, mut floor) = (f64::INFINITY, 0.0);
+        let mut iterations = 0;
+        while iterations < ITERATIONS {
+            iterations += 1;
             for ((x, h), f) in self.p.iter_mut().zip(&self.half).zip(&self.friction) {
                 *x = h + 0.5 * s * f;
             }
             self.project(model, held, t)?;
             self.previous.copy_from_slice(&self.friction);
             self.forces(model, held, t, slipping)?;
+            // Against the force's own size: its rounding, whatever the coordinates' sizes.
             let size = self.previous.iter().fold(0.0_f64, |a, x| a.max(x.abs()));
             let change = self
                 .previous
                 .iter()
                 .zip(&self.friction)
                 .fold(0.0_f64, |a, (x, y)| a.max((x - y).abs()));
+            floor = 4.0 * f64::EPSILON * size;
             // λ's curvature term is a difference, smooth in p to ε^(2/3) only: the iteration
             // settles where its change stops falling, within that.
-            if change <= 4.0 * f64::EPSILON * size || (change >= last && change <= 1e-8 * size) {
-                return Ok(true);
+            if change <= floor || (change >= last && change <= 1e-8 * size) {
+                return Ok(None);
             }
-            if change >= last && matches!(slipping, Slipping::Now) {
-                return Ok(false);
-            }
+            let stopped = !(change < last);
             last = change;
+            if stopped && (matches!(slipping, Slipping::Now) || !change.is_finite()) {
+                break;
+            }
         }
-        Ok(false)
+        Ok(Some(Unsolved {
+            solve: FRICTION,
+            cause: Cause::Step {
+                past: "the sliding force's turn (a slip about to stop, or a curvature it does not resolve)",
+            },
+            residual: last,
+            floor,
+            iterations,
+        }))
     }
 
     /// The number of slip rows of the stuck contacts.
@@ -433,7 +518,7 @@ impl Hold {
             self.c[a] = -row.iter().zip(&self.v).map(|(g, v)| g * v).sum::<f64>();
         }
         if lu_in_place(system, pivots).is_none() {
-            return Err("the held contacts' surfaces are not independent here".into());
+            return Err(Unsolved::dependent(PROJECTION));
         }
         lu_solve(system, pivots, &mut self.c[..rows]);
         for i in 0..n {
@@ -518,7 +603,7 @@ impl Hold {
             }
         }
         if lu_in_place(system, pivots).is_none() {
-            return Err("the held contacts' surfaces are not independent here".into());
+            return Err(Unsolved::dependent(MULTIPLIERS));
         }
         lu_solve(system, pivots, &mut self.lambda[..rows]);
         self.friction.fill(0.0);
@@ -735,103 +820,4 @@ fn rows_into(held: Held<'_, '_>, q: &[f64], out: &mut [f64], normals: bool) -> R
 #[inline]
 fn normal_force(rows: &[f64], n: usize, a: usize, lambda: f64) -> f64 {
     lambda * rows[a * n..(a + 1) * n].iter().map(|g| g * g).sum::<f64>().sqrt()
-}
-
-/// The direction ŝ of the slip s̃ (`slipped`, k entries) after a kick −cWŝ against itself, W =
-/// JM⁻¹Jᵀ the slip's metric (`metric`, k × k; `factor` its scratch): ŝ = x/|x| with
-/// x = (ρI + cW)⁻¹s̃ and |x| = 1, the slip after the kick ρŝ (ρ ≥ 0). ρ by Newton on
-/// 1/|x(ρ)| − 1 (Moré and Sorensen's secular equation: concave, increasing, nearly linear)
-/// from ρ = 0, safeguarded by bisection; ρ = 0 where the kick stops the slip. A backward kick
-/// (c < 0, a composition's backward substep) keeps s̃'s direction: its equation has a root near
-/// each of W's eigenvectors once the slip is small. `direction` gets ŝ (0 for s̃ = 0); `work`
-/// holds 2k entries.
-fn slip_after_kick(
-    (metric, factor): (&[f64], &mut [f64]),
-    slipped: &[f64],
-    c: f64,
-    (direction, work): (&mut [f64], &mut [f64]),
-) {
-    let k = slipped.len();
-    let size = slipped.iter().map(|x| x * x).sum::<f64>().sqrt();
-    let unit = |direction: &mut [f64], x: &[f64]| {
-        let size = x.iter().map(|y| y * y).sum::<f64>().sqrt();
-        for (d, y) in direction.iter_mut().zip(x) {
-            *d = if size > 0.0 { y / size } else { 0.0 };
-        }
-    };
-    unit(direction, slipped);
-    if !(size > 0.0 && c > 0.0 && c.is_finite()) {
-        return;
-    }
-    let (x, w) = work.split_at_mut(k);
-    let trace: f64 = (0..k).map(|i| metric[i * k + i]).sum();
-    // At ρ = |s̃|, |x| ≤ 1: the root lies in [0, |s̃|].
-    let (mut low, mut high, mut rho) = (0.0, size, 0.0);
-    let tolerance = 4.0 * f64::EPSILON * (size + c * trace);
-    for _ in 0..100 {
-        if !cholesky(metric, c, rho, factor, k) {
-            // W singular: the root is to the right of 0.
-            low = rho;
-            rho = 0.5 * (low + high);
-            continue;
-        }
-        // x = (ρI + cW)⁻¹s̃ = L⁻ᵀL⁻¹s̃, then w = L⁻¹x: |w|² = xᵀ(ρI + cW)⁻¹x.
-        forward(factor, slipped, w, k);
-        for i in (0..k).rev() {
-            let sum: f64 = (i + 1..k).map(|l| factor[l * k + i] * x[l]).sum();
-            x[i] = (w[i] - sum) / factor[i * k + i];
-        }
-        forward(factor, x, w, k);
-        let length = x.iter().map(|y| y * y).sum::<f64>().sqrt();
-        let curvature = w.iter().map(|y| y * y).sum::<f64>();
-        unit(direction, x);
-        let g = 1.0 / length - 1.0;
-        if g >= 0.0 {
-            if rho == 0.0 {
-                return;
-            }
-            high = rho;
-        } else {
-            low = rho;
-        }
-        let mut next = rho - g * length.powi(3) / curvature;
-        if !(next > low && next < high) {
-            next = 0.5 * (low + high);
-        }
-        if (next - rho).abs() <= tolerance {
-            return;
-        }
-        rho = next;
-    }
-}
-
-/// The Cholesky factor L of ρI + cW (k × k) into `factor`'s lower triangle: whether it is
-/// positive definite.
-fn cholesky(metric: &[f64], c: f64, rho: f64, factor: &mut [f64], k: usize) -> bool {
-    for i in 0..k {
-        for j in 0..=i {
-            let mut sum = c * metric[i * k + j] + if i == j { rho } else { 0.0 };
-            for l in 0..j {
-                sum -= factor[i * k + l] * factor[j * k + l];
-            }
-            if i == j {
-                // Not positive, or NaN: not positive definite.
-                if sum.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
-                    return false;
-                }
-                factor[i * k + i] = sum.sqrt();
-            } else {
-                factor[i * k + j] = sum / factor[j * k + j];
-            }
-        }
-    }
-    true
-}
-
-/// y = L⁻¹b for the lower triangle L in `factor` (k × k).
-fn forward(factor: &[f64], b: &[f64], y: &mut [f64], k: usize) {
-    for i in 0..k {
-        let sum: f64 = (0..i).map(|l| factor[i * k + l] * y[l]).sum();
-        y[i] = (b[i] - sum) / factor[i * k + i];
-    }
 }

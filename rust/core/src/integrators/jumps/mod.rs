@@ -28,6 +28,7 @@ mod reflect;
 mod resolve;
 mod schedule;
 mod surfaces;
+mod unsolved;
 mod variational;
 mod watch;
 
@@ -236,18 +237,24 @@ impl<'s> Contacts<'s> {
 }
 
 /// How far from contact c's surface a state q on it lies at most, by round-off:
-/// 10³ε|∇φ(q)|∞ max(1, |q|∞). A held state's φ, solved to a few ε of q, lies well within; a
-/// run may start there (a point put on a curved surface in floating point).
+/// 10³ε Σᵢ|∂φ/∂qᵢ| max(1, |qᵢ|), each coordinate's rounding through the surface's own
+/// gradient (a coordinate the surface does not depend on, however large, adds none). A held
+/// state's φ, solved to a few ε of q, lies well within; a run may start there (a point put on
+/// a curved surface in floating point).
 fn on_surface(c: &Contact<'_>, q: &[f64]) -> Result<f64, ModelError> {
     let mut gradient = vec![0.0; q.len()];
     c.surface.gradient(q, &mut gradient)?;
     Ok(round_off(&gradient, q))
 }
 
-/// 10³ε|∇φ|∞ max(1, |q|∞), ∇φ at q given ([`on_surface`]).
+/// 10³ε Σᵢ|∂φ/∂qᵢ| max(1, |qᵢ|), ∇φ at q given ([`on_surface`]).
 pub(super) fn round_off(gradient: &[f64], q: &[f64]) -> f64 {
-    let amax = |x: &[f64]| x.iter().fold(0.0_f64, |a, y| a.max(y.abs()));
-    1e3 * f64::EPSILON * amax(gradient) * amax(q).max(1.0)
+    1e3 * f64::EPSILON
+        * gradient
+            .iter()
+            .zip(q)
+            .map(|(g, x)| (g * x.abs().max(1.0)).abs())
+            .sum::<f64>()
 }
 
 /// The impacts of a run, in order of time, row by row: impact k on contact `contact[k]` during

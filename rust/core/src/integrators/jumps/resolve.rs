@@ -8,6 +8,7 @@ use std::borrow::{Borrow, BorrowMut};
 use std::ops::Deref;
 
 use super::hold::{Held, Hold};
+use super::unsolved::run_error;
 use super::{
     reflect, round_off, variational, Contact, Contacts, Impacts, Law, NativeSurface, Schedule, Switch, MAX_IMPACTS,
 };
@@ -886,7 +887,7 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
         let state = (scratch.q(), scratch.p(), t);
         hold.multipliers(scratch.model().as_lagrangian(), held, state, out)
             .map(|_| ())
-            .map_err(|source| Error::Model { step, time, source })
+            .map_err(|source| run_error(source, step, time))
     }
 
     /// The held step, what it holds now, and the scratch stepper.
@@ -1110,7 +1111,7 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
         let projected = hold.project(scratch.model().as_lagrangian(), held, t);
         p.copy_from_slice(&hold.p);
         (self.contact_q, self.piece_p) = (q, p);
-        projected.map_err(|source| Error::Model { step, time, source })
+        projected.map_err(|source| run_error(source, step, time))
     }
 
     /// The slip of sliding contact j at the scratch's state at time t along its direction at
@@ -1600,11 +1601,7 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
             };
             let model = self.scratch.model().as_lagrangian();
             hold.step(model, held, (ta, s), (&self.piece_q, &self.piece_p))
-                .map_err(|source| Error::Model {
-                    step,
-                    time: self.t,
-                    source,
-                })?;
+                .map_err(|source| run_error(source, step, self.t))?;
             self.piece_work = hold.work;
             self.scratch.restart(ta + s, &hold.q, &hold.p, s);
             return Ok(());
