@@ -52,17 +52,22 @@ fn particle() -> Weighed {
 
 /// The outside of the unit circle, |q| ≥ 1 (a native ellipsoid, outside).
 fn sphere() -> Contacts<'static> {
+    circle(false, "sphere")
+}
+
+/// The unit circle, a native ellipsoid held from `inside` or outside, e = 0.
+fn circle(inside: bool, name: &str) -> Contacts<'static> {
     let contact = Contact {
         surface: Box::new(NativeSurface::Ellipsoid {
             coordinates: vec![0, 1],
             centre: vec![0.0, 0.0],
             semi_axes: vec![1.0, 1.0],
-            inside: false,
+            inside,
         }),
         restitution: 0.0,
         law: Law::Reflect,
         friction: None,
-        name: "sphere".into(),
+        name: name.into(),
     };
     Contacts::new(vec![contact]).unwrap()
 }
@@ -214,19 +219,7 @@ fn a_held_step_past_the_surfaces_curvature_ends_the_run_with_a_contact_error_adv
     // At the bottom of the inside of the unit circle at speed 1, pressed by v² + g: a step of 2
     // moves it twice the radius, and no point of q₀ + s(q̇ + c∇φ) lies on the circle.
     let model = particle();
-    let contact = Contact {
-        surface: Box::new(NativeSurface::Ellipsoid {
-            coordinates: vec![0, 1],
-            centre: vec![0.0, 0.0],
-            semi_axes: vec![1.0, 1.0],
-            inside: true,
-        }),
-        restitution: 0.0,
-        law: Law::Reflect,
-        friction: None,
-        name: "bowl".into(),
-    };
-    let contacts = Contacts::new(vec![contact]).unwrap();
+    let contacts = circle(true, "bowl");
     let run = |h: f64| {
         let options = Options::new(h, 10);
         integrate_watching(

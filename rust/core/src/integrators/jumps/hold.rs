@@ -20,7 +20,7 @@
 use nalgebra::DMatrix;
 
 use super::friction::slip_after_kick;
-use super::unsolved::{disagreement, Cause, Unsolved};
+use super::unsolved::{diagnosis, Cause, Unsolved};
 use super::{Contact, Friction};
 use crate::integrators::{Composition, Method};
 use crate::model::Lagrangian;
@@ -328,7 +328,7 @@ impl Hold {
                 let floor: f64 = row.iter().zip(&self.rounding).map(|(g, d)| (g * d).abs()).sum();
                 let against = if self.r[a] == 0.0 { 0.0 } else { self.r[a].abs() / floor };
                 // NaN (a residual that left the numbers) is the worst.
-                if !(against <= ratio) {
+                if against > ratio || against.is_nan() {
                     ratio = against;
                     worst = (self.r[a].abs(), floor, a);
                 }
@@ -355,7 +355,12 @@ impl Hold {
         }
         if !converged {
             let (residual, floor, a) = worst;
-            let cause = self.diagnosis(held, s, (a, residual))?;
+            let stuck = (a >= m).then(|| &self.rows[a * n..(a + 1) * n]);
+            let cause = diagnosis(
+                (held.contacts, held.closed),
+                (&self.q, &self.v, s),
+                (a, stuck, residual),
+            )?;
             return Err(Box::new(Unsolved {
                 solve: POSITION,
                 cause,
@@ -403,45 +408,6 @@ impl Hold {
         Ok(())
     }
 
-    /// Why the position constraint's Newton failed at its last iterate `q` (from `start` by
-    /// the drift s·`v`), row a the worst with `residual`: a closed contact's gradient that is not
-    /// ∇φ ([`disagreement`] beyond 10⁻³), a residual near round-off far within the step's
-    /// reach (φ's precision), or else the step (past the surface's curvature).
-    #[cold]
-    fn diagnosis(&self, held: Held<'_, '_>, s: f64, (a, residual): (usize, f64)) -> Result<Cause, ModelError> {
-        let n = self.q.len();
-        let mut gradient = vec![0.0; n];
-        for &j in held.closed {
-            let contact = &held.contacts[j];
-            contact.surface.gradient(&self.q, &mut gradient)?;
-            let mismatch = disagreement(&*contact.surface, &self.q, &gradient, &gradient)?.max(disagreement(
-                &*contact.surface,
-                &self.q,
-                &gradient,
-                &self.v,
-            )?);
-            if mismatch > 1e-3 {
-                let contact = contact.name.clone();
-                return Ok(Cause::Gradient { contact, mismatch });
-            }
-        }
-        // The row's reach over the step: |row|·s|q̇|, coordinate by coordinate.
-        let row = if a < held.closed.len() {
-            held.contacts[held.closed[a]].surface.gradient(&self.q, &mut gradient)?;
-            &gradient[..]
-        } else {
-            &self.rows[a * n..(a + 1) * n]
-        };
-        let reach: f64 = row.iter().zip(&self.v).map(|(g, v)| (g * s * v).abs()).sum();
-        Ok(if residual <= 1e-8 * reach {
-            Cause::Precision
-        } else {
-            Cause::Step {
-                past: "the surface's curvature radius",
-            }
-        })
-    }
-
     /// The fixed point p = p̃ + (s/2)F(q, p) at t, projected (p̃ in `half`, F from `friction`), F
     /// against the slip `slipping` names: None where it settled, else why not. Against p₁'s own
     /// slip it gives up as soon as it stops contracting.
@@ -475,7 +441,7 @@ impl Hold {
             if change <= floor || (change >= last && change <= 1e-8 * size) {
                 return Ok(None);
             }
-            let stopped = !(change < last);
+            let stopped = change >= last || change.is_nan();
             last = change;
             if stopped && (matches!(slipping, Slipping::Now) || !change.is_finite()) {
                 break;

@@ -4,7 +4,7 @@
 
 use std::fmt;
 
-use super::Surface;
+use super::{Contact, Surface};
 use crate::{Error, ModelError};
 
 /// Why a held solve failed: what its diagnosis found.
@@ -95,12 +95,51 @@ impl fmt::Display for Unsolved {
 
 impl std::error::Error for Unsolved {}
 
+/// Why the held step's position Newton failed at its last iterate q (moving at q̇ = `v` over
+/// the step s), row a the worst with `residual` (a stuck slip row's given, a closed contact's
+/// its gradient at q): a closed contact's gradient that is not ∇φ ([`disagreement`] beyond
+/// 10⁻³, along ∇φ or q̇), a residual near round-off far within the step's reach |row|·s|q̇|
+/// (φ's precision), or else the step, past the surface's curvature. A cold path: it allocates.
+#[cold]
+pub(super) fn diagnosis(
+    (contacts, closed): (&[Contact<'_>], &[usize]),
+    (q, v, s): (&[f64], &[f64], f64),
+    (a, stuck, residual): (usize, Option<&[f64]>, f64),
+) -> Result<Cause, ModelError> {
+    let mut gradient = vec![0.0; q.len()];
+    for &j in closed {
+        let contact = &contacts[j];
+        contact.surface.gradient(q, &mut gradient)?;
+        let along = |e: &[f64]| disagreement(&*contact.surface, q, &gradient, e);
+        let mismatch = along(&gradient)?.max(along(v)?);
+        if mismatch > 1e-3 {
+            let contact = contact.name.clone();
+            return Ok(Cause::Gradient { contact, mismatch });
+        }
+    }
+    let row = match stuck {
+        Some(row) => row,
+        None => {
+            contacts[closed[a]].surface.gradient(q, &mut gradient)?;
+            &gradient[..]
+        }
+    };
+    let reach: f64 = row.iter().zip(v).map(|(g, v)| (g * s * v).abs()).sum();
+    Ok(if residual <= 1e-8 * reach {
+        Cause::Precision
+    } else {
+        Cause::Step {
+            past: "the surface's curvature radius",
+        }
+    })
+}
+
 /// How far `gradient`, the surface's ∇φ at q, lies from central differences of φ along the
 /// direction e: the least |(φ(q + he) − φ(q − he))/2h − ∇φ·e| / (|∇φ||e|) over steps h from a
 /// quarter of the scale of q along e down to 10⁻¹⁵ of it, so that whatever the surface's own
 /// scale one step balances its truncation against its rounding. 0 for e = 0. A cold path: it
 /// allocates.
-pub(super) fn disagreement(surface: &dyn Surface, q: &[f64], gradient: &[f64], e: &[f64]) -> Result<f64, ModelError> {
+fn disagreement(surface: &dyn Surface, q: &[f64], gradient: &[f64], e: &[f64]) -> Result<f64, ModelError> {
     let norm = |x: &[f64]| x.iter().map(|y| y * y).sum::<f64>().sqrt();
     let size = norm(e);
     let magnitude = norm(gradient);
