@@ -87,16 +87,71 @@ def _momentum_terms(traj: Trajectory, generator: Generator) -> tuple[np.ndarray,
     the larger of Σ|pᵢξᵢ| and ‖p‖∞‖ξ‖∞)."""
     if isinstance(generator, (Translation, Rotation, Cyclic)):
         return _core.momentum(generator.spec(), *traj._arrays()[1:])
+    return _core.momentum_along(_field(traj, generator), np.ascontiguousarray(traj.p, dtype=float))
+
+
+def _field(traj: Trajectory, generator: Generator) -> np.ndarray:
+    """ξ(q) at every saved state of ``traj``, shape (N, n): a declared generator's from the core
+    (p·ξ at the unit momenta), a closure's called at each state."""
+    q = np.ascontiguousarray(traj.q, dtype=float)
+    n = q.shape[1]
+    if isinstance(generator, (Translation, Rotation, Cyclic)):
+        spec, columns = generator.spec(), []
+        for i in range(n):
+            unit = np.zeros_like(q)
+            unit[:, i] = 1.0
+            columns.append(_core.momentum(spec, q, unit)[0])
+        return np.stack(columns, axis=1)
     if not callable(generator):
         raise TypeError(f"generator: expected a Translation, Rotation, Cyclic or a callable xi(q), got {generator!r}")
-    n = traj.q.shape[1]
-    xi = np.empty_like(traj.q)
-    for k, q in enumerate(traj.q):
-        row = returned("generator: xi(q)", generator(q.copy()))
+    xi = np.empty_like(q)
+    for k, x in enumerate(q):
+        row = returned("generator: xi(q)", generator(x.copy()))
         if row.shape != (n,):
             raise ValueError(f"generator: xi(q) must return shape ({n},), got {row.shape}")
         xi[k] = row
-    return _core.momentum_along(xi, np.ascontiguousarray(traj.p, dtype=float))
+    return xi
+
+
+def _acting(traj: Trajectory) -> list[tuple[str, np.ndarray | None]]:
+    """What besides L pushes the run's states, and along which rows at each saved state (N, k, n):
+    each contact's normal and friction (:func:`varmech.impacts.acting`) and the model's force
+    Q = ṗ − ∂L/∂q; None where the rows cannot be had (a contact loaded as its name, a force
+    that does not evaluate at a state alone)."""
+    found: list[tuple[str, np.ndarray | None]] = []
+    q = np.asarray(traj.q, dtype=float)
+    for c in traj.contacts:
+        if isinstance(c, _impacts.Contact):
+            found += _impacts.acting(c, q)
+        else:
+            found.append((f"contact {c!r} (given by functions its file does not store)", None))
+    if traj.model.forced:
+        what = "the model's force (Q·ξ ≠ 0)"
+        t, q, p = (np.ascontiguousarray(x, dtype=float) for x in traj._arrays())
+        core = traj.model._core
+        try:
+            v = _core.derivative(core, "velocity", t, q, p)
+            force = _core.derivative(core, "dp_dt", t, q, v) - _core.derivative(core, "dl_dq", t, q, v)
+        except (ValueError, RuntimeError):  # delayed forces need the run's history
+            found.append((what, None))
+        else:
+            found.append((what, force[:, None, :]))
+    return found
+
+
+def _broken(t: np.ndarray, xi: np.ndarray, acting: list[tuple[str, np.ndarray | None]]) -> str | None:
+    """Why the momentum of ξ (at the states, (N, n)) is not conserved, if something in ``acting``
+    has a component along it at a state: |row·ξ| beyond 10⁻⁹ of its terms' size."""
+    for what, rows in acting:
+        if rows is None:
+            return f"not judged: {what} may act along ξ"
+        value = np.einsum("skj,sj->sk", rows, xi)
+        terms = np.einsum("skj,sj->sk", np.abs(rows), np.abs(xi))
+        size = np.maximum(terms, np.max(np.abs(rows), axis=2) * np.max(np.abs(xi), axis=1)[:, None])
+        off = np.any(np.abs(value) > 1e-9 * size, axis=1)
+        if off.any():
+            return f"not conserved: {what} can push along ξ (at t = {t[int(np.argmax(off))]:.6g})"
+    return None
 
 
 @dataclass(frozen=True)
@@ -168,7 +223,8 @@ class InvariantStatistics:
         The first saved state where the quantity is not finite (None: it is finite throughout).
     verdict : str
         One of :data:`VERDICTS`; :data:`NOT_JUDGED` for an energy that is not conserved and has
-        no tracked balance to judge instead (affine velocity constraints).
+        no tracked balance to judge instead (affine velocity constraints), or a momentum that a
+        contact, its friction or a force pushes (the advice names it).
     advice : str
         For a failure or a too coarse run, where and how large and what to do; for a run too
         short, why; for a coarse band, to reduce dt; for a forced balance, its measured order;
@@ -316,7 +372,7 @@ def _statistics(record: _core.Statistics, name: str, initial: float, scale_name:
 NOT_JUDGED = "not judged"
 #: Why: affine velocity constraints' forces do work.
 AFFINE = "not conserved: the affine velocity constraints' moving surface does work, which the run does not track"
-#: The name of ``report.energy`` for a forced model or an L that depends on t: E − W is judged.
+#: The name of ``report.energy`` where anything puts energy in or takes it out: E − W is judged.
 BALANCE = "energy balance"
 #: The names ``report.energy`` takes, and their symbols in the report's text.
 _SYMBOLS = {"energy": "H", "Jacobi integral": "h", BALANCE: "(E − W)"}
@@ -387,8 +443,8 @@ class ConservationReport:
     method: str
     dt: float
     t_end: float
-    #: The energy, the Jacobi integral, or for forced systems and an L that depends on t the
-    #: balance E(t) − W(t) (W the forces' work less ∫∂L/∂t dt): ``energy.name`` says which.
+    #: The energy, the Jacobi integral, or where anything puts energy in or takes it out the
+    #: balance E(t) − W(t) (W as ``traj.work``): ``energy.name`` says which.
     energy: InvariantStatistics
     momenta: tuple[InvariantStatistics, ...]
     #: For constrained models: |g(q)|∞ and |G(q)M⁻¹p|∞ over the run; with velocity constraints
@@ -422,8 +478,9 @@ class ConservationReport:
         """Every quantity judged: energy (or balance) unless :data:`NOT_JUDGED`, momenta,
         constraints and their power."""
         energy = (self.energy,) if self.energy.verdict != NOT_JUDGED else ()
+        momenta = tuple(m for m in self.momenta if m.verdict != NOT_JUDGED)
         power = (self.constraint_power,) if self.constraint_power is not None else ()
-        return energy + self.momenta + (self.constraints or ()) + power
+        return energy + momenta + (self.constraints or ()) + power
 
     def __str__(self) -> str:
         lines = [f"Conservation report: {self.model}, {self.method}, dt = {self.dt:g}, t = 0 … {self.t_end:g}"]
@@ -443,12 +500,15 @@ class ConservationReport:
 def check_conservation(traj: Trajectory, generators: Sequence[Generator] | None = None, *, refine: bool = True) -> ConservationReport:
     """Check the energy, the Noether momenta and the constraints of ``traj``, and the power of the constraint forces.
 
-    The energy function E = p·q̇ − L is judged when L does not depend on t and no constraint
-    does work (affine velocity constraints A(q)q̇ + b(q) = 0 do); with forces acting, or L
-    depending on t, the report judges the balance E − W instead, W the energy put in (the
-    forces' work less ∫∂L/∂t dt, which the run tracks on its method's quadrature:
-    ``traj.work``). An energy that is not finite at a saved state fails the report in every
-    case. With velocity
+    The energy function E = p·q̇ − L is judged when nothing puts energy in or takes it out and
+    no constraint does work (affine velocity constraints A(q)q̇ + b(q) = 0 do); where anything
+    does, the report judges the balance E − W instead, W the energy put in as the run tracked
+    it (``traj.work``): the forces' work less ∫∂L/∂t dt on the method's quadrature, the
+    friction of held contacts, each impact's loss where e < 1 (its law's own; an elastic impact
+    puts in none) and each impulse's energy change. A momentum is judged only where no
+    contact's normal, friction slip row or force of the model pushes along its ξ at the run's
+    states; otherwise it is :data:`NOT_JUDGED`, its advice naming what pushes it. An energy
+    that is not finite at a saved state fails the report in every case. With velocity
     constraints the report judges the residuals |A(q)q̇ + b(q)| and only the momenta of the
     symmetries the model declares: a nonholonomic system need not conserve the momenta of the
     symmetries of its L (the native scenes declare those they conserve). Each quantity's error
@@ -499,11 +559,12 @@ def check_conservation(traj: Trajectory, generators: Sequence[Generator] | None 
     model = traj.model
     t, steps = np.asarray(traj.t), int(traj.steps)
     affine = bool(model.velocity_constraints) and model.affine
-    # Forces that do work: the model's own, or the friction of its contacts.
-    # The energy put in: by those forces, and by L's dependence on t.
-    forced = model.forced or _impacts.frictional(traj.contacts) or model.time_dependent
+    # Whether anything puts energy in or takes it out (forces, L's dependence on t, impacts,
+    # friction, impulses): then the balance E − W is judged, W as the run recorded it.
+    forced = _impacts.exchanges(model, traj.contacts, traj.impulses)
+    work = np.zeros(len(t)) if traj.work is None else np.asarray(traj.work)
     if not affine:
-        energy = energy_statistics(model, t, *traj._arrays()[1:], steps=steps, work=np.asarray(traj.work) if forced else None)
+        energy = energy_statistics(model, t, *traj._arrays()[1:], steps=steps, work=work if forced else None)
         if energy.verdict == "failed":
             energy = replace(energy, advice=f"{energy.advice}; {_failure_advice(traj)}")
         elif forced and energy.verdict == "secular drift" and refine:
@@ -516,12 +577,20 @@ def check_conservation(traj: Trajectory, generators: Sequence[Generator] | None 
     if energy.first_non_finite is not None:
         energy = replace(energy, advice=f"{energy.advice}: the model's energy p·q̇ − L does not evaluate there")
     momenta = []
+    # A momentum is judged where nothing pushes along its ξ: no contact's normal or friction,
+    # no force of the model.
+    acting = _acting(traj) if generators else []
     for k, xi in enumerate(generators):
         # A cyclic coordinate's momentum by its name (p_phi), as the model knows it.
         name = model.momentum_names[xi.index] if isinstance(xi, Cyclic) else xi.name if isinstance(xi, (Translation, Rotation)) else f"xi[{k}]"
         j, size = _momentum_terms(traj, xi)
         record = _core.statistics(t, j - j[0], size, size, steps)
-        momenta.append(_statistics(record, name, j[0], "mean max(Σ|pᵢξᵢ|, ‖p‖‖ξ‖)", t))
+        stats = _statistics(record, name, j[0], "mean max(Σ|pᵢξᵢ|, ‖p‖‖ξ‖)", t)
+        why = _broken(t, _field(traj, xi), acting) if acting else None
+        # Not conserved, so not judged; a non-finite momentum fails all the same.
+        if why is not None and stats.first_non_finite is None:
+            stats = replace(stats, verdict=NOT_JUDGED, advice=why)
+        momenta.append(stats)
     constraints: tuple[InvariantStatistics, ...] | None = None
     if model.constraints:
         (g, v), (g_size, v_size) = _core.constraint_residuals(model._core, *traj._arrays()[1:])

@@ -10,7 +10,7 @@ The layout, self-describing so that any HDF5 reader can use it (``docs/file_form
     /t           (N,)   float64   the saved times
     /q, /p       (N, n) float64   positions and momenta, one row a saved state
     /newton      (N,)   uint64    cumulative Newton iterations (only for methods that solve)
-    /work        (N,)   float64   cumulative work of the forces (only for forced models and contacts with friction)
+    /work        (N,)   float64   cumulative energy put in, W (only where something can put it in or take it out)
     /committed   (5,)   int64     rows, checkpoint slot, checkpoint length, steps, nfev
     /checkpoint0, /checkpoint1    uint8  the last committed state's checkpoint, in the slot
                                   /committed names (the other holds the one before)
@@ -518,7 +518,7 @@ def save(traj: Trajectory, path: str | os.PathLike[str], *, overwrite: bool = Fa
     cannot be written.
     """
     target = writable(path, overwrite, "path")
-    columns, names = columns_of(traj.model, traj.method, traj.contacts), [o.name for o in traj.events]
+    columns, names = columns_of(traj.model, traj.method, traj.contacts, traj.impulses), [o.name for o in traj.events]
     writer = Writer(
         target, model=traj.model, method=traj.method, dt=traj.dt, columns=columns, events=names, contacts=traj.contacts,
         impulses=traj.impulses,
@@ -528,12 +528,14 @@ def save(traj: Trajectory, path: str | os.PathLike[str], *, overwrite: bool = Fa
     return target
 
 
-def columns_of(model: Model, method: str, contacts: Sequence[Contact | str] = ()) -> tuple[str, ...]:
-    """The optional columns of a run of ``method`` on ``model`` watching ``contacts``: Newton
-    counts for the methods that solve equations, work for forced models, contacts with
-    friction and an L that depends on t."""
+def columns_of(
+    model: Model, method: str, contacts: Sequence[Contact | str] = (), impulses: Sequence[Impulse | float] = ()
+) -> tuple[str, ...]:
+    """The optional columns of a run of ``method`` on ``model`` watching ``contacts`` and
+    applying ``impulses``: Newton counts for the methods that solve equations, work where
+    anything can put energy in or take it out (``impacts.exchanges``)."""
     info = method_info(method)
-    worked = model.forced or model.time_dependent or _impacts.frictional(contacts)
+    worked = _impacts.exchanges(model, contacts, impulses)
     return (*(("newton",) if info.implicit or info.constrained else ()), *(("work",) if worked else ()))
 
 

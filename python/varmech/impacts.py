@@ -58,7 +58,7 @@ import json
 import warnings
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from typing import Any, Literal
+from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -68,6 +68,9 @@ from ._core import ContactError
 from ._util import floats, integer, number
 from ._warnings import VarmechWarning
 from .events import Occurrences
+
+if TYPE_CHECKING:
+    from .model import Model
 
 #: The public API; the rest serves :func:`varmech.integrate`.
 __all__ = ["Contact", "ContactError", "Friction", "ImpactWarning"]
@@ -470,9 +473,50 @@ def occurrence_names(contacts: Sequence[Contact | str]) -> list[str]:
     return names + [f"{n}.{kind}" for kind in SWITCHES for n in names]
 
 
-def frictional(contacts: Sequence[Contact | str]) -> bool:
-    """Whether some contact has friction, whose work a run then reports (``traj.work``)."""
-    return any(isinstance(c, Contact) and c.friction is not None for c in contacts)
+def exchanges(model: Model, contacts: Sequence[Contact | str], impulses: Sequence[object] = ()) -> bool:
+    """Whether anything can put energy into a run of ``model`` or take it out, so that the run
+    records the energy put in, W (``traj.work``), and :func:`varmech.check_conservation` judges
+    the balance E − W: the model's forces, an L that depends on t, a contact with friction or
+    with restitution below 1 (each law's own loss; an elastic contact puts in none), or an
+    impulse. The core counts W by the same rule (``Watch::exchanges``); a contact of Python
+    functions loaded from a file as its name counts, its coefficients unknown."""
+    touching = any(not isinstance(c, Contact) or c.friction is not None or c.restitution < 1 for c in contacts)
+    return model.forced or model.time_dependent or touching or len(impulses) > 0
+
+
+def acting(contact: Contact, q: np.ndarray) -> list[tuple[str, np.ndarray]]:
+    """The directions along which ``contact`` pushes at each configuration of ``q`` (N, n): its
+    normal ∇φ, and with friction its slip rows J (a particle's tangent plane as the projector
+    onto it), each as (what, rows of shape (N, k, n)). A momentum p·ξ whose ξ has a component
+    along them is changed by the contact: its symmetry is broken there."""
+    q = np.asarray(q, dtype=float)
+    surface = contact.phi
+    if isinstance(surface, _surfaces.Wall):
+        normals = np.zeros_like(q)
+        normals[:, surface.k] = 1.0
+    elif isinstance(surface, _surfaces.Ellipsoid):
+        normals = np.zeros_like(q)
+        sign = -2.0 if surface.inside else 2.0
+        for k, c, a in zip(surface.coordinates, surface.centre, surface.semi_axes):
+            normals[:, k] += sign * (q[:, k] - c) / (a * a)
+    else:
+        normals = np.array([np.asarray(contact.gradient(x.copy()), dtype=float) for x in q]).reshape(q.shape)
+    found = [(f"contact {contact.name!r} (its normal ∇φ·ξ ≠ 0)", normals[:, None, :])]
+    friction = contact.friction
+    if friction is None:
+        return found
+    what = f"the friction of contact {contact.name!r} (its slip rows J·ξ ≠ 0)"
+    if friction.slip is None:
+        # The tangent plane: J·ξ ≠ 0 exactly where ξ leaves the normal's line.
+        size = np.sum(normals**2, axis=1)[:, None, None]
+        outer = normals[:, :, None] * normals[:, None, :]
+        projector = np.eye(q.shape[1])[None] - np.divide(outer, size, out=np.zeros_like(outer), where=size > 0)
+        found.append((what, projector))
+    elif callable(friction.slip):
+        found.append((what, np.array([np.reshape(np.asarray(friction.slip(x.copy()), dtype=float), (-1, q.shape[1])) for x in q])))
+    else:
+        found.append((what, np.broadcast_to(np.asarray(friction.slip, dtype=float), (len(q), *np.shape(friction.slip)))))
+    return found
 
 
 class ImpactWarning(VarmechWarning, RuntimeWarning):

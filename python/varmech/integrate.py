@@ -471,7 +471,7 @@ def _run(
         if output is not None:
             target = files.writable(output, bool(overwrite), "output")
             streaming.checkpoint_period(checkpoint_every, save_every)
-            columns = files.columns_of(model, method, contacts)
+            columns = files.columns_of(model, method, contacts, impulses)
             names = [o.name for o in _events.occurrences_of(watched)] + _impacts.occurrence_names(contacts)
             writer = files.Writer(
                 target,

@@ -101,8 +101,9 @@ class Trajectory:
     work : ndarray, shape (N,) or None
         The energy put in up to each saved state, which E − E₀ balances: the work of a forced
         model's forces and of its contacts' friction (:class:`varmech.Friction`), less
-        ∫∂L/∂t dt for an L that depends on t (on the method's quadrature, Σ∂L_d/∂t). None for a
-        model with none of them.
+        ∫∂L/∂t dt for an L that depends on t (on the method's quadrature, Σ∂L_d/∂t), each
+        impact's loss where e < 1 (its law's own; none for e = 1) and each impulse's energy
+        change. Zeros (None from a file) where nothing puts energy in or takes it out.
     status : int
         0: the run reached its end; 1: a terminal event stopped it; -1: the partial trajectory
         of a failed run (``err.partial``).

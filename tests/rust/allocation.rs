@@ -625,7 +625,7 @@ where
         contacts: Some(&contacts),
         ..Watch::default()
     };
-    let mut watcher = Watcher::begin(model, &mut stepper, watch, "q0", false).unwrap();
+    let mut watcher = Watcher::begin(model, &mut stepper, watch, "q0").unwrap();
     let mut record = Trajectory::default();
     let mut poll = || Ok(());
     watcher.advance(&mut stepper, 1, &mut record, &mut poll).unwrap();

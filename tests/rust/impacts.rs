@@ -505,7 +505,7 @@ fn a_stepper_stepped_through_a_watcher_is_the_run_bit_for_bit() {
     )
     .unwrap();
     let mut stepper = Stepper::new(&free, Method::Verlet, &q0, &p0, &options).unwrap();
-    let mut watcher = Watcher::begin(&free, &mut stepper, with_contacts(&contacts), "q0", false).unwrap();
+    let mut watcher = Watcher::begin(&free, &mut stepper, with_contacts(&contacts), "q0").unwrap();
     let mut record = Trajectory::default();
     record.impacts.dim = 2;
     let mut poll = || -> Result<(), ModelError> { Ok(()) };
@@ -530,14 +530,14 @@ fn stepped_one_call_at_a_time<S: varmech::integrators::Dynamics>(
     contacts: &Contacts<'static>,
 ) -> (Vec<f64>, Vec<f64>, Impacts) {
     let mut stepper = Stepper::new(sys, Method::Verlet, q0, p0, options).unwrap();
-    drop(Watcher::begin(sys, &mut stepper, with_contacts(contacts), "q0", false).unwrap());
+    drop(Watcher::begin(sys, &mut stepper, with_contacts(contacts), "q0").unwrap());
     let mut impacts = Impacts {
         dim: q0.len(),
         ..Impacts::default()
     };
     let mut poll = || -> Result<(), ModelError> { Ok(()) };
     for _ in 0..options.steps {
-        let mut watcher = Watcher::resume(sys, &mut stepper, with_contacts(contacts), false).unwrap();
+        let mut watcher = Watcher::resume(sys, &mut stepper, with_contacts(contacts)).unwrap();
         let mut record = Trajectory::default();
         record.impacts.dim = q0.len();
         assert_eq!(watcher.advance(&mut stepper, 1, &mut record, &mut poll).unwrap(), None);
@@ -603,7 +603,7 @@ fn a_state_a_round_off_past_a_surface_leaves_it_and_one_further_past_is_refused(
     let options = Options::new(1e-3, 1);
     let (q0, p0) = ([-1e-17], [1.0]);
     let mut outside = Stepper::new(&ball, Method::Verlet, &[-1e-9], &p0, &options).unwrap();
-    match Watcher::begin(&ball, &mut outside, with_contacts(&contacts), "q0", false) {
+    match Watcher::begin(&ball, &mut outside, with_contacts(&contacts), "q0") {
         Err(Error::InvalidArgument { argument, reason }) => {
             assert_eq!(argument, "q0");
             assert!(reason.contains("floor"), "{reason}");
@@ -615,9 +615,9 @@ fn a_state_a_round_off_past_a_surface_leaves_it_and_one_further_past_is_refused(
     for begun in [true, false] {
         let mut stepper = Stepper::new(&ball, Method::Verlet, &q0, &p0, &options).unwrap();
         let mut watcher = if begun {
-            Watcher::begin(&ball, &mut stepper, with_contacts(&contacts), "q0", false).unwrap()
+            Watcher::begin(&ball, &mut stepper, with_contacts(&contacts), "q0").unwrap()
         } else {
-            Watcher::resume(&ball, &mut stepper, with_contacts(&contacts), false).unwrap()
+            Watcher::resume(&ball, &mut stepper, with_contacts(&contacts)).unwrap()
         };
         let mut record = Trajectory::default();
         record.impacts.dim = 1;

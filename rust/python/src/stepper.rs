@@ -104,7 +104,7 @@ impl Stepper {
             let mut stepper = integrators::Stepper::resume(sys, state)?;
             let watched = Watched::new(specs, impulses)?;
             let mut detector = lend(events)?;
-            let mut watcher = Watcher::begin(sys, &mut stepper, watched.watch(detector.as_mut()), argument, false)?;
+            let mut watcher = Watcher::begin(sys, &mut stepper, watched.watch(detector.as_mut()), argument)?;
             if fresh {
                 watcher.start(&mut stepper, &mut Trajectory::default())?;
             }
@@ -147,7 +147,7 @@ impl Stepper {
             let mut stepper = integrators::Stepper::resume(sys, state)?;
             let watched = Watched::new(specs, impulses)?;
             let mut detector = lend(events)?;
-            let mut watcher = Watcher::resume(sys, &mut stepper, watched.watch(detector.as_mut()), false)?;
+            let mut watcher = Watcher::resume(sys, &mut stepper, watched.watch(detector.as_mut()))?;
             let mut record = Trajectory::default();
             let advanced = watcher.advance(&mut stepper, n, &mut record, &mut poll);
             // The impacts and crossings of the steps completed, a failed step's excepted.

@@ -152,7 +152,9 @@ where
 /// [`MAX_IMPACTS`](super::MAX_IMPACTS) impacts in one step. A step without an impact is bit for
 /// bit the step without contacts. The impacts go to [`Trajectory::impacts`], and the saved
 /// states include the state just before and just after each (one time, two rows). The energy
-/// check ([`Options::max_energy_error`]) discounts the change of energy at the jumps (e < 1).
+/// check ([`Options::max_energy_error`]) balances E − E₀ against the work W, which holds the
+/// energy the contacts and impulses put in ([`super::Watch::exchanges`]: each law's own loss,
+/// none for e = 1).
 ///
 /// Refuses, naming `contacts`, a surface that does not fit the model's coordinates and the
 /// variational law on a method or model it does not fit; naming `q0`, an initial state outside
@@ -201,7 +203,7 @@ where
     P: Poll,
 {
     let argument = if fresh { "q0" } else { "checkpoint" };
-    match Watcher::begin(sys, &mut stepper, watch, argument, energy.is_some()) {
+    match Watcher::begin(sys, &mut stepper, watch, argument) {
         Ok(watcher) => run(sys, stepper, energy, end, save_every, poll, (watcher, fresh)),
         Err(error) => Err(fail(error, first_state(sys, &stepper))),
     }
@@ -408,9 +410,6 @@ where
         let n = save - stepper.steps();
         // Events and contacts: step by step, stopping after a terminal event's step.
         let advanced = watcher.advance(&mut stepper, n, &mut traj, &mut poll);
-        if let Some(watch) = watch.as_mut() {
-            watch.shift(watcher.take_energy_jump());
-        }
         let advanced = advanced.map(|stop| traj.terminated_by = stop);
         // A failure stops with the last good state kept, and the work counted.
         keep(&mut traj, &stepper);
@@ -535,12 +534,6 @@ impl EnergyWatch {
         };
         watch.push(&terms, stepper.work());
         Some(Ok(watch))
-    }
-
-    /// Discounts a change `delta` of the energy at jumps (impacts with e < 1): the check
-    /// judges E − W − E₀ of the smooth motion.
-    fn shift(&mut self, delta: f64) {
-        self.initial += delta;
     }
 
     fn push(&mut self, terms: &EnergyTerms, work: f64) {

@@ -57,10 +57,11 @@ pub struct StepperState {
     p_next: Vec<f64>,
     eq_next: Vec<f64>,
     ep_next: Vec<f64>,
-    /// The work of the held contacts' friction so far, and whether it is counted (a stepper
-    /// watching contacts with friction).
+    /// The energy the jumps and held contacts put in so far (friction's work, the impacts'
+    /// losses, the impulses' energy), and whether it is counted (a stepper watching what can
+    /// put energy in or take it out: [`super::Watch::exchanges`]).
     contact_work: f64,
-    frictional: bool,
+    exchanges: bool,
     // Wall-clock pacing, not state: a restored state starts a fresh one.
     #[serde(skip)]
     interrupt: InterruptPoll,
@@ -263,13 +264,13 @@ where
         Ok(())
     }
 
-    /// Counts the work of contact friction from now on (a watcher of frictional contacts
-    /// begun on this stepper): its work is then reported, as a forced model's is.
+    /// Counts the energy the contacts and impulses put in from now on (a watcher of what can
+    /// exchange it begun on this stepper): it is then reported, as a forced model's work is.
     pub(in crate::integrators) fn count_contact_work(&mut self) {
-        self.state.borrow_mut().frictional = true;
+        self.state.borrow_mut().exchanges = true;
     }
 
-    /// Adds w to the work of contact friction.
+    /// Adds w to the energy the contacts and impulses put in.
     pub(in crate::integrators) fn add_contact_work(&mut self, w: f64) {
         self.state.borrow_mut().contact_work += w;
     }
@@ -349,7 +350,7 @@ impl StepperState {
             eq_next: zeros(),
             ep_next: zeros(),
             contact_work: 0.0,
-            frictional: false,
+            exchanges: false,
             interrupt: InterruptPoll::new(),
         }
     }
@@ -781,7 +782,7 @@ impl<M: Deref<Target: Dynamics>, St: Borrow<StepperState>> Stepper<M, St> {
     /// watched without friction.
     pub fn forced_work(&self) -> Option<f64> {
         let lagrangian = self.model.as_lagrangian();
-        (lagrangian.is_forced() || lagrangian.is_time_dependent() || self.frictional).then(|| self.work())
+        (lagrangian.is_forced() || lagrangian.is_time_dependent() || self.exchanges).then(|| self.work())
     }
 }
 

@@ -89,16 +89,17 @@ impl Trajectory {
         self.p.extend_from_slice(stepper.p());
     }
 
-    /// Saves (q, p) as the state at time `t`, with the stepper's Newton count and work: a
-    /// state inside a step (just before or after an impact).
-    pub(super) fn push_state<M, St>(&mut self, t: f64, q: &[f64], p: &[f64], stepper: &Stepper<M, St>)
+    /// Saves (q, p) as the state at time `t`, with the stepper's Newton count and work less
+    /// `behind`, the energy put in after that state: a state inside a step (just before or
+    /// after an impact, a sample).
+    pub(super) fn push_state<M, St>(&mut self, t: f64, (q, p): (&[f64], &[f64]), stepper: &Stepper<M, St>, behind: f64)
     where
         M: Deref<Target: Dynamics>,
         St: std::borrow::Borrow<super::StepperState>,
     {
         self.t.push(t);
         self.newton.extend(stepper.newton());
-        self.work.extend(stepper.forced_work());
+        self.work.extend(stepper.forced_work().map(|w| w - behind));
         self.q.extend_from_slice(q);
         self.p.extend_from_slice(p);
     }

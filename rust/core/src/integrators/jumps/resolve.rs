@@ -78,10 +78,6 @@ pub(in crate::integrators) struct Resolver<'c, 's, M> {
     /// the schedule).
     pending: Impacts,
     blown: Impacts,
-    /// Whether the run checks its energy (then each jump's change of E is summed in
-    /// `energy_jump`, for the run's check to discount).
-    energy: bool,
-    energy_jump: f64,
     /// The method's discrete energy, for the variational law.
     discrete: Option<DiscreteEnergy>,
     /// The contacts held closed, in order (indices into `contacts`), and the held step (None
@@ -111,7 +107,15 @@ pub(in crate::integrators) struct Resolver<'c, 's, M> {
     directions: Vec<f64>,
     slip: Vec<f64>,
     direction: Vec<f64>,
-    /// The friction work of the last partial step, and of the step's pieces so far.
+    /// The energy put in by the step's pieces and jumps up to each of its impacts (just before,
+    /// just after), impulses (likewise) and releases: what its saved states inside the step
+    /// are behind its end.
+    pending_work: Vec<[f64; 2]>,
+    blown_work: Vec<[f64; 2]>,
+    released_work: Vec<f64>,
+    /// The friction work of the last partial step, and the energy the step's pieces and jumps
+    /// put in so far (friction's work, the laws' losses, the impulses' energy, the projections
+    /// onto closed contacts): the stepper's contact work once the step is resolved.
     piece_work: f64,
     step_work: f64,
     /// A partial step's end kept to be taken again: the location's nearest to the surface,
@@ -135,14 +139,12 @@ const MAX_SWITCHES: usize = 4 * MAX_IMPACTS;
 
 impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
     /// The resolver of `contacts` (checked by the caller, [`Contacts::check`]) and `schedule`
-    /// for a run of `stepper` on `model` from its state, `energy` when the run checks its
-    /// energy. The schedule's times after the state's are to come (and those at it, for
-    /// [`Resolver::start`]).
+    /// for a run of `stepper` on `model` from its state. The schedule's times after the state's
+    /// are to come (and those at it, for [`Resolver::start`]).
     pub(in crate::integrators) fn begin<St: Borrow<StepperState>>(
         model: M,
         stepper: &Stepper<M, St>,
         (contacts, schedule): (Option<&'c Contacts<'s>>, Option<&'c Schedule<'s>>),
-        energy: bool,
     ) -> Result<Self, Error> {
         let n = stepper.q().len();
         if let Some(schedule) = schedule {
@@ -184,8 +186,6 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
             zeros: vec![0.0; n],
             pending: Impacts::with_capacity(n, MAX_IMPACTS),
             blown: Impacts::with_capacity(n, schedule.map_or(0, |s| s.impulses().len())),
-            energy,
-            energy_jump: 0.0,
             discrete: (contacts.iter().any(|c| c.law == Law::Variational))
                 .then(|| DiscreteEnergy::new(stepper.method(), n))
                 .flatten(),
@@ -206,6 +206,9 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
             directions: vec![0.0; n * m],
             slip: vec![0.0; n],
             direction: vec![0.0; n],
+            pending_work: Vec::with_capacity(MAX_IMPACTS),
+            blown_work: Vec::with_capacity(schedule.map_or(0, |s| s.impulses().len())),
+            released_work: Vec::with_capacity(m),
             piece_work: 0.0,
             step_work: 0.0,
             kept: Kept {
@@ -461,6 +464,8 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
     ) -> Result<(), Error> {
         let (step, h) = (stepper.steps(), stepper.dt());
         let inside = self.impulse_inside(stepper.t()).is_some();
+        // The energy the step's pieces and jumps put in: none unless it is resolved.
+        self.step_work = 0.0;
         let resolved = if crossed || inside {
             match self.resolve(stepper, search.as_deref_mut(), &mut traj.events) {
                 Ok(resolved) => resolved,
@@ -510,21 +515,24 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
             let (a, b) = (&self.pending, &self.blown);
             let (mut i, mut k) = (0, 0);
             while i < a.len() || k < b.len() {
-                let (jumps, row) = if k == b.len() || (i < a.len() && a.t[i] <= b.t[k]) {
+                let (jumps, row, [before, after]) = if k == b.len() || (i < a.len() && a.t[i] <= b.t[k]) {
                     i += 1;
-                    (a, i - 1)
+                    (a, i - 1, self.pending_work[i - 1])
                 } else {
                     k += 1;
-                    (b, k - 1)
+                    (b, k - 1, self.blown_work[k - 1])
                 };
                 let (t, q) = (jumps.t[row], jumps.q_at(row));
-                traj.push_state(t, q, jumps.p_before_at(row), stepper);
-                traj.push_state(t, q, jumps.p_after_at(row), stepper);
+                traj.push_state(t, (q, jumps.p_before_at(row)), stepper, self.step_work - before);
+                traj.push_state(t, (q, jumps.p_after_at(row)), stepper, self.step_work - after);
             }
         }
         self.blown.clear();
         self.released.clear();
         self.changes.clear();
+        self.pending_work.clear();
+        self.blown_work.clear();
+        self.released_work.clear();
         traj.impacts.append(&mut self.pending);
     }
 
@@ -545,12 +553,16 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
         while schedule.impulses().get(self.next_impulse).is_some_and(|b| b.t == t) {
             self.contact_q.copy_from_slice(stepper.q());
             self.contact_p.copy_from_slice(stepper.p());
+            // Its own account: the step's (committed) is done with.
+            self.step_work = 0.0;
             self.blow(self.next_impulse, step, t)?;
             self.after_jump(step, t)?;
             traj.impacts.switches.append(&mut self.pending.switches);
+            let put = std::mem::take(&mut self.step_work);
+            stepper.add_contact_work(put);
             if !self.sampling() {
-                traj.push_state(t, &self.contact_q, &self.contact_p, stepper);
-                traj.push_state(t, &self.contact_q, &self.piece_p, stepper);
+                traj.push_state(t, (&self.contact_q, &self.contact_p), stepper, put);
+                traj.push_state(t, (&self.contact_q, &self.piece_p), stepper, 0.0);
             }
             stepper.jump_to(&self.contact_q, &self.piece_p)?;
             self.next_impulse += 1;
@@ -584,7 +596,12 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
             let source = format!("impulses[{k}] at t = {t} gives non-finite momenta").into();
             return Err(model_error(source));
         }
-        self.energy_change(step, t)
+        // The energy the blow puts in: E(q, p⁺) − E(q, p⁻), where the model has an energy.
+        let energy = |p: &[f64]| (model.energy(&self.contact_q, p, t).transpose()).map_err(model_error);
+        if let (Some(before), Some(after)) = (energy(&self.contact_p)?, energy(&self.piece_p)?) {
+            self.step_work += after.energy - before.energy;
+        }
+        Ok(())
     }
 
     /// The samples of the step just taken (those after its start, up to its end): each the
@@ -602,29 +619,32 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
         while let Some(&ts) = schedule.samples().get(self.next_sample).filter(|&&ts| ts <= t_end) {
             self.next_sample += 1;
             if ts == t_end {
-                traj.push_state(ts, stepper.q(), stepper.p(), stepper);
+                traj.push_state(ts, (stepper.q(), stepper.p()), stepper, 0.0);
                 continue;
             }
-            // The last jump or release before ts (an impact before an impulse at its time).
+            // The last jump or release before ts (an impact before an impulse at its time), and
+            // the energy put in up to it.
             let last = |jumps: &Impacts| jumps.t.iter().rposition(|&t| t < ts).map(|k| (jumps.t[k], k));
-            let mut from: Option<(&Impacts, usize, f64)> = None;
-            for jumps in [&self.pending, &self.released, &self.blown] {
+            let mut from: Option<(&Impacts, usize, f64, f64)> = None;
+            let (pending, released, blown) = (&self.pending_work, &self.released_work, &self.blown_work);
+            let offsets: [&dyn Fn(usize) -> f64; 3] = [&|k| pending[k][1], &|k| released[k], &|k| blown[k][1]];
+            for (jumps, offset) in [&self.pending, &self.released, &self.blown].into_iter().zip(offsets) {
                 if let Some((t, k)) = last(jumps) {
-                    if from.is_none_or(|(_, _, t0)| t > t0) {
-                        from = Some((jumps, k, t));
+                    if from.is_none_or(|(_, _, t0, _)| t > t0) {
+                        from = Some((jumps, k, t, offset(k)));
                     }
                 }
             }
-            let ta = match from {
-                Some((jumps, k, _)) => {
+            let (ta, put) = match from {
+                Some((jumps, k, _, put)) => {
                     self.piece_q.copy_from_slice(jumps.q_at(k));
                     self.piece_p.copy_from_slice(jumps.p_after_at(k));
-                    jumps.t[k]
+                    (jumps.t[k], put)
                 }
                 None => {
                     self.piece_q.copy_from_slice(&self.q);
                     self.piece_p.copy_from_slice(&self.p);
-                    self.t
+                    (self.t, 0.0)
                 }
             };
             // The contacts closed and stuck at ts: the step's changes from ts on undone.
@@ -646,7 +666,8 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
             std::mem::swap(&mut self.closed, &mut self.closed_then);
             std::mem::swap(&mut self.stuck, &mut self.stuck_then);
             sampled?;
-            traj.push_state(ts, self.scratch.q(), self.scratch.p(), stepper);
+            let behind = self.step_work - (put + self.piece_work);
+            traj.push_state(ts, (self.scratch.q(), self.scratch.p()), stepper, behind);
         }
         Ok(())
     }
@@ -673,6 +694,9 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
         self.pending.clear();
         self.blown.clear();
         self.released.clear();
+        self.pending_work.clear();
+        self.blown_work.clear();
+        self.released_work.clear();
         self.changes.clear();
         self.closed_start.clear();
         self.closed_start.extend_from_slice(&self.closed);
@@ -732,6 +756,7 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
                 self.open(k, step, t);
                 self.released
                     .push(k, step, t, &self.contact_q, &self.contact_p, &self.contact_p);
+                self.released_work.push(self.step_work);
                 self.restart_piece(step, None, t)?;
                 (ta, tau, last) = (t, tau - s, Some(k));
                 continue;
@@ -767,11 +792,12 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
                     if let Some(search) = search.as_deref_mut() {
                         search.piece(step, (t_blow, &self.contact_q, &self.contact_p), piece, occurrences)?;
                     }
-                    let k = self.next_impulse;
+                    let (k, before) = (self.next_impulse, self.step_work);
                     self.blow(k, step, t_blow)?;
                     self.after_jump(step, t_blow)?;
                     self.blown
                         .push(k, step, t_blow, &self.contact_q, &self.contact_p, &self.piece_p);
+                    self.blown_work.push([before, self.step_work]);
                     self.next_impulse += 1;
                     self.restart_piece(step, search.as_deref_mut(), t_blow)?;
                     (ta, tau, last) = (t_blow, tau - piece, None);
@@ -805,7 +831,7 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
             if let Some(search) = search.as_deref_mut() {
                 search.piece(step, (t_contact, &self.contact_q, &self.contact_p), s, occurrences)?;
             }
-            let contact = &contacts[j];
+            let (contact, before) = (&contacts[j], self.step_work);
             self.jump(j, step, (ta, s, tau - s), h)?;
             self.after_jump(step, t_contact)?;
             if !self.piece_p.iter().all(|x| x.is_finite()) {
@@ -816,14 +842,13 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
             }
             self.pending
                 .push(j, step, t_contact, &self.contact_q, &self.contact_p, &self.piece_p);
+            self.pending_work.push([before, self.step_work]);
             self.restart_piece(step, search.as_deref_mut(), t_contact)?;
             (ta, tau, last) = (t_contact, tau - s, Some(j));
         }
         // The step's end: the last piece's, at tₙ₊₁.
         stepper.jump_to(self.scratch.q(), self.scratch.p())?;
-        if self.frictional {
-            stepper.add_contact_work(self.step_work);
-        }
+        stepper.add_contact_work(self.step_work);
         std::mem::swap(&mut self.phi, &mut self.phi_end);
         if let Some(search) = search {
             search.piece(step, (stepper.t(), stepper.q(), stepper.p()), tau, occurrences)?;
@@ -1035,6 +1060,7 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
         }
         self.released
             .push(k, step, t, &self.contact_q, &self.piece_p, &self.piece_p);
+        self.released_work.push(self.step_work);
         Ok(())
     }
 
@@ -1100,18 +1126,29 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
     }
 
     /// `piece_p` made tangent to the closed contacts at `contact_q` and free of the stuck
-    /// ones' slip, at time t ([`Hold::project`]).
+    /// ones' slip, at time t ([`Hold::project`]); the energy that takes (their impulses, a
+    /// plastic impact and friction's) into the step's account, ½Δp·(q̇⁺ + q̇⁻), exact for the
+    /// held models' T = ½pᵀM⁻¹p.
     fn project_piece(&mut self, step: usize, t: f64) -> Result<(), Error> {
         let time = self.t;
         // Lent out while the held step is borrowed with the rest (moves, no copies).
         let (q, mut p) = (std::mem::take(&mut self.contact_q), std::mem::take(&mut self.piece_p));
+        let (mut v, mut w) = (std::mem::take(&mut self.v), std::mem::take(&mut self.w));
         let (hold, held, scratch) = self.holding();
         hold.q.copy_from_slice(&q);
         hold.p.copy_from_slice(&p);
-        let projected = hold.project(scratch.model().as_lagrangian(), held, t);
+        let model = scratch.model().as_lagrangian();
+        let projected = hold.project(model, held, t);
+        let velocities = model
+            .velocity(&q, &p, t, &mut v)
+            .and_then(|()| model.velocity(&q, &hold.p, t, &mut w));
+        let change = 0.5 * (0..p.len()).map(|i| (hold.p[i] - p[i]) * (v[i] + w[i])).sum::<f64>();
         p.copy_from_slice(&hold.p);
-        (self.contact_q, self.piece_p) = (q, p);
-        projected.map_err(|source| run_error(source, step, time))
+        (self.contact_q, self.piece_p, self.v, self.w) = (q, p, v, w);
+        projected.map_err(|source| run_error(source, step, time))?;
+        velocities.map_err(|source| Error::Model { step, time, source })?;
+        self.step_work += change;
+        Ok(())
     }
 
     /// The slip of sliding contact j at the scratch's state at time t along its direction at
@@ -1309,7 +1346,7 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
             }
         }
         let vectors = (&mut self.v[..], &mut self.w[..], &self.zeros[..]);
-        let reflection = reflect::multiplier(
+        let reflected = reflect::reflection(
             model.as_lagrangian(),
             (t, q, p),
             &self.normal,
@@ -1317,7 +1354,10 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
             vectors,
         )
         .map_err(model_error)?;
+        let reflection = reflected.lambda;
         // For e < 1, and beside a held contact, both laws take Newton's law, the reflection.
+        // The energy account takes each law's own loss: none for e = 1 (the variational law's
+        // change of E is the method's error, its E_d kept), Newton's law's otherwise.
         let variational = contact.law == Law::Variational && contact.restitution == 1.0 && self.closed.is_empty();
         let lambda = if variational && rest > 0.0 {
             let (lambda, found) = self.variational(step, (ta, s, rest), reflection)?;
@@ -1326,10 +1366,13 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
         } else {
             reflection
         };
+        let mut loss = reflected.loss(contact.restitution);
         for (x, (a, b)) in self.piece_p.iter_mut().zip(self.contact_p.iter().zip(&self.normal)) {
             *x = a + lambda * b;
         }
         if let Some(t_rest) = self.closes(j, step, t, (reflection, h))? {
+            // The whole normal velocity gone: the Zeno series' losses summed.
+            loss = reflected.loss(0.0);
             insert(&mut self.closed, j);
             self.switched(j, Switch::Closed, step, (t, t_rest));
             self.scratch.restart(t, &self.contact_q, &self.piece_p, h);
@@ -1338,7 +1381,8 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
                 self.switched(j, Switch::Stuck, step, (t, t_rest));
             }
         }
-        self.energy_change(step, t)
+        self.step_work += loss;
+        Ok(())
     }
 
     /// Whether contact j closes at its impact at time t, reflected with the multiplier
@@ -1393,21 +1437,6 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
         }
         self.piece_p.copy_from_slice(&self.w);
         Ok(Some(t + tail))
-    }
-
-    /// The change of energy at the jump at time t from (q̃, p⁻) (the contact buffers) to p⁺
-    /// (`piece_p`), summed when the run checks its energy.
-    fn energy_change(&mut self, step: usize, t: f64) -> Result<(), Error> {
-        if self.energy {
-            let (q, model) = (&self.contact_q[..], self.scratch.model());
-            let energy = |p: &[f64]| {
-                (model.energy(q, p, t).transpose()).map_err(|source| Error::Model { step, time: t, source })
-            };
-            if let (Some(before), Some(after)) = (energy(&self.contact_p)?, energy(&self.piece_p)?) {
-                self.energy_jump += after.energy - before.energy;
-            }
-        }
-        Ok(())
     }
 
     /// λ of the variational law ([`variational::multiplier`]) for the jump at the end of the
@@ -1612,11 +1641,6 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
             self.scratch.step().map_err(|e| e.at(step, self.t))?;
         }
         Ok(())
-    }
-
-    /// The change of energy at the jumps since the last call.
-    pub(in crate::integrators) fn take_energy_jump(&mut self) -> f64 {
-        std::mem::take(&mut self.energy_jump)
     }
 
     /// Force evaluations of the partial steps.

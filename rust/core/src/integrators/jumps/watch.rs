@@ -24,6 +24,20 @@ pub struct Watch<'w, 'e, 'c> {
     pub schedule: Option<&'w Schedule<'c>>,
 }
 
+impl Watch<'_, '_, '_> {
+    /// Whether what it watches can put energy in or take it out: contacts with friction or
+    /// e < 1 (each law's loss, the closures', the projections onto closed contacts), or
+    /// impulses. A run then counts that energy in its work W ([`Stepper::work`]), which it and
+    /// the report balance E − E₀ against, as a forced model's; elastic contacts alone put in
+    /// none (their laws' loss is 0).
+    pub fn exchanges(&self) -> bool {
+        let contacts = self
+            .contacts
+            .is_some_and(|c| c.contacts().iter().any(|c| c.friction.is_some() || c.restitution < 1.0));
+        contacts || self.schedule.is_some_and(|s| !s.impulses().is_empty())
+    }
+}
+
 /// A [`Watch`] begun on a stepper's state: the events' search and the contacts' resolver, with
 /// their scratch steppers and buffers, made once. [`Watcher::advance`] takes a stepper's steps
 /// as a run does ([`crate::integrators::integrate_watching`]: one loop for both), so that a
@@ -40,17 +54,16 @@ where
 {
     /// The watcher of `watch` for `stepper` on `model` from its state: the events started
     /// there, the contacts checked against the model and its method and the state (named
-    /// `argument`, `q0` or `checkpoint`, if outside a contact). `energy`: the caller checks the
-    /// energy, and takes the change at the jumps from [`Watcher::take_energy_jump`]. A stepper
-    /// watching contacts with friction counts their work from then on ([`Stepper::work`]).
+    /// `argument`, `q0` or `checkpoint`, if outside a contact). A stepper watching what can
+    /// put energy in or take it out ([`Watch::exchanges`]) counts that energy from then on
+    /// ([`Stepper::work`]).
     pub fn begin<St: BorrowMut<StepperState>>(
         model: M,
         stepper: &mut Stepper<M, St>,
         watch: Watch<'w, 'e, 'c>,
         argument: &'static str,
-        energy: bool,
     ) -> Result<Self, Error> {
-        Self::make(model, stepper, watch, Some(argument), energy)
+        Self::make(model, stepper, watch, Some(argument))
     }
 
     /// As [`Watcher::begin`], for a stepper whose state a watcher of the same `watch` has
@@ -63,9 +76,8 @@ where
         model: M,
         stepper: &mut Stepper<M, St>,
         watch: Watch<'w, 'e, 'c>,
-        energy: bool,
     ) -> Result<Self, Error> {
-        Self::make(model, stepper, watch, None, energy)
+        Self::make(model, stepper, watch, None)
     }
 
     /// The watcher, its contacts checked at the state named `argument` if given.
@@ -74,23 +86,19 @@ where
         stepper: &mut Stepper<M, St>,
         watch: Watch<'w, 'e, 'c>,
         argument: Option<&'static str>,
-        energy: bool,
     ) -> Result<Self, Error> {
+        if watch.exchanges() {
+            stepper.count_contact_work();
+        }
         let search = watch.events.map(|events| events.begin(model, &*stepper)).transpose()?;
         let resolver = (watch.contacts.is_some() || watch.schedule.is_some())
             .then(|| {
                 if let (Some(argument), Some(contacts)) = (argument, watch.contacts) {
                     contacts.check(&*model, stepper.method(), (stepper.t(), stepper.q()), argument)?;
                 }
-                Resolver::begin(model, stepper, (watch.contacts, watch.schedule), energy)
+                Resolver::begin(model, stepper, (watch.contacts, watch.schedule))
             })
             .transpose()?;
-        if watch
-            .contacts
-            .is_some_and(|c| c.contacts().iter().any(|c| c.friction.is_some()))
-        {
-            stepper.count_contact_work();
-        }
         Ok(Watcher { search, resolver })
     }
 
@@ -140,11 +148,6 @@ where
             (Some(search), None) => search.advance(stepper, n, &mut record.events, poll),
             (search, Some(resolver)) => resolver.advance(stepper, n, search, record, poll),
         }
-    }
-
-    /// The change of energy at the jumps since the last call (impacts with e < 1).
-    pub fn take_energy_jump(&mut self) -> f64 {
-        self.resolver.as_mut().map_or(0.0, |r| r.take_energy_jump())
     }
 
     /// Force evaluations of the partial steps (located events and impacts).
