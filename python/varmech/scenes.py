@@ -497,7 +497,8 @@ def kepler(e: float = 0.6) -> Scene:
     -------
     Scene
         A separable native model (n = 2) with the symmetry :class:`~varmech.Rotation` (in the
-        plane), step h = 2π/200, invariants ``"H"`` = −1/2 and ``"L"``, and the exact
+        plane), step h = 2π/200 (up to e = 0.6; beyond, shorter as the pericentre passage,
+        2π/200·((1 − e)/0.4)^(3/2)), invariants ``"H"`` = −1/2 and ``"L"``, and the exact
         reference (the pericentre again at t = 400π).
 
     Raises
@@ -729,7 +730,8 @@ def kepler_polar(e: float = 0.6) -> Scene:
     Returns
     -------
     Scene
-        A native general Lagrangian (n = 2) with the symmetry ``Cyclic(1)``, step h = 2π/200,
+        A native general Lagrangian (n = 2) with the symmetry ``Cyclic(1)``, step h = 2π/200
+        (up to e = 0.6; 2π/200·((1 − e)/0.4)^(3/2) beyond),
         invariants ``"E"`` = −1/2 and ``"p_theta"``, and the exact reference.
 
     Raises
