@@ -1,7 +1,8 @@
 //! Crafted checkpoints: a valid CRC over a state whose parts disagree with the model or method
 //! (every vector truncated or extended in turn, every count changed) is refused naming
-//! `checkpoint`, never a panic; and a checkpoint of another model, method or step is refused,
-//! naming what differs.
+//! `checkpoint`, never a panic; a checkpoint of another model, method or step is refused,
+//! naming what differs; and an edited value that the method derives (a coefficient, a cached
+//! force) is refused too.
 //!
 //! The crafting re-encodes a checkpoint through serde's data model: [`Value`] records the calls
 //! a checkpoint's `Serialize` makes and replays them into postcard, so that a mutated tree is
@@ -300,11 +301,12 @@ impl ser::SerializeStruct for Items {
     }
 }
 
-/// A mutation site: a sequence or an integer, by its position in a depth-first walk.
+/// A mutation site: a sequence, an integer or a float, by its position in a depth-first walk.
 #[derive(Clone, Copy, Debug, PartialEq)]
 enum Site {
     Seq,
     Integer,
+    Float,
 }
 
 /// Applies `f` to the `target`-th node of `kind` (depth-first), with the fields' path to it.
@@ -319,6 +321,7 @@ fn visit(
     let here = match value {
         Value::Seq(_) => kind == Site::Seq,
         Value::U32(_) | Value::U64(_) => kind == Site::Integer,
+        Value::F64(_) => kind == Site::Float,
         _ => false,
     };
     if here {
@@ -567,4 +570,111 @@ fn a_checkpoint_of_another_model_method_or_step_is_refused() {
     );
     refused(checkpoint.expect(None, Some(0.02)), "dt = 0.01, not 0.02");
     assert!(checkpoint.expect(Some(Method::Verlet), Some(0.01)).is_ok());
+}
+
+/// The fields of the run's own state that a float edit may change silently: what a checkpoint
+/// legitimately carries (the compensated-summation carries, the Newton and multiplier
+/// predictors, the Wisdom–Holman inner variables' carries) and q where the model does not
+/// see it (a cyclic coordinate). Everything else the method derives is checked.
+const RUN_STATE: [&str; 8] = [
+    "state.q.",
+    "state.eq.",
+    "state.ep.",
+    "last_dq.",
+    "lambda.",
+    "Midpoint.x.",
+    "inner.ex.",
+    "inner.ev.",
+];
+
+/// Every float of the checkpoint of `sys` after 5 steps of `method`, scaled by 1.02 in turn
+/// (a zero set to 0.5) with the CRC recomputed, is refused naming `checkpoint`, or leaves
+/// the next 20 steps as they were, or lies in the run's own state ([`RUN_STATE`]): an edited
+/// coefficient or cached force never steers the run.
+fn edited_values_are_refused<S: Dynamics + ?Sized>(
+    case: &str,
+    sys: &S,
+    method: Method,
+    q0: &[f64],
+    p0: &[f64],
+    dt: f64,
+) {
+    let traj = integrate(sys, method, q0, p0, &Options::new(dt, 5), || Ok(())).unwrap();
+    let original = record(&Checkpoint::from_bytes(&traj.checkpoint).unwrap());
+    let run = |bytes: &[u8]| -> Result<Vec<f64>, Error> {
+        let checkpoint = Checkpoint::from_bytes(bytes)?;
+        let more = resume(sys, checkpoint, 20, 20, || Ok(())).map_err(|f| f.error)?;
+        Ok([more.q, more.p].concat())
+    };
+    let unedited = run(&traj.checkpoint).unwrap();
+    let (mut edits, mut refused) = (0, 0);
+    for target in 0.. {
+        let mut crafted = original.clone();
+        let mut at = String::new();
+        let found = visit(
+            &mut crafted,
+            Site::Float,
+            target,
+            &mut 0,
+            &mut Vec::new(),
+            &mut |v, path| {
+                at = format!("{path}.");
+                if let Value::F64(x) = v {
+                    *x = if *x != 0.0 { *x * 1.02 } else { 0.5 };
+                }
+            },
+        );
+        if !found {
+            break;
+        }
+        edits += 1;
+        match run(&encode(&crafted)) {
+            Err(Error::InvalidArgument {
+                argument: "checkpoint", ..
+            }) => refused += 1,
+            Ok(r) if r.iter().zip(&unedited).any(|(a, b)| a.to_bits() != b.to_bits()) => {
+                assert!(
+                    RUN_STATE.iter().any(|s| at.contains(s)),
+                    "{case}: {at} edited steers the run silently"
+                )
+            }
+            _ => {}
+        }
+    }
+    assert!(edits > 20 && refused > 5, "{case}: {refused} of {edits} edits refused");
+}
+
+#[test]
+fn edited_coefficients_and_cached_forces_are_refused() {
+    let kepler = Kepler::problem(0.6).unwrap();
+    let (q0, p0) = (&kepler.initial.q, &kepler.initial.p);
+    for method in [Method::Verlet, Method::KahanLi8, Method::Galerkin4] {
+        edited_values_are_refused(&format!("kepler {method:?}"), &kepler.system, method, q0, p0, 0.05);
+    }
+    let dp = DoublePendulum::problem();
+    let (q0, p0) = (&dp.initial.q, &dp.initial.p);
+    edited_values_are_refused("double pendulum", &General(&dp.system), Method::Trapezoid, q0, p0, 0.01);
+    let chain = planar_chain(2).unwrap();
+    let (q0, p0) = (&chain.initial.q, &chain.initial.p);
+    edited_values_are_refused("planar chain", &chain.system, Method::Rattle4, q0, p0, 0.01);
+    let body = RigidBody::problem();
+    let sys = Constrained {
+        system: General(&body.system.system),
+        constraints: body.system.constraints.clone(),
+    };
+    let (q0, p0) = (&body.initial.q, &body.initial.p);
+    edited_values_are_refused("rigid body", &sys, Method::Midpoint, q0, p0, 0.01);
+    let sleigh = ChaplyginSleigh::problem(1.0, 0.5, 1.0).unwrap();
+    let (q0, p0) = (&sleigh.initial.q, &sleigh.initial.p);
+    edited_values_are_refused("sleigh", &sleigh.system, Method::Dla4, q0, p0, 0.01);
+    let solar = NBody::outer_solar_system();
+    let (q0, p0) = (&solar.initial.q, &solar.initial.p);
+    edited_values_are_refused(
+        "solar system",
+        &solar.system,
+        Method::WisdomHolmanCorrected,
+        q0,
+        p0,
+        100.0,
+    );
 }

@@ -1,6 +1,7 @@
 //! A run's whole state at a step, as bytes, to go on from later (in another process, after a
 //! crash) bit for bit.
 
+pub(super) mod derived;
 pub(super) mod shape;
 
 use serde::{Deserialize, Serialize};
@@ -22,8 +23,9 @@ use crate::Error;
 /// the same bits: the format number changes whenever the state's layout does.
 ///
 /// A CRC does not stop a crafted file: [`Checkpoint::resume_on`] checks every length and
-/// index of the decoded state against the model and method before a step, and the
-/// fingerprint against the model's.
+/// index of the decoded state against the model and method before a step, the fingerprint
+/// against the model's, and the values the method derives (its coefficients, its cached
+/// forces) computed again (`checkpoint/derived.rs`).
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Checkpoint {
     pub(super) state: StepperState,
@@ -209,6 +211,9 @@ impl Checkpoint {
         }
         if let Some(reason) = fingerprint.differs(&Fingerprint::of(model, &state)) {
             return Err(refuse(reason));
+        }
+        if let Some(reason) = state.derived_misfit(model) {
+            return Err(refuse(format!("{reason}: it was edited or damaged")));
         }
         Ok((state, watch))
     }

@@ -1,3 +1,4 @@
+use super::checkpoint::derived::{same, Reached};
 use super::stepper::{Clear, Phase};
 use super::{Increment, Splitting, StepError, StepStart};
 use crate::model::MechanicalSystem;
@@ -70,6 +71,29 @@ impl KickDrift {
             evaluations: &mut self.evaluations,
         };
         sequence(sys, &self.scaled, q, p, dq, dp, stage, counts)
+    }
+
+    /// Why a decoded step's derived values are not its own (see `checkpoint/derived.rs`), if
+    /// they are not: its fractions times the step it was last scaled for, and the force it
+    /// cached, ∇V at its last stage, which lies at the state's q to round-off.
+    pub(super) fn misfit(&self, sys: &dyn MechanicalSystem, at: &Reached<'_>) -> Option<String> {
+        let h = self.scaled_for;
+        let scaled = |(s, f): (&f64, &f64)| s.to_bits() == (f * h).to_bits();
+        if !h.is_nan() && !self.scaled.iter().zip(&self.fractions).all(scaled) {
+            return Some(format!(
+                "its stage coefficients times the step, {:?}, are not its fractions times dt = {h:?}",
+                self.scaled
+            ));
+        }
+        if !self.force_cached {
+            return None;
+        }
+        if !at.holds(&self.q) {
+            return Some("the last stage of its step, where its force was cached, is not at its state's q".to_string());
+        }
+        let mut force = vec![0.0; self.force.len()];
+        (sys.gradient(&self.q, &mut force).is_err() || !same(&force, &self.force))
+            .then(|| "its cached force is not the model's ∇V at its step's last stage".to_string())
     }
 
     /// The fractions times h, once per step size.

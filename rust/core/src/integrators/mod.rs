@@ -52,6 +52,7 @@ pub mod wisdom_holman;
 pub use crate::discrete::{Galerkin, Quadrature};
 pub use crate::error::StepError;
 pub use crate::solve::NewtonOptions;
+use checkpoint::derived::Reached;
 pub use checkpoint::{Checkpoint, Fingerprint, FORMAT as CHECKPOINT_FORMAT};
 pub use composition::Composition;
 pub use del::{Composed, Del, StepEquations, TwoPoint};
@@ -232,6 +233,22 @@ impl Integrator {
             Scheme::Midpoint(s) => s.keep_history(n, sys, h),
             Scheme::Trapezoid(s) => s.keep_history(n, sys, h),
             _ => {}
+        }
+    }
+
+    /// Why a decoded integrator's derived values are not those its method computes on `model`
+    /// at the state `at` (its caches; see `checkpoint/derived.rs`), if they are not.
+    pub(in crate::integrators) fn derived_misfit(&self, model: &dyn Dynamics, at: &Reached<'_>) -> Option<String> {
+        match &self.scheme {
+            Scheme::KickDrift(s) => s.misfit(model.as_mechanical()?, at),
+            Scheme::Rattle(s) => s.misfit(model.as_mechanical()?, model.holonomic()?, at),
+            Scheme::Midpoint(s) => s.misfit(model, at),
+            Scheme::Trapezoid(s) => s.misfit(model, at),
+            Scheme::Galerkin(s) => s.misfit(model, at),
+            Scheme::WisdomHolman(s) => s.misfit(model.as_mechanical()?.as_nbody()?, at),
+            // A composed stage's cache is not used (its next start is elsewhere), and explicit
+            // Runge–Kutta keeps none.
+            Scheme::ComposedMidpoint(_) | Scheme::ExplicitRk(_) => None,
         }
     }
 

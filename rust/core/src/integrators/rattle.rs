@@ -1,6 +1,7 @@
 use nalgebra::{DMatrix, DVector};
 use serde::{Deserialize, Serialize};
 
+use super::checkpoint::derived::{same, Reached};
 use super::{Increment, StepError, StepStart};
 use crate::error::SHAKE_UNCONVERGED;
 use crate::model::{HolonomicConstraints, MechanicalSystem};
@@ -120,6 +121,30 @@ impl Rattle {
 
     pub(super) fn reset(&mut self) {
         self.cached = false;
+    }
+
+    /// Why a decoded step's cache is not its own (see `checkpoint/derived.rs`), if it is not:
+    /// ∇V and G at its last step's end q₁, evaluated again there, q₁ the state's q to
+    /// round-off.
+    pub(super) fn misfit(
+        &self,
+        sys: &dyn MechanicalSystem,
+        constraints: &dyn HolonomicConstraints,
+        at: &Reached<'_>,
+    ) -> Option<String> {
+        if !self.cached {
+            return None;
+        }
+        if !at.holds(&self.q1) {
+            return Some(
+                "its last step's end, where its force and constraint Jacobian were cached, is not at its state's q"
+                    .to_string(),
+            );
+        }
+        let (mut grad, mut jac) = (vec![0.0; self.grad0.len()], self.jac0.clone());
+        let evaluated = sys.gradient(&self.q1, &mut grad).is_ok() && constraints.jacobian(&self.q1, &mut jac).is_ok();
+        (!(evaluated && same(&grad, &self.grad0) && same(jac.as_slice(), self.jac0.as_slice())))
+            .then(|| "its cached force or constraint Jacobian is not the model's at its last step's end".to_string())
     }
 
     /// One composed step's increments from (q, p) (the system is autonomous: t is not read).

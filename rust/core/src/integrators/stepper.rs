@@ -6,7 +6,7 @@ mod own_variables;
 use std::borrow::{Borrow, BorrowMut};
 use std::ops::Deref;
 
-use super::checkpoint::shape::shape;
+use super::checkpoint::{derived, shape::shape};
 use super::tangent;
 use super::{
     check_method, compensated, Dynamics, Gaps, General, Increment, Integrator, Method, Options, Poll, StepError,
@@ -384,23 +384,10 @@ impl StepperState {
                 self.steps
             ));
         }
-        let newton = self.integrator.newton_options().unwrap_or_default();
-        if let Err(e) = newton.check() {
+        if let Err(e) = self.integrator.newton_options().unwrap_or_default().check() {
             return Some(format!("its Newton options are not valid ({e})"));
         }
-        let options = Options {
-            t0,
-            compensated: self.compensated,
-            newton,
-            ..Options::new(h, 0)
-        };
-        // Of the model's size: the state's own vectors are what is checked.
-        let zeros = vec![0.0; model.dim()];
-        let fresh = StepperState::fresh(self.method(), &zeros, &zeros, &options);
-        let mut stepped = fresh.clone();
-        let (m, holonomic) = model.constraint_counts();
-        stepped.integrator.prepare(model.dim(), m, holonomic);
-        stepped.integrator.keep_history(model.dim(), model.as_lagrangian(), h);
+        let (fresh, stepped) = self.templates(model);
         let (found, fresh, stepped) = (shape(self), shape(&fresh), shape(&stepped));
         if found == fresh || found == stepped {
             return None;
@@ -422,6 +409,40 @@ impl StepperState {
                 stepped.len()
             ),
         })
+    }
+
+    /// The states of this one's method, clock and options on `model`, fresh and after a step
+    /// (its buffers sized, its history kept), of zeros: the templates a decoded state is
+    /// checked against.
+    fn templates<S: Dynamics + ?Sized>(&self, model: &S) -> (StepperState, StepperState) {
+        let options = Options {
+            t0: self.clock.t0,
+            compensated: self.compensated,
+            newton: self.integrator.newton_options().unwrap_or_default(),
+            ..Options::new(self.clock.h, 0)
+        };
+        // Of the model's size: the state's own vectors are what is checked.
+        let zeros = vec![0.0; model.dim()];
+        let fresh = StepperState::fresh(self.method(), &zeros, &zeros, &options);
+        let mut stepped = fresh.clone();
+        let (m, holonomic) = model.constraint_counts();
+        stepped.integrator.prepare(model.dim(), m, holonomic);
+        stepped
+            .integrator
+            .keep_history(model.dim(), model.as_lagrangian(), self.clock.h);
+        (fresh, stepped)
+    }
+
+    /// Why a decoded state's derived values (its method's constants and caches) are not what
+    /// its method computes on `model`, if they are not (see `checkpoint/derived.rs`); for a
+    /// state whose shape [`StepperState::misfit`] has checked.
+    pub(super) fn derived_misfit<S: Dynamics + ?Sized>(&self, model: &S) -> Option<String> {
+        derived::misfit(self, &self.templates(model).1, model)
+    }
+
+    /// The integrator, for the checks of a decoded state.
+    pub(super) fn integrator(&self) -> &Integrator {
+        &self.integrator
     }
 
     /// One step of `model`, which has as many coordinates as the state (checked when the

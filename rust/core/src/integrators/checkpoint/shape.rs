@@ -1,6 +1,8 @@
 //! The shape of a state: every length, matrix size, enum variant and structural count in it,
 //! read through serde's data model (the values of the numbers left out), so that a decoded
-//! state is checked against the state its model and method would have, whatever its parts.
+//! state is checked against the state its model and method would have, whatever its parts;
+//! and its constants, the floats a method derives from its coefficients, the step and the
+//! model alone ([`constants`]), which a decoded state must hold to the bit.
 
 use std::fmt;
 
@@ -19,6 +21,13 @@ const VALUES: [&str; 7] = [
     "max_iterations",
 ];
 
+/// The fields whose floats are constants of the method, the step and the model, never of the
+/// run: a kick–drift splitting's fractions (its `scaled`, the fractions times the step it last
+/// took, are checked against them, see `KickDrift::misfit`), a composition's γ, a quadrature's
+/// nodes, weights and Lagrange basis with its sign, and a delayed force's lags (where t − τ
+/// lies, and the interpolant's weights there).
+const CONSTANTS: [&str; 7] = ["fractions", "gamma", "nodes", "weights", "basis", "slopes", "lags"];
+
 /// One mark of a shape: where it is (the fields' path) and what (a length, a variant, …).
 #[derive(Debug, PartialEq)]
 pub(in crate::integrators) struct Mark {
@@ -34,6 +43,8 @@ pub(in crate::integrators) enum What {
     Count(u64),
     /// A pivot beyond its vector: no template has one.
     PivotOutOfRange(u64),
+    /// A constant's bits ([`constants`]).
+    Constant(u64),
 }
 
 impl fmt::Display for Mark {
@@ -46,12 +57,25 @@ impl fmt::Display for Mark {
             What::Present(false) => write!(f, "{at} absent"),
             What::Count(c) => write!(f, "{at} = {c}"),
             What::PivotOutOfRange(p) => write!(f, "{at} holding the index {p}, beyond its length"),
+            What::Constant(bits) => write!(f, "{at} = {:?}", f64::from_bits(bits)),
         }
     }
 }
 
 /// The marks of `value`'s shape, in order.
 pub(in crate::integrators) fn shape<T: Serialize + ?Sized>(value: &T) -> Vec<Mark> {
+    marks(value, false)
+}
+
+/// The floats of `value`'s constants (the fields [`CONSTANTS`] names, and all they hold), in
+/// order, with their paths.
+pub(in crate::integrators) fn constants<T: Serialize + ?Sized>(value: &T) -> Vec<Mark> {
+    let mut marks = marks(value, true);
+    marks.retain(|m| matches!(m.what, What::Constant(_)));
+    marks
+}
+
+fn marks<T: Serialize + ?Sized>(value: &T, constants: bool) -> Vec<Mark> {
     let mut marks = Vec::new();
     let mut path = Vec::new();
     value
@@ -59,6 +83,7 @@ pub(in crate::integrators) fn shape<T: Serialize + ?Sized>(value: &T) -> Vec<Mar
             marks: &mut marks,
             path: &mut path,
             mode: Mode::Shape,
+            constants,
         })
         .expect("a state's shape is always readable");
     marks
@@ -77,6 +102,8 @@ struct Shaper<'a> {
     marks: &'a mut Vec<Mark>,
     path: &'a mut Vec<&'static str>,
     mode: Mode,
+    /// Whether the constants' floats are marked too.
+    constants: bool,
 }
 
 #[derive(Debug)]
@@ -115,8 +142,18 @@ impl<'a> Shaper<'a> {
     }
 
     fn compound(self, length: Option<usize>) -> Compound<'a> {
-        let Shaper { marks, path, mode } = self;
-        let mut shaper = Shaper { marks, path, mode };
+        let Shaper {
+            marks,
+            path,
+            mode,
+            constants,
+        } = self;
+        let mut shaper = Shaper {
+            marks,
+            path,
+            mode,
+            constants,
+        };
         if let Some(n) = length {
             shaper.mark(What::Length(n));
         }
@@ -128,6 +165,7 @@ impl<'a> Shaper<'a> {
             marks: shaper.marks,
             path: shaper.path,
             mode,
+            constants,
             named: false,
         }
     }
@@ -145,6 +183,7 @@ struct Compound<'a> {
     marks: &'a mut Vec<Mark>,
     path: &'a mut Vec<&'static str>,
     mode: Mode,
+    constants: bool,
     /// The compound pushed a name on the path (a variant's), to pop at its end.
     named: bool,
 }
@@ -155,6 +194,7 @@ impl Compound<'_> {
             marks: self.marks,
             path: self.path,
             mode: self.mode,
+            constants: self.constants,
         })
     }
 
@@ -171,6 +211,7 @@ impl Compound<'_> {
             marks: self.marks,
             path: self.path,
             mode,
+            constants: self.constants,
         });
         self.path.pop();
         result
@@ -213,8 +254,15 @@ impl<'a> ser::Serializer for Shaper<'a> {
 
     integers!(serialize_u8: u8, serialize_u16: u16, serialize_u32: u32, serialize_u64: u64);
     integers!(serialize_i8: i8, serialize_i16: i16, serialize_i32: i32, serialize_i64: i64);
-    ignored!(serialize_bool: bool, serialize_f32: f32, serialize_f64: f64, serialize_char: char);
+    ignored!(serialize_bool: bool, serialize_f32: f32, serialize_char: char);
     ignored!(serialize_str: &str, serialize_bytes: &[u8]);
+
+    fn serialize_f64(mut self, v: f64) -> Result<(), Never> {
+        if self.constants && self.path.iter().any(|field| CONSTANTS.contains(field)) {
+            self.mark(What::Constant(v.to_bits()));
+        }
+        Ok(())
+    }
 
     fn serialize_none(mut self) -> Result<(), Never> {
         self.mark(What::Present(false));

@@ -19,7 +19,8 @@ pub use two_point::TwoPoint;
 
 use nalgebra::DMatrix;
 
-use super::{Increment, StepError, StepStart};
+use super::checkpoint::derived::{same, Reached};
+use super::{Dynamics, Increment, StepError, StepStart};
 use crate::discrete::Quadrature;
 use crate::discrete::Segment;
 use crate::model::{HolonomicConstraints, Lagrangian, VelocityConstraints};
@@ -298,6 +299,33 @@ impl<Sc: StepEquations> Del<Sc> {
     /// The options of the Newton iteration.
     pub(in crate::integrators) fn options(&self) -> NewtonOptions {
         self.options
+    }
+
+    /// Why a decoded step's derived values are not its own (see `checkpoint/derived.rs`), if
+    /// they are not: its continuum sign ±1 (0 before the run's first step), and the constraint
+    /// matrix it cached at its last step's end q₁ (first same as last), evaluated again there,
+    /// q₁ the state's q to round-off.
+    pub(in crate::integrators) fn misfit(&self, model: &dyn Dynamics, at: &Reached<'_>) -> Option<String> {
+        if ![-1.0, 0.0, 1.0].contains(&self.continuum_sign) {
+            return Some(format!("its continuum sign is {:?}, not ±1 or 0", self.continuum_sign));
+        }
+        let mp = &self.multipliers;
+        let constraints = match (model.holonomic(), model.velocity_constraints()) {
+            _ if !mp.cached || mp.g0.nrows() == 0 => return None,
+            (Some(g), Some(a)) => Constraints::Mixed(g, a, DiscreteConstraint::Midpoint),
+            (Some(g), None) => Constraints::Holonomic(g),
+            (None, Some(a)) => Constraints::Velocity(a, DiscreteConstraint::Midpoint),
+            (None, None) => return None,
+        };
+        if !at.holds(&mp.q1) {
+            return Some(
+                "its last step's end, where its constraint matrix was cached, is not at its state's q".to_string(),
+            );
+        }
+        let (mut matrix, mut parts) = (mp.g0.clone(), mp.parts.clone());
+        let evaluated = constraints.matrix(&mp.q1, &mut matrix, &mut parts).is_ok();
+        (!(evaluated && same(matrix.as_slice(), mp.g0.as_slice())))
+            .then(|| "its cached constraint matrix is not the model's at its last step's end".to_string())
     }
 
     pub(in crate::integrators) fn reset(&mut self) {

@@ -28,6 +28,7 @@ pub use kepler::kepler_drift;
 pub use kernel::Kernel;
 pub use stumpff::{stumpff, universal_functions};
 
+use super::checkpoint::derived::{same, Reached};
 use super::{Increment, StepStart};
 use crate::error::StepError;
 use crate::model::NBody;
@@ -90,6 +91,23 @@ impl WisdomHolman {
     /// shape: their values are set by the next step's model).
     pub(in crate::integrators) fn prepare(&mut self, n: usize) {
         self.jacobi = Some(Jacobi::sized(n / 3));
+    }
+
+    /// Why a decoded state's derived values are not its own (see `checkpoint/derived.rs`), if
+    /// they are not: its Jacobi masses and parameters the model's, and its inner variables,
+    /// while valid, those whose image is the state's (q, p), to the bit.
+    pub(in crate::integrators) fn misfit(&self, model: &NBody, at: &Reached<'_>) -> Option<String> {
+        if self.jacobi.as_ref().is_some_and(|j| *j != Jacobi::new(model)) {
+            return Some("its Jacobi masses and parameters are not the model's".to_string());
+        }
+        if !self.loaded {
+            return None;
+        }
+        let (mut own, mut q, mut p) = (self.clone(), vec![0.0; at.q.len()], vec![0.0; at.p.len()]);
+        own.synchronise(&mut q, &mut p);
+        (!(same(&q, at.q) && same(&p, at.p))).then(|| {
+            "its inner variables (the Jacobi coordinates it steps) are not those of its state (q, p)".to_string()
+        })
     }
 
     /// Forgets the inner variables: the next step starts from the (q, p) it is given.
