@@ -42,6 +42,7 @@ __all__ = [
     "beyond_limit",
     "catalogue",
     "central_differences",
+    "check_allocation",
     "constraint_curvature",
     "constraint_residuals",
     "cyclic_increments",
@@ -599,6 +600,10 @@ def ensemble(
     that stopped the ensemble, if any. ``progress(steps)`` gets the steps of all members every
     10 ms. ``contacts``: native contacts (as ``integrate``'s), each member resolving its impacts;
     ``impulses`` (their components as numbers) and ``t_eval`` as ``integrate``'s."""
+
+def check_allocation(argument: str, count: int, size: int) -> None:
+    """ValueError naming ``argument`` for ``count`` items of ``size`` bytes each that the memory
+    available to the process (free memory, its address-space limit, its cgroup's) cannot hold."""
 
 def integrate(
     model: _Model,

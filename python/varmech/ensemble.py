@@ -405,7 +405,7 @@ def ensemble(
     newton: dict[str, Any] = dict(newton_tolerance=newton_tolerance, newton_max_iterations=newton_max_iterations)
     watched, event_specs = _events.specs(events, model) if events is not None else ([], [])
     impulse_specs = _impulses.specs(impulses or (), t0, t0 + nsteps * dt)
-    times = _sample_times(t_eval, t0, t0 + nsteps * dt, save_every, None)
+    times = _sample_times(t_eval, t0, t0 + nsteps * dt, save_every, None, model.dim, len(q))
     settings = run | newton | dict(max_energy_error=max_energy_error, events=events, contacts=contacts, impulses=impulses, t_eval=t_eval)
     if client is not None:
         return _on_cluster(client, model, q, p, values, settings | dict(workers=workers), chunk_size, progress)

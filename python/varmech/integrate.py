@@ -330,7 +330,7 @@ def integrate(
 
     contact_specs = _impacts.specs(contacts or ())
     impulse_specs = _impulses.specs(impulses, t0, t_end) if impulses is not None else []
-    times = _sample_times(t_eval, t0, t_end, save_every, output)
+    times = _sample_times(t_eval, t0, t_end, save_every, output, model.dim)
 
     def first(steps: int, report: Callable[[int], None] | None) -> _core.TrajectoryRecord:
         return _core.integrate(
@@ -374,16 +374,32 @@ def integrate(
 
 
 def _sample_times(
-    t_eval: ArrayLike | None, t0: float, t_end: float, save_every: int, output: str | os.PathLike[str] | None
+    t_eval: ArrayLike | None,
+    t0: float,
+    t_end: float,
+    save_every: int,
+    output: str | os.PathLike[str] | None,
+    dim: int,
+    members: int = 1,
 ) -> np.ndarray | None:
     """``t_eval`` checked for a run over [t0, t_end] (``dense.eval_times``), refusing
-    ``save_every`` and ``output`` with it."""
+    ``save_every`` and ``output`` with it, and more times than the memory available can hold
+    the states of (t, q, p, Newton counts and work: 2·dim + 3 floats a row, and the times' two
+    copies the core makes), for each of ``members`` runs (an ensemble's, whose rows are stacked
+    too), before they are copied."""
     if t_eval is None:
         return None
     for name, clash in (("save_every", save_every != 1), ("output", output is not None)):
         if clash:
             raise ValueError(f"{name}: not with t_eval, which keeps the states at its times, not the run's own")
-    return dense.eval_times(t_eval, t0, t_end)
+    times = dense.eval_times(t_eval, t0, t_end)
+    try:
+        _core.check_allocation("t_eval", times.size * members, 8 * (2 * dim + 5) * (1 if members == 1 else 2))
+    except ValueError as e:
+        raise ValueError(
+            f"{e}: {members} × {times.size} states of {dim} coordinates; pass fewer t_eval times"
+        ) from None
+    return times
 
 
 def _go_on(
@@ -408,7 +424,7 @@ def _go_on(
     t_now = _core.Stepper.from_checkpoint(traj.model._core, traj.checkpoint).t
     nsteps = step_count(traj.dt, t_now, steps, t_end)
     save_every = positive_int("save_every", save_every)
-    times = _sample_times(t_eval, t_now, t_now + nsteps * traj.dt, save_every, output)
+    times = _sample_times(t_eval, t_now, t_now + nsteps * traj.dt, save_every, output, traj.model.dim)
     watched, specs = _events.specs(events, traj.model) if events is not None else ([], [])
     found = _events.found_before(traj.events, watched)
     initial = _events.first_energy(traj.model, traj) if watched else None

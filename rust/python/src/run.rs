@@ -2,6 +2,7 @@
 //! methods.
 
 use numpy::PyReadonlyArray1;
+use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use varmech::diagnostics;
 use varmech::integrators::{
@@ -304,7 +305,16 @@ fn methods() -> Vec<MethodInfo> {
         .collect()
 }
 
+/// Refuses, naming `argument` (ValueError), `count` items of `size` bytes each that the memory
+/// available to the process cannot hold ([`varmech::memory::check_bytes`]): for an allocation
+/// that Python sizes from an argument before the core sees it (`t_eval`'s rows).
+#[pyfunction]
+fn check_allocation(argument: &str, count: usize, size: usize) -> PyResult<()> {
+    varmech::memory::check_bytes(count, size).map_err(|reason| PyValueError::new_err(format!("{argument}: {reason}")))
+}
+
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(check_allocation, m)?)?;
     m.add_class::<TrajectoryRecord>()?;
     m.add_class::<MethodInfo>()?;
     m.add_function(wrap_pyfunction!(integrate, m)?)?;

@@ -224,7 +224,7 @@ where
         let reason = format!("{} models for {members} members", count.unwrap_or(0));
         return Err(Error::invalid("models", reason));
     }
-    check_memory(members, n, options)?;
+    check_memory(members, n, options, watched.samples.len())?;
     watched.check(n)?;
 
     let workers = parallel
@@ -337,15 +337,23 @@ fn member(
 }
 
 /// Refuses an ensemble whose saved states would not fit in memory twice over (the members'
-/// records, and the stacked arrays made of them), naming `save_every`.
-fn check_memory(members: usize, n: usize, options: &Options) -> Result<(), Error> {
-    let saved = (options.steps / options.save_every).saturating_add(2);
+/// records, and the stacked arrays made of them), naming `save_every`, or `t_eval` where the
+/// members keep the states at its `samples` times alone.
+fn check_memory(members: usize, n: usize, options: &Options, samples: usize) -> Result<(), Error> {
+    let (argument, saved, advice) = match samples {
+        0 => (
+            "save_every",
+            (options.steps / options.save_every).saturating_add(2),
+            "raise save_every",
+        ),
+        samples => ("t_eval", samples.saturating_add(2), "pass fewer t_eval times"),
+    };
     let rows = members.saturating_mul(saved).saturating_mul(2);
-    memory::check_allocation("save_every", rows, (2 * n + 3) * std::mem::size_of::<f64>()).map_err(|e| {
+    memory::check_bytes(rows, (2 * n + 3) * std::mem::size_of::<f64>()).map_err(|e| {
         let reason = format!(
-            "{members} members × {saved} saved states of {n} coordinates: {e}; raise save_every \
-             (or run fewer members at a time)"
+            "{members} members × {saved} saved states of {n} coordinates: {e}; {advice} (or run fewer members at a \
+             time)"
         );
-        Error::invalid("save_every", reason)
+        Error::invalid(argument, reason)
     })
 }

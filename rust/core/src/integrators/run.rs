@@ -357,11 +357,22 @@ where
     let mut traj = empty(sys);
     traj.impacts.dim = n;
     let start = stepper.steps();
-    let saved = ((end - start) / save_every).saturating_add(2);
+    // With samples their states alone are kept (and those about jumps, which grow the rows).
+    let (argument, saved, advice) = match watcher.samples() {
+        0 => (
+            "save_every",
+            ((end - start) / save_every).saturating_add(2),
+            "raise save_every",
+        ),
+        samples => ("t_eval", samples.saturating_add(2), "pass fewer t_eval times"),
+    };
     // Reserving succeeds beyond the memory there is (Linux overcommits) and the run would then
     // be killed when it fills the states: check against what is available first.
-    if let Err(e) = memory::check_allocation("save_every", saved, (2 * n + 3) * std::mem::size_of::<f64>()) {
-        return Err(fail(e, traj));
+    if let Err(Error::InvalidArgument { reason, .. }) =
+        memory::check_allocation(argument, saved, (2 * n + 3) * std::mem::size_of::<f64>())
+    {
+        let reason = format!("{reason}: {saved} states of {n} coordinates; {advice}");
+        return Err(fail(Error::invalid(argument, reason), traj));
     }
     // Newton counts and work only for the runs that have them (see `Trajectory::push`).
     let (newton, work) = (
@@ -377,9 +388,8 @@ where
     });
     if !reserved {
         let gib = saved as f64 * (2 * n + 3) as f64 * 8.0 / (1u64 << 30) as f64;
-        let reason =
-            format!("keeping {saved} states needs {gib:.3e} GiB, more than can be allocated; raise save_every");
-        return Err(fail(Error::invalid("save_every", reason), traj));
+        let reason = format!("keeping {saved} states needs {gib:.3e} GiB, more than can be allocated; {advice}");
+        return Err(fail(Error::invalid(argument, reason), traj));
     }
 
     // The first state, which a divergence's diagnosis linearizes at.

@@ -138,7 +138,31 @@ impl Lag {
 /// Refuses a delay that the history cannot read at the step h, naming `delays`: one shorter
 /// than the step (the history holds whole steps), or, for a term that reads the acceleration,
 /// than 3h/2 (the velocity a node after the one nearest t − τ must be known before the step).
+///
+/// Refuses too, naming `delays`, a history longer than the memory available: it holds the
+/// longest delay's τ/h steps of (q̄, v̄), 2n floats a step ([`crate::memory::check_allocation`]),
+/// and a long delay at a short step (τ = 10¹⁰ at h = 0.01: 10¹² steps) would abort the process
+/// at its allocation.
 pub(in crate::integrators) fn check_delays(sys: &dyn Lagrangian, h: f64) -> Result<(), crate::Error> {
+    let longest = sys.delays().iter().fold(0.0_f64, |a, &tau| a.max(tau));
+    // The ring's nodes, as `History::new` counts them: ⌈τ/h⌉, one more for the acceleration's
+    // neighbour, and two.
+    let nodes = (longest / h).ceil() + 3.0;
+    let bytes = 2 * sys.dim().max(1) * std::mem::size_of::<f64>();
+    // A count past usize (τ/h of 10³⁰⁰) is refused as one beyond the address space.
+    let count = if nodes < usize::MAX as f64 {
+        nodes as usize
+    } else {
+        usize::MAX
+    };
+    if let Err(crate::Error::InvalidArgument { reason, .. }) = crate::memory::check_allocation("delays", count, bytes) {
+        let reason = format!(
+            "{reason}: the history of τ = {longest:e} holds τ/dt = {:.3e} past states at dt = {h:e}; take a \
+             larger dt or a shorter τ",
+            longest / h
+        );
+        return Err(crate::Error::invalid("delays", reason));
+    }
     for (j, &tau) in sys.delays().iter().enumerate() {
         if tau < h {
             let reason =

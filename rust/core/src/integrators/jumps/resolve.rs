@@ -240,6 +240,11 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
         self.schedule.is_some_and(Schedule::sampling)
     }
 
+    /// How many samples the schedule holds.
+    pub(in crate::integrators) fn samples(&self) -> usize {
+        self.schedule.map_or(0, |s| s.samples().len())
+    }
+
     /// A new run's start (a resumed run's times at its start are the first run's): the samples
     /// at its t0 taken, then the impulses there applied (the states just before and after each
     /// saved).

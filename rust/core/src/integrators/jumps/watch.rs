@@ -121,6 +121,11 @@ where
         self.resolver.as_ref().is_some_and(|r| r.sampling())
     }
 
+    /// How many samples the run's schedule holds (0 without).
+    pub fn samples(&self) -> usize {
+        self.resolver.as_ref().map_or(0, |r| r.samples())
+    }
+
     /// The watcher of nothing: the steps many at a time, as a plain run takes them.
     pub(in crate::integrators) fn idle() -> Self {
         Watcher {
