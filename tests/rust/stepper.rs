@@ -245,3 +245,54 @@ fn malformed_arguments_are_refused_and_leave_the_state_alone() {
     assert_eq!(invalid_argument(Stepper::resume(&chain.system, &mut state)), "model");
     assert_eq!(snapshot(&Stepper::resume(&kepler.system, state).unwrap()), before);
 }
+
+/// Steps shorter than 4 ulp of the run's times are refused naming `dt` (t₀ = 1.7·10⁹ s of Unix
+/// time, steps of 0.1 µs: the times would repeat and the rows be lost), by a run, a resumed
+/// run and a stepper alike; at 4 ulp every time is its own and every step's row is kept.
+#[test]
+fn steps_below_the_resolution_of_the_time_are_refused_and_those_above_keep_every_row() {
+    let sho = HarmonicOscillator::problem(1.0).unwrap();
+    let (q0, p0) = (&sho.initial.q, &sho.initial.p);
+    let t0: f64 = 1.7e9;
+    let ulp = f64::from_bits(t0.to_bits() + 1) - t0;
+    let run = |t0: f64, dt: f64, steps: usize| {
+        let options = Options {
+            t0,
+            ..Options::new(dt, steps)
+        };
+        integrate(&sho.system, Method::Verlet, q0, p0, &options, || Ok(())).map_err(|f| f.error)
+    };
+    for dt in [1e-7, 3.99 * ulp] {
+        assert_eq!(invalid_argument(run(t0, dt, 1000)), "dt");
+        assert_eq!(invalid_argument(run(-t0, dt, 1000)), "dt");
+        let options = Options {
+            t0,
+            ..Options::new(dt, 0)
+        };
+        assert_eq!(
+            invalid_argument(Stepper::new(&sho.system, Method::Verlet, q0, p0, &options)),
+            "dt"
+        );
+    }
+    let traj = run(t0, 4.0 * ulp, 1000).unwrap();
+    assert_eq!((traj.t.len(), traj.steps), (1001, 1000));
+    assert!(traj.t.windows(2).all(|w| w[1] > w[0]));
+    // The same steps from t₀ = 0: the time is not read by the model, so the states are these.
+    let from_zero = run(0.0, 4.0 * ulp, 1000).unwrap();
+    assert_eq!(bits(&traj.q), bits(&from_zero.q));
+    // A stepper, and a run resumed, whose steps would reach a time where 4 ulp passes dt.
+    // Below 2⁵⁰ the floats are 1/8 apart, above it 1/4: steps of 0.6 pass below, not above.
+    let edge = 2.0_f64.powi(50);
+    let options = Options {
+        t0: edge - 8.0 * 0.6,
+        ..Options::new(0.6, 4)
+    };
+    let mut stepper = Stepper::new(&sho.system, Method::Verlet, q0, p0, &options).unwrap();
+    stepper.advance(7, || Ok(())).unwrap();
+    assert_eq!(invalid_argument(stepper.advance(2, || Ok(()))), "dt");
+    assert_eq!(stepper.steps(), 7, "the refused call took no step");
+    let first = integrate(&sho.system, Method::Verlet, q0, p0, &options, || Ok(())).unwrap();
+    let checkpoint = varmech::integrators::Checkpoint::from_bytes(&first.checkpoint).unwrap();
+    let resumed = varmech::integrators::resume(&sho.system, checkpoint, 10, 1, || Ok(()));
+    assert_eq!(invalid_argument(resumed.map_err(|f| f.error)), "dt");
+}

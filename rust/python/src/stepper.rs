@@ -129,6 +129,7 @@ impl Stepper {
     /// Advances `n` steps (one by [`integrators::Stepper::step`] where `single`), through the
     /// contacts' impacts if any: a [`Watcher`] resumed on the state, its impacts kept.
     fn go(&mut self, py: Python<'_>, n: usize, single: bool) -> PyResult<()> {
+        self.state.check_horizon(n).map_err(|e| to_pyerr(py, e))?;
         if self.unwatched() {
             return self.with(py, |stepper, poll| {
                 if single {

@@ -3,6 +3,7 @@
 use serde::{Deserialize, Serialize};
 
 use super::jumps::{Watch, Watcher};
+use super::stepper::Clock;
 use super::{Checkpoint, Detector, Dynamics, Failure, Method, NewtonOptions, Poll, Stepper, Trajectory};
 use crate::model::{EnergyTerms, Rest, Scale};
 use crate::{memory, Error, ModelError};
@@ -70,6 +71,7 @@ impl Options {
                 ),
             ));
         }
+        Clock::new(self.t0, self.dt).check_resolution(self.steps)?;
         self.newton.check()?;
         match self.max_energy_error {
             Some(x) if x.is_nan() || x <= 0.0 => {
@@ -315,6 +317,7 @@ fn resumed<S: Dynamics + ?Sized>(
         );
         return Err(fail(Error::invalid("steps", reason), empty(sys)));
     };
+    stepper.check_horizon(steps).map_err(|e| fail(e, empty(sys)))?;
     Ok((stepper, watch, end))
 }
 

@@ -125,6 +125,7 @@ where
     /// names the step (counted from 1) and the time it started at.
     pub fn step(&mut self) -> Result<(), Error> {
         let state = self.state.borrow_mut();
+        state.check_horizon(1)?;
         // The model's own loop, one step long: the fixed-size loops of small systems (the bits
         // of a generic step, at half its cost: the partial steps of impacts take it), and the
         // own variables of a method that has them, which a step from (q, p) would restart.
@@ -167,6 +168,7 @@ where
         poll: P,
     ) -> Result<bool, Error> {
         let (state, model) = (self.state.borrow_mut(), &*self.model);
+        state.check_horizon(n)?;
         state.polled(n, poll, |state, steps| {
             model.advance_with_tangent(state, steps, (&mut *tangent, &mut *x), large)
         })
@@ -180,6 +182,7 @@ where
     /// them and synchronises (q, p) once, at the end (see `own_variables.rs`).
     pub fn advance<P: Poll>(&mut self, n: usize, poll: P) -> Result<(), Error> {
         let state = self.state.borrow_mut();
+        state.check_horizon(n)?;
         let result = state.advance_polled(&*self.model, n, poll);
         state.synchronise();
         result
@@ -729,6 +732,12 @@ impl StepperState {
         Ok(false)
     }
 
+    /// Refuses, naming `dt`, `steps` more steps whose times the clock would not tell apart
+    /// ([`Clock::check_resolution`]).
+    pub fn check_horizon(&self, steps: usize) -> Result<(), Error> {
+        self.clock.check_resolution(self.steps.saturating_add(steps))
+    }
+
     /// The time tₙ = t₀ + n·h (counted from the last change of h, see [`Stepper::set_dt`]).
     pub fn t(&self) -> f64 {
         self.clock.at(self.steps)
@@ -817,11 +826,58 @@ pub(super) struct Clock {
 }
 
 impl Clock {
+    /// The clock of a run from t0 in steps of h.
+    pub(super) fn new(t0: f64, h: f64) -> Self {
+        Clock { t0, n0: 0, h }
+    }
+
     /// The time after `steps` steps.
     #[inline]
     pub(super) fn at(self, steps: usize) -> f64 {
         // Through i64: one instruction, where usize → f64 takes a dozen on x86-64.
         self.t0 + (steps - self.n0) as i64 as f64 * self.h
+    }
+
+    /// Refuses, naming `dt`, steps up to step `end` whose times [`Clock::at`] does not tell
+    /// apart: t₀ + k·h rounds to a float, and where h is below the floats' spacing near the
+    /// run's times, successive steps would share a time (a run at t₀ = 1.7·10⁹ s, Unix time,
+    /// of steps of 0.1 µs) and the saved rows, which a time tells apart, would be lost.
+    ///
+    /// k·h is within u/2 of its value and t₀ + k·h within u, u the spacing of the floats at
+    /// the largest of |t₀|, |t_end| and k·h, so that steps h ≥ 4u are a time apart at least u:
+    /// that is the bound. Refuses, naming `steps`, more than 2⁵³ steps from t₀, whose count k
+    /// is no longer a float's.
+    pub(super) fn check_resolution(self, end: usize) -> Result<(), Error> {
+        let k = end.saturating_sub(self.n0);
+        if k > 1 << 53 {
+            let reason = format!(
+                "{k} steps from t0 = {:?} are more than 2**53, past which step counts are not floats",
+                self.t0
+            );
+            return Err(Error::invalid("steps", reason));
+        }
+        let span = k as f64 * self.h;
+        let largest = self.t0.abs().max((self.t0 + span).abs()).max(span);
+        let ulp = f64::from_bits(largest.to_bits() + 1) - largest;
+        if self.h >= 4.0 * ulp {
+            return Ok(());
+        }
+        let near = if self.t0.abs() >= (self.t0 + span).abs() {
+            self.t0
+        } else {
+            self.t0 + span
+        };
+        let reason = format!(
+            "{:?} is below the resolution of the time over this run: the floats near t = {near:e} are {ulp:.4e} apart \
+             (ulp(t)), and steps shorter than 4 ulp(t) = {:.4e} are not told apart (t0 + k·dt would repeat values, and \
+             the run would lose steps); count the time from the run's start (t0 = 0, adding {:e} to its times \
+             afterwards), or take dt ≥ {:.4e}",
+            self.h,
+            4.0 * ulp,
+            self.t0,
+            4.0 * ulp
+        );
+        Err(Error::invalid("dt", reason))
     }
 }
 
