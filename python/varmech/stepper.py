@@ -256,7 +256,9 @@ class Stepper:
         vector (δq, δp) from the step's start to its end, in the core, with no Python call per
         step. The states are those of :meth:`advance`, bit for bit. The vectors are not
         renormalized: in a chaotic run they grow as e^(λ₁t), so a long one belongs to
-        :func:`varmech.lyapunov_spectrum`.
+        :func:`varmech.lyapunov_spectrum`; a step that takes them past the largest float is a
+        :class:`~varmech.DivergenceError` (the step kept), never vectors of inf or NaN:
+        renormalize them between shorter calls.
 
         Parameters
         ----------
@@ -278,7 +280,7 @@ class Stepper:
             forces), naming it; a stepper with contacts, impulses or events; ``steps, t_end``
             as for :meth:`advance`.
         DivergenceError, ConvergenceError
-            As :meth:`step`.
+            As :meth:`step`; DivergenceError too where the vectors overflow.
 
         Examples
         --------

@@ -7,8 +7,9 @@
 
 use varmech::diagnostics::{lyapunov, LyapunovOptions, Stretching};
 use varmech::integrators::{Dynamics, General, Method, Options, Stepper, Tangent};
+use varmech::model::{Mass, MechanicalSystem};
 use varmech::scenes::{DampedDrivenPendulum, DoublePendulum, FermiPastaUlam, HarmonicOscillator, HenonHeiles};
-use varmech::Error;
+use varmech::{Error, ModelError};
 
 /// One step of `method` from (q, p): the end (q, p) as one vector.
 fn step<S: Dynamics>(sys: &S, method: Method, h: f64, x: &[f64]) -> Vec<f64> {
@@ -439,4 +440,75 @@ fn rattles_tangent_map_is_its_steps_jacobian_on_the_constraint_manifold() {
     }
     assert!(worst_tangency < 1e-10, "G(q₁)δq₁ = {worst_tangency:e}");
     assert!(worst_error < 1e-9, "{worst_error:e}");
+}
+
+/// V = −q²/2 at its top, q = p = 0: the state stays there while a tangent vector grows by about
+/// h² a step, past any float at h = 10¹⁶⁰.
+struct Inverted(Mass);
+
+impl MechanicalSystem for Inverted {
+    fn dim(&self) -> usize {
+        1
+    }
+    fn mass(&self) -> &Mass {
+        &self.0
+    }
+    fn potential(&self, q: &[f64]) -> Result<f64, ModelError> {
+        Ok(-0.5 * q[0] * q[0])
+    }
+    fn gradient(&self, q: &[f64], grad: &mut [f64]) -> Result<(), ModelError> {
+        grad[0] = -q[0];
+        Ok(())
+    }
+}
+
+/// Tangent vectors that one step takes past the largest float stop the spectrum, and a
+/// stepper's tangent run, with a divergence saying what to change, never NaN exponents; at a
+/// step they survive (stretched 10¹⁰⁰ a step), the exponent is the step map's own.
+#[test]
+fn tangent_vectors_that_overflow_in_a_step_are_a_divergence_not_nan() {
+    let sys = Inverted(Mass::Scalar(1.0));
+    let options = |dt: f64| LyapunovOptions {
+        t0: 0.0,
+        dt,
+        steps: 4,
+        k: 2,
+        every: 1,
+        start: None,
+    };
+    for method in [Method::Verlet, Method::Yoshida4] {
+        match lyapunov(&sys, method, &[0.0], &[0.0], &options(1e160), || Ok(())) {
+            Err(Error::Divergence { step: 1, reason, .. }) => {
+                assert!(
+                    reason.contains("tangent vectors overflowed") && reason.contains("smaller dt"),
+                    "{reason}"
+                )
+            }
+            other => panic!("{method:?}: {other:?}"),
+        }
+    }
+    // Verlet's map at q = 0 is [[1 + h², h], [h, 1]] (δp first kicked by h/2·δq): its
+    // eigenvalue 1 + h²/2 + h√(1 + h²/4) is e^(λh) for the largest exponent.
+    let h = 1e50;
+    let largest = LyapunovOptions {
+        steps: 100,
+        k: 1,
+        ..options(h)
+    };
+    let found = lyapunov(&sys, Method::Verlet, &[0.0], &[0.0], &largest, || Ok(())).unwrap();
+    // After the first step (whose start leans on the contracting direction: the map is far
+    // from normal) the vector grows by the eigenvalue each step.
+    let (sums, t) = (&found.sums, &found.t);
+    let measured = (sums[sums.len() - 1] - sums[0]) / (t[t.len() - 1] - t[0]);
+    let exponent = (1.0 + h * h / 2.0 + h * (1.0 + h * h / 4.0).sqrt()).ln() / h;
+    assert!((measured / exponent - 1.0).abs() < 1e-12, "{measured} {exponent}");
+    let mut stepper = Stepper::new(&sys, Method::Verlet, &[0.0], &[0.0], &Options::new(1e160, 4)).unwrap();
+    let mut tangent = Tangent::new(Method::Verlet, &sys).unwrap();
+    let mut x = vec![1.0, 0.0];
+    let overflowed = stepper.advance_with_tangent(4, &mut tangent, &mut x, || Ok(()));
+    assert!(
+        matches!(overflowed, Err(Error::Divergence { step: 1, .. })),
+        "{overflowed:?}"
+    );
+    assert_eq!(stepper.steps(), 1, "the step that overflowed the vectors is kept");
 }

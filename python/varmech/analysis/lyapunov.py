@@ -141,7 +141,8 @@ def lyapunov_spectrum(
         all of them, the full spectrum.
     every
         Steps between re-orthonormalizations (a vector that grows past 1e100 is
-        re-orthonormalized at once, so it never overflows).
+        re-orthonormalized at once; one step that stretches the vectors past the largest float,
+        1e208 from 1e100, is a :class:`~varmech.DivergenceError` asking for a smaller ``dt``).
     segments
         The run's pieces whose estimates give the standard errors (at least 2).
     t0
@@ -162,6 +163,10 @@ def lyapunov_spectrum(
         more than the run's re-orthonormalizations, a kick–drift method on a model that is not
         separable, a model with constraints or delayed forces, a method without a tangent
         map, or a ``tangent0`` of another shape or of dependent columns, naming the argument.
+    DivergenceError
+        The tangent vectors overflowed in one step (the step is far too long for the motion's
+        instability: take a smaller ``dt``), or a column contracted past the smallest float
+        between re-orthonormalizations (take a smaller ``every``): their exponents would be NaN.
     VarmechError
         The model failing during the run, with the step and time.
 

@@ -49,10 +49,16 @@ const LARGE: f64 = 1e100;
 /// re-orthonormalized (modified Gram–Schmidt, twice) every `options.every` steps, at the run's
 /// end, and whenever one grows past 10¹⁰⁰. `poll` is called every 10–40 ms.
 ///
+/// A step that stretches the vectors past the largest float (10²⁰⁸ from 10¹⁰⁰: h·λ beyond
+/// 480, a step far too long for the motion), or a column that contracts past the smallest
+/// between re-orthonormalizations, stops the run with [`Error::Divergence`] saying what to
+/// change: its exponents would be NaN.
+///
 /// # Errors
 /// Invalid arguments, naming them (k outside 1 … 2n, `every` = 0, a model or method without a
 /// tangent map, [`Tangent::new`]); the model's errors and the run's, with the step and time;
-/// [`Error::Interrupted`] from `poll`.
+/// [`Error::Divergence`] for vectors that overflow or collapse (above); [`Error::Interrupted`]
+/// from `poll`.
 pub fn lyapunov<S: Dynamics + ?Sized, P: Poll>(
     sys: &S,
     method: Method,
@@ -137,6 +143,20 @@ pub fn lyapunov<S: Dynamics + ?Sized, P: Poll>(
         stepper.advance_with_tangent_below(due.min(steps) - done, carry, LARGE, Counting(|s| poll.poll(s)))?;
         done = stepper.steps();
         orthonormalize(&mut x, dim, &mut row);
+        // A column contracted to zero (or past the smallest float) since the last
+        // re-orthonormalization has no direction left: its ln R is −∞ and the rest NaN.
+        if !row.iter().all(|s| s.is_finite()) {
+            let reason = format!(
+                "the tangent vectors collapsed: a column contracted past the smallest float in the {every} steps \
+                 since the last re-orthonormalization, and its exponent would be NaN; re-orthonormalize more often \
+                 (a smaller every) or take a smaller dt"
+            );
+            return Err(Error::Divergence {
+                step: done,
+                time: stepper.t(),
+                reason,
+            });
+        }
         stretching.t.push(stepper.t());
         stretching.sums.extend_from_slice(&row);
     }

@@ -144,7 +144,9 @@ where
 
     /// As [`Stepper::step_with_tangent`], `n` steps, `poll` called as [`Stepper::advance`]
     /// calls it. The vectors are not renormalized: over many steps of a chaotic run they grow
-    /// past any float ([`crate::diagnostics::lyapunov`] renormalizes them).
+    /// ([`crate::diagnostics::lyapunov`] renormalizes them), and a step that takes them past
+    /// the largest float stops the call with [`Error::Divergence`] (renormalize them between
+    /// shorter calls), the step kept.
     pub fn advance_with_tangent<P: Poll>(
         &mut self,
         n: usize,
@@ -152,14 +154,17 @@ where
         x: &mut [f64],
         poll: P,
     ) -> Result<(), Error> {
-        self.advance_with_tangent_below(n, (tangent, x), f64::INFINITY, poll)
+        self.advance_with_tangent_below(n, (tangent, x), f64::MAX, poll)
             .map(drop)
     }
 
     /// As [`Stepper::advance_with_tangent`], stopping after the first step that takes a
     /// component of the vectors past `large` in magnitude: true then. A kick–drift step's
     /// tangent map is carried inside the method's own loop ([`super::tangent::Carried`]), so
-    /// that the states are those of [`Stepper::advance`] at its cost per step.
+    /// that the states are those of [`Stepper::advance`] at its cost per step. A step that
+    /// takes them past the largest float (or to NaN) is a [`Error::Divergence`]: its map
+    /// stretched them by more than a float holds, so no renormalization after it can recover
+    /// them.
     pub fn advance_with_tangent_below<P: Poll>(
         &mut self,
         n: usize,
@@ -169,9 +174,19 @@ where
     ) -> Result<bool, Error> {
         let (state, model) = (self.state.borrow_mut(), &*self.model);
         state.check_horizon(n)?;
-        state.polled(n, poll, |state, steps| {
+        let stopped = state.polled(n, poll, |state, steps| {
             model.advance_with_tangent(state, steps, (&mut *tangent, &mut *x), large)
-        })
+        })?;
+        if stopped && !x.iter().all(|v| v.is_finite()) {
+            let (step, time) = (state.steps, state.clock.at(state.steps.saturating_sub(1)));
+            let reason = "the tangent vectors overflowed in one step: its tangent map stretched them past the largest \
+                          float (by more than 1e208 a step, h·λ beyond 480, from vectors renormalized at 1e100), \
+                          so no renormalization can recover them; take a smaller dt, at which the step resolves the \
+                          motion's instability (and renormalize them more often)"
+                .to_string();
+            return Err(Error::Divergence { step, time, reason });
+        }
+        Ok(stopped)
     }
 
     /// Advances `n` steps, calling `poll` before a step every 10–40 ms of run time; an error

@@ -219,9 +219,9 @@ impl<S: MechanicalSystem + ?Sized> Clear for Carried<'_, S> {
     }
 }
 
-/// Whether a component of `x` is past `large` in magnitude.
+/// Whether a component of `x` is past `large` in magnitude, or NaN (a map that overflowed).
 pub(super) fn past(x: &[f64], large: f64) -> bool {
-    x.iter().any(|v| v.abs() > large)
+    x.iter().any(|v| v.abs() > large || v.is_nan())
 }
 
 /// A kick–drift step's tangent map: its stages replayed from the step's start for H at each
