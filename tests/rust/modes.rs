@@ -110,3 +110,20 @@ fn the_steps_come_from_the_methods_limits_and_phase_errors() {
     let h = accurate_step(Method::Verlet, 2.0, 1e-3).unwrap();
     assert!((phase_error(Method::Verlet, 2.0 * h).unwrap() / 1e-3 - 1.0).abs() < 1e-5);
 }
+
+/// The fastest frequency at enormous stiffness, where the squares of the Lanczos products leave
+/// the floats (κ of 10¹⁵⁴ on): the double pendulum's ω_max scales as √g, at g = 10²⁰⁰ and
+/// 10³⁰⁰ as at g = 1, never 0.
+#[test]
+fn the_fastest_frequency_at_enormous_stiffness_is_the_scaled_one() {
+    let q = [0.4, -1.1];
+    let omega = |g: f64| {
+        let pendulum = DoublePendulum::new(1.0, 2.0, 1.0, 0.5, g).unwrap();
+        Model::of(&General(&pendulum)).unwrap().fastest(&q, 0.0).unwrap().omega
+    };
+    let unit = omega(1.0);
+    for g in [1e160, 1e200, 1e300] {
+        let scaled = omega(g) / g.sqrt();
+        assert!((scaled / unit - 1.0).abs() < 1e-6, "g = {g:e}: {scaled} against {unit}");
+    }
+}

@@ -20,7 +20,7 @@ use nalgebra::DMatrix;
 use super::constraints::weighted;
 use super::{holonomic_rows, HolonomicConstraints, Lagrangian, Reaction};
 use crate::solve::difference::forward_step;
-use crate::solve::lanczos::extremes;
+use crate::solve::lanczos::{extremes, times_power_of_two};
 use crate::solve::lu::{lu_in_place, lu_solve};
 use crate::solve::splitmix;
 use crate::ModelError;
@@ -263,8 +263,16 @@ impl<'a> Rest<'a> {
         // noise, which would only blur the Ritz values.
         let dof = n.saturating_sub(m).max(1);
         let found = extremes(&start(n), stiffness, inverse, iterations.min(dof), TOLERANCE, noise)?;
+        // κ·2^e, e even: ω = √κ·2^(e/2), representable to ω of 10³⁰⁸ where κ is not.
+        let kappa = found.largest.max(-found.smallest);
+        let omega = times_power_of_two(kappa.max(0.0).sqrt(), found.exponent / 2);
+        if !omega.is_finite() || kappa.is_nan() {
+            let reason = "ω_max² at q, the largest eigenvalue κ of K y = κ M y (the stiffness over the mass), is past \
+                          the largest float (1.8e308) or not finite; take units of time or mass in which it is smaller";
+            return Err(reason.into());
+        }
         Ok(Fastest {
-            omega: found.largest.max(-found.smallest).max(0.0).sqrt(),
+            omega,
             iterations: found.iterations,
             // The whole tangent space spanned: T_k's eigenvalues are the pencil's.
             converged: found.converged || found.iterations >= dof,

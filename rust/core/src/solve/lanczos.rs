@@ -15,6 +15,10 @@ pub struct Extremes {
     /// largest ≤ κ_max.
     pub smallest: f64,
     pub largest: f64,
+    /// The pencil's scale: the eigenvalues are `smallest`·2^`exponent` and
+    /// `largest`·2^`exponent` (an even exponent, 0 but for a pencil whose products would
+    /// leave the floats' range, κ of 10²⁰⁰, say).
+    pub exponent: i32,
     /// Iterations taken (products Kv).
     pub iterations: usize,
     /// Whether both met the tolerance (their residual bounds β|s_k|, Parlett's (13.2.6), or
@@ -37,6 +41,12 @@ const CHECK: usize = 16;
 /// subspace would: continued from noise, the vectors would lose their orthogonality at once and
 /// the Ritz values could leave the spectrum.
 ///
+/// A pencil of any scale is taken: where the first product's size (|Kv|·|v|, about κ) lies
+/// outside 2^±400, every product Kv is scaled by an exact power of two 2^−e that brings it to
+/// 1 (the iteration is otherwise the same, bit for bit), and the eigenvalues are returned
+/// with e ([`Extremes::exponent`]): the squares the inner products take of κ would overflow
+/// from κ of 10¹⁵⁴ on, and the Ritz values would be lost.
+///
 /// # Errors
 /// The first error of `stiffness` or `inverse`.
 pub fn extremes<E>(
@@ -57,6 +67,7 @@ pub fn extremes<E>(
     let mut found = Extremes {
         smallest: 0.0,
         largest: 0.0,
+        exponent: 0,
         iterations: 0,
         converged: true,
     };
@@ -71,6 +82,12 @@ pub fn extremes<E>(
     found.converged = false;
     for k in 1..=max_iterations.max(1) {
         stiffness(&v, &mut kv)?;
+        if k == 1 {
+            found.exponent = scale_exponent(&v, &kv);
+        }
+        if found.exponent != 0 {
+            kv.iter_mut().for_each(|x| *x = times_power_of_two(*x, -found.exponent));
+        }
         let a = dot(&v, &kv);
         for i in 0..n {
             r[i] = kv[i] - a * u[i] - beta_last * u_last[i];
@@ -109,6 +126,32 @@ pub fn extremes<E>(
         beta_last = b;
     }
     Ok(found)
+}
+
+/// The even exponent e of 2 that brings the size of the product Kv, max|Kvᵢ|·max|vᵢ|, to 1
+/// where that size lies outside 2^±400; 0 inside (or where it is 0 or not finite).
+fn scale_exponent(v: &[f64], kv: &[f64]) -> i32 {
+    let largest = |x: &[f64]| x.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+    let (a, b) = (largest(kv), largest(v));
+    if !(a > 0.0 && b > 0.0 && a.is_finite() && b.is_finite()) {
+        return 0;
+    }
+    let e = (a.log2() + b.log2()).round() as i32;
+    if e.abs() <= 400 {
+        0
+    } else {
+        e & !1
+    }
+}
+
+/// x·2^e, exactly (but for underflow), in factors that are floats.
+pub fn times_power_of_two(mut x: f64, mut e: i32) -> f64 {
+    while e != 0 {
+        let step = e.clamp(-1000, 1000);
+        x *= 2.0_f64.powi(step);
+        e -= step;
+    }
+    x
 }
 
 fn scaled(x: &[f64], by: f64) -> Vec<f64> {
