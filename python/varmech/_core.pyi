@@ -669,8 +669,11 @@ def derivative(
     ∂L/∂q̇ = x, ``"dl_dq"`` ∂L/∂q(q, x, t), or ``"dp_dt"`` ṗ = ∂L/∂q + f(q, x, t) with x = q̇.
     With ``names`` (the user's arguments the states come from), the core's own errors name them."""
 
-def momentum(generator: Generator, q: _FloatArray, p: _FloatArray) -> tuple[_FloatArray, _FloatArray]:
-    """(J, Σ|pᵢξᵢ|) at each state."""
+def momentum(
+    generator: Generator, q: _FloatArray, p: _FloatArray, *, argument: str = "generator"
+) -> tuple[_FloatArray, _FloatArray]:
+    """(J, Σ|pᵢξᵢ|) at each state; ValueError naming ``argument`` for a generator that does not
+    apply to the states' coordinates."""
 
 def momentum_along(xi: _FloatArray, p: _FloatArray) -> tuple[_FloatArray, _FloatArray]:
     """(J = p·ξ, its size) at each state, from ξ(q) evaluated there."""

@@ -82,17 +82,19 @@ def momentum(traj: Trajectory, generator: Generator) -> np.ndarray:
     return _momentum_terms(traj, generator)[0]
 
 
-def _momentum_terms(traj: Trajectory, generator: Generator) -> tuple[np.ndarray, np.ndarray]:
+def _momentum_terms(traj: Trajectory, generator: Generator, argument: str = "generator") -> tuple[np.ndarray, np.ndarray]:
     """J = p·ξ(q) and its size at every saved state, by the core's rule (``Generator::momentum_terms``:
-    the larger of Σ|pᵢξᵢ| and ‖p‖∞‖ξ‖∞)."""
+    the larger of Σ|pᵢξᵢ| and ‖p‖∞‖ξ‖∞); a generator that does not fit the model's coordinates
+    is refused naming ``argument``."""
     if isinstance(generator, (Translation, Rotation, Cyclic)):
-        return _core.momentum(generator.spec(), *traj._arrays()[1:])
-    return _core.momentum_along(_field(traj, generator), np.ascontiguousarray(traj.p, dtype=float))
+        return _core.momentum(generator.spec(), *traj._arrays()[1:], argument=argument)
+    return _core.momentum_along(_field(traj, generator, argument), np.ascontiguousarray(traj.p, dtype=float))
 
 
-def _field(traj: Trajectory, generator: Generator) -> np.ndarray:
+def _field(traj: Trajectory, generator: Generator, argument: str = "generator") -> np.ndarray:
     """ξ(q) at every saved state of ``traj``, shape (N, n): a declared generator's from the core
-    (p·ξ at the unit momenta), a closure's called at each state."""
+    (p·ξ at the unit momenta), a closure's called at each state; one that does not fit the
+    model is refused naming ``argument``."""
     q = np.ascontiguousarray(traj.q, dtype=float)
     n = q.shape[1]
     if isinstance(generator, (Translation, Rotation, Cyclic)):
@@ -100,15 +102,15 @@ def _field(traj: Trajectory, generator: Generator) -> np.ndarray:
         for i in range(n):
             unit = np.zeros_like(q)
             unit[:, i] = 1.0
-            columns.append(_core.momentum(spec, q, unit)[0])
+            columns.append(_core.momentum(spec, q, unit, argument=argument)[0])
         return np.stack(columns, axis=1)
     if not callable(generator):
-        raise TypeError(f"generator: expected a Translation, Rotation, Cyclic or a callable xi(q), got {generator!r}")
+        raise TypeError(f"{argument}: expected a Translation, Rotation, Cyclic or a callable xi(q), got {generator!r}")
     xi = np.empty_like(q)
     for k, x in enumerate(q):
-        row = returned("generator: xi(q)", generator(x.copy()))
+        row = returned(f"{argument}: xi(q)", generator(x.copy()))
         if row.shape != (n,):
-            raise ValueError(f"generator: xi(q) must return shape ({n},), got {row.shape}")
+            raise ValueError(f"{argument}: xi(q) must return shape ({n},), got {row.shape}")
         xi[k] = row
     return xi
 
@@ -581,12 +583,13 @@ def check_conservation(traj: Trajectory, generators: Sequence[Generator] | None 
     # no force of the model.
     acting = _acting(traj) if generators else []
     for k, xi in enumerate(generators):
-        # A cyclic coordinate's momentum by its name (p_phi), as the model knows it.
+        # Checked against the model's coordinates first: then a cyclic coordinate's momentum is
+        # named as the model knows it (p_phi).
+        j, size = _momentum_terms(traj, xi, f"generators[{k}]")
         name = model.momentum_names[xi.index] if isinstance(xi, Cyclic) else xi.name if isinstance(xi, (Translation, Rotation)) else f"xi[{k}]"
-        j, size = _momentum_terms(traj, xi)
         record = _core.statistics(t, j - j[0], size, size, steps)
         stats = _statistics(record, name, j[0], "mean max(Σ|pᵢξᵢ|, ‖p‖‖ξ‖)", t)
-        why = _broken(t, _field(traj, xi), acting) if acting else None
+        why = _broken(t, _field(traj, xi, f"generators[{k}]"), acting) if acting else None
         # Not conserved, so not judged; a non-finite momentum fails all the same.
         if why is not None and stats.first_non_finite is None:
             stats = replace(stats, verdict=NOT_JUDGED, advice=why)

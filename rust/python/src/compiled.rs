@@ -111,7 +111,7 @@ impl CompiledModel {
         jit: bool,
         delays: Vec<f64>,
     ) -> PyResult<Self> {
-        generator::generators(py, symmetries, dim)?;
+        generator::generators(symmetries, dim)?;
         let known: &[&str] = match kind {
             "separable" => &[
                 "potential",

@@ -13,7 +13,7 @@ use varmech::ModelError;
 use crate::bind::{bind_model, dim_of};
 use crate::convert::{self, rows, slice, states, ArrayPair};
 use crate::errors::{model_error, model_error_at, to_pyerr};
-use crate::generator::Generator;
+use crate::generator::{checked, Generator};
 use crate::run::steps_count;
 
 /// Three arrays: the energy and its two terms.
@@ -99,17 +99,19 @@ fn derivative<'py>(
     Ok(convert::matrix(py, result?, n)?.into_any())
 }
 
-/// J = p·ξ(q) of a generator for each row of (q, p), and the size Σ|pᵢξᵢ| of its terms.
+/// J = p·ξ(q) of a generator for each row of (q, p), and the size Σ|pᵢξᵢ| of its terms; a
+/// generator that does not apply to the rows' n coordinates is a ValueError naming `argument`.
 #[pyfunction]
+#[pyo3(signature = (generator, q, p, *, argument="generator"))]
 fn momentum<'py>(
     py: Python<'py>,
     generator: Generator,
     q: PyReadonlyArray2<'py, f64>,
     p: PyReadonlyArray2<'py, f64>,
+    argument: &str,
 ) -> PyResult<ArrayPair<'py>> {
-    let g = model::Generator::from(generator);
     let ((q, n), (p, _)) = (rows("q", &q)?, rows("p", &p)?);
-    g.check(n).map_err(|e| to_pyerr(py, e))?;
+    let g = checked(generator, n, argument)?;
     let (j, size): (Vec<f64>, Vec<f64>) = q
         .chunks_exact(n.max(1))
         .zip(p.chunks_exact(n.max(1)))

@@ -3,7 +3,7 @@
 use pyo3::prelude::*;
 use varmech::model;
 
-use crate::errors::to_pyerr;
+use pyo3::exceptions::PyValueError;
 
 /// A generator ξ(q) of a symmetry (the core's `Generator`): `Translation(axis, spatial_dim)`,
 /// `Rotation(axis, spatial_dim)` or `Cyclic(index)`.
@@ -44,14 +44,20 @@ impl Generator {
     }
 }
 
-/// Generators, each checked (by the core) to apply to `dim` coordinates.
-pub fn generators(py: Python<'_>, specs: Vec<Generator>, dim: usize) -> PyResult<Vec<model::Generator>> {
-    specs
-        .into_iter()
-        .map(|spec| {
-            let g = model::Generator::from(spec);
-            g.check(dim).map_err(|e| to_pyerr(py, e))?;
-            Ok(g)
-        })
+/// Generators, each checked (by the core) to apply to `dim` coordinates: ValueError naming
+/// `symmetries[i]` and the model's dimension if not.
+pub fn generators(specs: Vec<Generator>, dim: usize) -> PyResult<Vec<model::Generator>> {
+    (specs.into_iter().enumerate())
+        .map(|(i, spec)| checked(spec, dim, &format!("symmetries[{i}]")))
         .collect()
+}
+
+/// The core's generator of `spec`, checked to apply to `dim` coordinates: ValueError naming
+/// `argument` if not.
+pub fn checked(spec: Generator, dim: usize, argument: &str) -> PyResult<model::Generator> {
+    let g = model::Generator::from(spec);
+    match g.misfit(dim) {
+        Some(reason) => Err(PyValueError::new_err(format!("{argument}: {reason}"))),
+        None => Ok(g),
+    }
 }

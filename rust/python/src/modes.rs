@@ -97,7 +97,7 @@ fn normal_modes<'py>(
     Vec<Option<usize>>,
 )> {
     let py = model.py();
-    let symmetries = generators(py, symmetries, dim_of(py, model)?)?;
+    let symmetries = generators(symmetries, dim_of(py, model)?)?;
     let modes: Result<Modes, ModelError> = on_model(model, &q, "q", |m, q| {
         let fields: Vec<Vec<f64>> = symmetries
             .iter()

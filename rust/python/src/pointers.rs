@@ -131,7 +131,6 @@ impl PointerSystem {
     #[new]
     #[pyo3(signature = (dim, potential, gradient, mass, symmetries))]
     fn new(
-        py: Python<'_>,
         dim: usize,
         potential: Handed<'_>,
         gradient: Handed<'_>,
@@ -144,7 +143,7 @@ impl PointerSystem {
             mass: convert::mass(mass, dim)?,
             potential: Entry::new("potential", potential, dim, 1)?,
             gradient: Entry::new("gradient", gradient, dim, dim)?,
-            symmetries: generator::generators(py, symmetries, dim)?,
+            symmetries: generator::generators(symmetries, dim)?,
             zeros: vec![0.0; dim],
         })
     }
@@ -204,7 +203,6 @@ impl PointerLagrangian {
     #[pyo3(signature = (dim, lagrangian, dl_dq, dl_dv, hessians, force, time_dependent, symmetries))]
     #[allow(clippy::too_many_arguments)]
     fn new(
-        py: Python<'_>,
         dim: usize,
         lagrangian: Handed<'_>,
         dl_dq: Option<Handed<'_>>,
@@ -215,7 +213,7 @@ impl PointerLagrangian {
         symmetries: Vec<Spec>,
     ) -> PyResult<Self> {
         check_closures(dim, [])?;
-        generator::generators(py, symmetries, dim)?;
+        generator::generators(symmetries, dim)?;
         let entry = |name, f: Option<Handed<'_>>, outputs| f.map(|f| Entry::new(name, f, dim, outputs)).transpose();
         Ok(PointerLagrangian {
             dim,

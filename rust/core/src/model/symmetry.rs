@@ -27,25 +27,35 @@ impl Generator {
         }
     }
 
-    /// Checks that the generator applies to `n` coordinates.
+    /// Checks that the generator applies to `n` coordinates ([`Generator::misfit`]), naming
+    /// `generator`.
     pub fn check(&self, n: usize) -> Result<(), crate::Error> {
-        let ok = match *self {
-            Generator::Translation { axis, spatial_dim } => {
-                spatial_dim > 0 && axis < spatial_dim && n.is_multiple_of(spatial_dim)
-            }
-            Generator::Rotation { axis, spatial_dim } => {
-                (spatial_dim == 2 || (spatial_dim == 3 && axis < 3)) && n.is_multiple_of(spatial_dim)
-            }
-            Generator::Cyclic { index } => index < n,
+        self.misfit(n)
+            .map_or(Ok(()), |reason| Err(crate::Error::invalid("generator", reason)))
+    }
+
+    /// Why the generator does not apply to `n` coordinates, if it does not: a cyclic index
+    /// beyond them; bodies of `spatial_dim` coordinates that do not divide them, an axis beyond
+    /// a body's, a rotation outside the plane or space.
+    pub fn misfit(&self, n: usize) -> Option<String> {
+        let (ok, what, rule) = match *self {
+            Generator::Translation { axis, spatial_dim } => (
+                spatial_dim > 0 && axis < spatial_dim && n.is_multiple_of(spatial_dim),
+                format!("Translation(axis={axis}, spatial_dim={spatial_dim})"),
+                format!("spatial_dim must divide {n} and axis be below spatial_dim"),
+            ),
+            Generator::Rotation { axis, spatial_dim } => (
+                (spatial_dim == 2 || (spatial_dim == 3 && axis < 3)) && n.is_multiple_of(spatial_dim),
+                format!("Rotation(axis={axis}, spatial_dim={spatial_dim})"),
+                format!("spatial_dim must be 2 (the plane) or 3 (space, about axis 0, 1 or 2) and divide {n}"),
+            ),
+            Generator::Cyclic { index } => (
+                index < n,
+                format!("Cyclic({index})"),
+                format!("its index must be below {n}"),
+            ),
         };
-        if ok {
-            Ok(())
-        } else {
-            Err(crate::Error::invalid(
-                "generator",
-                format!("{self:?} does not apply to {n} coordinates"),
-            ))
-        }
+        (!ok).then(|| format!("{what} does not apply to a model of {n} coordinates: {rule}"))
     }
 
     /// Writes ξ(q) into `out` (n entries): eₐ at each body for a translation along axis a, eₐ × xᵦ

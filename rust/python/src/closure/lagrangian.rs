@@ -39,7 +39,6 @@ impl ClosureLagrangian {
     #[pyo3(signature = (dim, lagrangian, dl_dq, dl_dv, hessians, force, time_dependent, symmetries, dl_dt=None))]
     #[allow(clippy::too_many_arguments)]
     fn new(
-        py: Python<'_>,
         dim: usize,
         lagrangian: Bound<'_, PyAny>,
         dl_dq: Option<Bound<'_, PyAny>>,
@@ -50,7 +49,7 @@ impl ClosureLagrangian {
         symmetries: Vec<Spec>,
         dl_dt: Option<Bound<'_, PyAny>>,
     ) -> PyResult<Self> {
-        generator::generators(py, symmetries, dim)?;
+        generator::generators(symmetries, dim)?;
         check_closures(
             dim,
             [

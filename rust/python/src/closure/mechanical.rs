@@ -29,7 +29,6 @@ impl ClosureModel {
     #[new]
     #[pyo3(signature = (dim, potential, gradient, mass, symmetries))]
     fn new(
-        py: Python<'_>,
         dim: usize,
         potential: Bound<'_, PyAny>,
         gradient: Option<Bound<'_, PyAny>>,
@@ -38,7 +37,7 @@ impl ClosureModel {
     ) -> PyResult<Self> {
         check_closures(dim, [("potential", Some(&potential)), ("gradient", gradient.as_ref())])?;
         let mass = convert::mass(mass, dim)?;
-        let symmetries = generator::generators(py, symmetries, dim)?;
+        let symmetries = generator::generators(symmetries, dim)?;
         Ok(ClosureModel {
             dim,
             mass,

@@ -35,7 +35,6 @@ impl ClosureNatural {
     /// Python model keeps them for the conservation report.
     #[pyo3(signature = (dim, mass, potential, gradient, mass_derivative, symmetries))]
     fn new(
-        py: Python<'_>,
         dim: usize,
         mass: Bound<'_, PyAny>,
         potential: Bound<'_, PyAny>,
@@ -43,7 +42,7 @@ impl ClosureNatural {
         mass_derivative: Option<Bound<'_, PyAny>>,
         symmetries: Vec<Spec>,
     ) -> PyResult<Self> {
-        generator::generators(py, symmetries, dim)?;
+        generator::generators(symmetries, dim)?;
         check_closures(
             dim,
             [
