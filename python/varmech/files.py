@@ -631,6 +631,32 @@ class Rows:
         return f"Rows({str(self._path)!r}, {self._name!r}, shape={self.shape})"
 
 
+#: Rows read at a time by :func:`read_through`.
+_BLOCK_ROWS = 2**16
+
+
+def read_through(path: Path) -> None:
+    """Reads every part of ``path`` that :func:`varmech.load` reads eagerly and a writer
+    appending to it touches (each column's committed rows, a block at a time, so memory stays
+    flat; both checkpoint slots; the committed counts), refusing it (ValueError naming
+    ``path``) where a checksum fails or a row is not finite: :func:`varmech.resume` reads a
+    file so before it writes, since libhdf5 can hang, deaf to Ctrl-C, writing into damaged
+    metadata that a lazy load never read."""
+    try:
+        with open_read(path) as f:
+            rows = int(f["committed"][0])
+            f["checkpoint0"][:], f["checkpoint1"][:]
+            for name in COLUMNS:
+                if name not in f:
+                    continue
+                for start in range(0, rows, _BLOCK_ROWS):
+                    block = f[name][start : min(rows, start + _BLOCK_ROWS)]
+                    if block.dtype.kind == "f" and not np.isfinite(block).all():
+                        raise ValueError(f"path: {str(path)!r} holds non-finite {name} rows: damaged")
+    except (OSError, KeyError, RuntimeError) as e:
+        raise ValueError(f"path: {str(path)!r} is corrupt or truncated: {e}") from e
+
+
 def planned_steps_of(path: str | os.PathLike[str]) -> int | None:
     """The step at which the run in ``path`` was asked to end (its ``planned_steps``), or None
     for a file that does not record it (a saved trajectory, or one from before format 3.1)."""

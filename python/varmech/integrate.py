@@ -27,7 +27,7 @@ from .scenes import Scene
 
 # Trajectory lives in varmech.trajectory; imported here, it is still found under its old name
 # (varmech.integrate.Trajectory), which pickles made before the move refer to.
-from .trajectory import Trajectory, _trajectory, load, take_partial
+from .trajectory import Trajectory, _trajectory, going_on_from, load, take_partial
 
 __all__ = [
     "integrate",
@@ -418,10 +418,8 @@ def _go_on(
     ``events`` from there (terminal counts after ``traj``'s crossings of the same events, an
     energy error from ``traj``'s first energy), keeping the states at ``t_eval`` if given."""
     contacts = _impacts.going_on(traj.contacts)
-    if traj.checkpoint is None:
-        raise ValueError("model: this trajectory has no checkpoint to go on from (it failed before its first state)")
     # The checkpoint's time: a trajectory of t_eval times ends at its last sample, not there.
-    t_now = _core.Stepper.from_checkpoint(traj.model._core, traj.checkpoint).t
+    t_now = going_on_from(traj, "model", "this trajectory").t
     nsteps = step_count(traj.dt, t_now, steps, t_end)
     save_every = positive_int("save_every", save_every)
     times = _sample_times(t_eval, t_now, t_now + nsteps * traj.dt, save_every, output, traj.model.dim)

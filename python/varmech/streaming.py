@@ -23,8 +23,6 @@ from collections.abc import Callable, Iterator, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-import numpy as np
-
 from . import _core, files
 from . import events as _events
 from . import impacts as _impacts
@@ -34,7 +32,7 @@ from ._util import step_count
 from .impacts import Contact
 from .impulses import Impulse
 from .model import Model
-from .trajectory import Trajectory, crossings, load, take_partial
+from .trajectory import Trajectory, crossings, going_on_from, load, take_partial
 
 if TYPE_CHECKING:
     from tqdm import tqdm
@@ -327,7 +325,9 @@ def resume(
     going_on = _impacts.going_on(stored.contacts, contacts)
     if stored.checkpoint is None or not len(stored.t):
         raise ValueError(f"path: {str(path)!r} has no checkpoint to resume from")
-    _check_checkpoint(path, stored)
+    # Every row and both checkpoints read, as load reads them, before anything is written.
+    files.read_through(Path(path))
+    _check_checkpoint(path, stored, model is not None)
     t_now = float(stored.t[-1])
     _, blows = _impulses.going_on(stored.impulses, impulses, t_now)
     more = _further(path, stored, steps, t_end)
@@ -382,24 +382,21 @@ def _further(path: str | os.PathLike[str], stored: Trajectory, steps: int | None
     return planned - stored.steps
 
 
-def _check_checkpoint(path: str | os.PathLike[str], stored: Trajectory) -> None:
-    """ValueError naming ``path`` unless the file's checkpoint is of its model, method and step
-    and is the state of its last committed row, at the step count ``/committed`` records."""
-    assert stored.checkpoint is not None
+def _check_checkpoint(path: str | os.PathLike[str], stored: Trajectory, given: bool) -> None:
+    """ValueError naming ``path`` unless the file's checkpoint goes on from its last committed
+    row (:func:`varmech.trajectory.going_on_from`, the check ``integrate(traj)`` makes too) with
+    its model (the one it stores, or the one ``given``), and that row is the run's own state
+    (not a sample of ``t_eval``: the rows appended go on from the file's)."""
     try:
-        at = _core.Stepper.from_checkpoint(stored.model._core, stored.checkpoint, method=stored.method, dt=stored.dt)
+        at = going_on_from(stored, "path", repr(str(path)), "committed row")
     except ValueError as e:
-        raise ValueError(f"path: {str(path)!r} has a damaged checkpoint: {e}") from e
-    last = (float(stored.t[-1]), stored.q[-1], stored.p[-1])
-    if at.steps != stored.steps or not all(_same(a, b) for a, b in zip((at.t, at.q, at.p), last)):
+        if str(e).startswith("path: "):
+            raise
+        whose = "model=" if given else "the model stored in it"
+        raise ValueError(f"path: {str(path)!r} cannot go on from its checkpoint with {whose}: {e}") from e
+    if at.t != float(stored.t[-1]):
         raise ValueError(
             f"path: {str(path)!r} cannot be resumed: its checkpoint (step {at.steps}, t = {at.t}) is not the state of "
-            f"its last committed row (step {stored.steps}, t = {last[0]}); the file is damaged, or its rows are "
-            "not the run's saved states (a trajectory of t_eval times)"
+            f"its last committed row (step {stored.steps}, t = {float(stored.t[-1])}): its rows are not the run's saved "
+            "states (a trajectory of t_eval times)"
         )
-
-
-def _same(a: Any, b: Any) -> bool:
-    """Equal to the bit."""
-    a, b = np.asarray(a, dtype=np.float64), np.asarray(b, dtype=np.float64)
-    return a.shape == b.shape and bool(np.array_equal(a.view(np.uint64), b.view(np.uint64)))

@@ -650,6 +650,37 @@ def load(
     )
 
 
+def going_on_from(traj: Trajectory, argument: str, what: str, row: str = "row") -> _core.Stepper:
+    """The core's stepper at ``traj``'s checkpoint, cross-checked against ``traj``: the one
+    check of every run that goes on from a trajectory or its file (``integrate(traj)``,
+    :func:`varmech.resume`). The checkpoint must be of ``traj``'s model, method and step (and
+    not edited: the core recomputes what it derives), at ``traj.steps``, and at its last row's
+    state (t, q, p) to the bit, unless the rows end before it (the samples of a ``t_eval`` run,
+    which went on to its checkpoint). A file whose ``/committed`` names another checkpoint
+    than its last row's is refused so, rather than continued from an older state. ValueError
+    naming ``argument``; ``what`` says what is refused (a file's path), ``row`` what its rows
+    are; the core's refusals of the checkpoint as they are."""
+    if traj.checkpoint is None:
+        raise ValueError(f"{argument}: {what} has no checkpoint to go on from (it failed before its first state)")
+    at = _core.Stepper.from_checkpoint(traj.model._core, traj.checkpoint, method=traj.method, dt=traj.dt)
+    rows = len(traj.t)
+    last = (float(traj.t[-1]), traj.q[-1], traj.p[-1]) if rows else (-np.inf, None, None)
+    sampled = last[0] < at.t
+    if at.steps != traj.steps or not (sampled or all(_same(a, b) for a, b in zip((at.t, at.q, at.p), last))):
+        raise ValueError(
+            f"{argument}: {what} cannot go on: its checkpoint (step {at.steps}, t = {at.t}) is not the state of its "
+            f"last {row} (step {traj.steps}, t = {last[0]}); it is damaged (a file's /committed naming an older "
+            "checkpoint), or its rows were changed"
+        )
+    return at
+
+
+def _same(a: Any, b: Any) -> bool:
+    """Equal to the bit."""
+    a, b = np.asarray(a, dtype=np.float64), np.asarray(b, dtype=np.float64)
+    return a.shape == b.shape and bool(np.array_equal(a.view(np.uint64), b.view(np.uint64)))
+
+
 def _stored_contacts(attrs: Any) -> tuple[Contact | str, ...]:
     """A file's contacts: the native ones rebuilt, the others (and all of a file written before
     contacts were stored) their names."""

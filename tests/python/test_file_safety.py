@@ -379,3 +379,47 @@ def test_a_continued_run_streamed_to_a_file_starts_with_its_state_committed(tmp_
     for name in ("t", "q", "p"):
         assert _same(getattr(streamed, name), getattr(in_memory, name)), name
     assert (streamed.steps, streamed.nfev) == (in_memory.steps, in_memory.nfev)
+
+
+def test_resume_reads_what_load_reads_before_it_writes(tmp_path):
+    # Issue 64 (resume-hang.py): one bit flipped in the metadata between q's and p's chunks and
+    # the Newton counts' chunk of a cleanly closed file. load refused it at once; resume, which
+    # loads lazily, reached it first in its writer (appending Newton counts) and hung in libhdf5,
+    # deaf to Ctrl-C. It now reads every committed row as load does before writing anything.
+    path = tmp_path / "bitflip.h5"
+    varmech.integrate(scenes.double_pendulum(), dt=0.01, method="midpoint", save_every=10, steps=2000, output=path,
+                      checkpoint_every=500)
+    with h5py.File(path, "r") as f:
+        end_of_p = max(f[name].id.get_chunk_info(0).byte_offset + f[name].id.get_chunk_info(0).size for name in "qp")
+        newton_at = f["newton"].id.get_chunk_info(0).byte_offset
+    # The reproducer's byte: 424 bytes into that metadata.
+    assert end_of_p + 424 < newton_at
+    _flip(path, end_of_p + 424, bit=6)
+    before = path.read_bytes()
+    load, resume = _load_and_resume(path)
+    assert load.startswith("load ValueError path: ") and "corrupt" in load, load
+    assert resume.startswith("resume ValueError path: ") and "corrupt" in resume, resume
+    assert path.read_bytes() == before
+
+
+def test_a_loaded_file_goes_on_only_from_its_last_rows_checkpoint(tmp_path):
+    # Issue 64 (load-continue.py): resume cross-checked /committed against the last row, load
+    # followed by integrate(traj) did not, and went on from the older checkpoint (t jumping
+    # back), with status 0. Both go through one check now.
+    s, path = _streamed(tmp_path)
+    with h5py.File(path, "r+") as f:
+        committed = f["committed"][()]
+        committed[1] = 1 - committed[1]
+        committed[2] = f[f"checkpoint{committed[1]}"].shape[0]
+        f["committed"][...] = committed
+    traj = varmech.load(path)
+    with pytest.raises(ValueError, match=r"^model: this trajectory cannot go on: its checkpoint \(step 900, .*\(step 1000"):
+        varmech.integrate(traj, steps=10)
+    with pytest.raises(ValueError, match=r"^path: .* cannot go on: its checkpoint \(step 900"):
+        varmech.resume(path, steps=10)
+    # An intact file goes on both ways to the same bits.
+    (tmp_path / "good").mkdir()
+    _, good = _streamed(tmp_path / "good")
+    more = varmech.integrate(varmech.load(good), steps=100, save_every=10)
+    resumed = varmech.resume(good, steps=100)
+    assert _same(more.q[-1], resumed.q[-1]) and more.t[-1] == resumed.t[-1]
