@@ -144,3 +144,16 @@ def releases_the_gil(run):
     running_while_we_run = not done.is_set()
     thread.join()
     return running_while_we_run and done.is_set()
+
+
+def refix_crc(checkpoint):
+    """``checkpoint`` with its CRC recomputed, as an editor of the bytes would (docs/file_format.md:
+    a 12-byte header, the postcard payload, its CRC-32C little-endian in the last 4 bytes)."""
+    payload = checkpoint[12:-4]
+    crc = 0xFFFFFFFF
+    for byte in payload:
+        crc ^= byte
+        for _ in range(8):
+            # CRC-32C (Castagnoli, iSCSI): the reflected polynomial 0x82F63B78.
+            crc = (crc >> 1) ^ (0x82F63B78 if crc & 1 else 0)
+    return checkpoint[:12] + payload + (crc ^ 0xFFFFFFFF).to_bytes(4, "little")

@@ -250,14 +250,19 @@ def test_a_flipped_bit_in_committed_or_in_the_rows_is_refused(tmp_path):
     assert varmech.resume(path, steps=10).steps == 1010
 
 
-def test_resume_refuses_a_checkpoint_that_is_not_the_last_rows_state(tmp_path):
-    s, path = _streamed(tmp_path)
+def _older_committed(path):
+    """``/committed`` rewritten with valid checksums to name the other checkpoint slot, which
+    holds the checkpoint before the last."""
     with h5py.File(path, "r+") as f:
-        # committed rewritten with valid checksums: the other slot holds the checkpoint before.
         committed = f["committed"][()]
         committed[1] = 1 - committed[1]
         committed[2] = f[f"checkpoint{committed[1]}"].shape[0]
         f["committed"][...] = committed
+
+
+def test_resume_refuses_a_checkpoint_that_is_not_the_last_rows_state(tmp_path):
+    s, path = _streamed(tmp_path)
+    _older_committed(path)
     before = path.read_bytes()
     with pytest.raises(ValueError, match=r"^path: .*its checkpoint \(step 900, .*\) is not the state of its last committed row \(step 1000"):
         varmech.resume(path, steps=10)
@@ -407,11 +412,7 @@ def test_a_loaded_file_goes_on_only_from_its_last_rows_checkpoint(tmp_path):
     # followed by integrate(traj) did not, and went on from the older checkpoint (t jumping
     # back), with status 0. Both go through one check now.
     s, path = _streamed(tmp_path)
-    with h5py.File(path, "r+") as f:
-        committed = f["committed"][()]
-        committed[1] = 1 - committed[1]
-        committed[2] = f[f"checkpoint{committed[1]}"].shape[0]
-        f["committed"][...] = committed
+    _older_committed(path)
     traj = varmech.load(path)
     with pytest.raises(ValueError, match=r"^model: this trajectory cannot go on: its checkpoint \(step 900, .*\(step 1000"):
         varmech.integrate(traj, steps=10)

@@ -135,7 +135,7 @@ def test_general_lagrangians_refuse_explicit_methods_and_name_bad_closures():
     broken = varmech.Lagrangian(2, model.lagrangian, dl_dq=lambda q, v, t: np.zeros(3), dl_dv=model.dl_dv)
     with pytest.raises(ValueError, match=r"dl_dq\(q, v, t\) returned 3 values, expected 2"):
         varmech.integrate(broken, [1.0, 0.0], [0.0, 1.0], dt=0.1, steps=1, method="midpoint")
-    with pytest.raises(ValueError, match="generator"):
+    with pytest.raises(ValueError, match=r"^symmetries\[0\]: Rotation\(axis=2, spatial_dim=2\) does not apply to a model of 3"):
         varmech.Lagrangian(3, model.lagrangian, dl_dq=model.dl_dq, dl_dv=model.dl_dv, symmetries=[varmech.Rotation(spatial_dim=2)])
     with pytest.raises(TypeError, match="^symmetries:"):
         varmech.Lagrangian(2, model.lagrangian, dl_dq=model.dl_dq, dl_dv=model.dl_dv, symmetries=["L"])

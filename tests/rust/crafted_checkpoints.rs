@@ -375,7 +375,7 @@ fn outcome<S: Dynamics + ?Sized>(sys: &S, bytes: &[u8]) -> Result<Result<(), Err
 /// Every sequence of the checkpoint of `sys` after 5 steps of `method`, truncated by one and
 /// extended by one in turn, is refused naming `checkpoint`; every integer, changed, is
 /// refused or resumed, never a panic.
-fn crafted_are_refused<S: Dynamics + ?Sized>(case: &str, sys: &S, method: Method, q0: &[f64], p0: &[f64], dt: f64) {
+fn crafted_are_refused(case: &str, sys: &dyn Dynamics, method: Method, q0: &[f64], p0: &[f64], dt: f64) {
     let traj = integrate(sys, method, q0, p0, &Options::new(dt, 5), || Ok(()))
         .unwrap_or_else(|f| panic!("{case}: {}", f.error));
     let original = record(&Checkpoint::from_bytes(&traj.checkpoint).unwrap());
@@ -457,27 +457,34 @@ fn crafted_are_refused<S: Dynamics + ?Sized>(case: &str, sys: &S, method: Method
     }
 }
 
-#[test]
-fn crafted_checkpoints_are_refused_never_a_panic() {
+/// Runs `check` on a case of every method family and model kind: (name, model, method, q0, p0,
+/// dt).
+fn each_case(mut check: impl FnMut(&str, &dyn Dynamics, Method, &[f64], &[f64], f64)) {
     let kepler = Kepler::problem(0.6).unwrap();
     let (q0, p0) = (&kepler.initial.q, &kepler.initial.p);
-    for method in [Method::KahanLi8, Method::Rk4, Method::Midpoint, Method::Galerkin4] {
-        crafted_are_refused(&format!("kepler {method:?}"), &kepler.system, method, q0, p0, 0.05);
+    for method in [
+        Method::Verlet,
+        Method::KahanLi8,
+        Method::Rk4,
+        Method::Midpoint,
+        Method::Galerkin4,
+    ] {
+        check(&format!("kepler {method:?}"), &kepler.system, method, q0, p0, 0.05);
     }
     let dp = DoublePendulum::problem();
     let (q0, p0) = (&dp.initial.q, &dp.initial.p);
-    crafted_are_refused("double pendulum", &General(&dp.system), Method::Trapezoid, q0, p0, 0.01);
+    check("double pendulum", &General(&dp.system), Method::Trapezoid, q0, p0, 0.01);
     let chain = planar_chain(2).unwrap();
     let (q0, p0) = (&chain.initial.q, &chain.initial.p);
-    for method in [Method::Rattle, Method::Shake] {
-        crafted_are_refused(&format!("planar chain {method:?}"), &chain.system, method, q0, p0, 0.01);
+    for method in [Method::Rattle, Method::Shake, Method::Rattle4] {
+        check(&format!("planar chain {method:?}"), &chain.system, method, q0, p0, 0.01);
     }
     let body = RigidBody::problem();
     let sys = Constrained {
         system: General(&body.system.system),
         constraints: body.system.constraints.clone(),
     };
-    crafted_are_refused(
+    check(
         "rigid body",
         &sys,
         Method::Midpoint,
@@ -487,10 +494,10 @@ fn crafted_checkpoints_are_refused_never_a_panic() {
     );
     let sleigh = ChaplyginSleigh::problem(1.0, 0.5, 1.0).unwrap();
     let (q0, p0) = (&sleigh.initial.q, &sleigh.initial.p);
-    crafted_are_refused("sleigh", &sleigh.system, Method::Dla4, q0, p0, 0.01);
+    check("sleigh", &sleigh.system, Method::Dla4, q0, p0, 0.01);
     let solar = NBody::outer_solar_system();
     let (q0, p0) = (&solar.initial.q, &solar.initial.p);
-    crafted_are_refused(
+    check(
         "solar system",
         &solar.system,
         Method::WisdomHolmanCorrected,
@@ -498,6 +505,11 @@ fn crafted_checkpoints_are_refused_never_a_panic() {
         p0,
         100.0,
     );
+}
+
+#[test]
+fn crafted_checkpoints_are_refused_never_a_panic() {
+    each_case(crafted_are_refused);
 }
 
 /// The reproducer of the panic (a format-2 Kepler kahan_li8 checkpoint, two payload bytes
@@ -591,14 +603,7 @@ const RUN_STATE: [&str; 8] = [
 /// (a zero set to 0.5) with the CRC recomputed, is refused naming `checkpoint`, or leaves
 /// the next 20 steps as they were, or lies in the run's own state ([`RUN_STATE`]): an edited
 /// coefficient or cached force never steers the run.
-fn edited_values_are_refused<S: Dynamics + ?Sized>(
-    case: &str,
-    sys: &S,
-    method: Method,
-    q0: &[f64],
-    p0: &[f64],
-    dt: f64,
-) {
+fn edited_values_are_refused(case: &str, sys: &dyn Dynamics, method: Method, q0: &[f64], p0: &[f64], dt: f64) {
     let traj = integrate(sys, method, q0, p0, &Options::new(dt, 5), || Ok(())).unwrap();
     let original = record(&Checkpoint::from_bytes(&traj.checkpoint).unwrap());
     let run = |bytes: &[u8]| -> Result<Vec<f64>, Error> {
@@ -646,35 +651,5 @@ fn edited_values_are_refused<S: Dynamics + ?Sized>(
 
 #[test]
 fn edited_coefficients_and_cached_forces_are_refused() {
-    let kepler = Kepler::problem(0.6).unwrap();
-    let (q0, p0) = (&kepler.initial.q, &kepler.initial.p);
-    for method in [Method::Verlet, Method::KahanLi8, Method::Galerkin4] {
-        edited_values_are_refused(&format!("kepler {method:?}"), &kepler.system, method, q0, p0, 0.05);
-    }
-    let dp = DoublePendulum::problem();
-    let (q0, p0) = (&dp.initial.q, &dp.initial.p);
-    edited_values_are_refused("double pendulum", &General(&dp.system), Method::Trapezoid, q0, p0, 0.01);
-    let chain = planar_chain(2).unwrap();
-    let (q0, p0) = (&chain.initial.q, &chain.initial.p);
-    edited_values_are_refused("planar chain", &chain.system, Method::Rattle4, q0, p0, 0.01);
-    let body = RigidBody::problem();
-    let sys = Constrained {
-        system: General(&body.system.system),
-        constraints: body.system.constraints.clone(),
-    };
-    let (q0, p0) = (&body.initial.q, &body.initial.p);
-    edited_values_are_refused("rigid body", &sys, Method::Midpoint, q0, p0, 0.01);
-    let sleigh = ChaplyginSleigh::problem(1.0, 0.5, 1.0).unwrap();
-    let (q0, p0) = (&sleigh.initial.q, &sleigh.initial.p);
-    edited_values_are_refused("sleigh", &sleigh.system, Method::Dla4, q0, p0, 0.01);
-    let solar = NBody::outer_solar_system();
-    let (q0, p0) = (&solar.initial.q, &solar.initial.p);
-    edited_values_are_refused(
-        "solar system",
-        &solar.system,
-        Method::WisdomHolmanCorrected,
-        q0,
-        p0,
-        100.0,
-    );
+    each_case(edited_values_are_refused);
 }

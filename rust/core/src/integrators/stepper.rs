@@ -122,10 +122,12 @@ where
     }
 
     /// Advances one step. On failure the state stays at the last good step, and the error
-    /// names the step (counted from 1) and the time it started at.
+    /// names the step (counted from 1) and the time it started at. Unlike
+    /// [`Stepper::advance`] it does not check the time's resolution
+    /// ([`StepperState::check_horizon`]): the partial steps of a located event or impact, far
+    /// below it, take it.
     pub fn step(&mut self) -> Result<(), Error> {
         let state = self.state.borrow_mut();
-        state.check_horizon(1)?;
         // The model's own loop, one step long: the fixed-size loops of small systems (the bits
         // of a generic step, at half its cost: the partial steps of impacts take it), and the
         // own variables of a method that has them, which a step from (q, p) would restart.
