@@ -1,12 +1,15 @@
 //! One model, one method and the state, advanced step by step; the state apart from its model.
 
 use serde::{Deserialize, Serialize};
+mod clock;
+mod decoded;
 mod own_variables;
+
+pub(super) use clock::Clock;
 
 use std::borrow::{Borrow, BorrowMut};
 use std::ops::Deref;
 
-use super::checkpoint::{derived, shape::shape};
 use super::tangent;
 use super::{
     check_method, compensated, Dynamics, Gaps, General, Increment, Integrator, Method, Options, Poll, StepError,
@@ -386,85 +389,6 @@ impl StepperState {
         self.integrator.reset();
     }
 
-    /// Why a decoded state (a checkpoint's, which its CRC does not protect against a crafted
-    /// file) cannot be stepped on `model`, if it cannot: every length, matrix size, variant
-    /// and count in it is compared with the state its method has on `model`, fresh or after a
-    /// step (the constrained methods size their buffers at the first step), every pivot must
-    /// index its vector, and the state, clock and options must be finite and in range. The
-    /// caller has checked the dimension and that the method integrates the model's kind.
-    pub(super) fn misfit<S: Dynamics + ?Sized>(&self, model: &S) -> Option<String> {
-        let vectors = [("q", &self.q), ("p", &self.p), ("eq", &self.eq), ("ep", &self.ep)];
-        if let Some((name, _)) = vectors.iter().find(|(_, x)| !x.iter().all(|v| v.is_finite())) {
-            return Some(format!("its state's {name} is not finite"));
-        }
-        let Clock { t0, n0, h } = self.clock;
-        if !(t0.is_finite() && h.is_finite() && h > 0.0 && n0 <= self.steps && self.t().is_finite()) {
-            return Some(format!(
-                "its clock (t0 = {t0}, dt = {h}, set at step {n0} of {}) is not a valid one",
-                self.steps
-            ));
-        }
-        if let Err(e) = self.integrator.newton_options().unwrap_or_default().check() {
-            return Some(format!("its Newton options are not valid ({e})"));
-        }
-        let (fresh, stepped) = self.templates(model);
-        let (found, fresh, stepped) = (shape(self), shape(&fresh), shape(&stepped));
-        if found == fresh || found == stepped {
-            return None;
-        }
-        let (at, expected) = found
-            .iter()
-            .zip(&stepped)
-            .find(|(a, b)| a != b)
-            .map_or_else(|| (None, None), |(a, b)| (Some(a), Some(b)));
-        Some(match (at, expected) {
-            (Some(a), Some(b)) => format!(
-                "its state does not fit this model and its method {}: {a} where they have {b}",
-                self.method().info().name
-            ),
-            _ => format!(
-                "its state does not fit this model and its method {}: {} parts where they have {}",
-                self.method().info().name,
-                found.len(),
-                stepped.len()
-            ),
-        })
-    }
-
-    /// The states of this one's method, clock and options on `model`, fresh and after a step
-    /// (its buffers sized, its history kept), of zeros: the templates a decoded state is
-    /// checked against.
-    fn templates<S: Dynamics + ?Sized>(&self, model: &S) -> (StepperState, StepperState) {
-        let options = Options {
-            t0: self.clock.t0,
-            compensated: self.compensated,
-            newton: self.integrator.newton_options().unwrap_or_default(),
-            ..Options::new(self.clock.h, 0)
-        };
-        // Of the model's size: the state's own vectors are what is checked.
-        let zeros = vec![0.0; model.dim()];
-        let fresh = StepperState::fresh(self.method(), &zeros, &zeros, &options);
-        let mut stepped = fresh.clone();
-        let (m, holonomic) = model.constraint_counts();
-        stepped.integrator.prepare(model.dim(), m, holonomic);
-        stepped
-            .integrator
-            .keep_history(model.dim(), model.as_lagrangian(), self.clock.h);
-        (fresh, stepped)
-    }
-
-    /// Why a decoded state's derived values (its method's constants and caches) are not what
-    /// its method computes on `model`, if they are not (see `checkpoint/derived.rs`); for a
-    /// state whose shape [`StepperState::misfit`] has checked.
-    pub(super) fn derived_misfit<S: Dynamics + ?Sized>(&self, model: &S) -> Option<String> {
-        derived::misfit(self, &self.templates(model).1, model)
-    }
-
-    /// The integrator, for the checks of a decoded state.
-    pub(super) fn integrator(&self) -> &Integrator {
-        &self.integrator
-    }
-
     /// One step of `model`, which has as many coordinates as the state (checked when the
     /// stepper was made or resumed).
     pub(super) fn step<S: Dynamics + ?Sized>(&mut self, model: &S) -> Result<(), Error> {
@@ -830,71 +754,6 @@ impl<M: Deref<Target: Dynamics>, St: Borrow<StepperState>> Stepper<M, St> {
     pub fn forced_work(&self) -> Option<f64> {
         let lagrangian = self.model.as_lagrangian();
         (lagrangian.is_forced() || lagrangian.is_time_dependent() || self.exchanges).then(|| self.work())
-    }
-}
-
-/// tₙ = t₀ + (n − n₀)·h: the time t₀ and steps n₀ when the step h was last set (see
-/// [`Stepper::set_dt`]).
-#[derive(Clone, Copy, Debug, Serialize, Deserialize)]
-pub(super) struct Clock {
-    t0: f64,
-    n0: usize,
-    pub(super) h: f64,
-}
-
-impl Clock {
-    /// The clock of a run from t0 in steps of h.
-    pub(super) fn new(t0: f64, h: f64) -> Self {
-        Clock { t0, n0: 0, h }
-    }
-
-    /// The time after `steps` steps.
-    #[inline]
-    pub(super) fn at(self, steps: usize) -> f64 {
-        // Through i64: one instruction, where usize → f64 takes a dozen on x86-64.
-        self.t0 + (steps - self.n0) as i64 as f64 * self.h
-    }
-
-    /// Refuses, naming `dt`, steps up to step `end` whose times [`Clock::at`] does not tell
-    /// apart: t₀ + k·h rounds to a float, and where h is below the floats' spacing near the
-    /// run's times, successive steps would share a time (a run at t₀ = 1.7·10⁹ s, Unix time,
-    /// of steps of 0.1 µs) and the saved rows, which a time tells apart, would be lost.
-    ///
-    /// k·h is within u/2 of its value and t₀ + k·h within u, u the spacing of the floats at
-    /// the largest of |t₀|, |t_end| and k·h, so that steps h ≥ 4u are a time apart at least u:
-    /// that is the bound. Refuses, naming `steps`, more than 2⁵³ steps from t₀, whose count k
-    /// is no longer a float's.
-    pub(super) fn check_resolution(self, end: usize) -> Result<(), Error> {
-        let k = end.saturating_sub(self.n0);
-        if k > 1 << 53 {
-            let reason = format!(
-                "{k} steps from t0 = {:?} are more than 2**53, past which step counts are not floats",
-                self.t0
-            );
-            return Err(Error::invalid("steps", reason));
-        }
-        let span = k as f64 * self.h;
-        let largest = self.t0.abs().max((self.t0 + span).abs()).max(span);
-        let ulp = f64::from_bits(largest.to_bits() + 1) - largest;
-        if self.h >= 4.0 * ulp {
-            return Ok(());
-        }
-        let near = if self.t0.abs() >= (self.t0 + span).abs() {
-            self.t0
-        } else {
-            self.t0 + span
-        };
-        let reason = format!(
-            "{:?} is below the resolution of the time over this run: the floats near t = {near:e} are {ulp:.4e} apart \
-             (ulp(t)), and steps shorter than 4 ulp(t) = {:.4e} are not told apart (t0 + k·dt would repeat values, and \
-             the run would lose steps); count the time from the run's start (t0 = 0, adding {:e} to its times \
-             afterwards), or take dt ≥ {:.4e}",
-            self.h,
-            4.0 * ulp,
-            self.t0,
-            4.0 * ulp
-        );
-        Err(Error::invalid("dt", reason))
     }
 }
 
