@@ -107,3 +107,31 @@ def test_a_routhian_of_closures_without_derivatives_runs_through_its_nested_solv
     for method in ("midpoint", "trapezoid", "galerkin4"):
         traj = varmech.integrate(reduced, [1.0], v0=[0.0], dt=0.01, t_end=20.0, method=method)
         assert varmech.check_conservation(traj).energy.verdict == "bounded"
+
+
+def test_a_ball_on_a_turntable_near_gimbal_lock_is_told_apart_from_one_a_smaller_step_saves():
+    # The ball's attitude is Euler angles: where θ comes near 0 (sin θ ≈ 0.02) ∂²L/∂q̇² is nearly
+    # singular, and no step that keeps is safe for long; where the run fails farther from it
+    # (sin θ ≈ 0.16), a quarter of the step runs.
+    near = varmech.scenes.ball_on_turntable(omega=1.0, x0=1.0, vx0=0.5, spin=0.0)
+    with pytest.raises(varmech.ConvergenceError, match="nearly singular here") as info:
+        varmech.integrate(near, dt=near.dt, t_end=near.t_end)
+    assert np.min(np.abs(np.sin(info.value.partial.q[:, 3]))) < 0.05
+    far = varmech.scenes.ball_on_turntable(omega=0.5, x0=1.0, vx0=0.5, spin=0.0)
+    with pytest.raises(varmech.ConvergenceError, match="a smaller step \\(dt\\) brings it closer"):
+        varmech.integrate(far, dt=far.dt, t_end=far.t_end)
+    varmech.integrate(far, dt=far.dt / 4, t_end=far.t_end)
+
+
+def test_a_solve_inside_the_model_that_fails_is_a_typed_error_with_its_own_advice():
+    # L = −cos q̇ is not convex in q̇: ∂L/∂q̇ = sin q̇ reaches no p beyond 1.
+    model = varmech.Lagrangian(
+        1, lambda q, v, t: -np.cos(v[0]) - 0.5 * q[0] ** 2, dl_dq=lambda q, v, t: -q.copy(), dl_dv=lambda q, v, t: np.sin(v)
+    )
+    with pytest.raises(ValueError, match="^q0, p0: the inverse Legendre transform .* has no solution near the last velocity"):
+        varmech.integrate(model, [1.0], [2.0], dt=0.01, steps=10, method="midpoint")
+    # From p = 0.5 the motion drives q̇ to π/2, where ∂²L/∂q̇² vanishes: the inverse Legendre
+    # transform inside a step fails, typed, at the step it failed in.
+    with pytest.raises(varmech.ConvergenceError, match="^the inverse Legendre transform") as info:
+        varmech.integrate(model, [1.0], [0.5], dt=0.01, steps=2000, method="midpoint")
+    assert info.value.step > 1 and len(info.value.partial) >= info.value.step

@@ -2,8 +2,6 @@
 
 use std::fmt;
 
-pub use crate::solve::Diagnosis;
-
 /// SHAKE's failure to reach its tolerance in its sweeps: its advice is not a smaller step.
 pub(crate) const SHAKE_UNCONVERGED: &str = "SHAKE did not reach its tolerance on the constraints";
 
@@ -20,14 +18,14 @@ pub enum Error {
     /// beyond the threshold the user set.
     Divergence { step: usize, time: f64, reason: String },
     /// Newton's method did not solve the implicit equations of `step` (which starts at `time`);
-    /// `diagnosis` says what would help.
+    /// `advice` says what would help, from the iteration's course ([`crate::solve::Diagnosis`]).
     Convergence {
         step: usize,
         time: f64,
         residual: f64,
         iterations: usize,
         reason: &'static str,
-        diagnosis: Diagnosis,
+        advice: &'static str,
     },
     /// The implicit equations of `step` (which starts at `time`) were solved, but on a branch
     /// that need not continue the trajectory: the step is too large for the dynamics there.
@@ -57,6 +55,16 @@ impl Error {
         }
     }
 
+    /// The model's error `source` during `step`: [`Error::Model`], or, where it is a solve of
+    /// the model's own that failed (the inverse Legendre transform inside a step, a Routhian's
+    /// cyclic velocities), that solve's typed error, with its diagnosis.
+    pub fn model(step: usize, time: f64, source: ModelError) -> Error {
+        match source.downcast::<StepError>() {
+            Ok(nested) => nested.at(step, time),
+            Err(source) => Error::Model { step, time, source },
+        }
+    }
+
     /// The same error, named by the run's `step` and its start `time`: a partial step's, which
     /// a run reports as its own step's.
     pub(crate) fn at(self, step: usize, time: f64) -> Error {
@@ -66,7 +74,7 @@ impl Error {
                 residual,
                 iterations,
                 reason,
-                diagnosis,
+                advice,
                 ..
             } => Error::Convergence {
                 step,
@@ -74,7 +82,7 @@ impl Error {
                 residual,
                 iterations,
                 reason,
-                diagnosis,
+                advice,
             },
             Error::SpuriousBranch { reason, .. } => Error::SpuriousBranch { step, time, reason },
             Error::Model { source, .. } => Error::Model { step, time, source },
@@ -98,18 +106,12 @@ impl fmt::Display for Error {
                 residual,
                 iterations,
                 reason,
-                diagnosis,
+                advice,
             } => {
-                // SHAKE's sweeps converge linearly at a rate the constraints' coupling sets, not h.
-                let advice = if *reason == SHAKE_UNCONVERGED {
-                    "more sweeps help (newton_max_iterations), or rattle, whose Newton iteration converges \
-                     quadratically"
-                } else {
-                    diagnosis.advice()
-                };
                 write!(
                     f,
-                    "{reason} at step {step} (t = {time}): residual {residual:.3e} after {iterations} iterations; {advice}"
+                    "{reason} at step {step} (t = {time}): residual {residual:.3e} after {iterations} iterations{}",
+                    joined(advice)
                 )
             }
             Error::SpuriousBranch { step, time, reason } => {
@@ -128,6 +130,15 @@ impl fmt::Display for Error {
                 write!(f, "contact not resolved in step {step} (from t = {time}): {reason}")
             }
         }
+    }
+}
+
+/// `advice` after a message, where there is some.
+fn joined(advice: &str) -> String {
+    if advice.is_empty() {
+        String::new()
+    } else {
+        format!("; {advice}")
     }
 }
 
@@ -159,12 +170,13 @@ pub(crate) fn check_vector(argument: &'static str, x: &[f64], n: usize) -> Resul
 pub enum StepError {
     /// The model failed while it was evaluated.
     Model(ModelError),
-    /// Newton's method did not solve the step's implicit equations.
+    /// Newton's method did not solve the step's implicit equations; `advice` says what would
+    /// help (from [`crate::solve::Diagnosis`]).
     Convergence {
         residual: f64,
         iterations: usize,
         reason: &'static str,
-        diagnosis: Diagnosis,
+        advice: &'static str,
     },
     /// The step's equations became non-finite: the solution is blowing up.
     NonFinite { reason: &'static str },
@@ -181,19 +193,19 @@ impl StepError {
     /// The error of the run that failed at `step`, which started at `time`.
     pub fn at(self, step: usize, time: f64) -> Error {
         match self {
-            StepError::Model(source) => Error::Model { step, time, source },
+            StepError::Model(source) => Error::model(step, time, source),
             StepError::Convergence {
                 residual,
                 iterations,
                 reason,
-                diagnosis,
+                advice,
             } => Error::Convergence {
                 step,
                 time,
                 residual,
                 iterations,
                 reason,
-                diagnosis,
+                advice,
             },
             StepError::NonFinite { reason } => Error::Divergence {
                 step,
@@ -206,6 +218,30 @@ impl StepError {
         }
     }
 }
+
+impl fmt::Display for StepError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            StepError::Model(e) | StepError::Interrupted(e) => write!(f, "{e}"),
+            StepError::Convergence {
+                residual,
+                iterations,
+                reason,
+                advice,
+            } => write!(
+                f,
+                "{reason}: residual {residual:.3e} after {iterations} iterations{}",
+                joined(advice)
+            ),
+            StepError::NonFinite { reason } | StepError::SpuriousBranch { reason } => write!(f, "{reason}"),
+            StepError::Method(e) => write!(f, "{e}"),
+        }
+    }
+}
+
+/// A solve's failure inside a model's evaluation travels as a [`ModelError`] and is typed again
+/// where the run reports it ([`Error::model`]).
+impl std::error::Error for StepError {}
 
 impl From<ModelError> for StepError {
     fn from(e: ModelError) -> Self {

@@ -97,9 +97,11 @@ pub fn to_pyerr(py: Python<'_>, error: Error) -> PyErr {
         }
         Error::SpuriousBranch { step, time, .. } => (SpuriousBranchError::new_err(error.to_string()), step, time),
         Error::Contact { step, time, .. } => (ContactError::new_err(error.to_string()), step, time),
-        Error::Model { step, time, source } => {
-            (raised(source, |source| Error::Model { step, time, source }), step, time)
-        }
+        Error::Model { step, time, source } => match Error::model(step, time, source) {
+            Error::Model { source, .. } => (raised(source, |source| Error::Model { step, time, source }), step, time),
+            // A solve inside the model's evaluation that failed: its own typed error.
+            typed => return to_pyerr(py, typed),
+        },
         Error::Interrupted { step, time, source } => (
             raised(source, |source| Error::Interrupted { step, time, source }),
             step,

@@ -190,6 +190,8 @@ impl NewtonProblem for Balance<'_> {
         non_finite_start: "the generalized force is non-finite at the guess",
         non_finite: "the generalized force became non-finite",
         not_converged: "Newton on the generalized force did not converge: no equilibrium near the guess",
+        outside: "the guess lies outside the region where Newton's iteration converges: start nearer the \
+                  equilibrium",
     };
 
     fn residual(&mut self, r: &mut [f64]) -> Result<(), StepError> {

@@ -305,7 +305,7 @@ impl Rattle {
                     residual: self.g.amax(),
                     iterations: 0,
                     reason: "G(q₁)M⁻¹G(q₁)ᵀ is singular: the constraints are not independent here",
-                    diagnosis: Diagnosis::Singular,
+                    advice: Diagnosis::Singular.advice(&PositionConstraint::<C>::REASONS),
                 });
             }
             lu_solve(&self.gram, &self.pivots, self.g.as_mut_slice());
@@ -391,7 +391,9 @@ impl Rattle {
                     residual,
                     iterations: sweeps,
                     reason: SHAKE_UNCONVERGED,
-                    diagnosis: Diagnosis::Cap,
+                    // SHAKE's sweeps converge linearly at a rate the constraints' coupling sets, not h.
+                    advice: "more sweeps help (newton_max_iterations), or rattle, whose Newton iteration \
+                             converges quadratically",
                 });
             }
             sweeps += 1;
@@ -473,6 +475,8 @@ impl<C: HolonomicConstraints + ?Sized> NewtonProblem for PositionConstraint<'_, 
         non_finite_start: "the constraints became non-finite",
         non_finite: "the constraints became non-finite",
         not_converged: "RATTLE's Newton iteration for the multipliers did not converge",
+        outside: "the step's drift ends too far from the constraints for Newton's iteration: a smaller step \
+                  (dt) brings it nearer",
     };
 
     fn residual(&mut self, r: &mut [f64]) -> Result<(), StepError> {

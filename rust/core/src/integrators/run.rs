@@ -534,7 +534,7 @@ impl EnergyWatch {
         let (step, time) = (0, stepper.t());
         let terms = match sys.energy(stepper.q(), stepper.p(), time)? {
             Ok(terms) => terms,
-            Err(source) => return Some(Err(Error::Model { step, time, source })),
+            Err(source) => return Some(Err(Error::model(step, time, source))),
         };
         if !terms.energy.is_finite() {
             let reason = not_finite(&terms);
@@ -562,7 +562,7 @@ impl EnergyWatch {
         let (step, time, work) = (stepper.steps(), stepper.t(), stepper.work());
         let terms = match sys.energy(stepper.q(), stepper.p(), time)? {
             Ok(terms) => terms,
-            Err(source) => return Some(Error::Model { step, time, source }),
+            Err(source) => return Some(Error::model(step, time, source)),
         };
         self.push(&terms, work);
         let error = terms.energy - work - self.initial;

@@ -442,7 +442,7 @@ impl StepperState {
         result?;
         tangent
             .apply(model.as_dynamics(), &mut self.integrator, (self.clock.h, &self.q), x)
-            .map_err(|source| Error::Model { step, time, source })
+            .map_err(|source| Error::model(step, time, source))
     }
 
     /// Steps of `model` one at a time, each as [`StepperState::step_with_tangent`], stopping
@@ -864,7 +864,7 @@ impl Clear for Always {
 /// [`Dynamics::check_initial`], a model's error dated at t0.
 fn check_initial<S: Dynamics + ?Sized>(model: &S, q0: &[f64], p0: &[f64], t0: f64) -> Result<(), Error> {
     model.check_initial(q0, p0).map_err(|e| match e {
-        Error::Model { step, source, .. } => Error::Model { step, time: t0, source },
+        Error::Model { step, source, .. } => Error::model(step, t0, source),
         e => e,
     })
 }

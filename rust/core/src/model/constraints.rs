@@ -322,6 +322,7 @@ impl<C: HolonomicConstraints + ?Sized> NewtonProblem for OntoConstraints<'_, C> 
         non_finite_start: "the constraints are non-finite at q0",
         non_finite: "Newton's projection became non-finite",
         not_converged: "no point of the constraints near q0 (Newton's projection failed)",
+        outside: "q0 lies too far from the constraints for Newton's projection: start nearer them",
     };
 
     fn residual(&mut self, r: &mut [f64]) -> Result<(), StepError> {

@@ -6,7 +6,9 @@ use serde::{Deserialize, Serialize};
 use super::{EnergyTerms, MechanicalSystem};
 use crate::error::StepError;
 use crate::solve::difference::{self, central_gradient, central_jacobian, Evaluations};
-use crate::solve::newton::{model_error, norm, Correction, Newton, NewtonOptions, NewtonProblem, Reasons, Rules};
+use crate::solve::newton::{
+    degenerate, model_error, norm, Correction, Newton, NewtonOptions, NewtonProblem, Reasons, Rules,
+};
 use crate::solve::scratch::with_scratch;
 use crate::ModelError;
 
@@ -362,6 +364,8 @@ impl<S: Lagrangian + ?Sized> NewtonProblem for InverseLegendre<'_, S> {
         non_finite_start: "the inverse Legendre transform ∂L/∂q̇ = p is non-finite at the start",
         non_finite: "the inverse Legendre transform ∂L/∂q̇ = p became non-finite",
         not_converged: "the inverse Legendre transform ∂L/∂q̇ = p did not converge",
+        outside: "∂L/∂q̇ = p has no solution near the last velocity: L is not convex in q̇ on the way \
+                  (∂²L/∂q̇² vanishes there), or p lies beyond what ∂L/∂q̇ reaches",
     };
 
     fn residual(&mut self, r: &mut [f64]) -> Result<(), StepError> {
@@ -393,8 +397,21 @@ impl<S: Lagrangian + ?Sized> NewtonProblem for InverseLegendre<'_, S> {
         Correction::relative(self.v, delta)
     }
 
+    /// Its Jacobian is ∂²L/∂q̇².
+    fn degenerate(&mut self) -> Result<bool, StepError> {
+        let n = self.v.len();
+        let mut mass = DMatrix::zeros(n, n);
+        self.jacobian(&mut mass)?;
+        Ok(degenerate(&mass))
+    }
+
     /// The rounding of p.
     fn noise(&self) -> f64 {
         4.0 * f64::EPSILON * norm(self.p)
+    }
+
+    /// ∂L/∂q̇'s terms are of the size of ∂²L/∂q̇² q̇; the corrections are measured relative.
+    fn offset(&self) -> f64 {
+        norm(self.v)
     }
 }

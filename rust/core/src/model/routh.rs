@@ -407,6 +407,8 @@ impl<L: Lagrangian + ?Sized> NewtonProblem for CyclicVelocities<'_, '_, L> {
         non_finite_start: "∂L/∂ċ is non-finite at the last cyclic velocities",
         non_finite: "the cyclic velocities became non-finite",
         not_converged: "the cyclic velocities did not converge: ∂L/∂ċ = μ has no nearby solution",
+        outside: "∂L/∂ċ = μ has no solution near the last cyclic velocities: L is not convex in ċ on the way, \
+                  or μ lies beyond what ∂L/∂ċ reaches",
     };
 
     /// Leaves the full state of the last node in the scratch.

@@ -114,6 +114,9 @@ pub(crate) struct Reasons {
     pub non_finite: &'static str,
     /// The iteration cap was reached.
     pub not_converged: &'static str,
+    /// What it means, and what helps, when the start lies outside the region where Newton's
+    /// iteration converges ([`Diagnosis::Diverged`]).
+    pub outside: &'static str,
 }
 
 /// What the history of a failed iteration says would help: the advice of its error.
@@ -126,49 +129,70 @@ pub enum Diagnosis {
     /// The corrections kept falling, but linearly with fresh Jacobians that disagree with
     /// differences of F: a model's supplied second derivatives are not those of its first.
     Linear,
-    /// The corrections stopped falling well above the noise of the equations there: they are
-    /// not smooth (a kink or jump in the model, or its derivatives).
+    /// The corrections stopped falling well above the noise of the equations there: they have
+    /// no solution nearby, or are not smooth (a kink or jump in the model, or its derivatives).
     Stalled,
     /// Still converging fast at the cap: too few iterations allowed.
     Cap,
     /// The Jacobian is singular.
     Singular,
+    /// The model's ∂²L/∂q̇² is nearly singular here, beyond what the sizes of its masses make
+    /// it ([`degenerate`]): coordinates close to a singularity of theirs.
+    Degenerate,
+}
+
+/// Whether ∂²L/∂q̇² = `mass` is nearly singular beyond the disparity of its diagonal: the
+/// condition number of D^(-1/2) M D^(-1/2), D = diag M, over 10³. A model whose masses differ
+/// (a planet and its moon) is not degenerate; coordinates near a singularity of their own are,
+/// whose rows of M become dependent (Euler angles at θ → 0: the φ and ψ rows, by 1/sin²θ).
+pub fn degenerate(mass: &DMatrix<f64>) -> bool {
+    let d = mass.diagonal().map(|x| x.abs().sqrt());
+    if d.iter().any(|x| !(x.is_finite() && *x > 0.0)) {
+        return true;
+    }
+    let scaled = DMatrix::from_fn(mass.nrows(), mass.ncols(), |i, j| mass[(i, j)] / (d[i] * d[j]));
+    let s = scaled.singular_values();
+    let (least, most) = (s.min(), s.max());
+    least.is_nan() || most.is_nan() || least * 1e3 < most
 }
 
 impl Diagnosis {
-    /// The diagnosis once the Jacobian is checked against differences of F: a linear
-    /// convergence with a Jacobian that agrees is the iteration not yet near the root, where
-    /// F's curvature, not J, slows it.
-    pub(crate) fn confirmed(self, jacobian_agrees: bool) -> Self {
+    /// The advice for a failure so diagnosed, of a problem that fails for `reasons`.
+    pub(crate) fn advice(self, reasons: &Reasons) -> &'static str {
         match self {
-            Diagnosis::Linear if jacobian_agrees => Diagnosis::Diverged,
-            other => other,
-        }
-    }
-
-    /// The advice for a failure so diagnosed.
-    pub fn advice(self) -> &'static str {
-        match self {
-            Diagnosis::Diverged => {
-                "the step's predictor lies outside the region where Newton's iteration converges: a smaller \
-                 step (dt) brings it closer"
-            }
+            Diagnosis::Diverged => reasons.outside,
             Diagnosis::Linear => {
                 "the corrections fell only linearly, and the Jacobian disagrees with differences of the \
                  equations: the model's second derivatives (hessians) are not those of its first; check them \
                  (varmech.check_derivatives); a smaller step does not help"
             }
             Diagnosis::Stalled => {
-                "the corrections stopped falling far above the noise of the equations: the model is not smooth \
-                 here (a kink or jump in L, its derivatives or forces); a smaller step does not help"
+                "the corrections stopped falling far above the noise of the equations: they have no solution \
+                 nearby, or the model is not smooth here (a kink or jump in L, its derivatives or forces); a \
+                 smaller step does not help"
             }
             Diagnosis::Cap => "it was still converging: allow more iterations (newton_max_iterations)",
-            Diagnosis::Singular => {
-                "the Jacobian is singular: ∂²L/∂q̇² is not invertible here (the Lagrangian is not regular) or \
-                 the constraints are dependent, unless the step lies at a fold of the discrete map, which a \
-                 smaller step avoids"
+            // The problem's reason says why, and what helps.
+            Diagnosis::Singular => "",
+            Diagnosis::Degenerate => {
+                "∂²L/∂q̇² is nearly singular here: the coordinates approach a singularity of theirs (Euler \
+                 angles at θ → 0 or π), where the velocities, and so what a step must resolve, grow without \
+                 bound; a smaller step helps only for a while, coordinates without the singularity help"
             }
         }
+    }
+
+    /// The diagnosis once the problem is looked at: a model nearly singular there
+    /// ([`NewtonProblem::degenerate`]) explains a failure that is no cap; a linear convergence
+    /// with a Jacobian that agrees with differences of F ([`NewtonProblem::jacobian_agrees`]) is
+    /// the iteration not yet near the root, where F's curvature, not J, slows it.
+    pub(crate) fn confirmed<P: NewtonProblem>(self, problem: &mut P) -> Result<Self, StepError> {
+        Ok(match self {
+            Diagnosis::Cap | Diagnosis::Singular => self,
+            _ if problem.degenerate()? => Diagnosis::Degenerate,
+            Diagnosis::Linear if problem.jacobian_agrees()? => Diagnosis::Diverged,
+            other => other,
+        })
     }
 }
 
@@ -184,6 +208,12 @@ pub(crate) trait NewtonProblem {
 
     /// Writes ∂F/∂x into `jac` (it is factorised in place afterwards).
     fn jacobian(&mut self, jac: &mut DMatrix<f64>) -> Result<(), StepError>;
+
+    /// Whether the model's ∂²L/∂q̇² is nearly singular at the problem's state ([`degenerate`]):
+    /// asked only to diagnose a failure. Default: not known to be.
+    fn degenerate(&mut self) -> Result<bool, StepError> {
+        Ok(false)
+    }
 
     /// Whether the Jacobian the problem supplies agrees with differences of F at the current x
     /// (a model's second derivatives need not be those of its first): asked only to diagnose a
@@ -202,7 +232,9 @@ pub(crate) trait NewtonProblem {
     fn noise(&self) -> f64;
 
     /// The size of what the unknowns are added to before F is evaluated (q₀ for a step's
-    /// increments): its rounding moves them by a few ε of it. Default: nothing.
+    /// increments), or of the unknowns themselves where the corrections are measured relative to
+    /// them (q̇ for the inverse Legendre transform): its rounding moves them by a few ε of it,
+    /// and F by ‖J‖ times that. Default: nothing.
     fn offset(&self) -> f64 {
         0.0
     }
@@ -522,7 +554,7 @@ impl Newton {
                             residual,
                             iterations: iteration - 1,
                             reason: reasons.singular,
-                            diagnosis: Diagnosis::Singular,
+                            advice: Diagnosis::Singular.advice(&reasons),
                         })
                     }
                 };
@@ -562,19 +594,21 @@ impl Newton {
             residual,
             iterations: options.max_iterations,
             reason: reasons.not_converged,
-            diagnosis: progress.diagnosis().confirmed(problem.jacobian_agrees()?),
+            advice: progress.diagnosis().confirmed(problem)?.advice(&reasons),
         })
     }
 }
 
 /// A failed iteration as the model layer reports it.
+/// A failed iteration as the model layer reports it: the model's own errors unchanged, and a
+/// failure of the solve itself whole, so that the run reports it typed ([`Error::model`]).
+///
+/// [`Error::model`]: crate::Error::model
 pub(crate) fn model_error(e: StepError) -> ModelError {
     match e {
         StepError::Model(e) | StepError::Interrupted(e) => e,
-        StepError::Convergence { reason, .. }
-        | StepError::NonFinite { reason }
-        | StepError::SpuriousBranch { reason } => reason.into(),
         StepError::Method(e) => e.to_string().into(),
+        e => Box::new(e),
     }
 }
 

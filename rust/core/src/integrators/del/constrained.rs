@@ -231,6 +231,8 @@ impl<S: Lagrangian + ?Sized> NewtonProblem for OntoHiddenConstraint<'_, S> {
         non_finite_start: "the velocity on the hidden constraint G(q₁)q̇ = 0 is non-finite",
         non_finite: "the momenta on the hidden constraint G(q₁)q̇ = 0 became non-finite",
         not_converged: "the momenta could not be put on the hidden constraint G(q₁)q̇ = 0",
+        outside: "the step's momenta end too far from the hidden constraint for Newton's iteration: a \
+                  smaller step (dt) brings them nearer",
     };
 
     fn residual(&mut self, r: &mut [f64]) -> Result<(), StepError> {

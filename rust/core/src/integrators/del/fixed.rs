@@ -97,14 +97,17 @@ impl<R: DiscreteLagrangian> Del<TwoPoint<R>> {
             let mut iteration = 0;
             loop {
                 if iteration == options.max_iterations {
-                    let agrees = self
-                        .unconstrained(sys, start, &mut x, &mut evaluations)
-                        .jacobian_agrees()?;
+                    let diagnosis = progress.diagnosis().confirmed(&mut self.unconstrained(
+                        sys,
+                        start,
+                        &mut x,
+                        &mut evaluations,
+                    ))?;
                     return Err(StepError::Convergence {
                         residual,
                         iterations: iteration,
                         reason: REASONS.not_converged,
-                        diagnosis: progress.diagnosis().confirmed(agrees),
+                        advice: diagnosis.advice(&REASONS),
                     });
                 }
                 iteration += 1;
@@ -132,7 +135,7 @@ impl<R: DiscreteLagrangian> Del<TwoPoint<R>> {
                         residual,
                         iterations: iteration - 1,
                         reason: REASONS.singular,
-                        diagnosis: Diagnosis::Singular,
+                        advice: Diagnosis::Singular.advice(&REASONS),
                     })?;
                 }
                 iterations += 1;

@@ -26,7 +26,7 @@ use crate::discrete::Segment;
 use crate::model::{HolonomicConstraints, Lagrangian, VelocityConstraints};
 use crate::solve::difference::{self, central_jacobian, Evaluations};
 use crate::solve::lu::lu_in_place;
-use crate::solve::newton::{norm, Correction, Newton, NewtonProblem, Reasons, Rules};
+use crate::solve::newton::{degenerate, norm, Correction, Newton, NewtonProblem, Reasons, Rules};
 use crate::solve::NewtonOptions;
 use crate::ModelError;
 use constrained::{constrained_equations, Multipliers, Parts};
@@ -513,10 +513,13 @@ struct Equations<'a, Sc, S: ?Sized> {
 
 /// Why a step's Newton iteration failed.
 const REASONS: Reasons = Reasons {
-    singular: "the Jacobian of the step's equations is singular",
+    singular: "the Jacobian of the step's equations is singular (∂²L/∂q̇² is not invertible here, or the \
+               step lies at a fold of the discrete map, which a smaller step avoids)",
     non_finite_start: "the implicit equations are non-finite at the predictor",
     non_finite: "the implicit equations became non-finite (Newton's method or the solution diverged)",
     not_converged: "Newton's method did not converge",
+    outside: "the step's predictor lies outside the region where Newton's iteration converges: a smaller step \
+              (dt) brings it closer",
 };
 
 impl<Sc: StepEquations, S: Lagrangian + ?Sized> NewtonProblem for Equations<'_, Sc, S> {
@@ -553,6 +556,21 @@ impl<Sc: StepEquations, S: Lagrangian + ?Sized> NewtonProblem for Equations<'_, 
             self.differenced_jacobian(jac)?;
         }
         finite_jacobian(jac.as_slice())
+    }
+
+    /// ∂²L/∂q̇² at q₀ and the step's velocity δq/h, by differences of ∂L/∂q̇.
+    fn degenerate(&mut self) -> Result<bool, StepError> {
+        let Self { sys, start, x, .. } = self;
+        let n = start.q.len();
+        let mut v: Vec<f64> = x[x.len() - n..].iter().map(|d| d / start.h).collect();
+        let (mut mass, mut plus, mut minus) = (DMatrix::zeros(n, n), vec![0.0; n], vec![0.0; n]);
+        let at = Evaluations {
+            plus: &mut plus,
+            minus: &mut minus,
+        };
+        let dl_dv = |v: &[f64], out: &mut [f64]| sys.dl_dv(start.q, v, start.t, out);
+        central_jacobian(dl_dv, &mut v, difference::unit, at, &mut mass)?;
+        Ok(degenerate(&mass))
     }
 
     /// The exact Jacobian, where there is one, against differences of F (10⁻⁴ relative in the

@@ -176,7 +176,7 @@ impl<M: Deref<Target: Dynamics>> Search<'_, '_, M> {
         self.p.copy_from_slice(p);
         let model = self.scratch.model().as_dynamics();
         let evaluated = self.detector.functions.evaluate(model, t, q, p, &mut self.g);
-        evaluated.map_err(|source| Error::Model { step, time: t, source })?;
+        evaluated.map_err(|source| Error::model(step, t, source))?;
         check_finite(&self.detector.specs, &self.g, step, t)
     }
 
@@ -258,7 +258,7 @@ fn check_finite(specs: &[EventSpec], g: &[f64], step: usize, time: f64) -> Resul
         Some(i) => {
             let (name, value) = (&specs[i].name, g[i]);
             let source = format!("event {name} returned a non-finite value g = {value} at t = {time}").into();
-            Err(Error::Model { step, time, source })
+            Err(Error::model(step, time, source))
         }
     }
 }

@@ -375,7 +375,7 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
         let stopped = stopped?;
         let (step, time) = (stepper.steps(), self.t);
         if let Some(source) = error {
-            return Err(Error::Model { step, time, source });
+            return Err(Error::model(step, time, source));
         }
         if stale {
             // φ at the next step's start: the stopped step's start, or the state.
@@ -583,7 +583,7 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
     /// The jump of impulse k at (q, p⁻) (the contact buffers) at time t: p⁺ = p⁻ + P(q) into
     /// `piece_p`, projected on the constraints of a constrained model (their workless impulse).
     fn blow(&mut self, k: usize, step: usize, t: f64) -> Result<(), Error> {
-        let model_error = |source| Error::Model { step, time: t, source };
+        let model_error = |source| Error::model(step, t, source);
         let impulse = &self.schedule.expect("a schedule blows").impulses()[k];
         impulse
             .blow
@@ -1119,7 +1119,7 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
                 let friction = contact.friction.as_ref().expect("a sliding contact has friction");
                 let x = &lambda[row..row + friction.rows(n)];
                 hold.slip_force((contact, friction), scratch.q(), x, direction)
-                    .map_err(|source| Error::Model { step, time, source })?;
+                    .map_err(|source| Error::model(step, time, source))?;
                 -x.iter().map(|y| y * y).sum::<f64>().sqrt()
             };
             let target = &mut self.directions[j * n..(j + 1) * n];
@@ -1151,7 +1151,7 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
         p.copy_from_slice(&hold.p);
         (self.contact_q, self.piece_p, self.v, self.w) = (q, p, v, w);
         projected.map_err(|source| run_error(source, step, time))?;
-        velocities.map_err(|source| Error::Model { step, time, source })?;
+        velocities.map_err(|source| Error::model(step, time, source))?;
         self.step_work += change;
         Ok(())
     }
@@ -1187,7 +1187,7 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
                 (q, p, t),
                 (slip, direction),
             )
-            .map_err(|source| Error::Model { step, time, source })?;
+            .map_err(|source| Error::model(step, time, source))?;
         let size = slip[..friction.rows(q.len())].iter().map(|x| x * x).sum::<f64>().sqrt();
         Ok((size, scale))
     }
@@ -1203,7 +1203,7 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
         } = self;
         let model = scratch.model().as_lagrangian();
         let (q, p) = (scratch.q(), scratch.p());
-        let model_error = |source| Error::Model { step, time, source };
+        let model_error = |source| Error::model(step, time, source);
         model.velocity(q, p, t, v).map_err(model_error)?;
         let speed = amax(v);
         model.dl_dq(q, zeros, t, w).map_err(model_error)?;
@@ -1220,7 +1220,7 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
             return Ok(());
         }
         let time = self.t;
-        let model_error = |source| Error::Model { step, time, source };
+        let model_error = |source| Error::model(step, time, source);
         self.scratch
             .model()
             .as_lagrangian()
@@ -1270,7 +1270,7 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
         if self.hold.is_none() {
             return Ok(());
         }
-        let model_error = |source| Error::Model { step, time: t, source };
+        let model_error = |source| Error::model(step, t, source);
         let h = self.scratch.dt();
         self.scratch
             .model()
@@ -1333,7 +1333,7 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
         let contacts = self.contacts;
         let contact = &contacts[j];
         let (t, time) = (ta + s, self.t);
-        let model_error = |source| Error::Model { step, time, source };
+        let model_error = |source| Error::model(step, time, source);
         let model = self.scratch.model();
         let (q, p) = (&self.contact_q[..], &self.contact_p[..]);
         contact.surface.gradient(q, &mut self.normal).map_err(model_error)?;
@@ -1404,7 +1404,7 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
             return Ok(None);
         }
         let time = self.t;
-        let model_error = |source| Error::Model { step, time, source };
+        let model_error = |source| Error::model(step, time, source);
         // p with the normal velocity gone, λ/(1 + e) along ∇φ; v⁺ = −e∇φ·q̇⁻ = eλ nᵀM⁻¹n/(1 + e).
         for (x, (a, b)) in self.w.iter_mut().zip(self.contact_p.iter().zip(&self.normal)) {
             *x = a + reflection / (1.0 + e) * b;
@@ -1454,7 +1454,7 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
         reflection: f64,
     ) -> Result<(f64, bool), Error> {
         let time = self.t;
-        let model_error = |source| Error::Model { step, time, source };
+        let model_error = |source| Error::model(step, time, source);
         let Resolver {
             scratch,
             discrete,
@@ -1521,7 +1521,7 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
             let (model, time) = (self.scratch.model().as_lagrangian(), self.t);
             let vectors = (&mut self.normal[..], &mut self.v[..]);
             let rate = phi_rate(&self.contacts[j], model, (ta, &self.piece_q, &self.piece_p), vectors)
-                .map_err(|source| Error::Model { step, time, source })?;
+                .map_err(|source| Error::model(step, time, source))?;
             let end = (tau, self.phi_end[j]);
             ((start, end), Some(quadratic_root(start.1, rate, end)))
         };
@@ -1553,7 +1553,7 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
         let (model, time) = (self.scratch.model().as_lagrangian(), self.t);
         let state = (ta + s, self.scratch.q(), self.scratch.p());
         let rate = phi_rate(&self.contacts[j], model, state, (&mut self.normal, &mut self.v))
-            .map_err(|source| Error::Model { step, time, source })?;
+            .map_err(|source| Error::model(step, time, source))?;
         Ok((phi, rate))
     }
 
@@ -1724,7 +1724,7 @@ fn crossing(start: f64, end: f64) -> bool {
 /// φ of every contact at q into `phi`; a surface's error names the run's step and time.
 fn evaluate(contacts: &[Contact<'_>], q: &[f64], phi: &mut [f64], step: usize, time: f64) -> Result<(), Error> {
     for (c, phi) in contacts.iter().zip(phi) {
-        *phi = gap(c, None, q).map_err(|source| Error::Model { step, time, source })?;
+        *phi = gap(c, None, q).map_err(|source| Error::model(step, time, source))?;
     }
     Ok(())
 }
