@@ -529,7 +529,9 @@ def check_conservation(traj: Trajectory, generators: Sequence[Generator] | None 
         For a balance (forced, or L depending on t) that would be "secular drift": run the same motion again at
         h/2 and call the balance "bounded" when its error falls at the method's order (the
         discretisation error of the work, not a drift), with the measured order in the advice.
-        This costs twice the run; ``False`` skips it.
+        This costs twice the run. For a conserved energy that would be "secular drift" or "too
+        short to judge": judge it again over the run continued as long again, "bounded" where
+        the error levels off there (a transient). This costs one more run. ``False`` skips both.
 
     Returns
     -------
@@ -571,6 +573,8 @@ def check_conservation(traj: Trajectory, generators: Sequence[Generator] | None 
             energy = replace(energy, advice=f"{energy.advice}; {_failure_advice(traj)}")
         elif forced and energy.verdict == "secular drift" and refine:
             energy = _refined(traj, energy)
+        elif not forced and energy.verdict in ("secular drift", "too short to judge") and refine:
+            energy = _continued(traj, energy)
     else:
         energy = energy_statistics(model, t, *traj._arrays()[1:], steps=steps)
         # Not conserved, so not judged; but a non-finite energy fails the run all the same.
@@ -666,6 +670,29 @@ def _refined(traj: Trajectory, stats: InvariantStatistics) -> InvariantStatistic
         )
         return replace(stats, verdict="bounded", advice=advice)
     return replace(stats, advice=f"it falls only as h^{measured:.2f} at h/2, not at {traj.method}'s order {order}")
+
+
+def _continued(traj: Trajectory, stats: InvariantStatistics) -> InvariantStatistics:
+    """An energy whose run rose too steadily to be called bounded ("secular drift", or "too short
+    to judge"), judged again over the run and its continuation as long again: a transient (the
+    Chaplygin sleigh's energy error rises while its spin decays, then stays) levels off there and
+    is "bounded", a drift keeps growing, and a run too short now may not be. Unchanged for a run
+    that did not reach its end, or saved off its steps."""
+    steps = (traj.t - traj.t[0]) / traj.dt
+    gaps = np.diff(np.rint(steps).astype(np.int64))
+    if traj.status != 0 or len(gaps) == 0 or np.any(gaps <= 0) or not np.allclose(steps, np.rint(steps), rtol=0, atol=1e-6):
+        return stats
+    # Saved as the run was, so that the batches of the verdict's statistics span equal times.
+    every = int(np.gcd.reduce(gaps))
+    more = integrate(traj, steps=int(traj.steps), save_every=every, max_energy_error=None, progress=False)
+    t, q, p = (np.concatenate([a, b[1:]]) for a, b in ((traj.t, more.t), (traj.q, more.q), (traj.p, more.p)))
+    longer = energy_statistics(traj.model, t, q, p, steps=int(more.steps))
+    if longer.verdict == stats.verdict or longer.verdict in ("failed", "too coarse"):
+        return stats
+    how = f"judged over the run continued as long again, to t = {t[-1]:.6g}"
+    if longer.verdict in ("bounded", "conserved to round-off"):
+        return replace(stats, verdict="bounded", advice=f"{how}: the error levels off, a transient")
+    return replace(stats, verdict=longer.verdict, advice=f"{how}: {longer.advice}" if longer.advice else how)
 
 
 def _failure_advice(traj: Trajectory) -> str:
