@@ -15,6 +15,8 @@ its work W (``traj.work``), and the report judges the balance E − W.
   the momentum of its coordinate.
 """
 
+import math
+
 import numpy as np
 import pytest
 
@@ -37,7 +39,8 @@ def test_each_impact_takes_the_laws_own_loss_and_the_balance_closes_to_round_off
     floor = varmech.Contact.wall(0, restitution=e, law=law, name="floor")
     traj = varmech.integrate(scene.model, scene.q0, scene.p0, dt=scene.dt, t_end=scene.t_end, save_every=1000, contacts=[floor])
     impacts = traj.events[0]
-    assert len(impacts) == 10
+    # The scene follows ten bounces, or those whose flights last 10⁻⁴ of the first (seven at 0.3).
+    assert len(impacts) == min(10, int(math.log(1e-4) / math.log(e)))
     after = np.searchsorted(traj.t, impacts.t, side="right") - 1
     k = np.arange(1, len(impacts) + 1)
     # The normal velocity √(2gh₀)eᵏ⁻¹ just before the k-th: the loss (1 − e²)gh₀e^{2(k−1)}.

@@ -79,6 +79,19 @@ def test_an_inelastic_ball_scene_falls_by_e_squared_per_bounce_and_ends_at_its_e
     assert abs(traj.p[-1, 0]) < 1e-12
 
 
+def test_a_nearly_dead_ball_scene_follows_the_bounces_its_step_can_resolve():
+    # e = 0.05: the tenth flight would last 2e⁹t₁ ≈ 1e-12 s, and a step resolving it 10¹³ steps
+    # to the tenth apex; the scene follows K = 3 bounces (e³ ≥ 10⁻⁴ > e⁴) to the apex after the
+    # third, h₀e⁶, in some 10⁵ steps, and its energy balance closes.
+    scene = scenes.bouncing_ball(restitution=0.05)
+    assert round(scene.t_end / scene.dt) < 500_000
+    traj = varmech.integrate(scene, dt=scene.dt, t_end=scene.t_end, save_every=100)
+    assert len(traj.events[0]) == 3
+    np.testing.assert_allclose(traj.q[-1], scene.reference.q, rtol=1e-8)
+    np.testing.assert_allclose(scene.reference.q, 0.05**6, rtol=1e-15)
+    assert varmech.check_conservation(traj).energy.verdict in ("bounded", "conserved to round-off")
+
+
 def test_the_elastic_ball_scene_keeps_its_energy_and_an_explicit_contact_overrides_the_scenes():
     scene = scenes.bouncing_ball()
     g, h0, dt = 9.81, 1.0, scene.dt

@@ -410,7 +410,7 @@ pub static CATALOGUE: [CatalogueEntry; 23] = [
                 general(s.value("restitution"))
             )
         },
-        // At most a fiftieth of the shortest flight, 2e⁹t₁ before the final apex, in N ≡ 5 (mod 10)
+        // At most a fiftieth of the shortest flight, 2eᴷ⁻¹t₁ before the final apex, in N ≡ 5 (mod 10)
         // steps: at e = 1 the k-th impact is then at (2k + 1)N/20 steps, at the fractions α = ¼
         // and ¾ of a step in turn, where the variational law's energy jumps g²h²(1 − 2α)/8 cancel
         // in pairs. A step commensurate with the flight would put every impact at one fraction,
@@ -418,7 +418,7 @@ pub static CATALOGUE: [CatalogueEntry; 23] = [
         dt: |s| {
             let (g, h0, e) = (s.value("g"), s.value("h0"), s.value("restitution"));
             let t_end = BouncingBall::horizon(g, h0, e);
-            let flight = 2.0 * e.powi(9) * (2.0 * h0 / g).sqrt();
+            let flight = 2.0 * e.powi(BouncingBall::bounces(e) - 1) * (2.0 * h0 / g).sqrt();
             let n = (steps_to(t_end, flight / 50.0)..).find(|n| n % 10 == 5);
             t_end / n.unwrap_or(1) as f64
         },
