@@ -96,6 +96,19 @@ def damped_oscillator():
 
 
 @pytest.fixture
+def kink():
+    """V = 5|q| with its exact derivatives: from rest at the kink, the midpoint step's equations
+    jump over 0 at q₁ = q₀ (the force is ±5 on either side), and have no solution."""
+    return varmech.Lagrangian(
+        1,
+        lambda q, v, t: 0.5 * v[0] ** 2 - 5 * abs(q[0]),
+        dl_dq=lambda q, v, t: np.array([-5.0 if q[0] >= 0 else 5.0]),
+        dl_dv=lambda q, v, t: v.copy(),
+        hessians=lambda q, v, t: (np.zeros((1, 1)), np.zeros((1, 1)), np.ones((1, 1))),
+    )
+
+
+@pytest.fixture
 def run_cli():
     """Runs ``python -m varmech <args>`` in a subprocess, capturing its text output."""
 

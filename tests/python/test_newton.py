@@ -53,15 +53,8 @@ def _diagnosed(model, q0, **options) -> str:
     return str(info.value)
 
 
-def test_a_step_without_a_solution_is_a_model_that_is_not_smooth_and_no_smaller_step_helps():
-    # V = 5|q| from rest at the kink: F jumps over 0 at q₁ = q₀ whatever the step.
-    kink = varmech.Lagrangian(
-        1,
-        lambda q, v, t: 0.5 * v[0] ** 2 - 5 * abs(q[0]),
-        dl_dq=lambda q, v, t: np.array([-5.0 if q[0] >= 0 else 5.0]),
-        dl_dv=lambda q, v, t: v.copy(),
-        hessians=lambda q, v, t: (np.zeros((1, 1)), np.zeros((1, 1)), np.ones((1, 1))),
-    )
+def test_a_step_without_a_solution_is_a_model_that_is_not_smooth_and_no_smaller_step_helps(kink):
+    # F jumps over 0 at q₁ = q₀ whatever the step.
     for dt in (0.1, 0.001):
         assert "not smooth here" in _diagnosed(kink, 0.0, dt=dt, steps=3)
 
