@@ -682,8 +682,9 @@ def _continued(traj: Trajectory, stats: InvariantStatistics) -> InvariantStatist
     gaps = np.diff(np.rint(steps).astype(np.int64))
     if traj.status != 0 or len(gaps) == 0 or np.any(gaps <= 0) or not np.allclose(steps, np.rint(steps), rtol=0, atol=1e-6):
         return stats
-    # Saved as the run was, so that the batches of the verdict's statistics span equal times.
-    every = int(np.gcd.reduce(gaps))
+    # Saved as the run was (its usual gap; the last one may be short), so that the batches of the
+    # verdict's statistics span equal times: a finer continuation would outweigh the run.
+    every = int(np.median(gaps))
     more = integrate(traj, steps=int(traj.steps), save_every=every, max_energy_error=None, progress=False)
     t, q, p = (np.concatenate([a, b[1:]]) for a, b in ((traj.t, more.t), (traj.q, more.q), (traj.p, more.p)))
     longer = energy_statistics(traj.model, t, q, p, steps=int(more.steps))
