@@ -83,13 +83,7 @@ fn every_method_family_resumes_bit_for_bit() {
     let kepler = Kepler::problem(0.6).unwrap();
     let (q0, p0) = (&kepler.initial.q, &kepler.initial.p);
     let dt = 2.0 * std::f64::consts::PI / 100.0;
-    for method in [
-        Method::Verlet,
-        Method::KahanLi8,
-        Method::Rk4,
-        Method::Midpoint,
-        Method::Galerkin4,
-    ] {
+    for method in crate::common::FAMILIES {
         resumes_bit_for_bit(&format!("kepler {method:?}"), &kepler.system, method, q0, p0, dt);
     }
 

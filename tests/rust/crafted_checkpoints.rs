@@ -462,13 +462,7 @@ fn crafted_are_refused(case: &str, sys: &dyn Dynamics, method: Method, q0: &[f64
 fn each_case(mut check: impl FnMut(&str, &dyn Dynamics, Method, &[f64], &[f64], f64)) {
     let kepler = Kepler::problem(0.6).unwrap();
     let (q0, p0) = (&kepler.initial.q, &kepler.initial.p);
-    for method in [
-        Method::Verlet,
-        Method::KahanLi8,
-        Method::Rk4,
-        Method::Midpoint,
-        Method::Galerkin4,
-    ] {
+    for method in crate::common::FAMILIES {
         check(&format!("kepler {method:?}"), &kepler.system, method, q0, p0, 0.05);
     }
     let dp = DoublePendulum::problem();

@@ -12,6 +12,15 @@ use varmech::Error;
 pub mod skate;
 pub mod tapes;
 
+/// One method of each family: explicit splitting, composition, baseline, implicit, Galerkin.
+pub const FAMILIES: [Method; 5] = [
+    Method::Verlet,
+    Method::KahanLi8,
+    Method::Rk4,
+    Method::Midpoint,
+    Method::Galerkin4,
+];
+
 /// splitmix64: reproducible points without a dependency.
 pub struct Points(pub u64);
 
