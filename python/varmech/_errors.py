@@ -55,8 +55,13 @@ _VARMECH_ERROR = """Base class of varmech's errors: catch it to catch any of the
 _DIVERGENCE_ERROR = """The solution blew up: a non-finite state, or an energy error beyond ``max_energy_error``.
 
     :func:`varmech.integrate` checks the energy error |E − E₀| at each saved state against
-    ``max_energy_error`` times the energy's scale (the mean kinetic energy so far); a state that
-    is not finite always stops the run. The usual cure is a smaller step.
+    ``max_energy_error`` times the energy's scale (the mean kinetic energy so far). Beyond it,
+    the error stops the run at once where the step is beyond the method's stability limit at
+    the first state, and, within the limit, where it grows (from the 64th saved state on, at
+    least twice the largest error while the run was half as long), or the state does (max |qᵢ|,
+    so judged): the bounded offset of a
+    symplectic method's modified energy at a coarse stable step runs to the end, however
+    large. A state that is not finite always stops the run. The usual cure is a smaller step.
 
     Attributes
     ----------
@@ -74,8 +79,8 @@ _DIVERGENCE_ERROR = """The solution blew up: a non-finite state, or an energy er
 
     Examples
     --------
-    Verlet at h = 3 on the pendulum (period ≈ 6.7): the energy error after one step is 4.4
-    times the kinetic energy.
+    Verlet at h = 3 on the pendulum (period ≈ 6.7), beyond its limit hω = 2: the energy error
+    after one step is 4.4 times the kinetic energy.
 
     >>> import varmech
     >>> try:
@@ -83,6 +88,17 @@ _DIVERGENCE_ERROR = """The solution blew up: a non-finite state, or an energy er
     ... except varmech.DivergenceError as err:
     ...     print(err.step, err.time, err.partial.t)
     1 3.0 [0. 3.]
+
+    Released from rest with its rod horizontal (q = π/2, where it has no small oscillation to
+    bound the step), the same pendulum swings through its bottom at hω = 3 and is thrown over
+    its top: the check stops it while its angle grows.
+
+    >>> import math
+    >>> try:
+    ...     varmech.integrate(varmech.scenes.pendulum(), [math.pi / 2], [0.0], dt=3.0, steps=1000)
+    ... except varmech.DivergenceError as err:
+    ...     print(err.step, "and the state growing" in str(err))
+    107 True
     """
 
 _CONVERGENCE_ERROR = """Newton's method did not solve a step's implicit equations; the message says what helps.

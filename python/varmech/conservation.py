@@ -39,7 +39,8 @@ __all__ = [
 #: "secular drift", "too coarse", "failed".
 VERDICTS: tuple[str, ...] = tuple(_core.VERDICTS)
 #: An error this large against the scale (less the mean error) is a failure; also
-#: ``integrate``'s default ``max_energy_error`` (against the running scale).
+#: ``integrate``'s default ``max_energy_error`` (against the running scale: beyond it, an error
+#: stops a run beyond the method's stability limit, and one within it where it grows).
 FAILURE: float = _core.FAILURE
 #: An error this large against the scale (less the mean error) is of the order of the scale:
 #: "too coarse", whatever its trend.

@@ -150,7 +150,13 @@ def integrate(
         Stop with :class:`~varmech.DivergenceError` when the energy error |E − E₀| at a saved
         state exceeds this times the energy's scale, the mean kinetic energy of the states saved
         so far (errors at round-off never stop a run; see
-        :class:`~varmech.InvariantStatistics`), or when the energy is not finite. A forced run,
+        :class:`~varmech.InvariantStatistics`): at once where the step is beyond the method's
+        stability limit at the first state, and, within it, where the error grows (from the
+        64th saved state on, at least twice the largest error while the run was half as long)
+        or the state does (max |qᵢ|: an orbit thrown out of its well); the bounded offset of a
+        symplectic method's modified energy at a coarse stable step, however large, runs to
+        the end, its size the verdict's to judge; or when the energy is not finite. To stop at an error of a given size, use a terminal event,
+        ``events=[varmech.events.energy_error(bound)]``. A forced run,
         or one of a Lagrangian that depends on t, checks its balance E − W instead, W the energy
         put in (the forces' work less ∫∂L/∂t dt, ``traj.work``). ``"auto"`` (default): 1
         (:data:`varmech.conservation.FAILURE`), the error at which the verdict is "failed"; no

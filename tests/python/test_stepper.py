@@ -210,7 +210,7 @@ def test_a_crafted_checkpoint_is_refused_naming_it_never_a_panic():
     kepler = scenes.kepler()
     # The reproducer (issue 32): format 2, two payload bytes changed and its CRC recomputed.
     reproducer = (Path(__file__).parents[1] / "rust" / "crafted_checkpoint.hex").read_text().strip()
-    with pytest.raises(ValueError, match="^checkpoint: written in checkpoint format 2, this varmech reads format 6"):
+    with pytest.raises(ValueError, match="^checkpoint: written in checkpoint format 2, this varmech reads format 7"):
         varmech.Stepper.from_checkpoint(kepler, bytes.fromhex(reproducer))
     stepper = varmech.Stepper(kepler, dt=0.05, method="kahan_li8")
     stepper.advance(5)

@@ -6,7 +6,9 @@
 //! is negative. For h < 2 F is monotone and the step's solution unique; for h > 2 F' changes sign
 //! where cos q̄ < −4/h², i.e. near the top, and the equation has several solutions there.
 
-use varmech::integrators::{integrate, Failure, Method, Options, Trajectory};
+use varmech::integrators::{
+    integrate, integrate_with_events, Detector, EventSpec, Failure, Method, NativeEvent, Options, Trajectory,
+};
 use varmech::scenes::Pendulum;
 use varmech::Error;
 
@@ -59,7 +61,7 @@ fn a_midpoint_step_beyond_the_fold_is_refused_as_a_spurious_branch() {
 fn below_the_fold_no_step_is_flagged() {
     // F' < 0 everywhere for h < 2: every step has one solution and none may be refused (the
     // run ends in rotation after many steps because its energy error reaches the separatrix,
-    // which only an energy threshold can tell; see the next test).
+    // which only an energy bound can tell; see the next test).
     for h in [0.1, 0.5, 1.0, 1.5] {
         let traj =
             run(Method::Midpoint, h, (400.0 / h) as usize, None).unwrap_or_else(|f| panic!("h = {h}: {}", f.error));
@@ -68,10 +70,12 @@ fn below_the_fold_no_step_is_flagged() {
 }
 
 #[test]
-fn with_an_energy_threshold_no_implicit_method_silently_goes_over_the_top() {
-    // A state with |q| ≥ π has passed the top, impossible at E₀ < 1. With a 1% energy threshold
-    // (the separatrix is 1% above E₀) every run from h = 0.5 to 4 either stops with a typed
-    // error or stays in libration, and every state it returns is in libration.
+fn with_an_energy_bound_no_implicit_method_silently_goes_over_the_top() {
+    // A state with |q| ≥ π has passed the top, impossible at E₀ < 1. The crossing is a jump of
+    // the energy error that stays, not growth, which the run's energy check lets run; a terminal
+    // event at a 1% energy error (the separatrix is 1% above E₀) stops it: every run from h = 0.5
+    // to 4 either stops with a typed error or at the event, or stays in libration, and every
+    // state it returns is in libration.
     for method in [
         Method::Midpoint,
         Method::Trapezoid,
@@ -80,7 +84,27 @@ fn with_an_energy_threshold_no_implicit_method_silently_goes_over_the_top() {
     ] {
         for h in [0.5, 1.0, 1.5, 2.0, 2.01, 2.5, 3.0, 4.0] {
             let steps = (400.0 / h) as usize;
-            let traj = match run(method, h, steps, Some(0.01)).map_err(|f| *f) {
+            let bound = NativeEvent::EnergyError {
+                bound: 0.01,
+                initial: f64::NAN,
+            };
+            bound.check("bound", 1).unwrap();
+            let spec = EventSpec {
+                name: "|E - E0| > 0.01".into(),
+                direction: 1,
+                terminal: 1,
+            };
+            let mut detector = Detector::new(Box::new(vec![bound]), vec![spec]).unwrap();
+            let run = integrate_with_events(
+                &Pendulum::new(),
+                method,
+                &[Q0],
+                &[0.0],
+                &Options::new(h, steps),
+                || Ok(()),
+                &mut detector,
+            );
+            let traj = match run.map_err(|f| *f) {
                 Ok(traj) => traj,
                 Err(Failure {
                     error: Error::Divergence { .. } | Error::Convergence { .. } | Error::SpuriousBranch { .. },

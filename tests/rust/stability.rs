@@ -1,7 +1,8 @@
 //! Linear stability exactly at the documented limits: on q̈ = −ω²q every method is stable 1%
 //! below its hω_max (reference/compositions.json, reference/splittings.json) and unstable 1%
 //! above (less for the splittings whose first unstable window is narrower), where the run stops
-//! with a typed divergence error rather than producing non-finite numbers.
+//! with a typed divergence error rather than producing non-finite numbers: with the energy
+//! check lifted and with it on.
 
 use varmech::integrators::{integrate, Method, Options};
 use varmech::scenes::HarmonicOscillator;
@@ -77,6 +78,53 @@ fn every_method_is_stable_just_below_and_unstable_just_above_its_limit() {
             // past any bounded ellipse, without overflowing.
             Ok(r) if margin(method) < 1e-2 && r > 1e30 => {}
             other => panic!("{} at hω = {h_above}: expected divergence, got {other:?}", info.name),
+        }
+    }
+}
+
+/// The same with the run's energy check on, as a run has it by default (every state saved): at
+/// 0.99 of the limit the energy error is a bounded offset of many times the kinetic energy,
+/// which the check lets run to the end; just above the limit the check stops the run, its
+/// partial trajectory finite, naming h·ω_max.
+#[test]
+fn the_energy_check_lets_a_run_below_the_limit_end_and_stops_one_above_it() {
+    const GUARDED: usize = 20_000;
+    let sys = HarmonicOscillator::new(1.0).unwrap();
+    for method in Method::ALL {
+        let (name, limit) = (method.info().name, method.info().h_omega_max);
+        if !(limit.is_finite() && limit > 0.0) {
+            continue;
+        }
+        let run = |h: f64| integrate(&sys, method, &[0.0], &[1.0], &Options::new(h, GUARDED), || Ok(()));
+        match run(0.99 * limit) {
+            Ok(traj) => {
+                // Bounded, though not small (symplectic Euler's offset reaches 49.5 times the
+                // energy): the second half's largest error is the first half's.
+                let largest = |ks: std::ops::Range<usize>| {
+                    ks.map(|k| (0.5 * (traj.q_at(k)[0].powi(2) + traj.p_at(k)[0].powi(2)) - 0.5).abs())
+                        .fold(0.0_f64, f64::max)
+                };
+                let (first, second) = (largest(0..GUARDED / 2), largest(GUARDED / 2..GUARDED + 1));
+                assert!(
+                    traj.steps == GUARDED && second <= 1.01 * first,
+                    "{name}: {first} then {second}"
+                );
+            }
+            Err(failure) => panic!("{name} at 0.99·hω_max: {:?}", failure.error),
+        }
+        match run((1.0 + margin(method)) * limit) {
+            Err(failure) => {
+                let partial = &failure.partial;
+                assert!(partial.q.iter().chain(&partial.p).all(|x| x.is_finite()), "{name}");
+                match failure.error {
+                    Error::Divergence { reason, .. } => assert!(
+                        reason.contains(&format!("is beyond {name}'s stability limit")),
+                        "{name}: {reason}"
+                    ),
+                    other => panic!("{name} above its limit: {other:?}"),
+                }
+            }
+            Ok(_) => panic!("{name} above its limit ran to the end"),
         }
     }
 }

@@ -143,7 +143,7 @@ impl Fnv {
 
 const MAGIC: &[u8; 8] = b"varmech\x01";
 /// The layout of [`StepperState`] and its parts; raise it whenever they change.
-pub const FORMAT: u32 = 6;
+pub const FORMAT: u32 = 7;
 const HEADER: usize = MAGIC.len() + 4;
 
 impl Checkpoint {

@@ -6,6 +6,7 @@ use super::jumps::{Watch, Watcher};
 use super::stepper::Clock;
 use super::{Checkpoint, Detector, Dynamics, Failure, Method, NewtonOptions, Poll, Stepper, Trajectory};
 use crate::model::{EnergyTerms, Rest, Scale};
+use crate::solve::newton::norm;
 use crate::{memory, Error, ModelError};
 
 /// Options of a fixed-step run.
@@ -19,11 +20,14 @@ pub struct Options {
     pub save_every: usize,
     /// Add the increments with compensated summation (on by default, as in Hairer's GNI codes).
     pub compensated: bool,
-    /// Stop with [`Error::Divergence`] when the energy error |E − E₀| at a saved state
-    /// exceeds this times the energy's scale, the mean kinetic energy over the states saved so
-    /// far ([`Scale`]; errors at round-off never stop a run), or the energy is not finite. A
-    /// forced run checks its balance E − W against the work W instead; a Lagrangian that
-    /// depends on t has no energy to check. `None`: only non-finite states stop the run.
+    /// Stop with [`Error::Divergence`] when the energy error |E − E₀| at a saved state is
+    /// beyond this times the energy's scale, the mean kinetic energy over the states saved so
+    /// far ([`Scale`]; errors at round-off never stop a run), where the step is beyond the
+    /// method's stability limit at the run's first state, or, within it, where the error grows:
+    /// it has at least doubled since the run was half as long, or the state, max |qᵢ|, has
+    /// ([`Growth`] says why that tells a blow-up from a symplectic method's bounded offset); or at once when the energy is not
+    /// finite. A forced run checks its balance E − W against the work W instead; a Lagrangian
+    /// that depends on t has no energy to check. `None`: only non-finite states stop the run.
     /// Default [`Scale::FAILURE`] = 1: the energy is then wrong by the size of the motion.
     /// Checking costs one energy evaluation per saved state.
     pub max_energy_error: Option<f64>,
@@ -430,7 +434,7 @@ where
             outcome = Err(error);
             break;
         }
-        if let Some(error) = watch.as_mut().and_then(|w| w.check(sys, &stepper)) {
+        if let Some(error) = watch.as_mut().and_then(|w| w.check(sys, &stepper, (&first.0, first.1))) {
             // The state of this step is kept: it is finite, only its energy is off.
             outcome = Err(error);
             break;
@@ -516,11 +520,73 @@ fn diagnosed<S: Dynamics + ?Sized>(
 const SAMPLING_PERIOD: usize = 1024;
 
 /// The run's energy check: E − W against its value at the start, judged by a running [`Scale`].
+/// An error beyond `tolerance` × the scale stops the run at once where the step is beyond the
+/// method's stability limit at the run's first state ([`beyond_limit`]; explicit Euler's, 0, at
+/// every step): a blow-up foretold, which the check before the run warned of. Within the limit
+/// it stops the run only where it grows, or the state does ([`Growth`]).
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub(super) struct EnergyWatch {
     initial: f64,
     scale: Scale,
     tolerance: f64,
+    growth: Growth,
+    /// The size of the state, max |qᵢ|, judged as the error is: an orbit thrown out of its well, or
+    /// a pendulum thrown over its top, has an error that jumps once and stays, and a state that
+    /// grows from then on.
+    spread: Growth,
+    /// Whether the step is beyond the limit, once an error has passed the scale: asked then
+    /// (Lanczos on the first state, as a divergence's diagnosis does), once a run.
+    beyond: Option<bool>,
+}
+
+/// Whether an energy error grows: the error at the n-th check (saved state) is at least
+/// [`Growth::FACTOR`] times the largest at the checks up to P, the largest power of two ≤ n/2
+/// (the run then at most half as long), from check [`Growth::FIRST`] on.
+///
+/// Why growth, not size, within the stability limit: a stable step of a symplectic method
+/// conserves a modified energy H̃ = H + O(hᵖ) (Hairer, Lubich & Wanner, GNI IX.8), so its error
+/// E − E₀ is an offset that stays bounded however large it is: on q̈ = −ω²q Verlet's H/H̃ reaches
+/// 1/(1 − (hω/2)²), 50 at 0.99 of its limit, many times the mean kinetic energy. The offset
+/// swings with the angle the step turns a mode by, slowly near a limit (at 0.99 of it: in 11
+/// steps for Verlet, 62 for kahan_li8, 99 for blanes_moan6; a mode far from its limit carries
+/// an offset far below the scale), rising from zero at the start over half that. A baseline of
+/// 32 checks spans that rise, so from check 64 on a bounded offset no longer doubles in a
+/// doubling of the run. An error that grows geometrically (a mode that turns unstable along a
+/// nonlinear run), or drifts or diffuses at least linearly, doubles in every doubling of the
+/// run, and is stopped within a doubling of passing `max_energy_error` × the scale. An offset
+/// that varies more slowly than the run has been long (a step yet closer to the limit, saved
+/// states that alias a near-limit oscillation) reads as growth; an error that jumps once and
+/// stays (an orbit thrown out of its well at one pericentre) does not, but the state it leaves
+/// grows, and the same test of max |qᵢ| stops it. The maxima at powers of two keep the test to four numbers, carried in the checkpoint
+/// so that a resumed run is judged as one run.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+struct Growth {
+    /// Checks so far (the initial state is check 0, with error 0).
+    checks: u64,
+    /// The largest |error| over every check.
+    largest: f64,
+    /// The largest |error| up to check 2ᵏ, 2ᵏ ≤ checks < 2ᵏ⁺¹, and up to check 2ᵏ⁻¹.
+    at_power: f64,
+    baseline: f64,
+}
+
+impl Growth {
+    /// How much an error must grow in a doubling of the run.
+    const FACTOR: f64 = 2.0;
+    /// The first check judged: the baseline then spans 32 checks, a bounded offset's rise.
+    const FIRST: u64 = 64;
+
+    /// Adds the next check's |error|; whether it grows.
+    fn grows(&mut self, error: f64) -> bool {
+        // Saturating: a crafted checkpoint's count must not overflow.
+        self.checks = self.checks.saturating_add(1);
+        self.largest = self.largest.max(error);
+        if self.checks.is_power_of_two() {
+            self.baseline = self.at_power;
+            self.at_power = self.largest;
+        }
+        self.checks >= Self::FIRST && error >= Self::FACTOR * self.baseline
+    }
 }
 
 impl EnergyWatch {
@@ -544,6 +610,12 @@ impl EnergyWatch {
             initial: terms.energy - stepper.work(),
             scale: Scale::default(),
             tolerance,
+            growth: Growth::default(),
+            spread: Growth {
+                largest: norm(stepper.q()),
+                ..Growth::default()
+            },
+            beyond: None,
         };
         watch.push(&terms, stepper.work());
         Some(Ok(watch))
@@ -553,8 +625,9 @@ impl EnergyWatch {
         self.scale.push(terms.kinetic, terms.size() + work.abs());
     }
 
-    /// The error that ends the run at the stepper's state, if any.
-    fn check<S, M>(&mut self, sys: &S, stepper: &Stepper<M>) -> Option<Error>
+    /// The error that ends the run at the stepper's state, if any; `first` is the run's first
+    /// state (q, t), where the stability limit is judged.
+    fn check<S, M>(&mut self, sys: &S, stepper: &Stepper<M>, first: (&[f64], f64)) -> Option<Error>
     where
         S: Dynamics + ?Sized,
         M: std::ops::Deref<Target: Dynamics>,
@@ -566,21 +639,43 @@ impl EnergyWatch {
         };
         self.push(&terms, work);
         let error = terms.energy - work - self.initial;
-        self.scale.fails(error, step as u64, self.tolerance).then(|| {
-            let scale = self.scale.scale();
-            let reason = if error.is_finite() {
-                format!(
-                    "energy error {:.3e} is {:.3e} times the energy scale {scale:.3e} (the mean kinetic energy), \
-                     beyond max_energy_error = {:.3e}; reduce dt",
-                    error.abs(),
-                    error.abs() / scale,
-                    self.tolerance
-                )
-            } else {
-                not_finite(&terms)
-            };
-            Error::Divergence { step, time, reason }
-        })
+        if !error.is_finite() {
+            let reason = not_finite(&terms);
+            return Some(Error::Divergence { step, time, reason });
+        }
+        let (baseline, spread) = (self.growth.baseline, self.spread.baseline);
+        let size = norm(stepper.q());
+        let grows = self.growth.grows(error.abs());
+        let spreads = self.spread.grows(size);
+        if !self.scale.fails(error, step as u64, self.tolerance) {
+            return None;
+        }
+        let (method, dt) = (stepper.method(), stepper.dt());
+        let beyond = *self.beyond.get_or_insert_with(|| {
+            method.info().h_omega_max == 0.0
+                || matches!(beyond_limit(sys, (method, dt), first, Rest::AFTER_FAILURE), Ok(Some(_)))
+        });
+        if !(beyond || grows || spreads) {
+            return None;
+        }
+        let scale = self.scale.scale();
+        let growing = if beyond {
+            String::new()
+        } else if grows {
+            format!(", and growing: it was at most {baseline:.3e} while the run was half as long")
+        } else {
+            format!(
+                ", and the state growing: max |qᵢ| = {size:.3e}, at most {spread:.3e} while the run was half as long"
+            )
+        };
+        let reason = format!(
+            "energy error {:.3e} is {:.3e} times the energy scale {scale:.3e} (the mean kinetic energy), \
+             beyond max_energy_error = {:.3e}{growing}; reduce dt",
+            error.abs(),
+            error.abs() / scale,
+            self.tolerance,
+        );
+        Some(Error::Divergence { step, time, reason })
     }
 }
 

@@ -23,7 +23,8 @@ pub struct Scale {
 
 impl Scale {
     /// An error this large relative to the scale fails the run; the default
-    /// `max_energy_error` of a run.
+    /// `max_energy_error` of a run (beyond which an error stops a run beyond the method's
+    /// stability limit, and one within it where it grows).
     pub const FAILURE: f64 = 1.0;
     /// Round-off is within this many ε of the terms' size, times √(1 + steps).
     pub const ROUND_OFF: f64 = 10.0;
