@@ -416,6 +416,11 @@ def equilibria(
     return found
 
 
+#: :func:`suggest_dt`'s default ``accuracy``: the phase error a period on the fastest mode, in
+#: radians.
+ACCURACY = 1e-3
+
+
 @dataclass(frozen=True)
 class StepSuggestion:
     """The step a method can take on a model, from its frequencies.
@@ -425,19 +430,19 @@ class StepSuggestion:
     method : str
         The method.
     dt : float
-        The suggested step: ``(1 − margin)·stable_dt``, or ``accurate_dt`` where smaller.
+        The suggested step: ``accurate_dt``, or ``(1 − margin)·stable_dt`` where smaller.
     stable_dt : float
         The stability limit h_ω/ω_max: the method blows up on the fastest mode above it.
-    accurate_dt : float or None
+    accurate_dt : float
         The largest step with a phase error of at most ``accuracy`` a period on the fastest
-        mode (None without ``accuracy``).
+        mode.
     omega_max : float
         The largest |λ| of the modes at the point.
     h_omega_max : float
         The method's stability limit on q̈ = −ω²q (inf for an unconditionally stable one).
     margin : float
         The fraction of ``stable_dt`` kept in reserve (the frequencies change along the run).
-    accuracy : float or None
+    accuracy : float
         The phase error a period asked for (radians).
 
     Examples
@@ -452,11 +457,11 @@ class StepSuggestion:
     method: str
     dt: float
     stable_dt: float
-    accurate_dt: float | None
+    accurate_dt: float
     omega_max: float
     h_omega_max: float
     margin: float
-    accuracy: float | None
+    accuracy: float
 
 
 def suggest_dt(
@@ -465,18 +470,29 @@ def suggest_dt(
     q: ArrayLike,
     *,
     t: float = 0.0,
-    accuracy: float | None = None,
+    accuracy: float = ACCURACY,
     margin: float = 0.1,
 ) -> StepSuggestion:
-    """The step ``method`` can take on ``model`` near q: its stability limit over the fastest
-    mode there, and, with ``accuracy``, the step that keeps the fastest mode's phase error a
-    period within it.
+    """The step ``method`` can take on ``model`` near q: the step that keeps the fastest mode's
+    phase error a period within ``accuracy``, and within the method's stability limit over the
+    fastest mode there.
 
     A method is stable on q̈ = −ω²q while hω < h_ω, its limit (2 for verlet; see
     :func:`varmech.methods`); on a model the fastest mode at q sets the step. The phase error a
     period is measured on the method's own one-step map of the oscillator (it grows as (hω)^p,
     p the method's order). Frequencies change along a nonlinear run: ``margin`` keeps a fraction
     of the limit in reserve.
+
+    Stability alone is not a step to run at: near its limit a method's energy error is a
+    bounded offset many times the motion's kinetic energy (Verlet's modified energy differs
+    from H by a factor 1/(1 − (hω/2)²)), which the conservation report calls "failed", and an
+    implicit method has no limit. The default ``accuracy``, 1e-3 rad a period
+    (``varmech.modes.ACCURACY``), keeps a second-order method's energy error near 0.1% of the
+    energy (Verlet's is (hω)²/4 of it, at hω = 0.062: 100 steps a period), far below the 0.3 of
+    the kinetic energy of a "too coarse" verdict: room for the frequencies of a nonlinear motion
+    to rise above those at q (a pendulum swinging through its bottom, an orbit at pericentre),
+    and a phase that drifts by a radian in a thousand periods. The eighth-order compositions and
+    the splittings reach it at hω of 1.4–1.8 (``blanes_moan6`` only at the margin).
 
     Parameters
     ----------
@@ -489,14 +505,15 @@ def suggest_dt(
     t
         The time.
     accuracy
-        The largest phase error a period on the fastest mode, in radians (default: none).
+        The largest phase error a period on the fastest mode, in radians (default 1e-3).
     margin
         The fraction of the stability limit kept in reserve, in [0, 1).
 
     Returns
     -------
     StepSuggestion
-        ``dt``, and what it comes from.
+        ``dt``, and what it comes from; ``dt`` is infinite only where ω_max = 0 (nothing at q
+        sets a time scale).
 
     Raises
     ------
@@ -508,15 +525,16 @@ def suggest_dt(
     Examples
     --------
     Two pendulums (g = l = 1) joined by a spring of stiffness 3 swing together at ω = 1 and
-    against each other at ω = √7, which sets verlet's limit 2/√7:
+    against each other at ω = √7, which sets verlet's limit 2/√7; the step is the accurate one,
+    a fiftieth of it:
 
     >>> import numpy as np, varmech
     >>> def V(q): return -np.cos(q[0]) - np.cos(q[1]) + 1.5 * (q[0] - q[1]) ** 2
     >>> def dV(q): return np.sin(q) + 3.0 * (q - q[::-1])
     >>> pendulums = varmech.MechanicalSystem(2, V, dV)
     >>> s = varmech.suggest_dt(pendulums, "verlet", [0.0, 0.0])
-    >>> round(s.stable_dt * 7**0.5, 6), s.dt / s.stable_dt
-    (2.0, 0.9)
+    >>> round(s.stable_dt * 7**0.5, 6), s.dt == s.accurate_dt, round(s.dt / s.stable_dt, 3)
+    (2.0, True, 0.031)
     """
     limits = stability_limits()
     if not isinstance(method, str) or method not in limits:
@@ -524,15 +542,12 @@ def suggest_dt(
     margin = finite("margin", margin)
     if not 0.0 <= margin < 1.0:
         raise ValueError(f"margin: must be in [0, 1), got {margin}")
-    if accuracy is not None:
-        accuracy = finite("accuracy", accuracy)
+    accuracy = finite("accuracy", accuracy)
     modes = normal_modes(model, q, t=t)
     omega = modes.omega_max
     stable = _core.stable_step(method, omega)
-    accurate = None if accuracy is None else _core.accurate_step(method, omega, accuracy)
-    dt = (1.0 - margin) * stable
-    if accurate is not None:
-        dt = min(dt, accurate)
+    accurate = _core.accurate_step(method, omega, accuracy)
+    dt = min((1.0 - margin) * stable, accurate)
     return StepSuggestion(method, dt, stable, accurate, omega, limits[method], margin, accuracy)
 
 

@@ -376,6 +376,32 @@ def test_the_step_for_a_phase_accuracy_has_the_methods_phase_error_and_order():
     assert abs(steps[0] / steps[1] - 2) < 0.01
 
 
+#: (model, q0, p0, methods) on which suggest_dt's step must run "bounded": the molecule, the
+#: pendulum at a small and a large amplitude (near its top), the double pendulum of the README
+#: from rest, Kepler at e = 0.6 from pericentre; the kind's default method, a fourth-order one
+#: and an implicit one (whose step is the accurate step alone).
+SUGGESTED = {
+    "molecule": (lambda: _molecule(), [0.1, 0.0, -0.2], [0.0, 0.0, 0.0], ("verlet", "yoshida4", "midpoint")),
+    "pendulum at 0.1": (lambda: varmech.scenes.pendulum().model, [0.1], [0.0], ("verlet", "yoshida4", "midpoint")),
+    "pendulum at 3": (lambda: varmech.scenes.pendulum().model, [3.0], [0.0], ("verlet", "yoshida4", "midpoint")),
+    "double pendulum": (lambda: varmech.scenes.double_pendulum().model, [0.5, 1.0], [0.0, 0.0], ("midpoint", "galerkin4")),
+    "kepler": (lambda: varmech.scenes.kepler().model, [0.4, 0.0], [0.0, 2.0], ("verlet", "yoshida4", "midpoint")),
+}
+
+
+@pytest.mark.parametrize("case", SUGGESTED)
+def test_the_suggested_step_runs_with_a_bounded_verdict(case):
+    make, q0, p0, names = SUGGESTED[case]
+    model = make()
+    for method in names:
+        s = varmech.suggest_dt(model, method, q0)
+        # The accurate step at the default accuracy, finite for the implicit method too.
+        assert s.accuracy == varmech.modes.ACCURACY == 1e-3 and s.dt == s.accurate_dt < math.inf, method
+        traj = varmech.integrate(model, q0, p0, dt=s.dt, steps=10_000, method=method)
+        report = varmech.check_conservation(traj).energy
+        assert report.verdict in ("bounded", "conserved to round-off"), (method, report)
+
+
 def test_bad_input_names_the_argument():
     model = _molecule()
     with pytest.raises(ValueError, match="q: must have shape"):
