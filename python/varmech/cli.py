@@ -372,6 +372,10 @@ def _main(argv: list[str] | None) -> int:
             )  # fmt: skip
         except (ValueError, TypeError) as e:
             parser.error(str(e))
+        except _core.VarmechError as e:
+            # A run of the measurement failed: said on one line, as ``run`` says it.
+            print(f"error: {type(e).__name__}: {e}", file=sys.stderr)
+            return 1
         for path in paths:
             print(f"wrote {path}")
         return 0

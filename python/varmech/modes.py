@@ -24,13 +24,16 @@ dozen force evaluations, by Lanczos's method) with the method's stability limit 
 from __future__ import annotations
 
 import functools
+import math
 import warnings
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike
 
 from . import _core
+from . import impacts as _impacts
 from ._util import finite, integer, number, vector
 from ._warnings import VarmechWarning
 from .methods import methods
@@ -603,6 +606,76 @@ def fastest_frequency(model: Model, q: ArrayLike, *, t: float = 0.0) -> float:
     t = finite("t", t)
     omega, _, _ = _core.fastest_frequency(model._core, q, t)
     return float(omega)
+
+
+#: The step by trial (:func:`step_by_trial`): the steps of its first candidate, the halvings it
+#: may take, and the agreement it asks of a step with its half step (of each coordinate's and
+#: momentum's excursion).
+TRIAL_STEPS = 8
+TRIAL_HALVINGS = 4
+TRIAL_TOLERANCE = 0.02
+
+
+def step_by_trial(model: Model, q: np.ndarray, p: np.ndarray, t_end: float, contacts: Sequence[_impacts.Contact] = ()) -> float:
+    """A step at which a short trial of the model's default method from (q, p) is accurate:
+    :meth:`varmech.Scene.of`'s default ``dt``.
+
+    The first candidate is a twentieth of the fastest small-oscillation period at q
+    (:func:`fastest_frequency`), at most ``t_end``/100 (``t_end``/1000 where nothing oscillates
+    there); the trial runs it over :data:`TRIAL_STEPS` steps, and again at half the step. The
+    difference of the two at the candidate's times, each coordinate and momentum against how
+    far it moved, estimates the candidate's error (step doubling: a fraction 1 − 2⁻ᵖ of it, p
+    the method's order); a candidate within :data:`TRIAL_TOLERANCE` is the step, rounded to three
+    significant digits (for tables and chart titles), else the trial halves it, over the same
+    horizon, at most :data:`TRIAL_HALVINGS` times: 248 steps at most. A step whose run fails
+    (a Newton iteration that does not converge, a state that blows up) is not accurate. The
+    trial sees the motion's start only: a motion that speeds up later (a close approach) needs
+    its own ``dt``.
+
+    Raises
+    ------
+    ValueError
+        Naming ``dt``, when no candidate is accurate, with each candidate and what it gave.
+    """
+    method = model.kind.default_method
+    try:
+        omega = fastest_frequency(model, q)
+    except ValueError:  # velocity constraints: no small oscillations to read a period from
+        omega = 0.0
+    h = min(2 * math.pi / omega / 20, t_end / 100) if math.isfinite(omega) and omega > 0 else t_end / 1000
+    specs = _impacts.specs(contacts) or None
+    times = np.arange(TRIAL_STEPS + 1, dtype=np.float64) * h
+
+    def trial(step: float) -> np.ndarray | str:
+        """The states at the first candidate's times by steps of ``step``, or why the run failed."""
+        try:
+            record = _core.integrate(
+                model._core, q, p, dt=step, steps=round(times[-1] / step), method=method, max_energy_error=None,
+                contacts=specs, t_eval=times,
+            )  # fmt: skip
+        except _core.VarmechError as e:
+            return f"{type(e).__name__} at step {getattr(e, 'step', '?')}"
+        return np.hstack([record.q, record.p])
+
+    tried = []
+    coarse = trial(h)
+    for _ in range(TRIAL_HALVINGS):
+        fine = trial(h / 2)
+        if isinstance(coarse, str) or isinstance(fine, str):
+            tried.append(f"{h:.3g} ({coarse if isinstance(coarse, str) else 'its half step: ' + fine})")
+        else:
+            moved = np.max(np.abs(fine - fine[0]), axis=0)
+            # Coordinates and momenta that move (a cyclic coordinate's momentum does not).
+            moving = (moved > 1e-9 * np.abs(fine[0])) & (moved > 1e-12 * np.max(moved))
+            error = float(np.max(np.abs(coarse - fine)[:, moving] / moved[moving])) if moving.any() else 0.0
+            if error <= TRIAL_TOLERANCE:
+                return float(f"{h:.3g}")
+            tried.append(f"{h:.3g} (differs from its half step by {error:.2g} of the motion)")
+        h, coarse = h / 2, fine
+    raise ValueError(
+        f"dt: no step of {method} is accurate over a trial of {times[-1]:.3g} from q0 "
+        f"(within {TRIAL_TOLERANCE:g} of its half step); tried {', '.join(tried)}; pass dt (--dt on the command line)"
+    )
 
 
 class StabilityWarning(VarmechWarning):

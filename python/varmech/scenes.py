@@ -8,7 +8,6 @@ functions below name them with their parameters for the reader."""
 
 from __future__ import annotations
 
-import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
@@ -20,7 +19,7 @@ from ._core import energy_terms
 from ._util import floats, positive
 from .impacts import Contact
 from .model import SCENE_COORDINATES, SCENE_UNITS, Model, NativeSystem, initial_state
-from .modes import fastest_frequency
+from .modes import step_by_trial
 
 __all__ = [
     "CATALOGUE",
@@ -201,9 +200,12 @@ class Scene:
             The horizon of the scene's runs.
         dt : float, optional
             A step that resolves the motion for a quick look; the measurements sweep around
-            it. Default: a twentieth of the fastest small-oscillation period at q0
-            (:func:`varmech.fastest_frequency`), at most ``t_end``/100 (``t_end``/1000 where the
-            model has no oscillation there).
+            it. Default: the step at which a short trial of the model's default method from
+            q0 agrees with the trial at half the step to 2% of the motion, from a twentieth
+            of the fastest small-oscillation period at q0 (:func:`varmech.fastest_frequency`),
+            at most ``t_end``/100, halved up to four times (``varmech.modes.step_by_trial``:
+            248 steps at most). The trial sees the motion's start: give ``dt`` where it
+            speeds up later (a close approach).
         name, description : str, optional
             What charts and tables call it (default: the model's ``name``).
         reference : Reference, optional
@@ -225,7 +227,8 @@ class Scene:
         TypeError
             ``model`` is not a varmech Model; a string where a number belongs.
         ValueError
-            Malformed ``q0``, ``p0``/``v0``, ``t_end`` or ``dt``, named.
+            Malformed ``q0``, ``p0``/``v0``, ``t_end`` or ``dt``, named; naming ``dt``, no
+            default step runs accurately from q0 (each step tried is named, with what it gave).
 
         Examples
         --------
@@ -242,7 +245,10 @@ class Scene:
             raise TypeError(f"model: expected a varmech Model (MechanicalSystem, Lagrangian, symbolic, ...), got {type(model).__name__}")
         q, p = initial_state(model, q0, p0, v0, 0.0)
         horizon = positive("t_end", t_end)
-        step = _default_dt(model, q, horizon) if dt is None else positive("dt", dt)
+        surfaces = tuple(contacts)
+        if not all(isinstance(c, Contact) for c in surfaces):
+            raise TypeError("contacts: expected varmech.Contact surfaces")
+        step = step_by_trial(model, q, p, horizon, surfaces) if dt is None else positive("dt", dt)
         if step > horizon:
             raise ValueError(f"dt: must not exceed t_end = {horizon:g}, got {step:g}")
         if reference is not None and not isinstance(reference, Reference):
@@ -254,23 +260,8 @@ class Scene:
         for argument, text in (("name", label), ("description", description), ("time_unit", time_unit)):
             if not isinstance(text, str):
                 raise TypeError(f"{argument}: expected a str, got {type(text).__name__}")
-        surfaces = tuple(contacts)
-        if not all(isinstance(c, Contact) for c in surfaces):
-            raise TypeError("contacts: expected varmech.Contact surfaces")
         parameters = dict(getattr(model, "parameters", None) or {})
         return cls(label, description, model, q, p, horizon, step, invariants, reference, parameters, surfaces, time_unit)
-
-
-def _default_dt(model: Model, q: np.ndarray, t_end: float) -> float:
-    """A twentieth of the fastest small-oscillation period at q, at most t_end/100; t_end/1000
-    where the model has no oscillation there (or its frequencies cannot be had: velocity
-    constraints). Rounded to three significant digits, for tables and chart titles."""
-    try:
-        omega = fastest_frequency(model, q)
-    except ValueError:
-        omega = 0.0
-    dt = min(2 * math.pi / omega / 20, t_end / 100) if math.isfinite(omega) and omega > 0 else t_end / 1000
-    return float(f"{dt:.3g}")
 
 
 def as_scene(

@@ -65,6 +65,36 @@ def test_scene_of_a_model_takes_its_step_from_its_fastest_oscillation():
     assert varmech.Scene.of(free, [0.0], [1.0], t_end=50.0).dt == 0.05
 
 
+#: The swinging Atwood machine (issue 64): a mass M = 3 on a rope over a pulley, its other end a
+#: mass m = 1 swinging at length r; from rest at r = 1, θ = 0.5 the swinging mass falls in to
+#: r = 0.16 at t = 0.66, where θ whirls.
+ATWOOD = """
+import sympy as sp
+r, th, vr, vth = sp.symbols("r theta v_r v_theta")
+q = [r, th]; v = [vr, vth]
+M, m, g = 3.0, 1.0, 9.81
+L = sp.Rational(1,2)*(M+m)*vr**2 + sp.Rational(1,2)*m*r**2*vth**2 - M*g*r + m*g*r*sp.cos(th)
+"""
+
+
+def test_scene_of_takes_the_step_at_which_a_trial_from_q0_is_accurate():
+    namespace: dict = {}
+    exec(ATWOOD, namespace)
+    model = varmech.symbolic.lagrangian(namespace["L"], namespace["q"], namespace["v"])
+    # A twentieth of the fastest period at q0, 0.104, does not converge at the whirl (step 7);
+    # the trial halves it twice, to where 8 steps agree with 16 half steps to 2% of the motion.
+    with pytest.raises(varmech.ConvergenceError, match="at step 7"):
+        varmech.integrate(model, [1.0, 0.5], v0=[0.0, 0.0], dt=0.104, t_end=52.0)
+    scene = varmech.Scene.of(model, [1.0, 0.5], v0=[0.0, 0.0], t_end=50.0)
+    assert scene.dt == 0.0259
+    traj = varmech.integrate(scene, dt=50.0 / math.ceil(50.0 / scene.dt), t_end=50.0)
+    assert varmech.check_conservation(traj).energy.verdict == "bounded"
+    # Where no step of the trial runs, the default is refused naming dt, with what was tried.
+    cliff = varmech.MechanicalSystem(1, lambda q: 0.5 * q[0] ** 2, lambda q: q if q[0] < 1 else np.array([np.nan]))
+    with pytest.raises(ValueError, match=r"^dt: no step of verlet is accurate .* tried 0\.1 \(DivergenceError at step 7\), 0\.05 .*; pass dt"):
+        varmech.Scene.of(cliff, [0.5], [1.0], t_end=10.0)
+
+
 def test_scene_of_refuses_what_is_not_a_scene_naming_the_argument():
     model = duffing()
     with pytest.raises(TypeError, match="model: expected a varmech Model"):
@@ -299,6 +329,19 @@ def test_a_failed_run_is_an_error_status_with_the_reason(own, run_cli):
     # Warned of first (the step is beyond verlet's limit there), then failed with its reason.
     assert "StabilityWarning: dt: h·ω_max = " in blown.stderr
     assert blown.returncode == 1 and "\nerror: DivergenceError: " in blown.stderr
+
+
+def test_the_swinging_atwood_machine_runs_from_the_command_line_and_a_failed_chart_says_why(tmp_path, run_cli):
+    path = tmp_path / "mine.py"
+    path.write_text(ATWOOD)
+    run = run_cli("run", f"{path}:L", "--q0", "1.0,0.5", "--t-end", "50")
+    assert "L: L; midpoint, dt = 0.0258933, 1931 steps" in run.stdout and "verdict: bounded" in run.stdout
+    # A chart whose run fails says so on one line, with status 1, as run does.
+    pytest.importorskip("matplotlib")
+    chart = run_cli("chart", "energy", f"{path}:L", "--q0", "1.0,0.5", "--t-end", "50", "--dt", "0.104", "--out", tmp_path, check=False)
+    assert chart.returncode == 1 and chart.stdout == ""
+    assert chart.stderr.startswith("error: ConvergenceError: Newton's method did not converge at step 7")
+    assert chart.stderr.count("\n") == 1 and "Traceback" not in chart.stderr
 
 
 def test_no_warning_from_a_reference_that_converges():
