@@ -59,18 +59,33 @@ def test_a_step_without_a_solution_is_a_model_that_is_not_smooth_and_no_smaller_
         assert "not smooth here" in _diagnosed(kink, 0.0, dt=dt, steps=3)
 
 
-def test_wrong_second_derivatives_are_named_and_a_smaller_step_is_not_advised():
-    # ∂²L/∂q̇² given as 0.6 instead of 1: Newton converges linearly at |1 − 1/0.6| = 2/3.
-    wrong = varmech.Lagrangian(
+def _wrong_mass(mass: float) -> varmech.Model:
+    """The pendulum whose Hessians give ∂²L/∂q̇² as ``mass`` instead of 1."""
+    return varmech.Lagrangian(
         1,
         lambda q, v, t: 0.5 * v[0] ** 2 + G * np.cos(q[0]),
         dl_dq=lambda q, v, t: np.array([-G * np.sin(q[0])]),
         dl_dv=lambda q, v, t: v.copy(),
-        hessians=lambda q, v, t: (np.array([[-G * np.cos(q[0])]]), np.zeros((1, 1)), np.full((1, 1), 0.6)),
+        hessians=lambda q, v, t: (np.array([[-G * np.cos(q[0])]]), np.zeros((1, 1)), np.full((1, 1), mass)),
     )
-    message = _diagnosed(wrong, 1.0, dt=0.1, steps=5, newton_max_iterations=20)
+
+
+def test_wrong_second_derivatives_are_named_and_a_smaller_step_is_not_advised():
+    # ∂²L/∂q̇² given as 0.6 instead of 1: Newton converges linearly at |1 − 1/0.6| = 2/3.
+    message = _diagnosed(_wrong_mass(0.6), 1.0, dt=0.1, steps=5, newton_max_iterations=20)
     assert "second derivatives (hessians) are not those of its first" in message
     assert "a smaller step does not help" in message
+
+
+def test_second_derivatives_that_make_newton_grow_are_named_not_the_step():
+    # ∂²L/∂q̇² given as 0.4 instead of 1: the corrections grow by |1 − 1/0.4| = 1.5 from any
+    # start, so that the course alone reads as a predictor outside Newton's region. The
+    # Jacobian disagrees with differences of F: the Hessians are named, at every step size,
+    # where "a smaller step" was advised and failed alike (found by tests/python/test_properties.py).
+    for dt in (0.1, 0.001):
+        message = _diagnosed(_wrong_mass(0.4), 1.0, dt=dt, steps=5)
+        assert "second derivatives (hessians) are not those of its first" in message
+        assert "a smaller step does not help" in message and "brings it closer" not in message
 
 
 def test_a_cap_reached_while_converging_advises_more_iterations_which_then_run():

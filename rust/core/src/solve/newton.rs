@@ -126,8 +126,9 @@ pub enum Diagnosis {
     /// that agrees with F: the start (the step's predictor) lies outside Newton's region of
     /// convergence. A smaller step brings the predictor closer.
     Diverged,
-    /// The corrections kept falling, but linearly with fresh Jacobians that disagree with
-    /// differences of F: a model's supplied second derivatives are not those of its first.
+    /// The corrections kept falling, but linearly, or did not fall, with fresh Jacobians that
+    /// disagree with differences of F: a model's supplied second derivatives are not those of
+    /// its first.
     Linear,
     /// The corrections stopped falling well above the noise of the equations there: they have
     /// no solution nearby, or are not smooth (a kink or jump in the model, or its derivatives).
@@ -162,9 +163,9 @@ impl Diagnosis {
         match self {
             Diagnosis::Diverged => reasons.outside,
             Diagnosis::Linear => {
-                "the corrections fell only linearly, and the Jacobian disagrees with differences of the \
-                 equations: the model's second derivatives (hessians) are not those of its first; check them \
-                 (varmech.check_derivatives); a smaller step does not help"
+                "the corrections fell only linearly or not at all, and the Jacobian disagrees with differences \
+                 of the equations: the model's second derivatives (hessians) are not those of its first; check \
+                 them (varmech.check_derivatives); a smaller step does not help"
             }
             Diagnosis::Stalled => {
                 "the corrections stopped falling far above the noise of the equations: they have no solution \
@@ -185,12 +186,15 @@ impl Diagnosis {
     /// The diagnosis once the problem is looked at: a model nearly singular there
     /// ([`NewtonProblem::degenerate`]) explains a failure that is no cap; a linear convergence
     /// with a Jacobian that agrees with differences of F ([`NewtonProblem::jacobian_agrees`]) is
-    /// the iteration not yet near the root, where F's curvature, not J, slows it.
+    /// the iteration not yet near the root, where F's curvature, not J, slows it; corrections
+    /// that grow or wander with a Jacobian that disagrees are the wrong Jacobian's (a Hessian too
+    /// small by half or more overshoots from every start), which no smaller step mends.
     pub(crate) fn confirmed<P: NewtonProblem>(self, problem: &mut P) -> Result<Self, StepError> {
         Ok(match self {
             Diagnosis::Cap | Diagnosis::Singular => self,
             _ if problem.degenerate()? => Diagnosis::Degenerate,
             Diagnosis::Linear if problem.jacobian_agrees()? => Diagnosis::Diverged,
+            Diagnosis::Diverged if !problem.jacobian_agrees()? => Diagnosis::Linear,
             other => other,
         })
     }
