@@ -127,3 +127,54 @@ fn the_fastest_frequency_at_enormous_stiffness_is_the_scaled_one() {
         assert!((scaled / unit - 1.0).abs() < 1e-6, "g = {g:e}: {scaled} against {unit}");
     }
 }
+
+/// L = ½q̇² − ½kq², whose ∂²L/∂q² it gives as −`factor`·k.
+struct WrongStiffness {
+    k: f64,
+    factor: f64,
+}
+
+impl varmech::model::Lagrangian for WrongStiffness {
+    fn dim(&self) -> usize {
+        1
+    }
+
+    fn lagrangian(&self, q: &[f64], v: &[f64], _t: f64) -> Result<f64, varmech::ModelError> {
+        Ok(0.5 * v[0] * v[0] - 0.5 * self.k * q[0] * q[0])
+    }
+
+    fn hessians(
+        &self,
+        _q: &[f64],
+        _v: &[f64],
+        _t: f64,
+        out: &mut varmech::model::Hessians,
+    ) -> Result<bool, varmech::ModelError> {
+        out.qq[(0, 0)] = -self.factor * self.k;
+        out.qv[(0, 0)] = 0.0;
+        out.vv[(0, 0)] = 1.0;
+        Ok(true)
+    }
+}
+
+#[test]
+fn an_equilibrium_search_with_wrong_hessians_names_them_not_the_guess() {
+    // K given as 0.45k: Newton's corrections grow by 1 − 1/0.45 ≈ −1.22 from every guess,
+    // however near the minimum (to 2e4 times it in the 50 iterations), a course that alone
+    // reads as a guess outside Newton's region. Checked against differences of the balance, the
+    // Jacobian disagrees: the Hessians are named (found by tests/rust/properties.rs).
+    let model = WrongStiffness { k: 3.0, factor: 0.45 };
+    for guess in [1e-6, 1e-8] {
+        let error = equilibrium(Model::from(&model), &[guess], 0.0, &NewtonOptions::default()).unwrap_err();
+        let text = error.to_string();
+        assert!(
+            text.contains("second derivatives (hessians) are not those of its first"),
+            "{text}"
+        );
+        assert!(!text.contains("start nearer"), "{text}");
+    }
+    // The right Hessians find q = 0.
+    let right = WrongStiffness { k: 3.0, factor: 1.0 };
+    let found = equilibrium(Model::from(&right), &[0.5], 0.0, &NewtonOptions::default()).unwrap();
+    assert!(found.q[0].abs() < 1e-14, "{:?}", found.q);
+}

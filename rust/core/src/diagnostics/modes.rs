@@ -233,6 +233,37 @@ impl NewtonProblem for Balance<'_> {
         }
     }
 
+    /// Whether [−K Gᵀ; G 0] from the model's own ∂²L/∂q² agrees with differences of the balance
+    /// in (q, λ): a model that supplies no Hessians agrees by construction.
+    fn jacobian_agrees(&mut self) -> Result<bool, StepError> {
+        let (n, u) = (self.q.len(), self.q.len() + self.lambda.len());
+        if !self
+            .model
+            .system
+            .hessians(&self.q, &vec![0.0; n], self.t, &mut Hessians::zeros(n))?
+        {
+            return Ok(true);
+        }
+        let (mut exact, mut differenced) = (DMatrix::zeros(u, u), DMatrix::zeros(u, u));
+        self.jacobian(&mut exact)?;
+        let (q, lambda) = (self.q.clone(), self.lambda.clone());
+        let mut x: Vec<f64> = q.iter().chain(&lambda).copied().collect();
+        let (mut plus, mut minus) = (vec![0.0; u], vec![0.0; u]);
+        let at = Evaluations {
+            plus: &mut plus,
+            minus: &mut minus,
+        };
+        let balance = |x: &[f64], r: &mut [f64]| {
+            self.q.copy_from_slice(&x[..n]);
+            self.lambda.copy_from_slice(&x[n..]);
+            self.residual(r)
+        };
+        let done = central_jacobian(balance, &mut x, unit, at, &mut differenced);
+        (self.q, self.lambda) = (q, lambda);
+        done?;
+        Ok((&exact - &differenced).amax() <= 1e-4 * differenced.amax())
+    }
+
     /// Not known beyond what the iteration adds ([`NewtonProblem::noise`]).
     fn noise(&self) -> f64 {
         0.0
