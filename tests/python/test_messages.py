@@ -63,3 +63,20 @@ def test_shake_on_a_linkage_asks_for_more_sweeps_not_a_smaller_step():
         assert err.value.residual > 1e-14 and err.value.iterations == 50
     traj = varmech.integrate(chain, dt=0.01, steps=20, method="shake", newton_max_iterations=500)
     assert np.all(np.isfinite(traj.q))
+
+
+def test_shake_past_its_linearization_asks_for_a_smaller_step_not_more_sweeps():
+    # A pendulum (a particle on the unit circle, g = 9.81) at hω = 0.94, inside Verlet's limit 2: the
+    # step moves q₁ so far from SHAKE's linearization at q₀ that the sweeps no longer bring the
+    # residual down, and 10⁴ of them fail as 50 do; a quarter of the step runs.
+    pendulum = varmech.MechanicalSystem(
+        2, lambda q: 9.81 * q[1], lambda q: np.array([0.0, 9.81]), mass=[1.0, 1.0],
+        constraints=lambda q: np.array([0.5 * (q @ q - 1)]), constraint_jacobian=lambda q: q.reshape(1, 2),
+        constraint_count=1,
+    )
+    for sweeps in (50, 10_000):
+        with pytest.raises(varmech.ConvergenceError, match=r"a smaller step \(dt\) helps, or rattle") as err:
+            varmech.integrate(pendulum, [1.0, 0.0], [0.0, 0.0], dt=0.3, steps=20, method="shake", newton_max_iterations=sweeps)
+        assert "more sweeps" not in str(err.value)
+    traj = varmech.integrate(pendulum, [1.0, 0.0], [0.0, 0.0], dt=0.075, steps=80, method="shake")
+    assert np.abs(np.hypot(*np.asarray(traj.q).T) - 1).max() < 1e-12
