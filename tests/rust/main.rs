@@ -35,6 +35,7 @@ mod nbody_kernel;
 mod nonholonomic;
 mod nonholonomic_scenes;
 mod nonholonomic_variants;
+mod properties;
 mod reactions;
 mod routh;
 mod solar_system;
