@@ -2,7 +2,7 @@
 # `make test` (build, run every test). PYTHON may name another interpreter.
 PYTHON ?= python3
 
-.PHONY: install tour lint guards test guards-then-rust test-rust test-python docs wheel-check test-aarch64 bench compare gallery
+.PHONY: install tour lint guards test guards-then-rust test-rust test-python docs wheel-check test-aarch64 bench compare gallery campaign
 
 # The extra `test` is the dependency groups test and dev of pyproject.toml, which need pip >= 25.1
 # (`pip install --group dev`): the extra keeps `make test` working with the pip a fresh Python has.
@@ -64,6 +64,20 @@ AARCH64 = CARGO_TARGET_AARCH64_UNKNOWN_LINUX_GNU_LINKER=aarch64-linux-gnu-gcc \
 	CC_aarch64_unknown_linux_gnu=aarch64-linux-gnu-gcc
 test-aarch64:
 	$(AARCH64) cargo test --release --target aarch64-unknown-linux-gnu --test core
+
+# The property tests' long campaign: the core's proptest properties with PROPTEST_CASES cases
+# each, then tests/python/property_campaign.py: random models, states, methods and steps, each
+# case in a process of its own, for CAMPAIGN_MINUTES (or CAMPAIGN_EXAMPLES cases), new ones each
+# seed (CAMPAIGN_SEED repeats one); it prints the outcomes' counts and every case that broke a
+# property (also written to campaign_failures.jsonl); a failed core property does not stop the
+# Python cases. CI runs a few of each (make test).
+CAMPAIGN_MINUTES ?= 15
+CAMPAIGN_EXAMPLES ?= 100000
+CAMPAIGN_SEED ?= $(shell date +%s)
+PROPTEST_CASES ?= 1000
+campaign: install
+	-env -u MAKEFLAGS -u MFLAGS PROPTEST_CASES=$(PROPTEST_CASES) cargo test --release --test core properties
+	$(PYTHON) tests/python/property_campaign.py --minutes $(CAMPAIGN_MINUTES) --examples $(CAMPAIGN_EXAMPLES) --seed $(CAMPAIGN_SEED)
 
 bench:
 	cargo bench --bench steps
