@@ -737,10 +737,20 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
                     Located::Error(e) => e,
                     Located::Resting => contact_error(format!(
                         "a body leaving the contact {} crosses it again at once (a resting or grazing contact, \
-                         such as e = 0 under a force pressing on it), which impacts cannot resolve; {} hold such \
-                         a contact closed on a model without forces or constraints of its own",
+                         such as e = 0 under a force pressing on it), which impacts cannot resolve; {}",
                         contact.name,
-                        Hold::methods()
+                        // A method that holds contacts missed this one's closing: its bounces
+                        // outran the step.
+                        if self.hold.is_some() {
+                            "this method holds such a contact closed once its bounces die out within a step: a \
+                             smaller step (dt) helps"
+                                .to_string()
+                        } else {
+                            format!(
+                                "{} hold such a contact closed on a model without forces or constraints of its own",
+                                Hold::methods()
+                            )
+                        }
                     )),
                 })?;
                 if let Some(s) = s {
