@@ -19,10 +19,10 @@ use proptest::prelude::*;
 use proptest::test_runner::{Config, RngSeed, TestCaseError, TestRunner};
 
 use varmech::diagnostics::{equilibrium, stable_step, Model};
-use varmech::integrators::{integrate, Dynamics, General, Method, Options, Trajectory};
-use varmech::model::{Constrained, Hessians, Lagrangian};
+use varmech::integrators::{integrate, General, Method, Options, Trajectory};
+use varmech::model::{Hessians, Lagrangian};
 
-use varmech::scenes::{NonholonomicScene, SceneModel, CATALOGUE};
+use varmech::scenes::CATALOGUE;
 use varmech::solve::NewtonOptions;
 use varmech::{Error, ModelError};
 
@@ -452,22 +452,6 @@ fn del_steps_are_reversible() {
         .unwrap();
 }
 
-/// Runs `body` with the scene as the core's [`Dynamics`], as the binding does.
-fn with_dynamics<R>(model: &SceneModel, body: impl FnOnce(&dyn Dynamics) -> R) -> R {
-    match model {
-        SceneModel::Mechanical(scene) => body(scene),
-        SceneModel::General(scene) => body(&General(scene)),
-        SceneModel::Constrained(scene) => body(scene),
-        SceneModel::ConstrainedGeneral(scene) => body(&Constrained {
-            system: General(&scene.system),
-            constraints: scene.constraints.clone(),
-        }),
-        SceneModel::Nonholonomic(NonholonomicScene::RollingDisk(scene)) => body(scene),
-        SceneModel::Nonholonomic(NonholonomicScene::ChaplyginSleigh(scene)) => body(scene),
-        SceneModel::Nonholonomic(NonholonomicScene::RollingSphere(scene)) => body(scene),
-    }
-}
-
 /// Every catalogue scene, with its defaults, runs 200 steps of any method that fits it at a
 /// random fraction (0.05 to 0.5) of the method's stability limit on the fastest mode at the
 /// scene's start (hω ≤ 1 for the unconditionally stable methods; the scene's own step for
@@ -481,7 +465,7 @@ fn native_scenes_run_at_random_steps_inside_the_stability_limit() {
             let entry = &CATALOGUE[entry];
             let problem = entry.setup().build().map_err(|e| TestCaseError::fail(format!("{e}")))?;
             let (q0, p0) = (&problem.initial.q, &problem.initial.p);
-            with_dynamics(&problem.system, |sys| {
+            problem.system.with_dynamics(|sys| {
                 let every = (Method::ALL.into_iter().chain(Method::CONSTRAINED))
                     .chain(Method::NONHOLONOMIC)
                     .chain(Method::WISDOM_HOLMAN);

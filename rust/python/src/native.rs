@@ -1,9 +1,9 @@
 //! Native scenes: every evaluation runs in Rust, with the GIL released.
 
 use pyo3::prelude::*;
-use varmech::integrators::{Dynamics, General};
-use varmech::model::{Constrained, HolonomicConstraints, MechanicalSystem};
-use varmech::scenes::{NonholonomicScene, Scene, SceneModel};
+use varmech::integrators::Dynamics;
+use varmech::model::{HolonomicConstraints, MechanicalSystem};
+use varmech::scenes::{Scene, SceneModel};
 
 use crate::generator::Generator;
 
@@ -20,21 +20,9 @@ impl NativeModel {
         NativeModel { native, name }
     }
 
-    /// Runs `body` with the scene as the core's [`Dynamics`]: a general Lagrangian wrapped in
-    /// [`General`] for the variational methods.
+    /// Runs `body` with the scene as the core's [`Dynamics`] ([`SceneModel::with_dynamics`]).
     pub fn with_integrable<R>(&self, body: impl FnOnce(&dyn Dynamics) -> R) -> R {
-        match &self.native {
-            SceneModel::Mechanical(scene) => body(scene),
-            SceneModel::General(scene) => body(&General(scene)),
-            SceneModel::Constrained(scene) => body(scene),
-            SceneModel::ConstrainedGeneral(scene) => body(&Constrained {
-                system: General(&scene.system),
-                constraints: scene.constraints.clone(),
-            }),
-            SceneModel::Nonholonomic(NonholonomicScene::RollingDisk(scene)) => body(scene),
-            SceneModel::Nonholonomic(NonholonomicScene::ChaplyginSleigh(scene)) => body(scene),
-            SceneModel::Nonholonomic(NonholonomicScene::RollingSphere(scene)) => body(scene),
-        }
+        self.native.with_dynamics(body)
     }
 }
 

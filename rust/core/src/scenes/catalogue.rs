@@ -10,6 +10,7 @@ use super::{
     Kepler, KeplerPolar, LagrangianScene, LinkedMasses, NBody, NonholonomicScene, Pendulum, Problem, RigidBody,
     RollingDisk, RollingSphere, Scene, SphericalPendulum,
 };
+use crate::integrators::{Dynamics, General};
 use crate::model::{Constrained, Distances, Lagrangian, MechanicalSystem};
 use crate::Error;
 
@@ -37,6 +38,23 @@ impl SceneModel {
             SceneModel::Nonholonomic(NonholonomicScene::RollingDisk(s)) => MechanicalSystem::dim(&s.system),
             SceneModel::Nonholonomic(NonholonomicScene::ChaplyginSleigh(s)) => MechanicalSystem::dim(&s.system),
             SceneModel::Nonholonomic(NonholonomicScene::RollingSphere(s)) => Lagrangian::dim(&s.system),
+        }
+    }
+
+    /// Runs `body` with the scene as the core's [`Dynamics`]: a general Lagrangian wrapped in
+    /// [`General`] for the variational methods.
+    pub fn with_dynamics<R>(&self, body: impl FnOnce(&dyn Dynamics) -> R) -> R {
+        match self {
+            SceneModel::Mechanical(scene) => body(scene),
+            SceneModel::General(scene) => body(&General(scene)),
+            SceneModel::Constrained(scene) => body(scene),
+            SceneModel::ConstrainedGeneral(scene) => body(&Constrained {
+                system: General(&scene.system),
+                constraints: scene.constraints.clone(),
+            }),
+            SceneModel::Nonholonomic(NonholonomicScene::RollingDisk(scene)) => body(scene),
+            SceneModel::Nonholonomic(NonholonomicScene::ChaplyginSleigh(scene)) => body(scene),
+            SceneModel::Nonholonomic(NonholonomicScene::RollingSphere(scene)) => body(scene),
         }
     }
 }
