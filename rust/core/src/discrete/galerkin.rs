@@ -300,6 +300,18 @@ impl Galerkin {
         Ok(work - self.quadrature.time_derivative(sys, at, &self.dl_dt)?)
     }
 
+    /// How much the slots amplify the rounding of the derivatives of L they sum:
+    /// maxⱼ Σᵢ |bᵢ|(h|ℓⱼ(cᵢ)| + |ℓⱼ'(cᵢ)|), at least 1 (Σᵢ bᵢℓₛ'(cᵢ) = 1).
+    pub(crate) fn noise_gain(&self, h: f64) -> f64 {
+        let quad = &self.quadrature;
+        (0..=quad.s).fold(1.0_f64, |gain, j| {
+            let slot = (0..quad.s)
+                .map(|i| quad.weights[i].abs() * (h.abs() * quad.basis[i][j].abs() + quad.slopes[i][j].abs()))
+                .sum::<f64>();
+            gain.max(slot)
+        })
+    }
+
     /// out = ∂L_d/∂Qⱼ = Σᵢ bᵢ[hℓⱼ(cᵢ)∂L/∂q + ℓⱼ'(cᵢ)∂L/∂q̇] from the last
     /// [`Galerkin::derivatives`].
     pub(crate) fn slot(&self, j: usize, h: f64, out: &mut [f64]) {

@@ -2,6 +2,7 @@ use super::{segment, StepEquations};
 use crate::discrete::{Galerkin, Quadrature};
 use crate::integrators::StepStart;
 use crate::model::Lagrangian;
+use crate::solve::difference;
 use crate::ModelError;
 
 /// The Galerkin variational integrator (Marsden & West 2001, §2.6; order 2s): its L_d made
@@ -24,6 +25,9 @@ impl StepEquations for Galerkin {
     ) -> Result<(), ModelError> {
         let (n, s, h) = (start.q.len(), self.quadrature.degree(), start.h);
         self.derivatives(sys, segment(&start, x), false)?;
+        // F sums the nodes' derivatives with weights whose sizes add up to 2.3 (s = 2) and 3
+        // (s = 3): so too their rounding, where they are differences.
+        difference::record(difference::take_noise() * self.noise_gain(h));
         for j in 1..s {
             self.slot(j, h, &mut out[(j - 1) * n..j * n]);
         }
