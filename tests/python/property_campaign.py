@@ -13,6 +13,7 @@ from __future__ import annotations
 import argparse
 import dataclasses
 import json
+import re
 import sys
 import time
 from collections import Counter
@@ -59,6 +60,7 @@ def main() -> int:
     verdicts: Counter[str] = Counter()
     errors: Counter[str] = Counter()
     confirmed: Counter[str] = Counter()
+    known: Counter[str] = Counter()
     by_family: Counter[str] = Counter()
     broken: list[tuple[str, pm.Spec, po.Outcome]] = []
     deadline = time.monotonic() + 60 * args.minutes
@@ -79,6 +81,8 @@ def main() -> int:
         elif outcome.kind not in ("misfit",):
             errors[outcome.kind] += 1
         confirmed[{True: "confirmed", False: "unconfirmed", None: "nothing to confirm"}[outcome.confirmed]] += 1
+        for problem in outcome.known:
+            known[next(k for pattern, k in po.KNOWN_OPEN.items() if re.search(pattern, problem))] += 1
         if outcome.problems:
             broken.append((family, spec, outcome))
             with args.out.open("a") as f:
@@ -93,13 +97,13 @@ def main() -> int:
     except Done:
         pass  # the time is up
     finally:
-        _summary(args, outcomes, verdicts, errors, confirmed, by_family, broken, started)
+        _summary(args, outcomes, verdicts, errors, confirmed, known, by_family, broken, started)
     return 1 if broken else 0
 
 
 def _summary(
     args: argparse.Namespace, outcomes: Counter[str], verdicts: Counter[str], errors: Counter[str],
-    confirmed: Counter[str], by_family: Counter[str], broken: list[tuple[str, pm.Spec, po.Outcome]], started: float,
+    confirmed: Counter[str], known: Counter[str], by_family: Counter[str], broken: list[tuple[str, pm.Spec, po.Outcome]], started: float,
 ) -> None:
     """Prints the campaign's counts, also when it ends early."""
     total = sum(outcomes.values())
@@ -108,6 +112,7 @@ def _summary(
     print(f"  typed errors and other outcomes: {dict(errors.most_common())}")
     print(f"  misfits refused by name: {outcomes['misfit']}")
     print(f"  refinement: {dict(confirmed.most_common())}")
+    print(f"  known open (issue 64's list, oracle.KNOWN_OPEN): {dict(known.most_common())}")
     print(f"  broke a property: {len(broken)} (written to {args.out})")
     for family, spec, outcome in broken:
         print(f"\n- {family}: {outcome.kind}: {outcome.problems[0][:600]}\n  {spec!r}")

