@@ -10,9 +10,6 @@ use varmech::integrators::{integrate, General, Method, NewtonOptions, Options, T
 use varmech::model::{Hessians, Lagrangian};
 use varmech::scenes::{HeavyTop, State};
 
-/// ∂L/∂q or ∂L/∂q̇ as a function of (q, q̇).
-type Gradient<'a> = &'a dyn Fn(&[f64], &[f64], &mut [f64]);
-
 /// Generic states: θ on both sides of π/2, every velocity non-zero.
 const STATES: [([f64; 3], [f64; 3]); 3] = [
     ([0.7, 0.3, -1.1], [0.4, -1.3, 2.2]),
@@ -51,31 +48,12 @@ fn the_hessians_are_the_derivatives_of_the_gradients() {
     for (q, v) in STATES {
         let mut h = Hessians::zeros(3);
         assert!(sys.hessians(&q, &v, 0.0, &mut h).unwrap());
-        let e = 1e-6;
         let mut worst = 0.0_f64;
+        let lq = |q: &[f64], v: &[f64], out: &mut [f64]| sys.dl_dq(q, v, 0.0, out).unwrap();
+        let lv = |q: &[f64], v: &[f64], out: &mut [f64]| sys.dl_dv(q, v, 0.0, out).unwrap();
         for j in 0..3 {
-            let diff = |f: Gradient, wrt_q: bool| {
-                let (mut a, mut b) = ([0.0; 3], [0.0; 3]);
-                let (mut qp, mut qm, mut vp, mut vm) = (q, q, v, v);
-                if wrt_q {
-                    qp[j] += e;
-                    qm[j] -= e;
-                } else {
-                    vp[j] += e;
-                    vm[j] -= e;
-                }
-                f(&qp, &vp, &mut a);
-                f(&qm, &vm, &mut b);
-                [0, 1, 2].map(|i| (a[i] - b[i]) / (2.0 * e))
-            };
-            let lq = |q: &[f64], v: &[f64], out: &mut [f64]| sys.dl_dq(q, v, 0.0, out).unwrap();
-            let lv = |q: &[f64], v: &[f64], out: &mut [f64]| sys.dl_dv(q, v, 0.0, out).unwrap();
-            // Column j of L_qq (∂/∂qⱼ of ∂L/∂q), of L_qq̇ (∂/∂q̇ⱼ of ∂L/∂q), of L_q̇q̇.
-            for (name, matrix, column) in [
-                ("qq", &h.qq, diff(&lq, true)),
-                ("qv", &h.qv, diff(&lq, false)),
-                ("vv", &h.vv, diff(&lv, false)),
-            ] {
+            let [qq, qv, vv] = common::hessian_columns(&lq, &lv, &q, &v, j);
+            for (name, matrix, column) in [("qq", &h.qq, qq), ("qv", &h.qv, qv), ("vv", &h.vv, vv)] {
                 for i in 0..3 {
                     let gap = (matrix[(i, j)] - column[i]).abs() / column[i].abs().max(1.0);
                     worst = worst.max(gap);
@@ -88,6 +66,7 @@ fn the_hessians_are_the_derivatives_of_the_gradients() {
                 }
             }
         }
+        let e = 1e-6;
         // L_qq̇ is also ∂p/∂q: entry (i, j) = ∂pⱼ/∂qᵢ, the transpose of what the loop checked.
         let lv = |q: &[f64], out: &mut [f64]| sys.dl_dv(q, &v, 0.0, out).unwrap();
         for i in 0..3 {

@@ -29,9 +29,6 @@ impl Lagrangian for FirstDerivativesOnly {
     }
 }
 
-/// ∂L/∂q or ∂L/∂q̇ as a function of (q, q̇).
-type Gradient<'a> = &'a dyn Fn(&[f64], &[f64], &mut [f64]);
-
 fn run<L: Lagrangian>(sys: &L, method: Method) -> Trajectory {
     common::run_general(sys, &DoublePendulum::problem().initial, method, 0.01, 500, 500)
         .unwrap_or_else(|e| panic!("{method:?}: {e}"))
@@ -43,30 +40,11 @@ fn the_double_pendulum_hessians_are_the_derivatives_of_its_gradients() {
     let (q, v) = ([0.3, -1.2], [0.7, 2.5]);
     let mut h = Hessians::zeros(2);
     assert!(sys.hessians(&q, &v, 0.0, &mut h).unwrap());
-    let e = 1e-6;
+    let lq = |q: &[f64], v: &[f64], out: &mut [f64]| sys.dl_dq(q, v, 0.0, out).unwrap();
+    let lv = |q: &[f64], v: &[f64], out: &mut [f64]| sys.dl_dv(q, v, 0.0, out).unwrap();
     for j in 0..2 {
-        let diff = |f: Gradient, wrt_q: bool| {
-            let (mut a, mut b) = ([0.0; 2], [0.0; 2]);
-            let (mut qp, mut qm, mut vp, mut vm) = (q, q, v, v);
-            if wrt_q {
-                qp[j] += e;
-                qm[j] -= e;
-            } else {
-                vp[j] += e;
-                vm[j] -= e;
-            }
-            f(&qp, &vp, &mut a);
-            f(&qm, &vm, &mut b);
-            [(a[0] - b[0]) / (2.0 * e), (a[1] - b[1]) / (2.0 * e)]
-        };
-        let lq = |q: &[f64], v: &[f64], out: &mut [f64]| sys.dl_dq(q, v, 0.0, out).unwrap();
-        let lv = |q: &[f64], v: &[f64], out: &mut [f64]| sys.dl_dv(q, v, 0.0, out).unwrap();
-        // Column j of L_qq (∂/∂qⱼ of ∂L/∂q), of L_qq̇ (∂/∂q̇ⱼ of ∂L/∂q), of L_q̇q̇.
-        for (matrix, column) in [
-            (&h.qq, diff(&lq, true)),
-            (&h.qv, diff(&lq, false)),
-            (&h.vv, diff(&lv, false)),
-        ] {
+        let [qq, qv, vv] = common::hessian_columns(&lq, &lv, &q, &v, j);
+        for (matrix, column) in [(&h.qq, qq), (&h.qv, qv), (&h.vv, vv)] {
             for i in 0..2 {
                 assert!(
                     (matrix[(i, j)] - column[i]).abs() < 1e-7 * column[i].abs().max(1.0),

@@ -54,32 +54,11 @@ fn the_derivatives_hessians_and_velocity_are_exact() {
     let (q, v) = ([0.8, 2.3], [-0.4, 1.1]);
     let mut h = Hessians::zeros(2);
     assert!(sys.hessians(&q, &v, 0.0, &mut h).unwrap());
-    let e = 1e-6;
+    let lq = |q: &[f64], v: &[f64], out: &mut [f64]| sys.dl_dq(q, v, 0.0, out).unwrap();
+    let lv = |q: &[f64], v: &[f64], out: &mut [f64]| sys.dl_dv(q, v, 0.0, out).unwrap();
     for j in 0..2 {
-        let column = |wrt_q: bool, momentum: bool| {
-            let (mut qp, mut qm, mut vp, mut vm) = (q, q, v, v);
-            if wrt_q {
-                qp[j] += e;
-                qm[j] -= e;
-            } else {
-                vp[j] += e;
-                vm[j] -= e;
-            }
-            let (mut a, mut b) = ([0.0; 2], [0.0; 2]);
-            if momentum {
-                sys.dl_dv(&qp, &vp, 0.0, &mut a).unwrap();
-                sys.dl_dv(&qm, &vm, 0.0, &mut b).unwrap();
-            } else {
-                sys.dl_dq(&qp, &vp, 0.0, &mut a).unwrap();
-                sys.dl_dq(&qm, &vm, 0.0, &mut b).unwrap();
-            }
-            [(a[0] - b[0]) / (2.0 * e), (a[1] - b[1]) / (2.0 * e)]
-        };
-        for (matrix, d) in [
-            (&h.qq, column(true, false)),
-            (&h.qv, column(false, false)),
-            (&h.vv, column(false, true)),
-        ] {
+        let [qq, qv, vv] = common::hessian_columns(&lq, &lv, &q, &v, j);
+        for (matrix, d) in [(&h.qq, qq), (&h.qv, qv), (&h.vv, vv)] {
             for i in 0..2 {
                 assert!((matrix[(i, j)] - d[i]).abs() < 1e-7 * d[i].abs().max(1.0), "({i}, {j})");
             }
@@ -89,6 +68,7 @@ fn the_derivatives_hessians_and_velocity_are_exact() {
     let (mut lq, mut lv) = ([0.0; 2], [0.0; 2]);
     sys.dl_dq(&q, &v, 0.0, &mut lq).unwrap();
     sys.dl_dv(&q, &v, 0.0, &mut lv).unwrap();
+    let e = 1e-6;
     for i in 0..2 {
         let d = |dq: f64, dv: f64| {
             let (mut qp, mut vp) = (q, v);

@@ -14,7 +14,7 @@
 //!   (it falls at the order at h/2), and the symmetric ones are reversible: the run back from
 //!   the end, momenta and magnetic coupling reversed, returns to the start.
 
-use nalgebra::DMatrix;
+use crate::common;
 use proptest::prelude::*;
 use proptest::test_runner::{Config, RngSeed, TestCaseError, TestRunner};
 
@@ -533,9 +533,6 @@ fn advises_a_smaller_step(error: &Error) -> bool {
     }
 }
 
-/// ∂L/∂q or ∂L/∂q̇ of a chain at (q, q̇), into the last argument.
-type Gradient<'a> = dyn Fn(&[f64], &[f64], &mut [f64]) + 'a;
-
 /// The Hessians of [`Chain`] are the derivatives of its gradients (the properties above rely
 /// on them being exact).
 #[test]
@@ -550,29 +547,11 @@ fn the_random_chains_hessians_are_their_gradients_derivatives() {
                 let n = c.n();
                 let mut h = Hessians::zeros(n);
                 c.hessians(&q, &v, 0.0, &mut h).unwrap();
-                let e = 1e-6;
-                let column = |f: &Gradient, wrt_q: bool, j: usize| {
-                    let (mut a, mut b) = (vec![0.0; n], vec![0.0; n]);
-                    let (mut qp, mut qm, mut vp, mut vm) = (q.clone(), q.clone(), v.clone(), v.clone());
-                    if wrt_q {
-                        qp[j] += e;
-                        qm[j] -= e;
-                    } else {
-                        vp[j] += e;
-                        vm[j] -= e;
-                    }
-                    f(&qp, &vp, &mut a);
-                    f(&qm, &vm, &mut b);
-                    DMatrix::from_iterator(n, 1, a.iter().zip(&b).map(|(x, y)| (x - y) / (2.0 * e)))
-                };
                 let lq = |q: &[f64], v: &[f64], out: &mut [f64]| c.dl_dq(q, v, 0.0, out).unwrap();
                 let lv = |q: &[f64], v: &[f64], out: &mut [f64]| c.dl_dv(q, v, 0.0, out).unwrap();
                 for j in 0..n {
-                    for (matrix, diff) in [
-                        (&h.qq, column(&lq, true, j)),
-                        (&h.qv, column(&lq, false, j)),
-                        (&h.vv, column(&lv, false, j)),
-                    ] {
+                    let [qq, qv, vv] = common::hessian_columns(&lq, &lv, &q, &v, j);
+                    for (matrix, diff) in [(&h.qq, qq), (&h.qv, qv), (&h.vv, vv)] {
                         for i in 0..n {
                             prop_assert!((matrix[(i, j)] - diff[i]).abs() <= 1e-6 * diff[i].abs().max(1.0));
                         }

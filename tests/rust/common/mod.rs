@@ -12,6 +12,27 @@ use varmech::Error;
 pub mod skate;
 pub mod tapes;
 
+/// ∂L/∂q or ∂L/∂q̇ as a function of (q, q̇).
+pub type Gradient<'a> = &'a dyn Fn(&[f64], &[f64], &mut [f64]);
+
+/// Column j of L_qq (∂/∂qⱼ of ∂L/∂q), of L_qq̇ (∂/∂q̇ⱼ of ∂L/∂q) and of L_q̇q̇, by central
+/// differences (step 1e-6) of the gradients `lq` and `lv` at (q, q̇): what a model's Hessians
+/// are checked against.
+pub fn hessian_columns(lq: Gradient, lv: Gradient, q: &[f64], v: &[f64], j: usize) -> [Vec<f64>; 3] {
+    let e = 1e-6;
+    let column = |f: Gradient, wrt_q: bool| {
+        let (mut qp, mut qm, mut vp, mut vm) = (q.to_vec(), q.to_vec(), v.to_vec(), v.to_vec());
+        let (plus, minus) = if wrt_q { (&mut qp, &mut qm) } else { (&mut vp, &mut vm) };
+        plus[j] += e;
+        minus[j] -= e;
+        let (mut a, mut b) = (vec![0.0; q.len()], vec![0.0; q.len()]);
+        f(&qp, &vp, &mut a);
+        f(&qm, &vm, &mut b);
+        a.iter().zip(&b).map(|(x, y)| (x - y) / (2.0 * e)).collect()
+    };
+    [column(lq, true), column(lq, false), column(lv, false)]
+}
+
 /// One method of each family: explicit splitting, composition, baseline, implicit, Galerkin.
 pub const FAMILIES: [Method; 5] = [
     Method::Verlet,
