@@ -83,13 +83,17 @@ def momentum(traj: Trajectory, generator: Generator) -> np.ndarray:
     return _momentum_terms(traj, generator)[0]
 
 
-def _momentum_terms(traj: Trajectory, generator: Generator, argument: str = "generator") -> tuple[np.ndarray, np.ndarray]:
+def _momentum_terms(
+    traj: Trajectory, generator: Generator, argument: str = "generator", field: np.ndarray | None = None
+) -> tuple[np.ndarray, np.ndarray]:
     """J = p·ξ(q) and its size at every saved state, by the core's rule (``Generator::momentum_terms``:
     the larger of Σ|pᵢξᵢ| and ‖p‖∞‖ξ‖∞); a generator that does not fit the model's coordinates
-    is refused naming ``argument``."""
+    is refused naming ``argument``. A closure's ξ at the states is ``field`` where given."""
     if isinstance(generator, (Translation, Rotation, Cyclic)):
         return _core.momentum(generator.spec(), *traj._arrays()[1:], argument=argument)
-    return _core.momentum_along(_field(traj, generator, argument), np.ascontiguousarray(traj.p, dtype=float))
+    if field is None:
+        field = _field(traj, generator, argument)
+    return _core.momentum_along(field, np.ascontiguousarray(traj.p, dtype=float))
 
 
 def _field(traj: Trajectory, generator: Generator, argument: str = "generator") -> np.ndarray:
@@ -590,11 +594,14 @@ def check_conservation(traj: Trajectory, generators: Sequence[Generator] | None 
     for k, xi in enumerate(generators):
         # Checked against the model's coordinates first: then a cyclic coordinate's momentum is
         # named as the model knows it (p_phi).
-        j, size = _momentum_terms(traj, xi, f"generators[{k}]")
+        argument = f"generators[{k}]"
+        # A closure's ξ at the states, once: its J and the test of what acts along it need it.
+        field = None if isinstance(xi, (Translation, Rotation, Cyclic)) else _field(traj, xi, argument)
+        j, size = _momentum_terms(traj, xi, argument, field)
         name = model.momentum_names[xi.index] if isinstance(xi, Cyclic) else xi.name if isinstance(xi, (Translation, Rotation)) else f"xi[{k}]"
         record = _core.statistics(t, j - j[0], size, size, steps)
         stats = _statistics(record, name, j[0], "mean max(Σ|pᵢξᵢ|, ‖p‖‖ξ‖)", t)
-        why = _broken(t, _field(traj, xi, f"generators[{k}]"), acting) if acting else None
+        why = _broken(t, _field(traj, xi, argument) if field is None else field, acting) if acting else None
         # Not conserved, so not judged; a non-finite momentum fails all the same.
         if why is not None and stats.first_non_finite is None:
             stats = replace(stats, verdict=NOT_JUDGED, advice=why)

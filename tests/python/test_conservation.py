@@ -146,3 +146,21 @@ def test_velocity_and_momentum_name_the_argument_of_the_wrong_shape():
         model.velocity(np.zeros((3, 2)), np.ones((3, 2)), t=[0.0, 1.0])
     # What fits still works: one q for many rows, one t for all.
     np.testing.assert_array_equal(model.momentum([1.0, 0.0], np.ones((3, 2))), np.ones((3, 2)))
+
+
+def test_a_closure_generator_is_called_once_a_saved_state_where_a_force_acts():
+    # Its J and the test of whether the force pushes along ξ share one evaluation of ξ(q).
+    model = varmech.Lagrangian(
+        2, lambda q, v, t: 0.5 * (v @ v) - 0.5 * (q @ q),
+        dl_dq=lambda q, v, t: -q, dl_dv=lambda q, v, t: v.copy(), force=lambda q, v, t: -0.1 * v,
+    )  # fmt: skip
+    traj = varmech.integrate(model, [1.0, 0.0], v0=[0.0, 1.0], dt=0.05, steps=100, method="midpoint")
+    calls = []
+
+    def xi(q):
+        calls.append(1)
+        return np.array([-q[1], q[0]])
+
+    report = varmech.check_conservation(traj, [xi])
+    assert len(calls) == len(traj.t)
+    assert report.momenta[0].verdict == "not judged" and "force" in report.momenta[0].advice
