@@ -189,6 +189,28 @@ def test_native_runs_release_the_gil():
     assert releases_the_gil(lambda: varmech.integrate(scene, dt=1.0, steps=5_000_000, save_every=1_000_000))
 
 
+@pytest.mark.parametrize("method", ["verlet", "midpoint", "explicit_euler"])
+def test_a_motion_below_the_differences_resolution_is_told_to_supply_derivatives(method):
+    # Differences step by 6e-6 at |q| < 1: at an amplitude of 1e-30 the term 2qh of
+    # V(q + h) − V(q − h) is below their rounding, the force comes out 0 and the particle
+    # flies off its potential's minimum, at every step. The advice names what helps.
+    potential = lambda q: float(0.5 * q[0] ** 2 + 2.0 * (1.0 - np.cos(q[0])))  # noqa: E731
+    with pytest.warns(varmech.DerivativeWarning):
+        bare = varmech.MechanicalSystem(1, potential, mass=[1.0])
+    for dt in (0.05, 0.05 / 16):
+        with pytest.raises(varmech.DivergenceError, match="supply the model's derivatives") as info:
+            varmech.integrate(bare, q0=[0.0], p0=[1e-30], dt=dt, steps=int(200 / dt), method=method)
+        assert "reduce dt" not in str(info.value)
+    exact = varmech.MechanicalSystem(1, potential, lambda q: q + 2.0 * np.sin(q), mass=[1.0])
+    traj = varmech.integrate(exact, q0=[0.0], p0=[1e-30], dt=0.05, steps=4000, method="verlet")
+    # ω² = 3: the amplitude is v0/√3, which the exact gradient keeps.
+    assert np.max(np.abs(traj.q)) == pytest.approx(1e-30 / np.sqrt(3.0), rel=0.01, abs=0.0)
+    # The same particle at amplitude 1e-3 moves its differenced forces' rounding far less than its
+    # energy: explicit Euler's own growth is told to reduce dt.
+    with pytest.raises(varmech.DivergenceError, match="reduce dt"):
+        varmech.integrate(bare, q0=[0.0], p0=[1e-3], dt=0.05, steps=100_000, method="explicit_euler")
+
+
 def test_newton_failure_raises_convergence_error_with_partial_trajectory():
     # V = |q|: at h = 1 from q0 = 0.001 the midpoint equation q1 = q0 - (h²/2) sign((q0 + q1)/2)
     # has no solution, and Newton's iterates flip sides for ever.

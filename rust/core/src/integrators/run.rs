@@ -6,6 +6,7 @@ use super::jumps::{Watch, Watcher};
 use super::stepper::Clock;
 use super::{Checkpoint, Detector, Dynamics, Failure, Method, NewtonOptions, Poll, Stepper, Trajectory};
 use crate::model::{EnergyTerms, Rest, Scale};
+use crate::solve::difference;
 use crate::solve::newton::norm;
 use crate::{memory, Error, ModelError};
 
@@ -668,15 +669,44 @@ impl EnergyWatch {
                 ", and the state growing: max |qᵢ| = {size:.3e}, at most {spread:.3e} while the run was half as long"
             )
         };
+        let advice = differences_advice(sys, (stepper.q(), stepper.p(), time), first.0, error.abs())
+            .unwrap_or_else(|| "reduce dt".into());
         let reason = format!(
             "energy error {:.3e} is {:.3e} times the energy scale {scale:.3e} (the mean kinetic energy), \
-             beyond max_energy_error = {:.3e}{growing}; reduce dt",
+             beyond max_energy_error = {:.3e}{growing}; {advice}",
             error.abs(),
             error.abs() / scale,
             self.tolerance,
         );
         Some(Error::Divergence { step, time, reason })
     }
+}
+
+/// The advice for an energy error that the rounding of derivatives taken by differences
+/// accounts for: their noise in the forces at (q, p, t), times the motion from the run's first
+/// state `first`, at least `error` (a motion far below the differences' step, as at amplitudes
+/// of 1e-100, loses its forces to rounding). None where derivatives are exact, or the noise
+/// accounts for less: then the step is to blame.
+fn differences_advice<S: Dynamics + ?Sized>(
+    sys: &S,
+    (q, p, t): (&[f64], &[f64], f64),
+    first: &[f64],
+    error: f64,
+) -> Option<String> {
+    let model = sys.as_lagrangian();
+    let (mut v, mut forces) = (vec![0.0; q.len()], vec![0.0; q.len()]);
+    difference::take_noise();
+    model.velocity(q, p, t, &mut v).ok()?;
+    model.gradients(q, &v, t, &mut forces, &mut vec![0.0; q.len()]).ok()?;
+    let noise = difference::take_noise();
+    let motion = q.iter().zip(first).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
+    (noise * motion >= error).then(|| {
+        format!(
+            "the error is within the rounding of the derivatives taken by differences (forces to ±{noise:.1e} \
+             over a motion of {motion:.1e}), which a smaller step does not lower: supply the model's \
+             derivatives, or scale its coordinates to order 1"
+        )
+    })
 }
 
 fn not_finite(terms: &EnergyTerms) -> String {
