@@ -580,6 +580,8 @@ def check_conservation(traj: Trajectory, generators: Sequence[Generator] | None 
             energy = _refined(traj, energy)
         elif not forced and energy.verdict in ("secular drift", "too short to judge") and refine:
             energy = _continued(traj, energy)
+        if energy.verdict == "secular drift" and not energy.advice:
+            energy = replace(energy, advice=_drift_advice(traj))
     else:
         energy = energy_statistics(model, t, *traj._arrays()[1:], steps=steps)
         # Not conserved, so not judged; but a non-finite energy fails the run all the same.
@@ -702,6 +704,16 @@ def _continued(traj: Trajectory, stats: InvariantStatistics) -> InvariantStatist
     if longer.verdict in ("bounded", "conserved to round-off"):
         return replace(stats, verdict="bounded", advice=f"{how}: the error levels off, a transient")
     return replace(stats, verdict=longer.verdict, advice=f"{how}: {longer.advice}" if longer.advice else how)
+
+
+def _drift_advice(traj: Trajectory) -> str:
+    """What to do about a drifting energy: reduce dt, and why a smaller step helps."""
+    info = {m.name: m for m in _core.methods()}.get(traj.method)
+    if info is not None and not info.symplectic:
+        return f"{traj.method} is not symplectic, so nothing bounds its energy error: reduce dt (the drift falls at order {info.order})"
+    # Backward error analysis bounds the error over exponentially long times only for h·ω small
+    # enough: near the stability limit, or at a resonance, the modified energy does not hold.
+    return "a symplectic method drifts only at a step too coarse for the motion: reduce dt"
 
 
 def _failure_advice(traj: Trajectory) -> str:

@@ -419,3 +419,12 @@ def test_a_drift_stays_a_drift_over_its_continuation_however_the_run_was_saved(s
     traj = varmech.integrate(scene, dt=2 * np.pi / 200, steps=500 * 200, method="rk4", save_every=save_every, max_energy_error=None)
     energy = varmech.check_conservation(traj).energy
     assert energy.verdict == "secular drift", energy
+
+
+def test_a_drift_says_what_helps_and_reducing_dt_does():
+    # RK4 is not symplectic: its oscillator loses energy at a rate that falls at least at its
+    # order, 4, as the advice says (measured: 2^4.9 from h = 0.4 to 0.2).
+    runs = [varmech.integrate(scenes.harmonic_oscillator(), dt=dt, steps=round(400 / dt), method="rk4") for dt in (0.4, 0.2)]
+    coarse, fine = (varmech.check_conservation(traj).energy for traj in runs)
+    assert coarse.verdict == "secular drift" and "rk4 is not symplectic" in coarse.advice and "reduce dt" in coarse.advice
+    assert coarse.drift_rate / fine.drift_rate > 2.0**3.5
