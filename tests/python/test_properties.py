@@ -95,3 +95,54 @@ def test_the_oracle_sees_a_crash_a_hang_and_a_wrong_verdict(monkeypatch):
     monkeypatch.setattr(varmech, "check_conservation", failing_at_h)
     caught = po.examine(spec)
     assert caught.verdict == "failed" and caught.confirmed is False and "converge" in caught.problems[0], caught
+
+
+#: Cases the campaigns found breaking a property, each with the outcome it has since its fix:
+#: (what it shows, its spec's fields as the campaign printed them, the outcome's kind, its verdict).
+FOUND = [
+    (
+        "a motion of 1e-126 below the differences' resolution: advised exact derivatives, not dt",
+        dict(family="chain", api="mechanical", n=1, coefficients={
+            "m": [1.1798132075667047], "k": [1.7747180804275164], "beta": [7.71448330246504e-281], "g": [0.0],
+            "kappa": [0.0], "alpha": [0.0], "gamma": [0.0], "eps": [0.11632605294606324], "u": [-0.3611141777308731],
+            "damping": [0.10853642622556639], "drive": [1.280380513684481, 0.5827889685747427]},
+            derivatives="none", q0=[0.0], v0=[1.953889865954315e-126], method="explicit_euler",
+            h_fraction=0.3431921066300851, steps=299),
+        "DivergenceError", None,
+    ),
+    (
+        "a refinement too short to judge contradicts no band",
+        dict(family="wall", api="mechanical", n=1, coefficients={
+            "k": [1.1], "m": [1.1], "g": [0.864078780143132], "floor": [1.2656444564612792]},
+            contact=(1.0, "variational", 0.0), q0=[0.0], v0=[0.2], method="mclachlan4", h_fraction=0.02, steps=60),
+        "completed", "bounded",
+    ),
+    (
+        "'failed' at 0.72 of the stability limit, where the error at h/2 falls 1900-fold",
+        dict(family="wall", api="mechanical", n=2, coefficients={
+            "k": [2.890042031960642, 3.105995735293521], "m": [0.5, 0.5], "g": [6.138633842967026], "floor": [1.1]},
+            contact=(1.4090070538856628e-61, "variational", 0.9420017073867482),
+            q0=[-0.21637888184476517, -0.03463040698210951], v0=[2.3009254052398544e-233, 1.141636627488106],
+            method="suzuki_umeno8", h_fraction=0.7209602068442023, steps=96),
+        "completed", "failed",
+    ),
+    (
+        "a symplectic method's drift at a coarse step, advised to reduce dt, bounded at h/2",
+        dict(family="chain", api="mechanical", n=2, coefficients={
+            "m": [2.713785198561196, 0.6483159514347443], "k": [1.7879937608804977, 1.3207145700966623],
+            "beta": [0.0, 0.0], "g": [4.538764271913137, 3.21990010180176e-279], "kappa": [0.0], "alpha": [-0.0],
+            "gamma": [1.0], "eps": [1.1012839930777908e-21, 0.8763453446725012],
+            "u": [0.09089154106844677, 0.5065865148598061], "damping": [0.37460115840943103, 0.29815993282332004],
+            "drive": [0.5, 2.2196393737357547]},
+            mass="matrix", q0=[-0.8353756736304279, -0.0707834093603894], v0=[0.005, 0.0], method="galerkin4",
+            h_fraction=0.7556826365529214, steps=80),
+        "completed", "secular drift",
+    ),
+]
+
+
+@pytest.mark.parametrize(("shows", "fields", "kind", "verdict"), FOUND, ids=[f[0][:40] for f in FOUND])
+def test_what_the_campaigns_found(shows, fields, kind, verdict):
+    outcome = _check(pm.Spec(**fields))
+    assert (outcome.kind, outcome.verdict) == (kind, verdict), outcome
+    assert not outcome.known, outcome
