@@ -19,6 +19,7 @@ import numpy as np
 from . import _core
 from . import impacts as _impacts
 from ._util import returned
+from .derivatives import blame
 from .integrate import integrate
 from .model import Cyclic, Generator, Model, Rotation, Translation
 from .trajectory import Trajectory
@@ -582,6 +583,10 @@ def check_conservation(traj: Trajectory, generators: Sequence[Generator] | None 
             energy = _continued(traj, energy)
         if energy.verdict == "secular drift" and not energy.advice:
             energy = replace(energy, advice=_drift_advice(traj))
+        if energy.verdict in ("secular drift", "too coarse", "failed") and energy.first_non_finite is None:
+            # Wrong derivatives integrate other dynamics than the energy's: no step mends that.
+            wrong = blame(model, traj.q[0], traj.v[0], float(traj.t[0]), "at the first state")
+            energy = energy if wrong is None else replace(energy, advice=wrong)
     else:
         energy = energy_statistics(model, t, *traj._arrays()[1:], steps=steps)
         # Not conserved, so not judged; but a non-finite energy fails the run all the same.

@@ -166,3 +166,23 @@ def check_derivatives(model: Model, q: ArrayLike, v: ArrayLike | None = None, t:
     if not mismatch:
         raise ValueError("model: supplies no derivatives to check")
     return DerivativeCheck(mismatch, rtol)
+
+
+def blame(model: Model, q: np.ndarray, v: np.ndarray, t: float, where: str) -> str | None:
+    """Where a closure model's supplied derivatives disagree with differences of its functions at
+    (q, q̇, t), the advice that says so: the run integrates other dynamics than its energy's, and
+    no step mends that. None for a model whose derivatives agree, supplies none, is not made of
+    closures, or whose closures fail there (nothing to blame). ``where`` names the state."""
+    if not isinstance(model, (MechanicalSystem, Lagrangian)):
+        return None
+    try:
+        check = check_derivatives(model, q, v, t)
+    except Exception:
+        return None
+    if check.ok:
+        return None
+    name, mismatch = check.worst
+    return (
+        f"the model's {name} disagrees with central differences {where} by {mismatch:.2e} (relative, above "
+        f"{check.rtol:g}), so reducing dt cannot help: mend {name} (varmech.check_derivatives(model, q) compares it at any q)"
+    )

@@ -20,8 +20,8 @@ from . import impulses as _impulses
 from ._progress import progress_bar
 from ._util import finite, positive, positive_int, returned_scalar, step_count, vector
 from .constraints import warn_if_integrable
-from .derivatives import check_derivatives
-from .model import Lagrangian, MechanicalSystem, Model, check_delays, initial_state
+from .derivatives import blame
+from .model import Lagrangian, Model, check_delays, initial_state
 from .modes import warn_if_unstable
 from .scenes import Scene
 
@@ -614,24 +614,10 @@ def symplecticity_defect(model: Model, method: str, q: ArrayLike, p: ArrayLike, 
 
 
 def _blame_derivatives(err: BaseException, model: Model) -> None:
-    """Where a closure model's supplied derivatives disagree with differences of its functions
-    at the run's last good state, a divergence is theirs, and reducing dt (which its message
-    advises) cannot help: the message says so instead, naming the derivative and
-    :func:`varmech.check_derivatives`."""
-    if not isinstance(model, (MechanicalSystem, Lagrangian)):
-        return
+    """A divergence that a closure model's wrong derivatives explain (:func:`derivatives.blame` at
+    the run's last good state) says so, instead of advising to reduce dt."""
     last = err.partial  # type: ignore[attr-defined]
-    try:
-        check = check_derivatives(model, last.q[-1], last.v[-1], float(last.t[-1]))
-    except Exception:
-        # Pointers, or no derivatives supplied, or a closure that fails there: nothing to blame.
-        return
-    if check.ok:
-        return
-    name, mismatch = check.worst
-    message = str(err).replace("; reduce dt", "", 1)
-    err.args = (
-        f"{message}; but the model's {name} disagrees with central differences at the last good state "
-        f"(t = {float(last.t[-1]):g}) by {mismatch:.2e} (relative, above {check.rtol:g}), so reducing dt cannot help: "
-        f"mend {name} (varmech.check_derivatives(model, q) compares it at any q)",
-    )
+    t = float(last.t[-1])
+    advice = blame(model, last.q[-1], last.v[-1], t, f"at the last good state (t = {t:g})")
+    if advice is not None:
+        err.args = (f"{str(err).replace('; reduce dt', '', 1)}; but {advice}",)

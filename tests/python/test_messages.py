@@ -52,6 +52,22 @@ def test_a_divergence_from_a_wrong_gradient_blames_the_gradient_not_dt():
     assert "disagrees" not in str(err.value)
 
 
+def test_a_verdict_from_a_wrong_gradient_blames_the_gradient_not_dt():
+    # The gradient of another potential (twice the pendulum's) runs bounded, conserving that
+    # potential's energy: the pendulum's errs by its own size at every step, 0.01 as 0.001.
+    pendulum = lambda q: float(9.81 * (1.0 - np.cos(q[0])))  # noqa: E731
+    wrong = varmech.MechanicalSystem(1, pendulum, lambda q: 2.0 * 9.81 * np.sin(q))
+    for dt in (0.01, 0.001):
+        traj = varmech.integrate(wrong, [1.0], [0.0], dt=dt, steps=round(50 / dt), max_energy_error=None)
+        energy = varmech.check_conservation(traj).energy
+        assert energy.verdict == "failed" and energy.max_rel_error > 0.9
+        assert energy.advice.startswith("the model's gradient disagrees with central differences at the first state")
+        assert "reducing dt cannot help" in energy.advice and "reduce dt;" not in energy.advice
+    right = varmech.MechanicalSystem(1, pendulum, lambda q: 9.81 * np.sin(q))
+    energy = varmech.check_conservation(varmech.integrate(right, [1.0], [0.0], dt=0.01, steps=5000)).energy
+    assert energy.verdict == "bounded" and energy.max_rel_error < 1e-3
+
+
 def test_shake_on_a_linkage_asks_for_more_sweeps_not_a_smaller_step():
     # Four links: SHAKE's sweeps converge linearly, about 90 a step here; a tenth of the step
     # does not bring them under the default 50, more sweeps do.
