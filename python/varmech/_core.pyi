@@ -652,11 +652,14 @@ def resume(
     contacts: list[tuple[str, float, str, str, Any, Any]] | None = None,
     impulses: list[tuple[float, str, Any]] | None = None,
     t_eval: _FloatArray | list[float] | None = None,
+    keep_energy_check: bool = True,
+    max_energy_error: float | None = None,
 ) -> TrajectoryRecord:
     """Goes on from a run's checkpoint for `steps` more steps, watching `events`, resolving the
     impacts on `contacts`, applying the `impulses` and taking the samples `t_eval` after the
     checkpoint's time (as `integrate`'s) if given; a checkpoint of another `method` or `dt`
-    than given is refused."""
+    than given is refused. The run's energy check goes on unless `keep_energy_check` is false:
+    then `max_energy_error` sets it (None: none)."""
 
 def energy_terms(model: _Model, t: _FloatArray, q: _FloatArray, p: _FloatArray) -> tuple[_FloatArray, _FloatArray, _FloatArray]:
     """(E, T, V) at each state: the energy function p·q̇ − L, its kinetic term E − V and its

@@ -161,7 +161,10 @@ def integrate(
         put in (the forces' work less ∫∂L/∂t dt, ``traj.work``). ``"auto"`` (default): 1
         (:data:`varmech.conservation.FAILURE`), the error at which the verdict is "failed"; no
         check where affine velocity constraints do work. ``None``: no energy check; non-finite
-        states still stop the run. The check costs one energy evaluation per saved state.
+        states still stop the run. The check costs one energy evaluation per saved state. A
+        continued run (``integrate(traj)``) keeps its run's check unless given one: a value
+        sets its level (the run's first energy, scale and growth kept, or, where the run had
+        no check, measured from the continuation's start), ``None`` lifts it.
     t0
         The initial time (default 0). It restarts a run from a state saved by hand: give that
         state's q, p and time, ``integrate(model, traj.q[-1], traj.p[-1], dt=dt, steps=n,
@@ -304,7 +307,9 @@ def integrate(
         named = [name for name, value in given.items() if value is not None and name != "t_eval"]
         if named:
             raise ValueError(f"{named[0]}: a continued run keeps its trajectory's {', '.join(named)}")
-        return _go_on(model, steps, t_end, save_every, progress, output, overwrite, checkpoint_every, events, t_eval)
+        # The run's own energy check goes on unless one is given.
+        check = {} if max_energy_error == "auto" else {"keep_energy_check": False, "max_energy_error": _energy_threshold(max_energy_error)}
+        return _go_on(model, steps, t_end, save_every, progress, output, overwrite, checkpoint_every, events, t_eval, check)
     contacts = _contacts_of(model, contacts) or None
     model, q0, p0 = _model_of(model, q0, p0, v0)
     if parameters is not None:
@@ -419,10 +424,12 @@ def _go_on(
     checkpoint_every: int | datetime.timedelta | None,
     events: Sequence[_events.Event | _events.EventFunction] | None,
     t_eval: ArrayLike | None = None,
+    check: Mapping[str, Any] | None = None,
 ) -> Trajectory:
     """``integrate(traj, steps=)``: the run of ``traj`` continued from its checkpoint, watching
     ``events`` from there (terminal counts after ``traj``'s crossings of the same events, an
-    energy error from ``traj``'s first energy), keeping the states at ``t_eval`` if given."""
+    energy error from ``traj``'s first energy), keeping the states at ``t_eval`` if given, its
+    energy check as ``check`` sets it (the binding's arguments; by default the run's own)."""
     contacts = _impacts.going_on(traj.contacts)
     # The checkpoint's time: a trajectory of t_eval times ends at its last sample, not there.
     t_now = going_on_from(traj, "model", "this trajectory").t
@@ -452,6 +459,7 @@ def _go_on(
         contacts=contacts,
         blows=_impulses.going_on(traj.impulses, None, t_now),
         times=times,
+        check=check or {},
     )
 
 
@@ -476,6 +484,7 @@ def _run(
     contacts: Sequence[_impacts.Contact] = (),
     blows: tuple[Sequence[_impulses.Impulse], list[_impulses.Spec]] = ((), []),
     times: np.ndarray | None = None,
+    check: Mapping[str, Any] | None = None,
 ) -> Trajectory:
     """Runs ``nsteps`` steps by ``first`` (a new run) or from ``checkpoint`` (after ``base``
     steps): in memory, or streamed to ``output`` in segments (:mod:`varmech.streaming`).
@@ -484,7 +493,9 @@ def _run(
     measured from ``initial_energy``. The run resolves the impacts on ``contacts``, which the
     result reports after the events' crossings, applies the impulses of ``blows`` (with their
     binding's tuples) after its start (a continued run's, those still to come) and keeps the
-    states at ``times`` alone if given (a continued run's; a new run's ``first`` takes its own)."""
+    states at ``times`` alone if given (a continued run's; a new run's ``first`` takes its own).
+    ``check``: the binding's arguments that set a continued run's energy check."""
+    check = check or {}
     impulses, impulse_specs = blows
     bar = progress_bar(total=nsteps, unit="step", desc=method, enabled=progress)
     try:
@@ -523,6 +534,7 @@ def _run(
                     found=found,
                     contacts=contacts,
                     impulses=impulse_specs,
+                    check=check,
                 )
             except BaseException as err:
                 # A file that cannot be read back (a disk that failed) leaves the error as it is.
@@ -556,6 +568,7 @@ def _run(
                     contacts=_impacts.specs(contacts) or None,
                     impulses=impulse_specs or None,
                     t_eval=times,
+                    **check,
                 )
             bar.update(record.steps - base - bar.n)
         except BaseException as err:

@@ -19,7 +19,7 @@ import os
 import signal
 import threading
 import time
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -86,13 +86,15 @@ def stream(
     found: Sequence[int] = (),
     contacts: Sequence[Contact] = (),
     impulses: list[Any] | None = None,
+    check: Mapping[str, Any] | None = None,
 ) -> None:
     """Runs ``steps`` steps in segments appended to ``writer``: the first by ``first`` (a new
     run) or from ``checkpoint`` (after ``base`` steps), every other from the last checkpoint.
     With events (``watched``, the binding's ``event_specs``), each segment watches them from
     its start, their crossings are committed with the segment's rows, terminal counts run over
     the whole run, and an energy error is measured from ``initial_energy`` (the run's first
-    energy; by default taken at its first state) after the ``found`` crossings of each so far. Closes the file with the
+    energy; by default taken at its first state) after the ``found`` crossings of each so far; a
+    continued run's energy check as ``check`` (the binding's arguments) sets it. Closes the file with the
     run's status; an exception stops the run with every state up to it committed, and closes
     the file saying why. Each segment resolves the impacts on ``contacts``, committed as the
     events after ``watched``'s, and applies the ``impulses`` (the binding's tuples) after its
@@ -131,7 +133,8 @@ def stream(
                 assert first is not None
                 record = first(0, None)
             else:
-                record = _core.resume(model._core, checkpoint, steps=0, save_every=save_every)
+                # A continued run's energy check, as ``check`` sets it, is its checkpoints' from here.
+                record = _core.resume(model._core, checkpoint, steps=0, save_every=save_every, **(check or {}))
             with _uninterrupted():
                 writer.append(record)
             if watched and initial_energy is None:

@@ -340,3 +340,29 @@ def test_a_streamed_run_that_fails_commits_its_last_segments_crossings(tmp_path)
     a, b = memory.value.partial, streamed.value.partial
     assert len(b.events[0]) == len(a.events[0]) > 0
     assert _same(b.events[0].t, a.events[0].t) and _same(b.q[-1], a.q[-1])
+
+
+def test_a_continued_run_takes_the_energy_check_it_is_given(tmp_path):
+    # Explicit Euler multiplies the oscillator's energy by 1 + h² a step: the run's own check
+    # stops it at step 49 whether or not it was continued; None lifts the check, and a level
+    # sets it; the states are the unbroken run's, bit for bit, whatever watches them.
+    scene = scenes.harmonic_oscillator()
+    first = varmech.integrate(scene, dt=0.1, steps=30, method="explicit_euler")
+    with pytest.raises(varmech.DivergenceError) as unbroken:
+        varmech.integrate(scene, dt=0.1, steps=2030, method="explicit_euler")
+    with pytest.raises(varmech.DivergenceError) as kept:
+        varmech.integrate(first, steps=2000)
+    assert kept.value.step == unbroken.value.step == 49
+    free = varmech.integrate(scene, dt=0.1, steps=2030, method="explicit_euler", max_energy_error=None)
+    for output in (None, tmp_path / "more.h5"):
+        lifted = varmech.integrate(first, steps=2000, max_energy_error=None, output=output)
+        assert lifted.status == 0 and np.array_equal(np.asarray(lifted.q), np.asarray(free.q)[30:])
+    with pytest.raises(varmech.DivergenceError) as tighter:
+        varmech.integrate(first, steps=2000, max_energy_error=0.5)
+    assert 30 < tighter.value.step < 49
+    # A run without a check given one: measured from the continuation's start.
+    with pytest.raises(varmech.DivergenceError, match="max_energy_error = 1.000e0"):
+        unchecked = varmech.integrate(scene, dt=0.1, steps=30, method="explicit_euler", max_energy_error=None)
+        varmech.integrate(unchecked, steps=2000, max_energy_error=1.0)
+    with pytest.raises(ValueError, match="max_energy_error"):
+        varmech.integrate(first, steps=10, max_energy_error=-1.0)

@@ -205,3 +205,46 @@ fn a_checkpoint_resumes_only_on_a_model_its_method_integrates() {
         refused.error
     );
 }
+
+/// A checkpoint's energy check goes on as the run's unless set: lifted, the continuation runs to
+/// its end on the unbroken run's states; tightened, it stops sooner; given to a run that had
+/// none, it is measured from the checkpoint. Explicit Euler on the oscillator multiplies the
+/// energy by 1 + h² a step, so its check stops the unbroken run at step 49.
+#[test]
+fn a_checkpoints_energy_check_is_the_runs_unless_set() {
+    use varmech::scenes::HarmonicOscillator;
+    let sys = HarmonicOscillator::new(1.0).unwrap();
+    let (q0, p0, dt) = ([0.0], [1.0], 0.1);
+    let run = |steps, check: Option<f64>| {
+        let options = Options {
+            max_energy_error: check,
+            ..Options::new(dt, steps)
+        };
+        integrate(&sys, Method::ExplicitEuler, &q0, &p0, &options, || Ok(()))
+    };
+    let stop = |result: Result<Trajectory, Box<varmech::integrators::Failure>>| match result {
+        Err(failure) => match failure.error {
+            Error::Divergence { step, .. } => step,
+            other => panic!("not a divergence: {other}"),
+        },
+        Ok(_) => usize::MAX,
+    };
+    let unbroken = stop(run(2030, Some(1.0)));
+    assert_eq!(unbroken, 49);
+    let from = |check: Option<f64>| Checkpoint::from_bytes(&run(30, check).unwrap().checkpoint).unwrap();
+    let go_on = |mut checkpoint: Checkpoint, set: Option<Option<f64>>| {
+        if let Some(tolerance) = set {
+            checkpoint.check_energy(tolerance);
+        }
+        resume(&sys, checkpoint, 2000, 1, || Ok(()))
+    };
+    assert_eq!(stop(go_on(from(Some(1.0)), None)), unbroken);
+    let lifted = go_on(from(Some(1.0)), Some(None)).unwrap();
+    let free = run(2030, None).unwrap();
+    assert_eq!(bits(&lifted.q), bits(&free.q[30..]));
+    let tighter = stop(go_on(from(Some(1.0)), Some(Some(0.5))));
+    assert!(30 < tighter && tighter < unbroken, "{tighter}");
+    // From step 30 the energy is 1.01³⁰ of the first; measured from there it takes as long again.
+    let fresh = stop(go_on(from(None), Some(Some(1.0))));
+    assert!(fresh > unbroken && fresh < 2030, "{fresh}");
+}

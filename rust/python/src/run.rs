@@ -144,7 +144,7 @@ pub(crate) fn detector_parts<'py>(
 /// samples `t_eval` after the checkpoint's time (as `integrate`'s) if given; a
 /// checkpoint of another `method` or `dt` than given is refused ([`Checkpoint::expect`]).
 #[pyfunction]
-#[pyo3(signature = (model, checkpoint, *, steps, save_every=1, progress=None, events=None, method=None, dt=None, contacts=None, impulses=None, t_eval=None))]
+#[pyo3(signature = (model, checkpoint, *, steps, save_every=1, progress=None, events=None, method=None, dt=None, contacts=None, impulses=None, t_eval=None, keep_energy_check=true, max_energy_error=None))]
 #[allow(clippy::too_many_arguments)]
 fn resume<'py>(
     py: Python<'py>,
@@ -159,8 +159,13 @@ fn resume<'py>(
     contacts: Option<Vec<ContactTuple<'py>>>,
     impulses: Option<Vec<ImpulseTuple<'py>>>,
     t_eval: Option<Vec<f64>>,
+    keep_energy_check: bool,
+    max_energy_error: Option<f64>,
 ) -> PyResult<TrajectoryRecord> {
-    let checkpoint = decode(py, checkpoint, method, dt)?;
+    let mut checkpoint = decode(py, checkpoint, method, dt)?;
+    if !keep_energy_check {
+        checkpoint.check_energy(max_energy_error);
+    }
     let events = detector_parts(py, model, events)?;
     let contacts = contacts.map(ContactSpecs::new).transpose()?;
     let schedule = ScheduleSpecs::new(impulses.unwrap_or_default(), t_eval.unwrap_or_default())?;

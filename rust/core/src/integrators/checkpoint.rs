@@ -31,6 +31,10 @@ pub struct Checkpoint {
     pub(super) state: StepperState,
     pub(super) watch: Option<EnergyWatch>,
     fingerprint: Fingerprint,
+    /// The tolerance of an energy check to start from the checkpoint's state, asked for by
+    /// [`Checkpoint::check_energy`] where the run had none: a request, never written.
+    #[serde(skip)]
+    pub(super) fresh_check: Option<f64>,
 }
 
 /// What a checkpoint was taken of, to refuse another: the model's kind, size and constraint
@@ -153,6 +157,7 @@ impl Checkpoint {
             fingerprint: Fingerprint::of(model, &state),
             state,
             watch,
+            fresh_check: None,
         }
     }
 
@@ -186,6 +191,7 @@ impl Checkpoint {
             state,
             watch,
             fingerprint,
+            ..
         } = self;
         // A state at odds with its own record is the checkpoint's fault, not the model's.
         if (fingerprint.dim, fingerprint.method) != (state.q().len(), state.method()) {
@@ -216,6 +222,19 @@ impl Checkpoint {
             return Err(refuse(format!("{reason}: it was edited or damaged")));
         }
         Ok((state, watch))
+    }
+
+    /// The energy check of the run going on from here, as `max_energy_error` sets a run's: None
+    /// for none; `Some(tolerance)` for one at `tolerance` × the scale, the run's own (its first
+    /// energy, scale and growth) where it checked its energy, else one from here. Without a
+    /// call, the run's own check goes on as it was.
+    pub fn check_energy(&mut self, tolerance: Option<f64>) {
+        self.fresh_check = None;
+        match (tolerance, self.watch.as_mut()) {
+            (None, _) => self.watch = None,
+            (Some(tolerance), Some(watch)) => watch.set_tolerance(tolerance),
+            (Some(tolerance), None) => self.fresh_check = Some(tolerance),
+        }
     }
 
     /// The stepper's state to go on with on `model`, checked as [`Checkpoint::resume_on`]

@@ -312,8 +312,15 @@ fn resumed<S: Dynamics + ?Sized>(
     if save_every == 0 {
         return Err(fail(Error::invalid("save_every", "must be at least 1"), empty(sys)));
     }
+    let fresh = checkpoint.fresh_check;
     let (state, watch) = checkpoint.resume_on(sys).map_err(|e| fail(e, empty(sys)))?;
     let stepper = Stepper::resume(sys, state).map_err(|e| fail(e, empty(sys)))?;
+    let watch = match (watch, fresh) {
+        (None, Some(tolerance)) => EnergyWatch::new(sys, &stepper, tolerance)
+            .transpose()
+            .map_err(|e| fail(e, empty(sys)))?,
+        (watch, _) => watch,
+    };
     let end = (stepper.steps().checked_add(steps)).filter(|_| (stepper.t() + steps as f64 * stepper.dt()).is_finite());
     let Some(end) = end else {
         let reason = format!(
@@ -620,6 +627,10 @@ impl EnergyWatch {
         };
         watch.push(&terms, stepper.work());
         Some(Ok(watch))
+    }
+
+    pub(super) fn set_tolerance(&mut self, tolerance: f64) {
+        self.tolerance = tolerance;
     }
 
     fn push(&mut self, terms: &EnergyTerms, work: f64) {
