@@ -700,7 +700,11 @@ def _continued(traj: Trajectory, stats: InvariantStatistics) -> InvariantStatist
     # Saved as the run was (its usual gap; the last one may be short), so that the batches of the
     # verdict's statistics span equal times: a finer continuation would outweigh the run.
     every = int(np.median(gaps))
-    more = integrate(traj, steps=int(traj.steps), save_every=every, max_energy_error=None, progress=False)
+    try:
+        more = integrate(traj, steps=int(traj.steps), save_every=every, max_energy_error=None, progress=False)
+    except _core.VarmechError:
+        # A continuation that fails (a state no longer finite) tells no transient from a drift.
+        return stats
     t, q, p = (np.concatenate([a, b[1:]]) for a, b in ((traj.t, more.t), (traj.q, more.q), (traj.p, more.p)))
     longer = energy_statistics(traj.model, t, q, p, steps=int(more.steps))
     if longer.verdict == stats.verdict or longer.verdict in ("failed", "too coarse"):

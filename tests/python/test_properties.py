@@ -138,6 +138,26 @@ FOUND = [
             h_fraction=0.7556826365529214, steps=80),
         "completed", "secular drift",
     ),
+    (
+        "a drift judged over its continuation, which the run's energy check no longer stops",
+        dict(family="sphere", api="mechanical", n=4, coefficients={
+            "r": [1.3689012023295457, 0.8466939276166401], "m": [1.3199800863307425, 0.95], "linked": [1.0], "g": [1.1],
+            "k": [0.5], "kappa": [2.6092655277776933]},
+            derivatives="none", mass="configuration", q0=[-7.441519124227835e-06, -0.47530586999840574, 0.7035447132361106,
+            -2.0539497262653886e-151], v0=[-7.441519124227835e-06, 0.0, 0.0, -2.0539497262653886e-151], method="trapezoid",
+            h_fraction=0.8791597253075547, steps=40),
+        "completed", "secular drift",
+    ),
+    (
+        "SHAKE past its linearization, mended by h/4 into a shortfall of sweeps that more sweeps mend",
+        dict(family="sphere", api="mechanical", n=4, coefficients={
+            "r": [0.6947381435920581, 0.99999], "m": [0.9858335288640797, 1.637373421718153], "linked": [1.0],
+            "g": [7.1572628260787905], "k": [1.2880974292864628e-69], "kappa": [1.8636202341677182]},
+            derivatives="none", q0=[-1.0212263366591623e-297, -0.5880451812346664, -0.4280625877357419, 3.755930338063118e-116],
+            v0=[0.811216805453894, -0.8577323063982838, 8.712944554527921e-100, -0.6074975783196201], method="shake",
+            h_fraction=0.5448790535870218, steps=283),
+        "ConvergenceError", None,
+    ),
 ]
 
 
