@@ -6,10 +6,13 @@ by RATTLE while the contact pushes, and released where its multiplier crosses 0.
 - a pendulum on a string whirled too slowly goes slack where cos θ = (2gl − v₀²)/(3gl), flies
   on the parabola and is caught by the string again where the parabola meets the circle;
 - samples (``t_eval``), files and their resume, ensembles and steppers go through holds as
-  through impacts; events on a held contact's motion are refused with ContactError.
+  through impacts; events on a held contact's motion are refused with ContactError;
+- a particle in a trap under gravity, pressed on a floor above its equilibrium, bounces to rest
+  at the limit of its Zeno series and is held there at every step (issue 64).
 """
 
 import math
+import warnings
 
 import numpy as np
 import pytest
@@ -173,3 +176,66 @@ def test_a_slider_streamed_to_a_file_and_resumed_is_one_run_with_its_release(tmp
     assert [o.name for o in resumed.events] == ["sphere", "sphere.closed", "sphere.released", "sphere.stuck", "sphere.slipped"]
     np.testing.assert_array_equal(resumed.events[2].t, released.t)
     np.testing.assert_array_equal(varmech.load(path, model=_particle()).events[2].q, released.q)
+
+
+#: Issue 64's cases: a trap ½kx² under gravity g (mass m) above the floor x ≥ −a, restitution
+#: e, from (x₀, v₀), at the step h of its property test.
+TRAPPED = {
+    "falls from rest": (3.3575621915367484, 1.6898067384630384, 6.283483229136442, 0.5889668115537644, 0.5458215677524878,
+                        0.0, 1.3036067969625391e-55, 0.8356555558181492),
+    "thrown up": (0.3653746425055403, 0.8756114838428447, 0.99999, 1.3264414980520427, 0.3413037757262099,
+                  1.7857279646163263e-190, 1.8163818877974123, 0.04871056203162395),
+}
+
+
+def _trapped_rest(k: float, m: float, g: float, a: float, e: float, x0: float, v0: float) -> float:
+    """When the trapped particle comes to rest on the floor: its first impact, then flights
+    harmonic about the equilibrium −gm/k, each from the floor (d = gm/k − a above it) at speed
+    v back to it after (2/ω)·atan(v/(ωd)), v falling by e at each."""
+    w, below = math.sqrt(k / m), g * m / k
+    y0, d = x0 + below, below - a
+    amplitude = math.hypot(y0, v0 / w)
+    t = (math.atan2(v0, w * y0) + math.acos(d / amplitude)) / w
+    v = e * w * math.sqrt(amplitude**2 - d**2)
+    while v > 1e-300:
+        t += 2 / w * math.atan(v / (w * d))
+        v *= e
+    return t
+
+
+@pytest.mark.parametrize("exact", [True, False], ids=["gradient", "differences"])
+@pytest.mark.parametrize(("method", "order"), [("verlet", 2), ("yoshida4", 4)])
+@pytest.mark.parametrize("name", list(TRAPPED))
+def test_a_trapped_particle_pressed_on_a_floor_above_its_equilibrium_bounces_to_rest_held_at_every_step(name, method, order, exact):
+    # Each closing leaves the normal velocity's round-off, ε|q̇⁻|, which was read as the body
+    # leaving the floor again: released, it crossed it at once, "a smaller step helps", and
+    # none did (issue 64). Held, it rests from the Zeno limit on, the balance E − W of its
+    # losses converging at the method's order.
+    k, m, g, a, e, x0, v0, h = TRAPPED[name]
+    k_, m_ = np.array([k]), np.array([m])
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # derivatives by differences, as asked
+        model = varmech.MechanicalSystem(
+            1, lambda q: float(0.5 * np.sum(k_ * q**2) + g * m * q[-1]), (lambda q: k_ * q + g * m) if exact else None, mass=m_, name="trap"
+        )
+    floor = varmech.Contact.wall(0, -a, restitution=e, law="reflect", name="floor")
+    t_rest = _trapped_rest(k, m, g, a, e, x0, v0)
+    balance = []
+    for div in (1, 2, 4, 16):
+        dt = h / div
+        traj = varmech.integrate(model, [x0], [m * v0], method=method, dt=dt, steps=math.ceil((t_rest + h) / dt), contacts=[floor])
+        impacts, closed, released, _, _ = traj.events
+        assert len(closed) == 1 and len(released) == 0 and len(impacts) >= 2, (div, closed.t, released.t)
+        # Closed at the Zeno limit, within the method's error (the series' rest taken as
+        # parabolas' from the closing impact: O(h³) of the harmonic flights').
+        assert abs(closed.t[0] - t_rest) <= 0.5 * dt ** min(order, 3) * t_rest, (div, closed.t[0], t_rest)
+        # Resting from there: on the floor, at rest.
+        after = traj.t > closed.t[0]
+        assert np.count_nonzero(after) >= 2
+        assert np.max(np.abs(traj.q[after, 0] + a)) <= 4 * np.finfo(float).eps * a, div
+        assert np.max(np.abs(traj.p[after, 0])) <= 1e-15 * m, div
+        energy = 0.5 * traj.p[:, 0] ** 2 / m + 0.5 * k * traj.q[:, 0] ** 2 + g * m * traj.q[:, 0]
+        balance.append(abs(energy[-1] - energy[0] - traj.work[-1]))
+    # The losses' account: E − W at rest is the method's error, which falls at its order.
+    assert balance[3] <= balance[2] / 4 ** (order - 1), balance
+    assert varmech.check_conservation(traj).energy.verdict in ("conserved to round-off", "bounded")

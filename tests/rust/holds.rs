@@ -5,8 +5,10 @@
 //! of impacts with `Error::Contact`; and Byerly's billiard ball, sliding on a rough table until
 //! it rolls at 5v₀/7 from t = 2v₀/(7μg), exactly, its run resumed bit for bit; and a wheel whose
 //! slip rows turn with its heading, rolling on its circle at the method's order while friction
-//! holds it, and skidding where that needs more than μ_s mg; and a held step past the surface's
-//! curvature ending the run with `Error::Contact`, which advises the smaller step that runs.
+//! holds it, and skidding where that needs more than μ_s mg; a held step past the surface's
+//! curvature ending the run with `Error::Contact`, which advises the smaller step that runs; and
+//! a particle in a trap pressed on a floor above its equilibrium, brought to rest at the Zeno
+//! limit of its harmonic flights and held there at every step.
 
 use nalgebra::DMatrix;
 use varmech::integrators::{
@@ -399,4 +401,143 @@ fn a_wheel_whose_slip_rows_turn_with_it_rolls_on_its_circle_at_the_methods_order
     )
     .unwrap();
     assert!(traj.work[traj.len() - 1] < 0.0, "it skids: friction does work");
+}
+
+/// A particle of mass m in the trap ½kx² under gravity g, V = ½kx² + gmx, its equilibrium
+/// x = −gm/k below a floor x ≥ −a.
+struct Trap {
+    mass: Mass,
+    k: f64,
+    weight: f64,
+}
+
+impl MechanicalSystem for Trap {
+    fn dim(&self) -> usize {
+        1
+    }
+
+    fn mass(&self) -> &Mass {
+        &self.mass
+    }
+
+    fn potential(&self, q: &[f64]) -> Result<f64, ModelError> {
+        Ok(0.5 * self.k * q[0] * q[0] + self.weight * q[0])
+    }
+
+    fn gradient(&self, q: &[f64], grad: &mut [f64]) -> Result<(), ModelError> {
+        grad[0] = self.k * q[0] + self.weight;
+        Ok(())
+    }
+}
+
+/// When the trapped particle (k, m, g) from (x₀, v₀) comes to rest on the floor x = −a with
+/// restitution e: its first impact, then flights harmonic about the equilibrium, each from
+/// the floor (at d = gm/k − a above it) at the speed v back to it after (2/ω)·atan(v/(ωd)),
+/// v falling by e at each.
+fn trapped_rest((k, m, g, a): (f64, f64, f64, f64), e: f64, (x0, v0): (f64, f64)) -> f64 {
+    let (w, below) = ((k / m).sqrt(), g * m / k);
+    let (y0, d) = (x0 + below, below - a);
+    let amplitude = y0.hypot(v0 / w);
+    let first = (v0.atan2(w * y0) + (d / amplitude).acos()) / w;
+    let (mut t, mut v) = (first, e * w * (amplitude * amplitude - d * d).sqrt());
+    while v > 1e-300 {
+        t += 2.0 / w * (v / (w * d)).atan();
+        v *= e;
+    }
+    t
+}
+
+#[test]
+fn a_trapped_particle_pressed_on_a_floor_above_its_equilibrium_bounces_to_rest_there_held_at_every_step() {
+    // Issue 64's cases (k, m, g, a, e, x₀, v₀, h) and a sweep of e and a. A closing leaves
+    // the round-off of the normal velocity it takes away, ε|q̇⁻|; where positive, it released
+    // the body, which crossed the floor again at once, and the run ended "a smaller step
+    // helps", at every step.
+    let mut cases = vec![
+        (
+            3.3575621915367484,
+            1.6898067384630384,
+            6.283483229136442,
+            0.5889668115537644,
+            0.5458215677524878,
+            0.0,
+            0.0,
+            0.8356555558181492,
+        ),
+        (
+            0.3653746425055403,
+            0.8756114838428447,
+            0.99999,
+            1.3264414980520427,
+            0.3413037757262099,
+            1.7857279646163263e-190,
+            1.8163818877974123,
+            0.04871056203162395,
+        ),
+    ];
+    for i in 0..6 {
+        for j in 0..4 {
+            let (e, a) = (0.1 + 0.15 * i as f64, 0.2 + 0.25 * j as f64);
+            cases.push((2.0, 1.3, 9.81, a, e, 0.5, 0.7, 0.1));
+        }
+    }
+    for (k, m, g, a, e, x0, v0, h) in cases {
+        let trap = Trap {
+            mass: Mass::diagonal(vec![m]).unwrap(),
+            k,
+            weight: g * m,
+        };
+        let contact = Contact {
+            surface: Box::new(NativeSurface::Wall {
+                coordinate: 0,
+                value: -a,
+            }),
+            restitution: e,
+            law: Law::Reflect,
+            friction: None,
+            name: "floor".into(),
+        };
+        let contacts = Contacts::new(vec![contact]).unwrap();
+        let t_rest = trapped_rest((k, m, g, a), e, (x0, v0));
+        for (method, order) in [(Method::Verlet, 2), (Method::Yoshida4, 4)] {
+            for div in [1, 2, 4, 16] {
+                let dt = h / div as f64;
+                // To a step past the rest.
+                let options = Options::new(dt, ((t_rest + h) / dt).ceil() as usize);
+                let traj = integrate_watching(
+                    &trap,
+                    method,
+                    &[x0],
+                    &[m * v0],
+                    &options,
+                    || Ok(()),
+                    with_contacts(&contacts),
+                )
+                .unwrap_or_else(|f| panic!("{method:?}, e = {e}, a = {a}, h/{div}: {}", f.error));
+                let switches = &traj.impacts.switches;
+                let case = format!("{method:?}, e = {e}, a = {a}, h/{div}");
+                assert_eq!(switches.kind, vec![Switch::Closed], "{case}: {:?}", switches.t);
+                // At the Zeno limit, within the method's error over the run (hω ≤ 1.2 here) and
+                // the rest of the series taken as parabolas' from the closing impact, O(h³).
+                let error = (switches.t[0] - t_rest).abs();
+                assert!(
+                    error <= 0.5 * dt.powi(order.min(3)) * t_rest,
+                    "{case}: closed {error} from {t_rest}"
+                );
+                // Resting from there: on the floor, at rest, pressed with λ = gm − ka.
+                let last = traj.len() - 1;
+                assert!(
+                    (traj.q_at(last)[0] + a).abs() <= 4.0 * f64::EPSILON * a,
+                    "{case}: {:?}",
+                    traj.q_at(last)
+                );
+                assert!(traj.p_at(last)[0].abs() <= 1e-15 * m, "{case}: {:?}", traj.p_at(last));
+                let lambda = multiplier(&trap, &traj, last, |_| vec![1.0]);
+                assert!(
+                    (lambda - (g * m - k * a)).abs() <= 1e-12 * g * m,
+                    "{case}: λ = {lambda}"
+                );
+            }
+        }
+    }
 }
