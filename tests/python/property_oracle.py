@@ -60,9 +60,6 @@ KNOWN_OPEN = {
     # The collision integrator under a composition, where a bounce's flight is about a step:
     # the body leaving the floor is found below it again within the step.
     "crosses it again at once": "a bounce within a step, under a method that holds contacts",
-    # A blow-up far outside Newton's region read as wrong Hessians (its differences there are
-    # no check of J), and a stall at ‖F‖ = 0.19 read as a kink, where h/4 runs.
-    "said a smaller step does not help, but h/4 gave Trajectory": "a failed Newton diagnosed as the model's",
     # A symplectic method near its limit on a chain whose energy wanders, called a drift; and
     # the converse, a short run's band where finer steps find the drift of a forced chain.
     "a 'secular drift' verdict that refinement does not confirm": "a coarse step's wander called a drift",
