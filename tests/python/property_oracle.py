@@ -61,9 +61,6 @@ KNOWN_OPEN = {
     # points out of the floor: the reflection, λ < 0, kicks the body in, and the next piece
     # crosses at once (h/16 runs). Elastic variational contacts, which no method holds, alike.
     "crosses it again at once": "a graze at a coarse step reflected into the floor",
-    # A blow-up far outside Newton's region read as wrong Hessians (its differences there are
-    # no check of J), and a stall at ‖F‖ = 0.19 read as a kink, where h/4 runs.
-    "said a smaller step does not help, but h/4 gave Trajectory": "a failed Newton diagnosed as the model's",
     # A short run's band where finer steps find the drift of a forced chain.
     "'bounded' verdict that refinement does not confirm: h: bounded [^;]*; h/2: secular drift": "a drift seen only at finer steps",
     # Impacts accumulating within a step (a body coming to rest), at any step: the advice to

@@ -14,6 +14,7 @@ import warnings
 import numpy as np
 import pytest
 
+import property_models as pm
 import varmech
 
 G = 9.81
@@ -103,6 +104,50 @@ def test_a_predictor_far_from_the_solution_advises_a_smaller_step_which_then_run
     varmech.integrate(kepler, dt=0.0125, steps=800, method="midpoint", max_energy_error=None)
 
 
+# Two cases of tests/python/test_properties.py (issue 64) whose failures read as the model's.
+# (a) A SymPy chain with exact Hessians: Newton wanders from the predictor of step 58 and
+# grows to ‖F‖ = 2e7, where differences of F with a step relative to q ≈ 1e4 span its
+# cos q terms and disagree with the exact J by 1 %: it was told its Hessians were wrong.
+BLOW_UP = pm.Spec(
+    family="chain", api="symbolic", n=2, derivatives="exact", mass="configuration", method="trapezoid",
+    coefficients={
+        "m": [2.5353717821052655, 1.6266289609897215], "k": [0.61, 5.0], "beta": [0.0, 0.0],
+        "g": [0.4396831119394929, 2.9750422578361747e-199], "kappa": [0.0], "alpha": [-0.0],
+        "gamma": [0.8965131768748473], "eps": [6.103515625e-05, 0.22034614814786832],
+        "u": [0.2122195489486255, 0.656074964230164], "damping": [0.17434880985175175, 0.4336023464256219],
+        "drive": [1.3852141799618047, 2.5237542098072145],
+    },
+    q0=[-0.45328713876291726, -0.05040135693682657], v0=[-0.46443684615749364, 0.5798956509667093],
+    h_fraction=0.823860208178289, steps=60,
+)  # fmt: skip
+# (b) A particle on a circle, Jacobian by differences: the first correction from the predictor
+# of step 7 is followed by one 4 750 times larger (no contraction at the start), and the
+# iteration settles into a wander at ‖F‖ ≈ 0.2, which read as a kink.
+WANDER = pm.Spec(
+    family="sphere", api="mechanical", n=2, derivatives="none", mass="configuration", method="trapezoid",
+    coefficients={
+        "r": [0.8258045511943796], "m": [1.3156996533966765], "linked": [1.0], "g": [9.588026076562837],
+        "k": [0.8893557735572968], "kappa": [0.5000281971151291],
+    },
+    q0=[-0.13965046507369716, 5.996381133103278e-155], v0=[0.502777654301982, 0.7146438635155903],
+    h_fraction=0.5118059582301526, steps=69,
+)  # fmt: skip
+
+
+@pytest.mark.parametrize("spec", [BLOW_UP, WANDER], ids=["blow_up", "wander"])
+def test_a_predictor_outside_newtons_region_is_told_so_and_a_quarter_step_runs(spec):
+    if spec.api == "symbolic":
+        pytest.importorskip("sympy")
+    case = pm.build(spec)
+    with pytest.raises(varmech.ConvergenceError) as info:
+        case.run()
+    message = str(info.value)
+    assert "a smaller step (dt) brings it closer" in message and "does not help" not in message
+    quarter = case.run(case.dt / 4)
+    assert quarter.status == 0 and quarter.t[-1] == pytest.approx(case.dt * spec.steps)
+    assert varmech.check_conservation(quarter).energy.verdict == "bounded"
+
+
 def test_a_routhian_of_closures_without_derivatives_runs_through_its_nested_solves():
     # The Routhian's derivatives solve ∂L/∂ċ = μ at every evaluation: the step's equations
     # carry that solve's noise as well as the differences'.
@@ -150,8 +195,6 @@ def test_galerkin6_sums_the_differences_rounding_as_its_slots_do():
     # closures without derivatives, stalled under galerkin6 at step 99 at ‖F‖ = 2.4e-12, 5.7
     # times the differences' rounding, which its slots sum with weights adding up to 3; its
     # twin with exact derivatives ran. Now it runs as the twin does.
-    import property_models as pm
-
     spec = pm.Spec(
         family="chain", api="lagrangian", n=3, derivatives="none", forcing="rayleigh", method="galerkin6",
         coefficients={

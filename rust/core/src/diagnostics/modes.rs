@@ -182,6 +182,8 @@ struct Balance<'a> {
     force: ForceAtRest,
     g: DMatrix<f64>,
     t: f64,
+    /// (q, λ) where the iteration started.
+    guess: (Vec<f64>, Vec<f64>),
 }
 
 impl NewtonProblem for Balance<'_> {
@@ -231,6 +233,12 @@ impl NewtonProblem for Balance<'_> {
             size: a.size.max(b.size),
             scale: 1.0,
         }
+    }
+
+    /// Back to the guess.
+    fn restart(&mut self) {
+        self.q.copy_from_slice(&self.guess.0);
+        self.lambda.copy_from_slice(&self.guess.1);
     }
 
     /// Whether [−K Gᵀ; G 0] from the model's own ∂²L/∂q² agrees with differences of the balance
@@ -320,10 +328,12 @@ pub fn equilibrium(model: Model<'_>, guess: &[f64], t: f64, options: &NewtonOpti
         force: ForceAtRest::new(n, m),
         g: DMatrix::zeros(m, n),
         t,
+        guess: (Vec::new(), Vec::new()),
     };
     if m > 0 {
         balance.lambda = least_squares_multipliers(&mut balance).map_err(|e| e.at(0, t))?;
     }
+    balance.guess = (balance.q.clone(), balance.lambda.clone());
     let rules = Rules { simplified: false };
     let solution = Newton::new(n + m)
         .solve(&mut balance, options, rules)

@@ -122,16 +122,18 @@ pub(crate) struct Reasons {
 /// What the history of a failed iteration says would help: the advice of its error.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Diagnosis {
-    /// The corrections grew, never fell below the first, or fell only slowly with a Jacobian
-    /// that agrees with F: the start (the step's predictor) lies outside Newton's region of
-    /// convergence. A smaller step brings the predictor closer.
+    /// The first correction did not contract the next (Deuflhard's θ₀ ≥ 1), the corrections
+    /// made no headway, or fell only slowly with a Jacobian that agrees with F: the start (the
+    /// step's predictor) lies outside Newton's region of convergence. A smaller step brings the
+    /// predictor closer.
     Diverged,
     /// The corrections kept falling, but linearly, or did not fall, with fresh Jacobians that
     /// disagree with differences of F: a model's supplied second derivatives are not those of
     /// its first.
     Linear,
-    /// The corrections stopped falling well above the noise of the equations there: they have
-    /// no solution nearby, or are not smooth (a kink or jump in the model, or its derivatives).
+    /// The corrections repeat (a cycle), or contracted and then stopped falling well above the
+    /// noise of the equations there: they have no solution nearby, or are not smooth (a kink or
+    /// jump in the model, or its derivatives).
     Stalled,
     /// Still converging fast at the cap: too few iterations allowed.
     Cap,
@@ -183,15 +185,19 @@ impl Diagnosis {
         }
     }
 
-    /// The diagnosis once the problem is looked at: a model nearly singular there
+    /// The diagnosis once the problem is looked at, back at its start
+    /// ([`NewtonProblem::restart`]): a model nearly singular there
     /// ([`NewtonProblem::degenerate`]) explains a failure that is no cap; a linear convergence
     /// with a Jacobian that agrees with differences of F ([`NewtonProblem::jacobian_agrees`]) is
     /// the iteration not yet near the root, where F's curvature, not J, slows it; corrections
     /// that grow or wander with a Jacobian that disagrees are the wrong Jacobian's (a Hessian too
     /// small by half or more overshoots from every start), which no smaller step mends.
     pub(crate) fn confirmed<P: NewtonProblem>(self, problem: &mut P) -> Result<Self, StepError> {
+        if matches!(self, Diagnosis::Cap | Diagnosis::Singular) {
+            return Ok(self);
+        }
+        problem.restart();
         Ok(match self {
-            Diagnosis::Cap | Diagnosis::Singular => self,
             _ if problem.degenerate()? => Diagnosis::Degenerate,
             Diagnosis::Linear if problem.jacobian_agrees()? => Diagnosis::Diverged,
             Diagnosis::Diverged if !problem.jacobian_agrees()? => Diagnosis::Linear,
@@ -213,6 +219,13 @@ pub(crate) trait NewtonProblem {
     /// Writes ∂F/∂x into `jac` (it is factorised in place afterwards).
     fn jacobian(&mut self, jac: &mut DMatrix<f64>) -> Result<(), StepError>;
 
+    /// Returns x to where the iteration started, before a failure is diagnosed there
+    /// ([`Diagnosis::confirmed`]): differences of F check J near the start, which a smaller step
+    /// moves, and not at a far iterate of a diverged course, where a difference step relative to
+    /// x spans F's curvature (and rounding of F's large values swamps them). Default: x stays
+    /// at the last iterate.
+    fn restart(&mut self) {}
+
     /// Whether the model's ∂²L/∂q̇² is nearly singular at the problem's state ([`degenerate`]):
     /// asked only to diagnose a failure. Default: not known to be.
     fn degenerate(&mut self) -> Result<bool, StepError> {
@@ -221,7 +234,8 @@ pub(crate) trait NewtonProblem {
 
     /// Whether the Jacobian the problem supplies agrees with differences of F at the current x
     /// (a model's second derivatives need not be those of its first): asked only to diagnose a
-    /// failure. Default: it does (a Jacobian by differences of F agrees by construction).
+    /// failure, after [`NewtonProblem::restart`]. Default: it does (a Jacobian by differences of
+    /// F agrees by construction).
     fn jacobian_agrees(&mut self) -> Result<bool, StepError> {
         Ok(true)
     }
@@ -273,6 +287,12 @@ pub(crate) enum Judgement {
 /// adds theirs.
 const NOISE_MARGIN: f64 = 4.0;
 
+/// How closely corrections must repeat to be a cycle: Newton's map returning to where it was
+/// (about a jump of F, which no iterate crosses to a root) repeats them to the rounding of the
+/// iterates, or approaches the cycle geometrically; an iteration wandering outside its region
+/// repeats no size to a part in a thousand twice running.
+const CYCLE: f64 = 1e-3;
+
 /// An iteration's progress, by the sizes of its corrections: whether the next step factorises
 /// a fresh Jacobian, when to stop, and why it failed. Shared by [`Newton::solve`] and the
 /// fixed-size DEL step, which must decide alike.
@@ -297,6 +317,9 @@ pub(crate) struct Progress {
     fresh_ratio: f64,
     fresh_ratio_before: f64,
     last_fresh: f64,
+    /// The second correction over the first, made with the first Jacobian where it is kept:
+    /// Deuflhard's contraction θ₀ at the start.
+    start_ratio: f64,
     stalls: usize,
     corrections: usize,
     /// ‖J‖∞ of the last fresh Jacobian: with the unknowns' size, the size of F's terms.
@@ -313,6 +336,7 @@ impl Progress {
             fresh_ratio: f64::INFINITY,
             fresh_ratio_before: f64::INFINITY,
             last_fresh: f64::INFINITY,
+            start_ratio: f64::NAN,
             stalls: 0,
             corrections: 0,
             jacobian_norm: 0.0,
@@ -330,8 +354,10 @@ impl Progress {
     #[inline(always)]
     pub fn judge(&mut self, fresh: bool, correction: Correction, tolerance: f64, simplified: bool) -> Judgement {
         let size = correction.size;
-        if self.corrections == 0 {
-            self.first = size;
+        match self.corrections {
+            0 => self.first = size,
+            1 => self.start_ratio = size / self.first,
+            _ => {}
         }
         let stalled = fresh && size > 0.5 * self.smallest;
         self.corrections += 1;
@@ -379,15 +405,29 @@ impl Progress {
     }
 
     /// Why the iteration failed, having reached its cap: by the course of its corrections,
-    /// the last two made with fresh Jacobians in ratio θ.
+    /// the last two made with fresh Jacobians in ratio θ, and the first two in ratio θ₀.
+    ///
+    /// Deuflhard's contraction θ₀ = ‖Δx₁‖/‖Δx₀‖ (Newton Methods for Nonlinear Problems,
+    /// Springer 2004) estimates h₀/2, h₀ = ω‖Δx₀‖ the Kantorovich quantity of the start, which
+    /// falls with ‖Δx₀‖, so with the step; Newton converges from where h₀ < 2, θ₀ < 1. A course
+    /// that did not contract at its start began outside that region, whatever it did after (a
+    /// wander that settles far from the root); one that contracted and then stalled met F's
+    /// lack of a root or of smoothness.
     pub fn diagnosis(&self) -> Diagnosis {
         let ratio = self.fresh_ratio;
         let same = |r: f64| (0.95..=1.05).contains(&r);
+        let repeats = |r: f64| (r - 1.0).abs() <= CYCLE;
         if self.corrections < 2 {
             // Too few to tell.
             Diagnosis::Cap
+        } else if repeats(ratio) && repeats(self.fresh_ratio_before) {
+            // The same correction again and again: a cycle about a point where F jumps.
+            Diagnosis::Stalled
+        } else if self.start_ratio >= 1.0 {
+            // No contraction from the start: outside Newton's region.
+            Diagnosis::Diverged
         } else if same(ratio) && same(self.fresh_ratio_before) {
-            // The same size again and again: a cycle about a point where F jumps, or flat.
+            // Contracted, then about the same size again and again: no root nearby, or flat.
             Diagnosis::Stalled
         } else if self.last > self.first / 16.0 {
             // No headway: wandering, or growing, far from a root.
@@ -618,7 +658,128 @@ pub(crate) fn model_error(e: StepError) -> ModelError {
 
 #[cfg(test)]
 mod tests {
-    use super::NewtonOptions;
+    use nalgebra::DMatrix;
+
+    use super::{difference, Correction, Diagnosis, Newton, NewtonOptions, NewtonProblem, Progress, Reasons, Rules};
+    use crate::error::StepError;
+
+    /// The diagnosis of a course of corrections, each made with a fresh Jacobian or a kept one
+    /// as the simplified iteration decides, none converging.
+    fn diagnosed(sizes: impl IntoIterator<Item = f64>) -> Diagnosis {
+        let mut progress = Progress::new();
+        for size in sizes {
+            let fresh = progress.fresh();
+            progress.judge(fresh, Correction { size, scale: 0.0 }, 1e-14, true);
+        }
+        progress.diagnosis()
+    }
+
+    #[test]
+    fn a_cycle_about_a_jump_is_a_stall_whatever_its_start() {
+        // V = 5|q| from rest at its kink: x = 0 → −a → a → −a …, corrections a, 2a, 2a, …
+        // (θ₀ = 2: the start never contracted, but the iteration repeats itself).
+        let a = 2.5e-6;
+        assert_eq!(diagnosed([a].into_iter().chain([2.0 * a; 20])), Diagnosis::Stalled);
+    }
+
+    #[test]
+    fn a_start_that_never_contracted_is_outside_newtons_region_however_the_course_ends() {
+        // Issue 64's stall at ‖F‖ = 0.19 on a circle: a first correction of 112, then one 4 750
+        // times larger, halving back to about 1 and wandering there; the last two ratios
+        // within 5 % of 1 read as a kink.
+        let halving = (0..18).map(|k| 5.3e5 * 0.5_f64.powi(k));
+        let wander = [1.72, 0.9965, 1.011, 0.983];
+        let course = [111.7].into_iter().chain(halving).chain(wander);
+        assert_eq!(diagnosed(course), Diagnosis::Diverged);
+    }
+
+    #[test]
+    fn a_course_that_contracted_is_told_by_how_it_ends() {
+        // Quadratic convergence to 1e-4 of the first correction, then about the same size again.
+        let stall = (0..10).map(|k| if k % 2 == 0 { 1.02e-4 } else { 0.99e-4 });
+        assert_eq!(
+            diagnosed([1.0, 1e-2, 1e-4].into_iter().chain(stall)),
+            Diagnosis::Stalled
+        );
+        assert_eq!(diagnosed((0..30).map(|k| (2.0_f64 / 3.0).powi(k))), Diagnosis::Linear);
+        assert_eq!(diagnosed([1.0, 1e-3, 1e-6]), Diagnosis::Cap);
+    }
+
+    /// F(x) = atan x with J = `gain`/(1 + x²) (1: exact), whose Newton iteration converges to
+    /// 0 from |x₀| < 1.39 and diverges from beyond.
+    struct Atan {
+        x: f64,
+        guess: f64,
+        gain: f64,
+    }
+
+    impl NewtonProblem for Atan {
+        const REASONS: Reasons = Reasons {
+            singular: "singular",
+            non_finite_start: "non-finite start",
+            non_finite: "non-finite",
+            not_converged: "not converged",
+            outside: "outside",
+        };
+
+        fn residual(&mut self, r: &mut [f64]) -> Result<(), StepError> {
+            r[0] = self.x.atan();
+            Ok(())
+        }
+
+        fn jacobian(&mut self, jac: &mut DMatrix<f64>) -> Result<(), StepError> {
+            jac[(0, 0)] = self.gain / (1.0 + self.x * self.x);
+            Ok(())
+        }
+
+        fn restart(&mut self) {
+            self.x = self.guess;
+        }
+
+        fn jacobian_agrees(&mut self) -> Result<bool, StepError> {
+            let x = self.x;
+            let h = difference::step(difference::unit(0, x));
+            let differenced = ((x + h).atan() - (x - h).atan()) / (2.0 * h);
+            let exact = self.gain / (1.0 + x * x);
+            Ok((exact - differenced).abs() <= 1e-4 * differenced.abs())
+        }
+
+        /// Measured as a step's increments are: absolute, against |x|.
+        fn correct(&mut self, delta: &[f64]) -> Correction {
+            self.x -= delta[0];
+            Correction {
+                size: delta[0].abs(),
+                scale: self.x.abs(),
+            }
+        }
+
+        fn noise(&self) -> f64 {
+            0.0
+        }
+    }
+
+    /// The advice of Newton's failure on [`Atan`] from x₀ within `cap` iterations.
+    fn atan_advice(x0: f64, gain: f64, cap: usize) -> &'static str {
+        let mut problem = Atan { x: x0, guess: x0, gain };
+        let options = NewtonOptions {
+            max_iterations: cap,
+            ..NewtonOptions::default()
+        };
+        match Newton::new(1).solve(&mut problem, &options, Rules { simplified: false }) {
+            Err(StepError::Convergence { advice, .. }) => advice,
+            other => panic!("{other:?}"),
+        }
+    }
+
+    #[test]
+    fn a_diverged_course_checks_its_jacobian_at_the_start_where_differences_are_a_check() {
+        // From x₀ = 2 the iterates grow to −2.3e10 in five corrections, where atan(x ± h)
+        // differ by a few units in the last place of π/2: J would disagree there. At x₀ it
+        // agrees.
+        assert_eq!(atan_advice(2.0, 1.0, 5), Atan::REASONS.outside);
+        // A Jacobian 0.4 of the true one grows by 1.5 from any start: it disagrees at the start.
+        assert_eq!(atan_advice(0.01, 0.4, 8), Diagnosis::Linear.advice(&Atan::REASONS));
+    }
 
     #[test]
     fn the_iteration_cap_is_bounded_and_named() {

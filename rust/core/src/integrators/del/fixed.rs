@@ -17,12 +17,13 @@ use crate::Error;
 
 impl<R: DiscreteLagrangian> Del<TwoPoint<R>> {
     /// The unconstrained step's equations at the unknowns `x`, counted in `evaluations`: for
-    /// the Jacobian where the model gives no second derivatives, and a failure's diagnosis.
+    /// the Jacobian where the model gives no second derivatives, and a failure's diagnosis
+    /// (started from `guess`).
     fn unconstrained<'a, S: Lagrangian + ?Sized>(
         &'a mut self,
         sys: &'a S,
         start: StepStart<'a>,
-        x: &'a mut [f64],
+        (x, guess): (&'a mut [f64], Option<&'a [f64]>),
         evaluations: &'a mut u64,
     ) -> Equations<'a, TwoPoint<R>, S> {
         Equations {
@@ -34,6 +35,7 @@ impl<R: DiscreteLagrangian> Del<TwoPoint<R>> {
             multipliers: &mut self.multipliers,
             block: &mut self.block,
             x,
+            guess,
             plus: &mut self.plus,
             minus: &mut self.minus,
             evaluations,
@@ -72,17 +74,21 @@ impl<R: DiscreteLagrangian> Del<TwoPoint<R>> {
         // Counts in locals, written back once.
         let (mut evaluations, mut iterations) = (self.evaluations, 0);
         let options = self.options;
+        // Extrapolates the last two increments (second order), the last one, or rest.
+        let predictor = |last: &[f64; N], before_last: &[f64; N], history: usize| -> [f64; N] {
+            std::array::from_fn(|i| match history {
+                0 => 0.0,
+                1 => last[i],
+                _ => 2.0 * last[i] - before_last[i],
+            })
+        };
         let increment = |t: f64, q: &[f64; N], p: &[f64; N], dq: &mut [f64; N], dp: &mut [f64; N]| {
             let start = StepStart { t, h, q, p };
             // The differences' rounding from this step's evaluations alone (Progress::noise).
             difference::take_noise();
             // The Newton iteration's values are the closure's own, so that they may stay in
             // registers: through memory, scalar stores feeding vector loads stall.
-            let mut x: [f64; N] = std::array::from_fn(|i| match history {
-                0 => 0.0,
-                1 => last[i],
-                _ => 2.0 * last[i] - before_last[i],
-            });
+            let mut x = predictor(&last, &before_last, history);
             let (mut r, mut lu, mut pivots, mut sign) = ([0.0; N], [[0.0; N]; N], [0; N], 0.0);
             let mut ws = Workspace::<[f64; N]>::default();
             evaluations += 1;
@@ -97,10 +103,11 @@ impl<R: DiscreteLagrangian> Del<TwoPoint<R>> {
             let mut iteration = 0;
             loop {
                 if iteration == options.max_iterations {
+                    let guess = predictor(&last, &before_last, history);
                     let diagnosis = progress.diagnosis().confirmed(&mut self.unconstrained(
                         sys,
                         start,
-                        &mut x,
+                        (&mut x, Some(&guess)),
                         &mut evaluations,
                     ))?;
                     return Err(StepError::Convergence {
@@ -123,7 +130,7 @@ impl<R: DiscreteLagrangian> Del<TwoPoint<R>> {
                     } else {
                         let mut jacobian = std::mem::take(self.newton.jacobian_mut());
                         let differenced = self
-                            .unconstrained(sys, start, &mut x, &mut evaluations)
+                            .unconstrained(sys, start, (&mut x, None), &mut evaluations)
                             .jacobian(&mut jacobian);
                         *self.newton.jacobian_mut() = jacobian;
                         differenced?;

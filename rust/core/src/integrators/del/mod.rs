@@ -236,6 +236,10 @@ pub struct Del<Sc> {
     m: usize,
     multipliers: Multipliers,
     x: Vec<f64>,
+    /// x at the step's start (the predictor), where a failure is diagnosed
+    /// ([`NewtonProblem::restart`]); scratch, refilled every step.
+    #[serde(skip)]
+    guess: Vec<f64>,
     plus: Vec<f64>,
     minus: Vec<f64>,
     newton: Newton,
@@ -264,6 +268,7 @@ impl<Sc: StepEquations> Del<Sc> {
             m: 0,
             multipliers: Multipliers::new(n, 0, 0),
             x: vec![0.0; m],
+            guess: Vec::new(),
             plus: vec![0.0; m],
             minus: vec![0.0; m],
             newton: Newton::new(m),
@@ -397,6 +402,8 @@ impl<Sc: StepEquations> Del<Sc> {
         }
         // The multipliers keep the last step's values: a force, smooth in time.
         self.scheme.predict(&self.predicted, &mut self.x[m..]);
+        self.guess.clear();
+        self.guess.extend_from_slice(&self.x);
         let mut equations = Equations {
             scheme: &mut self.scheme,
             sys,
@@ -406,6 +413,7 @@ impl<Sc: StepEquations> Del<Sc> {
             multipliers: &mut self.multipliers,
             block: &mut self.block,
             x: &mut self.x,
+            guess: Some(&self.guess),
             plus: &mut self.plus,
             minus: &mut self.minus,
             evaluations: &mut self.evaluations,
@@ -506,6 +514,8 @@ struct Equations<'a, Sc, S: ?Sized> {
     multipliers: &'a mut Multipliers,
     block: &'a mut DMatrix<f64>,
     x: &'a mut [f64],
+    /// x where the iteration started, for a failure's diagnosis.
+    guess: Option<&'a [f64]>,
     plus: &'a mut [f64],
     minus: &'a mut [f64],
     evaluations: &'a mut u64,
@@ -556,6 +566,13 @@ impl<Sc: StepEquations, S: Lagrangian + ?Sized> NewtonProblem for Equations<'_, 
             self.differenced_jacobian(jac)?;
         }
         finite_jacobian(jac.as_slice())
+    }
+
+    /// Back to the predictor.
+    fn restart(&mut self) {
+        if let Some(guess) = self.guess {
+            self.x.copy_from_slice(guess);
+        }
     }
 
     /// ∂²L/∂q̇² at q₀ and the step's velocity δq/h, by differences of ∂L/∂q̇.
