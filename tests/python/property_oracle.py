@@ -29,6 +29,7 @@ import traceback
 import warnings
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
+from typing import Any
 
 import numpy as np
 
@@ -261,8 +262,9 @@ SMALLER = ("a smaller step", "reduce dt", "smaller dt", "take a smaller", "a sma
 NO_HELP = ("does not help",)
 
 
-def _failed(case: Case, err: BaseException, h: float | None = None) -> Outcome:
-    """The failure ``err`` of ``case`` at the step h (default its own): its advice checked."""
+def _failed(case: Case, err: BaseException, h: float | None = None, depth: int = 0, **options: Any) -> Outcome:
+    """The failure ``err`` of ``case`` at the step h (default its own), run with ``options``: its
+    advice checked; where following it meets another failure, that one's (``depth`` deep)."""
     h = case.dt if h is None else h
     kind = type(err).__name__
     message = str(err)
@@ -271,21 +273,21 @@ def _failed(case: Case, err: BaseException, h: float | None = None) -> Outcome:
     if partial is None or not _finite(partial):
         out.problems.append(f"{kind} without a finite partial trajectory")
     if isinstance(err, varmech.ConvergenceError) and case.twin is not None:
-        twin = _attempt(lambda: case.run(h, model=case.twin))
+        twin = _attempt(lambda: case.run(h, model=case.twin, **options))
         if isinstance(twin, varmech.Trajectory):
             out.problems.append(f"ConvergenceError where the twin with exact derivatives converges: {message}")
     if "newton_max_iterations" in message:
-        more = _attempt(lambda: case.run(h, newton_max_iterations=2000))
-        if isinstance(more, type(err)):
+        more = _attempt(lambda: case.run(h, **{**options, "newton_max_iterations": 2000}))
+        if isinstance(more, type(err)) and not _mended(case, err, more, h, depth, **{**options, "newton_max_iterations": 2000}):
             out.problems.append(f"advised more iterations, but 2000 fail alike: {message}")
         return out
     if "hold such a contact closed" in message:
         # The advice: a method that holds the contact (Verlet and its compositions).
-        held = _attempt(lambda: case.run(h, method="verlet"))
+        held = _attempt(lambda: case.run(h, method="verlet", **options))
         if isinstance(held, TYPED) and "hold such a contact closed" not in str(held):
             # Verlet held the contact, and failed otherwise: its own advice must hold.
             verlet = Case(replace(case.spec, method="verlet"), case.model, case.twin, case.q0, case.p0, case.dt, case.contacts)
-            out.problems += [f"advised verlet, whose run then broke a property: {p}" for p in _failed(verlet, held).problems]
+            out.problems += [f"advised verlet, whose run then broke a property: {p}" for p in _failed(verlet, held, h, depth, **options).problems]
         elif not isinstance(held, varmech.Trajectory):
             out.problems.append(f"advised verlet, which holds the contact, but it raised {_text(held)} (at h: {message})")
         return out
@@ -294,13 +296,13 @@ def _failed(case: Case, err: BaseException, h: float | None = None) -> Outcome:
         if case.twin is None:
             out.problems.append(f"advised exact derivatives to a model that has them: {message}")
             return out
-        twin = _attempt(lambda: case.run(h, model=case.twin))
+        twin = _attempt(lambda: case.run(h, model=case.twin, **options))
         if not isinstance(twin, varmech.Trajectory):
             out.problems.append(f"advised exact derivatives, but the twin raised {_text(twin)}: {message}")
         return out
     if any(w in message for w in NO_HELP):
         # Our models are smooth and their derivatives right: such a diagnosis is wrong, unless h/4 fails alike.
-        quarter = _attempt(lambda: case.run(h / 4))
+        quarter = _attempt(lambda: case.run(h / 4, **options))
         if not isinstance(quarter, type(err)):
             out.problems.append(f"said a smaller step does not help, but h/4 gave {type(quarter).__name__}: {message}")
         else:
@@ -308,27 +310,37 @@ def _failed(case: Case, err: BaseException, h: float | None = None) -> Outcome:
         return out
     if any(w in message for w in SMALLER) or isinstance(err, (varmech.SpuriousBranchError, varmech.DivergenceError)):
         # A smaller step: h/4, or where that is not yet enough, h/16 runs.
-        smaller = _attempt(lambda: case.run(h / 4))
+        smaller = _attempt(lambda: case.run(h / 4, **options))
         finer = h / 4
         if not isinstance(smaller, varmech.Trajectory):
-            smaller = _attempt(lambda: case.run(h / 16))
+            smaller = _attempt(lambda: case.run(h / 16, **options))
             finer = h / 16
-        if not isinstance(smaller, varmech.Trajectory) and not _mended(case, err, smaller, finer):
+        if not isinstance(smaller, varmech.Trajectory) and not _mended(case, err, smaller, finer, depth, **options):
             out.problems.append(f"advised a smaller step, but h/16 raised {_text(smaller)} (at h: {message})")
         return out
     out.problems.append(f"{kind} whose advice says neither a smaller step nor what else helps: {message}")
     return out
 
 
-def _mended(case: Case, err: BaseException, smaller: BaseException, h: float) -> bool:
-    """Whether the smaller step ``h`` mended the failure ``err`` into another, of another
-    diagnosis, whose own advice holds there (SHAKE past its linearization at h, then at h/16
-    short of its tolerance after 50 linear sweeps, which 2000 reach)."""
-    if not isinstance(smaller, TYPED) or smaller.args[0].split(";")[1:2] == str(err).split(";")[1:2]:
+def _advice(err: BaseException) -> str:
+    """What a failure's advice asks for, in a word."""
+    message = str(err)
+    for word, phrases in (("iterations", ("newton_max_iterations",)), ("verlet", ("hold such a contact closed",)),
+                          ("derivatives", ("supply the model's derivatives",)), ("nothing", NO_HELP), ("smaller", SMALLER)):
+        if any(p in message for p in phrases):
+            return word
+    return "smaller" if isinstance(err, (varmech.SpuriousBranchError, varmech.DivergenceError)) else "other"
+
+
+def _mended(case: Case, err: BaseException, later: BaseException, h: float, depth: int, **options: Any) -> bool:
+    """Whether following the advice of ``err`` mended it into the failure ``later`` (at the step h,
+    run with ``options``) of other advice, which holds in turn: SHAKE past its linearization at
+    h, then at h/16 short of its tolerance after 50 linear sweeps, which 2000 reach; or 2000
+    sweeps reaching it at step 1, and then a step past the linearization, which h/4 runs. One
+    such link at most."""
+    if depth > 0 or not isinstance(later, TYPED) or _advice(later) == _advice(err):
         return False
-    if any(w in str(smaller) for w in SMALLER):
-        return False
-    return not _failed(case, smaller, h).problems
+    return not _failed(case, later, h, depth + 1, **options).problems
 
 
 # Isolation: each case in a forked process, with a time limit.

@@ -158,6 +158,16 @@ FOUND = [
             h_fraction=0.5448790535870218, steps=283),
         "ConvergenceError", None,
     ),
+    (
+        "SHAKE short of its tolerance after 50 linear sweeps; 2000 pass step 1, then past its linearization h/4 runs",
+        dict(family="sphere", api="mechanical", n=4, coefficients={
+            "r": [1.7642226682917, 1.1015563435798816], "m": [0.5000000000000001, 0.7], "linked": [1.0],
+            "g": [4.982716190412687], "k": [0.1677858839797069], "kappa": [1.5831495945608012]},
+            q0=[-0.19915093224929525, -0.8946423157904722, -0.9213066009087814, 0.5719055608982186],
+            v0=[-6.354936218749351e-296, 1.9994114853696322e-296, 4.460114047953504e-296, -5.3740027626255256e-297],
+            method="shake", h_fraction=0.5000000000000001, steps=85),
+        "ConvergenceError", None,
+    ),
 ]
 
 
