@@ -122,18 +122,17 @@ pub(crate) struct Reasons {
 /// What the history of a failed iteration says would help: the advice of its error.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Diagnosis {
-    /// The first correction did not contract the next (Deuflhard's θ₀ ≥ 1), the corrections
-    /// made no headway, or fell only slowly with a Jacobian that agrees with F: the start (the
-    /// step's predictor) lies outside Newton's region of convergence. A smaller step brings the
-    /// predictor closer.
+    /// No contraction at the start (Deuflhard's θ₀ ≥ 1), no headway, or a slow fall with a
+    /// Jacobian that agrees with F: the predictor lies outside Newton's region; a smaller step
+    /// brings it closer.
     Diverged,
-    /// The corrections kept falling, but linearly, or did not fall, with fresh Jacobians that
-    /// disagree with differences of F: a model's supplied second derivatives are not those of
-    /// its first.
+    /// The corrections fell linearly or not at all, with fresh Jacobians that disagree with
+    /// differences of F: the model's second derivatives are not those of its first.
     Linear,
-    /// The corrections repeat (a cycle), or contracted and then stopped falling well above the
-    /// noise of the equations there: they have no solution nearby, or are not smooth (a kink or
-    /// jump in the model, or its derivatives).
+    /// The corrections repeat: a cycle about a point where F jumps (a kink in the model).
+    Cycle,
+    /// The corrections contracted, then stopped falling well above the noise of the equations:
+    /// no solution near the predictor (a step too large for the motion), or F is not smooth.
     Stalled,
     /// Still converging fast at the cap: too few iterations allowed.
     Cap,
@@ -169,10 +168,14 @@ impl Diagnosis {
                  of the equations: the model's second derivatives (hessians) are not those of its first; check \
                  them (varmech.check_derivatives); a smaller step does not help"
             }
+            Diagnosis::Cycle => {
+                "the corrections repeat, a cycle about a jump of the equations: the model is not smooth here (a \
+                 kink or jump in L, its derivatives or forces); a smaller step does not help"
+            }
             Diagnosis::Stalled => {
                 "the corrections stopped falling far above the noise of the equations: they have no solution \
-                 nearby, or the model is not smooth here (a kink or jump in L, its derivatives or forces); a \
-                 smaller step does not help"
+                 near the predictor, as at a step too large for the motion (a smaller step (dt) helps), or the \
+                 model is not smooth here (a kink or jump in L, its derivatives or forces)"
             }
             Diagnosis::Cap => "it was still converging: allow more iterations (newton_max_iterations)",
             // The problem's reason says why, and what helps.
@@ -422,7 +425,7 @@ impl Progress {
             Diagnosis::Cap
         } else if repeats(ratio) && repeats(self.fresh_ratio_before) {
             // The same correction again and again: a cycle about a point where F jumps.
-            Diagnosis::Stalled
+            Diagnosis::Cycle
         } else if self.start_ratio >= 1.0 {
             // No contraction from the start: outside Newton's region.
             Diagnosis::Diverged
@@ -675,11 +678,11 @@ mod tests {
     }
 
     #[test]
-    fn a_cycle_about_a_jump_is_a_stall_whatever_its_start() {
+    fn a_cycle_about_a_jump_is_a_kink_whatever_its_start() {
         // V = 5|q| from rest at its kink: x = 0 → −a → a → −a …, corrections a, 2a, 2a, …
         // (θ₀ = 2: the start never contracted, but the iteration repeats itself).
         let a = 2.5e-6;
-        assert_eq!(diagnosed([a].into_iter().chain([2.0 * a; 20])), Diagnosis::Stalled);
+        assert_eq!(diagnosed([a].into_iter().chain([2.0 * a; 20])), Diagnosis::Cycle);
     }
 
     #[test]
