@@ -68,9 +68,6 @@ KNOWN_OPEN = {
     "the corrections repeat, a cycle about a jump": "a closure's cancellation read as a kink",
     # A short run's band where finer steps find the drift of a forced chain.
     "'bounded' verdict that refinement does not confirm: h: bounded [^;]*; h/2: secular drift": "a drift seen only at finer steps",
-    # Impacts accumulating within a step (a body coming to rest), at any step: the advice to
-    # shorten it does not hold; holding the contact does.
-    "more than 64 impacts in one step": "an accumulation of impacts advised a shorter step",
 }
 
 
@@ -309,6 +306,16 @@ def _failed(case: Case, err: BaseException, h: float | None = None, depth: int =
         if not isinstance(twin, varmech.Trajectory):
             out.problems.append(f"advised exact derivatives, but the twin raised {_text(twin)}: {message}")
         return out
+    if "stop the run before it" in message:
+        # An accumulation at t∞: the run up to just before it completes.
+        limit = float(message.split("t ≈ ")[1].split(" ")[0])
+        steps = int(0.99 * limit / h)
+        before = _attempt(lambda: varmech.integrate(
+            case.model, case.q0, case.p0, dt=h, steps=steps, method=case.spec.method, contacts=case.contacts or None,
+            progress=False, **options))
+        if not isinstance(before, varmech.Trajectory):
+            out.problems.append(f"advised stopping before t = {limit}, but that run raised {_text(before)}: {message}")
+        return out
     if any(w in message for w in NO_HELP):
         # Our models are smooth and their derivatives right: such a diagnosis is wrong, unless h/4 fails alike.
         quarter = _attempt(lambda: case.run(h / 4, **options))
@@ -335,6 +342,7 @@ def _advice(err: BaseException) -> str:
     """What a failure's advice asks for, in a word."""
     message = str(err)
     for word, phrases in (("iterations", ("newton_max_iterations",)), ("verlet", ("hold such a contact closed",)),
+                          ("stop", ("stop the run before it",)),
                           ("derivatives", ("supply the model's derivatives",)), ("nothing", NO_HELP), ("smaller", SMALLER)):
         if any(p in message for p in phrases):
             return word

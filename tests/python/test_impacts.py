@@ -214,6 +214,25 @@ def test_a_method_that_cannot_hold_a_contact_ends_an_accumulation_of_impacts_wit
     assert np.min(partial.q) > -1e-12
 
 
+@pytest.mark.parametrize("e", [0.95, 0.98])
+def test_an_accumulation_of_impacts_names_its_time_and_what_helps(e):
+    # At e near 1 the bounces shrink slowly and 64 fall within one step before the Zeno time
+    # t∞ = t₁(1 + 2e/(1 − e)), whatever the step: the error sums the flights' geometric series
+    # to t∞, advises stopping before it or a method that holds the contact, and each holds.
+    rest = math.sqrt(2 / G) * (1 + 2 * e / (1 - e))
+    floor = varmech.Contact(lambda q: q[0], lambda q: [1.0], restitution=e, law="reflect")
+    for method, dt in (("rk4", 0.05), ("midpoint", 0.5), ("midpoint", 0.05 / 16)):
+        with pytest.raises(varmech.ContactError, match="more than 64 impacts in one step, their flights shrinking") as info:
+            varmech.integrate(_ball(), [1.0], [0.0], dt=dt, steps=round(2 * rest / dt), contacts=[floor], method=method)
+        message = str(info.value)
+        assert float(message.split("t ≈ ")[1].split(" ")[0]) == pytest.approx(rest, rel=1e-6)
+        assert "which no step resolves: stop the run before it, or hold the contact: verlet" in message
+        before = varmech.integrate(_ball(), [1.0], [0.0], dt=dt, steps=int(0.99 * rest / dt), contacts=[floor], method=method)
+        assert before.status == 0
+    held = varmech.integrate(_ball(), [1.0], [0.0], dt=0.05, steps=round(2 * rest / 0.05), contacts=[floor], method="verlet")
+    assert held.status == 0 and np.max(np.abs(held.q[held.t > 1.01 * rest])) < 1e-12
+
+
 def test_a_particle_in_a_box_crosses_two_walls_in_one_step_at_its_corners():
     # A free particle in the unit square, steps of 0.5 against flights of about 1: many steps
     # cross two walls. The exact motion unfolds to a straight line: x = fold(x₀ + vt), with

@@ -830,12 +830,7 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
                 }
             };
             if self.pending.len() == MAX_IMPACTS {
-                return Err(contact_error(format!(
-                    "more than {MAX_IMPACTS} impacts in one step (an accumulation of impacts, as of a body \
-                     coming to rest on a surface); shorten the step or stop the run before, or hold the contact \
-                     ({} on a model without forces or constraints of its own, with e < 1)",
-                    Hold::methods()
-                )));
+                return Err(contact_error(self.too_many_impacts()));
             }
             // The contact state (q̃, p⁻), the end of this piece.
             self.partial(step, ta, s)?;
@@ -869,6 +864,37 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
             search.piece(step, (stepper.t(), stepper.q(), stepper.p()), tau, occurrences)?;
         }
         Ok(true)
+    }
+
+    /// Why a step met more than [`MAX_IMPACTS`] impacts, and what helps: flights that still
+    /// shrink geometrically (the last under half the first, and under 0.99 of the one before)
+    /// accumulate at a finite time, as a body coming to rest does, which no step resolves;
+    /// flights that do not (a chatter of equal ones) are a step too long for them.
+    fn too_many_impacts(&self) -> String {
+        let t = &self.pending.t;
+        let k = t.len();
+        let (first, last, before) = (t[1] - t[0], t[k - 1] - t[k - 2], t[k - 2] - t[k - 3]);
+        let ratio = last / before;
+        if !(last < 0.5 * first && ratio < 0.99) {
+            return format!(
+                "more than {MAX_IMPACTS} impacts in one step, in flights as short as {last:.3e}: shorten the step (dt)"
+            );
+        }
+        // The geometric series of the last flights' ratio sums to where they accumulate.
+        let limit = format!(" at t ≈ {:.6}", t[k - 1] + last * ratio / (1.0 - ratio));
+        let hold = if self.hold.is_some() {
+            "; this method holds a contact closed only where e < 1 and the body presses on it".to_string()
+        } else {
+            format!(
+                ", or hold the contact: {} hold such a contact closed on a model without forces or constraints of its \
+                 own, with e < 1",
+                Hold::methods()
+            )
+        };
+        format!(
+            "more than {MAX_IMPACTS} impacts in one step, their flights shrinking to an accumulation{limit} (a body \
+             coming to rest on a surface), which no step resolves: stop the run before it{hold}"
+        )
     }
 
     /// The first lift-off in the piece of size τ from ta, with the scratch at its end: among
