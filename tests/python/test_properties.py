@@ -194,17 +194,6 @@ FOUND = [
             h_fraction=0.8999999999999999, steps=100),
         "ConvergenceError", None,
     ),
-    (
-        "a closure's own cancellation, g(1 - cos q) at |q| = 1e-6, at the floor Newton measures at its cap",
-        dict(family="chain", api="mechanical", n=1, coefficients={
-            "m": [1.4878984193010973], "k": [1.4789750793927694], "beta": [0.0], "g": [0.08207969119632287],
-            "kappa": [0.7], "alpha": [0.0], "gamma": [0.0], "eps": [1.0106387500699925e-99],
-            "u": [1.2298719011101166e-234], "damping": [1.2298719011101166e-234],
-            "drive": [7.37323746933795e-173, 0.9140696376956874]},
-            derivatives="none", mass="configuration", q0=[0.0], v0=[-1e-05], method="midpoint",
-            h_fraction=0.6149839898479939, steps=43),
-        "completed", "bounded",
-    ),
 ]
 
 

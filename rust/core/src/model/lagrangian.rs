@@ -6,8 +6,9 @@ use serde::{Deserialize, Serialize};
 use super::{EnergyTerms, MechanicalSystem};
 use crate::error::StepError;
 use crate::solve::difference::{self, central_gradient, central_jacobian, Evaluations};
-use crate::solve::lu::degenerate;
-use crate::solve::newton::{model_error, norm, Correction, Newton, NewtonOptions, NewtonProblem, Reasons, Rules};
+use crate::solve::newton::{
+    degenerate, model_error, norm, Correction, Newton, NewtonOptions, NewtonProblem, Reasons, Rules,
+};
 use crate::solve::scratch::with_scratch;
 use crate::ModelError;
 

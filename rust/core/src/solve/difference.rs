@@ -33,28 +33,6 @@ pub(crate) fn record(noise: f64) {
     NOISE.with(|n| n.set(n.get().max(noise)));
 }
 
-/// F's rounding about x, measured: the second differences |F(x + sδ) + F(x − sδ) − 2F(x)|/2
-/// at s = 1, 2, their largest component. `f0` is F(x), `at(s, out)` writes F(x + sδ), and
-/// `plus`, `minus` are scratch of F's length. For δ near 1e-8 of x the smooth part, s²δᵀF''δ/2,
-/// is far below rounding, and the rounding of every evaluation inside F changes: what
-/// [`record`]'s estimate from the sizes of values cannot see, a closure's own cancellation
-/// (g(1 − cos q) at |q| ≈ 1e-6 rounds at εg), shows.
-pub fn measured_noise<E>(
-    f0: &[f64],
-    (plus, minus): (&mut [f64], &mut [f64]),
-    mut at: impl FnMut(f64, &mut [f64]) -> Result<(), E>,
-) -> Result<f64, E> {
-    let mut noise = 0.0_f64;
-    for s in [1.0, 2.0] {
-        at(s, plus)?;
-        at(-s, minus)?;
-        for ((a, b), c) in plus.iter().zip(minus.iter()).zip(f0) {
-            noise = noise.max(((a + b) - 2.0 * c).abs() / 2.0);
-        }
-    }
-    Ok(noise)
-}
-
 /// ε^{1/3}, written out: `f64::cbrt` is not a `const fn`, and a libm call per difference costs
 /// as much as a cheap model's gradient.
 pub const CBRT_EPSILON: f64 = 6.055_454_452_393_339_5e-6;

@@ -1,7 +1,6 @@
-//! LU factorisation with partial pivoting that allocates nothing, for the Newton loops, and
-//! the conditioning test of a mass matrix that diagnoses their failures.
+//! LU factorisation with partial pivoting that allocates nothing, for the Newton loops.
 //!
-//! The factorisation runs on the column-major slice of the matrix, specialised for n ≤ 8
+//! Both functions run on the column-major slice of the matrix, specialised for n ≤ 8
 //! ([`super::sized`]).
 
 use nalgebra::DMatrix;
@@ -78,19 +77,4 @@ pub(crate) fn substitute(a: &[f64], pivots: &[usize], b: &mut [f64], n: usize) {
         tail[0] = c;
         head.iter_mut().zip(&column[..k]).for_each(|(x, u)| *x -= c * u);
     }
-}
-
-/// Whether ∂²L/∂q̇² = `mass` is nearly singular beyond the disparity of its diagonal: the
-/// condition number of D^(-1/2) M D^(-1/2), D = diag M, over 10³. A model whose masses differ
-/// (a planet and its moon) is not degenerate; coordinates near a singularity of their own are,
-/// whose rows of M become dependent (Euler angles at θ → 0: the φ and ψ rows, by 1/sin²θ).
-pub fn degenerate(mass: &DMatrix<f64>) -> bool {
-    let d = mass.diagonal().map(|x| x.abs().sqrt());
-    if d.iter().any(|x| !(x.is_finite() && *x > 0.0)) {
-        return true;
-    }
-    let scaled = DMatrix::from_fn(mass.nrows(), mass.ncols(), |i, j| mass[(i, j)] / (d[i] * d[j]));
-    let s = scaled.singular_values();
-    let (least, most) = (s.min(), s.max());
-    least.is_nan() || most.is_nan() || least * 1e3 < most
 }

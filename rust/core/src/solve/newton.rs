@@ -139,8 +139,23 @@ pub enum Diagnosis {
     /// The Jacobian is singular.
     Singular,
     /// The model's ∂²L/∂q̇² is nearly singular here, beyond what the sizes of its masses make
-    /// it ([`super::lu::degenerate`]): coordinates close to a singularity of theirs.
+    /// it ([`degenerate`]): coordinates close to a singularity of theirs.
     Degenerate,
+}
+
+/// Whether ∂²L/∂q̇² = `mass` is nearly singular beyond the disparity of its diagonal: the
+/// condition number of D^(-1/2) M D^(-1/2), D = diag M, over 10³. A model whose masses differ
+/// (a planet and its moon) is not degenerate; coordinates near a singularity of their own are,
+/// whose rows of M become dependent (Euler angles at θ → 0: the φ and ψ rows, by 1/sin²θ).
+pub fn degenerate(mass: &DMatrix<f64>) -> bool {
+    let d = mass.diagonal().map(|x| x.abs().sqrt());
+    if d.iter().any(|x| !(x.is_finite() && *x > 0.0)) {
+        return true;
+    }
+    let scaled = DMatrix::from_fn(mass.nrows(), mass.ncols(), |i, j| mass[(i, j)] / (d[i] * d[j]));
+    let s = scaled.singular_values();
+    let (least, most) = (s.min(), s.max());
+    least.is_nan() || most.is_nan() || least * 1e3 < most
 }
 
 impl Diagnosis {
@@ -207,38 +222,40 @@ pub(crate) trait NewtonProblem {
     /// Writes ∂F/∂x into `jac` (it is factorised in place afterwards).
     fn jacobian(&mut self, jac: &mut DMatrix<f64>) -> Result<(), StepError>;
 
-    /// Returns x to where the iteration started, to diagnose a failure there
-    /// ([`Diagnosis::confirmed`]): differences check J near the start, not at a far iterate whose
-    /// difference step spans F's curvature. Default: x stays at the last iterate.
+    /// Returns x to where the iteration started, before a failure is diagnosed there
+    /// ([`Diagnosis::confirmed`]): differences of F check J near the start, which a smaller step
+    /// moves, and not at a far iterate of a diverged course, where a difference step relative to
+    /// x spans F's curvature (and rounding of F's large values swamps them). Default: x stays
+    /// at the last iterate.
     fn restart(&mut self) {}
 
-    /// Whether ∂²L/∂q̇² is nearly singular here ([`super::lu::degenerate`]), to diagnose a failure.
+    /// Whether the model's ∂²L/∂q̇² is nearly singular at the problem's state ([`degenerate`]):
+    /// asked only to diagnose a failure. Default: not known to be.
     fn degenerate(&mut self) -> Result<bool, StepError> {
         Ok(false)
     }
 
-    /// Whether the supplied Jacobian agrees with differences of F at x (a model's second
-    /// derivatives need not be those of its first), to diagnose a failure. Default: it does.
+    /// Whether the Jacobian the problem supplies agrees with differences of F at the current x
+    /// (a model's second derivatives need not be those of its first): asked only to diagnose a
+    /// failure, after [`NewtonProblem::restart`]. Default: it does (a Jacobian by differences of
+    /// F agrees by construction).
     fn jacobian_agrees(&mut self) -> Result<bool, StepError> {
         Ok(true)
-    }
-
-    /// F's rounding about x measured ([`difference::measured_noise`]; F(x) = `f0`, x left as it
-    /// was), for a stall above the estimated floor. Default: nothing measured.
-    fn measured_noise(&mut self, _f0: &[f64]) -> Result<f64, StepError> {
-        Ok(0.0)
     }
 
     /// Applies x ← x − δ (or the problem's own update along δ) and measures the correction.
     fn correct(&mut self, delta: &[f64]) -> Correction;
 
-    /// The rounding of F's terms at the last [`NewtonProblem::residual`] (max norm), where the
-    /// problem knows them; the iteration adds its own ([`Progress::noise`]).
+    /// The rounding of F's terms at the last [`NewtonProblem::residual`], in the max norm,
+    /// where the problem knows them (the iteration adds the rounding of its terms where F is
+    /// linear in x, and of the derivatives taken by differences for F,
+    /// [`difference::take_noise`]). Newton's corrections fall no further than J⁻¹ of F's noise.
     fn noise(&self) -> f64;
 
-    /// The size of what the unknowns are added to (q₀ for a step's increments; the unknowns
-    /// where corrections are relative, q̇ for the inverse Legendre map), whose rounding moves F
-    /// by ‖J‖ε times it. Default: nothing.
+    /// The size of what the unknowns are added to before F is evaluated (q₀ for a step's
+    /// increments), or of the unknowns themselves where the corrections are measured relative to
+    /// them (q̇ for the inverse Legendre transform): its rounding moves them by a few ε of it,
+    /// and F by ‖J‖ times that. Default: nothing.
     fn offset(&self) -> f64 {
         0.0
     }
@@ -327,11 +344,6 @@ impl Progress {
             corrections: 0,
             jacobian_norm: 0.0,
         }
-    }
-
-    /// Whether a correction has stalled.
-    pub fn stalled(&self) -> bool {
-        self.stalls > 0
     }
 
     /// Whether the next Newton step factorises a fresh Jacobian.
@@ -624,19 +636,6 @@ impl Newton {
                     noise: noise.unwrap_or_else(|| progress.noise(problem.noise(), correction, problem.offset())),
                 });
             }
-        }
-        // Stalled to the cap above the estimated floor: at the floor measured, converged.
-        let noise = if progress.stalled() {
-            problem.measured_noise(self.residual.as_slice())?
-        } else {
-            0.0
-        };
-        if Progress::at_floor(residual, noise) {
-            return Ok(Solution {
-                iterations: options.max_iterations,
-                residual,
-                noise,
-            });
         }
         Err(StepError::Convergence {
             residual,

@@ -25,8 +25,8 @@ use crate::discrete::Quadrature;
 use crate::discrete::Segment;
 use crate::model::{HolonomicConstraints, Lagrangian, VelocityConstraints};
 use crate::solve::difference::{self, central_jacobian, Evaluations};
-use crate::solve::lu::{degenerate, lu_in_place};
-use crate::solve::newton::{norm, Correction, Newton, NewtonProblem, Reasons, Rules};
+use crate::solve::lu::lu_in_place;
+use crate::solve::newton::{degenerate, norm, Correction, Newton, NewtonProblem, Reasons, Rules};
 use crate::solve::NewtonOptions;
 use crate::ModelError;
 use constrained::{constrained_equations, Multipliers, Parts};
@@ -551,23 +551,6 @@ impl<Sc: StepEquations, S: Lagrangian + ?Sized> NewtonProblem for Equations<'_, 
 
     fn noise(&self) -> f64 {
         rounding(self.start.p)
-    }
-
-    /// About x, by steps of 1e-8 of ‖x‖∞; x and the scheme's caches restored by F at x again.
-    /// A rare path, before a failure: x is copied.
-    fn measured_noise(&mut self, f0: &[f64]) -> Result<f64, StepError> {
-        let x0 = self.x.to_vec();
-        let delta = 1e-8 * norm(&x0);
-        let (mut plus, mut minus) = (vec![0.0; f0.len()], vec![0.0; f0.len()]);
-        let noise = difference::measured_noise(f0, (&mut plus, &mut minus), |s, out| {
-            for (x, a) in self.x.iter_mut().zip(&x0) {
-                *x = a + s * delta;
-            }
-            self.residual(out)
-        });
-        self.x.copy_from_slice(&x0);
-        self.residual(&mut plus)?;
-        noise
     }
 
     fn offset(&self) -> f64 {
