@@ -602,13 +602,14 @@ def check_conservation(traj: Trajectory, generators: Sequence[Generator] | None 
         # Checked against the model's coordinates first: then a cyclic coordinate's momentum is
         # named as the model knows it (p_phi).
         argument = f"generators[{k}]"
-        # A closure's ξ at the states, once: its J and the test of what acts along it need it.
-        field = None if isinstance(xi, (Translation, Rotation, Cyclic)) else _field(traj, xi, argument)
+        # ξ at the states, once, where a closure's J or the test of what acts along it needs it.
+        builtin = isinstance(xi, (Translation, Rotation, Cyclic))
+        field = _field(traj, xi, argument) if acting or not builtin else None
         j, size = _momentum_terms(traj, xi, argument, field)
         name = model.momentum_names[xi.index] if isinstance(xi, Cyclic) else xi.name if isinstance(xi, (Translation, Rotation)) else f"xi[{k}]"
         record = _core.statistics(t, j - j[0], size, size, steps)
         stats = _statistics(record, name, j[0], "mean max(Σ|pᵢξᵢ|, ‖p‖‖ξ‖)", t)
-        why = _broken(t, _field(traj, xi, argument) if field is None else field, acting) if acting else None
+        why = _broken(t, field, acting) if acting else None
         # Not conserved, so not judged; a non-finite momentum fails all the same.
         if why is not None and stats.first_non_finite is None:
             stats = replace(stats, verdict=NOT_JUDGED, advice=why)

@@ -459,7 +459,7 @@ def _go_on(
         contacts=contacts,
         blows=_impulses.going_on(traj.impulses, None, t_now),
         times=times,
-        check=check or {},
+        check=check,
     )
 
 
