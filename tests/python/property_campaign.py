@@ -5,7 +5,8 @@ verdicts confirmed and not by refinement, and every case that broke a property, 
 ``property_oracle.examine`` reproduces.
 
 Usage: ``python tests/python/property_campaign.py [--examples N] [--minutes M] [--seed S]
-[--out FILE]``; the cases that broke a property are also written to FILE as JSON lines.
+[--out FILE] [--families NAME ...]``; the cases that broke a property, and those of a kind
+left open (``"known"``), are also written to FILE as JSON lines.
 """
 
 from __future__ import annotations
@@ -53,9 +54,11 @@ def main() -> int:
     parser.add_argument("--seed", type=int, default=int(time.time()))
     parser.add_argument("--timeout", type=float, default=300.0, help="seconds a case may take before it counts as a hang")
     parser.add_argument("--out", type=Path, default=Path("campaign_failures.jsonl"))
+    parser.add_argument("--families", nargs="+", choices=sorted(WEIGHTS), default=sorted(WEIGHTS), help="draw only these")
     args = parser.parse_args()
     families = pm.strategies()
-    draw = st.one_of(*[st.tuples(st.just(name), families[name]) for name, w in WEIGHTS.items() for _ in range(w)])
+    weights = {name: w for name, w in WEIGHTS.items() if name in args.families}
+    draw = st.one_of(*[st.tuples(st.just(name), families[name]) for name, w in weights.items() for _ in range(w)])
     outcomes: Counter[str] = Counter()
     verdicts: Counter[str] = Counter()
     errors: Counter[str] = Counter()
@@ -85,8 +88,10 @@ def main() -> int:
             known[next(k for pattern, k in po.KNOWN_OPEN.items() if re.search(pattern, problem))] += 1
         if outcome.problems:
             broken.append((family, spec, outcome))
+        if outcome.problems or outcome.known:
             with args.out.open("a") as f:
-                f.write(json.dumps({"family": family, "spec": dataclasses.asdict(spec), "problems": outcome.problems}) + "\n")
+                row = {"family": family, "spec": dataclasses.asdict(spec), "problems": outcome.problems, "known": outcome.known}
+                f.write(json.dumps(row) + "\n")
         total = sum(outcomes.values())
         if total % 50 == 0:
             print(f"{total} cases, {len(broken)} broke a property", flush=True)
