@@ -1,0 +1,449 @@
+//! Impacts: the first contact a piece crosses, located to round-off, and the jump there by the
+//! contact's law, which may close the contact (the body then held on it).
+
+use std::ops::Deref;
+
+use super::gaps::{below, floor};
+use super::{dot, insert, Resolver};
+use crate::integrators::jumps::hold::Hold;
+use crate::integrators::jumps::{reflect, variational, Contact, Law, Switch, MAX_IMPACTS};
+use crate::integrators::Dynamics;
+use crate::model::Lagrangian;
+use crate::solve::bracket::newton;
+use crate::{Error, ModelError};
+
+impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
+    /// The first contact the piece of size τ from ta crosses (φ at its end in `phi_end`, the
+    /// scratch left where the location ends), and where: each located to round-off; `last`, the
+    /// contact of the jump the piece starts from, and any it starts on or past, only where φ
+    /// falls below its start.
+    pub(super) fn first_crossing(
+        &mut self,
+        step: usize,
+        (ta, tau): (f64, f64),
+        last: Option<usize>,
+    ) -> Result<Option<(f64, usize)>, Error> {
+        let mut first: Option<(f64, usize)> = None;
+        for j in 0..self.contacts.len() {
+            let leaving = last == Some(j) || self.phi_start[j] <= 0.0;
+            if self.closed.contains(&j) || !below(self.phi_end[j] - floor(self.phi_start[j], leaving), leaving) {
+                continue;
+            }
+            let s = match self.locate(j, step, (ta, tau), leaving) {
+                Ok(s) => s,
+                Err(Located::Error(e)) => return Err(e),
+                Err(Located::Resting) => return Err(self.contact_error(step, self.resting(j))),
+            };
+            if let Some(s) = s {
+                if first.is_none_or(|(s0, _)| s < s0) {
+                    first = Some((s, j));
+                }
+            }
+        }
+        Ok(first)
+    }
+
+    /// Why a body leaving contact j that crosses it again at once cannot go on, and what helps.
+    pub(super) fn resting(&self, j: usize) -> String {
+        format!(
+            "a body leaving the contact {} crosses it again at once (a resting or grazing contact, such as e = 0 \
+             under a force pressing on it), which impacts cannot resolve; {}",
+            self.contacts[j].name,
+            // A method that holds contacts missed this one's closing: its bounces outran the step.
+            if self.hold.is_some() {
+                "this method holds such a contact closed once its bounces die out within a step: a smaller step \
+                 (dt) helps"
+                    .to_string()
+            } else {
+                format!(
+                    "{} hold such a contact closed on a model without forces or constraints of its own",
+                    Hold::methods()
+                )
+            }
+        )
+    }
+
+    /// The impact on contact j at (q̃, p⁻) (the contact buffers), the end of the piece of size s
+    /// from ta with `rest` of the step h after it: the jump ([`Resolver::jump`]) and what it
+    /// does to the closed contacts, p⁺ into `piece_p`, the impact kept for the step's report.
+    pub(super) fn impact(
+        &mut self,
+        j: usize,
+        step: usize,
+        (ta, s, rest): (f64, f64, f64),
+        h: f64,
+    ) -> Result<(), Error> {
+        let (t, before) = (ta + s, self.step_work);
+        self.jump(j, step, (ta, s, rest), h)?;
+        self.after_jump(step, t)?;
+        if !self.piece_p.iter().all(|x| x.is_finite()) {
+            let reason = format!(
+                "a non-finite state after the impact on {} at t = {t}",
+                self.contacts[j].name
+            );
+            return Err(self.contact_error(step, reason));
+        }
+        self.pending
+            .push(j, step, t, &self.contact_q, &self.contact_p, &self.piece_p);
+        self.pending_work.push([before, self.step_work]);
+        Ok(())
+    }
+
+    /// Why a step met more than [`MAX_IMPACTS`] impacts, and what helps: flights that still
+    /// shrink geometrically (the last under half the first, and under 0.99 of the one before)
+    /// accumulate at a finite time, as a body coming to rest does, which no step resolves;
+    /// flights that do not (a chatter of equal ones) are a step too long for them.
+    pub(super) fn too_many_impacts(&self) -> String {
+        let t = &self.pending.t;
+        let k = t.len();
+        let (first, last, before) = (t[1] - t[0], t[k - 1] - t[k - 2], t[k - 2] - t[k - 3]);
+        let ratio = last / before;
+        if !(last < 0.5 * first && ratio < 0.99) {
+            return format!(
+                "more than {MAX_IMPACTS} impacts in one step, in flights as short as {last:.3e}: shorten the step (dt)"
+            );
+        }
+        // The geometric series of the last flights' ratio sums to where they accumulate.
+        let limit = format!(" at t ≈ {:.6}", t[k - 1] + last * ratio / (1.0 - ratio));
+        let hold = if self.hold.is_some() {
+            "; this method holds a contact closed only where e < 1 and the body presses on it".to_string()
+        } else {
+            format!(
+                ", or hold the contact: {} hold such a contact closed on a model without forces or constraints of its \
+                 own, with e < 1",
+                Hold::methods()
+            )
+        };
+        format!(
+            "more than {MAX_IMPACTS} impacts in one step, their flights shrinking to an accumulation{limit} (a body \
+             coming to rest on a surface), which no step resolves: stop the run before it{hold}"
+        )
+    }
+
+    /// The jump on contact j at (q̃, p⁻) (the contact buffers), at the end of the piece of size s
+    /// from ta with `rest` of the step after it: p⁺ into `piece_p`. The contact closes there
+    /// ([`Resolver::closes`]) when the rest of its bounces would last less than the step h.
+    pub(super) fn jump(&mut self, j: usize, step: usize, (ta, s, rest): (f64, f64, f64), h: f64) -> Result<(), Error> {
+        let contacts = self.contacts;
+        let contact = &contacts[j];
+        let (t, time) = (ta + s, self.t);
+        let model_error = |source| Error::model(step, time, source);
+        let model = self.scratch.model();
+        let (q, p) = (&self.contact_q[..], &self.contact_p[..]);
+        contact.surface.gradient(q, &mut self.normal).map_err(model_error)?;
+        // On a constrained model, the part of ∇φ the constraints let act: the surface's impulse
+        // comes with the constraints' workless one that keeps the momenta on them, which adds up
+        // to ∇φ projected M-orthogonally (the projection's affine part cancels).
+        for (x, (a, b)) in self.v.iter_mut().zip(p.iter().zip(&self.normal)) {
+            *x = a + b;
+        }
+        if let Some(projected) = model.project(q, &self.v) {
+            let (_, with) = projected?;
+            let (_, without) = model.project(q, p).expect("a constrained model projects")?;
+            for (x, (a, b)) in self.normal.iter_mut().zip(with.iter().zip(&without)) {
+                *x = a - b;
+            }
+        }
+        let vectors = (&mut self.v[..], &mut self.w[..], &self.zeros[..]);
+        let reflected = reflect::reflection(
+            model.as_lagrangian(),
+            (t, q, p),
+            &self.normal,
+            contact.restitution,
+            vectors,
+        )
+        .map_err(model_error)?;
+        let reflection = reflected.lambda;
+        // For e < 1, and beside a held contact, both laws take Newton's law, the reflection.
+        // The energy account takes each law's own loss: none for e = 1 (the variational law's
+        // change of E is the method's error, its E_d kept), Newton's law's otherwise.
+        let variational = contact.law == Law::Variational && contact.restitution == 1.0 && self.closed.is_empty();
+        let lambda = if variational && rest > 0.0 {
+            let (lambda, found) = self.variational(step, (ta, s, rest), reflection)?;
+            self.pending.grazing += usize::from(!found);
+            lambda
+        } else {
+            reflection
+        };
+        let mut loss = reflected.loss(contact.restitution);
+        for (x, (a, b)) in self.piece_p.iter_mut().zip(self.contact_p.iter().zip(&self.normal)) {
+            *x = a + lambda * b;
+        }
+        if let Some(t_rest) = self.closes(j, step, t, (reflection, h))? {
+            // The whole normal velocity gone: the Zeno series' losses summed.
+            loss = reflected.loss(0.0);
+            insert(&mut self.closed, j);
+            self.switched(j, Switch::Closed, step, (t, t_rest));
+            self.scratch.restart(t, &self.contact_q, &self.piece_p, h);
+            if self.sticks(j, step, t)? {
+                self.project_piece(step, t)?;
+                self.switched(j, Switch::Stuck, step, (t, t_rest));
+            }
+        }
+        self.step_work += loss;
+        Ok(())
+    }
+
+    /// Whether contact j closes at its impact at time t, reflected with the multiplier
+    /// `reflection` (the normal, ∇φ, in `normal`): the body pressing on the surface once its
+    /// normal velocity is gone (λ > 0), and the Zeno series of the rebounds, flights of
+    /// 2v⁺/|a|, 2ev⁺/|a|, … under the normal acceleration a = −λ∇φᵀM⁻¹∇φ, summing to
+    /// T∞ = 2v⁺/(|a|(1 − e)) ≤ h (at once for v⁺ = 0). Then the momenta lose their normal
+    /// velocity (`piece_p`: the reflection with e = 0) and the contact is held from t: the
+    /// series' limit t + T∞, when the body comes to rest on the surface, is returned.
+    pub(super) fn closes(
+        &mut self,
+        j: usize,
+        step: usize,
+        t: f64,
+        (reflection, h): (f64, f64),
+    ) -> Result<Option<f64>, Error> {
+        let e = self.contacts[j].restitution;
+        // Elastic contacts close only on an arrival without normal velocity.
+        if self.hold.is_none() || (e == 1.0 && reflection != 0.0) {
+            return Ok(None);
+        }
+        let time = self.t;
+        let model_error = |source| Error::model(step, time, source);
+        // p with the normal velocity gone, λ/(1 + e) along ∇φ; v⁺ = −e∇φ·q̇⁻ = eλ nᵀM⁻¹n/(1 + e).
+        for (x, (a, b)) in self.w.iter_mut().zip(self.contact_p.iter().zip(&self.normal)) {
+            *x = a + reflection / (1.0 + e) * b;
+        }
+        let model = self.scratch.model().as_lagrangian();
+        model
+            .velocity(&self.contact_q, &self.normal, t, &mut self.v)
+            .map_err(model_error)?;
+        let metric_plus = dot(&self.normal, &self.v);
+        model
+            .velocity(&self.contact_q, &self.zeros, t, &mut self.v)
+            .map_err(model_error)?;
+        let metric = metric_plus - dot(&self.normal, &self.v);
+        let rebound = e * reflection * metric / (1.0 + e);
+        insert(&mut self.closed, j);
+        let a = self.closed.iter().position(|&k| k == j).expect("just inserted");
+        self.scratch.restart(t, &self.contact_q, &self.w, h);
+        let mut lambda = std::mem::take(&mut self.lambda);
+        let pressed = self.multipliers(t, &mut lambda, step).map(|()| lambda[a]);
+        self.lambda = lambda;
+        self.closed.retain(|&k| k != j);
+        let pressed = pressed?;
+        if pressed.is_nan() || pressed <= 0.0 {
+            return Ok(None);
+        }
+        let tail = if rebound == 0.0 {
+            0.0
+        } else if e < 1.0 {
+            2.0 * rebound / (pressed * metric * (1.0 - e))
+        } else {
+            return Ok(None);
+        };
+        if tail.is_nan() || tail > h {
+            return Ok(None);
+        }
+        self.piece_p.copy_from_slice(&self.w);
+        Ok(Some(t + tail))
+    }
+
+    /// λ of the variational law ([`variational::multiplier`]) for the jump at the end of the
+    /// piece of size s from ta, from the reflection's λ: E_d of the piece after the jump, to
+    /// the step's end `rest` later, equal to E_d of the piece before. Leaves `piece_q` at q̃.
+    pub(super) fn variational(
+        &mut self,
+        step: usize,
+        (ta, s, rest): (f64, f64, f64),
+        reflection: f64,
+    ) -> Result<(f64, bool), Error> {
+        let time = self.t;
+        let model_error = |source| Error::model(step, time, source);
+        let Resolver {
+            scratch,
+            discrete,
+            piece_q,
+            piece_p,
+            contact_q,
+            contact_p,
+            normal,
+            v,
+            ..
+        } = self;
+        let Some(discrete) = discrete.as_mut() else {
+            return Ok((reflection, false));
+        };
+        let t = ta + s;
+        let before = (&piece_q[..], &piece_p[..]);
+        let target = discrete
+            .energy(scratch.model(), ta, s, before, (contact_q, contact_p))
+            .map_err(|e| e.at(step, time))?;
+        scratch
+            .model()
+            .as_lagrangian()
+            .velocity(contact_q, contact_p, t, v)
+            .map_err(model_error)?;
+        let scale = contact_p.iter().zip(v.iter()).map(|(a, b)| a * b).sum::<f64>();
+        piece_q.copy_from_slice(contact_q);
+        let mut last = f64::NAN;
+        let after = |lambda: f64| {
+            last = lambda;
+            for (x, (a, b)) in piece_p.iter_mut().zip(contact_p.iter().zip(normal.iter())) {
+                *x = a + lambda * b;
+            }
+            scratch.restart(t, piece_q, piece_p, rest);
+            scratch.step().map_err(|e| e.at(step, time))?;
+            let end = (scratch.q(), scratch.p());
+            discrete
+                .energy(scratch.model(), t, rest, (piece_q, piece_p), end)
+                .map_err(|e| e.at(step, time))
+        };
+        let found = variational::multiplier(after, reflection, target, scale)?;
+        // The scratch holds the piece after the jump for the λ taken: the next piece's first step.
+        if last == found.0 {
+            self.keep(t, rest);
+        }
+        Ok(found)
+    }
+
+    /// The s ∈ (0, τ] where φⱼ along the piece from (ta, piece_q, piece_p) falls through 0,
+    /// by Newton's method in the bracket ([`newton`]) to round-off. A piece that starts above the surface
+    /// brackets it by its ends (φⱼ falls through 0 once in a step short against the path's
+    /// curvature); one leaving it (`leaving`: it starts on that surface and only φⱼ < 0 counts)
+    /// is bracketed by samples ([`Resolver::leaving_bracket`]). None when no sample is below
+    /// (round-off at the piece's end).
+    pub(super) fn locate(
+        &mut self,
+        j: usize,
+        step: usize,
+        (ta, tau): (f64, f64),
+        leaving: bool,
+    ) -> Result<Option<f64>, Located> {
+        let floor = floor(self.phi_start[j], leaving);
+        let start = (0.0, self.phi_start[j] - floor);
+        let ((a, b), guess) = if leaving {
+            match self.leaving_bracket(j, step, (ta, tau), start, floor)? {
+                Some(bracket) => (bracket, None),
+                None => return Ok(None),
+            }
+        } else {
+            // The partial steps' q(s) leaves with the velocity q̇ at the piece's start.
+            let (model, time) = (self.scratch.model().as_lagrangian(), self.t);
+            let vectors = (&mut self.normal[..], &mut self.v[..]);
+            let rate = phi_rate(&self.contacts[j], model, (ta, &self.piece_q, &self.piece_p), vectors)
+                .map_err(|source| Error::model(step, time, source))?;
+            let end = (tau, self.phi_end[j]);
+            ((start, end), Some(quadratic_root(start.1, rate, end)))
+        };
+        let tolerance = 4.0 * f64::EPSILON * tau;
+        let mut least = f64::INFINITY;
+        let (s, _) = newton(
+            |s| {
+                let (phi, rate) = self.phi_rate_along(j, step, ta, s)?;
+                // The nearest so far, which the contact state will be.
+                if (phi - floor).abs() < least {
+                    least = (phi - floor).abs();
+                    self.keep(ta, s);
+                }
+                Ok::<_, Error>((phi - floor, rate))
+            },
+            a,
+            b,
+            guess,
+            tolerance,
+        )?;
+        Ok(Some(s))
+    }
+
+    /// φⱼ and its rate ∇φⱼ·q̇ at the end of the partial step of size s from the piece's start:
+    /// the rate of the flow through that state, within the method's error of the partial
+    /// steps' own rate in s, which is what [`newton`] needs.
+    pub(super) fn phi_rate_along(&mut self, j: usize, step: usize, ta: f64, s: f64) -> Result<(f64, f64), Error> {
+        let phi = self.phi_along(j, step, ta, s)?;
+        let (model, time) = (self.scratch.model().as_lagrangian(), self.t);
+        let state = (ta + s, self.scratch.q(), self.scratch.p());
+        let rate = phi_rate(&self.contacts[j], model, state, (&mut self.normal, &mut self.v))
+            .map_err(|source| Error::model(step, time, source))?;
+        Ok((phi, rate))
+    }
+
+    /// The bracket of a crossing of φⱼ − `floor` (`start` its value at s = 0) on a piece
+    /// leaving the surface: eight samples over (0, τ], refined towards 0 up to four times while
+    /// the first is already below; a body below at every one crosses again at once
+    /// ([`Located::Resting`]). None when no sample is below.
+    pub(super) fn leaving_bracket(
+        &mut self,
+        j: usize,
+        step: usize,
+        (ta, tau): (f64, f64),
+        start: (f64, f64),
+        floor: f64,
+    ) -> Result<Option<Bracket>, Located> {
+        let mut hi = tau;
+        for _ in 0..4 {
+            let mut previous = start;
+            let mut found = None;
+            for k in 1..=8 {
+                let x = hi * k as f64 / 8.0;
+                let v = self.phi_along(j, step, ta, x)? - floor;
+                if below(v, true) {
+                    found = Some((k, x, v));
+                    break;
+                }
+                previous = (x, v);
+            }
+            let Some((k, x, v)) = found else {
+                return Ok(None);
+            };
+            if k > 1 {
+                return Ok(Some((previous, (x, v))));
+            }
+            hi = x;
+        }
+        Err(Located::Resting)
+    }
+
+    /// φⱼ at the end of the partial step of size s from the piece's start.
+    pub(super) fn phi_along(&mut self, j: usize, step: usize, ta: f64, s: f64) -> Result<f64, Error> {
+        self.partial(step, ta, s)?;
+        let surface = &self.contacts[j].surface;
+        surface.phi(self.scratch.q()).map_err(|source| Error::Model {
+            step,
+            time: self.t,
+            source,
+        })
+    }
+}
+
+/// Two points (s, φ − floor) on either side of a crossing.
+pub(super) type Bracket = ((f64, f64), (f64, f64));
+
+/// Why a crossing was not located.
+pub(super) enum Located {
+    Error(Error),
+    /// Below the surface at every sample of a piece leaving it.
+    Resting,
+}
+
+impl From<Error> for Located {
+    fn from(e: Error) -> Self {
+        Located::Error(e)
+    }
+}
+
+/// ∇φ·q̇ of `contact` at the state (t, q, p), with ∇φ and q̇ left in `normal` and `v`.
+pub(super) fn phi_rate(
+    contact: &Contact<'_>,
+    model: &dyn Lagrangian,
+    (t, q, p): (f64, &[f64], &[f64]),
+    (normal, v): (&mut [f64], &mut [f64]),
+) -> Result<f64, ModelError> {
+    contact.surface.gradient(q, normal)?;
+    model.velocity(q, p, t, v)?;
+    Ok(dot(normal, v))
+}
+
+/// The root in (0, τ) of the quadratic through φ(0) = φ₀ > 0 with φ′(0) = r₀ and φ(τ) = φ₁ ≤ 0
+/// (NaN where round-off leaves it none): the crossing of a flight whose φ is quadratic in
+/// time (a straight chord of a circle, a parabola over a wall) to round-off, in the form
+/// 2φ₀/(√(r₀² − 4cφ₀) − r₀), which does not cancel.
+pub(super) fn quadratic_root(phi0: f64, r0: f64, (tau, phi1): (f64, f64)) -> f64 {
+    let c = (phi1 - phi0 - r0 * tau) / (tau * tau);
+    2.0 * phi0 / ((r0 * r0 - 4.0 * c * phi0).sqrt() - r0)
+}
