@@ -720,18 +720,30 @@ def _drift_advice(traj: Trajectory) -> str:
     """What to do about a drifting energy: reduce dt, and why a smaller step helps."""
     info = {m.name: m for m in _core.methods()}.get(traj.method)
     if info is not None and not info.symplectic:
-        return f"{traj.method} is not symplectic, so nothing bounds its energy error: reduce dt (the drift falls at order {info.order})"
+        return _not_symplectic(info)
     # Backward error analysis bounds the error over exponentially long times only for h·ω small
     # enough: near the stability limit, or at a resonance, the modified energy does not hold.
     return "a symplectic method drifts only at a step too coarse for the motion: reduce dt"
 
 
+def _not_symplectic(info: _core.MethodInfo) -> str:
+    """What helps the energy error of a method that is not symplectic, as a run's divergence
+    says it: nothing bounds it, so a smaller step only slows its growth."""
+    return (
+        f"reduce dt ({info.name} is not symplectic: its energy error grows along the run, slower at a smaller "
+        f"step, by order {info.order}), or take a symplectic method, whose error stays bounded: verlet (rattle on "
+        "a constrained model)"
+    )
+
+
 def _failure_advice(traj: Trajectory) -> str:
     """What to do about a failed energy: reduce dt, and whether the step is past the method's
     linear stability limit h·ω_max when the linearisation at the initial state gives an estimate."""
+    info = {m.name: m for m in _core.methods()}.get(traj.method)
+    if info is not None and not info.symplectic:
+        return _not_symplectic(info)
     advice = "reduce dt"
     h_omega = _h_omega(traj.model, traj.q[0], traj.dt, float(traj.t[0]))
-    info = {m.name: m for m in _core.methods()}.get(traj.method)
     if h_omega is not None and info is not None and h_omega >= info.h_omega_max:
         advice += (
             f": h·ω ≈ {h_omega:.3g} at the initial state (linear estimate) is past {traj.method}'s "

@@ -316,6 +316,11 @@ def _failed(case: Case, err: BaseException, h: float | None = None, depth: int =
         if not isinstance(before, varmech.Trajectory):
             out.problems.append(f"advised stopping before t = {limit}, but that run raised {_text(before)}: {message}")
         return out
+    if "take a symplectic method" in message:
+        # Either remedy of a method that is not symplectic: a symplectic one at h, or a smaller step.
+        other = _attempt(lambda: case.run(h, method="rattle" if case.model.constraints else "verlet", **options))
+        if isinstance(other, varmech.Trajectory):
+            return out
     if any(w in message for w in NO_HELP):
         # Our models are smooth and their derivatives right: such a diagnosis is wrong, unless h/4 fails alike.
         quarter = _attempt(lambda: case.run(h / 4, **options))

@@ -167,6 +167,23 @@ def test_energy_threshold_raises_divergence_error():
         assert len(info.value.partial) == k + 1
 
 
+def test_a_method_that_is_not_symplectic_is_told_its_error_grows_and_what_bounds_it():
+    # Explicit Euler multiplies the oscillator's energy by 1 + h² a step, so its error passes
+    # the scale at a time that goes as 1/h: a step 4 times smaller fails 4 times later, and no
+    # step runs for ever. Verlet's error, at the same step, stays bounded.
+    failed = {}
+    for dt in (0.1, 0.025):
+        with pytest.raises(varmech.DivergenceError) as info:
+            varmech.integrate(scenes.harmonic_oscillator(), dt=dt, steps=round(400 / dt), method="explicit_euler")
+        message = str(info.value)
+        assert "explicit_euler is not symplectic: its energy error grows along the run" in message
+        assert "by order 1), or take a symplectic method, whose error stays bounded: verlet" in message
+        failed[dt] = info.value.time
+    assert failed[0.025] / failed[0.1] == pytest.approx(4, rel=0.1)
+    verlet = varmech.integrate(scenes.harmonic_oscillator(), dt=0.1, steps=4000, method="verlet")
+    assert varmech.check_conservation(verlet).energy.verdict == "bounded"
+
+
 @pytest.mark.parametrize("native", [True, False])
 def test_ctrl_c_interrupts_a_long_run_and_keeps_the_partial_trajectory(native, interrupt_after):
     scene = scenes.kepler()

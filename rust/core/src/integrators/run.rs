@@ -681,7 +681,7 @@ impl EnergyWatch {
             )
         };
         let advice = differences_advice(sys, (stepper.q(), stepper.p(), time), first.0, error.abs())
-            .unwrap_or_else(|| "reduce dt".into());
+            .unwrap_or_else(|| step_advice(method));
         let reason = format!(
             "energy error {:.3e} is {:.3e} times the energy scale {scale:.3e} (the mean kinetic energy), \
              beyond max_energy_error = {:.3e}{growing}; {advice}",
@@ -718,6 +718,22 @@ fn differences_advice<S: Dynamics + ?Sized>(
              derivatives, or scale its coordinates to order 1"
         )
     })
+}
+
+/// What helps an energy error that a step too coarse accounts for. A method that is not
+/// symplectic conserves no modified energy: its error grows along any run, so a smaller step
+/// only slows it (a run k times as long needs a step k times smaller at order 1), and a
+/// symplectic method bounds it.
+fn step_advice(method: Method) -> String {
+    let info = method.info();
+    if info.symplectic {
+        return "reduce dt".into();
+    }
+    format!(
+        "reduce dt ({} is not symplectic: its energy error grows along the run, slower at a smaller step, by \
+         order {}), or take a symplectic method, whose error stays bounded: verlet (rattle on a constrained model)",
+        info.name, info.order
+    )
 }
 
 fn not_finite(terms: &EnergyTerms) -> String {
