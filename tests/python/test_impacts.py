@@ -214,7 +214,7 @@ def test_a_method_that_cannot_hold_a_contact_ends_an_accumulation_of_impacts_wit
     assert np.min(partial.q) > -1e-12
 
 
-@pytest.mark.parametrize("e", [0.95, 0.98])
+@pytest.mark.parametrize("e", [0.95, 0.98, 0.99])
 def test_an_accumulation_of_impacts_names_its_time_and_what_helps(e):
     # At e near 1 the bounces shrink slowly and 64 fall within one step before the Zeno time
     # t∞ = t₁(1 + 2e/(1 − e)), whatever the step: the error sums the flights' geometric series

@@ -89,21 +89,23 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
         Ok(())
     }
 
-    /// Why a step met more than [`MAX_IMPACTS`] impacts, and what helps: flights that still
-    /// shrink geometrically (the last under half the first, and under 0.99 of the one before)
-    /// accumulate at a finite time, as a body coming to rest does, which no step resolves;
-    /// flights that do not (a chatter of equal ones) are a step too long for them.
+    /// Why a step met more than [`MAX_IMPACTS`] impacts, and what helps: flights that shrink
+    /// geometrically (each of the last [`SHRINKING`] shorter than the one before, at a mean
+    /// ratio r below 0.999, so that they sum to within 10³ flights) accumulate at a finite
+    /// time, as a body coming to rest does (r = e under a constant force), which no step
+    /// resolves; flights that do not (a chatter of equal ones) are a step too long for them.
     pub(super) fn too_many_impacts(&self) -> String {
         let t = &self.pending.t;
         let k = t.len();
-        let (first, last, before) = (t[1] - t[0], t[k - 1] - t[k - 2], t[k - 2] - t[k - 3]);
-        let ratio = last / before;
-        if !(last < 0.5 * first && ratio < 0.99) {
+        let (first, last) = (t[1] - t[0], t[k - 1] - t[k - 2]);
+        let ratio = (last / first).powf(1.0 / (k - 2) as f64);
+        let shrinking = t.windows(3).rev().take(SHRINKING).all(|w| w[2] - w[1] < w[1] - w[0]);
+        if !(shrinking && ratio < 0.999) {
             return format!(
                 "more than {MAX_IMPACTS} impacts in one step, in flights as short as {last:.3e}: shorten the step (dt)"
             );
         }
-        // The geometric series of the last flights' ratio sums to where they accumulate.
+        // The geometric series of the flights' ratio sums to where they accumulate.
         let limit = format!(" at t ≈ {:.6}", t[k - 1] + last * ratio / (1.0 - ratio));
         let hold = if self.hold.is_some() {
             "; this method holds a contact closed only where e < 1 and the body presses on it".to_string()
@@ -188,7 +190,10 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
     /// `reflection` (the normal, ∇φ, in `normal`): the body pressing on the surface once its
     /// normal velocity is gone (λ > 0), and the Zeno series of the rebounds, flights of
     /// 2v⁺/|a|, 2ev⁺/|a|, … under the normal acceleration a = −λ∇φᵀM⁻¹∇φ, summing to
-    /// T∞ = 2v⁺/(|a|(1 − e)) ≤ h (at once for v⁺ = 0). Then the momenta lose their normal
+    /// T∞ = 2v⁺/(|a|(1 − e)) ≤ h (at once for v⁺ = 0), or, for e near 1, where T∞ is longer,
+    /// flights under h/[`MAX_IMPACTS`]: their bounces, of height |a|(2v⁺/|a|)²/8, are below the
+    /// method's error in a step, and more of them than a step resolves would fall in it (for
+    /// e > 1 − 1/[`MAX_IMPACTS`]). Then the momenta lose their normal
     /// velocity (`piece_p`: the reflection with e = 0) and the contact is held from t: the
     /// series' limit t + T∞, when the body comes to rest on the surface, is returned.
     pub(super) fn closes(
@@ -237,7 +242,7 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
         } else {
             return Ok(None);
         };
-        if tail.is_nan() || tail > h {
+        if tail.is_nan() || (tail > h && tail * (1.0 - e) * MAX_IMPACTS as f64 > h) {
             return Ok(None);
         }
         self.piece_p.copy_from_slice(&self.w);
@@ -410,6 +415,9 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
         })
     }
 }
+
+/// The last flights of a step's impacts that must each shrink for an accumulation.
+const SHRINKING: usize = 16;
 
 /// Two points (s, φ − floor) on either side of a crossing.
 pub(super) type Bracket = ((f64, f64), (f64, f64));
