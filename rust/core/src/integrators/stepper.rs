@@ -4,16 +4,19 @@ use serde::{Deserialize, Serialize};
 mod clock;
 mod decoded;
 mod own_variables;
+mod phase;
 
 pub(super) use clock::Clock;
+pub use phase::Clear;
+pub(super) use phase::{Always, Phase};
 
 use std::borrow::{Borrow, BorrowMut};
 use std::ops::Deref;
 
 use super::tangent;
 use super::{
-    check_method, compensated, Dynamics, Gaps, General, Increment, Integrator, Method, Options, Poll, StepError,
-    StepStart, Tangent,
+    check_method, compensated, Dynamics, Gaps, General, Increment, Integrator, Method, Options, Poll, StepStart,
+    Tangent,
 };
 use crate::error::check_vector;
 use crate::model::{Lagrangian, MechanicalSystem};
@@ -754,110 +757,6 @@ impl<M: Deref<Target: Dynamics>, St: Borrow<StepperState>> Stepper<M, St> {
     pub fn forced_work(&self) -> Option<f64> {
         let lagrangian = self.model.as_lagrangian();
         (lagrangian.is_forced() || lagrangian.is_time_dependent() || self.exchanges).then(|| self.work())
-    }
-}
-
-/// A stepper's state as a method's own loop advances it: (qₙ, pₙ), the carries (e_q, e_p) of
-/// compensated summation, and the steps done, counted up as the loop goes; `start_q`,
-/// `start_p` receive the start of a step found not clear (see [`Phase::run`]).
-pub(super) struct Phase<'a> {
-    pub(super) q: &'a mut [f64],
-    pub(super) p: &'a mut [f64],
-    pub(super) eq: &'a mut [f64],
-    pub(super) ep: &'a mut [f64],
-    pub(super) start_q: &'a mut [f64],
-    pub(super) start_p: &'a mut [f64],
-    pub(super) compensated: bool,
-    pub(super) steps: &'a mut usize,
-    pub(super) clock: Clock,
-}
-
-impl Phase<'_> {
-    /// `steps` steps of N coordinates with the state in fixed-size arrays: `increment(t, q, p,
-    /// δq, δp)` writes each step's increments, which are added as [`StepperState::step`] adds
-    /// them (the same bits), in one loop with no dispatch. Stops at the first failure, dated
-    /// as the stepper dates it, with the last good state kept; and after the first step whose
-    /// end q is not `clear`, kept, its start written to (`start_q`, `start_p`): true then. The
-    /// loop of the methods' own fixed-size paths ([`super::KickDrift::run`], the DEL step's).
-    #[inline(always)]
-    pub(super) fn run<const N: usize, F, C>(self, steps: usize, mut increment: F, clear: &mut C) -> Result<bool, Error>
-    where
-        F: FnMut(f64, &[f64; N], &[f64; N], &mut [f64; N], &mut [f64; N]) -> Result<(), StepError>,
-        C: Clear + ?Sized,
-    {
-        let array = |x: &[f64]| -> [f64; N] { std::array::from_fn(|i| x[i]) };
-        let Phase {
-            q: state_q,
-            p: state_p,
-            eq: state_eq,
-            ep: state_ep,
-            start_q,
-            start_p,
-            compensated,
-            steps: done,
-            clock,
-        } = self;
-        let (mut q, mut p, mut eq, mut ep) = (array(state_q), array(state_p), array(state_eq), array(state_ep));
-        let (mut dq, mut dp) = ([0.0; N], [0.0; N]);
-        let (mut q_next, mut p_next, mut eq_next, mut ep_next) = ([0.0; N], [0.0; N], [0.0; N], [0.0; N]);
-        // The count in a local, written back once: through the pointer it would cost stores.
-        let mut n = *done;
-        let mut result = Ok(false);
-        for _ in 0..steps {
-            if let Err(e) = increment(clock.at(n), &q, &p, &mut dq, &mut dp) {
-                result = Err(e.at(n + 1, clock.at(n)));
-                break;
-            }
-            let finite = if compensated {
-                compensated::add(&q, &eq, &dq, &mut q_next, &mut eq_next)
-                    & compensated::add(&p, &ep, &dp, &mut p_next, &mut ep_next)
-            } else {
-                compensated::add_plain(&q, &dq, &mut q_next) & compensated::add_plain(&p, &dp, &mut p_next)
-            };
-            if !finite {
-                result = Err(diverged(n + 1, clock.at(n)));
-                break;
-            }
-            let stop = !clear.clear(&q_next, &p_next);
-            if stop {
-                start_q.copy_from_slice(&q);
-                start_p.copy_from_slice(&p);
-            }
-            (q, p) = (q_next, p_next);
-            if compensated {
-                (eq, ep) = (eq_next, ep_next);
-            }
-            n += 1;
-            if stop {
-                result = Ok(true);
-                break;
-            }
-        }
-        *done = n;
-        state_q.copy_from_slice(&q);
-        state_p.copy_from_slice(&p);
-        state_eq.copy_from_slice(&eq);
-        state_ep.copy_from_slice(&ep);
-        result
-    }
-}
-
-/// What a method's own loop checks at the end of each step: whether the step is clear, so that
-/// the loop goes on ([`Gaps`]: it crosses no contact; [`super::tangent::Carried`]: its tangent
-/// map carried the vectors, none past a bound). A trait, not a closure, so that the check is
-/// inlined into the loop: as a closure it was called out of line, a third of a Verlet step.
-pub trait Clear {
-    /// Whether the step ending at (q, p) is clear.
-    fn clear(&mut self, q: &[f64], p: &[f64]) -> bool;
-}
-
-/// Nothing watched: every step is clear.
-pub(super) struct Always;
-
-impl Clear for Always {
-    #[inline(always)]
-    fn clear(&mut self, _: &[f64], _: &[f64]) -> bool {
-        true
     }
 }
 
