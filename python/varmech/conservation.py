@@ -609,7 +609,7 @@ def check_conservation(traj: Trajectory, generators: Sequence[Generator] | None 
         name = model.momentum_names[xi.index] if isinstance(xi, Cyclic) else xi.name if isinstance(xi, (Translation, Rotation)) else f"xi[{k}]"
         record = _core.statistics(t, j - j[0], size, size, steps)
         stats = _statistics(record, name, j[0], "mean max(Σ|pᵢξᵢ|, ‖p‖‖ξ‖)", t)
-        why = _broken(t, field, acting) if acting else None
+        why = _broken(t, field, acting) if acting and field is not None else None
         # Not conserved, so not judged; a non-finite momentum fails all the same.
         if why is not None and stats.first_non_finite is None:
             stats = replace(stats, verdict=NOT_JUDGED, advice=why)
