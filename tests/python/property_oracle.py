@@ -62,9 +62,10 @@ KNOWN_OPEN = {
     # points out of the floor: the reflection, λ < 0, kicks the body in, and the next piece
     # crosses at once (h/16 runs). Elastic variational contacts, which no method holds, alike.
     "crosses it again at once": "a graze at a coarse step reflected into the floor",
-    # A cycle at |F| ≈ 1e-13, the rounding of a closure's own cancellation (g(1 − cos q) at
-    # |q| ≈ 1e-6 rounds at εg, not at ε|V|): differences record the noise of f's value, which
-    # misses it, so Newton reads the floor as a jump (at h/2 of a run that h and h/4 complete).
+    # A cycle at |F| ≈ 1e-12, the rounding of a closure's own cancellation (g(1 − cos q) at
+    # small |q| rounds at εg, not at ε|V|): differences record the noise of f's value, which
+    # misses it. At Newton's cap the noise is measured (difference.measured_noise), but its
+    # quanta can escape the samples, and then Newton reads the floor as a jump.
     "the corrections repeat, a cycle about a jump": "a closure's cancellation read as a kink",
     # A short run's band where finer steps find the drift of a forced chain.
     "'bounded' verdict that refinement does not confirm: h: bounded [^;]*; h/2: secular drift": "a drift seen only at finer steps",

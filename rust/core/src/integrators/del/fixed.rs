@@ -103,6 +103,21 @@ impl<R: DiscreteLagrangian> Del<TwoPoint<R>> {
             let mut iteration = 0;
             loop {
                 if iteration == options.max_iterations {
+                    // At the cap above the estimated floor: at the floor measured (ws restored
+                    // at x after), converged ([`Newton::solve`] alike). δ is relative to q₀ + x,
+                    // where F is evaluated: a step's increment alone may be below q₀'s rounding.
+                    let delta = 1e-6 * (norm(&x) + norm(start.q));
+                    let (mut plus, mut minus) = ([0.0; N], [0.0; N]);
+                    let noise = difference::measured_noise(&r, (&mut plus, &mut minus), |s, out| {
+                        evaluations += 1;
+                        let at: [f64; N] = std::array::from_fn(|i| x[i] + s * delta);
+                        self.scheme.equations_in(&mut ws, sys, start, &at, out)
+                    })?;
+                    evaluations += 1;
+                    self.scheme.equations_in(&mut ws, sys, start, &x, &mut plus)?;
+                    if Progress::at_floor(residual, noise) {
+                        break;
+                    }
                     let guess = predictor(&last, &before_last, history);
                     let diagnosis = progress.diagnosis().confirmed(&mut self.unconstrained(
                         sys,
