@@ -278,6 +278,9 @@ class MethodInfo:
     @property
     def splitting(self) -> tuple[list[float], list[float]] | None:
         """The kick fractions a₀, …, aₛ and drift fractions b₁, …, bₛ of a kick–drift method."""
+    @property
+    def features(self) -> list[str]:
+        """What its step offers: ``discrete_energy``, ``tangent_map``, ``held_step``, ``delayed_forces``."""
 
 @final
 class ModelKind:

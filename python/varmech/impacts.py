@@ -8,9 +8,10 @@ The step that crosses a surface is split at the contact: the method's own partia
 p⁺ = p⁻ + λ∇φ(q̃), and the method's partial step of size (1 − α)h to the grid time tₙ₊₁. The
 contact's ``law`` fixes λ:
 
-- ``"variational"`` (the default; kick–drift methods, ``MethodInfo.splitting``, the implicit
-  two-point rules ``midpoint`` and ``trapezoid`` and the Galerkin rules ``galerkin4`` and
-  ``galerkin6``): the variational collision integrator of Fetecau, Marsden, Ortiz & West (2003).
+- ``"variational"`` (the default; the methods with ``"discrete_energy"`` in
+  ``MethodInfo.features``: kick–drift methods, ``MethodInfo.splitting``, the implicit two-point
+  rules ``midpoint`` and ``trapezoid`` and the Galerkin rules ``galerkin4`` and ``galerkin6``):
+  the variational collision integrator of Fetecau, Marsden, Ortiz & West (2003).
   λ keeps the discrete energy E_d = −∂L_d/∂τ of the piece after the jump equal to that of the
   piece before, which makes the action of the two partial steps stationary in the contact point
   and the fraction, so **the step across an impact is symplectic** (measured defect ≤ 1e-9,
@@ -99,7 +100,8 @@ class Friction:
     :func:`varmech.check_conservation` balances against the energy.
 
     Friction acts on held contacts, so it needs a method that holds one (verlet and its
-    compositions) and a model without forces or constraints of its own.
+    compositions, ``"held_step"`` in ``MethodInfo.features``) and a model without forces or
+    constraints of its own.
 
     Attributes
     ----------

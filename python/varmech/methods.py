@@ -11,7 +11,8 @@ __all__ = [
 ]
 
 #: Facts about one fixed-step method (name, order, stages, force_evaluations, implicit,
-#: constrained, symplectic, symmetric, h_omega_max, reference): see ``_core.MethodInfo``.
+#: constrained, symplectic, symmetric, h_omega_max, reference, splitting, features): see
+#: ``_core.MethodInfo``.
 MethodInfo = _core.MethodInfo
 
 
@@ -23,8 +24,9 @@ def methods() -> list[MethodInfo]:
     list of MethodInfo
         One record a method: ``name``, ``order``, ``stages``, ``force_evaluations`` a step,
         ``implicit``, ``constrained``, ``nbody``, ``symplectic``, ``symmetric``, the linear
-        stability limit ``h_omega_max`` on q̈ = −ω²q (inf: none; nan: not defined), and its
-        ``reference``.
+        stability limit ``h_omega_max`` on q̈ = −ω²q (inf: none; nan: not defined), its
+        ``reference``, and ``features``, what its step offers beyond the models it integrates
+        (``"discrete_energy"``, ``"tangent_map"``, ``"held_step"``, ``"delayed_forces"``).
 
     Examples
     --------
@@ -32,6 +34,8 @@ def methods() -> list[MethodInfo]:
     >>> verlet = {m.name: m for m in varmech.methods()}["verlet"]
     >>> verlet.order, verlet.force_evaluations, verlet.symplectic, verlet.h_omega_max
     (2, 1, True, 2.0)
+    >>> [m.name for m in varmech.methods() if "delayed_forces" in m.features]
+    ['midpoint', 'trapezoid']
     """
     return _core.methods()
 

@@ -279,6 +279,23 @@ def test_bad_delays_are_refused_naming_them(build, run, error, match):
         varmech.integrate(model, [1.0], v0=[0.0], **({"dt": 0.01, "t_end": 2.0} | run))
 
 
+def test_the_methods_that_take_delayed_forces_are_those_whose_features_say_so():
+    # Every method that integrates the model runs it exactly where MethodInfo.features has
+    # "delayed_forces"; the others are refused, naming the ones that do.
+    model, taking = _oscillator(0.5), []
+    for m in varmech.methods():
+        try:
+            varmech.integrate(model, [1.0], v0=[0.0], dt=0.01, steps=100, method=m.name)
+        except ValueError as err:
+            assert "delayed_forces" not in m.features, str(err)
+            if "does not take delayed forces" in str(err):
+                assert str(err).startswith(f"method: {m.name} does not take delayed forces; use midpoint or trapezoid")
+            continue
+        assert "delayed_forces" in m.features, m.name
+        taking.append(m.name)
+    assert taking == ["midpoint", "trapezoid"]
+
+
 def test_a_model_stored_in_the_earlier_slots_is_refused_naming_delays():
     recipe = _oscillator(0.5)._recipe()
     assert varmech.model.from_recipe(recipe).delays == (0.5,)

@@ -54,12 +54,7 @@ fn orders<S: Dynamics + ?Sized>(sys: &S, method: Method, taus: &[f64], q0: &[f64
 
 #[test]
 fn the_methods_with_a_discrete_energy_are_the_kick_drift_methods_the_two_point_and_galerkin_rules() {
-    let all = Method::ALL
-        .into_iter()
-        .chain(Method::CONSTRAINED)
-        .chain(Method::NONHOLONOMIC)
-        .chain(Method::WISDOM_HOLMAN);
-    for method in all {
+    for method in Method::every() {
         let expected = Splitting::of(method).is_some()
             || matches!(
                 method,

@@ -12,8 +12,8 @@
 
 use nalgebra::DMatrix;
 use varmech::integrators::{
-    integrate_watching, Contact, Contacts, Dynamics, Friction, Law, Method, NativeSurface, Options, Slip, SlipRows,
-    Switch, Trajectory,
+    integrate_watching, Composition, Contact, Contacts, Dynamics, Feature, Friction, Law, Method, NativeSurface,
+    Options, Slip, SlipRows, Switch, Trajectory,
 };
 use varmech::model::{Mass, MechanicalSystem, Reaction};
 use varmech::scenes::BouncingBall;
@@ -125,6 +125,19 @@ fn a_ball_with_e_below_1_comes_to_rest_at_the_zeno_limit_and_rests_with_lambda_m
             assert!((lambda - G).abs() <= 1e-9 * G, "dt = {dt}: λ = {lambda}");
         }
         assert_eq!(traj.steps, options.steps);
+    }
+}
+
+#[test]
+fn the_methods_with_a_held_step_are_verlet_and_its_compositions() {
+    // The held step is RATTLE composed as the method composes Verlet: the table's
+    // `Feature::HeldStep` must be that structure's, for every method.
+    for method in Method::every() {
+        assert_eq!(
+            method.supports(Feature::HeldStep),
+            Composition::of(method).is_some(),
+            "{method:?}"
+        );
     }
 }
 

@@ -6,7 +6,7 @@
 //! volume change, and −2β to the method's order.
 
 use varmech::diagnostics::{lyapunov, LyapunovOptions, Stretching};
-use varmech::integrators::{Dynamics, General, Method, Options, Stepper, Tangent};
+use varmech::integrators::{Dynamics, Feature, General, Method, ModelKind, Options, Stepper, Tangent};
 use varmech::model::{Mass, MechanicalSystem};
 use varmech::scenes::{DampedDrivenPendulum, DoublePendulum, FermiPastaUlam, HarmonicOscillator, HenonHeiles};
 use varmech::{Error, ModelError};
@@ -270,6 +270,38 @@ fn bad_requests_are_refused_naming_the_argument() {
         || Ok(())
     )
     .is_ok());
+}
+
+#[test]
+fn a_tangent_map_is_made_exactly_for_the_methods_the_table_gives_one() {
+    // Each method on a model it integrates: Hénon–Heiles, or the planar chain on constraints.
+    // Those with `Feature::TangentMap` get one; the others are refused naming the method and
+    // listing those that have one.
+    let hh = HenonHeiles::new();
+    let chain = varmech::scenes::planar_chain(2).unwrap();
+    let listed = Method::names(|m| m.supports(Feature::TangentMap));
+    for method in Method::every() {
+        let made = if ModelKind::Separable.admits(method) {
+            Tangent::new(method, &hh)
+        } else if ModelKind::ConstrainedSeparable.admits(method) {
+            Tangent::new(method, &chain.system)
+        } else {
+            assert!(
+                !method.supports(Feature::TangentMap),
+                "{method:?}: no model here to check it on"
+            );
+            continue;
+        };
+        match made {
+            Ok(_) => assert!(method.supports(Feature::TangentMap), "{method:?}"),
+            Err(Error::InvalidArgument { argument, reason }) => {
+                assert!(!method.supports(Feature::TangentMap), "{method:?}: {reason}");
+                assert_eq!(argument, "method");
+                assert!(listed.iter().all(|name| reason.contains(name)), "{reason}");
+            }
+            Err(other) => panic!("{method:?}: {other}"),
+        }
+    }
 }
 
 #[test]

@@ -466,11 +466,8 @@ fn native_scenes_run_at_random_steps_inside_the_stability_limit() {
             let problem = entry.setup().build().map_err(|e| TestCaseError::fail(format!("{e}")))?;
             let (q0, p0) = (&problem.initial.q, &problem.initial.p);
             problem.system.with_dynamics(|sys| {
-                let every = (Method::ALL.into_iter().chain(Method::CONSTRAINED))
-                    .chain(Method::NONHOLONOMIC)
-                    .chain(Method::WISDOM_HOLMAN);
                 // Explicit Euler has no stable step: none is inside its limit.
-                let methods: Vec<Method> = every
+                let methods: Vec<Method> = Method::every()
                     .filter(|&m| sys.kind().admits(m) && (m.info().h_omega_max > 0.0 || m.info().h_omega_max.is_nan()))
                     .collect();
                 let method = *pick.get(&methods);

@@ -131,9 +131,10 @@ def lyapunov_spectrum(
     steps
         Steps of the run.
     method
-        A kick–drift method (``"verlet"``, ``"yoshida4"``, ``"blanes_moan4"``, ``"aba864"``, …)
-        or an implicit rule (``"midpoint"``, ``"trapezoid"``, ``"galerkin4"``, ``"galerkin6"``),
-        or ``"rattle"`` on holonomic constraints.
+        A method with ``"tangent_map"`` in its ``MethodInfo.features``: a kick–drift method
+        (``"verlet"``, ``"yoshida4"``, ``"blanes_moan4"``, ``"aba864"``, …) or an implicit rule
+        (``"midpoint"``, ``"trapezoid"``, ``"galerkin4"``, ``"galerkin6"``), or ``"rattle"`` on
+        holonomic constraints.
         Default: the model's default method (``"verlet"`` for a separable model, ``"midpoint"``
         for any other).
     k

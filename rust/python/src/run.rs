@@ -253,6 +253,9 @@ fn symplecticity_defect<'py>(
 /// between synchronisations; ``whc``'s corrector adds 20 kicks at the start and at every saved
 /// state. ``splitting`` is (a₀, …, aₛ; b₁, …, bₛ), the kick and drift fractions of a kick–drift
 /// method, Ψ_h = φ^V_{aₛh} ∘ φ^T_{bₛh} ∘ … ∘ φ^T_{b₁h} ∘ φ^V_{a₀h}; None for the others.
+/// ``features`` names what its step offers beyond the models it integrates, from the core's one
+/// table: ``discrete_energy`` (the variational collision law), ``tangent_map`` (Lyapunov
+/// spectra), ``held_step`` (contacts held closed, friction), ``delayed_forces``.
 #[pyclass(frozen, get_all, module = "varmech._core")]
 pub struct MethodInfo {
     name: &'static str,
@@ -268,6 +271,7 @@ pub struct MethodInfo {
     h_omega_max: f64,
     reference: &'static str,
     splitting: Option<(Vec<f64>, Vec<f64>)>,
+    features: Vec<&'static str>,
 }
 
 impl From<integrators::MethodInfo> for MethodInfo {
@@ -286,6 +290,7 @@ impl From<integrators::MethodInfo> for MethodInfo {
             h_omega_max: i.h_omega_max,
             reference: i.reference,
             splitting: Splitting::of(i.method).map(|s| (s.kicks().to_vec(), s.drifts().to_vec())),
+            features: i.features.iter().map(|f| f.name()).collect(),
         }
     }
 }
@@ -301,13 +306,7 @@ impl MethodInfo {
 /// constrained ones, the nonholonomic ones and the N-body ones.
 #[pyfunction]
 fn methods() -> Vec<MethodInfo> {
-    Method::ALL
-        .iter()
-        .chain(&Method::CONSTRAINED)
-        .chain(&Method::NONHOLONOMIC)
-        .chain(&Method::WISDOM_HOLMAN)
-        .map(|m| m.info().into())
-        .collect()
+    Method::every().map(|m| m.info().into()).collect()
 }
 
 /// Refuses, naming `argument` (ValueError), `count` items of `size` bytes each that the memory

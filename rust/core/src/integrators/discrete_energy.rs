@@ -2,7 +2,7 @@
 //! variational collision integrator conserves across an impact (Fetecau, Marsden, Ortiz &
 //! West 2003), for an autonomous L.
 
-use super::{Dynamics, Increment, Integrator, Method, Splitting, StepStart};
+use super::{Dynamics, Feature, Increment, Integrator, Method, Splitting, StepStart};
 use crate::model::{Lagrangian, MechanicalSystem};
 use crate::{ModelError, StepError};
 
@@ -52,9 +52,12 @@ const PASSES: usize = 50;
 
 impl DiscreteEnergy {
     /// The discrete energy of `method`'s step on n coordinates; None where the method has none
-    /// here (the kick–drift methods, the midpoint and trapezoidal rules and the Galerkin rules
-    /// have one).
+    /// ([`Feature::DiscreteEnergy`]: the kick–drift methods, the midpoint and trapezoidal rules
+    /// and the Galerkin rules have one).
     pub fn new(method: Method, n: usize) -> Option<DiscreteEnergy> {
+        if !method.supports(Feature::DiscreteEnergy) {
+            return None;
+        }
         let rule = match method {
             Method::Midpoint => Rule::Midpoint,
             Method::Trapezoid => Rule::Trapezoid,

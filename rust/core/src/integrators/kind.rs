@@ -1,7 +1,7 @@
 //! Which method integrates which kind of model: the one table that decides it, words the
 //! refusal and names each kind's default method.
 
-use super::Method;
+use super::{one_of, Method};
 use crate::Error;
 
 /// The kinds of model the methods tell apart.
@@ -114,6 +114,7 @@ impl Method {
     /// Why this method does not integrate a model of `kind` (whether or not it does).
     pub(super) fn refusal(self, kind: ModelKind) -> Error {
         let name = self.info().name;
+        let admitted = |kind: ModelKind| one_of(&Method::names(|m| kind.admits(m)));
         let reason = match kind {
             _ if Method::WISDOM_HOLMAN.contains(&self) => format!(
                 "{name} integrates the gravitational N-body problem alone (Jacobi coordinates about a central \
@@ -129,12 +130,14 @@ impl Method {
             {
                 format!("{name} integrates systems with holonomic constraints")
             }
-            ModelKind::Separable | ModelKind::Lagrangian | ModelKind::Gravitational => {
-                format!("{name} needs a separable mechanical system; use midpoint or trapezoid")
-            }
-            ModelKind::ConstrainedSeparable => {
-                format!("{name} would ignore the constraints; use rattle, rattle4 or shake")
-            }
+            ModelKind::Separable | ModelKind::Lagrangian | ModelKind::Gravitational => format!(
+                "{name} needs a separable mechanical system; use {}",
+                admitted(ModelKind::Lagrangian)
+            ),
+            ModelKind::ConstrainedSeparable => format!(
+                "{name} would ignore the constraints; use {}",
+                admitted(ModelKind::ConstrainedSeparable)
+            ),
             ModelKind::ConstrainedLagrangian => format!(
                 "{name} does not integrate a general Lagrangian on constraints; use trapezoid (RATTLE's \
                  discrete Lagrangian) or midpoint"

@@ -112,6 +112,46 @@ pub struct MethodInfo {
     /// Wisdom–Holman methods, which do not integrate the oscillator).
     pub h_omega_max: f64,
     pub reference: &'static str,
+    /// What its step offers beyond the kinds of model it integrates ([`Method::features`]).
+    pub features: &'static [Feature],
+}
+
+/// What a method's step offers beyond the kinds of model it integrates ([`ModelKind`]): which
+/// method has which is [`Method::features`] alone, and every check that refuses a method for
+/// a feature reads it there.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Feature {
+    /// E_d = −∂L_d/∂τ of its step ([`super::DiscreteEnergy`]), which the variational collision
+    /// law keeps across an impact.
+    DiscreteEnergy,
+    /// The linearization DΨ_h of its step in (q, p) ([`super::Tangent`]): Lyapunov spectra.
+    TangentMap,
+    /// A step with contacts held closed, RATTLE composed as the method is (jumps/hold.rs):
+    /// bodies at rest on a contact, and friction.
+    HeldStep,
+    /// Delayed forces: one force node a step, which the run's history keeps (del/history.rs).
+    DelayedForces,
+}
+
+impl Feature {
+    /// Its name in the Python API (`MethodInfo.features`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Feature::DiscreteEnergy => "discrete_energy",
+            Feature::TangentMap => "tangent_map",
+            Feature::HeldStep => "held_step",
+            Feature::DelayedForces => "delayed_forces",
+        }
+    }
+}
+
+/// Names as a message offers them: "a", "a or b", "a, b or c".
+pub(crate) fn one_of(names: &[&str]) -> String {
+    match names {
+        [] => String::new(),
+        [one] => (*one).to_string(),
+        [rest @ .., last] => format!("{} or {last}", rest.join(", ")),
+    }
 }
 
 impl Method {
@@ -154,6 +194,52 @@ impl Method {
         Method::WisdomHolmanCorrected,
         Method::WisdomHolmanLazyKernel,
     ];
+
+    /// Every method: the unconstrained ones, then the constrained, the nonholonomic and the
+    /// N-body ones.
+    pub fn every() -> impl Iterator<Item = Method> {
+        Method::ALL
+            .into_iter()
+            .chain(Method::CONSTRAINED)
+            .chain(Method::NONHOLONOMIC)
+            .chain(Method::WISDOM_HOLMAN)
+    }
+
+    /// The names of the methods that `pick` picks, in [`Method::every`]'s order.
+    pub fn names(pick: impl Fn(Method) -> bool) -> Vec<&'static str> {
+        Method::every().filter(|&m| pick(m)).map(|m| m.info().name).collect()
+    }
+
+    /// The one table of method × feature: what this method's step offers (a line a family,
+    /// every method named, so that a new one must take its line).
+    pub fn features(self) -> &'static [Feature] {
+        use Feature::*;
+        use Method::*;
+        match self {
+            Verlet | Yoshida4 | Suzuki4 | McLachlan4 | Yoshida6 | KahanLi6 | SuzukiUmeno8 | KahanLi8 | McLachlan6
+            | McLachlan8 => &[DiscreteEnergy, TangentMap, HeldStep],
+            SymplecticEuler | McLachlan8Dkd | BlanesMoan4 | BlanesMoan6 | Aba864 | Aba1064 => {
+                &[DiscreteEnergy, TangentMap]
+            }
+            Midpoint | Trapezoid => &[DiscreteEnergy, TangentMap, DelayedForces],
+            Galerkin4 | Galerkin6 => &[DiscreteEnergy, TangentMap],
+            Rattle => &[TangentMap],
+            ExplicitEuler
+            | Rk4
+            | Rattle4
+            | Shake
+            | CortesMartinez
+            | Dla4
+            | WisdomHolman
+            | WisdomHolmanCorrected
+            | WisdomHolmanLazyKernel => &[],
+        }
+    }
+
+    /// Whether this method's step offers `feature` ([`Method::features`]).
+    pub fn supports(self, feature: Feature) -> bool {
+        self.features().contains(&feature)
+    }
 
     /// The method's facts.
     pub fn info(self) -> MethodInfo {
@@ -338,23 +424,19 @@ impl Method {
             symmetric,
             h_omega_max,
             reference,
+            features: self.features(),
         }
     }
 
     /// The method called `name` (as listed by [`Method::info`]).
     pub fn from_name(name: &str) -> Result<Method, Error> {
-        let all = || {
-            Method::ALL
-                .into_iter()
-                .chain(Method::CONSTRAINED)
-                .chain(Method::NONHOLONOMIC)
-                .chain(Method::WISDOM_HOLMAN)
-        };
-        all().find(|m| m.info().name == name).ok_or_else(|| {
-            let names: Vec<_> = all().map(|m| m.info().name).collect();
+        Method::every().find(|m| m.info().name == name).ok_or_else(|| {
             Error::invalid(
                 "method",
-                format!("unknown method {name:?}; choose one of {}", names.join(", ")),
+                format!(
+                    "unknown method {name:?}; choose one of {}",
+                    Method::names(|_| true).join(", ")
+                ),
             )
         })
     }

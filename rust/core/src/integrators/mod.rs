@@ -72,7 +72,8 @@ pub use jumps::{
 };
 pub use kick_drift::KickDrift;
 pub use kind::ModelKind;
-pub use method::{Method, MethodInfo};
+use method::one_of;
+pub use method::{Feature, Method, MethodInfo};
 pub use poll::{Counting, Poll};
 pub use rattle::Rattle;
 pub use run::{
@@ -110,9 +111,9 @@ enum Scheme {
 }
 
 /// Refuses a method that does not integrate the model's kind ([`Method::check`]) and, for a
-/// model with delayed forces, a method other than the two-point rules (whose one force node a
-/// step the history keeps) or a delay the history cannot read at the step h
-/// ([`del::check_delays`]): for a new stepper, a resumed state and a checkpoint alike.
+/// model with delayed forces, a method without [`Feature::DelayedForces`] (the two-point rules,
+/// whose one force node a step the history keeps) or a delay the history cannot read at the
+/// step h ([`del::check_delays`]): for a new stepper, a resumed state and a checkpoint alike.
 pub(in crate::integrators) fn check_method<S: Dynamics + ?Sized>(
     model: &S,
     method: Method,
@@ -123,11 +124,11 @@ pub(in crate::integrators) fn check_method<S: Dynamics + ?Sized>(
     if delays.is_empty() {
         return Ok(());
     }
-    if !matches!(method, Method::Midpoint | Method::Trapezoid) {
+    if !method.supports(Feature::DelayedForces) {
         let reason = format!(
-            "{} does not take delayed forces; use midpoint or trapezoid, whose one force node a step \
-             the run's history keeps",
-            method.info().name
+            "{} does not take delayed forces; use {}, whose one force node a step the run's history keeps",
+            method.info().name,
+            one_of(&Method::names(|m| m.supports(Feature::DelayedForces)))
         );
         return Err(crate::Error::invalid("method", reason));
     }

@@ -23,7 +23,9 @@
 use nalgebra::DMatrix;
 
 use super::stepper::Clear;
-use super::{Del, Dynamics, Integrator, Method, ModelKind, Rattle, Splitting, StepEquations, StepStart};
+use super::{
+    one_of, Del, Dynamics, Feature, Integrator, Method, ModelKind, Rattle, Splitting, StepEquations, StepStart,
+};
 use crate::model::{Mass, MechanicalSystem};
 use crate::solve::difference::{central_jacobian, unit, Evaluations};
 use crate::solve::lu::{lu_in_place, lu_solve};
@@ -57,14 +59,27 @@ impl Tangent {
     /// then depends on the run's past, so it is no map of (q, p) alone).
     pub fn new<S: Dynamics + ?Sized>(method: Method, model: &S) -> Result<Tangent, Error> {
         let n = model.dim();
+        let with_map = |kind: Option<ModelKind>| {
+            one_of(&Method::names(|m| {
+                m.supports(Feature::TangentMap) && kind.is_none_or(|kind| kind.admits(m))
+            }))
+        };
+        if !method.supports(Feature::TangentMap) {
+            let reason = format!(
+                "{} has no tangent map here; use a kick–drift method, an implicit rule or RATTLE: {}",
+                method.info().name,
+                with_map(None)
+            );
+            return Err(Error::invalid("method", reason));
+        }
         let map = if let Some(splitting) = Splitting::of(method) {
             // A constrained model's system is separable too, but its steps are RATTLE's.
             if model.as_mechanical().is_none() || model.holonomic().is_some() {
                 let reason = format!(
                     "the tangent map of {} (a kick–drift step) needs a separable model, L = ½q̇ᵀMq̇ − V(q); \
-                     this one is not: take midpoint, trapezoid, galerkin4 or galerkin6, whose implicit \
-                     steps have one for any L",
-                    method.info().name
+                     this one is not: take {}, whose implicit steps have one for any L",
+                    method.info().name,
+                    with_map(Some(ModelKind::Lagrangian))
                 );
                 return Err(Error::invalid("model", reason));
             }
@@ -74,17 +89,18 @@ impl Tangent {
             // check refuses the others, naming the method.
             method.check(model.kind())?;
             Map::Implicit(Implicit::default())
-        } else if matches!(
-            method,
-            Method::Midpoint | Method::Trapezoid | Method::Galerkin4 | Method::Galerkin6
-        ) {
+        } else {
+            // The implicit rules.
             if !matches!(
                 model.kind(),
                 ModelKind::Separable | ModelKind::Lagrangian | ModelKind::Gravitational
             ) {
-                let reason = "has constraints: the implicit rules' tangent map here is that of an unconstrained step; \
-                              on holonomic constraints of a separable model, RATTLE's (method rattle) maps the \
-                              constraint manifold's tangent space";
+                let reason = format!(
+                    "has constraints: the implicit rules' tangent map here is that of an unconstrained step; on \
+                     holonomic constraints of a separable model, that of {} maps the constraint manifold's \
+                     tangent space",
+                    with_map(Some(ModelKind::ConstrainedSeparable))
+                );
                 return Err(Error::invalid("model", reason));
             }
             if !model.as_lagrangian().delays().is_empty() {
@@ -93,15 +109,6 @@ impl Tangent {
                 return Err(Error::invalid("model", reason));
             }
             Map::Implicit(Implicit::default())
-        } else {
-            return Err(Error::invalid(
-                "method",
-                format!(
-                    "{} has no tangent map here: the kick–drift methods (verlet, yoshida4, blanes_moan4, \
-                     aba864, …), the implicit rules (midpoint, trapezoid, galerkin4, galerkin6) and rattle have one",
-                    method.info().name
-                ),
-            ));
         };
         Ok(Tangent {
             map,

@@ -22,7 +22,7 @@ use nalgebra::DMatrix;
 use super::friction::slip_after_kick;
 use super::unsolved::{diagnosis, Cause, Unsolved};
 use super::{Contact, Friction};
-use crate::integrators::{Composition, Method};
+use crate::integrators::{Composition, Feature, Method};
 use crate::model::Lagrangian;
 use crate::solve::difference;
 use crate::solve::lu::{lu_in_place, lu_solve};
@@ -134,9 +134,12 @@ pub(super) struct Hold {
 
 impl Hold {
     /// The held step of `method` on n coordinates and `contacts` (any of them closed at once,
-    /// and stuck if they have friction); None where the method is not Verlet or a composition
-    /// of it.
+    /// and stuck if they have friction); None where the method has no held step
+    /// ([`Feature::HeldStep`]: Verlet and its compositions have one).
     pub(super) fn new(method: Method, n: usize, contacts: &[Contact<'_>]) -> Option<Hold> {
+        if !method.supports(Feature::HeldStep) {
+            return None;
+        }
         let gamma = Composition::of(method)?.gamma().to_vec();
         let m = contacts.len();
         let rows = m + contacts
@@ -185,9 +188,12 @@ impl Hold {
         })
     }
 
-    /// The methods that hold a contact, as an error names them.
-    pub(super) fn methods() -> &'static str {
-        "verlet and its compositions (yoshida4, suzuki4, mclachlan4, yoshida6, kahan_li6, kahan_li8, …)"
+    /// The methods that hold a contact ([`Feature::HeldStep`]), as an error names them: the held
+    /// step is RATTLE composed as the method composes Verlet, so they are Verlet and its
+    /// compositions.
+    pub(super) fn methods() -> String {
+        let names = Method::names(|m| m.supports(Feature::HeldStep));
+        format!("{} and its compositions ({})", names[0], names[1..].join(", "))
     }
 
     /// The held step of size τ from (t, q, p) on `held`: its end in `q` and `p`, the work of

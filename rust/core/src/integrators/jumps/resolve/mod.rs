@@ -19,7 +19,7 @@ use super::unsolved::run_error;
 use super::{Contact, Contacts, Impacts, Law, NativeSurface, Schedule, Switch, MAX_IMPACTS};
 use crate::integrators::events::Search;
 use crate::integrators::DiscreteEnergy;
-use crate::integrators::{Counting, Dynamics, Method, Occurrence, Poll, Stepper, StepperState, Trajectory};
+use crate::integrators::{Counting, Dynamics, Feature, Method, Occurrence, Poll, Stepper, StepperState, Trajectory};
 use crate::Error;
 
 mod gaps;
@@ -32,13 +32,14 @@ pub use gaps::Gaps;
 use gaps::{crosses, crossing, evaluate, gap};
 
 /// Why the variational law does not fit `method` on `model`, if it does not: it needs the
-/// method's discrete energy ([`DiscreteEnergy`]) and a conservative, autonomous, unconstrained
-/// model (the energy balance is E_d's alone).
+/// method's discrete energy ([`Feature::DiscreteEnergy`]) and a conservative, autonomous,
+/// unconstrained model (the energy balance is E_d's alone).
 pub(super) fn variational_misfit<S: Dynamics + ?Sized>(model: &S, method: Method) -> Option<String> {
-    if DiscreteEnergy::new(method, 0).is_none() {
+    if !method.supports(Feature::DiscreteEnergy) {
         return Some(format!(
-            "needs a kick–drift method, a two-point rule (midpoint, trapezoid) or a Galerkin rule, not {}; give \
-             the contact law reflect or use such a method",
+            "needs a kick–drift method, a two-point rule or a Galerkin rule, whose steps have a discrete energy \
+             ({}), not {}; give the contact law reflect or use such a method",
+            Method::names(|m| m.supports(Feature::DiscreteEnergy)).join(", "),
             method.info().name
         ));
     }
