@@ -9,7 +9,7 @@ from __future__ import annotations
 import inspect
 import textwrap
 from collections.abc import Callable, Mapping, Sequence
-from typing import Literal, TypeVar
+from typing import Any, Literal, TypeVar
 
 from ._catalogue import DECLARED, declared
 
@@ -167,3 +167,18 @@ def documented(
         return f
 
     return decorate
+
+
+def scene_doc(returns: str, **sections: Any) -> Callable[[F], F]:
+    """:func:`documented` for a scene function of :mod:`varmech.scenes`."""
+    return documented(returns, twins="scene", **sections)
+
+
+def closure_doc(returns: str, **sections: Any) -> Callable[[F], F]:
+    """:func:`documented` for a closure twin of :mod:`varmech.examples`."""
+    return documented(returns, twins="closure", **sections)
+
+
+def symbolic_doc(returns: str, **sections: Any) -> Callable[[F], F]:
+    """:func:`documented` for a symbolic twin of :mod:`varmech.symbolic.examples`."""
+    return documented(returns, twins="symbolic", **sections)

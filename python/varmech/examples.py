@@ -12,7 +12,7 @@ import math
 import numpy as np
 
 from ._catalogue import declared
-from ._doc import documented
+from ._doc import closure_doc
 from .model import Cyclic, Lagrangian, MechanicalSystem, Rotation, Translation
 from .scenes import CATALOGUE, Scene
 
@@ -42,11 +42,7 @@ __all__ = [
 ]
 
 
-@documented(
-    "n = 1, with V and ∇V as NumPy closures.",
-    twins="closure",
-    parameters={"omega": "The angular frequency ω."},
-)
+@closure_doc("n = 1, with V and ∇V as NumPy closures.", parameters={"omega": "The angular frequency ω."})
 def harmonic_oscillator(omega: float = 1.0) -> MechanicalSystem:
     """The harmonic oscillator H = p²/2 + ω²q²/2 as a separable closure model.
 
@@ -61,7 +57,7 @@ def harmonic_oscillator(omega: float = 1.0) -> MechanicalSystem:
     return MechanicalSystem(1, lambda q: 0.5 * w2 * q[0] * q[0], lambda q: w2 * q, name="harmonic_oscillator (closure)")
 
 
-@documented("n = 1, with V = −cos q and ∇V = sin q.", twins="closure")
+@closure_doc("n = 1, with V = −cos q and ∇V = sin q.")
 def pendulum() -> MechanicalSystem:
     """The pendulum H = p²/2 − cos q as a separable closure model.
 
@@ -76,9 +72,8 @@ def pendulum() -> MechanicalSystem:
     return MechanicalSystem(1, lambda q: -math.cos(q[0]), np.sin, name="pendulum (closure)")
 
 
-@documented(
+@closure_doc(
     "n = 2, with the symmetry ``Rotation(spatial_dim=2)`` (angular momentum).",
-    twins="closure",
     see_also=["varmech.examples.kepler_polar : the same problem in polar coordinates."],
 )
 def kepler() -> MechanicalSystem:
@@ -102,7 +97,7 @@ def kepler() -> MechanicalSystem:
     return MechanicalSystem(2, potential, gradient, symmetries=[Rotation(spatial_dim=2)], name="kepler (closure)")
 
 
-@documented("n = 2, separable.", twins="closure")
+@closure_doc("n = 2, separable.")
 def henon_heiles() -> MechanicalSystem:
     """The Hénon–Heiles potential V = (x² + y²)/2 + x²y − y³/3 as a closure model.
 
@@ -125,9 +120,8 @@ def henon_heiles() -> MechanicalSystem:
     return MechanicalSystem(2, potential, gradient, name="henon_heiles (closure)")
 
 
-@documented(
+@closure_doc(
     "n = 2m.",
-    twins="closure",
     parameters={
         "m": "The number of stiff springs; the chain has 2m masses.",
         "omega": "The stiff springs' frequency ω.",
@@ -171,9 +165,8 @@ def fermi_pasta_ulam(m: int = 3, omega: float = 50.0) -> MechanicalSystem:
     return MechanicalSystem(2 * m, potential, gradient, name="fermi_pasta_ulam (closure)")
 
 
-@documented(
+@closure_doc(
     "n = 3N, mass diag(m₁, m₁, m₁, m₂, …), with the three translations and the three rotations as symmetries.",
-    twins="closure",
     parameters={
         "G": "The gravitational constant.",
         "masses": ("array_like, shape (N,)", "The bodies' masses."),
@@ -216,9 +209,8 @@ def nbody(G: float, masses: np.ndarray) -> MechanicalSystem:
     return MechanicalSystem(3 * n, potential, gradient, mass=np.repeat(m, 3), symmetries=symmetries, name="nbody (closure)")
 
 
-@documented(
+@closure_doc(
     "n = 2, with ∂L/∂q, ∂L/∂v and the three Hessians as closures.",
-    twins="closure",
     parameters={
         "m1, m2": ("float, default 1.0, 2.0", "The bobs' masses."),
         "l1, l2": ("float, default 2.0, 3.0", "The rods' lengths."),
@@ -263,11 +255,7 @@ def double_pendulum(m1: float = 1.0, m2: float = 2.0, l1: float = 2.0, l2: float
     return Lagrangian(2, lagrangian, dl_dq=dl_dq, dl_dv=dl_dv, hessians=hessians, name="double_pendulum (closure)")
 
 
-@documented(
-    "n = 2, with the symmetry ``Cyclic(1)`` (the momentum p_φ).",
-    twins="closure",
-    parameters={"m": "The bob's mass."},
-)
+@closure_doc("n = 2, with the symmetry ``Cyclic(1)`` (the momentum p_φ).", parameters={"m": "The bob's mass."})
 def spherical_pendulum(m: float = 1.0, l: float = 1.0, g: float = 1.0) -> Lagrangian:
     """The spherical pendulum in (θ, φ) as a general Lagrangian; φ is cyclic.
 
@@ -304,9 +292,8 @@ def spherical_pendulum(m: float = 1.0, l: float = 1.0, g: float = 1.0) -> Lagran
     )
 
 
-@documented(
+@closure_doc(
     "n = 3, with the symmetries ``Cyclic(1)`` and ``Cyclic(2)``.",
-    twins="closure",
     parameters={"i1": "The moment of inertia about a transverse axis through the pivot."},
 )
 def heavy_top(i1: float = 1.0, i3: float = 0.5, mgl: float = 1.0) -> Lagrangian:
@@ -354,7 +341,7 @@ def heavy_top(i1: float = 1.0, i3: float = 0.5, mgl: float = 1.0) -> Lagrangian:
     )
 
 
-@documented("n = 2, with the symmetry ``Cyclic(1)`` (the angular momentum p_θ).", twins="closure")
+@closure_doc("n = 2, with the symmetry ``Cyclic(1)`` (the angular momentum p_θ).")
 def kepler_polar(m: float = 1.0, k: float = 1.0) -> Lagrangian:
     """Kepler's problem in polar coordinates (r, θ), L = ½m(ṙ² + r²θ̇²) + k/r, as a general
     Lagrangian with exact first and second derivatives; θ is cyclic.
@@ -386,7 +373,7 @@ def kepler_polar(m: float = 1.0, k: float = 1.0) -> Lagrangian:
     return Lagrangian(2, lagrangian, dl_dq=dl_dq, dl_dv=dl_dv, hessians=hessians, symmetries=[Cyclic(1)], name="kepler_polar (closure)")
 
 
-@documented("n = 2, rotation invariant.", twins="closure", see_also=["charged_particle_nonuniform : κ = 1/4."])
+@closure_doc("n = 2, rotation invariant.", see_also=["charged_particle_nonuniform : κ = 1/4."])
 def charged_particle(B: float = 1.0, kappa: float = 0.0) -> Lagrangian:
     """A unit charge of unit mass in the plane, in the field B(q) = B(1 + κ|q|²) ẑ, in the
     symmetric gauge: L = ½|v|² + a(|q|²)(x v_y − y v_x) with a(r²) = ½B(1 + κr²/2).
@@ -420,7 +407,7 @@ def charged_particle(B: float = 1.0, kappa: float = 0.0) -> Lagrangian:
     return Lagrangian(2, lagrangian, dl_dq=dl_dq, dl_dv=dl_dv, symmetries=[Rotation(spatial_dim=2)], name="charged_particle (closure)")
 
 
-@documented("n = 2, rotation invariant.", twins="closure")
+@closure_doc("n = 2, rotation invariant.")
 def charged_particle_nonuniform() -> Lagrangian:
     """The charged particle in the native scene's non-uniform field B(q) = (1 + |q|²/4) ẑ:
     :func:`charged_particle` with B = 1, κ = 1/4.
@@ -436,9 +423,8 @@ def charged_particle_nonuniform() -> Lagrangian:
     return charged_particle(kappa=0.25)
 
 
-@documented(
+@closure_doc(
     "n = 1, forced: its energy is not conserved but balanced against the work done.",
-    twins="closure",
     parameters={"drive": ("float, default 2/3", "The driving frequency Ω.")},
 )
 def damped_driven_pendulum(gamma: float = 0.5, amplitude: float = 1.5, drive: float = 2.0 / 3.0) -> Lagrangian:
@@ -462,9 +448,8 @@ def damped_driven_pendulum(gamma: float = 0.5, amplitude: float = 1.5, drive: fl
     )
 
 
-@documented(
+@closure_doc(
     "n = 2 with one holonomic constraint.",
-    twins="closure",
     parameters={"m": "The bob's mass."},
     raises="Naming ``mass`` when ``m`` is not finite and positive.",
 )
@@ -500,9 +485,8 @@ def _e(q: np.ndarray) -> np.ndarray:
     return np.column_stack([-v, s * np.eye(3) - cross])
 
 
-@documented(
+@closure_doc(
     "n = 4 with a configuration-dependent mass and the constraint |q|² = 1.",
-    twins="closure",
     parameters={"inertia": ("tuple of 3 float, default (0.5, 0.9, 1.0)", "The principal moments of inertia I.")},
 )
 def rigid_body(inertia: tuple[float, float, float] = (0.5, 0.9, 1.0)) -> MechanicalSystem:
@@ -548,7 +532,7 @@ def rigid_body(inertia: tuple[float, float, float] = (0.5, 0.9, 1.0)) -> Mechani
     )
 
 
-@documented("n = 1, without the floor.", twins="closure")
+@closure_doc("n = 1, without the floor.")
 def bouncing_ball(g: float = 9.81) -> MechanicalSystem:
     """The ball above its floor, H = p²/2 + gq; the floor q = 0 is a contact, which in the closure
     twin is ``Contact(lambda q: q[0], lambda q: [1.0])``.
@@ -565,7 +549,7 @@ def bouncing_ball(g: float = 9.81) -> MechanicalSystem:
     return MechanicalSystem(1, lambda q: g * q[0], lambda q: np.array([g]), name="bouncing_ball (closure)")
 
 
-@documented("n = 2, without the table's wall.", twins="closure")
+@closure_doc("n = 2, without the table's wall.")
 def elliptic_billiard() -> MechanicalSystem:
     """The elliptic billiard's free particle, H = |p|²/2; the table x²/A² + y²/B² ≤ 1 is a
     contact (:class:`varmech.surfaces.Ellipsoid`).
@@ -580,9 +564,8 @@ def elliptic_billiard() -> MechanicalSystem:
     return MechanicalSystem(2, lambda q: 0.0, lambda q: np.zeros(2), name="elliptic_billiard (closure)")
 
 
-@documented(
+@closure_doc(
     "n = 4 with two velocity (nonholonomic) constraints.",
-    twins="closure",
     parameters={"radius": "The disk's radius R."},
     raises="Naming ``mass`` when ``radius`` is 0.",
 )
@@ -611,9 +594,8 @@ def rolling_disk(radius: float = 1.0) -> MechanicalSystem:
     )
 
 
-@documented(
+@closure_doc(
     "n = 3 with one velocity constraint.",
-    twins="closure",
     raises="Naming ``mass`` when ``inertia`` is not finite and positive.",
 )
 def chaplygin_sleigh(inertia: float = 1.0, blade: float = 1.0) -> MechanicalSystem:
@@ -637,9 +619,8 @@ def chaplygin_sleigh(inertia: float = 1.0, blade: float = 1.0) -> MechanicalSyst
     )
 
 
-@documented(
+@closure_doc(
     "n = 5 with two velocity constraints and the symmetry ``Cyclic(2)``.",
-    twins="closure",
     parameters={
         "omega": "The table's rate of turn Ω.",
         "name": 'The model\'s name, less " (closure)".',
@@ -686,11 +667,7 @@ def rolling_sphere(alpha: float = 0.5, g: float = 9.81, radius: float = 1.0, ome
     )
 
 
-@documented(
-    "n = 5 with two affine velocity constraints.",
-    twins="closure",
-    parameters={"omega": "The table's rate of turn Ω."},
-)
+@closure_doc("n = 5 with two affine velocity constraints.", parameters={"omega": "The table's rate of turn Ω."})
 def ball_on_turntable(omega: float = 1.0, radius: float = 1.0) -> Lagrangian:
     """The ball of :func:`rolling_sphere` on a level table turning at Ω: its velocity
     constraints are affine, so the table does work and the energy is not conserved.

@@ -4,7 +4,7 @@ velocity constraints (rolling without slipping, a skate's blade)."""
 
 from __future__ import annotations
 
-from .._doc import FETECAU, bloch, documented, hlw
+from .._doc import FETECAU, bloch, hlw, scene_doc
 from ._scene import Scene, get
 
 __all__ = [
@@ -21,10 +21,9 @@ __all__ = [
 ]
 
 
-@documented(
+@scene_doc(
     'A native constrained separable model (n = 2, one constraint), with step h = 0.1 and invariant ``"H"``; '
     'integrated by ``rattle`` by default.',
-    twins="scene",
     see_also=["pendulum : the same pendulum in its angle."],
     references=[hlw("VII.1")],
 )
@@ -48,11 +47,10 @@ def cartesian_pendulum() -> Scene:
     return get("cartesian_pendulum")
 
 
-@documented(
+@scene_doc(
     'A native constrained separable model (n = 3, one constraint) with the symmetry '
     ':class:`~varmech.Rotation` about z, step h = 0.01, invariants ``"H"`` and ``"L_z"``, and the reference '
     'at T = 50.',
-    twins="scene",
     see_also=["spherical_pendulum : the same pendulum in its angles."],
 )
 def cartesian_spherical_pendulum() -> Scene:
@@ -75,10 +73,9 @@ def cartesian_spherical_pendulum() -> Scene:
     return get("cartesian_spherical_pendulum")
 
 
-@documented(
+@scene_doc(
     "A native constrained separable model (n = 2·links), with step h = 0.01; integrated by ``rattle`` by "
     "default.",
-    twins="scene",
     parameters={"links": "The number of links, at least 1."},
     raises="``links`` not a whole number, or below 1.",
 )
@@ -102,9 +99,8 @@ def planar_chain(links: int = 8) -> Scene:
     return get("planar_chain", links=links)
 
 
-@documented(
+@scene_doc(
     "A native constrained general Lagrangian (n = 4, one constraint), with step h = 0.01.",
-    twins="scene",
     references=[hlw("VII.5")],
 )
 def rigid_body() -> Scene:
@@ -128,10 +124,9 @@ def rigid_body() -> Scene:
     return get("rigid_body")
 
 
-@documented(
+@scene_doc(
     'A separable native model (n = 1) with its floor in ``contacts``, the exact reference at the last apex, '
     'and invariant ``"H"``.',
-    twins="scene",
     parameters={
         "g": "The gravitational acceleration, positive.",
         "h0": "The height of the drop, positive.",
@@ -163,10 +158,9 @@ def bouncing_ball(g: float = 9.81, h0: float = 1.0, restitution: float = 1.0) ->
     return get("bouncing_ball", g=g, h0=h0, restitution=restitution)
 
 
-@documented(
+@scene_doc(
     'A separable native model (n = 2) with its wall in ``contacts`` and invariants ``"E"`` and ``"L1L2"``; '
     'no reference state.',
-    twins="scene",
     parameters={
         "A, B": "The semi-axes, A ≥ B > 0 (the foci on the x axis).",
         "x0, y0": "The initial position, strictly inside the table.",
@@ -199,10 +193,9 @@ def elliptic_billiard(A: float = 2.0, B: float = 1.0, x0: float = 0.3, y0: float
     return get("elliptic_billiard", A=A, B=B, x0=x0, y0=y0, px0=px0, py0=py0)
 
 
-@documented(
+@scene_doc(
     'A native nonholonomic model (n = 4, two velocity constraints) with the symmetries ``Cyclic(2)`` and '
     '``Cyclic(3)``, invariants ``"E"``, ``"p[2]"`` and ``"p[3]"``, and the exact reference at T = 100.',
-    twins="scene",
     parameters={
         "radius": "The disk's radius R, positive.",
         "turn": "The turning rate θ̇, non-zero.",
@@ -231,10 +224,9 @@ def rolling_disk(radius: float = 1.0, turn: float = 0.7, roll: float = 2.0) -> S
     return get("rolling_disk", radius=radius, turn=turn, roll=roll)
 
 
-@documented(
+@scene_doc(
     'A native nonholonomic model (n = 3, one velocity constraint), with step h = 0.01, invariant ``"E"`` and '
     'the closed-form reference at T = 40.',
-    twins="scene",
     parameters={
         "inertia": "The moment of inertia I about the centre, positive.",
         "blade": "The distance b of the blade behind the centre, positive.",
@@ -264,10 +256,9 @@ def chaplygin_sleigh(inertia: float = 1.0, blade: float = 1.0, spin: float = 1.0
     return get("chaplygin_sleigh", inertia=inertia, blade=blade, spin=spin)
 
 
-@documented(
+@scene_doc(
     "A native nonholonomic model (n = 5) with the symmetry ``Cyclic(2)``, step h = 0.01, invariants ``\"E\"`` "
     "and ``\"p[2]\"``, and Byerly's exact reference at T = 1.",
-    twins="scene",
     parameters={
         "alpha": "The inclination α in radians, in [0, π/2).",
         "g": "The gravitational acceleration (finite).",
@@ -302,10 +293,9 @@ def rolling_sphere(alpha: float = 0.5, g: float = 9.81, radius: float = 1.0, vx0
     return get("rolling_sphere", alpha=alpha, g=g, radius=radius, vx0=vx0, vy0=vy0, spin=spin)
 
 
-@documented(
+@scene_doc(
     'A native nonholonomic model (n = 5, affine constraints) with the symmetry ``Cyclic(2)``, invariants '
     '``"J"`` and ``"p[2]"``, and the exact reference at 14π/Ω.',
-    twins="scene",
     parameters={
         "omega": "The table's angular velocity Ω, positive.",
         "radius": "The ball's radius, positive.",

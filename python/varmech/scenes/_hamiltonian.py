@@ -7,7 +7,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .. import _core
-from .._doc import documented, hlw
+from .._doc import hlw, scene_doc
 from .._util import floats, positive
 from ..model import NativeSystem
 from ._scene import Scene, get
@@ -23,10 +23,9 @@ __all__ = [
 ]
 
 
-@documented(
+@scene_doc(
     'A separable native model (n = 1), with step h = 0.1, invariant ``"H"`` = 1/2 and the exact reference at '
     't = 10.',
-    twins="scene",
     parameters={"omega": "The angular frequency ω > 0, in inverse time units."},
     raises="``omega`` not finite and positive.",
     see_also=["varmech.analysis.stability.growth_factor : the methods' linear stability on this equation."],
@@ -47,9 +46,8 @@ def harmonic_oscillator(omega: float = 1.0) -> Scene:
     return get("harmonic_oscillator", omega=omega)
 
 
-@documented(
+@scene_doc(
     'A separable native model (n = 1), with invariant ``"H"`` and the reference at t = 2π.',
-    twins="scene",
     see_also=["cartesian_pendulum : the same pendulum in (x, y) on a constraint."],
     references=[hlw("I.1")],
 )
@@ -70,11 +68,10 @@ def pendulum() -> Scene:
     return get("pendulum")
 
 
-@documented(
+@scene_doc(
     'A separable native model (n = 2) with the symmetry :class:`~varmech.Rotation` (in the plane), step h = '
     '2π/200 (up to e = 0.6; beyond, shorter as the pericentre passage, 2π/200·((1 − e)/0.4)^(3/2)), '
     'invariants ``"H"`` = −1/2 and ``"L"``, and the exact reference (the pericentre again at t = 400π).',
-    twins="scene",
     parameters={"e": "The eccentricity, in [0, 1)."},
     raises="``e`` not in [0, 1).",
     see_also=["kepler_polar : the same orbit in polar coordinates."],
@@ -99,9 +96,8 @@ def kepler(e: float = 0.6) -> Scene:
     return get("kepler", e=e)
 
 
-@documented(
+@scene_doc(
     'A separable native model (n = 2), with step h = 0.1 and invariant ``"H"`` = 0.13.',
-    twins="scene",
     see_also=["varmech.poincare_section : its sections, the classic picture of its chaos."],
     references=['M. Hénon and C. Heiles, "The applicability of the third integral of motion: some numerical '
         'experiments", *Astron. J.* 69 (1964) 73–79; Hairer, Lubich & Wanner, *Geometric Numerical '
@@ -125,9 +121,8 @@ def henon_heiles() -> Scene:
     return get("henon_heiles")
 
 
-@documented(
+@scene_doc(
     'A separable native model (n = 6), with step h = 0.001 and invariants ``"H"`` and ``"I"`` = 1.',
-    twins="scene",
     references=[hlw("I.5")],
 )
 def fermi_pasta_ulam() -> Scene:
@@ -149,10 +144,9 @@ def fermi_pasta_ulam() -> Scene:
     return get("fermi_pasta_ulam")
 
 
-@documented(
+@scene_doc(
     'A native N-body model (n = 18) with translation and rotation symmetries (total linear and angular '
     'momentum), step h = 50 days, invariant ``"H"`` and the reference; its ``time_unit`` is ``"days"``.',
-    twins="scene",
     see_also=["nbody : any gravitational N-body problem."],
     references=[hlw("I.2.4")],
 )
@@ -176,9 +170,8 @@ def outer_solar_system() -> Scene:
     return get("outer_solar_system")
 
 
-@documented(
+@scene_doc(
     "The model with its initial state, horizon and step; no invariants or reference.",
-    twins="scene",
     parameters={
         "masses": ("array_like, shape (N,)", "The masses, finite and positive; at least two bodies."),
         "positions, velocities": ("array_like, shape (N, 3)", "The initial positions and velocities (finite); the momenta are pᵢ = mᵢvᵢ."),

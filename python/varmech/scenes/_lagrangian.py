@@ -3,7 +3,7 @@ terms linear in q̇, and forces."""
 
 from __future__ import annotations
 
-from .._doc import documented
+from .._doc import scene_doc
 from ._scene import Scene, get
 
 __all__ = [
@@ -17,10 +17,7 @@ __all__ = [
 ]
 
 
-@documented(
-    'A native general Lagrangian (n = 2), with step h = 0.01, invariant ``"E"`` and the reference at T = 10.',
-    twins="scene",
-)
+@scene_doc('A native general Lagrangian (n = 2), with step h = 0.01, invariant ``"E"`` and the reference at T = 10.')
 def double_pendulum() -> Scene:
     """The planar double pendulum in its two angles, a Lagrangian with configuration-dependent mass.
 
@@ -41,10 +38,9 @@ def double_pendulum() -> Scene:
     return get("double_pendulum")
 
 
-@documented(
+@scene_doc(
     'A native general Lagrangian (n = 2) with the symmetry ``Cyclic(1)``, step h = 0.01, invariants ``"E"`` '
     'and ``"p_phi"``, and the reference at T = 50.',
-    twins="scene",
     see_also=[
         "cartesian_spherical_pendulum : the same pendulum in (x, y, z) on the unit sphere.",
         "varmech.routh : the pendulum reduced by its cyclic φ.",
@@ -68,10 +64,9 @@ def spherical_pendulum() -> Scene:
     return get("spherical_pendulum")
 
 
-@documented(
+@scene_doc(
     'A native general Lagrangian (n = 3) with the symmetries ``Cyclic(1)`` and ``Cyclic(2)``, step h = 0.01, '
     'and invariants ``"E"``, ``"p_phi"`` and ``"p_psi"``.',
-    twins="scene",
     see_also=["varmech.routh : the top reduced to θ alone."],
     references=["H. Goldstein, C. Poole and J. Safko, *Classical Mechanics*, 3rd ed., Addison-Wesley, 2002, Sec. 5.7."],
 )
@@ -94,11 +89,10 @@ def heavy_top() -> Scene:
     return get("heavy_top")
 
 
-@documented(
+@scene_doc(
     'A native general Lagrangian (n = 2) with the symmetry ``Cyclic(1)``, step h = 2π/200 (up to e = 0.6; '
     '2π/200·((1 − e)/0.4)^(3/2) beyond), invariants ``"E"`` = −1/2 and ``"p_theta"``, and the exact '
     'reference.',
-    twins="scene",
     parameters={"e": "The eccentricity, in [0, 1)."},
     raises="``e`` not in [0, 1).",
     see_also=["kepler : the same orbit in Cartesian coordinates."],
@@ -121,10 +115,9 @@ def kepler_polar(e: float = 0.6) -> Scene:
     return get("kepler_polar", e=e)
 
 
-@documented(
+@scene_doc(
     'A native general Lagrangian (n = 2) with the symmetry :class:`~varmech.Rotation`, step h = 0.05, '
     'invariants ``"E"`` and ``"L"``, and the exact reference at t = 10.',
-    twins="scene",
     parameters={"B": "The field strength (any finite value; 0 is a free particle)."},
     raises="``B`` not finite.",
     see_also=["charged_particle_nonuniform : the same charge in a field that varies."],
@@ -148,10 +141,9 @@ def charged_particle(B: float = 1.0) -> Scene:
     return get("charged_particle", B=B)
 
 
-@documented(
+@scene_doc(
     'A native general Lagrangian (n = 2) with the symmetry :class:`~varmech.Rotation`, step h = 0.05, and '
     'invariants ``"E"`` and ``"L"``.',
-    twins="scene",
     see_also=["charged_particle : the uniform field, with an exact solution."],
 )
 def charged_particle_nonuniform() -> Scene:
@@ -174,9 +166,8 @@ def charged_particle_nonuniform() -> Scene:
     return get("charged_particle_nonuniform")
 
 
-@documented(
+@scene_doc(
     "A native, forced general Lagrangian (n = 1), with step h = 0.01 and no invariants.",
-    twins="scene",
     parameters={
         "gamma": "The damping coefficient γ ≥ 0.",
         "amplitude": "The amplitude A of the driving torque (finite).",

@@ -32,7 +32,7 @@ import numpy as np
 import sympy as sp
 
 from .._catalogue import declared
-from .._doc import documented
+from .._doc import documented, symbolic_doc
 from ..model import Rotation
 from ..scenes import CATALOGUE, LONG_RUNS, Scene
 from ._constructors import lagrangian, mechanical
@@ -63,9 +63,8 @@ __all__ = [
 _G = 9.80665
 
 
-@documented(
+@symbolic_doc(
     "A general Lagrangian, n = 2.",
-    twins="symbolic",
     parameters={
         "m1, m2": ("float, default 1.0, 2.0", "The bobs' masses."),
         "l1, l2": ("float, default 2.0, 3.0", "The rods' lengths."),
@@ -101,7 +100,7 @@ def double_pendulum(
     return lagrangian(L, [q1, q2], [v1, v2], parameters=parameters, jit=jit, name="double_pendulum (symbolic)")
 
 
-@documented("A general Lagrangian, n = 2, φ cyclic.", twins="symbolic")
+@symbolic_doc("A general Lagrangian, n = 2, φ cyclic.")
 def spherical_pendulum(m: float = 1.0, l: float = 1.0, g: float = 1.0, *, jit: bool = True) -> SymbolicModel:
     """The spherical pendulum in its polar angle θ from the downward vertical and its azimuth
     φ::
@@ -124,9 +123,8 @@ def spherical_pendulum(m: float = 1.0, l: float = 1.0, g: float = 1.0, *, jit: b
     )
 
 
-@documented(
+@symbolic_doc(
     "A general Lagrangian, n = 3, φ and ψ cyclic.",
-    twins="symbolic",
     parameters={"I1": "The transverse moment of inertia about the pivot."},
     see_also=["varmech.symbolic.routh : reduces it by its cyclic angles."],
 )
@@ -158,9 +156,8 @@ def heavy_top(I1: float = 1.0, I3: float = 0.5, Mgl: float = 1.0, *, jit: bool =
     )
 
 
-@documented(
+@symbolic_doc(
     "A separable mechanical system, n = 2, rotation invariant.",
-    twins="symbolic",
     see_also=["kepler_polar : the same problem in polar coordinates."],
 )
 def kepler(*, jit: bool = True) -> SymbolicModel:
@@ -192,7 +189,7 @@ def kepler(*, jit: bool = True) -> SymbolicModel:
     )
 
 
-@documented("A general Lagrangian, n = 2, θ cyclic.", twins="symbolic")
+@symbolic_doc("A general Lagrangian, n = 2, θ cyclic.")
 def kepler_polar(m: float = 1.0, k: float = 1.0, *, jit: bool = True) -> SymbolicModel:
     """Kepler's problem in polar coordinates (r, θ)::
 
@@ -213,9 +210,8 @@ def kepler_polar(m: float = 1.0, k: float = 1.0, *, jit: bool = True) -> Symboli
     return lagrangian(L, [r, th], [vr, vth], parameters={m_: m, k_: k}, jit=jit, name="kepler_polar (symbolic)")
 
 
-@documented(
+@symbolic_doc(
     "A general Lagrangian (linear in the velocities), n = 2, rotation invariant.",
-    twins="symbolic",
     parameters={
         "kappa": "Its growth κ with |q|².",
         "e": "The charge.",
@@ -256,7 +252,7 @@ def charged_particle(
     )
 
 
-@documented("As :func:`charged_particle` returns it.", twins="symbolic")
+@symbolic_doc("As :func:`charged_particle` returns it.")
 def charged_particle_nonuniform(*, jit: bool = True) -> SymbolicModel:
     """The charged particle in the native scene's non-uniform field B(q) = (1 + |q|²/4) ẑ:
     :func:`charged_particle` with B = 1, κ = ¼.
@@ -270,9 +266,8 @@ def charged_particle_nonuniform(*, jit: bool = True) -> SymbolicModel:
     return charged_particle(kappa=0.25, jit=jit)
 
 
-@documented(
+@symbolic_doc(
     "A forced general Lagrangian, n = 1.",
-    twins="symbolic",
     parameters={
         "amplitude": "The torque's amplitude A.",
         "drive": ("float, default 2/3", "The driving frequency Ω."),
@@ -318,9 +313,8 @@ def damped_driven_pendulum(
     )
 
 
-@documented(
+@symbolic_doc(
     "A separable mechanical system, n = 2, with one holonomic constraint.",
-    twins="symbolic",
     raises="Naming ``mass`` when ``m`` is not finite and positive.",
 )
 def cartesian_pendulum(m: float = 1.0, l: float = 1.0, g: float = 1.0, *, jit: bool = True) -> SymbolicModel:
