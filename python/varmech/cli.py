@@ -18,6 +18,7 @@ from pathlib import Path
 from typing import Any
 
 from . import _core, charts, scenes
+from ._catalogue import declared
 from ._version import __version__
 from .charts.recipes import KINDS, chart
 from .conservation import check_conservation
@@ -29,38 +30,16 @@ from .table import Table
 
 __all__: list[str] = []  # internal: importable, not part of the public API
 
-#: Showcase runs of the tour, scene → (methods, horizon) with None for the scene's t_end: each
-#: over a horizon long enough to tell bounded from drifting. A scene without one runs with its
-#: kind's default and accurate methods over its t_end (see :func:`tour_runs`).
-TOUR: dict[str, tuple[tuple[str, ...], float | None]] = {
-    "harmonic_oscillator": (("verlet", "rk4", "symplectic_euler"), 1000.0),
-    "pendulum": (("verlet", "yoshida4", "rk4"), 2000.0),
-    "kepler": (("verlet", "kahan_li8", "rk4"), None),
-    "henon_heiles": (("verlet", "kahan_li6", "rk4"), 5000.0),
-    "fermi_pasta_ulam": (("verlet", "mclachlan4", "rk4"), 200.0),
-    "outer_solar_system": (("verlet", "kahan_li8", "rk4"), None),
-    "double_pendulum": (("midpoint", "trapezoid"), 100.0),
-    "spherical_pendulum": (("midpoint", "trapezoid"), 1000.0),
-    "heavy_top": (("midpoint", "galerkin4"), None),
-    "kepler_polar": (("midpoint", "galerkin4"), None),
-    "charged_particle": (("midpoint", "galerkin4"), 1000.0),
-    "charged_particle_nonuniform": (("midpoint", "trapezoid"), 1000.0),
-    "cartesian_pendulum": (("rattle", "shake"), 1000.0),
-    "planar_chain": (("rattle", "rattle4"), 100.0),
-    "rigid_body": (("trapezoid", "midpoint"), 100.0),
-    # A hundred bounces and more, where the variational impacts' O(h²) energy jumps stay bounded.
-    "bouncing_ball": (("verlet", "kahan_li6"), 1000.0),
-}
-
-
 def tour_runs() -> list[tuple[scenes.Scene, tuple[str, ...], float]]:
-    """(scene, methods, horizon) for every scene of the catalogue, in its order: the showcase
-    of :data:`TOUR`, or the kind's default and accurate methods over the scene's t_end."""
+    """(scene, methods, horizon) for every scene of the catalogue, in its order: its showcase
+    run, as declared with it (``tour``, :mod:`varmech._catalogue`: each over a horizon long
+    enough to tell bounded from drifting, None for the scene's t_end), or the kind's default and
+    accurate methods over the scene's t_end."""
     runs = []
     for name in scenes.CATALOGUE:
         scene = scenes.get(name)
         kind = scene.model.kind
-        methods, horizon = TOUR.get(name, (tuple(dict.fromkeys((kind.default_method, kind.accurate_method))), None))
+        methods, horizon = declared(name).tour or (tuple(dict.fromkeys((kind.default_method, kind.accurate_method))), None)
         runs.append((scene, methods, horizon if horizon is not None else scene.t_end))
     return runs
 

@@ -11,6 +11,8 @@ import math
 
 import numpy as np
 
+from ._catalogue import declared
+from ._doc import closure_doc
 from .model import Cyclic, Lagrangian, MechanicalSystem, Rotation, Translation
 from .scenes import CATALOGUE, Scene
 
@@ -40,22 +42,9 @@ __all__ = [
 ]
 
 
+@closure_doc("n = 1, with V and ∇V as NumPy closures.", parameters={"omega": "The angular frequency ω."})
 def harmonic_oscillator(omega: float = 1.0) -> MechanicalSystem:
     """The harmonic oscillator H = p²/2 + ω²q²/2 as a separable closure model.
-
-    Parameters
-    ----------
-    omega : float, default 1.0
-        The angular frequency ω.
-
-    Returns
-    -------
-    MechanicalSystem
-        n = 1, with V and ∇V as NumPy closures.
-
-    See Also
-    --------
-    varmech.scenes.harmonic_oscillator : the native scene it twins.
 
     Examples
     --------
@@ -68,17 +57,9 @@ def harmonic_oscillator(omega: float = 1.0) -> MechanicalSystem:
     return MechanicalSystem(1, lambda q: 0.5 * w2 * q[0] * q[0], lambda q: w2 * q, name="harmonic_oscillator (closure)")
 
 
+@closure_doc("n = 1, with V = −cos q and ∇V = sin q.")
 def pendulum() -> MechanicalSystem:
     """The pendulum H = p²/2 − cos q as a separable closure model.
-
-    Returns
-    -------
-    MechanicalSystem
-        n = 1, with V = −cos q and ∇V = sin q.
-
-    See Also
-    --------
-    varmech.scenes.pendulum : the native scene it twins.
 
     Examples
     --------
@@ -91,18 +72,12 @@ def pendulum() -> MechanicalSystem:
     return MechanicalSystem(1, lambda q: -math.cos(q[0]), np.sin, name="pendulum (closure)")
 
 
+@closure_doc(
+    "n = 2, with the symmetry ``Rotation(spatial_dim=2)`` (angular momentum).",
+    see_also=["varmech.examples.kepler_polar : the same problem in polar coordinates."],
+)
 def kepler() -> MechanicalSystem:
     """Kepler's problem H = |p|²/2 − 1/|q| in the plane as a closure model, rotation invariant.
-
-    Returns
-    -------
-    MechanicalSystem
-        n = 2, with the symmetry ``Rotation(spatial_dim=2)`` (angular momentum).
-
-    See Also
-    --------
-    varmech.scenes.kepler : the native scene it twins.
-    varmech.examples.kepler_polar : the same problem in polar coordinates.
 
     Examples
     --------
@@ -122,17 +97,9 @@ def kepler() -> MechanicalSystem:
     return MechanicalSystem(2, potential, gradient, symmetries=[Rotation(spatial_dim=2)], name="kepler (closure)")
 
 
+@closure_doc("n = 2, separable.")
 def henon_heiles() -> MechanicalSystem:
     """The Hénon–Heiles potential V = (x² + y²)/2 + x²y − y³/3 as a closure model.
-
-    Returns
-    -------
-    MechanicalSystem
-        n = 2, separable.
-
-    See Also
-    --------
-    varmech.scenes.henon_heiles : the native scene it twins.
 
     Examples
     --------
@@ -153,30 +120,17 @@ def henon_heiles() -> MechanicalSystem:
     return MechanicalSystem(2, potential, gradient, name="henon_heiles (closure)")
 
 
+@closure_doc(
+    "n = 2m.",
+    parameters={
+        "m": "The number of stiff springs; the chain has 2m masses.",
+        "omega": "The stiff springs' frequency ω.",
+    },
+    raises="Naming ``m`` when below 1.",
+)
 def fermi_pasta_ulam(m: int = 3, omega: float = 50.0) -> MechanicalSystem:
     """The Fermi–Pasta–Ulam chain: m stiff linear springs of frequency ω alternating with soft
     quartic ones, fixed ends, as a closure model with the springs vectorised.
-
-    Parameters
-    ----------
-    m : int, default 3
-        The number of stiff springs; the chain has 2m masses.
-    omega : float, default 50.0
-        The stiff springs' frequency ω.
-
-    Returns
-    -------
-    MechanicalSystem
-        n = 2m.
-
-    Raises
-    ------
-    ValueError
-        Naming ``m`` when below 1.
-
-    See Also
-    --------
-    varmech.scenes.fermi_pasta_ulam : the native scene it twins.
 
     Examples
     --------
@@ -211,31 +165,18 @@ def fermi_pasta_ulam(m: int = 3, omega: float = 50.0) -> MechanicalSystem:
     return MechanicalSystem(2 * m, potential, gradient, name="fermi_pasta_ulam (closure)")
 
 
+@closure_doc(
+    "n = 3N, mass diag(m₁, m₁, m₁, m₂, …), with the three translations and the three rotations as symmetries.",
+    parameters={
+        "G": "The gravitational constant.",
+        "masses": ("array_like, shape (N,)", "The bodies' masses."),
+    },
+    raises="Naming ``mass`` for a mass that is not finite and positive.",
+    see_also=["varmech.scenes.nbody : the native N-body scene it twins."],
+)
 def nbody(G: float, masses: np.ndarray) -> MechanicalSystem:
     """The gravitational N-body problem in 3 dimensions, V = −Σ G mᵢmⱼ/|qᵢ − qⱼ|, vectorised
     over the pairs.
-
-    Parameters
-    ----------
-    G : float
-        The gravitational constant.
-    masses : array_like, shape (N,)
-        The bodies' masses.
-
-    Returns
-    -------
-    MechanicalSystem
-        n = 3N, mass diag(m₁, m₁, m₁, m₂, …), with the three translations and the three
-        rotations as symmetries.
-
-    Raises
-    ------
-    ValueError
-        Naming ``mass`` for a mass that is not finite and positive.
-
-    See Also
-    --------
-    varmech.scenes.nbody : the native N-body scene it twins.
 
     Examples
     --------
@@ -268,28 +209,16 @@ def nbody(G: float, masses: np.ndarray) -> MechanicalSystem:
     return MechanicalSystem(3 * n, potential, gradient, mass=np.repeat(m, 3), symmetries=symmetries, name="nbody (closure)")
 
 
+@closure_doc(
+    "n = 2, with ∂L/∂q, ∂L/∂v and the three Hessians as closures.",
+    parameters={
+        "m1, m2": ("float, default 1.0, 2.0", "The bobs' masses."),
+        "l1, l2": ("float, default 2.0, 3.0", "The rods' lengths."),
+    },
+)
 def double_pendulum(m1: float = 1.0, m2: float = 2.0, l1: float = 2.0, l2: float = 3.0, g: float = 9.80665) -> Lagrangian:
     """The planar double pendulum in its two angles as a general Lagrangian with exact first and
     second derivatives.
-
-    Parameters
-    ----------
-    m1, m2 : float, default 1.0, 2.0
-        The bobs' masses.
-    l1, l2 : float, default 2.0, 3.0
-        The rods' lengths.
-    g : float, default 9.80665
-        The gravitational acceleration.
-
-    Returns
-    -------
-    Lagrangian
-        n = 2, with ∂L/∂q, ∂L/∂v and the three Hessians as closures.
-
-    See Also
-    --------
-    varmech.scenes.double_pendulum : the native scene it twins.
-    varmech.symbolic.examples.double_pendulum : its symbolic twin.
 
     Examples
     --------
@@ -326,26 +255,9 @@ def double_pendulum(m1: float = 1.0, m2: float = 2.0, l1: float = 2.0, l2: float
     return Lagrangian(2, lagrangian, dl_dq=dl_dq, dl_dv=dl_dv, hessians=hessians, name="double_pendulum (closure)")
 
 
+@closure_doc("n = 2, with the symmetry ``Cyclic(1)`` (the momentum p_φ).", parameters={"m": "The bob's mass."})
 def spherical_pendulum(m: float = 1.0, l: float = 1.0, g: float = 1.0) -> Lagrangian:
     """The spherical pendulum in (θ, φ) as a general Lagrangian; φ is cyclic.
-
-    Parameters
-    ----------
-    m : float, default 1.0
-        The bob's mass.
-    l : float, default 1.0
-        The rod's length.
-    g : float, default 1.0
-        The gravitational acceleration.
-
-    Returns
-    -------
-    Lagrangian
-        n = 2, with the symmetry ``Cyclic(1)`` (the momentum p_φ).
-
-    See Also
-    --------
-    varmech.scenes.spherical_pendulum : the native scene it twins.
 
     Examples
     --------
@@ -380,27 +292,13 @@ def spherical_pendulum(m: float = 1.0, l: float = 1.0, g: float = 1.0) -> Lagran
     )
 
 
+@closure_doc(
+    "n = 3, with the symmetries ``Cyclic(1)`` and ``Cyclic(2)``.",
+    parameters={"i1": "The moment of inertia about a transverse axis through the pivot."},
+)
 def heavy_top(i1: float = 1.0, i3: float = 0.5, mgl: float = 1.0) -> Lagrangian:
     """The heavy symmetric top in Euler angles (θ, φ, ψ), θ from the upward vertical, as a
     general Lagrangian with exact first and second derivatives; φ and ψ are cyclic.
-
-    Parameters
-    ----------
-    i1 : float, default 1.0
-        The moment of inertia about a transverse axis through the pivot.
-    i3 : float, default 0.5
-        The moment of inertia about the symmetry axis.
-    mgl : float, default 1.0
-        Mass × gravity × the pivot's distance to the centre of mass.
-
-    Returns
-    -------
-    Lagrangian
-        n = 3, with the symmetries ``Cyclic(1)`` and ``Cyclic(2)``.
-
-    See Also
-    --------
-    varmech.scenes.heavy_top : the native scene it twins.
 
     Examples
     --------
@@ -443,25 +341,10 @@ def heavy_top(i1: float = 1.0, i3: float = 0.5, mgl: float = 1.0) -> Lagrangian:
     )
 
 
+@closure_doc("n = 2, with the symmetry ``Cyclic(1)`` (the angular momentum p_θ).")
 def kepler_polar(m: float = 1.0, k: float = 1.0) -> Lagrangian:
     """Kepler's problem in polar coordinates (r, θ), L = ½m(ṙ² + r²θ̇²) + k/r, as a general
     Lagrangian with exact first and second derivatives; θ is cyclic.
-
-    Parameters
-    ----------
-    m : float, default 1.0
-        The mass.
-    k : float, default 1.0
-        The strength of the attraction k/r.
-
-    Returns
-    -------
-    Lagrangian
-        n = 2, with the symmetry ``Cyclic(1)`` (the angular momentum p_θ).
-
-    See Also
-    --------
-    varmech.scenes.kepler_polar : the native scene it twins.
 
     Examples
     --------
@@ -490,26 +373,10 @@ def kepler_polar(m: float = 1.0, k: float = 1.0) -> Lagrangian:
     return Lagrangian(2, lagrangian, dl_dq=dl_dq, dl_dv=dl_dv, hessians=hessians, symmetries=[Cyclic(1)], name="kepler_polar (closure)")
 
 
+@closure_doc("n = 2, rotation invariant.", see_also=["charged_particle_nonuniform : κ = 1/4."])
 def charged_particle(B: float = 1.0, kappa: float = 0.0) -> Lagrangian:
     """A unit charge of unit mass in the plane, in the field B(q) = B(1 + κ|q|²) ẑ, in the
     symmetric gauge: L = ½|v|² + a(|q|²)(x v_y − y v_x) with a(r²) = ½B(1 + κr²/2).
-
-    Parameters
-    ----------
-    B : float, default 1.0
-        The field at the origin.
-    kappa : float, default 0.0
-        Its growth κ with |q|²; 0 is the uniform field.
-
-    Returns
-    -------
-    Lagrangian
-        n = 2, rotation invariant.
-
-    See Also
-    --------
-    varmech.scenes.charged_particle : the native scene it twins.
-    charged_particle_nonuniform : κ = 1/4.
 
     Examples
     --------
@@ -540,18 +407,10 @@ def charged_particle(B: float = 1.0, kappa: float = 0.0) -> Lagrangian:
     return Lagrangian(2, lagrangian, dl_dq=dl_dq, dl_dv=dl_dv, symmetries=[Rotation(spatial_dim=2)], name="charged_particle (closure)")
 
 
+@closure_doc("n = 2, rotation invariant.")
 def charged_particle_nonuniform() -> Lagrangian:
     """The charged particle in the native scene's non-uniform field B(q) = (1 + |q|²/4) ẑ:
     :func:`charged_particle` with B = 1, κ = 1/4.
-
-    Returns
-    -------
-    Lagrangian
-        n = 2, rotation invariant.
-
-    See Also
-    --------
-    varmech.scenes.charged_particle_nonuniform : the native scene it twins.
 
     Examples
     --------
@@ -564,27 +423,13 @@ def charged_particle_nonuniform() -> Lagrangian:
     return charged_particle(kappa=0.25)
 
 
+@closure_doc(
+    "n = 1, forced: its energy is not conserved but balanced against the work done.",
+    parameters={"drive": ("float, default 2/3", "The driving frequency Ω.")},
+)
 def damped_driven_pendulum(gamma: float = 0.5, amplitude: float = 1.5, drive: float = 2.0 / 3.0) -> Lagrangian:
     """The damped, driven pendulum θ̈ + γθ̇ + sin θ = A cos Ωt: L = ½θ̇² + cos θ, the Rayleigh
     dissipation ½γθ̇² and the driving torque as a force.
-
-    Parameters
-    ----------
-    gamma : float, default 0.5
-        The damping γ.
-    amplitude : float, default 1.5
-        The driving torque's amplitude A.
-    drive : float, default 2/3
-        The driving frequency Ω.
-
-    Returns
-    -------
-    Lagrangian
-        n = 1, forced: its energy is not conserved but balanced against the work done.
-
-    See Also
-    --------
-    varmech.scenes.damped_driven_pendulum : the native scene it twins.
 
     Examples
     --------
@@ -603,32 +448,14 @@ def damped_driven_pendulum(gamma: float = 0.5, amplitude: float = 1.5, drive: fl
     )
 
 
+@closure_doc(
+    "n = 2 with one holonomic constraint.",
+    parameters={"m": "The bob's mass."},
+    raises="Naming ``mass`` when ``m`` is not finite and positive.",
+)
 def cartesian_pendulum(m: float = 1.0, l: float = 1.0, g: float = 1.0) -> MechanicalSystem:
     """The planar pendulum in Cartesian coordinates (x, y): V = mgy on the constraint
     g(q) = ½(x² + y² − l²) = 0.
-
-    Parameters
-    ----------
-    m : float, default 1.0
-        The bob's mass.
-    l : float, default 1.0
-        The rod's length.
-    g : float, default 1.0
-        The gravitational acceleration.
-
-    Returns
-    -------
-    MechanicalSystem
-        n = 2 with one holonomic constraint.
-
-    Raises
-    ------
-    ValueError
-        Naming ``mass`` when ``m`` is not finite and positive.
-
-    See Also
-    --------
-    varmech.scenes.cartesian_pendulum : the native scene it twins.
 
     Examples
     --------
@@ -658,24 +485,14 @@ def _e(q: np.ndarray) -> np.ndarray:
     return np.column_stack([-v, s * np.eye(3) - cross])
 
 
+@closure_doc(
+    "n = 4 with a configuration-dependent mass and the constraint |q|² = 1.",
+    parameters={"inertia": ("tuple of 3 float, default (0.5, 0.9, 1.0)", "The principal moments of inertia I.")},
+)
 def rigid_body(inertia: tuple[float, float, float] = (0.5, 0.9, 1.0)) -> MechanicalSystem:
     """The free rigid body in unit quaternions as a natural system on |q| = 1:
     M(q) = 4EᵀIE + αqqᵀ (α = 4 tr I/3 fills the direction q, which the constraint freezes),
     U = q₁² − q₂² − q₃² + q₄².
-
-    Parameters
-    ----------
-    inertia : tuple of 3 float, default (0.5, 0.9, 1.0)
-        The principal moments of inertia I.
-
-    Returns
-    -------
-    MechanicalSystem
-        n = 4 with a configuration-dependent mass and the constraint |q|² = 1.
-
-    See Also
-    --------
-    varmech.scenes.rigid_body : the native scene it twins.
 
     Examples
     --------
@@ -715,23 +532,10 @@ def rigid_body(inertia: tuple[float, float, float] = (0.5, 0.9, 1.0)) -> Mechani
     )
 
 
+@closure_doc("n = 1, without the floor.")
 def bouncing_ball(g: float = 9.81) -> MechanicalSystem:
     """The ball above its floor, H = p²/2 + gq; the floor q = 0 is a contact, which in the closure
     twin is ``Contact(lambda q: q[0], lambda q: [1.0])``.
-
-    Parameters
-    ----------
-    g : float, default 9.81
-        The gravitational acceleration.
-
-    Returns
-    -------
-    MechanicalSystem
-        n = 1, without the floor.
-
-    See Also
-    --------
-    varmech.scenes.bouncing_ball : the native scene it twins, floor included.
 
     Examples
     --------
@@ -745,18 +549,10 @@ def bouncing_ball(g: float = 9.81) -> MechanicalSystem:
     return MechanicalSystem(1, lambda q: g * q[0], lambda q: np.array([g]), name="bouncing_ball (closure)")
 
 
+@closure_doc("n = 2, without the table's wall.")
 def elliptic_billiard() -> MechanicalSystem:
     """The elliptic billiard's free particle, H = |p|²/2; the table x²/A² + y²/B² ≤ 1 is a
     contact (:class:`varmech.surfaces.Ellipsoid`).
-
-    Returns
-    -------
-    MechanicalSystem
-        n = 2, without the table's wall.
-
-    See Also
-    --------
-    varmech.scenes.elliptic_billiard : the native scene it twins, wall included.
 
     Examples
     --------
@@ -768,28 +564,14 @@ def elliptic_billiard() -> MechanicalSystem:
     return MechanicalSystem(2, lambda q: 0.0, lambda q: np.zeros(2), name="elliptic_billiard (closure)")
 
 
+@closure_doc(
+    "n = 4 with two velocity (nonholonomic) constraints.",
+    parameters={"radius": "The disk's radius R."},
+    raises="Naming ``mass`` when ``radius`` is 0.",
+)
 def rolling_disk(radius: float = 1.0) -> MechanicalSystem:
     """The vertical disk of radius R rolling on a plane, q = (x, y, θ, φ), mass
     diag(1, 1, R²/4, R²/2), with ẋ = Rφ̇cosθ, ẏ = Rφ̇sinθ as velocity constraints.
-
-    Parameters
-    ----------
-    radius : float, default 1.0
-        The disk's radius R.
-
-    Returns
-    -------
-    MechanicalSystem
-        n = 4 with two velocity (nonholonomic) constraints.
-
-    Raises
-    ------
-    ValueError
-        Naming ``mass`` when ``radius`` is 0.
-
-    See Also
-    --------
-    varmech.scenes.rolling_disk : the native scene it twins.
 
     Examples
     --------
@@ -812,30 +594,13 @@ def rolling_disk(radius: float = 1.0) -> MechanicalSystem:
     )
 
 
+@closure_doc(
+    "n = 3 with one velocity constraint.",
+    raises="Naming ``mass`` when ``inertia`` is not finite and positive.",
+)
 def chaplygin_sleigh(inertia: float = 1.0, blade: float = 1.0) -> MechanicalSystem:
     """The Chaplygin sleigh, q = (x, y, θ), mass diag(1, 1, I), its blade b behind the centre:
     −ẋ sin θ + ẏ cos θ − bθ̇ = 0.
-
-    Parameters
-    ----------
-    inertia : float, default 1.0
-        The moment of inertia I about the centre.
-    blade : float, default 1.0
-        The blade's distance b behind the centre.
-
-    Returns
-    -------
-    MechanicalSystem
-        n = 3 with one velocity constraint.
-
-    Raises
-    ------
-    ValueError
-        Naming ``mass`` when ``inertia`` is not finite and positive.
-
-    See Also
-    --------
-    varmech.scenes.chaplygin_sleigh : the native scene it twins.
 
     Examples
     --------
@@ -854,34 +619,19 @@ def chaplygin_sleigh(inertia: float = 1.0, blade: float = 1.0) -> MechanicalSyst
     )
 
 
+@closure_doc(
+    "n = 5 with two velocity constraints and the symmetry ``Cyclic(2)``.",
+    parameters={
+        "omega": "The table's rate of turn Ω.",
+        "name": 'The model\'s name, less " (closure)".',
+    },
+    see_also=["ball_on_turntable : the level turning table."],
+)
 def rolling_sphere(alpha: float = 0.5, g: float = 9.81, radius: float = 1.0, omega: float = 0.0, name: str = "rolling_sphere") -> Lagrangian:
     """The ball (unit mass, I = 2a²/5) rolling on a rough plane inclined at α, or on a level table
     turning at Ω, q = (x, y, φ, θ, ψ) in ZXZ Euler angles:
     L = ½(ẋ² + ẏ²) + ½I(φ̇² + θ̇² + ψ̇² + 2φ̇ψ̇cosθ) + g sinα x, with
     ẋ − aω_y + Ωy = 0, ẏ + aω_x − Ωx = 0 (affine for Ω ≠ 0).
-
-    Parameters
-    ----------
-    alpha : float, default 0.5
-        The plane's inclination α.
-    g : float, default 9.81
-        The gravitational acceleration.
-    radius : float, default 1.0
-        The ball's radius a.
-    omega : float, default 0.0
-        The table's rate of turn Ω.
-    name : str, default "rolling_sphere"
-        The model's name, less " (closure)".
-
-    Returns
-    -------
-    Lagrangian
-        n = 5 with two velocity constraints and the symmetry ``Cyclic(2)``.
-
-    See Also
-    --------
-    varmech.scenes.rolling_sphere : the native scene it twins.
-    ball_on_turntable : the level turning table.
 
     Examples
     --------
@@ -917,25 +667,10 @@ def rolling_sphere(alpha: float = 0.5, g: float = 9.81, radius: float = 1.0, ome
     )
 
 
+@closure_doc("n = 5 with two affine velocity constraints.", parameters={"omega": "The table's rate of turn Ω."})
 def ball_on_turntable(omega: float = 1.0, radius: float = 1.0) -> Lagrangian:
     """The ball of :func:`rolling_sphere` on a level table turning at Ω: its velocity
     constraints are affine, so the table does work and the energy is not conserved.
-
-    Parameters
-    ----------
-    omega : float, default 1.0
-        The table's rate of turn Ω.
-    radius : float, default 1.0
-        The ball's radius a.
-
-    Returns
-    -------
-    Lagrangian
-        n = 5 with two affine velocity constraints.
-
-    See Also
-    --------
-    varmech.scenes.ball_on_turntable : the native scene it twins.
 
     Examples
     --------
@@ -947,8 +682,8 @@ def ball_on_turntable(omega: float = 1.0, radius: float = 1.0) -> Lagrangian:
 
 
 def closure_of(scene: Scene) -> MechanicalSystem | Lagrangian:
-    """The closure twin of a built-in scene: the function of this module with the scene's name,
-    at its default parameters (an N-body scene's twin has the scene's G and masses).
+    """The closure twin of a built-in scene (declared with it, :mod:`varmech._catalogue`): the
+    function of this module with the scene's name, at its default parameters (an N-body scene's twin has the scene's G and masses).
 
     Parameters
     ----------
@@ -982,7 +717,6 @@ def closure_of(scene: Scene) -> MechanicalSystem | Lagrangian:
     gravity = getattr(scene.model._core, "gravity", None)
     if gravity is not None:
         return nbody(*gravity)
-    twin = globals().get(scene.name) if scene.name in CATALOGUE else None
-    if twin is None:
+    if scene.name not in CATALOGUE or not declared(scene.name).closure:
         raise ValueError(f"scene: {scene.name!r} has no closure twin in varmech.examples")
-    return twin()
+    return globals()[scene.name]()

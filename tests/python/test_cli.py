@@ -7,8 +7,9 @@ import pytest
 
 import varmech
 from varmech import scenes
+from varmech._catalogue import DECLARED
 from varmech.charts.recipes import KINDS, chart, fitting_methods, scenes_for
-from varmech.cli import TOUR, TOUR_REDUCED, tour_runs
+from varmech.cli import TOUR_REDUCED, tour_runs
 
 
 def test_methods_table(run_cli):
@@ -71,8 +72,10 @@ def test_tour_prints_reports_and_writes_plots(tmp_path, run_cli):
 def test_the_tour_runs_every_scene_with_its_showcase_or_its_kinds_methods():
     runs = {scene.name: (methods, horizon) for scene, methods, horizon in tour_runs()}
     assert list(runs) == list(scenes.CATALOGUE)
-    for name, (methods, horizon) in TOUR.items():
-        assert runs[name] == (methods, horizon if horizon is not None else scenes.get(name).t_end)
+    for name, declared in DECLARED.items():
+        if declared.tour is not None:
+            methods, horizon = declared.tour
+            assert runs[name] == (methods, horizon if horizon is not None else scenes.get(name).t_end)
     kind = scenes.damped_driven_pendulum().model.kind
     assert runs["damped_driven_pendulum"] == ((kind.default_method, kind.accurate_method), 100.0)
 

@@ -12,6 +12,7 @@ import pytest
 
 import varmech
 from varmech import examples, scenes
+from varmech._catalogue import DECLARED
 
 
 def _same_runs(native, python):
@@ -154,7 +155,7 @@ def test_impact_scenes_carry_native_contacts_that_pickle_and_compare_by_value():
     assert ball.contacts == (varmech.Contact.wall(0, restitution=0.8, name="floor"),)
     assert billiard.contacts == (varmech.Contact.ellipsoid([3.0, 1.0], name="wall"),)
     assert pickle.loads(pickle.dumps(billiard)).contacts == billiard.contacts
-    assert all(not scenes.get(name).contacts for name in scenes.CATALOGUE if name not in scenes.CONTACTS)
+    assert all(not scenes.get(name).contacts for name in scenes.CATALOGUE if DECLARED[name].contacts is None)
 
 
 def test_bad_impact_scenes_and_shapes_are_named():

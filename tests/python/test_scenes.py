@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 from varmech import _core, examples, scenes
+from varmech._catalogue import DECLARED
 from varmech.analysis._energy import energy_of
 
 #: The catalogue names cyclic momenta by their angle; the model's generators by their index.
@@ -88,6 +89,23 @@ def test_an_unknown_parameter_is_refused_by_name():
         scenes.kepler(e=1.5)
     with pytest.raises(TypeError, match="e: must be a number"):
         scenes.get("kepler", e="high")
+
+
+def test_each_scene_is_declared_once_with_what_python_adds():
+    """The declarations name the catalogue's scenes, in its order: a new scene is one line there.
+    What each declares is what its scene and model carry, and its closure twin exists exactly
+    where declared (the N-body planets aside, whose twin is examples.nbody of their masses)."""
+    assert list(DECLARED) == list(scenes.CATALOGUE)
+    for name, declared in DECLARED.items():
+        scene = scenes.get(name)
+        assert scene.model.coordinates == (declared.coordinates or tuple(f"q[{i}]" for i in range(scene.model.dim)))
+        assert scene.model.units["t"] == scene.time_unit.replace("time units", "1")
+        assert bool(scene.contacts) == (declared.contacts is not None), name
+        if declared.closure or name == "outer_solar_system":
+            assert examples.closure_of(scene).dim == scene.model.dim
+        else:
+            with pytest.raises(ValueError, match=name):
+                examples.closure_of(scene)
 
 
 def test_a_scene_without_a_closure_twin_is_refused_by_name():

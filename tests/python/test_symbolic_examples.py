@@ -20,6 +20,7 @@ if not hasattr(_core, "CompiledModel"):
 import varmech  # noqa: E402
 import varmech.symbolic as symbolic  # noqa: E402
 from varmech import examples, scenes  # noqa: E402
+from varmech._catalogue import DECLARED  # noqa: E402
 from varmech.analysis.baselines import Rhs  # noqa: E402
 from varmech.symbolic import examples as symbolic_examples  # noqa: E402
 
@@ -53,17 +54,16 @@ def closure_of(model):
     )
 
 
-TWINS = [
-    "double_pendulum",
-    "spherical_pendulum",
-    "heavy_top",
-    "kepler",
-    "kepler_polar",
-    "charged_particle",
-    "charged_particle_nonuniform",
-    "damped_driven_pendulum",
-    "cartesian_pendulum",
-]
+#: The scenes declared with a symbolic twin (varmech._catalogue).
+TWINS = [name for name, declared in DECLARED.items() if declared.symbolic]
+
+
+def test_the_symbolic_twins_are_those_declared():
+    assert len(TWINS) == 9
+    for name in scenes.CATALOGUE:
+        if name not in TWINS:
+            with pytest.raises(ValueError, match=name):
+                symbolic_examples.symbolic_of(scenes.get(name))
 
 
 @pytest.mark.parametrize("name", TWINS)

@@ -31,6 +31,8 @@ import math
 import numpy as np
 import sympy as sp
 
+from .._catalogue import declared
+from .._doc import documented, symbolic_doc
 from ..model import Rotation
 from ..scenes import CATALOGUE, LONG_RUNS, Scene
 from ._constructors import lagrangian, mechanical
@@ -61,6 +63,13 @@ __all__ = [
 _G = 9.80665
 
 
+@symbolic_doc(
+    "A general Lagrangian, n = 2.",
+    parameters={
+        "m1, m2": ("float, default 1.0, 2.0", "The bobs' masses."),
+        "l1, l2": ("float, default 2.0, 3.0", "The rods' lengths."),
+    },
+)
 def double_pendulum(
     m1: float = 1.0, m2: float = 2.0, l1: float = 2.0, l2: float = 3.0, g: float = _G, *, jit: bool = True
 ) -> SymbolicModel:
@@ -71,27 +80,6 @@ def double_pendulum(
 
     with the native scene's l = (2, 3), m = (1, 2), g = 9.80665 by default. A general
     Lagrangian (its mass matrix depends on θ₁ − θ₂).
-
-    Parameters
-    ----------
-    m1, m2 : float, default 1.0, 2.0
-        The bobs' masses.
-    l1, l2 : float, default 2.0, 3.0
-        The rods' lengths.
-    g : float, default 9.80665
-        The gravitational acceleration.
-    jit : bool, default True
-        Compile the model's tapes (Cranelift), or interpret them.
-
-    Returns
-    -------
-    SymbolicModel
-        A general Lagrangian, n = 2.
-
-    See Also
-    --------
-    varmech.scenes.double_pendulum : the native scene it twins.
-    varmech.examples.double_pendulum : its closure twin.
 
     Examples
     --------
@@ -112,6 +100,7 @@ def double_pendulum(
     return lagrangian(L, [q1, q2], [v1, v2], parameters=parameters, jit=jit, name="double_pendulum (symbolic)")
 
 
+@symbolic_doc("A general Lagrangian, n = 2, φ cyclic.")
 def spherical_pendulum(m: float = 1.0, l: float = 1.0, g: float = 1.0, *, jit: bool = True) -> SymbolicModel:
     """The spherical pendulum in its polar angle θ from the downward vertical and its azimuth
     φ::
@@ -119,26 +108,6 @@ def spherical_pendulum(m: float = 1.0, l: float = 1.0, g: float = 1.0, *, jit: b
         L = ½ml²(θ̇² + sin²θ φ̇²) + mgl cos θ
 
     (m = l = g = 1 by default). φ is cyclic: p_φ = ml² sin²θ φ̇ is conserved.
-
-    Parameters
-    ----------
-    m : float, default 1.0
-        The mass.
-    l : float, default 1.0
-        The rod's length.
-    g : float, default 1.0
-        The gravitational acceleration.
-    jit : bool, default True
-        Compile the model's tapes (Cranelift), or interpret them.
-
-    Returns
-    -------
-    SymbolicModel
-        A general Lagrangian, n = 2, φ cyclic.
-
-    See Also
-    --------
-    varmech.scenes.spherical_pendulum : the native scene it twins.
 
     Examples
     --------
@@ -154,6 +123,11 @@ def spherical_pendulum(m: float = 1.0, l: float = 1.0, g: float = 1.0, *, jit: b
     )
 
 
+@symbolic_doc(
+    "A general Lagrangian, n = 3, φ and ψ cyclic.",
+    parameters={"I1": "The transverse moment of inertia about the pivot."},
+    see_also=["varmech.symbolic.routh : reduces it by its cyclic angles."],
+)
 def heavy_top(I1: float = 1.0, I3: float = 0.5, Mgl: float = 1.0, *, jit: bool = True) -> SymbolicModel:
     """The heavy symmetric top in Euler angles (θ, φ, ψ), θ from the upward vertical::
 
@@ -161,27 +135,6 @@ def heavy_top(I1: float = 1.0, I3: float = 0.5, Mgl: float = 1.0, *, jit: bool =
 
     (I₁ = 1, I₃ = ½, Mgl = 1 by default). φ and ψ are cyclic: p_φ and p_ψ are conserved, and
     :func:`varmech.symbolic.routh` ignores them in closed form.
-
-    Parameters
-    ----------
-    I1 : float, default 1.0
-        The transverse moment of inertia about the pivot.
-    I3 : float, default 0.5
-        The moment of inertia about the symmetry axis.
-    Mgl : float, default 1.0
-        Mass × gravity × the pivot's distance to the centre of mass.
-    jit : bool, default True
-        Compile the model's tapes (Cranelift), or interpret them.
-
-    Returns
-    -------
-    SymbolicModel
-        A general Lagrangian, n = 3, φ and ψ cyclic.
-
-    See Also
-    --------
-    varmech.scenes.heavy_top : the native scene it twins.
-    varmech.symbolic.routh : reduces it by its cyclic angles.
 
     Examples
     --------
@@ -203,6 +156,10 @@ def heavy_top(I1: float = 1.0, I3: float = 0.5, Mgl: float = 1.0, *, jit: bool =
     )
 
 
+@symbolic_doc(
+    "A separable mechanical system, n = 2, rotation invariant.",
+    see_also=["kepler_polar : the same problem in polar coordinates."],
+)
 def kepler(*, jit: bool = True) -> SymbolicModel:
     """Kepler's problem in the plane as the native scene has it, the separable mechanical
     system with unit mass and no parameters::
@@ -210,21 +167,6 @@ def kepler(*, jit: bool = True) -> SymbolicModel:
         L = ½|q̇|² + 1/|q|,   H = |p|²/2 − 1/|q|
 
     rotation invariant: the angular momentum x p_y − y p_x is conserved.
-
-    Parameters
-    ----------
-    jit : bool, default True
-        Compile the model's tapes (Cranelift), or interpret them.
-
-    Returns
-    -------
-    SymbolicModel
-        A separable mechanical system, n = 2, rotation invariant.
-
-    See Also
-    --------
-    varmech.scenes.kepler : the native scene it twins.
-    kepler_polar : the same problem in polar coordinates.
 
     Examples
     --------
@@ -247,30 +189,13 @@ def kepler(*, jit: bool = True) -> SymbolicModel:
     )
 
 
+@symbolic_doc("A general Lagrangian, n = 2, θ cyclic.")
 def kepler_polar(m: float = 1.0, k: float = 1.0, *, jit: bool = True) -> SymbolicModel:
     """Kepler's problem in polar coordinates (r, θ)::
 
         L = ½m(ṙ² + r²θ̇²) + k/r
 
     (m = k = 1 by default). θ is cyclic: p_θ = mr²θ̇ is conserved.
-
-    Parameters
-    ----------
-    m : float, default 1.0
-        The mass.
-    k : float, default 1.0
-        The strength of the attraction k/r.
-    jit : bool, default True
-        Compile the model's tapes (Cranelift), or interpret them.
-
-    Returns
-    -------
-    SymbolicModel
-        A general Lagrangian, n = 2, θ cyclic.
-
-    See Also
-    --------
-    varmech.scenes.kepler_polar : the native scene it twins.
 
     Examples
     --------
@@ -285,6 +210,14 @@ def kepler_polar(m: float = 1.0, k: float = 1.0, *, jit: bool = True) -> Symboli
     return lagrangian(L, [r, th], [vr, vth], parameters={m_: m, k_: k}, jit=jit, name="kepler_polar (symbolic)")
 
 
+@symbolic_doc(
+    "A general Lagrangian (linear in the velocities), n = 2, rotation invariant.",
+    parameters={
+        "kappa": "Its growth κ with |q|².",
+        "e": "The charge.",
+    },
+    see_also=["charged_particle_nonuniform : κ = 1/4."],
+)
 def charged_particle(
     B: float = 1.0, kappa: float = 0.0, m: float = 1.0, e: float = 1.0, *, jit: bool = True
 ) -> SymbolicModel:
@@ -296,29 +229,6 @@ def charged_particle(
     (∇×A = B(q) for A = a(|q|²)(−y, x)). κ = 0 is the uniform field, in which the particle
     gyrates at Ω = eB/m. Rotation invariant: the canonical angular momentum x p_y − y p_x is
     conserved. The defaults are the native scene's (m = e = B = 1, κ = 0).
-
-    Parameters
-    ----------
-    B : float, default 1.0
-        The field at the origin.
-    kappa : float, default 0.0
-        Its growth κ with |q|².
-    m : float, default 1.0
-        The mass.
-    e : float, default 1.0
-        The charge.
-    jit : bool, default True
-        Compile the model's tapes (Cranelift), or interpret them.
-
-    Returns
-    -------
-    SymbolicModel
-        A general Lagrangian (linear in the velocities), n = 2, rotation invariant.
-
-    See Also
-    --------
-    varmech.scenes.charged_particle : the native scene it twins.
-    charged_particle_nonuniform : κ = 1/4.
 
     Examples
     --------
@@ -342,23 +252,10 @@ def charged_particle(
     )
 
 
+@symbolic_doc("As :func:`charged_particle` returns it.")
 def charged_particle_nonuniform(*, jit: bool = True) -> SymbolicModel:
     """The charged particle in the native scene's non-uniform field B(q) = (1 + |q|²/4) ẑ:
     :func:`charged_particle` with B = 1, κ = ¼.
-
-    Parameters
-    ----------
-    jit : bool, default True
-        Compile the model's tapes (Cranelift), or interpret them.
-
-    Returns
-    -------
-    SymbolicModel
-        As :func:`charged_particle` returns it.
-
-    See Also
-    --------
-    varmech.scenes.charged_particle_nonuniform : the native scene it twins.
 
     Examples
     --------
@@ -369,6 +266,13 @@ def charged_particle_nonuniform(*, jit: bool = True) -> SymbolicModel:
     return charged_particle(kappa=0.25, jit=jit)
 
 
+@symbolic_doc(
+    "A forced general Lagrangian, n = 1.",
+    parameters={
+        "amplitude": "The torque's amplitude A.",
+        "drive": ("float, default 2/3", "The driving frequency Ω."),
+    },
+)
 def damped_driven_pendulum(
     gamma: float = 0.5,
     amplitude: float = 1.5,
@@ -386,32 +290,6 @@ def damped_driven_pendulum(
     with the Rayleigh dissipation R and the driving torque Q as a force (``amplitude`` is A,
     ``drive`` is Ω). The defaults are the native scene's, Baker & Gollub's chaotic regime
     (γ = ½, A = 3/2, Ω = 2/3, m = l = g = 1).
-
-    Parameters
-    ----------
-    gamma : float, default 0.5
-        The damping γ.
-    amplitude : float, default 1.5
-        The torque's amplitude A.
-    drive : float, default 2/3
-        The driving frequency Ω.
-    m : float, default 1.0
-        The mass.
-    l : float, default 1.0
-        The rod's length.
-    g : float, default 1.0
-        The gravitational acceleration.
-    jit : bool, default True
-        Compile the model's tapes (Cranelift), or interpret them.
-
-    Returns
-    -------
-    SymbolicModel
-        A forced general Lagrangian, n = 1.
-
-    See Also
-    --------
-    varmech.scenes.damped_driven_pendulum : the native scene it twins.
 
     Examples
     --------
@@ -435,37 +313,16 @@ def damped_driven_pendulum(
     )
 
 
+@symbolic_doc(
+    "A separable mechanical system, n = 2, with one holonomic constraint.",
+    raises="Naming ``mass`` when ``m`` is not finite and positive.",
+)
 def cartesian_pendulum(m: float = 1.0, l: float = 1.0, g: float = 1.0, *, jit: bool = True) -> SymbolicModel:
     """The planar pendulum in Cartesian coordinates (x, y) on its circle::
 
         L = ½m(ẋ² + ẏ²) − mgy,   g(q) = ½(x² + y² − l²) = 0
 
     (m = l = g = 1 by default), integrated by ``rattle``.
-
-    Parameters
-    ----------
-    m : float, default 1.0
-        The mass.
-    l : float, default 1.0
-        The rod's length.
-    g : float, default 1.0
-        The gravitational acceleration.
-    jit : bool, default True
-        Compile the model's tapes (Cranelift), or interpret them.
-
-    Returns
-    -------
-    SymbolicModel
-        A separable mechanical system, n = 2, with one holonomic constraint.
-
-    Raises
-    ------
-    ValueError
-        Naming ``mass`` when ``m`` is not finite and positive.
-
-    See Also
-    --------
-    varmech.scenes.cartesian_pendulum : the native scene it twins.
 
     Examples
     --------
@@ -487,6 +344,11 @@ def cartesian_pendulum(m: float = 1.0, l: float = 1.0, g: float = 1.0, *, jit: b
     )
 
 
+@documented(
+    "A general Lagrangian, n = 2.",
+    parameters={"k": "The spring's stiffness."},
+    see_also=["elastic_pendulum_cartesian : the same pendulum, separable.", 'scene : its scene, ``scene("elastic_pendulum")``.'],
+)
 def elastic_pendulum(
     m: float = 1.0, k: float = 10.0, l0: float = 1.0, g: float = _G, *, jit: bool = True
 ) -> SymbolicModel:
@@ -500,29 +362,6 @@ def elastic_pendulum(
     energy is conserved, and the motion is chaotic at large amplitude. It hangs at rest at
     r = l_eq = l₀ + mg/k, about which the small oscillations are the radial one at √(k/m) and
     the swing at √(g/l_eq). Defaults: m = 1, k = 10, l₀ = 1, g = 9.80665.
-
-    Parameters
-    ----------
-    m : float, default 1.0
-        The mass.
-    k : float, default 10.0
-        The spring's stiffness.
-    l0 : float, default 1.0
-        The spring's rest length l₀.
-    g : float, default 9.80665
-        The gravitational acceleration.
-    jit : bool, default True
-        Compile the model's tapes (Cranelift), or interpret them.
-
-    Returns
-    -------
-    SymbolicModel
-        A general Lagrangian, n = 2.
-
-    See Also
-    --------
-    elastic_pendulum_cartesian : the same pendulum, separable.
-    scene : its scene, ``scene("elastic_pendulum")``.
 
     Examples
     --------
@@ -546,6 +385,12 @@ def elastic_pendulum(
     )
 
 
+@documented(
+    "A separable mechanical system, n = 2.",
+    parameters={"k": "The spring's stiffness."},
+    raises="Naming ``mass`` when ``m`` is not finite and positive.",
+    see_also=["elastic_pendulum : the same pendulum in polar coordinates."],
+)
 def elastic_pendulum_cartesian(
     m: float = 1.0, k: float = 10.0, l0: float = 1.0, g: float = _G, *, jit: bool = True
 ) -> SymbolicModel:
@@ -557,33 +402,6 @@ def elastic_pendulum_cartesian(
     The same two degrees of freedom as in polar coordinates, but with a constant mass matrix:
     the model is separable, so every explicit composition applies (up to Kahan–Li's order 8),
     where the polar form takes only the implicit methods. Defaults as :func:`elastic_pendulum`.
-
-    Parameters
-    ----------
-    m : float, default 1.0
-        The mass.
-    k : float, default 10.0
-        The spring's stiffness.
-    l0 : float, default 1.0
-        The spring's rest length l₀.
-    g : float, default 9.80665
-        The gravitational acceleration.
-    jit : bool, default True
-        Compile the model's tapes (Cranelift), or interpret them.
-
-    Returns
-    -------
-    SymbolicModel
-        A separable mechanical system, n = 2.
-
-    Raises
-    ------
-    ValueError
-        Naming ``mass`` when ``m`` is not finite and positive.
-
-    See Also
-    --------
-    elastic_pendulum : the same pendulum in polar coordinates.
 
     Examples
     --------
@@ -600,6 +418,14 @@ def elastic_pendulum_cartesian(
     )
 
 
+@documented(
+    "A Lagrangian in t's presence, separable once simplified, n = 1.",
+    parameters={
+        "R": "The hoop's radius.",
+        "Omega": "The hoop's rate of turn Ω.",
+    },
+    see_also=["varmech.symbolic.lagrangian : builds it from L(θ, θ̇, t)."],
+)
 def rotating_hoop(
     m: float = 1.0, R: float = 1.0, Omega: float = 5.0, g: float = _G, *, jit: bool = True
 ) -> SymbolicModel:
@@ -623,28 +449,6 @@ def rotating_hoop(
     T + V = h + mR²Ω² sin²θ is not: the motor works on the bead at the rate
     d(T + V)/dt = mR²Ω² sin 2θ θ̇. For Ω² > g/R the bottom is unstable and the bead rests
     (relative to the hoop) at cos θ* = g/(RΩ²). Defaults: m = R = 1, Ω = 5, g = 9.80665.
-
-    Parameters
-    ----------
-    m : float, default 1.0
-        The mass.
-    R : float, default 1.0
-        The hoop's radius.
-    Omega : float, default 5.0
-        The hoop's rate of turn Ω.
-    g : float, default 9.80665
-        The gravitational acceleration.
-    jit : bool, default True
-        Compile the model's tapes (Cranelift), or interpret them.
-
-    Returns
-    -------
-    SymbolicModel
-        A Lagrangian in t's presence, separable once simplified, n = 1.
-
-    See Also
-    --------
-    varmech.symbolic.lagrangian : builds it from L(θ, θ̇, t).
 
     Examples
     --------
@@ -673,6 +477,13 @@ def rotating_hoop(
     )
 
 
+@documented(
+    "A Lagrangian that depends on t, forced by the reactive force, n = 1.",
+    parameters={
+        "burn": "The burn rate k = −ṁ.",
+        "exhaust": "The exhaust speed c relative to the rocket.",
+    },
+)
 def rocket(
     m0: float = 10.0, burn: float = 0.4, exhaust: float = 400.0, g: float = _G, *, jit: bool = True
 ) -> SymbolicModel:
@@ -689,24 +500,6 @@ def rocket(
     The run stops with a :class:`~varmech.VarmechError` at the step where the mass has burnt
     out, t = m₀/k. Defaults: m₀ = 10, k = 0.4, c = 400, g = 9.80665: a thrust kc = 160 above
     the weight m₀g ≈ 98, burn-out at t = 25.
-
-    Parameters
-    ----------
-    m0 : float, default 10.0
-        The initial mass m₀.
-    burn : float, default 0.4
-        The burn rate k = −ṁ.
-    exhaust : float, default 400.0
-        The exhaust speed c relative to the rocket.
-    g : float, default 9.80665
-        The gravitational acceleration.
-    jit : bool, default True
-        Compile the model's tapes (Cranelift), or interpret them.
-
-    Returns
-    -------
-    SymbolicModel
-        A Lagrangian that depends on t, forced by the reactive force, n = 1.
 
     Examples
     --------
@@ -727,6 +520,10 @@ def rocket(
     )
 
 
+@documented(
+    "An autonomous Lagrangian forced by the reactive force, n = 1.",
+    parameters={"rho": "The chain's mass per length ρ."},
+)
 def falling_chain(rho: float = 1.0, g: float = _G, *, jit: bool = True) -> SymbolicModel:
     """Cayley's falling chain: a chain heaped at the edge of a hole falls through it, its
     hanging part (length x, mass ρx) picking up links at rest from the heap.
@@ -740,20 +537,6 @@ def falling_chain(rho: float = 1.0, g: float = _G, *, jit: bool = True) -> Symbo
     each link's pickup is an inelastic collision, and E − E₀ balances the reactive force's work
     −∫½ρẋ³ dt, which the run tracks (``traj.work``). The chain needs x₀ > 0 (no mass hangs at
     x = 0). Defaults: ρ = 1, g = 9.80665.
-
-    Parameters
-    ----------
-    rho : float, default 1.0
-        The chain's mass per length ρ.
-    g : float, default 9.80665
-        The gravitational acceleration.
-    jit : bool, default True
-        Compile the model's tapes (Cranelift), or interpret them.
-
-    Returns
-    -------
-    SymbolicModel
-        An autonomous Lagrangian forced by the reactive force, n = 1.
 
     Examples
     --------
@@ -773,6 +556,13 @@ def falling_chain(rho: float = 1.0, g: float = _G, *, jit: bool = True) -> Symbo
     )
 
 
+@documented(
+    "An autonomous Lagrangian forced by the reactive force, n = 1.",
+    parameters={
+        "m0": "The plough's own mass m₀.",
+        "rho": "The snow's mass per length ρ.",
+    },
+)
 def snowplough(m0: float = 1.0, rho: float = 0.5, push: float = 0.0, *, jit: bool = True) -> SymbolicModel:
     """A snowplough of mass m₀ driven by a constant force F into snow of mass ρ per length at
     rest, which it gathers: at x its mass is m₀ + ρx.
@@ -784,22 +574,6 @@ def snowplough(m0: float = 1.0, rho: float = 0.5, push: float = 0.0, *, jit: boo
 
     The kinetic energy is not conserved even coasting: gathering the snow is inelastic.
     Defaults: m₀ = 1, ρ = 0.5, F = 0.
-
-    Parameters
-    ----------
-    m0 : float, default 1.0
-        The plough's own mass m₀.
-    rho : float, default 0.5
-        The snow's mass per length ρ.
-    push : float, default 0.0
-        The driving force F.
-    jit : bool, default True
-        Compile the model's tapes (Cranelift), or interpret them.
-
-    Returns
-    -------
-    SymbolicModel
-        An autonomous Lagrangian forced by the reactive force, n = 1.
 
     Examples
     --------
@@ -819,6 +593,13 @@ def snowplough(m0: float = 1.0, rho: float = 0.5, push: float = 0.0, *, jit: boo
     )
 
 
+@documented(
+    "A Lagrangian that depends on t, forced by the reactive force, n = 1.",
+    parameters={
+        "m0": "The belt's own mass m₀.",
+        "rate": "The rate k at which sand falls on it.",
+    },
+)
 def conveyor_belt(m0: float = 1.0, rate: float = 0.2, push: float = 0.2, *, jit: bool = True) -> SymbolicModel:
     """A conveyor belt of mass m₀ onto which sand falls vertically at the rate k (so that the
     mass it carries is m₀ + kt), driven along by a constant force F; its position x.
@@ -832,22 +613,6 @@ def conveyor_belt(m0: float = 1.0, rate: float = 0.2, push: float = 0.2, *, jit:
     ½kv₀² at which the kinetic energy grows, the other half lost as the sand is brought up to
     speed (the energy balance carries it as −∂L/∂t = −½kẋ²). Defaults: m₀ = 1, k = 0.2,
     F = 0.2 (a belt at v₀ = 1 keeps its speed).
-
-    Parameters
-    ----------
-    m0 : float, default 1.0
-        The belt's own mass m₀.
-    rate : float, default 0.2
-        The rate k at which sand falls on it.
-    push : float, default 0.2
-        The driving force F.
-    jit : bool, default True
-        Compile the model's tapes (Cranelift), or interpret them.
-
-    Returns
-    -------
-    SymbolicModel
-        A Lagrangian that depends on t, forced by the reactive force, n = 1.
 
     Examples
     --------
@@ -866,26 +631,9 @@ def conveyor_belt(m0: float = 1.0, rate: float = 0.2, push: float = 0.2, *, jit:
     )
 
 
-#: The twin of each built-in scene by the scene's name.
-_TWINS = {
-    f.__name__: f
-    for f in (
-        double_pendulum,
-        spherical_pendulum,
-        heavy_top,
-        kepler,
-        kepler_polar,
-        charged_particle,
-        charged_particle_nonuniform,
-        damped_driven_pendulum,
-        cartesian_pendulum,
-    )
-}
-
-
 def symbolic_of(scene: Scene, *, jit: bool = True) -> SymbolicModel:
-    """The symbolic twin of a built-in scene: the function of this module with the scene's
-    name, at the scene's parameters (a catalogue parameter is passed on when the twin has a
+    """The symbolic twin of a built-in scene (declared with it, :mod:`varmech._catalogue`): the
+    function of this module with the scene's name, at the scene's parameters (a catalogue parameter is passed on when the twin has a
     keyword of that name, compared without case — the charged particle's ``b`` is ``B``; the
     others, such as Kepler's eccentricity ``e``, set the initial state, not the model).
 
@@ -921,9 +669,9 @@ def symbolic_of(scene: Scene, *, jit: bool = True) -> SymbolicModel:
     ...
     ValueError: scene: 'pendulum' has no symbolic twin in varmech.symbolic.examples
     """
-    twin = _TWINS.get(scene.name) if scene.name in CATALOGUE else None
-    if twin is None:
+    if scene.name not in CATALOGUE or not declared(scene.name).symbolic:
         raise ValueError(f"scene: {scene.name!r} has no symbolic twin in varmech.symbolic.examples")
+    twin = globals()[scene.name]
     keywords = {name.lower(): name for name in inspect.signature(twin).parameters if name != "jit"}
     given = {keywords[name.lower()]: value for name, value in scene.parameters.items() if name.lower() in keywords}
     return twin(**given, jit=jit)
