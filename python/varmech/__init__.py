@@ -30,6 +30,7 @@ from ._version import __version__ as __version__
 from ._warnings import DerivativeWarning, VarmechWarning
 from .analysis import sections, stability
 from .analysis.energy_growth import energy_growth
+from .analysis.implicit import implicit_regions
 from .analysis.lyapunov import LyapunovSpectrum, Megno, lyapunov_spectrum, megno
 from .analysis.phase_portrait import phase_portrait
 from .analysis.reference import ReferenceWarning
@@ -37,7 +38,6 @@ from .analysis.sections import poincare_section
 from .analysis.stability import (
     growth_factor,
     growth_table,
-    implicit_regions,
     stability_scan,
     stability_table,
     unstable_intervals,

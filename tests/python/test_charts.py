@@ -10,10 +10,11 @@ import pytest
 
 import varmech
 from varmech import charts
+from varmech.analysis.implicit import implicit_regions
 from varmech.analysis.nonholonomic import nonholonomic_energy
 from varmech.analysis.phase_portrait import phase_portrait
 from varmech.analysis.sections import poincare_section
-from varmech.analysis.stability import growth_table, implicit_regions, spectrum
+from varmech.analysis.stability import growth_table, spectrum
 
 matplotlib = pytest.importorskip("matplotlib")
 

@@ -11,12 +11,12 @@ import pytest
 import varmech
 from conftest import REFERENCE_DIR
 from varmech import stability
+from varmech.analysis.implicit import implicit_regions
 from varmech.analysis.stability import (
     COMPOSITION_NAMES,
     REFERENCE_LIMITS,
     growth_factor,
     growth_table,
-    implicit_regions,
     stability_scan,
     stability_table,
     step_matrix,

@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 
 from .. import scenes
-from ..analysis import energy_growth, sections, stability, work_precision
+from ..analysis import energy_growth, implicit, sections, stability, work_precision
 from ..analysis._orbits import energy_at
 from ..analysis.baselines import REBOUND_METHODS
 from ..analysis.nonholonomic import nonholonomic_energy
@@ -138,7 +138,7 @@ def _spectrum(sc, methods, quick, progress, options):
 
 
 def _implicit_regions(sc, methods, quick, progress, options):
-    table = stability.implicit_regions(methods, scene=sc, progress=progress)
+    table = implicit.implicit_regions(methods, scene=sc, progress=progress)
     draw = lambda t, p: implicit_regions_chart(t, p, title=f"{sc.name}: outcome of the implicit steps by step and initial angle")  # noqa: E731
     return [("implicit_regions", table, {"implicit_regions": draw})]
 

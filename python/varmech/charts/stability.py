@@ -138,13 +138,13 @@ def stability_chart(
 @documented
 def implicit_regions_chart(table: Table, path: str | Path | None = None, title: str = "", *, ax: Axes | Sequence[Axes] | None = None) -> Figure:
     """A categorical map of the outcome over step size h (columns) and initial angle q₀ (rows),
-    one panel per method, from :func:`~varmech.analysis.stability.implicit_regions`. Writes ``path``
+    one panel per method, from :func:`~varmech.analysis.implicit.implicit_regions`. Writes ``path``
     (PNG or SVG).
 
     Parameters
     ----------
     table : Table
-        A table returned by :func:`~varmech.analysis.stability.implicit_regions`.
+        A table returned by :func:`~varmech.analysis.implicit.implicit_regions`.
     {path}
     title : str, optional
         The figure's title (default: the scene and the number of steps).
@@ -156,14 +156,14 @@ def implicit_regions_chart(table: Table, path: str | Path | None = None, title: 
 
     See Also
     --------
-    varmech.analysis.stability.implicit_regions : The measurements.
+    varmech.analysis.implicit.implicit_regions : The measurements.
 
     Examples
     --------
     >>> import tempfile
     >>> from pathlib import Path
     >>> import matplotlib.pyplot as plt
-    >>> from varmech.analysis.stability import implicit_regions
+    >>> from varmech.analysis.implicit import implicit_regions
     >>> from varmech.charts import implicit_regions_chart
     >>> table = implicit_regions("midpoint", h_values=(0.5, 3.0), q0_values=(1.0, 3.0))
     >>> with tempfile.TemporaryDirectory() as folder:
