@@ -4,8 +4,8 @@ executables, interleaved, best of several rounds, reported as ratios.
     cargo bench --no-run                       # in each checkout; note the executables it prints
     python benches/criterion_ab.py --before DIR --after DIR [--rounds 5]
 
-DIR holds the bench executables `steps`, `implicit` and `constraints` of one build (copied out
-of target/release/deps). Each round runs every selected bench once in each build, alternating,
+DIR holds the bench executables `steps`, `implicit`, `constraints` and `impacts` of one build
+(copied out of target/release/deps). Each round runs every selected bench once in each build, alternating,
 so that the noise of a shared machine falls on both alike; a bench's figure is its best
 (smallest) criterion estimate over the rounds.
 """
@@ -17,7 +17,8 @@ import re
 import subprocess
 from pathlib import Path
 
-#: (executable, criterion filter): the step loops issue 12 promised to keep as fast.
+#: (executable, criterion filter): the step loops issue 12 promised to keep as fast, and the
+#: impacts' resolution (a billiard by each law, and a contact never hit).
 BENCHES = [
     ("steps", "^kepler/verlet$"),
     ("steps", "^kepler/kahan_li8$"),
@@ -26,6 +27,9 @@ BENCHES = [
     ("implicit", "^double_pendulum/midpoint$"),
     ("implicit", "^double_pendulum/galerkin4$"),
     ("constraints", "^rattle_chain/8$"),
+    ("impacts", "^billiard/reflect$"),
+    ("impacts", "^billiard/variational$"),
+    ("impacts", "^billiard/never_hit$"),
 ]
 
 UNITS = {"ps": 1e-12, "ns": 1e-9, "µs": 1e-6, "us": 1e-6, "ms": 1e-3, "s": 1.0}

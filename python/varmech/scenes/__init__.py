@@ -42,6 +42,9 @@ from ._lagrangian import (
 from ._scene import CATALOGUE, SYMBOLIC, TIME_UNITS, Reference, Scene, as_scene, get
 from ._scene import LONG_RUNS as LONG_RUNS
 
+# Named, documented and pickled where users meet them: here (and as varmech.Scene).
+Scene.__module__ = Reference.__module__ = __name__
+
 __all__ = [
     "CATALOGUE",
     "SYMBOLIC",
