@@ -28,7 +28,6 @@ pytest.importorskip("sympy")
         "varmech.impulses",
         "varmech.impacts",
         "varmech.surfaces",
-        "varmech.scenes",
         "varmech.scenes._scene",
         "varmech.scenes._hamiltonian",
         "varmech.scenes._lagrangian",

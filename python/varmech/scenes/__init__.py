@@ -39,18 +39,16 @@ from ._lagrangian import (
     kepler_polar,
     spherical_pendulum,
 )
-from ._scene import CATALOGUE, SYMBOLIC, TIME_UNITS, Reference, Scene, as_scene, get
+from ._scene import CATALOGUE, SYMBOLIC, TIME_UNITS, as_scene, get
 from ._scene import LONG_RUNS as LONG_RUNS
+from ._scene import Reference as Reference
+from ._scene import Scene as Scene
 
-# Named, documented and pickled where users meet them: here (and as varmech.Scene).
-Scene.__module__ = Reference.__module__ = __name__
-
+# Scene and Reference are documented once, as varmech.Scene and varmech.Reference.
 __all__ = [
     "CATALOGUE",
     "SYMBOLIC",
     "TIME_UNITS",
-    "Reference",
-    "Scene",
     "as_scene",
     "ball_on_turntable",
     "bouncing_ball",
