@@ -52,6 +52,15 @@ _VARMECH_ERROR = """Base class of varmech's errors: catch it to catch any of the
     DivergenceError 1 -1 2
     """
 
+# The attributes that say where a run failed, as DivergenceError, ConvergenceError and
+# SpuriousBranchError have them, put into their docstrings for ``{failed step}``.
+_FAILED_STEP = """Attributes
+    ----------
+    step : int
+        The step that failed (1 for the first).
+    time : float
+        The time tₙ at the start of that step."""
+
 _DIVERGENCE_ERROR = """The solution blew up: a non-finite state, or an energy error beyond ``max_energy_error``.
 
     :func:`varmech.integrate` checks the energy error |E − E₀| at each saved state against
@@ -63,12 +72,7 @@ _DIVERGENCE_ERROR = """The solution blew up: a non-finite state, or an energy er
     symplectic method's modified energy at a coarse stable step runs to the end, however
     large. A state that is not finite always stops the run. The usual cure is a smaller step.
 
-    Attributes
-    ----------
-    step : int
-        The step that failed (1 for the first).
-    time : float
-        The time tₙ at the start of that step.
+    {failed step}
     partial : Trajectory
         The run up to the last good step (``status`` -1): the states before the blow-up, to
         look at or to go on from with a smaller step.
@@ -112,12 +116,7 @@ _CONVERGENCE_ERROR = """Newton's method did not solve a step's implicit equation
     with the first, its smoothness where the corrections stall far above the noise, more
     iterations where they were still falling.
 
-    Attributes
-    ----------
-    step : int
-        The step that failed (1 for the first).
-    time : float
-        The time tₙ at the start of that step.
+    {failed step}
     residual : float
         ‖F‖∞, the max-norm of the step's equations F(qₙ₊₁) = 0 at the last iterate.
     iterations : int
@@ -149,12 +148,7 @@ _SPURIOUS_BRANCH_ERROR = """A step's implicit equations were solved beyond a fol
     pendulum jumping over the top with too little energy). A subclass of
     :class:`ConvergenceError`, whose ``residual`` and ``iterations`` it does not set.
 
-    Attributes
-    ----------
-    step : int
-        The step that failed (1 for the first).
-    time : float
-        The time tₙ at the start of that step.
+    {failed step}
     partial : Trajectory
         The run up to the last good step (``status`` -1).
 
@@ -222,11 +216,14 @@ _CONTACT_ERROR = """A contact could not be resolved: a non-finite state through 
 
 #: The numpydoc docstrings of the binding's exceptions, which :func:`install` sets.
 DOCSTRINGS: dict[type[BaseException], str] = {
-    VarmechError: _VARMECH_ERROR,
-    DivergenceError: _DIVERGENCE_ERROR,
-    ConvergenceError: _CONVERGENCE_ERROR,
-    SpuriousBranchError: _SPURIOUS_BRANCH_ERROR,
-    ContactError: _CONTACT_ERROR,
+    cls: doc.replace("{failed step}", _FAILED_STEP)
+    for cls, doc in {
+        VarmechError: _VARMECH_ERROR,
+        DivergenceError: _DIVERGENCE_ERROR,
+        ConvergenceError: _CONVERGENCE_ERROR,
+        SpuriousBranchError: _SPURIOUS_BRANCH_ERROR,
+        ContactError: _CONTACT_ERROR,
+    }.items()
 }
 
 #: The docstrings' examples, for doctest (the classes belong to module ``varmech``).

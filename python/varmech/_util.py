@@ -1,16 +1,30 @@
-"""Argument checks shared by the public functions."""
+"""Argument checks shared by the public functions, and the filling of shared docstring sections."""
 
 from __future__ import annotations
 
 import inspect
 import math
-from typing import Any
+from collections.abc import Callable, Mapping
+from typing import Any, TypeVar
 
 import numpy as np
 from numpy.typing import ArrayLike
 
 #: The largest count (steps, dimensions, indices) the core's unsigned integers take.
 MAX_COUNT = 2**63 - 1
+
+_F = TypeVar("_F", bound=Callable[..., Any])
+
+
+def with_sections(f: _F, sections: Mapping[str, str]) -> _F:
+    """``f`` with ``sections`` (by placeholder, e.g. ``{returns}``) put into its docstring for
+    their placeholders, as matplotlib's and SciPy's docstring templates do: the sections a
+    family of functions shares, written once."""
+    doc = f.__doc__ or ""
+    for placeholder, section in sections.items():
+        doc = doc.replace(placeholder, section)
+    f.__doc__ = doc
+    return f
 
 
 def _shown(x: Any) -> str:

@@ -45,15 +45,41 @@ import inspect
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
-from typing import Any, Literal
+from typing import Any, Literal, TypeVar
 
 import numpy as np
 
 from . import _core
-from ._util import finite, integer, number, positive, positive_int
+from ._util import finite, integer, number, positive, positive_int, with_sections
 
 #: An event function g(t, q, p) (or g(t, q, v), see :class:`Event`).
 EventFunction = Callable[[float, np.ndarray, np.ndarray], float]
+
+_F = TypeVar("_F", bound=Callable[..., Any])
+
+# The docstring sections the built-in events share, put in for their placeholders by
+# :func:`_documented` (as varmech.charts does its charts').
+_SECTIONS = {
+    "{terminal}": """terminal
+        Stop the run at the end of the step of the first crossing (True), of the k-th (an
+        integer k), or never (False).""",
+    "{returns}": """Returns
+    -------
+    Event
+        The event, for ``integrate(..., events=[...])``: its crossings are located by a partial
+        step of the method and kept in ``traj.events``.""",
+    # escape's and encounter's, both checked by _distance.
+    "{distance raises}": """Raises
+    ------
+    ValueError
+        ``radius`` not finite and positive, or ``groups`` not lists of indices of one length,
+        naming it.""",
+}
+
+
+def _documented(event: _F) -> _F:
+    """``event`` with the shared sections put into its docstring for their placeholders."""
+    return with_sections(event, _SECTIONS)
 
 
 @dataclass(frozen=True)
@@ -160,6 +186,7 @@ class Occurrences:
         return self.name == other.name and all(np.array_equal(a, b) for a, b in pairs)
 
 
+@_documented
 def crossing(k: int, value: float = 0.0, *, direction: int = 0, terminal: bool | int = False) -> Event:
     """The coordinate q_k crossing ``value``: g = q_k − value (evaluated natively).
 
@@ -171,15 +198,9 @@ def crossing(k: int, value: float = 0.0, *, direction: int = 0, terminal: bool |
         The level it crosses.
     direction
         +1: only upward crossings (g from − to +); −1: only downward; 0: both.
-    terminal
-        Stop the run at the end of the step of the first crossing (True), of the k-th (an
-        integer k), or never (False).
+    {terminal}
 
-    Returns
-    -------
-    Event
-        The event, for ``integrate(..., events=[...])``: its crossings are located by a partial
-        step of the method and kept in ``traj.events``.
+    {returns}
 
     Raises
     ------
@@ -200,6 +221,7 @@ def crossing(k: int, value: float = 0.0, *, direction: int = 0, terminal: bool |
     return Event(None, direction, terminal, name=f"q[{k}] = {value:g}", native=("crossing", (k, value)))
 
 
+@_documented
 def energy_error(bound: float, *, terminal: bool | int = True) -> Event:
     """The energy error growing beyond ``bound``: g = |E(q, p) − E₀| − bound, E₀ the energy at
     the start, crossing upward (evaluated natively). Terminal by default: a run that stops when
@@ -209,15 +231,9 @@ def energy_error(bound: float, *, terminal: bool | int = True) -> Event:
     ----------
     bound
         The largest acceptable |E − E₀|, absolute.
-    terminal
-        Stop the run at the end of the step of the first crossing (True), of the k-th (an
-        integer k), or never (False).
+    {terminal}
 
-    Returns
-    -------
-    Event
-        The event, for ``integrate(..., events=[...])``: its crossings are located by a partial
-        step of the method and kept in ``traj.events``.
+    {returns}
 
     Raises
     ------
@@ -239,6 +255,7 @@ def energy_error(bound: float, *, terminal: bool | int = True) -> Event:
     return Event(None, +1, terminal, name=f"|E - E0| > {bound:g}", native=("energy_error", bound))
 
 
+@_documented
 def multiplier(k: int = 0, *, direction: int = 0, terminal: bool | int = False) -> Event:
     """The multiplier λ_k of the model's constraints crossing 0: g = λ_k (evaluated natively, in
     the core). λ is :meth:`Trajectory.reactions`'s, with Lagrange's sign (the constraints'
@@ -252,9 +269,7 @@ def multiplier(k: int = 0, *, direction: int = 0, terminal: bool | int = False) 
         The row of λ (holonomic constraints first, then velocity constraints).
     direction
         +1: only crossings upward; −1: only downward; 0: both.
-    terminal
-        Stop the run at the end of the step of the first crossing (True), of the k-th (an
-        integer k), or never (False).
+    {terminal}
 
     Returns
     -------
@@ -288,6 +303,7 @@ def multiplier(k: int = 0, *, direction: int = 0, terminal: bool | int = False) 
     return Event(None, direction, terminal, name=f"lambda[{k}] = 0", native=("multiplier", k))
 
 
+@_documented
 def escape(radius: float, *, groups: Sequence[Sequence[int]] | None = None, dim: int = 3, terminal: bool | int = True) -> Event:
     """A group of coordinates (a body's position) leaving the ball of ``radius`` about the
     origin: g = maxⱼ |x_j|² − radius², crossing upward (evaluated natively). Terminal by default.
@@ -302,21 +318,11 @@ def escape(radius: float, *, groups: Sequence[Sequence[int]] | None = None, dim:
         problem).
     dim
         The size of each block when ``groups`` is not given.
-    terminal
-        Stop the run at the end of the step of the first crossing (True), of the k-th (an
-        integer k), or never (False).
+    {terminal}
 
-    Returns
-    -------
-    Event
-        The event, for ``integrate(..., events=[...])``: its crossings are located by a partial
-        step of the method and kept in ``traj.events``.
+    {returns}
 
-    Raises
-    ------
-    ValueError
-        ``radius`` not finite and positive, or ``groups`` not lists of indices of one length,
-        naming it.
+    {distance raises}
 
     Examples
     --------
@@ -333,6 +339,7 @@ def escape(radius: float, *, groups: Sequence[Sequence[int]] | None = None, dim:
     return _distance("escape", radius, groups, dim, +1, terminal)
 
 
+@_documented
 def encounter(radius: float, *, groups: Sequence[Sequence[int]] | None = None, dim: int = 3, terminal: bool | int = True) -> Event:
     """Two groups of coordinates (bodies' positions) coming closer than ``radius``:
     g = min_{i<j} |x_i − x_j|² − radius², crossing downward; with a single group, its distance
@@ -344,21 +351,11 @@ def encounter(radius: float, *, groups: Sequence[Sequence[int]] | None = None, d
         The distance below which the groups have met.
     groups, dim
         The positions, as for :func:`escape`.
-    terminal
-        Stop the run at the end of the step of the first crossing (True), of the k-th (an
-        integer k), or never (False).
+    {terminal}
 
-    Returns
-    -------
-    Event
-        The event, for ``integrate(..., events=[...])``: its crossings are located by a partial
-        step of the method and kept in ``traj.events``.
+    {returns}
 
-    Raises
-    ------
-    ValueError
-        ``radius`` not finite and positive, or ``groups`` not lists of indices of one length,
-        naming it.
+    {distance raises}
 
     Examples
     --------

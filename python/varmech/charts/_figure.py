@@ -9,6 +9,8 @@ from typing import TYPE_CHECKING, Any, TypeVar
 
 import numpy as np
 
+from .._util import with_sections
+
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
     from matplotlib.figure import Figure
@@ -16,8 +18,9 @@ if TYPE_CHECKING:
 _F = TypeVar("_F", bound=Callable[..., Any])
 
 # The docstring sections every chart shares, put in for the placeholders ``{path}``, ``{ax}``,
-# ``{returns}`` and ``{raises}`` by :func:`documented`, as matplotlib's and SciPy's docstring
-# templates do. ``{raises}`` ends mid-sentence, for a chart's own cases.
+# ``{returns}``, ``{raises}`` and ``{examples}`` by :func:`documented`, as matplotlib's and SciPy's
+# docstring templates do. ``{raises}`` ends mid-sentence, for a chart's own cases; ``{examples}``
+# opens the Examples with the imports of an example that writes its figure to a temporary folder.
 _SECTIONS = {
     "{path}": """path : str or pathlib.Path, optional
         A file to write the figure to, ending in ``.png`` or ``.svg`` (its folder is created);
@@ -39,16 +42,17 @@ _SECTIONS = {
     ValueError
         ``path`` does not end in ``.png`` or ``.svg``, or ``ax`` holds another number of Axes
         than the chart has panels""",
+    "{examples}": """Examples
+    --------
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> import matplotlib.pyplot as plt""",
 }
 
 
 def documented(chart: _F) -> _F:
     """``chart`` with the shared sections put into its docstring for their placeholders."""
-    doc = chart.__doc__ or ""
-    for placeholder, section in _SECTIONS.items():
-        doc = doc.replace(placeholder, section)
-    chart.__doc__ = doc
-    return chart
+    return with_sections(chart, _SECTIONS)
 
 
 def colormap(name: str) -> Any:

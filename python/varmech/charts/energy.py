@@ -51,11 +51,7 @@ def energy_error(
     varmech.check_conservation : The verdict in the legend.
     varmech.charts.work_precision.energy_growth_chart : The same over a long run, from a table.
 
-    Examples
-    --------
-    >>> import tempfile
-    >>> from pathlib import Path
-    >>> import matplotlib.pyplot as plt
+    {examples}
     >>> import varmech
     >>> from varmech.charts import energy_error
     >>> scene = varmech.scenes.harmonic_oscillator()

@@ -53,11 +53,7 @@ def nonholonomic_energy_chart(table: Table, path: str | Path | None = None, titl
     --------
     varmech.analysis.nonholonomic.nonholonomic_energy : The measurements.
 
-    Examples
-    --------
-    >>> import tempfile
-    >>> from pathlib import Path
-    >>> import matplotlib.pyplot as plt
+    {examples}
     >>> import varmech
     >>> from varmech.analysis.nonholonomic import nonholonomic_energy
     >>> from varmech.charts import nonholonomic_energy_chart

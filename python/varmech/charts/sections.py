@@ -54,11 +54,7 @@ def poincare_chart(
     --------
     varmech.analysis.sections.poincare_section : The measurements.
 
-    Examples
-    --------
-    >>> import tempfile
-    >>> from pathlib import Path
-    >>> import matplotlib.pyplot as plt
+    {examples}
     >>> import varmech
     >>> from varmech.analysis.sections import poincare_section
     >>> from varmech.charts import poincare_chart
@@ -124,11 +120,7 @@ def phase_portrait_chart(table: Table, path: str | Path | None = None, title: st
     --------
     varmech.analysis.phase_portrait.phase_portrait : The measurements.
 
-    Examples
-    --------
-    >>> import tempfile
-    >>> from pathlib import Path
-    >>> import matplotlib.pyplot as plt
+    {examples}
     >>> import varmech
     >>> from varmech.analysis.phase_portrait import phase_portrait
     >>> from varmech.charts import phase_portrait_chart

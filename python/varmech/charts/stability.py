@@ -69,11 +69,7 @@ def stability_chart(
     --------
     varmech.analysis.stability.growth_table : The measurements.
 
-    Examples
-    --------
-    >>> import tempfile
-    >>> from pathlib import Path
-    >>> import matplotlib.pyplot as plt
+    {examples}
     >>> from varmech.analysis.stability import growth_table
     >>> from varmech.charts import stability_chart
     >>> table = growth_table(["verlet", "rk4"], [0.5, 1.0, 2.5, 3.0], limits=False)
@@ -158,11 +154,7 @@ def implicit_regions_chart(table: Table, path: str | Path | None = None, title: 
     --------
     varmech.analysis.implicit.implicit_regions : The measurements.
 
-    Examples
-    --------
-    >>> import tempfile
-    >>> from pathlib import Path
-    >>> import matplotlib.pyplot as plt
+    {examples}
     >>> from varmech.analysis.implicit import implicit_regions
     >>> from varmech.charts import implicit_regions_chart
     >>> table = implicit_regions("midpoint", h_values=(0.5, 3.0), q0_values=(1.0, 3.0))
@@ -233,11 +225,7 @@ def spectrum_chart(table: Table, path: str | Path | None = None, title: str = ""
     varmech.analysis.stability.spectrum : The measurements.
     varmech.suggest_dt : The step from the same modes.
 
-    Examples
-    --------
-    >>> import tempfile
-    >>> from pathlib import Path
-    >>> import matplotlib.pyplot as plt
+    {examples}
     >>> import varmech
     >>> from varmech.charts import spectrum_chart
     >>> table = varmech.analysis.stability.spectrum(varmech.scenes.fermi_pasta_ulam(), ["verlet", "yoshida4", "midpoint"])

@@ -68,11 +68,7 @@ def work_precision_chart(
     --------
     varmech.work_precision : The measurements.
 
-    Examples
-    --------
-    >>> import tempfile
-    >>> from pathlib import Path
-    >>> import matplotlib.pyplot as plt
+    {examples}
     >>> import varmech
     >>> from varmech.charts import work_precision_chart
     >>> table = varmech.work_precision(varmech.scenes.harmonic_oscillator(), ["verlet"],
@@ -158,11 +154,7 @@ def energy_growth_chart(table: Table, path: str | Path | None = None, title: str
     .. [1] D. Brouwer, "On the accumulation of errors in numerical integration",
        *Astron. J.* 46, 149–153 (1937).
 
-    Examples
-    --------
-    >>> import tempfile
-    >>> from pathlib import Path
-    >>> import matplotlib.pyplot as plt
+    {examples}
     >>> import varmech
     >>> from varmech.charts import energy_growth_chart
     >>> table = varmech.energy_growth(varmech.scenes.harmonic_oscillator(), ["verlet", "rk4"],
