@@ -182,8 +182,7 @@ _CONTACT_ERROR = """A contact could not be resolved: a non-finite state through 
     A ball with e < 1 bounces ever lower and faster, and its impacts accumulate at a finite
     time. Under verlet and its compositions the contact then closes and holds the ball (see
     :mod:`varmech.impacts`); other methods cannot hold it, and raise this error there: stop
-    the run before it (a terminal event), or take such a method. Events are not yet located on
-    a held contact's motion: a run with events raises this error when a contact closes.
+    the run before it (a terminal event), or take such a method.
 
     Attributes
     ----------

@@ -459,3 +459,24 @@ def test_slip_functions_compose_with_files_resume_and_ensembles(tmp_path):
     runs = varmech.ensemble(_wheel(), np.tile(q0, (2, 1)), np.tile(p0, (2, 1)), dt=0.01, steps=60, contacts=[_ground(0.5, 0.3)], progress=False)
     for member in runs:
         np.testing.assert_array_equal(member.q, whole.q)
+
+
+@pytest.mark.parametrize("method", ["verlet", "yoshida4"])
+def test_events_on_byerlys_ball_are_located_where_it_slides_and_where_it_rolls_to_round_off(method):
+    # Both motions are polynomials of degree ≤ 2, which the held steps follow exactly: the
+    # crossings of x(0.2) (sliding) and x(1.0) (rolling) are at those times to round-off.
+    v0, mu = 2.0, 0.2
+    rolls = 2 * v0 / (7 * mu * G)
+
+    def x(t: float) -> float:
+        return v0 * t - mu * G * t * t / 2 if t <= rolls else x(rolls) + 5 * v0 / 7 * (t - rolls)
+
+    run = {"dt": 0.01, "steps": 150, "method": method, "contacts": [_floor(mu)]}
+    events = [varmech.events.crossing(0, x(0.2)), varmech.events.crossing(0, x(1.0))]
+    watched = varmech.integrate(_ball(), [0.0, R, 0.0], [M * v0, 0.0, 0.0], events=events, **run)
+    for crossing, t in zip(watched.events[:2], (0.2, 1.0)):
+        assert len(crossing) == 1 and abs(crossing.t[0] - t) < 1e-14
+        assert crossing.q[0][1] == R, "on the floor"
+    plain = varmech.integrate(_ball(), [0.0, R, 0.0], [M * v0, 0.0, 0.0], **run)
+    assert np.array_equal(watched.q, plain.q) and np.array_equal(watched.p, plain.p)
+    assert np.array_equal(watched.events[5].t, plain.events[3].t), "its stick where it was"

@@ -79,12 +79,22 @@ impl<'f> Detector<'f> {
             t: 0.0,
             q: q.to_vec(),
             p: p.to_vec(),
+            q_at: q.to_vec(),
+            p_at: p.to_vec(),
             g,
             g_next: vec![0.0; m],
             g_trial: vec![0.0; m],
             counts: vec![0; m],
         })
     }
+}
+
+/// The partial steps of a piece that the run's method alone does not take: a held contact's
+/// (RATTLE on the closed contacts, [`crate::integrators::jumps`]). A crossing on such a piece
+/// is located on them, so that the located state keeps the contact.
+pub(in crate::integrators) trait PieceSteps {
+    /// The state τ into the piece, from its start (the search's kept start).
+    fn state_at(&mut self, step: usize, tau: f64) -> Result<(&[f64], &[f64]), Error>;
 }
 
 /// A run's detector: the scratch [`Stepper`] of the partial steps, on the run's model, and the
@@ -97,6 +107,9 @@ pub(in crate::integrators) struct Search<'d, 'f, M> {
     t: f64,
     q: Vec<f64>,
     p: Vec<f64>,
+    /// The state of the last partial step.
+    q_at: Vec<f64>,
+    p_at: Vec<f64>,
     g: Vec<f64>,
     g_next: Vec<f64>,
     g_trial: Vec<f64>,
@@ -141,9 +154,21 @@ impl<M: Deref<Target: Dynamics>> Search<'_, '_, M> {
     pub(in crate::integrators) fn piece(
         &mut self,
         step: usize,
+        end: (f64, &[f64], &[f64]),
+        tau: f64,
+        occurrences: &mut Vec<Occurrence>,
+    ) -> Result<(), Error> {
+        self.piece_on(step, end, tau, occurrences, None)
+    }
+
+    /// [`Search::piece`], its crossings located on `steps` where given (a held piece's).
+    pub(in crate::integrators) fn piece_on(
+        &mut self,
+        step: usize,
         (t, q, p): (f64, &[f64], &[f64]),
         tau: f64,
         occurrences: &mut Vec<Occurrence>,
+        mut steps: Option<&mut dyn PieceSteps>,
     ) -> Result<(), Error> {
         let model = self.scratch.model().as_dynamics();
         let functions = &mut self.detector.functions;
@@ -157,7 +182,7 @@ impl<M: Deref<Target: Dynamics>> Search<'_, '_, M> {
         check_finite(&self.detector.specs, &self.g_next, step, t)?;
         for i in 0..self.g.len() {
             if crosses(self.detector.specs[i].direction, self.g[i], self.g_next[i]) {
-                let occurrence = self.locate(i, step, tau)?;
+                let occurrence = self.locate(i, step, tau, &mut steps)?;
                 occurrences.push(occurrence);
             }
         }
@@ -197,34 +222,58 @@ impl<M: Deref<Target: Dynamics>> Search<'_, '_, M> {
 
     /// The crossing of event i in step `step` of size h: τ* with f(τ*) = 0, f(τ) = ±gᵢ(Φ_τ(zₙ))
     /// signed so that f(0) < 0 ≤ f(h), and the partial step's state there.
-    fn locate(&mut self, i: usize, step: usize, h: f64) -> Result<Occurrence, Error> {
+    fn locate(
+        &mut self,
+        i: usize,
+        step: usize,
+        h: f64,
+        steps: &mut Option<&mut dyn PieceSteps>,
+    ) -> Result<Occurrence, Error> {
         let sign = -self.g[i].signum();
         let (start, end) = ((0.0, sign * self.g[i]), (h, sign * self.g_next[i]));
-        let (tau, _) = illinois(|tau| Ok(sign * self.partial_step(i, step, tau)?), start, end, 0.0)?;
-        self.partial_step(i, step, tau)?;
+        let (tau, _) = illinois(
+            |tau| Ok(sign * self.partial_step(i, step, tau, steps)?),
+            start,
+            end,
+            0.0,
+        )?;
+        self.partial_step(i, step, tau, steps)?;
         Ok(Occurrence {
             event: i,
             step,
             t: self.t + tau,
-            q: self.scratch.q().to_vec(),
-            p: self.scratch.p().to_vec(),
+            q: self.q_at.clone(),
+            p: self.p_at.clone(),
             q_start: self.q.clone(),
             p_start: self.p.clone(),
         })
     }
 
-    /// gᵢ(Φ_τ(zₙ)): the scratch stepper reset to zₙ, one step of size τ (an error names the
-    /// run's `step`).
-    fn partial_step(&mut self, i: usize, step: usize, tau: f64) -> Result<f64, Error> {
-        self.scratch.reset(self.t, &self.q, &self.p)?;
-        self.scratch.set_dt(tau)?;
-        self.scratch.step()?;
-        let s = &self.scratch;
-        let (t, model) = (self.t + tau, s.model().as_dynamics());
+    /// gᵢ(Φ_τ(zₙ)), Φ_τ(zₙ) kept in `q_at`, `p_at`: `steps`' state τ into the piece, or the
+    /// scratch stepper reset to zₙ and one step of size τ (an error names the run's `step`).
+    fn partial_step(
+        &mut self,
+        i: usize,
+        step: usize,
+        tau: f64,
+        steps: &mut Option<&mut dyn PieceSteps>,
+    ) -> Result<f64, Error> {
+        let (q, p) = match steps {
+            Some(steps) => steps.state_at(step, tau)?,
+            None => {
+                self.scratch.reset(self.t, &self.q, &self.p)?;
+                self.scratch.set_dt(tau)?;
+                self.scratch.step()?;
+                (self.scratch.q(), self.scratch.p())
+            }
+        };
+        self.q_at.copy_from_slice(q);
+        self.p_at.copy_from_slice(p);
+        let (t, model) = (self.t + tau, self.scratch.model().as_dynamics());
         let evaluated = self
             .detector
             .functions
-            .evaluate(model, t, s.q(), s.p(), &mut self.g_trial);
+            .evaluate(model, t, &self.q_at, &self.p_at, &mut self.g_trial);
         evaluated.map_err(|source: ModelError| Error::Model {
             step,
             time: self.t,

@@ -12,7 +12,7 @@ mod detector;
 mod native;
 
 pub use detector::Detector;
-pub(in crate::integrators) use detector::Search;
+pub(in crate::integrators) use detector::{PieceSteps, Search};
 pub use native::NativeEvent;
 
 use super::Dynamics;

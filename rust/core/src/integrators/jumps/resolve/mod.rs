@@ -17,7 +17,7 @@ use std::ops::Deref;
 use super::hold::{Held, Hold};
 use super::unsolved::run_error;
 use super::{Contact, Contacts, Impacts, Law, NativeSurface, Schedule, Switch, MAX_IMPACTS};
-use crate::integrators::events::Search;
+use crate::integrators::events::{PieceSteps, Search};
 use crate::integrators::DiscreteEnergy;
 use crate::integrators::{Counting, Dynamics, Feature, Method, Occurrence, Poll, Stepper, StepperState, Trajectory};
 use crate::Error;
@@ -553,14 +553,6 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
         let (mut ta, mut tau, mut last) = (self.t, h, None);
         let mut switches = 0;
         loop {
-            if search.is_some() && !self.closed.is_empty() {
-                return Err(self.contact_error(
-                    step,
-                    "events are not located on the motion of a held contact yet: run without events while a body \
-                     rests or slides on a contact (its closures and releases are reported with its impacts)"
-                        .into(),
-                ));
-            }
             // The piece to the next impulse inside the step, or to the step's end, and the
             // earliest occurrence in it.
             let inside = self.impulse_inside(t_end);
@@ -603,7 +595,11 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
             self.contact_p.copy_from_slice(self.scratch.p());
             let t = ta + s;
             if let Some(search) = search.as_deref_mut() {
-                search.piece(step, (t, &self.contact_q, &self.contact_p), s, occurrences)?;
+                // The end's buffers lent out while the piece's steps are the resolver's.
+                let (q, p) = (std::mem::take(&mut self.contact_q), std::mem::take(&mut self.contact_p));
+                let watched = self.watch_piece(search, step, (ta, s), (t, &q, &p), occurrences);
+                (self.contact_q, self.contact_p) = (q, p);
+                watched?;
             }
             last = match next {
                 Next::Release(k) => {
@@ -632,9 +628,41 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
         stepper.add_contact_work(self.step_work);
         std::mem::swap(&mut self.phi, &mut self.phi_end);
         if let Some(search) = search {
-            search.piece(step, (stepper.t(), stepper.q(), stepper.p()), tau, occurrences)?;
+            self.watch_piece(
+                search,
+                step,
+                (ta, tau),
+                (stepper.t(), stepper.q(), stepper.p()),
+                occurrences,
+            )?;
         }
         Ok(true)
+    }
+
+    /// `search`'s crossings on the piece of size s from ta, which ends at `end`: located on
+    /// the held steps while a contact is closed (the scratch then redone to the piece's end,
+    /// which the loop goes on from), else on the search's own partial steps of the method.
+    fn watch_piece(
+        &mut self,
+        search: &mut Search<'_, '_, M>,
+        step: usize,
+        (ta, s): (f64, f64),
+        end: (f64, &[f64], &[f64]),
+        occurrences: &mut Vec<Occurrence>,
+    ) -> Result<(), Error> {
+        if self.closed.is_empty() {
+            return search.piece(step, end, s, occurrences);
+        }
+        let mut held = HeldSteps {
+            resolver: self,
+            ta,
+            taken: false,
+        };
+        search.piece_on(step, end, s, occurrences, Some(&mut held))?;
+        if held.taken {
+            self.partial(step, ta, s)?;
+        }
+        Ok(())
     }
 
     /// The earliest occurrence in the piece of size τ from ta, with the scratch at its end, and
@@ -721,6 +749,23 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
     /// Force evaluations of the partial steps.
     pub(in crate::integrators) fn force_evaluations(&self) -> u64 {
         self.scratch.force_evaluations() - self.counted
+    }
+}
+
+/// A held piece from (ta, `piece_q`, `piece_p`): its partial steps are the resolver's held
+/// steps, on which a search locates its crossings.
+struct HeldSteps<'r, 'c, 's, M> {
+    resolver: &'r mut Resolver<'c, 's, M>,
+    ta: f64,
+    /// Whether a step was taken, leaving the scratch elsewhere.
+    taken: bool,
+}
+
+impl<M: Deref<Target: Dynamics>> PieceSteps for HeldSteps<'_, '_, '_, M> {
+    fn state_at(&mut self, step: usize, tau: f64) -> Result<(&[f64], &[f64]), Error> {
+        self.taken = true;
+        self.resolver.partial(step, self.ta, tau)?;
+        Ok((self.resolver.scratch.q(), self.resolver.scratch.p()))
     }
 }
 
