@@ -20,8 +20,8 @@ The measurements (work–precision, energy growth, stability, sections) live in
 :mod:`varmech.analysis` and are re-exported here; :mod:`varmech.charts` draws them.
 """
 
-import importlib
-from types import ModuleType
+import importlib as _importlib
+from types import ModuleType as _ModuleType
 
 from . import _errors, analysis, events, pointers, scenes
 from ._cite import cite
@@ -161,8 +161,21 @@ __all__ = [
 _errors.install()
 
 
-def __getattr__(name: str) -> ModuleType:
-    # varmech.symbolic imports SymPy (an optional extra), so it is imported on first use.
-    if name == "symbolic":
-        return importlib.import_module(".symbolic", __name__)
+#: The public modules (the API reference's), which ``dir(varmech)`` lists beside ``__all__``;
+#: the others are the package's own layers.
+_MODULES = (
+    "analysis", "charts", "conservation", "dense", "events", "examples", "files", "impacts",
+    "pointers", "scenes", "streaming", "surfaces", "symbolic", "trajectory",
+)  # fmt: skip
+
+
+def __getattr__(name: str) -> _ModuleType:
+    # varmech.symbolic imports SymPy (an optional extra), and charts matplotlib: imported on
+    # first use.
+    if name in ("symbolic", "charts", "examples"):
+        return _importlib.import_module(f".{name}", __name__)
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return sorted([*__all__, *_MODULES])

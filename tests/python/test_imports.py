@@ -198,3 +198,13 @@ def test_each_module_imports_first_in_a_fresh_interpreter(name):
         pytest.skip("SymPy (the extra symbolic) is not installed")
     done = run_python(f"import {name}")
     assert done.returncode == 0, done.stderr
+
+
+def test_the_top_level_shows_the_public_api_and_its_modules_and_nothing_else():
+    import varmech
+
+    shown = set(dir(varmech))
+    assert shown == set(varmech.__all__) | set(varmech._MODULES)
+    assert not any(name.startswith("_") for name in shown)
+    for name in shown:
+        assert getattr(varmech, name) is not None, name
