@@ -30,7 +30,7 @@ from .conservation import NOT_JUDGED, VERDICTS, ConservationReport, check_conser
 from .impacts import Contact
 from .impulses import Impulse
 from .integrate import integrate
-from .model import Model, NativeSystem, _scene_model
+from .model import Model, NativeSystem, scene_model
 from .scenes import Scene
 from .scenes._scene import contacts_of, model_and_state
 from .trajectory import Trajectory, labelled_dataset, of_record
@@ -720,7 +720,7 @@ def _member_models(model: Model, values: dict[str, np.ndarray], members: int) ->
     if isinstance(model, NativeSystem):
         assert model.parameters is not None
         base = model.parameters
-        return [_scene_model(model.name, {**base, **{k: float(v[i]) for k, v in values.items()}}) for i in range(members)]
+        return [scene_model(model.name, {**base, **{k: float(v[i]) for k, v in values.items()}}) for i in range(members)]
     return [model.with_parameters(**{k: float(v[i]) for k, v in values.items()}) for i in range(members)]
 
 
