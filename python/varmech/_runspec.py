@@ -39,9 +39,11 @@ class RunSpec:
     A new run starts at ``t0`` from a state given beside the spec; a continued one goes on from
     ``checkpoint`` after ``base`` steps, its events watched after ``found`` crossings of each,
     an energy error measured from ``initial_energy``, and its energy check kept unless
-    ``keep_energy_check`` is false (then ``max_energy_error`` sets it). ``steps`` are the steps
-    this run takes (a stepper's spec: none), ``times`` the checked ``t_eval``, and ``output``,
-    ``overwrite``, ``checkpoint_every`` and ``progress`` as :func:`varmech.integrate` takes them.
+    ``keep_energy_check`` is false (then ``max_energy_error`` sets it); the method's own state
+    (``compensated``, ``t0``, the Newton options) is then the checkpoint's, and those fields are
+    not read (nor by a stepper made from a checkpoint). ``steps`` are the steps this run takes
+    (a stepper's spec: none), ``times`` the checked ``t_eval``, and ``output``, ``overwrite``,
+    ``checkpoint_every`` and ``progress`` as :func:`varmech.integrate` takes them.
     """
 
     method: str

@@ -275,7 +275,7 @@ def integrate(
             raise ValueError(f"{named[0]}: a continued run keeps its trajectory's {', '.join(named)}")
         # The run's own energy check goes on unless one is given.
         keep = max_energy_error == "auto"
-        check = RunSpec(
+        options = RunSpec(
             model.method,
             model.dt,
             save_every=save_every,
@@ -286,7 +286,7 @@ def integrate(
             checkpoint_every=checkpoint_every,
             progress=progress,
         )
-        return _go_on(model, steps, t_end, events, t_eval, check)
+        return _go_on(model, steps, t_end, events, t_eval, options)
     contacts = contacts_of(model, contacts) or None
     model, q0, p0 = model_and_state(model, q0, p0, v0)
     if parameters is not None:
