@@ -402,13 +402,17 @@ def ensemble(
     save_every = positive_int("save_every", save_every)
     workers = None if workers is None else positive_int("workers", workers)
     chunk_size = None if chunk_size is None else positive_int("chunk_size", chunk_size)
-    run: dict[str, Any] = dict(dt=dt, steps=nsteps, method=method, save_every=save_every, compensated=bool(compensated), t0=t0)
     newton_tolerance, newton_max_iterations = newton_options(newton_tolerance, newton_max_iterations)
-    newton: dict[str, Any] = dict(newton_tolerance=newton_tolerance, newton_max_iterations=newton_max_iterations)
     watched, event_specs = _events.specs(events, model) if events is not None else ([], [])
     impulse_specs = _impulses.specs(impulses or (), t0, t0 + nsteps * dt)
     times = sample_times(t_eval, t0, t0 + nsteps * dt, save_every, None, model.dim, len(q))
-    settings = run | newton | dict(max_energy_error=max_energy_error, events=events, contacts=contacts, impulses=impulses, t_eval=t_eval)
+    # Each member's integrate keywords, where the members run one integrate each (serially, in
+    # processes, on a cluster), which builds each one's spec.
+    settings: dict[str, Any] = dict(
+        dt=dt, steps=nsteps, method=method, save_every=save_every, compensated=bool(compensated), t0=t0,
+        newton_tolerance=newton_tolerance, newton_max_iterations=newton_max_iterations, max_energy_error=max_energy_error,
+        events=events, contacts=contacts, impulses=impulses, t_eval=t_eval,
+    )
     if client is not None:
         return _on_cluster(client, model, q, p, values, settings | dict(workers=workers), chunk_size, progress)
     cores = [m._core for m in (models if values else models[:1])]

@@ -158,6 +158,7 @@ class Stepper:
         newton_tolerance, newton_max_iterations = newton_options(newton_tolerance, newton_max_iterations)
         q, p = initial_state(model, q0, p0, v0, t0)
         self._model = model
+        # What it was built with; its state, dt included, is the core stepper's from here on.
         self._spec = RunSpec(
             method,
             dt,
