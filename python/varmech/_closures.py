@@ -13,7 +13,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from . import _core, pointers
-from ._model import Model, coordinate_names, handed
+from ._model import Model, coordinate_names, handed_pointer
 from ._symmetries import Symmetry, generator_specs
 from ._util import callable_as, floats, positive_int, returned
 from ._warnings import DerivativeWarning
@@ -219,7 +219,7 @@ class MechanicalSystem(Model):
         self.mass = m
         if native is not None:
             self._core = _core.PointerSystem(
-                int(dim), handed(native["potential"]), handed(native["gradient"]), m, generator_specs(symmetries)
+                int(dim), handed_pointer(native["potential"]), handed_pointer(native["gradient"]), m, generator_specs(symmetries)
             )
             return
         self._core = _core.ClosureModel(int(dim), potential, gradient, m, generator_specs(symmetries))
@@ -519,7 +519,7 @@ class Lagrangian(Model):
             damping = (lambda v: c @ v) if c.ndim == 2 else (lambda v: c * v)
             total_force = (lambda q, v, t: -damping(v)) if force is None else (lambda q, v, t: _forced(force(q, v, t), dim) - damping(v))
         if native is not None:
-            handed = {k: handed(f) for k, f in native.items()}
+            handed = {k: handed_pointer(f) for k, f in native.items()}
             self._core = _core.PointerLagrangian(
                 int(dim),
                 handed["lagrangian"],
