@@ -13,8 +13,8 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from . import _core, pointers
-from ._model import Model, _handed, coordinate_names
-from ._symmetries import Symmetry, _specs
+from ._model import Model, coordinate_names, handed_pointer
+from ._symmetries import Symmetry, generator_specs
 from ._util import callable_as, floats, positive_int, returned
 from ._warnings import DerivativeWarning
 
@@ -207,7 +207,7 @@ class MechanicalSystem(Model):
         self.symmetries = tuple(symmetries)
         self.name = name
         if callable(mass) and native is None:
-            self._core = _core.ClosureNatural(int(dim), mass, potential, gradient, mass_derivative, _specs(symmetries))
+            self._core = _core.ClosureNatural(int(dim), mass, potential, gradient, mass_derivative, generator_specs(symmetries))
             self._constrain(constraints, constraint_jacobian, constraint_count)
             self._core = _roll(self._core, velocity_constraints, velocity_constraint_count, velocity_constraint_offset)
             return
@@ -219,10 +219,10 @@ class MechanicalSystem(Model):
         self.mass = m
         if native is not None:
             self._core = _core.PointerSystem(
-                int(dim), _handed(native["potential"]), _handed(native["gradient"]), m, _specs(symmetries)
+                int(dim), handed_pointer(native["potential"]), handed_pointer(native["gradient"]), m, generator_specs(symmetries)
             )
             return
-        self._core = _core.ClosureModel(int(dim), potential, gradient, m, _specs(symmetries))
+        self._core = _core.ClosureModel(int(dim), potential, gradient, m, generator_specs(symmetries))
         self._constrain(constraints, constraint_jacobian, constraint_count)
         self._core = _roll(self._core, velocity_constraints, velocity_constraint_count, velocity_constraint_offset)
 
@@ -519,7 +519,7 @@ class Lagrangian(Model):
             damping = (lambda v: c @ v) if c.ndim == 2 else (lambda v: c * v)
             total_force = (lambda q, v, t: -damping(v)) if force is None else (lambda q, v, t: _forced(force(q, v, t), dim) - damping(v))
         if native is not None:
-            handed = {k: _handed(f) for k, f in native.items()}
+            handed = {k: handed_pointer(f) for k, f in native.items()}
             self._core = _core.PointerLagrangian(
                 int(dim),
                 handed["lagrangian"],
@@ -528,14 +528,14 @@ class Lagrangian(Model):
                 handed.get("hessians"),
                 handed.get("force"),
                 bool(time_dependent),
-                _specs(symmetries),
+                generator_specs(symmetries),
             )
             lagrangian = native["lagrangian"]
             dl_dq, dl_dv, hessians, total_force = (native[k] if k in native else None for k in list(functions)[1:])
         else:
             self._core = _roll(
                 _core.ClosureLagrangian(
-                    int(dim), lagrangian, dl_dq, dl_dv, hessians, total_force, bool(time_dependent), _specs(symmetries), dl_dt
+                    int(dim), lagrangian, dl_dq, dl_dv, hessians, total_force, bool(time_dependent), generator_specs(symmetries), dl_dt
                 ),
                 velocity_constraints,
                 velocity_constraint_count,

@@ -37,7 +37,7 @@ def momentum_name(coordinate: str, index: int) -> str:
     return f"p[{index}]" if coordinate == f"q[{index}]" else f"p_{coordinate}"
 
 
-def _handed(function: pointers.Function) -> tuple[int, pointers.Function]:
+def handed_pointer(function: pointers.Function) -> tuple[int, pointers.Function]:
     """A pointer as the binding takes it: its address, and the object it keeps alive."""
     return function.address, function
 

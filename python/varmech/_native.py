@@ -10,7 +10,7 @@ from typing import Any
 from . import _core
 from ._catalogue import DIMENSIONLESS, declared
 from ._model import RECIPES, Model, coordinate_names, field, numbers
-from ._symmetries import _symmetry_from_spec
+from ._symmetries import symmetry_of_generator
 
 
 class NativeSystem(Model):
@@ -47,7 +47,7 @@ class NativeSystem(Model):
         self._core: _core.NativeModel = core
         self._coordinates = coordinate_names(coordinates, core.dim)
         self.name = core.name
-        self.symmetries = tuple(_symmetry_from_spec(g) for g in core.symmetries)
+        self.symmetries = tuple(symmetry_of_generator(g) for g in core.symmetries)
         self.parameters = None if parameters is None else dict(parameters)
 
     def __reduce__(self) -> tuple[Any, ...]:
@@ -77,9 +77,15 @@ class NativeSystem(Model):
             return {"kind": "nbody", "G": gravity[0], "masses": list(gravity[1])}
         return None
 
-def _scene_model(name: str, parameters: dict[str, float]) -> NativeSystem:
-    """The native model of catalogue scene ``name`` with ``parameters`` (a scene's, a pickle's)."""
+def scene_model(name: str, parameters: dict[str, float]) -> NativeSystem:
+    """The native model of catalogue scene ``name`` with ``parameters`` (a scene's, a recipe's,
+    an ensemble member's)."""
     return NativeSystem(_core.scene(name, **parameters).model, parameters, declared(name).coordinates)
+
+
+def _scene_model(name: str, parameters: dict[str, float]) -> NativeSystem:
+    """A pickled native scene model: pickles name this function, so it keeps its name."""
+    return scene_model(name, parameters)
 
 
 def _nbody_model(gravitational_constant: float, masses: list[float]) -> NativeSystem:
@@ -92,7 +98,7 @@ def _scene_of_recipe(recipe: dict[str, Any]) -> NativeSystem:
     values = numbers(list(parameters.values()), "parameters")
     if not all(isinstance(k, str) for k in parameters):
         raise TypeError("parameters are not named")
-    return _scene_model(field(recipe, "name", str), dict(zip(parameters, values)))
+    return scene_model(field(recipe, "name", str), dict(zip(parameters, values)))
 
 
 def _nbody_of_recipe(recipe: dict[str, Any]) -> NativeSystem:

@@ -222,7 +222,7 @@ Symmetry = Translation | Rotation | Cyclic
 Generator = Symmetry | Callable[[np.ndarray], ArrayLike]
 
 
-def _specs(symmetries: Sequence[Symmetry]) -> list[_core.Generator]:
+def generator_specs(symmetries: Sequence[Symmetry]) -> list[_core.Generator]:
     """The specs the binding checks (it knows which generators apply to how many coordinates)."""
     for s in symmetries:
         if not isinstance(s, (Translation, Rotation, Cyclic)):
@@ -230,7 +230,7 @@ def _specs(symmetries: Sequence[Symmetry]) -> list[_core.Generator]:
     return [s.spec() for s in symmetries]
 
 
-def _symmetry_from_spec(g: _core.Generator) -> Symmetry:
+def symmetry_of_generator(g: _core.Generator) -> Symmetry:
     match g:
         case _core.Generator.Translation(axis, spatial_dim):
             return Translation(axis, spatial_dim)

@@ -24,14 +24,16 @@ from . import events as _events
 from . import impacts as _impacts
 from . import impulses as _impulses
 from ._progress import progress_bar, thread_lock
+from ._runspec import RunSpec, energy_threshold, newton_options, sample_times
 from ._util import finite, floats, positive, positive_int, step_count
 from .conservation import NOT_JUDGED, VERDICTS, ConservationReport, check_conservation
 from .impacts import Contact
 from .impulses import Impulse
-from .integrate import _contacts_of, _energy_threshold, _model_of, _newton, _sample_times, integrate
-from .model import Model, NativeSystem, _scene_model
+from .integrate import integrate
+from .model import Model, NativeSystem, scene_model
 from .scenes import Scene
-from .trajectory import Trajectory, _trajectory, labelled_dataset
+from .scenes._scene import contacts_of, model_and_state
+from .trajectory import Trajectory, labelled_dataset, of_record
 
 if TYPE_CHECKING:
     import xarray
@@ -380,9 +382,9 @@ def ensemble(
     >>> bool(np.array_equal(runs[1].q, single.q))
     True
     """
-    contacts = list(_contacts_of(model, contacts))
+    contacts = list(contacts_of(model, contacts))
     contact_specs = _impacts.specs(contacts)
-    model, _, _ = _model_of(model, None, None, None)
+    model, _, _ = model_and_state(model, None, None, None)
     n = model.dim
     q = np.array(floats("q0", q0))
     if q.ndim != 2 or q.shape[1] != n or q.shape[0] == 0:
@@ -400,13 +402,17 @@ def ensemble(
     save_every = positive_int("save_every", save_every)
     workers = None if workers is None else positive_int("workers", workers)
     chunk_size = None if chunk_size is None else positive_int("chunk_size", chunk_size)
-    run: dict[str, Any] = dict(dt=dt, steps=nsteps, method=method, save_every=save_every, compensated=bool(compensated), t0=t0)
-    newton_tolerance, newton_max_iterations = _newton(newton_tolerance, newton_max_iterations)
-    newton: dict[str, Any] = dict(newton_tolerance=newton_tolerance, newton_max_iterations=newton_max_iterations)
+    newton_tolerance, newton_max_iterations = newton_options(newton_tolerance, newton_max_iterations)
     watched, event_specs = _events.specs(events, model) if events is not None else ([], [])
     impulse_specs = _impulses.specs(impulses or (), t0, t0 + nsteps * dt)
-    times = _sample_times(t_eval, t0, t0 + nsteps * dt, save_every, None, model.dim, len(q))
-    settings = run | newton | dict(max_energy_error=max_energy_error, events=events, contacts=contacts, impulses=impulses, t_eval=t_eval)
+    times = sample_times(t_eval, t0, t0 + nsteps * dt, save_every, None, model.dim, len(q))
+    # Each member's integrate keywords, where the members run one integrate each (serially, in
+    # processes, on a cluster), which builds each one's spec.
+    settings: dict[str, Any] = dict(
+        dt=dt, steps=nsteps, method=method, save_every=save_every, compensated=bool(compensated), t0=t0,
+        newton_tolerance=newton_tolerance, newton_max_iterations=newton_max_iterations, max_energy_error=max_energy_error,
+        events=events, contacts=contacts, impulses=impulses, t_eval=t_eval,
+    )
     if client is not None:
         return _on_cluster(client, model, q, p, values, settings | dict(workers=workers), chunk_size, progress)
     cores = [m._core for m in (models if values else models[:1])]
@@ -417,23 +423,31 @@ def ensemble(
         and all(kind == "generalized" for _, kind, _ in impulse_specs)
     )
     if len(released) == len(cores) and native:
-        threshold = _energy_threshold(max_energy_error)
-        bar = progress_bar(total=nsteps * members, unit="step", desc=f"{method} ×{members}", enabled=progress)
-        try:
-            report = None if bar.disable else (lambda done: bar.update(done - bar.n))
-            results, interrupted = _core.ensemble(
-                released, q, p, **run, **newton, max_energy_error=threshold, workers=workers, chunk_size=chunk_size, progress=report,
-                events=event_specs or None,
-                contacts=contact_specs or None,
-                impulses=impulse_specs or None,
-                t_eval=times,
-            )
-        finally:
-            bar.close()
+        # The members' run, each member's as integrate would specify it (the energy threshold
+        # checked here, where the core checks it; integrate checks it for each member otherwise).
+        spec = RunSpec(
+            method,
+            dt,
+            steps=nsteps,
+            save_every=save_every,
+            compensated=bool(compensated),
+            max_energy_error=energy_threshold(max_energy_error),
+            t0=t0,
+            newton_tolerance=newton_tolerance,
+            newton_max_iterations=newton_max_iterations,
+            events=tuple(watched),
+            event_specs=event_specs,
+            contacts=tuple(contacts),
+            contact_specs=contact_specs,
+            impulses=tuple(impulses or ()),
+            impulse_specs=impulse_specs,
+            times=times,
+        )
+        results, interrupted = _on_threads(released, q, p, spec, workers, chunk_size, members, progress)
         trajs, errors = [], []
         for i, (record, error) in enumerate(results):
             status: dict[str, Any] = {} if error is None else {"status": -1, "message": str(error)}
-            trajs.append(_trajectory(record, models[i], method, dt, watched, contacts, tuple(impulses or ()), **status))
+            trajs.append(of_record(record, models[i], spec, **status))
             errors.append(error)
         result = Ensemble(trajs, errors, values)
         if interrupted is not None:
@@ -443,6 +457,47 @@ def ensemble(
     if workers is not None and workers > 1 and members > 1:
         return _in_processes(model, q, p, values, settings, workers, chunk_size, progress)
     return _serial(models, q, p, values, settings, progress)
+
+
+def _on_threads(
+    released: list[Any],
+    q: np.ndarray,
+    p: np.ndarray,
+    spec: RunSpec,
+    workers: int | None,
+    chunk_size: int | None,
+    members: int,
+    progress: bool | None,
+) -> tuple[list[tuple[Any, BaseException | None]], BaseException | None]:
+    """The members run as ``spec`` specifies, in the core's parallel loop on ``workers``
+    threads: each member's record and error, and the KeyboardInterrupt that stopped them (or
+    None)."""
+    bar = progress_bar(total=spec.steps * members, unit="step", desc=f"{spec.method} ×{members}", enabled=progress)
+    try:
+        report = None if bar.disable else (lambda done: bar.update(done - bar.n))
+        return _core.ensemble(
+            released,
+            q,
+            p,
+            dt=spec.dt,
+            steps=spec.steps,
+            method=spec.method,
+            save_every=spec.save_every,
+            compensated=spec.compensated,
+            t0=spec.t0,
+            newton_tolerance=spec.newton_tolerance,
+            newton_max_iterations=spec.newton_max_iterations,
+            max_energy_error=spec.max_energy_error,
+            workers=workers,
+            chunk_size=chunk_size,
+            progress=report,
+            events=spec.event_specs or None,
+            contacts=spec.contact_specs or None,
+            impulses=spec.impulse_specs or None,
+            t_eval=spec.times,
+        )
+    finally:
+        bar.close()
 
 
 def _on_cluster(
@@ -669,7 +724,7 @@ def _member_models(model: Model, values: dict[str, np.ndarray], members: int) ->
     if isinstance(model, NativeSystem):
         assert model.parameters is not None
         base = model.parameters
-        return [_scene_model(model.name, {**base, **{k: float(v[i]) for k, v in values.items()}}) for i in range(members)]
+        return [scene_model(model.name, {**base, **{k: float(v[i]) for k, v in values.items()}}) for i in range(members)]
     return [model.with_parameters(**{k: float(v[i]) for k, v in values.items()}) for i in range(members)]
 
 

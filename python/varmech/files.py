@@ -45,12 +45,13 @@ import subprocess
 import sys
 from collections.abc import Iterator, Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
 
 from . import impacts as _impacts
 from . import impulses as _impulses
+from ._runspec import RunSpec
 from ._version import __version__
 from .events import Occurrences
 from .impacts import Contact
@@ -107,24 +108,27 @@ class Writer:
     """A trajectory file being written: :meth:`append` adds a run's rows and its checkpoint,
     committed together; :meth:`close` records how the run ended.
 
-    ``columns`` are the optional columns the run has (``"newton"``, ``"work"``).
+    The file is laid out for a run of ``model`` as ``spec`` specifies it: its method, step,
+    saving period (0: unknown), contacts and impulses, the optional columns they call for
+    (:func:`columns_of`), the crossings of its occurrences (``events``, their names; by default
+    the spec's, :meth:`RunSpec.occurrence_names`), and, where ``planned``, the end the run is
+    asked to reach (``spec.planned``; a saved trajectory has none). Errors name ``argument``.
     """
 
     def __init__(
         self,
         path: Path,
-        *,
         model: Model,
-        method: str,
-        dt: float,
-        columns: tuple[str, ...],
-        save_every: int = 0,
-        events: Sequence[str] = (),
+        spec: RunSpec,
+        *,
+        events: Sequence[str] | None = None,
         argument: str = "path",
-        contacts: Sequence[Contact | str] = (),
-        impulses: Sequence[Impulse | float] = (),
-        planned: int | None = None,
+        planned: bool = True,
     ):
+        method, contacts, impulses = spec.method, spec.contacts, spec.impulses
+        columns = columns_of(model, method, contacts, impulses)
+        if events is None:
+            events = spec.occurrence_names()
         h5py = _h5py()
         self.path = path
         self._argument = argument
@@ -138,9 +142,9 @@ class Writer:
                     "format_version": FORMAT_VERSION,
                     "varmech_version": __version__,
                     "method": method,
-                    "dt": dt,
+                    "dt": spec.dt,
                     "dim": n,
-                    "save_every": save_every,
+                    "save_every": spec.save_every,
                     "model": repr(model),
                     "complete": False,
                     "steps": 0,
@@ -149,8 +153,8 @@ class Writer:
                     "message": "The run stopped before closing its file.",
                 }
             )
-            if planned is not None:
-                f.attrs["planned_steps"] = planned
+            if planned:
+                f.attrs["planned_steps"] = spec.planned
             if contacts:
                 # The native ones as data; one of Python functions by its name (resume takes it again).
                 f.attrs["contacts"] = [_impacts.name(c) for c in contacts]
@@ -187,10 +191,12 @@ class Writer:
         self._datasets: dict[str, Any] | None = None
 
     @classmethod
-    def reopen(cls, path: Path, stored: Trajectory, events: Sequence[str] = (), planned: int | None = None) -> Writer:
+    def reopen(cls, path: Path, stored: Trajectory, spec: RunSpec) -> Writer:
         """The writer appending to the file ``path`` (loaded as ``stored``) after its committed
-        rows, marked incomplete until it closes again, with the crossings of ``events`` (named
-        as the file's, if it has any), its run's planned end now step ``planned``."""
+        rows the run ``spec`` specifies, marked incomplete until it closes again, with the
+        crossings of its occurrences (named as the file's, if it has any), its run's planned
+        end now ``spec.planned``."""
+        events = spec.occurrence_names()
         h5py = _h5py()
         writer = cls.__new__(cls)
         writer.path, writer._argument = path, "path"
@@ -206,8 +212,7 @@ class Writer:
                 _recover(path)
                 f = h5py.File(path, "r+", libver="latest")
             f.attrs.update({"complete": False, "status": -1, "message": "The run stopped before closing its file."})
-            if planned is not None:
-                f.attrs["planned_steps"] = planned
+            f.attrs["planned_steps"] = spec.planned
             rows, slot = (int(x) for x in f["committed"][:2])
             stored_names = [o.name for o in stored.events]
             if events and stored_names and list(events) != stored_names:
@@ -518,11 +523,12 @@ def save(traj: Trajectory, path: str | os.PathLike[str], *, overwrite: bool = Fa
     cannot be written.
     """
     target = writable(path, overwrite, "path")
-    columns, names = columns_of(traj.model, traj.method, traj.contacts, traj.impulses), [o.name for o in traj.events]
-    writer = Writer(
-        target, model=traj.model, method=traj.method, dt=traj.dt, columns=columns, events=names, contacts=traj.contacts,
-        impulses=traj.impulses,
-    )
+    # A loaded trajectory's contacts and impulses of Python functions are their names and times,
+    # which the writer stores as such; its saving period is unknown (0).
+    contacts = cast("tuple[Contact, ...]", traj.contacts)
+    impulses = cast("tuple[Impulse, ...]", traj.impulses)
+    spec = RunSpec(traj.method, traj.dt, save_every=0, contacts=contacts, impulses=impulses)
+    writer = Writer(target, traj.model, spec, events=[o.name for o in traj.events], planned=False)
     writer.append(traj, events=traj.events)
     writer.close(traj.status, traj.message)
     return target

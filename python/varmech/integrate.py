@@ -7,64 +7,35 @@ import contextlib
 import datetime
 import math
 import os
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Mapping, Sequence
+from dataclasses import replace
 from typing import Any, Literal
 
 import numpy as np
 from numpy.typing import ArrayLike
 
-from . import _core, dense, files, streaming
+from . import _core, files, streaming
 from . import events as _events
 from . import impacts as _impacts
 from . import impulses as _impulses
 from ._progress import progress_bar
+from ._runspec import RunSpec, energy_threshold, newton_options, sample_times
 from ._util import finite, positive, positive_int, returned_scalar, step_count, vector
 from .constraints import warn_if_integrable
 from .derivatives import blame
 from .model import Lagrangian, Model, check_delays, initial_state
 from .modes import warn_if_unstable
 from .scenes import Scene
+from .scenes._scene import contacts_of, model_and_state
 
 # Trajectory lives in varmech.trajectory; imported here, it is still found under its old name
 # (varmech.integrate.Trajectory), which pickles made before the move refer to.
-from .trajectory import Trajectory, _trajectory, going_on_from, load, take_partial
+from .trajectory import Trajectory, going_on_from, load, of_record, take_partial
 
 __all__ = [
     "integrate",
     "symplecticity_defect",
 ]
-
-
-def _model_of(
-    model: Model | Scene, q0: ArrayLike | None, p0: ArrayLike | None, v0: ArrayLike | None
-) -> tuple[Model, ArrayLike | None, ArrayLike | None]:
-    """The model of a model or scene, and (q0, p0), a scene's initial state by default."""
-    if isinstance(model, Scene):
-        if q0 is None:
-            q0 = model.q0
-            if p0 is None and v0 is None:
-                p0 = model.p0
-        model = model.model
-    if not isinstance(model, Model):
-        raise TypeError(f"model: expected a varmech model or scene, got {type(model).__name__}")
-    return model, q0, p0
-
-
-def _contacts_of(model: Model | Scene, contacts: Sequence[_impacts.Contact] | None) -> tuple[_impacts.Contact, ...]:
-    """The contacts a run or a stepper of ``model`` watches: ``contacts``, a scene's by default
-    (``[]``: none)."""
-    return tuple(model.contacts if contacts is None and isinstance(model, Scene) else contacts or ())
-
-
-def _energy_threshold(max_energy_error: float | None | Literal["auto"]) -> float | None:
-    """The run's energy threshold: ``"auto"`` is the failure level of the verdicts, for the
-    energy or its balance E − W (forced, L depending on t); the core checks neither where
-    affine constraints do work."""
-    if max_energy_error is None:
-        return None
-    if isinstance(max_energy_error, str) and max_energy_error == "auto":
-        return _core.FAILURE
-    return positive("max_energy_error", max_energy_error)
 
 
 def _check_time_independent(
@@ -86,11 +57,6 @@ def _check_time_independent(
             f"time_dependent: L(q0, q̇0, t) changes with t ({shown}), but {model.name} was not declared "
             "time-dependent; pass time_dependent=True, or its energy would be judged as conserved"
         )
-
-
-def _newton(tolerance: float, max_iterations: int) -> tuple[float, int]:
-    """The implicit methods' Newton tolerance and iteration cap, checked."""
-    return positive("newton_tolerance", tolerance), positive_int("newton_max_iterations", max_iterations)
 
 
 def integrate(
@@ -308,10 +274,21 @@ def integrate(
         if named:
             raise ValueError(f"{named[0]}: a continued run keeps its trajectory's {', '.join(named)}")
         # The run's own energy check goes on unless one is given.
-        check = {} if max_energy_error == "auto" else {"keep_energy_check": False, "max_energy_error": _energy_threshold(max_energy_error)}
-        return _go_on(model, steps, t_end, save_every, progress, output, overwrite, checkpoint_every, events, t_eval, check)
-    contacts = _contacts_of(model, contacts) or None
-    model, q0, p0 = _model_of(model, q0, p0, v0)
+        keep = max_energy_error == "auto"
+        options = RunSpec(
+            model.method,
+            model.dt,
+            save_every=save_every,
+            max_energy_error=None if keep else energy_threshold(max_energy_error),
+            keep_energy_check=keep,
+            output=output,
+            overwrite=overwrite,
+            checkpoint_every=checkpoint_every,
+            progress=progress,
+        )
+        return _go_on(model, steps, t_end, events, t_eval, options)
+    contacts = contacts_of(model, contacts) or None
+    model, q0, p0 = model_and_state(model, q0, p0, v0)
     if parameters is not None:
         if not isinstance(parameters, Mapping):
             raise TypeError(f"parameters: expected a dict {{name: value}}, got {type(parameters).__name__}")
@@ -325,8 +302,8 @@ def integrate(
     t0 = 0.0 if t0 is None else finite("t0", t0)
     nsteps = step_count(dt, t0, steps, t_end)
     save_every = positive_int("save_every", save_every)
-    threshold = _energy_threshold(max_energy_error)
-    newton_tolerance, newton_max_iterations = _newton(newton_tolerance, newton_max_iterations)
+    threshold = energy_threshold(max_energy_error)
+    newton_tolerance, newton_max_iterations = newton_options(newton_tolerance, newton_max_iterations)
     q, p = initial_state(model, q0, p0, v0, t0)
     if model.velocity_constraints:
         warn_if_integrable(model, q)
@@ -339,250 +316,129 @@ def integrate(
     _check_time_independent(model, q, p, tuple(s for s in probes if math.isfinite(s)), starts)
     warn_if_unstable(model, method, q, dt, t0)
 
-    contact_specs = _impacts.specs(contacts or ())
-    impulse_specs = _impulses.specs(impulses, t0, t_end) if impulses is not None else []
-    times = _sample_times(t_eval, t0, t_end, save_every, output, model.dim)
-
-    def first(steps: int, report: Callable[[int], None] | None) -> _core.TrajectoryRecord:
-        return _core.integrate(
-            model._core,
-            q,
-            p,
-            dt=dt,
-            steps=steps,
-            method=method,
-            save_every=save_every,
-            compensated=bool(compensated),
-            max_energy_error=threshold,
-            t0=t0,
-            newton_tolerance=newton_tolerance,
-            newton_max_iterations=newton_max_iterations,
-            progress=report,
-            events=event_specs or None,
-            contacts=contact_specs or None,
-            impulses=impulse_specs or None,
-            t_eval=times,
-        )
-
-    return _run(
-        first,
-        None,
-        0,
-        model,
+    spec = RunSpec(
         method,
         dt,
-        nsteps,
-        save_every,
-        progress,
-        output,
-        overwrite,
-        checkpoint_every,
-        watched,
-        event_specs,
+        steps=nsteps,
+        save_every=save_every,
+        compensated=bool(compensated),
+        max_energy_error=threshold,
+        t0=t0,
+        newton_tolerance=newton_tolerance,
+        newton_max_iterations=newton_max_iterations,
+        events=tuple(watched),
+        event_specs=event_specs,
         contacts=tuple(contacts or ()),
-        blows=(tuple(impulses or ()), impulse_specs),
+        contact_specs=_impacts.specs(contacts or ()),
+        impulses=tuple(impulses or ()),
+        impulse_specs=_impulses.specs(impulses, t0, t_end) if impulses is not None else [],
+        times=sample_times(t_eval, t0, t_end, save_every, output, model.dim),
+        output=output,
+        overwrite=overwrite,
+        checkpoint_every=checkpoint_every,
+        progress=progress,
     )
-
-
-def _sample_times(
-    t_eval: ArrayLike | None,
-    t0: float,
-    t_end: float,
-    save_every: int,
-    output: str | os.PathLike[str] | None,
-    dim: int,
-    members: int = 1,
-) -> np.ndarray | None:
-    """``t_eval`` checked for a run over [t0, t_end] (``dense.eval_times``), refusing
-    ``save_every`` and ``output`` with it, and more times than the memory available can hold
-    the states of (t, q, p, Newton counts and work: 2·dim + 3 floats a row, and the times' two
-    copies the core makes), for each of ``members`` runs (an ensemble's, whose rows are stacked
-    too), before they are copied."""
-    if t_eval is None:
-        return None
-    for name, clash in (("save_every", save_every != 1), ("output", output is not None)):
-        if clash:
-            raise ValueError(f"{name}: not with t_eval, which keeps the states at its times, not the run's own")
-    times = dense.eval_times(t_eval, t0, t_end)
-    try:
-        _core.check_allocation("t_eval", times.size * members, 8 * (2 * dim + 5) * (1 if members == 1 else 2))
-    except ValueError as e:
-        raise ValueError(
-            f"{e}: {members} × {times.size} states of {dim} coordinates; pass fewer t_eval times"
-        ) from None
-    return times
+    return _run(model, spec, (q, p))
 
 
 def _go_on(
     traj: Trajectory,
     steps: int | None,
     t_end: float | None,
-    save_every: int,
-    progress: bool | None,
-    output: str | os.PathLike[str] | None,
-    overwrite: bool,
-    checkpoint_every: int | datetime.timedelta | None,
     events: Sequence[_events.Event | _events.EventFunction] | None,
-    t_eval: ArrayLike | None = None,
-    check: Mapping[str, Any] | None = None,
+    t_eval: ArrayLike | None,
+    options: RunSpec,
 ) -> Trajectory:
     """``integrate(traj, steps=)``: the run of ``traj`` continued from its checkpoint, watching
     ``events`` from there (terminal counts after ``traj``'s crossings of the same events, an
-    energy error from ``traj``'s first energy), keeping the states at ``t_eval`` if given, its
-    energy check as ``check`` sets it (the binding's arguments; by default the run's own)."""
+    energy error from ``traj``'s first energy), keeping the states at ``t_eval`` if given, with
+    the saving period, energy check, output and progress of ``options`` (its arguments, not yet
+    checked against the run)."""
     contacts = _impacts.going_on(traj.contacts)
     # The checkpoint's time: a trajectory of t_eval times ends at its last sample, not there.
     t_now = going_on_from(traj, "model", "this trajectory").t
     nsteps = step_count(traj.dt, t_now, steps, t_end)
-    save_every = positive_int("save_every", save_every)
-    times = _sample_times(t_eval, t_now, t_now + nsteps * traj.dt, save_every, output, traj.model.dim)
+    save_every = positive_int("save_every", options.save_every)
+    times = sample_times(t_eval, t_now, t_now + nsteps * traj.dt, save_every, options.output, traj.model.dim)
     watched, specs = _events.specs(events, traj.model) if events is not None else ([], [])
     found = _events.found_before(traj.events, watched)
     initial = _events.first_energy(traj.model, traj) if watched else None
-    return _run(
-        None,
-        traj.checkpoint,
-        traj.steps,
-        traj.model,
-        traj.method,
-        traj.dt,
-        nsteps,
-        save_every,
-        progress,
-        output,
-        overwrite,
-        checkpoint_every,
-        watched,
-        specs,
-        initial,
-        found,
+    impulses, impulse_specs = _impulses.going_on(traj.impulses, None, t_now)
+    spec = replace(
+        options,
+        steps=nsteps,
+        save_every=save_every,
+        events=tuple(watched),
+        event_specs=specs,
         contacts=contacts,
-        blows=_impulses.going_on(traj.impulses, None, t_now),
+        contact_specs=_impacts.specs(contacts),
+        impulses=impulses,
+        impulse_specs=impulse_specs,
         times=times,
-        check=check,
+        checkpoint=traj.checkpoint,
+        base=traj.steps,
+        found=tuple(found),
+        initial_energy=initial,
     )
+    return _run(traj.model, spec)
 
 
-def _run(
-    first: Callable[[int, Callable[[int], None] | None], _core.TrajectoryRecord] | None,
-    checkpoint: bytes | None,
-    base: int,
-    model: Model,
-    method: str,
-    dt: float,
-    nsteps: int,
-    save_every: int,
-    progress: bool | None,
-    output: str | os.PathLike[str] | None,
-    overwrite: bool,
-    checkpoint_every: int | datetime.timedelta | None,
-    watched: Sequence[_events.Event],
-    event_specs: list[Any],
-    initial_energy: float | None = None,
-    found: Sequence[int] = (),
-    *,
-    contacts: Sequence[_impacts.Contact] = (),
-    blows: tuple[Sequence[_impulses.Impulse], list[_impulses.Spec]] = ((), []),
-    times: np.ndarray | None = None,
-    check: Mapping[str, Any] | None = None,
-) -> Trajectory:
-    """Runs ``nsteps`` steps by ``first`` (a new run) or from ``checkpoint`` (after ``base``
-    steps): in memory, or streamed to ``output`` in segments (:mod:`varmech.streaming`).
-    ``watched`` are the run's events (``event_specs`` the binding's), whose crossings the result
-    reports; a continued run's are watched after ``found`` crossings of each, an energy error
-    measured from ``initial_energy``. The run resolves the impacts on ``contacts``, which the
-    result reports after the events' crossings, applies the impulses of ``blows`` (with their
-    binding's tuples) after its start (a continued run's, those still to come) and keeps the
-    states at ``times`` alone if given (a continued run's; a new run's ``first`` takes its own).
-    ``check``: the binding's arguments that set a continued run's energy check."""
-    check = check or {}
-    impulses, impulse_specs = blows
-    bar = progress_bar(total=nsteps, unit="step", desc=method, enabled=progress)
+def _run(model: Model, spec: RunSpec, state: tuple[np.ndarray, np.ndarray] | None = None) -> Trajectory:
+    """Runs ``model`` as ``spec`` specifies: from ``state`` (q, p: a new run) or from
+    ``spec.checkpoint`` (a continued run), in memory, or streamed to ``spec.output`` in
+    segments (:mod:`varmech.streaming`). The result reports the crossings of the spec's events,
+    then the impacts on its contacts."""
+    bar = progress_bar(total=spec.steps, unit="step", desc=spec.method, enabled=spec.progress)
     try:
-        if output is not None:
-            target = files.writable(output, bool(overwrite), "output")
-            streaming.checkpoint_period(checkpoint_every, save_every)
-            columns = files.columns_of(model, method, contacts, impulses)
-            names = [o.name for o in _events.occurrences_of(watched)] + _impacts.occurrence_names(contacts)
-            writer = files.Writer(
-                target,
-                model=model,
-                method=method,
-                dt=dt,
-                columns=columns,
-                save_every=save_every,
-                events=names,
-                argument="output",
-                contacts=contacts,
-                impulses=impulses,
-                planned=base + nsteps,
-            )
+        if spec.output is not None:
+            target = files.writable(spec.output, bool(spec.overwrite), "output")
+            streaming.checkpoint_period(spec.checkpoint_every, spec.save_every)
+            writer = files.Writer(target, model, spec, argument="output")
             try:
-                streaming.stream(
-                    first,
-                    writer,
-                    model,
-                    checkpoint=checkpoint,
-                    base=base,
-                    steps=nsteps,
-                    save_every=save_every,
-                    checkpoint_every=checkpoint_every,
-                    bar=bar,
-                    watched=watched,
-                    event_specs=event_specs,
-                    initial_energy=initial_energy,
-                    found=found,
-                    contacts=contacts,
-                    impulses=impulse_specs,
-                    check=check,
-                )
+                streaming.stream(writer, model, spec, bar, state)
             except BaseException as err:
                 # A file that cannot be read back (a disk that failed) leaves the error as it is.
                 with contextlib.suppress(ValueError):
                     err.partial = load(target, model=model, lazy=True)  # type: ignore[attr-defined]
                 raise
             return load(target, model=model, lazy=files.larger_than_memory(target))
-        if checkpoint_every is not None:
+        if spec.checkpoint_every is not None:
             raise ValueError("checkpoint_every: checkpoints are written to a file; pass output=")
 
         def report(steps: int) -> None:
-            bar.update(steps - base - bar.n)
+            bar.update(steps - spec.base - bar.n)
 
         shown = None if bar.disable else report
         try:
-            if checkpoint is None:
-                assert first is not None
-                record = first(nsteps, shown)
+            if spec.checkpoint is None:
+                assert state is not None
+                record = spec.start(model, *state, spec.steps, shown)
             else:
-                assert not watched or initial_energy is not None
-                specs = _events.going_on(event_specs, found, initial_energy) if watched and initial_energy is not None else None
                 record = _core.resume(
                     model._core,
-                    checkpoint,
-                    steps=nsteps,
-                    save_every=save_every,
+                    spec.checkpoint,
+                    steps=spec.steps,
+                    save_every=spec.save_every,
                     progress=shown,
-                    events=specs,
-                    method=method,
-                    dt=dt,
-                    contacts=_impacts.specs(contacts) or None,
-                    impulses=impulse_specs or None,
-                    t_eval=times,
-                    **check,
+                    events=spec.events_from(spec.found, spec.initial_energy),
+                    method=spec.method,
+                    dt=spec.dt,
+                    contacts=spec.contact_specs or None,
+                    impulses=spec.impulse_specs or None,
+                    t_eval=spec.times,
+                    **spec.energy_check,
                 )
-            bar.update(record.steps - base - bar.n)
+            bar.update(record.steps - spec.base - bar.n)
         except BaseException as err:
             partial = take_partial(err)
             if partial is not None:
-                err.partial = _trajectory(  # type: ignore[attr-defined]
-                    partial, model, method, dt, watched, contacts, impulses, status=-1, message=str(err)
-                )
+                err.partial = of_record(partial, model, spec, status=-1, message=str(err))  # type: ignore[attr-defined]
                 if isinstance(err, _core.DivergenceError):
                     _blame_derivatives(err, model)
             raise
     finally:
         bar.close()
-    return _trajectory(record, model, method, dt, watched, contacts, impulses)
+    return of_record(record, model, spec)
 
 
 def symplecticity_defect(model: Model, method: str, q: ArrayLike, p: ArrayLike, dt: float) -> float:

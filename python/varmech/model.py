@@ -25,12 +25,13 @@ from ._model import numbers as numbers
 from ._native import NativeSystem as NativeSystem
 from ._native import _nbody_model as _nbody_model
 from ._native import _scene_model as _scene_model
+from ._native import scene_model as scene_model
 from ._symmetries import Cyclic as Cyclic
 from ._symmetries import Generator as Generator
 from ._symmetries import Rotation as Rotation
 from ._symmetries import Symmetry as Symmetry
 from ._symmetries import Translation as Translation
-from ._symmetries import _specs as _specs
+from ._symmetries import generator_specs as generator_specs
 from ._symmetries import symmetry_data as symmetry_data
 from ._symmetries import symmetry_of as symmetry_of
 

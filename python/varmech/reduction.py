@@ -113,7 +113,7 @@ def _check_cyclic(model: Model, cyclic: list[int], q: np.ndarray) -> None:
             )
 
 
-def _indices(cyclic: Sequence[int], n: int) -> list[int]:
+def cyclic_indices(cyclic: Sequence[int], n: int) -> list[int]:
     """``cyclic`` as distinct indices of n coordinates that leave one, or ValueError."""
     try:
         indices = [operator.index(i) for i in cyclic]
@@ -195,7 +195,7 @@ class ReducedModel(Model):
             raise ValueError("model: is reduced already; ignore all the cyclic coordinates of the full model at once")
         self._arguments = {"full": full, "cyclic": cyclic, "momenta": momenta, "reference": reference}
         n = full.dim
-        indices = _indices(cyclic, n)
+        indices = cyclic_indices(cyclic, n)
         m = len(indices)
         mu = vector("momenta", momenta, m)
         ref = np.zeros(m) if reference is None else vector("reference", reference, m)
@@ -458,7 +458,7 @@ def routh(
             raise ValueError(f"cyclic: {model.name} has no cyclic coordinate around its initial state")
     if isinstance(model, Scene):
         if momenta is None:
-            momenta = np.asarray(model.p0)[_indices(cyclic, model.model.dim)]
+            momenta = np.asarray(model.p0)[cyclic_indices(cyclic, model.model.dim)]
         around = np.asarray(model.q0, dtype=float)
         model = model.model
     else:
@@ -466,7 +466,7 @@ def routh(
     if momenta is None:
         raise ValueError("momenta: the conserved momenta μ of the ignored coordinates are required")
     reduced = ReducedModel(model, cyclic, momenta, reference=reference)
-    _check_cyclic(model, _indices(cyclic, model.dim), around)
+    _check_cyclic(model, cyclic_indices(cyclic, model.dim), around)
     return reduced
 
 

@@ -12,13 +12,14 @@ from . import _core
 from . import events as _events
 from . import impacts as _impacts
 from . import impulses as _impulses
+from ._runspec import RunSpec, newton_options
 from ._util import finite, floats, positive, step_count
 from .events import Event, EventFunction, Occurrences
 from .impacts import Contact
 from .impulses import Impulse
-from .integrate import _contacts_of, _model_of, _newton
 from .model import Model, check_delays, initial_state
 from .scenes import Scene
+from .scenes._scene import contacts_of, model_and_state
 
 __all__ = [
     "Stepper",
@@ -144,39 +145,35 @@ class Stepper:
         impulses: Sequence[Impulse] | None = None,
         events: Sequence[Event | EventFunction] | None = None,
     ) -> None:
-        contacts = _contacts_of(model, contacts)
+        contacts = contacts_of(model, contacts)
         specs = _impacts.specs(contacts)
         blows = _impulses.specs(impulses or (), finite("t0", t0), math.inf)
-        model, q0, p0 = _model_of(model, q0, p0, v0)
-        self._watch_events(model, events)
-        check_delays(model, bool(specs or blows or self._event_specs))
+        model, q0, p0 = model_and_state(model, q0, p0, v0)
+        watched, event_specs = _events.specs(events, model) if events is not None else ([], [])
+        check_delays(model, bool(specs or blows or event_specs))
         if method is None:
             method = model.kind.default_method
         dt = positive("dt", dt)
         t0 = finite("t0", t0)
-        newton_tolerance, newton_max_iterations = _newton(newton_tolerance, newton_max_iterations)
+        newton_tolerance, newton_max_iterations = newton_options(newton_tolerance, newton_max_iterations)
         q, p = initial_state(model, q0, p0, v0, t0)
         self._model = model
-        self._contacts = contacts
-        self._impulses = tuple(impulses or ())
-        self._stepper = _core.Stepper(
-            model._core,
-            q,
-            p,
-            dt=dt,
-            method=method,
-            t0=t0,
+        # What it was built with; its state, dt included, is the core stepper's from here on.
+        self._spec = RunSpec(
+            method,
+            dt,
             compensated=bool(compensated),
+            t0=t0,
             newton_tolerance=newton_tolerance,
             newton_max_iterations=newton_max_iterations,
-            contacts=specs or None,
-            impulses=blows or None,
-            events=self._event_specs or None,
+            events=tuple(watched),
+            event_specs=event_specs,
+            contacts=contacts,
+            contact_specs=specs,
+            impulses=tuple(impulses or ()),
+            impulse_specs=blows,
         )
-
-    def _watch_events(self, model: Model, events: Sequence[Event | EventFunction] | None) -> None:
-        """Keeps the events as Events and their spec tuples, checked against the model."""
-        self._events, self._event_specs = _events.specs(events, model) if events is not None else ([], [])
+        self._stepper = self._spec.stepper(model, q, p)
 
     def step(self) -> None:
         """Advance one step, from tₙ to tₙ₊₁ = tₙ + h.
@@ -349,7 +346,7 @@ class Stepper:
         """
         t0 = self.t if t0 is None else finite("t0", t0)
         q, p = initial_state(self._model, q0, p0, v0, t0)
-        self._stepper.reset(q, p, t0, events=self._event_specs or None)
+        self._stepper.reset(q, p, t0, events=self._spec.event_specs or None)
 
     @property
     def model(self) -> Model:
@@ -359,40 +356,40 @@ class Stepper:
     @property
     def contacts(self) -> tuple[Contact, ...]:
         """The contacts whose impacts the steps go through (empty without them)."""
-        return self._contacts
+        return self._spec.contacts
 
     @property
     def impacts(self) -> tuple[Occurrences, ...]:
         """Each contact's impacts since the start or the last :meth:`reset`, in the order of
         :attr:`contacts`: the times, the contact configurations q̃ and the momenta p⁻ just before
         the jump, as a run's ``traj.events`` holds them (:attr:`impacts_after` has p⁺)."""
-        return _impacts.occurrences(self._stepper, self._contacts)
+        return _impacts.occurrences(self._stepper, self._spec.contacts)
 
     @property
     def impacts_after(self) -> tuple[Occurrences, ...]:
         """As :attr:`impacts`, with the momenta p⁺ just after each jump (a run's saved state
         just after the impact)."""
-        return _impacts.occurrences(self._stepper, self._contacts, after=True)
+        return _impacts.occurrences(self._stepper, self._spec.contacts, after=True)
 
     @property
     def switches(self) -> tuple[Occurrences, ...]:
         """Each contact's closures since the start or the last :meth:`reset`, in the order of
         :attr:`contacts` (``"<name>.closed"``), then each one's releases (``"<name>.released"``),
         as a run's ``traj.events`` holds them after the impacts (see :mod:`varmech.impacts`)."""
-        return _impacts.switches(self._stepper, self._contacts)
+        return _impacts.switches(self._stepper, self._spec.contacts)
 
     @property
     def events(self) -> tuple[Occurrences, ...]:
         """Each event's located crossings since the start or the last :meth:`reset`, in the order
         of the ``events`` given, as a run's ``traj.events``."""
-        return _events.occurrences(self._stepper, self._events)
+        return _events.occurrences(self._stepper, self._spec.events)
 
     @property
     def terminated_by(self) -> str | None:
         """The name of the event whose terminal count stopped the last :meth:`step` or
         :meth:`advance`, or None."""
         i = self._stepper.terminated_by
-        return None if i is None else str(self._event_specs[i][0])
+        return None if i is None else str(self._spec.event_specs[i][0])
 
     @property
     def method(self) -> str:
@@ -547,25 +544,35 @@ class Stepper:
         if not isinstance(checkpoint, (bytes, bytearray, memoryview)):
             # bytes() would read a str as an error and an int n as n zero bytes.
             raise TypeError(f"checkpoint: expected the bytes of Stepper.checkpoint(), got {type(checkpoint).__name__}")
-        contacts = _contacts_of(model, contacts)
+        contacts = contacts_of(model, contacts)
         specs = _impacts.specs(contacts)
         blows = _impulses.specs(impulses or (), -math.inf, math.inf)
-        model, _, _ = _model_of(model, None, None, None)
+        model, _, _ = model_and_state(model, None, None, None)
+        watched, event_specs = _events.specs(events, model) if events is not None else ([], [])
+        core = _core.Stepper.from_checkpoint(
+            model._core, bytes(checkpoint), method=method, dt=dt, contacts=specs or None, impulses=blows or None,
+            events=event_specs or None,
+        )
         stepper = cls.__new__(cls)
         stepper._model = model
-        stepper._contacts = contacts
-        stepper._impulses = tuple(impulses or ())
-        stepper._watch_events(model, events)
-        stepper._stepper = _core.Stepper.from_checkpoint(
-            model._core, bytes(checkpoint), method=method, dt=dt, contacts=specs or None, impulses=blows or None,
-            events=stepper._event_specs or None,
+        # What it watches; its step, summation and Newton options are the checkpoint's.
+        stepper._spec = RunSpec(
+            core.method,
+            core.dt,
+            events=tuple(watched),
+            event_specs=event_specs,
+            contacts=contacts,
+            contact_specs=specs,
+            impulses=tuple(impulses or ()),
+            impulse_specs=blows,
         )
+        stepper._stepper = core
         return stepper
 
     def __reduce__(self) -> tuple[object, ...]:
         # By its model, checkpoint, contacts, impulses and events: the unpickled stepper goes on
         # bit for bit (its impacts and crossings counted from there).
-        return (_unpickled, (self._model, self.checkpoint(), self._contacts, self._impulses, tuple(self._events)))
+        return (_unpickled, (self._model, self.checkpoint(), self._spec.contacts, self._spec.impulses, self._spec.events))
 
     def __repr__(self) -> str:
         return f"Stepper({self._model.name!r}, method={self.method!r}, dt={self.dt:g}, t={self.t:g}, steps={self.steps})"

@@ -19,15 +19,18 @@ import os
 import signal
 import threading
 import time
-from collections.abc import Callable, Iterator, Mapping, Sequence
+from collections.abc import Iterator, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
+
+import numpy as np
 
 from . import _core, files
 from . import events as _events
 from . import impacts as _impacts
 from . import impulses as _impulses
 from ._progress import progress_bar
+from ._runspec import RunSpec
 from ._util import step_count
 from .impacts import Contact
 from .impulses import Impulse
@@ -46,10 +49,6 @@ __all__ = [
 SEGMENT_SECONDS = 2.0
 #: Saved states kept in memory at most between two appends.
 SEGMENT_ROWS = 4 * files.CHUNK_ROWS
-
-Progress = Callable[[int], None] | None
-#: The first segment: ``first(steps, progress)`` runs it and returns the binding's record.
-First = Callable[[int, Progress], Any]
 
 
 def checkpoint_period(checkpoint_every: int | datetime.timedelta | None, save_every: int) -> tuple[int | None, float]:
@@ -70,38 +69,28 @@ def checkpoint_period(checkpoint_every: int | datetime.timedelta | None, save_ev
 
 
 def stream(
-    first: First | None,
     writer: files.Writer,
     model: Model,
-    *,
-    checkpoint: bytes | None,
-    base: int,
-    steps: int,
-    save_every: int,
-    checkpoint_every: int | datetime.timedelta | None,
+    spec: RunSpec,
     bar: tqdm[Any],
-    watched: Sequence[_events.Event] = (),
-    event_specs: list[Any] | None = None,
-    initial_energy: float | None = None,
-    found: Sequence[int] = (),
-    contacts: Sequence[Contact] = (),
-    impulses: list[Any] | None = None,
-    check: Mapping[str, Any] | None = None,
+    state: tuple[np.ndarray, np.ndarray] | None = None,
 ) -> None:
-    """Runs ``steps`` steps in segments appended to ``writer``: the first by ``first`` (a new
-    run) or from ``checkpoint`` (after ``base`` steps), every other from the last checkpoint.
-    With events (``watched``, the binding's ``event_specs``), each segment watches them from
-    its start, their crossings are committed with the segment's rows, terminal counts run over
-    the whole run, and an energy error is measured from ``initial_energy`` (the run's first
-    energy; by default taken at its first state) after the ``found`` crossings of each so far; a
-    continued run's energy check as ``check`` (the binding's arguments) sets it. Closes the file with the
-    run's status; an exception stops the run with every state up to it committed, and closes
-    the file saying why. Each segment resolves the impacts on ``contacts``, committed as the
-    events after ``watched``'s, and applies the ``impulses`` (the binding's tuples) after its
-    start."""
-    cap, seconds = checkpoint_period(checkpoint_every, save_every)
-    contact_specs = _impacts.specs(contacts) or None
-    found = list(found) or [0] * len(watched)
+    """Runs ``spec.steps`` steps of ``model`` in segments appended to ``writer``: the first
+    from ``state`` (q, p: a new run) or from ``spec.checkpoint`` (after ``spec.base`` steps),
+    every other from the last checkpoint, each at most ``spec.checkpoint_every`` long. With
+    events, each segment watches them from its start, their crossings are committed with the
+    segment's rows, terminal counts run over the whole run, and an energy error is measured
+    from ``spec.initial_energy`` (the run's first energy; by default taken at its first state)
+    after the ``spec.found`` crossings of each so far; a continued run's energy check as
+    ``spec.energy_check`` sets it. Closes the file with the run's status; an exception stops
+    the run with every state up to it committed, and closes the file saying why. Each segment
+    resolves the impacts on the spec's contacts, committed as the events after its events',
+    and applies its impulses after its start."""
+    steps, save_every, watched, contacts = spec.steps, spec.save_every, spec.events, spec.contacts
+    base, checkpoint, initial_energy = spec.base, spec.checkpoint, spec.initial_energy
+    cap, seconds = checkpoint_period(spec.checkpoint_every, save_every)
+    contact_specs = spec.contact_specs or None
+    found = list(spec.found) or [0] * len(watched)
     done, rate = 0, None
     segment = files.CHUNK_ROWS * save_every
 
@@ -130,11 +119,11 @@ def stream(
             # its trajectory in memory does, with the state it goes on from); every segment
             # then goes on from a checkpoint.
             if checkpoint is None:
-                assert first is not None
-                record = first(0, None)
+                assert state is not None
+                record = spec.start(model, *state, 0, None)
             else:
-                # A continued run's energy check, as ``check`` sets it, is its checkpoints' from here.
-                record = _core.resume(model._core, checkpoint, steps=0, save_every=save_every, **(check or {}))
+                # A continued run's energy check, as the spec sets it, is its checkpoints' from here.
+                record = _core.resume(model._core, checkpoint, steps=0, save_every=save_every, **spec.energy_check)
             with _uninterrupted():
                 writer.append(record)
             if watched and initial_energy is None:
@@ -148,19 +137,15 @@ def stream(
             started = time.perf_counter()
             assert checkpoint is not None  # committed before the first segment
             try:
-                specs = None
-                if watched:
-                    assert event_specs is not None and initial_energy is not None
-                    specs = _events.going_on(event_specs, found, initial_energy)
                 record = _core.resume(
                     model._core,
                     checkpoint,
                     steps=take,
                     save_every=save_every,
                     progress=None if bar.disable else report,
-                    events=specs,
+                    events=spec.events_from(found, initial_energy),
                     contacts=contact_specs,
-                    impulses=impulses or None,
+                    impulses=spec.impulse_specs or None,
                 )
             except BaseException as err:
                 # The segment's states and crossings up to the stop are committed; the file is
@@ -332,34 +317,33 @@ def resume(
     files.read_through(Path(path))
     _check_checkpoint(path, stored, model is not None)
     t_now = float(stored.t[-1])
-    _, blows = _impulses.going_on(stored.impulses, impulses, t_now)
+    still, blows = _impulses.going_on(stored.impulses, impulses, t_now)
     more = _further(path, stored, steps, t_end)
     if save_every is None:
         save_every = files.save_every_of(path)
     watched, specs = _events.specs(events, stored.model) if events is not None else ([], [])
-    names = [o.name for o in _events.occurrences_of(watched)] + _impacts.occurrence_names(going_on)
-    writer = files.Writer.reopen(Path(path), stored, names, planned=stored.steps + more)
-    initial = _events.first_energy(stored.model, stored)
-    counts = _events.found_before(stored.events, watched)
+    spec = RunSpec(
+        stored.method,
+        stored.dt,
+        steps=more,
+        save_every=save_every,
+        events=tuple(watched),
+        event_specs=specs,
+        contacts=going_on,
+        contact_specs=_impacts.specs(going_on),
+        impulses=still,
+        impulse_specs=blows,
+        checkpoint_every=checkpoint_every,
+        progress=progress,
+        checkpoint=stored.checkpoint,
+        base=stored.steps,
+        found=tuple(_events.found_before(stored.events, watched)),
+        initial_energy=_events.first_energy(stored.model, stored),
+    )
+    writer = files.Writer.reopen(Path(path), stored, spec)
     bar = progress_bar(total=more, unit="step", desc=stored.method, enabled=progress)
     try:
-        stream(
-            None,
-            writer,
-            stored.model,
-            checkpoint=stored.checkpoint,
-            base=stored.steps,
-            steps=more,
-            save_every=save_every,
-            checkpoint_every=checkpoint_every,
-            bar=bar,
-            watched=watched,
-            event_specs=specs,
-            initial_energy=initial,
-            found=counts,
-            contacts=going_on,
-            impulses=blows,
-        )
+        stream(writer, stored.model, spec, bar)
     finally:
         bar.close()
     return load(path, model=stored.model, lazy=files.larger_than_memory(path))

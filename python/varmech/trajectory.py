@@ -16,6 +16,7 @@ from . import _core, dense, files
 from . import events as _events
 from . import impacts as _impacts
 from . import impulses as _impulses
+from ._runspec import RunSpec
 from ._version import __version__
 from .events import Occurrences
 from .impacts import Contact
@@ -481,38 +482,29 @@ def take_partial(err: BaseException) -> _core.TrajectoryRecord | None:
     return partial
 
 
-def _trajectory(
-    record: _core.TrajectoryRecord,
-    model: Model,
-    method: str,
-    dt: float,
-    events: Sequence[_events.Event] = (),
-    contacts: Sequence[Contact | str] = (),
-    impulses: Sequence[Impulse] = (),
-    **status: Any,
-) -> Trajectory:
-    """The Trajectory of the binding's record of a run, with its events' crossings and its
-    contacts' impacts after them (and the status of a terminal event's stop, unless `status` is
-    given)."""
+def of_record(record: _core.TrajectoryRecord, model: Model, spec: RunSpec, **status: Any) -> Trajectory:
+    """The Trajectory of the binding's record of a run of ``model`` as ``spec`` specifies it,
+    with its events' crossings and its contacts' impacts after them (and the status of a
+    terminal event's stop, unless `status` is given)."""
     r = record
-    found = crossings(r, events, contacts)
-    status = status or _events.termination(r, events, found)
+    found = crossings(r, spec.events, spec.contacts)
+    status = status or _events.termination(r, spec.events, found)
     _impacts.warn_grazing(r.grazing, stacklevel=4)
     return Trajectory(
         r.t,
         r.q,
         r.p,
         model,
-        method,
-        dt,
+        spec.method,
+        spec.dt,
         r.steps,
         r.force_evaluations,
         r.newton,
         r.work,
         checkpoint=r.checkpoint,
         events=found,
-        contacts=tuple(contacts),
-        impulses=tuple(impulses),
+        contacts=spec.contacts,
+        impulses=spec.impulses,
         **status,
     )
 

@@ -19,7 +19,7 @@ from ..model import Model
 from ..table import Table
 from ._energy import relative_error
 from ._interrupt import interruptible
-from .stability import IMPLICIT_METHODS, _bar, _method, _probe
+from .stability import IMPLICIT_METHODS, checked_method, probe, progress_for
 
 DEFAULT_H_VALUES = (0.1, 0.25, 0.5, 1.0, 1.5, 2.0, 2.5, 3.0, 4.0, 6.0)
 # Initial angles from rest; π/2 is left out, where H₀ = −cos q₀ = 0 and a relative energy error
@@ -110,7 +110,7 @@ def implicit_regions(
     """
     names = list(IMPLICIT_METHODS) if method is None else ([method] if isinstance(method, str) else list(method))
     for name in names:
-        _method(name)
+        checked_method(name)
     # A model's runs start from rest, its other coordinates at 0; the horizon is the runs' own.
     origin = np.zeros(scene.dim) if isinstance(scene, Model) else None
     sc = scenes.as_scene(scene, q0=origin, p0=origin, t_end=1.0, dt=1.0)
@@ -130,13 +130,13 @@ def implicit_regions(
     plan = [(name, h, q0) for name in names for h in hs for q0 in q0s]
 
     def body() -> None:
-        for name, h, q0 in _progress(plan, total=len(plan), desc=f"implicit regions {sc.name}", enabled=_bar(progress, len(plan))):
+        for name, h, q0 in _progress(plan, total=len(plan), desc=f"implicit regions {sc.name}", enabled=progress_for(progress, len(plan))):
             q = np.array(sc.q0, dtype=float)
             q[0] = q0
             p = np.zeros(n)
             outcome, traj = "ok", None
             try:
-                traj = _probe(sc.model, q, p, dt=h, steps=int(steps), method=name, max_energy_error=None)
+                traj = probe(sc.model, q, p, dt=h, steps=int(steps), method=name, max_energy_error=None)
             except SpuriousBranchError as err:
                 outcome, traj = "spurious branch", getattr(err, "partial", None)
             except ConvergenceError as err:

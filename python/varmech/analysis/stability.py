@@ -132,7 +132,9 @@ def _oscillator() -> Any:
     return _OSCILLATOR
 
 
-def _method(method: str) -> MethodInfo:
+def checked_method(method: str) -> MethodInfo:
+    """The :class:`~varmech.MethodInfo` of ``method``, one that integrates the linear test
+    equation; ValueError naming ``method`` otherwise."""
     for info in _methods():
         if info.name == method:
             if info.constrained or info.nonholonomic:
@@ -153,7 +155,7 @@ def _unconstrained() -> list[str]:
     return [m.name for m in _methods() if not m.constrained and not m.nonholonomic and not m.nbody]
 
 
-def _probe(*args: Any, **kwargs: Any) -> Any:
+def probe(*args: Any, **kwargs: Any) -> Any:
     """:func:`~varmech.integrate` where a measurement steps beyond a method's limit on
     purpose: without the :class:`~varmech.StabilityWarning` it would give."""
     with warnings.catch_warnings():
@@ -163,8 +165,8 @@ def _probe(*args: Any, **kwargs: Any) -> Any:
 
 def _step_matrix(method: str, y: float) -> np.ndarray:
     model = _oscillator()
-    a = _probe(model, [1.0], [0.0], dt=y, steps=1, method=method, max_energy_error=None)
-    b = _probe(model, [0.0], [1.0], dt=y, steps=1, method=method, max_energy_error=None)
+    a = probe(model, [1.0], [0.0], dt=y, steps=1, method=method, max_energy_error=None)
+    b = probe(model, [0.0], [1.0], dt=y, steps=1, method=method, max_energy_error=None)
     return np.array([[a.q[-1, 0], b.q[-1, 0]], [a.p[-1, 0], b.p[-1, 0]]])
 
 
@@ -212,7 +214,7 @@ def step_matrix(method: str, h_omega: float) -> np.ndarray:
     >>> float(np.linalg.det(psi))
     1.0
     """
-    _method(method)
+    checked_method(method)
     return _step_matrix(method, positive("h_omega", h_omega))
 
 
@@ -264,18 +266,19 @@ def growth_factor(method: str, h_omega: float | ArrayLike, *, progress: bool | N
     >>> round(growth_factor("explicit_euler", 1.0), 6)                 # √(1 + y²)
     1.414214
     """
-    _method(method)
+    checked_method(method)
     if np.ndim(h_omega) == 0:
         return _rho(_step_matrix(method, positive("h_omega", h_omega)))  # type: ignore[arg-type]
     ys = np.asarray(h_omega, dtype=float)
     out = np.empty(ys.shape)
     flat = ys.ravel()
-    for i in _progress(range(flat.size), total=flat.size, desc=f"growth {method}", enabled=_bar(progress, flat.size)):
+    for i in _progress(range(flat.size), total=flat.size, desc=f"growth {method}", enabled=progress_for(progress, flat.size)):
         out.flat[i] = _rho(_step_matrix(method, positive("h_omega", flat[i])))
     return out
 
 
-def _bar(progress: bool | None, n: int) -> bool | None:
+def progress_for(progress: bool | None, n: int) -> bool | None:
+    """A measurement's ``progress`` for ``n`` items: none by default for a short one."""
     return False if n < _PROGRESS_MIN and progress is None else progress
 
 
@@ -378,11 +381,11 @@ def stability_scan(
     >>> stability_scan("midpoint", h_omega_max=3.0, resolution=0.01)   # A-stable
     inf
     """
-    _method(method)
+    checked_method(method)
     h_omega_max, resolution, tol = _check_scan(h_omega_max, resolution, tol)
     grid = _grid(h_omega_max, resolution)
     previous = 0.0
-    bar = _progress(grid, total=grid.size, desc=f"stability {method}", enabled=_bar(progress, grid.size))
+    bar = _progress(grid, total=grid.size, desc=f"stability {method}", enabled=progress_for(progress, grid.size))
     for y in bar:
         if _rho(_step_matrix(method, float(y))) > 1.0 + tol:
             if previous == 0.0:
@@ -437,10 +440,10 @@ def unstable_intervals(
     >>> unstable_intervals("midpoint", 3.0, resolution=0.01)
     []
     """
-    _method(method)
+    checked_method(method)
     h_omega_max, resolution, tol = _check_scan(h_omega_max, resolution, tol)
     grid = _grid(h_omega_max, resolution)
-    rho = growth_factor(method, grid, progress=_bar(progress, grid.size))
+    rho = growth_factor(method, grid, progress=progress_for(progress, grid.size))
     unstable = rho > 1.0 + tol
     intervals: list[tuple[float, float]] = []
     i, n = 0, grid.size
@@ -472,7 +475,7 @@ def _methods_arg(methods: Iterable[str] | str | None) -> list[str]:
         methods = [methods]
     names = list(methods)
     for name in names:
-        _method(name)
+        checked_method(name)
     return names
 
 
@@ -551,7 +554,7 @@ def growth_table(
     plan = [(name, float(y)) for name in names for y in ys]
 
     def body() -> None:
-        for name, y in _progress(plan, total=len(plan), desc="growth table", enabled=_bar(progress, len(plan))):
+        for name, y in _progress(plan, total=len(plan), desc="growth table", enabled=progress_for(progress, len(plan))):
             table.append(name, y, _rho(_step_matrix(name, y)))
         if limits:
             top = float(ys.max())

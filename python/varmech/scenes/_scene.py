@@ -298,6 +298,28 @@ def as_scene(
     raise TypeError(f"scene: expected a varmech Scene, a scene's name or a Model, got {type(subject).__name__}")
 
 
+def model_and_state(
+    model: Model | Scene, q0: ArrayLike | None, p0: ArrayLike | None, v0: ArrayLike | None
+) -> tuple[Model, ArrayLike | None, ArrayLike | None]:
+    """The model of a model or scene that a run or stepper is given, and (q0, p0), a scene's
+    initial state by default; TypeError naming ``model`` for anything else."""
+    if isinstance(model, Scene):
+        if q0 is None:
+            q0 = model.q0
+            if p0 is None and v0 is None:
+                p0 = model.p0
+        model = model.model
+    if not isinstance(model, Model):
+        raise TypeError(f"model: expected a varmech model or scene, got {type(model).__name__}")
+    return model, q0, p0
+
+
+def contacts_of(model: Model | Scene, contacts: Sequence[Contact] | None) -> tuple[Contact, ...]:
+    """The contacts a run or a stepper of ``model`` watches: ``contacts``, a scene's by default
+    (``[]``: none)."""
+    return tuple(model.contacts if contacts is None and isinstance(model, Scene) else contacts or ())
+
+
 #: The core's catalogue of scenes by name, in the order of the tour: each entry's
 #: ``parameters`` (with their defaults) and ``description``.
 CATALOGUE: dict[str, _core.CatalogueEntry] = {entry.name: entry for entry in _core.catalogue()}

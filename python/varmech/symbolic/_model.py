@@ -12,7 +12,7 @@ import sympy as sp
 
 from .. import _core
 from .._util import finite
-from ..model import RECIPES, Model, Symmetry, _specs, field, integers, numbers, symmetry_data, symmetry_of
+from ..model import RECIPES, Model, Symmetry, field, generator_specs, integers, numbers, symmetry_data, symmetry_of
 from . import _tree
 from ._lower import Tape
 from ._rhs import FirstOrder
@@ -66,7 +66,7 @@ def _compile(spec: Spec) -> _core.CompiledModel:
         velocity_constraints=spec.velocity_constraints,
         time_dependent=spec.time_dependent,
         forced=spec.forced,
-        symmetries=_specs(spec.symmetries),
+        symmetries=generator_specs(spec.symmetries),
         jit=spec.jit,
         delays=list(spec.delays),
     )

@@ -11,7 +11,7 @@ import sympy as sp
 from numpy.typing import ArrayLike
 
 from .._util import vector
-from ..reduction import _indices
+from ..reduction import cyclic_indices
 from ._derive import vanishes
 from ._model import SymbolicModel
 
@@ -33,7 +33,7 @@ def routhian(model: SymbolicModel, cyclic: Sequence[int], momenta: ArrayLike) ->
     if not isinstance(model, SymbolicModel):
         raise TypeError(f"model: expected a SymbolicModel (varmech.symbolic), got {type(model).__name__}")
     n = model.dim
-    indices = _indices(cyclic, n)
+    indices = cyclic_indices(cyclic, n)
     mu_values = vector("momenta", momenta, len(indices))
     if model.forced or model.constraints:
         raise ValueError(
