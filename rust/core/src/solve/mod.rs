@@ -7,6 +7,7 @@
 //!   equations built from them;
 //! - `newton`: Newton's method, simplified (a kept Jacobian) or full, with [`NewtonOptions`];
 //! - [`bracket`]: a root of a function on a bracket (Illinois), for locating events;
+//! - `secant`: a root of a scalar function by the secant method, without a bracket;
 //! - `secular`: the secular equation of a trust region's boundary (Moré–Sorensen);
 //! - [`lanczos`]: the extreme eigenvalues of a symmetric-definite pencil, from its products;
 //! - [`interrupt`]: when to poll for Ctrl-C, and the check the iterative solves poll;
@@ -66,6 +67,7 @@ pub mod lanczos;
 pub(crate) mod lu;
 pub(crate) mod newton;
 pub(crate) mod scratch;
+pub(crate) mod secant;
 pub(crate) mod secular;
 pub(crate) mod splitmix;
 
