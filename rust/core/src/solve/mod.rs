@@ -6,6 +6,7 @@
 //! - [`difference`]: gradients and Jacobians by central differences;
 //!   equations built from them;
 //! - `newton`: Newton's method, simplified (a kept Jacobian) or full, with [`NewtonOptions`];
+//! - `fixed_point`: Picard's iteration x ← G(x), stopped at its round-off floor;
 //! - [`bracket`]: a root of a function on a bracket (Illinois), for locating events;
 //! - `secant`: a root of a scalar function by the secant method, without a bracket;
 //! - `secular`: the secular equation of a trust region's boundary (Moré–Sorensen);
@@ -62,6 +63,7 @@ pub(crate) fn fill(dst: &mut [f64], value: f64) {
 pub mod bracket;
 pub(crate) mod cholesky;
 pub mod difference;
+pub(crate) mod fixed_point;
 pub mod interrupt;
 pub mod lanczos;
 pub(crate) mod lu;

@@ -25,6 +25,7 @@ use super::{Contact, Friction};
 use crate::integrators::{Composition, Feature, Method};
 use crate::model::Lagrangian;
 use crate::solve::difference;
+use crate::solve::fixed_point::{self, Pass};
 use crate::solve::lu::{lu_in_place, lu_solve};
 use crate::ModelError;
 
@@ -424,10 +425,7 @@ impl Hold {
         (t, s): (f64, f64),
         slipping: Slipping,
     ) -> Result<Option<Unsolved>, ModelError> {
-        let (mut last, mut floor) = (f64::INFINITY, 0.0);
-        let mut iterations = 0;
-        while iterations < ITERATIONS {
-            iterations += 1;
+        let outcome = fixed_point::iterate(ITERATIONS, || {
             for ((x, h), f) in self.p.iter_mut().zip(&self.half).zip(&self.friction) {
                 *x = h + 0.5 * s * f;
             }
@@ -441,26 +439,26 @@ impl Hold {
                 .iter()
                 .zip(&self.friction)
                 .fold(0.0_f64, |a, (x, y)| a.max((x - y).abs()));
-            floor = 4.0 * f64::EPSILON * size;
             // λ's curvature term is a difference, smooth in p to ε^(2/3) only: the iteration
             // settles where its change stops falling, within that.
-            if change <= floor || (change >= last && change <= 1e-8 * size) {
-                return Ok(None);
-            }
-            let stopped = change >= last || change.is_nan();
-            last = change;
-            if stopped && (matches!(slipping, Slipping::Now) || !change.is_finite()) {
-                break;
-            }
+            Ok::<_, ModelError>(Pass {
+                change,
+                floor: 4.0 * f64::EPSILON * size,
+                stall: 1e-8 * size,
+                give_up: matches!(slipping, Slipping::Now) || !change.is_finite(),
+            })
+        })?;
+        if outcome.settled {
+            return Ok(None);
         }
         Ok(Some(Unsolved {
             solve: FRICTION,
             cause: Cause::Step {
                 past: "the sliding force's turn (a slip about to stop, or a curvature it does not resolve)",
             },
-            residual: last,
-            floor,
-            iterations,
+            residual: outcome.change,
+            floor: outcome.floor,
+            iterations: outcome.passes,
         }))
     }
 
