@@ -6,6 +6,7 @@
 //! - [`difference`]: gradients and Jacobians by central differences;
 //!   equations built from them;
 //! - `newton`: Newton's method, simplified (a kept Jacobian) or full, with [`NewtonOptions`];
+//!   `newton::plain`, its plain form for equations that judge their own residuals;
 //! - `fixed_point`: Picard's iteration x ← G(x), stopped at its round-off floor;
 //! - [`bracket`]: a root of a function on a bracket (Illinois), for locating events;
 //! - `secant`: a root of a scalar function by the secant method, without a bracket;
