@@ -1,4 +1,5 @@
-//! A root of a continuous function on a bracket, by the Illinois method.
+//! A root of a continuous function on a bracket: by the Illinois method, by Newton's method
+//! kept in the bracket, or by bisection of a bracket found by doubling.
 
 /// A root x* of f on the bracket [a, b] with f(a) < 0 ≤ f(b) (or f(a) > 0 ≥ f(b)), by the
 /// Illinois method (Dowell & Jarratt 1971): regula falsi, with the function value at an end
@@ -115,6 +116,44 @@ pub fn newton<E>(
     Ok(if fa.abs() < fb.abs() { (a, fa) } else { (b, fb) })
 }
 
+/// The root of an increasing f on the side of 0 that `guess` is on (f(0) < 0 for guess ≥ 0,
+/// f(0) > 0 for guess < 0): bracketed from [0, guess] by doubling its far end, then bisected
+/// to adjacent doubles, each at most `limit` times (2·1100 halvings span the doubles).
+/// NaN where f is not finite at a far end, or no bracket is found.
+pub(crate) fn bisection(f: impl Fn(f64) -> f64, guess: f64, limit: usize) -> f64 {
+    let sign = if guess < 0.0 { -1.0 } else { 1.0 };
+    let (mut near, mut far) = (0.0, if guess == 0.0 { f64::MIN_POSITIVE } else { guess });
+    let beyond = |value: f64| sign * value >= 0.0;
+    let mut bracketed = false;
+    for _ in 0..limit {
+        let value = f(far);
+        if !value.is_finite() {
+            return f64::NAN;
+        }
+        if beyond(value) {
+            bracketed = true;
+            break;
+        }
+        near = far;
+        far *= 2.0;
+    }
+    if !bracketed {
+        return f64::NAN;
+    }
+    for _ in 0..limit {
+        let mid = 0.5 * (near + far);
+        if mid == near || mid == far {
+            break;
+        }
+        if beyond(f(mid)) {
+            far = mid;
+        } else {
+            near = mid;
+        }
+    }
+    0.5 * (near + far)
+}
+
 /// Whether [a, b] is within `tolerance`, or within 4 ulps of its larger end.
 fn converged(a: f64, b: f64, tolerance: f64) -> bool {
     let width = (b - a).abs();
@@ -131,5 +170,22 @@ fn toward(x: f64, y: f64) -> f64 {
         x.next_up()
     } else {
         x.next_down()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::bisection;
+
+    #[test]
+    fn bisection_finds_a_cube_root_either_side_of_zero() {
+        let root = bisection(|x| x * x * x - 10.0, 0.5, 2200);
+        assert!((root - 10.0_f64.cbrt()).abs() <= 4.0 * f64::EPSILON * root, "{root}");
+        let root = bisection(|x| x * x * x + 10.0, -0.5, 2200);
+        assert!(
+            (root + 10.0_f64.cbrt()).abs() <= 4.0 * f64::EPSILON * root.abs(),
+            "{root}"
+        );
+        assert!(bisection(|_| f64::NAN, 1.0, 2200).is_nan());
     }
 }

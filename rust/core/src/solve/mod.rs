@@ -8,7 +8,8 @@
 //! - `newton`: Newton's method, simplified (a kept Jacobian) or full, with [`NewtonOptions`];
 //!   `newton::plain`, its plain form for equations that judge their own residuals;
 //! - `fixed_point`: Picard's iteration x ← G(x), stopped at its round-off floor;
-//! - [`bracket`]: a root of a function on a bracket (Illinois), for locating events;
+//! - [`bracket`]: a root of a function on a bracket (Illinois, or Newton kept in it), for
+//!   locating events, and bisection of a bracket found by doubling;
 //! - `secant`: a root of a scalar function by the secant method, without a bracket;
 //! - `secular`: the secular equation of a trust region's boundary (Moré–Sorensen);
 //! - [`lanczos`]: the extreme eigenvalues of a symmetric-definite pencil, from its products;

@@ -1,6 +1,7 @@
 //! The Kepler drift: the exact flow of a two-body problem, by a universal-variable solver.
 
 use super::stumpff::universal_functions;
+use crate::solve::bracket::bisection;
 
 /// Newton iterations before the bracketed fallback; from the second-order guess Newton converges
 /// in 2–4 iterations for a step below a tenth of the period.
@@ -101,12 +102,13 @@ pub fn kepler_drift(x: [f64; 3], v: [f64; 3], mu: f64, dt: f64) -> ([f64; 3], [f
     }
     // On convergence g and r are those of the X before the last correction, a round-off away.
     if !converged {
-        let root = bracketed(
+        let root = bisection(
             |xu| {
                 let g = universal_functions(beta, xu);
                 r0 * xu + eta0 * g[2] + zeta0 * g[3] - dt
             },
             dt * r0i,
+            FALLBACK_ITERATIONS,
         );
         g = universal_functions(beta, root);
         r = r0 + eta0 * g[1] + zeta0 * g[2];
@@ -123,42 +125,6 @@ pub fn kepler_drift(x: [f64; 3], v: [f64; 3], mu: f64, dt: f64) -> ([f64; 3], [f
         dv[k] = fd * x[k] + gd * v[k];
     }
     (dx, dv)
-}
-
-/// The root of the increasing function `t` (t(0) = −dt), bracketed from [0, `guess`] by
-/// doubling and then bisected to adjacent doubles; bounded, NaN for non-finite data.
-fn bracketed(t: impl Fn(f64) -> f64, guess: f64) -> f64 {
-    let sign = if guess < 0.0 { -1.0 } else { 1.0 };
-    let (mut near, mut far) = (0.0, if guess == 0.0 { f64::MIN_POSITIVE } else { guess });
-    let beyond = |value: f64| sign * value >= 0.0;
-    let mut bracketed = false;
-    for _ in 0..FALLBACK_ITERATIONS {
-        let value = t(far);
-        if !value.is_finite() {
-            return f64::NAN;
-        }
-        if beyond(value) {
-            bracketed = true;
-            break;
-        }
-        near = far;
-        far *= 2.0;
-    }
-    if !bracketed {
-        return f64::NAN;
-    }
-    for _ in 0..FALLBACK_ITERATIONS {
-        let mid = 0.5 * (near + far);
-        if mid == near || mid == far {
-            break;
-        }
-        if beyond(t(mid)) {
-            far = mid;
-        } else {
-            near = mid;
-        }
-    }
-    0.5 * (near + far)
 }
 
 #[inline(always)]
