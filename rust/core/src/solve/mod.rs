@@ -9,7 +9,7 @@
 //!   `newton::plain`, its plain form for equations that judge their own residuals;
 //! - `fixed_point`: Picard's iteration x ← G(x), stopped at its round-off floor;
 //! - [`bracket`]: a root of a function on a bracket (Illinois, or Newton kept in it), for
-//!   locating events, and bisection of a bracket found by doubling;
+//!   locating events, and bisection (of a bracket found by doubling, or of a predicate);
 //! - `secant`: a root of a scalar function by the secant method, without a bracket;
 //! - `secular`: the secular equation of a trust region's boundary (Moré–Sorensen);
 //! - [`lanczos`]: the extreme eigenvalues of a symmetric-definite pencil, from its products;
