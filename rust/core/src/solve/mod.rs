@@ -6,10 +6,12 @@
 //! - [`difference`]: gradients and Jacobians by central differences;
 //!   equations built from them;
 //! - `newton`: Newton's method, simplified (a kept Jacobian) or full, with [`NewtonOptions`];
-//!   `newton::plain`, its plain form for equations that judge their own residuals;
+//!   `newton::plain`, its plain form for equations that judge their own residuals, and on a
+//!   scalar equation;
 //! - `fixed_point`: Picard's iteration x ← G(x), stopped at its round-off floor;
 //! - [`bracket`]: a root of a function on a bracket (Illinois, or Newton kept in it), for
 //!   locating events, and bisection (of a bracket found by doubling, or of a predicate);
+//! - `laguerre`: a root of a scalar function by Laguerre's iteration (Conway's, for Kepler);
 //! - `secant`: a root of a scalar function by the secant method, without a bracket;
 //! - `secular`: the secular equation of a trust region's boundary (Moré–Sorensen);
 //! - [`lanczos`]: the extreme eigenvalues of a symmetric-definite pencil, from its products;
@@ -67,6 +69,7 @@ pub(crate) mod cholesky;
 pub mod difference;
 pub(crate) mod fixed_point;
 pub mod interrupt;
+pub(crate) mod laguerre;
 pub mod lanczos;
 pub(crate) mod lu;
 pub(crate) mod newton;

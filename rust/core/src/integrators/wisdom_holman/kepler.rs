@@ -2,6 +2,8 @@
 
 use super::stumpff::universal_functions;
 use crate::solve::bracket::bisection;
+use crate::solve::laguerre::laguerre;
+use crate::solve::newton::plain;
 
 /// Newton iterations before the bracketed fallback; from the second-order guess Newton converges
 /// in 2–4 iterations for a step below a tenth of the period.
@@ -72,34 +74,22 @@ pub fn kepler_drift(x: [f64; 3], v: [f64; 3], mu: f64, dt: f64) -> ([f64; 3], [f
         xu = first;
     } else {
         xu = if beta > 0.0 { beta * dt / mu } else { dtr0i };
-        for _ in 0..LAGUERRE_ITERATIONS {
+        // A NaN step stops too: Newton and the fallback take over.
+        let derivatives = |xu: f64| {
             let g = universal_functions(beta, xu);
             let t = r0 * xu + eta0 * g[2] + zeta0 * g[3] - dt;
-            let tp = r0 + eta0 * g[1] + zeta0 * g[2];
-            let tpp = eta0 * g[0] + zeta0 * g[1];
-            let step = 5.0 * t / (tp + (16.0 * tp * tp - 20.0 * t * tpp).abs().sqrt().copysign(tp));
-            xu -= step;
-            // A NaN step stops too: Newton and the fallback take over.
-            if step.abs() <= 1e-8 * xu.abs() || step.is_nan() {
-                break;
-            }
-        }
+            (t, r0 + eta0 * g[1] + zeta0 * g[2], eta0 * g[0] + zeta0 * g[1])
+        };
+        xu = laguerre(derivatives, xu, LAGUERRE_ITERATIONS, 1e-8);
     }
     // Newton's iteration, quadratic: once a correction is below 1e-9 of X one more step reaches
-    // round-off, where a close pericentre leaves X wandering by a few ulps (a stop on exact
-    // repetition would not come).
-    let mut converged = false;
-    for _ in 0..NEWTON_ITERATIONS {
-        let (next, gn, rn) = newton(xu);
-        (g, r) = (gn, rn);
-        let correction = next - xu;
-        xu = next;
-        if polishing {
-            converged = true;
-            break;
-        }
-        polishing = correction.abs() <= 1e-9 * xu.abs();
-    }
+    // round-off, where a close pericentre leaves X wandering by a few ulps.
+    let map = |xu: f64| {
+        let next;
+        (next, g, r) = newton(xu);
+        next
+    };
+    let (_, converged) = plain::scalar(map, xu, polishing, (NEWTON_ITERATIONS, 1e-9));
     // On convergence g and r are those of the X before the last correction, a round-off away.
     if !converged {
         let root = bisection(

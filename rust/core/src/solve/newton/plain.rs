@@ -1,5 +1,6 @@
 //! Newton's method in its plain form, for equations whose caller measures each residual
-//! against its own round-off floor (the held contacts' position constraints).
+//! against its own round-off floor (the held contacts' position constraints), and on a scalar
+//! equation whose Newton map the caller arranges to round well (Kepler's).
 
 use nalgebra::DMatrix;
 
@@ -50,6 +51,29 @@ pub(crate) fn solve<E>(
     Ok(Ended::Unconverged)
 }
 
+/// Newton's iteration x ← N(x) on a scalar equation f(x) = 0, N(x) = x − f(x)/f′(x) the
+/// caller's `map` (arranged as its terms round best), at most `iterations` times. Quadratic: once
+/// a correction is within `tolerance`·|x| one more reaches round-off, where x may wander by a few
+/// ulps (a stop on exact repetition might not come); `polishing`: that one more is all that is
+/// left. Returns the last x and whether it converged.
+pub(crate) fn scalar(
+    mut map: impl FnMut(f64) -> f64,
+    mut x: f64,
+    mut polishing: bool,
+    (iterations, tolerance): (usize, f64),
+) -> (f64, bool) {
+    for _ in 0..iterations {
+        let next = map(x);
+        let correction = next - x;
+        x = next;
+        if polishing {
+            return (x, true);
+        }
+        polishing = correction.abs() <= tolerance * x.abs();
+    }
+    (x, false)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -75,5 +99,22 @@ mod tests {
         };
         let ended = solve(30, (4.0, 1e3), &mut x, (&mut jacobian, &mut pivots, &mut r), flat);
         assert_eq!(ended, Ok(Ended::Singular));
+    }
+
+    #[test]
+    fn a_scalar_newton_polishes_once_and_gives_up_on_a_cycle() {
+        let (root, converged) = scalar(|x| 0.5 * (x + 2.0 / x), 1.0, false, (32, 1e-9));
+        assert!(
+            converged && (root - 2.0_f64.sqrt()).abs() <= f64::EPSILON * root,
+            "{root}"
+        );
+        // x³ − 2x + 2 from 0: Newton cycles 0 → 1 → 0.
+        let (_, converged) = scalar(
+            |x| x - (x * x * x - 2.0 * x + 2.0) / (3.0 * x * x - 2.0),
+            0.0,
+            false,
+            (32, 1e-9),
+        );
+        assert!(!converged);
     }
 }
