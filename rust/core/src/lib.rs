@@ -15,8 +15,9 @@
 //! - [`diagnostics`]: energy series, Noether momenta, conservation verdicts, symplecticity
 //!   defect.
 //!
-//! Beside them, [`solve`] holds the numerics every layer shares (Newton's method, central
-//! differences, the in-place LU, the interrupt check), [`memory`] the guard on allocations that
+//! Beside them, [`solve`] holds the numerics every layer shares, each solver once (Newton's
+//! method, central differences, the in-place LU and Cholesky, fixed-point iteration, the secant
+//! and bracketing root finders, the interrupt check), [`memory`] the guard on allocations that
 //! users' arguments size, and [`scenes`], which use the model layer only, hold the native test problems with
 //! their published reference solutions and the catalogue that lists them by name.
 //!

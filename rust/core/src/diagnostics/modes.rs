@@ -20,6 +20,7 @@ use crate::error::StepError;
 use crate::integrators::{integrate, Dynamics, Method, Options};
 use crate::model::{reaction_force, Fastest, ForceAtRest, Hessians, HolonomicConstraints, Lagrangian, Rest};
 use crate::scenes::HarmonicOscillator;
+use crate::solve::bracket::bisect;
 use crate::solve::difference::{central_jacobian, unit, Evaluations};
 use crate::solve::newton::{Correction, Newton, NewtonProblem, Reasons, Rules};
 use crate::solve::NewtonOptions;
@@ -718,13 +719,6 @@ pub fn accurate_step(method: Method, omega_max: f64, accuracy: f64) -> Result<f6
             ));
         }
     }
-    while high - low > 1e-6 * low {
-        let mid = 0.5 * (low + high);
-        if within(mid)? {
-            low = mid;
-        } else {
-            high = mid;
-        }
-    }
+    let (low, _) = bisect(within, (low, high), usize::MAX, |low, high| high - low > 1e-6 * low)?;
     Ok(low / omega_max)
 }

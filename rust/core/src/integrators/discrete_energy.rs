@@ -4,6 +4,7 @@
 
 use super::{Dynamics, Feature, Increment, Integrator, Method, Splitting, StepStart};
 use crate::model::{Lagrangian, MechanicalSystem};
+use crate::solve::fixed_point::{self, Pass};
 use crate::{ModelError, StepError};
 
 /// The methods with a discrete energy here, and their data.
@@ -143,7 +144,7 @@ impl DiscreteEnergy {
     /// ½[E(q₀, v) + E(q₁, v)], E(q, v) = v·∂L/∂q̇ − L, with v solved from the half-sum of the
     /// trapezoid's momenta p₀,₁ = ∂L/∂q̇(q₀,₁, v) ∓ (τ/2)∂L/∂q(q₀,₁, v):
     /// ½[∂L/∂q̇(q₀, v) + ∂L/∂q̇(q₁, v)] = p̄ + (τ/4)[∂L/∂q(q₀, v) − ∂L/∂q(q₁, v)], by the
-    /// inverse Legendre map at q̄ iterated, v ← q̇(q̄, p̄ + shift(v)) with
+    /// inverse Legendre map at q̄ iterated ([`fixed_point::iterate`]), v ← q̇(q̄, p̄ + shift(v)) with
     /// shift = (τ/4)[∂L/∂q(q₀, v) − ∂L/∂q(q₁, v)] + ∂L/∂q̇(q̄, v) − ½[∂L/∂q̇(q₀, v) + ∂L/∂q̇(q₁, v)]:
     /// a contraction by O(τ‖q₁ − q₀‖) and O(‖q₁ − q₀‖²), exact in one pass for a constant mass.
     fn trapezoid(
@@ -168,8 +169,8 @@ impl DiscreteEnergy {
         } = self;
         v.fill(0.0);
         sys.velocity(mean, target, t, v)?;
-        let mut step = f64::INFINITY;
-        for _ in 0..PASSES {
+        // Settled at no change, or where the changes stop falling (round-off): judged below.
+        let settled = fixed_point::iterate(PASSES, || {
             sys.gradients(q0, v, t, force, momentum)?;
             sys.gradients(q1, v, t, force_end, momentum_end)?;
             // `new` holds ∂L/∂q̇(q̄, v), then the target p̄ + shift, then the next v.
@@ -181,14 +182,16 @@ impl DiscreteEnergy {
             target.copy_from_slice(new);
             new.copy_from_slice(v);
             sys.velocity(mean, target, t, new)?;
-            let last = step;
-            step = new.iter().zip(v.iter()).fold(0.0_f64, |m, (a, b)| m.max((a - b).abs()));
+            let change = new.iter().zip(v.iter()).fold(0.0_f64, |m, (a, b)| m.max((a - b).abs()));
             v.copy_from_slice(new);
-            // Converged to round-off: no change, or no more progress.
-            if step == 0.0 || step >= last {
-                break;
-            }
-        }
+            Ok::<_, ModelError>(Pass {
+                change,
+                floor: 0.0,
+                stall: f64::INFINITY,
+                give_up: false,
+            })
+        })?;
+        let step = settled.change;
         let scale = v.iter().fold(1.0_f64, |m, x| m.max(x.abs()));
         if step.is_nan() || step > 1e-6 * scale {
             return Err(format!(

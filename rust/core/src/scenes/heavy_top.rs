@@ -1,5 +1,8 @@
+use std::convert::Infallible;
+
 use super::{Problem, State};
 use crate::model::{Generator, Hessians, Lagrangian};
+use crate::solve::bracket::bisect;
 use crate::{Error, ModelError};
 
 /// The heavy symmetric top about a fixed point, in Euler angles q = (θ, φ, ψ): the nutation θ
@@ -129,23 +132,15 @@ impl HeavyTop {
         }
         // Bisection between a point where f < 0 (or an end) and one where f ≥ 0, until the two
         // are adjacent; returns the point where f ≥ 0 (inside the motion).
-        let bisect = |mut outside: f64, mut inside: f64| {
+        let boundary = |outside: f64, inside: f64| {
             if f(outside) >= 0.0 {
                 return outside;
             }
-            loop {
-                let mid = 0.5 * (outside + inside);
-                if mid == outside || mid == inside {
-                    return inside;
-                }
-                if f(mid) >= 0.0 {
-                    inside = mid;
-                } else {
-                    outside = mid;
-                }
-            }
+            let holds = |u: f64| Ok::<_, Infallible>(f(u) >= 0.0);
+            let Ok((inside, _)) = bisect(holds, (inside, outside), usize::MAX, |_, _| true);
+            inside
         };
-        let (u_min, u_max) = (bisect(-1.0, u_top), bisect(1.0, u_top));
+        let (u_min, u_max) = (boundary(-1.0, u_top), boundary(1.0, u_top));
         Some((u_max.acos(), u_min.acos()))
     }
 

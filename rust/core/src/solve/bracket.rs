@@ -1,4 +1,7 @@
-//! A root of a continuous function on a bracket, by the Illinois method.
+//! A root of a continuous function on a bracket: by the Illinois method, by Newton's method
+//! kept in the bracket, or by bisection (of a bracket found by doubling, or of a predicate).
+
+use std::convert::Infallible;
 
 /// A root x* of f on the bracket [a, b] with f(a) < 0 ≤ f(b) (or f(a) > 0 ≥ f(b)), by the
 /// Illinois method (Dowell & Jarratt 1971): regula falsi, with the function value at an end
@@ -115,6 +118,65 @@ pub fn newton<E>(
     Ok(if fa.abs() < fb.abs() { (a, fa) } else { (b, fb) })
 }
 
+/// The root of an increasing f on the side of 0 that `guess` is on (f(0) < 0 for guess ≥ 0,
+/// f(0) > 0 for guess < 0): bracketed from [0, guess] by doubling its far end, then
+/// [`bisect`]ed to adjacent doubles, each at most `limit` times (2·1100 halvings span the
+/// doubles); the midpoint of the last bracket. NaN where f is not finite at a far end, or no
+/// bracket is found.
+pub(crate) fn bisection(f: impl Fn(f64) -> f64, guess: f64, limit: usize) -> f64 {
+    let sign = if guess < 0.0 { -1.0 } else { 1.0 };
+    let (mut near, mut far) = (0.0, if guess == 0.0 { f64::MIN_POSITIVE } else { guess });
+    let beyond = |value: f64| sign * value >= 0.0;
+    let mut bracketed = false;
+    for _ in 0..limit {
+        let value = f(far);
+        if !value.is_finite() {
+            return f64::NAN;
+        }
+        if beyond(value) {
+            bracketed = true;
+            break;
+        }
+        near = far;
+        far *= 2.0;
+    }
+    if !bracketed {
+        return f64::NAN;
+    }
+    let beyond = |x: f64| Ok::<_, Infallible>(beyond(f(x)));
+    let Ok((far, near)) = bisect(beyond, (far, near), limit, |_, _| true);
+    0.5 * (near + far)
+}
+
+/// The boundary of the set where `holds`, between an end `inside` it and one `outside`, by
+/// bisection: the midpoint replaces the end on its side, at most `limit` times, while
+/// `wide(inside, outside)` and the midpoint does not round onto an end (the ends adjacent).
+/// Returns the last (inside, outside).
+///
+/// `holds` may fail (e.g. a model error); its first error is returned.
+pub(crate) fn bisect<E>(
+    mut holds: impl FnMut(f64) -> Result<bool, E>,
+    (mut inside, mut outside): (f64, f64),
+    limit: usize,
+    wide: impl Fn(f64, f64) -> bool,
+) -> Result<(f64, f64), E> {
+    for _ in 0..limit {
+        if !wide(inside, outside) {
+            break;
+        }
+        let mid = 0.5 * (inside + outside);
+        if mid == inside || mid == outside {
+            break;
+        }
+        if holds(mid)? {
+            inside = mid;
+        } else {
+            outside = mid;
+        }
+    }
+    Ok((inside, outside))
+}
+
 /// Whether [a, b] is within `tolerance`, or within 4 ulps of its larger end.
 fn converged(a: f64, b: f64, tolerance: f64) -> bool {
     let width = (b - a).abs();
@@ -131,5 +193,30 @@ fn toward(x: f64, y: f64) -> f64 {
         x.next_up()
     } else {
         x.next_down()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{bisect, bisection};
+
+    #[test]
+    fn bisection_finds_a_cube_root_either_side_of_zero() {
+        let root = bisection(|x| x * x * x - 10.0, 0.5, 2200);
+        assert!((root - 10.0_f64.cbrt()).abs() <= 4.0 * f64::EPSILON * root, "{root}");
+        let root = bisection(|x| x * x * x + 10.0, -0.5, 2200);
+        assert!(
+            (root + 10.0_f64.cbrt()).abs() <= 4.0 * f64::EPSILON * root.abs(),
+            "{root}"
+        );
+        assert!(bisection(|_| f64::NAN, 1.0, 2200).is_nan());
+    }
+
+    #[test]
+    fn bisect_stops_at_its_width_and_passes_an_error_on() {
+        let holds = |x: f64| Ok::<_, ()>(x * x <= 2.0);
+        let (inside, outside) = bisect(holds, (1.0, 2.0), usize::MAX, |a, b| b - a > 1e-6).unwrap();
+        assert!(inside * inside <= 2.0 && outside * outside > 2.0 && outside - inside <= 1e-6);
+        assert_eq!(bisect(|_| Err(7), (1.0, 2.0), usize::MAX, |_, _| true), Err(7));
     }
 }

@@ -1,10 +1,19 @@
 //! Numerical solvers shared by every layer, each allocation-free in its loop:
 //!
 //! - `lu`: LU factorisation with partial pivoting, in place;
+//! - `cholesky`: Cholesky factorisation of a small symmetric positive-definite matrix, in
+//!   place, and its triangular solves;
 //! - [`difference`]: gradients and Jacobians by central differences;
 //!   equations built from them;
 //! - `newton`: Newton's method, simplified (a kept Jacobian) or full, with [`NewtonOptions`];
-//! - [`bracket`]: a root of a function on a bracket (Illinois), for locating events;
+//!   `newton::plain`, its plain form for equations that judge their own residuals, and on a
+//!   scalar equation;
+//! - `fixed_point`: Picard's iteration x ← G(x), stopped at its round-off floor;
+//! - [`bracket`]: a root of a function on a bracket (Illinois, or Newton kept in it), for
+//!   locating events, and bisection (of a bracket found by doubling, or of a predicate);
+//! - `laguerre`: a root of a scalar function by Laguerre's iteration (Conway's, for Kepler);
+//! - `secant`: a root of a scalar function by the secant method, without a bracket;
+//! - `secular`: the secular equation of a trust region's boundary (Moré–Sorensen);
 //! - [`lanczos`]: the extreme eigenvalues of a symmetric-definite pencil, from its products;
 //! - [`interrupt`]: when to poll for Ctrl-C, and the check the iterative solves poll;
 //! - `scratch`: per-thread workspaces, for functions whose signatures take none.
@@ -56,12 +65,17 @@ pub(crate) fn fill(dst: &mut [f64], value: f64) {
 }
 
 pub mod bracket;
+pub(crate) mod cholesky;
 pub mod difference;
+pub(crate) mod fixed_point;
 pub mod interrupt;
+pub(crate) mod laguerre;
 pub mod lanczos;
 pub(crate) mod lu;
 pub(crate) mod newton;
 pub(crate) mod scratch;
+pub(crate) mod secant;
+pub(crate) mod secular;
 pub(crate) mod splitmix;
 
 pub use newton::{Diagnosis, NewtonOptions};

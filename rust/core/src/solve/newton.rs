@@ -20,6 +20,7 @@ use crate::error::StepError;
 use crate::{Error, ModelError};
 
 mod diagnosis;
+pub(crate) mod plain;
 
 pub(crate) use diagnosis::Reasons;
 pub use diagnosis::{degenerate, Diagnosis};

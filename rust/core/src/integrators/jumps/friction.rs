@@ -11,6 +11,7 @@
 
 use std::sync::Arc;
 
+use crate::solve::secular;
 use crate::ModelError;
 
 /// Slip rows J(q) that depend on the configuration, k × n: a velocity constraint J(q)q̇ = 0,
@@ -174,99 +175,21 @@ impl Friction {
 
 /// The direction ŝ of the slip s̃ (`slipped`, k entries) after a kick −cWŝ against itself, W =
 /// JM⁻¹Jᵀ the slip's metric (`metric`, k × k; `factor` its scratch): ŝ = x/|x| with
-/// x = (ρI + cW)⁻¹s̃ and |x| = 1, the slip after the kick ρŝ (ρ ≥ 0). ρ by Newton on
-/// 1/|x(ρ)| − 1 (Moré and Sorensen's secular equation: concave, increasing, nearly linear)
-/// from ρ = 0, safeguarded by bisection; ρ = 0 where the kick stops the slip. A backward kick
-/// (c < 0, a composition's backward substep) keeps s̃'s direction: its equation has a root near
-/// each of W's eigenvectors once the slip is small. `direction` gets ŝ (0 for s̃ = 0); `work`
-/// holds 2k entries.
+/// x = (ρI + cW)⁻¹s̃ and |x| = 1, the slip after the kick ρŝ (ρ ≥ 0), by Moré and Sorensen's
+/// secular equation ([`secular::direction`]); ρ = 0 where the kick stops the slip. A backward
+/// kick (c < 0, a composition's backward substep) keeps s̃'s direction: its equation has a root
+/// near each of W's eigenvectors once the slip is small. `direction` gets ŝ (0 for s̃ = 0);
+/// `work` holds 2k entries.
 pub(super) fn slip_after_kick(
     (metric, factor): (&[f64], &mut [f64]),
     slipped: &[f64],
     c: f64,
     (direction, work): (&mut [f64], &mut [f64]),
 ) {
-    let k = slipped.len();
     let size = slipped.iter().map(|x| x * x).sum::<f64>().sqrt();
-    let unit = |direction: &mut [f64], x: &[f64]| {
-        let size = x.iter().map(|y| y * y).sum::<f64>().sqrt();
-        for (d, y) in direction.iter_mut().zip(x) {
-            *d = if size > 0.0 { y / size } else { 0.0 };
-        }
-    };
-    unit(direction, slipped);
     if !(size > 0.0 && c > 0.0 && c.is_finite()) {
+        secular::unit(direction, slipped);
         return;
     }
-    let (x, w) = work.split_at_mut(k);
-    let trace: f64 = (0..k).map(|i| metric[i * k + i]).sum();
-    // At ρ = |s̃|, |x| ≤ 1: the root lies in [0, |s̃|].
-    let (mut low, mut high, mut rho) = (0.0, size, 0.0);
-    let tolerance = 4.0 * f64::EPSILON * (size + c * trace);
-    for _ in 0..100 {
-        if !cholesky(metric, c, rho, factor, k) {
-            // W singular: the root is to the right of 0.
-            low = rho;
-            rho = 0.5 * (low + high);
-            continue;
-        }
-        // x = (ρI + cW)⁻¹s̃ = L⁻ᵀL⁻¹s̃, then w = L⁻¹x: |w|² = xᵀ(ρI + cW)⁻¹x.
-        forward(factor, slipped, w, k);
-        for i in (0..k).rev() {
-            let sum: f64 = (i + 1..k).map(|l| factor[l * k + i] * x[l]).sum();
-            x[i] = (w[i] - sum) / factor[i * k + i];
-        }
-        forward(factor, x, w, k);
-        let length = x.iter().map(|y| y * y).sum::<f64>().sqrt();
-        let curvature = w.iter().map(|y| y * y).sum::<f64>();
-        unit(direction, x);
-        let g = 1.0 / length - 1.0;
-        if g >= 0.0 {
-            if rho == 0.0 {
-                return;
-            }
-            high = rho;
-        } else {
-            low = rho;
-        }
-        let mut next = rho - g * length.powi(3) / curvature;
-        if !(next > low && next < high) {
-            next = 0.5 * (low + high);
-        }
-        if (next - rho).abs() <= tolerance {
-            return;
-        }
-        rho = next;
-    }
-}
-
-/// The Cholesky factor L of ρI + cW (k × k) into `factor`'s lower triangle: whether it is
-/// positive definite.
-fn cholesky(metric: &[f64], c: f64, rho: f64, factor: &mut [f64], k: usize) -> bool {
-    for i in 0..k {
-        for j in 0..=i {
-            let mut sum = c * metric[i * k + j] + if i == j { rho } else { 0.0 };
-            for l in 0..j {
-                sum -= factor[i * k + l] * factor[j * k + l];
-            }
-            if i == j {
-                // Not positive, or NaN: not positive definite.
-                if sum.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
-                    return false;
-                }
-                factor[i * k + i] = sum.sqrt();
-            } else {
-                factor[i * k + j] = sum / factor[j * k + j];
-            }
-        }
-    }
-    true
-}
-
-/// y = L⁻¹b for the lower triangle L in `factor` (k × k).
-fn forward(factor: &[f64], b: &[f64], y: &mut [f64], k: usize) {
-    for i in 0..k {
-        let sum: f64 = (0..i).map(|l| factor[i * k + l] * y[l]).sum();
-        y[i] = (b[i] - sum) / factor[i * k + i];
-    }
+    secular::direction((metric, c), slipped, factor, (direction, work));
 }

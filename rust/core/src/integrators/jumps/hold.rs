@@ -25,7 +25,9 @@ use super::{Contact, Friction};
 use crate::integrators::{Composition, Feature, Method};
 use crate::model::Lagrangian;
 use crate::solve::difference;
+use crate::solve::fixed_point::{self, Pass};
 use crate::solve::lu::{lu_in_place, lu_solve};
+use crate::solve::newton::{self, plain::Ended};
 use crate::ModelError;
 
 /// Newton iterations of the position constraint at most: it starts O(τ²) off and converges
@@ -293,73 +295,66 @@ impl Hold {
         self.start.copy_from_slice(&self.q);
         self.c[..rows].fill(0.0);
         // Each residual is judged against its round-off floor, the rounding of q₁'s every
-        // coordinate (of the terms q₀ + s(q̇ + shift) it sums) through its row: the iteration
-        // stops where it reaches that floor, or where it stops falling within 10³ of it (a φ
-        // rounding more than its terms), whatever the coordinates' sizes.
-        let mut last = f64::INFINITY;
+        // coordinate (of the terms q₀ + s(q̇ + shift) it sums) through its row: Newton stops
+        // where it reaches that floor, or where it stops falling within 10³ of it (a φ rounding
+        // more than its terms), whatever the coordinates' sizes.
         let mut worst = (f64::NAN, f64::NAN, 0);
-        let mut converged = false;
-        for _ in 0..ITERATIONS {
-            for i in 0..n {
-                let (mut shift, mut size) = (0.0, 0.0);
-                for k in 0..rows {
-                    let x = self.c[k] * self.inverse[k * n + i];
-                    shift += x;
-                    size += x.abs();
+        let (system, pivots) = &mut self.systems[rows - 1];
+        let ended = newton::plain::solve(
+            ITERATIONS,
+            (4.0, STALLED),
+            &mut self.c[..rows],
+            (system, pivots, &mut self.r[..rows]),
+            |c, jacobian, r| {
+                for i in 0..n {
+                    let (mut shift, mut size) = (0.0, 0.0);
+                    for (k, ck) in c.iter().enumerate() {
+                        let x = ck * self.inverse[k * n + i];
+                        shift += x;
+                        size += x.abs();
+                    }
+                    self.q[i] = self.start[i] + s * (self.v[i] + shift);
+                    self.rounding[i] =
+                        f64::EPSILON * (self.start[i].abs() + self.q[i].abs() + s.abs() * (self.v[i].abs() + size));
                 }
-                self.q[i] = self.start[i] + s * (self.v[i] + shift);
-                self.rounding[i] =
-                    f64::EPSILON * (self.start[i].abs() + self.q[i].abs() + s.abs() * (self.v[i].abs() + size));
-            }
-            if midpoint {
-                for ((x, x0), x1) in self.shifted.iter_mut().zip(&self.start).zip(&self.q) {
-                    *x = 0.5 * (x0 + x1);
+                if midpoint {
+                    for ((x, x0), x1) in self.shifted.iter_mut().zip(&self.start).zip(&self.q) {
+                        *x = 0.5 * (x0 + x1);
+                    }
+                    rows_into(held, &self.shifted, &mut self.shifted_rows, false)?;
                 }
-                rows_into(held, &self.shifted, &mut self.shifted_rows, false)?;
-            }
-            let (system, pivots) = &mut self.systems[rows - 1];
-            let mut ratio = 0.0_f64;
-            for a in 0..rows {
-                let row = if a < m {
-                    let surface = &held.contacts[held.closed[a]].surface;
-                    surface.gradient(&self.q, &mut self.gradient)?;
-                    self.r[a] = -surface.phi(&self.q)?;
-                    &self.gradient[..]
-                } else {
-                    let rows = if midpoint { &self.shifted_rows } else { &self.rows };
-                    let row = &rows[a * n..(a + 1) * n];
-                    self.r[a] = -(0..n).map(|i| row[i] * (self.q[i] - self.start[i])).sum::<f64>();
-                    row
-                };
-                let floor: f64 = row.iter().zip(&self.rounding).map(|(g, d)| (g * d).abs()).sum();
-                let against = if self.r[a] == 0.0 { 0.0 } else { self.r[a].abs() / floor };
-                // NaN (a residual that left the numbers) is the worst.
-                if against > ratio || against.is_nan() {
-                    ratio = against;
-                    worst = (self.r[a].abs(), floor, a);
+                let mut ratio = 0.0_f64;
+                for a in 0..rows {
+                    let row = if a < m {
+                        let surface = &held.contacts[held.closed[a]].surface;
+                        surface.gradient(&self.q, &mut self.gradient)?;
+                        r[a] = -surface.phi(&self.q)?;
+                        &self.gradient[..]
+                    } else {
+                        let rows = if midpoint { &self.shifted_rows } else { &self.rows };
+                        let row = &rows[a * n..(a + 1) * n];
+                        r[a] = -(0..n).map(|i| row[i] * (self.q[i] - self.start[i])).sum::<f64>();
+                        row
+                    };
+                    let floor: f64 = row.iter().zip(&self.rounding).map(|(g, d)| (g * d).abs()).sum();
+                    let against = if r[a] == 0.0 { 0.0 } else { r[a].abs() / floor };
+                    // NaN (a residual that left the numbers) is the worst.
+                    if against > ratio || against.is_nan() {
+                        ratio = against;
+                        worst = (r[a].abs(), floor, a);
+                    }
+                    for b in 0..rows {
+                        let w = &self.inverse[b * n..(b + 1) * n];
+                        jacobian[(a, b)] = s * row.iter().zip(w).map(|(g, w)| g * w).sum::<f64>();
+                    }
                 }
-                for b in 0..rows {
-                    let w = &self.inverse[b * n..(b + 1) * n];
-                    system[(a, b)] = s * row.iter().zip(w).map(|(g, w)| g * w).sum::<f64>();
-                }
-            }
-            if ratio <= 4.0 || (ratio >= last && ratio <= STALLED) {
-                converged = true;
-                break;
-            }
-            last = ratio;
-            if !ratio.is_finite() {
-                break;
-            }
-            if lu_in_place(system, pivots).is_none() {
-                return Err(Unsolved::dependent(POSITION));
-            }
-            lu_solve(system, pivots, &mut self.r[..rows]);
-            for k in 0..rows {
-                self.c[k] += self.r[k];
-            }
+                Ok::<_, ModelError>(ratio)
+            },
+        )?;
+        if ended == Ended::Singular {
+            return Err(Unsolved::dependent(POSITION));
         }
-        if !converged {
+        if ended == Ended::Unconverged {
             let (residual, floor, a) = worst;
             let stuck = (a >= m).then(|| &self.rows[a * n..(a + 1) * n]);
             let cause = diagnosis(
@@ -424,10 +419,7 @@ impl Hold {
         (t, s): (f64, f64),
         slipping: Slipping,
     ) -> Result<Option<Unsolved>, ModelError> {
-        let (mut last, mut floor) = (f64::INFINITY, 0.0);
-        let mut iterations = 0;
-        while iterations < ITERATIONS {
-            iterations += 1;
+        let outcome = fixed_point::iterate(ITERATIONS, || {
             for ((x, h), f) in self.p.iter_mut().zip(&self.half).zip(&self.friction) {
                 *x = h + 0.5 * s * f;
             }
@@ -441,26 +433,26 @@ impl Hold {
                 .iter()
                 .zip(&self.friction)
                 .fold(0.0_f64, |a, (x, y)| a.max((x - y).abs()));
-            floor = 4.0 * f64::EPSILON * size;
             // λ's curvature term is a difference, smooth in p to ε^(2/3) only: the iteration
             // settles where its change stops falling, within that.
-            if change <= floor || (change >= last && change <= 1e-8 * size) {
-                return Ok(None);
-            }
-            let stopped = change >= last || change.is_nan();
-            last = change;
-            if stopped && (matches!(slipping, Slipping::Now) || !change.is_finite()) {
-                break;
-            }
+            Ok::<_, ModelError>(Pass {
+                change,
+                floor: 4.0 * f64::EPSILON * size,
+                stall: 1e-8 * size,
+                give_up: matches!(slipping, Slipping::Now) || !change.is_finite(),
+            })
+        })?;
+        if outcome.settled {
+            return Ok(None);
         }
         Ok(Some(Unsolved {
             solve: FRICTION,
             cause: Cause::Step {
                 past: "the sliding force's turn (a slip about to stop, or a curvature it does not resolve)",
             },
-            residual: last,
-            floor,
-            iterations,
+            residual: outcome.change,
+            floor: outcome.floor,
+            iterations: outcome.passes,
         }))
     }
 

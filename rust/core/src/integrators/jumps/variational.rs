@@ -2,14 +2,16 @@
 //! (2003), "Nonsmooth Lagrangian mechanics and variational collision integrators", SIAM J. Appl.
 //! Dyn. Syst. 2, 381–416.
 
+use crate::solve::secant::secant;
 use crate::Error;
 
 /// λ with the discrete energy of the piece after the jump, `after(λ)`, equal to `target`, that of
 /// the piece before: the contact point and the fraction of the step then make the action of the
 /// two pieces stationary, D₂L_d(q_k, q̃, τ₁) + D₁L_d(q̃, q_{k+1}, τ₂) = λ∇φ(q̃) and
 /// E_d(q_k, q̃, τ₁) = E_d(q̃, q_{k+1}, τ₂), so the step across the impact is symplectic. Solved by
-/// secants from the reflection's λ `exact`, O(τ²) away; `(exact, false)` where there is no root
-/// near it (a grazing impact, |∇φ·q̇| of order τ). `scale` sizes the energies' round-off.
+/// secants ([`secant`]) from the reflection's λ `exact`, O(τ²) away; `(exact, false)` where
+/// there is no root near it (a grazing impact, |∇φ·q̇| of order τ). `scale` sizes the energies'
+/// round-off.
 pub(super) fn multiplier(
     mut after: impl FnMut(f64) -> Result<f64, Error>,
     exact: f64,
@@ -22,29 +24,19 @@ pub(super) fn multiplier(
     // no further secant could tell a better one (the billiard's, where the laws coincide, is
     // the reflection's at once).
     let noise = 16.0 * f64::EPSILON * (target.abs() + scale.abs());
-    let (mut lam0, mut lam1) = (exact, exact * (1.0 + 1e-6));
-    let mut f0 = after(lam0)? - target;
+    let f0 = after(exact)? - target;
     if f0.abs() <= noise {
         return Ok((exact, true));
     }
-    for _ in 0..40 {
-        let f1 = after(lam1)? - target;
-        if f1.abs() <= noise || (lam1 - lam0).abs() <= 4.0 * f64::EPSILON * lam1.abs() {
-            let (lo, hi) = if exact > 0.0 {
-                (0.5 * exact, 1.5 * exact)
-            } else {
-                (1.5 * exact, 0.5 * exact)
-            };
-            return Ok(if (lo..=hi).contains(&lam1) {
-                (lam1, true)
-            } else {
-                (exact, false)
-            });
-        }
-        if f1 == f0 || !f1.is_finite() {
-            break;
-        }
-        (lam0, lam1, f0) = (lam1, lam1 - f1 * (lam1 - lam0) / (f1 - f0), f1);
-    }
-    Ok((exact, false))
+    let energy = |lam| Ok::<_, Error>(after(lam)? - target);
+    let root = secant(energy, (exact, f0), exact * (1.0 + 1e-6), noise, 40)?;
+    let (lo, hi) = if exact > 0.0 {
+        (0.5 * exact, 1.5 * exact)
+    } else {
+        (1.5 * exact, 0.5 * exact)
+    };
+    Ok(match root {
+        Some(lam) if (lo..=hi).contains(&lam) => (lam, true),
+        _ => (exact, false),
+    })
 }

@@ -1,6 +1,9 @@
 //! The Kepler drift: the exact flow of a two-body problem, by a universal-variable solver.
 
 use super::stumpff::universal_functions;
+use crate::solve::bracket::bisection;
+use crate::solve::laguerre::laguerre;
+use crate::solve::newton::plain;
 
 /// Newton iterations before the bracketed fallback; from the second-order guess Newton converges
 /// in 2–4 iterations for a step below a tenth of the period.
@@ -71,42 +74,31 @@ pub fn kepler_drift(x: [f64; 3], v: [f64; 3], mu: f64, dt: f64) -> ([f64; 3], [f
         xu = first;
     } else {
         xu = if beta > 0.0 { beta * dt / mu } else { dtr0i };
-        for _ in 0..LAGUERRE_ITERATIONS {
+        // A NaN step stops too: Newton and the fallback take over.
+        let derivatives = |xu: f64| {
             let g = universal_functions(beta, xu);
             let t = r0 * xu + eta0 * g[2] + zeta0 * g[3] - dt;
-            let tp = r0 + eta0 * g[1] + zeta0 * g[2];
-            let tpp = eta0 * g[0] + zeta0 * g[1];
-            let step = 5.0 * t / (tp + (16.0 * tp * tp - 20.0 * t * tpp).abs().sqrt().copysign(tp));
-            xu -= step;
-            // A NaN step stops too: Newton and the fallback take over.
-            if step.abs() <= 1e-8 * xu.abs() || step.is_nan() {
-                break;
-            }
-        }
+            (t, r0 + eta0 * g[1] + zeta0 * g[2], eta0 * g[0] + zeta0 * g[1])
+        };
+        xu = laguerre(derivatives, xu, LAGUERRE_ITERATIONS, 1e-8);
     }
     // Newton's iteration, quadratic: once a correction is below 1e-9 of X one more step reaches
-    // round-off, where a close pericentre leaves X wandering by a few ulps (a stop on exact
-    // repetition would not come).
-    let mut converged = false;
-    for _ in 0..NEWTON_ITERATIONS {
-        let (next, gn, rn) = newton(xu);
-        (g, r) = (gn, rn);
-        let correction = next - xu;
-        xu = next;
-        if polishing {
-            converged = true;
-            break;
-        }
-        polishing = correction.abs() <= 1e-9 * xu.abs();
-    }
+    // round-off, where a close pericentre leaves X wandering by a few ulps.
+    let map = |xu: f64| {
+        let next;
+        (next, g, r) = newton(xu);
+        next
+    };
+    let (_, converged) = plain::scalar(map, xu, polishing, (NEWTON_ITERATIONS, 1e-9));
     // On convergence g and r are those of the X before the last correction, a round-off away.
     if !converged {
-        let root = bracketed(
+        let root = bisection(
             |xu| {
                 let g = universal_functions(beta, xu);
                 r0 * xu + eta0 * g[2] + zeta0 * g[3] - dt
             },
             dt * r0i,
+            FALLBACK_ITERATIONS,
         );
         g = universal_functions(beta, root);
         r = r0 + eta0 * g[1] + zeta0 * g[2];
@@ -123,42 +115,6 @@ pub fn kepler_drift(x: [f64; 3], v: [f64; 3], mu: f64, dt: f64) -> ([f64; 3], [f
         dv[k] = fd * x[k] + gd * v[k];
     }
     (dx, dv)
-}
-
-/// The root of the increasing function `t` (t(0) = −dt), bracketed from [0, `guess`] by
-/// doubling and then bisected to adjacent doubles; bounded, NaN for non-finite data.
-fn bracketed(t: impl Fn(f64) -> f64, guess: f64) -> f64 {
-    let sign = if guess < 0.0 { -1.0 } else { 1.0 };
-    let (mut near, mut far) = (0.0, if guess == 0.0 { f64::MIN_POSITIVE } else { guess });
-    let beyond = |value: f64| sign * value >= 0.0;
-    let mut bracketed = false;
-    for _ in 0..FALLBACK_ITERATIONS {
-        let value = t(far);
-        if !value.is_finite() {
-            return f64::NAN;
-        }
-        if beyond(value) {
-            bracketed = true;
-            break;
-        }
-        near = far;
-        far *= 2.0;
-    }
-    if !bracketed {
-        return f64::NAN;
-    }
-    for _ in 0..FALLBACK_ITERATIONS {
-        let mid = 0.5 * (near + far);
-        if mid == near || mid == far {
-            break;
-        }
-        if beyond(t(mid)) {
-            far = mid;
-        } else {
-            near = mid;
-        }
-    }
-    0.5 * (near + far)
 }
 
 #[inline(always)]
