@@ -32,9 +32,52 @@ from .model import Model
 
 
 @dataclass(frozen=True, eq=False)
+class Jumps:
+    """What a run watches and applies besides its steps (events, contacts, impulses): each as
+    the run's result reports it, beside the binding's tuples of it. A new kind of jump is a
+    field here, made in :meth:`of`, and its keyword in :attr:`binding`."""
+
+    #: The events watched, and the binding's tuples of them (checked against the model).
+    events: tuple[Event, ...] = ()
+    event_specs: list[tuple[str, int, int, str, Any]] = field(default_factory=list)
+    #: The contacts, and the binding's tuples of them.
+    contacts: tuple[Contact, ...] = ()
+    contact_specs: list[_impacts.Spec] = field(default_factory=list)
+    #: The impulses, and the binding's tuples of those within the run's span.
+    impulses: tuple[Impulse, ...] = ()
+    impulse_specs: list[_impulses.Spec] = field(default_factory=list)
+
+    @classmethod
+    def of(
+        cls,
+        model: Model,
+        events: Sequence[Event | _events.EventFunction] | None,
+        contacts: Sequence[Contact] | None,
+        impulses: tuple[Sequence[Impulse], list[_impulses.Spec]] = ((), []),
+    ) -> Jumps:
+        """The jumps of a run of ``model``: ``events`` checked against it (None: none),
+        ``contacts``, and ``impulses`` with their tuples (``impulses.specs`` over the run's span,
+        or ``impulses.going_on`` for a continued run)."""
+        watched, event_specs = _events.specs(events, model) if events is not None else ([], [])
+        contacts = tuple(contacts or ())
+        return cls(tuple(watched), event_specs, contacts, _impacts.specs(contacts), tuple(impulses[0]), impulses[1])
+
+    def __bool__(self) -> bool:
+        return bool(self.event_specs or self.contact_specs or self.impulse_specs)
+
+    @property
+    def binding(self) -> dict[str, Any]:
+        """The binding's keywords of the jumps (None where there are none)."""
+        return {
+            "events": self.event_specs or None,
+            "contacts": self.contact_specs or None,
+            "impulses": self.impulse_specs or None,
+        }
+
+
+@dataclass(frozen=True, eq=False)
 class RunSpec:
-    """How a run goes, its arguments checked: the binding's forms of its events, contacts and
-    impulses beside the objects its result reports.
+    """How a run goes, its arguments checked, with its :class:`Jumps`.
 
     A new run starts at ``t0`` from a state given beside the spec; a continued one goes on from
     ``checkpoint`` after ``base`` steps, its events watched after ``found`` crossings of each,
@@ -56,15 +99,7 @@ class RunSpec:
     t0: float = 0.0
     newton_tolerance: float = 1e-14
     newton_max_iterations: int = 50
-    #: The events watched, and the binding's tuples of them (checked against the model).
-    events: tuple[Event, ...] = ()
-    event_specs: list[tuple[str, int, int, str, Any]] = field(default_factory=list)
-    #: The contacts, and the binding's tuples of them.
-    contacts: tuple[Contact, ...] = ()
-    contact_specs: list[_impacts.Spec] = field(default_factory=list)
-    #: The impulses, and the binding's tuples of those within the run's span.
-    impulses: tuple[Impulse, ...] = ()
-    impulse_specs: list[_impulses.Spec] = field(default_factory=list)
+    jumps: Jumps = field(default_factory=Jumps)
     times: np.ndarray | None = None
     output: str | os.PathLike[str] | None = None
     overwrite: bool = False
@@ -92,25 +127,24 @@ class RunSpec:
     ) -> _core.TrajectoryRecord:
         """The binding's record of the new run's first ``steps`` steps from (q, p) at
         :attr:`t0`, reporting its step count to ``progress``."""
-        return _core.integrate(
-            model._core,
-            q,
-            p,
-            dt=self.dt,
-            steps=steps,
-            method=self.method,
-            save_every=self.save_every,
-            compensated=self.compensated,
-            max_energy_error=self.max_energy_error,
-            t0=self.t0,
-            newton_tolerance=self.newton_tolerance,
-            newton_max_iterations=self.newton_max_iterations,
-            progress=progress,
-            events=self.event_specs or None,
-            contacts=self.contact_specs or None,
-            impulses=self.impulse_specs or None,
-            t_eval=self.times,
-        )
+        return _core.integrate(model._core, q, p, **(self.binding | {"steps": steps}), progress=progress)
+
+    @property
+    def binding(self) -> dict[str, Any]:
+        """The binding's keywords of a new run of :attr:`steps` steps (integrate's, ensemble's)."""
+        return {
+            "dt": self.dt,
+            "steps": self.steps,
+            "method": self.method,
+            "save_every": self.save_every,
+            "compensated": self.compensated,
+            "max_energy_error": self.max_energy_error,
+            "t0": self.t0,
+            "newton_tolerance": self.newton_tolerance,
+            "newton_max_iterations": self.newton_max_iterations,
+            "t_eval": self.times,
+            **self.jumps.binding,
+        }
 
     def stepper(self, model: Model, q: np.ndarray, p: np.ndarray) -> _core.Stepper:
         """The binding's stepper of ``model`` from (q, p) at :attr:`t0`."""
@@ -124,24 +158,23 @@ class RunSpec:
             compensated=self.compensated,
             newton_tolerance=self.newton_tolerance,
             newton_max_iterations=self.newton_max_iterations,
-            contacts=self.contact_specs or None,
-            impulses=self.impulse_specs or None,
-            events=self.event_specs or None,
+            **self.jumps.binding,
         )
 
     def occurrence_names(self) -> list[str]:
         """The names of the run's occurrences, as its result and its file list them: each
         event's, then each contact's."""
-        return [o.name for o in _events.occurrences_of(self.events)] + _impacts.occurrence_names(self.contacts)
+        jumps = self.jumps
+        return [o.name for o in _events.occurrences_of(jumps.events)] + _impacts.occurrence_names(jumps.contacts)
 
     def events_from(self, found: Sequence[int], initial_energy: float | None) -> list[Any] | None:
         """The binding's tuples of the events watched from a checkpoint after ``found``
         crossings of each, an energy error measured from ``initial_energy``; None without
         events."""
-        if not self.events:
+        if not self.jumps.events:
             return None
         assert initial_energy is not None
-        return _events.going_on(self.event_specs, found, initial_energy)
+        return _events.going_on(self.jumps.event_specs, found, initial_energy)
 
 
 def energy_threshold(max_energy_error: float | None | Literal["auto"]) -> float | None:

@@ -21,10 +21,9 @@ from numpy.typing import ArrayLike
 
 from . import _core
 from . import events as _events
-from . import impacts as _impacts
 from . import impulses as _impulses
 from ._progress import progress_bar, thread_lock
-from ._runspec import RunSpec, energy_threshold, newton_options, sample_times
+from ._runspec import Jumps, RunSpec, energy_threshold, newton_options, sample_times
 from ._util import finite, floats, positive, positive_int, step_count
 from .conservation import NOT_JUDGED, VERDICTS, ConservationReport, check_conservation
 from .impacts import Contact
@@ -383,7 +382,6 @@ def ensemble(
     True
     """
     contacts = list(contacts_of(model, contacts))
-    contact_specs = _impacts.specs(contacts)
     model, _, _ = model_and_state(model, None, None, None)
     n = model.dim
     q = np.array(floats("q0", q0))
@@ -403,8 +401,7 @@ def ensemble(
     workers = None if workers is None else positive_int("workers", workers)
     chunk_size = None if chunk_size is None else positive_int("chunk_size", chunk_size)
     newton_tolerance, newton_max_iterations = newton_options(newton_tolerance, newton_max_iterations)
-    watched, event_specs = _events.specs(events, model) if events is not None else ([], [])
-    impulse_specs = _impulses.specs(impulses or (), t0, t0 + nsteps * dt)
+    jumps = Jumps.of(model, events, contacts, (impulses or (), _impulses.specs(impulses or (), t0, t0 + nsteps * dt)))
     times = sample_times(t_eval, t0, t0 + nsteps * dt, save_every, None, model.dim, len(q))
     # Each member's integrate keywords, where the members run one integrate each (serially, in
     # processes, on a cluster), which builds each one's spec.
@@ -418,9 +415,9 @@ def ensemble(
     cores = [m._core for m in (models if values else models[:1])]
     released = [c for c in cores if isinstance(c, (_core.NativeModel, _core.CompiledModel))]
     native = (
-        all(e.native is not None for e in watched)
+        all(e.native is not None for e in jumps.events)
         and all(c.native for c in contacts)
-        and all(kind == "generalized" for _, kind, _ in impulse_specs)
+        and all(kind == "generalized" for _, kind, _ in jumps.impulse_specs)
     )
     if len(released) == len(cores) and native:
         # The members' run, each member's as integrate would specify it (the energy threshold
@@ -435,12 +432,7 @@ def ensemble(
             t0=t0,
             newton_tolerance=newton_tolerance,
             newton_max_iterations=newton_max_iterations,
-            events=tuple(watched),
-            event_specs=event_specs,
-            contacts=tuple(contacts),
-            contact_specs=contact_specs,
-            impulses=tuple(impulses or ()),
-            impulse_specs=impulse_specs,
+            jumps=jumps,
             times=times,
         )
         results, interrupted = _on_threads(released, q, p, spec, workers, chunk_size, members, progress)
@@ -475,27 +467,7 @@ def _on_threads(
     bar = progress_bar(total=spec.steps * members, unit="step", desc=f"{spec.method} ×{members}", enabled=progress)
     try:
         report = None if bar.disable else (lambda done: bar.update(done - bar.n))
-        return _core.ensemble(
-            released,
-            q,
-            p,
-            dt=spec.dt,
-            steps=spec.steps,
-            method=spec.method,
-            save_every=spec.save_every,
-            compensated=spec.compensated,
-            t0=spec.t0,
-            newton_tolerance=spec.newton_tolerance,
-            newton_max_iterations=spec.newton_max_iterations,
-            max_energy_error=spec.max_energy_error,
-            workers=workers,
-            chunk_size=chunk_size,
-            progress=report,
-            events=spec.event_specs or None,
-            contacts=spec.contact_specs or None,
-            impulses=spec.impulse_specs or None,
-            t_eval=spec.times,
-        )
+        return _core.ensemble(released, q, p, **spec.binding, workers=workers, chunk_size=chunk_size, progress=report)
     finally:
         bar.close()
 

@@ -51,7 +51,7 @@ import numpy as np
 
 from . import impacts as _impacts
 from . import impulses as _impulses
-from ._runspec import RunSpec
+from ._runspec import Jumps, RunSpec
 from ._version import __version__
 from .events import Occurrences
 from .impacts import Contact
@@ -125,7 +125,7 @@ class Writer:
         argument: str = "path",
         planned: bool = True,
     ):
-        method, contacts, impulses = spec.method, spec.contacts, spec.impulses
+        method, contacts, impulses = spec.method, spec.jumps.contacts, spec.jumps.impulses
         columns = columns_of(model, method, contacts, impulses)
         if events is None:
             events = spec.occurrence_names()
@@ -527,7 +527,7 @@ def save(traj: Trajectory, path: str | os.PathLike[str], *, overwrite: bool = Fa
     # which the writer stores as such; its saving period is unknown (0).
     contacts = cast("tuple[Contact, ...]", traj.contacts)
     impulses = cast("tuple[Impulse, ...]", traj.impulses)
-    spec = RunSpec(traj.method, traj.dt, save_every=0, contacts=contacts, impulses=impulses)
+    spec = RunSpec(traj.method, traj.dt, save_every=0, jumps=Jumps(contacts=contacts, impulses=impulses))
     writer = Writer(target, traj.model, spec, events=[o.name for o in traj.events], planned=False)
     writer.append(traj, events=traj.events)
     writer.close(traj.status, traj.message)

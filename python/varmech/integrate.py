@@ -19,7 +19,7 @@ from . import events as _events
 from . import impacts as _impacts
 from . import impulses as _impulses
 from ._progress import progress_bar
-from ._runspec import RunSpec, energy_threshold, newton_options, sample_times
+from ._runspec import Jumps, RunSpec, energy_threshold, newton_options, sample_times
 from ._util import finite, positive, positive_int, returned_scalar, step_count, vector
 from .constraints import warn_if_integrable
 from .derivatives import blame
@@ -307,10 +307,10 @@ def integrate(
     q, p = initial_state(model, q0, p0, v0, t0)
     if model.velocity_constraints:
         warn_if_integrable(model, q)
-    watched, event_specs = _events.specs(events, model) if events is not None else ([], [])
-    check_delays(model, bool(event_specs or contacts or impulses), nsteps * dt)
     # A horizon past the largest float is the core's to refuse (naming dt); probe finite times.
     t_end = t0 + nsteps * dt
+    jumps = Jumps.of(model, events, contacts, (impulses or (), _impulses.specs(impulses or (), t0, t_end)))
+    check_delays(model, bool(jumps), nsteps * dt)
     probes = (t0, t0 + dt, t0 + 0.5, t0 + 1.0, t0 + 0.37 * (t_end - t0), t_end)
     starts = "q0, v0" if v0 is not None else "q0, p0"
     _check_time_independent(model, q, p, tuple(s for s in probes if math.isfinite(s)), starts)
@@ -326,12 +326,7 @@ def integrate(
         t0=t0,
         newton_tolerance=newton_tolerance,
         newton_max_iterations=newton_max_iterations,
-        events=tuple(watched),
-        event_specs=event_specs,
-        contacts=tuple(contacts or ()),
-        contact_specs=_impacts.specs(contacts or ()),
-        impulses=tuple(impulses or ()),
-        impulse_specs=_impulses.specs(impulses, t0, t_end) if impulses is not None else [],
+        jumps=jumps,
         times=sample_times(t_eval, t0, t_end, save_every, output, model.dim),
         output=output,
         overwrite=overwrite,
@@ -360,20 +355,14 @@ def _go_on(
     nsteps = step_count(traj.dt, t_now, steps, t_end)
     save_every = positive_int("save_every", options.save_every)
     times = sample_times(t_eval, t_now, t_now + nsteps * traj.dt, save_every, options.output, traj.model.dim)
-    watched, specs = _events.specs(events, traj.model) if events is not None else ([], [])
-    found = _events.found_before(traj.events, watched)
-    initial = _events.first_energy(traj.model, traj) if watched else None
-    impulses, impulse_specs = _impulses.going_on(traj.impulses, None, t_now)
+    jumps = Jumps.of(traj.model, events, contacts, _impulses.going_on(traj.impulses, None, t_now))
+    found = _events.found_before(traj.events, jumps.events)
+    initial = _events.first_energy(traj.model, traj) if jumps.events else None
     spec = replace(
         options,
         steps=nsteps,
         save_every=save_every,
-        events=tuple(watched),
-        event_specs=specs,
-        contacts=contacts,
-        contact_specs=_impacts.specs(contacts),
-        impulses=impulses,
-        impulse_specs=impulse_specs,
+        jumps=jumps,
         times=times,
         checkpoint=traj.checkpoint,
         base=traj.steps,
@@ -423,8 +412,8 @@ def _run(model: Model, spec: RunSpec, state: tuple[np.ndarray, np.ndarray] | Non
                     events=spec.events_from(spec.found, spec.initial_energy),
                     method=spec.method,
                     dt=spec.dt,
-                    contacts=spec.contact_specs or None,
-                    impulses=spec.impulse_specs or None,
+                    contacts=spec.jumps.contact_specs or None,
+                    impulses=spec.jumps.impulse_specs or None,
                     t_eval=spec.times,
                     **spec.energy_check,
                 )

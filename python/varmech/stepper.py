@@ -12,7 +12,7 @@ from . import _core
 from . import events as _events
 from . import impacts as _impacts
 from . import impulses as _impulses
-from ._runspec import RunSpec, newton_options
+from ._runspec import Jumps, RunSpec, newton_options
 from ._util import finite, floats, positive, step_count
 from .events import Event, EventFunction, Occurrences
 from .impacts import Contact
@@ -146,11 +146,10 @@ class Stepper:
         events: Sequence[Event | EventFunction] | None = None,
     ) -> None:
         contacts = contacts_of(model, contacts)
-        specs = _impacts.specs(contacts)
         blows = _impulses.specs(impulses or (), finite("t0", t0), math.inf)
         model, q0, p0 = model_and_state(model, q0, p0, v0)
-        watched, event_specs = _events.specs(events, model) if events is not None else ([], [])
-        check_delays(model, bool(specs or blows or event_specs))
+        jumps = Jumps.of(model, events, contacts, (impulses or (), blows))
+        check_delays(model, bool(jumps))
         if method is None:
             method = model.kind.default_method
         dt = positive("dt", dt)
@@ -166,12 +165,7 @@ class Stepper:
             t0=t0,
             newton_tolerance=newton_tolerance,
             newton_max_iterations=newton_max_iterations,
-            events=tuple(watched),
-            event_specs=event_specs,
-            contacts=contacts,
-            contact_specs=specs,
-            impulses=tuple(impulses or ()),
-            impulse_specs=blows,
+            jumps=jumps,
         )
         self._stepper = self._spec.stepper(model, q, p)
 
@@ -346,7 +340,7 @@ class Stepper:
         """
         t0 = self.t if t0 is None else finite("t0", t0)
         q, p = initial_state(self._model, q0, p0, v0, t0)
-        self._stepper.reset(q, p, t0, events=self._spec.event_specs or None)
+        self._stepper.reset(q, p, t0, events=self._spec.jumps.event_specs or None)
 
     @property
     def model(self) -> Model:
@@ -356,40 +350,40 @@ class Stepper:
     @property
     def contacts(self) -> tuple[Contact, ...]:
         """The contacts whose impacts the steps go through (empty without them)."""
-        return self._spec.contacts
+        return self._spec.jumps.contacts
 
     @property
     def impacts(self) -> tuple[Occurrences, ...]:
         """Each contact's impacts since the start or the last :meth:`reset`, in the order of
         :attr:`contacts`: the times, the contact configurations q̃ and the momenta p⁻ just before
         the jump, as a run's ``traj.events`` holds them (:attr:`impacts_after` has p⁺)."""
-        return _impacts.occurrences(self._stepper, self._spec.contacts)
+        return _impacts.occurrences(self._stepper, self._spec.jumps.contacts)
 
     @property
     def impacts_after(self) -> tuple[Occurrences, ...]:
         """As :attr:`impacts`, with the momenta p⁺ just after each jump (a run's saved state
         just after the impact)."""
-        return _impacts.occurrences(self._stepper, self._spec.contacts, after=True)
+        return _impacts.occurrences(self._stepper, self._spec.jumps.contacts, after=True)
 
     @property
     def switches(self) -> tuple[Occurrences, ...]:
         """Each contact's closures since the start or the last :meth:`reset`, in the order of
         :attr:`contacts` (``"<name>.closed"``), then each one's releases (``"<name>.released"``),
         as a run's ``traj.events`` holds them after the impacts (see :mod:`varmech.impacts`)."""
-        return _impacts.switches(self._stepper, self._spec.contacts)
+        return _impacts.switches(self._stepper, self._spec.jumps.contacts)
 
     @property
     def events(self) -> tuple[Occurrences, ...]:
         """Each event's located crossings since the start or the last :meth:`reset`, in the order
         of the ``events`` given, as a run's ``traj.events``."""
-        return _events.occurrences(self._stepper, self._spec.events)
+        return _events.occurrences(self._stepper, self._spec.jumps.events)
 
     @property
     def terminated_by(self) -> str | None:
         """The name of the event whose terminal count stopped the last :meth:`step` or
         :meth:`advance`, or None."""
         i = self._stepper.terminated_by
-        return None if i is None else str(self._spec.event_specs[i][0])
+        return None if i is None else str(self._spec.jumps.event_specs[i][0])
 
     @property
     def method(self) -> str:
@@ -545,26 +539,17 @@ class Stepper:
             # bytes() would read a str as an error and an int n as n zero bytes.
             raise TypeError(f"checkpoint: expected the bytes of Stepper.checkpoint(), got {type(checkpoint).__name__}")
         contacts = contacts_of(model, contacts)
-        specs = _impacts.specs(contacts)
         blows = _impulses.specs(impulses or (), -math.inf, math.inf)
         model, _, _ = model_and_state(model, None, None, None)
-        watched, event_specs = _events.specs(events, model) if events is not None else ([], [])
-        core = _core.Stepper.from_checkpoint(
-            model._core, bytes(checkpoint), method=method, dt=dt, contacts=specs or None, impulses=blows or None,
-            events=event_specs or None,
-        )
+        jumps = Jumps.of(model, events, contacts, (impulses or (), blows))
+        core = _core.Stepper.from_checkpoint(model._core, bytes(checkpoint), method=method, dt=dt, **jumps.binding)
         stepper = cls.__new__(cls)
         stepper._model = model
         # What it watches; its step, summation and Newton options are the checkpoint's.
         stepper._spec = RunSpec(
             core.method,
             core.dt,
-            events=tuple(watched),
-            event_specs=event_specs,
-            contacts=contacts,
-            contact_specs=specs,
-            impulses=tuple(impulses or ()),
-            impulse_specs=blows,
+            jumps=jumps,
         )
         stepper._stepper = core
         return stepper
@@ -572,7 +557,7 @@ class Stepper:
     def __reduce__(self) -> tuple[object, ...]:
         # By its model, checkpoint, contacts, impulses and events: the unpickled stepper goes on
         # bit for bit (its impacts and crossings counted from there).
-        return (_unpickled, (self._model, self.checkpoint(), self._spec.contacts, self._spec.impulses, self._spec.events))
+        return (_unpickled, (self._model, self.checkpoint(), self._spec.jumps.contacts, self._spec.jumps.impulses, self._spec.jumps.events))
 
     def __repr__(self) -> str:
         return f"Stepper({self._model.name!r}, method={self.method!r}, dt={self.dt:g}, t={self.t:g}, steps={self.steps})"

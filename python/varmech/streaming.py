@@ -30,7 +30,7 @@ from . import events as _events
 from . import impacts as _impacts
 from . import impulses as _impulses
 from ._progress import progress_bar
-from ._runspec import RunSpec
+from ._runspec import Jumps, RunSpec
 from ._util import step_count
 from .impacts import Contact
 from .impulses import Impulse
@@ -86,10 +86,10 @@ def stream(
     the run with every state up to it committed, and closes the file saying why. Each segment
     resolves the impacts on the spec's contacts, committed as the events after its events',
     and applies its impulses after its start."""
-    steps, save_every, watched, contacts = spec.steps, spec.save_every, spec.events, spec.contacts
+    steps, save_every, watched, contacts = spec.steps, spec.save_every, spec.jumps.events, spec.jumps.contacts
     base, checkpoint, initial_energy = spec.base, spec.checkpoint, spec.initial_energy
     cap, seconds = checkpoint_period(spec.checkpoint_every, save_every)
-    contact_specs = spec.contact_specs or None
+    contact_specs = spec.jumps.contact_specs or None
     found = list(spec.found) or [0] * len(watched)
     done, rate = 0, None
     segment = files.CHUNK_ROWS * save_every
@@ -145,7 +145,7 @@ def stream(
                     progress=None if bar.disable else report,
                     events=spec.events_from(found, initial_energy),
                     contacts=contact_specs,
-                    impulses=spec.impulse_specs or None,
+                    impulses=spec.jumps.impulse_specs or None,
                 )
             except BaseException as err:
                 # The segment's states and crossings up to the stop are committed; the file is
@@ -321,23 +321,18 @@ def resume(
     more = _further(path, stored, steps, t_end)
     if save_every is None:
         save_every = files.save_every_of(path)
-    watched, specs = _events.specs(events, stored.model) if events is not None else ([], [])
+    jumps = Jumps.of(stored.model, events, going_on, (still, blows))
     spec = RunSpec(
         stored.method,
         stored.dt,
         steps=more,
         save_every=save_every,
-        events=tuple(watched),
-        event_specs=specs,
-        contacts=going_on,
-        contact_specs=_impacts.specs(going_on),
-        impulses=still,
-        impulse_specs=blows,
+        jumps=jumps,
         checkpoint_every=checkpoint_every,
         progress=progress,
         checkpoint=stored.checkpoint,
         base=stored.steps,
-        found=tuple(_events.found_before(stored.events, watched)),
+        found=tuple(_events.found_before(stored.events, jumps.events)),
         initial_energy=_events.first_energy(stored.model, stored),
     )
     writer = files.Writer.reopen(Path(path), stored, spec)

@@ -487,8 +487,8 @@ def of_record(record: _core.TrajectoryRecord, model: Model, spec: RunSpec, **sta
     with its events' crossings and its contacts' impacts after them (and the status of a
     terminal event's stop, unless `status` is given)."""
     r = record
-    found = crossings(r, spec.events, spec.contacts)
-    status = status or _events.termination(r, spec.events, found)
+    found = crossings(r, spec.jumps.events, spec.jumps.contacts)
+    status = status or _events.termination(r, spec.jumps.events, found)
     _impacts.warn_grazing(r.grazing, stacklevel=4)
     return Trajectory(
         r.t,
@@ -503,8 +503,8 @@ def of_record(record: _core.TrajectoryRecord, model: Model, spec: RunSpec, **sta
         r.work,
         checkpoint=r.checkpoint,
         events=found,
-        contacts=spec.contacts,
-        impulses=spec.impulses,
+        contacts=spec.jumps.contacts,
+        impulses=spec.jumps.impulses,
         **status,
     )
 
