@@ -35,6 +35,7 @@ mod dynamics;
 mod ensemble;
 pub mod events;
 mod explicit_rk;
+mod impacts;
 pub mod jumps;
 mod kick_drift;
 mod kind;
@@ -45,6 +46,7 @@ mod run;
 mod splitting;
 mod step;
 mod stepper;
+mod surfaces;
 mod tangent;
 mod trajectory;
 pub mod wisdom_holman;
@@ -65,10 +67,10 @@ pub use ensemble::{
 };
 pub use events::{Detector, EventFunctions, EventSpec, NativeEvent, Occurrence};
 pub use explicit_rk::ExplicitRk;
+pub use impacts::{Impacts, Switch, Switches};
 pub use jumps::{
-    impulsive, Blow, Contact, Contacts, Friction, Gaps, Generalized, Impacts, Impulse, Law, NativeContact,
-    NativeSurface, PointFunction, Schedule, Slip, SlipRows, Struck, Surface, Switch, Switches, Watch, Watcher,
-    MAX_IMPACTS,
+    impulsive, Blow, Contact, Contacts, Friction, Gaps, Generalized, Impulse, Law, NativeContact, PointFunction,
+    Schedule, Slip, SlipRows, Struck, Watch, Watcher, MAX_IMPACTS,
 };
 pub use kick_drift::KickDrift;
 pub use kind::ModelKind;
@@ -84,6 +86,7 @@ pub use splitting::{Leading, Splitting};
 pub use step::{Increment, StepStart};
 use stepper::Phase;
 pub use stepper::{Clear, Stepper, StepperState};
+pub use surfaces::{NativeSurface, Surface};
 pub use tangent::Tangent;
 pub use trajectory::{Failure, Trajectory};
 pub use wisdom_holman::{Kernel, WisdomHolman};

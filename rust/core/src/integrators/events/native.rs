@@ -1,7 +1,7 @@
 //! The built-in event functions, evaluated in Rust (no call out of the core per step).
 
 use super::EventFunctions;
-use crate::integrators::jumps::{check_ellipsoid, ellipsoid, wall, NativeSurface, Surface};
+use crate::integrators::surfaces::{check_ellipsoid, ellipsoid, wall, NativeSurface, Surface};
 use crate::integrators::Dynamics;
 use crate::model::Reaction;
 use crate::{Error, ModelError};

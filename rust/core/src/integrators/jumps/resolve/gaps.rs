@@ -1,8 +1,9 @@
 //! φ of a run's contacts: whether a step crosses one, and the check after each step of the
 //! method's own loop ([`Gaps`]).
 
-use crate::integrators::jumps::{Contact, NativeSurface};
+use crate::integrators::jumps::Contact;
 use crate::integrators::Clear;
+use crate::integrators::NativeSurface;
 use crate::{Error, ModelError};
 
 /// Whether a step from φ at its start to φ at its end crosses a contact.

@@ -16,10 +16,11 @@ use std::ops::Deref;
 
 use super::hold::{Held, Hold};
 use super::unsolved::run_error;
-use super::{Contact, Contacts, Impacts, Law, NativeSurface, Schedule, Switch, MAX_IMPACTS};
+use super::{Contact, Contacts, Law, Schedule, MAX_IMPACTS};
 use crate::integrators::events::{PieceSteps, Search};
 use crate::integrators::DiscreteEnergy;
 use crate::integrators::{Counting, Dynamics, Feature, Method, Occurrence, Poll, Stepper, StepperState, Trajectory};
+use crate::integrators::{Impacts, NativeSurface, Switch};
 use crate::Error;
 
 mod gaps;

@@ -5,8 +5,8 @@ use std::ops::Deref;
 
 use super::{amax, dot, insert, Resolver};
 use crate::integrators::jumps::unsolved::run_error;
-use crate::integrators::jumps::Switch;
 use crate::integrators::Dynamics;
+use crate::integrators::Switch;
 use crate::solve::bracket::illinois;
 use crate::Error;
 

@@ -6,8 +6,8 @@ use std::ops::Deref;
 
 use super::{insert, Resolver};
 use crate::integrators::events::Search;
-use crate::integrators::jumps::{Impacts, Switch};
 use crate::integrators::{Dynamics, Stepper, StepperState, Trajectory};
+use crate::integrators::{Impacts, Switch};
 use crate::Error;
 
 impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {

@@ -1,9 +1,33 @@
-//! The native surfaces, evaluated in Rust: φ with the arithmetic of the native events
-//! [`crate::integrators::NativeEvent::Crossing`] and `::Ellipsoid`, which call the same
-//! functions, so that a contact and its event agree to the bit.
+//! Surfaces φ(q) ≥ 0, which contacts ([`super::Contact`]) and the native events share: the
+//! [`Surface`] trait, and the native surfaces, evaluated in Rust with the arithmetic of the
+//! native events [`crate::integrators::NativeEvent::Crossing`] and `::Ellipsoid`, which call
+//! the same functions, so that a contact and its event agree to the bit.
 
-use super::Surface;
 use crate::ModelError;
+
+/// A unilateral constraint's function φ(q) ≥ 0 (positive on the allowed side) and its gradient.
+///
+/// The binding implements it with Python callables, whose exceptions come back as the
+/// [`ModelError`] unchanged.
+pub trait Surface {
+    /// φ(q).
+    fn phi(&self, q: &[f64]) -> Result<f64, ModelError>;
+
+    /// Writes ∇φ(q) into `out` (n entries).
+    fn gradient(&self, q: &[f64], out: &mut [f64]) -> Result<(), ModelError>;
+
+    /// Why the surface cannot act on n coordinates, if it cannot (a native surface's
+    /// coordinates out of range). By default it can.
+    fn misfit(&self, _n: usize) -> Option<String> {
+        None
+    }
+
+    /// The surface as a native one, which a run evaluates after every step without dispatch
+    /// ([`super::Gaps`]); None (the default) for the others.
+    fn native(&self) -> Option<&NativeSurface> {
+        None
+    }
+}
 
 /// A native surface φ(q) ≥ 0.
 #[derive(Clone, Debug, PartialEq)]
