@@ -2,7 +2,8 @@
 
 use nalgebra::DMatrix;
 
-use super::{Gaps, Increment, Integrator, ModelKind, StepError, StepStart, StepperState, Tangent};
+use super::clear::Gaps;
+use super::{Increment, Integrator, ModelKind, StepError, StepStart, StepperState, Tangent};
 use crate::model::{
     self, Constrained, EnergyTerms, HolonomicConstraints, Lagrangian, MechanicalSystem, Mixed, Nonholonomic,
     PhaseState, VelocityConstraints,

@@ -1,5 +1,6 @@
 use super::checkpoint::derived::{same, Reached};
-use super::stepper::{Clear, Phase};
+use super::clear::Clear;
+use super::stepper::Phase;
 use super::{Increment, Splitting, StepError, StepStart};
 use crate::model::MechanicalSystem;
 use crate::{Error, ModelError};

@@ -27,6 +27,7 @@
 
 use serde::{Deserialize, Serialize};
 mod checkpoint;
+mod clear;
 pub mod compensated;
 mod composition;
 mod del;
@@ -56,6 +57,7 @@ pub use crate::error::StepError;
 pub use crate::solve::NewtonOptions;
 use checkpoint::derived::Reached;
 pub use checkpoint::{Checkpoint, Fingerprint, FORMAT as CHECKPOINT_FORMAT};
+pub use clear::{Clear, Gaps};
 pub use composition::Composition;
 pub use del::{Composed, Del, StepEquations, TwoPoint};
 use del::{Constraints, DiscreteConstraint};
@@ -69,8 +71,8 @@ pub use events::{Detector, EventFunctions, EventSpec, NativeEvent, Occurrence};
 pub use explicit_rk::ExplicitRk;
 pub use impacts::{Impacts, Switch, Switches};
 pub use jumps::{
-    impulsive, Blow, Contact, Contacts, Friction, Gaps, Generalized, Impulse, Law, NativeContact, PointFunction,
-    Schedule, Slip, SlipRows, Struck, Watch, Watcher, MAX_IMPACTS,
+    impulsive, Blow, Contact, Contacts, Friction, Generalized, Impulse, Law, NativeContact, PointFunction, Schedule,
+    Slip, SlipRows, Struck, Watch, Watcher, MAX_IMPACTS,
 };
 pub use kick_drift::KickDrift;
 pub use kind::ModelKind;
@@ -85,7 +87,7 @@ pub use run::{
 pub use splitting::{Leading, Splitting};
 pub use step::{Increment, StepStart};
 use stepper::Phase;
-pub use stepper::{Clear, Stepper, StepperState};
+pub use stepper::{Stepper, StepperState};
 pub use surfaces::{NativeSurface, Surface};
 pub use tangent::Tangent;
 pub use trajectory::{Failure, Trajectory};

@@ -7,16 +7,15 @@ mod own_variables;
 mod phase;
 
 pub(super) use clock::Clock;
-pub use phase::Clear;
-pub(super) use phase::{Always, Phase};
+pub(super) use phase::Phase;
 
 use std::borrow::{Borrow, BorrowMut};
 use std::ops::Deref;
 
+use super::clear::{Always, Clear, Gaps};
 use super::tangent;
 use super::{
-    check_method, compensated, Dynamics, Gaps, General, Increment, Integrator, Method, Options, Poll, StepStart,
-    Tangent,
+    check_method, compensated, Dynamics, General, Increment, Integrator, Method, Options, Poll, StepStart, Tangent,
 };
 use crate::error::check_vector;
 use crate::model::{Lagrangian, MechanicalSystem};

@@ -22,7 +22,7 @@
 
 use nalgebra::DMatrix;
 
-use super::stepper::Clear;
+use super::clear::Clear;
 use super::{
     one_of, Del, Dynamics, Feature, Integrator, Method, ModelKind, Rattle, Splitting, StepEquations, StepStart,
 };

@@ -6,8 +6,9 @@
 
 use super::{correct, finite_jacobian, rounding, segment, Constraints, Del, Equations, TwoPoint, REASONS};
 use crate::discrete::{DiscreteLagrangian, Workspace};
+use crate::integrators::clear::Clear;
 use crate::integrators::del::StepEquations;
-use crate::integrators::stepper::{Clear, Phase};
+use crate::integrators::stepper::Phase;
 use crate::integrators::{StepError, StepStart};
 use crate::model::Lagrangian;
 use crate::solve::difference;

@@ -31,7 +31,6 @@ mod variational;
 mod watch;
 
 pub use friction::{Friction, Slip, SlipRows};
-pub use resolve::Gaps;
 pub(in crate::integrators) use resolve::Resolver;
 pub use schedule::{Blow, Generalized, Impulse, PointFunction, Schedule, Struck};
 pub use watch::{Watch, Watcher};

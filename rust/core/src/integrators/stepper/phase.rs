@@ -1,7 +1,8 @@
-//! The state as a method's own loop advances it ([`Phase`]), and what that loop checks after
-//! each step ([`Clear`]).
+//! The state as a method's own loop advances it ([`Phase`]); what that loop checks after each
+//! step is a [`crate::integrators::Clear`].
 
 use super::{diverged, Clock};
+use crate::integrators::clear::Clear;
 use crate::integrators::{compensated, StepError};
 use crate::Error;
 
@@ -92,24 +93,5 @@ impl Phase<'_> {
         state_eq.copy_from_slice(&eq);
         state_ep.copy_from_slice(&ep);
         result
-    }
-}
-
-/// What a method's own loop checks at the end of each step: whether the step is clear, so that
-/// the loop goes on ([`Gaps`]: it crosses no contact; [`super::tangent::Carried`]: its tangent
-/// map carried the vectors, none past a bound). A trait, not a closure, so that the check is
-/// inlined into the loop: as a closure it was called out of line, a third of a Verlet step.
-pub trait Clear {
-    /// Whether the step ending at (q, p) is clear.
-    fn clear(&mut self, q: &[f64], p: &[f64]) -> bool;
-}
-
-/// Nothing watched: every step is clear.
-pub(in crate::integrators) struct Always;
-
-impl Clear for Always {
-    #[inline(always)]
-    fn clear(&mut self, _: &[f64], _: &[f64]) -> bool {
-        true
     }
 }

@@ -3,8 +3,8 @@
 
 use std::ops::Deref;
 
-use super::gaps::{below, floor};
 use super::{dot, insert, Resolver};
+use crate::integrators::clear::{below, floor};
 use crate::integrators::jumps::hold::Hold;
 use crate::integrators::jumps::{reflect, variational, Contact, Law, MAX_IMPACTS};
 use crate::integrators::Dynamics;

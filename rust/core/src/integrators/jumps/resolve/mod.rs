@@ -9,7 +9,8 @@
 //! - `held.rs`: a held contact's lift-off, and what a jump does to the held contacts;
 //! - `stick_slip.rs`: a held contact's friction switching between sticking and sliding;
 //! - `timed.rs`: the schedule's impulses, and its samples (partial steps from the last jump);
-//! - `gaps.rs`: φ checked after each step of the method's own loop ([`Gaps`]).
+//! - `gaps.rs`: φ of the contacts at a state (the check after each step of the method's own
+//!   loop is [`Gaps`], integrators/clear.rs).
 
 use std::borrow::{Borrow, BorrowMut};
 use std::ops::Deref;
@@ -20,7 +21,7 @@ use super::{Contact, Contacts, Law, Schedule, MAX_IMPACTS};
 use crate::integrators::events::{PieceSteps, Search};
 use crate::integrators::DiscreteEnergy;
 use crate::integrators::{Counting, Dynamics, Feature, Method, Occurrence, Poll, Stepper, StepperState, Trajectory};
-use crate::integrators::{Impacts, NativeSurface, Switch};
+use crate::integrators::{Impacts, NativeSurface, Surface, Switch};
 use crate::Error;
 
 mod gaps;
@@ -29,8 +30,8 @@ mod impact;
 mod stick_slip;
 mod timed;
 
-pub use gaps::Gaps;
-use gaps::{crosses, crossing, evaluate, gap};
+use crate::integrators::clear::{crosses, crossing, gap, Gaps};
+use gaps::evaluate;
 
 /// Why the variational law does not fit `method` on `model`, if it does not: it needs the
 /// method's discrete energy ([`Feature::DiscreteEnergy`]) and a conservative, autonomous,
@@ -60,7 +61,8 @@ pub(super) fn variational_misfit<S: Dynamics + ?Sized>(model: &S, method: Method
 /// (a copy of the run's stepper) and every buffer of the resolution, made once per run.
 pub(in crate::integrators) struct Resolver<'c, 's, M> {
     contacts: &'c [Contact<'s>],
-    /// Each contact's surface, if native ([`Gaps`]).
+    /// Each contact's surface and name, and its surface if native ([`Gaps`]).
+    surfaces: Vec<(&'c (dyn Surface + 's), &'c str)>,
     native: Vec<Option<&'c NativeSurface>>,
     schedule: Option<&'c Schedule<'s>>,
     /// The next impulse and sample of the schedule (those before are done).
@@ -178,6 +180,7 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
         let t0 = stepper.t();
         let mut resolver = Resolver {
             contacts,
+            surfaces: contacts.iter().map(|c| (&*c.surface, c.name.as_str())).collect(),
             native: contacts.iter().map(|c| c.surface.native()).collect(),
             schedule,
             next_impulse: schedule.map_or(0, |s| s.impulses().partition_point(|b| b.t <= t0)),
@@ -379,7 +382,7 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
         poll: &mut P,
     ) -> Result<usize, Error> {
         let before = stepper.steps();
-        let mut gaps = Gaps::new(self.contacts, &self.native, &mut self.phi, &mut self.phi_end);
+        let mut gaps = Gaps::new(&self.surfaces, &self.native, &mut self.phi, &mut self.phi_end);
         let start = (&mut self.t, &mut self.q[..], &mut self.p[..]);
         let stopped = stepper.advance_while(n, Counting(|steps| poll.poll(steps)), &mut gaps, start);
         let (swapped, stale, error) = (gaps.swapped, gaps.stale, gaps.error.take());
@@ -435,7 +438,7 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
             let kept = hold.step(model, held, (t, h), (&self.q, &self.p)).is_ok()
                 && hold.pressing(model, held, t + h).unwrap_or(false)
                 && (0..self.contacts.len()).filter(open).all(|j| {
-                    gap(&self.contacts[j], None, &hold.q).is_ok_and(|phi| {
+                    gap(self.surfaces[j], None, &hold.q).is_ok_and(|phi| {
                         self.phi_end[j] = phi;
                         !crossing(self.phi[j], phi)
                     })
@@ -458,7 +461,7 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
         if taken > 0 {
             stepper.jump_to(&self.q, &self.p)?;
             for &j in &self.closed {
-                self.phi[j] = gap(&self.contacts[j], None, &self.q).map_err(|source| Error::Model {
+                self.phi[j] = gap(self.surfaces[j], None, &self.q).map_err(|source| Error::Model {
                     step: stepper.steps(),
                     time: self.t,
                     source,
