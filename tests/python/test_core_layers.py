@@ -1,6 +1,7 @@
-"""The core's layers (docs/development.md): solve → model → discrete → integrators →
-diagnostics, no module using one above it; scenes use the model (and their catalogue hands
-them out as the integrators' Dynamics). Read from the `crate::` paths of each Rust file.
+"""The code's shape (docs/development.md): no source file over 800 lines, and the core's
+layers, solve → model → discrete → integrators → diagnostics, no module using one above it;
+scenes use the model (and their catalogue hands them out as the integrators' Dynamics). Read
+from the `crate::` paths of each Rust file.
 
 The modules inside integrators/ still use each other both ways in places (issue 65): their
 mutual pairs are counted here, so that a change can lower the count but not raise it.
@@ -71,3 +72,10 @@ def test_the_integrators_modules_use_each_other_both_ways_no_more_than_now():
     graph = _integrators_graph()
     mutual = sorted((a, b) for a in graph for b in graph[a] if a < b and a in graph.get(b, ()))
     assert len(mutual) <= MUTUAL_PAIRS, mutual
+
+
+def test_no_source_file_is_over_800_lines():
+    root = CORE.parents[2]
+    files = [*root.glob("rust/**/*.rs"), *root.glob("python/**/*.py")]
+    long = {str(f.relative_to(root)): n for f in files if (n := len(f.read_text().splitlines())) > 800}
+    assert len(files) > 100 and not long, long

@@ -1,16 +1,16 @@
 //! Contacts held closed: their multipliers, the lift-off where one crosses 0, what a jump does
-//! to them, and the contacts a state rests on.
+//! to them, the contacts a state rests on, and the events located on a held piece.
 
 use std::ops::Deref;
 
 use super::gaps::evaluate;
 use super::{amax, dot, Resolver};
-use crate::integrators::events::Search;
+use crate::integrators::events::{PieceSteps, Search};
 use crate::integrators::jumps::hold::{Held, Hold};
 use crate::integrators::jumps::round_off;
 use crate::integrators::jumps::unsolved::run_error;
 use crate::integrators::Switch;
-use crate::integrators::{Dynamics, Stepper};
+use crate::integrators::{Dynamics, Occurrence, Stepper};
 use crate::solve::bracket::illinois;
 use crate::Error;
 
@@ -239,5 +239,48 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
             self.aim(step, t)?;
         }
         Ok(())
+    }
+
+    /// `search`'s crossings on the piece of size s from ta, which ends at `end`: located on
+    /// the held steps while a contact is closed (the scratch then redone to the piece's end,
+    /// which the loop goes on from), else on the search's own partial steps of the method.
+    pub(super) fn watch_piece(
+        &mut self,
+        search: &mut Search<'_, '_, M>,
+        step: usize,
+        (ta, s): (f64, f64),
+        end: (f64, &[f64], &[f64]),
+        occurrences: &mut Vec<Occurrence>,
+    ) -> Result<(), Error> {
+        if self.closed.is_empty() {
+            return search.piece(step, end, s, occurrences);
+        }
+        let mut held = HeldSteps {
+            resolver: self,
+            ta,
+            taken: false,
+        };
+        search.piece_on(step, end, s, occurrences, Some(&mut held))?;
+        if held.taken {
+            self.partial(step, ta, s)?;
+        }
+        Ok(())
+    }
+}
+
+/// A held piece from (ta, `piece_q`, `piece_p`): its partial steps are the resolver's held
+/// steps, on which a search locates its crossings.
+struct HeldSteps<'r, 'c, 's, M> {
+    resolver: &'r mut Resolver<'c, 's, M>,
+    ta: f64,
+    /// Whether a step was taken, leaving the scratch elsewhere.
+    taken: bool,
+}
+
+impl<M: Deref<Target: Dynamics>> PieceSteps for HeldSteps<'_, '_, '_, M> {
+    fn state_at(&mut self, step: usize, tau: f64) -> Result<(&[f64], &[f64]), Error> {
+        self.taken = true;
+        self.resolver.partial(step, self.ta, tau)?;
+        Ok((self.resolver.scratch.q(), self.resolver.scratch.p()))
     }
 }

@@ -18,7 +18,7 @@ use std::ops::Deref;
 use super::hold::{Held, Hold};
 use super::unsolved::run_error;
 use super::{Contact, Contacts, Law, Schedule, MAX_IMPACTS};
-use crate::integrators::events::{PieceSteps, Search};
+use crate::integrators::events::Search;
 use crate::integrators::DiscreteEnergy;
 use crate::integrators::{Counting, Dynamics, Feature, Method, Occurrence, Poll, Stepper, StepperState, Trajectory};
 use crate::integrators::{Impacts, NativeSurface, Surface, Switch};
@@ -643,32 +643,6 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
         Ok(true)
     }
 
-    /// `search`'s crossings on the piece of size s from ta, which ends at `end`: located on
-    /// the held steps while a contact is closed (the scratch then redone to the piece's end,
-    /// which the loop goes on from), else on the search's own partial steps of the method.
-    fn watch_piece(
-        &mut self,
-        search: &mut Search<'_, '_, M>,
-        step: usize,
-        (ta, s): (f64, f64),
-        end: (f64, &[f64], &[f64]),
-        occurrences: &mut Vec<Occurrence>,
-    ) -> Result<(), Error> {
-        if self.closed.is_empty() {
-            return search.piece(step, end, s, occurrences);
-        }
-        let mut held = HeldSteps {
-            resolver: self,
-            ta,
-            taken: false,
-        };
-        search.piece_on(step, end, s, occurrences, Some(&mut held))?;
-        if held.taken {
-            self.partial(step, ta, s)?;
-        }
-        Ok(())
-    }
-
     /// The earliest occurrence in the piece of size τ from ta, with the scratch at its end, and
     /// where: a lift-off, a friction switch, a contact crossed (the last jump's, `last`, one the
     /// piece leaves), or the impulse that ends the piece (`impulse`). A tie goes to the
@@ -753,23 +727,6 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
     /// Force evaluations of the partial steps.
     pub(in crate::integrators) fn force_evaluations(&self) -> u64 {
         self.scratch.force_evaluations() - self.counted
-    }
-}
-
-/// A held piece from (ta, `piece_q`, `piece_p`): its partial steps are the resolver's held
-/// steps, on which a search locates its crossings.
-struct HeldSteps<'r, 'c, 's, M> {
-    resolver: &'r mut Resolver<'c, 's, M>,
-    ta: f64,
-    /// Whether a step was taken, leaving the scratch elsewhere.
-    taken: bool,
-}
-
-impl<M: Deref<Target: Dynamics>> PieceSteps for HeldSteps<'_, '_, '_, M> {
-    fn state_at(&mut self, step: usize, tau: f64) -> Result<(&[f64], &[f64]), Error> {
-        self.taken = true;
-        self.resolver.partial(step, self.ta, tau)?;
-        Ok((self.resolver.scratch.q(), self.resolver.scratch.p()))
     }
 }
 
