@@ -9,6 +9,7 @@ from typing_extensions import disjoint_base
 
 __all__ = [
     "FAILURE",
+    "IMPACT_LAWS",
     "ROUND_OFF",
     "TAPE_OPS",
     "TOO_COARSE",
@@ -685,6 +686,7 @@ def momentum_along(xi: _FloatArray, p: _FloatArray) -> tuple[_FloatArray, _Float
     """(J = p·ξ, its size) at each state, from ξ(q) evaluated there."""
 
 VERDICTS: tuple[str, str, str, str, str, str]
+IMPACT_LAWS: tuple[str, ...]
 FAILURE: float
 TOO_COARSE: float
 ROUND_OFF: float

@@ -65,7 +65,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from . import surfaces as _surfaces
-from ._core import ContactError
+from ._core import IMPACT_LAWS, ContactError
 from ._util import floats, integer, number
 from ._warnings import VarmechWarning
 from .events import Occurrences
@@ -78,6 +78,8 @@ __all__ = ["Contact", "ContactError", "Friction", "ImpactWarning"]
 
 #: The kinds of a contact's switches, by the code the core reports them with.
 SWITCHES = ("closed", "released", "stuck", "slipped")
+#: The impact laws, by name: the core's (``_core.IMPACT_LAWS``), which the check reads.
+LawName = Literal["variational", "reflect"]
 
 
 @dataclass(frozen=True)
@@ -264,15 +266,15 @@ class Contact:
     #: kick–drift methods, the two-point rules ``midpoint`` and ``trapezoid``, the Galerkin rules), or
     #: ``"reflect"``, the exact reflection of the momenta between the method's partial steps (any
     #: method; symplectic across an impact only to the method's order).
-    law: Literal["variational", "reflect"] = "variational"
+    law: LawName = "variational"
     #: Coulomb friction while the contact is held, if any.
     friction: Friction | None = None
 
     def __post_init__(self) -> None:
         if not (isinstance(self.restitution, (int, float)) and 0.0 <= float(self.restitution) <= 1.0):
             raise ValueError(f"restitution: must lie in [0, 1], got {self.restitution!r}")
-        if self.law not in ("variational", "reflect"):
-            raise ValueError(f"law: 'variational' or 'reflect', got {self.law!r}")
+        if self.law not in IMPACT_LAWS:
+            raise ValueError(f"law: {' or '.join(map(repr, IMPACT_LAWS))}, got {self.law!r}")
         if self.friction is not None and not isinstance(self.friction, Friction):
             raise TypeError(f"friction: expected a varmech.Friction, got {type(self.friction).__name__}")
 
@@ -302,7 +304,7 @@ class Contact:
         *,
         restitution: float = 1.0,
         name: str | None = None,
-        law: Literal["variational", "reflect"] = "variational",
+        law: LawName = "variational",
         friction: Friction | None = None,
     ) -> Contact:
         """The wall q_k ≥ ``value`` (a floor, a side of a box): φ = q_k − value, watched in the
@@ -358,7 +360,7 @@ class Contact:
         inside: bool = True,
         restitution: float = 1.0,
         name: str | None = None,
-        law: Literal["variational", "reflect"] = "variational",
+        law: LawName = "variational",
         friction: Friction | None = None,
     ) -> Contact:
         """The ellipsoid Σᵢ ((q_{kᵢ} − cᵢ)/aᵢ)² ≤ 1 in the ``coordinates`` kᵢ (default the first

@@ -9,10 +9,16 @@ use std::sync::Arc;
 use numpy::PyArray1;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
+use pyo3::types::PyTuple;
 use varmech::integrators::{Contact, Contacts, Friction, Law, NativeContact, NativeSurface, Slip, SlipRows, Surface};
 use varmech::ModelError;
 
 use crate::closure::readers::{call_array, call_scalar, call_vector};
+
+/// `IMPACT_LAWS`, the names of the contacts' laws ([`Law::ALL`]), which Python's contacts check.
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add("IMPACT_LAWS", PyTuple::new(m.py(), Law::ALL.map(Law::name))?)
+}
 
 /// The tuple Python passes: name, restitution, law, kind, payload and friction.
 pub type ContactTuple<'py> = (String, f64, String, String, Bound<'py, PyAny>, Option<FrictionTuple>);
@@ -81,13 +87,11 @@ impl ContactSpecs {
     pub fn new(tuples: Vec<ContactTuple<'_>>) -> PyResult<Self> {
         let mut contacts = Vec::with_capacity(tuples.len());
         for (name, restitution, law, kind, payload, friction) in tuples {
-            let law = match law.as_str() {
-                "reflect" => Law::Reflect,
-                "variational" => Law::Variational,
-                _ => {
-                    let message = format!("contacts: {name}: law 'variational' or 'reflect', got {law:?}");
-                    return Err(PyValueError::new_err(message));
-                }
+            let Some(law) = Law::named(&law) else {
+                let names = Law::ALL.map(|law| format!("'{}'", law.name())).join(" or ");
+                return Err(PyValueError::new_err(format!(
+                    "contacts: {name}: law {names}, got {law:?}"
+                )));
             };
             let kind = match kind.as_str() {
                 "crossing" => {

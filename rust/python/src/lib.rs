@@ -45,6 +45,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     scenes::register(m)?;
     routh::register(m)?;
     run::register(m)?;
+    contacts::register(m)?;
     ensemble::register(m)?;
     m.add_class::<stepper::Stepper>()?;
     diagnostics::register(m)?;

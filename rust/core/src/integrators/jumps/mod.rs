@@ -37,6 +37,7 @@ pub use watch::{Watch, Watcher};
 
 use super::{Dynamics, Method, NativeSurface, Surface};
 use crate::{Error, ModelError};
+use reflect::Reflection;
 
 /// Impacts resolved in one step at most: more is an accumulation (a body coming to rest, Zeno),
 /// which ends the run with [`Error::Contact`].
@@ -59,6 +60,9 @@ pub enum Law {
 }
 
 impl Law {
+    /// Every law, in the order the binding lists them.
+    pub const ALL: [Law; 2] = [Law::Variational, Law::Reflect];
+
     /// The law's name, as the Python API spells it.
     pub fn name(self) -> &'static str {
         match self {
@@ -66,6 +70,59 @@ impl Law {
             Law::Variational => "variational",
         }
     }
+
+    /// The law of that name, if any.
+    pub fn named(name: &str) -> Option<Law> {
+        Law::ALL.into_iter().find(|law| law.name() == name)
+    }
+
+    /// Why the law does not fit `method` on `model`, if it does not.
+    fn misfit(self, model: &dyn Dynamics, method: Method) -> Option<String> {
+        match self {
+            Law::Reflect => None,
+            Law::Variational => variational::misfit(model, method),
+        }
+    }
+
+    /// Whether the law asks for the discrete energy of the pieces about an impact
+    /// ([`Impact::discrete_energy`]), which the resolver then makes.
+    fn needs_discrete_energy(self) -> bool {
+        self == Law::Variational
+    }
+
+    /// The jump at `impact`.
+    fn jump(self, impact: &mut dyn Impact) -> Result<Jump, Error> {
+        match self {
+            Law::Reflect => Ok(reflect::newton(impact)),
+            Law::Variational => variational::jump(impact),
+        }
+    }
+}
+
+/// An impact as a law sees it ([`Law::jump`]): Newton's law there, and the pieces of the step
+/// about it for a law that needs their discrete energy.
+trait Impact {
+    /// The reflection of p⁻ with the contact's restitution e (Newton's law), and e.
+    fn newton(&self) -> (Reflection, f64);
+
+    /// Whether a law must take Newton's here: a contact held beside it (the jump's λ is not the
+    /// surface's alone), or no step left after it.
+    fn newton_only(&self) -> bool;
+
+    /// E_d of the piece before the impact, and the energy's scale; None where the method has no
+    /// discrete energy.
+    fn discrete_energy(&mut self) -> Result<Option<(f64, f64)>, Error>;
+
+    /// E_d of the piece after the impact, p⁺ = p⁻ + λ∇φ.
+    fn discrete_energy_after(&mut self, lambda: f64) -> Result<f64, Error>;
+}
+
+/// A law's jump p⁺ = p⁻ + λ∇φ: its λ, the energy it takes (its own loss, which the energy
+/// account counts), and whether it fell back on Newton's law at a grazing impact.
+struct Jump {
+    lambda: f64,
+    loss: f64,
+    grazing: bool,
 }
 
 /// A unilateral constraint φ(q) ≥ 0 with its coefficient of restitution e ∈ [0, 1] (1:
@@ -187,10 +244,8 @@ impl<'s> Contacts<'s> {
     ) -> Result<(), Error> {
         self.fit(model.dim())?;
         for (i, c) in self.contacts.iter().enumerate() {
-            if c.law == Law::Variational {
-                if let Some(reason) = resolve::variational_misfit(model, method) {
-                    return Err(c.refused(i, format!("the variational collision integrator {reason}")));
-                }
+            if let Some(reason) = c.law.misfit(model.as_dynamics(), method) {
+                return Err(c.refused(i, reason));
             }
             let model_error = |source| Error::Model {
                 step: 0,

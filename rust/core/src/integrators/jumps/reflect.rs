@@ -1,7 +1,18 @@
 //! The reflection law: the exact reflection in the metric of the kinetic energy.
 
+use super::{Impact, Jump};
 use crate::model::Lagrangian;
 use crate::ModelError;
+
+/// Newton's law: the reflection with the contact's restitution, and its loss.
+pub(super) fn newton(impact: &mut dyn Impact) -> Jump {
+    let (reflection, e) = impact.newton();
+    Jump {
+        lambda: reflection.lambda,
+        loss: reflection.loss(e),
+        grazing: false,
+    }
+}
 
 /// The reflection of p at (t, q) off the normal n in the metric of the kinetic energy: λ of
 /// p⁺ = p + λn such that the normal velocity n·q̇ goes to −e times itself,

@@ -6,7 +6,8 @@ use std::ops::Deref;
 use super::{dot, insert, Resolver};
 use crate::integrators::clear::{below, floor};
 use crate::integrators::jumps::hold::Hold;
-use crate::integrators::jumps::{reflect, variational, Contact, Law, MAX_IMPACTS};
+use crate::integrators::jumps::reflect::{self, Reflection};
+use crate::integrators::jumps::{Contact, Impact, MAX_IMPACTS};
 use crate::integrators::Dynamics;
 use crate::integrators::Switch;
 use crate::model::Lagrangian;
@@ -157,18 +158,20 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
         )
         .map_err(model_error)?;
         let reflection = reflected.lambda;
-        // For e < 1, and beside a held contact, both laws take Newton's law, the reflection.
-        // The energy account takes each law's own loss: none for e = 1 (the variational law's
-        // change of E is the method's error, its E_d kept), Newton's law's otherwise.
-        let variational = contact.law == Law::Variational && contact.restitution == 1.0 && self.closed.is_empty();
-        let lambda = if variational && rest > 0.0 {
-            let (lambda, found) = self.variational(step, (ta, s, rest), reflection)?;
-            self.pending.grazing += usize::from(!found);
-            lambda
-        } else {
-            reflection
+        let mut at = At {
+            resolver: self,
+            step,
+            piece: (ta, s, rest),
+            newton: (reflected, contact.restitution),
+            last: f64::NAN,
         };
-        let mut loss = reflected.loss(contact.restitution);
+        let jump = contact.law.jump(&mut at)?;
+        // The scratch holds the piece after the jump for the λ taken: the next piece's first step.
+        if at.last == jump.lambda {
+            self.keep(t, rest);
+        }
+        self.pending.grazing += usize::from(jump.grazing);
+        let (lambda, mut loss) = (jump.lambda, jump.loss);
         for (x, (a, b)) in self.piece_p.iter_mut().zip(self.contact_p.iter().zip(&self.normal)) {
             *x = a + lambda * b;
         }
@@ -248,64 +251,6 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
         }
         self.piece_p.copy_from_slice(&self.w);
         Ok(Some(t + tail))
-    }
-
-    /// λ of the variational law ([`variational::multiplier`]) for the jump at the end of the
-    /// piece of size s from ta, from the reflection's λ: E_d of the piece after the jump, to
-    /// the step's end `rest` later, equal to E_d of the piece before. Leaves `piece_q` at q̃.
-    pub(super) fn variational(
-        &mut self,
-        step: usize,
-        (ta, s, rest): (f64, f64, f64),
-        reflection: f64,
-    ) -> Result<(f64, bool), Error> {
-        let time = self.t;
-        let model_error = |source| Error::model(step, time, source);
-        let Resolver {
-            scratch,
-            discrete,
-            piece_q,
-            piece_p,
-            contact_q,
-            contact_p,
-            normal,
-            v,
-            ..
-        } = self;
-        let Some(discrete) = discrete.as_mut() else {
-            return Ok((reflection, false));
-        };
-        let t = ta + s;
-        let before = (&piece_q[..], &piece_p[..]);
-        let target = discrete
-            .energy(scratch.model(), ta, s, before, (contact_q, contact_p))
-            .map_err(|e| e.at(step, time))?;
-        scratch
-            .model()
-            .as_lagrangian()
-            .velocity(contact_q, contact_p, t, v)
-            .map_err(model_error)?;
-        let scale = contact_p.iter().zip(v.iter()).map(|(a, b)| a * b).sum::<f64>();
-        piece_q.copy_from_slice(contact_q);
-        let mut last = f64::NAN;
-        let after = |lambda: f64| {
-            last = lambda;
-            for (x, (a, b)) in piece_p.iter_mut().zip(contact_p.iter().zip(normal.iter())) {
-                *x = a + lambda * b;
-            }
-            scratch.restart(t, piece_q, piece_p, rest);
-            scratch.step().map_err(|e| e.at(step, time))?;
-            let end = (scratch.q(), scratch.p());
-            discrete
-                .energy(scratch.model(), t, rest, (piece_q, piece_p), end)
-                .map_err(|e| e.at(step, time))
-        };
-        let found = variational::multiplier(after, reflection, target, scale)?;
-        // The scratch holds the piece after the jump for the λ taken: the next piece's first step.
-        if last == found.0 {
-            self.keep(t, rest);
-        }
-        Ok(found)
     }
 
     /// The s ∈ (0, τ] where φⱼ along the piece from (ta, piece_q, piece_p) falls through 0,
@@ -455,4 +400,63 @@ pub(super) fn phi_rate(
 pub(super) fn quadratic_root(phi0: f64, r0: f64, (tau, phi1): (f64, f64)) -> f64 {
     let c = (phi1 - phi0 - r0 * tau) / (tau * tau);
     2.0 * phi0 / ((r0 * r0 - 4.0 * c * phi0).sqrt() - r0)
+}
+
+/// An impact on the resolver's contact buffers (q̃, p⁻, ∇φ), as its law sees it.
+struct At<'r, 'c, 's, M> {
+    resolver: &'r mut Resolver<'c, 's, M>,
+    step: usize,
+    /// The piece's start ta, its size s to the impact, and the rest of the step after it.
+    piece: (f64, f64, f64),
+    newton: (Reflection, f64),
+    /// The λ of the last piece after the impact taken, whose end the scratch holds.
+    last: f64,
+}
+
+impl<M: Deref<Target: Dynamics>> Impact for At<'_, '_, '_, M> {
+    fn newton(&self) -> (Reflection, f64) {
+        self.newton
+    }
+
+    fn newton_only(&self) -> bool {
+        !self.resolver.closed.is_empty() || self.piece.2 <= 0.0
+    }
+
+    /// E_d of the piece from ta to the impact; leaves `piece_q` at q̃, the next piece's start.
+    fn discrete_energy(&mut self) -> Result<Option<(f64, f64)>, Error> {
+        let (step, (ta, s, _)) = (self.step, self.piece);
+        let r = &mut *self.resolver;
+        let time = r.t;
+        let Some(discrete) = r.discrete.as_mut() else {
+            return Ok(None);
+        };
+        let before = (&r.piece_q[..], &r.piece_p[..]);
+        let target = discrete
+            .energy(r.scratch.model(), ta, s, before, (&r.contact_q, &r.contact_p))
+            .map_err(|e| e.at(step, time))?;
+        r.scratch
+            .model()
+            .as_lagrangian()
+            .velocity(&r.contact_q, &r.contact_p, ta + s, &mut r.v)
+            .map_err(|source| Error::model(step, time, source))?;
+        r.piece_q.copy_from_slice(&r.contact_q);
+        Ok(Some((target, dot(&r.contact_p, &r.v))))
+    }
+
+    fn discrete_energy_after(&mut self, lambda: f64) -> Result<f64, Error> {
+        self.last = lambda;
+        let (step, (ta, s, rest)) = (self.step, self.piece);
+        let r = &mut *self.resolver;
+        let (t, time) = (ta + s, r.t);
+        for (x, (a, b)) in r.piece_p.iter_mut().zip(r.contact_p.iter().zip(&r.normal)) {
+            *x = a + lambda * b;
+        }
+        r.scratch.restart(t, &r.piece_q, &r.piece_p, rest);
+        r.scratch.step().map_err(|e| e.at(step, time))?;
+        let discrete = r.discrete.as_mut().expect("asked for after discrete_energy");
+        let end = (r.scratch.q(), r.scratch.p());
+        discrete
+            .energy(r.scratch.model(), t, rest, (&r.piece_q, &r.piece_p), end)
+            .map_err(|e| e.at(step, time))
+    }
 }

@@ -17,10 +17,10 @@ use std::ops::Deref;
 
 use super::hold::{Held, Hold};
 use super::unsolved::run_error;
-use super::{Contact, Contacts, Law, Schedule, MAX_IMPACTS};
+use super::{Contact, Contacts, Schedule, MAX_IMPACTS};
 use crate::integrators::events::Search;
 use crate::integrators::DiscreteEnergy;
-use crate::integrators::{Counting, Dynamics, Feature, Method, Occurrence, Poll, Stepper, StepperState, Trajectory};
+use crate::integrators::{Counting, Dynamics, Occurrence, Poll, Stepper, StepperState, Trajectory};
 use crate::integrators::{Impacts, NativeSurface, Surface, Switch};
 use crate::Error;
 
@@ -32,30 +32,6 @@ mod timed;
 
 use crate::integrators::clear::{crosses, crossing, gap, Gaps};
 use gaps::evaluate;
-
-/// Why the variational law does not fit `method` on `model`, if it does not: it needs the
-/// method's discrete energy ([`Feature::DiscreteEnergy`]) and a conservative, autonomous,
-/// unconstrained model (the energy balance is E_d's alone).
-pub(super) fn variational_misfit<S: Dynamics + ?Sized>(model: &S, method: Method) -> Option<String> {
-    if !method.supports(Feature::DiscreteEnergy) {
-        return Some(format!(
-            "needs a kick–drift method, a two-point rule or a Galerkin rule, whose steps have a discrete energy \
-             ({}), not {}; give the contact law reflect or use such a method",
-            Method::names(|m| m.supports(Feature::DiscreteEnergy)).join(", "),
-            method.info().name
-        ));
-    }
-    let lagrangian = model.as_lagrangian();
-    let constrained = model.constraint_counts() != (0, 0) || model.velocity_constraints().is_some();
-    if lagrangian.is_forced() || lagrangian.is_time_dependent() || constrained {
-        return Some(
-            "keeps the discrete energy, which needs a conservative, autonomous, unconstrained model; give the \
-             contact law reflect"
-                .into(),
-        );
-    }
-    None
-}
 
 /// A run's resolver: the contacts and the schedule, the scratch stepper of the partial steps
 /// (a copy of the run's stepper) and every buffer of the resolution, made once per run.
@@ -203,7 +179,7 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
             zeros: vec![0.0; n],
             pending: Impacts::with_capacity(n, MAX_IMPACTS),
             blown: Impacts::with_capacity(n, schedule.map_or(0, |s| s.impulses().len())),
-            discrete: (contacts.iter().any(|c| c.law == Law::Variational))
+            discrete: (contacts.iter().any(|c| c.law.needs_discrete_energy()))
                 .then(|| DiscreteEnergy::new(stepper.method(), n))
                 .flatten(),
             closed: Vec::with_capacity(m),
