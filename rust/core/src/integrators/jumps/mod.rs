@@ -118,10 +118,13 @@ trait Impact {
 }
 
 /// A law's jump p⁺ = p⁻ + λ∇φ: its λ, the energy it takes (its own loss, which the energy
-/// account counts), and whether it fell back on Newton's law at a grazing impact.
+/// account counts), the restitution it took (which decides whether the contact closes: the
+/// rebounds of Newton's law with it die out within the step), and whether it fell back on
+/// Newton's law at a grazing impact.
 struct Jump {
     lambda: f64,
     loss: f64,
+    restitution: f64,
     grazing: bool,
 }
 

@@ -10,6 +10,7 @@ pub(super) fn newton(impact: &mut dyn Impact) -> Jump {
     Jump {
         lambda: reflection.lambda,
         loss: reflection.loss(e),
+        restitution: e,
         grazing: false,
     }
 }

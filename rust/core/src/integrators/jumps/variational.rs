@@ -39,6 +39,7 @@ pub(super) fn jump(impact: &mut dyn Impact) -> Result<Jump, Error> {
     let mut jump = Jump {
         lambda: newton.lambda,
         loss: newton.loss(e),
+        restitution: e,
         grazing: false,
     };
     if e < 1.0 || impact.newton_only() {

@@ -175,7 +175,10 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
         for (x, (a, b)) in self.piece_p.iter_mut().zip(self.contact_p.iter().zip(&self.normal)) {
             *x = a + lambda * b;
         }
-        if let Some(t_rest) = self.closes(j, step, t, (reflection, h))? {
+        // Newton's λ for the restitution the law took (the contact's own: the same bits).
+        let e = (jump.restitution, contact.restitution);
+        let newton = reflection * ((1.0 + e.0) / (1.0 + e.1));
+        if let Some(t_rest) = self.closes(j, step, t, (newton, e.0, h))? {
             // The whole normal velocity gone: the Zeno series' losses summed.
             loss = reflected.loss(0.0);
             insert(&mut self.closed, j);
@@ -191,7 +194,7 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
     }
 
     /// Whether contact j closes at its impact at time t, reflected with the multiplier
-    /// `reflection` (the normal, ∇φ, in `normal`): the body pressing on the surface once its
+    /// `reflection` of Newton's law with restitution e, the law's (the normal, ∇φ, in `normal`): the body pressing on the surface once its
     /// normal velocity is gone (λ > 0), and the Zeno series of the rebounds, flights of
     /// 2v⁺/|a|, 2ev⁺/|a|, … under the normal acceleration a = −λ∇φᵀM⁻¹∇φ, summing to
     /// T∞ = 2v⁺/(|a|(1 − e)) ≤ h (at once for v⁺ = 0), or, for e near 1, where T∞ is longer,
@@ -205,9 +208,8 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
         j: usize,
         step: usize,
         t: f64,
-        (reflection, h): (f64, f64),
+        (reflection, e, h): (f64, f64, f64),
     ) -> Result<Option<f64>, Error> {
-        let e = self.contacts[j].restitution;
         // Elastic contacts close only on an arrival without normal velocity.
         if self.hold.is_none() || (e == 1.0 && reflection != 0.0) {
             return Ok(None);
