@@ -8,7 +8,11 @@ mutual pairs are counted here, so that a change can lower the count but not rais
 """
 
 import re
+import shutil
+import subprocess
 from pathlib import Path
+
+import pytest
 
 CORE = Path(__file__).resolve().parents[2] / "rust" / "core" / "src"
 LAYERS = ["solve", "model", "discrete", "integrators", "diagnostics"]
@@ -79,3 +83,20 @@ def test_no_source_file_is_over_800_lines():
     files = [*root.glob("rust/**/*.rs"), *root.glob("python/**/*.py")]
     long = {str(f.relative_to(root)): n for f in files if (n := len(f.read_text().splitlines())) > 800}
     assert len(files) > 100 and not long, long
+
+
+def test_the_guides_new_impact_law_applies_and_touches_three_files():
+    """docs/development.md's example diff of a new impact law applies to this tree as written
+    and touches three files outside tests and docs (issue 65's measure of a jump kind)."""
+    root = CORE.parents[2]
+    if shutil.which("git") is None or not (root / ".git").exists():
+        pytest.skip("needs the git checkout")
+    guide = (root / "docs" / "development.md").read_text()
+    diff = re.search(r"### Example: a new impact law.*?```diff\n(.*?)```", guide, re.S)
+    assert diff is not None
+    files = set(re.findall(r"^\+\+\+ b/(\S+)", diff.group(1), re.M))
+    assert len(files) == 3 and not any(f.startswith(("tests/", "docs/")) for f in files), files
+    check = subprocess.run(
+        ["git", "apply", "--check", "-"], cwd=root, input=diff.group(1), text=True, capture_output=True
+    )
+    assert check.returncode == 0, check.stderr
