@@ -57,7 +57,7 @@ pub(in crate::integrators) fn gap(
 }
 
 /// φ of a run's contacts, checked at the end of each step the method's own loop takes
-/// ([`crate::integrators::Dynamics::advance_while`]): a step is clear when it crosses no
+/// ([`crate::integrators::Dynamics::advance`] with [`crate::integrators::Carry::Gaps`]): a step is clear when it crosses no
 /// contact, by the test the one-at-a-time loop judges a step by; φ at its end is then the next
 /// step's start. A failing φ stops the steps as a crossing does, its error kept for the run.
 ///

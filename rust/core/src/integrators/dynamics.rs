@@ -2,8 +2,7 @@
 
 use nalgebra::DMatrix;
 
-use super::clear::Gaps;
-use super::{Increment, Integrator, ModelKind, StepError, StepStart, StepperState, Tangent};
+use super::{Carry, Increment, Integrator, ModelKind, StepError, StepStart, StepperState};
 use crate::model::{
     self, Constrained, EnergyTerms, HolonomicConstraints, Lagrangian, MechanicalSystem, Mixed, Nonholonomic,
     PhaseState, VelocityConstraints,
@@ -54,36 +53,14 @@ pub trait Dynamics {
         increment: &mut Increment,
     ) -> Result<(), StepError>;
 
-    /// Advances `state` by `steps` steps of its method on this model, stopping at the first
-    /// failure with the last good state kept. The stepper calls it for the steps between two
-    /// interrupt polls, so that a model may run them in a loop of its own, specialised to its
-    /// type and size; by default, one step after the other.
-    fn advance(&self, state: &mut StepperState, steps: usize) -> Result<(), Error> {
-        for _ in 0..steps {
-            state.step(self)?;
-        }
-        Ok(())
-    }
-
-    /// As [`Dynamics::advance`], with the contacts' `gaps` checked at the end of every step:
-    /// stops after the first step that is not clear ([`Gaps::clear`]), which is kept; true
-    /// then. By default, one step after the other.
-    fn advance_while(&self, state: &mut StepperState, steps: usize, gaps: &mut Gaps<'_, '_>) -> Result<bool, Error> {
-        state.step_while(self, steps, gaps)
-    }
-
-    /// As [`Dynamics::advance`], the tangent vectors `x` carried by each step's tangent map
-    /// ([`Tangent`]), stopping after the first step that takes one past `large` (true then).
-    /// By default one step after the other, each as [`super::Stepper::step_with_tangent`]
-    /// takes it.
-    fn advance_with_tangent(
-        &self,
-        state: &mut StepperState,
-        steps: usize,
-        carry: (&mut Tangent, &mut [f64]),
-        large: f64,
-    ) -> Result<bool, Error> {
-        state.step_with_tangent_while(self.as_dynamics(), steps, carry, large)
+    /// Advances `state` by `steps` steps of its method on this model, carrying `carry`
+    /// ([`Carry`]: nothing, the contacts' gaps, tangent vectors), stopping at the first failure
+    /// with the last good state kept, or after the first step that `carry` stops at (true
+    /// then). The stepper calls it for the steps between two interrupt polls, so that a model
+    /// may run them in a loop of its own, specialised to its type and size; by default, one
+    /// step after the other.
+    fn advance(&self, state: &mut StepperState, steps: usize, carry: Carry<'_, '_, '_>) -> Result<bool, Error> {
+        state.steps_carrying(self, steps, carry)
     }
 
     /// The energy function and its terms at (q, p, t), where no constraint does work (a forced
@@ -171,22 +148,8 @@ impl<S: MechanicalSystem> Dynamics for S {
         integrator.increment(self, start, increment)
     }
 
-    fn advance(&self, state: &mut StepperState, steps: usize) -> Result<(), Error> {
-        state.advance_separable(self, steps)
-    }
-
-    fn advance_while(&self, state: &mut StepperState, steps: usize, gaps: &mut Gaps<'_, '_>) -> Result<bool, Error> {
-        state.advance_separable_while(self, steps, gaps)
-    }
-
-    fn advance_with_tangent(
-        &self,
-        state: &mut StepperState,
-        steps: usize,
-        carry: (&mut Tangent, &mut [f64]),
-        large: f64,
-    ) -> Result<bool, Error> {
-        state.advance_separable_with_tangent(self, steps, carry, large)
+    fn advance(&self, state: &mut StepperState, steps: usize, carry: Carry<'_, '_, '_>) -> Result<bool, Error> {
+        state.advance_separable(self, steps, carry)
     }
 
     fn energy(&self, q: &[f64], p: &[f64], t: f64) -> Option<Result<EnergyTerms, ModelError>> {
@@ -227,12 +190,8 @@ impl<L: Lagrangian> Dynamics for General<'_, L> {
         integrator.increment_lagrangian(self.0, start, increment)
     }
 
-    fn advance(&self, state: &mut StepperState, steps: usize) -> Result<(), Error> {
-        state.advance_lagrangian(self.0, steps)
-    }
-
-    fn advance_while(&self, state: &mut StepperState, steps: usize, gaps: &mut Gaps<'_, '_>) -> Result<bool, Error> {
-        state.advance_lagrangian_while(self.0, steps, gaps)
+    fn advance(&self, state: &mut StepperState, steps: usize, carry: Carry<'_, '_, '_>) -> Result<bool, Error> {
+        state.advance_lagrangian(self.0, steps, carry)
     }
 
     /// E = p·q̇ − L: conserved, or (forced, L depending on t) balanced against the work.

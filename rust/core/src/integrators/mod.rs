@@ -87,7 +87,7 @@ pub use run::{
 pub use splitting::{Leading, Splitting};
 pub use step::{Increment, StepStart};
 use stepper::Phase;
-pub use stepper::{Stepper, StepperState};
+pub use stepper::{Carry, Stepper, StepperState};
 pub use surfaces::{NativeSurface, Surface};
 pub use tangent::Tangent;
 pub use trajectory::{Failure, Trajectory};

@@ -1,24 +1,22 @@
 //! One model, one method and the state, advanced step by step; the state apart from its model.
 
 use serde::{Deserialize, Serialize};
+mod carry;
 mod clock;
 mod decoded;
 mod own_variables;
 mod phase;
 
+pub use carry::Carry;
 pub(super) use clock::Clock;
 pub(super) use phase::Phase;
 
 use std::borrow::{Borrow, BorrowMut};
 use std::ops::Deref;
 
-use super::clear::{Always, Clear, Gaps};
-use super::tangent;
-use super::{
-    check_method, compensated, Dynamics, General, Increment, Integrator, Method, Options, Poll, StepStart, Tangent,
-};
+use super::clear::Gaps;
+use super::{check_method, compensated, Dynamics, Increment, Integrator, Method, Options, Poll, StepStart, Tangent};
 use crate::error::check_vector;
-use crate::model::{Lagrangian, MechanicalSystem};
 use crate::solve::interrupt::InterruptPoll;
 use crate::Error;
 
@@ -136,9 +134,9 @@ where
         // The model's own loop, one step long: the fixed-size loops of small systems (the bits
         // of a generic step, at half its cost: the partial steps of impacts take it), and the
         // own variables of a method that has them, which a step from (q, p) would restart.
-        let result = self.model.advance(state, 1);
+        let result = self.model.advance(state, 1, Carry::Nothing);
         state.synchronise();
-        result
+        result.map(drop)
     }
 
     /// Advances one step, as [`Stepper::step`], and carries the tangent vectors in `x` (2n × k,
@@ -146,7 +144,10 @@ where
     /// ([`Tangent`], made for this stepper's method and model). The states are those of
     /// [`Stepper::step`], bit for bit.
     pub fn step_with_tangent(&mut self, tangent: &mut Tangent, x: &mut [f64]) -> Result<(), Error> {
-        self.state.borrow_mut().step_with_tangent(&*self.model, tangent, x)
+        let state = self.state.borrow_mut();
+        let result = self.model.advance(state, 1, Carry::Tangent(tangent, x, f64::MAX));
+        state.synchronise();
+        result.map(drop)
     }
 
     /// As [`Stepper::step_with_tangent`], `n` steps, `poll` called as [`Stepper::advance`]
@@ -182,7 +183,7 @@ where
         let (state, model) = (self.state.borrow_mut(), &*self.model);
         state.check_horizon(n)?;
         let stopped = state.polled(n, poll, |state, steps| {
-            model.advance_with_tangent(state, steps, (&mut *tangent, &mut *x), large)
+            model.advance(state, steps, Carry::Tangent(&mut *tangent, &mut *x, large))
         })?;
         if stopped && !x.iter().all(|v| v.is_finite()) {
             let (step, time) = (state.steps, state.clock.at(state.steps.saturating_sub(1)));
@@ -205,9 +206,10 @@ where
     pub fn advance<P: Poll>(&mut self, n: usize, poll: P) -> Result<(), Error> {
         let state = self.state.borrow_mut();
         state.check_horizon(n)?;
-        let result = state.advance_polled(&*self.model, n, poll);
+        let model = &*self.model;
+        let result = state.polled(n, poll, |state, steps| model.advance(state, steps, Carry::Nothing));
         state.synchronise();
-        result
+        result.map(drop)
     }
 
     /// As [`Stepper::advance`], with the contacts' `gaps` checked at the end of every step
@@ -225,13 +227,8 @@ where
     ) -> Result<bool, Error> {
         let state = self.state.borrow_mut();
         let model = &*self.model;
-        let own = state.integrator.own_variables().is_some();
         let result = state.polled(n, poll, |state, steps| {
-            if own {
-                state.advance_own_while(model, steps, gaps)
-            } else {
-                model.advance_while(state, steps, gaps)
-            }
+            model.advance(state, steps, Carry::Gaps(&mut *gaps))
         });
         state.synchronise();
         if result? {
@@ -429,80 +426,6 @@ impl StepperState {
         Ok(())
     }
 
-    /// One step of `model` as [`Stepper::step`] takes it, with the tangent vectors `x` carried
-    /// by its tangent map.
-    fn step_with_tangent<S: Dynamics + ?Sized>(
-        &mut self,
-        model: &S,
-        tangent: &mut Tangent,
-        x: &mut [f64],
-    ) -> Result<(), Error> {
-        let (step, time) = (self.steps + 1, self.t());
-        tangent.begin(time, &self.q, &self.p);
-        let result = model.advance(self, 1);
-        self.synchronise();
-        result?;
-        tangent
-            .apply(model.as_dynamics(), &mut self.integrator, (self.clock.h, &self.q), x)
-            .map_err(|source| Error::model(step, time, source))
-    }
-
-    /// Steps of `model` one at a time, each as [`StepperState::step_with_tangent`], stopping
-    /// after the first that takes a component of `x` past `large` (true then).
-    pub(super) fn step_with_tangent_while<S: Dynamics + ?Sized>(
-        &mut self,
-        model: &S,
-        steps: usize,
-        (tangent, x): (&mut Tangent, &mut [f64]),
-        large: f64,
-    ) -> Result<bool, Error> {
-        for _ in 0..steps {
-            self.step_with_tangent(model, tangent, x)?;
-            if tangent::past(x, large) {
-                return Ok(true);
-            }
-        }
-        Ok(false)
-    }
-
-    /// As [`StepperState::step_with_tangent_while`] on a separable system: a kick–drift step's
-    /// tangent map carried as the check at each step's end ([`super::tangent::Carried`]) of the
-    /// loop that [`StepperState::advance_separable_while`] runs; other maps step by step.
-    pub(super) fn advance_separable_with_tangent<S: MechanicalSystem>(
-        &mut self,
-        sys: &S,
-        steps: usize,
-        (tangent, x): (&mut Tangent, &mut [f64]),
-        large: f64,
-    ) -> Result<bool, Error> {
-        let h = self.clock.h;
-        let Some(mut carried) = tangent.carried(sys, h, (&self.q, &self.p), &mut *x, large) else {
-            return self.step_with_tangent_while(sys, steps, (tangent, x), large);
-        };
-        let stopped = self.advance_separable_while(sys, steps, &mut carried)?;
-        match carried.failed.take() {
-            // The step whose map failed is kept, as a step of the stepper's own keeps it.
-            Some(source) => Err(Error::Model {
-                step: self.steps,
-                time: self.clock.at(self.steps - 1),
-                source,
-            }),
-            None => Ok(stopped),
-        }
-    }
-
-    /// `n` steps of `model`, `poll` called before a step when due.
-    fn advance_polled<S, P>(&mut self, model: &S, n: usize, poll: P) -> Result<(), Error>
-    where
-        S: Dynamics + ?Sized,
-        P: Poll,
-    {
-        // This step and those after it that need no poll, in one call: the model's own loop
-        // ([`Dynamics::advance`]) runs them.
-        self.polled(n, poll, |state, steps| model.advance(state, steps).map(|()| false))
-            .map(drop)
-    }
-
     /// `n` steps in runs of those that need no poll before them, `poll` called before a run
     /// when due; `run(state, k)` takes k steps, true when it stopped after fewer (then so does
     /// this, true).
@@ -535,43 +458,6 @@ impl StepperState {
         Ok(false)
     }
 
-    /// Steps of `model` one at a time, stopping after the first whose end q is not `clear`:
-    /// true then, with its start in (q_next, p_next), where the step's swap leaves it.
-    pub(super) fn step_while<S, C>(&mut self, model: &S, steps: usize, clear: &mut C) -> Result<bool, Error>
-    where
-        S: Dynamics + ?Sized,
-        C: Clear + ?Sized,
-    {
-        for _ in 0..steps {
-            self.step(model)?;
-            if !clear.clear(&self.q, &self.p) {
-                return Ok(true);
-            }
-        }
-        Ok(false)
-    }
-
-    /// As [`StepperState::step_while`] for a method with its own variables: each step as
-    /// [`Stepper::step`] takes it, (q, p) synchronised for `gaps`, its start kept first.
-    fn advance_own_while<S: Dynamics + ?Sized>(
-        &mut self,
-        model: &S,
-        steps: usize,
-        gaps: &mut Gaps<'_, '_>,
-    ) -> Result<bool, Error> {
-        for _ in 0..steps {
-            self.q_next.copy_from_slice(&self.q);
-            self.p_next.copy_from_slice(&self.p);
-            let result = model.advance(self, 1);
-            self.synchronise();
-            result?;
-            if !gaps.clear(&self.q, &self.p) {
-                return Ok(true);
-            }
-        }
-        Ok(false)
-    }
-
     /// The integrator, and the state as a method's own loop advances it.
     fn phase(&mut self) -> (&mut Integrator, Phase<'_>) {
         let StepperState {
@@ -599,80 +485,6 @@ impl StepperState {
             clock: *clock,
         };
         (integrator, phase)
-    }
-
-    /// `steps` steps of a separable system: the methods with their own variables on them
-    /// (`own_variables.rs`), every other as [`StepperState::advance_separable_while`].
-    pub(super) fn advance_separable<S: MechanicalSystem>(&mut self, sys: &S, steps: usize) -> Result<(), Error> {
-        if let Some(result) = sys.as_nbody().and_then(|nbody| self.advance_own(nbody, steps)) {
-            return result;
-        }
-        self.advance_separable_while(sys, steps, &mut Always).map(drop)
-    }
-
-    /// `steps` steps of a separable system, stopping after the first whose end q is not
-    /// `clear` (true then, as [`StepperState::step_while`]): the kick–drift methods on up to 4
-    /// coordinates in a loop of fixed-size arrays ([`super::KickDrift::run`]; the driver's
-    /// costs, not the physics, dominate such small steps), every other case step by step. Not
-    /// for the methods with their own variables.
-    pub(super) fn advance_separable_while<S, C>(&mut self, sys: &S, steps: usize, clear: &mut C) -> Result<bool, Error>
-    where
-        S: MechanicalSystem,
-        C: Clear + ?Sized,
-    {
-        let (integrator, phase) = self.phase();
-        if let Some(kick_drift) = integrator.kick_drift() {
-            match phase.q.len() {
-                1 => return kick_drift.run::<S, 1, C>(sys, phase, steps, clear),
-                2 => return kick_drift.run::<S, 2, C>(sys, phase, steps, clear),
-                3 => return kick_drift.run::<S, 3, C>(sys, phase, steps, clear),
-                4 => return kick_drift.run::<S, 4, C>(sys, phase, steps, clear),
-                _ => {}
-            }
-        }
-        self.step_while(sys, steps, clear)
-    }
-
-    /// `steps` steps of a general Lagrangian, as [`StepperState::advance_lagrangian_while`].
-    pub(super) fn advance_lagrangian<L: Lagrangian>(&mut self, sys: &L, steps: usize) -> Result<(), Error> {
-        self.advance_lagrangian_while(sys, steps, &mut Always).map(drop)
-    }
-
-    /// `steps` steps of a general Lagrangian, stopping after the first whose end q is not
-    /// `clear` (true then, as [`StepperState::step_while`]): the two-point DEL methods on up
-    /// to 4 coordinates in their loop of fixed-size arrays ([`super::Del::run`]; the driver's
-    /// costs, not the physics, dominate such small steps), every other case step by step.
-    pub(super) fn advance_lagrangian_while<L, C>(&mut self, sys: &L, steps: usize, clear: &mut C) -> Result<bool, Error>
-    where
-        L: Lagrangian,
-        C: Clear + ?Sized,
-    {
-        let mut left = steps;
-        while left > 0 {
-            let (integrator, phase) = self.phase();
-            let n = phase.q.len();
-            let fixed = match n {
-                1 => integrator.run_two_point::<L, 1, C>(sys, phase, left, clear),
-                2 => integrator.run_two_point::<L, 2, C>(sys, phase, left, clear),
-                3 => integrator.run_two_point::<L, 3, C>(sys, phase, left, clear),
-                4 => integrator.run_two_point::<L, 4, C>(sys, phase, left, clear),
-                _ => None,
-            };
-            if let Some(result) = fixed {
-                return result;
-            }
-            self.step(&General(sys))?;
-            left -= 1;
-            if !clear.clear(&self.q, &self.p) {
-                return Ok(true);
-            }
-            // Only a run's first step makes the loop apply (it judges the continuum limit's
-            // sign): once past it, a case the loop does not take steps on without asking.
-            if left < steps - 1 {
-                return self.step_while(&General(sys), left, clear);
-            }
-        }
-        Ok(false)
     }
 
     /// Refuses, naming `dt`, `steps` more steps whose times the clock would not tell apart
