@@ -28,6 +28,7 @@
 use serde::{Deserialize, Serialize};
 mod checkpoint;
 mod clear;
+mod clock;
 pub mod compensated;
 mod composition;
 mod del;
@@ -41,6 +42,7 @@ pub mod jumps;
 mod kick_drift;
 mod kind;
 mod method;
+mod options;
 mod poll;
 mod rattle;
 mod run;
@@ -78,11 +80,12 @@ pub use kick_drift::KickDrift;
 pub use kind::ModelKind;
 use method::one_of;
 pub use method::{Feature, Method, MethodInfo};
+pub use options::Options;
 pub use poll::{Counting, Poll};
 pub use rattle::Rattle;
 pub use run::{
     beyond_limit, integrate, integrate_watching, integrate_with_events, resume, resume_watching, resume_with_events,
-    BeyondLimit, Options,
+    BeyondLimit,
 };
 pub use splitting::{Leading, Splitting};
 pub use step::{Increment, StepStart};

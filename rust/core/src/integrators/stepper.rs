@@ -2,19 +2,18 @@
 
 use serde::{Deserialize, Serialize};
 mod carry;
-mod clock;
 mod decoded;
 mod own_variables;
 mod phase;
 
 pub use carry::Carry;
-pub(super) use clock::Clock;
 pub(super) use phase::Phase;
 
 use std::borrow::{Borrow, BorrowMut};
 use std::ops::Deref;
 
 use super::clear::Gaps;
+use super::clock::Clock;
 use super::{check_method, compensated, Dynamics, Increment, Integrator, Method, Options, Poll, StepStart, Tangent};
 use crate::error::check_vector;
 use crate::solve::interrupt::InterruptPoll;
