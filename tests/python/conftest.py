@@ -1,6 +1,6 @@
 """Shared set-up of the Python tests: the repository's reference data, the closure models that
-several tests build, and helpers to run the command line, to press Ctrl-C and to see whether a
-run lets go of the GIL."""
+several tests build, closures that raise the user's own exception, and helpers to run the
+command line, to press Ctrl-C and to see whether a run lets go of the GIL."""
 
 import math
 import os
@@ -139,6 +139,36 @@ def interrupt_after():
     yield start
     for timer in timers:
         timer.join()
+
+
+class Boom(Exception):
+    """The user's own exception, raised by a closure under test: varmech must pass it on unchanged."""
+
+
+def raising_when(condition, closure, message):
+    """``closure`` (a model function, an event), raising ``Boom(message)`` instead at a call whose
+    arguments meet ``condition``."""
+
+    def raising(*args):
+        if condition(*args):
+            raise Boom(message)
+        return closure(*args)
+
+    return raising
+
+
+def raising_after(calls, closure, message):
+    """``closure``, raising ``Boom(message)`` instead from its call ``calls + 1`` on; the calls so
+    far are the result's attribute ``calls``, which a test may move on."""
+
+    def raising(*args):
+        raising.calls += 1
+        if raising.calls > calls:
+            raise Boom(message)
+        return closure(*args)
+
+    raising.calls = 0
+    return raising
 
 
 def releases_the_gil(run):
