@@ -1,6 +1,7 @@
 """Shared set-up of the Python tests: the repository's reference data, the closure models that
 several tests build, closures that raise the user's own exception, and helpers to run the
-command line, to press Ctrl-C and to see whether a run lets go of the GIL."""
+command line, to press Ctrl-C, to wait for a streamed run's rows and to see whether a run lets go
+of the GIL."""
 
 import math
 import os
@@ -169,6 +170,23 @@ def raising_after(calls, closure, message):
 
     raising.calls = 0
     return raising
+
+
+def committed(path, rows, poll, seconds=60):
+    """Whether the streamed run writing ``path`` commits ``rows`` rows within ``seconds``, read in
+    SWMR mode every ``poll`` seconds (a file not there yet, or not laid out yet, is waited for)."""
+    import h5py
+
+    deadline = time.monotonic() + seconds
+    while time.monotonic() < deadline:
+        time.sleep(poll)
+        try:
+            with h5py.File(path, "r", swmr=True) as f:
+                if f["committed"][0] >= rows:
+                    return True
+        except (OSError, KeyError):
+            pass
+    return False
 
 
 def releases_the_gil(run):
