@@ -17,15 +17,14 @@ import os
 # two-core machine they would distort every timing.
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
-import argparse
 import math
 import time
 import timeit
 from dataclasses import dataclass
 from functools import partial
-from pathlib import Path
 
 import numpy as np
+from _common import publish, quick_arguments, rebound_simulation
 
 import varmech
 from varmech import examples, scenes
@@ -84,7 +83,6 @@ def verlet_loop(gradient, q, p, inv_mass, h, steps):
 
 
 def solar_system(quick: bool, repeat: int) -> list[Row]:
-    import rebound
     from scipy.integrate import solve_ivp
 
     scene = scenes.outer_solar_system()
@@ -116,12 +114,7 @@ def solar_system(quick: bool, repeat: int) -> list[Row]:
     varmech_row(closure, "varmech verlet (NumPy closure)", "verlet", h)
 
     def make_sim(integrator):
-        sim = rebound.Simulation()
-        sim.G = G
-        for m, x, p in zip(masses, scene.q0.reshape(-1, 3), scene.p0.reshape(-1, 3)):
-            v = p / m
-            sim.add(m=m, x=x[0], y=x[1], z=x[2], vx=v[0], vy=v[1], vz=v[2])
-        sim.integrator = integrator
+        sim = rebound_simulation(G, masses, scene.q0, scene.p0, integrator)
         sim.dt = h
         return sim
 
@@ -345,10 +338,7 @@ def table(rows: list[Row]) -> str:
 
 
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--quick", action="store_true", help="a tenth of each horizon, fewer repeats")
-    parser.add_argument("--markdown", type=Path, help="also write the tables to this file")
-    args = parser.parse_args()
+    args = quick_arguments(__doc__, "a tenth of each horizon, fewer repeats", "also write the tables to this file")
     repeat = 2 if args.quick else 5
 
     sun = solar_system(args.quick, repeat)
@@ -370,10 +360,7 @@ def main() -> None:
     text += [f"| {k} | {v:.2f} |" for k, v in ratios.items()]
     call, step = facts["closure call (s)"] * 1e9, facts["varmech closure step (s)"] * 1e9
     text += ["", f"Kepler closure call: {call:.0f} ns; varmech step with it: {step:.0f} ns."]
-    report = "\n".join(text)
-    print(report)
-    if args.markdown:
-        args.markdown.write_text(report + "\n")
+    publish("\n".join(text), args.markdown)
 
 
 if __name__ == "__main__":

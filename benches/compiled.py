@@ -18,12 +18,11 @@ import os
 
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
-import argparse
 import subprocess
 import sys
 from functools import partial
-from pathlib import Path
 
+from _common import publish, quick_arguments
 from compare import best_times_interleaved
 
 import varmech
@@ -63,10 +62,7 @@ def build_seconds(name: str) -> float:
 
 
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--quick", action="store_true", help="fewer steps and repeats")
-    parser.add_argument("--markdown", type=Path, help="also write the table to this file")
-    args = parser.parse_args()
+    args = quick_arguments(__doc__, "fewer steps and repeats")
     repeat = 3 if args.quick else 7
     steps = 2_000 if args.quick else 20_000
     lines = [
@@ -91,11 +87,8 @@ def main() -> None:
             f"| {t['closure'] / t['jit']:.1f} | {build:.3f} |"
         )
         print(lines[-1], flush=True)
-    report = "\n".join(lines)
     print()
-    print(report)
-    if args.markdown:
-        args.markdown.write_text(report + "\n")
+    publish("\n".join(lines), args.markdown)
 
 
 if __name__ == "__main__":

@@ -17,10 +17,9 @@ import os
 
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
-import argparse
-from pathlib import Path
 
 import numpy as np
+from _common import publish, quick_arguments
 
 import varmech
 from varmech import scenes
@@ -44,10 +43,7 @@ def seconds_at(rows: list, error: float) -> float:
 
 
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--quick", action="store_true", help="t = 100 and fewer repeats")
-    parser.add_argument("--markdown", type=Path, help="also write the table to this file")
-    args = parser.parse_args()
+    args = quick_arguments(__doc__, "t = 100 and fewer repeats")
     scene = scenes.get("elastic_pendulum")
     t_end = 100.0 if args.quick else scene.t_end
     steps = {m: [int(t_end) * 2**k for k in RATES[m]] for m in METHODS}
@@ -76,10 +72,7 @@ def main() -> None:
         if best is None or np.isnan(theirs):
             continue
         lines.append(f"| {error:.0e} | {best[0] * 1e3:.2f} ms | {best[1]} | {theirs * 1e3:.1f} ms | {theirs / best[0]:.0f} |")
-    report = "\n".join(lines)
-    print(report)
-    if args.markdown:
-        args.markdown.write_text(report + "\n")
+    publish("\n".join(lines), args.markdown)
 
 
 if __name__ == "__main__":

@@ -24,6 +24,7 @@ import math
 import platform
 import time
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import sympy as sp
@@ -71,6 +72,15 @@ def timings(repeat: int) -> dict[str, float]:
     return best
 
 
+def saved(plt: Any, fig: Any, path: Path) -> Path:
+    """``path``, where ``fig`` is written laid out (its folder made if needed), then closed."""
+    fig.tight_layout()
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path
+
+
 def lift_off_chart(out: Path) -> Path:
     """The gallery's figure ``<out>/sphere_lift_off.png``: the particle sliding from rest at
     θ₀ = 0.3 on the unit sphere (held), its λ falling to 0 where cos θ = (2/3)cos θ₀, and the
@@ -107,12 +117,7 @@ def lift_off_chart(out: Path) -> Path:
     bx.set_xlabel("t")
     bx.set_ylabel("λ / mg")
     bx.set_title("The sphere's push, held until it reaches 0")
-    fig.tight_layout()
-    out.mkdir(parents=True, exist_ok=True)
-    path = out / "sphere_lift_off.png"
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    return saved(plt, fig, out / "sphere_lift_off.png")
 
 
 def billiard_chart(out: Path) -> Path:
@@ -143,12 +148,7 @@ def billiard_chart(out: Path) -> Path:
     bx.set_xlabel("t")
     bx.set_ylabel("−W / E₀")
     bx.set_title("The work of friction: 2/7 of the energy, then none")
-    fig.tight_layout()
-    out.mkdir(parents=True, exist_ok=True)
-    path = out / "billiard_ball_rolls.png"
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    return saved(plt, fig, out / "billiard_ball_rolls.png")
 
 
 def main() -> None:

@@ -23,6 +23,7 @@ import time
 from pathlib import Path
 
 import numpy as np
+from _common import publish
 from scipy.integrate import solve_ivp
 
 import varmech
@@ -188,10 +189,7 @@ def main() -> None:
         lines.append(f"| {rtol:g}{mark} | {seconds:.3f} | {value:.5f} | {seconds / full:.0f} |")
     lines += ["", "Target (issue 37): ≥ 30× faster than SciPy's DOP853 at matched accuracy of λ₁.", ""]
     lines += implicit_section(args.repeat)
-    text = "\n".join(lines) + "\n"
-    print(text)
-    if args.markdown:
-        args.markdown.write_text(text)
+    publish("\n".join(lines) + "\n", args.markdown)
 
 
 if __name__ == "__main__":

@@ -16,6 +16,7 @@ from pathlib import Path
 
 import numpy as np
 import rebound
+from _common import publish, rebound_simulation
 
 import varmech
 
@@ -27,12 +28,7 @@ def simulation(integrator: str) -> rebound.Simulation:
     """REBOUND's copy of the scene, with its MEGNO variational particles (seed 1)."""
     scene = varmech.scenes.outer_solar_system()
     G, masses = scene.model._core.gravity
-    sim = rebound.Simulation()
-    sim.G = G
-    for m, x, p in zip(masses, scene.q0.reshape(-1, 3), scene.p0.reshape(-1, 3)):
-        v = p / m
-        sim.add(m=m, x=x[0], y=x[1], z=x[2], vx=v[0], vy=v[1], vz=v[2])
-    sim.integrator = integrator
+    sim = rebound_simulation(G, masses, scene.q0, scene.p0, integrator)
     if integrator == "whfast":
         sim.dt = H
     sim.init_megno(seed=1)
@@ -87,10 +83,7 @@ def main() -> None:
         "",
         f"varmech's run to {HORIZONS[-1]:g} days took {seconds['own']:.1f} s (its Hessian differenced: 36 gradients a kick).",
     ]
-    text = "\n".join(lines)
-    print(text)
-    if args.markdown:
-        args.markdown.write_text(text + "\n")
+    publish("\n".join(lines), args.markdown)
 
 
 if __name__ == "__main__":

@@ -29,6 +29,7 @@ from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
+from _common import publish
 
 import varmech
 from varmech import scenes
@@ -182,10 +183,7 @@ def main() -> None:
         "|---|---|---|---|",
     ]
     lines += [f"| {n} | {dt:.4g} | {errors[(n, dt)]:.2e} | {best[(n, dt)] * 1e3:.2f} ms |" for n, dt in configs]
-    text = "\n".join(lines) + "\n"
-    print(text)
-    if args.markdown:
-        args.markdown.write_text(text)
+    publish("\n".join(lines) + "\n", args.markdown)
 
 
 if __name__ == "__main__":

@@ -86,6 +86,14 @@ numpydoc_xref_aliases = {
 # the build runs where no network is, so none is fetched. Each lists the objects these pages
 # name (Sphinx's inventory format 2), at its project's stable address.
 MECHANICS = "modules/physics/mechanics/api"
+
+
+def _pages(folder: str, *names: str, role: str = "py:class") -> dict[str, tuple[str, str]]:
+    """Objects each documented on a page of its own, ``<folder>/<name>.html#<name>`` (the layout
+    of autosummary's generated pages)."""
+    return {name: (role, f"{folder}/{name}.html#{name}") for name in names}
+
+
 EXTERNAL = {
     # numpydoc links the Python types of the docstrings' sections (bool, list, callable, …).
     "python": ("https://docs.python.org/3/", {
@@ -99,13 +107,11 @@ EXTERNAL = {
         **{name: ("std:term", f"glossary.html#term-{name}") for name in ("function", "iterable", "sequence", "generator", "mapping")},
     }),
     "numpy": ("https://numpy.org/doc/stable/", {
-        "numpy.ndarray": ("py:class", "reference/generated/numpy.ndarray.html#numpy.ndarray"),
+        **_pages("reference/generated", "numpy.ndarray"),
         # An alias (py:data in NumPy's own inventory), listed as a class: annotations link classes.
         "numpy.typing.ArrayLike": ("py:class", "reference/typing.html#numpy.typing.ArrayLike"),
     }),
-    "scipy": ("https://docs.scipy.org/doc/scipy/", {
-        "scipy.integrate.solve_ivp": ("py:function", "reference/generated/scipy.integrate.solve_ivp.html#scipy.integrate.solve_ivp"),
-    }),
+    "scipy": ("https://docs.scipy.org/doc/scipy/", _pages("reference/generated", "scipy.integrate.solve_ivp", role="py:function")),
     "sympy": ("https://docs.sympy.org/latest/", {
         **{
             f"sympy.physics.mechanics.{name}": ("py:class", f"{MECHANICS}/kane_lagrange.html#sympy.physics.mechanics.{module}.{name}")
@@ -113,16 +119,9 @@ EXTERNAL = {
         },
         "sympy.physics.mechanics.System": ("py:class", f"{MECHANICS}/system.html#sympy.physics.mechanics.system.System"),
     }),
-    "matplotlib": ("https://matplotlib.org/stable/", {
-        "matplotlib.axes.Axes": ("py:class", "api/_as_gen/matplotlib.axes.Axes.html#matplotlib.axes.Axes"),
-        "matplotlib.figure.Figure": ("py:class", "api/_as_gen/matplotlib.figure.Figure.html#matplotlib.figure.Figure"),
-    }),
-    "xarray": ("https://docs.xarray.dev/en/stable/", {
-        "xarray.Dataset": ("py:class", "generated/xarray.Dataset.html#xarray.Dataset"),
-    }),
-    "pandas": ("https://pandas.pydata.org/docs/", {
-        "pandas.DataFrame": ("py:class", "reference/api/pandas.DataFrame.html#pandas.DataFrame"),
-    }),
+    "matplotlib": ("https://matplotlib.org/stable/", _pages("api/_as_gen", "matplotlib.axes.Axes", "matplotlib.figure.Figure")),
+    "xarray": ("https://docs.xarray.dev/en/stable/", _pages("generated", "xarray.Dataset")),
+    "pandas": ("https://pandas.pydata.org/docs/", _pages("reference/api", "pandas.DataFrame")),
 }  # fmt: skip
 
 

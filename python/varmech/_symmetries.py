@@ -5,19 +5,60 @@ from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 from dataclasses import astuple, dataclass
-from typing import Any
+from typing import Any, TypeVar
 
 import numpy as np
 from numpy.typing import ArrayLike
 
 from . import _core
-from ._util import integer
+from ._util import integer, with_sections
 
 _AXES = "xyz"
 
+# The docstring sections the built-in symmetries share, put in for their placeholders by
+# :func:`_documented` (as varmech.events does its events').
+_SECTIONS = {
+    # Translation's and Rotation's, both checked by _Axial.__post_init__.
+    "{axial raises}": """Raises
+    ------
+    ValueError
+        ``axis`` not an integer ≥ 0 or ``spatial_dim`` not a positive integer, naming it.""",
+    # Every symmetry's: its momentum along a run.
+    "{momentum}": """See Also
+    --------
+    varmech.momentum : J along a trajectory.""",
+    "{spec}": """The core's generator of this symmetry, as the binding takes it.
 
+        Returns
+        -------
+        varmech._core.Generator
+            The generator's kind and data, checked against the model's dimension when a model
+            is built with it.""",
+}
+
+_F = TypeVar("_F", bound=Callable[..., Any])
+
+
+def _documented(f: _F) -> _F:
+    """``f`` (a symmetry's class or its ``spec``) with the shared sections put into its docstring for
+    their placeholders."""
+    return with_sections(f, _SECTIONS)
+
+
+class _Axial:
+    """What Translation and Rotation share: ``axis`` and ``spatial_dim``, checked as they are made."""
+
+    axis: int
+    spatial_dim: int
+
+    def __post_init__(self) -> None:
+        integer("axis", self.axis)
+        integer("spatial_dim", self.spatial_dim, 1)
+
+
+@_documented
 @dataclass(frozen=True)
-class Translation:
+class Translation(_Axial):
     """Every body moves along ``axis``: J is the total linear momentum along it.
 
     Coordinates are laid out body by body, each body with ``spatial_dim`` coordinates. The
@@ -33,14 +74,9 @@ class Translation:
     name : str
         ``"P_x"``, ``"P_y"``, ``"P_z"`` (``"P_k"`` beyond 3 dimensions), as reports name J.
 
-    Raises
-    ------
-    ValueError
-        ``axis`` not an integer ≥ 0 or ``spatial_dim`` not a positive integer, naming it.
+    {axial raises}
 
-    See Also
-    --------
-    varmech.momentum : J along a trajectory.
+    {momentum}
 
     Examples
     --------
@@ -57,23 +93,14 @@ class Translation:
     axis: int
     spatial_dim: int = 3
 
-    def __post_init__(self) -> None:
-        integer("axis", self.axis)
-        integer("spatial_dim", self.spatial_dim, 1)
-
     @property
     def name(self) -> str:
         """The momentum's name in reports."""
         return f"P_{_AXES[self.axis]}" if self.axis < 3 else f"P_{self.axis}"
 
+    @_documented
     def spec(self) -> _core.Generator:
-        """The core's generator of this symmetry, as the binding takes it.
-
-        Returns
-        -------
-        varmech._core.Generator
-            The generator's kind and data, checked against the model's dimension when a model
-            is built with it.
+        """{spec}
 
         Examples
         --------
@@ -84,8 +111,9 @@ class Translation:
         return _core.Generator.Translation(self.axis, self.spatial_dim)
 
 
+@_documented
 @dataclass(frozen=True)
-class Rotation:
+class Rotation(_Axial):
     """Every body turns about ``axis`` (in the plane when ``spatial_dim`` is 2): J is the total
     angular momentum about it.
 
@@ -101,14 +129,9 @@ class Rotation:
     name : str
         ``"L"`` in the plane, else ``"L_x"``, ``"L_y"``, ``"L_z"``.
 
-    Raises
-    ------
-    ValueError
-        ``axis`` not an integer ≥ 0 or ``spatial_dim`` not a positive integer, naming it.
+    {axial raises}
 
-    See Also
-    --------
-    varmech.momentum : J along a trajectory.
+    {momentum}
 
     Examples
     --------
@@ -124,23 +147,14 @@ class Rotation:
     axis: int = 2
     spatial_dim: int = 3
 
-    def __post_init__(self) -> None:
-        integer("axis", self.axis)
-        integer("spatial_dim", self.spatial_dim, 1)
-
     @property
     def name(self) -> str:
         """The momentum's name in reports."""
         return "L" if self.spatial_dim == 2 else f"L_{_AXES[self.axis]}"
 
+    @_documented
     def spec(self) -> _core.Generator:
-        """The core's generator of this symmetry, as the binding takes it.
-
-        Returns
-        -------
-        varmech._core.Generator
-            The generator's kind and data, checked against the model's dimension when a model
-            is built with it.
+        """{spec}
 
         Examples
         --------
@@ -153,6 +167,7 @@ class Rotation:
         return _core.Generator.Rotation(self.axis, self.spatial_dim)
 
 
+@_documented
 @dataclass(frozen=True)
 class Cyclic:
     """Coordinate ``index`` is cyclic (∂L/∂q_index = 0): J = p_index.
@@ -172,9 +187,7 @@ class Cyclic:
     ValueError
         ``index`` not an integer ≥ 0 (``Cyclic(-1)``, ``Cyclic(1.5)``).
 
-    See Also
-    --------
-    varmech.momentum : J along a trajectory.
+    {momentum}
     varmech.routh : the model reduced by its cyclic coordinates.
 
     Examples
@@ -198,14 +211,9 @@ class Cyclic:
         """The momentum's name in reports."""
         return f"p[{self.index}]"
 
+    @_documented
     def spec(self) -> _core.Generator:
-        """The core's generator of this symmetry, as the binding takes it.
-
-        Returns
-        -------
-        varmech._core.Generator
-            The generator's kind and data, checked against the model's dimension when a model
-            is built with it.
+        """{spec}
 
         Examples
         --------

@@ -59,14 +59,14 @@ import json
 import warnings
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any, Literal
+from typing import TYPE_CHECKING, Any, Literal, TypeVar
 
 import numpy as np
 from numpy.typing import ArrayLike
 
 from . import surfaces as _surfaces
 from ._core import IMPACT_LAWS, ContactError
-from ._util import floats, integer, number
+from ._util import floats, integer, number, with_sections
 from ._warnings import VarmechWarning
 from .events import Occurrences
 
@@ -80,6 +80,23 @@ __all__ = ["Contact", "ContactError", "Friction", "ImpactWarning"]
 SWITCHES = ("closed", "released", "stuck", "slipped")
 #: The impact laws, by name: the core's (``_core.IMPACT_LAWS``), which the check reads.
 LawName = Literal["variational", "reflect"]
+
+# The parameters the native contacts' constructors (Contact.wall, Contact.ellipsoid) share,
+# which Contact and Friction document, put in for their placeholder (as varmech.events does its
+# events' sections).
+_NATIVE_SECTIONS = {
+    "{law and friction}": """law : {"variational", "reflect"}, default "variational"
+            The impact law (see :class:`Contact`).
+        friction : Friction, optional
+            Coulomb friction while the contact is held (see :class:`Friction`).""",
+}
+
+_F = TypeVar("_F", bound=Callable[..., Any])
+
+
+def _native_documented(constructor: _F) -> _F:
+    """``constructor`` with the shared sections put into its docstring for their placeholders."""
+    return with_sections(constructor, _NATIVE_SECTIONS)
 
 
 @dataclass(frozen=True)
@@ -297,6 +314,7 @@ class Contact:
         return isinstance(self.phi, _surfaces.Surface) and (self.friction is None or not callable(self.friction.slip))
 
     @classmethod
+    @_native_documented
     def wall(
         cls,
         k: int,
@@ -321,10 +339,7 @@ class Contact:
             The coefficient of restitution e ∈ [0, 1].
         name : str, optional
             The contact's name (default ``"q[k] ≥ value"``).
-        law : {"variational", "reflect"}, default "variational"
-            The impact law (see :class:`Contact`).
-        friction : Friction, optional
-            Coulomb friction while the contact is held (see :class:`Friction`).
+        {law and friction}
 
         Returns
         -------
@@ -351,6 +366,7 @@ class Contact:
         return cls(surface, _surfaces.Gradient(surface), restitution, label, law, friction)
 
     @classmethod
+    @_native_documented
     def ellipsoid(
         cls,
         semi_axes: ArrayLike,
@@ -386,10 +402,7 @@ class Contact:
             The coefficient of restitution e ∈ [0, 1].
         name : str, optional
             The contact's name (default ``"ellipsoid"`` or ``"outside an ellipsoid"``).
-        law : {"variational", "reflect"}, default "variational"
-            The impact law (see :class:`Contact`).
-        friction : Friction, optional
-            Coulomb friction while the contact is held (see :class:`Friction`).
+        {law and friction}
 
         Returns
         -------

@@ -1,6 +1,7 @@
 """Shared set-up of the Python tests: the repository's reference data, the closure models that
-several tests build, and helpers to run the command line, to press Ctrl-C and to see whether a
-run lets go of the GIL."""
+several tests build, closures that raise the user's own exception, and helpers to run the
+command line, to press Ctrl-C, to wait for a streamed run's rows and to see whether a run lets go
+of the GIL."""
 
 import math
 import os
@@ -139,6 +140,53 @@ def interrupt_after():
     yield start
     for timer in timers:
         timer.join()
+
+
+class Boom(Exception):
+    """The user's own exception, raised by a closure under test: varmech must pass it on unchanged."""
+
+
+def raising_when(condition, closure, message):
+    """``closure`` (a model function, an event), raising ``Boom(message)`` instead at a call whose
+    arguments meet ``condition``."""
+
+    def raising(*args):
+        if condition(*args):
+            raise Boom(message)
+        return closure(*args)
+
+    return raising
+
+
+def raising_after(calls, closure, message):
+    """``closure``, raising ``Boom(message)`` instead from its call ``calls + 1`` on; the calls so
+    far are the result's attribute ``calls``, which a test may move on."""
+
+    def raising(*args):
+        raising.calls += 1
+        if raising.calls > calls:
+            raise Boom(message)
+        return closure(*args)
+
+    raising.calls = 0
+    return raising
+
+
+def committed(path, rows, poll, seconds=60):
+    """Whether the streamed run writing ``path`` commits ``rows`` rows within ``seconds``, read in
+    SWMR mode every ``poll`` seconds (a file not there yet, or not laid out yet, is waited for)."""
+    import h5py
+
+    deadline = time.monotonic() + seconds
+    while time.monotonic() < deadline:
+        time.sleep(poll)
+        try:
+            with h5py.File(path, "r", swmr=True) as f:
+                if f["committed"][0] >= rows:
+                    return True
+        except (OSError, KeyError):
+            pass
+    return False
 
 
 def releases_the_gil(run):

@@ -15,6 +15,7 @@ import pytest
 from scipy.special import ellipk
 
 import varmech
+from conftest import Boom, raising_when
 from varmech import sections
 from varmech.events import Event, crossing, encounter, energy_error, escape
 
@@ -170,15 +171,8 @@ def test_an_event_function_with_the_wrong_signature_is_a_type_error_naming_it():
 
 
 def test_an_event_that_raises_propagates_unchanged_with_the_partial_trajectory():
-    class Stop(Exception):
-        pass
-
-    def late(t, q, p):
-        if t > 5.0:
-            raise Stop("from the event")
-        return q[0]
-
-    with pytest.raises(Stop, match="from the event") as info:
+    late = raising_when(lambda t, q, p: t > 5.0, lambda t, q, p: q[0], "from the event")
+    with pytest.raises(Boom, match="from the event") as info:
         varmech.integrate(PENDULUM, dt=0.01, t_end=20.0, events=[late])
     partial = info.value.partial  # type: ignore[attr-defined]
     assert partial.status == -1 and 5.0 <= partial.t[-1] <= 5.02

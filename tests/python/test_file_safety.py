@@ -11,7 +11,6 @@ import shutil
 import signal
 import subprocess
 import sys
-import time
 from pathlib import Path
 
 import h5py
@@ -19,6 +18,7 @@ import numpy as np
 import pytest
 
 import varmech
+from conftest import committed
 from varmech import files, scenes
 
 DATA = Path(__file__).parent / "data"
@@ -182,16 +182,7 @@ def _killed_early(path):
     open (SWMR)."""
     proc = subprocess.Popen([sys.executable, "-c", KILLED_EARLY, str(path)], stderr=subprocess.PIPE, text=True)
     try:
-        deadline = time.monotonic() + 60
-        while time.monotonic() < deadline:
-            time.sleep(0.1)
-            try:
-                with h5py.File(path, "r", swmr=True) as f:
-                    if f["committed"][0] >= 1:
-                        break
-            except (OSError, KeyError):
-                pass
-        else:
+        if not committed(path, 1, poll=0.1):
             pytest.fail("nothing committed in 60 s")
         proc.send_signal(signal.SIGKILL)
         proc.wait()

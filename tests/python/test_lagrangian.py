@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 import varmech
+from conftest import Boom, raising_when
 from varmech import examples, scenes
 
 
@@ -161,18 +162,11 @@ def test_forced_system_keeps_its_energy_balance_with_the_tracked_work(damped_osc
 
 
 def test_a_force_closure_that_raises_propagates_unchanged():
-    class Stall(Exception):
-        pass
-
-    def force(q, v, t):
-        if t > 0.5:
-            raise Stall("stalled")
-        return np.zeros(1)
-
+    force = raising_when(lambda q, v, t: t > 0.5, lambda q, v, t: np.zeros(1), "stalled")
     model = varmech.Lagrangian(
         1, lambda q, v, t: 0.5 * v[0] ** 2 - 0.5 * q[0] ** 2, dl_dq=lambda q, v, t: -q.copy(), dl_dv=lambda q, v, t: v.copy(), force=force
     )
-    with pytest.raises(Stall) as info:
+    with pytest.raises(Boom, match="stalled") as info:
         varmech.integrate(model, [1.0], [0.0], dt=0.1, steps=100, method="midpoint")
     assert info.value.partial.steps == 5 and len(info.value.partial.work) == 6
 

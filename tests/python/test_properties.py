@@ -44,28 +44,22 @@ def _check(spec: pm.Spec) -> po.Outcome:
     return outcome
 
 
-@settings(CI, max_examples=24)
-@given(FAMILIES["closures"])
-def test_closure_models(spec):
-    _check(spec)
+@pytest.mark.parametrize(
+    "family, examples",
+    [
+        ("closures", 24),  # closure models
+        ("symbolic", 40),  # SymPy models
+        ("sphere", 32),  # particles on circles and spheres
+        ("wall", 32),  # a particle above a floor
+    ],
+)
+def test_a_family_of_random_models(family, examples):
+    @settings(CI, max_examples=examples)
+    @given(FAMILIES[family])
+    def check(spec):
+        _check(spec)
 
-
-@settings(CI, max_examples=40)
-@given(FAMILIES["symbolic"])
-def test_symbolic_models(spec):
-    _check(spec)
-
-
-@settings(CI, max_examples=32)
-@given(FAMILIES["sphere"])
-def test_particles_on_circles_and_spheres(spec):
-    _check(spec)
-
-
-@settings(CI, max_examples=32)
-@given(FAMILIES["wall"])
-def test_a_particle_above_a_floor(spec):
-    _check(spec)
+    check()
 
 
 def test_the_oracle_sees_a_crash_a_hang_and_a_wrong_verdict(monkeypatch):

@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 import varmech
+from conftest import Boom, raising_after
 
 G = 9.81
 
@@ -196,23 +197,13 @@ def test_reactions_name_the_model_without_constraints_and_pass_a_closures_error_
     with pytest.raises(ValueError, match="model: has no holonomic constraints"):
         varmech.integrate(varmech.scenes.pendulum(), dt=0.1, steps=10).reactions()
 
-    class Boom(Exception):
-        pass
-
-    calls = {"n": 0}
-
-    def jacobian(q):
-        calls["n"] += 1
-        if calls["n"] > 10_000:
-            raise Boom("the user's own")
-        return q[None, :].copy()
-
+    jacobian = raising_after(10_000, lambda q: q[None, :].copy(), "the user's own")
     model = varmech.MechanicalSystem(
         2, lambda q: q[1], lambda q: np.array([0.0, 1.0]),
         constraints=lambda q: np.array([0.5 * (q @ q - 1.0)]), constraint_jacobian=jacobian, constraint_count=1,
     )
     traj = varmech.integrate(model, [0.0, -1.0], v0=[1.0, 0.0], dt=0.01, steps=10)
-    calls["n"] = 10_000
+    jacobian.calls = 10_000
     with pytest.raises(Boom, match="the user's own"):
         traj.reactions()
 

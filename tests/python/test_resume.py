@@ -6,13 +6,13 @@ import signal
 import subprocess
 import sys
 import textwrap
-import time
 
 import h5py
 import numpy as np
 import pytest
 
 import varmech
+from conftest import committed
 from varmech import scenes
 
 N, M, EVERY = 100, 150, 17
@@ -153,16 +153,9 @@ def _start(path):
         text=True,
     )
     assert proc.stdout.readline().strip() == "started"
-    deadline = time.monotonic() + 60
     # Until a few segments are committed.
-    while time.monotonic() < deadline:
-        time.sleep(0.2)
-        try:
-            with h5py.File(path, "r", swmr=True) as f:
-                if f["committed"][0] >= 500:
-                    return proc
-        except (OSError, KeyError):
-            pass
+    if committed(path, 500, poll=0.2):
+        return proc
     proc.kill()
     pytest.fail("the run committed nothing in 60 s")
 

@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 import varmech
+from conftest import Boom, raising_when
 from varmech import examples, scenes
 
 
@@ -89,14 +90,11 @@ def test_a_time_dependent_lagrangian_reduces_and_reconstructs():
 
 
 def test_an_exception_in_a_closure_propagates_through_the_reduced_model():
-    class Boom(Exception):
-        pass
-
-    def dl_dq(q, v, t):
-        if t > 0.5:
-            raise Boom("from dl_dq")
-        return np.array([math.sin(q[0]) * math.cos(q[0]) * v[1] ** 2 - math.sin(q[0]), 0.0])
-
+    dl_dq = raising_when(
+        lambda q, v, t: t > 0.5,
+        lambda q, v, t: np.array([math.sin(q[0]) * math.cos(q[0]) * v[1] ** 2 - math.sin(q[0]), 0.0]),
+        "from dl_dq",
+    )
     model = varmech.Lagrangian(
         2,
         lambda q, v, t: 0.5 * (v[0] ** 2 + math.sin(q[0]) ** 2 * v[1] ** 2) + math.cos(q[0]),

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 import varmech
-from conftest import refix_crc
+from conftest import Boom, raising_after, refix_crc
 from varmech import examples, scenes
 
 
@@ -141,17 +141,7 @@ def test_a_model_that_is_not_one_is_refused():
 
 
 def test_a_closure_exception_propagates_and_the_state_stays_at_the_last_good_step():
-    class Boom(Exception):
-        pass
-
-    calls = {"n": 0}
-
-    def gradient(q):
-        calls["n"] += 1
-        if calls["n"] > 20:
-            raise Boom("no more forces")
-        return q
-
+    gradient = raising_after(20, lambda q: q, "no more forces")
     model = varmech.MechanicalSystem(1, lambda q: 0.5 * q[0] ** 2, gradient)
     stepper = varmech.Stepper(model, [1.0], [0.0], dt=0.1, method="verlet")
     reference = varmech.integrate(scenes.harmonic_oscillator().model, [1.0], [0.0], dt=0.1, steps=30, method="verlet")
