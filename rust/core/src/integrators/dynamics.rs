@@ -4,8 +4,8 @@ use nalgebra::DMatrix;
 
 use super::{Carry, Increment, Integrator, ModelKind, StepError, StepStart, StepperState};
 use crate::model::{
-    self, Constrained, EnergyTerms, HolonomicConstraints, Lagrangian, MechanicalSystem, Mixed, Nonholonomic,
-    PhaseState, VelocityConstraints,
+    self, Constrained, ConstraintSet, EnergyTerms, HolonomicConstraints, Lagrangian, MechanicalSystem, Mixed,
+    Nonholonomic, PhaseState, VelocityConstraints,
 };
 use crate::{Error, ModelError};
 
@@ -15,7 +15,9 @@ use crate::{Error, ModelError};
 /// method fits is decided by [`ModelKind`] alone.
 pub trait Dynamics {
     /// Number of coordinates n.
-    fn dim(&self) -> usize;
+    fn dim(&self) -> usize {
+        self.as_lagrangian().dim()
+    }
 
     /// The kind of model, which decides the methods that apply ([`crate::integrators::Method::check`]).
     fn kind(&self) -> ModelKind;
@@ -39,10 +41,16 @@ pub trait Dynamics {
         )
     }
 
+    /// The model's constraints, holonomic and velocity, as one record; by default none. The
+    /// counts, the rows of their forces and whether energy is conserved follow from it.
+    fn constraints(&self) -> ConstraintSet<'_> {
+        ConstraintSet::default()
+    }
+
     /// The number of constraints m and how many of them are holonomic, which size a
-    /// constrained method's buffers. Default: none.
+    /// constrained method's buffers.
     fn constraint_counts(&self) -> (usize, usize) {
-        (0, 0)
+        self.constraints().counts()
     }
 
     /// One step's increments (δq, δp) from `start`.
@@ -63,10 +71,13 @@ pub trait Dynamics {
         state.steps_carrying(self, steps, carry)
     }
 
-    /// The energy function and its terms at (q, p, t), where no constraint does work (a forced
-    /// run, or one of an L that depends on t, balances it against the energy put in,
-    /// [`super::Stepper::work`]).
-    fn energy(&self, q: &[f64], p: &[f64], t: f64) -> Option<Result<EnergyTerms, ModelError>>;
+    /// The energy function and its terms at (q, p, t) (E = p·q̇ − L; H for a separable
+    /// system), where no constraint does work: None where affine velocity constraints' forces
+    /// do (linear constraints' and fixed holonomic ones' do none). A forced run, or one of an L
+    /// that depends on t, balances it against the energy put in ([`super::Stepper::work`]).
+    fn energy(&self, q: &[f64], p: &[f64], t: f64) -> Option<Result<EnergyTerms, ModelError>> {
+        (!self.constraints().is_affine()).then(|| self.as_lagrangian().energy_terms(q, p, t))
+    }
 
     /// The system as a Lagrangian, for the diagnostics (energy function, Legendre transforms).
     fn as_lagrangian(&self) -> &dyn Lagrangian;
@@ -91,20 +102,22 @@ pub trait Dynamics {
         None
     }
 
-    /// The velocity constraints A(q)q̇ = 0 of a nonholonomic system; None for the others.
+    /// The velocity constraints A(q)q̇ + b(q) = 0 of a nonholonomic system; None for the others.
     fn velocity_constraints(&self) -> Option<&dyn VelocityConstraints> {
-        None
+        self.constraints().velocity
     }
 
     /// The holonomic constraints g(q) = 0 of a constrained system; None for the others.
     fn holonomic(&self) -> Option<&dyn HolonomicConstraints> {
-        None
+        self.constraints().holonomic
     }
 
     /// The forces of constraint at (q, p, t) into `out` ([`model::Reaction::solve`], made for
-    /// this model's n and m); None without constraints.
-    fn reaction(&self, _out: &mut model::Reaction, _q: &[f64], _p: &[f64], _t: f64) -> Option<Result<(), ModelError>> {
-        None
+    /// this model's n and m, on the rows of [`Dynamics::constraints`]); None without constraints.
+    fn reaction(&self, out: &mut model::Reaction, q: &[f64], p: &[f64], t: f64) -> Option<Result<(), ModelError>> {
+        let constraints = self.constraints();
+        let rows = |q: &[f64], c: &mut DMatrix<f64>, b: &mut [f64]| constraints.rows(q, c, b);
+        (!constraints.is_empty()).then(|| out.solve(self.as_lagrangian(), &rows, (q, p, t)))
     }
 
     /// The [`Self::reaction`]s at the states (`t[k]`, q row k, p row k); None without
@@ -124,10 +137,6 @@ pub trait Dynamics {
 }
 
 impl<S: MechanicalSystem> Dynamics for S {
-    fn dim(&self) -> usize {
-        MechanicalSystem::dim(self)
-    }
-
     fn kind(&self) -> ModelKind {
         if MechanicalSystem::as_nbody(self).is_some() {
             ModelKind::Gravitational
@@ -152,10 +161,6 @@ impl<S: MechanicalSystem> Dynamics for S {
         state.advance_separable(self, steps, carry)
     }
 
-    fn energy(&self, q: &[f64], p: &[f64], t: f64) -> Option<Result<EnergyTerms, ModelError>> {
-        Some(self.energy_terms(q, p, t))
-    }
-
     fn as_lagrangian(&self) -> &dyn Lagrangian {
         self
     }
@@ -173,10 +178,6 @@ impl<S: MechanicalSystem> Dynamics for S {
 pub struct General<'a, L: ?Sized>(pub &'a L);
 
 impl<L: Lagrangian> Dynamics for General<'_, L> {
-    fn dim(&self) -> usize {
-        self.0.dim()
-    }
-
     fn kind(&self) -> ModelKind {
         ModelKind::Lagrangian
     }
@@ -194,11 +195,6 @@ impl<L: Lagrangian> Dynamics for General<'_, L> {
         state.advance_lagrangian(self.0, steps, carry)
     }
 
-    /// E = p·q̇ − L: conserved, or (forced, L depending on t) balanced against the work.
-    fn energy(&self, q: &[f64], p: &[f64], t: f64) -> Option<Result<EnergyTerms, ModelError>> {
-        Some(self.0.energy_terms(q, p, t))
-    }
-
     fn as_lagrangian(&self) -> &dyn Lagrangian {
         self.0
     }
@@ -210,16 +206,15 @@ impl<L: Lagrangian> Dynamics for General<'_, L> {
 
 /// A separable mechanical system on holonomic constraints, for RATTLE and SHAKE.
 impl<S: MechanicalSystem, C: HolonomicConstraints> Dynamics for Constrained<S, C> {
-    fn dim(&self) -> usize {
-        MechanicalSystem::dim(&self.system)
-    }
-
     fn kind(&self) -> ModelKind {
         ModelKind::ConstrainedSeparable
     }
 
-    fn constraint_counts(&self) -> (usize, usize) {
-        (self.constraints.count(), self.constraints.count())
+    fn constraints(&self) -> ConstraintSet<'_> {
+        ConstraintSet {
+            holonomic: Some(&self.constraints),
+            velocity: None,
+        }
     }
 
     fn increment(
@@ -229,10 +224,6 @@ impl<S: MechanicalSystem, C: HolonomicConstraints> Dynamics for Constrained<S, C
         increment: &mut Increment,
     ) -> Result<(), StepError> {
         integrator.increment_constrained(&self.system, &self.constraints, start, increment)
-    }
-
-    fn energy(&self, q: &[f64], p: &[f64], t: f64) -> Option<Result<EnergyTerms, ModelError>> {
-        Some(self.system.energy_terms(q, p, t))
     }
 
     fn as_lagrangian(&self) -> &dyn Lagrangian {
@@ -247,10 +238,6 @@ impl<S: MechanicalSystem, C: HolonomicConstraints> Dynamics for Constrained<S, C
         Some(self.residuals(q, p))
     }
 
-    fn holonomic(&self) -> Option<&dyn HolonomicConstraints> {
-        Some(&self.constraints)
-    }
-
     fn as_mechanical(&self) -> Option<&dyn MechanicalSystem> {
         Some(&self.system)
     }
@@ -258,26 +245,20 @@ impl<S: MechanicalSystem, C: HolonomicConstraints> Dynamics for Constrained<S, C
     fn project(&self, q: &[f64], p: &[f64]) -> Option<Result<PhaseState, Error>> {
         Some(Constrained::project(self, q, p))
     }
-
-    fn reaction(&self, out: &mut model::Reaction, q: &[f64], p: &[f64], t: f64) -> Option<Result<(), ModelError>> {
-        let rows = model::holonomic_rows(&self.constraints);
-        Some(out.solve(&self.system, &rows, (q, p, t)))
-    }
 }
 
 /// A general Lagrangian on holonomic constraints, for the implicit variational methods with
 /// multipliers (the constrained DEL equations; see [`super::Del`]).
 impl<L: Lagrangian, C: HolonomicConstraints> Dynamics for Constrained<General<'_, L>, C> {
-    fn dim(&self) -> usize {
-        self.system.0.dim()
-    }
-
     fn kind(&self) -> ModelKind {
         ModelKind::ConstrainedLagrangian
     }
 
-    fn constraint_counts(&self) -> (usize, usize) {
-        (self.constraints.count(), self.constraints.count())
+    fn constraints(&self) -> ConstraintSet<'_> {
+        ConstraintSet {
+            holonomic: Some(&self.constraints),
+            velocity: None,
+        }
     }
 
     fn increment(
@@ -287,10 +268,6 @@ impl<L: Lagrangian, C: HolonomicConstraints> Dynamics for Constrained<General<'_
         increment: &mut Increment,
     ) -> Result<(), StepError> {
         integrator.increment_constrained_lagrangian(self.system.0, &self.constraints, start, increment)
-    }
-
-    fn energy(&self, q: &[f64], p: &[f64], t: f64) -> Option<Result<EnergyTerms, ModelError>> {
-        self.system.energy(q, p, t)
     }
 
     fn as_lagrangian(&self) -> &dyn Lagrangian {
@@ -305,17 +282,8 @@ impl<L: Lagrangian, C: HolonomicConstraints> Dynamics for Constrained<General<'_
         Some(self.residuals_general(q, p))
     }
 
-    fn holonomic(&self) -> Option<&dyn HolonomicConstraints> {
-        Some(&self.constraints)
-    }
-
     fn project(&self, q: &[f64], p: &[f64]) -> Option<Result<PhaseState, Error>> {
         Some(self.project_general(q, p))
-    }
-
-    fn reaction(&self, out: &mut model::Reaction, q: &[f64], p: &[f64], t: f64) -> Option<Result<(), ModelError>> {
-        let rows = model::holonomic_rows(&self.constraints);
-        Some(out.solve(self.system.0, &rows, (q, p, t)))
     }
 }
 
@@ -342,12 +310,15 @@ impl<L: Lagrangian, C: HolonomicConstraints> Constrained<General<'_, L>, C> {
 /// A Lagrangian with velocity constraints A(q)q̇ = 0, for the discrete Lagrange–d'Alembert
 /// integrator (see [`super::Del`]).
 impl<L: Lagrangian, C: VelocityConstraints> Dynamics for Nonholonomic<L, C> {
-    fn dim(&self) -> usize {
-        self.system.dim()
-    }
-
     fn kind(&self) -> ModelKind {
         ModelKind::Nonholonomic
+    }
+
+    fn constraints(&self) -> ConstraintSet<'_> {
+        ConstraintSet {
+            holonomic: None,
+            velocity: Some(&self.constraints),
+        }
     }
 
     /// |A(q₀)q̇₀|∞ within 1e-10 of the state's size; otherwise `p0` is off the constraints. A
@@ -364,10 +335,6 @@ impl<L: Lagrangian, C: VelocityConstraints> Dynamics for Nonholonomic<L, C> {
         )
     }
 
-    fn constraint_counts(&self) -> (usize, usize) {
-        (self.constraints.count(), 0)
-    }
-
     fn increment(
         &self,
         integrator: &mut Integrator,
@@ -375,14 +342,6 @@ impl<L: Lagrangian, C: VelocityConstraints> Dynamics for Nonholonomic<L, C> {
         increment: &mut Increment,
     ) -> Result<(), StepError> {
         integrator.increment_nonholonomic(&self.system, &self.constraints, start, increment)
-    }
-
-    /// E = p·q̇ − L, unless the constraints are affine ([`VelocityConstraints::is_affine`]):
-    /// linear constraints' forces do no work, affine ones' do, so that their runs have no
-    /// energy to watch.
-    fn energy(&self, q: &[f64], p: &[f64], t: f64) -> Option<Result<EnergyTerms, ModelError>> {
-        let conserved = !self.constraints.is_affine();
-        conserved.then(|| self.system.energy_terms(q, p, t))
     }
 
     fn as_lagrangian(&self) -> &dyn Lagrangian {
@@ -397,17 +356,8 @@ impl<L: Lagrangian, C: VelocityConstraints> Dynamics for Nonholonomic<L, C> {
         Some(self.residuals(q, p))
     }
 
-    fn velocity_constraints(&self) -> Option<&dyn VelocityConstraints> {
-        Some(&self.constraints)
-    }
-
     fn project(&self, q: &[f64], p: &[f64]) -> Option<Result<PhaseState, Error>> {
         Some(Nonholonomic::project(self, q, p))
-    }
-
-    fn reaction(&self, out: &mut model::Reaction, q: &[f64], p: &[f64], t: f64) -> Option<Result<(), ModelError>> {
-        let rows = model::velocity_rows(&self.constraints);
-        Some(out.solve(&self.system, &rows, (q, p, t)))
     }
 }
 
@@ -415,12 +365,12 @@ impl<L: Lagrangian, C: VelocityConstraints> Dynamics for Nonholonomic<L, C> {
 /// Lagrange–d'Alembert integrator with g(q₁) = 0 among its discrete constraints (see
 /// [`super::Del`]); its kind is the nonholonomic one, whose methods all take both.
 impl<L: Lagrangian, H: HolonomicConstraints, C: VelocityConstraints> Dynamics for Mixed<L, H, C> {
-    fn dim(&self) -> usize {
-        self.system.dim()
-    }
-
     fn kind(&self) -> ModelKind {
         ModelKind::Nonholonomic
+    }
+
+    fn constraints(&self) -> ConstraintSet<'_> {
+        Mixed::constraints(self)
     }
 
     /// |g(q₀)|∞ (else `q0` is off the constraints) and |[G; A](q₀)q̇₀ + [0; b]|∞ (else `p0`)
@@ -436,11 +386,6 @@ impl<L: Lagrangian, H: HolonomicConstraints, C: VelocityConstraints> Dynamics fo
         )
     }
 
-    fn constraint_counts(&self) -> (usize, usize) {
-        let holonomic = self.holonomic.count();
-        (holonomic + self.velocity.count(), holonomic)
-    }
-
     fn increment(
         &self,
         integrator: &mut Integrator,
@@ -448,13 +393,6 @@ impl<L: Lagrangian, H: HolonomicConstraints, C: VelocityConstraints> Dynamics fo
         increment: &mut Increment,
     ) -> Result<(), StepError> {
         integrator.increment_mixed(&self.system, (&self.holonomic, &self.velocity), start, increment)
-    }
-
-    /// E = p·q̇ − L, unless the velocity constraints are affine (the holonomic ones, fixed, do
-    /// no work).
-    fn energy(&self, q: &[f64], p: &[f64], t: f64) -> Option<Result<EnergyTerms, ModelError>> {
-        let conserved = !self.velocity.is_affine();
-        conserved.then(|| self.system.energy_terms(q, p, t))
     }
 
     fn as_lagrangian(&self) -> &dyn Lagrangian {
@@ -469,21 +407,8 @@ impl<L: Lagrangian, H: HolonomicConstraints, C: VelocityConstraints> Dynamics fo
         Some(self.residuals(q, p))
     }
 
-    fn velocity_constraints(&self) -> Option<&dyn VelocityConstraints> {
-        Some(&self.velocity)
-    }
-
-    fn holonomic(&self) -> Option<&dyn HolonomicConstraints> {
-        Some(&self.holonomic)
-    }
-
     fn project(&self, q: &[f64], p: &[f64]) -> Option<Result<PhaseState, Error>> {
         Some(Mixed::project(self, q, p))
-    }
-
-    fn reaction(&self, out: &mut model::Reaction, q: &[f64], p: &[f64], t: f64) -> Option<Result<(), ModelError>> {
-        let rows = |q: &[f64], c: &mut DMatrix<f64>, b: &mut [f64]| self.rows(q, c, b);
-        Some(out.solve(&self.system, &rows, (q, p, t)))
     }
 }
 

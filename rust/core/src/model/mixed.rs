@@ -1,7 +1,9 @@
-use nalgebra::{DMatrix, DVector};
+use nalgebra::DVector;
 
 use super::constraints::{momentum_projection, row_norm};
-use super::{inverse_mass, project, HolonomicConstraints, Lagrangian, PhaseState, Residuals, VelocityConstraints};
+use super::{
+    inverse_mass, project, ConstraintSet, HolonomicConstraints, Lagrangian, PhaseState, Residuals, VelocityConstraints,
+};
 use crate::{Error, ModelError};
 
 /// A Lagrangian system S on holonomic constraints H, g(q) = 0, and velocity constraints C,
@@ -18,27 +20,12 @@ pub struct Mixed<S, H, C> {
 }
 
 impl<S: Lagrangian, H: HolonomicConstraints, C: VelocityConstraints> Mixed<S, H, C> {
-    /// [G(q); A(q)] and [0; b(q)], allocated (diagnostics and set-up).
-    fn stacked(&self, q: &[f64]) -> Result<(DMatrix<f64>, DVector<f64>), ModelError> {
-        let (k, m, n) = (self.holonomic.count(), self.velocity.count(), q.len());
-        let (mut g, mut a) = (DMatrix::zeros(k, n), DMatrix::zeros(m, n));
-        self.holonomic.jacobian(q, &mut g)?;
-        self.velocity.matrix(q, &mut a)?;
-        let mut b = DVector::zeros(k + m);
-        self.velocity.offset(q, &mut b.as_mut_slice()[k..])?;
-        let mut stacked = DMatrix::zeros(k + m, n);
-        stacked.rows_mut(0, k).copy_from(&g);
-        stacked.rows_mut(k, m).copy_from(&a);
-        Ok((stacked, b))
-    }
-
-    /// [G(q); A(q)] into `c` and [0; b(q)] into `b`: the rows of the forces of constraint
-    /// ([`super::Reaction::solve`]), allocated as [`Self::stacked`].
-    pub fn rows(&self, q: &[f64], c: &mut DMatrix<f64>, b: &mut [f64]) -> Result<(), ModelError> {
-        let (stacked, offset) = self.stacked(q)?;
-        c.copy_from(&stacked);
-        b.copy_from_slice(offset.as_slice());
-        Ok(())
+    /// Both sets of constraints, as one record.
+    pub fn constraints(&self) -> ConstraintSet<'_> {
+        ConstraintSet {
+            holonomic: Some(&self.holonomic),
+            velocity: Some(&self.velocity),
+        }
     }
 
     /// q̇(q, p), the inverse Legendre transform.
@@ -52,7 +39,7 @@ impl<S: Lagrangian, H: HolonomicConstraints, C: VelocityConstraints> Mixed<S, H,
         let k = self.holonomic.count();
         let mut g = vec![0.0; k];
         self.holonomic.residual(q, &mut g)?;
-        let (stacked, b) = self.stacked(q)?;
+        let (stacked, b) = self.constraints().stacked(q)?;
         let mut v = vec![0.0; q.len()];
         self.velocity()(q, p, &mut v)?;
         let v = DVector::from_column_slice(&v);
@@ -74,7 +61,7 @@ impl<S: Lagrangian, H: HolonomicConstraints, C: VelocityConstraints> Mixed<S, H,
         let velocity = self.velocity();
         let minv = inverse_mass(&velocity);
         let (q, _) = project(&self.holonomic, &minv, &velocity, q0, p0)?;
-        let (stacked, b) = self.stacked(&q).map_err(model)?;
+        let (stacked, b) = self.constraints().stacked(&q).map_err(model)?;
         let p = momentum_projection(&stacked, &b, &minv, &velocity, &q, p0)?;
         Ok((q, p))
     }

@@ -11,6 +11,7 @@
 //! - [`VelocityConstraints`]: nonholonomic constraints A(q)q̇ = 0, and [`Nonholonomic`], a
 //!   Lagrangian system on them; [`curvature`], Frobenius' test of whether they integrate;
 //! - [`Mixed`]: a Lagrangian system on holonomic and velocity constraints together;
+//!   [`ConstraintSet`], a model's constraints of either kind as one record;
 //! - [`NBody`]: point masses under Newtonian gravity, the model of the N-body scenes and of
 //!   the Wisdom–Holman methods;
 //! - [`Rest`]: a model held at rest at q, its multipliers, tangent space and fastest frequency;
@@ -22,6 +23,7 @@
 //! Derivatives a model does not supply come from [`crate::solve::difference`].
 
 pub mod compiled;
+mod constraint_set;
 mod constraints;
 mod energy;
 mod frobenius;
@@ -38,6 +40,7 @@ mod routh;
 mod scale;
 mod symmetry;
 
+pub use constraint_set::ConstraintSet;
 pub use constraints::{
     check_dense, differenced_jacobian, inverse_mass, project, residuals, Action, Anchor, Constrained, Distances,
     HolonomicConstraints, Link, PhaseState, Residuals,
@@ -51,7 +54,7 @@ pub use mixed::Mixed;
 pub use natural::{differenced_kinetic_gradient, kinetic_gradient_from_mass_derivative, Natural, NaturalSystem};
 pub use nbody::{NBody, PairKernel};
 pub use nonholonomic::{differenced_derivative, Nonholonomic, VelocityConstraints};
-pub use reactions::{holonomic_rows, velocity_rows, Reaction, Reactions, Rows};
+pub use reactions::{Reaction, Reactions, Rows};
 pub use rest::{reaction_force, Fastest, ForceAtRest, Rest};
 pub use routh::Routhian;
 pub use scale::Scale;

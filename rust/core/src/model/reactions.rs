@@ -16,7 +16,7 @@
 
 use nalgebra::DMatrix;
 
-use super::{HolonomicConstraints, Lagrangian, VelocityConstraints};
+use super::Lagrangian;
 use crate::solve::lu::{lu_in_place, lu_solve};
 use crate::ModelError;
 
@@ -169,25 +169,5 @@ impl Reaction {
         self.power = self.force.iter().zip(&self.v).map(|(f, v)| f * v).sum();
         self.power_size = self.force.iter().zip(&self.v).map(|(f, v)| (f * v).abs()).sum();
         Ok(())
-    }
-}
-
-/// The rows of holonomic constraints: G(q), b = 0.
-pub fn holonomic_rows<C: HolonomicConstraints + ?Sized>(
-    constraints: &C,
-) -> impl Fn(&[f64], &mut DMatrix<f64>, &mut [f64]) -> Result<(), ModelError> + '_ {
-    |q, c, b| {
-        b.fill(0.0);
-        constraints.jacobian(q, c)
-    }
-}
-
-/// The rows of velocity constraints: A(q) and b(q).
-pub fn velocity_rows<C: VelocityConstraints + ?Sized>(
-    constraints: &C,
-) -> impl Fn(&[f64], &mut DMatrix<f64>, &mut [f64]) -> Result<(), ModelError> + '_ {
-    |q, c, b| {
-        constraints.matrix(q, c)?;
-        constraints.offset(q, b)
     }
 }

@@ -18,7 +18,7 @@
 use nalgebra::DMatrix;
 
 use super::constraints::weighted;
-use super::{holonomic_rows, HolonomicConstraints, Lagrangian, Reaction};
+use super::{ConstraintSet, HolonomicConstraints, Lagrangian, Reaction};
 use crate::solve::difference::forward_step;
 use crate::solve::lanczos::{extremes, times_power_of_two};
 use crate::solve::lu::{lu_in_place, lu_solve};
@@ -154,7 +154,11 @@ impl<'a> Rest<'a> {
             let mut p = vec![0.0; n];
             system.dl_dv(q, &vec![0.0; n], t, &mut p)?;
             let mut reaction = Reaction::new(n, m);
-            reaction.solve(system, &holonomic_rows(c), (q, &p, t))?;
+            let holonomic = ConstraintSet {
+                holonomic: Some(c),
+                velocity: None,
+            };
+            reaction.solve(system, &|q, c, b| holonomic.rows(q, c, b), (q, &p, t))?;
             rest.multipliers = reaction.multipliers;
         }
         Ok(rest)
