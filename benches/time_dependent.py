@@ -93,7 +93,8 @@ def oscillator() -> tuple[object, object]:
 def run(core, method: str, steps: int) -> float:
     start = time.perf_counter()
     n = core.dim
-    _core.integrate(core, np.full(n, 0.6), np.zeros(n), dt=0.005, steps=steps, method=method, save_every=steps, max_energy_error=None)
+    spec = _core.RunSpec(dt=0.005, steps=steps, method=method, save_every=steps, max_energy_error=None)
+    _core.integrate(core, np.full(n, 0.6), np.zeros(n), spec)
     return time.perf_counter() - start
 
 

@@ -31,6 +31,7 @@ __all__ = [
     "PointerLagrangian",
     "PointerSystem",
     "RouthModel",
+    "RunSpec",
     "SceneRecord",
     "SceneReference",
     "SpuriousBranchError",
@@ -163,39 +164,15 @@ class Stepper:
     `impulses` and `events`, the steps go through their impacts and blows and locate the
     crossings as a run's do, bit for bit."""
 
-    def __new__(
-        cls,
-        model: _Model,
-        q0: _FloatArray,
-        p0: _FloatArray,
-        *,
-        dt: float,
-        method: str,
-        t0: float = 0.0,
-        compensated: bool = True,
-        newton_tolerance: float = 1e-14,
-        newton_max_iterations: int = 50,
-        contacts: list[tuple[str, float, str, str, Any, Any]] | None = None,
-        impulses: list[tuple[float, str, Any]] | None = None,
-        events: list[tuple[str, int, int, str, Any]] | None = None,
-    ) -> Stepper: ...
+    def __new__(cls, model: _Model, q0: _FloatArray, p0: _FloatArray, spec: RunSpec) -> Stepper: ...
     def checkpoint(self) -> bytes:
         """The stepper's whole state as bytes, with its model's fingerprint (see [`Checkpoint`])."""
     @staticmethod
-    def from_checkpoint(
-        model: _Model,
-        checkpoint: bytes,
-        *,
-        method: str | None = None,
-        dt: float | None = None,
-        contacts: list[tuple[str, float, str, str, Any, Any]] | None = None,
-        impulses: list[tuple[float, str, Any]] | None = None,
-        events: list[tuple[str, int, int, str, Any]] | None = None,
-    ) -> Stepper:
+    def from_checkpoint(model: _Model, checkpoint: bytes, spec: RunSpec) -> Stepper:
         """The stepper of `model` at the state of `checkpoint` (from `checkpoint()`, or a run's),
-        checked against the model (and `method` and `dt` where given), watching `contacts`
-        (checked at its state, naming `checkpoint`) and `events` and applying the `impulses`
-        after its time."""
+        checked against the model (and the spec's `method` and `dt` where given), watching its
+        `contacts` (checked at its state, naming `checkpoint`) and `events` and applying its
+        `impulses` after its time."""
     def step(self) -> None:
         """Advances one step."""
     def advance(self, n: int) -> None:
@@ -580,90 +557,73 @@ def ensemble(
     models: list[NativeModel | CompiledModel],
     q0: _FloatArray,
     p0: _FloatArray,
+    spec: RunSpec,
     *,
-    dt: float,
-    steps: int,
-    method: str,
-    save_every: int = 1,
-    compensated: bool = True,
-    max_energy_error: float | None = None,
-    t0: float = 0.0,
-    newton_tolerance: float = 1e-14,
-    newton_max_iterations: int = 50,
     workers: int | None = None,
     chunk_size: int | None = None,
     progress: Callable[[int], object] | None = None,
-    events: list[tuple[str, int, int, str, Any]] | None = None,
-    contacts: list[tuple[str, float, str, str, Any, Any]] | None = None,
-    impulses: list[tuple[float, str, Any]] | None = None,
-    t_eval: _FloatArray | list[float] | None = None,
 ) -> tuple[list[tuple[TrajectoryRecord, BaseException | None]], BaseException | None]:
     """Members (rows of q0 and p0, (members, n)) integrated in parallel with the GIL released,
     with one shared model or one a member, each watching the built-in ``events``: each member's
     record (the partial one of a failure) and exception, and the exception (KeyboardInterrupt)
     that stopped the ensemble, if any. ``progress(steps)`` gets the steps of all members every
-    10 ms. ``contacts``: native contacts (as ``integrate``'s), each member resolving its impacts;
-    ``impulses`` (their components as numbers) and ``t_eval`` as ``integrate``'s."""
+    10 ms. The spec's contacts: native ones, each member resolving its impacts; its impulses:
+    their components as numbers."""
 
 def check_allocation(argument: str, count: int, size: int) -> None:
     """ValueError naming ``argument`` for ``count`` items of ``size`` bytes each that the memory
     available to the process (free memory, its address-space limit, its cgroup's) cannot hold."""
 
-def integrate(
-    model: _Model,
-    q0: _FloatArray,
-    p0: _FloatArray,
-    *,
-    dt: float,
-    steps: int,
-    method: str,
-    save_every: int = 1,
-    compensated: bool = True,
-    max_energy_error: float | None = None,
-    t0: float = 0.0,
-    newton_tolerance: float = 1e-14,
-    newton_max_iterations: int = 50,
-    progress: Callable[[int], object] | None = None,
-    events: list[tuple[str, int, int, str, Any]] | None = None,
-    contacts: list[tuple[str, float, str, str, Any, Any]] | None = None,
-    impulses: list[tuple[float, str, Any]] | None = None,
-    t_eval: _FloatArray | list[float] | None = None,
-) -> TrajectoryRecord:
-    """The saved states; on failure the exception carries ``_varmech_partial``, the
-    TrajectoryRecord up to the failure. ``progress(steps)`` is called with the steps completed at
-    the Ctrl-C check's stride; an exception from it stops the run. ``events``: spec tuples
+@final
+class RunSpec:
+    """How a run goes (varmech._runspec.RunSpec's binding): a new run's `method`, `dt` and
+    options, or a continued one's (`method` and `dt`, where given, checked against its
+    checkpoint, and its energy check kept unless `keep_energy_check` is false, then
+    `max_energy_error` sets it), and what it watches and applies. ``events``: spec tuples
     (name, direction, terminal count or 0, kind, payload), kind ``"p"``/``"v"`` (payload g(t, q,
     p) or g(t, q, v)), ``"crossing"`` ((k, value)), ``"ellipsoid"`` ((coordinates, centre,
     semi_axes, inside)), ``"energy_error"`` (bound), ``"escape"``, ``"encounter"`` ((radius,
     groups)); see varmech.events and varmech.surfaces. ``contacts``: tuples (name, restitution,
-    law, kind, payload), kind ``"crossing"`` or ``"ellipsoid"`` (the events' payloads) or
-    ``"functions"`` ((phi, gradient)), law ``"reflect"`` or ``"variational"``; the impacts on
-    them are resolved in the step loop (see varmech.impacts). ``impulses``: tuples (t, kind,
-    payload), kind ``"generalized"`` (the components), ``"function"`` (P(q)) or ``"point"``
-    ((x(q), its Jacobian or None, the impulse vector)), each splitting its step. ``t_eval``: the
-    sample times, whose states alone are then saved."""
+    law, kind, payload, friction), kind ``"crossing"`` or ``"ellipsoid"`` (the events' payloads)
+    or ``"functions"`` ((phi, gradient)), law one of ``IMPACT_LAWS``; the impacts on them are
+    resolved in the step loop (see varmech.impacts). ``impulses``: tuples (t, kind, payload),
+    kind ``"generalized"`` (the components), ``"function"`` (P(q)) or ``"point"`` ((x(q), its
+    Jacobian or None, the impulse vector)), each splitting its step. ``t_eval``: the sample
+    times, whose states alone are then saved."""
+
+    def __new__(
+        cls,
+        *,
+        method: str | None = None,
+        dt: float | None = None,
+        steps: int = 0,
+        save_every: int = 1,
+        compensated: bool = True,
+        max_energy_error: float | None = None,
+        keep_energy_check: bool = True,
+        t0: float = 0.0,
+        newton_tolerance: float = 1e-14,
+        newton_max_iterations: int = 50,
+        events: list[tuple[str, int, int, str, Any]] | None = None,
+        contacts: list[tuple[str, float, str, str, Any, Any]] | None = None,
+        impulses: list[tuple[float, str, Any]] | None = None,
+        t_eval: _FloatArray | list[float] | None = None,
+    ) -> RunSpec: ...
+
+def integrate(
+    model: _Model, q0: _FloatArray, p0: _FloatArray, spec: RunSpec, *, progress: Callable[[int], object] | None = None
+) -> TrajectoryRecord:
+    """The saved states of the run `spec` describes; on failure the exception carries
+    ``_varmech_partial``, the TrajectoryRecord up to the failure. ``progress(steps)`` is called
+    with the steps completed at the Ctrl-C check's stride; an exception from it stops the run."""
 
 def resume(
-    model: _Model,
-    checkpoint: bytes,
-    *,
-    steps: int,
-    save_every: int = 1,
-    progress: Callable[[int], object] | None = None,
-    events: list[tuple[str, int, int, str, Any]] | None = None,
-    method: str | None = None,
-    dt: float | None = None,
-    contacts: list[tuple[str, float, str, str, Any, Any]] | None = None,
-    impulses: list[tuple[float, str, Any]] | None = None,
-    t_eval: _FloatArray | list[float] | None = None,
-    keep_energy_check: bool = True,
-    max_energy_error: float | None = None,
+    model: _Model, checkpoint: bytes, spec: RunSpec, *, progress: Callable[[int], object] | None = None
 ) -> TrajectoryRecord:
-    """Goes on from a run's checkpoint for `steps` more steps, watching `events`, resolving the
-    impacts on `contacts`, applying the `impulses` and taking the samples `t_eval` after the
-    checkpoint's time (as `integrate`'s) if given; a checkpoint of another `method` or `dt`
-    than given is refused. The run's energy check goes on unless `keep_energy_check` is false:
-    then `max_energy_error` sets it (None: none)."""
+    """Goes on from a run's checkpoint for the spec's `steps` more steps, watching its events,
+    resolving the impacts on its contacts, applying its impulses and taking its samples
+    `t_eval` after the checkpoint's time (as `integrate`'s); a checkpoint of another `method`
+    or `dt` than the spec's is refused."""
 
 def energy_terms(model: _Model, t: _FloatArray, q: _FloatArray, p: _FloatArray) -> tuple[_FloatArray, _FloatArray, _FloatArray]:
     """(E, T, V) at each state: the energy function p·q̇ − L, its kinetic term E − V and its

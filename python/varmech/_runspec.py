@@ -127,12 +127,12 @@ class RunSpec:
     ) -> _core.TrajectoryRecord:
         """The binding's record of the new run's first ``steps`` steps from (q, p) at
         :attr:`t0`, reporting its step count to ``progress``."""
-        return _core.integrate(model._core, q, p, **(self.binding | {"steps": steps}), progress=progress)
+        return _core.integrate(model._core, q, p, self.binding(steps=steps), progress=progress)
 
-    @property
-    def binding(self) -> dict[str, Any]:
-        """The binding's keywords of a new run of :attr:`steps` steps (integrate's, ensemble's)."""
-        return {
+    def binding(self, **changes: Any) -> _core.RunSpec:
+        """The binding's spec of a new run of :attr:`steps` steps, ``changes`` replacing its
+        keywords: :func:`varmech.integrate`'s, :func:`varmech.ensemble`'s, a stepper's."""
+        return _core.RunSpec(**({
             "dt": self.dt,
             "steps": self.steps,
             "method": self.method,
@@ -144,22 +144,28 @@ class RunSpec:
             "newton_max_iterations": self.newton_max_iterations,
             "t_eval": self.times,
             **self.jumps.binding,
-        }
+        } | changes))  # fmt: skip
+
+    def continued(self, found: Sequence[int], initial_energy: float | None, **changes: Any) -> _core.RunSpec:
+        """The binding's spec of the run going on from a checkpoint after ``found`` crossings of
+        each event, an energy error measured from ``initial_energy`` (:meth:`events_from`),
+        ``changes`` replacing its keywords: its method and step checked against the checkpoint,
+        whose state sets the rest."""
+        return _core.RunSpec(**({
+            "method": self.method,
+            "dt": self.dt,
+            "steps": self.steps,
+            "save_every": self.save_every,
+            "events": self.events_from(found, initial_energy),
+            "contacts": self.jumps.contact_specs or None,
+            "impulses": self.jumps.impulse_specs or None,
+            "t_eval": self.times,
+            **self.energy_check,
+        } | changes))  # fmt: skip
 
     def stepper(self, model: Model, q: np.ndarray, p: np.ndarray) -> _core.Stepper:
         """The binding's stepper of ``model`` from (q, p) at :attr:`t0`."""
-        return _core.Stepper(
-            model._core,
-            q,
-            p,
-            dt=self.dt,
-            method=self.method,
-            t0=self.t0,
-            compensated=self.compensated,
-            newton_tolerance=self.newton_tolerance,
-            newton_max_iterations=self.newton_max_iterations,
-            **self.jumps.binding,
-        )
+        return _core.Stepper(model._core, q, p, self.binding())
 
     def occurrence_names(self) -> list[str]:
         """The names of the run's occurrences, as its result and its file list them: each

@@ -467,7 +467,7 @@ def _on_threads(
     bar = progress_bar(total=spec.steps * members, unit="step", desc=f"{spec.method} ×{members}", enabled=progress)
     try:
         report = None if bar.disable else (lambda done: bar.update(done - bar.n))
-        return _core.ensemble(released, q, p, **spec.binding, workers=workers, chunk_size=chunk_size, progress=report)
+        return _core.ensemble(released, q, p, spec.binding(), workers=workers, chunk_size=chunk_size, progress=report)
     finally:
         bar.close()
 

@@ -403,20 +403,8 @@ def _run(model: Model, spec: RunSpec, state: tuple[np.ndarray, np.ndarray] | Non
                 assert state is not None
                 record = spec.start(model, *state, spec.steps, shown)
             else:
-                record = _core.resume(
-                    model._core,
-                    spec.checkpoint,
-                    steps=spec.steps,
-                    save_every=spec.save_every,
-                    progress=shown,
-                    events=spec.events_from(spec.found, spec.initial_energy),
-                    method=spec.method,
-                    dt=spec.dt,
-                    contacts=spec.jumps.contact_specs or None,
-                    impulses=spec.jumps.impulse_specs or None,
-                    t_eval=spec.times,
-                    **spec.energy_check,
-                )
+                going_on = spec.continued(spec.found, spec.initial_energy)
+                record = _core.resume(model._core, spec.checkpoint, going_on, progress=shown)
             bar.update(record.steps - spec.base - bar.n)
         except BaseException as err:
             partial = take_partial(err)

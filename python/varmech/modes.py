@@ -649,10 +649,10 @@ def step_by_trial(model: Model, q: np.ndarray, p: np.ndarray, t_end: float, cont
     def trial(step: float) -> np.ndarray | str:
         """The states at the first candidate's times by steps of ``step``, or why the run failed."""
         try:
-            record = _core.integrate(
-                model._core, q, p, dt=step, steps=round(times[-1] / step), method=method, max_energy_error=None,
-                contacts=specs, t_eval=times,
-            )  # fmt: skip
+            spec = _core.RunSpec(
+                dt=step, steps=round(times[-1] / step), method=method, max_energy_error=None, contacts=specs, t_eval=times
+            )
+            record = _core.integrate(model._core, q, p, spec)
         except _core.VarmechError as e:
             return f"{type(e).__name__} at step {getattr(e, 'step', '?')}"
         return np.hstack([record.q, record.p])

@@ -542,7 +542,7 @@ class Stepper:
         blows = _impulses.specs(impulses or (), -math.inf, math.inf)
         model, _, _ = model_and_state(model, None, None, None)
         jumps = Jumps.of(model, events, contacts, (impulses or (), blows))
-        core = _core.Stepper.from_checkpoint(model._core, bytes(checkpoint), method=method, dt=dt, **jumps.binding)
+        core = _core.Stepper.from_checkpoint(model._core, bytes(checkpoint), _core.RunSpec(method=method, dt=dt, **jumps.binding))
         stepper = cls.__new__(cls)
         stepper._model = model
         # What it watches; its step, summation and Newton options are the checkpoint's.

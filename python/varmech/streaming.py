@@ -123,7 +123,7 @@ def stream(
                 record = spec.start(model, *state, 0, None)
             else:
                 # A continued run's energy check, as the spec sets it, is its checkpoints' from here.
-                record = _core.resume(model._core, checkpoint, steps=0, save_every=save_every, **spec.energy_check)
+                record = _core.resume(model._core, checkpoint, _core.RunSpec(steps=0, save_every=save_every, **spec.energy_check))
             with _uninterrupted():
                 writer.append(record)
             if watched and initial_energy is None:
@@ -137,16 +137,12 @@ def stream(
             started = time.perf_counter()
             assert checkpoint is not None  # committed before the first segment
             try:
-                record = _core.resume(
-                    model._core,
-                    checkpoint,
-                    steps=take,
-                    save_every=save_every,
-                    progress=None if bar.disable else report,
-                    events=spec.events_from(found, initial_energy),
-                    contacts=contact_specs,
-                    impulses=spec.jumps.impulse_specs or None,
-                )
+                # Each segment goes on from the last one's checkpoint: its method, step and energy check.
+                segment_spec = spec.continued(
+                    found, initial_energy, method=None, dt=None, steps=take, save_every=save_every,
+                    contacts=contact_specs, t_eval=None, keep_energy_check=True,
+                )  # fmt: skip
+                record = _core.resume(model._core, checkpoint, segment_spec, progress=None if bar.disable else report)
             except BaseException as err:
                 # The segment's states and crossings up to the stop are committed; the file is
                 # closed below.

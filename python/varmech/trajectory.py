@@ -654,7 +654,7 @@ def going_on_from(traj: Trajectory, argument: str, what: str, row: str = "row") 
     are; the core's refusals of the checkpoint as they are."""
     if traj.checkpoint is None:
         raise ValueError(f"{argument}: {what} has no checkpoint to go on from (it failed before its first state)")
-    at = _core.Stepper.from_checkpoint(traj.model._core, traj.checkpoint, method=traj.method, dt=traj.dt)
+    at = _core.Stepper.from_checkpoint(traj.model._core, traj.checkpoint, _core.RunSpec(method=traj.method, dt=traj.dt))
     rows = len(traj.t)
     last = (float(traj.t[-1]), traj.q[-1], traj.p[-1]) if rows else (-np.inf, None, None)
     sampled = last[0] < at.t

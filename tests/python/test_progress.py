@@ -19,10 +19,9 @@ def test_the_binding_reports_increasing_step_counts_without_changing_the_run():
     s = varmech.scenes.kepler()
     steps = 5_000_000
     calls = []
-    reported = _core.integrate(
-        s.model._core, s.q0, s.p0, dt=s.dt, steps=steps, method="verlet", save_every=steps, progress=calls.append
-    )
-    silent = _core.integrate(s.model._core, s.q0, s.p0, dt=s.dt, steps=steps, method="verlet", save_every=steps)
+    spec = _core.RunSpec(dt=s.dt, steps=steps, method="verlet", save_every=steps)
+    reported = _core.integrate(s.model._core, s.q0, s.p0, spec, progress=calls.append)
+    silent = _core.integrate(s.model._core, s.q0, s.p0, spec)
     # Polled every 10–40 ms over a run of about 0.2 s: several reports, increasing, within the run.
     assert len(calls) >= 2 and calls == sorted(set(calls)) and 0 <= calls[0] and calls[-1] < steps
     np.testing.assert_array_equal(reported.q, silent.q)
@@ -40,9 +39,8 @@ def test_an_exception_from_the_report_stops_the_run_unchanged_with_its_partial_t
             raise Stop(steps)
 
     with pytest.raises(Stop) as info:
-        _core.integrate(
-            s.model._core, s.q0, s.p0, dt=s.dt, steps=50_000_000, method="verlet", save_every=1000, progress=report
-        )
+        spec = _core.RunSpec(dt=s.dt, steps=50_000_000, method="verlet", save_every=1000)
+        _core.integrate(s.model._core, s.q0, s.p0, spec, progress=report)
     partial = info.value._varmech_partial
     assert 0 < partial.steps < 50_000_000 and partial.steps == info.value.args[0]
 

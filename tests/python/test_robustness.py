@@ -171,4 +171,4 @@ def test_huge_counts_are_value_errors_naming_the_argument(kepler, argument):
 
     kwargs = dict(dt=0.1, steps=1, method="verlet") | {argument: 2**70}
     with pytest.raises(ValueError, match=f"^{argument}:"):
-        _core.integrate(kepler.model._core, np.asarray(kepler.q0), np.asarray(kepler.p0), **kwargs)
+        _core.RunSpec(**kwargs)

@@ -130,7 +130,9 @@ def test_dl_dt_kept_from_the_gradients_gives_the_evaluated_ones_balance(method):
     gradients = lower(symbols.expressions["gradients"][: 2 * spec.dim], slots, {})
     evaluated = _compile(dataclasses.replace(spec, functions={**spec.functions, "gradients": gradients}))
     runs = [
-        varmech._core.integrate(core, np.array([0.6]), np.array([0.0]), dt=0.01, steps=2000, method=method, save_every=1, max_energy_error=None)
+        varmech._core.integrate(
+            core, np.array([0.6]), np.array([0.0]), varmech._core.RunSpec(dt=0.01, steps=2000, method=method, max_energy_error=None)
+        )
         for core in (model._core, evaluated)
     ]
     kept, other = runs

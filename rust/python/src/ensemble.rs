@@ -5,17 +5,16 @@
 use numpy::PyReadonlyArray2;
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
-use varmech::integrators::{self, Dynamics, MemberEvents, MemberWatch, Members, Method, Parallel};
+use varmech::integrators::{self, Dynamics, MemberEvents, MemberWatch, Members, Parallel};
 
 use crate::bind::check_signals;
 use crate::compiled::CompiledModel;
-use crate::contacts::{ContactSpecs, ContactTuple};
-use crate::convert::{self, rows};
+use crate::convert::rows;
 use crate::errors::{model_error, to_pyerr};
-use crate::events::{EventTuple, Events};
+use crate::events::Events;
 use crate::native::NativeModel;
-use crate::run::{newton_max_iterations_count, reporting, run_options, save_every_count, steps_count};
-use crate::schedule::{ImpulseTuple, ScheduleSpecs};
+use crate::run::reporting;
+use crate::runspec::RunSpec;
 use crate::trajectory::TrajectoryRecord;
 
 /// A model the core evaluates without the GIL.
@@ -66,40 +65,19 @@ type MemberResult = (TrajectoryRecord, Option<Py<PyAny>>);
 /// record and exception (None when it completed), and the exception (KeyboardInterrupt) that
 /// stopped the ensemble, if one did: the members then stopped where they were.
 #[pyfunction]
-#[pyo3(signature = (models, q0, p0, *, dt, steps, method, save_every=1, compensated=true, max_energy_error=None, t0=0.0, newton_tolerance=1e-14, newton_max_iterations=50, workers=None, chunk_size=None, progress=None, events=None, contacts=None, impulses=None, t_eval=None))]
+#[pyo3(signature = (models, q0, p0, spec, *, workers=None, chunk_size=None, progress=None))]
 #[allow(clippy::too_many_arguments)]
 fn ensemble<'py>(
     py: Python<'py>,
     models: Vec<Bound<'py, PyAny>>,
     q0: PyReadonlyArray2<'py, f64>,
     p0: PyReadonlyArray2<'py, f64>,
-    dt: f64,
-    #[pyo3(from_py_with = steps_count)] steps: usize,
-    #[pyo3(from_py_with = convert::method)] method: Method,
-    #[pyo3(from_py_with = save_every_count)] save_every: usize,
-    compensated: bool,
-    max_energy_error: Option<f64>,
-    t0: f64,
-    newton_tolerance: f64,
-    #[pyo3(from_py_with = newton_max_iterations_count)] newton_max_iterations: usize,
+    spec: &RunSpec,
     workers: Option<usize>,
     chunk_size: Option<usize>,
     progress: Option<Py<PyAny>>,
-    events: Option<Vec<EventTuple<'py>>>,
-    contacts: Option<Vec<ContactTuple<'py>>>,
-    impulses: Option<Vec<ImpulseTuple<'py>>>,
-    t_eval: Option<Vec<f64>>,
 ) -> PyResult<(Vec<MemberResult>, Option<Py<PyAny>>)> {
-    let options = run_options(
-        dt,
-        steps,
-        save_every,
-        compensated,
-        max_energy_error,
-        t0,
-        newton_tolerance,
-        newton_max_iterations,
-    );
+    let (method, options) = spec.options()?;
     let ((q0, _), (p0, _)) = (rows("q0", &q0)?, rows("p0", &p0)?);
     let models = Models(
         models
@@ -112,7 +90,7 @@ fn ensemble<'py>(
         return Err(PyValueError::new_err("models: at least one model is needed"));
     }
     let n = models.with_model(0, |sys| sys.dim());
-    let events = match events {
+    let events = match spec.events(py)? {
         Some(tuples) => {
             let (functions, specs) = Events::new(py, tuples, n)?;
             let functions = functions.into_native(&specs)?;
@@ -120,16 +98,16 @@ fn ensemble<'py>(
         }
         None => MemberEvents::default(),
     };
-    let contacts = match contacts {
-        Some(tuples) => ContactSpecs::new(tuples)?.into_native()?,
+    let contacts = match spec.contacts(py)? {
+        Some(contacts) => contacts.into_native()?,
         None => Vec::new(),
     };
-    let impulses = ScheduleSpecs::new(impulses.unwrap_or_default(), Vec::new())?.into_native()?;
+    let impulses = spec.schedule(py)?.into_native()?;
     let watched = MemberWatch {
         events,
         contacts,
         impulses,
-        samples: t_eval.unwrap_or_default(),
+        samples: spec.t_eval().to_vec(),
     };
     let parallel = Parallel { workers, chunk_size };
     let run = py.detach(|| {

@@ -27,6 +27,7 @@ mod native;
 mod pointers;
 mod routh;
 mod run;
+mod runspec;
 mod scenes;
 mod schedule;
 mod stepper;
@@ -45,6 +46,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     scenes::register(m)?;
     routh::register(m)?;
     run::register(m)?;
+    runspec::register(m)?;
     contacts::register(m)?;
     ensemble::register(m)?;
     m.add_class::<stepper::Stepper>()?;

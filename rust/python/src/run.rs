@@ -5,62 +5,37 @@ use numpy::PyReadonlyArray1;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use varmech::diagnostics;
-use varmech::integrators::{
-    self, Checkpoint, Counting, Detector, EventSpec, Failure, Method, NewtonOptions, Options, Splitting, Trajectory,
-    Watch,
-};
+use varmech::integrators::{self, Counting, Detector, EventSpec, Failure, Method, Splitting, Trajectory, Watch};
 use varmech::ModelError;
 
 use crate::bind::{bind_model, dim_of, Poll};
-use crate::contacts::{ContactSpecs, ContactTuple};
+use crate::contacts::ContactSpecs;
 use crate::convert::{self, count, slice};
 use crate::errors::{boxed, failure_to_pyerr, to_pyerr};
 use crate::events::{EventTuple, Events};
-use crate::schedule::{ImpulseTuple, ScheduleSpecs};
+use crate::runspec::RunSpec;
+use crate::schedule::ScheduleSpecs;
 use crate::trajectory::TrajectoryRecord;
 
-/// Integrates; returns the saved states as a [`TrajectoryRecord`] or raises with
-/// `_varmech_partial`, the states up to the failure. The run watches `events` (spec tuples, see
-/// [`Events::new`]), resolves the impacts on `contacts` (see [`ContactSpecs::new`]), applies
-/// `impulses` (see [`ScheduleSpecs::new`]) and saves the states at `t_eval` alone, if given
-/// ([`integrators::integrate_watching`]).
+/// Integrates as `spec` says; returns the saved states as a [`TrajectoryRecord`] or raises
+/// with `_varmech_partial`, the states up to the failure. The run watches the spec's events (see
+/// [`Events::new`]), resolves the impacts on its contacts (see [`ContactSpecs::new`]), applies
+/// its impulses (see [`ScheduleSpecs::new`]) and saves the states at its `t_eval` alone, if
+/// given ([`integrators::integrate_watching`]).
 #[pyfunction]
-#[pyo3(signature = (model, q0, p0, *, dt, steps, method, save_every=1, compensated=true, max_energy_error=None, t0=0.0, newton_tolerance=1e-14, newton_max_iterations=50, progress=None, events=None, contacts=None, impulses=None, t_eval=None))]
-#[allow(clippy::too_many_arguments)]
+#[pyo3(signature = (model, q0, p0, spec, *, progress=None))]
 fn integrate<'py>(
     py: Python<'py>,
     model: &Bound<'py, PyAny>,
     q0: PyReadonlyArray1<'py, f64>,
     p0: PyReadonlyArray1<'py, f64>,
-    dt: f64,
-    #[pyo3(from_py_with = steps_count)] steps: usize,
-    #[pyo3(from_py_with = convert::method)] method: Method,
-    #[pyo3(from_py_with = save_every_count)] save_every: usize,
-    compensated: bool,
-    max_energy_error: Option<f64>,
-    t0: f64,
-    newton_tolerance: f64,
-    #[pyo3(from_py_with = newton_max_iterations_count)] newton_max_iterations: usize,
+    spec: &RunSpec,
     progress: Option<Py<PyAny>>,
-    events: Option<Vec<EventTuple<'py>>>,
-    contacts: Option<Vec<ContactTuple<'py>>>,
-    impulses: Option<Vec<ImpulseTuple<'py>>>,
-    t_eval: Option<Vec<f64>>,
 ) -> PyResult<TrajectoryRecord> {
-    let options = run_options(
-        dt,
-        steps,
-        save_every,
-        compensated,
-        max_energy_error,
-        t0,
-        newton_tolerance,
-        newton_max_iterations,
-    );
+    let (method, options) = spec.options()?;
     let (q0, p0) = (slice("q0", &q0)?, slice("p0", &p0)?);
-    let events = detector_parts(py, model, events)?;
-    let contacts = contacts.map(ContactSpecs::new).transpose()?;
-    let schedule = ScheduleSpecs::new(impulses.unwrap_or_default(), t_eval.unwrap_or_default())?;
+    let events = detector_parts(py, model, spec.events(py)?)?;
+    let (contacts, schedule) = (spec.contacts(py)?, spec.schedule(py)?);
     let result = bind_model(py, model, |sys, poll| {
         let report = reporting(poll, &progress);
         watching(events, contacts.as_ref(), &schedule, |watch| {
@@ -101,33 +76,6 @@ fn watching<'c>(
     })
 }
 
-/// A run's [`Options`] from the binding's arguments (`integrate`'s and `ensemble`'s).
-#[allow(clippy::too_many_arguments)]
-pub(crate) fn run_options(
-    dt: f64,
-    steps: usize,
-    save_every: usize,
-    compensated: bool,
-    max_energy_error: Option<f64>,
-    t0: f64,
-    newton_tolerance: f64,
-    newton_max_iterations: usize,
-) -> Options {
-    let newton = NewtonOptions {
-        tolerance: newton_tolerance,
-        max_iterations: newton_max_iterations,
-    };
-    Options {
-        dt,
-        steps,
-        save_every,
-        compensated,
-        max_energy_error,
-        t0,
-        newton,
-    }
-}
-
 /// The event functions and specs of `events`, checked against the model.
 pub(crate) fn detector_parts<'py>(
     py: Python<'py>,
@@ -139,36 +87,24 @@ pub(crate) fn detector_parts<'py>(
         .transpose()
 }
 
-/// Goes on from a run's checkpoint for `steps` more steps (see [`integrators::resume`]),
-/// watching `events`, resolving the impacts on `contacts` and applying `impulses` and taking the
-/// samples `t_eval` after the checkpoint's time (as `integrate`'s) if given; a
-/// checkpoint of another `method` or `dt` than given is refused ([`Checkpoint::expect`]).
+/// Goes on from a run's checkpoint for the spec's `steps` more steps (see
+/// [`integrators::resume`]), watching its events, resolving the impacts on its contacts,
+/// applying its impulses and taking its samples `t_eval` after the checkpoint's time (as
+/// `integrate`'s); a checkpoint of another method or `dt` than the spec's is refused
+/// ([`Checkpoint::expect`]).
 #[pyfunction]
-#[pyo3(signature = (model, checkpoint, *, steps, save_every=1, progress=None, events=None, method=None, dt=None, contacts=None, impulses=None, t_eval=None, keep_energy_check=true, max_energy_error=None))]
-#[allow(clippy::too_many_arguments)]
+#[pyo3(signature = (model, checkpoint, spec, *, progress=None))]
 fn resume<'py>(
     py: Python<'py>,
     model: &Bound<'py, PyAny>,
     checkpoint: &[u8],
-    #[pyo3(from_py_with = steps_count)] steps: usize,
-    #[pyo3(from_py_with = save_every_count)] save_every: usize,
+    spec: &RunSpec,
     progress: Option<Py<PyAny>>,
-    events: Option<Vec<EventTuple<'py>>>,
-    method: Option<&str>,
-    dt: Option<f64>,
-    contacts: Option<Vec<ContactTuple<'py>>>,
-    impulses: Option<Vec<ImpulseTuple<'py>>>,
-    t_eval: Option<Vec<f64>>,
-    keep_energy_check: bool,
-    max_energy_error: Option<f64>,
 ) -> PyResult<TrajectoryRecord> {
-    let mut checkpoint = decode(py, checkpoint, method, dt)?;
-    if !keep_energy_check {
-        checkpoint.check_energy(max_energy_error);
-    }
-    let events = detector_parts(py, model, events)?;
-    let contacts = contacts.map(ContactSpecs::new).transpose()?;
-    let schedule = ScheduleSpecs::new(impulses.unwrap_or_default(), t_eval.unwrap_or_default())?;
+    let checkpoint = spec.checkpoint(py, checkpoint)?;
+    let events = detector_parts(py, model, spec.events(py)?)?;
+    let (contacts, schedule) = (spec.contacts(py)?, spec.schedule(py)?);
+    let (steps, save_every) = (spec.steps, spec.save_every);
     let result = bind_model(py, model, |sys, poll| {
         let report = reporting(poll, &progress);
         watching(events, contacts.as_ref(), &schedule, |watch| {
@@ -176,14 +112,6 @@ fn resume<'py>(
         })
     })?;
     record(py, result)
-}
-
-/// The checkpoint in `bytes`, refused unless of `method` and `dt` where given.
-pub(crate) fn decode(py: Python<'_>, bytes: &[u8], method: Option<&str>, dt: Option<f64>) -> PyResult<Checkpoint> {
-    let method = method.map(Method::from_name).transpose().map_err(|e| to_pyerr(py, e))?;
-    let checkpoint = Checkpoint::from_bytes(bytes).map_err(|e| to_pyerr(py, e))?;
-    checkpoint.expect(method, dt).map_err(|e| to_pyerr(py, e))?;
-    Ok(checkpoint)
 }
 
 /// The poll of a run: the Ctrl-C check, then `progress(steps)` if given.

@@ -7,18 +7,19 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyBytes;
 use varmech::integrators::{
-    self, Checkpoint, Contacts, Detector, Dynamics, EventSpec, Impacts, Method, NewtonOptions, Occurrence, Options,
-    Schedule, StepperState, Tangent, Trajectory, Watch, Watcher,
+    self, Checkpoint, Contacts, Detector, Dynamics, EventSpec, Impacts, Occurrence, Schedule, StepperState, Tangent,
+    Trajectory, Watch, Watcher,
 };
 use varmech::Error;
 
 use crate::bind::{bind_model, Poll};
-use crate::contacts::{ContactSpecs, ContactTuple};
-use crate::convert::{self, slice};
+use crate::contacts::ContactSpecs;
+use crate::convert::slice;
 use crate::errors::to_pyerr;
 use crate::events::{EventTuple, Events};
-use crate::run::{decode, detector_parts};
-use crate::schedule::{ImpulseTuple, ScheduleSpecs};
+use crate::run::detector_parts;
+use crate::runspec::RunSpec;
+use crate::schedule::ScheduleSpecs;
 use crate::trajectory::{event_arrays, impact_arrays, switch_arrays, EventArrays, ImpactArrays, SwitchArrays};
 
 /// One model, one method and the state, advanced step by step
@@ -55,20 +56,19 @@ pub struct Stepper {
 type Core<'s, 'a> = integrators::Stepper<&'s dyn Dynamics, &'a mut StepperState>;
 
 impl Stepper {
-    /// The stepper of `state` on `model`, watching `contacts` (checked at the state, named
-    /// `argument` if outside one) and `events` (started at the state) and applying `impulses`:
+    /// The stepper of `state` on `model`, watching the spec's contacts (checked at the state,
+    /// named `argument` if outside one) and events (started at the state) and applying its impulses:
     /// those at the state's time too where `fresh` (a new stepper; a checkpoint's were its
     /// run's).
     fn watching<'py>(
         py: Python<'py>,
         model: &Bound<'py, PyAny>,
         state: StepperState,
-        (contacts, impulses, events): Specs<'py>,
+        spec: &RunSpec,
         (argument, fresh): (&'static str, bool),
     ) -> PyResult<Self> {
-        let contacts = contacts.map(ContactSpecs::new).transpose()?;
-        let impulses = ScheduleSpecs::new(impulses.unwrap_or_default(), Vec::new())?;
-        let events = detector_parts(py, model, events)?;
+        let (contacts, impulses) = (spec.contacts(py)?, spec.schedule(py)?);
+        let events = detector_parts(py, model, spec.events(py)?)?;
         let n = state.q().len();
         let mut stepper = Stepper {
             model: model.clone().unbind(),
@@ -167,13 +167,6 @@ impl Stepper {
     }
 }
 
-/// A stepper's contacts, impulses and events, as the constructor takes them.
-type Specs<'py> = (
-    Option<Vec<ContactTuple<'py>>>,
-    Option<Vec<ImpulseTuple<'py>>>,
-    Option<Vec<EventTuple<'py>>>,
-);
-
 /// A call's [`Detector`] of the stepper's event functions, lent to it with a copy of their specs.
 fn lend(events: &mut Option<(Events, Vec<EventSpec>)>) -> Result<Option<Detector<'_>>, varmech::Error> {
     events
@@ -209,38 +202,20 @@ impl<'a> Watched<'a> {
 #[pymethods]
 impl Stepper {
     #[new]
-    #[pyo3(signature = (model, q0, p0, *, dt, method, t0=0.0, compensated=true, newton_tolerance=1e-14, newton_max_iterations=50, contacts=None, impulses=None, events=None))]
-    #[allow(clippy::too_many_arguments)]
     fn new<'py>(
         py: Python<'py>,
         model: &Bound<'py, PyAny>,
         q0: PyReadonlyArray1<'py, f64>,
         p0: PyReadonlyArray1<'py, f64>,
-        dt: f64,
-        #[pyo3(from_py_with = convert::method)] method: Method,
-        t0: f64,
-        compensated: bool,
-        newton_tolerance: f64,
-        newton_max_iterations: usize,
-        contacts: Option<Vec<ContactTuple<'py>>>,
-        impulses: Option<Vec<ImpulseTuple<'py>>>,
-        events: Option<Vec<EventTuple<'py>>>,
+        spec: &RunSpec,
     ) -> PyResult<Self> {
-        let options = Options {
-            compensated,
-            t0,
-            newton: NewtonOptions {
-                tolerance: newton_tolerance,
-                max_iterations: newton_max_iterations,
-            },
-            ..Options::new(dt, 0)
-        };
+        let (method, options) = spec.options()?;
         let (q0, p0) = (slice("q0", &q0)?, slice("p0", &p0)?);
         let state = bind_model(py, model, |sys, _| {
             integrators::Stepper::new(sys, method, q0, p0, &options).map(integrators::Stepper::into_state)
         })?
         .map_err(|e| to_pyerr(py, e))?;
-        Stepper::watching(py, model, state, (contacts, impulses, events), ("q0", true))
+        Stepper::watching(py, model, state, spec, ("q0", true))
     }
 
     /// The stepper's whole state as bytes, with its model's fingerprint (see [`Checkpoint`]).
@@ -250,27 +225,22 @@ impl Stepper {
     }
 
     /// The stepper of `model` at the state of `checkpoint` (from `checkpoint()`, or a run's),
-    /// checked against the model (and `method` and `dt` where given).
+    /// checked against the model (and the spec's method and `dt` where given), watching what
+    /// `spec` says.
     #[staticmethod]
-    #[pyo3(signature = (model, checkpoint, *, method=None, dt=None, contacts=None, impulses=None, events=None))]
-    #[allow(clippy::too_many_arguments)]
     fn from_checkpoint<'py>(
         py: Python<'py>,
         model: &Bound<'py, PyAny>,
         checkpoint: &[u8],
-        method: Option<&str>,
-        dt: Option<f64>,
-        contacts: Option<Vec<ContactTuple<'py>>>,
-        impulses: Option<Vec<ImpulseTuple<'py>>>,
-        events: Option<Vec<EventTuple<'py>>>,
+        spec: &RunSpec,
     ) -> PyResult<Self> {
-        let checkpoint = decode(py, checkpoint, method, dt)?;
+        let checkpoint = spec.checkpoint(py, checkpoint)?;
         let state = bind_model(py, model, |sys, _| {
             let state = checkpoint.into_state(sys)?;
             integrators::Stepper::resume(sys, state).map(integrators::Stepper::into_state)
         })?
         .map_err(|e| to_pyerr(py, e))?;
-        Stepper::watching(py, model, state, (contacts, impulses, events), ("checkpoint", false))
+        Stepper::watching(py, model, state, spec, ("checkpoint", false))
     }
 
     /// Advances one step.
