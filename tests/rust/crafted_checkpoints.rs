@@ -12,10 +12,7 @@ use std::panic::{catch_unwind, AssertUnwindSafe};
 
 use serde::ser::{self, Serialize, SerializeSeq, SerializeStruct, SerializeTuple, SerializeTupleStruct};
 use varmech::integrators::{integrate, resume, Checkpoint, Dynamics, General, Method, Options};
-use varmech::model::Constrained;
-use varmech::scenes::{
-    planar_chain, ChaplyginSleigh, DoublePendulum, HarmonicOscillator, HenonHeiles, Kepler, NBody, RigidBody,
-};
+use varmech::scenes::{planar_chain, ChaplyginSleigh, DoublePendulum, HarmonicOscillator, HenonHeiles, Kepler, NBody};
 use varmech::Error;
 
 /// One call of serde's data model, with what it holds.
@@ -473,19 +470,7 @@ fn each_case(mut check: impl FnMut(&str, &dyn Dynamics, Method, &[f64], &[f64], 
     for method in [Method::Rattle, Method::Shake, Method::Rattle4] {
         check(&format!("planar chain {method:?}"), &chain.system, method, q0, p0, 0.01);
     }
-    let body = RigidBody::problem();
-    let sys = Constrained {
-        system: General(&body.system.system),
-        constraints: body.system.constraints.clone(),
-    };
-    check(
-        "rigid body",
-        &sys,
-        Method::Midpoint,
-        &body.initial.q,
-        &body.initial.p,
-        0.01,
-    );
+    crate::common::with_rigid_body(|sys, s| check("rigid body", sys, Method::Midpoint, &s.q, &s.p, 0.01));
     let sleigh = ChaplyginSleigh::problem(1.0, 0.5, 1.0).unwrap();
     let (q0, p0) = (&sleigh.initial.q, &sleigh.initial.p);
     check("sleigh", &sleigh.system, Method::Dla4, q0, p0, 0.01);

@@ -4,7 +4,7 @@
 use crate::common;
 
 use nalgebra::DMatrix;
-use varmech::integrators::{integrate, General, Method, NewtonOptions, Options, Trajectory};
+use varmech::integrators::{Method, NewtonOptions, Options, Trajectory};
 use varmech::model::{Lagrangian, Natural, NaturalSystem};
 use varmech::scenes::DoublePendulum;
 use varmech::{Error, ModelError};
@@ -33,15 +33,7 @@ fn run_with<L: Lagrangian>(
         newton,
         ..Options::new(t_end / steps as f64, steps)
     };
-    integrate(
-        &General(sys),
-        method,
-        &problem.initial.q,
-        &problem.initial.p,
-        &options,
-        || Ok(()),
-    )
-    .map_err(|f| f.error)
+    common::run_general_with(sys, &problem.initial, method, &options)
 }
 
 #[test]
@@ -322,16 +314,8 @@ fn the_energy_function_of_a_general_lagrangian_uses_the_inverse_legendre_transfo
         max_energy_error: Some(1e-6),
         ..Options::new(0.1, 100)
     };
-    let failure = integrate(
-        &General(&problem.system),
-        Method::Midpoint,
-        &problem.initial.q,
-        &problem.initial.p,
-        &options,
-        || Ok(()),
-    )
-    .unwrap_err();
-    assert!(matches!(failure.error, Error::Divergence { .. }), "{}", failure.error);
+    let error = common::run_general_with(&problem.system, &problem.initial, Method::Midpoint, &options).unwrap_err();
+    assert!(matches!(error, Error::Divergence { .. }), "{error}");
 }
 
 #[test]

@@ -6,8 +6,8 @@ use crate::common;
 
 use common::InvariantStatistics;
 use varmech::diagnostics::Verdict;
-use varmech::integrators::{integrate, General, Method, NewtonOptions, Options, Trajectory};
-use varmech::model::{Hessians, Lagrangian};
+use varmech::integrators::{Method, NewtonOptions, Options, Trajectory};
+use varmech::model::Lagrangian;
 use varmech::scenes::{HeavyTop, State};
 
 /// Generic states: θ on both sides of π/2, every velocity non-zero.
@@ -46,26 +46,7 @@ fn state(sys: &HeavyTop, q: [f64; 3], v: [f64; 3]) -> State {
 fn the_hessians_are_the_derivatives_of_the_gradients() {
     let sys = top();
     for (q, v) in STATES {
-        let mut h = Hessians::zeros(3);
-        assert!(sys.hessians(&q, &v, 0.0, &mut h).unwrap());
-        let mut worst = 0.0_f64;
-        let lq = |q: &[f64], v: &[f64], out: &mut [f64]| sys.dl_dq(q, v, 0.0, out).unwrap();
-        let lv = |q: &[f64], v: &[f64], out: &mut [f64]| sys.dl_dv(q, v, 0.0, out).unwrap();
-        for j in 0..3 {
-            let [qq, qv, vv] = common::hessian_columns(&lq, &lv, &q, &v, j);
-            for (name, matrix, column) in [("qq", &h.qq, qq), ("qv", &h.qv, qv), ("vv", &h.vv, vv)] {
-                for i in 0..3 {
-                    let gap = (matrix[(i, j)] - column[i]).abs() / column[i].abs().max(1.0);
-                    worst = worst.max(gap);
-                    assert!(
-                        gap < 1e-7,
-                        "{name} ({i}, {j}) at q = {q:?}: {} vs {}",
-                        matrix[(i, j)],
-                        column[i]
-                    );
-                }
-            }
-        }
+        let (h, worst) = common::assert_hessians(&sys, &q, &v, 1e-7);
         let e = 1e-6;
         // L_qq̇ is also ∂p/∂q: entry (i, j) = ∂pⱼ/∂qᵢ, the transpose of what the loop checked.
         let lv = |q: &[f64], out: &mut [f64]| sys.dl_dv(q, &v, 0.0, out).unwrap();
@@ -168,15 +149,7 @@ fn midpoint_and_galerkin4_converge_at_their_orders_to_a_self_converged_galerkin6
             newton,
             ..Options::new(t / steps as f64, steps)
         };
-        integrate(
-            &General(sys),
-            method,
-            &problem.initial.q,
-            &problem.initial.p,
-            &options,
-            || Ok(()),
-        )
-        .unwrap_or_else(|f| panic!("{method:?}: {}", f.error))
+        common::run_general_with(sys, &problem.initial, method, &options).unwrap_or_else(|e| panic!("{method:?}: {e}"))
     };
     let reference = run(Method::Galerkin6, 4000, to_round_off);
     let end = reference.len() - 1;

@@ -5,8 +5,8 @@ use varmech::integrators::{
     integrate, integrate_ensemble_watching, Dynamics, Ensemble, General, MemberWatch, Method, Options, Parallel,
     Shared, Trajectory,
 };
-use varmech::model::{Lagrangian, MechanicalSystem};
-use varmech::scenes::{Problem, State};
+use varmech::model::{Constrained, Hessians, Lagrangian, MechanicalSystem};
+use varmech::scenes::{Problem, RigidBody, State};
 use varmech::Error;
 
 pub mod skate;
@@ -127,7 +127,56 @@ pub fn run_general<L: Lagrangian>(
         save_every,
         ..Options::new(h, steps)
     };
-    integrate(&General(sys), method, &initial.q, &initial.p, &options, || Ok(())).map_err(|f| f.error)
+    run_general_with(sys, initial, method, &options)
+}
+
+/// Integrates the general Lagrangian `sys` from `initial` with `options`.
+pub fn run_general_with<L: Lagrangian>(
+    sys: &L,
+    initial: &State,
+    method: Method,
+    options: &Options,
+) -> Result<Trajectory, Error> {
+    integrate(&General(sys), method, &initial.q, &initial.p, options, || Ok(())).map_err(|f| f.error)
+}
+
+/// Asserts that the Hessians of `sys` at (q, q̇), t = 0, are the central differences of its
+/// gradients ([`hessian_columns`]) to `tolerance` relative to max(1, |difference|); returns
+/// them, and the largest such gap.
+pub fn assert_hessians<L: Lagrangian + ?Sized>(sys: &L, q: &[f64], v: &[f64], tolerance: f64) -> (Hessians, f64) {
+    let n = q.len();
+    let mut h = Hessians::zeros(n);
+    assert!(sys.hessians(q, v, 0.0, &mut h).unwrap());
+    let lq = |q: &[f64], v: &[f64], out: &mut [f64]| sys.dl_dq(q, v, 0.0, out).unwrap();
+    let lv = |q: &[f64], v: &[f64], out: &mut [f64]| sys.dl_dv(q, v, 0.0, out).unwrap();
+    let mut worst = 0.0_f64;
+    for j in 0..n {
+        let [qq, qv, vv] = hessian_columns(&lq, &lv, q, v, j);
+        for (name, matrix, column) in [("qq", &h.qq, qq), ("qv", &h.qv, qv), ("vv", &h.vv, vv)] {
+            for i in 0..n {
+                let gap = (matrix[(i, j)] - column[i]).abs() / column[i].abs().max(1.0);
+                worst = worst.max(gap);
+                assert!(
+                    gap < tolerance,
+                    "{name} ({i}, {j}) at q = {q:?}: {} vs {}",
+                    matrix[(i, j)],
+                    column[i]
+                );
+            }
+        }
+    }
+    (h, worst)
+}
+
+/// Runs `body` on the rigid body, its Lagrangian on its constraints as a general one, and its
+/// initial state.
+pub fn with_rigid_body<R>(body: impl FnOnce(&dyn Dynamics, &State) -> R) -> R {
+    let problem = RigidBody::problem();
+    let sys = Constrained {
+        system: General(&problem.system.system),
+        constraints: problem.system.constraints.clone(),
+    };
+    body(&sys, &problem.initial)
 }
 
 /// The statistics and verdict of the energy of `sys` along `traj`.
