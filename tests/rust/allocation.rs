@@ -14,12 +14,15 @@ use std::ops::Deref;
 
 use varmech::integrators::{
     integrate, integrate_watching, integrate_with_events, Contact, Contacts, Detector, DiscreteEnergy, Dynamics,
-    EventSpec, Friction, General, Law, Method, ModelKind, NativeEvent, NativeSurface, Options, Slip, SlipRows, Stepper,
-    StepperState, Tangent, Trajectory, Watch, Watcher,
+    EventSpec, Friction, General, Law, Method, ModelKind, NativeEvent, Options, Slip, SlipRows, Stepper, StepperState,
+    Tangent, Trajectory, Watch, Watcher,
 };
 use varmech::model::Routhian;
 use varmech::scenes::{self, NBody, NonholonomicScene, SceneModel};
 
+#[path = "common/contacts.rs"]
+#[allow(dead_code)] // the others serve the impact and hold tests
+mod contacts;
 #[path = "common/skate.rs"]
 #[allow(dead_code)] // the skate's other forms serve the mixed-constraints tests
 mod skate;
@@ -449,19 +452,7 @@ fn the_discrete_energy_allocates_nothing() {
 /// table |q| ≤ `radius` (reflect law), and its impacts.
 fn billiard(steps: usize, radius: f64) -> (usize, usize) {
     let free = scenes::EllipticBilliard::new(1.0, 1.0).unwrap();
-    let table = Contact {
-        surface: Box::new(NativeSurface::Ellipsoid {
-            coordinates: vec![0, 1],
-            centre: vec![0.0, 0.0],
-            semi_axes: vec![radius, radius],
-            inside: true,
-        }),
-        restitution: 1.0,
-        law: Law::Reflect,
-        friction: None,
-        name: "table".into(),
-    };
-    let contacts = Contacts::new(vec![table]).unwrap();
+    let contacts = contacts::table(radius, Law::Reflect);
     let options = Options {
         save_every: 100,
         ..Options::new(0.01, steps)
@@ -532,17 +523,12 @@ fn held_run<S: Dynamics>(
 /// Allocations of a run of `steps` steps of 0.01 of the ball resting on its floor (e = 0.5).
 fn resting(steps: usize) -> usize {
     let ball = scenes::BouncingBall::new(9.81).unwrap();
-    let floor = Contact {
-        surface: Box::new(NativeSurface::Wall {
-            coordinate: 0,
-            value: 0.0,
-        }),
-        restitution: 0.5,
-        law: Law::Reflect,
-        friction: None,
-        name: "floor".into(),
-    };
-    let (count, traj) = held_run(&ball, floor, (&[0.0], &[0.0]), (0.01, steps));
+    let (count, traj) = held_run(
+        &ball,
+        contacts::wall(0, 0.0, 0.5, Law::Reflect, "floor"),
+        (&[0.0], &[0.0]),
+        (0.01, steps),
+    );
     assert_eq!((traj.q_at(1)[0], traj.p_at(1)[0]), (0.0, 0.0));
     count
 }
@@ -574,20 +560,12 @@ impl SlipRows for Turning {
 fn sliding(slip: Slip, steps: usize) -> usize {
     let free = scenes::FreeBody::new(vec![1.0, 1.0]).unwrap();
     let rim = Contact {
-        surface: Box::new(NativeSurface::Ellipsoid {
-            coordinates: vec![0, 1],
-            centre: vec![0.0, 0.0],
-            semi_axes: vec![1.0, 1.0],
-            inside: true,
-        }),
-        restitution: 0.0,
-        law: Law::Reflect,
         friction: Some(Friction {
             static_coefficient: 0.5,
             kinetic: 0.5,
             slip,
         }),
-        name: "rim".into(),
+        ..contacts::ellipsoid(1.0, true, 0.0, Law::Reflect, "rim")
     };
     let (count, traj) = held_run(&free, rim, (&[1.0, 0.0], &[0.0, 1.0]), (0.001, steps));
     assert!(traj.work[1] < 0.0);
@@ -610,16 +588,7 @@ fn watched_allocations<M>(model: M, mut stepper: Stepper<M>, coordinate: usize, 
 where
     M: Deref<Target: Dynamics> + Copy,
 {
-    let far = Contact {
-        surface: Box::new(NativeSurface::Wall {
-            coordinate,
-            value: -1e9,
-        }),
-        restitution: 1.0,
-        law: Law::Reflect,
-        friction: None,
-        name: "far".into(),
-    };
+    let far = contacts::wall(coordinate, -1e9, 1.0, Law::Reflect, "far");
     let contacts = Contacts::new(vec![far]).unwrap();
     let watch = Watch {
         contacts: Some(&contacts),

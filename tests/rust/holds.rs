@@ -19,7 +19,8 @@ use varmech::model::{Mass, MechanicalSystem, Reaction};
 use varmech::scenes::BouncingBall;
 use varmech::{Error, ModelError};
 
-use crate::impacts::{drop_ball, floor, split_run, with_contacts};
+use crate::common::contacts::{circle, floor, wall};
+use crate::impacts::{drop_ball, split_run, watching, with_contacts};
 
 const G: f64 = 9.81;
 
@@ -54,24 +55,7 @@ fn particle() -> Weighed {
 
 /// The outside of the unit circle, |q| ≥ 1 (a native ellipsoid, outside).
 fn sphere() -> Contacts<'static> {
-    circle(false, "sphere")
-}
-
-/// The unit circle, a native ellipsoid held from `inside` or outside, e = 0.
-fn circle(inside: bool, name: &str) -> Contacts<'static> {
-    let contact = Contact {
-        surface: Box::new(NativeSurface::Ellipsoid {
-            coordinates: vec![0, 1],
-            centre: vec![0.0, 0.0],
-            semi_axes: vec![1.0, 1.0],
-            inside,
-        }),
-        restitution: 0.0,
-        law: Law::Reflect,
-        friction: None,
-        name: name.into(),
-    };
-    Contacts::new(vec![contact]).unwrap()
+    circle(1.0, false, 0.0, Law::Reflect, "sphere")
 }
 
 /// λ of the contact φ at a saved state of `traj` on `model`, ∇φ given.
@@ -234,18 +218,10 @@ fn a_held_step_past_the_surfaces_curvature_ends_the_run_with_a_contact_error_adv
     // At the bottom of the inside of the unit circle at speed 1, pressed by v² + g: a step of 2
     // moves it twice the radius, and no point of q₀ + s(q̇ + c∇φ) lies on the circle.
     let model = particle();
-    let contacts = circle(true, "bowl");
+    let contacts = circle(1.0, true, 0.0, Law::Reflect, "bowl");
     let run = |h: f64| {
         let options = Options::new(h, 10);
-        integrate_watching(
-            &model,
-            Method::Verlet,
-            &[0.0, -1.0],
-            &[1.0, 0.0],
-            &options,
-            || Ok(()),
-            with_contacts(&contacts),
-        )
+        watching(&model, Method::Verlet, (&[0.0, -1.0], &[1.0, 0.0]), &options, &contacts)
     };
     let failure = run(2.0).unwrap_err();
     let Error::Contact { step, time, ref reason } = failure.error else {
@@ -500,16 +476,7 @@ fn a_trapped_particle_pressed_on_a_floor_above_its_equilibrium_bounces_to_rest_t
             k,
             weight: g * m,
         };
-        let contact = Contact {
-            surface: Box::new(NativeSurface::Wall {
-                coordinate: 0,
-                value: -a,
-            }),
-            restitution: e,
-            law: Law::Reflect,
-            friction: None,
-            name: "floor".into(),
-        };
+        let contact = wall(0, -a, e, Law::Reflect, "floor");
         let contacts = Contacts::new(vec![contact]).unwrap();
         let t_rest = trapped_rest((k, m, g, a), e, (x0, v0));
         for (method, order) in [(Method::Verlet, 2), (Method::Yoshida4, 4)] {

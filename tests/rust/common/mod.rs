@@ -9,6 +9,7 @@ use varmech::model::{Constrained, Hessians, Lagrangian, MechanicalSystem};
 use varmech::scenes::{Problem, RigidBody, State};
 use varmech::Error;
 
+pub mod contacts;
 pub mod skate;
 pub mod tapes;
 
