@@ -152,6 +152,17 @@ impl Lagrangian for LagrangianOnly {
     }
 }
 
+/// Asserts that `got` is `exact` to `tolerance` relative to max(1, |exact|), entry by entry.
+fn assert_close(exact: &[f64], got: &[f64], tolerance: f64) {
+    assert!(
+        exact
+            .iter()
+            .zip(got)
+            .all(|(a, b)| (a - b).abs() < tolerance * a.abs().max(1.0)),
+        "{exact:?} vs {got:?}"
+    );
+}
+
 #[test]
 fn central_difference_derivatives_reproduce_the_exact_ones() {
     let problem = DoublePendulum::problem();
@@ -160,22 +171,10 @@ fn central_difference_derivatives_reproduce_the_exact_ones() {
     let (mut exact, mut approx) = ([0.0; 2], [0.0; 2]);
     problem.system.dl_dq(&q, &v, 0.0, &mut exact).unwrap();
     only.dl_dq(&q, &v, 0.0, &mut approx).unwrap();
-    assert!(
-        exact
-            .iter()
-            .zip(&approx)
-            .all(|(a, b)| (a - b).abs() < 1e-8 * a.abs().max(1.0)),
-        "{exact:?} vs {approx:?}"
-    );
+    assert_close(&exact, &approx, 1e-8);
     problem.system.dl_dv(&q, &v, 0.0, &mut exact).unwrap();
     only.dl_dv(&q, &v, 0.0, &mut approx).unwrap();
-    assert!(
-        exact
-            .iter()
-            .zip(&approx)
-            .all(|(a, b)| (a - b).abs() < 1e-8 * a.abs().max(1.0)),
-        "{exact:?} vs {approx:?}"
-    );
+    assert_close(&exact, &approx, 1e-8);
 
     // Over T = 2: the pendulum is chaotic, and later on its growth, not the derivatives, would
     // decide the difference.
@@ -227,13 +226,7 @@ fn a_natural_system_with_differenced_mass_derivative_matches_the_exact_lagrangia
     );
     problem.system.dl_dq(&q, &v, 0.0, &mut exact).unwrap();
     natural.dl_dq(&q, &v, 0.0, &mut got).unwrap();
-    assert!(
-        exact
-            .iter()
-            .zip(&got)
-            .all(|(a, b)| (a - b).abs() < 1e-9 * a.abs().max(1.0)),
-        "{exact:?} vs {got:?}"
-    );
+    assert_close(&exact, &got, 1e-9);
     let e = |l: &dyn Lagrangian| l.energy(&problem.initial.q, &problem.initial.p, 0.0).unwrap();
     assert!((e(&problem.system) - e(&natural)).abs() < 1e-13 * e(&problem.system).abs());
     let a = run(&problem.system, Method::Midpoint, 200, 2.0, 200).unwrap();
