@@ -20,6 +20,7 @@ use varmech::scenes::BouncingBall;
 use varmech::{Error, ModelError};
 
 use crate::common::contacts::{circle, floor, wall};
+use crate::common::Potential;
 use crate::impacts::{drop_ball, split_run, watching, with_contacts};
 
 const G: f64 = 9.81;
@@ -392,33 +393,6 @@ fn a_wheel_whose_slip_rows_turn_with_it_rolls_on_its_circle_at_the_methods_order
     assert!(traj.work[traj.len() - 1] < 0.0, "it skids: friction does work");
 }
 
-/// A particle of mass m in the trap ½kx² under gravity g, V = ½kx² + gmx, its equilibrium
-/// x = −gm/k below a floor x ≥ −a.
-struct Trap {
-    mass: Mass,
-    k: f64,
-    weight: f64,
-}
-
-impl MechanicalSystem for Trap {
-    fn dim(&self) -> usize {
-        1
-    }
-
-    fn mass(&self) -> &Mass {
-        &self.mass
-    }
-
-    fn potential(&self, q: &[f64]) -> Result<f64, ModelError> {
-        Ok(0.5 * self.k * q[0] * q[0] + self.weight * q[0])
-    }
-
-    fn gradient(&self, q: &[f64], grad: &mut [f64]) -> Result<(), ModelError> {
-        grad[0] = self.k * q[0] + self.weight;
-        Ok(())
-    }
-}
-
 /// When the trapped particle (k, m, g) from (x₀, v₀) comes to rest on the floor x = −a with
 /// restitution e: its first impact, then flights harmonic about the equilibrium, each from
 /// the floor (at d = gm/k − a above it) at the speed v back to it after (2/ω)·atan(v/(ωd)),
@@ -471,10 +445,13 @@ fn a_trapped_particle_pressed_on_a_floor_above_its_equilibrium_bounces_to_rest_t
         }
     }
     for (k, m, g, a, e, x0, v0, h) in cases {
-        let trap = Trap {
+        // A particle of mass m in the trap ½kx² under gravity g, V = ½kx² + gmx, its equilibrium
+        // x = −gm/k below the floor x ≥ −a.
+        let trap = Potential {
+            dim: 1,
             mass: Mass::diagonal(vec![m]).unwrap(),
-            k,
-            weight: g * m,
+            potential: |q: &[f64]| 0.5 * k * q[0] * q[0] + g * m * q[0],
+            gradient: |q: &[f64], grad: &mut [f64]| grad[0] = k * q[0] + g * m,
         };
         let contact = wall(0, -a, e, Law::Reflect, "floor");
         let contacts = Contacts::new(vec![contact]).unwrap();

@@ -5,9 +5,9 @@ use varmech::integrators::{
     integrate, integrate_ensemble_watching, Dynamics, Ensemble, General, MemberWatch, Method, Options, Parallel,
     Shared, Trajectory,
 };
-use varmech::model::{Constrained, Hessians, Lagrangian, MechanicalSystem};
+use varmech::model::{Constrained, Hessians, Lagrangian, Mass, MechanicalSystem};
 use varmech::scenes::{Problem, RigidBody, State};
-use varmech::Error;
+use varmech::{Error, ModelError};
 
 pub mod contacts;
 pub mod skate;
@@ -42,6 +42,44 @@ pub const FAMILIES: [Method; 5] = [
     Method::Midpoint,
     Method::Galerkin4,
 ];
+
+/// A model of constant mass in a potential given by its two functions, V(q) and ∇V(q).
+#[derive(Clone)]
+pub struct Potential<V = fn(&[f64]) -> f64, G = fn(&[f64], &mut [f64])> {
+    pub dim: usize,
+    pub mass: Mass,
+    pub potential: V,
+    pub gradient: G,
+}
+
+impl Potential {
+    /// A unit mass (each coordinate's) in V, of gradient ∇V.
+    pub fn unit(dim: usize, potential: fn(&[f64]) -> f64, gradient: fn(&[f64], &mut [f64])) -> Self {
+        let mass = Mass::scalar(1.0).unwrap();
+        Potential {
+            dim,
+            mass,
+            potential,
+            gradient,
+        }
+    }
+}
+
+impl<V: Fn(&[f64]) -> f64, G: Fn(&[f64], &mut [f64])> MechanicalSystem for Potential<V, G> {
+    fn dim(&self) -> usize {
+        self.dim
+    }
+    fn mass(&self) -> &Mass {
+        &self.mass
+    }
+    fn potential(&self, q: &[f64]) -> Result<f64, ModelError> {
+        Ok((self.potential)(q))
+    }
+    fn gradient(&self, q: &[f64], grad: &mut [f64]) -> Result<(), ModelError> {
+        (self.gradient)(q, grad);
+        Ok(())
+    }
+}
 
 /// splitmix64: reproducible points without a dependency.
 pub struct Points(pub u64);
