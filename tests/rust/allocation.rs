@@ -18,7 +18,7 @@ use varmech::integrators::{
     Tangent, Trajectory, Watch, Watcher,
 };
 use varmech::model::Routhian;
-use varmech::scenes::{self, NBody, NonholonomicScene, SceneModel};
+use varmech::scenes::{self, NBody, NonholonomicScene, Problem, SceneModel};
 
 #[path = "common/contacts.rs"]
 #[allow(dead_code)] // the others serve the impact and hold tests
@@ -63,6 +63,11 @@ fn counted<S: Dynamics>(sys: &S, method: Method, q0: &[f64], p0: &[f64], options
     count
 }
 
+/// Allocations made by one run of `method` on a scene's `problem` from its initial state.
+fn counted_from<S: Dynamics>(problem: &Problem<S>, method: Method, options: &Options) -> usize {
+    counted(&problem.system, method, &problem.initial.q, &problem.initial.p, options)
+}
+
 fn allocations(method: Method, steps: usize, max_energy_error: Option<f64>) -> usize {
     let problem = NBody::outer_solar_system();
     let options = Options {
@@ -70,13 +75,7 @@ fn allocations(method: Method, steps: usize, max_energy_error: Option<f64>) -> u
         max_energy_error,
         ..Options::new(10.0, steps)
     };
-    counted(
-        &problem.system,
-        method,
-        &problem.initial.q,
-        &problem.initial.p,
-        &options,
-    )
+    counted_from(&problem, method, &options)
 }
 
 #[test]
@@ -85,16 +84,22 @@ fn the_step_loop_allocates_nothing() {
         // Newton's difference Jacobians make the implicit methods slow on 18 coordinates; a
         // shorter long run proves the same.
         let long_steps = if method.info().implicit { 2_000 } else { 100_000 };
-        // The energy check runs at every saved state; its tolerance is one it cannot reach,
-        // since explicit Euler's energy error reaches the kinetic energy within the long run.
-        for check in [None, Some(f64::MAX)] {
-            let short = allocations(method, 100, check);
-            let long = allocations(method, long_steps, check);
-            assert_eq!(
-                short, long,
-                "{method:?}: {short} allocations for 100 steps, {long} for {long_steps}"
-            );
-        }
+        as_many_long_as_short(allocations, method, long_steps);
+    }
+}
+
+/// Asserts that a run of `long_steps` steps of `method` makes as many `allocations` as a run of
+/// 100, with and without an energy check. The check runs at every saved state; its tolerance is
+/// one it cannot reach, since explicit Euler's energy error reaches the kinetic energy within
+/// the long run.
+fn as_many_long_as_short(allocations: fn(Method, usize, Option<f64>) -> usize, method: Method, long_steps: usize) {
+    for check in [None, Some(f64::MAX)] {
+        let short = allocations(method, 100, check);
+        let long = allocations(method, long_steps, check);
+        assert_eq!(
+            short, long,
+            "{method:?}: {short} allocations for 100 steps, {long} for {long_steps}"
+        );
     }
 }
 
@@ -113,13 +118,7 @@ fn constrained_allocations(method: Method, steps: usize, max_energy_error: Optio
         options.newton.tolerance = 1e-10;
         options.newton.max_iterations = 1_000;
     }
-    counted(
-        &problem.system,
-        method,
-        &problem.initial.q,
-        &problem.initial.p,
-        &options,
-    )
+    counted_from(&problem, method, &options)
 }
 
 #[test]
@@ -127,14 +126,7 @@ fn the_constrained_step_loop_allocates_nothing() {
     for method in Method::CONSTRAINED {
         // SHAKE's forty-odd sweeps a step make it the slow one; a shorter long run proves the same.
         let long_steps = if method == Method::Shake { 2_000 } else { 10_000 };
-        for check in [None, Some(f64::MAX)] {
-            let short = constrained_allocations(method, 100, check);
-            let long = constrained_allocations(method, long_steps, check);
-            assert_eq!(
-                short, long,
-                "{method:?}: {short} allocations for 100 steps, {long} for {long_steps}"
-            );
-        }
+        as_many_long_as_short(constrained_allocations, method, long_steps);
     }
 }
 
