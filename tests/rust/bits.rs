@@ -97,12 +97,7 @@ fn the_implicit_and_constrained_methods_keep_their_bits() {
     };
     let mut actual = Vec::new();
     let dp = DoublePendulum::problem();
-    for m in [
-        Method::Midpoint,
-        Method::Trapezoid,
-        Method::Galerkin4,
-        Method::Galerkin6,
-    ] {
+    for m in crate::common::IMPLICIT {
         let f = run(
             &General(&dp.system),
             m,

@@ -114,12 +114,7 @@ fn every_implicit_method_conserves_the_canonical_angular_momentum_to_round_off()
     let problem = ChargedParticle::nonuniform_field();
     let rotation = problem.system.symmetries()[0];
     let steps = 100_000;
-    for method in [
-        Method::Midpoint,
-        Method::Trapezoid,
-        Method::Galerkin4,
-        Method::Galerkin6,
-    ] {
+    for method in crate::common::IMPLICIT {
         let traj = run(&problem, method, 0.05, steps, 10);
         let j: Vec<f64> = (0..traj.len())
             .map(|k| rotation.momentum(traj.q_at(k), traj.p_at(k)))

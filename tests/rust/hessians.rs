@@ -44,12 +44,7 @@ fn the_double_pendulum_hessians_are_the_derivatives_of_its_gradients() {
 fn an_exact_jacobian_finds_the_same_steps_with_fewer_evaluations() {
     let problem = DoublePendulum::problem();
     let differenced = FirstDerivativesOnly(problem.system.clone());
-    for method in [
-        Method::Midpoint,
-        Method::Trapezoid,
-        Method::Galerkin4,
-        Method::Galerkin6,
-    ] {
+    for method in crate::common::IMPLICIT {
         let exact = run(&problem.system, method);
         let by_differences = run(&differenced, method);
         let k = exact.len() - 1;

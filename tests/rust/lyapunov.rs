@@ -314,12 +314,7 @@ fn the_implicit_rules_tangent_maps_are_their_steps_jacobians() {
     let double = DoublePendulum::new(1.0, 2.0, 2.0, 3.0, 9.81).unwrap();
     let hh = HenonHeiles::new();
     let (damped, _) = taylor(1.077);
-    for method in [
-        Method::Midpoint,
-        Method::Trapezoid,
-        Method::Galerkin4,
-        Method::Galerkin6,
-    ] {
+    for method in crate::common::IMPLICIT {
         let (error, defect) = check(&General(&double), method, 0.01, &[0.5, 1.0, 0.3, -0.2]);
         assert!(error < 1e-9, "{method:?} on the double pendulum: {error:e}");
         assert!(

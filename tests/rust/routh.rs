@@ -1,19 +1,12 @@
 //! Routh reduction: the Routhian R = L − μ·ċ of a model with cyclic coordinates, integrated by
 //! the DEL integrators, against closed forms, relative equilibria and the unreduced model.
 
-use crate::common;
+use crate::common::{self, IMPLICIT};
 
 use varmech::discrete::{DiscreteLagrangian, Midpoint, Trapezoidal};
 use varmech::integrators::{integrate, Method, Options, Trajectory};
 use varmech::model::{Hessians, Lagrangian, Routhian};
 use varmech::scenes::{self, HeavyTop, SphericalPendulum, State};
-
-const IMPLICIT: [Method; 4] = [
-    Method::Midpoint,
-    Method::Trapezoid,
-    Method::Galerkin4,
-    Method::Galerkin6,
-];
 
 /// The spherical pendulum (m = l = g = 1) and its Routhian at p_φ = μ.
 fn spherical(mu: f64) -> (SphericalPendulum, f64) {

@@ -81,6 +81,15 @@ impl<V: Fn(&[f64]) -> f64, G: Fn(&[f64], &mut [f64])> MechanicalSystem for Poten
     }
 }
 
+/// The implicit methods, the variational integrators of general Lagrangians: every method of
+/// [`Method::ALL`] that [`MethodInfo::implicit`](varmech::integrators::MethodInfo) marks.
+pub const IMPLICIT: [Method; 4] = [
+    Method::Midpoint,
+    Method::Trapezoid,
+    Method::Galerkin4,
+    Method::Galerkin6,
+];
+
 /// splitmix64: reproducible points without a dependency.
 pub struct Points(pub u64);
 
