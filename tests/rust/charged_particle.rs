@@ -116,13 +116,9 @@ fn every_implicit_method_conserves_the_canonical_angular_momentum_to_round_off()
     let steps = 100_000;
     for method in crate::common::IMPLICIT {
         let traj = run(&problem, method, 0.05, steps, 10);
-        let j: Vec<f64> = (0..traj.len())
-            .map(|k| rotation.momentum(traj.q_at(k), traj.p_at(k)))
-            .collect();
+        let j: Vec<f64> = common::along(&traj, |q, p| rotation.momentum(q, p));
         let stats = InvariantStatistics::new(&j);
-        let e: Vec<f64> = (0..traj.len())
-            .map(|k| problem.system.energy(traj.q_at(k), traj.p_at(k), 0.0).unwrap())
-            .collect();
+        let e: Vec<f64> = common::along(&traj, |q, p| problem.system.energy(q, p, 0.0).unwrap());
         let energy = common::energy_statistics(&problem.system, &traj);
         println!(
             "{method:?}: J0 = {}, max |ΔJ/J| = {:.2e}; max |ΔE|/⟨T⟩ = {:.2e} ({:?})",

@@ -37,9 +37,7 @@ fn residuals(sys: &LinkedMasses, traj: &Trajectory) -> (f64, f64) {
 
 /// The energy errors H − H₀ at the saved states, and their least-squares slope in t.
 fn energy_drift(sys: &LinkedMasses, traj: &Trajectory) -> (f64, f64) {
-    let e: Vec<f64> = (0..traj.len())
-        .map(|k| varmech::model::hamiltonian(&sys.system, traj.q_at(k), traj.p_at(k)).unwrap())
-        .collect();
+    let e: Vec<f64> = common::along(traj, |q, p| varmech::model::hamiltonian(&sys.system, q, p).unwrap());
     let errors: Vec<f64> = e.iter().map(|x| x - e[0]).collect();
     let n = errors.len() as f64;
     let (mt, me) = (traj.t.iter().sum::<f64>() / n, errors.iter().sum::<f64>() / n);

@@ -263,9 +263,7 @@ fn energy_stays_bounded_and_newton_converges_in_a_few_iterations() {
     let problem = DoublePendulum::problem();
     let steps = 100_000;
     let traj = run(&problem.system, Method::Midpoint, steps, 1000.0, 10).unwrap();
-    let e: Vec<f64> = (0..traj.len())
-        .map(|k| problem.system.energy(traj.q_at(k), traj.p_at(k), 0.0).unwrap())
-        .collect();
+    let e: Vec<f64> = common::along(&traj, |q, p| problem.system.energy(q, p, 0.0).unwrap());
     let stats = common::energy_statistics(&problem.system, &traj);
     assert_eq!(stats.verdict, varmech::diagnostics::Verdict::Bounded, "{stats:?}");
     // O(h²) at h = 0.01 on this fast pendulum: 3.5e-3, in a band that does not grow.
@@ -331,15 +329,11 @@ fn spherical_pendulum_conserves_its_azimuthal_momentum_and_reaches_the_reference
     };
     // Discrete Noether: p_φ to round-off over 10⁵ steps; the energy stays in a band.
     let traj = run(Method::Midpoint, 100_000, 1000.0, 10);
-    let j: Vec<f64> = (0..traj.len())
-        .map(|k| cyclic.momentum(traj.q_at(k), traj.p_at(k)))
-        .collect();
+    let j: Vec<f64> = common::along(&traj, |q, p| cyclic.momentum(q, p));
     let stats = InvariantStatistics::new(&j);
     assert!((stats.initial - 0.8496881019282854).abs() < 1e-15);
     assert!(stats.max_rel_error <= 1e-12, "p_φ error {:.3e}", stats.max_rel_error);
-    let e: Vec<f64> = (0..traj.len())
-        .map(|k| problem.system.energy(traj.q_at(k), traj.p_at(k), 0.0).unwrap())
-        .collect();
+    let e: Vec<f64> = common::along(&traj, |q, p| problem.system.energy(q, p, 0.0).unwrap());
     assert!((e[0] + 0.030489444711168545).abs() < 1e-15);
     assert!(common::conserved(
         common::energy_statistics(&problem.system, &traj).verdict

@@ -123,13 +123,9 @@ fn the_angular_momentum_is_conserved_to_round_off_as_the_angle_grows() {
             (1, NewtonOptions::default(), 1e-14),
         ] {
             let traj = run_polar_with(method, periods, 200, 10, newton);
-            let l: Vec<f64> = (0..traj.len())
-                .map(|k| cyclic.momentum(traj.q_at(k), traj.p_at(k)))
-                .collect();
+            let l: Vec<f64> = common::along(&traj, |q, p| cyclic.momentum(q, p));
             let stats = InvariantStatistics::new(&l);
-            let e: Vec<f64> = (0..traj.len())
-                .map(|k| problem.system.energy(traj.q_at(k), traj.p_at(k), 0.0).unwrap())
-                .collect();
+            let e: Vec<f64> = common::along(&traj, |q, p| problem.system.energy(q, p, 0.0).unwrap());
             let e_err = e.iter().fold(0.0_f64, |m, x| m.max((x - e[0]).abs() / 0.5));
             println!(
                 "{method:?}, {periods} periods of 200 steps, Newton tolerance {:e}: p_θ = {}, max relative error {:.2e}; \

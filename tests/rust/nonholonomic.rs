@@ -104,9 +104,7 @@ fn residual<L: Lagrangian, C: VelocityConstraints>(model: &Nonholonomic<L, C>, t
 
 /// The energies at the saved states.
 fn energies<L: Lagrangian, C>(model: &Nonholonomic<L, C>, traj: &Trajectory) -> Vec<f64> {
-    (0..traj.len())
-        .map(|k| model.system.energy(traj.q_at(k), traj.p_at(k), 0.0).unwrap())
-        .collect()
+    common::along(traj, |q, p| model.system.energy(q, p, 0.0).unwrap())
 }
 
 /// The disk: m = 1, I = 1/4 about a diameter, J = 1/2 about the axle, R = 1; θ̇ = 0.7, φ̇ = 2.

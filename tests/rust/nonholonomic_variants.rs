@@ -66,9 +66,7 @@ fn run(method: Method, (q0, p0): (&[f64], &[f64]), h: f64, steps: usize, save_ev
 
 /// The energy errors E − E₀ at the saved states.
 fn energy_errors(model: &Particle, traj: &Trajectory) -> Vec<f64> {
-    let e: Vec<f64> = (0..traj.len())
-        .map(|k| model.system.energy(traj.q_at(k), traj.p_at(k), 0.0).unwrap())
-        .collect();
+    let e: Vec<f64> = common::along(traj, |q, p| model.system.energy(q, p, 0.0).unwrap());
     e.iter().map(|x| x - e[0]).collect()
 }
 

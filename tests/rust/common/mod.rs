@@ -133,6 +133,11 @@ pub fn run<S: MechanicalSystem>(
     .unwrap_or_else(|f| panic!("{:?} failed: {}", method, f.error))
 }
 
+/// `f` of each saved state (q, p) of `traj`.
+pub fn along<T>(traj: &Trajectory, f: impl Fn(&[f64], &[f64]) -> T) -> Vec<T> {
+    (0..traj.len()).map(|k| f(traj.q_at(k), traj.p_at(k))).collect()
+}
+
 /// ‖(q, p) − (q_ref, p_ref)‖₂ at the last saved state.
 pub fn final_error(traj: &Trajectory, q_ref: &[f64], p_ref: &[f64]) -> f64 {
     let k = traj.len() - 1;
