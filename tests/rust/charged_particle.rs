@@ -147,10 +147,9 @@ fn midpoint_and_galerkin4_converge_at_orders_two_and_four_in_a_non_uniform_field
     println!("Galerkin-6 reference: h vs h/2 differ by {own:.2e}");
     assert!(own < 1e-13, "{own:e}");
     for (method, n0) in [(Method::Midpoint, 200), (Method::Galerkin4, 25)] {
-        let errors: Vec<f64> = (0..4)
-            .map(|k| common::final_error(&at_end(method, n0 << k), q_ref, p_ref))
-            .collect();
-        common::assert_order(&format!("{method:?}"), &errors, method.info().order as f64, 0.3);
+        common::assert_method_order(method, n0, 3, |steps| {
+            common::final_error(&at_end(method, steps), q_ref, p_ref)
+        });
     }
 }
 

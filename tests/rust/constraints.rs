@@ -101,15 +101,11 @@ fn rattle_converges_at_order_two_and_its_composition_at_order_four() {
     let p = scenes::cartesian_pendulum();
     let reference = pendulum_reference();
     for (method, n0) in [(Method::Rattle, 200), (Method::Rattle4, 100)] {
-        let errors: Vec<f64> = (0..4)
-            .map(|k| {
-                let steps = n0 << k;
-                let traj = run(&p, method, 10.0 / steps as f64, steps, steps, None);
-                let q = traj.q_at(1);
-                (q[0] - reference[0]).hypot(q[1] - reference[1])
-            })
-            .collect();
-        common::assert_order(&format!("{method:?}"), &errors, method.info().order as f64, 0.3);
+        common::assert_method_order(method, n0, 3, |steps| {
+            let traj = run(&p, method, 10.0 / steps as f64, steps, steps, None);
+            let q = traj.q_at(1);
+            (q[0] - reference[0]).hypot(q[1] - reference[1])
+        });
     }
 }
 

@@ -166,6 +166,13 @@ pub fn assert_order(what: &str, errors: &[f64], order: f64, tolerance: f64) -> V
     orders
 }
 
+/// Asserts that `method` converges at its order ± 0.3 over `halvings` halvings of the step from
+/// `n0` steps ([`assert_order`]), `error(steps)` being the error of a run of so many steps.
+pub fn assert_method_order(method: Method, n0: usize, halvings: usize, error: impl FnMut(usize) -> f64) {
+    let errors: Vec<f64> = (0..=halvings).map(|k| n0 << k).map(error).collect();
+    assert_order(&format!("{method:?}"), &errors, method.info().order as f64, 0.3);
+}
+
 /// Integrates the general Lagrangian `sys` from `initial` with `steps` steps of size h, keeping
 /// every `save_every`-th state.
 pub fn run_general<L: Lagrangian>(
