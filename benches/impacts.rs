@@ -8,31 +8,18 @@
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use std::hint::black_box;
-use varmech::integrators::{
-    integrate, integrate_watching, Contact, Contacts, Law, Method, NativeSurface, Options, Watch,
-};
+use varmech::integrators::{integrate, integrate_watching, Contacts, Law, Method, Options, Watch};
 use varmech::scenes::EllipticBilliard;
+
+#[path = "../tests/rust/common/contacts.rs"]
+#[allow(dead_code)] // the others serve the tests
+mod contacts;
+use contacts::table;
 
 const STEPS: usize = 20_000;
 const DT: f64 = 0.05;
 const Q0: [f64; 2] = [0.3, -0.2];
 const P0: [f64; 2] = [0.6, 0.8];
-
-fn table(radius: f64, law: Law) -> Contacts<'static> {
-    let contact = Contact {
-        surface: Box::new(NativeSurface::Ellipsoid {
-            coordinates: vec![0, 1],
-            centre: vec![0.0, 0.0],
-            semi_axes: vec![radius, radius],
-            inside: true,
-        }),
-        restitution: 1.0,
-        law,
-        friction: None,
-        name: "table".into(),
-    };
-    Contacts::new(vec![contact]).unwrap()
-}
 
 fn run(free: &EllipticBilliard, contacts: Option<&Contacts<'_>>, method: Method) -> usize {
     let options = Options {

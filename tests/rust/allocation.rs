@@ -14,12 +14,15 @@ use std::ops::Deref;
 
 use varmech::integrators::{
     integrate, integrate_watching, integrate_with_events, Contact, Contacts, Detector, DiscreteEnergy, Dynamics,
-    EventSpec, Friction, General, Law, Method, ModelKind, NativeEvent, NativeSurface, Options, Slip, SlipRows, Stepper,
-    StepperState, Tangent, Trajectory, Watch, Watcher,
+    EventSpec, Friction, General, Law, Method, ModelKind, NativeEvent, Options, Slip, SlipRows, Stepper, StepperState,
+    Tangent, Trajectory, Watch, Watcher,
 };
 use varmech::model::Routhian;
-use varmech::scenes::{self, NBody, NonholonomicScene, SceneModel};
+use varmech::scenes::{self, NBody, NonholonomicScene, Problem, SceneModel};
 
+#[path = "common/contacts.rs"]
+#[allow(dead_code)] // the others serve the impact and hold tests
+mod contacts;
 #[path = "common/skate.rs"]
 #[allow(dead_code)] // the skate's other forms serve the mixed-constraints tests
 mod skate;
@@ -60,6 +63,11 @@ fn counted<S: Dynamics>(sys: &S, method: Method, q0: &[f64], p0: &[f64], options
     count
 }
 
+/// Allocations made by one run of `method` on a scene's `problem` from its initial state.
+fn counted_from<S: Dynamics>(problem: &Problem<S>, method: Method, options: &Options) -> usize {
+    counted(&problem.system, method, &problem.initial.q, &problem.initial.p, options)
+}
+
 fn allocations(method: Method, steps: usize, max_energy_error: Option<f64>) -> usize {
     let problem = NBody::outer_solar_system();
     let options = Options {
@@ -67,13 +75,7 @@ fn allocations(method: Method, steps: usize, max_energy_error: Option<f64>) -> u
         max_energy_error,
         ..Options::new(10.0, steps)
     };
-    counted(
-        &problem.system,
-        method,
-        &problem.initial.q,
-        &problem.initial.p,
-        &options,
-    )
+    counted_from(&problem, method, &options)
 }
 
 #[test]
@@ -82,16 +84,22 @@ fn the_step_loop_allocates_nothing() {
         // Newton's difference Jacobians make the implicit methods slow on 18 coordinates; a
         // shorter long run proves the same.
         let long_steps = if method.info().implicit { 2_000 } else { 100_000 };
-        // The energy check runs at every saved state; its tolerance is one it cannot reach,
-        // since explicit Euler's energy error reaches the kinetic energy within the long run.
-        for check in [None, Some(f64::MAX)] {
-            let short = allocations(method, 100, check);
-            let long = allocations(method, long_steps, check);
-            assert_eq!(
-                short, long,
-                "{method:?}: {short} allocations for 100 steps, {long} for {long_steps}"
-            );
-        }
+        as_many_long_as_short(allocations, method, long_steps);
+    }
+}
+
+/// Asserts that a run of `long_steps` steps of `method` makes as many `allocations` as a run of
+/// 100, with and without an energy check. The check runs at every saved state; its tolerance is
+/// one it cannot reach, since explicit Euler's energy error reaches the kinetic energy within
+/// the long run.
+fn as_many_long_as_short(allocations: fn(Method, usize, Option<f64>) -> usize, method: Method, long_steps: usize) {
+    for check in [None, Some(f64::MAX)] {
+        let short = allocations(method, 100, check);
+        let long = allocations(method, long_steps, check);
+        assert_eq!(
+            short, long,
+            "{method:?}: {short} allocations for 100 steps, {long} for {long_steps}"
+        );
     }
 }
 
@@ -110,13 +118,7 @@ fn constrained_allocations(method: Method, steps: usize, max_energy_error: Optio
         options.newton.tolerance = 1e-10;
         options.newton.max_iterations = 1_000;
     }
-    counted(
-        &problem.system,
-        method,
-        &problem.initial.q,
-        &problem.initial.p,
-        &options,
-    )
+    counted_from(&problem, method, &options)
 }
 
 #[test]
@@ -124,14 +126,7 @@ fn the_constrained_step_loop_allocates_nothing() {
     for method in Method::CONSTRAINED {
         // SHAKE's forty-odd sweeps a step make it the slow one; a shorter long run proves the same.
         let long_steps = if method == Method::Shake { 2_000 } else { 10_000 };
-        for check in [None, Some(f64::MAX)] {
-            let short = constrained_allocations(method, 100, check);
-            let long = constrained_allocations(method, long_steps, check);
-            assert_eq!(
-                short, long,
-                "{method:?}: {short} allocations for 100 steps, {long} for {long_steps}"
-            );
-        }
+        as_many_long_as_short(constrained_allocations, method, long_steps);
     }
 }
 
@@ -449,19 +444,7 @@ fn the_discrete_energy_allocates_nothing() {
 /// table |q| ≤ `radius` (reflect law), and its impacts.
 fn billiard(steps: usize, radius: f64) -> (usize, usize) {
     let free = scenes::EllipticBilliard::new(1.0, 1.0).unwrap();
-    let table = Contact {
-        surface: Box::new(NativeSurface::Ellipsoid {
-            coordinates: vec![0, 1],
-            centre: vec![0.0, 0.0],
-            semi_axes: vec![radius, radius],
-            inside: true,
-        }),
-        restitution: 1.0,
-        law: Law::Reflect,
-        friction: None,
-        name: "table".into(),
-    };
-    let contacts = Contacts::new(vec![table]).unwrap();
+    let contacts = contacts::table(radius, Law::Reflect);
     let options = Options {
         save_every: 100,
         ..Options::new(0.01, steps)
@@ -532,17 +515,12 @@ fn held_run<S: Dynamics>(
 /// Allocations of a run of `steps` steps of 0.01 of the ball resting on its floor (e = 0.5).
 fn resting(steps: usize) -> usize {
     let ball = scenes::BouncingBall::new(9.81).unwrap();
-    let floor = Contact {
-        surface: Box::new(NativeSurface::Wall {
-            coordinate: 0,
-            value: 0.0,
-        }),
-        restitution: 0.5,
-        law: Law::Reflect,
-        friction: None,
-        name: "floor".into(),
-    };
-    let (count, traj) = held_run(&ball, floor, (&[0.0], &[0.0]), (0.01, steps));
+    let (count, traj) = held_run(
+        &ball,
+        contacts::wall(0, 0.0, 0.5, Law::Reflect, "floor"),
+        (&[0.0], &[0.0]),
+        (0.01, steps),
+    );
     assert_eq!((traj.q_at(1)[0], traj.p_at(1)[0]), (0.0, 0.0));
     count
 }
@@ -574,20 +552,12 @@ impl SlipRows for Turning {
 fn sliding(slip: Slip, steps: usize) -> usize {
     let free = scenes::FreeBody::new(vec![1.0, 1.0]).unwrap();
     let rim = Contact {
-        surface: Box::new(NativeSurface::Ellipsoid {
-            coordinates: vec![0, 1],
-            centre: vec![0.0, 0.0],
-            semi_axes: vec![1.0, 1.0],
-            inside: true,
-        }),
-        restitution: 0.0,
-        law: Law::Reflect,
         friction: Some(Friction {
             static_coefficient: 0.5,
             kinetic: 0.5,
             slip,
         }),
-        name: "rim".into(),
+        ..contacts::ellipsoid(1.0, true, 0.0, Law::Reflect, "rim")
     };
     let (count, traj) = held_run(&free, rim, (&[1.0, 0.0], &[0.0, 1.0]), (0.001, steps));
     assert!(traj.work[1] < 0.0);
@@ -610,16 +580,7 @@ fn watched_allocations<M>(model: M, mut stepper: Stepper<M>, coordinate: usize, 
 where
     M: Deref<Target: Dynamics> + Copy,
 {
-    let far = Contact {
-        surface: Box::new(NativeSurface::Wall {
-            coordinate,
-            value: -1e9,
-        }),
-        restitution: 1.0,
-        law: Law::Reflect,
-        friction: None,
-        name: "far".into(),
-    };
+    let far = contacts::wall(coordinate, -1e9, 1.0, Law::Reflect, "far");
     let contacts = Contacts::new(vec![far]).unwrap();
     let watch = Watch {
         contacts: Some(&contacts),

@@ -4,8 +4,7 @@
 //! changes a fingerprint.
 
 use varmech::integrators::{integrate, Dynamics, General, Method, Options, Trajectory};
-use varmech::model::Constrained;
-use varmech::scenes::{planar_chain, DampedDrivenPendulum, DoublePendulum, Kepler, RigidBody};
+use varmech::scenes::{planar_chain, DampedDrivenPendulum, DoublePendulum, Kepler};
 
 /// FNV-1a over the bits of every saved (t, q, p), the Newton counts and work per saved state,
 /// and the run's step, evaluation and iteration counts.
@@ -98,12 +97,7 @@ fn the_implicit_and_constrained_methods_keep_their_bits() {
     };
     let mut actual = Vec::new();
     let dp = DoublePendulum::problem();
-    for m in [
-        Method::Midpoint,
-        Method::Trapezoid,
-        Method::Galerkin4,
-        Method::Galerkin6,
-    ] {
+    for m in crate::common::IMPLICIT {
         let f = run(
             &General(&dp.system),
             m,
@@ -133,15 +127,12 @@ fn the_implicit_and_constrained_methods_keep_their_bits() {
         );
         actual.push((format!("planar chain {}", m.info().name), f));
     }
-    let body = RigidBody::problem();
-    let sys = Constrained {
-        system: General(&body.system.system),
-        constraints: body.system.constraints.clone(),
-    };
-    for m in [Method::Midpoint, Method::Trapezoid] {
-        let f = run(&sys, m, &body.initial.q, &body.initial.p, &options(0.01, 300));
-        actual.push((format!("rigid body {}", m.info().name), f));
-    }
+    crate::common::with_rigid_body(|sys, s| {
+        for m in [Method::Midpoint, Method::Trapezoid] {
+            let f = run(sys, m, &s.q, &s.p, &options(0.01, 300));
+            actual.push((format!("rigid body {}", m.info().name), f));
+        }
+    });
     check(actual, IMPLICIT);
 }
 
@@ -215,15 +206,7 @@ fn the_reference_midpoint_loop_takes_varmechs_newton_steps() {
         save_every: steps,
         ..Options::new(h, steps)
     };
-    let traj = integrate(
-        &General(&dp.system),
-        Method::Midpoint,
-        &dp.initial.q,
-        &dp.initial.p,
-        &options,
-        || Ok(()),
-    )
-    .unwrap();
+    let traj = crate::common::run_general_with(&dp.system, &dp.initial, Method::Midpoint, &options).unwrap();
     let (q0, p0) = ([dp.initial.q[0], dp.initial.q[1]], [dp.initial.p[0], dp.initial.p[1]]);
     let (q, p, iterations) = reference::midpoint(&dp.system, q0, p0, h, steps);
     println!(

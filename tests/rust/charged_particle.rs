@@ -114,20 +114,11 @@ fn every_implicit_method_conserves_the_canonical_angular_momentum_to_round_off()
     let problem = ChargedParticle::nonuniform_field();
     let rotation = problem.system.symmetries()[0];
     let steps = 100_000;
-    for method in [
-        Method::Midpoint,
-        Method::Trapezoid,
-        Method::Galerkin4,
-        Method::Galerkin6,
-    ] {
+    for method in crate::common::IMPLICIT {
         let traj = run(&problem, method, 0.05, steps, 10);
-        let j: Vec<f64> = (0..traj.len())
-            .map(|k| rotation.momentum(traj.q_at(k), traj.p_at(k)))
-            .collect();
+        let j: Vec<f64> = common::along(&traj, |q, p| rotation.momentum(q, p));
         let stats = InvariantStatistics::new(&j);
-        let e: Vec<f64> = (0..traj.len())
-            .map(|k| problem.system.energy(traj.q_at(k), traj.p_at(k), 0.0).unwrap())
-            .collect();
+        let e: Vec<f64> = common::along(&traj, |q, p| problem.system.energy(q, p, 0.0).unwrap());
         let energy = common::energy_statistics(&problem.system, &traj);
         println!(
             "{method:?}: J0 = {}, max |ΔJ/J| = {:.2e}; max |ΔE|/⟨T⟩ = {:.2e} ({:?})",
@@ -156,10 +147,9 @@ fn midpoint_and_galerkin4_converge_at_orders_two_and_four_in_a_non_uniform_field
     println!("Galerkin-6 reference: h vs h/2 differ by {own:.2e}");
     assert!(own < 1e-13, "{own:e}");
     for (method, n0) in [(Method::Midpoint, 200), (Method::Galerkin4, 25)] {
-        let errors: Vec<f64> = (0..4)
-            .map(|k| common::final_error(&at_end(method, n0 << k), q_ref, p_ref))
-            .collect();
-        common::assert_order(&format!("{method:?}"), &errors, method.info().order as f64, 0.3);
+        common::assert_method_order(method, n0, 3, |steps| {
+            common::final_error(&at_end(method, steps), q_ref, p_ref)
+        });
     }
 }
 

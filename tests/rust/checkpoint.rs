@@ -3,10 +3,8 @@
 //! and model kind; damaged checkpoints are refused.
 
 use varmech::integrators::{integrate, resume, Checkpoint, Dynamics, General, Method, Options, Trajectory};
-use varmech::model::{Constrained, Routhian};
-use varmech::scenes::{
-    planar_chain, DampedDrivenPendulum, DoublePendulum, Kepler, NBody, RigidBody, SphericalPendulum,
-};
+use varmech::model::Routhian;
+use varmech::scenes::{planar_chain, DampedDrivenPendulum, DoublePendulum, Kepler, NBody, SphericalPendulum};
 use varmech::Error;
 
 /// Runs N + M steps at once, and N steps then M more from the checkpoint (through its bytes);
@@ -108,19 +106,7 @@ fn every_method_family_resumes_bit_for_bit() {
         let case = format!("planar chain {method:?}");
         resumes_bit_for_bit(&case, &chain.system, method, &chain.initial.q, &chain.initial.p, 0.01);
     }
-    let body = RigidBody::problem();
-    let sys = Constrained {
-        system: General(&body.system.system),
-        constraints: body.system.constraints.clone(),
-    };
-    resumes_bit_for_bit(
-        "rigid body",
-        &sys,
-        Method::Midpoint,
-        &body.initial.q,
-        &body.initial.p,
-        0.01,
-    );
+    crate::common::with_rigid_body(|sys, s| resumes_bit_for_bit("rigid body", sys, Method::Midpoint, &s.q, &s.p, 0.01));
 
     // Routh-reduced: the spherical pendulum's θ alone, at p_φ = μ.
     let sp = SphericalPendulum::problem();
@@ -136,20 +122,18 @@ fn every_method_family_resumes_bit_for_bit() {
     }
 }
 
+/// The checkpoint of 10 steps (h = 0.01) of `method` on Kepler's problem (e = 0.6).
+fn kepler_checkpoint(method: Method) -> Vec<u8> {
+    let kepler = Kepler::problem(0.6).unwrap();
+    let (q0, p0) = (&kepler.initial.q, &kepler.initial.p);
+    integrate(&kepler.system, method, q0, p0, &Options::new(0.01, 10), || Ok(()))
+        .unwrap()
+        .checkpoint
+}
+
 #[test]
 fn damaged_checkpoints_are_refused_naming_the_checkpoint() {
-    let kepler = Kepler::problem(0.6).unwrap();
-    let options = Options::new(0.01, 10);
-    let traj = integrate(
-        &kepler.system,
-        Method::Midpoint,
-        &kepler.initial.q,
-        &kepler.initial.p,
-        &options,
-        || Ok(()),
-    )
-    .unwrap();
-    let bytes = traj.checkpoint;
+    let bytes = kepler_checkpoint(Method::Midpoint);
     assert!(Checkpoint::from_bytes(&bytes).is_ok());
     let mut flipped = bytes.clone();
     let middle = flipped.len() / 2;
@@ -176,20 +160,10 @@ fn damaged_checkpoints_are_refused_naming_the_checkpoint() {
 
 #[test]
 fn a_checkpoint_resumes_only_on_a_model_its_method_integrates() {
-    let kepler = Kepler::problem(0.6).unwrap();
-    let options = Options::new(0.01, 10);
-    let traj = integrate(
-        &kepler.system,
-        Method::Verlet,
-        &kepler.initial.q,
-        &kepler.initial.p,
-        &options,
-        || Ok(()),
-    )
-    .unwrap();
+    let bytes = kepler_checkpoint(Method::Verlet);
     let dp = DoublePendulum::problem();
     // A general Lagrangian with as many coordinates, which Verlet does not integrate.
-    let checkpoint = Checkpoint::from_bytes(&traj.checkpoint).unwrap();
+    let checkpoint = Checkpoint::from_bytes(&bytes).unwrap();
     let refused = resume(&General(&dp.system), checkpoint, 10, 1, || Ok(())).unwrap_err();
     assert!(
         matches!(refused.error, Error::InvalidArgument { argument: "method", .. }),
@@ -197,7 +171,7 @@ fn a_checkpoint_resumes_only_on_a_model_its_method_integrates() {
         refused.error
     );
     let solar = NBody::outer_solar_system();
-    let checkpoint = Checkpoint::from_bytes(&traj.checkpoint).unwrap();
+    let checkpoint = Checkpoint::from_bytes(&bytes).unwrap();
     let refused = resume(&solar.system, checkpoint, 10, 1, || Ok(())).unwrap_err();
     assert!(
         matches!(refused.error, Error::InvalidArgument { argument: "model", .. }),

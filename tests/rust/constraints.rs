@@ -37,9 +37,7 @@ fn residuals(sys: &LinkedMasses, traj: &Trajectory) -> (f64, f64) {
 
 /// The energy errors H − H₀ at the saved states, and their least-squares slope in t.
 fn energy_drift(sys: &LinkedMasses, traj: &Trajectory) -> (f64, f64) {
-    let e: Vec<f64> = (0..traj.len())
-        .map(|k| varmech::model::hamiltonian(&sys.system, traj.q_at(k), traj.p_at(k)).unwrap())
-        .collect();
+    let e: Vec<f64> = common::along(traj, |q, p| varmech::model::hamiltonian(&sys.system, q, p).unwrap());
     let errors: Vec<f64> = e.iter().map(|x| x - e[0]).collect();
     let n = errors.len() as f64;
     let (mt, me) = (traj.t.iter().sum::<f64>() / n, errors.iter().sum::<f64>() / n);
@@ -103,15 +101,11 @@ fn rattle_converges_at_order_two_and_its_composition_at_order_four() {
     let p = scenes::cartesian_pendulum();
     let reference = pendulum_reference();
     for (method, n0) in [(Method::Rattle, 200), (Method::Rattle4, 100)] {
-        let errors: Vec<f64> = (0..4)
-            .map(|k| {
-                let steps = n0 << k;
-                let traj = run(&p, method, 10.0 / steps as f64, steps, steps, None);
-                let q = traj.q_at(1);
-                (q[0] - reference[0]).hypot(q[1] - reference[1])
-            })
-            .collect();
-        common::assert_order(&format!("{method:?}"), &errors, method.info().order as f64, 0.3);
+        common::assert_method_order(method, n0, 3, |steps| {
+            let traj = run(&p, method, 10.0 / steps as f64, steps, steps, None);
+            let q = traj.q_at(1);
+            (q[0] - reference[0]).hypot(q[1] - reference[1])
+        });
     }
 }
 

@@ -12,10 +12,7 @@ use std::panic::{catch_unwind, AssertUnwindSafe};
 
 use serde::ser::{self, Serialize, SerializeSeq, SerializeStruct, SerializeTuple, SerializeTupleStruct};
 use varmech::integrators::{integrate, resume, Checkpoint, Dynamics, General, Method, Options};
-use varmech::model::Constrained;
-use varmech::scenes::{
-    planar_chain, ChaplyginSleigh, DoublePendulum, HarmonicOscillator, HenonHeiles, Kepler, NBody, RigidBody,
-};
+use varmech::scenes::{planar_chain, ChaplyginSleigh, DoublePendulum, HarmonicOscillator, HenonHeiles, Kepler, NBody};
 use varmech::Error;
 
 /// One call of serde's data model, with what it holds.
@@ -126,6 +123,24 @@ fn unsupported<T>(what: &str) -> Result<T, Unsupported> {
     Err(Unsupported(format!("{what} is not in a checkpoint")))
 }
 
+/// Serializer methods of the scalars a checkpoint holds: each records its value as the variant.
+macro_rules! recorded {
+    ($($method:ident($ty:ty) => $variant:ident),+) => {$(
+        fn $method(self, v: $ty) -> Result<Value, Unsupported> {
+            Ok(Value::$variant(v))
+        }
+    )+};
+}
+
+/// Serializer methods of the scalars no checkpoint holds: each refuses, naming its type.
+macro_rules! refused {
+    ($($method:ident($ty:ident)),+) => {$(
+        fn $method(self, _: $ty) -> Result<Value, Unsupported> {
+            unsupported(stringify!($ty))
+        }
+    )+};
+}
+
 impl ser::Serializer for Recorder {
     type Ok = Value;
     type Error = Unsupported;
@@ -137,42 +152,22 @@ impl ser::Serializer for Recorder {
     type SerializeStruct = Items;
     type SerializeStructVariant = ser::Impossible<Value, Unsupported>;
 
-    fn serialize_bool(self, v: bool) -> Result<Value, Unsupported> {
-        Ok(Value::Bool(v))
-    }
-    fn serialize_i8(self, _: i8) -> Result<Value, Unsupported> {
-        unsupported("i8")
-    }
-    fn serialize_i16(self, _: i16) -> Result<Value, Unsupported> {
-        unsupported("i16")
-    }
-    fn serialize_i32(self, _: i32) -> Result<Value, Unsupported> {
-        unsupported("i32")
-    }
-    fn serialize_i64(self, _: i64) -> Result<Value, Unsupported> {
-        unsupported("i64")
-    }
-    fn serialize_u8(self, v: u8) -> Result<Value, Unsupported> {
-        Ok(Value::U8(v))
-    }
-    fn serialize_u16(self, _: u16) -> Result<Value, Unsupported> {
-        unsupported("u16")
-    }
-    fn serialize_u32(self, v: u32) -> Result<Value, Unsupported> {
-        Ok(Value::U32(v))
-    }
-    fn serialize_u64(self, v: u64) -> Result<Value, Unsupported> {
-        Ok(Value::U64(v))
-    }
-    fn serialize_f32(self, _: f32) -> Result<Value, Unsupported> {
-        unsupported("f32")
-    }
-    fn serialize_f64(self, v: f64) -> Result<Value, Unsupported> {
-        Ok(Value::F64(v))
-    }
-    fn serialize_char(self, _: char) -> Result<Value, Unsupported> {
-        unsupported("char")
-    }
+    recorded!(
+        serialize_bool(bool) => Bool,
+        serialize_u8(u8) => U8,
+        serialize_u32(u32) => U32,
+        serialize_u64(u64) => U64,
+        serialize_f64(f64) => F64
+    );
+    refused!(
+        serialize_i8(i8),
+        serialize_i16(i16),
+        serialize_i32(i32),
+        serialize_i64(i64),
+        serialize_u16(u16),
+        serialize_f32(f32),
+        serialize_char(char)
+    );
     fn serialize_str(self, v: &str) -> Result<Value, Unsupported> {
         // Strings travel as their bytes' sequence, as postcard writes them.
         Ok(Value::Seq(v.bytes().map(Value::U8).collect()))
@@ -253,41 +248,28 @@ impl Items {
     }
 }
 
-impl ser::SerializeSeq for Items {
-    type Ok = Value;
-    type Error = Unsupported;
-    fn serialize_element<T: Serialize + ?Sized>(&mut self, v: &T) -> Result<(), Unsupported> {
-        self.items.push(v.serialize(Recorder)?);
-        Ok(())
-    }
-    fn end(self) -> Result<Value, Unsupported> {
-        Ok(self.finish())
-    }
+/// The compounds whose elements are collected in order: sequences, tuples and tuple structs.
+macro_rules! collect_items {
+    ($($compound:ident :: $element:ident),+) => {$(
+        impl ser::$compound for Items {
+            type Ok = Value;
+            type Error = Unsupported;
+            fn $element<T: Serialize + ?Sized>(&mut self, v: &T) -> Result<(), Unsupported> {
+                self.items.push(v.serialize(Recorder)?);
+                Ok(())
+            }
+            fn end(self) -> Result<Value, Unsupported> {
+                Ok(self.finish())
+            }
+        }
+    )+};
 }
 
-impl ser::SerializeTuple for Items {
-    type Ok = Value;
-    type Error = Unsupported;
-    fn serialize_element<T: Serialize + ?Sized>(&mut self, v: &T) -> Result<(), Unsupported> {
-        self.items.push(v.serialize(Recorder)?);
-        Ok(())
-    }
-    fn end(self) -> Result<Value, Unsupported> {
-        Ok(self.finish())
-    }
-}
-
-impl ser::SerializeTupleStruct for Items {
-    type Ok = Value;
-    type Error = Unsupported;
-    fn serialize_field<T: Serialize + ?Sized>(&mut self, v: &T) -> Result<(), Unsupported> {
-        self.items.push(v.serialize(Recorder)?);
-        Ok(())
-    }
-    fn end(self) -> Result<Value, Unsupported> {
-        Ok(self.finish())
-    }
-}
+collect_items!(
+    SerializeSeq::serialize_element,
+    SerializeTuple::serialize_element,
+    SerializeTupleStruct::serialize_field
+);
 
 impl ser::SerializeStruct for Items {
     type Ok = Value;
@@ -357,6 +339,18 @@ fn encode(value: &Value) -> Vec<u8> {
     bytes
 }
 
+/// A copy of `original` with its `target`-th node of `site` (depth-first) changed by `edit`, and
+/// the fields' path to that node; None where it has no such node.
+fn edited(original: &Value, site: Site, target: usize, mut edit: impl FnMut(&mut Value)) -> Option<(Value, String)> {
+    let mut crafted = original.clone();
+    let mut at = String::new();
+    let found = visit(&mut crafted, site, target, &mut 0, &mut Vec::new(), &mut |v, path| {
+        at = path.to_string();
+        edit(v);
+    });
+    found.then_some((crafted, at))
+}
+
 /// Resumes `bytes` on `sys` for a few steps, catching a panic.
 fn outcome<S: Dynamics + ?Sized>(sys: &S, bytes: &[u8]) -> Result<Result<(), Error>, String> {
     catch_unwind(AssertUnwindSafe(|| {
@@ -392,29 +386,19 @@ fn crafted_are_refused(case: &str, sys: &dyn Dynamics, method: Method, q0: &[f64
     for target in 0.. {
         let mut changed = 0;
         for edit in ["truncated", "extended"] {
-            let mut crafted = original.clone();
-            let mut at = String::new();
-            let found = visit(
-                &mut crafted,
-                Site::Seq,
-                target,
-                &mut 0,
-                &mut Vec::new(),
-                &mut |v, path| {
-                    at = path.to_string();
-                    if let Value::Seq(items) = v {
-                        match (edit, items.last().cloned()) {
-                            ("truncated", Some(_)) => drop(items.pop()),
-                            ("extended", Some(last)) => items.push(last),
-                            // An empty sequence: extended by a zero of postcard's every type.
-                            _ => items.push(Value::U8(0)),
-                        }
+            let crafted = edited(&original, Site::Seq, target, |v| {
+                if let Value::Seq(items) = v {
+                    match (edit, items.last().cloned()) {
+                        ("truncated", Some(_)) => drop(items.pop()),
+                        ("extended", Some(last)) => items.push(last),
+                        // An empty sequence: extended by a zero of postcard's every type.
+                        _ => items.push(Value::U8(0)),
                     }
-                },
-            );
-            if !found {
+                }
+            });
+            let Some((crafted, at)) = crafted else {
                 break;
-            }
+            };
             changed += 1;
             match outcome(sys, &encode(&crafted)) {
                 Err(panic) => panic!("{case}: {at} {edit} panics: {panic}"),
@@ -431,26 +415,14 @@ fn crafted_are_refused(case: &str, sys: &dyn Dynamics, method: Method, q0: &[f64
     }
     assert!(sites > 10, "{case}: {sites} sequences");
     for target in 0.. {
-        let mut crafted = original.clone();
-        let mut at = String::new();
-        let found = visit(
-            &mut crafted,
-            Site::Integer,
-            target,
-            &mut 0,
-            &mut Vec::new(),
-            &mut |v, path| {
-                at = path.to_string();
-                match v {
-                    Value::U32(x) => *x = x.wrapping_add(1),
-                    Value::U64(x) => *x = x.wrapping_add(1) | (1 << 40),
-                    _ => {}
-                }
-            },
-        );
-        if !found {
+        let crafted = edited(&original, Site::Integer, target, |v| match v {
+            Value::U32(x) => *x = x.wrapping_add(1),
+            Value::U64(x) => *x = x.wrapping_add(1) | (1 << 40),
+            _ => {}
+        });
+        let Some((crafted, at)) = crafted else {
             break;
-        }
+        };
         if let Err(panic) = outcome(sys, &encode(&crafted)) {
             panic!("{case}: {at} changed panics: {panic}");
         }
@@ -473,19 +445,7 @@ fn each_case(mut check: impl FnMut(&str, &dyn Dynamics, Method, &[f64], &[f64], 
     for method in [Method::Rattle, Method::Shake, Method::Rattle4] {
         check(&format!("planar chain {method:?}"), &chain.system, method, q0, p0, 0.01);
     }
-    let body = RigidBody::problem();
-    let sys = Constrained {
-        system: General(&body.system.system),
-        constraints: body.system.constraints.clone(),
-    };
-    check(
-        "rigid body",
-        &sys,
-        Method::Midpoint,
-        &body.initial.q,
-        &body.initial.p,
-        0.01,
-    );
+    crate::common::with_rigid_body(|sys, s| check("rigid body", sys, Method::Midpoint, &s.q, &s.p, 0.01));
     let sleigh = ChaplyginSleigh::problem(1.0, 0.5, 1.0).unwrap();
     let (q0, p0) = (&sleigh.initial.q, &sleigh.initial.p);
     check("sleigh", &sleigh.system, Method::Dla4, q0, p0, 0.01);
@@ -608,24 +568,15 @@ fn edited_values_are_refused(case: &str, sys: &dyn Dynamics, method: Method, q0:
     let unedited = run(&traj.checkpoint).unwrap();
     let (mut edits, mut refused) = (0, 0);
     for target in 0.. {
-        let mut crafted = original.clone();
-        let mut at = String::new();
-        let found = visit(
-            &mut crafted,
-            Site::Float,
-            target,
-            &mut 0,
-            &mut Vec::new(),
-            &mut |v, path| {
-                at = format!("{path}.");
-                if let Value::F64(x) = v {
-                    *x = if *x != 0.0 { *x * 1.02 } else { 0.5 };
-                }
-            },
-        );
-        if !found {
+        let crafted = edited(&original, Site::Float, target, |v| {
+            if let Value::F64(x) = v {
+                *x = if *x != 0.0 { *x * 1.02 } else { 0.5 };
+            }
+        });
+        let Some((crafted, path)) = crafted else {
             break;
-        }
+        };
+        let at = format!("{path}.");
         edits += 1;
         match run(&encode(&crafted)) {
             Err(Error::InvalidArgument {

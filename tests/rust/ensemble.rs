@@ -2,14 +2,35 @@
 //! and interrupts per member; bad input refused before any member starts.
 
 use varmech::integrators::{
-    integrate, integrate_ensemble, integrate_with_events, Detector, EventSpec, Failure, General, MemberEvents, Method,
-    NativeEvent, Options, Outcome, Parallel, Shared, Trajectory,
+    integrate, integrate_ensemble, integrate_with_events, Detector, Ensemble, EventSpec, Failure, General,
+    MemberEvents, Members, Method, NativeEvent, Options, Outcome, Parallel, Poll, Shared, Trajectory,
 };
 use varmech::scenes::{DampedDrivenPendulum, DoublePendulum, HarmonicOscillator};
 use varmech::{Error, ModelError};
 
 fn never() -> Result<(), ModelError> {
     Ok(())
+}
+
+/// The ensemble of the members, rows of (q0, p0), with `models` by `method`, without events.
+fn run_ensemble<M: Members + ?Sized>(
+    models: &M,
+    method: Method,
+    (q0, p0): (&[f64], &[f64]),
+    options: &Options,
+    parallel: Parallel,
+    poll: impl Poll,
+) -> Result<Ensemble, Error> {
+    integrate_ensemble(
+        models,
+        method,
+        q0,
+        p0,
+        options,
+        parallel,
+        &MemberEvents::default(),
+        poll,
+    )
 }
 
 /// `members` initial states of the double pendulum about its scene's, row by row.
@@ -61,17 +82,8 @@ fn every_member_is_bit_for_bit_its_single_run_whatever_the_threads_and_chunks() 
                 workers: Some(workers),
                 chunk_size: Some(chunk_size),
             };
-            let ensemble = integrate_ensemble(
-                &Shared(&sys),
-                Method::Midpoint,
-                &q0,
-                &p0,
-                &options,
-                parallel,
-                &MemberEvents::default(),
-                never,
-            )
-            .unwrap();
+            let ensemble =
+                run_ensemble(&Shared(&sys), Method::Midpoint, (&q0, &p0), &options, parallel, never).unwrap();
             assert!(ensemble.interrupted.is_none());
             assert_eq!(ensemble.members.len(), members);
             for (i, (member, single)) in ensemble.members.iter().zip(&singles).enumerate() {
@@ -93,14 +105,12 @@ fn a_member_past_its_stability_limit_fails_alone_with_its_step_and_partial_traje
     let models: Vec<HarmonicOscillator> = omegas.iter().map(|&w| HarmonicOscillator::new(w).unwrap()).collect();
     let options = Options::new(0.1, 200);
     let (q0, p0) = (vec![0.0; 4], vec![1.0; 4]);
-    let ensemble = integrate_ensemble(
+    let ensemble = run_ensemble(
         models.as_slice(),
         Method::Verlet,
-        &q0,
-        &p0,
+        (&q0, &p0),
         &options,
         Parallel::default(),
-        &MemberEvents::default(),
         never,
     )
     .unwrap();
@@ -145,14 +155,12 @@ fn a_drive_amplitude_sweep_equals_its_separate_runs() {
         workers: Some(2),
         chunk_size: Some(4),
     };
-    let ensemble = integrate_ensemble(
+    let ensemble = run_ensemble(
         models.as_slice(),
         Method::Midpoint,
-        &q0,
-        &p0,
+        (&q0, &p0),
         &options,
         parallel,
-        &MemberEvents::default(),
         never,
     )
     .unwrap();
@@ -189,17 +197,7 @@ fn an_interrupt_stops_every_member_keeping_a_prefix_of_its_run() {
         chunk_size: None,
     };
     let stop = || Err::<(), ModelError>("stop".into());
-    let ensemble = integrate_ensemble(
-        &Shared(&sys),
-        Method::Midpoint,
-        &q0,
-        &p0,
-        &options,
-        parallel,
-        &MemberEvents::default(),
-        stop,
-    )
-    .unwrap();
+    let ensemble = run_ensemble(&Shared(&sys), Method::Midpoint, (&q0, &p0), &options, parallel, stop).unwrap();
     assert_eq!(ensemble.interrupted.unwrap().to_string(), "stop");
     for (i, member) in ensemble.members.iter().enumerate() {
         let Failure { error, partial } = failure(member);
@@ -236,17 +234,7 @@ fn bad_input_is_refused_naming_the_argument() {
     };
     let shared = Shared(&sys);
     let run = |q0: &[f64], p0: &[f64], options: &Options, parallel| {
-        integrate_ensemble(
-            &shared,
-            Method::Midpoint,
-            q0,
-            p0,
-            options,
-            parallel,
-            &MemberEvents::default(),
-            never,
-        )
-        .map(|_| ())
+        run_ensemble(&shared, Method::Midpoint, (q0, p0), options, parallel, never).map(|_| ())
     };
     let default = Parallel::default();
     assert_eq!(named(run(&q0[..5], &p0[..5], &options, default)), "q0");
@@ -258,14 +246,12 @@ fn bad_input_is_refused_naming_the_argument() {
         assert_eq!(named(run(&q0, &p0, &options, parallel)), expected);
     }
     let models = [HarmonicOscillator::new(1.0).unwrap()];
-    let two = integrate_ensemble(
+    let two = run_ensemble(
         &models[..],
         Method::Verlet,
-        &[0.0, 1.0],
-        &[1.0, 0.0],
+        (&[0.0, 1.0], &[1.0, 0.0]),
         &options,
         default,
-        &MemberEvents::default(),
         never,
     );
     assert_eq!(named(two.map(|_| ())), "models");

@@ -47,17 +47,15 @@ fn newton_in_the_bracket_finds_a_root_to_round_off_in_fewer_evaluations() {
     // A root at an end of the bracket, and tolerance 0 (4 ulps of the root).
     let (x, fx) = newton(|x: f64| Ok::<_, ()>((x - 1.0, 1.0)), (1.0, 0.0), (3.0, 2.0), None, 0.0).unwrap();
     assert_eq!((x, fx), (1.0, 0.0));
-    let mut calls = 0;
-    let f = |x: f64| {
-        calls += 1;
-        Ok::<_, ()>((x * x - 2.0, 2.0 * x))
-    };
-    let (x, _) = newton(f, (0.0, -2.0), (2.0, 2.0), None, 0.0).unwrap();
-    assert!((x - 2.0_f64.sqrt()).abs() <= 4.0 * f64::EPSILON * 2.0, "{x}");
-    assert!(calls <= 7, "{calls} evaluations");
-    // From a guess at the root (an interpolant's, as an impact's): that point and the probe
-    // past it. A guess outside the bracket is not taken: the secant point's evaluations.
-    for (guess, most) in [(Some(2.0_f64.sqrt()), 2), (Some(-1.0), 7), (Some(f64::NAN), 7)] {
+    // √2, from no guess; from a guess at the root (an interpolant's, as an impact's): that point
+    // and the probe past it. A guess outside the bracket is not taken: the secant point's
+    // evaluations.
+    for (guess, most) in [
+        (None, 7),
+        (Some(2.0_f64.sqrt()), 2),
+        (Some(-1.0), 7),
+        (Some(f64::NAN), 7),
+    ] {
         let mut calls = 0;
         let f = |x: f64| {
             calls += 1;

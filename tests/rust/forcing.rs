@@ -82,12 +82,7 @@ fn the_energy_balance_with_the_tracked_work_holds_to_round_off() {
 #[test]
 fn the_discrete_energy_decay_matches_the_exact_rate_at_the_method_order() {
     let t_end = 20.0;
-    for method in [
-        Method::Midpoint,
-        Method::Trapezoid,
-        Method::Galerkin4,
-        Method::Galerkin6,
-    ] {
+    for method in crate::common::IMPLICIT {
         let n0 = if method.info().order > 2 { 25 } else { 100 };
         let errors: Vec<f64> = (0..4)
             .map(|k| {

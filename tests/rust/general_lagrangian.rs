@@ -4,7 +4,7 @@
 use crate::common;
 
 use nalgebra::DMatrix;
-use varmech::integrators::{integrate, General, Method, NewtonOptions, Options, Trajectory};
+use varmech::integrators::{Method, NewtonOptions, Options, Trajectory};
 use varmech::model::{Lagrangian, Natural, NaturalSystem};
 use varmech::scenes::DoublePendulum;
 use varmech::{Error, ModelError};
@@ -33,15 +33,7 @@ fn run_with<L: Lagrangian>(
         newton,
         ..Options::new(t_end / steps as f64, steps)
     };
-    integrate(
-        &General(sys),
-        method,
-        &problem.initial.q,
-        &problem.initial.p,
-        &options,
-        || Ok(()),
-    )
-    .map_err(|f| f.error)
+    common::run_general_with(sys, &problem.initial, method, &options)
 }
 
 #[test]
@@ -51,14 +43,10 @@ fn galerkin_integrators_converge_at_orders_four_and_six_to_the_reference() {
     // Galerkin-6 gets two halvings here: a third would end at 6e-11, against a reference
     // accurate to about 1e-11 (its three halvings are measured at T = 3, in the next test).
     for (method, n0, halvings) in [(Method::Galerkin4, 500, 3), (Method::Galerkin6, 500, 2)] {
-        let errors: Vec<f64> = (0..=halvings)
-            .map(|k| {
-                let steps = n0 << k;
-                let traj = run(&problem.system, method, steps, problem.t_end, steps).unwrap();
-                common::final_error(&traj, &reference.q, &reference.p)
-            })
-            .collect();
-        common::assert_order(&format!("{method:?}"), &errors, method.info().order as f64, 0.3);
+        common::assert_method_order(method, n0, halvings, |steps| {
+            let traj = run(&problem.system, method, steps, problem.t_end, steps).unwrap();
+            common::final_error(&traj, &reference.q, &reference.p)
+        });
     }
 }
 
@@ -160,6 +148,17 @@ impl Lagrangian for LagrangianOnly {
     }
 }
 
+/// Asserts that `got` is `exact` to `tolerance` relative to max(1, |exact|), entry by entry.
+fn assert_close(exact: &[f64], got: &[f64], tolerance: f64) {
+    assert!(
+        exact
+            .iter()
+            .zip(got)
+            .all(|(a, b)| (a - b).abs() < tolerance * a.abs().max(1.0)),
+        "{exact:?} vs {got:?}"
+    );
+}
+
 #[test]
 fn central_difference_derivatives_reproduce_the_exact_ones() {
     let problem = DoublePendulum::problem();
@@ -168,22 +167,10 @@ fn central_difference_derivatives_reproduce_the_exact_ones() {
     let (mut exact, mut approx) = ([0.0; 2], [0.0; 2]);
     problem.system.dl_dq(&q, &v, 0.0, &mut exact).unwrap();
     only.dl_dq(&q, &v, 0.0, &mut approx).unwrap();
-    assert!(
-        exact
-            .iter()
-            .zip(&approx)
-            .all(|(a, b)| (a - b).abs() < 1e-8 * a.abs().max(1.0)),
-        "{exact:?} vs {approx:?}"
-    );
+    assert_close(&exact, &approx, 1e-8);
     problem.system.dl_dv(&q, &v, 0.0, &mut exact).unwrap();
     only.dl_dv(&q, &v, 0.0, &mut approx).unwrap();
-    assert!(
-        exact
-            .iter()
-            .zip(&approx)
-            .all(|(a, b)| (a - b).abs() < 1e-8 * a.abs().max(1.0)),
-        "{exact:?} vs {approx:?}"
-    );
+    assert_close(&exact, &approx, 1e-8);
 
     // Over T = 2: the pendulum is chaotic, and later on its growth, not the derivatives, would
     // decide the difference.
@@ -235,13 +222,7 @@ fn a_natural_system_with_differenced_mass_derivative_matches_the_exact_lagrangia
     );
     problem.system.dl_dq(&q, &v, 0.0, &mut exact).unwrap();
     natural.dl_dq(&q, &v, 0.0, &mut got).unwrap();
-    assert!(
-        exact
-            .iter()
-            .zip(&got)
-            .all(|(a, b)| (a - b).abs() < 1e-9 * a.abs().max(1.0)),
-        "{exact:?} vs {got:?}"
-    );
+    assert_close(&exact, &got, 1e-9);
     let e = |l: &dyn Lagrangian| l.energy(&problem.initial.q, &problem.initial.p, 0.0).unwrap();
     assert!((e(&problem.system) - e(&natural)).abs() < 1e-13 * e(&problem.system).abs());
     let a = run(&problem.system, Method::Midpoint, 200, 2.0, 200).unwrap();
@@ -278,9 +259,7 @@ fn energy_stays_bounded_and_newton_converges_in_a_few_iterations() {
     let problem = DoublePendulum::problem();
     let steps = 100_000;
     let traj = run(&problem.system, Method::Midpoint, steps, 1000.0, 10).unwrap();
-    let e: Vec<f64> = (0..traj.len())
-        .map(|k| problem.system.energy(traj.q_at(k), traj.p_at(k), 0.0).unwrap())
-        .collect();
+    let e: Vec<f64> = common::along(&traj, |q, p| problem.system.energy(q, p, 0.0).unwrap());
     let stats = common::energy_statistics(&problem.system, &traj);
     assert_eq!(stats.verdict, varmech::diagnostics::Verdict::Bounded, "{stats:?}");
     // O(h²) at h = 0.01 on this fast pendulum: 3.5e-3, in a band that does not grow.
@@ -322,16 +301,8 @@ fn the_energy_function_of_a_general_lagrangian_uses_the_inverse_legendre_transfo
         max_energy_error: Some(1e-6),
         ..Options::new(0.1, 100)
     };
-    let failure = integrate(
-        &General(&problem.system),
-        Method::Midpoint,
-        &problem.initial.q,
-        &problem.initial.p,
-        &options,
-        || Ok(()),
-    )
-    .unwrap_err();
-    assert!(matches!(failure.error, Error::Divergence { .. }), "{}", failure.error);
+    let error = common::run_general_with(&problem.system, &problem.initial, Method::Midpoint, &options).unwrap_err();
+    assert!(matches!(error, Error::Divergence { .. }), "{error}");
 }
 
 #[test]
@@ -354,15 +325,11 @@ fn spherical_pendulum_conserves_its_azimuthal_momentum_and_reaches_the_reference
     };
     // Discrete Noether: p_φ to round-off over 10⁵ steps; the energy stays in a band.
     let traj = run(Method::Midpoint, 100_000, 1000.0, 10);
-    let j: Vec<f64> = (0..traj.len())
-        .map(|k| cyclic.momentum(traj.q_at(k), traj.p_at(k)))
-        .collect();
+    let j: Vec<f64> = common::along(&traj, |q, p| cyclic.momentum(q, p));
     let stats = InvariantStatistics::new(&j);
     assert!((stats.initial - 0.8496881019282854).abs() < 1e-15);
     assert!(stats.max_rel_error <= 1e-12, "p_φ error {:.3e}", stats.max_rel_error);
-    let e: Vec<f64> = (0..traj.len())
-        .map(|k| problem.system.energy(traj.q_at(k), traj.p_at(k), 0.0).unwrap())
-        .collect();
+    let e: Vec<f64> = common::along(&traj, |q, p| problem.system.energy(q, p, 0.0).unwrap());
     assert!((e[0] + 0.030489444711168545).abs() < 1e-15);
     assert!(common::conserved(
         common::energy_statistics(&problem.system, &traj).verdict

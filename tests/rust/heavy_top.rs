@@ -6,9 +6,9 @@ use crate::common;
 
 use common::InvariantStatistics;
 use varmech::diagnostics::Verdict;
-use varmech::integrators::{integrate, General, Method, NewtonOptions, Options, Trajectory};
-use varmech::model::{Hessians, Lagrangian};
-use varmech::scenes::{HeavyTop, State};
+use varmech::integrators::{Method, NewtonOptions, Options, Trajectory};
+use varmech::model::Lagrangian;
+use varmech::scenes::{HeavyTop, Problem, State};
 
 /// Generic states: θ on both sides of π/2, every velocity non-zero.
 const STATES: [([f64; 3], [f64; 3]); 3] = [
@@ -22,9 +22,7 @@ fn top() -> HeavyTop {
 }
 
 fn energy(sys: &HeavyTop, traj: &Trajectory) -> Vec<f64> {
-    (0..traj.len())
-        .map(|k| sys.energy(traj.q_at(k), traj.p_at(k), 0.0).unwrap())
-        .collect()
+    common::along(traj, |q, p| sys.energy(q, p, 0.0).unwrap())
 }
 
 fn thetas(traj: &Trajectory) -> Vec<f64> {
@@ -46,26 +44,7 @@ fn state(sys: &HeavyTop, q: [f64; 3], v: [f64; 3]) -> State {
 fn the_hessians_are_the_derivatives_of_the_gradients() {
     let sys = top();
     for (q, v) in STATES {
-        let mut h = Hessians::zeros(3);
-        assert!(sys.hessians(&q, &v, 0.0, &mut h).unwrap());
-        let mut worst = 0.0_f64;
-        let lq = |q: &[f64], v: &[f64], out: &mut [f64]| sys.dl_dq(q, v, 0.0, out).unwrap();
-        let lv = |q: &[f64], v: &[f64], out: &mut [f64]| sys.dl_dv(q, v, 0.0, out).unwrap();
-        for j in 0..3 {
-            let [qq, qv, vv] = common::hessian_columns(&lq, &lv, &q, &v, j);
-            for (name, matrix, column) in [("qq", &h.qq, qq), ("qv", &h.qv, qv), ("vv", &h.vv, vv)] {
-                for i in 0..3 {
-                    let gap = (matrix[(i, j)] - column[i]).abs() / column[i].abs().max(1.0);
-                    worst = worst.max(gap);
-                    assert!(
-                        gap < 1e-7,
-                        "{name} ({i}, {j}) at q = {q:?}: {} vs {}",
-                        matrix[(i, j)],
-                        column[i]
-                    );
-                }
-            }
-        }
+        let (h, worst) = common::assert_hessians(&sys, &q, &v, 1e-7);
         let e = 1e-6;
         // L_qq̇ is also ∂p/∂q: entry (i, j) = ∂pⱼ/∂qᵢ, the transpose of what the loop checked.
         let lv = |q: &[f64], out: &mut [f64]| sys.dl_dv(q, &v, 0.0, out).unwrap();
@@ -134,9 +113,7 @@ fn midpoint_conserves_both_cyclic_momenta_to_round_off_and_bounds_the_energy() {
     let steps = 10_000;
     let traj = common::run_general(sys, &problem.initial, Method::Midpoint, 0.01, steps, 10).unwrap();
     for (generator, name) in sys.symmetries().into_iter().zip(["p_φ", "p_ψ"]) {
-        let values: Vec<f64> = (0..traj.len())
-            .map(|k| generator.momentum(traj.q_at(k), traj.p_at(k)))
-            .collect();
+        let values: Vec<f64> = common::along(&traj, |q, p| generator.momentum(q, p));
         let stats = InvariantStatistics::new(&values);
         println!(
             "{name}: J₀ = {}, max relative error {:.2e}",
@@ -168,15 +145,7 @@ fn midpoint_and_galerkin4_converge_at_their_orders_to_a_self_converged_galerkin6
             newton,
             ..Options::new(t / steps as f64, steps)
         };
-        integrate(
-            &General(sys),
-            method,
-            &problem.initial.q,
-            &problem.initial.p,
-            &options,
-            || Ok(()),
-        )
-        .unwrap_or_else(|f| panic!("{method:?}: {}", f.error))
+        common::run_general_with(sys, &problem.initial, method, &options).unwrap_or_else(|e| panic!("{method:?}: {e}"))
     };
     let reference = run(Method::Galerkin6, 4000, to_round_off);
     let end = reference.len() - 1;
@@ -302,6 +271,17 @@ fn the_turning_points_are_the_roots_of_the_cubic_around_the_motion() {
     assert!((theta_max - u1.acos()).abs() < 1e-14, "{theta_max} vs {}", u1.acos());
 }
 
+/// [`HeavyTop::problem`], its energy and the turning points (θ_min, θ_max) of its initial state
+/// ([`HeavyTop::turning_points`]), printed.
+pub(crate) fn released_top() -> (Problem<HeavyTop>, f64, (f64, f64)) {
+    let problem = HeavyTop::problem();
+    let (q0, p0) = (&problem.initial.q, &problem.initial.p);
+    let energy = problem.system.energy(q0, p0, 0.0).unwrap();
+    let (theta_min, theta_max) = problem.system.turning_points(p0[1], p0[2], energy).unwrap();
+    println!("turning points: θ_min = {theta_min:.12}, θ_max = {theta_max:.12}");
+    (problem, energy, (theta_min, theta_max))
+}
+
 /// The run of [`HeavyTop::problem`] stays in the band [θ_min, θ_max] of
 /// [`HeavyTop::turning_points`] and reaches both ends, each to O(h²): the midpoint rule keeps
 /// p_φ and p_ψ exactly and a modified energy E + O(h²), and the saved states sample each turn
@@ -309,12 +289,8 @@ fn the_turning_points_are_the_roots_of_the_cubic_around_the_motion() {
 /// no excursion outside the band beyond 1.3e-15, and the largest θ short of θ_max by 0.0100h²).
 #[test]
 fn the_unreduced_midpoint_run_fills_the_nutation_band_of_the_turning_points() {
-    let problem = HeavyTop::problem();
-    let sys = &problem.system;
-    let (q0, p0) = (&problem.initial.q, &problem.initial.p);
-    let e0 = sys.energy(q0, p0, 0.0).unwrap();
-    let (theta_min, theta_max) = sys.turning_points(p0[1], p0[2], e0).unwrap();
-    println!("turning points: θ_min = {theta_min}, θ_max = {theta_max}");
+    let (problem, _, (theta_min, theta_max)) = released_top();
+    let (sys, q0) = (&problem.system, &problem.initial.q);
     // Released with θ̇₀ = 0, θ₀ is a turning point (the upper one: φ̇₀ = 0 makes the cusps).
     assert!((theta_min - q0[0]).abs() < 1e-14, "{theta_min}");
 

@@ -4,7 +4,7 @@
 use crate::common;
 
 use varmech::integrators::{Method, Trajectory};
-use varmech::model::{Hessians, Lagrangian};
+use varmech::model::Lagrangian;
 use varmech::scenes::DoublePendulum;
 use varmech::ModelError;
 
@@ -37,36 +37,14 @@ fn run<L: Lagrangian>(sys: &L, method: Method) -> Trajectory {
 #[test]
 fn the_double_pendulum_hessians_are_the_derivatives_of_its_gradients() {
     let sys = DoublePendulum::problem().system;
-    let (q, v) = ([0.3, -1.2], [0.7, 2.5]);
-    let mut h = Hessians::zeros(2);
-    assert!(sys.hessians(&q, &v, 0.0, &mut h).unwrap());
-    let lq = |q: &[f64], v: &[f64], out: &mut [f64]| sys.dl_dq(q, v, 0.0, out).unwrap();
-    let lv = |q: &[f64], v: &[f64], out: &mut [f64]| sys.dl_dv(q, v, 0.0, out).unwrap();
-    for j in 0..2 {
-        let [qq, qv, vv] = common::hessian_columns(&lq, &lv, &q, &v, j);
-        for (matrix, column) in [(&h.qq, qq), (&h.qv, qv), (&h.vv, vv)] {
-            for i in 0..2 {
-                assert!(
-                    (matrix[(i, j)] - column[i]).abs() < 1e-7 * column[i].abs().max(1.0),
-                    "({i}, {j}): {} vs {}",
-                    matrix[(i, j)],
-                    column[i]
-                );
-            }
-        }
-    }
+    common::assert_hessians(&sys, &[0.3, -1.2], &[0.7, 2.5], 1e-7);
 }
 
 #[test]
 fn an_exact_jacobian_finds_the_same_steps_with_fewer_evaluations() {
     let problem = DoublePendulum::problem();
     let differenced = FirstDerivativesOnly(problem.system.clone());
-    for method in [
-        Method::Midpoint,
-        Method::Trapezoid,
-        Method::Galerkin4,
-        Method::Galerkin6,
-    ] {
+    for method in crate::common::IMPLICIT {
         let exact = run(&problem.system, method);
         let by_differences = run(&differenced, method);
         let k = exact.len() - 1;

@@ -19,7 +19,9 @@ use varmech::model::{Mass, MechanicalSystem, Reaction};
 use varmech::scenes::BouncingBall;
 use varmech::{Error, ModelError};
 
-use crate::impacts::{drop_ball, floor, split_run, with_contacts};
+use crate::common::contacts::{circle, floor, wall};
+use crate::common::Potential;
+use crate::impacts::{drop_ball, split_run, watching, with_contacts};
 
 const G: f64 = 9.81;
 
@@ -54,24 +56,7 @@ fn particle() -> Weighed {
 
 /// The outside of the unit circle, |q| ≥ 1 (a native ellipsoid, outside).
 fn sphere() -> Contacts<'static> {
-    circle(false, "sphere")
-}
-
-/// The unit circle, a native ellipsoid held from `inside` or outside, e = 0.
-fn circle(inside: bool, name: &str) -> Contacts<'static> {
-    let contact = Contact {
-        surface: Box::new(NativeSurface::Ellipsoid {
-            coordinates: vec![0, 1],
-            centre: vec![0.0, 0.0],
-            semi_axes: vec![1.0, 1.0],
-            inside,
-        }),
-        restitution: 0.0,
-        law: Law::Reflect,
-        friction: None,
-        name: name.into(),
-    };
-    Contacts::new(vec![contact]).unwrap()
+    circle(1.0, false, 0.0, Law::Reflect, "sphere")
 }
 
 /// λ of the contact φ at a saved state of `traj` on `model`, ∇φ given.
@@ -234,18 +219,10 @@ fn a_held_step_past_the_surfaces_curvature_ends_the_run_with_a_contact_error_adv
     // At the bottom of the inside of the unit circle at speed 1, pressed by v² + g: a step of 2
     // moves it twice the radius, and no point of q₀ + s(q̇ + c∇φ) lies on the circle.
     let model = particle();
-    let contacts = circle(true, "bowl");
+    let contacts = circle(1.0, true, 0.0, Law::Reflect, "bowl");
     let run = |h: f64| {
         let options = Options::new(h, 10);
-        integrate_watching(
-            &model,
-            Method::Verlet,
-            &[0.0, -1.0],
-            &[1.0, 0.0],
-            &options,
-            || Ok(()),
-            with_contacts(&contacts),
-        )
+        watching(&model, Method::Verlet, (&[0.0, -1.0], &[1.0, 0.0]), &options, &contacts)
     };
     let failure = run(2.0).unwrap_err();
     let Error::Contact { step, time, ref reason } = failure.error else {
@@ -416,33 +393,6 @@ fn a_wheel_whose_slip_rows_turn_with_it_rolls_on_its_circle_at_the_methods_order
     assert!(traj.work[traj.len() - 1] < 0.0, "it skids: friction does work");
 }
 
-/// A particle of mass m in the trap ½kx² under gravity g, V = ½kx² + gmx, its equilibrium
-/// x = −gm/k below a floor x ≥ −a.
-struct Trap {
-    mass: Mass,
-    k: f64,
-    weight: f64,
-}
-
-impl MechanicalSystem for Trap {
-    fn dim(&self) -> usize {
-        1
-    }
-
-    fn mass(&self) -> &Mass {
-        &self.mass
-    }
-
-    fn potential(&self, q: &[f64]) -> Result<f64, ModelError> {
-        Ok(0.5 * self.k * q[0] * q[0] + self.weight * q[0])
-    }
-
-    fn gradient(&self, q: &[f64], grad: &mut [f64]) -> Result<(), ModelError> {
-        grad[0] = self.k * q[0] + self.weight;
-        Ok(())
-    }
-}
-
 /// When the trapped particle (k, m, g) from (x₀, v₀) comes to rest on the floor x = −a with
 /// restitution e: its first impact, then flights harmonic about the equilibrium, each from
 /// the floor (at d = gm/k − a above it) at the speed v back to it after (2/ω)·atan(v/(ωd)),
@@ -495,21 +445,15 @@ fn a_trapped_particle_pressed_on_a_floor_above_its_equilibrium_bounces_to_rest_t
         }
     }
     for (k, m, g, a, e, x0, v0, h) in cases {
-        let trap = Trap {
+        // A particle of mass m in the trap ½kx² under gravity g, V = ½kx² + gmx, its equilibrium
+        // x = −gm/k below the floor x ≥ −a.
+        let trap = Potential {
+            dim: 1,
             mass: Mass::diagonal(vec![m]).unwrap(),
-            k,
-            weight: g * m,
+            potential: |q: &[f64]| 0.5 * k * q[0] * q[0] + g * m * q[0],
+            gradient: |q: &[f64], grad: &mut [f64]| grad[0] = k * q[0] + g * m,
         };
-        let contact = Contact {
-            surface: Box::new(NativeSurface::Wall {
-                coordinate: 0,
-                value: -a,
-            }),
-            restitution: e,
-            law: Law::Reflect,
-            friction: None,
-            name: "floor".into(),
-        };
+        let contact = wall(0, -a, e, Law::Reflect, "floor");
         let contacts = Contacts::new(vec![contact]).unwrap();
         let t_rest = trapped_rest((k, m, g, a), e, (x0, v0));
         for (method, order) in [(Method::Verlet, 2), (Method::Yoshida4, 4)] {

@@ -4,7 +4,7 @@
 //! without an impact, a resumed run and an ensemble member are those of the plain run.
 
 use varmech::integrators::{
-    integrate, integrate_watching, integrate_with_events, resume_watching, Checkpoint, Contact, Contacts, Detector,
+    integrate, integrate_watching, integrate_with_events, resume_watching, Checkpoint, Contacts, Detector,
     DiscreteEnergy, Dynamics, EventSpec, Failure, General, Impacts, Law, MemberWatch, Method, NativeContact,
     NativeEvent, NativeSurface, Options, Stepper, Trajectory, Watch, Watcher,
 };
@@ -12,23 +12,10 @@ use varmech::model::Lagrangian;
 use varmech::scenes::{planar_chain, BouncingBall, EllipticBilliard, NBody};
 use varmech::{Error, ModelError};
 
+use crate::common::contacts::{floor, table, wall};
 use crate::common::verlet_ensemble;
 
 const G: f64 = 9.81;
-
-pub(crate) fn floor(restitution: f64, law: Law) -> Contacts<'static> {
-    let contact = Contact {
-        surface: Box::new(NativeSurface::Wall {
-            coordinate: 0,
-            value: 0.0,
-        }),
-        restitution,
-        law,
-        friction: None,
-        name: "floor".into(),
-    };
-    Contacts::new(vec![contact]).unwrap()
-}
 
 /// The ball (g = 9.81) dropped from rest at height 1 with verlet, watching `watch`.
 pub(crate) fn drop_ball(options: &Options, watch: Watch<'_, '_, '_>) -> Result<Trajectory, Box<Failure>> {
@@ -44,6 +31,17 @@ pub(crate) fn with_contacts<'w>(contacts: &'w Contacts<'static>) -> Watch<'w, 's
     }
 }
 
+/// The run of `model` by `method` from (q0, p0), resolving the impacts on `contacts`.
+pub(crate) fn watching<S: Dynamics + ?Sized>(
+    model: &S,
+    method: Method,
+    (q0, p0): (&[f64], &[f64]),
+    options: &Options,
+    contacts: &Contacts<'static>,
+) -> Result<Trajectory, Box<Failure>> {
+    integrate_watching(model, method, q0, p0, options, || Ok(()), with_contacts(contacts))
+}
+
 #[test]
 fn the_ball_first_hits_the_floor_at_the_exact_time_and_keeps_its_energy() {
     let ball = BouncingBall::new(G).unwrap();
@@ -51,16 +49,7 @@ fn the_ball_first_hits_the_floor_at_the_exact_time_and_keeps_its_energy() {
     let (h0, dt) = (1.0, 1e-3);
     let period = 2.0 * (2.0 * h0 / G).sqrt();
     let options = Options::new(dt, (20.0 * period / dt) as usize);
-    let traj = integrate_watching(
-        &ball,
-        Method::Verlet,
-        &[h0],
-        &[0.0],
-        &options,
-        || Ok(()),
-        with_contacts(&contacts),
-    )
-    .unwrap();
+    let traj = watching(&ball, Method::Verlet, (&[h0], &[0.0]), &options, &contacts).unwrap();
     let impacts = &traj.impacts;
     assert_eq!(impacts.len(), 20, "{:?}", impacts.t);
     // Verlet is exact on the parabola, and the contact is located to round-off.
@@ -94,41 +83,19 @@ fn the_ball_first_hits_the_floor_at_the_exact_time_and_keeps_its_energy() {
     assert_eq!(traj.p_at(k + 1), impacts.p_after_at(0));
 }
 
-/// The circular table |q| ≤ r as a native ellipsoid with equal semi-axes.
-fn circle(r: f64, law: Law) -> Contacts<'static> {
-    let contact = Contact {
-        surface: Box::new(NativeSurface::Ellipsoid {
-            coordinates: vec![0, 1],
-            centre: vec![0.0, 0.0],
-            semi_axes: vec![r, r],
-            inside: true,
-        }),
-        restitution: 1.0,
-        law,
-        friction: None,
-        name: "table".into(),
-    };
-    Contacts::new(vec![contact]).unwrap()
+/// The circular billiard: the free particle, its unit table (reflect law) and its start (q0, p0).
+fn billiard() -> (EllipticBilliard, Contacts<'static>, ([f64; 2], [f64; 2])) {
+    let free = EllipticBilliard::new(1.0, 1.0).unwrap();
+    (free, table(1.0, Law::Reflect), ([0.3, -0.2], [0.6, 0.8]))
 }
 
 #[test]
 fn the_circular_billiard_stays_on_the_table_with_its_speed_and_angular_momentum() {
     // A free particle: Verlet is exact between impacts, and the reflection at the circle, along
     // its radius, keeps |p| and the angular momentum L = x p_y − y p_x about the centre.
-    let free = EllipticBilliard::new(1.0, 1.0).unwrap();
-    let contacts = circle(1.0, Law::Reflect);
-    let (q0, p0) = ([0.3, -0.2], [0.6, 0.8]);
+    let (free, contacts, (q0, p0)) = billiard();
     let options = Options::new(0.01, 100_000);
-    let traj = integrate_watching(
-        &free,
-        Method::Verlet,
-        &q0,
-        &p0,
-        &options,
-        || Ok(()),
-        with_contacts(&contacts),
-    )
-    .unwrap();
+    let traj = watching(&free, Method::Verlet, (&q0, &p0), &options, &contacts).unwrap();
     // Chords of length 2√(1 − d²), d = |L|/|p| the distance of the path from the centre.
     let angular = |q: &[f64], p: &[f64]| q[0] * p[1] - q[1] * p[0];
     let l0 = angular(&q0, &p0);
@@ -168,16 +135,7 @@ fn the_circular_billiard_stays_on_the_table_with_its_speed_and_angular_momentum(
 fn a_step_without_an_impact_is_bit_for_bit_the_step_without_contacts() {
     // A floor the ball never reaches, with and without an event beside it.
     let ball = BouncingBall::new(G).unwrap();
-    let far = Contact {
-        surface: Box::new(NativeSurface::Wall {
-            coordinate: 0,
-            value: -1e3,
-        }),
-        restitution: 1.0,
-        law: Law::Reflect,
-        friction: None,
-        name: "far".into(),
-    };
+    let far = wall(0, -1e3, 1.0, Law::Reflect, "far");
     let contacts = Contacts::new(vec![far]).unwrap();
     let options = Options {
         save_every: 7,
@@ -185,16 +143,7 @@ fn a_step_without_an_impact_is_bit_for_bit_the_step_without_contacts() {
     };
     for method in [Method::Verlet, Method::Yoshida4, Method::Midpoint] {
         let plain = integrate(&ball, method, &[1.0], &[2.0], &options, || Ok(())).unwrap();
-        let watched = integrate_watching(
-            &ball,
-            method,
-            &[1.0],
-            &[2.0],
-            &options,
-            || Ok(()),
-            with_contacts(&contacts),
-        )
-        .unwrap();
+        let watched = watching(&ball, method, (&[1.0], &[2.0]), &options, &contacts).unwrap();
         assert!(watched.impacts.is_empty());
         assert_eq!(
             (&watched.t, &watched.q, &watched.p),
@@ -279,16 +228,7 @@ pub(crate) fn split_run<S: Dynamics>(
     };
     let run = |steps: usize| {
         let options = Options { steps, ..whole.clone() };
-        integrate_watching(
-            model,
-            Method::Verlet,
-            q0,
-            p0,
-            &options,
-            || Ok(()),
-            with_contacts(contacts),
-        )
-        .unwrap()
+        watching(model, Method::Verlet, (q0, p0), &options, contacts).unwrap()
     };
     let (all, part) = (run(steps), run(first));
     let checkpoint = Checkpoint::from_bytes(&part.checkpoint).unwrap();
@@ -306,9 +246,7 @@ pub(crate) fn split_run<S: Dynamics>(
 
 #[test]
 fn a_resumed_run_with_its_contacts_is_the_whole_run_bit_for_bit() {
-    let free = EllipticBilliard::new(1.0, 1.0).unwrap();
-    let contacts = circle(1.0, Law::Reflect);
-    let start = ([0.3, -0.2], [0.6, 0.8]);
+    let (free, contacts, start) = billiard();
     let [all, part, rest] = split_run(&free, &contacts, (&start.0, &start.1), (0.01, 3000, 1234, 10));
     assert!(part.impacts.len() >= 5 && rest.impacts.len() >= 5);
     assert_eq!(rest.steps, 3000);
@@ -351,14 +289,12 @@ fn an_ensemble_member_is_its_single_run_bit_for_bit() {
     for (i, outcome) in ensemble.members.iter().enumerate() {
         let member = outcome.as_ref().unwrap();
         let rows = 2 * i..2 * i + 2;
-        let single = integrate_watching(
+        let single = watching(
             &free,
             Method::Verlet,
-            &q0[rows.clone()],
-            &p0[rows],
+            (&q0[rows.clone()], &p0[rows]),
             &options,
-            || Ok(()),
-            with_contacts(&contacts),
+            &contacts,
         )
         .unwrap();
         assert!(single.impacts.len() >= 5);
@@ -438,15 +374,7 @@ fn contacts_that_do_not_fit_are_refused_by_name() {
     let ball = BouncingBall::new(G).unwrap();
     let options = Options::new(0.01, 10);
     let refusal = |contacts: &Contacts<'static>, method: Method, q0: f64| {
-        let run = integrate_watching(
-            &ball,
-            method,
-            &[q0],
-            &[0.0],
-            &options,
-            || Ok(()),
-            with_contacts(contacts),
-        );
+        let run = watching(&ball, method, (&[q0], &[0.0]), &options, contacts);
         match run.unwrap_err().error {
             Error::InvalidArgument { argument, reason } => (argument, reason),
             other => panic!("{other}"),
@@ -459,51 +387,22 @@ fn contacts_that_do_not_fit_are_refused_by_name() {
         "{reason}"
     );
     assert_eq!(refusal(&floor(1.0, Law::Reflect), Method::Verlet, -0.1).0, "q0");
-    let wrong = Contact {
-        surface: Box::new(NativeSurface::Wall {
-            coordinate: 3,
-            value: 0.0,
-        }),
-        restitution: 1.0,
-        law: Law::Reflect,
-        friction: None,
-        name: "wall".into(),
-    };
+    let wrong = wall(3, 0.0, 1.0, Law::Reflect, "wall");
     let (argument, reason) = refusal(&Contacts::new(vec![wrong]).unwrap(), Method::Verlet, 1.0);
     assert_eq!(
         (argument, reason.as_str()),
         ("contacts", "\"wall\" (contacts[0]): coordinate 3 is not in 0 … 0")
     );
-    let elastic = Contact {
-        surface: Box::new(NativeSurface::Wall {
-            coordinate: 0,
-            value: 0.0,
-        }),
-        restitution: 1.5,
-        law: Law::Reflect,
-        friction: None,
-        name: "wall".into(),
-    };
+    let elastic = wall(0, 0.0, 1.5, Law::Reflect, "wall");
     assert!(Contacts::new(vec![elastic]).is_err());
 }
 
 #[test]
 fn a_stepper_stepped_through_a_watcher_is_the_run_bit_for_bit() {
     // Stepper-level stepping with contacts (the binding's Stepper): the run's own loop.
-    let free = EllipticBilliard::new(1.0, 1.0).unwrap();
-    let contacts = circle(1.0, Law::Reflect);
-    let (q0, p0) = ([0.3, -0.2], [0.6, 0.8]);
+    let (free, contacts, (q0, p0)) = billiard();
     let options = Options::new(0.01, 2000);
-    let run = integrate_watching(
-        &free,
-        Method::Verlet,
-        &q0,
-        &p0,
-        &options,
-        || Ok(()),
-        with_contacts(&contacts),
-    )
-    .unwrap();
+    let run = watching(&free, Method::Verlet, (&q0, &p0), &options, &contacts).unwrap();
     let mut stepper = Stepper::new(&free, Method::Verlet, &q0, &p0, &options).unwrap();
     let mut watcher = Watcher::begin(&free, &mut stepper, with_contacts(&contacts), "q0").unwrap();
     let mut record = Trajectory::default();
@@ -554,32 +453,14 @@ fn a_stepper_stepped_through_a_watcher_resumed_for_each_step_is_the_run_bit_for_
     let on_floor = floor(1.0, Law::Variational);
     let options = Options::new(1e-2, 600);
     let (q0, p0) = ([1.0], [0.0]);
-    let run = integrate_watching(
-        &ball,
-        Method::Verlet,
-        &q0,
-        &p0,
-        &options,
-        || Ok(()),
-        with_contacts(&on_floor),
-    );
+    let run = watching(&ball, Method::Verlet, (&q0, &p0), &options, &on_floor);
     let ball_run = (
         run.unwrap(),
         stepped_one_call_at_a_time(&ball, (&q0, &p0), &options, &on_floor),
     );
-    let billiard = EllipticBilliard::new(1.0, 1.0).unwrap();
-    let on_table = circle(1.0, Law::Reflect);
+    let (billiard, on_table, (q0, p0)) = billiard();
     let options = Options::new(1e-2, 1000);
-    let (q0, p0) = ([0.3, -0.2], [0.6, 0.8]);
-    let run = integrate_watching(
-        &billiard,
-        Method::Verlet,
-        &q0,
-        &p0,
-        &options,
-        || Ok(()),
-        with_contacts(&on_table),
-    );
+    let run = watching(&billiard, Method::Verlet, (&q0, &p0), &options, &on_table);
     let billiard_run = (
         run.unwrap(),
         stepped_one_call_at_a_time(&billiard, (&q0, &p0), &options, &on_table),
@@ -629,16 +510,9 @@ fn a_state_a_round_off_past_a_surface_leaves_it_and_one_further_past_is_refused(
     }
 }
 
-/// A wall q_k ≥ `value` (reflect law), named "wall".
-fn wall(coordinate: usize, value: f64, law: Law) -> Contacts<'static> {
-    let contact = Contact {
-        surface: Box::new(NativeSurface::Wall { coordinate, value }),
-        restitution: 1.0,
-        law,
-        friction: None,
-        name: "wall".into(),
-    };
-    Contacts::new(vec![contact]).unwrap()
+/// A wall q_k ≥ `value` (e = 1 under `law`) alone, named "wall".
+fn lone_wall(coordinate: usize, value: f64, law: Law) -> Contacts<'static> {
+    Contacts::new(vec![wall(coordinate, value, 1.0, law, "wall")]).unwrap()
 }
 
 /// The run of `method` on `model` from (q0, p0) with `contacts` and no events, which takes its
@@ -653,7 +527,7 @@ fn same_bits<S: Dynamics>(
     contacts: &Contacts<'static>,
     plain: bool,
 ) -> usize {
-    let fast = integrate_watching(model, method, q0, p0, options, || Ok(()), with_contacts(contacts)).unwrap();
+    let fast = watching(model, method, (q0, p0), options, contacts).unwrap();
     let other = if plain {
         integrate(model, method, q0, p0, options, || Ok(())).unwrap()
     } else {
@@ -688,7 +562,7 @@ fn a_contact_never_hit_leaves_every_step_loop_bit_for_bit_the_plain_one() {
     // model), the method's own variables (Wisdom–Holman), the fixed-size DEL loop (midpoint
     // and trapezoid on the ball as a general Lagrangian) and a constrained model's (RATTLE).
     let ball = BouncingBall::new(G).unwrap();
-    let far = wall(0, -1e3, Law::Reflect);
+    let far = lone_wall(0, -1e3, Law::Reflect);
     for compensated in [true, false] {
         let options = Options {
             save_every: 7,
@@ -714,7 +588,7 @@ fn a_contact_never_hit_leaves_every_step_loop_bit_for_bit_the_plain_one() {
             method,
             initial,
             &options,
-            &wall(4, -1e9, Law::Reflect),
+            &lone_wall(4, -1e9, Law::Reflect),
             true,
         );
     }
@@ -729,7 +603,7 @@ fn a_contact_never_hit_leaves_every_step_loop_bit_for_bit_the_plain_one() {
         Method::Rattle,
         initial,
         &options,
-        &wall(1, -1e3, Law::Reflect),
+        &lone_wall(1, -1e3, Law::Reflect),
         true,
     );
 }
@@ -765,7 +639,7 @@ fn steps_with_impacts_in_the_methods_loop_are_bit_for_bit_those_taken_one_at_a_t
             method,
             (&[0.3, -0.2], &[0.6, 0.8]),
             &options,
-            &circle(1.0, Law::Reflect),
+            &table(1.0, Law::Reflect),
             false,
         );
         assert!(impacts >= 10, "{method:?}: {impacts} impacts");

@@ -12,8 +12,9 @@ use varmech::model::Lagrangian;
 use varmech::scenes::{BouncingBall, DoublePendulum, HarmonicOscillator};
 use varmech::Error;
 
+use crate::common::contacts::floor;
 use crate::common::verlet_ensemble;
-use crate::impacts::{drop_ball, floor, with_contacts};
+use crate::impacts::{drop_ball, with_contacts};
 
 fn blow(t: f64, p: &[f64]) -> Impulse<'static> {
     Impulse {

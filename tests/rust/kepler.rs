@@ -26,9 +26,7 @@ fn symplectic_methods_conserve_angular_momentum_and_bound_the_energy() {
     for method in Method::ALL.into_iter().filter(|m| m.info().symplectic) {
         let steps = 200 * steps_per_period(method);
         let traj = run(&problem, method, problem.t_end, steps, 10);
-        let l: Vec<f64> = (0..traj.len())
-            .map(|k| rotation.momentum(traj.q_at(k), traj.p_at(k)))
-            .collect();
+        let l: Vec<f64> = common::along(&traj, |q, p| rotation.momentum(q, p));
         let l_stats = InvariantStatistics::new(&l);
         assert!((l_stats.initial - 0.8).abs() < 1e-15);
         // Explicit methods conserve L to round-off; the implicit ones to the round-off of

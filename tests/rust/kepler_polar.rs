@@ -7,8 +7,8 @@ use crate::common;
 use common::InvariantStatistics;
 use std::f64::consts::PI;
 
-use varmech::integrators::{integrate, General, Method, NewtonOptions, Options, Trajectory};
-use varmech::model::{Hessians, Lagrangian};
+use varmech::integrators::{Method, NewtonOptions, Options, Trajectory};
+use varmech::model::Lagrangian;
 use varmech::scenes::{Kepler, KeplerPolar, State};
 
 const E: f64 = 0.6;
@@ -31,15 +31,8 @@ fn run_polar_with(
         newton,
         ..Options::new(2.0 * PI / steps_per_period as f64, steps)
     };
-    integrate(
-        &General(&problem.system),
-        method,
-        &problem.initial.q,
-        &problem.initial.p,
-        &options,
-        || Ok(()),
-    )
-    .unwrap_or_else(|f| panic!("{method:?}: {}", f.error))
+    common::run_general_with(&problem.system, &problem.initial, method, &options)
+        .unwrap_or_else(|e| panic!("{method:?}: {e}"))
 }
 
 /// (x, y, p_x, p_y) of a polar state (m = 1): p_x = p_r cos θ − (p_θ/r) sin θ, and so on.
@@ -52,18 +45,7 @@ fn cartesian(q: &[f64], p: &[f64]) -> [f64; 4] {
 fn the_derivatives_hessians_and_velocity_are_exact() {
     let sys = KeplerPolar::new(1.7, 0.9).unwrap();
     let (q, v) = ([0.8, 2.3], [-0.4, 1.1]);
-    let mut h = Hessians::zeros(2);
-    assert!(sys.hessians(&q, &v, 0.0, &mut h).unwrap());
-    let lq = |q: &[f64], v: &[f64], out: &mut [f64]| sys.dl_dq(q, v, 0.0, out).unwrap();
-    let lv = |q: &[f64], v: &[f64], out: &mut [f64]| sys.dl_dv(q, v, 0.0, out).unwrap();
-    for j in 0..2 {
-        let [qq, qv, vv] = common::hessian_columns(&lq, &lv, &q, &v, j);
-        for (matrix, d) in [(&h.qq, qq), (&h.qv, qv), (&h.vv, vv)] {
-            for i in 0..2 {
-                assert!((matrix[(i, j)] - d[i]).abs() < 1e-7 * d[i].abs().max(1.0), "({i}, {j})");
-            }
-        }
-    }
+    common::assert_hessians(&sys, &q, &v, 1e-7);
     // dl_dq and dl_dv are the derivatives of L.
     let (mut lq, mut lv) = ([0.0; 2], [0.0; 2]);
     sys.dl_dq(&q, &v, 0.0, &mut lq).unwrap();
@@ -141,13 +123,9 @@ fn the_angular_momentum_is_conserved_to_round_off_as_the_angle_grows() {
             (1, NewtonOptions::default(), 1e-14),
         ] {
             let traj = run_polar_with(method, periods, 200, 10, newton);
-            let l: Vec<f64> = (0..traj.len())
-                .map(|k| cyclic.momentum(traj.q_at(k), traj.p_at(k)))
-                .collect();
+            let l: Vec<f64> = common::along(&traj, |q, p| cyclic.momentum(q, p));
             let stats = InvariantStatistics::new(&l);
-            let e: Vec<f64> = (0..traj.len())
-                .map(|k| problem.system.energy(traj.q_at(k), traj.p_at(k), 0.0).unwrap())
-                .collect();
+            let e: Vec<f64> = common::along(&traj, |q, p| problem.system.energy(q, p, 0.0).unwrap());
             let e_err = e.iter().fold(0.0_f64, |m, x| m.max((x - e[0]).abs() / 0.5));
             println!(
                 "{method:?}, {periods} periods of 200 steps, Newton tolerance {:e}: p_θ = {}, max relative error {:.2e}; \

@@ -5,11 +5,11 @@
 //! under the midpoint rule, and the damped, driven pendulum's sum: the discrete map's exact
 //! volume change, and −2β to the method's order.
 
+use crate::common::Potential;
 use varmech::diagnostics::{lyapunov, LyapunovOptions, Stretching};
 use varmech::integrators::{Dynamics, Feature, General, Method, ModelKind, Options, Stepper, Tangent};
-use varmech::model::{Mass, MechanicalSystem};
 use varmech::scenes::{DampedDrivenPendulum, DoublePendulum, FermiPastaUlam, HarmonicOscillator, HenonHeiles};
-use varmech::{Error, ModelError};
+use varmech::Error;
 
 /// One step of `method` from (q, p): the end (q, p) as one vector.
 fn step<S: Dynamics>(sys: &S, method: Method, h: f64, x: &[f64]) -> Vec<f64> {
@@ -314,12 +314,7 @@ fn the_implicit_rules_tangent_maps_are_their_steps_jacobians() {
     let double = DoublePendulum::new(1.0, 2.0, 2.0, 3.0, 9.81).unwrap();
     let hh = HenonHeiles::new();
     let (damped, _) = taylor(1.077);
-    for method in [
-        Method::Midpoint,
-        Method::Trapezoid,
-        Method::Galerkin4,
-        Method::Galerkin6,
-    ] {
+    for method in crate::common::IMPLICIT {
         let (error, defect) = check(&General(&double), method, 0.01, &[0.5, 1.0, 0.3, -0.2]);
         assert!(error < 1e-9, "{method:?} on the double pendulum: {error:e}");
         assert!(
@@ -476,22 +471,8 @@ fn rattles_tangent_map_is_its_steps_jacobian_on_the_constraint_manifold() {
 
 /// V = −q²/2 at its top, q = p = 0: the state stays there while a tangent vector grows by about
 /// h² a step, past any float at h = 10¹⁶⁰.
-struct Inverted(Mass);
-
-impl MechanicalSystem for Inverted {
-    fn dim(&self) -> usize {
-        1
-    }
-    fn mass(&self) -> &Mass {
-        &self.0
-    }
-    fn potential(&self, q: &[f64]) -> Result<f64, ModelError> {
-        Ok(-0.5 * q[0] * q[0])
-    }
-    fn gradient(&self, q: &[f64], grad: &mut [f64]) -> Result<(), ModelError> {
-        grad[0] = -q[0];
-        Ok(())
-    }
+fn inverted() -> Potential {
+    Potential::unit(1, |q| -0.5 * q[0] * q[0], |q, grad| grad[0] = -q[0])
 }
 
 /// Tangent vectors that one step takes past the largest float stop the spectrum, and a
@@ -499,7 +480,7 @@ impl MechanicalSystem for Inverted {
 /// step they survive (stretched 10¹⁰⁰ a step), the exponent is the step map's own.
 #[test]
 fn tangent_vectors_that_overflow_in_a_step_are_a_divergence_not_nan() {
-    let sys = Inverted(Mass::Scalar(1.0));
+    let sys = inverted();
     let options = |dt: f64| LyapunovOptions {
         t0: 0.0,
         dt,

@@ -3,15 +3,12 @@
 //! Byerly's sphere on a rough incline, a particle held to a circle by x ẋ + y ẏ = 0 against
 //! RATTLE, and the Chaplygin sleigh.
 
-use crate::common;
+use crate::common::{self, Potential};
 use crate::nonholonomic_scenes::{ball, build};
 
 use nalgebra::DMatrix;
 use varmech::integrators::{integrate, Dynamics, General, Method, Options, Trajectory};
-use varmech::model::{
-    Anchor, Constrained, Distances, Hessians, Lagrangian, Link, Mass, MechanicalSystem, Nonholonomic,
-    VelocityConstraints,
-};
+use varmech::model::{Anchor, Constrained, Distances, Hessians, Lagrangian, Link, Nonholonomic, VelocityConstraints};
 use varmech::scenes::{Blade, FreeBody, NonholonomicScene, SceneModel};
 use varmech::{Error, ModelError};
 
@@ -107,9 +104,7 @@ fn residual<L: Lagrangian, C: VelocityConstraints>(model: &Nonholonomic<L, C>, t
 
 /// The energies at the saved states.
 fn energies<L: Lagrangian, C>(model: &Nonholonomic<L, C>, traj: &Trajectory) -> Vec<f64> {
-    (0..traj.len())
-        .map(|k| model.system.energy(traj.q_at(k), traj.p_at(k), 0.0).unwrap())
-        .collect()
+    common::along(traj, |q, p| model.system.energy(q, p, 0.0).unwrap())
 }
 
 /// The disk: m = 1, I = 1/4 about a diameter, J = 1/2 about the axle, R = 1; θ̇ = 0.7, φ̇ = 2.
@@ -247,26 +242,12 @@ impl VelocityConstraints for Radial {
 
 /// A unit mass in the plane under V = y + x² (gravity and a spring to the vertical axis,
 /// so that the midpoint and trapezoidal L_d differ).
-#[derive(Clone)]
-struct Bowl(Mass);
-
-impl MechanicalSystem for Bowl {
-    fn dim(&self) -> usize {
-        2
-    }
-
-    fn mass(&self) -> &Mass {
-        &self.0
-    }
-
-    fn potential(&self, q: &[f64]) -> Result<f64, ModelError> {
-        Ok(q[1] + q[0] * q[0])
-    }
-
-    fn gradient(&self, q: &[f64], grad: &mut [f64]) -> Result<(), ModelError> {
-        grad.copy_from_slice(&[2.0 * q[0], 1.0]);
-        Ok(())
-    }
+fn bowl() -> Potential {
+    Potential::unit(
+        2,
+        |q| q[1] + q[0] * q[0],
+        |q, grad| grad.copy_from_slice(&[2.0 * q[0], 1.0]),
+    )
 }
 
 #[test]
@@ -275,7 +256,7 @@ fn a_particle_held_to_a_circle_by_a_velocity_constraint_is_the_pendulum() {
     // midpoint, q̄·δq = ½(|q₁|² − |q₀|²) = 0, is the holonomic one: the DLA step is the
     // constrained DEL step of the midpoint rule to round-off, and matches RATTLE (the
     // trapezoidal L_d) to order 2.
-    let bowl = Bowl(Mass::scalar(1.0).unwrap());
+    let bowl = bowl();
     let model = Nonholonomic {
         system: bowl.clone(),
         constraints: Radial,

@@ -3,33 +3,20 @@
 //! contrast, and Yoshida's triple jump of the reversible step (`dla4`), on the nonholonomic
 //! particle in a harmonic well, reversible (L even in q̇, A linear in it) and quasi-periodic.
 
-use crate::common;
+use crate::common::{self, Potential};
 
 use nalgebra::DMatrix;
 use varmech::integrators::{integrate, Method, Options, Trajectory};
-use varmech::model::{Lagrangian, Mass, MechanicalSystem, Nonholonomic, VelocityConstraints};
+use varmech::model::{Lagrangian, Nonholonomic, VelocityConstraints};
 use varmech::ModelError;
 
 /// A unit mass in V = ½(x² + y² + z²).
-struct Well(Mass);
-
-impl MechanicalSystem for Well {
-    fn dim(&self) -> usize {
-        3
-    }
-
-    fn mass(&self) -> &Mass {
-        &self.0
-    }
-
-    fn potential(&self, q: &[f64]) -> Result<f64, ModelError> {
-        Ok(0.5 * q.iter().map(|x| x * x).sum::<f64>())
-    }
-
-    fn gradient(&self, q: &[f64], grad: &mut [f64]) -> Result<(), ModelError> {
-        grad.copy_from_slice(q);
-        Ok(())
-    }
+fn well() -> Potential {
+    Potential::unit(
+        3,
+        |q| 0.5 * q.iter().map(|x| x * x).sum::<f64>(),
+        |q, grad| grad.copy_from_slice(q),
+    )
 }
 
 /// The nonholonomic particle's constraint ż = y ẋ (Bloch 2003, §1.6): A(q) = (−y, 0, 1), whose
@@ -53,11 +40,11 @@ impl VelocityConstraints for Knife {
     }
 }
 
-type Particle = Nonholonomic<Well, Knife>;
+type Particle = Nonholonomic<Potential, Knife>;
 
 fn particle() -> Particle {
     Nonholonomic {
-        system: Well(Mass::scalar(1.0).unwrap()),
+        system: well(),
         constraints: Knife,
     }
 }
@@ -79,9 +66,7 @@ fn run(method: Method, (q0, p0): (&[f64], &[f64]), h: f64, steps: usize, save_ev
 
 /// The energy errors E − E₀ at the saved states.
 fn energy_errors(model: &Particle, traj: &Trajectory) -> Vec<f64> {
-    let e: Vec<f64> = (0..traj.len())
-        .map(|k| model.system.energy(traj.q_at(k), traj.p_at(k), 0.0).unwrap())
-        .collect();
+    let e: Vec<f64> = common::along(traj, |q, p| model.system.energy(q, p, 0.0).unwrap());
     e.iter().map(|x| x - e[0]).collect()
 }
 
@@ -184,7 +169,7 @@ fn dla4_is_of_order_4_and_keeps_the_constraint_and_a_bounded_energy() {
 #[test]
 fn the_variants_take_velocity_constraints_alone() {
     // On a model without velocity constraints they are refused, naming the method.
-    let well = Well(Mass::scalar(1.0).unwrap());
+    let well = well();
     for method in Method::NONHOLONOMIC {
         let err = integrate(&well, method, &Q0, &P0, &Options::new(0.1, 10), || Ok(())).unwrap_err();
         let message = err.error.to_string();

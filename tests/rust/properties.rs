@@ -317,12 +317,7 @@ fn apart(a: &Trajectory, b: &Trajectory) -> f64 {
 
 /// A random chain, method, state and step hω ≤ 1 on its fastest mode at the start.
 fn del_case(second: Second) -> impl Strategy<Value = (Chain, Method, Vec<f64>, Vec<f64>, f64)> {
-    let methods = prop::sample::select(vec![
-        Method::Midpoint,
-        Method::Trapezoid,
-        Method::Galerkin4,
-        Method::Galerkin6,
-    ]);
+    let methods = prop::sample::select(crate::common::IMPLICIT.to_vec());
     (chain(second, true), methods, 0.02f64..1.0)
         .prop_flat_map(|(c, method, h_omega)| {
             let n = c.n();

@@ -1,19 +1,12 @@
 //! Routh reduction: the Routhian R = L − μ·ċ of a model with cyclic coordinates, integrated by
 //! the DEL integrators, against closed forms, relative equilibria and the unreduced model.
 
-use crate::common;
+use crate::common::{self, IMPLICIT};
 
 use varmech::discrete::{DiscreteLagrangian, Midpoint, Trapezoidal};
 use varmech::integrators::{integrate, Method, Options, Trajectory};
 use varmech::model::{Hessians, Lagrangian, Routhian};
 use varmech::scenes::{self, HeavyTop, SphericalPendulum, State};
-
-const IMPLICIT: [Method; 4] = [
-    Method::Midpoint,
-    Method::Trapezoid,
-    Method::Galerkin4,
-    Method::Galerkin6,
-];
 
 /// The spherical pendulum (m = l = g = 1) and its Routhian at p_φ = μ.
 fn spherical(mu: f64) -> (SphericalPendulum, f64) {
@@ -231,12 +224,8 @@ fn steady_precession_of_the_top_is_a_fixed_point_of_every_reduced_map() {
 
 #[test]
 fn the_reduced_top_nutates_between_the_turning_points_of_its_effective_energy() {
-    let problem = HeavyTop::problem();
-    let top = &problem.system;
-    let (q0, p0) = (&problem.initial.q, &problem.initial.p);
-    let energy = top.energy(q0, p0, 0.0).unwrap();
-    let (theta_min, theta_max) = top.turning_points(p0[1], p0[2], energy).unwrap();
-    println!("turning points: θ_min = {theta_min:.12}, θ_max = {theta_max:.12}");
+    let (problem, energy, (theta_min, theta_max)) = crate::heavy_top::released_top();
+    let (top, q0, p0) = (&problem.system, &problem.initial.q, &problem.initial.p);
     let r = Routhian::new(top, &[1, 2], &p0[1..], &[0.0, 0.0]).unwrap();
     let reduced_energy = r.energy(&q0[..1], &p0[..1], 0.0).unwrap();
     assert!((reduced_energy - energy).abs() <= 1e-14 * energy.abs());

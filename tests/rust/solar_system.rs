@@ -63,9 +63,7 @@ fn kahan_li_8_converges_to_the_reference_at_order_8() {
     assert!(e.max < 1e-9, "max relative energy error at h = 200 days: {:.3e}", e.max);
 
     for g in problem.system.symmetries() {
-        let j: Vec<f64> = (0..traj.len())
-            .map(|k| g.momentum(traj.q_at(k), traj.p_at(k)))
-            .collect();
+        let j: Vec<f64> = common::along(&traj, |q, p| g.momentum(q, p));
         let s = InvariantStatistics::new(&j);
         // Round-off relative to the largest momentum of a body times the number of steps' √.
         let scale = problem.initial.p.iter().fold(0.0_f64, |m, x| m.max(x.abs()));

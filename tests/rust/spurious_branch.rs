@@ -76,12 +76,7 @@ fn with_an_energy_bound_no_implicit_method_silently_goes_over_the_top() {
     // event at a 1% energy error (the separatrix is 1% above E₀) stops it: every run from h = 0.5
     // to 4 either stops with a typed error or at the event, or stays in libration, and every
     // state it returns is in libration.
-    for method in [
-        Method::Midpoint,
-        Method::Trapezoid,
-        Method::Galerkin4,
-        Method::Galerkin6,
-    ] {
+    for method in crate::common::IMPLICIT {
         for h in [0.5, 1.0, 1.5, 2.0, 2.01, 2.5, 3.0, 4.0] {
             let steps = (400.0 / h) as usize;
             let bound = NativeEvent::EnergyError {

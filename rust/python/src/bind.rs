@@ -170,9 +170,6 @@ fn is_affine(py: Python<'_>, model: &Bound<'_, PyAny>) -> PyResult<bool> {
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PyModelKind>()?;
-    m.add_function(wrap_pyfunction!(is_affine, m)?)?;
-    m.add_function(wrap_pyfunction!(kind_of, m)?)?;
-    m.add_function(wrap_pyfunction!(is_time_dependent, m)?)?;
-    m.add_function(wrap_pyfunction!(is_forced, m)?)?;
+    add_functions!(m, [is_affine, kind_of, is_time_dependent, is_forced]);
     Ok(())
 }

@@ -92,6 +92,48 @@ fn required(name: &'static str, f: Option<Function>) -> PyResult<Function> {
     f.ok_or_else(|| PyValueError::new_err(format!("functions: the model needs a {name:?} function")))
 }
 
+/// The constructors of [`Compiled`]'s variants over one system type `S`: unconstrained, on
+/// holonomic constraints, on velocity constraints, on both.
+type Variants<S> = (
+    fn(S) -> Compiled,
+    fn(Constrained<S, CompiledConstraints>) -> Compiled,
+    fn(Nonholonomic<S, CompiledVelocityConstraints>) -> Compiled,
+    fn(Mixed<S, CompiledConstraints, CompiledVelocityConstraints>) -> Compiled,
+);
+
+const SEPARABLE: Variants<CompiledSeparable> = (
+    Compiled::Separable,
+    Compiled::ConstrainedSeparable,
+    Compiled::NonholonomicSeparable,
+    Compiled::MixedSeparable,
+);
+
+const LAGRANGIAN: Variants<CompiledLagrangian> = (
+    Compiled::Lagrangian,
+    Compiled::ConstrainedLagrangian,
+    Compiled::NonholonomicLagrangian,
+    Compiled::MixedLagrangian,
+);
+
+/// `system` on the constraints given, as the variant of `variants` that holds them.
+fn on_constraints<S>(
+    system: S,
+    holonomic: Option<CompiledConstraints>,
+    velocity: Option<CompiledVelocityConstraints>,
+    (plain, constrained, nonholonomic, mixed): Variants<S>,
+) -> Compiled {
+    match (holonomic, velocity) {
+        (Some(holonomic), Some(velocity)) => mixed(Mixed {
+            system,
+            holonomic,
+            velocity,
+        }),
+        (Some(constraints), None) => constrained(Constrained { system, constraints }),
+        (None, Some(constraints)) => nonholonomic(Nonholonomic { system, constraints }),
+        (None, None) => plain(system),
+    }
+}
+
 #[pymethods]
 impl CompiledModel {
     #[new]
@@ -158,35 +200,29 @@ impl CompiledModel {
                 "forced: must be true exactly when a \"force\" function is given",
             ));
         }
-        let constraint_functions = match constraints {
-            0 => None,
-            m => Some(
-                CompiledConstraints::new(
-                    m,
-                    dim,
-                    params.clone(),
-                    required("constraints", f("constraints")?)?,
-                    required("constraint_jacobian", f("constraint_jacobian")?)?,
-                )
-                .map_err(err)?,
-            ),
+        // The two functions, named `[value, derivative]`, of `count` constraints; None where `count` is 0.
+        let pair = |count: usize, [value, derivative]: [&'static str; 2]| match count {
+            0 => Ok(None),
+            m => PyResult::Ok(Some((
+                m,
+                required(value, f(value)?)?,
+                required(derivative, f(derivative)?)?,
+            ))),
         };
+        let constraint_functions = pair(constraints, ["constraints", "constraint_jacobian"])?
+            .map(|(m, g, jacobian)| CompiledConstraints::new(m, dim, params.clone(), g, jacobian))
+            .transpose()
+            .map_err(err)?;
         if constraints > 0 && velocity_constraints > 0 {
             check_total("velocity_constraints", constraints, velocity_constraints, dim)?;
         }
-        let rolling = match velocity_constraints {
-            0 => None,
-            m => Some(
-                CompiledVelocityConstraints::new(
-                    m,
-                    dim,
-                    params.clone(),
-                    required("velocity_constraints", f("velocity_constraints")?)?,
-                    required("velocity_constraint_derivative", f("velocity_constraint_derivative")?)?,
-                )
-                .map_err(err)?,
-            ),
-        };
+        let rolling = pair(
+            velocity_constraints,
+            ["velocity_constraints", "velocity_constraint_derivative"],
+        )?
+        .map(|(m, a, derivative)| CompiledVelocityConstraints::new(m, dim, params.clone(), a, derivative))
+        .transpose()
+        .map_err(err)?;
         let model = match kind {
             "separable" => {
                 if time_dependent || forced || !delays.is_empty() {
@@ -202,22 +238,7 @@ impl CompiledModel {
                     required("mass", f("mass")?)?,
                 )
                 .map_err(err)?;
-                match (constraint_functions, rolling) {
-                    (Some(holonomic), Some(velocity)) => Compiled::MixedSeparable(Mixed {
-                        system: s,
-                        holonomic,
-                        velocity,
-                    }),
-                    (Some(c), None) => Compiled::ConstrainedSeparable(Constrained {
-                        system: s,
-                        constraints: c,
-                    }),
-                    (None, Some(c)) => Compiled::NonholonomicSeparable(Nonholonomic {
-                        system: s,
-                        constraints: c,
-                    }),
-                    (None, None) => Compiled::Separable(s),
-                }
+                on_constraints(s, constraint_functions, rolling, SEPARABLE)
             }
             "lagrangian" => {
                 let l = CompiledLagrangian::new(
@@ -244,22 +265,7 @@ impl CompiledModel {
                     ),
                 )
                 .map_err(err)?;
-                match (constraint_functions, rolling) {
-                    (Some(holonomic), Some(velocity)) => Compiled::MixedLagrangian(Mixed {
-                        system: l,
-                        holonomic,
-                        velocity,
-                    }),
-                    (Some(c), None) => Compiled::ConstrainedLagrangian(Constrained {
-                        system: l,
-                        constraints: c,
-                    }),
-                    (None, Some(c)) => Compiled::NonholonomicLagrangian(Nonholonomic {
-                        system: l,
-                        constraints: c,
-                    }),
-                    (None, None) => Compiled::Lagrangian(l),
-                }
+                on_constraints(l, constraint_functions, rolling, LAGRANGIAN)
             }
             other => {
                 return Err(PyValueError::new_err(format!(

@@ -85,8 +85,6 @@ fn project<'py>(
 }
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
-    m.add_function(wrap_pyfunction!(constraint_residuals, m)?)?;
-    m.add_function(wrap_pyfunction!(project, m)?)?;
-    m.add_function(wrap_pyfunction!(reactions, m)?)?;
+    add_functions!(m, [constraint_residuals, project, reactions]);
     Ok(())
 }

@@ -317,14 +317,19 @@ fn lyapunov<'py>(
 }
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
-    m.add_function(wrap_pyfunction!(lyapunov, m)?)?;
-    m.add_function(wrap_pyfunction!(constraint_curvature, m)?)?;
-    m.add_function(wrap_pyfunction!(energy_terms, m)?)?;
-    m.add_function(wrap_pyfunction!(derivative, m)?)?;
-    m.add_function(wrap_pyfunction!(momentum, m)?)?;
-    m.add_function(wrap_pyfunction!(momentum_along, m)?)?;
-    m.add_function(wrap_pyfunction!(energy_statistics, m)?)?;
-    m.add_function(wrap_pyfunction!(statistics, m)?)?;
+    add_functions!(
+        m,
+        [
+            lyapunov,
+            constraint_curvature,
+            energy_terms,
+            derivative,
+            momentum,
+            momentum_along,
+            energy_statistics,
+            statistics
+        ]
+    );
     m.add_class::<Statistics>()?;
     m.add("VERDICTS", PyTuple::new(m.py(), Verdict::ALL.map(Verdict::name))?)?;
     m.add("FAILURE", Scale::FAILURE)?;

@@ -131,6 +131,6 @@ fn ensemble<'py>(
 }
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
-    m.add_function(wrap_pyfunction!(ensemble, m)?)?;
+    add_functions!(m, [ensemble]);
     Ok(())
 }

@@ -145,10 +145,15 @@ fn central_differences<'py>(
 }
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
-    m.add_function(wrap_pyfunction!(impulse_components, m)?)?;
-    m.add_function(wrap_pyfunction!(impulse_response, m)?)?;
-    m.add_function(wrap_pyfunction!(engage, m)?)?;
-    m.add_function(wrap_pyfunction!(inverse_mass, m)?)?;
-    m.add_function(wrap_pyfunction!(central_differences, m)?)?;
+    add_functions!(
+        m,
+        [
+            impulse_components,
+            impulse_response,
+            engage,
+            inverse_mass,
+            central_differences
+        ]
+    );
     Ok(())
 }

@@ -10,6 +10,13 @@
 //! ([`bind::kind_of`] only shows it). The Python API in `python/varmech` is built on these functions;
 //! `_core.pyi` documents them.
 
+/// Adds the `#[pyfunction]`s listed to the module `m` (each module's `register` lists its own).
+macro_rules! add_functions {
+    ($m:expr, [$($function:ident),+ $(,)?]) => {
+        $($m.add_function(pyo3::wrap_pyfunction!($function, $m)?)?;)+
+    };
+}
+
 mod bind;
 mod closure;
 mod compiled;
@@ -35,24 +42,29 @@ mod trajectory;
 
 use pyo3::prelude::*;
 
+/// A module's `register`: adds its functions and classes to `_core`.
+type Register = fn(&Bound<'_, PyModule>) -> PyResult<()>;
+
 #[pymodule]
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
-    errors::register(m)?;
     m.add_class::<generator::Generator>()?;
-    bind::register(m)?;
-    closure::register(m)?;
-    compiled::register(m)?;
-    pointers::register(m)?;
-    scenes::register(m)?;
-    routh::register(m)?;
-    run::register(m)?;
-    runspec::register(m)?;
-    contacts::register(m)?;
-    ensemble::register(m)?;
     m.add_class::<stepper::Stepper>()?;
-    diagnostics::register(m)?;
-    constraints::register(m)?;
-    impulsive::register(m)?;
-    modes::register(m)?;
-    Ok(())
+    let modules: [Register; 15] = [
+        errors::register,
+        bind::register,
+        closure::register,
+        compiled::register,
+        pointers::register,
+        scenes::register,
+        routh::register,
+        run::register,
+        runspec::register,
+        contacts::register,
+        ensemble::register,
+        diagnostics::register,
+        constraints::register,
+        impulsive::register,
+        modes::register,
+    ];
+    modules.iter().try_for_each(|register| register(m))
 }

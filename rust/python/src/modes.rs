@@ -211,12 +211,17 @@ fn accurate_step(method: &Bound<'_, PyAny>, omega_max: f64, accuracy: f64) -> Py
 }
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
-    m.add_function(wrap_pyfunction!(linearize, m)?)?;
-    m.add_function(wrap_pyfunction!(normal_modes, m)?)?;
-    m.add_function(wrap_pyfunction!(equilibrium, m)?)?;
-    m.add_function(wrap_pyfunction!(fastest_frequency, m)?)?;
-    m.add_function(wrap_pyfunction!(beyond_limit, m)?)?;
-    m.add_function(wrap_pyfunction!(stable_step, m)?)?;
-    m.add_function(wrap_pyfunction!(accurate_step, m)?)?;
+    add_functions!(
+        m,
+        [
+            linearize,
+            normal_modes,
+            equilibrium,
+            fastest_frequency,
+            beyond_limit,
+            stable_step,
+            accurate_step
+        ]
+    );
     Ok(())
 }

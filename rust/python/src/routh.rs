@@ -191,9 +191,6 @@ fn cyclic_velocity<'py>(
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<RouthModel>()?;
-    m.add_function(wrap_pyfunction!(routh, m)?)?;
-    m.add_function(wrap_pyfunction!(cyclic_increments, m)?)?;
-    m.add_function(wrap_pyfunction!(amended_potential, m)?)?;
-    m.add_function(wrap_pyfunction!(cyclic_velocity, m)?)?;
+    add_functions!(m, [routh, cyclic_increments, amended_potential, cyclic_velocity]);
     Ok(())
 }

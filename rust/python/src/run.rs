@@ -246,12 +246,8 @@ fn check_allocation(argument: &str, count: usize, size: usize) -> PyResult<()> {
 }
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
-    m.add_function(wrap_pyfunction!(check_allocation, m)?)?;
     m.add_class::<TrajectoryRecord>()?;
     m.add_class::<MethodInfo>()?;
-    m.add_function(wrap_pyfunction!(integrate, m)?)?;
-    m.add_function(wrap_pyfunction!(resume, m)?)?;
-    m.add_function(wrap_pyfunction!(symplecticity_defect, m)?)?;
-    m.add_function(wrap_pyfunction!(methods, m)?)?;
+    add_functions!(m, [check_allocation, integrate, resume, symplecticity_defect, methods]);
     Ok(())
 }

@@ -178,8 +178,6 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PyCatalogueEntry>()?;
     m.add_class::<SceneRecord>()?;
     m.add_class::<SceneReference>()?;
-    m.add_function(wrap_pyfunction!(scene, m)?)?;
-    m.add_function(wrap_pyfunction!(catalogue, m)?)?;
-    m.add_function(wrap_pyfunction!(nbody, m)?)?;
+    add_functions!(m, [scene, catalogue, nbody]);
     Ok(())
 }

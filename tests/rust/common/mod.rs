@@ -5,10 +5,11 @@ use varmech::integrators::{
     integrate, integrate_ensemble_watching, Dynamics, Ensemble, General, MemberWatch, Method, Options, Parallel,
     Shared, Trajectory,
 };
-use varmech::model::{Lagrangian, MechanicalSystem};
-use varmech::scenes::{Problem, State};
-use varmech::Error;
+use varmech::model::{Constrained, Hessians, Lagrangian, Mass, MechanicalSystem};
+use varmech::scenes::{Problem, RigidBody, State};
+use varmech::{Error, ModelError};
 
+pub mod contacts;
 pub mod skate;
 pub mod tapes;
 
@@ -40,6 +41,53 @@ pub const FAMILIES: [Method; 5] = [
     Method::Rk4,
     Method::Midpoint,
     Method::Galerkin4,
+];
+
+/// A model of constant mass in a potential given by its two functions, V(q) and ∇V(q).
+#[derive(Clone)]
+pub struct Potential<V = fn(&[f64]) -> f64, G = fn(&[f64], &mut [f64])> {
+    pub dim: usize,
+    pub mass: Mass,
+    pub potential: V,
+    pub gradient: G,
+}
+
+impl Potential {
+    /// A unit mass (each coordinate's) in V, of gradient ∇V.
+    pub fn unit(dim: usize, potential: fn(&[f64]) -> f64, gradient: fn(&[f64], &mut [f64])) -> Self {
+        let mass = Mass::scalar(1.0).unwrap();
+        Potential {
+            dim,
+            mass,
+            potential,
+            gradient,
+        }
+    }
+}
+
+impl<V: Fn(&[f64]) -> f64, G: Fn(&[f64], &mut [f64])> MechanicalSystem for Potential<V, G> {
+    fn dim(&self) -> usize {
+        self.dim
+    }
+    fn mass(&self) -> &Mass {
+        &self.mass
+    }
+    fn potential(&self, q: &[f64]) -> Result<f64, ModelError> {
+        Ok((self.potential)(q))
+    }
+    fn gradient(&self, q: &[f64], grad: &mut [f64]) -> Result<(), ModelError> {
+        (self.gradient)(q, grad);
+        Ok(())
+    }
+}
+
+/// The implicit methods, the variational integrators of general Lagrangians: every method of
+/// [`Method::ALL`] that [`MethodInfo::implicit`](varmech::integrators::MethodInfo) marks.
+pub const IMPLICIT: [Method; 4] = [
+    Method::Midpoint,
+    Method::Trapezoid,
+    Method::Galerkin4,
+    Method::Galerkin6,
 ];
 
 /// splitmix64: reproducible points without a dependency.
@@ -85,6 +133,11 @@ pub fn run<S: MechanicalSystem>(
     .unwrap_or_else(|f| panic!("{:?} failed: {}", method, f.error))
 }
 
+/// `f` of each saved state (q, p) of `traj`.
+pub fn along<T>(traj: &Trajectory, f: impl Fn(&[f64], &[f64]) -> T) -> Vec<T> {
+    (0..traj.len()).map(|k| f(traj.q_at(k), traj.p_at(k))).collect()
+}
+
 /// ‖(q, p) − (q_ref, p_ref)‖₂ at the last saved state.
 pub fn final_error(traj: &Trajectory, q_ref: &[f64], p_ref: &[f64]) -> f64 {
     let k = traj.len() - 1;
@@ -113,6 +166,13 @@ pub fn assert_order(what: &str, errors: &[f64], order: f64, tolerance: f64) -> V
     orders
 }
 
+/// Asserts that `method` converges at its order ± 0.3 over `halvings` halvings of the step from
+/// `n0` steps ([`assert_order`]), `error(steps)` being the error of a run of so many steps.
+pub fn assert_method_order(method: Method, n0: usize, halvings: usize, error: impl FnMut(usize) -> f64) {
+    let errors: Vec<f64> = (0..=halvings).map(|k| n0 << k).map(error).collect();
+    assert_order(&format!("{method:?}"), &errors, method.info().order as f64, 0.3);
+}
+
 /// Integrates the general Lagrangian `sys` from `initial` with `steps` steps of size h, keeping
 /// every `save_every`-th state.
 pub fn run_general<L: Lagrangian>(
@@ -127,7 +187,56 @@ pub fn run_general<L: Lagrangian>(
         save_every,
         ..Options::new(h, steps)
     };
-    integrate(&General(sys), method, &initial.q, &initial.p, &options, || Ok(())).map_err(|f| f.error)
+    run_general_with(sys, initial, method, &options)
+}
+
+/// Integrates the general Lagrangian `sys` from `initial` with `options`.
+pub fn run_general_with<L: Lagrangian>(
+    sys: &L,
+    initial: &State,
+    method: Method,
+    options: &Options,
+) -> Result<Trajectory, Error> {
+    integrate(&General(sys), method, &initial.q, &initial.p, options, || Ok(())).map_err(|f| f.error)
+}
+
+/// Asserts that the Hessians of `sys` at (q, q̇), t = 0, are the central differences of its
+/// gradients ([`hessian_columns`]) to `tolerance` relative to max(1, |difference|); returns
+/// them, and the largest such gap.
+pub fn assert_hessians<L: Lagrangian + ?Sized>(sys: &L, q: &[f64], v: &[f64], tolerance: f64) -> (Hessians, f64) {
+    let n = q.len();
+    let mut h = Hessians::zeros(n);
+    assert!(sys.hessians(q, v, 0.0, &mut h).unwrap());
+    let lq = |q: &[f64], v: &[f64], out: &mut [f64]| sys.dl_dq(q, v, 0.0, out).unwrap();
+    let lv = |q: &[f64], v: &[f64], out: &mut [f64]| sys.dl_dv(q, v, 0.0, out).unwrap();
+    let mut worst = 0.0_f64;
+    for j in 0..n {
+        let [qq, qv, vv] = hessian_columns(&lq, &lv, q, v, j);
+        for (name, matrix, column) in [("qq", &h.qq, qq), ("qv", &h.qv, qv), ("vv", &h.vv, vv)] {
+            for i in 0..n {
+                let gap = (matrix[(i, j)] - column[i]).abs() / column[i].abs().max(1.0);
+                worst = worst.max(gap);
+                assert!(
+                    gap < tolerance,
+                    "{name} ({i}, {j}) at q = {q:?}: {} vs {}",
+                    matrix[(i, j)],
+                    column[i]
+                );
+            }
+        }
+    }
+    (h, worst)
+}
+
+/// Runs `body` on the rigid body, its Lagrangian on its constraints as a general one, and its
+/// initial state.
+pub fn with_rigid_body<R>(body: impl FnOnce(&dyn Dynamics, &State) -> R) -> R {
+    let problem = RigidBody::problem();
+    let sys = Constrained {
+        system: General(&problem.system.system),
+        constraints: problem.system.constraints.clone(),
+    };
+    body(&sys, &problem.initial)
 }
 
 /// The statistics and verdict of the energy of `sys` along `traj`.

@@ -47,21 +47,22 @@ pub fn kepler(mu: f64, jit: bool) -> CompiledSeparable {
             b.function(outputs, n, params)
         }
     };
-    let mut b = Builder::default();
-    let (x, y, m) = (b.input(0), b.input(1), b.op(Op::Param(0)));
-    let (xx, yy) = (b.binary(Binary::Mul, x, x), b.binary(Binary::Mul, y, y));
-    let r2 = b.binary(Binary::Add, xx, yy);
-    let s = b.unary(Unary::Sqrt, r2);
+    // Both tapes start alike: a builder with x, y, μ, r² and √r².
+    let start = || {
+        let mut b = Builder::default();
+        let (x, y, m) = (b.input(0), b.input(1), b.op(Op::Param(0)));
+        let (xx, yy) = (b.binary(Binary::Mul, x, x), b.binary(Binary::Mul, y, y));
+        let r2 = b.binary(Binary::Add, xx, yy);
+        let s = b.unary(Unary::Sqrt, r2);
+        (b, [x, y, m, r2, s])
+    };
+    let (mut b, [x, y, m, r2, s]) = start();
     let d = b.binary(Binary::Mul, r2, s);
     let k = b.binary(Binary::Div, m, d);
     let (gx, gy) = (b.binary(Binary::Mul, k, x), b.binary(Binary::Mul, k, y));
     let gradient = finish(b, vec![gx, gy], 2, 1);
 
-    let mut b = Builder::default();
-    let (x, y, m) = (b.input(0), b.input(1), b.op(Op::Param(0)));
-    let (xx, yy) = (b.binary(Binary::Mul, x, x), b.binary(Binary::Mul, y, y));
-    let r2 = b.binary(Binary::Add, xx, yy);
-    let s = b.unary(Unary::Sqrt, r2);
+    let (mut b, [_, _, m, _, s]) = start();
     let v = b.binary(Binary::Div, m, s);
     let v = b.unary(Unary::Neg, v);
     let potential = finish(b, vec![v], 2, 1);
