@@ -9,13 +9,9 @@ pub struct HenonHeiles {
     mass: Mass,
 }
 
-impl HenonHeiles {
-    pub fn new() -> Self {
-        HenonHeiles {
-            mass: Mass::Scalar(1.0),
-        }
-    }
+unit_mass!(HenonHeiles);
 
+impl HenonHeiles {
     /// The long-run protocol of the SciML benchmarks: q = (0.1, 0), p = (0, 0.5), H = 0.13, to
     /// t = 5·10⁴ (no reference state; the energy is the invariant to check).
     pub fn problem() -> Problem<Self> {
@@ -29,12 +25,6 @@ impl HenonHeiles {
             t_end: 5e4,
             reference: None,
         }
-    }
-}
-
-impl Default for HenonHeiles {
-    fn default() -> Self {
-        Self::new()
     }
 }
 

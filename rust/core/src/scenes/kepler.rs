@@ -9,13 +9,9 @@ pub struct Kepler {
     mass: Mass,
 }
 
-impl Kepler {
-    pub fn new() -> Self {
-        Kepler {
-            mass: Mass::Scalar(1.0),
-        }
-    }
+unit_mass!(Kepler);
 
+impl Kepler {
     /// HLW's work–precision protocol: q = (1 − e, 0), p = (0, √((1+e)/(1−e))), whose orbit has
     /// period 2π, H = −1/2 and L = √(1 − e²); integrated over 200 periods, after which the exact
     /// state is the initial state.
@@ -39,12 +35,6 @@ impl Kepler {
             t_end,
             reference: Some((reference, "exact: 200 whole periods")),
         })
-    }
-}
-
-impl Default for Kepler {
-    fn default() -> Self {
-        Self::new()
     }
 }
 

@@ -9,6 +9,26 @@
 //! which names the sources; tests and benches use these problems (as diffsol ships its test
 //! problems in the library).
 
+/// `new()`, the system of unit mass, and `Default` as `new()`: for the scenes whose system has
+/// no parameter (its one field its mass, 1), as the Hénon–Heiles, Kepler and pendulum ones.
+macro_rules! unit_mass {
+    ($scene:ident) => {
+        impl $scene {
+            pub fn new() -> Self {
+                $scene {
+                    mass: Mass::Scalar(1.0),
+                }
+            }
+        }
+
+        impl Default for $scene {
+            fn default() -> Self {
+                Self::new()
+            }
+        }
+    };
+}
+
 mod bouncing_ball;
 mod catalogue;
 mod chaplygin_sleigh;
