@@ -40,18 +40,7 @@ impl ChaplyginSleigh {
     /// κ = bU/(I + b²), E = ½(I + b²)ω₀²: it relaxes to straight-line motion at speed U. The
     /// reference holds θ and the momenta at T; its x and y (integrals of those) are NaN.
     pub fn problem(inertia: f64, blade: f64, spin: f64) -> Result<Problem<Nonholonomic<FreeBody, Blade>>, Error> {
-        if !(inertia.is_finite() && inertia > 0.0) {
-            return Err(Error::invalid(
-                "inertia",
-                format!("must be finite and positive, got {inertia}"),
-            ));
-        }
-        if !(blade.is_finite() && blade > 0.0) {
-            return Err(Error::invalid(
-                "blade",
-                format!("must be finite and positive, got {blade}"),
-            ));
-        }
+        super::positive(&[("inertia", inertia), ("blade", blade)])?;
         if !spin.is_finite() {
             return Err(Error::invalid("spin", format!("must be finite, got {spin}")));
         }

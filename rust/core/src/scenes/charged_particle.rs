@@ -22,9 +22,7 @@ pub struct ChargedParticle {
 
 impl ChargedParticle {
     pub fn new(m: f64, charge: f64, b: f64, kappa: f64) -> Result<Self, Error> {
-        if !(m.is_finite() && m > 0.0) {
-            return Err(Error::invalid("m", format!("must be finite and positive, got {m}")));
-        }
+        super::positive(&[("m", m)])?;
         super::finite(&[("charge", charge), ("B", b), ("kappa", kappa)])?;
         Ok(ChargedParticle { m, charge, b, kappa })
     }

@@ -22,11 +22,7 @@ pub struct DampedDrivenPendulum {
 
 impl DampedDrivenPendulum {
     pub fn new(m: f64, l: f64, g: f64, gamma: f64, amplitude: f64, drive: f64) -> Result<Self, Error> {
-        for (name, x) in [("m", m), ("l", l)] {
-            if !(x.is_finite() && x > 0.0) {
-                return Err(Error::invalid(name, format!("must be finite and positive, got {x}")));
-            }
-        }
+        super::positive(&[("m", m), ("l", l)])?;
         // R = ½γθ̇² dissipates only for γ ≥ 0.
         if !(gamma.is_finite() && gamma >= 0.0) {
             return Err(Error::invalid(

@@ -19,11 +19,7 @@ pub struct DoublePendulum {
 
 impl DoublePendulum {
     pub fn new(m1: f64, m2: f64, l1: f64, l2: f64, g: f64) -> Result<Self, Error> {
-        for (name, x) in [("m1", m1), ("m2", m2), ("l1", l1), ("l2", l2)] {
-            if !(x.is_finite() && x > 0.0) {
-                return Err(Error::invalid(name, format!("must be finite and positive, got {x}")));
-            }
-        }
+        super::positive(&[("m1", m1), ("m2", m2), ("l1", l1), ("l2", l2)])?;
         if !g.is_finite() {
             return Err(Error::invalid("g", "must be finite"));
         }

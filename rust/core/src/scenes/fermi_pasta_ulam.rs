@@ -20,12 +20,7 @@ impl FermiPastaUlam {
         if m == 0 {
             return Err(Error::invalid("m", "needs at least one stiff spring"));
         }
-        if !(omega.is_finite() && omega > 0.0) {
-            return Err(Error::invalid(
-                "omega",
-                format!("must be finite and positive, got {omega}"),
-            ));
-        }
+        super::positive(&[("omega", omega)])?;
         Ok(FermiPastaUlam {
             m,
             omega,

@@ -12,12 +12,7 @@ pub struct HarmonicOscillator {
 
 impl HarmonicOscillator {
     pub fn new(omega: f64) -> Result<Self, Error> {
-        if !(omega.is_finite() && omega > 0.0) {
-            return Err(Error::invalid(
-                "omega",
-                format!("must be finite and positive, got {omega}"),
-            ));
-        }
+        super::positive(&[("omega", omega)])?;
         Ok(HarmonicOscillator {
             omega,
             mass: Mass::Scalar(1.0),

@@ -18,11 +18,7 @@ pub struct KeplerPolar {
 
 impl KeplerPolar {
     pub fn new(m: f64, k: f64) -> Result<Self, Error> {
-        for (name, x) in [("m", m), ("k", k)] {
-            if !(x.is_finite() && x > 0.0) {
-                return Err(Error::invalid(name, format!("must be finite and positive, got {x}")));
-            }
-        }
+        super::positive(&[("m", m), ("k", k)])?;
         Ok(KeplerPolar { m, k })
     }
 

@@ -265,6 +265,17 @@ impl NonholonomicScene {
     }
 }
 
+/// Refuses the first of a scene's named values that is not finite and positive, naming it.
+pub(crate) fn positive(values: &[(&'static str, f64)]) -> Result<(), crate::Error> {
+    match values.iter().find(|(_, x)| !(x.is_finite() && *x > 0.0)) {
+        Some((name, x)) => Err(crate::Error::invalid(
+            name,
+            format!("must be finite and positive, got {x}"),
+        )),
+        None => Ok(()),
+    }
+}
+
 /// Refuses the first of a scene's named values that is not finite, naming it.
 pub(crate) fn finite(values: &[(&'static str, f64)]) -> Result<(), crate::Error> {
     match values.iter().find(|(_, x)| !x.is_finite()) {

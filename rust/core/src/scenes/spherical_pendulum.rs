@@ -17,11 +17,7 @@ pub struct SphericalPendulum {
 
 impl SphericalPendulum {
     pub fn new(m: f64, l: f64, g: f64) -> Result<Self, Error> {
-        for (name, x) in [("m", m), ("l", l)] {
-            if !(x.is_finite() && x > 0.0) {
-                return Err(Error::invalid(name, format!("must be finite and positive, got {x}")));
-            }
-        }
+        super::positive(&[("m", m), ("l", l)])?;
         if !g.is_finite() {
             return Err(Error::invalid("g", "must be finite"));
         }
