@@ -55,11 +55,7 @@ impl BouncingBall {
         let t_end = Self::horizon(g, h0, restitution);
         Ok(Problem {
             system,
-            initial: State {
-                t: 0.0,
-                q: vec![h0],
-                p: vec![0.0],
-            },
+            initial: State::start(vec![h0], vec![0.0]),
             t_end,
             reference: Some((
                 State {

@@ -66,11 +66,7 @@ impl ChaplyginSleigh {
                 system: FreeBody::new(vec![1.0, 1.0, inertia])?,
                 constraints: Blade { distance: blade },
             },
-            initial: State {
-                t: 0.0,
-                q: vec![0.0, 0.0, 0.0],
-                p: vec![0.0, blade * spin, inertia * spin],
-            },
+            initial: State::start(vec![0.0, 0.0, 0.0], vec![0.0, blade * spin, inertia * spin]),
             t_end,
             reference: Some((
                 reference,

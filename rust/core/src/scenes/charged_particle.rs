@@ -78,7 +78,7 @@ impl ChargedParticle {
         let mut p = vec![0.0; 2];
         system.dl_dv(&q, &[0.0, -1.0], 0.0, &mut p).expect("exact");
         Problem {
-            initial: State { t: 0.0, q, p },
+            initial: State::start(q, p),
             t_end: 200.0,
             reference: None,
             system,

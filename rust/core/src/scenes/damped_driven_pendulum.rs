@@ -47,11 +47,7 @@ impl DampedDrivenPendulum {
     pub fn problem(gamma: f64, amplitude: f64, drive: f64) -> Result<Problem<Self>, Error> {
         Ok(Problem {
             system: Self::new(1.0, 1.0, 1.0, gamma, amplitude, drive)?,
-            initial: State {
-                t: 0.0,
-                q: vec![0.0],
-                p: vec![0.0],
-            },
+            initial: State::start(vec![0.0], vec![0.0]),
             t_end: 100.0,
             reference: None,
         })

@@ -68,7 +68,7 @@ impl DoublePendulum {
         let q_ref = vec![0.87467888012, 0.55850349694];
         let p_ref = momentum(&q_ref, &[-4.08255226002, 1.66594428518]);
         Problem {
-            initial: State { t: 0.0, q: q0, p: p0 },
+            initial: State::start(q0, p0),
             t_end: 10.0,
             reference: Some((
                 State {

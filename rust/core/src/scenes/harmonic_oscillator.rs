@@ -41,11 +41,7 @@ impl HarmonicOscillator {
         };
         Ok(Problem {
             system,
-            initial: State {
-                t: 0.0,
-                q: vec![0.0],
-                p: vec![1.0],
-            },
+            initial: State::start(vec![0.0], vec![1.0]),
             t_end,
             reference: Some((reference, "exact solution")),
         })

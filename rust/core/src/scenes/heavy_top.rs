@@ -152,7 +152,7 @@ impl HeavyTop {
         let mut p0 = vec![0.0; 3];
         system.dl_dv(&q0, &[0.0, 0.0, 5.0], 0.0, &mut p0).expect("exact");
         Problem {
-            initial: State { t: 0.0, q: q0, p: p0 },
+            initial: State::start(q0, p0),
             t_end: 50.0,
             reference: None,
             system,

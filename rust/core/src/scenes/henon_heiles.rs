@@ -17,11 +17,7 @@ impl HenonHeiles {
     pub fn problem() -> Problem<Self> {
         Problem {
             system: Self::new(),
-            initial: State {
-                t: 0.0,
-                q: vec![0.1, 0.0],
-                p: vec![0.0, 0.5],
-            },
+            initial: State::start(vec![0.1, 0.0], vec![0.0, 0.5]),
             t_end: 5e4,
             reference: None,
         }

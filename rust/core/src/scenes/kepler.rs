@@ -19,11 +19,7 @@ impl Kepler {
         if !(0.0..1.0).contains(&e) {
             return Err(Error::invalid("e", format!("eccentricity must lie in [0, 1), got {e}")));
         }
-        let initial = State {
-            t: 0.0,
-            q: vec![1.0 - e, 0.0],
-            p: vec![0.0, ((1.0 + e) / (1.0 - e)).sqrt()],
-        };
+        let initial = State::start(vec![1.0 - e, 0.0], vec![0.0, ((1.0 + e) / (1.0 - e)).sqrt()]);
         let t_end = 200.0 * 2.0 * std::f64::consts::PI;
         let reference = State {
             t: t_end,

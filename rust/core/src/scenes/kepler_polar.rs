@@ -37,11 +37,7 @@ impl KeplerPolar {
         }
         let t_end = 200.0 * 2.0 * std::f64::consts::PI;
         let p = vec![0.0, (1.0 - e * e).sqrt()];
-        let initial = State {
-            t: 0.0,
-            q: vec![1.0 - e, 0.0],
-            p: p.clone(),
-        };
+        let initial = State::start(vec![1.0 - e, 0.0], p.clone());
         let reference = State {
             t: t_end,
             q: vec![1.0 - e, 400.0 * std::f64::consts::PI],

@@ -84,6 +84,13 @@ pub struct State {
     pub p: Vec<f64>,
 }
 
+impl State {
+    /// The state (q, p) at t = 0, where a scene's protocol starts.
+    pub(crate) fn start(q: Vec<f64>, p: Vec<f64>) -> State {
+        State { t: 0.0, q, p }
+    }
+}
+
 /// A system with its initial state, the horizon of its test protocol and a reference solution.
 #[derive(Clone, Debug)]
 pub struct Problem<S> {

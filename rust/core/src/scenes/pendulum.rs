@@ -31,11 +31,7 @@ impl Pendulum {
         let t = 2.0 * std::f64::consts::PI;
         Problem {
             system: Self::new(),
-            initial: State {
-                t: 0.0,
-                q: vec![0.0],
-                p: vec![1.0],
-            },
+            initial: State::start(vec![0.0], vec![1.0]),
             t_end: t,
             reference: Some((
                 State {

@@ -48,7 +48,7 @@ impl SphericalPendulum {
             p: vec![f64::NAN, p0[1]],
         };
         Problem {
-            initial: State { t: 0.0, q: q0, p: p0 },
+            initial: State::start(q0, p0),
             t_end: 50.0,
             reference: Some((
                 reference,
