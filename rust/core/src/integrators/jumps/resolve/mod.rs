@@ -518,12 +518,7 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
         self.piece_p.copy_from_slice(&self.p);
         self.phi_start.copy_from_slice(&self.phi);
         self.pending.clear();
-        self.blown.clear();
-        self.released.clear();
-        self.pending_work.clear();
-        self.blown_work.clear();
-        self.released_work.clear();
-        self.changes.clear();
+        self.forget_jumps();
         self.closed_start.clear();
         self.closed_start.extend_from_slice(&self.closed);
         self.stuck_start.clear();
