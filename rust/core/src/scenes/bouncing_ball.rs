@@ -13,9 +13,7 @@ pub struct BouncingBall {
 
 impl BouncingBall {
     pub fn new(g: f64) -> Result<Self, Error> {
-        if !(g.is_finite() && g > 0.0) {
-            return Err(Error::invalid("g", format!("must be finite and positive, got {g}")));
-        }
+        super::positive(&[("g", g)])?;
         Ok(BouncingBall {
             g,
             mass: Mass::Scalar(1.0),
@@ -47,9 +45,7 @@ impl BouncingBall {
     /// ([`Self::horizon`]), where q = h₀e²ᴷ and p = 0 (exact).
     pub fn problem(g: f64, h0: f64, restitution: f64) -> Result<Problem<Self>, Error> {
         let system = Self::new(g)?;
-        if !(h0.is_finite() && h0 > 0.0) {
-            return Err(Error::invalid("h0", format!("must be finite and positive, got {h0}")));
-        }
+        super::positive(&[("h0", h0)])?;
         if !(restitution > 0.0 && restitution <= 1.0) {
             return Err(Error::invalid(
                 "restitution",
@@ -59,11 +55,7 @@ impl BouncingBall {
         let t_end = Self::horizon(g, h0, restitution);
         Ok(Problem {
             system,
-            initial: State {
-                t: 0.0,
-                q: vec![h0],
-                p: vec![0.0],
-            },
+            initial: State::start(vec![h0], vec![0.0]),
             t_end,
             reference: Some((
                 State {

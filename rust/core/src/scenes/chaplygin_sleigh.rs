@@ -40,18 +40,7 @@ impl ChaplyginSleigh {
     /// κ = bU/(I + b²), E = ½(I + b²)ω₀²: it relaxes to straight-line motion at speed U. The
     /// reference holds θ and the momenta at T; its x and y (integrals of those) are NaN.
     pub fn problem(inertia: f64, blade: f64, spin: f64) -> Result<Problem<Nonholonomic<FreeBody, Blade>>, Error> {
-        if !(inertia.is_finite() && inertia > 0.0) {
-            return Err(Error::invalid(
-                "inertia",
-                format!("must be finite and positive, got {inertia}"),
-            ));
-        }
-        if !(blade.is_finite() && blade > 0.0) {
-            return Err(Error::invalid(
-                "blade",
-                format!("must be finite and positive, got {blade}"),
-            ));
-        }
+        super::positive(&[("inertia", inertia), ("blade", blade)])?;
         if !spin.is_finite() {
             return Err(Error::invalid("spin", format!("must be finite, got {spin}")));
         }
@@ -77,11 +66,7 @@ impl ChaplyginSleigh {
                 system: FreeBody::new(vec![1.0, 1.0, inertia])?,
                 constraints: Blade { distance: blade },
             },
-            initial: State {
-                t: 0.0,
-                q: vec![0.0, 0.0, 0.0],
-                p: vec![0.0, blade * spin, inertia * spin],
-            },
+            initial: State::start(vec![0.0, 0.0, 0.0], vec![0.0, blade * spin, inertia * spin]),
             t_end,
             reference: Some((
                 reference,

@@ -22,9 +22,7 @@ pub struct ChargedParticle {
 
 impl ChargedParticle {
     pub fn new(m: f64, charge: f64, b: f64, kappa: f64) -> Result<Self, Error> {
-        if !(m.is_finite() && m > 0.0) {
-            return Err(Error::invalid("m", format!("must be finite and positive, got {m}")));
-        }
+        super::positive(&[("m", m)])?;
         super::finite(&[("charge", charge), ("B", b), ("kappa", kappa)])?;
         Ok(ChargedParticle { m, charge, b, kappa })
     }
@@ -80,7 +78,7 @@ impl ChargedParticle {
         let mut p = vec![0.0; 2];
         system.dl_dv(&q, &[0.0, -1.0], 0.0, &mut p).expect("exact");
         Problem {
-            initial: State { t: 0.0, q, p },
+            initial: State::start(q, p),
             t_end: 200.0,
             reference: None,
             system,

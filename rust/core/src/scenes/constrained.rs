@@ -102,11 +102,7 @@ pub fn cartesian_pendulum() -> Problem<LinkedMasses> {
     let (system, q0) = chain(2, 1, 2.0).expect("valid parameters");
     Problem {
         system,
-        initial: State {
-            t: 0.0,
-            q: q0,
-            p: vec![0.0; 2],
-        },
+        initial: State::start(q0, vec![0.0; 2]),
         t_end: 1e4,
         reference: None,
     }
@@ -126,7 +122,7 @@ pub fn cartesian_spherical_pendulum() -> Problem<LinkedMasses> {
     let p0 = vec![0.0, 1.0f64.sin() * 1.2, 0.0];
     Problem {
         system,
-        initial: State { t: 0.0, q: q0, p: p0 },
+        initial: State::start(q0, p0),
         t_end: 50.0,
         reference: Some((
             State {

@@ -22,11 +22,7 @@ pub struct DampedDrivenPendulum {
 
 impl DampedDrivenPendulum {
     pub fn new(m: f64, l: f64, g: f64, gamma: f64, amplitude: f64, drive: f64) -> Result<Self, Error> {
-        for (name, x) in [("m", m), ("l", l)] {
-            if !(x.is_finite() && x > 0.0) {
-                return Err(Error::invalid(name, format!("must be finite and positive, got {x}")));
-            }
-        }
+        super::positive(&[("m", m), ("l", l)])?;
         // R = ½γθ̇² dissipates only for γ ≥ 0.
         if !(gamma.is_finite() && gamma >= 0.0) {
             return Err(Error::invalid(
@@ -51,11 +47,7 @@ impl DampedDrivenPendulum {
     pub fn problem(gamma: f64, amplitude: f64, drive: f64) -> Result<Problem<Self>, Error> {
         Ok(Problem {
             system: Self::new(1.0, 1.0, 1.0, gamma, amplitude, drive)?,
-            initial: State {
-                t: 0.0,
-                q: vec![0.0],
-                p: vec![0.0],
-            },
+            initial: State::start(vec![0.0], vec![0.0]),
             t_end: 100.0,
             reference: None,
         })

@@ -19,11 +19,7 @@ pub struct DoublePendulum {
 
 impl DoublePendulum {
     pub fn new(m1: f64, m2: f64, l1: f64, l2: f64, g: f64) -> Result<Self, Error> {
-        for (name, x) in [("m1", m1), ("m2", m2), ("l1", l1), ("l2", l2)] {
-            if !(x.is_finite() && x > 0.0) {
-                return Err(Error::invalid(name, format!("must be finite and positive, got {x}")));
-            }
-        }
+        super::positive(&[("m1", m1), ("m2", m2), ("l1", l1), ("l2", l2)])?;
         if !g.is_finite() {
             return Err(Error::invalid("g", "must be finite"));
         }
@@ -72,7 +68,7 @@ impl DoublePendulum {
         let q_ref = vec![0.87467888012, 0.55850349694];
         let p_ref = momentum(&q_ref, &[-4.08255226002, 1.66594428518]);
         Problem {
-            initial: State { t: 0.0, q: q0, p: p0 },
+            initial: State::start(q0, p0),
             t_end: 10.0,
             reference: Some((
                 State {

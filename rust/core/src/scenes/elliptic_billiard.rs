@@ -67,11 +67,7 @@ impl EllipticBilliard {
         }
         Ok(Problem {
             system,
-            initial: State {
-                t: 0.0,
-                q: q0.to_vec(),
-                p: p0.to_vec(),
-            },
+            initial: State::start(q0.to_vec(), p0.to_vec()),
             t_end: Self::HORIZON,
             reference: None,
         })

@@ -20,12 +20,7 @@ impl FermiPastaUlam {
         if m == 0 {
             return Err(Error::invalid("m", "needs at least one stiff spring"));
         }
-        if !(omega.is_finite() && omega > 0.0) {
-            return Err(Error::invalid(
-                "omega",
-                format!("must be finite and positive, got {omega}"),
-            ));
-        }
+        super::positive(&[("omega", omega)])?;
         Ok(FermiPastaUlam {
             m,
             omega,
@@ -42,7 +37,7 @@ impl FermiPastaUlam {
         p[1] = std::f64::consts::SQRT_2;
         Problem {
             system: Self::new(3, 50.0).expect("valid parameters"),
-            initial: State { t: 0.0, q, p },
+            initial: State::start(q, p),
             t_end: 200.0,
             reference: None,
         }

@@ -12,12 +12,7 @@ pub struct HarmonicOscillator {
 
 impl HarmonicOscillator {
     pub fn new(omega: f64) -> Result<Self, Error> {
-        if !(omega.is_finite() && omega > 0.0) {
-            return Err(Error::invalid(
-                "omega",
-                format!("must be finite and positive, got {omega}"),
-            ));
-        }
+        super::positive(&[("omega", omega)])?;
         Ok(HarmonicOscillator {
             omega,
             mass: Mass::Scalar(1.0),
@@ -46,11 +41,7 @@ impl HarmonicOscillator {
         };
         Ok(Problem {
             system,
-            initial: State {
-                t: 0.0,
-                q: vec![0.0],
-                p: vec![1.0],
-            },
+            initial: State::start(vec![0.0], vec![1.0]),
             t_end,
             reference: Some((reference, "exact solution")),
         })

@@ -30,11 +30,7 @@ impl HeavyTop {
     /// I₁ and I₃ must be finite and positive, Mgl finite (Mgl < 0 puts the centre of mass below
     /// the fixed point).
     pub fn new(i1: f64, i3: f64, mgl: f64) -> Result<Self, Error> {
-        for (name, x) in [("i1", i1), ("i3", i3)] {
-            if !(x.is_finite() && x > 0.0) {
-                return Err(Error::invalid(name, format!("must be finite and positive, got {x}")));
-            }
-        }
+        super::positive(&[("i1", i1), ("i3", i3)])?;
         if !mgl.is_finite() {
             return Err(Error::invalid("mgl", format!("must be finite, got {mgl}")));
         }
@@ -156,7 +152,7 @@ impl HeavyTop {
         let mut p0 = vec![0.0; 3];
         system.dl_dv(&q0, &[0.0, 0.0, 5.0], 0.0, &mut p0).expect("exact");
         Problem {
-            initial: State { t: 0.0, q: q0, p: p0 },
+            initial: State::start(q0, p0),
             t_end: 50.0,
             reference: None,
             system,

@@ -9,32 +9,18 @@ pub struct HenonHeiles {
     mass: Mass,
 }
 
-impl HenonHeiles {
-    pub fn new() -> Self {
-        HenonHeiles {
-            mass: Mass::Scalar(1.0),
-        }
-    }
+unit_mass!(HenonHeiles);
 
+impl HenonHeiles {
     /// The long-run protocol of the SciML benchmarks: q = (0.1, 0), p = (0, 0.5), H = 0.13, to
     /// t = 5·10⁴ (no reference state; the energy is the invariant to check).
     pub fn problem() -> Problem<Self> {
         Problem {
             system: Self::new(),
-            initial: State {
-                t: 0.0,
-                q: vec![0.1, 0.0],
-                p: vec![0.0, 0.5],
-            },
+            initial: State::start(vec![0.1, 0.0], vec![0.0, 0.5]),
             t_end: 5e4,
             reference: None,
         }
-    }
-}
-
-impl Default for HenonHeiles {
-    fn default() -> Self {
-        Self::new()
     }
 }
 

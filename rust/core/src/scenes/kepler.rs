@@ -9,13 +9,9 @@ pub struct Kepler {
     mass: Mass,
 }
 
-impl Kepler {
-    pub fn new() -> Self {
-        Kepler {
-            mass: Mass::Scalar(1.0),
-        }
-    }
+unit_mass!(Kepler);
 
+impl Kepler {
     /// HLW's work–precision protocol: q = (1 − e, 0), p = (0, √((1+e)/(1−e))), whose orbit has
     /// period 2π, H = −1/2 and L = √(1 − e²); integrated over 200 periods, after which the exact
     /// state is the initial state.
@@ -23,11 +19,7 @@ impl Kepler {
         if !(0.0..1.0).contains(&e) {
             return Err(Error::invalid("e", format!("eccentricity must lie in [0, 1), got {e}")));
         }
-        let initial = State {
-            t: 0.0,
-            q: vec![1.0 - e, 0.0],
-            p: vec![0.0, ((1.0 + e) / (1.0 - e)).sqrt()],
-        };
+        let initial = State::start(vec![1.0 - e, 0.0], vec![0.0, ((1.0 + e) / (1.0 - e)).sqrt()]);
         let t_end = 200.0 * 2.0 * std::f64::consts::PI;
         let reference = State {
             t: t_end,
@@ -39,12 +31,6 @@ impl Kepler {
             t_end,
             reference: Some((reference, "exact: 200 whole periods")),
         })
-    }
-}
-
-impl Default for Kepler {
-    fn default() -> Self {
-        Self::new()
     }
 }
 

@@ -18,11 +18,7 @@ pub struct KeplerPolar {
 
 impl KeplerPolar {
     pub fn new(m: f64, k: f64) -> Result<Self, Error> {
-        for (name, x) in [("m", m), ("k", k)] {
-            if !(x.is_finite() && x > 0.0) {
-                return Err(Error::invalid(name, format!("must be finite and positive, got {x}")));
-            }
-        }
+        super::positive(&[("m", m), ("k", k)])?;
         Ok(KeplerPolar { m, k })
     }
 
@@ -41,11 +37,7 @@ impl KeplerPolar {
         }
         let t_end = 200.0 * 2.0 * std::f64::consts::PI;
         let p = vec![0.0, (1.0 - e * e).sqrt()];
-        let initial = State {
-            t: 0.0,
-            q: vec![1.0 - e, 0.0],
-            p: p.clone(),
-        };
+        let initial = State::start(vec![1.0 - e, 0.0], p.clone());
         let reference = State {
             t: t_end,
             q: vec![1.0 - e, 400.0 * std::f64::consts::PI],

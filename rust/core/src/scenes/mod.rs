@@ -9,6 +9,26 @@
 //! which names the sources; tests and benches use these problems (as diffsol ships its test
 //! problems in the library).
 
+/// `new()`, the system of unit mass, and `Default` as `new()`: for the scenes whose system has
+/// no parameter (its one field its mass, 1), as the Hénon–Heiles, Kepler and pendulum ones.
+macro_rules! unit_mass {
+    ($scene:ident) => {
+        impl $scene {
+            pub fn new() -> Self {
+                $scene {
+                    mass: Mass::Scalar(1.0),
+                }
+            }
+        }
+
+        impl Default for $scene {
+            fn default() -> Self {
+                Self::new()
+            }
+        }
+    };
+}
+
 mod bouncing_ball;
 mod catalogue;
 mod chaplygin_sleigh;
@@ -62,6 +82,13 @@ pub struct State {
     pub t: f64,
     pub q: Vec<f64>,
     pub p: Vec<f64>,
+}
+
+impl State {
+    /// The state (q, p) at t = 0, where a scene's protocol starts.
+    pub(crate) fn start(q: Vec<f64>, p: Vec<f64>) -> State {
+        State { t: 0.0, q, p }
+    }
 }
 
 /// A system with its initial state, the horizon of its test protocol and a reference solution.
@@ -242,6 +269,17 @@ impl NonholonomicScene {
             NonholonomicScene::ChaplyginSleigh(s) => s.constraints.count(),
             NonholonomicScene::RollingSphere(s) => s.constraints.count(),
         }
+    }
+}
+
+/// Refuses the first of a scene's named values that is not finite and positive, naming it.
+pub(crate) fn positive(values: &[(&'static str, f64)]) -> Result<(), crate::Error> {
+    match values.iter().find(|(_, x)| !(x.is_finite() && *x > 0.0)) {
+        Some((name, x)) => Err(crate::Error::invalid(
+            name,
+            format!("must be finite and positive, got {x}"),
+        )),
+        None => Ok(()),
     }
 }
 

@@ -52,11 +52,7 @@ impl NBody {
         let t_end = 500_000.0;
         Problem {
             system: Self::new(G, MASSES.to_vec()).expect("valid data"),
-            initial: State {
-                t: 0.0,
-                q: X0.concat(),
-                p: momenta(&V0),
-            },
+            initial: State::start(X0.concat(), momenta(&V0)),
             t_end,
             reference: Some((
                 State {

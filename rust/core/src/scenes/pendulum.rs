@@ -9,13 +9,9 @@ pub struct Pendulum {
     mass: Mass,
 }
 
-impl Pendulum {
-    pub fn new() -> Self {
-        Pendulum {
-            mass: Mass::Scalar(1.0),
-        }
-    }
+unit_mass!(Pendulum);
 
+impl Pendulum {
     /// The exact flow from the bottom, (q, p) = (0, p₀) with |p₀| < 2 (libration):
     /// q(t) = 2 arcsin(k sn(t | k²)), p(t) = 2k cn(t | k²) with k = p₀/2.
     pub fn exact_from_bottom(p0: f64, t: f64) -> Result<(f64, f64), Error> {
@@ -35,11 +31,7 @@ impl Pendulum {
         let t = 2.0 * std::f64::consts::PI;
         Problem {
             system: Self::new(),
-            initial: State {
-                t: 0.0,
-                q: vec![0.0],
-                p: vec![1.0],
-            },
+            initial: State::start(vec![0.0], vec![1.0]),
             t_end: t,
             reference: Some((
                 State {
@@ -50,12 +42,6 @@ impl Pendulum {
                 "Hairer, Lubich & Wanner, GNI I.1; GNI test codes",
             )),
         }
-    }
-}
-
-impl Default for Pendulum {
-    fn default() -> Self {
-        Self::new()
     }
 }
 

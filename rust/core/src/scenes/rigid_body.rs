@@ -76,7 +76,7 @@ impl RigidBody {
         );
         Problem {
             system: Constrained { system, constraints },
-            initial: State { t: 0.0, q: q0, p: p0 },
+            initial: State::start(q0, p0),
             t_end: 10.0,
             reference: None,
         }

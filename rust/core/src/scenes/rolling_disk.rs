@@ -92,11 +92,7 @@ impl RollingDisk {
                 system: FreeBody::new(inertia.to_vec())?,
                 constraints: Rolling { radius },
             },
-            initial: State {
-                t: 0.0,
-                q: vec![0.0, 0.0, theta0, 0.0],
-                p: p0,
-            },
+            initial: State::start(vec![0.0, 0.0, theta0, 0.0], p0),
             t_end,
             reference: Some((reference, "exact: θ̇, φ̇ constant, the contact point on a circle")),
         })

@@ -201,7 +201,7 @@ impl RollingSphere {
                 system: self,
                 constraints: contact,
             },
-            initial: State { t: 0.0, q, p },
+            initial: State::start(q, p),
             t_end: reference.0.t,
             reference: Some(reference),
         }

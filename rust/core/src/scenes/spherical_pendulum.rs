@@ -17,11 +17,7 @@ pub struct SphericalPendulum {
 
 impl SphericalPendulum {
     pub fn new(m: f64, l: f64, g: f64) -> Result<Self, Error> {
-        for (name, x) in [("m", m), ("l", l)] {
-            if !(x.is_finite() && x > 0.0) {
-                return Err(Error::invalid(name, format!("must be finite and positive, got {x}")));
-            }
-        }
+        super::positive(&[("m", m), ("l", l)])?;
         if !g.is_finite() {
             return Err(Error::invalid("g", "must be finite"));
         }
@@ -52,7 +48,7 @@ impl SphericalPendulum {
             p: vec![f64::NAN, p0[1]],
         };
         Problem {
-            initial: State { t: 0.0, q: q0, p: p0 },
+            initial: State::start(q0, p0),
             t_end: 50.0,
             reference: Some((
                 reference,

@@ -6,7 +6,10 @@
 //! bytes, strings, objects and masked arrays are refused with a TypeError naming the closure:
 //! NumPy would drop an imaginary part, read bytes as their codes and a mask as nothing.
 
-use numpy::{PyArray1, PyArrayDescrMethods, PyArrayDyn, PyArrayMethods, PyUntypedArray, PyUntypedArrayMethods};
+use numpy::ndarray::Dimension;
+use numpy::{
+    PyArray, PyArray1, PyArrayDescrMethods, PyArrayDyn, PyArrayMethods, PyUntypedArray, PyUntypedArrayMethods,
+};
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyFloat, PyInt, PyList, PyTuple};
@@ -108,6 +111,20 @@ fn admit<'py>(result: Bound<'py, PyAny>, call: &str, expected: &str) -> Result<B
     array.call_method1("astype", ("float64",)).map_err(boxed)
 }
 
+/// A closure's array result: a plain float64 ndarray as it is, anything else [`admit`]ted.
+fn admitted<'py>(
+    result: PyResult<Bound<'py, PyAny>>,
+    call: &str,
+    expected: &str,
+) -> Result<Bound<'py, PyAny>, ModelError> {
+    let result = result.map_err(boxed)?;
+    if plain_float64(&result) {
+        Ok(result)
+    } else {
+        admit(result, call, expected)
+    }
+}
+
 /// Reads a closure's result, a float; a wrong type is a TypeError naming the closure as `call`.
 pub fn call_scalar(result: PyResult<Bound<'_, PyAny>>, call: &str) -> Result<f64, ModelError> {
     let result = result.map_err(boxed)?;
@@ -122,14 +139,9 @@ pub fn call_scalar(result: PyResult<Bound<'_, PyAny>>, call: &str) -> Result<f64
 /// Reads a closure's result, an array (n,) of floats, into `out`. A wrong length is a
 /// ValueError and a wrong type a TypeError, both naming the closure as `call`.
 pub fn call_vector(result: PyResult<Bound<'_, PyAny>>, call: &str, out: &mut [f64]) -> Result<(), ModelError> {
-    let result = result.map_err(boxed)?;
     let n = out.len();
     let expected = format!("a 1-d array of {n} floats");
-    let result = if plain_float64(&result) {
-        result
-    } else {
-        admit(result, call, &expected)?
-    };
+    let result = admitted(result, call, &expected)?;
     let Ok(arr) = result.cast::<PyArray1<f64>>() else {
         let shape = result
             .getattr("shape")
@@ -140,16 +152,9 @@ pub fn call_vector(result: PyResult<Bound<'_, PyAny>>, call: &str, out: &mut [f6
             type_name(&result)
         ))));
     };
-    let ro = arr.readonly();
-    let view = ro.as_array();
-    if view.len() != n {
-        return Err(boxed(PyValueError::new_err(format!(
-            "{call} returned {} values, expected {n} (one per coordinate)",
-            view.len()
-        ))));
-    }
-    out.iter_mut().zip(view.iter()).for_each(|(o, v)| *o = *v);
-    Ok(())
+    read_into(arr, out, |got| {
+        (got[0] != n).then(|| format!("{call} returned {} values, expected {n} (one per coordinate)", got[0]))
+    })
 }
 
 /// Reads a closure's result, a float array of `shape`, into `out` in C order. A wrong shape is
@@ -160,26 +165,30 @@ pub fn call_array(
     shape: &[usize],
     out: &mut [f64],
 ) -> Result<(), ModelError> {
-    let result = result.map_err(boxed)?;
     let expected = format!("an array of shape {shape:?} of floats");
-    let result = if plain_float64(&result) {
-        result
-    } else {
-        admit(result, call, &expected)?
-    };
+    let result = admitted(result, call, &expected)?;
     let array = result.cast::<PyArrayDyn<f64>>().map_err(|_| {
         boxed(PyTypeError::new_err(format!(
             "{call} must return {expected}, got {}",
             type_name(&result)
         )))
     })?;
+    read_into(array, out, |got| {
+        (got != shape).then(|| format!("{call} returned an array of shape {got:?}, expected {shape:?}"))
+    })
+}
+
+/// Copies a closure's result `array` into `out` in C order, or refuses its shape with the
+/// ValueError that `wrong` words (None: the shape expected).
+fn read_into<D: Dimension>(
+    array: &Bound<'_, PyArray<f64, D>>,
+    out: &mut [f64],
+    wrong: impl FnOnce(&[usize]) -> Option<String>,
+) -> Result<(), ModelError> {
     let readonly = array.readonly();
     let view = readonly.as_array();
-    if view.shape() != shape {
-        return Err(boxed(PyValueError::new_err(format!(
-            "{call} returned an array of shape {:?}, expected {shape:?}",
-            view.shape()
-        ))));
+    if let Some(message) = wrong(view.shape()) {
+        return Err(boxed(PyValueError::new_err(message)));
     }
     out.iter_mut().zip(view.iter()).for_each(|(o, v)| *o = *v);
     Ok(())

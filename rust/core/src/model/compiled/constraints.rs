@@ -17,6 +17,8 @@ pub struct CompiledConstraints {
     jacobian: Function,
 }
 
+with_parameters!(CompiledConstraints);
+
 impl CompiledConstraints {
     /// Refuses functions of the wrong shape, naming them.
     pub fn new(m: usize, n: usize, params: Vec<f64>, residual: Function, jacobian: Function) -> Result<Self, Error> {
@@ -28,15 +30,6 @@ impl CompiledConstraints {
             params,
             residual,
             jacobian,
-        })
-    }
-
-    /// The same functions with another parameter vector (of the same length, finite).
-    pub fn with_parameters(&self, params: &[f64]) -> Result<Self, Error> {
-        check_parameters(params, self.params.len())?;
-        Ok(CompiledConstraints {
-            params: params.to_vec(),
-            ..self.clone()
         })
     }
 }

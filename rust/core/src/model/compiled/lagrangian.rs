@@ -37,6 +37,8 @@ pub struct CompiledLagrangian {
     history: Option<Function>,
 }
 
+with_parameters!(CompiledLagrangian);
+
 impl CompiledLagrangian {
     /// Refuses functions with the wrong number of outputs or parameters, naming the function,
     /// masses without a force (the reactive force of a changing mass is one), and delays that
@@ -137,15 +139,6 @@ impl CompiledLagrangian {
             delayed_accelerations,
             delayed_of_past_alone,
             history,
-        })
-    }
-
-    /// The same functions with another parameter vector (of the same length, finite).
-    pub fn with_parameters(&self, params: &[f64]) -> Result<Self, Error> {
-        check_parameters(params, self.params.len())?;
-        Ok(CompiledLagrangian {
-            params: params.to_vec(),
-            ..self.clone()
         })
     }
 

@@ -11,6 +11,23 @@
 //! - [`CompiledConstraints`]: g(q) = 0 with its exact Jacobian;
 //! - [`CompiledVelocityConstraints`]: A(q)q̇ = 0 with its exact derivatives ∂A/∂q.
 
+/// `with_parameters` of a compiled model whose parameter vector `params` is all that its
+/// parameters change: the same functions with another vector (of the same length, finite).
+macro_rules! with_parameters {
+    ($model:ident) => {
+        impl $model {
+            /// The same functions with another parameter vector (of the same length, finite).
+            pub fn with_parameters(&self, params: &[f64]) -> Result<Self, Error> {
+                check_parameters(params, self.params.len())?;
+                Ok($model {
+                    params: params.to_vec(),
+                    ..self.clone()
+                })
+            }
+        }
+    };
+}
+
 mod constraints;
 mod function;
 #[cfg(feature = "jit")]

@@ -18,6 +18,8 @@ pub struct CompiledVelocityConstraints {
     derivative: Function,
 }
 
+with_parameters!(CompiledVelocityConstraints);
+
 impl CompiledVelocityConstraints {
     /// Refuses functions of the wrong shape, naming them.
     pub fn new(m: usize, n: usize, params: Vec<f64>, matrix: Function, derivative: Function) -> Result<Self, Error> {
@@ -36,15 +38,6 @@ impl CompiledVelocityConstraints {
             params,
             matrix,
             derivative,
-        })
-    }
-
-    /// The same functions with another parameter vector (of the same length, finite).
-    pub fn with_parameters(&self, params: &[f64]) -> Result<Self, Error> {
-        check_parameters(params, self.params.len())?;
-        Ok(CompiledVelocityConstraints {
-            params: params.to_vec(),
-            ..self.clone()
         })
     }
 }

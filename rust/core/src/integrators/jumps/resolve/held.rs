@@ -77,12 +77,7 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
     /// The held step, what it holds now, and the scratch stepper.
     pub(super) fn holding(&mut self) -> (&mut Hold, Held<'_, 's>, &Stepper<M>) {
         let hold = self.hold.as_mut().expect("a contact closes only where it can be held");
-        let held = Held {
-            contacts: self.contacts,
-            closed: &self.closed,
-            stuck: &self.stuck,
-            directions: &self.directions,
-        };
+        let held = held!(self);
         (hold, held, &self.scratch)
     }
 

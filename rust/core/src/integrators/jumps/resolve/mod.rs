@@ -24,6 +24,20 @@ use crate::integrators::{Counting, Dynamics, Occurrence, Poll, Stepper, StepperS
 use crate::integrators::{Impacts, NativeSurface, Surface, Switch};
 use crate::Error;
 
+/// What the resolver `$r` holds now, a [`Held`] of its contacts, the closed and stuck ones and
+/// their slip directions: a macro, so that it borrows those fields alone, beside the held step
+/// (`hold`, borrowed mutably with it).
+macro_rules! held {
+    ($r:expr) => {
+        Held {
+            contacts: $r.contacts,
+            closed: &$r.closed,
+            stuck: &$r.stuck,
+            directions: &$r.directions,
+        }
+    };
+}
+
 mod gaps;
 mod held;
 mod impact;
@@ -395,12 +409,7 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
         let (Some(hold), h) = (self.hold.as_mut(), stepper.dt()) else {
             return Ok(0);
         };
-        let held = Held {
-            contacts: self.contacts,
-            closed: &self.closed,
-            stuck: &self.stuck,
-            directions: &self.directions,
-        };
+        let held = held!(self);
         let model = self.scratch.model().as_lagrangian();
         self.t = stepper.t();
         self.q.copy_from_slice(stepper.q());
@@ -518,12 +527,7 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
         self.piece_p.copy_from_slice(&self.p);
         self.phi_start.copy_from_slice(&self.phi);
         self.pending.clear();
-        self.blown.clear();
-        self.released.clear();
-        self.pending_work.clear();
-        self.blown_work.clear();
-        self.released_work.clear();
-        self.changes.clear();
+        self.forget_jumps();
         self.closed_start.clear();
         self.closed_start.extend_from_slice(&self.closed);
         self.stuck_start.clear();
@@ -679,12 +683,7 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
         }
         if let (Some(hold), false) = (self.hold.as_mut(), self.closed.is_empty() || s == 0.0) {
             // The held step, its end set on the scratch as a free piece's would be.
-            let held = Held {
-                contacts: self.contacts,
-                closed: &self.closed,
-                stuck: &self.stuck,
-                directions: &self.directions,
-            };
+            let held = held!(self);
             let model = self.scratch.model().as_lagrangian();
             hold.step(model, held, (ta, s), (&self.piece_q, &self.piece_p))
                 .map_err(|source| run_error(source, step, self.t))?;

@@ -36,13 +36,19 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
                 traj.push_state(t, (q, jumps.p_after_at(row)), stepper, self.step_work - after);
             }
         }
+        self.forget_jumps();
+        traj.impacts.append(&mut self.pending);
+    }
+
+    /// Forgets a step's impulses, releases and switches and the work of its jumps (not its
+    /// impacts, `pending`): once they are saved, or before a step's resolution.
+    pub(super) fn forget_jumps(&mut self) {
         self.blown.clear();
         self.released.clear();
         self.changes.clear();
         self.pending_work.clear();
         self.blown_work.clear();
         self.released_work.clear();
-        traj.impacts.append(&mut self.pending);
     }
 
     /// The impulses at the stepper's time, a point of the grid (the end of the step just taken,
