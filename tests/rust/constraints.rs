@@ -3,7 +3,7 @@
 
 use crate::common;
 
-use varmech::integrators::{integrate, General, Method, Options, Trajectory};
+use varmech::integrators::{integrate, Dynamics, General, Method, Options, Trajectory};
 use varmech::model::Lagrangian;
 use varmech::model::{Constrained, Distances, Residuals};
 use varmech::scenes::{self, LinkedMasses, Pendulum, PointMasses, Problem, RigidBody};
@@ -31,7 +31,7 @@ fn run(
 /// max over the saved states of |g(q)|∞ and |G(q)M⁻¹p|∞.
 fn residuals(sys: &LinkedMasses, traj: &Trajectory) -> (f64, f64) {
     (0..traj.len())
-        .map(|k| sys.residuals(traj.q_at(k), traj.p_at(k)).unwrap())
+        .map(|k| sys.constraint_residuals(traj.q_at(k), traj.p_at(k)).unwrap().unwrap())
         .fold((0.0, 0.0), |(a, b), r| (a.max(r.position), b.max(r.velocity)))
 }
 
@@ -189,12 +189,12 @@ fn inconsistent_initial_data_is_refused_and_projection_makes_it_consistent() {
     .error;
     assert!(error.to_string().contains("holonomic constraints"), "{error}");
 
-    let (q, v) = p.system.project(&q_off, &p_off).unwrap();
-    let Residuals { position, velocity, .. } = p.system.residuals(&q, &v).unwrap();
+    let (q, v) = Dynamics::project(&p.system, &q_off, &p_off).unwrap().unwrap();
+    let Residuals { position, velocity, .. } = p.system.constraint_residuals(&q, &v).unwrap().unwrap();
     assert!(position <= 1e-15 && velocity <= 1e-15, "{position:e}, {velocity:e}");
     assert!(integrate(&p.system, Method::Rattle, &q, &v, &options, || Ok(())).is_ok());
     assert!(
-        p.system.project(&[0.0, 0.0], &[0.0, 0.0]).is_err(),
+        Dynamics::project(&p.system, &[0.0, 0.0], &[0.0, 0.0]).unwrap().is_err(),
         "the anchor has no nearest point"
     );
 }
@@ -252,7 +252,7 @@ fn the_rigid_body_in_quaternions_stays_on_the_unit_sphere_at_the_orders_of_its_m
     for method in [Method::Trapezoid, Method::Midpoint] {
         let traj = run(method, 10_000, 100.0, 10);
         let (position, velocity) = (0..traj.len())
-            .map(|k| sys.residuals_general(traj.q_at(k), traj.p_at(k)).unwrap())
+            .map(|k| sys.constraint_residuals(traj.q_at(k), traj.p_at(k)).unwrap().unwrap())
             .fold((0.0_f64, 0.0_f64), |(a, b), r| (a.max(r.position), b.max(r.velocity)));
         let e0 = problem.system.system.energy(q0, p0, 0.0).unwrap();
         let energy = (0..traj.len())

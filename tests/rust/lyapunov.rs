@@ -450,7 +450,7 @@ fn rattles_tangent_map_is_its_steps_jacobian_on_the_constraint_manifold() {
         let delta = 1e-5;
         let onto = |s: f64| {
             let moved: Vec<f64> = x.iter().zip(&v).map(|(x, v)| x + s * delta * v).collect();
-            let (q, p) = sys.project(&moved[..4], &moved[4..]).unwrap();
+            let (q, p) = Dynamics::project(sys, &moved[..4], &moved[4..]).unwrap().unwrap();
             q.into_iter().chain(p).collect::<Vec<f64>>()
         };
         let (plus, minus) = (onto(1.0), onto(-1.0));

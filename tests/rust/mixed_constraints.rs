@@ -54,7 +54,7 @@ fn the_skate_holds_both_constraints_to_round_off_and_its_energy_without_drift() 
     let (mut position, mut velocity) = (0.0_f64, 0.0_f64);
     let mut energy = Vec::with_capacity(traj.len());
     for k in 0..traj.len() {
-        let r = model.residuals(traj.q_at(k), traj.p_at(k)).unwrap();
+        let r = model.constraint_residuals(traj.q_at(k), traj.p_at(k)).unwrap().unwrap();
         position = position.max(r.position);
         velocity = velocity.max(r.velocity / r.velocity_size);
         energy.push(Lagrangian::energy(&model.system, traj.q_at(k), traj.p_at(k), 0.0).unwrap());
@@ -88,7 +88,7 @@ fn cortes_martinez_takes_the_mixed_constraints_too() {
     // Its discrete constraint at the step's start: of order 1, on both constraints.
     let (model, q0, p0) = skate();
     let traj = run(&model, Method::CortesMartinez, &q0, &p0, 0.01, 400, 400);
-    let r = model.residuals(traj.q_at(1), traj.p_at(1)).unwrap();
+    let r = model.constraint_residuals(traj.q_at(1), traj.p_at(1)).unwrap().unwrap();
     assert!(
         r.position <= 1e-14 && r.velocity <= 1e-14 * r.velocity_size.max(1.0),
         "{r:?}"
@@ -152,8 +152,10 @@ fn initial_states_off_either_constraint_are_refused_by_name() {
     assert_eq!(off(&q0, &[0.0, 0.3, 0.0, INERTIA * OMEGA]), "p0");
     assert_eq!(off(&q0, &[0.0, 0.0, 0.2, INERTIA * OMEGA]), "p0");
     // The projection puts them back, on both.
-    let (q, p) = model.project(&[0.1, 0.2, 1.1, 0.1], &[0.4, 0.3, 0.2, 0.6]).unwrap();
-    let r = model.residuals(&q, &p).unwrap();
+    let (q, p) = Dynamics::project(&model, &[0.1, 0.2, 1.1, 0.1], &[0.4, 0.3, 0.2, 0.6])
+        .unwrap()
+        .unwrap();
+    let r = model.constraint_residuals(&q, &p).unwrap().unwrap();
     assert!(r.position <= 1e-15 && r.velocity <= 1e-15, "{r:?}");
     assert!(run_result(&model, &q, &p).is_ok());
 }

@@ -98,7 +98,7 @@ fn run<L: Lagrangian, C: VelocityConstraints>(
 /// max over the saved states of |A(q)q̇|∞ relative to ‖A‖∞‖q̇‖∞.
 fn residual<L: Lagrangian, C: VelocityConstraints>(model: &Nonholonomic<L, C>, traj: &Trajectory) -> f64 {
     (0..traj.len())
-        .map(|k| model.residuals(traj.q_at(k), traj.p_at(k)).unwrap())
+        .map(|k| model.constraint_residuals(traj.q_at(k), traj.p_at(k)).unwrap().unwrap())
         .fold(0.0, |a, r| a.max(r.velocity / r.velocity_size))
 }
 
@@ -346,9 +346,9 @@ fn initial_data_off_the_velocity_constraints_is_refused_naming_p0() {
     let err = integrate(&model, Method::Trapezoid, &q0, &p0, &options(0.1, 10, 1), || Ok(())).unwrap_err();
     assert!(err.error.to_string().starts_with("method:"), "{}", err.error);
     // The projection puts it back: M-orthogonally, q unchanged.
-    let (q, p) = model.project(&q0, &p0).unwrap();
+    let (q, p) = Dynamics::project(&model, &q0, &p0).unwrap().unwrap();
     assert_eq!(q, q0);
-    assert!(model.residuals(&q, &p).unwrap().velocity <= 1e-15);
+    assert!(model.constraint_residuals(&q, &p).unwrap().unwrap().velocity <= 1e-15);
 }
 
 #[test]

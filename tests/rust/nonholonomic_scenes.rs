@@ -76,7 +76,7 @@ fn the_ball_on_a_turntable_circles_at_two_sevenths_of_its_rate_keeping_its_jacob
             j = j.max((model.system.jacobi_integral(omega, q, p).unwrap() - j0).abs() / j0.abs());
             e = e.max((model.system.energy(q, p, 0.0).unwrap() - e0).abs() / e0);
             spin = spin.max((p[2] - p0[2]).abs());
-            let r = model.residuals(q, p).unwrap();
+            let r = model.constraint_residuals(q, p).unwrap().unwrap();
             constraint = constraint.max(r.velocity / r.velocity_size);
         }
         println!(

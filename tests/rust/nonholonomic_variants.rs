@@ -6,7 +6,7 @@
 use crate::common::{self, Potential};
 
 use nalgebra::DMatrix;
-use varmech::integrators::{integrate, Method, Options, Trajectory};
+use varmech::integrators::{integrate, Dynamics, Method, Options, Trajectory};
 use varmech::model::{Lagrangian, Nonholonomic, VelocityConstraints};
 use varmech::ModelError;
 
@@ -66,14 +66,14 @@ fn run(method: Method, (q0, p0): (&[f64], &[f64]), h: f64, steps: usize, save_ev
 
 /// The energy errors E − E₀ at the saved states.
 fn energy_errors(model: &Particle, traj: &Trajectory) -> Vec<f64> {
-    let e: Vec<f64> = common::along(traj, |q, p| model.system.energy(q, p, 0.0).unwrap());
+    let e: Vec<f64> = common::along(traj, |q, p| Lagrangian::energy(&model.system, q, p, 0.0).unwrap());
     e.iter().map(|x| x - e[0]).collect()
 }
 
 /// max over the saved states of |A(q)q̇| relative to ‖A‖∞‖q̇‖∞.
 fn constraint_residual(model: &Particle, traj: &Trajectory) -> f64 {
     (0..traj.len())
-        .map(|k| model.residuals(traj.q_at(k), traj.p_at(k)).unwrap())
+        .map(|k| model.constraint_residuals(traj.q_at(k), traj.p_at(k)).unwrap().unwrap())
         .fold(0.0, |a, r| a.max(r.velocity / r.velocity_size))
 }
 

@@ -22,23 +22,30 @@ pub trait Dynamics {
     /// The kind of model, which decides the methods that apply ([`crate::integrators::Method::check`]).
     fn kind(&self) -> ModelKind;
 
-    /// Whether (q₀, p₀) is admissible initial data: for constrained systems |g(q₀)|∞ and
-    /// |G(q₀)q̇₀|∞ within 1e-10 (relative to the state's size), since the methods hold the
-    /// constraints where they start and starting off them is a user error. `q0` and `p0` are
-    /// finite and of the right length here.
+    /// Whether (q₀, p₀) is admissible initial data: the constraints' position and velocity
+    /// residuals ([`Dynamics::constraint_residuals`]) within 1e-10 (relative to the state's
+    /// size), since the methods hold the constraints where they start and starting off them is
+    /// a user error. `q0` and `p0` are finite and of the right length here. A holonomic set that
+    /// fails to evaluate is refused naming `q0`; a set with velocity rows fails with the model's
+    /// own error at step 0 (the stepper sets its time).
     fn check_initial(&self, q0: &[f64], p0: &[f64]) -> Result<(), Error> {
         let Some(residuals) = self.constraint_residuals(q0, p0) else {
             return Ok(());
         };
-        let residuals =
-            residuals.map_err(|e| Error::invalid("q0", format!("the constraints failed to evaluate: {e}")))?;
-        on_constraints(
-            &residuals,
-            q0,
-            p0,
-            ("constraints", "|g(q0)|"),
-            ("hidden constraint", "|G(q0)M⁻¹p0|"),
-        )
+        let set = self.constraints();
+        let residuals = match set.velocity {
+            None => residuals.map_err(|e| Error::invalid("q0", format!("the constraints failed to evaluate: {e}")))?,
+            Some(_) => residuals.map_err(at_start)?,
+        };
+        let (position, velocity) = match (set.holonomic, set.velocity) {
+            (_, None) => (("constraints", "|g(q0)|"), ("hidden constraint", "|G(q0)M⁻¹p0|")),
+            (None, Some(_)) => (("constraints", "|g(q0)|"), ("velocity constraints", "|A(q0)q̇0|")),
+            (Some(_), Some(_)) => (
+                ("holonomic constraints", "|g(q0)|"),
+                ("constraints' velocities", "|G(q0)q̇0, A(q0)q̇0 + b|"),
+            ),
+        };
+        on_constraints(&residuals, q0, p0, position, velocity)
     }
 
     /// The model's constraints, holonomic and velocity, as one record; by default none. The
@@ -92,14 +99,22 @@ pub trait Dynamics {
         None
     }
 
-    /// |g(q)|∞ and |G(q)M⁻¹p|∞, with their sizes, for a constrained system; None for the others.
-    fn constraint_residuals(&self, _q: &[f64], _p: &[f64]) -> Option<Result<model::Residuals, ModelError>> {
-        None
+    /// The residuals of [`Dynamics::constraints`] at (q, p), with their sizes
+    /// ([`ConstraintSet::residuals`], q̇ by the inverse Legendre transform); None without
+    /// constraints.
+    fn constraint_residuals(&self, q: &[f64], p: &[f64]) -> Option<Result<model::Residuals, ModelError>> {
+        let set = self.constraints();
+        let velocity = |q: &[f64], p: &[f64], v: &mut [f64]| self.as_lagrangian().velocity(q, p, 0.0, v);
+        (!set.is_empty()).then(|| set.residuals(&velocity, q, p))
     }
 
-    /// The nearest consistent state for a constrained system; None for the others.
-    fn project(&self, _q: &[f64], _p: &[f64]) -> Option<Result<PhaseState, Error>> {
-        None
+    /// The nearest consistent state ([`ConstraintSet::project`], M⁻¹ from the inverse Legendre
+    /// transform); None without constraints.
+    fn project(&self, q: &[f64], p: &[f64]) -> Option<Result<PhaseState, Error>> {
+        let set = self.constraints();
+        let velocity = |q: &[f64], p: &[f64], v: &mut [f64]| self.as_lagrangian().velocity(q, p, 0.0, v);
+        let minv = model::inverse_mass(&velocity);
+        (!set.is_empty()).then(|| set.project(&minv, &velocity, q, p))
     }
 
     /// The velocity constraints A(q)q̇ + b(q) = 0 of a nonholonomic system; None for the others.
@@ -234,16 +249,8 @@ impl<S: MechanicalSystem, C: HolonomicConstraints> Dynamics for Constrained<S, C
         self
     }
 
-    fn constraint_residuals(&self, q: &[f64], p: &[f64]) -> Option<Result<model::Residuals, ModelError>> {
-        Some(self.residuals(q, p))
-    }
-
     fn as_mechanical(&self) -> Option<&dyn MechanicalSystem> {
         Some(&self.system)
-    }
-
-    fn project(&self, q: &[f64], p: &[f64]) -> Option<Result<PhaseState, Error>> {
-        Some(Constrained::project(self, q, p))
     }
 }
 
@@ -277,34 +284,6 @@ impl<L: Lagrangian, C: HolonomicConstraints> Dynamics for Constrained<General<'_
     fn as_dynamics(&self) -> &dyn Dynamics {
         self
     }
-
-    fn constraint_residuals(&self, q: &[f64], p: &[f64]) -> Option<Result<model::Residuals, ModelError>> {
-        Some(self.residuals_general(q, p))
-    }
-
-    fn project(&self, q: &[f64], p: &[f64]) -> Option<Result<PhaseState, Error>> {
-        Some(self.project_general(q, p))
-    }
-}
-
-impl<L: Lagrangian, C: HolonomicConstraints> Constrained<General<'_, L>, C> {
-    /// q̇(q, p), the inverse Legendre transform.
-    fn velocity(&self) -> impl Fn(&[f64], &[f64], &mut [f64]) -> Result<(), ModelError> + '_ {
-        |q, p, v| self.system.0.velocity(q, p, 0.0, v)
-    }
-
-    /// |g(q)|∞ and |G(q)q̇(q, p)|∞, with their sizes.
-    pub fn residuals_general(&self, q: &[f64], p: &[f64]) -> Result<model::Residuals, ModelError> {
-        model::residuals(&self.constraints, &self.velocity(), q, p)
-    }
-
-    /// The nearest consistent state, with M(q)⁻¹x = q̇(q, x) − q̇(q, 0) (exact for L quadratic
-    /// in q̇, whose inverse Legendre transform is affine in p).
-    pub fn project_general(&self, q0: &[f64], p0: &[f64]) -> Result<PhaseState, Error> {
-        let velocity = self.velocity();
-        let minv = model::inverse_mass(&velocity);
-        model::project(&self.constraints, &minv, &velocity, q0, p0)
-    }
 }
 
 /// A Lagrangian with velocity constraints A(q)q̇ = 0, for the discrete Lagrange–d'Alembert
@@ -319,20 +298,6 @@ impl<L: Lagrangian, C: VelocityConstraints> Dynamics for Nonholonomic<L, C> {
             holonomic: None,
             velocity: Some(&self.constraints),
         }
-    }
-
-    /// |A(q₀)q̇₀|∞ within 1e-10 of the state's size; otherwise `p0` is off the constraints. A
-    /// model error is the model's own, at step 0 (the stepper sets its time).
-    fn check_initial(&self, q0: &[f64], p0: &[f64]) -> Result<(), Error> {
-        let residuals = self.residuals(q0, p0).map_err(at_start)?;
-        // No position residual: it is 0.
-        on_constraints(
-            &residuals,
-            q0,
-            p0,
-            ("constraints", "|g(q0)|"),
-            ("velocity constraints", "|A(q0)q̇0|"),
-        )
     }
 
     fn increment(
@@ -351,14 +316,6 @@ impl<L: Lagrangian, C: VelocityConstraints> Dynamics for Nonholonomic<L, C> {
     fn as_dynamics(&self) -> &dyn Dynamics {
         self
     }
-
-    fn constraint_residuals(&self, q: &[f64], p: &[f64]) -> Option<Result<model::Residuals, ModelError>> {
-        Some(self.residuals(q, p))
-    }
-
-    fn project(&self, q: &[f64], p: &[f64]) -> Option<Result<PhaseState, Error>> {
-        Some(Nonholonomic::project(self, q, p))
-    }
 }
 
 /// A Lagrangian on holonomic and velocity constraints together, for the discrete
@@ -371,19 +328,6 @@ impl<L: Lagrangian, H: HolonomicConstraints, C: VelocityConstraints> Dynamics fo
 
     fn constraints(&self) -> ConstraintSet<'_> {
         Mixed::constraints(self)
-    }
-
-    /// |g(q₀)|∞ (else `q0` is off the constraints) and |[G; A](q₀)q̇₀ + [0; b]|∞ (else `p0`)
-    /// within 1e-10 of the state's size. A model error is the model's own, at step 0.
-    fn check_initial(&self, q0: &[f64], p0: &[f64]) -> Result<(), Error> {
-        let residuals = self.residuals(q0, p0).map_err(at_start)?;
-        on_constraints(
-            &residuals,
-            q0,
-            p0,
-            ("holonomic constraints", "|g(q0)|"),
-            ("constraints' velocities", "|G(q0)q̇0, A(q0)q̇0 + b|"),
-        )
     }
 
     fn increment(
@@ -401,14 +345,6 @@ impl<L: Lagrangian, H: HolonomicConstraints, C: VelocityConstraints> Dynamics fo
 
     fn as_dynamics(&self) -> &dyn Dynamics {
         self
-    }
-
-    fn constraint_residuals(&self, q: &[f64], p: &[f64]) -> Option<Result<model::Residuals, ModelError>> {
-        Some(self.residuals(q, p))
-    }
-
-    fn project(&self, q: &[f64], p: &[f64]) -> Option<Result<PhaseState, Error>> {
-        Some(Mixed::project(self, q, p))
     }
 }
 

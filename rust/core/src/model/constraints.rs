@@ -1,6 +1,5 @@
 use nalgebra::{DMatrix, DVector};
 
-use super::MechanicalSystem;
 use crate::error::StepError;
 use crate::solve::difference::{self, central_jacobian, Evaluations};
 use crate::solve::newton::{Correction, Newton, NewtonOptions, NewtonProblem, Reasons, Rules};
@@ -193,31 +192,6 @@ pub struct Residuals {
     pub velocity_size: f64,
 }
 
-/// The constraint [`Residuals`] at one state, q̇ = `velocity`(q, p).
-pub fn residuals<C: HolonomicConstraints + ?Sized>(
-    constraints: &C,
-    velocity: Action<'_>,
-    q: &[f64],
-    p: &[f64],
-) -> Result<Residuals, ModelError> {
-    let (m, n) = (constraints.count(), q.len());
-    let mut g = vec![0.0; m];
-    constraints.residual(q, &mut g)?;
-    let mut jac = DMatrix::zeros(m, n);
-    constraints.jacobian(q, &mut jac)?;
-    let mut v = vec![0.0; n];
-    velocity(q, p, &mut v)?;
-    let hidden = &jac * DVector::from_column_slice(&v);
-    let norm = row_norm(&jac);
-    let amax = |x: &[f64]| x.iter().fold(0.0_f64, |a, y| a.max(y.abs()));
-    Ok(Residuals {
-        position: amax(&g),
-        velocity: hidden.amax(),
-        position_size: norm * amax(q),
-        velocity_size: norm * amax(&v),
-    })
-}
-
 /// The nearest consistent state: q on g = 0 by Newton's method along W = M⁻¹Gᵀ (the nearest
 /// point in the kinetic metric, to first order), then p ← p − Gᵀμ with (GW)μ = Gq̇(q, p), the
 /// M-orthogonal projection onto Gq̇ = 0 (exact when q̇ is affine in p, as for every L quadratic
@@ -348,26 +322,5 @@ impl<C: HolonomicConstraints + ?Sized> NewtonProblem for OntoConstraints<'_, C> 
     /// g's rounding at q, a few ε of the scale of q.
     fn noise(&self) -> f64 {
         4.0 * f64::EPSILON * self.scale
-    }
-}
-
-impl<S: MechanicalSystem, C: HolonomicConstraints> Constrained<S, C> {
-    /// q̇ = M⁻¹p, the constant mass's inverse.
-    fn minv(&self) -> impl Fn(&[f64], &[f64], &mut [f64]) -> Result<(), ModelError> + '_ {
-        |_q, x, out| {
-            self.system.mass().velocity(x, out);
-            Ok(())
-        }
-    }
-
-    /// The constraint residuals |g(q)|∞ and |G(q)M⁻¹p|∞ at one state, with their sizes.
-    pub fn residuals(&self, q: &[f64], p: &[f64]) -> Result<Residuals, ModelError> {
-        residuals(&self.constraints, &self.minv(), q, p)
-    }
-
-    /// The nearest consistent state (see [`project`]).
-    pub fn project(&self, q0: &[f64], p0: &[f64]) -> Result<PhaseState, Error> {
-        let minv = self.minv();
-        project(&self.constraints, &minv, &minv, q0, p0)
     }
 }

@@ -42,7 +42,7 @@ mod symmetry;
 
 pub use constraint_set::ConstraintSet;
 pub use constraints::{
-    check_dense, differenced_jacobian, inverse_mass, project, residuals, Action, Anchor, Constrained, Distances,
+    check_dense, differenced_jacobian, inverse_mass, project, Action, Anchor, Constrained, Distances,
     HolonomicConstraints, Link, PhaseState, Residuals,
 };
 pub use energy::{hamiltonian, EnergyTerms};

@@ -1,12 +1,10 @@
 use std::cell::RefCell;
 
-use nalgebra::{DMatrix, DVector};
+use nalgebra::DMatrix;
 
-use super::constraints::{momentum_projection, row_norm};
-use super::{inverse_mass, Lagrangian, Residuals};
 use crate::solve::difference;
 use crate::solve::scratch::with_scratch;
-use crate::{Error, ModelError};
+use crate::ModelError;
 
 /// Velocity constraints A(q)q̇ + b(q) = 0 affine in the velocities, m rows on n coordinates,
 /// that need not integrate to constraints on the positions (nonholonomic: rolling without
@@ -110,52 +108,9 @@ fn shifted<R>(q: &[f64], body: impl FnOnce(&mut [f64], &mut DMatrix<f64>, &mut V
 
 /// A Lagrangian system S with velocity constraints C: what the discrete Lagrange–d'Alembert
 /// integrator ([`crate::integrators::Del`] with the midpoint rule) integrates. S is any
-/// [`Lagrangian`]: a separable or natural mechanical system, or a general L(q, q̇, t).
+/// [`super::Lagrangian`]: a separable or natural mechanical system, or a general L(q, q̇, t).
 #[derive(Clone, Debug)]
 pub struct Nonholonomic<S, C> {
     pub system: S,
     pub constraints: C,
-}
-
-impl<S: Lagrangian, C: VelocityConstraints> Nonholonomic<S, C> {
-    /// A(q), allocated (diagnostics and set-up).
-    fn matrix(&self, q: &[f64]) -> Result<DMatrix<f64>, ModelError> {
-        let mut a = DMatrix::zeros(self.constraints.count(), q.len());
-        self.constraints.matrix(q, &mut a)?;
-        Ok(a)
-    }
-
-    /// b(q), allocated (diagnostics and set-up).
-    fn offset(&self, q: &[f64]) -> Result<DVector<f64>, ModelError> {
-        let mut b = DVector::zeros(self.constraints.count());
-        self.constraints.offset(q, b.as_mut_slice())?;
-        Ok(b)
-    }
-
-    /// |A(q)q̇ + b(q)|∞ with q̇ = q̇(q, p) (as `velocity`), judged against
-    /// ‖A(q)‖∞‖q̇‖∞ + |b(q)|∞; the position entries are 0 (there is no constraint on q).
-    pub fn residuals(&self, q: &[f64], p: &[f64]) -> Result<Residuals, ModelError> {
-        let (a, b) = (self.matrix(q)?, self.offset(q)?);
-        let mut v = vec![0.0; q.len()];
-        self.system.velocity(q, p, 0.0, &mut v)?;
-        let v = DVector::from_column_slice(&v);
-        Ok(Residuals {
-            position: 0.0,
-            velocity: (&a * &v + &b).amax(),
-            position_size: 0.0,
-            velocity_size: row_norm(&a) * v.amax() + b.amax(),
-        })
-    }
-
-    /// The nearest consistent state: q unchanged, p ← p − Aᵀμ with (AM⁻¹Aᵀ)μ = Aq̇(q, p) + b(q),
-    /// the M-orthogonal projection onto A(q)q̇ + b(q) = 0, M(q)⁻¹x = q̇(q, x) − q̇(q, 0) (exact
-    /// for L quadratic in q̇).
-    pub fn project(&self, q: &[f64], p: &[f64]) -> Result<(Vec<f64>, Vec<f64>), Error> {
-        let model = |e: ModelError| Error::invalid("q0", format!("the velocity constraints failed to evaluate: {e}"));
-        let velocity = |q: &[f64], p: &[f64], v: &mut [f64]| self.system.velocity(q, p, 0.0, v);
-        let minv = inverse_mass(&velocity);
-        let (a, b) = (self.matrix(q).map_err(model)?, self.offset(q).map_err(model)?);
-        let p = momentum_projection(&a, &b, &minv, &velocity, q, p)?;
-        Ok((q.to_vec(), p))
-    }
 }
