@@ -59,10 +59,6 @@ class Outcome:
 #: (docs/validation.md, *Properties*), each by a phrase of its problem. A case that breaks one
 #: is reported under ``known``; any other problem fails it. Keys are regular expressions.
 KNOWN_OPEN = {
-    # A graze located at a coarse step (hω ≈ 1.2–1.7) where the partial step's momentum already
-    # points out of the floor: the reflection, λ < 0, kicks the body in, and the next piece
-    # crosses at once (h/16 runs). Elastic variational contacts, which no method holds, alike.
-    "crosses it again at once": "a graze at a coarse step reflected into the floor",
     # A cycle at |F| ≈ 1e-12, the rounding of a closure's own cancellation (g(1 − cos q) at
     # small |q| rounds at εg, not at ε|V|): differences record the noise of f's value, which
     # misses it. At Newton's cap the noise is measured (difference.measured_noise), but its

@@ -178,6 +178,34 @@ def test_grazing_impacts_in_an_elliptic_billiard_follow_the_exact_billiard_map_w
     np.testing.assert_allclose(hits.q, exact[:n, 1:], rtol=0, atol=tolerance)
 
 
+def _trapped():
+    # V = ½q² + q: ω = 1, at rest from 0 its lowest point is −2.
+    return varmech.MechanicalSystem(1, lambda q: 0.5 * q[0] ** 2 + q[0], lambda q: q + 1.0, name="trapped")
+
+
+@pytest.mark.parametrize("law", ["reflect", "variational"])
+def test_a_graze_whose_momentum_already_leaves_the_floor_takes_no_impulse(law):
+    # Above the floor q ≥ −2 + δ, Verlet at hω = 1.2–1.6 dips through it near the turning point
+    # with the momentum already pointing out (∇φ·q̇ > 0), where Newton's λ < 0 kicked the body
+    # into the floor and the run ended ("crosses it again at once") in 36 of the 252 runs of
+    # both laws.
+    # A surface only pushes: such a crossing takes no impulse, and the body stays above it.
+    for h in (1.2, 1.4, 1.6):
+        for e in (1.0, 0.5):
+            for delta in np.linspace(-0.05, 0.05, 21):
+                floor = -2.0 + delta
+                wall = varmech.Contact.wall(0, floor, restitution=e, law=law)
+                traj = varmech.integrate(_trapped(), [0.0], [0.0], dt=h, steps=60, method="verlet", contacts=[wall])
+                assert traj.status == 0 and np.min(traj.q) >= floor - 1e-12, (h, e, delta)
+
+
+def test_a_run_through_grazes_converges_as_its_step_is_refined():
+    # The reproducer of the test above (hω = 1.4, δ = 0.015) refined: q(84) converges.
+    wall = [varmech.Contact.wall(0, -1.985)]
+    ends = [varmech.integrate(_trapped(), [0.0], [0.0], dt=1.4 / 2**k, steps=60 * 2**k, method="verlet", contacts=wall).q[-1, 0] for k in (3, 5, 7)]
+    assert abs(ends[1] - ends[2]) < abs(ends[0] - ends[2]) / 4
+
+
 def test_a_ball_with_e_below_1_comes_to_rest_at_the_zeno_limit_and_then_rests_on_the_floor():
     # The bounces' flights 2eᵏt₁ sum to t∞ = t₁(1 + e)/(1 − e): the floor closes at the impact
     # whose rebounds would last less than a step, at that limit, and holds the ball at rest.

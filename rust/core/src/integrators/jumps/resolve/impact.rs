@@ -158,6 +158,13 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
         )
         .map_err(model_error)?;
         let reflection = reflected.lambda;
+        // A surface only pushes (λ ≥ 0, Signorini): a crossing whose momentum already leaves
+        // (∇φ·q̇ > 0, a graze the partial steps of a coarse step dip through) takes no impulse,
+        // where the reflection would kick the body into the surface.
+        if reflection < 0.0 {
+            self.piece_p.copy_from_slice(&self.contact_p);
+            return Ok(());
+        }
         let mut at = At {
             resolver: self,
             step,
