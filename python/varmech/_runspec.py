@@ -183,6 +183,15 @@ class RunSpec:
         return _events.going_on(self.jumps.event_specs, found, initial_energy)
 
 
+def continuing(previous: Any, jumps: Jumps) -> dict[str, Any]:
+    """The :class:`RunSpec` fields of a run going on from ``previous`` (a trajectory, or a
+    file's, lazy) watching ``jumps``: its checkpoint and steps, the crossings its events already
+    had, and its first energy, from which an energy-error event measures (None without events)."""
+    found = tuple(_events.found_before(previous.events, jumps.events))
+    initial = _events.first_energy(previous.model, previous) if jumps.events else None
+    return {"checkpoint": previous.checkpoint, "base": previous.steps, "found": found, "initial_energy": initial}
+
+
 def energy_threshold(max_energy_error: float | None | Literal["auto"]) -> float | None:
     """The run's energy threshold: ``"auto"`` is the failure level of the verdicts, for the
     energy or its balance E − W (forced, L depending on t); the core checks neither where

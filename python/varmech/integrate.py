@@ -19,7 +19,7 @@ from . import events as _events
 from . import impacts as _impacts
 from . import impulses as _impulses
 from ._progress import progress_bar
-from ._runspec import Jumps, RunSpec, energy_threshold, newton_options, sample_times
+from ._runspec import Jumps, RunSpec, continuing, energy_threshold, newton_options, sample_times
 from ._util import finite, positive, positive_int, returned_scalar, step_count, vector
 from .constraints import warn_if_integrable
 from .derivatives import blame
@@ -356,19 +356,7 @@ def _go_on(
     save_every = positive_int("save_every", options.save_every)
     times = sample_times(t_eval, t_now, t_now + nsteps * traj.dt, save_every, options.output, traj.model.dim)
     jumps = Jumps.of(traj.model, events, contacts, _impulses.going_on(traj.impulses, None, t_now))
-    found = _events.found_before(traj.events, jumps.events)
-    initial = _events.first_energy(traj.model, traj) if jumps.events else None
-    spec = replace(
-        options,
-        steps=nsteps,
-        save_every=save_every,
-        jumps=jumps,
-        times=times,
-        checkpoint=traj.checkpoint,
-        base=traj.steps,
-        found=tuple(found),
-        initial_energy=initial,
-    )
+    spec = replace(options, steps=nsteps, save_every=save_every, jumps=jumps, times=times, **continuing(traj, jumps))
     return _run(traj.model, spec)
 
 

@@ -30,7 +30,7 @@ from . import events as _events
 from . import impacts as _impacts
 from . import impulses as _impulses
 from ._progress import progress_bar
-from ._runspec import Jumps, RunSpec
+from ._runspec import Jumps, RunSpec, continuing
 from ._util import step_count
 from .impacts import Contact
 from .impulses import Impulse
@@ -326,10 +326,7 @@ def resume(
         jumps=jumps,
         checkpoint_every=checkpoint_every,
         progress=progress,
-        checkpoint=stored.checkpoint,
-        base=stored.steps,
-        found=tuple(_events.found_before(stored.events, jumps.events)),
-        initial_energy=_events.first_energy(stored.model, stored),
+        **continuing(stored, jumps),
     )
     writer = files.Writer.reopen(Path(path), stored, spec)
     bar = progress_bar(total=more, unit="step", desc=stored.method, enabled=progress)

@@ -141,6 +141,16 @@ macro_rules! refused {
     )+};
 }
 
+/// Serializer methods of the variants with fields, which no checkpoint holds: each refuses,
+/// naming its kind.
+macro_rules! refused_variants {
+    ($($method:ident -> $compound:ident: $what:literal),+) => {$(
+        fn $method(self, _: &'static str, _: u32, _: &'static str, _: usize) -> Result<Self::$compound, Unsupported> {
+            unsupported($what)
+        }
+    )+};
+}
+
 impl ser::Serializer for Recorder {
     type Ok = Value;
     type Error = Unsupported;
@@ -211,30 +221,16 @@ impl ser::Serializer for Recorder {
     fn serialize_tuple_struct(self, n: &'static str, _: usize) -> Result<Items, Unsupported> {
         Ok(items(Kind::TupleStruct(n)))
     }
-    fn serialize_tuple_variant(
-        self,
-        _: &'static str,
-        _: u32,
-        _: &'static str,
-        _: usize,
-    ) -> Result<Self::SerializeTupleVariant, Unsupported> {
-        unsupported("a tuple variant")
-    }
     fn serialize_map(self, _: Option<usize>) -> Result<Self::SerializeMap, Unsupported> {
         unsupported("a map")
     }
     fn serialize_struct(self, n: &'static str, _: usize) -> Result<Items, Unsupported> {
         Ok(items(Kind::Struct(n)))
     }
-    fn serialize_struct_variant(
-        self,
-        _: &'static str,
-        _: u32,
-        _: &'static str,
-        _: usize,
-    ) -> Result<Self::SerializeStructVariant, Unsupported> {
-        unsupported("a struct variant")
-    }
+    refused_variants!(
+        serialize_tuple_variant -> SerializeTupleVariant: "a tuple variant",
+        serialize_struct_variant -> SerializeStructVariant: "a struct variant"
+    );
 }
 
 impl Items {

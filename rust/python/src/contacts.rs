@@ -73,6 +73,23 @@ impl Surface for &Functions {
     }
 }
 
+/// The native surface of a contact's or an event's payload: `"crossing"` (k, value), the wall
+/// q_k ≥ value, or `"ellipsoid"` (coordinates, centre, semi_axes, inside).
+pub(crate) fn native_surface(ellipsoid: bool, payload: &Bound<'_, PyAny>) -> PyResult<NativeSurface> {
+    Ok(if ellipsoid {
+        let (coordinates, centre, semi_axes, inside) = payload.extract()?;
+        NativeSurface::Ellipsoid {
+            coordinates,
+            centre,
+            semi_axes,
+            inside,
+        }
+    } else {
+        let (coordinate, value) = payload.extract()?;
+        NativeSurface::Wall { coordinate, value }
+    })
+}
+
 /// A contact's surface: native, or Python's functions.
 enum Kind {
     Native(NativeSurface),
@@ -94,19 +111,7 @@ impl ContactSpecs {
                 )));
             };
             let kind = match kind.as_str() {
-                "crossing" => {
-                    let (coordinate, value) = payload.extract()?;
-                    Kind::Native(NativeSurface::Wall { coordinate, value })
-                }
-                "ellipsoid" => {
-                    let (coordinates, centre, semi_axes, inside) = payload.extract()?;
-                    Kind::Native(NativeSurface::Ellipsoid {
-                        coordinates,
-                        centre,
-                        semi_axes,
-                        inside,
-                    })
-                }
+                "crossing" | "ellipsoid" => Kind::Native(native_surface(kind == "ellipsoid", &payload)?),
                 "functions" => {
                     let (phi, gradient) = payload.extract()?;
                     Kind::Functions(Functions { phi, gradient })

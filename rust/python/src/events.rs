@@ -8,6 +8,7 @@ use pyo3::prelude::*;
 use varmech::integrators::{Dynamics, EventFunctions, EventSpec, NativeEvent};
 use varmech::ModelError;
 
+use crate::contacts::native_surface;
 use crate::errors::{boxed, to_pyerr};
 
 /// One event function: built in, or a Python g(t, q, p) or g(t, q, v) (`velocities`).
@@ -40,19 +41,8 @@ impl Events {
                     function: payload.unbind(),
                     velocities: kind == "v",
                 },
-                "crossing" => {
-                    let (coordinate, value) = payload.extract()?;
-                    Function::Native(NativeEvent::Crossing { coordinate, value })
-                }
-                "ellipsoid" => {
-                    let (coordinates, centre, semi_axes, inside) = payload.extract()?;
-                    Function::Native(NativeEvent::Ellipsoid {
-                        coordinates,
-                        centre,
-                        semi_axes,
-                        inside,
-                    })
-                }
+                // The crossing of a contact's surface: g = φ.
+                "crossing" | "ellipsoid" => Function::Native(native_surface(kind == "ellipsoid", &payload)?.into()),
                 "energy_error" => {
                     // (bound, E₀) for a resumed run; bound alone, E₀ taken at the start.
                     let (bound, initial) = payload

@@ -1,6 +1,6 @@
 use super::checkpoint::derived::{same, Reached};
 use super::clear::Clear;
-use super::stepper::Phase;
+use super::stepper::{array, Phase};
 use super::{Increment, Splitting, StepError, StepStart};
 use crate::model::MechanicalSystem;
 use crate::{Error, ModelError};
@@ -119,9 +119,8 @@ impl KickDrift {
         steps: usize,
         clear: &mut C,
     ) -> Result<bool, Error> {
-        let array = |x: &[f64]| -> [f64; N] { std::array::from_fn(|i| x[i]) };
         self.scale(state.clock.h);
-        let (mut stage_q, mut stage_p, mut force) = (array(&self.q), array(&self.p), array(&self.force));
+        let (mut stage_q, mut stage_p, mut force) = (array::<N>(&self.q), array::<N>(&self.p), array::<N>(&self.force));
         // Counts in locals, written back once: through the pointers they would cost stores.
         let (mut cached, mut evaluations) = (self.force_cached, self.evaluations);
         let scaled = &self.scaled;

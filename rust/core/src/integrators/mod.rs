@@ -263,12 +263,18 @@ impl Integrator {
 
     /// The options of the implicit methods' Newton iteration; None for the explicit methods.
     pub fn newton_options(&self) -> Option<NewtonOptions> {
+        self.newton_solve().map(|(options, _)| options)
+    }
+
+    /// The options and the iterations so far of the methods that solve their step by Newton's
+    /// method; None for the others.
+    fn newton_solve(&self) -> Option<(NewtonOptions, u64)> {
         match &self.scheme {
-            Scheme::Midpoint(s) => Some(s.options()),
-            Scheme::Trapezoid(s) => Some(s.options()),
-            Scheme::Galerkin(s) => Some(s.options()),
-            Scheme::ComposedMidpoint(s) => Some(s.options()),
-            Scheme::Rattle(s) => Some(s.options()),
+            Scheme::Midpoint(s) => Some((s.options(), s.iterations())),
+            Scheme::Trapezoid(s) => Some((s.options(), s.iterations())),
+            Scheme::Galerkin(s) => Some((s.options(), s.iterations())),
+            Scheme::ComposedMidpoint(s) => Some((s.options(), s.iterations())),
+            Scheme::Rattle(s) => Some((s.options(), s.iterations())),
             _ => None,
         }
     }
@@ -337,14 +343,7 @@ impl Integrator {
 
     /// Newton iterations made so far; None for the methods that solve no equations.
     pub fn newton(&self) -> Option<u64> {
-        match &self.scheme {
-            Scheme::Midpoint(s) => Some(s.iterations()),
-            Scheme::Trapezoid(s) => Some(s.iterations()),
-            Scheme::Galerkin(s) => Some(s.iterations()),
-            Scheme::ComposedMidpoint(s) => Some(s.iterations()),
-            Scheme::Rattle(s) => Some(s.iterations()),
-            _ => None,
-        }
+        self.newton_solve().map(|(_, iterations)| iterations)
     }
 
     /// Newton iterations made so far (0 for the explicit methods).

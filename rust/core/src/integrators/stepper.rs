@@ -7,7 +7,7 @@ mod own_variables;
 mod phase;
 
 pub use carry::Carry;
-pub(super) use phase::Phase;
+pub(super) use phase::{array, Phase};
 
 use std::borrow::{Borrow, BorrowMut};
 use std::ops::Deref;

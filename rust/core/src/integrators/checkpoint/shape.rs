@@ -241,6 +241,24 @@ macro_rules! ignored {
     };
 }
 
+// A tuple struct and a struct are a compound of unnamed length; a tuple and a struct variant
+// mark their variant (`$ok` the compound, which names the impl's lifetime).
+macro_rules! compounds {
+    ($ok:ty: $($name:ident),*) => {
+        $(fn $name(self, _: &'static str, _: usize) -> Result<$ok, Never> {
+            Ok(self.compound(None))
+        })*
+    };
+}
+
+macro_rules! variants {
+    ($ok:ty: $($name:ident),*) => {
+        $(fn $name(self, _: &'static str, index: u32, variant: &'static str, _: usize) -> Result<$ok, Never> {
+            Ok(self.variant(index, variant))
+        })*
+    };
+}
+
 impl<'a> ser::Serializer for Shaper<'a> {
     type Ok = ();
     type Error = Never;
@@ -311,37 +329,12 @@ impl<'a> ser::Serializer for Shaper<'a> {
         Ok(self.compound(None))
     }
 
-    fn serialize_tuple_struct(self, _: &'static str, _: usize) -> Result<Compound<'a>, Never> {
-        Ok(self.compound(None))
-    }
-
-    fn serialize_tuple_variant(
-        self,
-        _: &'static str,
-        index: u32,
-        variant: &'static str,
-        _: usize,
-    ) -> Result<Compound<'a>, Never> {
-        Ok(self.variant(index, variant))
-    }
-
     fn serialize_map(self, len: Option<usize>) -> Result<Compound<'a>, Never> {
         Ok(self.compound(Some(len.unwrap_or(usize::MAX))))
     }
 
-    fn serialize_struct(self, _: &'static str, _: usize) -> Result<Compound<'a>, Never> {
-        Ok(self.compound(None))
-    }
-
-    fn serialize_struct_variant(
-        self,
-        _: &'static str,
-        index: u32,
-        variant: &'static str,
-        _: usize,
-    ) -> Result<Compound<'a>, Never> {
-        Ok(self.variant(index, variant))
-    }
+    compounds!(Compound<'a>: serialize_tuple_struct, serialize_struct);
+    variants!(Compound<'a>: serialize_tuple_variant, serialize_struct_variant);
 }
 
 // Every compound a serializer hands out is a Compound: its elements (sequences, tuples, their

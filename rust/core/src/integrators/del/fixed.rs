@@ -8,7 +8,7 @@ use super::{correct, finite_jacobian, rounding, segment, Constraints, Del, Equat
 use crate::discrete::{DiscreteLagrangian, Workspace};
 use crate::integrators::clear::Clear;
 use crate::integrators::del::StepEquations;
-use crate::integrators::stepper::Phase;
+use crate::integrators::stepper::{array, Phase};
 use crate::integrators::{StepError, StepStart};
 use crate::model::Lagrangian;
 use crate::solve::difference;
@@ -59,7 +59,6 @@ impl<R: DiscreteLagrangian> Del<TwoPoint<R>> {
         steps: usize,
         clear: &mut C,
     ) -> Result<bool, Error> {
-        let array = |x: &[f64]| -> [f64; N] { std::array::from_fn(|i| x[i]) };
         let h = phase.clock.h;
         let (mut last, mut before_last, mut history) =
             (array(&self.last_dq), array(&self.before_last_dq), self.history);

@@ -40,6 +40,26 @@ pub enum NativeEvent {
     },
 }
 
+/// The crossing of a native surface: g = φ.
+impl From<NativeSurface> for NativeEvent {
+    fn from(surface: NativeSurface) -> Self {
+        match surface {
+            NativeSurface::Wall { coordinate, value } => NativeEvent::Crossing { coordinate, value },
+            NativeSurface::Ellipsoid {
+                coordinates,
+                centre,
+                semi_axes,
+                inside,
+            } => NativeEvent::Ellipsoid {
+                coordinates,
+                centre,
+                semi_axes,
+                inside,
+            },
+        }
+    }
+}
+
 impl NativeEvent {
     /// Refuses coordinates outside 0 … n − 1, empty or unequal groups, and radii, bounds or
     /// semi-axes that are not finite and positive (naming `events` and the event's `name`).

@@ -39,7 +39,6 @@ impl Phase<'_> {
         F: FnMut(f64, &[f64; N], &[f64; N], &mut [f64; N], &mut [f64; N]) -> Result<(), StepError>,
         C: Clear + ?Sized,
     {
-        let array = |x: &[f64]| -> [f64; N] { std::array::from_fn(|i| x[i]) };
         let Phase {
             q: state_q,
             p: state_p,
@@ -94,4 +93,10 @@ impl Phase<'_> {
         state_ep.copy_from_slice(&ep);
         result
     }
+}
+
+/// The first N values of `x` as an array: the fixed-size loops' copy of a slice.
+#[inline(always)]
+pub(in crate::integrators) fn array<const N: usize>(x: &[f64]) -> [f64; N] {
+    std::array::from_fn(|i| x[i])
 }

@@ -43,6 +43,20 @@ mod x86 {
     use super::Lanes;
     use std::arch::x86_64::*;
 
+    /// The [`Lanes`] methods that are one intrinsic of the lanes: `name(b, …) = intrinsic` gives
+    /// `name(self, b, …)`, `intrinsic(self, b, …)`.
+    macro_rules! lane_ops {
+        ($features:literal; $($name:ident($($arg:ident),*) = $intrinsic:ident),* $(,)?) => {
+            $(
+                #[inline]
+                #[target_feature(enable = $features)]
+                unsafe fn $name(self, $($arg: Self),*) -> Self {
+                    $intrinsic(self, $($arg),*)
+                }
+            )*
+        };
+    }
+
     /// Generates the [`Lanes`] impl of one x86 vector type from its intrinsics.
     macro_rules! lanes {
         ($t:ty, $width:expr, $features:literal, $set1:ident, $loadu:ident, $storeu:ident, $add:ident,
@@ -64,41 +78,16 @@ mod x86 {
                 unsafe fn store(self, p: *mut f64) {
                     unsafe { $storeu(p, self) }
                 }
-                #[inline]
-                #[target_feature(enable = $features)]
-                unsafe fn add(self, b: Self) -> Self {
-                    $add(self, b)
-                }
-                #[inline]
-                #[target_feature(enable = $features)]
-                unsafe fn sub(self, b: Self) -> Self {
-                    $sub(self, b)
-                }
-                #[inline]
-                #[target_feature(enable = $features)]
-                unsafe fn mul(self, b: Self) -> Self {
-                    $mul(self, b)
-                }
-                #[inline]
-                #[target_feature(enable = $features)]
-                unsafe fn div(self, b: Self) -> Self {
-                    $div(self, b)
-                }
-                #[inline]
-                #[target_feature(enable = $features)]
-                unsafe fn sqrt(self) -> Self {
-                    $sqrt(self)
-                }
-                #[inline]
-                #[target_feature(enable = $features)]
-                unsafe fn mul_add(self, b: Self, c: Self) -> Self {
-                    $fmadd(self, b, c)
-                }
-                #[inline]
-                #[target_feature(enable = $features)]
-                unsafe fn neg_mul_add(self, b: Self, c: Self) -> Self {
-                    $fnmadd(self, b, c)
-                }
+                lane_ops!(
+                    $features;
+                    add(b) = $add,
+                    sub(b) = $sub,
+                    mul(b) = $mul,
+                    div(b) = $div,
+                    sqrt() = $sqrt,
+                    mul_add(b, c) = $fmadd,
+                    neg_mul_add(b, c) = $fnmadd,
+                );
                 #[inline]
                 #[target_feature(enable = $features)]
                 unsafe fn sum(self) -> f64 {
