@@ -198,6 +198,16 @@ FOUND = [
             method="midpoint", h_fraction=0.783971773797176, steps=97),
         "completed", "bounded",
     ),
+    (
+        "the same at g = 2.15: quanta of 9e-13 and 3.7e-12 met only at shifts below or above δ",
+        dict(family="chain", api="lagrangian", n=1, coefficients={
+            "m": [0.99999], "k": [2.2092565585052704], "beta": [0.0], "g": [2.1470188474317426], "kappa": [0.0],
+            "alpha": [0.0], "gamma": [0.062411198101095314], "eps": [0.8944048022221177], "u": [0.5676647303551285],
+            "damping": [0.4743593772044481], "drive": [0.99999, 1.9293370497570066]},
+            derivatives="none", forcing="damping", q0=[-0.15551747518018788], v0=[1.1598492074905522],
+            method="midpoint", h_fraction=0.783971773797176, steps=97),
+        "completed", "bounded",
+    ),
 ]
 
 

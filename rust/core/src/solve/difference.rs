@@ -34,31 +34,54 @@ pub(crate) fn record(noise: f64) {
 }
 
 /// F's rounding about x, measured: the second differences |F(x + sδ) + F(x − sδ) − 2F(x)|/2
-/// at s = 1, …, 8, their largest component. `f0` is F(x), `at(s, out)` writes F(x + sδ), and
-/// `plus`, `minus` are scratch of F's length. The rounding of every evaluation inside F changes
-/// with x: what [`record`]'s estimate from the sizes of values cannot see, a closure's own
+/// at s = 1, …, 8, their largest component, at δ and at 1e-2 and 1e-4 of it, the largest of
+/// the scales that measure one. `f0` is F(x), `at(s, out)` writes F(x + sδ), and `plus`,
+/// `minus` are scratch of F's length. The rounding of every evaluation inside F changes with
+/// x: what [`record`]'s estimate from the sizes of values cannot see, a closure's own
 /// cancellation (g(1 − cos q) at |q| ≈ 1e-6 rounds at εg), shows. A difference's rounding comes
-/// in quanta (f's ulp over 2h), which a sample may miss: hence eight. Rounding does not grow
-/// with s, and F's smooth part s²δᵀF''δ/2 does: where the largest at s = 5 … 8 is over twice
-/// the largest at s = 1 … 4 (four times for curvature alone), the differences are curvature (a
-/// near-singular step's), and none is measured (0).
+/// in quanta (f's ulp over 2h), flat over some shifts and met by others: hence eight samples
+/// at three scales. Rounding does not grow with s, and F's smooth part s²δᵀF''δ/2 does: where
+/// the largest at s = 5 … 8 is over twice the largest at s = 1 … 4 (four times for curvature
+/// alone), the differences are curvature, and that scale measures none.
 pub fn measured_noise<E>(
     f0: &[f64],
     (plus, minus): (&mut [f64], &mut [f64]),
     mut at: impl FnMut(f64, &mut [f64]) -> Result<(), E>,
 ) -> Result<f64, E> {
-    let mut sizes = [0.0_f64; 8];
-    for (k, size) in sizes.iter_mut().enumerate() {
-        let s = (k + 1) as f64;
-        at(s, plus)?;
-        at(-s, minus)?;
-        for ((a, b), c) in plus.iter().zip(minus.iter()).zip(f0) {
-            *size = size.max(((a + b) - 2.0 * c).abs() / 2.0);
+    let mut noise = 0.0_f64;
+    for scale in [1.0, 1e-2, 1e-4] {
+        let mut sizes = [0.0_f64; 8];
+        for (k, size) in sizes.iter_mut().enumerate() {
+            let s = scale * (k + 1) as f64;
+            at(s, plus)?;
+            at(-s, minus)?;
+            for ((a, b), c) in plus.iter().zip(minus.iter()).zip(f0) {
+                *size = size.max(((a + b) - 2.0 * c).abs() / 2.0);
+            }
+        }
+        let largest = |x: &[f64]| x.iter().fold(0.0_f64, |a, &b| a.max(b));
+        let (near, far) = (largest(&sizes[..4]), largest(&sizes[4..]));
+        if far <= 2.0 * near {
+            noise = noise.max(far.max(near));
         }
     }
-    let largest = |x: &[f64]| x.iter().fold(0.0_f64, |a, &b| a.max(b));
-    let (near, far) = (largest(&sizes[..4]), largest(&sizes[4..]));
-    Ok(if far <= 2.0 * near { far.max(near) } else { 0.0 })
+    Ok(noise)
+}
+
+/// The δ of [`measured_noise`] for unknowns of norm `x` added to values of norm `offset` (a
+/// step's increments to q₀: an increment alone may be below q₀'s rounding): 1e-6 of their sum.
+/// Where F's evaluation records rounding ([`recorded`]: derivatives by differences, a nested
+/// solve), the offset is taken at least at the differences' floor ([`unit`]): a shift far
+/// below their step leaves every evaluation of f rounding alike, and no sample meets its
+/// quanta. Not otherwise: a larger δ would reach across a kink of exact derivatives and read
+/// its jump as noise.
+pub fn measuring_step(x: f64, offset: f64, recorded: bool) -> f64 {
+    1e-6 * (x + if recorded { unit(0, offset) } else { offset })
+}
+
+/// Whether rounding was recorded ([`record`]) on this thread since the last [`take_noise`].
+pub fn recorded() -> bool {
+    NOISE.with(|n| n.get() > 0.0)
 }
 
 /// ε^{1/3}, written out: `f64::cbrt` is not a `const fn`, and a libm call per difference costs

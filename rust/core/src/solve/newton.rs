@@ -313,6 +313,14 @@ impl Progress {
         residual <= NOISE_MARGIN * noise
     }
 
+    /// Whether an iteration at its cap, ‖F‖∞ = `residual`, is converged at the noise measured
+    /// about it ([`NewtonProblem::measured_noise`]): at that floor, and not where ∂²L/∂q̇² is
+    /// nearly singular ([`NewtonProblem::degenerate`]), whose F varies on every scale a
+    /// measurement takes, as rounding does.
+    pub fn at_measured_floor<P: NewtonProblem>(problem: &mut P, residual: f64, noise: f64) -> Result<bool, StepError> {
+        Ok(Progress::at_floor(residual, noise) && !problem.degenerate()?)
+    }
+
     /// Why the iteration failed, having reached its cap: by the course of its corrections,
     /// the last two made with fresh Jacobians in ratio θ, and the first two in ratio θ₀.
     ///
@@ -544,9 +552,9 @@ impl Newton {
             }
         }
         // At the cap above the estimated floor (an iteration wandering in noise the estimate
-        // misses reads as a stall, a cycle or a slow fall): at the floor measured, converged.
+        // misses reads as a stall, a cycle or a slow fall).
         let noise = problem.measured_noise(self.residual.as_slice())?;
-        if Progress::at_floor(residual, noise) {
+        if Progress::at_measured_floor(problem, residual, noise)? {
             return Ok(Solution {
                 iterations: options.max_iterations,
                 residual,

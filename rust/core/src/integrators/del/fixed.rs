@@ -104,10 +104,12 @@ impl<R: DiscreteLagrangian> Del<TwoPoint<R>> {
             loop {
                 if iteration == options.max_iterations {
                     // At the cap above the estimated floor: at the floor measured (ws restored
-                    // at x after), converged ([`Newton::solve`] alike). δ is relative to q₀ + x,
-                    // where F is evaluated: a step's increment alone may be below q₀'s rounding.
-                    let delta = 1e-6 * (norm(&x) + norm(start.q));
+                    // at x after), converged ([`Newton::solve`] alike).
                     let (mut plus, mut minus) = ([0.0; N], [0.0; N]);
+                    difference::take_noise();
+                    evaluations += 1;
+                    self.scheme.equations_in(&mut ws, sys, start, &x, &mut plus)?;
+                    let delta = difference::measuring_step(norm(&x), norm(start.q), difference::recorded());
                     let noise = difference::measured_noise(&r, (&mut plus, &mut minus), |s, out| {
                         evaluations += 1;
                         let at: [f64; N] = std::array::from_fn(|i| x[i] + s * delta);
@@ -115,7 +117,11 @@ impl<R: DiscreteLagrangian> Del<TwoPoint<R>> {
                     })?;
                     evaluations += 1;
                     self.scheme.equations_in(&mut ws, sys, start, &x, &mut plus)?;
-                    if Progress::at_floor(residual, noise) {
+                    if Progress::at_measured_floor(
+                        &mut self.unconstrained(sys, start, (&mut x, None), &mut evaluations),
+                        residual,
+                        noise,
+                    )? {
                         break;
                     }
                     let guess = predictor(&last, &before_last, history);

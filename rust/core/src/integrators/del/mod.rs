@@ -553,13 +553,15 @@ impl<Sc: StepEquations, S: Lagrangian + ?Sized> NewtonProblem for Equations<'_, 
         rounding(self.start.p)
     }
 
-    /// About x, by steps of 1e-8 of ‖x‖∞ + ‖q₀‖∞ (F is evaluated at q₀ + x: an increment alone
-    /// may be below q₀'s rounding); x and the scheme's caches restored by F at x again. A rare
-    /// path, before a failure: x is copied.
+    /// About x, by steps relative to ‖x‖∞ + ‖q₀‖∞ ([`difference::measuring_step`]: F is
+    /// evaluated at q₀ + x); x and the scheme's caches restored by F at x again. A rare path,
+    /// before a failure: x is copied.
     fn measured_noise(&mut self, f0: &[f64]) -> Result<f64, StepError> {
         let x0 = self.x.to_vec();
-        let delta = 1e-6 * (norm(&x0) + self.offset());
         let (mut plus, mut minus) = (vec![0.0; f0.len()], vec![0.0; f0.len()]);
+        difference::take_noise();
+        self.residual(&mut plus)?;
+        let delta = difference::measuring_step(norm(&x0), self.offset(), difference::recorded());
         let noise = difference::measured_noise(f0, (&mut plus, &mut minus), |s, out| {
             for (x, a) in self.x.iter_mut().zip(&x0) {
                 *x = a + s * delta;
