@@ -91,6 +91,16 @@ def test_the_oracle_sees_a_crash_a_hang_and_a_wrong_verdict(monkeypatch):
     assert caught.verdict == "failed" and caught.confirmed is False and "converge" in caught.problems[0], caught
 
 
+def _damped_chain(g: float) -> dict:
+    """Seed 99's damped closure pendulum on a spring (no derivatives, midpoint), with gravity g."""
+    return dict(family="chain", api="lagrangian", n=1, coefficients={
+        "m": [0.99999], "k": [2.2092565585052704], "beta": [0.0], "g": [g], "kappa": [0.0],
+        "alpha": [0.0], "gamma": [0.062411198101095314], "eps": [0.8944048022221177], "u": [0.5676647303551285],
+        "damping": [0.4743593772044481], "drive": [0.99999, 1.9293370497570066]},
+        derivatives="none", forcing="damping", q0=[-0.15551747518018788], v0=[1.1598492074905522],
+        method="midpoint", h_fraction=0.783971773797176, steps=97)
+
+
 #: Cases the campaigns found breaking a property, each with the outcome it has since its fix:
 #: (what it shows, its spec's fields as the campaign printed them, the outcome's kind, its verdict).
 FOUND = [
@@ -190,22 +200,12 @@ FOUND = [
     ),
     (
         "a damped closure decayed to where g(1 − cos q) rounds at εg: Newton at its measured noise",
-        dict(family="chain", api="lagrangian", n=1, coefficients={
-            "m": [0.99999], "k": [2.2092565585052704], "beta": [0.0], "g": [0.062411198101095314], "kappa": [0.0],
-            "alpha": [0.0], "gamma": [0.062411198101095314], "eps": [0.8944048022221177], "u": [0.5676647303551285],
-            "damping": [0.4743593772044481], "drive": [0.99999, 1.9293370497570066]},
-            derivatives="none", forcing="damping", q0=[-0.15551747518018788], v0=[1.1598492074905522],
-            method="midpoint", h_fraction=0.783971773797176, steps=97),
+        _damped_chain(0.062411198101095314),
         "completed", "bounded",
     ),
     (
         "the same at g = 2.15: quanta of 9e-13 and 3.7e-12 met only at shifts below or above δ",
-        dict(family="chain", api="lagrangian", n=1, coefficients={
-            "m": [0.99999], "k": [2.2092565585052704], "beta": [0.0], "g": [2.1470188474317426], "kappa": [0.0],
-            "alpha": [0.0], "gamma": [0.062411198101095314], "eps": [0.8944048022221177], "u": [0.5676647303551285],
-            "damping": [0.4743593772044481], "drive": [0.99999, 1.9293370497570066]},
-            derivatives="none", forcing="damping", q0=[-0.15551747518018788], v0=[1.1598492074905522],
-            method="midpoint", h_fraction=0.783971773797176, steps=97),
+        _damped_chain(2.1470188474317426),
         "completed", "bounded",
     ),
 ]
