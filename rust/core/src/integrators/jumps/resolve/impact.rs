@@ -201,8 +201,9 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
     }
 
     /// Whether contact j closes at its impact at time t, reflected with the multiplier
-    /// `reflection` of Newton's law with restitution e, the law's (the normal, ∇φ, in `normal`): the body pressing on the surface once its
-    /// normal velocity is gone (λ > 0), and the Zeno series of the rebounds, flights of
+    /// `reflection` of Newton's law with restitution e, the law's (the normal, ∇φ, in
+    /// `normal`): the body pressing on the surface once its normal velocity is gone (λ > 0),
+    /// and the Zeno series of the rebounds, flights of
     /// 2v⁺/|a|, 2ev⁺/|a|, … under the normal acceleration a = −λ∇φᵀM⁻¹∇φ, summing to
     /// T∞ = 2v⁺/(|a|(1 − e)) ≤ h (at once for v⁺ = 0), or, for e near 1, where T∞ is longer,
     /// flights under h/[`MAX_IMPACTS`]: their bounces, of height |a|(2v⁺/|a|)²/8, are below the
