@@ -35,26 +35,33 @@ pub(crate) fn record(noise: f64) {
 
 /// F's rounding about x, measured: the second differences |F(x + sδ) + F(x − sδ) − 2F(x)|/2
 /// at s = 1, …, 8, their largest component, at δ and at 1e-2 and 1e-4 of it, the largest of
-/// the scales that measure one. `f0` is F(x), `at(s, out)` writes F(x + sδ), and `plus`,
-/// `minus` are scratch of F's length. The rounding of every evaluation inside F changes with
-/// x: what [`record`]'s estimate from the sizes of values cannot see, a closure's own
-/// cancellation (g(1 − cos q) at |q| ≈ 1e-6 rounds at εg), shows. A difference's rounding comes
-/// in quanta (f's ulp over 2h), flat over some shifts and met by others: hence eight samples
-/// at three scales. Rounding does not grow with s, and F's smooth part s²δᵀF''δ/2 does: where
-/// the largest at s = 5 … 8 is over twice the largest at s = 1 … 4 (four times for curvature
-/// alone), the differences are curvature, and that scale measures none.
+/// the scales that measure one. `f0` is the residual F(x) the caller judges; `at(shift, out)`
+/// writes F(x + shift) (every unknown shifted alike), `plus`, `minus` are scratch of F's
+/// length, and x has norm `x` and is added to values of norm `offset` (δ: [`measuring_step`]).
+/// F is evaluated at x first, for the rounding it records, and last, to leave the caller's
+/// caches at x. The rounding of every evaluation inside F changes with x: what [`record`]'s
+/// estimate from the sizes of values cannot see, a closure's own cancellation (g(1 − cos q) at
+/// |q| ≈ 1e-6 rounds at εg), shows. A difference's rounding comes in quanta (f's ulp over 2h),
+/// flat over some shifts and met by others: hence eight samples at three scales. Rounding does
+/// not grow with s, and F's smooth part s²δᵀF''δ/2 does: where the largest at s = 5 … 8 is over
+/// twice the largest at s = 1 … 4 (four times for curvature alone), the differences are
+/// curvature, and that scale measures none.
 pub fn measured_noise<E>(
     f0: &[f64],
     (plus, minus): (&mut [f64], &mut [f64]),
+    (x, offset): (f64, f64),
     mut at: impl FnMut(f64, &mut [f64]) -> Result<(), E>,
 ) -> Result<f64, E> {
+    take_noise();
+    at(0.0, plus)?;
+    let delta = measuring_step(x, offset, recorded());
     let mut noise = 0.0_f64;
     for scale in [1.0, 1e-2, 1e-4] {
         let mut sizes = [0.0_f64; 8];
         for (k, size) in sizes.iter_mut().enumerate() {
-            let s = scale * (k + 1) as f64;
-            at(s, plus)?;
-            at(-s, minus)?;
+            let shift = scale * (k + 1) as f64 * delta;
+            at(shift, plus)?;
+            at(-shift, minus)?;
             for ((a, b), c) in plus.iter().zip(minus.iter()).zip(f0) {
                 *size = size.max(((a + b) - 2.0 * c).abs() / 2.0);
             }
@@ -65,6 +72,7 @@ pub fn measured_noise<E>(
             noise = noise.max(far.max(near));
         }
     }
+    at(0.0, plus)?;
     Ok(noise)
 }
 
@@ -75,12 +83,12 @@ pub fn measured_noise<E>(
 /// below their step leaves every evaluation of f rounding alike, and no sample meets its
 /// quanta. Not otherwise: a larger δ would reach across a kink of exact derivatives and read
 /// its jump as noise.
-pub fn measuring_step(x: f64, offset: f64, recorded: bool) -> f64 {
+fn measuring_step(x: f64, offset: f64, recorded: bool) -> f64 {
     1e-6 * (x + if recorded { unit(0, offset) } else { offset })
 }
 
 /// Whether rounding was recorded ([`record`]) on this thread since the last [`take_noise`].
-pub fn recorded() -> bool {
+fn recorded() -> bool {
     NOISE.with(|n| n.get() > 0.0)
 }
 

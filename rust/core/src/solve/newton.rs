@@ -570,7 +570,6 @@ impl Newton {
     }
 }
 
-/// A failed iteration as the model layer reports it.
 /// A failed iteration as the model layer reports it: the model's own errors unchanged, and a
 /// failure of the solve itself whole, so that the run reports it typed ([`Error::model`]).
 ///

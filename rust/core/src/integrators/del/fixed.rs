@@ -106,17 +106,12 @@ impl<R: DiscreteLagrangian> Del<TwoPoint<R>> {
                     // At the cap above the estimated floor: at the floor measured (ws restored
                     // at x after), converged ([`Newton::solve`] alike).
                     let (mut plus, mut minus) = ([0.0; N], [0.0; N]);
-                    difference::take_noise();
-                    evaluations += 1;
-                    self.scheme.equations_in(&mut ws, sys, start, &x, &mut plus)?;
-                    let delta = difference::measuring_step(norm(&x), norm(start.q), difference::recorded());
-                    let noise = difference::measured_noise(&r, (&mut plus, &mut minus), |s, out| {
+                    let sizes = (norm(&x), norm(start.q));
+                    let noise = difference::measured_noise(&r, (&mut plus, &mut minus), sizes, |shift, out| {
                         evaluations += 1;
-                        let at: [f64; N] = std::array::from_fn(|i| x[i] + s * delta);
+                        let at: [f64; N] = std::array::from_fn(|i| x[i] + shift);
                         self.scheme.equations_in(&mut ws, sys, start, &at, out)
                     })?;
-                    evaluations += 1;
-                    self.scheme.equations_in(&mut ws, sys, start, &x, &mut plus)?;
                     if Progress::at_measured_floor(
                         &mut self.unconstrained(sys, start, (&mut x, None), &mut evaluations),
                         residual,

@@ -553,23 +553,19 @@ impl<Sc: StepEquations, S: Lagrangian + ?Sized> NewtonProblem for Equations<'_, 
         rounding(self.start.p)
     }
 
-    /// About x, by steps relative to ‖x‖∞ + ‖q₀‖∞ ([`difference::measuring_step`]: F is
-    /// evaluated at q₀ + x); x and the scheme's caches restored by F at x again. A rare path,
-    /// before a failure: x is copied.
+    /// About x, by steps relative to ‖x‖∞ + ‖q₀‖∞ (F is evaluated at q₀ + x); x and the
+    /// scheme's caches left at x. A rare path, before a failure: x is copied.
     fn measured_noise(&mut self, f0: &[f64]) -> Result<f64, StepError> {
         let x0 = self.x.to_vec();
         let (mut plus, mut minus) = (vec![0.0; f0.len()], vec![0.0; f0.len()]);
-        difference::take_noise();
-        self.residual(&mut plus)?;
-        let delta = difference::measuring_step(norm(&x0), self.offset(), difference::recorded());
-        let noise = difference::measured_noise(f0, (&mut plus, &mut minus), |s, out| {
+        let sizes = (norm(&x0), self.offset());
+        let noise = difference::measured_noise(f0, (&mut plus, &mut minus), sizes, |shift, out| {
             for (x, a) in self.x.iter_mut().zip(&x0) {
-                *x = a + s * delta;
+                *x = a + shift;
             }
             self.residual(out)
         });
         self.x.copy_from_slice(&x0);
-        self.residual(&mut plus)?;
         noise
     }
 
