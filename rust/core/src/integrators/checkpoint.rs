@@ -6,7 +6,7 @@ pub(super) mod shape;
 
 use serde::{Deserialize, Serialize};
 
-use super::run::EnergyWatch;
+use super::divergence::EnergyWatch;
 use super::{check_method, Dynamics, Method, NewtonOptions, StepperState};
 use crate::Error;
 
@@ -179,7 +179,7 @@ impl Checkpoint {
 
     /// The state and energy check, to go on with on `model`. Refuses, naming `checkpoint`, a
     /// state that does not fit the model and its method (every length, size and index
-    /// checked, see [`StepperState::misfit`]) and a checkpoint of another model, method or
+    /// checked, see [`shape::misfit`]) and a checkpoint of another model, method or
     /// options (its [`Fingerprint`], naming the first difference); naming `model` or `method`
     /// one of another size or kind ([`super::Stepper::resume`]'s checks).
     pub(super) fn resume_on<S: Dynamics + ?Sized>(
@@ -212,13 +212,13 @@ impl Checkpoint {
             return Err(Error::invalid("model", reason));
         }
         check_method(model, state.method(), state.dt())?;
-        if let Some(reason) = state.misfit(model) {
+        if let Some(reason) = shape::misfit(&state, model) {
             return Err(refuse(reason));
         }
         if let Some(reason) = fingerprint.differs(&Fingerprint::of(model, &state)) {
             return Err(refuse(reason));
         }
-        if let Some(reason) = state.derived_misfit(model) {
+        if let Some(reason) = derived::misfit(&state, model) {
             return Err(refuse(format!("{reason}: it was edited or damaged")));
         }
         Ok((state, watch))

@@ -1,7 +1,7 @@
 //! Which method integrates which kind of model: the one table that decides it, words the
 //! refusal and names each kind's default method.
 
-use super::{one_of, Method};
+use super::{one_of, Method, MethodInfo, Splitting};
 use crate::Error;
 
 /// The kinds of model the methods tell apart.
@@ -101,6 +101,42 @@ impl ModelKind {
 }
 
 impl Method {
+    /// The method's facts ([`Method::facts`]), with what the table above says it integrates
+    /// and its stages.
+    pub fn info(self) -> MethodInfo {
+        let (name, order, symplectic, symmetric, h_omega_max, reference) = self.facts();
+        let implicit = ModelKind::Lagrangian.admits(self) || ModelKind::Nonholonomic.admits(self);
+        let constrained = ModelKind::ConstrainedSeparable.admits(self);
+        let nonholonomic = !ModelKind::Lagrangian.admits(self) && ModelKind::Nonholonomic.admits(self);
+        let nbody = !ModelKind::Separable.admits(self) && ModelKind::Gravitational.admits(self);
+        let stages = match self {
+            Method::Rattle4 | Method::Dla4 => 3,
+            _ => Splitting::of(self).map_or(1, |s| s.stages()),
+        };
+        let force_evaluations = match self {
+            Method::Rk4 => 4,
+            Method::WisdomHolmanLazyKernel => 2,
+            _ if implicit => 0,
+            _ => stages,
+        };
+        MethodInfo {
+            method: self,
+            name,
+            order,
+            stages,
+            force_evaluations,
+            implicit,
+            constrained,
+            nonholonomic,
+            nbody,
+            symplectic,
+            symmetric,
+            h_omega_max,
+            reference,
+            features: self.features(),
+        }
+    }
+
     /// Whether this method integrates a model of `kind`, with the reason and the methods that
     /// would if it does not.
     pub fn check(self, kind: ModelKind) -> Result<(), Error> {

@@ -1,4 +1,3 @@
-use super::{ModelKind, Splitting};
 use crate::Error;
 use serde::{Deserialize, Serialize};
 
@@ -94,16 +93,16 @@ pub struct MethodInfo {
     pub force_evaluations: usize,
     /// Whether each step solves implicit equations (by Newton's method); implicit methods
     /// integrate general Lagrangians, explicit ones only separable mechanical systems (read
-    /// from the table of [`ModelKind`]).
+    /// from the table of [`ModelKind`](super::ModelKind)).
     pub implicit: bool,
     /// Whether the method integrates separable systems on holonomic constraints (and only
-    /// those; read from the table of [`ModelKind`]).
+    /// those; read from the table of [`ModelKind`](super::ModelKind)).
     pub constrained: bool,
     /// Whether the method integrates velocity constraints A(q)q̇ = 0 and only those (read from
-    /// the table of [`ModelKind`]; `midpoint`, which integrates them too, is not among these).
+    /// the table of [`ModelKind`](super::ModelKind); `midpoint`, which integrates them too, is not among these).
     pub nonholonomic: bool,
     /// Whether the method integrates the gravitational N-body problem only (the Wisdom–Holman
-    /// methods; read from the table of [`ModelKind`]).
+    /// methods; read from the table of [`ModelKind`](super::ModelKind)).
     pub nbody: bool,
     pub symplectic: bool,
     pub symmetric: bool,
@@ -116,7 +115,7 @@ pub struct MethodInfo {
     pub features: &'static [Feature],
 }
 
-/// What a method's step offers beyond the kinds of model it integrates ([`ModelKind`]): which
+/// What a method's step offers beyond the kinds of model it integrates ([`ModelKind`](super::ModelKind)): which
 /// method has which is [`Method::features`] alone, and every check that refuses a method for
 /// a feature reads it there.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -241,9 +240,11 @@ impl Method {
         self.features().contains(&feature)
     }
 
-    /// The method's facts.
-    pub fn info(self) -> MethodInfo {
-        let (name, order, symplectic, symmetric, h_omega_max, reference) = match self {
+    /// The method's own facts, as its literature gives them: name, order, whether symplectic
+    /// and symmetric, stability limit and reference ([`Method::info`] adds what the table of
+    /// kinds says it integrates, and its stages).
+    pub(super) fn facts(self) -> (&'static str, u32, bool, bool, f64, &'static str) {
+        match self {
             Method::ExplicitEuler => ("explicit_euler", 1, false, false, 0.0, "baseline"),
             Method::SymplecticEuler => ("symplectic_euler", 1, true, false, 2.0, "HLW I.1; L_d = h L(q0, v)"),
             Method::Verlet => ("verlet", 2, true, true, 2.0, "HLW I.3; trapezoidal L_d"),
@@ -395,36 +396,6 @@ impl Method {
                 f64::NAN,
                 "Wisdom, Holman & Touma (1996), §10; Rein, Tamayo & Brown, MNRAS 489 (2019)",
             ),
-        };
-        let implicit = ModelKind::Lagrangian.admits(self) || ModelKind::Nonholonomic.admits(self);
-        let constrained = ModelKind::ConstrainedSeparable.admits(self);
-        let nonholonomic = !ModelKind::Lagrangian.admits(self) && ModelKind::Nonholonomic.admits(self);
-        let nbody = !ModelKind::Separable.admits(self) && ModelKind::Gravitational.admits(self);
-        let stages = match self {
-            Method::Rattle4 | Method::Dla4 => 3,
-            _ => Splitting::of(self).map_or(1, |s| s.stages()),
-        };
-        let force_evaluations = match self {
-            Method::Rk4 => 4,
-            Method::WisdomHolmanLazyKernel => 2,
-            _ if implicit => 0,
-            _ => stages,
-        };
-        MethodInfo {
-            method: self,
-            name,
-            order,
-            stages,
-            force_evaluations,
-            implicit,
-            constrained,
-            nonholonomic,
-            nbody,
-            symplectic,
-            symmetric,
-            h_omega_max,
-            reference,
-            features: self.features(),
         }
     }
 

@@ -33,6 +33,7 @@ pub mod compensated;
 mod composition;
 mod del;
 mod discrete_energy;
+mod divergence;
 mod dynamics;
 mod ensemble;
 pub mod events;
@@ -64,6 +65,7 @@ pub use composition::Composition;
 pub use del::{Composed, Del, StepEquations, TwoPoint};
 use del::{Constraints, DiscreteConstraint};
 pub use discrete_energy::DiscreteEnergy;
+pub use divergence::{beyond_limit, BeyondLimit};
 pub use dynamics::{Dynamics, General};
 pub use ensemble::{
     integrate_ensemble, integrate_ensemble_watching, Ensemble, MemberEvents, MemberWatch, Members, Outcome, Parallel,
@@ -83,10 +85,7 @@ pub use method::{Feature, Method, MethodInfo};
 pub use options::Options;
 pub use poll::{Counting, Poll};
 pub use rattle::Rattle;
-pub use run::{
-    beyond_limit, integrate, integrate_watching, integrate_with_events, resume, resume_watching, resume_with_events,
-    BeyondLimit,
-};
+pub use run::{integrate, integrate_watching, integrate_with_events, resume, resume_watching, resume_with_events};
 pub use splitting::{Leading, Splitting};
 pub use step::{Increment, StepStart};
 use stepper::Phase;

@@ -20,14 +20,11 @@
 use super::shape;
 use crate::integrators::{Dynamics, Integrator, StepperState};
 
-/// Why `state`'s derived values are not those of its method on `model`, `template` a fresh
-/// state of that method, step and model, if they are not.
-pub(in crate::integrators) fn misfit<S: Dynamics + ?Sized>(
-    state: &StepperState,
-    template: &StepperState,
-    model: &S,
-) -> Option<String> {
-    let (found, expected) = (shape::constants(state), shape::constants(template));
+/// Why `state`'s derived values (its method's constants and caches) are not those of its
+/// method on `model`, if they are not; for a state whose shape [`shape::misfit`] has checked.
+pub(in crate::integrators) fn misfit<S: Dynamics + ?Sized>(state: &StepperState, model: &S) -> Option<String> {
+    let template = state.templates(model).1;
+    let (found, expected) = (shape::constants(state), shape::constants(&template));
     if found != expected {
         let differs = found.iter().zip(&expected).find(|(a, b)| a != b);
         return Some(match differs {

@@ -8,6 +8,8 @@ use std::fmt;
 
 use serde::ser::{self, Serialize};
 
+use crate::integrators::{Dynamics, StepperState};
+
 /// Integer fields that hold values (counts, the clock, the predictor's history), not sizes:
 /// their values are not part of the shape. A field named `…pivots` is checked instead: each
 /// pivot is an index into its own vector.
@@ -60,6 +62,40 @@ impl fmt::Display for Mark {
             What::Constant(bits) => write!(f, "{at} = {:?}", f64::from_bits(bits)),
         }
     }
+}
+
+/// Why a decoded state (a checkpoint's, which its CRC does not protect against a crafted file)
+/// cannot be stepped on `model`, if it cannot: its values in range
+/// ([`StepperState::values_misfit`]), and every length, matrix size, variant and count in it as
+/// in the state its method has on `model`, fresh or after a step (the constrained methods size
+/// their buffers at the first step), every pivot indexing its vector. The caller has checked
+/// the dimension and that the method integrates the model's kind.
+pub(in crate::integrators) fn misfit<S: Dynamics + ?Sized>(state: &StepperState, model: &S) -> Option<String> {
+    if let Some(reason) = state.values_misfit() {
+        return Some(reason);
+    }
+    let (fresh, stepped) = state.templates(model);
+    let (found, fresh, stepped) = (shape(state), shape(&fresh), shape(&stepped));
+    if found == fresh || found == stepped {
+        return None;
+    }
+    let (at, expected) = found
+        .iter()
+        .zip(&stepped)
+        .find(|(a, b)| a != b)
+        .map_or_else(|| (None, None), |(a, b)| (Some(a), Some(b)));
+    Some(match (at, expected) {
+        (Some(a), Some(b)) => format!(
+            "its state does not fit this model and its method {}: {a} where they have {b}",
+            state.method().info().name
+        ),
+        _ => format!(
+            "its state does not fit this model and its method {}: {} parts where they have {}",
+            state.method().info().name,
+            found.len(),
+            stepped.len()
+        ),
+    })
 }
 
 /// The marks of `value`'s shape, in order.
