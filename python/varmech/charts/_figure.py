@@ -55,6 +55,25 @@ def documented(chart: _F) -> _F:
     return with_sections(chart, _SECTIONS)
 
 
+def draws(measurement: str) -> Callable[[_F], _F]:
+    """:func:`documented`, for a chart of the table of one analysis function, ``measurement``
+    (its dotted name): the placeholder ``{measures}`` too, the See Also to that function and the
+    Examples' opening that imports it and the chart, which each such chart wrote alike."""
+
+    def decorate(chart: _F) -> _F:
+        module, name = measurement.rsplit(".", 1)
+        section = f"""See Also
+    --------
+    {measurement} : The measurements.
+
+    {{examples}}
+    >>> from {module} import {name}
+    >>> from varmech.charts import {chart.__name__}"""
+        return documented(with_sections(chart, {"{measures}": section}))
+
+    return decorate
+
+
 def colormap(name: str) -> Any:
     """matplotlib's colour map ``name``, from its registry (no pyplot)."""
     import matplotlib
