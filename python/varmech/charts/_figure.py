@@ -57,11 +57,14 @@ def documented(chart: _F) -> _F:
 
 def draws(measurement: str) -> Callable[[_F], _F]:
     """:func:`documented`, for a chart of the table of one analysis function, ``measurement``
-    (its dotted name): the placeholder ``{measures}`` too, the See Also to that function and the
-    Examples' opening that imports it and the chart, which each such chart wrote alike."""
+    (its dotted name), with two placeholders more that each such chart wrote alike: ``{table}``,
+    the parameter ``table`` returned by that function, and ``{measures}``, the See Also to it and
+    the Examples' opening that imports it and the chart."""
 
     def decorate(chart: _F) -> _F:
         module, name = measurement.rsplit(".", 1)
+        table = f"""table : Table
+        A table returned by :func:`~{measurement}`."""
         section = f"""See Also
     --------
     {measurement} : The measurements.
@@ -69,7 +72,7 @@ def draws(measurement: str) -> Callable[[_F], _F]:
     {{examples}}
     >>> from {module} import {name}
     >>> from varmech.charts import {chart.__name__}"""
-        return documented(with_sections(chart, {"{measures}": section}))
+        return documented(with_sections(chart, {"{table}": table, "{measures}": section}))
 
     return decorate
 

@@ -38,8 +38,7 @@ def nonholonomic_energy_chart(table: Table, path: str | Path | None = None, titl
 
     Parameters
     ----------
-    table : Table
-        A table returned by :func:`~varmech.analysis.nonholonomic.nonholonomic_energy`.
+    {table}
     {path}
     title : str, optional
         The figure's title (default the table's title).

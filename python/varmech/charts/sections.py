@@ -99,8 +99,7 @@ def phase_portrait_chart(table: Table, path: str | Path | None = None, title: st
 
     Parameters
     ----------
-    table : Table
-        A table returned by :func:`~varmech.analysis.phase_portrait.phase_portrait`.
+    {table}
     {path}
     title : str, optional
         The figure's title (default none).

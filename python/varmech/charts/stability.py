@@ -52,8 +52,7 @@ def stability_chart(
 
     Parameters
     ----------
-    table : Table
-        A table returned by :func:`~varmech.analysis.stability.growth_table`.
+    {table}
     {path}
     title : str, optional
         The figure's title (default: what is plotted).
@@ -133,8 +132,7 @@ def implicit_regions_chart(table: Table, path: str | Path | None = None, title: 
 
     Parameters
     ----------
-    table : Table
-        A table returned by :func:`~varmech.analysis.implicit.implicit_regions`.
+    {table}
     {path}
     title : str, optional
         The figure's title (default: the scene and the number of steps).
