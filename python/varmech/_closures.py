@@ -144,22 +144,9 @@ class MechanicalSystem(Model):
         name: str = "mechanical system",
         coordinates: Sequence[str] | None = None,
     ):
-        self._arguments = {
-            "dim": dim,
-            "potential": potential,
-            "gradient": gradient,
-            "mass": mass,
-            "mass_derivative": mass_derivative,
-            "constraints": constraints,
-            "constraint_jacobian": constraint_jacobian,
-            "constraint_count": constraint_count,
-            "velocity_constraints": velocity_constraints,
-            "velocity_constraint_count": velocity_constraint_count,
-            "velocity_constraint_offset": velocity_constraint_offset,
-            "symmetries": symmetries,
-            "name": name,
-            "coordinates": coordinates,
-        }
+        # What it pickles as (Model.__reduce__): every argument by name, as given, before any
+        # is checked; only the arguments are local yet.
+        self._arguments = {name: value for name, value in locals().items() if name != "self"}
         dim = positive_int("dim", dim)
         self._coordinates = coordinate_names(coordinates, dim)
         if (constraints is None) != (constraint_count is None) or (constraint_jacobian is not None and constraints is None):
@@ -455,24 +442,9 @@ class Lagrangian(Model):
         energy_name: str = "energy",
         coordinates: Sequence[str] | None = None,
     ):
-        self._arguments = {
-            "dim": dim,
-            "lagrangian": lagrangian,
-            "dl_dq": dl_dq,
-            "dl_dv": dl_dv,
-            "hessians": hessians,
-            "force": force,
-            "rayleigh": rayleigh,
-            "time_dependent": time_dependent,
-            "velocity_constraints": velocity_constraints,
-            "velocity_constraint_count": velocity_constraint_count,
-            "velocity_constraint_offset": velocity_constraint_offset,
-            "symmetries": symmetries,
-            "name": name,
-            "dl_dt": dl_dt,
-            "energy_name": energy_name,
-            "coordinates": coordinates,
-        }
+        # What it pickles as (Model.__reduce__): every argument by name, as given, before any
+        # is checked; only the arguments are local yet.
+        self._arguments = {name: value for name, value in locals().items() if name != "self"}
         dim = positive_int("dim", dim)
         self._coordinates = coordinate_names(coordinates, dim)
         if not isinstance(energy_name, str) or not energy_name.strip():

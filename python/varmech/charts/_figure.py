@@ -55,6 +55,28 @@ def documented(chart: _F) -> _F:
     return with_sections(chart, _SECTIONS)
 
 
+def draws(measurement: str) -> Callable[[_F], _F]:
+    """:func:`documented`, for a chart of the table of one analysis function, ``measurement``
+    (its dotted name), with two placeholders more that each such chart wrote alike: ``{table}``,
+    the parameter ``table`` returned by that function, and ``{measures}``, the See Also to it and
+    the Examples' opening that imports it and the chart."""
+
+    def decorate(chart: _F) -> _F:
+        module, name = measurement.rsplit(".", 1)
+        table = f"""table : Table
+        A table returned by :func:`~{measurement}`."""
+        section = f"""See Also
+    --------
+    {measurement} : The measurements.
+
+    {{examples}}
+    >>> from {module} import {name}
+    >>> from varmech.charts import {chart.__name__}"""
+        return documented(with_sections(chart, {"{table}": table, "{measures}": section}))
+
+    return decorate
+
+
 def colormap(name: str) -> Any:
     """matplotlib's colour map ``name``, from its registry (no pyplot)."""
     import matplotlib

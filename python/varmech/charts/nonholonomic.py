@@ -13,7 +13,7 @@ if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
 from ..table import Table
-from ._figure import Canvas, documented, time_label
+from ._figure import Canvas, draws, time_label
 
 __all__ = [
     "nonholonomic_energy_chart",
@@ -28,7 +28,7 @@ LABELS = {
 }
 
 
-@documented
+@draws("varmech.analysis.nonholonomic.nonholonomic_energy")
 def nonholonomic_energy_chart(table: Table, path: str | Path | None = None, title: str = "", *, ax: Axes | None = None) -> Figure:
     """Plot the relative energy error |E − E₀|/E₀ of a
     :func:`~varmech.analysis.nonholonomic.nonholonomic_energy` table against t on log–log axes,
@@ -38,8 +38,7 @@ def nonholonomic_energy_chart(table: Table, path: str | Path | None = None, titl
 
     Parameters
     ----------
-    table : Table
-        A table returned by :func:`~varmech.analysis.nonholonomic.nonholonomic_energy`.
+    {table}
     {path}
     title : str, optional
         The figure's title (default the table's title).
@@ -49,14 +48,8 @@ def nonholonomic_energy_chart(table: Table, path: str | Path | None = None, titl
 
     {raises}.
 
-    See Also
-    --------
-    varmech.analysis.nonholonomic.nonholonomic_energy : The measurements.
-
-    {examples}
+    {measures}
     >>> import varmech
-    >>> from varmech.analysis.nonholonomic import nonholonomic_energy
-    >>> from varmech.charts import nonholonomic_energy_chart
     >>> table = nonholonomic_energy(steps=200, samples=10)
     >>> with tempfile.TemporaryDirectory() as folder:
     ...     path = Path(folder) / "rolling_disk.png"

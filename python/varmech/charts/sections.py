@@ -14,7 +14,7 @@ if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
 from ..table import Table
-from ._figure import Canvas, colormap, documented, state_label
+from ._figure import Canvas, colormap, draws, state_label
 
 
 def _henon_heiles_boundary(energy: float) -> tuple[np.ndarray, np.ndarray] | None:
@@ -27,7 +27,7 @@ def _henon_heiles_boundary(energy: float) -> tuple[np.ndarray, np.ndarray] | Non
     return np.concatenate([y, y[::-1]]), np.concatenate([py, -py[::-1]])
 
 
-@documented
+@draws("varmech.analysis.sections.poincare_section")
 def poincare_chart(
     table: Table | Sequence[Table], path: str | Path | None = None, title: str = "", *, ax: Axes | Sequence[Axes] | None = None
 ) -> Figure:
@@ -50,14 +50,8 @@ def poincare_chart(
 
     {raises}, or no table is given.
 
-    See Also
-    --------
-    varmech.analysis.sections.poincare_section : The measurements.
-
-    {examples}
+    {measures}
     >>> import varmech
-    >>> from varmech.analysis.sections import poincare_section
-    >>> from varmech.charts import poincare_chart
     >>> tables = [poincare_section(varmech.scenes.henon_heiles(), energy, orbits=2, dt=0.1,
     ...                            t_end=60.0, progress=False) for energy in (1 / 12, 1 / 8)]
     >>> with tempfile.TemporaryDirectory() as folder:
@@ -96,7 +90,7 @@ def poincare_chart(
     return canvas.done(tables[0].meta)
 
 
-@documented
+@draws("varmech.analysis.phase_portrait.phase_portrait")
 def phase_portrait_chart(table: Table, path: str | Path | None = None, title: str = "", *, ax: Axes | None = None) -> Figure:
     """Draw the orbits of :func:`varmech.analysis.phase_portrait.phase_portrait` in the (q, p) plane:
     librations in blues, rotations in oranges (darker for higher energy), undetermined orbits
@@ -105,8 +99,7 @@ def phase_portrait_chart(table: Table, path: str | Path | None = None, title: st
 
     Parameters
     ----------
-    table : Table
-        A table returned by :func:`~varmech.analysis.phase_portrait.phase_portrait`.
+    {table}
     {path}
     title : str, optional
         The figure's title (default none).
@@ -116,14 +109,8 @@ def phase_portrait_chart(table: Table, path: str | Path | None = None, title: st
 
     {raises}.
 
-    See Also
-    --------
-    varmech.analysis.phase_portrait.phase_portrait : The measurements.
-
-    {examples}
+    {measures}
     >>> import varmech
-    >>> from varmech.analysis.phase_portrait import phase_portrait
-    >>> from varmech.charts import phase_portrait_chart
     >>> table = phase_portrait(varmech.scenes.pendulum(), [-0.5, 2.0], dt=0.05, t_end=20.0,
     ...                        progress=False)
     >>> with tempfile.TemporaryDirectory() as folder:

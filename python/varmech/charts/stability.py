@@ -16,7 +16,7 @@ if TYPE_CHECKING:
 
 from ..analysis.stability import OUTCOMES, REFERENCE_LIMITS
 from ..table import Table
-from ._figure import Canvas, documented, time_label
+from ._figure import Canvas, documented, draws, time_label
 
 # Outcome colours of the implicit-regions map, in the order of OUTCOMES.
 _OUTCOME_COLOURS = {
@@ -34,7 +34,7 @@ _MARKERS = "osD^vPX*<>"
 _LINESTYLES = ("-", "--", "-.", (0, (3, 1, 1, 1, 1, 1)), ":")
 
 
-@documented
+@draws("varmech.analysis.stability.growth_table")
 def stability_chart(
     table: Table, path: str | Path | None = None, title: str = "", limits: Mapping[str, float] | None = None, *, ax: Axes | None = None
 ) -> Figure:
@@ -52,8 +52,7 @@ def stability_chart(
 
     Parameters
     ----------
-    table : Table
-        A table returned by :func:`~varmech.analysis.stability.growth_table`.
+    {table}
     {path}
     title : str, optional
         The figure's title (default: what is plotted).
@@ -65,13 +64,7 @@ def stability_chart(
 
     {raises}.
 
-    See Also
-    --------
-    varmech.analysis.stability.growth_table : The measurements.
-
-    {examples}
-    >>> from varmech.analysis.stability import growth_table
-    >>> from varmech.charts import stability_chart
+    {measures}
     >>> table = growth_table(["verlet", "rk4"], [0.5, 1.0, 2.5, 3.0], limits=False)
     >>> with tempfile.TemporaryDirectory() as folder:   # the reference limits are marked
     ...     path = Path(folder) / "stability.png"
@@ -131,7 +124,7 @@ def stability_chart(
     return canvas.done(table.meta)
 
 
-@documented
+@draws("varmech.analysis.implicit.implicit_regions")
 def implicit_regions_chart(table: Table, path: str | Path | None = None, title: str = "", *, ax: Axes | Sequence[Axes] | None = None) -> Figure:
     """A categorical map of the outcome over step size h (columns) and initial angle q₀ (rows),
     one panel per method, from :func:`~varmech.analysis.implicit.implicit_regions`. Writes ``path``
@@ -139,8 +132,7 @@ def implicit_regions_chart(table: Table, path: str | Path | None = None, title: 
 
     Parameters
     ----------
-    table : Table
-        A table returned by :func:`~varmech.analysis.implicit.implicit_regions`.
+    {table}
     {path}
     title : str, optional
         The figure's title (default: the scene and the number of steps).
@@ -150,13 +142,7 @@ def implicit_regions_chart(table: Table, path: str | Path | None = None, title: 
 
     {raises}.
 
-    See Also
-    --------
-    varmech.analysis.implicit.implicit_regions : The measurements.
-
-    {examples}
-    >>> from varmech.analysis.implicit import implicit_regions
-    >>> from varmech.charts import implicit_regions_chart
+    {measures}
     >>> table = implicit_regions("midpoint", h_values=(0.5, 3.0), q0_values=(1.0, 3.0))
     >>> with tempfile.TemporaryDirectory() as folder:
     ...     path = Path(folder) / "implicit.png"
