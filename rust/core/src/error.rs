@@ -67,29 +67,17 @@ impl Error {
 
     /// The same error, named by the run's `step` and its start `time`: a partial step's, which
     /// a run reports as its own step's.
-    pub(crate) fn at(self, step: usize, time: f64) -> Error {
-        match self {
-            Error::Divergence { reason, .. } => Error::Divergence { step, time, reason },
-            Error::Convergence {
-                residual,
-                iterations,
-                reason,
-                advice,
-                ..
-            } => Error::Convergence {
-                step,
-                time,
-                residual,
-                iterations,
-                reason,
-                advice,
-            },
-            Error::SpuriousBranch { reason, .. } => Error::SpuriousBranch { step, time, reason },
-            Error::Model { source, .. } => Error::Model { step, time, source },
-            Error::Interrupted { source, .. } => Error::Interrupted { step, time, source },
-            Error::Contact { reason, .. } => Error::Contact { step, time, reason },
-            e @ Error::InvalidArgument { .. } => e,
+    pub(crate) fn at(mut self, step: usize, time: f64) -> Error {
+        match &mut self {
+            Error::Divergence { step: s, time: t, .. }
+            | Error::Convergence { step: s, time: t, .. }
+            | Error::SpuriousBranch { step: s, time: t, .. }
+            | Error::Model { step: s, time: t, .. }
+            | Error::Interrupted { step: s, time: t, .. }
+            | Error::Contact { step: s, time: t, .. } => (*s, *t) = (step, time),
+            Error::InvalidArgument { .. } => {}
         }
+        self
     }
 }
 
