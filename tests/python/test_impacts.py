@@ -1,6 +1,7 @@
 """Impacts with unilateral constraints (reference/impulses_and_rolling.md): the bouncing ball's
 exact bounce times and heights, its restitution law, and the elliptic billiard's focal invariant."""
 
+import functools
 import math
 
 import numpy as np
@@ -223,6 +224,33 @@ def test_a_ball_with_e_below_1_comes_to_rest_at_the_zeno_limit_and_then_rests_on
     after = traj.t > impacts.t[-1]
     assert np.sum(after) > 1000 and np.max(np.abs(traj.q[after])) < 1e-15 and np.all(traj.p[after] == 0)
     assert traj.status == 0 and np.min(traj.q) > -1e-12
+
+
+@pytest.mark.parametrize("method", ["verlet", "rk4", "midpoint"])
+def test_a_flight_that_ends_exactly_at_a_steps_end_is_an_impact_at_the_next_steps_start(method):
+    # Dropped from 1/2 under g = 1 onto a floor with e = 1/2, the ball lands at t = 1, 2, 2.5,
+    # 2.75, …, t∞ = 3; at dt = 1/4 each of these is a step's end, which every method here
+    # reaches exactly (q quadratic in t), with φ = 0 there: no crossing of the piece that left
+    # the floor, so the next step starts on it moving in, and the impact is there (it was
+    # taken for a body resting on the floor, which impacts cannot resolve).
+    ball = varmech.MechanicalSystem(1, lambda q: q[0], lambda q: np.array([1.0]), name="ball")
+    floor = varmech.Contact.wall(0, 0.0, restitution=0.5, law="reflect")
+    run = functools.partial(varmech.integrate, ball, [0.5], [0.0], dt=0.25, method=method, contacts=[floor])
+    if method == "verlet":
+        # It holds the floor once the rebounds would last less than a step: at rest from t∞.
+        traj = run(steps=20)
+        impacts, closed = traj.events[:2]
+        np.testing.assert_allclose(impacts.t[:4], [1.0, 2.0, 2.5, 2.75], rtol=0, atol=1e-15)
+        assert len(closed) == 1 and closed.t[0] == 3.0
+        assert np.all(traj.q[traj.t >= 3.0] == 0.0) and traj.status == 0
+    else:
+        # The others cannot hold it: their impacts go on into the accumulation in the step
+        # from 2.75 (to t's resolution: flights of 0 are its limit, not a chatter a shorter
+        # step resolves), which stops the run with the advice to hold the contact.
+        np.testing.assert_allclose(run(steps=11).events[0].t[:3], [1.0, 2.0, 2.5], rtol=0, atol=1e-15)
+        with pytest.raises(varmech.ContactError, match="cannot resolve|shrinking to an accumulation at t ≈ 3.0") as info:
+            run(steps=20)
+        assert info.value.time == 2.75 and "hold such a contact closed" in str(info.value)
 
 
 def test_a_method_that_cannot_hold_a_contact_ends_an_accumulation_of_impacts_with_a_contact_error():

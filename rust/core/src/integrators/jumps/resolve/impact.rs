@@ -34,6 +34,12 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
             let s = match self.locate(j, step, (ta, tau), leaving) {
                 Ok(s) => s,
                 Err(Located::Error(e)) => return Err(e),
+                // A flight that ended exactly on the surface at the last step's end (φ = 0
+                // there is no crossing of a piece leaving it) arrives at this piece's start.
+                Err(Located::Resting) if last != Some(j) && self.arriving(j, step, ta)? => {
+                    self.partial(step, ta, 0.0)?;
+                    Some(0.0)
+                }
                 Err(Located::Resting) => return Err(self.contact_error(step, self.resting(j))),
             };
             if let Some(s) = s {
@@ -43,6 +49,15 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
             }
         }
         Ok(first)
+    }
+
+    /// Whether the piece from ta starts moving into contact j: ∇φⱼ·q̇ < 0.
+    fn arriving(&mut self, j: usize, step: usize, ta: f64) -> Result<bool, Error> {
+        let (model, time) = (self.scratch.model().as_lagrangian(), self.t);
+        let vectors = (&mut self.normal[..], &mut self.v[..]);
+        let rate = phi_rate(&self.contacts[j], model, (ta, &self.piece_q, &self.piece_p), vectors)
+            .map_err(|source| Error::model(step, time, source))?;
+        Ok(rate < 0.0)
     }
 
     /// Why a body leaving contact j that crosses it again at once cannot go on, and what helps.
@@ -92,7 +107,7 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
     }
 
     /// Why a step met more than [`MAX_IMPACTS`] impacts, and what helps: flights that shrink
-    /// geometrically (each of the last [`SHRINKING`] shorter than the one before, at a mean
+    /// geometrically (each of the last [`SHRINKING`] shorter than the one before or at t's resolution, at a mean
     /// ratio r below 0.999, so that they sum to within 10³ flights) accumulate at a finite
     /// time, as a body coming to rest does (r = e under a constant force), which no step
     /// resolves; flights that do not (a chatter of equal ones) are a step too long for them.
@@ -101,7 +116,14 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
         let k = t.len();
         let (first, last) = (t[1] - t[0], t[k - 1] - t[k - 2]);
         let ratio = (last / first).powf(1.0 / (k - 2) as f64);
-        let shrinking = t.windows(3).rev().take(SHRINKING).all(|w| w[2] - w[1] < w[1] - w[0]);
+        // Flights at t's resolution (0 or a few ulps, as t rounds): the series is at its
+        // limit to round-off.
+        let resolution = 4.0 * f64::EPSILON * t[k - 1].abs();
+        let shrinking = t
+            .windows(3)
+            .rev()
+            .take(SHRINKING)
+            .all(|w| w[2] - w[1] < w[1] - w[0] || w[2] - w[1] <= resolution);
         if !(shrinking && ratio < 0.999) {
             return format!(
                 "more than {MAX_IMPACTS} impacts in one step, in flights as short as {last:.3e}: shorten the step (dt)"
