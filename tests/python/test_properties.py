@@ -196,7 +196,10 @@ FOUND = [
             q0=[6.103515625e-05, 4.0501448914459753e-44, 0.2783151791242946, 1e-06],
             v0=[1.993638431312266, 0.2783151791242946, 1.1707998210691475, 1.5591874831504495], method="trapezoid",
             h_fraction=0.8999999999999999, steps=100),
-        "ConvergenceError", None,
+        # At step 96 Newton meets a fold of the DEL map or stalls before it, as the last bits of
+        # NumPy's cos fall (its SIMD paths differ between machines): either typed error, whose
+        # advice, a smaller step, the oracle checks.
+        ("ConvergenceError", "SpuriousBranchError"), None,
     ),
     (
         "a damped closure decayed to where g(1 − cos q) rounds at εg: Newton at its measured noise",
@@ -214,5 +217,5 @@ FOUND = [
 @pytest.mark.parametrize(("shows", "fields", "kind", "verdict"), FOUND, ids=[f[0][:40] for f in FOUND])
 def test_what_the_campaigns_found(shows, fields, kind, verdict):
     outcome = _check(pm.Spec(**fields))
-    assert (outcome.kind, outcome.verdict) == (kind, verdict), outcome
+    assert outcome.kind in (kind if isinstance(kind, tuple) else (kind,)) and outcome.verdict == verdict, outcome
     assert not outcome.known, outcome
