@@ -331,6 +331,14 @@ def _failed(case: Case, err: BaseException, h: float | None = None, depth: int =
         other = _attempt(lambda: case.run(h, method="rattle" if case.model.constraints else "verlet", **options))
         if isinstance(other, varmech.Trajectory):
             return out
+    if "take a symmetric method" in message:
+        # Either remedy of a method that is not symmetric, reflecting impacts: a symmetric one at
+        # h (or the variational law), or a smaller step.
+        e, _, mu = case.spec.contact or (1.0, "reflect", 0.0)
+        variational = build(replace(case.spec, contact=(e, "variational", mu)))
+        remedies = (lambda: case.run(h, method="verlet", **options), lambda: variational.run(h, **options))
+        if any(isinstance(_attempt(remedy), varmech.Trajectory) for remedy in remedies):
+            return out
     if any(w in message for w in NO_HELP):
         # Our models are smooth and their derivatives right: such a diagnosis is wrong, unless h/4 fails alike.
         quarter = _attempt(lambda: case.run(h / 4, **options))

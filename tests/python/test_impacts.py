@@ -253,6 +253,35 @@ def test_a_flight_that_ends_exactly_at_a_steps_end_is_an_impact_at_the_next_step
         assert info.value.time == 2.75 and "hold such a contact closed" in str(info.value)
 
 
+def test_symplectic_euler_under_newtons_law_drifts_at_order_one_by_the_same_amount_at_each_impact():
+    # Its modified energy H − (h/2)q̇·∇V + O(h²) is odd in p: each reflection moves it by O(h),
+    # alike at every impact (15 in t = 60 of a trapped particle on an elastic floor), so the
+    # error grows with the impacts and halves with h; Verlet's is even in p, bounded at order 2.
+    trap = varmech.MechanicalSystem(1, lambda q: 0.5 * q[0] ** 2 + q[0], lambda q: np.array([q[0] + 1.0]), name="trap")
+    floor = varmech.Contact.wall(0, -1.5, restitution=1.0, law="reflect")
+
+    def error(method, dt):
+        traj = varmech.integrate(trap, [0.0], [1.0], dt=dt, steps=round(60 / dt), method=method, contacts=[floor],
+                                 save_every=round(0.5 / dt), max_energy_error=None)
+        energy = 0.5 * traj.p[:, 0] ** 2 + 0.5 * traj.q[:, 0] ** 2 + traj.q[:, 0]
+        assert len(traj.events[0]) == 15
+        return traj.t, np.abs(energy - energy[0])
+
+    t, drift = error("symplectic_euler", 0.01)
+    thirds = [np.max(drift[t <= end]) for end in (20, 40, 60)]
+    np.testing.assert_allclose(np.array(thirds) / thirds[0], [1, 2, 3], rtol=0.05)
+    assert 1.9 < np.max(error("symplectic_euler", 0.02)[1]) / np.max(drift) < 2.1
+    t, band = error("verlet", 0.01)
+    assert np.max(band) < 1.01 * np.max(band[t <= 20]) and 3.9 < np.max(error("verlet", 0.02)[1]) / np.max(band) < 4.1
+    # At a coarse step the drift stops the run, and the advice names its cause and remedies.
+    with pytest.raises(varmech.DivergenceError, match="symplectic_euler is not symmetric") as info:
+        varmech.integrate(trap, [0.0], [1.0], dt=0.5, steps=2000, method="symplectic_euler", contacts=[floor])
+    assert 'take a symmetric method, whose energy stays bounded across impacts: verlet, or law="variational"' in str(info.value)
+    for remedy in (dict(method="verlet", contacts=[floor]),
+                   dict(method="symplectic_euler", contacts=[varmech.Contact.wall(0, -1.5, law="variational")])):
+        assert varmech.integrate(trap, [0.0], [1.0], dt=0.5, steps=2000, **remedy).status == 0
+
+
 def test_a_method_that_cannot_hold_a_contact_ends_an_accumulation_of_impacts_with_a_contact_error():
     # rk4 cannot hold the floor: past the accumulation time the impacts cannot go on, a typed
     # error with the step and time, and the whole run up to that step, impacts included.

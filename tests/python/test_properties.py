@@ -202,6 +202,14 @@ FOUND = [
         ("ConvergenceError", "SpuriousBranchError"), None,
     ),
     (
+        "symplectic Euler's elastic bounces drift at order 1: advised a symmetric method, which runs",
+        dict(family="wall", api="mechanical", n=1, coefficients={
+            "k": [2.662282863916816], "m": [0.6], "g": [1.1796371729301414], "floor": [0.7620911678392257]},
+            contact=(1.0, "reflect", 0.0), q0=[1.0163394907001655], v0=[1.3087765018551814],
+            method="symplectic_euler", h_fraction=0.7620911678392257, steps=71),
+        "DivergenceError", None,
+    ),
+    (
         "a damped closure decayed to where g(1 − cos q) rounds at εg: Newton at its measured noise",
         _damped_chain(0.062411198101095314),
         "completed", "bounded",

@@ -184,7 +184,13 @@ impl EnergyWatch {
 
     /// The error that ends the run at the stepper's state, if any; `first` is the run's first
     /// state (q, t), where the stability limit is judged.
-    pub(super) fn check<S, M>(&mut self, sys: &S, stepper: &Stepper<M>, first: (&[f64], f64)) -> Option<Error>
+    pub(super) fn check<S, M>(
+        &mut self,
+        sys: &S,
+        stepper: &Stepper<M>,
+        first: (&[f64], f64),
+        reflects: bool,
+    ) -> Option<Error>
     where
         S: Dynamics + ?Sized,
         M: std::ops::Deref<Target: Dynamics>,
@@ -226,7 +232,7 @@ impl EnergyWatch {
             )
         };
         let advice = differences_advice(sys, (stepper.q(), stepper.p(), time), first.0, error.abs())
-            .unwrap_or_else(|| step_advice(method));
+            .unwrap_or_else(|| step_advice(method, reflects));
         let reason = format!(
             "energy error {:.3e} is {:.3e} times the energy scale {scale:.3e} (the mean kinetic energy), \
              beyond max_energy_error = {:.3e}{growing}; {advice}",
@@ -265,14 +271,26 @@ fn differences_advice<S: Dynamics + ?Sized>(
     })
 }
 
-/// What helps an energy error that a step too coarse accounts for. A method that is not
-/// symplectic conserves no modified energy: its error grows along any run, so a smaller step
-/// only slows it (a run k times as long needs a step k times smaller at order 1), and a
-/// symplectic method bounds it.
-fn step_advice(method: Method) -> String {
+/// What helps an energy error that a step too coarse accounts for, in a run that reflects
+/// impacts by Newton's law (`reflects`) or not. A method that is not symplectic conserves no
+/// modified energy: its error grows along any run, so a smaller step only slows it (a run k
+/// times as long needs a step k times smaller at order 1), and a symplectic method bounds it. A
+/// symplectic one that is not symmetric (symplectic Euler) has a modified energy odd in p, at
+/// first order (H̃ = H − (h/2)q̇·∇V + O(h²)): a reflection of p moves it by O(h), with the same
+/// sign at every impact, a drift of order 1; a symmetric method's is even in p, and the
+/// variational law keeps the discrete energy across the impact.
+fn step_advice(method: Method, reflects: bool) -> String {
     let info = method.info();
-    if info.symplectic {
+    if info.symplectic && !(reflects && !info.symmetric) {
         return "reduce dt".into();
+    }
+    if info.symplectic {
+        return format!(
+            "reduce dt ({} is not symmetric: each impact reflected by Newton's law moves its modified energy by \
+             O(h), alike at every one, a drift that falls at order 1), or take a symmetric method, whose energy \
+             stays bounded across impacts: verlet, or law=\"variational\"",
+            info.name
+        );
     }
     format!(
         "reduce dt ({} is not symplectic: its energy error grows along the run, slower at a smaller step, by \

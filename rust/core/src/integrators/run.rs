@@ -360,7 +360,11 @@ where
             outcome = Err(error);
             break;
         }
-        if let Some(error) = watch.as_mut().and_then(|w| w.check(sys, &stepper, (&first.0, first.1))) {
+        let reflects = watcher.reflects();
+        if let Some(error) = watch
+            .as_mut()
+            .and_then(|w| w.check(sys, &stepper, (&first.0, first.1), reflects))
+        {
             // The state of this step is kept: it is finite, only its energy is off.
             outcome = Err(error);
             break;

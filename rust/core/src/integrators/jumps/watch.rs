@@ -155,6 +155,12 @@ where
         }
     }
 
+    /// Whether it reflects impacts by Newton's law ([`super::Law::Reflect`]), which moves the modified
+    /// energy of a method that is not symmetric.
+    pub fn reflects(&self) -> bool {
+        self.resolver.as_ref().is_some_and(|r| r.reflects())
+    }
+
     /// Force evaluations of the partial steps (located events and impacts).
     pub fn force_evaluations(&self) -> u64 {
         self.search.as_ref().map_or(0, |s| s.force_evaluations())

@@ -17,7 +17,7 @@ use std::ops::Deref;
 
 use super::hold::{Held, Hold};
 use super::unsolved::run_error;
-use super::{Contact, Contacts, Schedule, MAX_IMPACTS};
+use super::{Contact, Contacts, Law, Schedule, MAX_IMPACTS};
 use crate::integrators::events::Search;
 use crate::integrators::DiscreteEnergy;
 use crate::integrators::{Counting, Dynamics, Occurrence, Poll, Stepper, StepperState, Trajectory};
@@ -697,6 +697,11 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
             self.scratch.step().map_err(|e| e.at(step, self.t))?;
         }
         Ok(())
+    }
+
+    /// Whether a contact's law is Newton's ([`Law::Reflect`]).
+    pub(in crate::integrators) fn reflects(&self) -> bool {
+        self.contacts.iter().any(|c| c.law == Law::Reflect)
     }
 
     /// Force evaluations of the partial steps.
