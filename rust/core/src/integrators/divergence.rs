@@ -281,7 +281,7 @@ fn differences_advice<S: Dynamics + ?Sized>(
 /// variational law keeps the discrete energy across the impact.
 fn step_advice(method: Method, reflects: bool) -> String {
     let info = method.info();
-    if info.symplectic && !(reflects && !info.symmetric) {
+    if info.symplectic && (info.symmetric || !reflects) {
         return "reduce dt".into();
     }
     if info.symplectic {
