@@ -347,6 +347,8 @@ where
     } else {
         save_every
     };
+    // What the energy check's advice needs of the contacts, fixed for the run.
+    let reflects = watcher.reflects();
     while stepper.steps() < end && outcome.is_ok() {
         // Every `save_every`-th state is saved, and the last.
         let save = (stepper.steps() / period + 1).saturating_mul(period).min(end);
@@ -360,7 +362,6 @@ where
             outcome = Err(error);
             break;
         }
-        let reflects = watcher.reflects();
         if let Some(error) = watch
             .as_mut()
             .and_then(|w| w.check(sys, &stepper, (&first.0, first.1), reflects))

@@ -155,8 +155,8 @@ where
         }
     }
 
-    /// Whether it reflects impacts by Newton's law ([`super::Law::Reflect`]), which moves the modified
-    /// energy of a method that is not symmetric.
+    /// Whether it reflects impacts by Newton's law ([`super::Law::Reflect`]), which moves the
+    /// modified energy of a method that is not symmetric.
     pub fn reflects(&self) -> bool {
         self.resolver.as_ref().is_some_and(|r| r.reflects())
     }

@@ -35,8 +35,9 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
                 Ok(s) => s,
                 Err(Located::Error(e)) => return Err(e),
                 // A flight that ended exactly on the surface at the last step's end (φ = 0
-                // there is no crossing of a piece leaving it) arrives at this piece's start.
-                Err(Located::Resting) if last != Some(j) && self.arriving(j, step, ta)? => {
+                // there is no crossing of a piece leaving it) arrives, moving into it, at this
+                // piece's start.
+                Err(Located::Resting) if last != Some(j) && self.start_rate(j, step, ta)? < 0.0 => {
                     self.partial(step, ta, 0.0)?;
                     Some(0.0)
                 }
@@ -51,13 +52,12 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
         Ok(first)
     }
 
-    /// Whether the piece from ta starts moving into contact j: ∇φⱼ·q̇ < 0.
-    fn arriving(&mut self, j: usize, step: usize, ta: f64) -> Result<bool, Error> {
+    /// φⱼ's rate ∇φⱼ·q̇ at the piece's start (ta, `piece_q`, `piece_p`).
+    fn start_rate(&mut self, j: usize, step: usize, ta: f64) -> Result<f64, Error> {
         let (model, time) = (self.scratch.model().as_lagrangian(), self.t);
         let vectors = (&mut self.normal[..], &mut self.v[..]);
-        let rate = phi_rate(&self.contacts[j], model, (ta, &self.piece_q, &self.piece_p), vectors)
-            .map_err(|source| Error::model(step, time, source))?;
-        Ok(rate < 0.0)
+        phi_rate(&self.contacts[j], model, (ta, &self.piece_q, &self.piece_p), vectors)
+            .map_err(|source| Error::model(step, time, source))
     }
 
     /// Why a body leaving contact j that crosses it again at once cannot go on, and what helps.
@@ -107,10 +107,11 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
     }
 
     /// Why a step met more than [`MAX_IMPACTS`] impacts, and what helps: flights that shrink
-    /// geometrically (each of the last [`SHRINKING`] shorter than the one before or at t's resolution, at a mean
-    /// ratio r below 0.999, so that they sum to within 10³ flights) accumulate at a finite
-    /// time, as a body coming to rest does (r = e under a constant force), which no step
-    /// resolves; flights that do not (a chatter of equal ones) are a step too long for them.
+    /// geometrically (each of the last [`SHRINKING`] shorter than the one before, or at t's
+    /// resolution, at a mean ratio r below 0.999, so that they sum to within 10³ flights)
+    /// accumulate at a finite time, as a body coming to rest does (r = e under a constant
+    /// force), which no step resolves; flights that do not (a chatter of equal ones) are a step
+    /// too long for them.
     pub(super) fn too_many_impacts(&self) -> String {
         let t = &self.pending.t;
         let k = t.len();
@@ -307,10 +308,7 @@ impl<'c, 's, M: Deref<Target: Dynamics>> Resolver<'c, 's, M> {
             }
         } else {
             // The partial steps' q(s) leaves with the velocity q̇ at the piece's start.
-            let (model, time) = (self.scratch.model().as_lagrangian(), self.t);
-            let vectors = (&mut self.normal[..], &mut self.v[..]);
-            let rate = phi_rate(&self.contacts[j], model, (ta, &self.piece_q, &self.piece_p), vectors)
-                .map_err(|source| Error::model(step, time, source))?;
+            let rate = self.start_rate(j, step, ta)?;
             let end = (tau, self.phi_end[j]);
             ((start, end), Some(quadratic_root(start.1, rate, end)))
         };
