@@ -358,10 +358,10 @@ def build(spec: Spec) -> Case:
             q0, p0 = varmech.project(model, q0, v0=v0)
         else:
             p0 = model.momentum(q0, v0)
+        if spec.dt is not None:
+            return Case(spec, model, twin, np.asarray(q0), np.asarray(p0), spec.dt, contacts)
         sphere = _pendulum(spec, model, q0, p0) if spec.family == "sphere" else None
         omega = _fastest(model, q0, v0, sphere)
-    if spec.dt is not None:
-        return Case(spec, model, twin, np.asarray(q0), np.asarray(p0), spec.dt, contacts)
     info = METHODS[spec.method]
     limit = info.h_omega_max
     if not limit > 0:  # explicit Euler: unstable at every step

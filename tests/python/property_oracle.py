@@ -335,8 +335,8 @@ def _failed(case: Case, err: BaseException, h: float | None = None, depth: int =
         # Either remedy of a method that is not symmetric, reflecting impacts: a symmetric one at
         # h (or the variational law), or a smaller step.
         e, _, mu = case.spec.contact or (1.0, "reflect", 0.0)
-        variational = build(replace(case.spec, contact=(e, "variational", mu)))
-        remedies = (lambda: case.run(h, method="verlet", **options), lambda: variational.run(h, **options))
+        variational = replace(case.spec, contact=(e, "variational", mu))
+        remedies = (lambda: case.run(h, method="verlet", **options), lambda: build(variational).run(h, **options))
         if any(isinstance(_attempt(remedy), varmech.Trajectory) for remedy in remedies):
             return out
     if any(w in message for w in NO_HELP):
