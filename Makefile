@@ -46,8 +46,10 @@ guards-then-rust: guards
 test-rust:
 	env -u MAKEFLAGS -u MFLAGS cargo test --release --workspace
 
+# pytest's own workers, one per core (pytest-xdist): a core the Rust job leaves idle when it
+# finishes takes tests from the other (worksteal), so neither job waits on the other.
 test-python:
-	$(PYTHON) -m pytest -q -m "not wheel"
+	$(PYTHON) -m pytest -q -m "not wheel" -n auto --dist worksteal
 
 # The packaging check (tests/python/test_wheel.py): a manylinux2014 wheel built with zig, checked by
 # auditwheel, installed into a fresh venv and running the quickstart. A release build of its own
