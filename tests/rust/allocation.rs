@@ -13,9 +13,9 @@ use std::cell::Cell;
 use std::ops::Deref;
 
 use varmech::integrators::{
-    integrate, integrate_watching, integrate_with_events, Contact, Contacts, Detector, DiscreteEnergy, Dynamics,
-    EventSpec, Friction, General, Law, Method, ModelKind, NativeEvent, Options, Slip, SlipRows, Stepper, StepperState,
-    Tangent, Trajectory, Watch, Watcher,
+    integrate, integrate_watching, Contact, Contacts, Detector, DiscreteEnergy, Dynamics, EventSpec, Friction, General,
+    Law, Method, ModelKind, NativeEvent, Options, Slip, SlipRows, Stepper, StepperState, Tangent, Trajectory, Watch,
+    Watcher,
 };
 use varmech::model::Routhian;
 use varmech::scenes::{self, NBody, NonholonomicScene, Problem, SceneModel};
@@ -290,7 +290,16 @@ fn event_allocations<S: Dynamics>(
     let functions = events.into_iter().map(|(e, _)| e).collect::<Vec<_>>();
     let mut detector = Detector::new(Box::new(functions), specs).unwrap();
     let before = allocated();
-    let traj = integrate_with_events(sys, method, start.0, start.1, &options, || Ok(()), &mut detector).unwrap();
+    let traj = integrate_watching(
+        sys,
+        method,
+        start.0,
+        start.1,
+        &options,
+        || Ok(()),
+        Watch::events(&mut detector),
+    )
+    .unwrap();
     assert!(traj.events.is_empty() && traj.steps == steps);
     allocated() - before
 }

@@ -2,8 +2,8 @@
 //! and interrupts per member; bad input refused before any member starts.
 
 use varmech::integrators::{
-    integrate, integrate_ensemble, integrate_with_events, Detector, Ensemble, EventSpec, Failure, General,
-    MemberEvents, Members, Method, NativeEvent, Options, Outcome, Parallel, Poll, Shared, Trajectory,
+    integrate, integrate_ensemble, integrate_watching, Detector, Ensemble, EventSpec, Failure, General, MemberEvents,
+    MemberWatch, Members, Method, NativeEvent, Options, Outcome, Parallel, Poll, Shared, Trajectory, Watch,
 };
 use varmech::scenes::{DampedDrivenPendulum, DoublePendulum, HarmonicOscillator};
 use varmech::{Error, ModelError};
@@ -21,16 +21,7 @@ fn run_ensemble<M: Members + ?Sized>(
     parallel: Parallel,
     poll: impl Poll,
 ) -> Result<Ensemble, Error> {
-    integrate_ensemble(
-        models,
-        method,
-        q0,
-        p0,
-        options,
-        parallel,
-        &MemberEvents::default(),
-        poll,
-    )
+    integrate_ensemble(models, method, q0, p0, options, parallel, &MemberWatch::default(), poll)
 }
 
 /// `members` initial states of the double pendulum about its scene's, row by row.
@@ -300,6 +291,10 @@ fn members_watching_native_events_are_bit_for_bit_their_single_runs_with_events(
             },
         ],
     };
+    let watched = MemberWatch {
+        events: events.clone(),
+        ..MemberWatch::default()
+    };
     for workers in [1, 2] {
         let parallel = Parallel {
             workers: Some(workers),
@@ -312,21 +307,21 @@ fn members_watching_native_events_are_bit_for_bit_their_single_runs_with_events(
             &p0,
             &options,
             parallel,
-            &events,
+            &watched,
             never,
         )
         .unwrap();
         for (i, member) in ensemble.members.iter().enumerate() {
             let mut detector = Detector::new(Box::new(events.functions.clone()), events.specs.clone()).unwrap();
             let rows = 2 * i..2 * i + 2;
-            let single = integrate_with_events(
+            let single = integrate_watching(
                 &sys,
                 Method::Midpoint,
                 &q0[rows.clone()],
                 &p0[rows],
                 &options,
                 never,
-                &mut detector,
+                Watch::events(&mut detector),
             )
             .unwrap();
             let member = member.as_ref().unwrap();
@@ -365,7 +360,10 @@ fn members_watching_native_events_are_bit_for_bit_their_single_runs_with_events(
         &p0,
         &options,
         Parallel::default(),
-        &bad,
+        &MemberWatch {
+            events: bad,
+            ..MemberWatch::default()
+        },
         never,
     );
     assert!(

@@ -4,7 +4,9 @@
 
 use std::f64::consts::PI;
 
-use varmech::integrators::{integrate, integrate_with_events, Detector, EventSpec, Method, NativeEvent, Options};
+use varmech::integrators::{
+    integrate, integrate_watching, Detector, Dynamics, EventSpec, Method, NativeEvent, Options, Trajectory, Watch,
+};
 use varmech::scenes::{EllipticBilliard, HarmonicOscillator};
 use varmech::solve::bracket::{illinois, newton};
 
@@ -84,13 +86,25 @@ fn crossing(direction: i8, terminal: usize) -> Detector<'static> {
     Detector::new(Box::new(crossing), vec![spec]).unwrap()
 }
 
+/// The run of `sys` watching the `detector`'s events.
+fn watching<S: Dynamics>(
+    sys: &S,
+    method: Method,
+    q0: &[f64],
+    p0: &[f64],
+    options: &Options,
+    detector: &mut Detector<'_>,
+) -> Trajectory {
+    integrate_watching(sys, method, q0, p0, options, || Ok(()), Watch::events(detector)).unwrap()
+}
+
 /// The crossings of q = 0 of q = cos t (ω = 1 from q = 1, p = 0) with `method` at step h over
 /// t ∈ [0, 20]: the largest error of the located times against (k + ½)π.
 fn crossing_error(method: Method, h: f64, direction: i8) -> (usize, f64) {
     let sys = HarmonicOscillator::new(1.0).unwrap();
     let options = Options::new(h, (20.0 / h).round() as usize);
     let mut detector = crossing(direction, 0);
-    let traj = integrate_with_events(&sys, method, &[1.0], &[0.0], &options, || Ok(()), &mut detector).unwrap();
+    let traj = watching(&sys, method, &[1.0], &[0.0], &options, &mut detector);
     let worst = traj.events.iter().fold(0.0_f64, |m, e| {
         // Downward crossings at (2j + ½)π, upward at (2j + 3/2)π.
         let exact = ((e.t / PI - 0.5).round() + 0.5) * PI;
@@ -125,7 +139,7 @@ fn directions_keep_their_crossings_and_a_count_terminal_stops_after_its_step() {
     let sys = HarmonicOscillator::new(1.0).unwrap();
     let options = Options::new(0.01, 2000);
     let mut detector = crossing(0, 3);
-    let traj = integrate_with_events(&sys, Method::Verlet, &[1.0], &[0.0], &options, || Ok(()), &mut detector).unwrap();
+    let traj = watching(&sys, Method::Verlet, &[1.0], &[0.0], &options, &mut detector);
     assert_eq!(traj.events.len(), 3);
     assert_eq!(traj.terminated_by, Some(0));
     // The run stops at the end of the step of the third crossing (5π/2), a state of the grid
@@ -155,7 +169,7 @@ fn each_crossing_carries_the_state_at_the_start_of_its_step() {
     for method in [Method::Verlet, Method::Midpoint] {
         let options = Options::new(0.1, 200);
         let mut detector = crossing(0, 0);
-        let traj = integrate_with_events(&sys, method, &[1.0], &[0.0], &options, || Ok(()), &mut detector).unwrap();
+        let traj = watching(&sys, method, &[1.0], &[0.0], &options, &mut detector);
         assert_eq!(traj.events.len(), 6, "{method:?}");
         for e in &traj.events {
             let k = e.step - 1;
@@ -190,7 +204,7 @@ fn the_ellipsoid_event_finds_a_free_particle_at_the_wall_at_the_exact_time() {
         };
         let mut detector = Detector::new(Box::new(vec![wall]), vec![spec]).unwrap();
         let options = Options::new(0.01, 1000);
-        let traj = integrate_with_events(&sys, Method::Verlet, q0, p0, &options, || Ok(()), &mut detector).unwrap();
+        let traj = watching(&sys, Method::Verlet, q0, p0, &options, &mut detector);
         assert_eq!((traj.events.len(), traj.terminated_by), (1, Some(0)));
         traj.events[0].clone()
     };

@@ -4,9 +4,9 @@
 //! without an impact, a resumed run and an ensemble member are those of the plain run.
 
 use varmech::integrators::{
-    integrate, integrate_watching, integrate_with_events, resume_watching, Checkpoint, Contacts, Detector,
-    DiscreteEnergy, Dynamics, EventSpec, Failure, General, Impacts, Law, MemberWatch, Method, NativeContact,
-    NativeEvent, NativeSurface, Options, Stepper, Trajectory, Watch, Watcher,
+    integrate, integrate_watching, resume_watching, Checkpoint, Contacts, Detector, DiscreteEnergy, Dynamics,
+    EventSpec, Failure, General, Impacts, Law, MemberWatch, Method, NativeContact, NativeEvent, NativeSurface, Options,
+    Stepper, Trajectory, Watch, Watcher,
 };
 use varmech::model::Lagrangian;
 use varmech::scenes::{planar_chain, BouncingBall, EllipticBilliard, NBody};
@@ -153,7 +153,16 @@ fn a_step_without_an_impact_is_bit_for_bit_the_step_without_contacts() {
         assert_eq!(watched.checkpoint, plain.checkpoint, "{method:?}");
 
         let mut events = height(0.5, -1);
-        let alone = integrate_with_events(&ball, method, &[1.0], &[2.0], &options, || Ok(()), &mut events).unwrap();
+        let alone = integrate_watching(
+            &ball,
+            method,
+            &[1.0],
+            &[2.0],
+            &options,
+            || Ok(()),
+            Watch::events(&mut events),
+        )
+        .unwrap();
         let mut events = height(0.5, -1);
         let watch = Watch {
             events: Some(&mut events),

@@ -7,7 +7,7 @@
 //! where cos q̄ < −4/h², i.e. near the top, and the equation has several solutions there.
 
 use varmech::integrators::{
-    integrate, integrate_with_events, Detector, EventSpec, Failure, Method, NativeEvent, Options, Trajectory,
+    integrate, integrate_watching, Detector, EventSpec, Failure, Method, NativeEvent, Options, Trajectory, Watch,
 };
 use varmech::scenes::Pendulum;
 use varmech::Error;
@@ -90,14 +90,14 @@ fn with_an_energy_bound_no_implicit_method_silently_goes_over_the_top() {
                 terminal: 1,
             };
             let mut detector = Detector::new(Box::new(vec![bound]), vec![spec]).unwrap();
-            let run = integrate_with_events(
+            let run = integrate_watching(
                 &Pendulum::new(),
                 method,
                 &[Q0],
                 &[0.0],
                 &Options::new(h, steps),
                 || Ok(()),
-                &mut detector,
+                Watch::events(&mut detector),
             );
             let traj = match run.map_err(|f| *f) {
                 Ok(traj) => traj,

@@ -112,7 +112,7 @@ fn ensemble<'py>(
     let parallel = Parallel { workers, chunk_size };
     let run = py.detach(|| {
         let report = reporting(&check_signals, &progress);
-        integrators::integrate_ensemble_watching(&models, method, q0, p0, &options, parallel, &watched, report)
+        integrators::integrate_ensemble(&models, method, q0, p0, &options, parallel, &watched, report)
     });
     let run = run.map_err(|e| to_pyerr(py, e))?;
     let members = run

@@ -2,8 +2,8 @@
 
 use varmech::diagnostics::{self, Statistics, Verdict};
 use varmech::integrators::{
-    integrate, integrate_ensemble_watching, Dynamics, Ensemble, General, MemberWatch, Method, Options, Parallel,
-    Shared, Trajectory,
+    integrate, integrate_ensemble, Dynamics, Ensemble, General, MemberWatch, Method, Options, Parallel, Shared,
+    Trajectory,
 };
 use varmech::model::{Constrained, Hessians, Lagrangian, Mass, MechanicalSystem};
 use varmech::scenes::{Problem, RigidBody, State};
@@ -306,7 +306,7 @@ pub fn verlet_ensemble<S: Dynamics + Sync>(
         workers: Some(2),
         chunk_size: None,
     };
-    integrate_ensemble_watching(&Shared(sys), Method::Verlet, q0, p0, options, parallel, watched, || {
+    integrate_ensemble(&Shared(sys), Method::Verlet, q0, p0, options, parallel, watched, || {
         Ok(())
     })
     .unwrap()

@@ -70,9 +70,8 @@ impl Parallel {
     }
 }
 
-/// The native events every member watches, with their specs: each member runs
-/// [`integrate_with_events`] with its own copy of the functions (an event may keep state, such
-/// as the energy at the start of the run). None (the default): the members run [`integrate`].
+/// The native events every member watches, with their specs: each member watches its own copy
+/// of the functions (an event may keep state, such as the energy at the start of the run).
 #[derive(Clone, Debug, Default)]
 pub struct MemberEvents {
     pub functions: Vec<NativeEvent>,
@@ -146,48 +145,23 @@ impl std::error::Error for Stopped {}
 /// their next poll, 10–40 ms of run time apart).
 const POLL: Duration = Duration::from_millis(10);
 
-/// Integrates every member: member i is [`integrate`] of `models`' member i from row i of
-/// `q0` and `p0` (each members × n, row by row) with `options`, run on at most
-/// `parallel.workers` threads in tasks of `parallel.chunk_size` members, each member watching
-/// `events` (none when empty).
+/// Integrates every member: member i is [`integrate_watching`] of `models`' member i from row
+/// i of `q0` and `p0` (each members × n, row by row) with `options` and its own copy of
+/// `watched` (events, the impacts on contacts, impulses and samples), run on at most
+/// `parallel.workers` threads in tasks of `parallel.chunk_size` members; each member is bit for
+/// bit its single run.
 ///
 /// `poll` is called on the calling thread every 10 ms with the steps completed by all members
 /// so far; an error from it stops every member at its next poll (within 40 ms of run time) with
 /// [`Error::Interrupted`], keeping its states, and is returned in [`Ensemble::interrupted`].
 ///
 /// Refuses (before any member starts) rows that are not whole, a `p0` of another size than
-/// `q0`, models not one a member, `workers` or `chunk_size` of 0, invalid options or events
-/// (checked against the model's n, naming `events`), and an
+/// `q0`, models not one a member, `workers` or `chunk_size` of 0, invalid options, what a
+/// member's run would refuse (naming `events`, `contacts`, `impulses` or `t_eval`), and an
 /// ensemble whose saved states, twice over (the records and the stacked arrays made of them),
 /// would not fit in the memory available (naming `save_every`).
 #[allow(clippy::too_many_arguments)]
 pub fn integrate_ensemble<M, P>(
-    models: &M,
-    method: Method,
-    q0: &[f64],
-    p0: &[f64],
-    options: &Options,
-    parallel: Parallel,
-    events: &MemberEvents,
-    poll: P,
-) -> Result<Ensemble, Error>
-where
-    M: Members + ?Sized,
-    P: Poll,
-{
-    let watched = MemberWatch {
-        events: events.clone(),
-        ..MemberWatch::default()
-    };
-    integrate_ensemble_watching(models, method, q0, p0, options, parallel, &watched, poll)
-}
-
-/// As [`integrate_ensemble`], every member watching `watched` (each its own copy) as
-/// [`integrate_watching`] does: events, the impacts on contacts, impulses and samples; each
-/// member is bit for bit its single run. Refuses, before any member starts, what a member's run
-/// would refuse (naming `events`, `contacts`, `impulses` or `t_eval`).
-#[allow(clippy::too_many_arguments)]
-pub fn integrate_ensemble_watching<M, P>(
     models: &M,
     method: Method,
     q0: &[f64],

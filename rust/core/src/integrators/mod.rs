@@ -21,7 +21,7 @@
 //!   [`StepperState`] apart from the model, to resume;
 //! - [`integrate`]: a run of a [`Stepper`] with saving and an energy check, into a
 //!   [`Trajectory`]; [`resume`] goes on from its [`Checkpoint`], bit for bit;
-//!   [`integrate_with_events`] also watches [`events`], located by partial steps;
+//!   [`integrate_watching`] also watches [`events`], located by partial steps, and contacts;
 //! - [`integrate_ensemble`]: many such runs in parallel ([`Ensemble`]), each bit for bit its
 //!   single run.
 
@@ -68,8 +68,7 @@ pub use discrete_energy::DiscreteEnergy;
 pub use divergence::{beyond_limit, BeyondLimit};
 pub use dynamics::{Dynamics, General};
 pub use ensemble::{
-    integrate_ensemble, integrate_ensemble_watching, Ensemble, MemberEvents, MemberWatch, Members, Outcome, Parallel,
-    Shared, Stopped,
+    integrate_ensemble, Ensemble, MemberEvents, MemberWatch, Members, Outcome, Parallel, Shared, Stopped,
 };
 pub use events::{Detector, EventFunctions, EventSpec, NativeEvent, Occurrence};
 pub use explicit_rk::ExplicitRk;
@@ -85,7 +84,7 @@ pub use method::{Feature, Method, MethodInfo};
 pub use options::Options;
 pub use poll::{Counting, Poll};
 pub use rattle::Rattle;
-pub use run::{integrate, integrate_watching, integrate_with_events, resume, resume_watching, resume_with_events};
+pub use run::{integrate, integrate_watching, resume, resume_watching};
 pub use splitting::{Leading, Splitting};
 pub use step::{Increment, StepStart};
 use stepper::Phase;

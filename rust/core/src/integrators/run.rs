@@ -2,7 +2,7 @@
 
 use super::divergence::{diagnosed, EnergyWatch};
 use super::jumps::{Watch, Watcher};
-use super::{Checkpoint, Detector, Dynamics, Failure, Method, Options, Poll, Stepper, Trajectory};
+use super::{Checkpoint, Dynamics, Failure, Method, Options, Poll, Stepper, Trajectory};
 use crate::{memory, Error};
 
 /// Integrates `sys` from (q0, p0) with `method` for `options.steps` steps of `options.dt`.
@@ -39,35 +39,13 @@ where
     )
 }
 
-// Events: the run with a [`Detector`] (begin).
-/// As [`integrate`], watching the `events`' functions after every step (the steps are then
-/// taken one at a time): each crossing is located by a partial step of the method
-/// ([`Detector`]) and pushed to [`Trajectory::events`]. When an event reaches its terminal
-/// count, the run stops at the end of that step, its state saved, with
+/// As [`integrate`], watching `watch`'s events and resolving the impacts on its contacts.
+///
+/// The events' functions are evaluated after every step (the steps are then taken one at a
+/// time): each crossing is located by a partial step of the method
+/// ([`Detector`](super::Detector)) and pushed to [`Trajectory::events`]. When an event reaches
+/// its terminal count, the run stops at the end of that step, its state saved, with
 /// [`Trajectory::terminated_by`] set.
-pub fn integrate_with_events<S, P>(
-    sys: &S,
-    method: Method,
-    q0: &[f64],
-    p0: &[f64],
-    options: &Options,
-    poll: P,
-    events: &mut Detector<'_>,
-) -> Result<Trajectory, Box<Failure>>
-where
-    S: Dynamics + ?Sized,
-    P: Poll,
-{
-    let watch = Watch {
-        events: Some(events),
-        ..Watch::default()
-    };
-    integrate_watching(sys, method, q0, p0, options, poll, watch)
-}
-// Events (end).
-
-/// As [`integrate`], watching `watch`'s events (as [`integrate_with_events`] does) and
-/// resolving the impacts on its contacts.
 ///
 /// The step that crosses a contact's φ = 0 is split at the contact: the method's partial step
 /// of size αh from (qₙ, pₙ) to the contact configuration q̃ (α located to round-off), the jump
@@ -175,28 +153,6 @@ where
 {
     let (stepper, watch, end) = resumed(sys, checkpoint, steps, save_every)?;
     run(sys, stepper, watch, end, save_every, poll, (Watcher::idle(), false))
-}
-
-/// As [`resume`], watching the `events` as [`integrate_with_events`] does, from the
-/// checkpoint's state on (crossings before it are the first run's; a terminal count is this
-/// run's).
-pub fn resume_with_events<S, P>(
-    sys: &S,
-    checkpoint: Checkpoint,
-    steps: usize,
-    save_every: usize,
-    poll: P,
-    events: &mut Detector<'_>,
-) -> Result<Trajectory, Box<Failure>>
-where
-    S: Dynamics + ?Sized,
-    P: Poll,
-{
-    let watch = Watch {
-        events: Some(events),
-        ..Watch::default()
-    };
-    resume_watching(sys, checkpoint, steps, save_every, poll, watch)
 }
 
 /// As [`resume`], watching `watch`'s events and contacts as [`integrate_watching`] does, from

@@ -30,7 +30,7 @@ pub struct Trajectory {
     /// The [`super::Checkpoint`] of the last state, as bytes ([`super::Checkpoint::to_bytes`]):
     /// [`super::resume`] goes on from it. Empty for a run that failed before its first state.
     pub checkpoint: Vec<u8>,
-    /// The located event crossings, in order of time ([`super::integrate_with_events`]).
+    /// The located event crossings, in order of time ([`super::integrate_watching`]).
     pub events: Vec<Occurrence>,
     /// The event whose terminal count stopped the run, if one did.
     pub terminated_by: Option<usize>,

@@ -9,7 +9,7 @@ use crate::integrators::{Counting, Dynamics, Poll, Stepper, StepperState};
 use crate::solve::bracket::illinois;
 use crate::{Error, ModelError};
 
-/// Event functions with their [`EventSpec`]s, for a run ([`crate::integrators::integrate_with_events`]).
+/// Event functions with their [`EventSpec`]s, for a run ([`crate::integrators::integrate_watching`]).
 ///
 /// After every step (tₙ, qₙ, pₙ) → (tₙ₊₁, qₙ₊₁, pₙ₊₁) the run evaluates every gᵢ; a crossing
 /// of event i is gᵢ(zₙ) ≠ 0 and gᵢ(zₙ₊₁) of the other sign or 0, in the spec's direction. It is

@@ -4,7 +4,7 @@
 //! - [`EventFunctions`]: the functions, all evaluated at once into a slice;
 //! - [`EventSpec`]: each one's name, direction and terminal count;
 //! - [`Detector`]: the functions with their specs, which a run given them
-//!   ([`super::integrate_with_events`]) checks after every step, locating each crossing;
+//!   ([`super::integrate_watching`]) checks after every step, locating each crossing;
 //! - [`NativeEvent`]: the built-in functions, evaluated without leaving Rust;
 //! - [`Occurrence`]: a located crossing, a state of the integrator.
 

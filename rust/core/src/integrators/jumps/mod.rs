@@ -158,7 +158,7 @@ impl std::fmt::Debug for Contact<'_> {
 }
 
 /// A contact on a native surface, owned and `Send + Sync`: every member of an ensemble makes
-/// its own [`Contacts`] of them ([`super::integrate_ensemble_watching`]).
+/// its own [`Contacts`] of them ([`super::integrate_ensemble`]).
 #[derive(Clone, Debug, PartialEq)]
 pub struct NativeContact {
     pub surface: NativeSurface,

@@ -16,7 +16,7 @@ use crate::Error;
 /// in pieces at each jump, and the events are evaluated and located on the pieces.
 #[derive(Default)]
 pub struct Watch<'w, 'e, 'c> {
-    /// The events, located by partial steps of the method ([`crate::integrators::integrate_with_events`]).
+    /// The events, located by partial steps of the method ([`crate::integrators::integrate_watching`]).
     pub events: Option<&'w mut Detector<'e>>,
     /// The unilateral contacts φ(q) ≥ 0, whose impacts the run resolves.
     pub contacts: Option<&'w Contacts<'c>>,
@@ -24,7 +24,15 @@ pub struct Watch<'w, 'e, 'c> {
     pub schedule: Option<&'w Schedule<'c>>,
 }
 
-impl Watch<'_, '_, '_> {
+impl<'w, 'e> Watch<'w, 'e, '_> {
+    /// The `events` alone.
+    pub fn events(events: &'w mut Detector<'e>) -> Self {
+        Watch {
+            events: Some(events),
+            ..Watch::default()
+        }
+    }
+
     /// Whether what it watches can put energy in or take it out: contacts with friction or
     /// e < 1 (each law's loss, the closures', the projections onto closed contacts), or
     /// impulses. A run then counts that energy in its work W ([`Stepper::work`]), which it and
