@@ -551,21 +551,35 @@ impl Newton {
                 });
             }
         }
-        // At the cap above the estimated floor (an iteration wandering in noise the estimate
-        // misses reads as a stall, a cycle or a slow fall).
+        self.at_cap(problem, residual, &progress, options.max_iterations)
+    }
+
+    /// The iteration at its cap above the estimated floor (an iteration wandering in noise the
+    /// estimate misses reads as a stall, a cycle or a slow fall): converged at the floor
+    /// measured about it, else its failure diagnosed. Out of line: the rare path's code would
+    /// crowd the iteration's loop and cost every solve.
+    #[cold]
+    #[inline(never)]
+    fn at_cap<P: NewtonProblem>(
+        &mut self,
+        problem: &mut P,
+        residual: f64,
+        progress: &Progress,
+        iterations: usize,
+    ) -> Result<Solution, StepError> {
         let noise = problem.measured_noise(self.residual.as_slice())?;
         if Progress::at_measured_floor(problem, residual, noise)? {
             return Ok(Solution {
-                iterations: options.max_iterations,
+                iterations,
                 residual,
                 noise,
             });
         }
         Err(StepError::Convergence {
             residual,
-            iterations: options.max_iterations,
-            reason: reasons.not_converged,
-            advice: progress.diagnosis().confirmed(problem)?.advice(&reasons),
+            iterations,
+            reason: P::REASONS.not_converged,
+            advice: progress.diagnosis().confirmed(problem)?.advice(&P::REASONS),
         })
     }
 }

@@ -43,6 +43,42 @@ impl<R: DiscreteLagrangian> Del<TwoPoint<R>> {
         }
     }
 
+    /// The iteration at its cap above the estimated floor: converged (Ok) at the floor
+    /// measured about x (ws restored at x after), as [`crate::solve::newton::Newton::solve`]
+    /// judges it, else its failure diagnosed. Out of line: the rare path's code would crowd
+    /// the loop's registers and cost every step (5% of a double pendulum's instructions).
+    #[cold]
+    #[inline(never)]
+    fn at_cap<S: Lagrangian + ?Sized, const N: usize>(
+        &mut self,
+        sys: &S,
+        start: StepStart<'_>,
+        (x, ws): (&mut [f64; N], &mut Workspace<[f64; N]>),
+        cap: Cap<'_, N>,
+        evaluations: &mut u64,
+    ) -> Result<(), StepError> {
+        let (r, residual) = cap.residual;
+        let (mut plus, mut minus) = ([0.0; N], [0.0; N]);
+        let sizes = (norm(x), norm(start.q));
+        let noise = difference::measured_noise(r, (&mut plus, &mut minus), sizes, |shift, out| {
+            *evaluations += 1;
+            let at: [f64; N] = std::array::from_fn(|i| x[i] + shift);
+            self.scheme.equations_in(ws, sys, start, &at, out)
+        })?;
+        let equations = &mut self.unconstrained(sys, start, (x, None), evaluations);
+        if Progress::at_measured_floor(equations, residual, noise)? {
+            return Ok(());
+        }
+        let equations = &mut self.unconstrained(sys, start, (x, Some(cap.guess)), evaluations);
+        let diagnosis = cap.progress.diagnosis().confirmed(equations)?;
+        Err(StepError::Convergence {
+            residual,
+            iterations: self.options.max_iterations,
+            reason: REASONS.not_converged,
+            advice: diagnosis.advice(&REASONS),
+        })
+    }
+
     /// Whether [`Del::run`] takes the next steps of `sys`: no constraints and no forces, and
     /// the run's first step made (which judges the continuum limit's determinant sign).
     pub(in crate::integrators) fn runs_fixed<S: Lagrangian + ?Sized>(&self, sys: &S) -> bool {
@@ -103,35 +139,14 @@ impl<R: DiscreteLagrangian> Del<TwoPoint<R>> {
             let mut iteration = 0;
             loop {
                 if iteration == options.max_iterations {
-                    // At the cap above the estimated floor: at the floor measured (ws restored
-                    // at x after), converged ([`Newton::solve`] alike).
-                    let (mut plus, mut minus) = ([0.0; N], [0.0; N]);
-                    let sizes = (norm(&x), norm(start.q));
-                    let noise = difference::measured_noise(&r, (&mut plus, &mut minus), sizes, |shift, out| {
-                        evaluations += 1;
-                        let at: [f64; N] = std::array::from_fn(|i| x[i] + shift);
-                        self.scheme.equations_in(&mut ws, sys, start, &at, out)
-                    })?;
-                    if Progress::at_measured_floor(
-                        &mut self.unconstrained(sys, start, (&mut x, None), &mut evaluations),
-                        residual,
-                        noise,
-                    )? {
-                        break;
-                    }
                     let guess = predictor(&last, &before_last, history);
-                    let diagnosis = progress.diagnosis().confirmed(&mut self.unconstrained(
-                        sys,
-                        start,
-                        (&mut x, Some(&guess)),
-                        &mut evaluations,
-                    ))?;
-                    return Err(StepError::Convergence {
-                        residual,
-                        iterations: iteration,
-                        reason: REASONS.not_converged,
-                        advice: diagnosis.advice(&REASONS),
-                    });
+                    let at_cap = Cap {
+                        residual: (&r, residual),
+                        progress: &progress,
+                        guess: &guess,
+                    };
+                    self.at_cap(sys, start, (&mut x, &mut ws), at_cap, &mut evaluations)?;
+                    break;
                 }
                 iteration += 1;
                 self.newton.poll_interrupt()?;
@@ -207,4 +222,12 @@ impl<R: DiscreteLagrangian> Del<TwoPoint<R>> {
         self.newton.keep(&r, lu.as_flattened(), &pivots, sign, iterations);
         result
     }
+}
+
+/// What [`Del::at_cap`] judges: F at x and its norm, the iteration's course, and the step's
+/// predictor (where a diagnosis starts).
+struct Cap<'a, const N: usize> {
+    residual: (&'a [f64; N], f64),
+    progress: &'a Progress,
+    guess: &'a [f64; N],
 }

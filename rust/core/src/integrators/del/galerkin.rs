@@ -26,8 +26,12 @@ impl StepEquations for Galerkin {
         let (n, s, h) = (start.q.len(), self.quadrature.degree(), start.h);
         self.derivatives(sys, segment(&start, x), false)?;
         // F sums the nodes' derivatives with weights whose sizes add up to 2.3 (s = 2) and 3
-        // (s = 3): so too their rounding, where they are differences.
-        difference::record(difference::take_noise() * self.noise_gain(h));
+        // (s = 3): so too their rounding, where they are differences (none recorded else, and
+        // the gain, about a hundred instructions, is not worth computing).
+        let noise = difference::take_noise();
+        if noise > 0.0 {
+            difference::record(noise * self.noise_gain(h));
+        }
         for j in 1..s {
             self.slot(j, h, &mut out[(j - 1) * n..j * n]);
         }
