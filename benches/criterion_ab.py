@@ -8,6 +8,11 @@ DIR holds the bench executables `steps`, `implicit`, `constraints` and `impacts`
 (copied out of target/release/deps). Each round runs every selected bench once in each build, alternating,
 so that the noise of a shared machine falls on both alike; a bench's figure is its best
 (smallest) criterion estimate over the rounds.
+
+With --instructions, the figure is instead the instructions of one iteration of the bench,
+counted by callgrind (valgrind): criterion's --test mode runs it once, and a run that selects
+no bench gives the executable's set-up to subtract. Deterministic, so a change of a few
+percent shows where a shared machine's timings scatter by tens.
 """
 
 from __future__ import annotations
@@ -15,6 +20,7 @@ from __future__ import annotations
 import argparse
 import re
 import subprocess
+import tempfile
 from pathlib import Path
 
 #: (executable, criterion filter): the step loops issue 12 promised to keep as fast, and the
@@ -50,12 +56,36 @@ def seconds(executable: Path, pattern: str) -> float:
     return float(value) * UNITS[unit]
 
 
+def instructions(executable: Path, pattern: str) -> int:
+    """Instructions of one iteration of the bench `pattern` of `executable` (callgrind)."""
+
+    def total(selected: str) -> int:
+        with tempfile.TemporaryDirectory() as tmp:
+            out = Path(tmp) / "callgrind.out"
+            command = ["valgrind", "--tool=callgrind", f"--callgrind-out-file={out}", str(executable), "--bench", "--test", selected]
+            subprocess.run(command, capture_output=True, check=True)
+            summary = re.search(r"^summary: (\d+)", out.read_text(), re.M)
+        if summary is None:
+            raise RuntimeError(f"{executable.name}: no callgrind summary")
+        return int(summary.group(1))
+
+    return total(pattern) - total("^no bench$")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--before", type=Path, required=True)
     parser.add_argument("--after", type=Path, required=True)
     parser.add_argument("--rounds", type=int, default=5)
+    parser.add_argument("--instructions", action="store_true", help="count instructions (callgrind) instead of timing")
     args = parser.parse_args()
+    if args.instructions:
+        print("| bench | before | after | instructions after / before |")
+        print("|---|---:|---:|---:|")
+        for exe, pattern in BENCHES:
+            before, after = (instructions(folder / exe, pattern) for folder in (args.before, args.after))
+            print(f"| {pattern.strip('^$')} | {before:,} | {after:,} | {after / before:.3f} |", flush=True)
+        return
     best: dict[tuple[str, str], float] = {}
     for _ in range(args.rounds):
         for exe, pattern in BENCHES:
