@@ -11,13 +11,15 @@ so that the noise of a shared machine falls on both alike; a bench's figure is i
 
 With --instructions, the figure is instead the instructions of one iteration of the bench,
 counted by callgrind (valgrind): criterion's --test mode runs it once, and a run that selects
-no bench gives the executable's set-up to subtract. Deterministic, so a change of a few
-percent shows where a shared machine's timings scatter by tens.
+no bench gives the executable's set-up to subtract. Repeatable to a few thousand
+instructions (0.5% of the smallest bench), so a change of a few percent shows where a shared
+machine's timings scatter by tens.
 """
 
 from __future__ import annotations
 
 import argparse
+import functools
 import re
 import subprocess
 import tempfile
@@ -56,20 +58,24 @@ def seconds(executable: Path, pattern: str) -> float:
     return float(value) * UNITS[unit]
 
 
+@functools.cache
+def counted(executable: Path, selected: str) -> int:
+    """Instructions of `executable` run once in criterion's --test mode on the benches
+    `selected` (callgrind); cached, so that each executable's set-up is counted once."""
+    with tempfile.TemporaryDirectory() as tmp:
+        out = Path(tmp) / "callgrind.out"
+        command = ["valgrind", "--tool=callgrind", f"--callgrind-out-file={out}", str(executable), "--bench", "--test", selected]
+        subprocess.run(command, capture_output=True, check=True)
+        summary = re.search(r"^summary: (\d+)", out.read_text(), re.M)
+    if summary is None:
+        raise RuntimeError(f"{executable.name}: no callgrind summary")
+    return int(summary.group(1))
+
+
 def instructions(executable: Path, pattern: str) -> int:
-    """Instructions of one iteration of the bench `pattern` of `executable` (callgrind)."""
-
-    def total(selected: str) -> int:
-        with tempfile.TemporaryDirectory() as tmp:
-            out = Path(tmp) / "callgrind.out"
-            command = ["valgrind", "--tool=callgrind", f"--callgrind-out-file={out}", str(executable), "--bench", "--test", selected]
-            subprocess.run(command, capture_output=True, check=True)
-            summary = re.search(r"^summary: (\d+)", out.read_text(), re.M)
-        if summary is None:
-            raise RuntimeError(f"{executable.name}: no callgrind summary")
-        return int(summary.group(1))
-
-    return total(pattern) - total("^no bench$")
+    """Instructions of one iteration of the bench `pattern` of `executable`: its run less the
+    executable's set-up (a run that selects no bench)."""
+    return counted(executable, pattern) - counted(executable, "^no bench$")
 
 
 def main() -> None:
