@@ -46,7 +46,7 @@ impl<R: DiscreteLagrangian> Del<TwoPoint<R>> {
     /// The iteration at its cap above the estimated floor: converged (Ok) at the floor
     /// measured about x (ws restored at x after), as [`crate::solve::newton::Newton::solve`]
     /// judges it, else its failure diagnosed. Out of line: the rare path's code would crowd
-    /// the loop's registers and cost every step (5% of a double pendulum's instructions).
+    /// the loop's registers and cost every step (6% of a double pendulum's instructions).
     #[cold]
     #[inline(never)]
     fn at_cap<S: Lagrangian + ?Sized, const N: usize>(
