@@ -45,7 +45,10 @@ pub(crate) fn record(noise: f64) {
 /// flat over some shifts and met by others: hence eight samples at three scales. Rounding does
 /// not grow with s, and F's smooth part s²δᵀF''δ/2 does: where the largest at s = 5 … 8 is over
 /// twice the largest at s = 1 … 4 (four times for curvature alone), the differences are
-/// curvature, and that scale measures none.
+/// curvature, and that scale measures none. Neither curvature nor a jump of F within reach
+/// shrinks as the shift grows, and rounding σ moves a sample by σ at most: a sample a larger
+/// shift's undercuts by d proves σ ≥ d/2, though a quantum met only at large s reads as
+/// curvature to the test above.
 pub fn measured_noise<E>(
     f0: &[f64],
     (plus, minus): (&mut [f64], &mut [f64]),
@@ -56,6 +59,8 @@ pub fn measured_noise<E>(
     at(0.0, plus)?;
     let delta = measuring_step(x, offset, recorded());
     let mut noise = 0.0_f64;
+    // The least sample at a larger shift than those of the scale in hand.
+    let mut beyond = f64::INFINITY;
     for scale in [1.0, 1e-2, 1e-4] {
         let mut sizes = [0.0_f64; 8];
         for (k, size) in sizes.iter_mut().enumerate() {
@@ -70,6 +75,10 @@ pub fn measured_noise<E>(
         let (near, far) = (largest(&sizes[..4]), largest(&sizes[4..]));
         if far <= 2.0 * near {
             noise = noise.max(far.max(near));
+        }
+        for &size in sizes.iter().rev() {
+            noise = noise.max((size - beyond) / 2.0);
+            beyond = beyond.min(size);
         }
     }
     at(0.0, plus)?;
@@ -186,8 +195,44 @@ where
 
 #[cfg(test)]
 mod tests {
+    use super::measured_noise;
+
     #[test]
     fn cbrt_epsilon_is_the_cube_root_of_epsilon() {
         assert_eq!(super::CBRT_EPSILON.to_bits(), f64::EPSILON.cbrt().to_bits());
+    }
+
+    /// F(x + shift) for x = 1, δ = 1e-6 (nothing recorded): `f(shift)`.
+    fn measured(f: impl Fn(f64) -> f64) -> f64 {
+        let f0 = [f(0.0)];
+        let (mut plus, mut minus) = ([0.0], [0.0]);
+        measured_noise::<()>(&f0, (&mut plus, &mut minus), (1.0, 0.0), |shift, out| {
+            out[0] = f(shift);
+            Ok(())
+        })
+        .unwrap()
+    }
+
+    #[test]
+    fn curvature_and_a_jump_within_reach_measure_no_noise() {
+        assert_eq!(measured(|s| 3.0 * s * s), 0.0);
+        // A jump of 1e-9 at 5.5δ: met by the five largest shifts alone.
+        assert_eq!(measured(|s| if s > 5.5e-6 { 1e-9 } else { 0.0 }), 0.0);
+    }
+
+    #[test]
+    fn a_quantum_met_only_at_large_shifts_is_measured() {
+        // Seed 99's damped chain at g = 4.86: a quantum of 6.6e-12 at s = 5, 6 and 8 of δ's
+        // scale (and at 7 of 1e-2 δ's), where the halves' test reads curvature.
+        let met = [5e-6, 6e-6, 8e-6, 7e-8];
+        let f = |s: f64| {
+            if met.iter().any(|m| (s.abs() - m).abs() < 1e-15) {
+                1.32e-11
+            } else {
+                0.0
+            }
+        };
+        let noise = measured(f);
+        assert!((6.5e-12..=6.7e-12).contains(&noise), "{noise:e}");
     }
 }
