@@ -377,6 +377,26 @@ mod tests {
     }
 
     #[test]
+    fn an_error_of_a_few_subnormal_spacings_is_round_off() {
+        // A motion decayed to 1e-310 rounds at η = 2⁻¹⁰⁷⁴ (4.9e-324), not at ε of its size: a
+        // closure chain's energy error of 4η after 106 steps.
+        let t: Vec<f64> = (0..107).map(|k| k as f64).collect();
+        let error: Vec<f64> = t
+            .iter()
+            .map(|x| if x % 3.0 == 0.0 { 4.0 * f64::from_bits(1) } else { 0.0 })
+            .collect();
+        let (size, terms) = (vec![2.75e-312; t.len()], vec![3e-312; t.len()]);
+        let series = Series {
+            t: &t,
+            error: &error,
+            size: &size,
+            terms: &terms,
+            steps: 106,
+        };
+        assert_eq!(Statistics::new(&series).unwrap().verdict, Verdict::ConservedToRoundOff);
+    }
+
+    #[test]
     fn an_oscillation_over_few_periods_is_not_drift() {
         // One slow period of the error over the run: its batch means swing, but do not trend.
         let t: Vec<f64> = (0..400).map(|k| k as f64 * 0.01).collect();

@@ -1,14 +1,21 @@
 //! The size a conserved quantity's error is judged against.
 
 use serde::{Deserialize, Serialize};
+
+/// η = 2⁻¹⁰⁷⁴, the least subnormal number: the spacing of the values below the normal range.
+const SUBNORMAL_SPACING: f64 = f64::from_bits(1);
+
 /// Running sizes of a conserved quantity J along a run: its scale, the mean of a size
 /// sampled at each saved state (the kinetic energy |T| for the energy, Σ|pᵢξᵢ| for a Noether
 /// momentum), and the largest size of the terms J is computed from (|T| + |V| for the energy),
 /// which sets J's rounding error.
 ///
-/// An error is *round-off* up to [`Scale::ROUND_OFF`] · ε · max(terms) · √(1 + steps), a
+/// An error is *round-off* up to [`Scale::ROUND_OFF`] · (ε · max(terms) + η) · √(1 + steps), a
 /// small multiple of the terms' rounding error grown as a random walk over the steps (Brouwer's
-/// law for compensated summation), and *fails* at [`Scale::FAILURE`] × the scale, where J is
+/// law for compensated summation); η, the spacing of the subnormal numbers, is the rounding of
+/// values that have underflowed (a motion decayed to 1e-310 rounds at η, not at ε of its size:
+/// Higham, *Accuracy and Stability of Numerical Algorithms*, §2.1), and *fails* at
+/// [`Scale::FAILURE`] × the scale, where J is
 /// wrong by its own size. The mean kinetic energy is the energy's scale because it is the size
 /// of the motion: |H₀| is no scale when V's zero is arbitrary (H₀ = 0 for a pendulum released
 /// at its pivot's height), and max |V| is none for orbits that dive deep into a potential well
@@ -54,12 +61,17 @@ impl Scale {
 
     /// The round-off level after `steps` steps.
     pub fn round_off(&self, steps: u64) -> f64 {
-        Self::ROUND_OFF * f64::EPSILON * self.max_terms * (1.0 + steps as f64).sqrt()
+        Self::ROUND_OFF * self.rounding() * (1.0 + steps as f64).sqrt()
     }
 
     /// The most biased rounding can add over `steps` steps.
     pub fn biased_round_off(&self, steps: u64) -> f64 {
-        Self::BIASED_ROUND_OFF * f64::EPSILON * self.max_terms * steps as f64
+        Self::BIASED_ROUND_OFF * self.rounding() * steps as f64
+    }
+
+    /// One rounding of the terms: ε of their size, and η where they have underflowed.
+    fn rounding(&self) -> f64 {
+        f64::EPSILON * self.max_terms + SUBNORMAL_SPACING
     }
 
     /// Whether `error` fails after `steps` steps: not finite, or beyond both round-off and
