@@ -119,12 +119,15 @@ DIFFERENCES = 1e-9
 
 
 def _floor(case: Case, traj: varmech.Trajectory, stats: varmech.InvariantStatistics) -> float:
-    """What the energy error cannot fall below: its round-off level and, for a model whose
-    derivatives are differences (it has a twin), their accuracy of the energy's terms."""
+    """What the energy error cannot fall below: its round-off level; the chain's g(1 − cos q),
+    which rounds at εg however small q is (at |q| = 1e-68 it is 0, and V loses gq²/2: the
+    size of the terms computed cannot show it); and, for a model whose derivatives are
+    differences (it has a twin), their accuracy of the energy's terms."""
+    walk = ROUND_OFF * np.finfo(float).eps * math.sqrt(1 + traj.steps)
+    cancelled = walk * float(np.sum(np.abs(case.spec.coefficients["g"]))) if case.spec.family == "chain" else 0.0
     if case.twin is None:
-        return stats.round_off
-    terms = stats.round_off / (ROUND_OFF * np.finfo(float).eps * math.sqrt(1 + traj.steps))
-    return stats.round_off + DIFFERENCES * terms
+        return stats.round_off + cancelled
+    return stats.round_off + cancelled + DIFFERENCES * (stats.round_off / walk)
 
 
 def _judged(case: Case, dt: float) -> tuple[varmech.Trajectory | BaseException, varmech.InvariantStatistics | None, float]:

@@ -219,6 +219,37 @@ FOUND = [
         _damped_chain(2.1470188474317426),
         "completed", "bounded",
     ),
+    (
+        "the same at g = 4.86: a quantum of 6.6e-12 met only at large shifts, read as curvature",
+        _damped_chain(4.857057834572034),
+        "completed", "bounded",
+    ),
+    (
+        "an energy of 1e-312 off by 4 subnormal spacings: round-off, which ε of its size missed",
+        dict(family="chain", api="lagrangian", n=3, coefficients={
+            "m": [2.253962911814727, 1.257660129485635, 2.3998077084464566],
+            "k": [0.8150409986958578, 0.19578224803386962, 0.7182712239768699],
+            "beta": [0.8150409986958578, 0.19578224803386962, 0.7182712239768699], "g": [0.0, 0.0, 0.0],
+            "kappa": [0.0, 0.0], "alpha": [-0.0, 0.0], "gamma": [0.0, 0.0],
+            "eps": [0.11099072021593762, 1.2788666154106853e-227, 0.5770353899032973],
+            "u": [2.2341799221680702e-102, 2.225073858507e-311, 1e-10],
+            "damping": [0.2581477007682533, 0.03312952331758901, 0.16107457363474578],
+            "drive": [1.4712554458332434e-139, 2.7333216127544024]},
+            derivatives="first", mass="configuration", forcing="damping", q0=[-0.0, 0.0, -2.225073858507203e-309],
+            v0=[6.684509965716889e-174, 5.26694180523578e-156, 6.684509965716889e-174], method="galerkin4",
+            h_fraction=1 / 3, steps=106),
+        "completed", "conserved to round-off",
+    ),
+    (
+        "a pendulum at 1e-68, where g(1 − cos q) is 0: the energy's floor is the model's, εg",
+        dict(family="chain", api="lagrangian", n=1, coefficients={
+            "m": [0.6519657865568941], "k": [0.688199098514525], "beta": [0.0], "g": [2.5910957159304333],
+            "kappa": [1.4182596965996443], "alpha": [0.0], "gamma": [0.0], "eps": [1.401298464324817e-45],
+            "u": [0.3254425454869714], "damping": [1e-08], "drive": [1.7770299632759285, 2.069525354989979]},
+            mass="configuration", forcing="damping", q0=[-3.9039650464062596e-84], v0=[-3.756472907335217e-68],
+            method="trapezoid", h_fraction=0.8955932174559459, steps=90),
+        "completed", "bounded",
+    ),
 ]
 
 
