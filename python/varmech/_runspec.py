@@ -24,7 +24,7 @@ from . import _core, dense
 from . import events as _events
 from . import impacts as _impacts
 from . import impulses as _impulses
-from ._util import positive, positive_int
+from ._util import finite, positive, positive_int, step_count
 from .events import Event
 from .impacts import Contact
 from .impulses import Impulse
@@ -109,6 +109,42 @@ class RunSpec:
     base: int = 0
     found: tuple[int, ...] = ()
     initial_energy: float | None = None
+
+    @classmethod
+    def checked(cls, model: Model, members: int = 1, **run: Any) -> RunSpec:
+        """A new run's spec from :func:`varmech.integrate`'s keywords ``run`` (``dt``, ``steps``
+        or ``t_end``, ``method``, ``save_every``, ``compensated``, ``max_energy_error``, ``t0``,
+        the Newton options, ``events``, ``contacts``, ``impulses``, ``t_eval``, and any of
+        ``output``, ``overwrite``, ``checkpoint_every``, ``progress``), each checked and named;
+        ``t_eval``'s times are held for each of ``members`` runs (an ensemble's)."""
+        method = model.kind.default_method if run["method"] is None else run["method"]
+        if run["dt"] is None:
+            raise ValueError("dt: the step is required")
+        dt = positive("dt", run["dt"])
+        t0 = 0.0 if run["t0"] is None else finite("t0", run["t0"])
+        steps = step_count(dt, t0, run["steps"], run["t_end"])
+        save_every = positive_int("save_every", run["save_every"])
+        threshold = energy_threshold(run["max_energy_error"])
+        tolerance, iterations = newton_options(run["newton_tolerance"], run["newton_max_iterations"])
+        # A horizon past the largest float is the core's to refuse (naming dt).
+        t_end = t0 + steps * dt
+        impulses = run["impulses"] or ()
+        jumps = Jumps.of(model, run["events"], run["contacts"], (impulses, _impulses.specs(impulses, t0, t_end)))
+        files = {k: run[k] for k in ("output", "overwrite", "checkpoint_every", "progress") if k in run}
+        return cls(
+            method,
+            dt,
+            steps=steps,
+            save_every=save_every,
+            compensated=bool(run["compensated"]),
+            max_energy_error=threshold,
+            t0=t0,
+            newton_tolerance=tolerance,
+            newton_max_iterations=iterations,
+            jumps=jumps,
+            times=sample_times(run["t_eval"], t0, t_end, save_every, files.get("output"), model.dim, members),
+            **files,
+        )
 
     @property
     def planned(self) -> int:

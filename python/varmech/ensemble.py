@@ -21,10 +21,9 @@ from numpy.typing import ArrayLike
 
 from . import _core
 from . import events as _events
-from . import impulses as _impulses
 from ._progress import progress_bar, thread_lock
-from ._runspec import Jumps, RunSpec, energy_threshold, newton_options, sample_times
-from ._util import finite, floats, positive, positive_int, step_count
+from ._runspec import RunSpec
+from ._util import floats, positive_int
 from .conservation import NOT_JUDGED, VERDICTS, ConservationReport, check_conservation
 from .impacts import Contact
 from .impulses import Impulse
@@ -391,50 +390,28 @@ def ensemble(
     members = q.shape[0]
     values = _parameter_values(model, parameters, members)
     models = _member_models(model, values, members)
-    t0 = 0.0 if t0 is None else finite("t0", t0)
-    p = _momenta(models, q, p0, v0, t0)
-    if method is None:
-        method = model.kind.default_method
-    dt = positive("dt", dt)
-    nsteps = step_count(dt, t0, steps, t_end)
-    save_every = positive_int("save_every", save_every)
-    workers = None if workers is None else positive_int("workers", workers)
-    chunk_size = None if chunk_size is None else positive_int("chunk_size", chunk_size)
-    newton_tolerance, newton_max_iterations = newton_options(newton_tolerance, newton_max_iterations)
-    jumps = Jumps.of(model, events, contacts, (impulses or (), _impulses.specs(impulses or (), t0, t0 + nsteps * dt)))
-    times = sample_times(t_eval, t0, t0 + nsteps * dt, save_every, None, model.dim, len(q))
     # Each member's integrate keywords, where the members run one integrate each (serially, in
     # processes, on a cluster), which builds each one's spec.
     settings: dict[str, Any] = dict(
-        dt=dt, steps=nsteps, method=method, save_every=save_every, compensated=bool(compensated), t0=t0,
+        dt=dt, steps=steps, t_end=t_end, method=method, save_every=save_every, compensated=compensated, t0=t0,
         newton_tolerance=newton_tolerance, newton_max_iterations=newton_max_iterations, max_energy_error=max_energy_error,
         events=events, contacts=contacts, impulses=impulses, t_eval=t_eval,
     )
+    spec = RunSpec.checked(model, members, **settings)
+    workers = None if workers is None else positive_int("workers", workers)
+    chunk_size = None if chunk_size is None else positive_int("chunk_size", chunk_size)
+    p = _momenta(models, q, p0, v0, spec.t0)
     if client is not None:
         return _on_cluster(client, model, q, p, values, settings | dict(workers=workers), chunk_size, progress)
     cores = [m._core for m in (models if values else models[:1])]
     released = [c for c in cores if isinstance(c, (_core.NativeModel, _core.CompiledModel))]
     native = (
-        all(e.native is not None for e in jumps.events)
+        all(e.native is not None for e in spec.jumps.events)
         and all(c.native for c in contacts)
-        and all(kind == "generalized" for _, kind, _ in jumps.impulse_specs)
+        and all(kind == "generalized" for _, kind, _ in spec.jumps.impulse_specs)
     )
     if len(released) == len(cores) and native:
-        # The members' run, each member's as integrate would specify it (the energy threshold
-        # checked here, where the core checks it; integrate checks it for each member otherwise).
-        spec = RunSpec(
-            method,
-            dt,
-            steps=nsteps,
-            save_every=save_every,
-            compensated=bool(compensated),
-            max_energy_error=energy_threshold(max_energy_error),
-            t0=t0,
-            newton_tolerance=newton_tolerance,
-            newton_max_iterations=newton_max_iterations,
-            jumps=jumps,
-            times=times,
-        )
+        # The members' run, each member's as integrate would specify it.
         results, interrupted = _on_threads(released, q, p, spec, workers, chunk_size, members, progress)
         trajs, errors = [], []
         for i, (record, error) in enumerate(results):

@@ -19,8 +19,8 @@ from . import events as _events
 from . import impacts as _impacts
 from . import impulses as _impulses
 from ._progress import progress_bar
-from ._runspec import Jumps, RunSpec, continuing, energy_threshold, newton_options, sample_times
-from ._util import finite, positive, positive_int, returned_scalar, step_count, vector
+from ._runspec import Jumps, RunSpec, continuing, energy_threshold, sample_times
+from ._util import positive, positive_int, returned_scalar, step_count, vector
 from .constraints import warn_if_integrable
 from .derivatives import blame
 from .model import Lagrangian, Model, check_delays, initial_state
@@ -294,45 +294,21 @@ def integrate(
             raise TypeError(f"parameters: expected a dict {{name: value}}, got {type(parameters).__name__}")
         # Keys may be the model's SymPy symbols, whose str is the name.
         model = model.with_parameters(**{str(name): value for name, value in parameters.items()})
-    if method is None:
-        method = model.kind.default_method
-    if dt is None:
-        raise ValueError("dt: the step is required")
-    dt = positive("dt", dt)
-    t0 = 0.0 if t0 is None else finite("t0", t0)
-    nsteps = step_count(dt, t0, steps, t_end)
-    save_every = positive_int("save_every", save_every)
-    threshold = energy_threshold(max_energy_error)
-    newton_tolerance, newton_max_iterations = newton_options(newton_tolerance, newton_max_iterations)
+    spec = RunSpec.checked(
+        model, dt=dt, steps=steps, t_end=t_end, method=method, save_every=save_every, compensated=compensated,
+        max_energy_error=max_energy_error, t0=t0, newton_tolerance=newton_tolerance,
+        newton_max_iterations=newton_max_iterations, events=events, contacts=contacts, impulses=impulses, t_eval=t_eval,
+        output=output, overwrite=overwrite, checkpoint_every=checkpoint_every, progress=progress,
+    )
+    t0, duration = spec.t0, spec.steps * spec.dt
     q, p = initial_state(model, q0, p0, v0, t0)
     if model.velocity_constraints:
         warn_if_integrable(model, q)
-    # A horizon past the largest float is the core's to refuse (naming dt); probe finite times.
-    t_end = t0 + nsteps * dt
-    jumps = Jumps.of(model, events, contacts, (impulses or (), _impulses.specs(impulses or (), t0, t_end)))
-    check_delays(model, bool(jumps), nsteps * dt)
-    probes = (t0, t0 + dt, t0 + 0.5, t0 + 1.0, t0 + 0.37 * (t_end - t0), t_end)
+    check_delays(model, bool(spec.jumps), duration)
+    probes = (t0, t0 + spec.dt, t0 + 0.5, t0 + 1.0, t0 + 0.37 * duration, t0 + duration)
     starts = "q0, v0" if v0 is not None else "q0, p0"
     _check_time_independent(model, q, p, tuple(s for s in probes if math.isfinite(s)), starts)
-    warn_if_unstable(model, method, q, dt, t0)
-
-    spec = RunSpec(
-        method,
-        dt,
-        steps=nsteps,
-        save_every=save_every,
-        compensated=bool(compensated),
-        max_energy_error=threshold,
-        t0=t0,
-        newton_tolerance=newton_tolerance,
-        newton_max_iterations=newton_max_iterations,
-        jumps=jumps,
-        times=sample_times(t_eval, t0, t_end, save_every, output, model.dim),
-        output=output,
-        overwrite=overwrite,
-        checkpoint_every=checkpoint_every,
-        progress=progress,
-    )
+    warn_if_unstable(model, spec.method, q, spec.dt, t0)
     return _run(model, spec, (q, p))
 
 
