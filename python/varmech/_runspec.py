@@ -12,6 +12,7 @@ what the core computes.
 from __future__ import annotations
 
 import datetime
+import math
 import os
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
@@ -116,18 +117,20 @@ class RunSpec:
         or ``t_end``, ``method``, ``save_every``, ``compensated``, ``max_energy_error``, ``t0``,
         the Newton options, ``events``, ``contacts``, ``impulses``, ``t_eval``, and any of
         ``output``, ``overwrite``, ``checkpoint_every``, ``progress``), each checked and named;
-        ``t_eval``'s times are held for each of ``members`` runs (an ensemble's)."""
+        ``t_eval``'s times are held for each of ``members`` runs (an ensemble's). Without
+        ``steps`` and ``t_end`` the run has no horizon (a :class:`varmech.Stepper`'s)."""
         method = model.kind.default_method if run["method"] is None else run["method"]
         if run["dt"] is None:
             raise ValueError("dt: the step is required")
         dt = positive("dt", run["dt"])
         t0 = 0.0 if run["t0"] is None else finite("t0", run["t0"])
-        steps = step_count(dt, t0, run["steps"], run["t_end"])
-        save_every = positive_int("save_every", run["save_every"])
-        threshold = energy_threshold(run["max_energy_error"])
+        open_ended = "steps" not in run and "t_end" not in run
+        steps = 0 if open_ended else step_count(dt, t0, run["steps"], run["t_end"])
+        save_every = positive_int("save_every", run.get("save_every", 1))
+        threshold = energy_threshold(run.get("max_energy_error"))
         tolerance, iterations = newton_options(run["newton_tolerance"], run["newton_max_iterations"])
         # A horizon past the largest float is the core's to refuse (naming dt).
-        t_end = t0 + steps * dt
+        t_end = math.inf if open_ended else t0 + steps * dt
         impulses = run["impulses"] or ()
         jumps = Jumps.of(model, run["events"], run["contacts"], (impulses, _impulses.specs(impulses, t0, t_end)))
         files = {k: run[k] for k in ("output", "overwrite", "checkpoint_every", "progress") if k in run}
@@ -142,7 +145,7 @@ class RunSpec:
             newton_tolerance=tolerance,
             newton_max_iterations=iterations,
             jumps=jumps,
-            times=sample_times(run["t_eval"], t0, t_end, save_every, files.get("output"), model.dim, members),
+            times=sample_times(run.get("t_eval"), t0, t_end, save_every, files.get("output"), model.dim, members),
             **files,
         )
 

@@ -12,7 +12,7 @@ from . import _core
 from . import events as _events
 from . import impacts as _impacts
 from . import impulses as _impulses
-from ._runspec import Jumps, RunSpec, newton_options
+from ._runspec import Jumps, RunSpec
 from ._util import finite, floats, positive, step_count
 from .events import Event, EventFunction, Occurrences
 from .impacts import Contact
@@ -146,27 +146,15 @@ class Stepper:
         events: Sequence[Event | EventFunction] | None = None,
     ) -> None:
         contacts = contacts_of(model, contacts)
-        blows = _impulses.specs(impulses or (), finite("t0", t0), math.inf)
         model, q0, p0 = model_and_state(model, q0, p0, v0)
-        jumps = Jumps.of(model, events, contacts, (impulses or (), blows))
-        check_delays(model, bool(jumps))
-        if method is None:
-            method = model.kind.default_method
-        dt = positive("dt", dt)
-        t0 = finite("t0", t0)
-        newton_tolerance, newton_max_iterations = newton_options(newton_tolerance, newton_max_iterations)
-        q, p = initial_state(model, q0, p0, v0, t0)
-        self._model = model
         # What it was built with; its state, dt included, is the core stepper's from here on.
-        self._spec = RunSpec(
-            method,
-            dt,
-            compensated=bool(compensated),
-            t0=t0,
-            newton_tolerance=newton_tolerance,
-            newton_max_iterations=newton_max_iterations,
-            jumps=jumps,
+        self._spec = RunSpec.checked(
+            model, dt=dt, method=method, t0=t0, compensated=compensated, newton_tolerance=newton_tolerance,
+            newton_max_iterations=newton_max_iterations, contacts=contacts, impulses=impulses, events=events,
         )
+        check_delays(model, bool(self._spec.jumps))
+        q, p = initial_state(model, q0, p0, v0, self._spec.t0)
+        self._model = model
         self._stepper = self._spec.stepper(model, q, p)
 
     def step(self) -> None:
