@@ -118,7 +118,7 @@ pub trait DiscreteLagrangian {
     fn quadrature(&self) -> (&'static [f64], &'static [f64]);
 
     /// ∂L/∂t at the quadrature's nodes as the last D₁L_d's evaluation left it in `ws`, node by
-    /// node (None, or fewer, where it did not): for [`Quadrature::time_derivative`]. None by
+    /// node (None, or fewer, where it did not): for `Quadrature::time_derivative`. None by
     /// default.
     fn kept_dl_dt<'w, V: Vector>(&self, _ws: &'w Workspace<V>) -> &'w [Option<f64>] {
         &[]

@@ -22,7 +22,7 @@ use crate::Error;
 /// checkpoint is refused rather than resumed. Only the library that wrote it reads it back to
 /// the same bits: the format number changes whenever the state's layout does.
 ///
-/// A CRC does not stop a crafted file: [`Checkpoint::resume_on`] checks every length and
+/// A CRC does not stop a crafted file: `Checkpoint::resume_on` checks every length and
 /// index of the decoded state against the model and method before a step, the fingerprint
 /// against the model's, and the values the method derives (its coefficients, its cached
 /// forces) computed again (`checkpoint/derived.rs`).
@@ -167,7 +167,7 @@ impl Checkpoint {
     }
 
     /// The state checkpointed, as decoded (not checked against a model: see
-    /// [`Checkpoint::resume_on`]).
+    /// `Checkpoint::resume_on`).
     pub fn state(&self) -> &StepperState {
         &self.state
     }
@@ -237,7 +237,7 @@ impl Checkpoint {
         }
     }
 
-    /// The stepper's state to go on with on `model`, checked as [`Checkpoint::resume_on`]
+    /// The stepper's state to go on with on `model`, checked as `Checkpoint::resume_on`
     /// does.
     pub fn into_state<S: Dynamics + ?Sized>(self, model: &S) -> Result<StepperState, Error> {
         self.resume_on(model).map(|(state, _)| state)

@@ -7,7 +7,7 @@ use super::surfaces::{NativeSurface, Surface};
 use crate::ModelError;
 
 /// What a method's own loop checks at the end of each step: whether the step is clear, so that
-/// the loop goes on ([`Gaps`]: it crosses no contact; [`super::tangent::Carried`]: its tangent
+/// the loop goes on ([`Gaps`]: it crosses no contact; `super::tangent::Carried`: its tangent
 /// map carried the vectors, none past a bound). A trait, not a closure, so that the check is
 /// inlined into the loop: as a closure it was called out of line, a third of a Verlet step.
 pub trait Clear {

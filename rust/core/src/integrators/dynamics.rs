@@ -81,7 +81,7 @@ pub trait Dynamics {
     /// The energy function and its terms at (q, p, t) (E = p·q̇ − L; H for a separable
     /// system), where no constraint does work: None where affine velocity constraints' forces
     /// do (linear constraints' and fixed holonomic ones' do none). A forced run, or one of an L
-    /// that depends on t, balances it against the energy put in ([`super::Stepper::work`]).
+    /// that depends on t, balances it against the energy put in (`super::Stepper::work`).
     fn energy(&self, q: &[f64], p: &[f64], t: f64) -> Option<Result<EnergyTerms, ModelError>> {
         (!self.constraints().is_affine()).then(|| self.as_lagrangian().energy_terms(q, p, t))
     }

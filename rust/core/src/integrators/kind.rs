@@ -101,7 +101,7 @@ impl ModelKind {
 }
 
 impl Method {
-    /// The method's facts ([`Method::facts`]), with what the table above says it integrates
+    /// The method's facts (`Method::facts`), with what the table above says it integrates
     /// and its stages.
     pub fn info(self) -> MethodInfo {
         let (name, order, symplectic, symmetric, h_omega_max, reference) = self.facts();

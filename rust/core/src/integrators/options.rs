@@ -21,7 +21,7 @@ pub struct Options {
     /// far ([`Scale`]; errors at round-off never stop a run), where the step is beyond the
     /// method's stability limit at the run's first state, or, within it, where the error grows:
     /// it has at least doubled since the run was half as long, or the state, max |qᵢ|, has
-    /// ([`Growth`] says why that tells a blow-up from a symplectic method's bounded offset); or at once when the energy is not
+    /// (`Growth` says why that tells a blow-up from a symplectic method's bounded offset); or at once when the energy is not
     /// finite. A forced run checks its balance E − W against the work W instead; a Lagrangian
     /// that depends on t has no energy to check. `None`: only non-finite states stop the run.
     /// Default [`Scale::FAILURE`] = 1: the energy is then wrong by the size of the motion.

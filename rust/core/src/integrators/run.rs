@@ -139,7 +139,7 @@ fn start<'s, S: Dynamics + ?Sized>(
 ///
 /// Refuses a model with another number of coordinates or of a kind the checkpoint's method
 /// does not integrate, a checkpoint whose state does not fit the model or whose fingerprint is
-/// another model's ([`Checkpoint::resume_on`]), and `save_every` = 0.
+/// another model's (`Checkpoint::resume_on`), and `save_every` = 0.
 pub fn resume<S, P>(
     sys: &S,
     checkpoint: Checkpoint,

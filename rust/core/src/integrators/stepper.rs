@@ -78,7 +78,7 @@ where
     /// methods.
     ///
     /// Refuses, in this order: q0 or p0 of the wrong length or not finite, malformed options, a
-    /// method that does not integrate the model's kind or its delays ([`check_method`]), and
+    /// method that does not integrate the model's kind or its delays (`check_method`), and
     /// initial data off the constraints ([`Dynamics::check_initial`]).
     pub fn new(model: M, method: Method, q0: &[f64], p0: &[f64], options: &Options) -> Result<Self, Error> {
         let n = model.dim();
@@ -167,7 +167,7 @@ where
 
     /// As [`Stepper::advance_with_tangent`], stopping after the first step that takes a
     /// component of the vectors past `large` in magnitude: true then. A kick–drift step's
-    /// tangent map is carried inside the method's own loop ([`super::tangent::Carried`]), so
+    /// tangent map is carried inside the method's own loop (`super::tangent::Carried`), so
     /// that the states are those of [`Stepper::advance`] at its cost per step. A step that
     /// takes them past the largest float (or to NaN) is a [`Error::Divergence`]: its map
     /// stretched them by more than a float holds, so no renormalization after it can recover
@@ -487,7 +487,7 @@ impl StepperState {
     }
 
     /// Refuses, naming `dt`, `steps` more steps whose times the clock would not tell apart
-    /// ([`Clock::check_resolution`]).
+    /// (`Clock::check_resolution`).
     pub fn check_horizon(&self, steps: usize) -> Result<(), Error> {
         self.clock.check_resolution(self.steps.saturating_add(steps))
     }

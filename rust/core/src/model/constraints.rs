@@ -112,7 +112,7 @@ impl HolonomicConstraints for Distances {
     }
 }
 
-/// A state (q, p), as [`Constrained::project`] returns it.
+/// A state (q, p), as [`ConstraintSet::project`](super::ConstraintSet::project) returns it.
 pub type PhaseState = (Vec<f64>, Vec<f64>);
 
 /// A separable mechanical system S (H = ½pᵀM⁻¹p + V) on the constraints C: what RATTLE and

@@ -97,7 +97,7 @@ pub trait Lagrangian {
     /// [`Lagrangian::gradients`], with ∂L/∂t where the model takes it from the same evaluation
     /// (a compiled L of t: one tape, its common subexpressions shared), so that the discrete
     /// rules keep it from Newton's last evaluation for the energy balance
-    /// ([`crate::discrete::Quadrature::time_derivative`]) instead of evaluating
+    /// (`crate::discrete::Quadrature::time_derivative`) instead of evaluating
     /// [`Lagrangian::dl_dt`] again; None (the default) where it does not.
     fn gradients_and_dl_dt(
         &self,

@@ -6,7 +6,7 @@ use crate::{Error, ModelError};
 /// first, with principal moments I and a potential U(q) = q₁² − q₂² − q₃² + q₄² (HLW's GNI
 /// rigid-body example), on the constraint |q|² = 1 (HLW VII.5).
 ///
-/// The body angular velocity is ω = 2E(q)q̇ with E(q) = [−q_v, q₁I − [q_v]×] (3 × 4), so
+/// The body angular velocity is ω = 2E(q)q̇ with E(q) = [−q_v, q₁I − \[q_v\]×] (3 × 4), so
 /// T = ½ωᵀIω = 2q̇ᵀE(q)ᵀIE(q)q̇. That quadratic form is singular along q, so T gets
 /// (α/2)(q·q̇)², which vanishes on the hidden constraint q·q̇ = 0 and leaves the motion
 /// unchanged: L = 2q̇ᵀEᵀIEq̇ + (α/2)(q·q̇)² − U(q), a natural system with

@@ -18,7 +18,7 @@ thread_local! {
 
 /// The largest rounding error of the derivatives taken by differences on this thread since the
 /// last call, and a fresh start: what an equation built from them carries as noise
-/// ([`crate::solve::newton`] judges a stall against it). Not the O(h²) truncation: that is
+/// (`crate::solve::newton` judges a stall against it). Not the O(h²) truncation: that is
 /// smooth, and Newton solves through it; the rounding of f at x ± h, which the difference
 /// divides by 2h, is in steps, too flat over a Newton correction to sample (see
 /// [`central_gradient`] for its bound).
@@ -37,9 +37,9 @@ pub(crate) fn record(noise: f64) {
 /// at s = 1, …, 8, their largest component, at δ and at 1e-2 and 1e-4 of it, the largest of
 /// the scales that measure one. `f0` is the residual F(x) the caller judges; `at(shift, out)`
 /// writes F(x + shift) (every unknown shifted alike), `plus`, `minus` are scratch of F's
-/// length, and x has norm `x` and is added to values of norm `offset` (δ: [`measuring_step`]).
+/// length, and x has norm `x` and is added to values of norm `offset` (δ: `measuring_step`).
 /// F is evaluated at x first, for the rounding it records, and last, to leave the caller's
-/// caches at x. The rounding of every evaluation inside F changes with x: what [`record`]'s
+/// caches at x. The rounding of every evaluation inside F changes with x: what `record`'s
 /// estimate from the sizes of values cannot see, a closure's own cancellation (g(1 − cos q) at
 /// |q| ≈ 1e-6 rounds at εg), shows. A difference's rounding comes in quanta (f's ulp over 2h),
 /// flat over some shifts and met by others: hence eight samples at three scales. Rounding does

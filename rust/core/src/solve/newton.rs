@@ -30,7 +30,7 @@ pub use diagnosis::{degenerate, Diagnosis};
 /// The implicit integrators stop when ‖δ‖∞ ≤ tolerance·‖x‖∞, x the unknowns as increments from
 /// q₀ (the step's δq, and the Galerkin control points' offsets), or at the noise floor of the
 /// equations (their own accuracy, as when derivatives come from differences: see
-/// [`Progress`]). The scale is the increment,
+/// `Progress`). The scale is the increment,
 /// not the position: the discrete velocity δq/h, and so p₁, carries the increment's relative
 /// precision, which a scale of ‖q‖∞ would give away as a cyclic angle grows. The other
 /// iterations measure their corrections their own way (RATTLE: the move of q₁ against ‖q₀‖∞).

@@ -66,7 +66,7 @@ pub trait StepEquations {
     fn quadrature(&mut self) -> &mut Quadrature;
 
     /// Told before the evaluation of F at which Newton's iteration ends
-    /// ([`NewtonProblem::finishing`]). Default: nothing.
+    /// (`NewtonProblem::finishing`). Default: nothing.
     fn finishing(&mut self) {}
 }
 
@@ -213,8 +213,8 @@ impl Constraints<'_> {
 /// multipliers, the forces (h/2)[G; A]ᵀλ at q₀ and (h/2)[G; A]ᵀμ at q₁ of the stacked
 /// constraint matrix:
 ///
-/// p₀ + D₁L_d(q₀, q₁) − (h/2)[G; A](q₀)ᵀλ = 0,   g(q₁) = 0,   A(q̄)(q₁ − q₀) + h b(q̄) = 0,
-/// p₁ = D₂L_d(q₀, q₁) − (h/2)[G; A](q₁)ᵀμ,   [G; A](q₁)q̇(q₁, p₁) + [0; b(q₁)] = 0,
+/// p₀ + D₁L_d(q₀, q₁) − (h/2)\[G; A\](q₀)ᵀλ = 0,   g(q₁) = 0,   A(q̄)(q₁ − q₀) + h b(q̄) = 0,
+/// p₁ = D₂L_d(q₀, q₁) − (h/2)\[G; A\](q₁)ᵀμ,   \[G; A\](q₁)q̇(q₁, p₁) + [0; b(q₁)] = 0,
 ///
 /// the constrained DEL equations (RATTLE's discrete constraint g(q₁) = 0) and the reversible
 /// DLA step at once: as symmetric as each, so that [`super::Method::Dla4`] composes it to

@@ -25,7 +25,7 @@ pub enum NativeEvent {
     /// g = |E(q, p) − E₀| − bound, E₀ the energy at the start of the run (NaN until the run
     /// starts; a resumed run is given its first run's): the energy error growing beyond a bound.
     EnergyError { bound: f64, initial: f64 },
-    /// g = maxⱼ |x_j|² − r², x_j = q[groups[j]] (e.g. a body's position): a group leaving the
+    /// g = maxⱼ |x_j|² − r², x_j = q\[groups\[j\]\] (e.g. a body's position): a group leaving the
     /// ball of radius r about the origin (escape).
     Escape { radius: f64, groups: Vec<Vec<usize>> },
     /// g = min_{i<j} |x_i − x_j|² − r² over the groups (e.g. bodies), or |x₀|² − r² for a single

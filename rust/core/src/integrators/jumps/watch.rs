@@ -35,7 +35,7 @@ impl<'w, 'e> Watch<'w, 'e, '_> {
 
     /// Whether what it watches can put energy in or take it out: contacts with friction or
     /// e < 1 (each law's loss, the closures', the projections onto closed contacts), or
-    /// impulses. A run then counts that energy in its work W ([`Stepper::work`]), which it and
+    /// impulses. A run then counts that energy in its work W (`Stepper::work`), which it and
     /// the report balance E − E₀ against, as a forced model's; elastic contacts alone put in
     /// none (their laws' loss is 0).
     pub fn exchanges(&self) -> bool {
@@ -64,7 +64,7 @@ where
     /// there, the contacts checked against the model and its method and the state (named
     /// `argument`, `q0` or `checkpoint`, if outside a contact). A stepper watching what can
     /// put energy in or take it out ([`Watch::exchanges`]) counts that energy from then on
-    /// ([`Stepper::work`]).
+    /// (`Stepper::work`).
     pub fn begin<St: BorrowMut<StepperState>>(
         model: M,
         stepper: &mut Stepper<M, St>,

@@ -14,7 +14,7 @@ use crate::{Error, ModelError};
 /// forces, their delays and one function of their slots ([`crate::model::delayed_block`])
 /// whose outputs are Q, then a block of n a delay (with whether each reads the acceleration
 /// τ ago, and whether they read the past alone, not the state now), with the history before
-/// the run where given: (q(s), q̇(s), q̈(s)), a function of the one slot [s].
+/// the run where given: (q(s), q̇(s), q̈(s)), a function of the one slot \[s\].
 #[derive(Clone, Debug)]
 pub struct CompiledLagrangian {
     n: usize,

@@ -42,7 +42,7 @@ pub enum Diagnosis {
     /// The Jacobian is singular.
     Singular,
     /// The model's ∂²L/∂q̇² is nearly singular here, beyond what the sizes of its masses make
-    /// it ([`degenerate`]): coordinates close to a singularity of theirs.
+    /// it (`degenerate`): coordinates close to a singularity of theirs.
     Degenerate,
 }
 
