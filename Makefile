@@ -12,14 +12,16 @@ install:
 tour: install
 	$(PYTHON) -m varmech tour --out out/tour
 
-# The guards: formatting, clippy on every target of both crates, the core's rustdoc links, ruff,
-# mypy on the package, and stubtest of the binding against its stub _core.pyi.
+# The guards: formatting, clippy on every target of both crates, the rustdoc links of both (the
+# core's public docs, the binding's private ones: a cdylib has no public Rust API), ruff, mypy on
+# the package, and stubtest of the binding against its stub _core.pyi.
 lint: install guards
 
 guards:
 	cargo fmt --all --check
 	cargo clippy --workspace --all-targets -- -D warnings
 	RUSTDOCFLAGS="-D warnings" cargo doc --no-deps -p varmech
+	RUSTDOCFLAGS="-D warnings" cargo doc --no-deps --document-private-items -p varmech-python
 	$(PYTHON) -m ruff check python tests benches docs
 	$(PYTHON) -m mypy
 	$(PYTHON) -m mypy.stubtest varmech._core

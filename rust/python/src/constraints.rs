@@ -46,7 +46,7 @@ fn constraint_residuals<'py>(
 }
 
 /// The multipliers λ (N, m), the generalized constraint forces Cᵀλ (N, n), their power and its
-/// size (N,) at each state (t, q, p) of a constrained model ([`varmech::model::reaction`]).
+/// size (N,) at each state (t, q, p) of a constrained model ([`varmech::model::Reactions`]).
 type ReactionArrays<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<f64>>, ArrayPair<'py>);
 
 #[pyfunction]

@@ -58,8 +58,8 @@ type MemberResult = (TrajectoryRecord, Option<Py<PyAny>>);
 /// Integrates the members (rows of `q0` and `p0`, (members, n)) with `models` (one shared, or
 /// one a member) on at most `workers` threads in tasks of `chunk_size` members, the GIL
 /// released, each watching `events` (spec tuples of built-in events, see [`Events::new`]) and
-/// resolving the impacts on `contacts` (native surfaces, see [`ContactSpecs::new`]), applying
-/// `impulses` (their components as numbers, see [`ScheduleSpecs::new`]) and taking the samples
+/// resolving the impacts on `contacts` (native surfaces, see [`crate::contacts::ContactSpecs::new`]), applying
+/// `impulses` (their components as numbers, see [`crate::schedule::ScheduleSpecs::new`]) and taking the samples
 /// `t_eval`;
 /// `progress(steps)` gets the steps of all members so far. Returns each member's
 /// record and exception (None when it completed), and the exception (KeyboardInterrupt) that

@@ -37,7 +37,7 @@ impl From<model::Generator> for Generator {
 
 #[pymethods]
 impl Generator {
-    /// The name of the conserved momentum (P_x, L, p[1], ...).
+    /// The name of the conserved momentum (P_x, L, p\[1\], ...).
     #[getter]
     fn name(&self) -> String {
         model::Generator::from(*self).name()

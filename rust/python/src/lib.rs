@@ -9,6 +9,8 @@
 //! ([`errors`]). Policy, such as which method fits which kind of model, is the core's
 //! ([`bind::kind_of`] only shows it). The Python API in `python/varmech` is built on these functions;
 //! `_core.pyi` documents them.
+// A cdylib's Rust items are nobody's API: its docs are read with --document-private-items.
+#![allow(rustdoc::private_intra_doc_links)]
 
 /// Adds the `#[pyfunction]`s listed to the module `m` (each module's `register` lists its own).
 macro_rules! add_functions {

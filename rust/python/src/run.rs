@@ -91,7 +91,7 @@ pub(crate) fn detector_parts<'py>(
 /// [`integrators::resume`]), watching its events, resolving the impacts on its contacts,
 /// applying its impulses and taking its samples `t_eval` after the checkpoint's time (as
 /// `integrate`'s); a checkpoint of another method or `dt` than the spec's is refused
-/// ([`Checkpoint::expect`]).
+/// ([`varmech::integrators::Checkpoint::expect`]).
 #[pyfunction]
 #[pyo3(signature = (model, checkpoint, spec, *, progress=None))]
 fn resume<'py>(
