@@ -537,7 +537,8 @@ def check_conservation(traj: Trajectory, generators: Sequence[Generator] | None 
         discretisation error of the work, not a drift), with the measured order in the advice.
         This costs twice the run. For a conserved energy that would be "secular drift" or "too
         short to judge": judge it again over the run continued as long again, "bounded" where
-        the error levels off there (a transient). This costs one more run. ``False`` skips both.
+        the error levels off there (a transient) or its rise stops there (a slow oscillation). This
+        costs one more run. ``False`` skips both.
 
     Returns
     -------
@@ -692,8 +693,9 @@ def _continued(traj: Trajectory, stats: InvariantStatistics) -> InvariantStatist
     """An energy whose run rose too steadily to be called bounded ("secular drift", or "too short
     to judge"), judged again over the run and its continuation as long again: a transient (the
     Chaplygin sleigh's energy error rises while its spin decays, then stays) levels off there and
-    is "bounded", a drift keeps growing, and a run too short now may not be. Unchanged for a run
-    that did not reach its end, or saved off its steps."""
+    is "bounded", as is a drift whose rate the continuation alone does not keep (a quarter of it,
+    or the other sign: a slow oscillation's rise); a drift keeps growing, and a run too short now
+    may not be. Unchanged for a run that did not reach its end, or saved off its steps."""
     steps = (traj.t - traj.t[0]) / traj.dt
     gaps = np.diff(np.rint(steps).astype(np.int64))
     if traj.status != 0 or len(gaps) == 0 or np.any(gaps <= 0) or not np.allclose(steps, np.rint(steps), rtol=0, atol=1e-6):
@@ -708,9 +710,15 @@ def _continued(traj: Trajectory, stats: InvariantStatistics) -> InvariantStatist
         return stats
     t, q, p = (np.concatenate([a, b[1:]]) for a, b in ((traj.t, more.t), (traj.q, more.q), (traj.p, more.p)))
     longer = energy_statistics(traj.model, t, q, p, steps=int(more.steps))
+    how = f"judged over the run continued as long again, to t = {t[-1]:.6g}"
+    if stats.verdict == longer.verdict == "secular drift":
+        # A drift keeps its rate; a slow oscillation's rise (energy passing between modes over
+        # longer than the run) or a transient's stops, though the whole may still read as one.
+        rate, then = stats.drift_rate, energy_statistics(traj.model, more.t, more.q, more.p, steps=int(more.steps)).drift_rate
+        if not (then * rate > 0 and abs(then) >= abs(rate) / 4):
+            return replace(stats, verdict="bounded", advice=f"{how}: its rise stops there (rate {then:.3g} after {rate:.3g}), no drift")
     if longer.verdict == stats.verdict or longer.verdict in ("failed", "too coarse"):
         return stats
-    how = f"judged over the run continued as long again, to t = {t[-1]:.6g}"
     if longer.verdict in ("bounded", "conserved to round-off"):
         return replace(stats, verdict="bounded", advice=f"{how}: the error levels off, a transient")
     return replace(stats, verdict=longer.verdict, advice=f"{how}: {longer.advice}" if longer.advice else how)

@@ -59,10 +59,9 @@ class Outcome:
 #: (docs/validation.md, *Properties*), each by a phrase of its problem. A case that breaks one
 #: is reported under ``known``; any other problem fails it. Keys are regular expressions.
 KNOWN_OPEN = {
-    # A short run's band where finer steps find a drift: a forced chain's, a closing contact's,
-    # or none at all (seed 7171: galerkin6 on a conservative 5-chain, "secular drift" at h/2
-    # and h/4 over 30 time units is a slow oscillation's rise; 10 and 20 times longer runs are
-    # bounded at the same size). The verdict's recurrence counts T's fastest oscillation.
+    # A short run's band where finer steps find a drift: a forced chain's, or a closing
+    # contact's (the continuation that tells a conserved energy's slow oscillation from a drift,
+    # seed 7171's 5-chain in FOUND, does not judge a balance).
     "'bounded' verdict that refinement does not confirm: h: bounded [^;]*; h/2: secular drift": "a drift seen only at finer steps",
 }
 
