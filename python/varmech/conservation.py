@@ -644,7 +644,14 @@ def energy_statistics(
     a run of ``steps`` steps, by varmech or any other integrator; with ``work`` (the work of the
     forces up to each state), of the balance E − W."""
     t, q, p = (np.ascontiguousarray(x, dtype=float) for x in (t, q, p))
-    e, kinetic, potential = _core.energy_terms(model._core, t, q, p)
+    return _energy_judged(model, t, _core.energy_terms(model._core, t, q, p), steps, work)
+
+
+def _energy_judged(
+    model: Model, t: np.ndarray, terms: tuple[np.ndarray, np.ndarray, np.ndarray], steps: int, work: np.ndarray | None = None
+) -> InvariantStatistics:
+    """:func:`energy_statistics` from the energy's terms (E, T, V) at times ``t``, evaluated."""
+    e, kinetic, potential = terms
     w = np.zeros(len(t)) if work is None else np.ascontiguousarray(work, dtype=float)
     record = _core.energy_statistics(t, e, kinetic, potential, w, int(steps))
     return _statistics(record, model.energy_name if work is None else BALANCE, e[0] - w[0], "mean kinetic energy", t)
@@ -708,13 +715,17 @@ def _continued(traj: Trajectory, stats: InvariantStatistics) -> InvariantStatist
     except _core.VarmechError:
         # A continuation that fails (a state no longer finite) tells no transient from a drift.
         return stats
-    t, q, p = (np.concatenate([a, b[1:]]) for a, b in ((traj.t, more.t), (traj.q, more.q), (traj.p, more.p)))
-    longer = energy_statistics(traj.model, t, q, p, steps=int(more.steps))
+    joined = ((traj.t, more.t), (traj.q, more.q), (traj.p, more.p))
+    t, q, p = (np.ascontiguousarray(np.concatenate([a, b[1:]]), dtype=float) for a, b in joined)
+    terms = _core.energy_terms(traj.model._core, t, q, p)
+    longer = _energy_judged(traj.model, t, terms, int(more.steps))
     how = f"judged over the run continued as long again, to t = {t[-1]:.6g}"
     if stats.verdict == longer.verdict == "secular drift":
-        # A drift keeps its rate; a slow oscillation's rise (energy passing between modes over
-        # longer than the run) or a transient's stops, though the whole may still read as one.
-        rate, then = stats.drift_rate, energy_statistics(traj.model, more.t, more.q, more.p, steps=int(more.steps)).drift_rate
+        # A drift keeps its rate over the continuation alone (from the run's last state, its
+        # terms above); a slow oscillation's rise (energy passing between modes) stops there.
+        k = len(traj.t) - 1
+        ahead = _energy_judged(traj.model, t[k:], (terms[0][k:], terms[1][k:], terms[2][k:]), int(more.steps))
+        rate, then = stats.drift_rate, ahead.drift_rate
         if not (then * rate > 0 and abs(then) >= abs(rate) / 4):
             return replace(stats, verdict="bounded", advice=f"{how}: its rise stops there (rate {then:.3g} after {rate:.3g}), no drift")
     if longer.verdict == stats.verdict or longer.verdict in ("failed", "too coarse"):
